@@ -1,0 +1,1 @@
+"""The science: robot models, IK, task requirements, DTF, mu_path (numpy/pinocchio)."""

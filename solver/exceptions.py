@@ -1,0 +1,62 @@
+"""Exceptions raised by the solver for invalid input.
+
+Every exception carries the data that locates the problem (``field``, and ``waypoint`` where a
+waypoint is at fault), so the service can name them in its ``422`` answer. An expected failure
+(an unreachable placement, a singular configuration along a path) is never an exception: it comes
+back as data in the result.
+"""
+
+from __future__ import annotations
+
+
+class SolverError(Exception):
+    """Base class of every input error the solver raises.
+
+    Attributes:
+        field: dotted name of the offending input, as a caller would spell it
+            (``"path.waypoints"``, ``"robot.joint_velocity_limits"``, ``"q"``).
+        waypoint: index of the offending waypoint, or ``None``.
+        message: what is wrong, naming the offending value.
+    """
+
+    def __init__(self, field: str, message: str, *, waypoint: int | None = None) -> None:
+        """Store where the error is and what it is."""
+        self.field = field
+        self.waypoint = waypoint
+        self.message = message
+        where = field if waypoint is None else f"{field}[{waypoint}]"
+        super().__init__(f"{where}: {message}")
+
+
+class InvalidInputError(SolverError):
+    """A value has the wrong shape, is not finite, or is out of its allowed range."""
+
+
+class RepeatedWaypointError(SolverError):
+    """Two consecutive waypoints are the same pose: the segment between them has no direction."""
+
+    def __init__(self, index: int, *, field: str = "path.waypoints") -> None:
+        """Name the second waypoint of the repeated pair."""
+        super().__init__(
+            field,
+            f"waypoint {index} repeats waypoint {index - 1} (same position and orientation): "
+            "a segment needs a displacement or a rotation",
+            waypoint=index,
+        )
+
+
+class UnknownRobotError(SolverError):
+    """A robot name that is not in the catalogue."""
+
+    def __init__(self, name: str, known: list[str]) -> None:
+        """Name the robot asked for and the ones that exist."""
+        super().__init__("robot.model", f"unknown robot {name!r}; known robots: {', '.join(known)}")
+        self.name = name
+
+
+class RobotModelError(SolverError):
+    """A URDF that cannot be parsed, or whose frames or chain do not fit the request."""
+
+
+class NoAnalyticIkError(SolverError):
+    """Path evaluation needs an arm with an analytic IK (a UR arm from the catalogue)."""

@@ -1,0 +1,341 @@
+"""Robot models: the catalogue of UR arms and robots read from a URDF.
+
+A :class:`Robot` wraps a pinocchio model with the two frames the method needs: the base frame
+{B} in which poses and twists are expressed, and the tool point {TCP} (the tool frame {F} times
+an optional offset T_F_TCP). For UR arms {B} is the controller's ``base`` frame (the URDF's
+``base_link`` turned by pi about z, and the frame of the DH parameters) and {F} is the flange
+``tool0``.
+
+The CB-series arms (ur3, ur5, ur10) are the example-robot-data URDFs, loaded by path. No URDF
+ships for the e-series, so ur3e, ur5e, ur10e and ur16e are built from their published nominal DH
+parameters (spec section 8).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import functools
+import importlib.metadata
+import math
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+import pinocchio as pin
+
+from solver.exceptions import InvalidInputError, RobotModelError, UnknownRobotError
+
+UR_JOINT_NAMES = (
+    "shoulder_pan_joint",
+    "shoulder_lift_joint",
+    "elbow_joint",
+    "wrist_1_joint",
+    "wrist_2_joint",
+    "wrist_3_joint",
+)
+
+
+@dataclass(frozen=True)
+class UrDh:
+    """Standard DH parameters of a UR arm (metres).
+
+    alpha = [pi/2, 0, 0, pi/2, -pi/2, 0] and a1 = a4 = a5 = a6 = d2 = d3 = 0 for every UR arm,
+    so six lengths describe the whole chain.
+    """
+
+    d1: float
+    a2: float
+    a3: float
+    d4: float
+    d5: float
+    d6: float
+
+    @property
+    def a(self) -> tuple[float, ...]:
+        """Link lengths a_1..a_6 (m)."""
+        return (0.0, self.a2, self.a3, 0.0, 0.0, 0.0)
+
+    @property
+    def d(self) -> tuple[float, ...]:
+        """Link offsets d_1..d_6 (m)."""
+        return (self.d1, 0.0, 0.0, self.d4, self.d5, self.d6)
+
+    @property
+    def alpha(self) -> tuple[float, ...]:
+        """Link twists alpha_1..alpha_6 (rad)."""
+        return (math.pi / 2, 0.0, 0.0, math.pi / 2, -math.pi / 2, 0.0)
+
+
+# Spec section 8 for the e-series; the CB-series values are the lengths of the
+# example-robot-data URDFs (tests check the URDF chain against these to 1e-12).
+UR_DH: dict[str, UrDh] = {
+    "ur3": UrDh(0.1519, -0.24365, -0.21325, 0.11235, 0.08535, 0.0819),
+    "ur5": UrDh(0.089159, -0.425, -0.39225, 0.10915, 0.09465, 0.0823),
+    "ur10": UrDh(0.1273, -0.612, -0.5723, 0.163941, 0.1157, 0.0922),
+    "ur3e": UrDh(0.15185, -0.24355, -0.2132, 0.13105, 0.08535, 0.0921),
+    "ur5e": UrDh(0.1625, -0.425, -0.3922, 0.1333, 0.0997, 0.0996),
+    "ur10e": UrDh(0.1807, -0.6127, -0.57155, 0.17415, 0.11985, 0.11655),
+    "ur16e": UrDh(0.1807, -0.4784, -0.36, 0.17415, 0.11985, 0.11655),
+}
+
+_PI = math.pi
+# Datasheet joint speeds of the e-series (rad/s), spec section 8.
+_E_SERIES_SPEEDS: dict[str, tuple[float, ...]] = {
+    "ur3e": (_PI, _PI, _PI, 2 * _PI, 2 * _PI, 2 * _PI),
+    "ur5e": (_PI,) * 6,
+    "ur10e": (2 * _PI / 3, 2 * _PI / 3, _PI, _PI, _PI, _PI),
+    "ur16e": (2 * _PI / 3, 2 * _PI / 3, _PI, _PI, _PI, _PI),
+}
+
+
+@dataclass(frozen=True, eq=False)
+class Robot:
+    """A serial arm with its base frame, tool point and joint limits.
+
+    Attributes:
+        name: catalogue name, or ``"urdf"`` for a robot read from a request.
+        model: pinocchio model; its frame ``tool_point_frame`` is the tool point {TCP}.
+        base_frame: name of the frame {B} poses and twists are expressed in.
+        tool_frame: name of the tool frame {F} (the flange for UR arms).
+        joint_names: names of the n joints, in configuration order.
+        q_lower: shape (n,), rad, lower joint position limits.
+        q_upper: shape (n,), rad, upper joint position limits.
+        qdot_max: shape (n,), rad/s, joint speed limits (all > 0).
+        transform_tool_to_tcp: shape (4, 4), the tool point in the tool frame, T_F_TCP.
+        transform_world_to_base: shape (4, 4), {B} in the model's root frame (fixed).
+        dh: the analytic-IK parameters when the arm is a UR, else ``None``.
+    """
+
+    name: str
+    model: pin.Model
+    base_frame: str
+    tool_frame: str
+    joint_names: tuple[str, ...]
+    q_lower: np.ndarray
+    q_upper: np.ndarray
+    qdot_max: np.ndarray
+    transform_tool_to_tcp: np.ndarray
+    transform_world_to_base: np.ndarray
+    dh: UrDh | None = None
+
+    @property
+    def dof(self) -> int:
+        """Number of joints n."""
+        return len(self.joint_names)
+
+    @property
+    def tool_point_frame(self) -> int:
+        """Pinocchio frame id of the tool point {TCP}."""
+        return int(self.model.getFrameId("tool_point"))
+
+    def with_options(
+        self,
+        *,
+        qdot_max: np.ndarray | list[float] | None = None,
+        transform_tool_to_tcp: np.ndarray | None = None,
+    ) -> Robot:
+        """Return a copy with other joint speed limits and/or another tool point.
+
+        Args:
+            qdot_max: shape (n,), rad/s, each finite and > 0; ``None`` keeps the model's.
+            transform_tool_to_tcp: shape (4, 4), T_F_TCP; ``None`` keeps the current one.
+
+        Raises:
+            InvalidInputError: a limit has the wrong shape, is not finite or is <= 0.
+        """
+        robot = self
+        if qdot_max is not None:
+            limits = np.asarray(qdot_max, dtype=float)
+            if limits.shape != (self.dof,):
+                raise InvalidInputError(
+                    "robot.joint_velocity_limits",
+                    f"{limits.shape=} but the robot has {self.dof} joints",
+                )
+            bad = np.flatnonzero(~np.isfinite(limits) | (limits <= 0.0))
+            if bad.size:
+                j = int(bad[0])
+                raise InvalidInputError(
+                    "robot.joint_velocity_limits",
+                    f"joint {j} ({self.joint_names[j]}) limit {limits[j]!r} rad/s must be "
+                    "finite and > 0",
+                )
+            robot = dataclasses.replace(robot, qdot_max=limits.copy())
+        if transform_tool_to_tcp is not None:
+            tcp = np.asarray(transform_tool_to_tcp, dtype=float)
+            model = pin.Model(robot.model)
+            _set_tool_point(model, robot.tool_frame, tcp)
+            robot = dataclasses.replace(robot, model=model, transform_tool_to_tcp=tcp.copy())
+        return robot
+
+
+def _set_tool_point(model: pin.Model, tool_frame: str, transform_tool_to_tcp: np.ndarray) -> None:
+    """Add (or move) the frame ``tool_point`` = tool frame * T_F_TCP in ``model``."""
+    tool = model.frames[model.getFrameId(tool_frame)]
+    placement = tool.placement * pin.SE3(transform_tool_to_tcp)
+    if model.existFrame("tool_point"):
+        model.frames[model.getFrameId("tool_point")].placement = placement
+    else:
+        model.addFrame(pin.Frame("tool_point", tool.parentJoint, placement, pin.FrameType.OP_FRAME))
+
+
+def _robot_from_model(
+    name: str,
+    model: pin.Model,
+    *,
+    base_frame: str,
+    tool_frame: str,
+    qdot_max: np.ndarray | None = None,
+    dh: UrDh | None = None,
+) -> Robot:
+    """Check the frames of ``model`` and wrap it as a :class:`Robot`."""
+    for field, frame in (("robot.base_frame", base_frame), ("robot.tool_frame", tool_frame)):
+        if not model.existFrame(frame):
+            names = ", ".join(f.name for f in model.frames if f.name != "universe")
+            raise RobotModelError(field, f"no frame {frame!r} in the model; frames: {names}")
+    base = model.frames[model.getFrameId(base_frame)]
+    if base.parentJoint != 0:
+        raise RobotModelError(
+            "robot.base_frame",
+            f"frame {base_frame!r} moves with joint {model.names[base.parentJoint]!r}; "
+            "the base frame must be fixed to the root",
+        )
+    if any(model.joints[j].nq != 1 or model.joints[j].nv != 1 for j in range(1, model.njoints)):
+        raise RobotModelError(
+            "robot.urdf", "only revolute and prismatic joints are supported between base and tool"
+        )
+    data = model.createData()
+    pin.framesForwardKinematics(model, data, pin.neutral(model))
+    transform_world_to_base = data.oMf[model.getFrameId(base_frame)].homogeneous.copy()
+    limits = model.velocityLimit.copy() if qdot_max is None else np.asarray(qdot_max, float)
+    _set_tool_point(model, tool_frame, np.eye(4))
+    robot = Robot(
+        name=name,
+        model=model,
+        base_frame=base_frame,
+        tool_frame=tool_frame,
+        joint_names=tuple(model.names[1:]),
+        q_lower=model.lowerPositionLimit.copy(),
+        q_upper=model.upperPositionLimit.copy(),
+        qdot_max=limits,
+        transform_tool_to_tcp=np.eye(4),
+        transform_world_to_base=transform_world_to_base,
+        dh=dh,
+    )
+    bad = np.flatnonzero(~np.isfinite(limits) | (limits <= 0.0))
+    if bad.size:
+        j = int(bad[0])
+        raise RobotModelError(
+            "robot.urdf",
+            f"joint {robot.joint_names[j]!r} has velocity limit {limits[j]!r}; give "
+            "robot.joint_velocity_limits (rad/s, > 0)",
+        )
+    return robot
+
+
+def robot_from_urdf(urdf: str, *, base_frame: str, tool_frame: str, name: str = "urdf") -> Robot:
+    """Read a serial arm from URDF text.
+
+    Joints that do not move the tool frame (grippers, fingers) are locked at their neutral
+    position, so the model is the chain from the root to ``tool_frame``.
+
+    Args:
+        urdf: the URDF document.
+        base_frame: link or frame that poses are expressed in; fixed to the root.
+        tool_frame: link or frame of the tool flange.
+        name: name reported for the robot.
+
+    Raises:
+        RobotModelError: the URDF cannot be parsed, a frame is missing, or the chain has
+            joints other than 1-DOF revolute or prismatic ones.
+    """
+    try:
+        full = pin.buildModelFromXML(urdf)
+    except (RuntimeError, ValueError) as exc:
+        raise RobotModelError("robot.urdf", f"cannot parse the URDF: {exc}") from exc
+    if not full.existFrame(tool_frame):
+        names = ", ".join(f.name for f in full.frames if f.name != "universe")
+        raise RobotModelError(
+            "robot.tool_frame", f"no frame {tool_frame!r} in the model; frames: {names}"
+        )
+    tool_joint = full.frames[full.getFrameId(tool_frame)].parentJoint
+    chain = set(full.supports[tool_joint])
+    locked = [j for j in range(1, full.njoints) if j not in chain]
+    model = pin.buildReducedModel(full, locked, pin.neutral(full)) if locked else full
+    if model.nv == 0:
+        raise RobotModelError("robot.tool_frame", f"no joint moves frame {tool_frame!r}")
+    return _robot_from_model(name, model, base_frame=base_frame, tool_frame=tool_frame)
+
+
+def _ur_model_from_dh(dh: UrDh) -> pin.Model:
+    """Build a pinocchio model of a UR arm from standard DH parameters.
+
+    Standard DH: T_{i-1,i} = Rz(q_i) Tz(d_i) Tx(a_i) Rx(alpha_i) = Tz(d_i) Rz(q_i) Tx(a_i)
+    Rx(alpha_i), so joint i sits at Tx(a_{i-1}) Rx(alpha_{i-1}) Tz(d_i) after joint i-1. The
+    root frame is ``base``; ``tool0`` is frame 6 (the flange).
+    """
+    model = pin.Model()
+    model.addFrame(pin.Frame("base", 0, pin.SE3.Identity(), pin.FrameType.OP_FRAME))
+    parent = 0
+    previous = pin.SE3.Identity()
+    inertia = pin.Inertia(1.0, np.zeros(3), np.eye(3) * 1e-3)
+    for i, name in enumerate(UR_JOINT_NAMES):
+        placement = previous * pin.SE3(np.eye(3), np.array([0.0, 0.0, dh.d[i]]))
+        parent = model.addJoint(
+            parent,
+            pin.JointModelRZ(),
+            placement,
+            name,
+            np.full(1, np.inf),
+            np.full(1, np.inf),
+            np.full(1, -2 * math.pi),
+            np.full(1, 2 * math.pi),
+        )
+        model.appendBodyToJoint(parent, inertia, pin.SE3.Identity())
+        model.addJointFrame(parent)
+        rot_x = pin.utils.rotate("x", dh.alpha[i])
+        previous = pin.SE3(rot_x, np.array([dh.a[i], 0.0, 0.0]))
+    model.addFrame(pin.Frame("tool0", parent, previous, pin.FrameType.OP_FRAME))
+    return model
+
+
+def example_robot_data_dir() -> Path:
+    """Folder of the robot descriptions the ``example-robot-data`` wheel installs.
+
+    The wheel ships URDFs only (its Python loader is another package, which we do not use), so
+    files are found through the distribution's metadata.
+    """
+    dist = importlib.metadata.distribution("example-robot-data")
+    return Path(str(dist.locate_file("cmeel.prefix/share/example-robot-data/robots")))
+
+
+@functools.cache
+def catalogue() -> dict[str, Robot]:
+    """All robots of the catalogue by name, built once."""
+    robots: dict[str, Robot] = {}
+    for name in ("ur3", "ur5", "ur10"):
+        path = example_robot_data_dir() / "ur_description" / "urdf" / f"{name}_robot.urdf"
+        robot = robot_from_urdf(path.read_text(), base_frame="base", tool_frame="tool0", name=name)
+        robots[name] = dataclasses.replace(robot, dh=UR_DH[name])
+    for name, speeds in _E_SERIES_SPEEDS.items():
+        model = _ur_model_from_dh(UR_DH[name])
+        robots[name] = _robot_from_model(
+            name,
+            model,
+            base_frame="base",
+            tool_frame="tool0",
+            qdot_max=np.array(speeds),
+            dh=UR_DH[name],
+        )
+    return robots
+
+
+def get_robot(name: str) -> Robot:
+    """The catalogue robot ``name``.
+
+    Raises:
+        UnknownRobotError: no robot of that name.
+    """
+    robots = catalogue()
+    if name not in robots:
+        raise UnknownRobotError(name, sorted(robots))
+    return robots[name]

@@ -1,0 +1,87 @@
+"""Small rigid-body helpers: quaternions, poses, placements (numpy)."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from solver.exceptions import InvalidInputError
+
+QUATERNION_NORM_TOLERANCE = 1e-6
+
+
+def rotation_from_quaternion(
+    quaternion_xyzw: np.ndarray | list[float], *, field: str
+) -> np.ndarray:
+    """Rotation matrix of a unit quaternion in ROS order (x, y, z, w).
+
+    Args:
+        quaternion_xyzw: shape (4,), unit norm to within 1e-6 (it is never normalised past that).
+        field: name of the input, for the error message.
+
+    Returns:
+        shape (3, 3), a rotation matrix.
+
+    Raises:
+        InvalidInputError: wrong shape, not finite, or a norm off by more than 1e-6.
+    """
+    quat = np.asarray(quaternion_xyzw, dtype=float)
+    if quat.shape != (4,) or not np.all(np.isfinite(quat)):
+        raise InvalidInputError(field, f"needs 4 finite numbers (x, y, z, w), got {quat.tolist()}")
+    norm = float(np.linalg.norm(quat))
+    if abs(norm - 1.0) > QUATERNION_NORM_TOLERANCE:
+        raise InvalidInputError(
+            field, f"quaternion norm is {norm!r}; a unit quaternion is needed (tolerance 1e-6)"
+        )
+    x, y, z, w = quat / norm
+    return np.array(
+        [
+            [1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
+            [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
+            [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)],
+        ]
+    )
+
+
+def pose_matrix(
+    position: np.ndarray | list[float], quaternion_xyzw: np.ndarray | list[float], *, field: str
+) -> np.ndarray:
+    """Homogeneous transform of a position (m) and a unit quaternion (x, y, z, w).
+
+    Raises:
+        InvalidInputError: a position that is not 3 finite numbers, or a bad quaternion.
+    """
+    pos = np.asarray(position, dtype=float)
+    if pos.shape != (3,) or not np.all(np.isfinite(pos)):
+        raise InvalidInputError(field, f"position needs 3 finite numbers, got {pos.tolist()}")
+    transform = np.eye(4)
+    transform[:3, :3] = rotation_from_quaternion(quaternion_xyzw, field=field)
+    transform[:3, 3] = pos
+    return transform
+
+
+@dataclass(frozen=True)
+class Placement:
+    """Where the workpiece frame {O} sits in the base frame {B} (spec section 1).
+
+    T_B_O = Trans(x, y, z) * Rot_z(yaw); x, y, z in metres, yaw in radians.
+    """
+
+    x: float
+    y: float
+    z: float
+    yaw: float
+
+    def transform_workpiece_to_base(self) -> np.ndarray:
+        """T_B_O, shape (4, 4)."""
+        c, s = math.cos(self.yaw), math.sin(self.yaw)
+        return np.array(
+            [
+                [c, -s, 0.0, self.x],
+                [s, c, 0.0, self.y],
+                [0.0, 0.0, 1.0, self.z],
+                [0.0, 0.0, 0.0, 1.0],
+            ]
+        )
