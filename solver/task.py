@@ -44,7 +44,7 @@ class TaskRequirements:
         twist = np.zeros((self.h.shape[0], 6))
         pure_rotation = self.h == 0.0
         twist[:, :3] = self.u_T
-        with np.errstate(divide="ignore"):
+        with np.errstate(divide="ignore", invalid="ignore"):
             twist[:, 3:] = np.where(pure_rotation[:, None], self.u_R, self.u_R / self.h[:, None])
         twist[np.isinf(self.h), 3:] = 0.0
         return twist

@@ -39,8 +39,12 @@ import numpy as np
 from solver.robots import UrDh
 
 N_BRANCHES = 8
-# A solution whose |sin q5|, |sin q3| or shoulder lever (m) is below this is singular.
-SINGULAR_TOLERANCE = 1e-9
+# A solution whose |sin q5|, |sin q3| or shoulder lever (m) is below this is singular. acos near
+# +-1 resolves angles only to ~sqrt(machine epsilon) = 1.5e-8, so an exactly singular pose comes
+# back with |sin q5| up to ~1e-8; 1e-7 catches it (V_max there would be ~1e-7 of its usual size).
+SINGULAR_TOLERANCE = 1e-7
+# A cosine computed as 1 + rounding error still has its (singular) solution.
+REACH_TOLERANCE = 1e-10
 
 # Status codes of a (pose, branch) solution.
 OK = 0
@@ -130,7 +134,7 @@ def solve_batch(dh: UrDh, flange_in_base: np.ndarray) -> tuple[np.ndarray, np.nd
     radius = np.hypot(wrist[:, 0], wrist[:, 1])
     with np.errstate(divide="ignore", invalid="ignore"):
         ratio1 = dh.d4 / radius
-    reach1 = np.abs(ratio1) <= 1.0
+    reach1 = np.abs(ratio1) <= 1.0 + REACH_TOLERANCE
     shoulder_sign = np.array([1.0, -1.0])
     q1 = (
         np.arctan2(wrist[:, 1], wrist[:, 0])[:, None]
@@ -139,7 +143,7 @@ def solve_batch(dh: UrDh, flange_in_base: np.ndarray) -> tuple[np.ndarray, np.nd
     )  # (N, 2)
     c1, s1 = np.cos(q1), np.sin(q1)
     cos5 = (pos[:, 0, None] * s1 - pos[:, 1, None] * c1 - dh.d4) / dh.d6
-    reach5 = np.abs(cos5) <= 1.0
+    reach5 = np.abs(cos5) <= 1.0 + REACH_TOLERANCE
     wrist_sign = np.array([1.0, -1.0])
     q5 = wrist_sign * np.arccos(np.clip(cos5, -1.0, 1.0))[:, :, None]  # (N, 2, 2)
     # x and y axes of the flange seen from frame 1 give q6 (divided by sin q5 -> its sign).
@@ -156,7 +160,7 @@ def solve_batch(dh: UrDh, flange_in_base: np.ndarray) -> tuple[np.ndarray, np.nd
     t14 = _inverse(t01) @ poses[:, None, None] @ _inverse(t56) @ _inverse(t45)
     px, py = t14[..., 0, 3], t14[..., 1, 3]
     cos3 = (px * px + py * py - dh.a2**2 - dh.a3**2) / (2 * dh.a2 * dh.a3)
-    reach3 = np.abs(cos3) <= 1.0
+    reach3 = np.abs(cos3) <= 1.0 + REACH_TOLERANCE
     # Elbow "up" (index 0) takes sign(q3) = shoulder sign: axis order (N, shoulder, wrist, elbow)
     elbow_sign = shoulder_sign[:, None, None] * np.array([1.0, -1.0])
     q3 = elbow_sign * np.arccos(np.clip(cos3, -1.0, 1.0))[..., None]  # (N, 2, 2, 2)

@@ -1,0 +1,37 @@
+"""Known answers shared by the tests, each with where it comes from and its tolerance."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[1]
+EXAMPLES = ROOT / "examples"
+
+UR_MODELS = ("ur3", "ur5", "ur10", "ur3e", "ur5e", "ur10e", "ur16e")
+E_SERIES = ("ur3e", "ur5e", "ur10e", "ur16e")
+
+# Sensors 2022 Table 3 (task requirements of three UR5e path segments): u_T, u_R, h (m).
+SENSORS_TABLE_3 = {
+    "i": ([0.9999, 0.0, 0.0117], [0.6209, 0.7625, -0.1820], 4.4632),
+    "ii": ([-0.9893, 0.0, 0.1459], [0.0865, -0.9761, -0.1994], 0.0360),
+    "iii": ([0.9992, 0.0, 0.0411], [0.9997, -0.0249, 0.0011], 0.7454),
+}
+
+
+def unit(vector: list[float]) -> np.ndarray:
+    """The table's 4-digit directions, renormalised (they are unit only to ~1e-4)."""
+    arr = np.asarray(vector, dtype=float)
+    return arr / np.linalg.norm(arr)
+
+
+# Relative agreement between the closed-form DTF and the LP optimum (issue 2).
+DTF_LP_RTOL = 1e-9
+# FK(IK(T)) = T (issue 2), on every matrix entry (metres for the position column).
+FK_IK_ATOL = 1e-9
+# The CB-series URDFs write pi/2 as 1.57079632679 (error 5e-12 rad), so their chain matches the
+# exact-pi/2 DH chain only to ~1e-11 m over a 1 m arm.
+CB_URDF_VS_DH_ATOL = 1e-10
+TWO_PI = 2 * math.pi
