@@ -17,6 +17,7 @@ import dataclasses
 import functools
 import importlib.metadata
 import math
+import re
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -308,13 +309,33 @@ def example_robot_data_dir() -> Path:
     return Path(str(dist.locate_file("cmeel.prefix/share/example-robot-data/robots")))
 
 
+def _exact_right_angles(urdf: str) -> str:
+    """Restore pi/2 and pi in the joint orientations (rpy) where the UR URDFs round them.
+
+    ``rpy="0.0 1.57079632679 0.0"`` is pi/2 - 5e-12: the chain then misses the DH chain (and the
+    controller) by ~1e-11 m, which near a singularity grows to ~1e-9 relative in J^-1. Joint
+    limits are left as written.
+    """
+    exact = {"1.57079632679": math.pi / 2, "3.14159265359": math.pi}
+
+    def fix(match: re.Match[str]) -> str:
+        values = []
+        for token in match.group(1).split():
+            sign, digits = ("-", token[1:]) if token.startswith("-") else ("", token)
+            values.append(f"{sign}{exact[digits]!r}" if digits in exact else token)
+        return f'rpy="{" ".join(values)}"'
+
+    return re.sub(r'rpy="([^"]*)"', fix, urdf)
+
+
 @functools.cache
 def catalogue() -> dict[str, Robot]:
     """All robots of the catalogue by name, built once."""
     robots: dict[str, Robot] = {}
     for name in ("ur3", "ur5", "ur10"):
         path = example_robot_data_dir() / "ur_description" / "urdf" / f"{name}_robot.urdf"
-        robot = robot_from_urdf(path.read_text(), base_frame="base", tool_frame="tool0", name=name)
+        urdf = _exact_right_angles(path.read_text())
+        robot = robot_from_urdf(urdf, base_frame="base", tool_frame="tool0", name=name)
         robots[name] = dataclasses.replace(robot, dh=UR_DH[name])
     for name, speeds in _E_SERIES_SPEEDS.items():
         model = _ur_model_from_dh(UR_DH[name])

@@ -31,7 +31,7 @@ def unit(vector: list[float]) -> np.ndarray:
 DTF_LP_RTOL = 1e-9
 # FK(IK(T)) = T (issue 2), on every matrix entry (metres for the position column).
 FK_IK_ATOL = 1e-9
-# The CB-series URDFs write pi/2 as 1.57079632679 (error 5e-12 rad), so their chain matches the
-# exact-pi/2 DH chain only to ~1e-11 m over a 1 m arm.
-CB_URDF_VS_DH_ATOL = 1e-10
+# The CB-series URDFs round pi/2 (1.57079632679); the catalogue restores it, so their chain
+# matches the DH chain to rounding.
+CB_URDF_VS_DH_ATOL = 1e-12
 TWO_PI = 2 * math.pi

@@ -128,68 +128,93 @@ def solve_batch(dh: UrDh, flange_in_base: np.ndarray) -> tuple[np.ndarray, np.nd
         the wrist centre on the shoulder's singular surface; q is still filled there).
     """
     poses = np.asarray(flange_in_base, dtype=float)
-    n_poses = poses.shape[0]
-    rot, pos = poses[:, :3, :3], poses[:, :3, 3]
-    wrist = pos - dh.d6 * rot[:, :, 2]
-    radius = np.hypot(wrist[:, 0], wrist[:, 1])
+    rotation = np.moveaxis(poses[:, :3, :3], 0, -1)
+    position = np.moveaxis(poses[:, :3, 3], 0, -1)
+    q, status = solve_components(dh, rotation, position)
+    return np.moveaxis(q, 0, -1).swapaxes(0, 1), status.T
+
+
+def solve_components(
+    dh: UrDh, rotation: np.ndarray, position: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
+    """All eight analytic IK branches, component-first layout (the fast path of the map).
+
+    Args:
+        dh: the arm's DH parameters.
+        rotation: shape (3, 3, M), R_B_F of M flange poses (columns: flange x, y, z axes).
+        position: shape (3, M), flange positions in {B} (m).
+
+    Returns:
+        q: shape (6, 8, M), rad in [-pi, pi), NaN where unreachable; status: shape (8, M).
+    """
+    n_x, n_y = rotation[0, 0], rotation[1, 0]  # flange x axis
+    a_x, a_y, a_z = rotation[0, 2], rotation[1, 2], rotation[2, 2]  # flange z axis (= z5)
+    w_x = position[0] - dh.d6 * a_x  # wrist centre: the origin of frame 5
+    w_y = position[1] - dh.d6 * a_y
+    w_z = position[2] - dh.d6 * a_z
+    radius = np.hypot(w_x, w_y)
     with np.errstate(divide="ignore", invalid="ignore"):
         ratio1 = dh.d4 / radius
     reach1 = np.abs(ratio1) <= 1.0 + REACH_TOLERANCE
-    shoulder_sign = np.array([1.0, -1.0])
-    q1 = (
-        np.arctan2(wrist[:, 1], wrist[:, 0])[:, None]
-        + shoulder_sign * np.arccos(np.clip(ratio1, -1.0, 1.0))[:, None]
-        + math.pi / 2
-    )  # (N, 2)
+    sign = np.array([1.0, -1.0])[:, None]
+    # Shoulder level, shape (2, M): w . z1 = d4 with z1 = (sin q1, -cos q1, 0).
+    q1 = np.arctan2(w_y, w_x) + sign * np.arccos(np.clip(ratio1, -1.0, 1.0)) + math.pi / 2
     c1, s1 = np.cos(q1), np.sin(q1)
-    cos5 = (pos[:, 0, None] * s1 - pos[:, 1, None] * c1 - dh.d4) / dh.d6
+    cos5 = a_x * s1 - a_y * c1  # z5 . z1
     reach5 = np.abs(cos5) <= 1.0 + REACH_TOLERANCE
-    wrist_sign = np.array([1.0, -1.0])
-    q5 = wrist_sign * np.arccos(np.clip(cos5, -1.0, 1.0))[:, :, None]  # (N, 2, 2)
-    # x and y axes of the flange seen from frame 1 give q6 (divided by sin q5 -> its sign).
-    nx, ny = rot[:, 0, 0, None], rot[:, 1, 0, None]
-    ox, oy = rot[:, 0, 1, None], rot[:, 1, 1, None]
-    q6 = np.arctan2(
-        wrist_sign * (-ox * s1 + oy * c1)[:, :, None],
-        wrist_sign * (nx * s1 - ny * c1)[:, :, None],
-    )
-    q1_b = np.broadcast_to(q1[:, :, None], q5.shape)
-    t01 = dh_transform(q1_b, dh.d1, 0.0, dh.alpha[0])
-    t45 = dh_transform(q5, dh.d5, 0.0, dh.alpha[4])
-    t56 = dh_transform(q6, dh.d6, 0.0, 0.0)
-    t14 = _inverse(t01) @ poses[:, None, None] @ _inverse(t56) @ _inverse(t45)
-    px, py = t14[..., 0, 3], t14[..., 1, 3]
-    cos3 = (px * px + py * py - dh.a2**2 - dh.a3**2) / (2 * dh.a2 * dh.a3)
+    cos5 = np.clip(cos5, -1.0, 1.0)
+    # Wrist level, shape (2, 2, M): sin q5 = +-|z1 x z5| (the wrist sign), exact near 0 where
+    # sqrt(1 - cos^2) would lose half the digits.
+    cross_z = s1 * a_y + c1 * a_x
+    sin5 = sign[:, :, None] * np.sqrt(a_z * a_z + cross_z * cross_z)[None]
+    sin5 = np.swapaxes(sin5, 0, 1)  # (shoulder, wrist, M)
+    q5 = np.arctan2(sin5, cos5[:, None])
+    wrist_singular = np.abs(sin5) < SINGULAR_TOLERANCE
+    inv5 = 1.0 / np.where(wrist_singular, 1.0, sin5)
+    c1w, s1w = c1[:, None], s1[:, None]
+    # z4 = (z1 x z5) / sin q5; x5 = -(z4 x z5) and y5 = -z4 give q6 from the flange x axis.
+    # Where sin q5 = 0 the wrist has a continuum of solutions: take the one with q6 = 0,
+    # z4 = x6 x z5 (it is flagged singular).
+    n_z = rotation[2, 0]
+    z4_x = np.where(wrist_singular, n_y * a_z - n_z * a_y, -c1w * a_z * inv5)
+    z4_y = np.where(wrist_singular, n_z * a_x - n_x * a_z, -s1w * a_z * inv5)
+    z4_z = np.where(wrist_singular, n_x * a_y - n_y * a_x, cross_z[:, None] * inv5)
+    x5_x = -(z4_y * a_z - z4_z * a_y)
+    x5_y = -(z4_z * a_x - z4_x * a_z)
+    x5_z = -(z4_x * a_y - z4_y * a_x)
+    q6 = np.arctan2(-(n_x * z4_x + n_y * z4_y + n_z * z4_z), n_x * x5_x + n_y * x5_y + n_z * x5_z)
+    # Planar arm in frame 1 (x1 = (c1, s1, 0), y1 = z0): frame 3 origin o3 = w - d5 z4 - d4 z1.
+    plane_x = (w_x - dh.d5 * z4_x) * c1w + (w_y - dh.d5 * z4_y) * s1w
+    plane_y = w_z - dh.d5 * z4_z - dh.d1
+    q234 = np.arctan2(z4_x * c1w + z4_y * s1w, -z4_z)
+    cos3 = (plane_x * plane_x + plane_y * plane_y - dh.a2**2 - dh.a3**2) / (2 * dh.a2 * dh.a3)
     reach3 = np.abs(cos3) <= 1.0 + REACH_TOLERANCE
-    # Elbow "up" (index 0) takes sign(q3) = shoulder sign: axis order (N, shoulder, wrist, elbow)
-    elbow_sign = shoulder_sign[:, None, None] * np.array([1.0, -1.0])
-    q3 = elbow_sign * np.arccos(np.clip(cos3, -1.0, 1.0))[..., None]  # (N, 2, 2, 2)
-    q2 = np.arctan2(py, px)[..., None] - np.arctan2(dh.a3 * np.sin(q3), dh.a2 + dh.a3 * np.cos(q3))
-    q234 = np.arctan2(t14[..., 1, 0], t14[..., 0, 0])[..., None]
-    q4 = q234 - q2 - q3
-    shape = (n_poses, 2, 2, 2)
+    # Elbow level, shape (2, 2, 2, M): "up" takes sign(q3) = shoulder sign.
+    elbow_sign = (sign[:, None, None] * np.array([1.0, -1.0])[:, None]).reshape(2, 1, 2, 1)
+    sin3 = elbow_sign * np.sqrt(1.0 - np.clip(cos3, -1.0, 1.0) ** 2)[:, :, None]
+    cos3_e = np.clip(cos3, -1.0, 1.0)[:, :, None]
+    q3 = np.arctan2(sin3, cos3_e)
+    q2 = np.arctan2(plane_y, plane_x)[:, :, None] - np.arctan2(dh.a3 * sin3, dh.a2 + dh.a3 * cos3_e)
+    q4 = q234[:, :, None] - q2 - q3
+    shape = q3.shape  # (shoulder, wrist, elbow, M)
     q = np.stack(
         [
-            np.broadcast_to(q1[:, :, None, None], shape),
+            np.broadcast_to(q1[:, None, None], shape),
             q2,
             q3,
             q4,
-            np.broadcast_to(q5[..., None], shape),
-            np.broadcast_to(q6[..., None], shape),
-        ],
-        axis=-1,
+            np.broadcast_to(q5[:, :, None], shape),
+            np.broadcast_to(q6[:, :, None], shape),
+        ]
     )
-    # (N, shoulder, wrist, elbow, 6) -> (N, shoulder, elbow, wrist, 6) -> (N, 8, 6)
-    q = wrap_angle(np.swapaxes(q, 2, 3).reshape(n_poses, N_BRANCHES, 6))
-    reach = (
-        reach1[:, None, None, None]
-        & reach5[:, :, None, None]
-        & np.broadcast_to(reach3[..., None], shape)
-    )
-    reach = np.swapaxes(reach, 2, 3).reshape(n_poses, N_BRANCHES)
-    singular = singular_mask(dh, q)
+    # (6, shoulder, wrist, elbow, M) -> (6, shoulder, elbow, wrist, M) -> (6, 8, M)
+    n_poses = position.shape[1]
+    q = wrap_angle(np.swapaxes(q, 2, 3).reshape(6, N_BRANCHES, n_poses))
+    reach = np.broadcast_to(reach1 & reach5[:, None, None] & reach3[:, :, None], shape)
+    reach = np.swapaxes(reach, 1, 2).reshape(N_BRANCHES, n_poses)
+    singular = singular_mask(dh, np.moveaxis(q, 0, -1))
     status = np.where(reach, np.where(singular, SINGULAR, OK), UNREACHABLE)
-    q[~reach] = np.nan
+    q[:, ~reach] = np.nan
     return q, status
 
 
