@@ -34,8 +34,14 @@ def joint_speeds_per_unit_twist(
         tool_point: shape (3, ...) broadcastable to q, the tool point's position in {B} (m).
 
     Returns:
-        shape (6, ...), joint speeds (rad/s).
+        shape (6, ...), joint speeds (rad/s); inf or NaN at an exactly singular q.
     """
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return _joint_speeds(dh, q, twist, tool_point)
+
+
+def _joint_speeds(dh: UrDh, q: np.ndarray, twist: np.ndarray, tool_point: np.ndarray) -> np.ndarray:
+    """The body of :func:`joint_speeds_per_unit_twist`."""
     c1, s1 = np.cos(q[0]), np.sin(q[0])
     q23 = q[1] + q[2]
     q234 = q23 + q[3]

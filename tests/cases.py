@@ -35,3 +35,5 @@ FK_IK_ATOL = 1e-9
 # matches the DH chain to rounding.
 CB_URDF_VS_DH_ATOL = 1e-12
 TWO_PI = 2 * math.pi
+# A capability-map cell against /v1/evaluate at that placement (issue 3): relative.
+MAP_EVALUATE_RTOL = 1e-9

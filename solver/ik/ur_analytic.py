@@ -141,12 +141,16 @@ def solve_components(
 
     Args:
         dh: the arm's DH parameters.
-        rotation: shape (3, 3, M), R_B_F of M flange poses (columns: flange x, y, z axes).
-        position: shape (3, M), flange positions in {B} (m).
+        rotation: shape (3, 3, *batch), R_B_F of the flange poses (columns: flange x, y, z
+            axes); batch axes broadcast with those of ``position``.
+        position: shape (3, *batch), flange positions in {B} (m).
 
     Returns:
-        q: shape (6, 8, M), rad in [-pi, pi), NaN where unreachable; status: shape (8, M).
+        q: shape (6, 8, *batch), rad in [-pi, pi), NaN where unreachable;
+        status: shape (8, *batch).
     """
+    batch = np.broadcast_shapes(rotation.shape[2:], position.shape[1:])
+    ones = (1,) * len(batch)
     n_x, n_y = rotation[0, 0], rotation[1, 0]  # flange x axis
     a_x, a_y, a_z = rotation[0, 2], rotation[1, 2], rotation[2, 2]  # flange z axis (= z5)
     w_x = position[0] - dh.d6 * a_x  # wrist centre: the origin of frame 5
@@ -156,7 +160,7 @@ def solve_components(
     with np.errstate(divide="ignore", invalid="ignore"):
         ratio1 = dh.d4 / radius
     reach1 = np.abs(ratio1) <= 1.0 + REACH_TOLERANCE
-    sign = np.array([1.0, -1.0])[:, None]
+    sign = np.array([1.0, -1.0]).reshape((2, *ones))
     # Shoulder level, shape (2, M): w . z1 = d4 with z1 = (sin q1, -cos q1, 0).
     q1 = np.arctan2(w_y, w_x) + sign * np.arccos(np.clip(ratio1, -1.0, 1.0)) + math.pi / 2
     c1, s1 = np.cos(q1), np.sin(q1)
@@ -166,7 +170,7 @@ def solve_components(
     # Wrist level, shape (2, 2, M): sin q5 = +-|z1 x z5| (the wrist sign), exact near 0 where
     # sqrt(1 - cos^2) would lose half the digits.
     cross_z = s1 * a_y + c1 * a_x
-    sin5 = sign[:, :, None] * np.sqrt(a_z * a_z + cross_z * cross_z)[None]
+    sin5 = sign[:, None] * np.sqrt(a_z * a_z + cross_z * cross_z)[None]
     sin5 = np.swapaxes(sin5, 0, 1)  # (shoulder, wrist, M)
     q5 = np.arctan2(sin5, cos5[:, None])
     wrist_singular = np.abs(sin5) < SINGULAR_TOLERANCE
@@ -190,7 +194,7 @@ def solve_components(
     cos3 = (plane_x * plane_x + plane_y * plane_y - dh.a2**2 - dh.a3**2) / (2 * dh.a2 * dh.a3)
     reach3 = np.abs(cos3) <= 1.0 + REACH_TOLERANCE
     # Elbow level, shape (2, 2, 2, M): "up" takes sign(q3) = shoulder sign.
-    elbow_sign = (sign[:, None, None] * np.array([1.0, -1.0])[:, None]).reshape(2, 1, 2, 1)
+    elbow_sign = sign[:, None, None] * np.array([1.0, -1.0]).reshape((1, 1, 2, *ones))
     sin3 = elbow_sign * np.sqrt(1.0 - np.clip(cos3, -1.0, 1.0) ** 2)[:, :, None]
     cos3_e = np.clip(cos3, -1.0, 1.0)[:, :, None]
     q3 = np.arctan2(sin3, cos3_e)
@@ -208,10 +212,9 @@ def solve_components(
         ]
     )
     # (6, shoulder, wrist, elbow, M) -> (6, shoulder, elbow, wrist, M) -> (6, 8, M)
-    n_poses = position.shape[1]
-    q = wrap_angle(np.swapaxes(q, 2, 3).reshape(6, N_BRANCHES, n_poses))
+    q = wrap_angle(np.swapaxes(q, 2, 3).reshape((6, N_BRANCHES, *batch)))
     reach = np.broadcast_to(reach1 & reach5[:, None, None] & reach3[:, :, None], shape)
-    reach = np.swapaxes(reach, 1, 2).reshape(N_BRANCHES, n_poses)
+    reach = np.swapaxes(reach, 1, 2).reshape((N_BRANCHES, *batch))
     singular = singular_mask(dh, np.moveaxis(q, 0, -1))
     status = np.where(reach, np.where(singular, SINGULAR, OK), UNREACHABLE)
     q[:, ~reach] = np.nan

@@ -1,0 +1,135 @@
+"""Following IK branches along a path, batched over branches and placements (spec section 4).
+
+A branch is feasible along a path when every waypoint has a regular solution on it, no joint
+moves more than ``max_joint_step`` between neighbouring waypoints, and each joint's whole path,
+unwrapped, fits inside its position limits with some 2 pi copy. The first failure names the
+waypoint; at one waypoint ``unreachable`` comes before ``singular`` before ``discontinuous``,
+and ``joint_limits`` is the first waypoint whose joint range no copy can hold.
+
+Layout: joint axis first, waypoints last: q (6, *batch, W).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from solver.ik.ur_analytic import SINGULAR, UNREACHABLE
+
+REASONS = ("unreachable", "joint_limits", "singular", "discontinuous")
+FEASIBLE = -1  # reason code of a feasible branch
+_UNREACHABLE, _JOINT_LIMITS, _SINGULAR, _DISCONTINUOUS = range(4)
+_TWO_PI = 2 * math.pi
+_EDGE = 1e-12  # slack (rad) when fitting a joint's 2 pi copy inside its limits
+
+
+@dataclass(frozen=True)
+class Tracked:
+    """Branches followed along a path.
+
+    Attributes:
+        reason: shape batch, index into ``REASONS``, or ``FEASIBLE``.
+        failed_waypoint: shape batch, the first failing waypoint, or -1.
+        q: shape (6, *batch, W), rad, the continuous joint paths with the 2 pi copy that fits the
+            limits (the first waypoint nearest zero among those that fit); meaningful only where
+            feasible.
+    """
+
+    reason: np.ndarray
+    failed_waypoint: np.ndarray
+    q: np.ndarray
+
+
+def _first_true(mask: np.ndarray) -> np.ndarray:
+    """Index of the first True along the last axis, or the axis length where there is none."""
+    first: np.ndarray = np.where(mask.any(axis=-1), mask.argmax(axis=-1), mask.shape[-1])
+    return first
+
+
+def track(
+    q: np.ndarray,
+    status: np.ndarray,
+    *,
+    lower: np.ndarray,
+    upper: np.ndarray,
+    max_joint_step: float,
+) -> Tracked:
+    """Follow IK branches along a path.
+
+    Args:
+        q: shape (6, *batch, W), rad in [-pi, pi), each branch's solution at every waypoint.
+        status: shape (*batch, W), the IK status of those solutions.
+        lower: shape (6,), rad, lower position limits.
+        upper: shape (6,), rad, upper position limits.
+        max_joint_step: rad, the largest move of any joint between neighbouring waypoints.
+
+    Returns:
+        The first failure of each branch, and the joint paths.
+    """
+    n_waypoints = q.shape[-1]
+    step = np.diff(q, axis=-1)
+    step = (step + math.pi) % _TWO_PI - math.pi
+    with np.errstate(invalid="ignore"):
+        jump = np.any(np.abs(step) > max_joint_step, axis=0)
+    first = np.stack(
+        [
+            _first_true(status == UNREACHABLE),
+            np.full(status.shape[:-1], n_waypoints),  # joint limits: filled below
+            _first_true(status == SINGULAR),
+            _first_true(jump) + 1,
+        ]
+    )
+    first[_DISCONTINUOUS] = np.where(jump.any(axis=-1), first[_DISCONTINUOUS], n_waypoints)
+    path = np.concatenate([q[..., :1], q[..., :1] + np.cumsum(step, axis=-1)], axis=-1)
+    lower_b = lower.reshape((6,) + (1,) * (q.ndim - 1))
+    upper_b = upper.reshape((6,) + (1,) * (q.ndim - 1))
+    k_low = np.ceil((lower_b - np.minimum.accumulate(path, axis=-1)) / _TWO_PI - _EDGE)
+    k_high = np.floor((upper_b - np.maximum.accumulate(path, axis=-1)) / _TWO_PI + _EDGE)
+    no_fit = np.any(k_low > k_high, axis=0)
+    other = first[[_UNREACHABLE, _SINGULAR, _DISCONTINUOUS]].min(axis=0)
+    # Joint limits count only on a path that got through every waypoint otherwise.
+    first[_JOINT_LIMITS] = np.where(other == n_waypoints, _first_true(no_fit), n_waypoints)
+    failed = first.min(axis=0)
+    # argmin takes the lowest code at a tie: unreachable, then singular, then discontinuous.
+    reason = np.where(failed < n_waypoints, first.argmin(axis=0), FEASIBLE)
+    shift = np.clip(np.round(-path[..., 0] / _TWO_PI), k_low[..., -1], k_high[..., -1])
+    shifted = path + _TWO_PI * np.nan_to_num(shift)[..., None]
+    return Tracked(
+        reason=reason,
+        failed_waypoint=np.where(reason == FEASIBLE, -1, failed),
+        q=shifted,
+    )
+
+
+# Branches whose mu_path agree to this (relative) are tied: elbow up and down share qd1, qd5 and
+# qd6 exactly, so when one of those joints limits the path they differ only by rounding.
+TIE_RTOL = 1e-12
+
+
+def choose_branch(
+    mu_path: np.ndarray, feasible: np.ndarray, failed_waypoint: np.ndarray
+) -> np.ndarray:
+    """The ``auto`` branch: the highest mu_path, or the furthest failure when none is feasible.
+
+    Ties (within ``TIE_RTOL``) go to the first branch in ``BRANCHES`` order, so the choice does
+    not depend on rounding.
+
+    Args:
+        mu_path: shape (B, *batch), m/s (any value where infeasible).
+        feasible: shape (B, *batch), bool.
+        failed_waypoint: shape (B, *batch), the first failing waypoint where infeasible.
+
+    Returns:
+        shape batch, the index of the chosen branch on axis 0.
+    """
+    values = np.where(feasible, mu_path, -np.inf)
+    top = values.max(axis=0)
+    tied = feasible & (values >= top - TIE_RTOL * np.abs(top))
+    furthest = np.where(feasible, -1, failed_waypoint).max(axis=0)
+    fallback = ~feasible & (failed_waypoint == furthest)
+    chosen: np.ndarray = np.where(
+        feasible.any(axis=0), tied.argmax(axis=0), fallback.argmax(axis=0)
+    )
+    return chosen

@@ -1,0 +1,182 @@
+"""Capability map: every cell is what evaluate_path gives there, feasible or not."""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+
+import numpy as np
+import pytest
+
+from solver.capability_map import capability_map, grid_axis
+from solver.evaluate import evaluate_path
+from solver.exceptions import InvalidInputError
+from solver.ik.ur_analytic import BRANCHES, Branch
+from solver.kinematics import tool_pose_in_base
+from solver.robots import get_robot
+from solver.tracking import REASONS
+from tests.cases import MAP_EVALUATE_RTOL
+from tests.solver.test_evaluate import load_path
+
+
+def _compare_cells(robot, path, cmap, cells, **kwargs) -> set[str]:
+    """Assert each cell equals evaluate_path there; return the reasons seen."""
+    seen = set()
+    for k, j, i in cells:
+        expected = evaluate_path(robot, path, cmap.placement((k, j, i)), **kwargs)
+        if expected.feasible:
+            assert cmap.mu_path[k, j, i] == pytest.approx(expected.mu_path, rel=MAP_EVALUATE_RTOL)
+            assert cmap.bottleneck_waypoint[k, j, i] == expected.bottleneck_waypoint
+            assert cmap.bottleneck_joint[k, j, i] == expected.bottleneck_joint
+            seen.add("feasible")
+        else:
+            assert math.isnan(cmap.mu_path[k, j, i])
+            assert REASONS[cmap.reason[k, j, i]] == expected.reason
+            assert cmap.failed_waypoint[k, j, i] == expected.failed_waypoint
+            seen.add(expected.reason)
+        assert BRANCHES[cmap.branch[k, j, i]] == expected.branch
+    return seen
+
+
+@pytest.mark.parametrize(
+    ("robot_name", "path_name"), [("ur5", "curved_line"), ("ur10e", "s_curve")]
+)
+def test_random_cells_equal_evaluate(robot_name: str, path_name: str) -> None:
+    """Issue 3: random cells equal /v1/evaluate there (rel 1e-9), infeasible ones included."""
+    robot = get_robot(robot_name)
+    path = load_path(path_name)
+    step = 0.1
+    cmap = capability_map(
+        robot,
+        path,
+        xs=grid_axis(-1.0, 1.0, step, field="x"),
+        ys=grid_axis(-1.0, 1.0, step, field="y"),
+        z=0.1,
+        yaws=np.array([0.0, 1.2, -2.5]),
+    )
+    rng = np.random.default_rng(12)
+    shape = cmap.mu_path.shape
+    feasible = np.argwhere(~np.isnan(cmap.mu_path))
+    infeasible = np.argwhere(np.isnan(cmap.mu_path))
+    picks = [*feasible[rng.choice(len(feasible), 25, replace=False)]]
+    # Every reason that occurs, twice each, and random infeasible cells.
+    for code in np.unique(cmap.reason[cmap.reason >= 0]):
+        where = np.argwhere(cmap.reason == code)
+        picks += [*where[rng.choice(len(where), min(2, len(where)), replace=False)]]
+    picks += [*infeasible[rng.choice(len(infeasible), 10, replace=False)]]
+    seen = _compare_cells(robot, path, cmap, [tuple(int(v) for v in p) for p in picks])
+    assert {"feasible", "unreachable"} <= seen
+    assert len(picks) >= 35 and shape == (3, 21, 21)
+
+
+def test_a_named_branch_and_a_small_step() -> None:
+    robot = get_robot("ur5e")
+    path = load_path("curved_line")
+    kwargs = {"branch": Branch("right", "down", "flip"), "max_joint_step": 0.05}
+    cmap = capability_map(
+        robot,
+        path,
+        xs=np.array([-0.3, 0.0, 0.3]),
+        ys=np.array([0.3, 0.5]),
+        z=0.0,
+        yaws=np.array([0.0, math.pi / 2]),
+        **kwargs,
+    )
+    cells = [tuple(int(v) for v in c) for c in np.ndindex(cmap.mu_path.shape)]
+    _compare_cells(robot, path, cmap, cells, **kwargs)
+
+
+def test_best_and_worst_are_the_extreme_cells() -> None:
+    cmap = capability_map(
+        get_robot("ur5"),
+        load_path("curved_line"),
+        xs=grid_axis(-0.6, 0.6, 0.1, field="x"),
+        ys=grid_axis(0.0, 0.8, 0.1, field="y"),
+        z=0.1,
+        yaws=np.array([0.0, 0.5]),
+    )
+    best, worst = cmap.extreme(best=True), cmap.extreme(best=False)
+    assert cmap.mu_path[best] == np.nanmax(cmap.mu_path)
+    assert cmap.mu_path[worst] == np.nanmin(cmap.mu_path)
+    assert np.isnan(cmap.mu_path).any()  # the grid reaches beyond the arm
+
+
+def test_progress_is_reported_per_chunk() -> None:
+    fractions: list[float] = []
+    capability_map(
+        get_robot("ur5"),
+        load_path("curved_line")[:20],
+        xs=np.linspace(-0.2, 0.2, 10),
+        ys=np.linspace(0.3, 0.5, 10),
+        z=0.1,
+        yaws=np.array([0.0, 1.0]),
+        chunk=30,
+        progress=fractions.append,
+    )
+    assert fractions == pytest.approx(
+        [30 / 200, 60 / 200, 90 / 200, 100 / 200, 130 / 200, 160 / 200, 190 / 200, 1.0]
+    )
+
+
+def test_infeasible_everywhere() -> None:
+    cmap = capability_map(
+        get_robot("ur3"),
+        load_path("curved_line"),
+        xs=np.array([3.0]),
+        ys=np.array([3.0]),
+        z=0.0,
+        yaws=np.array([0.0]),
+    )
+    assert cmap.extreme(best=True) is None and REASONS[cmap.reason[0, 0, 0]] == "unreachable"
+
+
+@pytest.mark.parametrize(
+    ("lower", "upper", "step", "expected"),
+    [(-0.25, 0.25, 0.02, 26), (0.25, 0.65, 0.02, 21), (0.0, 0.0, 0.1, 1), (0.0, 0.35, 0.1, 4)],
+)
+def test_grid_axis(lower: float, upper: float, step: float, expected: int) -> None:
+    axis = grid_axis(lower, upper, step, field="grid.x")
+    assert len(axis) == expected and axis[0] == lower and axis[-1] <= upper + 1e-12
+
+
+@pytest.mark.parametrize(("lower", "upper", "step"), [(0, 1, 0), (1, 0, 0.1), (0, math.inf, 1)])
+def test_bad_grid_axis(lower: float, upper: float, step: float) -> None:
+    with pytest.raises(InvalidInputError) as info:
+        grid_axis(lower, upper, step, field="grid.x")
+    assert info.value.field == "grid.x"
+
+
+def test_joint_limit_and_singular_cells_equal_evaluate() -> None:
+    limited = dataclasses.replace(
+        get_robot("ur5e"), q_lower=np.full(6, -math.pi / 2), q_upper=np.full(6, math.pi)
+    )
+    path = load_path("curved_line")
+    cmap = capability_map(
+        limited,
+        path,
+        xs=grid_axis(-0.4, 0.4, 0.2, field="x"),
+        ys=grid_axis(-0.6, 0.6, 0.2, field="y"),
+        z=0.1,
+        yaws=np.array([0.0, 2.0]),
+    )
+    cells = [tuple(int(v) for v in c) for c in np.ndindex(cmap.mu_path.shape)]
+    assert "joint_limits" in _compare_cells(limited, path, cmap, cells)
+    # A path through the wrist singularity at the placement (0, 0, 0, 0).
+    robot = get_robot("ur5e")
+    q_path = np.tile([0.3, -1.1, 1.2, -0.4, 0.0, 0.7], (5, 1))
+    q_path[:, 4] = np.linspace(-0.2, 0.2, 5)
+    q_path[:, 0] += np.linspace(0, 0.1, 5)
+    singular_path = np.array([tool_pose_in_base(robot, q) for q in q_path])
+    kwargs = {"branch": Branch("left", "up", "flip")}
+    cmap = capability_map(
+        robot,
+        singular_path,
+        xs=np.array([-0.05, 0.0, 0.05]),
+        ys=np.array([0.0, 0.05]),
+        z=0.0,
+        yaws=np.array([0.0, 0.2]),
+        **kwargs,
+    )
+    assert REASONS[cmap.reason[0, 0, 1]] == "singular"
+    cells = [tuple(int(v) for v in c) for c in np.ndindex(cmap.mu_path.shape)]
+    assert "singular" in _compare_cells(robot, singular_path, cmap, cells, **kwargs)
