@@ -1,0 +1,12 @@
+"""The versioned API: every resource router under ``/v1``."""
+
+from __future__ import annotations
+
+from fastapi import APIRouter
+
+from service.api.routes import dtf, evaluate, robots
+
+api_router = APIRouter(prefix="/v1")
+api_router.include_router(robots.router)
+api_router.include_router(dtf.router)
+api_router.include_router(evaluate.router)

@@ -1,0 +1,29 @@
+"""``POST /v1/dtf``: the DTF index at one configuration (spec section 3)."""
+
+from __future__ import annotations
+
+from fastapi import APIRouter
+
+from service import convert
+from service.errors import ERROR_RESPONSES
+from service.schemas import DtfRequest, DtfResponse
+from solver.dtf import chiu, dtf, twist_per_unit_speed, yoshikawa
+from solver.kinematics import check_configuration, jacobian_in_base
+
+router = APIRouter(prefix="/dtf", tags=["dtf"], responses=ERROR_RESPONSES)
+
+
+@router.post("", summary="Largest tool speed along a direction at one configuration")
+def post_dtf(body: DtfRequest) -> DtfResponse:
+    """V_max, Omega_max and the joint speeds there, plus Yoshikawa and Chiu for comparison."""
+    robot = convert.robot_from_schema(body.robot)
+    q = check_configuration(robot, body.q)
+    jacobian = jacobian_in_base(robot, q)
+    h = convert.h_of(body.h)
+    result = dtf(
+        jacobian, u_T=body.u_T, u_R=body.u_R, h=h, qdot_max=robot.qdot_max, method=body.method
+    )
+    twist = twist_per_unit_speed(body.u_T, body.u_R, h)
+    return convert.dtf_response(
+        result, robot, yoshikawa=yoshikawa(jacobian), chiu=chiu(jacobian, twist)
+    )

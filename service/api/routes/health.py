@@ -1,0 +1,15 @@
+"""``GET /healthz``: is the service up."""
+
+from __future__ import annotations
+
+from fastapi import APIRouter
+
+from service.schemas import HealthResponse
+
+router = APIRouter(tags=["health"])
+
+
+@router.get("/healthz", summary="Liveness check")
+def healthz() -> HealthResponse:
+    """Answer ``{"status": "ok"}`` while the service runs."""
+    return HealthResponse(status="ok")

@@ -1,0 +1,26 @@
+"""Service settings, read from the environment (prefix ``DTF_``) through :func:`get_settings`."""
+
+from __future__ import annotations
+
+import functools
+
+from pydantic import Field
+from pydantic_settings import BaseSettings, SettingsConfigDict
+
+
+class Settings(BaseSettings):
+    """Settings of the service; each one can be set as ``DTF_<NAME>`` in the environment."""
+
+    model_config = SettingsConfigDict(env_prefix="DTF_")
+
+    max_body_bytes: int = Field(
+        default=2_000_000,
+        gt=0,
+        description="Largest request body accepted (bytes); a larger one is answered 413.",
+    )
+
+
+@functools.cache
+def get_settings() -> Settings:
+    """The settings, read from the environment on first use and kept."""
+    return Settings()

@@ -1,0 +1,144 @@
+"""Conversions between request/response schemas and solver objects (numpy, dataclasses)."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import asdict
+from typing import cast
+
+import numpy as np
+
+from service import schemas
+from solver.dtf import DtfResult
+from solver.evaluate import Branch, PathEvaluation
+from solver.robots import Robot, get_robot, robot_from_urdf
+from solver.spatial import Placement, pose_matrix
+
+
+def robot_from_schema(spec: schemas.Robot) -> Robot:
+    """The solver robot a request names, with its speed limits and tool point.
+
+    Raises:
+        UnknownRobotError: ``model`` is not in the catalogue.
+        RobotModelError: the URDF or its frames do not fit.
+        InvalidInputError: ``joint_velocity_limits`` has the wrong length.
+    """
+    if spec.model is not None:
+        robot = get_robot(spec.model)
+    else:  # schemas.Robot makes sure urdf and both frames are given
+        robot = robot_from_urdf(
+            spec.urdf or "", base_frame=spec.base_frame or "", tool_frame=spec.tool_frame or ""
+        )
+    tcp = None if spec.tcp is None else pose_matrix_of(spec.tcp, field="robot.tcp")
+    return robot.with_options(qdot_max=spec.joint_velocity_limits, transform_tool_to_tcp=tcp)
+
+
+def pose_matrix_of(pose: schemas.Pose, *, field: str) -> np.ndarray:
+    """T of a pose, shape (4, 4), metres."""
+    return pose_matrix(pose.position, pose.orientation, field=field)
+
+
+def waypoints_of(path: schemas.Path) -> np.ndarray:
+    """T_O_i of every waypoint, shape (N, 4, 4), metres, in the workpiece frame {O}."""
+    return np.array(
+        [pose_matrix_of(pose, field=f"path.waypoints.{i}") for i, pose in enumerate(path.waypoints)]
+    )
+
+
+def placement_of(placement: schemas.Placement) -> Placement:
+    """The solver's placement (m, rad)."""
+    return Placement(x=placement.x, y=placement.y, z=placement.z, yaw=placement.yaw)
+
+
+def branch_of(choice: schemas.Branch | str) -> Branch | None:
+    """The solver's branch label; ``None`` for ``"auto"``."""
+    if isinstance(choice, str):
+        return None
+    return Branch(shoulder=choice.shoulder, elbow=choice.elbow, wrist=choice.wrist)
+
+
+def h_of(h: float | None) -> float:
+    """The solver's h (m): ``math.inf`` for the API's ``null`` (pure translation)."""
+    return math.inf if h is None else h
+
+
+def h_to_api(h: float) -> float | None:
+    """The API's h (m): ``None`` for ``math.inf`` (pure translation)."""
+    return None if math.isinf(h) else float(h)
+
+
+def dtf_response(
+    result: DtfResult, robot: Robot, *, yoshikawa: float, chiu: float
+) -> schemas.DtfResponse:
+    """The response of ``POST /v1/dtf``."""
+    return schemas.DtfResponse(
+        v_max=result.v_max,
+        omega_max=result.omega_max,
+        qdot=result.qdot.tolist(),
+        limiting_joint=result.limiting_joint,
+        limiting_joint_name=robot.joint_names[result.limiting_joint],
+        method=result.method,
+        yoshikawa=yoshikawa,
+        chiu=chiu,
+    )
+
+
+def robot_info(robot: Robot) -> schemas.RobotInfo:
+    """One catalogue entry of ``GET /v1/robots``."""
+    return schemas.RobotInfo(
+        name=robot.name,
+        dof=robot.dof,
+        joint_names=list(robot.joint_names),
+        q_lower=robot.q_lower.tolist(),
+        q_upper=robot.q_upper.tolist(),
+        qdot_max=robot.qdot_max.tolist(),
+        base_frame=robot.base_frame,
+        tool_frame=robot.tool_frame,
+    )
+
+
+def _optional_list(values: np.ndarray | None, i: int) -> list[float] | None:
+    return None if values is None else values[i].tolist()
+
+
+def _optional_float(values: np.ndarray | None, i: int) -> float | None:
+    return None if values is None else float(values[i])
+
+
+def evaluate_response(evaluation: PathEvaluation, robot: Robot) -> schemas.EvaluateResponse:
+    """The response of ``POST /v1/evaluate``."""
+    ev = evaluation
+    waypoints = []
+    for i in range(ev.h.shape[0]):
+        limiting = None if ev.limiting_joint is None else int(ev.limiting_joint[i])
+        waypoints.append(
+            schemas.WaypointResult(
+                index=i,
+                q=_optional_list(ev.q, i),
+                u_T=ev.u_T[i].tolist(),
+                u_R=ev.u_R[i].tolist(),
+                h=h_to_api(float(ev.h[i])),
+                v_max=_optional_float(ev.v_max, i),
+                omega_max=_optional_float(ev.omega_max, i),
+                qdot=_optional_list(ev.qdot, i),
+                limiting_joint=limiting,
+                limiting_joint_name=None if limiting is None else robot.joint_names[limiting],
+            )
+        )
+    bottleneck = None
+    if ev.bottleneck_waypoint is not None and ev.bottleneck_joint is not None:
+        bottleneck = schemas.Bottleneck(
+            waypoint=ev.bottleneck_waypoint,
+            joint=ev.bottleneck_joint,
+            joint_name=robot.joint_names[ev.bottleneck_joint],
+        )
+    branch = None if ev.branch is None else schemas.Branch.model_validate(asdict(ev.branch))
+    return schemas.EvaluateResponse(
+        feasible=ev.feasible,
+        mu_path=ev.mu_path,
+        bottleneck=bottleneck,
+        reason=cast(schemas.FailureReason | None, ev.reason),  # pydantic checks the value
+        failed_waypoint=ev.failed_waypoint,
+        branch=branch,
+        waypoints=waypoints,
+    )

@@ -1,0 +1,154 @@
+"""Error answers: schema and solver input errors as ``422``, oversized bodies as ``413``.
+
+Both use FastAPI's validation-error shape, ``{"detail": [{"loc": [...], "msg": ..., "type":
+...}]}``, so a client reads every input error the same way.
+"""
+
+from __future__ import annotations
+
+import re
+from typing import Any
+
+from fastapi import Request, status
+from fastapi.exception_handlers import http_exception_handler
+from fastapi.exceptions import RequestValidationError
+from fastapi.responses import JSONResponse, Response
+from starlette.datastructures import Headers
+from starlette.exceptions import HTTPException as StarletteHTTPException
+from starlette.types import ASGIApp, Message, Receive, Scope, Send
+
+from service.config import get_settings
+from service.schemas import ErrorDetail, ErrorResponse
+from solver.exceptions import SolverError
+
+
+def _error_type(error: SolverError) -> str:
+    """``RepeatedWaypointError`` -> ``"repeated_waypoint"``."""
+    name = type(error).__name__.removesuffix("Error")
+    return re.sub(r"(?<!^)(?=[A-Z])", "_", name).lower()
+
+
+def solver_error_location(error: SolverError) -> list[str | int]:
+    """Where a solver error is, as a FastAPI ``loc``: ``["body", *field, waypoint?]``.
+
+    ``"path.waypoints"`` with waypoint 3 gives ``["body", "path", "waypoints", 3]``.
+    """
+    parts: list[str | int] = [int(p) if p.isdigit() else p for p in error.field.split(".")]
+    if error.waypoint is not None:
+        parts.append(error.waypoint)
+    return ["body", *parts]
+
+
+ERROR_RESPONSES: dict[int | str, dict[str, Any]] = {
+    status.HTTP_413_CONTENT_TOO_LARGE: {
+        "model": ErrorResponse,
+        "description": "The body is over the size limit (setting DTF_MAX_BODY_BYTES).",
+    },
+    status.HTTP_422_UNPROCESSABLE_CONTENT: {
+        "model": ErrorResponse,
+        "description": "Bad input; each detail's loc names the field (and waypoint index).",
+    },
+}
+"""OpenAPI entries of the error answers, for routers that take a body."""
+
+
+def _error_response(status_code: int, details: list[ErrorDetail]) -> JSONResponse:
+    """An error answer with its ``detail`` list."""
+    return JSONResponse(status_code=status_code, content=ErrorResponse(detail=details).model_dump())
+
+
+async def request_validation_error_handler(
+    request: Request, error: RequestValidationError
+) -> JSONResponse:
+    """Answer a schema error with ``422`` as FastAPI does, without echoing the input.
+
+    FastAPI's own answer repeats each offending ``input``, which breaks on the NaN it is
+    refusing (JSON has no NaN) and can run to megabytes for a whole path.
+    """
+    details = [ErrorDetail(loc=e["loc"], msg=e["msg"], type=e["type"]) for e in error.errors()]
+    return _error_response(status.HTTP_422_UNPROCESSABLE_CONTENT, details)
+
+
+async def http_error_handler(request: Request, error: StarletteHTTPException) -> Response:
+    """FastAPI's answer, except that a body it cannot decode is a ``422`` like any bad input.
+
+    FastAPI answers ``400`` when the JSON parser itself fails (bytes that are not UTF-8, arrays
+    nested deeper than the parser's recursion limit) rather than reporting a syntax error.
+    """
+    cause = error.__cause__
+    if error.status_code == 400 and isinstance(cause, UnicodeDecodeError | RecursionError):
+        detail = ErrorDetail(
+            loc=["body"], msg=f"cannot decode the JSON: {cause}", type="json_invalid"
+        )
+        return _error_response(status.HTTP_422_UNPROCESSABLE_CONTENT, [detail])
+    return await http_exception_handler(request, error)
+
+
+async def solver_error_handler(request: Request, error: SolverError) -> JSONResponse:
+    """Answer a solver input error with ``422`` naming the field (and waypoint)."""
+    detail = ErrorDetail(
+        loc=solver_error_location(error), msg=error.message, type=_error_type(error)
+    )
+    return _error_response(status.HTTP_422_UNPROCESSABLE_CONTENT, [detail])
+
+
+def _too_large(size: int, limit: int) -> JSONResponse:
+    """The ``413`` answer, for a body of at least ``size`` bytes."""
+    detail = ErrorDetail(
+        loc=["body"],
+        msg=f"request body is over the limit of {limit} bytes (at least {size} bytes)",
+        type="body_too_large",
+    )
+    return _error_response(status.HTTP_413_CONTENT_TOO_LARGE, [detail])
+
+
+class BodySizeLimitMiddleware:
+    """Answer ``413`` to a request whose body is over ``Settings.max_body_bytes`` (pure ASGI).
+
+    A declared ``Content-Length`` over the limit is refused before reading; otherwise the body
+    is read (counting the bytes as they stream in, so a chunked body cannot slip through) and
+    handed on in one piece.
+    """
+
+    def __init__(self, app: ASGIApp) -> None:
+        """Wrap ``app``."""
+        self.app = app
+
+    async def __call__(self, scope: Scope, receive: Receive, send: Send) -> None:
+        """Check the body size of an HTTP request, then pass it on."""
+        if scope["type"] != "http":
+            await self.app(scope, receive, send)
+            return
+        limit = get_settings().max_body_bytes
+        declared = Headers(scope=scope).get("content-length", "")
+        if declared.isdigit() and int(declared) > limit:
+            await _too_large(int(declared), limit)(scope, receive, send)
+            return
+        chunks: list[bytes] = []
+        size = 0
+        more_body = True
+        while more_body:
+            message = await receive()
+            if message["type"] != "http.request":  # the client went away
+                return
+            chunk: bytes = message.get("body", b"")
+            size += len(chunk)
+            if size > limit:
+                await _too_large(size, limit)(scope, receive, send)
+                return
+            chunks.append(chunk)
+            more_body = message.get("more_body", False)
+        body: Message | None = {
+            "type": "http.request",
+            "body": b"".join(chunks),
+            "more_body": False,
+        }
+
+        async def replay() -> Message:
+            nonlocal body
+            if body is None:
+                return await receive()
+            message, body = body, None
+            return message
+
+        await self.app(scope, replay, send)

@@ -1,0 +1,49 @@
+"""Request and response bodies of the API (pydantic), split by direction.
+
+Request models are strict, refuse unknown fields and refuse NaN and infinities; every field says
+its unit, and every model carries an example, so ``/docs`` reads as a manual.
+"""
+
+from service.schemas.common import (
+    Branch,
+    IkPolicy,
+    Path,
+    Placement,
+    Pose,
+    RequestModel,
+    ResponseModel,
+    Robot,
+)
+from service.schemas.dtf import DtfRequest, DtfResponse
+from service.schemas.errors import ErrorDetail, ErrorResponse
+from service.schemas.evaluate import (
+    Bottleneck,
+    EvaluateRequest,
+    EvaluateResponse,
+    FailureReason,
+    WaypointResult,
+)
+from service.schemas.robots import HealthResponse, RobotInfo, RobotsResponse
+
+__all__ = [
+    "Bottleneck",
+    "Branch",
+    "DtfRequest",
+    "DtfResponse",
+    "ErrorDetail",
+    "ErrorResponse",
+    "EvaluateRequest",
+    "EvaluateResponse",
+    "FailureReason",
+    "HealthResponse",
+    "IkPolicy",
+    "Path",
+    "Placement",
+    "Pose",
+    "RequestModel",
+    "ResponseModel",
+    "Robot",
+    "RobotInfo",
+    "RobotsResponse",
+    "WaypointResult",
+]

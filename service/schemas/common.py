@@ -1,0 +1,222 @@
+"""Objects shared by several routes: Pose, Robot, Path, Placement, IK branch (api.md).
+
+Every request model is strict (a number is a JSON number, not a string), refuses unknown fields,
+and refuses NaN and infinities, so bad input of any kind is a ``422`` that names the field.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Annotated, Literal
+
+from pydantic import (
+    BaseModel,
+    ConfigDict,
+    Discriminator,
+    Field,
+    PositiveFloat,
+    Tag,
+    ValidationInfo,
+    field_validator,
+    model_validator,
+)
+from pydantic_core import PydanticCustomError
+
+from solver.evaluate import DEFAULT_MAX_JOINT_STEP
+from solver.spatial import QUATERNION_NORM_TOLERANCE
+
+Vector3 = Annotated[list[float], Field(min_length=3, max_length=3)]
+Quaternion = Annotated[list[float], Field(min_length=4, max_length=4)]
+
+
+class RequestModel(BaseModel):
+    """Base of request bodies: strict types, no unknown fields, finite numbers only."""
+
+    model_config = ConfigDict(allow_inf_nan=False, strict=True, extra="forbid")
+
+
+class ResponseModel(BaseModel):
+    """Base of response bodies: finite numbers only (``null`` where a value does not exist)."""
+
+    model_config = ConfigDict(allow_inf_nan=False)
+
+
+class Pose(RequestModel):
+    """A tool point pose: position and unit quaternion in ROS order (x, y, z, w)."""
+
+    model_config = ConfigDict(
+        json_schema_extra={"examples": [{"position": [0.4, 0.1, 0.2], "orientation": [1, 0, 0, 0]}]}
+    )
+
+    position: Vector3 = Field(description="Position [x, y, z] (m).")
+    orientation: Quaternion = Field(
+        description="Unit quaternion [qx, qy, qz, qw] (dimensionless, ROS order). A norm off "
+        "by more than 1e-6 is refused, never normalised."
+    )
+
+    @field_validator("orientation")
+    @classmethod
+    def _unit_norm(cls, value: list[float]) -> list[float]:
+        norm = math.hypot(*value)
+        if abs(norm - 1.0) > QUATERNION_NORM_TOLERANCE:
+            raise PydanticCustomError(
+                "unit_quaternion",
+                "quaternion norm is {norm}; a unit quaternion is needed (tolerance 1e-6)",
+                {"norm": norm},
+            )
+        return value
+
+
+class Robot(RequestModel):
+    """The arm: a catalogue ``model``, or a ``urdf`` with its ``base_frame`` and ``tool_frame``."""
+
+    model_config = ConfigDict(
+        json_schema_extra={
+            "examples": [
+                {"model": "ur5e"},
+                {"model": "ur5", "joint_velocity_limits": [3.0, 3.0, 3.0, 3.0, 3.0, 3.0]},
+                {
+                    "urdf": "<robot name='arm'>...</robot>",
+                    "base_frame": "base",
+                    "tool_frame": "tool0",
+                },
+            ]
+        }
+    )
+
+    model: str | None = Field(
+        default=None, description="A robot name from GET /v1/robots. Give model or urdf."
+    )
+    urdf: str | None = Field(
+        default=None,
+        description="URDF document of a serial arm (lengths in m, angles in rad). Give model or "
+        "urdf; joints that do not move tool_frame are locked.",
+    )
+    base_frame: str | None = Field(
+        default=None,
+        validate_default=True,
+        description="With urdf only, required: the frame fixed to the root that poses and twists "
+        "are expressed in.",
+    )
+    tool_frame: str | None = Field(
+        default=None,
+        validate_default=True,
+        description="With urdf only, required: the tool flange frame.",
+    )
+    joint_velocity_limits: list[PositiveFloat] | None = Field(
+        default=None,
+        min_length=1,
+        description="Joint speed limits (rad/s; m/s for prismatic joints), one per joint, "
+        "each > 0. Default: the model's.",
+    )
+    tcp: Pose | None = Field(
+        default=None,
+        description="Tool point relative to the tool frame (m, unit quaternion). Default: "
+        "identity, the tool point is the tool frame.",
+    )
+
+    @field_validator("urdf")
+    @classmethod
+    def _not_both(cls, value: str | None, info: ValidationInfo) -> str | None:
+        if value is not None and info.data.get("model") is not None:
+            raise PydanticCustomError("robot_source", "give model or urdf, not both")
+        return value
+
+    @field_validator("base_frame", "tool_frame")
+    @classmethod
+    def _frames_go_with_urdf(cls, value: str | None, info: ValidationInfo) -> str | None:
+        if value is None and info.data.get("urdf") is not None:
+            raise PydanticCustomError("missing", "required with urdf")
+        if value is not None and info.data.get("model") is not None:
+            raise PydanticCustomError("robot_source", "only with urdf, not with model")
+        return value
+
+    @model_validator(mode="after")
+    def _model_or_urdf(self) -> Robot:
+        if self.model is None and self.urdf is None:
+            raise PydanticCustomError(
+                "robot_source", "give model (a name from GET /v1/robots) or urdf"
+            )
+        return self
+
+
+class Path(RequestModel):
+    """Tool point poses in the workpiece frame {O}, in machining order."""
+
+    model_config = ConfigDict(
+        json_schema_extra={
+            "examples": [
+                {
+                    "waypoints": [
+                        {"position": [0.0, 0.0, 0.0], "orientation": [1, 0, 0, 0]},
+                        {"position": [0.01, 0.0, 0.0], "orientation": [1, 0, 0, 0]},
+                    ]
+                }
+            ]
+        }
+    )
+
+    waypoints: list[Pose] = Field(
+        min_length=2,
+        description="N >= 2 poses in {O} (m, unit quaternions); consecutive ones distinct.",
+    )
+
+
+class Placement(RequestModel):
+    """Where the workpiece frame {O} sits in the base frame {B}: Trans(x, y, z) Rot_z(yaw)."""
+
+    model_config = ConfigDict(
+        json_schema_extra={"examples": [{"x": 0.0, "y": 0.45, "z": 0.1, "yaw": 0.0}]}
+    )
+
+    x: float = Field(description="x of {O} in {B} (m).")
+    y: float = Field(description="y of {O} in {B} (m).")
+    z: float = Field(description="z of {O} in {B} (m), the table height.")
+    yaw: float = Field(description="Rotation of {O} about the z axis of {B} (rad).")
+
+
+class Branch(RequestModel):
+    """A named inverse-kinematics branch of a UR arm."""
+
+    model_config = ConfigDict(
+        json_schema_extra={"examples": [{"shoulder": "left", "elbow": "up", "wrist": "noflip"}]}
+    )
+
+    shoulder: Literal["left", "right"] = Field(description="Shoulder choice (joint 1).")
+    elbow: Literal["up", "down"] = Field(description="Elbow choice (joint 3).")
+    wrist: Literal["flip", "noflip"] = Field(description="Wrist choice (joint 5).")
+
+
+def _branch_kind(value: object) -> str:
+    """Tag of an ``ik.branch`` value: ``auto`` for a string, ``named`` otherwise."""
+    return "auto" if isinstance(value, str) else "named"
+
+
+BranchChoice = Annotated[
+    Annotated[Literal["auto"], Tag("auto")] | Annotated[Branch, Tag("named")],
+    Discriminator(_branch_kind),
+]
+
+
+class IkPolicy(RequestModel):
+    """How inverse kinematics is followed along the path."""
+
+    model_config = ConfigDict(
+        json_schema_extra={
+            "examples": [
+                {"branch": "auto", "max_joint_step": 0.35},
+                {"branch": {"shoulder": "left", "elbow": "up", "wrist": "noflip"}},
+            ]
+        }
+    )
+
+    branch: BranchChoice = Field(
+        default="auto",
+        description='"auto": the feasible branch, continuous along the path, with the highest '
+        "mu_path; or a named branch to follow.",
+    )
+    max_joint_step: float = Field(
+        default=DEFAULT_MAX_JOINT_STEP,
+        gt=0.0,
+        description="Largest move of any joint between neighbouring waypoints (rad), > 0.",
+    )

@@ -1,0 +1,95 @@
+"""``POST /v1/dtf``: the DTF index at one configuration (spec section 3)."""
+
+from __future__ import annotations
+
+from typing import Literal
+
+from pydantic import ConfigDict, Field
+
+from service.schemas.common import RequestModel, ResponseModel, Robot, Vector3
+
+
+class DtfRequest(RequestModel):
+    """A configuration and a task direction: how fast can the tool point go?"""
+
+    model_config = ConfigDict(
+        json_schema_extra={
+            "examples": [
+                {
+                    "robot": {"model": "ur5e"},
+                    "q": [0.0, -1.2, 1.5, -1.9, -1.5708, 0.3],
+                    "u_T": [1.0, 0.0, 0.0],
+                    "u_R": [0.0, 0.0, 1.0],
+                    "h": 0.5,
+                }
+            ]
+        }
+    )
+
+    robot: Robot = Field(description="The arm, its speed limits and tool point.")
+    q: list[float] = Field(
+        min_length=1, description="Joint positions (rad; m for prismatic joints), n values."
+    )
+    u_T: Vector3 | None = Field(
+        default=None,
+        description="Unit direction of the linear tool velocity in {B} (dimensionless). "
+        "Required unless h = 0.",
+    )
+    u_R: Vector3 | None = Field(
+        default=None,
+        description="Unit direction of the angular tool velocity in {B} (dimensionless). "
+        "Required unless h is null.",
+    )
+    h: float | None = Field(
+        ge=0.0,
+        description="V / Omega (m), >= 0: linear over angular speed. null for pure "
+        "translation, 0 for pure reorientation.",
+    )
+    method: Literal["auto", "closed_form", "lp"] = Field(
+        default="auto",
+        description="closed_form (J^-1, non-singular 6-joint arms), lp (exact for every arm), "
+        "or auto: closed_form where it applies, else lp.",
+    )
+
+
+class DtfResponse(ResponseModel):
+    """The largest feasible tool speed along the direction, and the joint speeds there."""
+
+    model_config = ConfigDict(
+        json_schema_extra={
+            "examples": [
+                {
+                    "v_max": 0.98679,
+                    "omega_max": 1.97358,
+                    "qdot": [-0.00913, -2.22647, 3.14159, -0.91513, 0.05789, -1.98187],
+                    "limiting_joint": 2,
+                    "limiting_joint_name": "elbow_joint",
+                    "method": "closed_form",
+                    "yoshikawa": 0.10447,
+                    "chiu": 0.49846,
+                }
+            ]
+        }
+    )
+
+    v_max: float = Field(
+        description="Largest linear tool speed (m/s) with every joint within its limit; 0 for "
+        "pure reorientation (h = 0)."
+    )
+    omega_max: float = Field(
+        description="Angular tool speed at v_max (rad/s), v_max / h; 0 for pure translation. "
+        "For h = 0 the largest angular speed."
+    )
+    qdot: list[float] = Field(
+        description="Joint speeds at that maximum (rad/s), n values; one sits on its limit."
+    )
+    limiting_joint: int = Field(description="Index (from 0) of the joint on its speed limit.")
+    limiting_joint_name: str = Field(description="Name of the joint on its speed limit.")
+    method: Literal["closed_form", "lp"] = Field(description="The method that was used.")
+    yoshikawa: float = Field(
+        description="Yoshikawa manipulability sqrt(det(J J^T)) (mixed units), for comparison."
+    )
+    chiu: float = Field(
+        description="Chiu's directional index [t^T (J J^T)^-1 t]^(-1/2), t = [u_T; u_R / h] "
+        "normalised (mixed units), for comparison; 0 when t is out of reach."
+    )

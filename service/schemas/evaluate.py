@@ -1,0 +1,165 @@
+"""``POST /v1/evaluate``: mu_path of a path at one placement (spec sections 2-4)."""
+
+from __future__ import annotations
+
+from typing import Literal
+
+from pydantic import ConfigDict, Field
+from pydantic.config import JsonDict
+
+from service.schemas.common import (
+    Branch,
+    IkPolicy,
+    Path,
+    Placement,
+    RequestModel,
+    ResponseModel,
+    Robot,
+)
+
+_REQUEST_EXAMPLE: JsonDict = {
+    "robot": {"model": "ur5"},
+    "path": {
+        "waypoints": [
+            {
+                "position": [-0.15, 0.06, 0.018197678601],
+                "orientation": [0.96832240956, -0.186557136879, 0.165133112436, -0.016709308821],
+            },
+            {
+                "position": [-0.147727272727, 0.059048361684, 0.019009432799],
+                "orientation": [0.968479713301, -0.186511311708, 0.164318393215, -0.016125792377],
+            },
+        ]
+    },
+    "placement": {"x": 0.0, "y": 0.45, "z": 0.1, "yaw": 0.0},
+    "ik": {"branch": "auto", "max_joint_step": 0.35},
+}
+
+_RESPONSE_EXAMPLE_WAYPOINT: JsonDict = {
+    "index": 0,
+    "q": [2.105848, 2.500149, 1.960595, -3.089811, 1.302015, 0.942819],
+    "u_T": [0.876082, -0.366834, 0.312912],
+    "u_R": [-0.416804, 0.908953, -0.008888],
+    "h": 1.277384,
+    "v_max": 1.963078,
+    "omega_max": 1.536795,
+    "qdot": [-2.319085, 0.598154, 3.15, -2.880975, 1.040122, -2.658396],
+    "limiting_joint": 2,
+    "limiting_joint_name": "elbow_joint",
+}
+_RESPONSE_EXAMPLE: JsonDict = {
+    "feasible": True,
+    "mu_path": 1.963078,
+    "bottleneck": {"waypoint": 0, "joint": 2, "joint_name": "elbow_joint"},
+    "reason": None,
+    "failed_waypoint": None,
+    "branch": {"shoulder": "right", "elbow": "down", "wrist": "noflip"},
+    "waypoints": [
+        _RESPONSE_EXAMPLE_WAYPOINT,
+        {
+            "index": 1,
+            "q": [2.102773, 2.500954, 1.964739, -3.093618, 1.30339, 0.939297],
+            "u_T": [0.876082, -0.366834, 0.312912],
+            "u_R": [-0.416804, 0.908953, -0.008888],
+            "h": 1.277384,
+            "v_max": 1.980425,
+            "omega_max": 1.550375,
+            "qdot": [-2.355864, 0.625913, 3.15, -2.905565, 1.049536, -2.696284],
+            "limiting_joint": 2,
+            "limiting_joint_name": "elbow_joint",
+        },
+    ],
+}
+FailureReason = Literal["unreachable", "joint_limits", "singular", "discontinuous"]
+
+
+class EvaluateRequest(RequestModel):
+    """A path, a workpiece placement and an IK policy."""
+
+    model_config = ConfigDict(json_schema_extra={"examples": [_REQUEST_EXAMPLE]})
+
+    robot: Robot = Field(
+        description="The arm; path evaluation needs analytic IK, so a catalogue (UR) model."
+    )
+    path: Path = Field(description="The waypoints, in the workpiece frame {O}.")
+    placement: Placement = Field(description="Where {O} sits in the base frame {B}.")
+    ik: IkPolicy = Field(
+        default_factory=IkPolicy, description="IK branch and continuity bound; default auto."
+    )
+
+
+class WaypointResult(ResponseModel):
+    """Task requirements and, when feasible, the DTF at one waypoint (all in {B})."""
+
+    model_config = ConfigDict(json_schema_extra={"examples": [_RESPONSE_EXAMPLE_WAYPOINT]})
+
+    index: int = Field(description="Waypoint index (from 0).")
+    q: list[float] | None = Field(
+        description="Joint positions (rad), n values; null when infeasible."
+    )
+    u_T: list[float] = Field(
+        description="Unit direction of the linear velocity (dimensionless), [0, 0, 0] for pure "
+        "reorientation."
+    )
+    u_R: list[float] = Field(
+        description="Unit direction of the angular velocity (dimensionless), [0, 0, 0] for pure "
+        "translation."
+    )
+    h: float | None = Field(
+        description="V / Omega (m); null for pure translation, 0 for pure reorientation."
+    )
+    v_max: float | None = Field(
+        description="DTF: largest linear tool speed (m/s); null when infeasible."
+    )
+    omega_max: float | None = Field(
+        description="Angular tool speed at v_max (rad/s); null when infeasible."
+    )
+    qdot: list[float] | None = Field(
+        description="Joint speeds at v_max (rad/s), n values; null when infeasible."
+    )
+    limiting_joint: int | None = Field(
+        description="Index of the joint on its speed limit; null when infeasible."
+    )
+    limiting_joint_name: str | None = Field(
+        description="Name of the joint on its speed limit; null when infeasible."
+    )
+
+
+class Bottleneck(ResponseModel):
+    """Where the path is slowest: the waypoint of mu_path and its limiting joint."""
+
+    model_config = ConfigDict(
+        json_schema_extra={"examples": [{"waypoint": 0, "joint": 2, "joint_name": "elbow_joint"}]}
+    )
+
+    waypoint: int = Field(description="Index of the waypoint with the smallest v_max.")
+    joint: int = Field(description="Index of the joint on its speed limit there.")
+    joint_name: str = Field(description="Name of that joint.")
+
+
+class EvaluateResponse(ResponseModel):
+    """Feasibility, mu_path and per-waypoint detail of the path at the placement."""
+
+    model_config = ConfigDict(json_schema_extra={"examples": [_RESPONSE_EXAMPLE]})
+
+    feasible: bool = Field(
+        description="Every waypoint reachable within the joint limits on one branch, "
+        "followed continuously."
+    )
+    mu_path: float | None = Field(
+        description="Highest constant feed rate (m/s) with every joint within its speed limit "
+        "along the whole path: min over waypoints of v_max. null when infeasible."
+    )
+    bottleneck: Bottleneck | None = Field(
+        description="Where mu_path is attained; null when infeasible."
+    )
+    reason: FailureReason | None = Field(
+        description="Why the placement is infeasible; null when feasible."
+    )
+    failed_waypoint: int | None = Field(
+        description="Index of the first waypoint that fails; null when feasible."
+    )
+    branch: Branch | None = Field(
+        description="IK branch used (when infeasible with auto: the one that got furthest)."
+    )
+    waypoints: list[WaypointResult] = Field(description="One entry per waypoint, in path order.")

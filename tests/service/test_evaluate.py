@@ -1,0 +1,69 @@
+from __future__ import annotations
+
+import json
+from typing import Any
+
+import pytest
+from fastapi.testclient import TestClient
+
+from tests.cases import EXAMPLES
+
+PER_WAYPOINT_IF_FEASIBLE = ("q", "v_max", "omega_max", "qdot", "limiting_joint")
+
+
+def post(client: TestClient, body: dict[str, Any]) -> dict[str, Any]:
+    response = client.post("/v1/evaluate", json=body)
+    assert response.status_code == 200, response.text
+    result: dict[str, Any] = response.json()
+    return result
+
+
+def test_example_request_is_feasible_and_consistent(client: TestClient) -> None:
+    body = json.loads((EXAMPLES / "evaluate_request.json").read_text())
+    result = post(client, body)
+    assert result["feasible"] is True
+    assert result["reason"] is None and result["failed_waypoint"] is None
+    waypoints = result["waypoints"]
+    assert [w["index"] for w in waypoints] == list(range(len(body["path"]["waypoints"])))
+    speeds = [w["v_max"] for w in waypoints]
+    assert result["mu_path"] == min(speeds)
+    bottleneck = result["bottleneck"]
+    assert bottleneck["waypoint"] == speeds.index(min(speeds))
+    slowest = waypoints[bottleneck["waypoint"]]
+    assert bottleneck["joint"] == slowest["limiting_joint"]
+    assert bottleneck["joint_name"] == slowest["limiting_joint_name"]
+    for waypoint in waypoints:
+        assert waypoint["omega_max"] == pytest.approx(waypoint["v_max"] / waypoint["h"], rel=1e-9)
+
+
+def test_named_branch_is_followed_and_echoed(
+    client: TestClient, evaluate_body: dict[str, Any]
+) -> None:
+    auto = post(client, evaluate_body)
+    evaluate_body["ik"]["branch"] = auto["branch"]
+    named = post(client, evaluate_body)
+    assert named["branch"] == auto["branch"]
+    assert named["mu_path"] == auto["mu_path"]
+
+
+def test_unreachable_placement_is_an_answer_not_an_error(
+    client: TestClient, evaluate_body: dict[str, Any]
+) -> None:
+    evaluate_body["placement"]["x"] = 5.0
+    result = post(client, evaluate_body)
+    assert result["feasible"] is False
+    assert result["reason"] == "unreachable"
+    assert result["failed_waypoint"] == 0
+    assert result["mu_path"] is None and result["bottleneck"] is None
+    for waypoint in result["waypoints"]:
+        assert all(waypoint[key] is None for key in PER_WAYPOINT_IF_FEASIBLE)
+        assert len(waypoint["u_T"]) == 3 and len(waypoint["u_R"]) == 3
+
+
+def test_pure_translation_has_null_h(client: TestClient, evaluate_body: dict[str, Any]) -> None:
+    first, second = evaluate_body["path"]["waypoints"]
+    second["orientation"] = first["orientation"]
+    result = post(client, evaluate_body)
+    assert result["feasible"] is True
+    assert all(w["h"] is None and w["omega_max"] == 0 for w in result["waypoints"])
+    assert all(w["u_R"] == [0.0, 0.0, 0.0] for w in result["waypoints"])

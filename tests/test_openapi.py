@@ -1,0 +1,21 @@
+"""The committed openapi/openapi.json is the app's spec (regenerate: scripts/gen_openapi.py)."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+from service.main import app
+
+SPEC_PATH = Path(__file__).resolve().parents[1] / "openapi" / "openapi.json"
+
+
+def test_committed_spec_matches_the_app() -> None:
+    committed = json.loads(SPEC_PATH.read_text())
+    generated = json.loads(json.dumps(app.openapi()))
+    assert committed == generated, "openapi/openapi.json is stale: run scripts/gen_openapi.py"
+
+
+def test_routes_of_this_round_are_in_the_spec() -> None:
+    paths = json.loads(SPEC_PATH.read_text())["paths"]
+    assert {"/healthz", "/v1/robots", "/v1/dtf", "/v1/evaluate"} <= set(paths)
