@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import math
 from dataclasses import asdict
-from typing import cast
 
 import numpy as np
 
@@ -23,14 +22,17 @@ def robot_from_schema(spec: schemas.Robot) -> Robot:
         RobotModelError: the URDF or its frames do not fit.
         InvalidInputError: ``joint_velocity_limits`` has the wrong length.
     """
+    tcp = None if spec.tcp is None else pose_matrix_of(spec.tcp, field="robot.tcp")
     if spec.model is not None:
-        robot = get_robot(spec.model)
+        robot = get_robot(spec.model).with_options(qdot_max=spec.joint_velocity_limits)
     else:  # schemas.Robot makes sure urdf and both frames are given
         robot = robot_from_urdf(
-            spec.urdf or "", base_frame=spec.base_frame or "", tool_frame=spec.tool_frame or ""
+            spec.urdf or "",
+            base_frame=spec.base_frame or "",
+            tool_frame=spec.tool_frame or "",
+            qdot_max=spec.joint_velocity_limits,
         )
-    tcp = None if spec.tcp is None else pose_matrix_of(spec.tcp, field="robot.tcp")
-    return robot.with_options(qdot_max=spec.joint_velocity_limits, transform_tool_to_tcp=tcp)
+    return robot.with_options(transform_tool_to_tcp=tcp)
 
 
 def pose_matrix_of(pose: schemas.Pose, *, field: str) -> np.ndarray:
@@ -137,7 +139,7 @@ def evaluate_response(evaluation: PathEvaluation, robot: Robot) -> schemas.Evalu
         feasible=ev.feasible,
         mu_path=ev.mu_path,
         bottleneck=bottleneck,
-        reason=cast(schemas.FailureReason | None, ev.reason),  # pydantic checks the value
+        reason=ev.reason,
         failed_waypoint=ev.failed_waypoint,
         branch=branch,
         waypoints=waypoints,

@@ -81,7 +81,12 @@ def twist_per_unit_speed(
         twist[:3] = _unit(np.zeros(3) if u_T is None else u_T, "u_T")
     if math.isfinite(h):
         rotation = _unit(np.zeros(3) if u_R is None else u_R, "u_R")
-        twist[3:] = rotation if h == 0.0 else rotation / h
+        with np.errstate(over="ignore"):
+            twist[3:] = rotation if h == 0.0 else rotation / h
+    if not np.all(np.isfinite(twist)):
+        raise InvalidInputError(
+            "h", f"h = {h!r} m is too small to divide by; use 0 for pure reorientation"
+        )
     return twist
 
 
@@ -147,11 +152,14 @@ def lp_speed(
     Returns:
         The optimum s and the joint speeds qdot there, shape (n,).
     """
+    # Solved in scaled variables, x = qdot / qdot_max in [-1, 1] and t / max|t|, so that a tiny h
+    # (u_R / h large) or unusual limits do not reach HiGHS as extreme coefficients.
     n = jacobian.shape[1]
+    scale = float(np.max(np.abs(twist)))
     cost = np.zeros(n + 1)
     cost[-1] = -1.0
-    a_eq = np.hstack([jacobian, -twist[:, None]])
-    bounds = [(-float(v), float(v)) for v in qdot_max] + [(0.0, None)]
+    a_eq = np.hstack([jacobian * qdot_max, -twist[:, None] / scale])
+    bounds = [(-1.0, 1.0)] * n + [(0.0, None)]
     result = scipy.optimize.linprog(
         cost,
         A_eq=a_eq,
@@ -162,7 +170,7 @@ def lp_speed(
     )
     if result.status != 0:  # The origin is always feasible and s is bounded: not expected.
         raise RuntimeError(f"HiGHS failed on the DTF LP: {result.message}")
-    return float(result.x[-1]), np.asarray(result.x[:n])
+    return float(result.x[-1]) / scale, np.asarray(result.x[:n]) * qdot_max
 
 
 def dtf(
@@ -232,6 +240,7 @@ def chiu(jacobian: np.ndarray, twist_direction: np.ndarray) -> float:
     """
     jac = np.asarray(jacobian, dtype=float)
     t = np.asarray(twist_direction, dtype=float)
+    t = t / np.max(np.abs(t))  # first, so that the norm cannot overflow
     t = t / np.linalg.norm(t)
     solution, _, rank, _ = np.linalg.lstsq(jac @ jac.T, t, rcond=None)
     if rank < 6 and np.linalg.norm(jac @ np.linalg.pinv(jac) @ t - t) > 1e-9:

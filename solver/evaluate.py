@@ -23,7 +23,7 @@ from solver.kinematics import jacobian_in_base
 from solver.robots import Robot, UrDh
 from solver.spatial import Placement
 from solver.task import TaskRequirements, task_requirements
-from solver.tracking import FEASIBLE, REASONS, choose_branch, track
+from solver.tracking import FEASIBLE, REASONS, Reason, choose_branch, track
 
 __all__ = ["Branch", "PathEvaluation", "evaluate_path", "DEFAULT_MAX_JOINT_STEP"]
 
@@ -52,7 +52,7 @@ class PathEvaluation:
     mu_path: float | None
     bottleneck_waypoint: int | None
     bottleneck_joint: int | None
-    reason: str | None
+    reason: Reason | None
     failed_waypoint: int | None
     branch: Branch | None
     u_T: np.ndarray

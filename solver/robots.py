@@ -89,6 +89,12 @@ _E_SERIES_SPEEDS: dict[str, tuple[float, ...]] = {
 }
 
 
+# Joint speed limits outside this range (rad/s) are input errors: no arm is that slow or fast,
+# and the LP solver treats bounds past 1e20 as infinite.
+MIN_SPEED_LIMIT = 1e-6
+MAX_SPEED_LIMIT = 1e4
+
+
 @dataclass(frozen=True, eq=False)
 class Robot:
     """A serial arm with its base frame, tool point and joint limits.
@@ -146,27 +152,45 @@ class Robot:
         """
         robot = self
         if qdot_max is not None:
-            limits = np.asarray(qdot_max, dtype=float)
-            if limits.shape != (self.dof,):
-                raise InvalidInputError(
-                    "robot.joint_velocity_limits",
-                    f"{limits.shape=} but the robot has {self.dof} joints",
-                )
-            bad = np.flatnonzero(~np.isfinite(limits) | (limits <= 0.0))
-            if bad.size:
-                j = int(bad[0])
-                raise InvalidInputError(
-                    "robot.joint_velocity_limits",
-                    f"joint {j} ({self.joint_names[j]}) limit {limits[j]!r} rad/s must be "
-                    "finite and > 0",
-                )
-            robot = dataclasses.replace(robot, qdot_max=limits.copy())
+            limits = check_speed_limits(qdot_max, self.joint_names)
+            robot = dataclasses.replace(robot, qdot_max=limits)
         if transform_tool_to_tcp is not None:
             tcp = np.asarray(transform_tool_to_tcp, dtype=float)
             model = pin.Model(robot.model)
             _set_tool_point(model, robot.tool_frame, tcp)
             robot = dataclasses.replace(robot, model=model, transform_tool_to_tcp=tcp.copy())
         return robot
+
+
+def check_speed_limits(
+    qdot_max: np.ndarray | list[float], joint_names: tuple[str, ...]
+) -> np.ndarray:
+    """Joint speed limits as a float array, after checking them.
+
+    Args:
+        qdot_max: shape (n,), rad/s, each in [MIN_SPEED_LIMIT, MAX_SPEED_LIMIT].
+        joint_names: the n joint names, for the message.
+
+    Raises:
+        InvalidInputError: wrong length, not finite, or out of range.
+    """
+    limits = np.array(qdot_max, dtype=float)
+    field = "robot.joint_velocity_limits"
+    if limits.shape != (len(joint_names),):
+        raise InvalidInputError(
+            field, f"{limits.shape=} but the robot has {len(joint_names)} joints"
+        )
+    bad = np.flatnonzero(
+        ~np.isfinite(limits) | (limits < MIN_SPEED_LIMIT) | (limits > MAX_SPEED_LIMIT)
+    )
+    if bad.size:
+        j = int(bad[0])
+        raise InvalidInputError(
+            field,
+            f"joint {j} ({joint_names[j]}) limit {limits[j]!r} rad/s must be > 0, within "
+            f"[{MIN_SPEED_LIMIT}, {MAX_SPEED_LIMIT}] rad/s",
+        )
+    return limits
 
 
 def _set_tool_point(model: pin.Model, tool_frame: str, transform_tool_to_tcp: np.ndarray) -> None:
@@ -185,7 +209,7 @@ def _robot_from_model(
     *,
     base_frame: str,
     tool_frame: str,
-    qdot_max: np.ndarray | None = None,
+    qdot_max: np.ndarray | list[float] | None = None,
     dh: UrDh | None = None,
 ) -> Robot:
     """Check the frames of ``model`` and wrap it as a :class:`Robot`."""
@@ -207,14 +231,23 @@ def _robot_from_model(
     data = model.createData()
     pin.framesForwardKinematics(model, data, pin.neutral(model))
     transform_world_to_base = data.oMf[model.getFrameId(base_frame)].homogeneous.copy()
-    limits = model.velocityLimit.copy() if qdot_max is None else np.asarray(qdot_max, float)
+    joint_names = tuple(model.names[1:])
+    if qdot_max is not None:
+        limits = check_speed_limits(qdot_max, joint_names)
+    else:
+        try:
+            limits = check_speed_limits(model.velocityLimit, joint_names)
+        except InvalidInputError as exc:
+            raise RobotModelError(
+                "robot.urdf", f"{exc.message}; give robot.joint_velocity_limits (rad/s)"
+            ) from exc
     _set_tool_point(model, tool_frame, np.eye(4))
     robot = Robot(
         name=name,
         model=model,
         base_frame=base_frame,
         tool_frame=tool_frame,
-        joint_names=tuple(model.names[1:]),
+        joint_names=joint_names,
         q_lower=model.lowerPositionLimit.copy(),
         q_upper=model.upperPositionLimit.copy(),
         qdot_max=limits,
@@ -222,18 +255,17 @@ def _robot_from_model(
         transform_world_to_base=transform_world_to_base,
         dh=dh,
     )
-    bad = np.flatnonzero(~np.isfinite(limits) | (limits <= 0.0))
-    if bad.size:
-        j = int(bad[0])
-        raise RobotModelError(
-            "robot.urdf",
-            f"joint {robot.joint_names[j]!r} has velocity limit {limits[j]!r}; give "
-            "robot.joint_velocity_limits (rad/s, > 0)",
-        )
     return robot
 
 
-def robot_from_urdf(urdf: str, *, base_frame: str, tool_frame: str, name: str = "urdf") -> Robot:
+def robot_from_urdf(
+    urdf: str,
+    *,
+    base_frame: str,
+    tool_frame: str,
+    name: str = "urdf",
+    qdot_max: np.ndarray | list[float] | None = None,
+) -> Robot:
     """Read a serial arm from URDF text.
 
     Joints that do not move the tool frame (grippers, fingers) are locked at their neutral
@@ -244,6 +276,8 @@ def robot_from_urdf(urdf: str, *, base_frame: str, tool_frame: str, name: str = 
         base_frame: link or frame that poses are expressed in; fixed to the root.
         tool_frame: link or frame of the tool flange.
         name: name reported for the robot.
+        qdot_max: shape (n,), rad/s, joint speed limits; ``None`` takes the URDF's (which then
+            must be usable).
 
     Raises:
         RobotModelError: the URDF cannot be parsed, a frame is missing, or the chain has
@@ -264,7 +298,9 @@ def robot_from_urdf(urdf: str, *, base_frame: str, tool_frame: str, name: str = 
     model = pin.buildReducedModel(full, locked, pin.neutral(full)) if locked else full
     if model.nv == 0:
         raise RobotModelError("robot.tool_frame", f"no joint moves frame {tool_frame!r}")
-    return _robot_from_model(name, model, base_frame=base_frame, tool_frame=tool_frame)
+    return _robot_from_model(
+        name, model, base_frame=base_frame, tool_frame=tool_frame, qdot_max=qdot_max
+    )
 
 
 def _ur_model_from_dh(dh: UrDh) -> pin.Model:

@@ -10,6 +10,25 @@ import numpy as np
 from solver.exceptions import InvalidInputError
 
 QUATERNION_NORM_TOLERANCE = 1e-6
+# Positions and placements farther than this from the origin (m) are input errors: no robot cell
+# is that large, and squares of far larger numbers overflow.
+MAX_COORDINATE = 1e3
+
+
+def check_position(position: np.ndarray | list[float], *, field: str) -> np.ndarray:
+    """A position as a float array of shape (3,), finite and within MAX_COORDINATE (m).
+
+    Raises:
+        InvalidInputError: wrong shape, not finite, or too far.
+    """
+    pos = np.asarray(position, dtype=float)
+    if pos.shape != (3,) or not np.all(np.isfinite(pos)):
+        raise InvalidInputError(field, f"position needs 3 finite numbers, got {pos.tolist()}")
+    if np.max(np.abs(pos)) > MAX_COORDINATE:
+        raise InvalidInputError(
+            field, f"position {pos.tolist()} m is beyond +-{MAX_COORDINATE} m (units are metres)"
+        )
+    return pos
 
 
 def rotation_from_quaternion(
@@ -53,9 +72,7 @@ def pose_matrix(
     Raises:
         InvalidInputError: a position that is not 3 finite numbers, or a bad quaternion.
     """
-    pos = np.asarray(position, dtype=float)
-    if pos.shape != (3,) or not np.all(np.isfinite(pos)):
-        raise InvalidInputError(field, f"position needs 3 finite numbers, got {pos.tolist()}")
+    pos = check_position(position, field=field)
     transform = np.eye(4)
     transform[:3, :3] = rotation_from_quaternion(quaternion_xyzw, field=field)
     transform[:3, 3] = pos
@@ -73,6 +90,16 @@ class Placement:
     y: float
     z: float
     yaw: float
+
+    def __post_init__(self) -> None:
+        """Check the values.
+
+        Raises:
+            InvalidInputError: a value that is not finite, or a position beyond MAX_COORDINATE.
+        """
+        check_position([self.x, self.y, self.z], field="placement")
+        if not math.isfinite(self.yaw):
+            raise InvalidInputError("placement.yaw", f"yaw {self.yaw!r} rad is not finite")
 
     def transform_workpiece_to_base(self) -> np.ndarray:
         """T_B_O, shape (4, 4)."""

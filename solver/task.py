@@ -18,6 +18,7 @@ import numpy as np
 import pinocchio as pin
 
 from solver.exceptions import InvalidInputError, RepeatedWaypointError
+from solver.spatial import MAX_COORDINATE
 
 # A displacement below this (m) or a rotation below this (rad) counts as none.
 LINEAR_TOLERANCE = 1e-9
@@ -69,6 +70,10 @@ def check_waypoints(poses: np.ndarray, *, field: str = "path.waypoints") -> np.n
     for i, pose in enumerate(arr):
         if not np.all(np.isfinite(pose)):
             raise InvalidInputError(field, "pose has values that are not finite", waypoint=i)
+        if np.max(np.abs(pose[:3, 3])) > MAX_COORDINATE:
+            raise InvalidInputError(
+                field, f"position is beyond +-{MAX_COORDINATE} m (units are metres)", waypoint=i
+            )
         rotation = pose[:3, :3]
         if np.abs(rotation.T @ rotation - np.eye(3)).max() > 1e-6 or np.linalg.det(rotation) < 0:
             raise InvalidInputError(field, "orientation is not a rotation", waypoint=i)

@@ -13,12 +13,14 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Literal
 
 import numpy as np
 
 from solver.ik.ur_analytic import SINGULAR, UNREACHABLE
 
-REASONS = ("unreachable", "joint_limits", "singular", "discontinuous")
+Reason = Literal["unreachable", "joint_limits", "singular", "discontinuous"]
+REASONS: tuple[Reason, ...] = ("unreachable", "joint_limits", "singular", "discontinuous")
 FEASIBLE = -1  # reason code of a feasible branch
 _UNREACHABLE, _JOINT_LIMITS, _SINGULAR, _DISCONTINUOUS = range(4)
 _TWO_PI = 2 * math.pi

@@ -33,6 +33,7 @@ from __future__ import annotations
 import itertools
 import math
 from dataclasses import dataclass
+from typing import Literal
 
 import numpy as np
 
@@ -52,18 +53,25 @@ UNREACHABLE = 1
 SINGULAR = 2
 
 
+Shoulder = Literal["left", "right"]
+Elbow = Literal["up", "down"]
+Wrist = Literal["noflip", "flip"]
+
+
 @dataclass(frozen=True)
 class Branch:
-    """Name of an IK branch of a UR arm."""
+    """Name of an IK branch of a UR arm (the signs are in the module docstring)."""
 
-    shoulder: str
-    elbow: str
-    wrist: str
+    shoulder: Shoulder
+    elbow: Elbow
+    wrist: Wrist
 
 
+_SHOULDERS: tuple[Shoulder, ...] = ("left", "right")
+_ELBOWS: tuple[Elbow, ...] = ("up", "down")
+_WRISTS: tuple[Wrist, ...] = ("noflip", "flip")
 BRANCHES: tuple[Branch, ...] = tuple(
-    Branch(s, e, w)
-    for s, e, w in itertools.product(("left", "right"), ("up", "down"), ("noflip", "flip"))
+    Branch(s, e, w) for s, e, w in itertools.product(_SHOULDERS, _ELBOWS, _WRISTS)
 )
 
 

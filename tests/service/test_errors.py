@@ -146,6 +146,17 @@ EVALUATE_CASES: list[tuple[str, Changes, Loc]] = [
         {("robot", "joint_velocity_limits"): [3.0] * 7},
         ["body", "robot", "joint_velocity_limits"],
     ),
+    (
+        "position near the float limit",
+        {(*WAYPOINTS, 2, "position"): [1e308, 0.0, 0.0]},
+        ["body", "path", "waypoints", 2],
+    ),
+    ("placement in millimetres", {("placement", "y"): 4500.0}, ["body", "placement"]),
+    (
+        "huge speed limits",
+        {("robot", "joint_velocity_limits"): [1e30] * 6},
+        ["body", "robot", "joint_velocity_limits"],
+    ),
 ]
 
 
@@ -334,24 +345,12 @@ def test_middleware_hands_on_the_whole_body(body_limit: int) -> None:
     assert received == [b"a" * 200 + b"b" * 200]
 
 
-# Finite but extreme numbers: valid input, so 200 or 422, never a 5xx. The xfails are solver bugs
-# reported to the solver's owner; strict, so they turn into failures once fixed.
+# Finite but extreme numbers: each is either answered (200) or refused naming its field (422),
+# never a 5xx.
 EXTREME_DTF_CASES = [
-    pytest.param(
-        {("h",): 1e-320},
-        marks=pytest.mark.xfail(strict=True, reason="solver.dtf: u_R / h overflows, NaN result"),
-        id="subnormal h",
-    ),
-    pytest.param(
-        {("h",): 1e-300},
-        marks=pytest.mark.xfail(strict=True, reason="solver.dtf.chiu divides by zero"),
-        id="tiny h",
-    ),
-    pytest.param(
-        {("h",): 1e-200, ("method",): "lp"},
-        marks=pytest.mark.xfail(strict=True, reason="HiGHS model error on 1e200 coefficients"),
-        id="tiny h, lp",
-    ),
+    pytest.param({("h",): 1e-320}, ["body", "h"], id="subnormal h"),
+    pytest.param({("h",): 1e-300}, None, id="tiny h"),
+    pytest.param({("h",): 1e-200, ("method",): "lp"}, None, id="tiny h, lp"),
     pytest.param(
         {
             ("h",): None,
@@ -359,17 +358,26 @@ EXTREME_DTF_CASES = [
             ("method",): "lp",
             ("robot", "joint_velocity_limits"): [1e30] * 6,
         },
-        marks=pytest.mark.xfail(strict=True, reason="HiGHS: bounds >= 1e20 are infinite"),
+        ["body", "robot", "joint_velocity_limits"],
         id="huge limits, lp",
     ),
-    pytest.param({("h",): 1e300}, id="huge h"),
-    pytest.param({("robot", "joint_velocity_limits"): [1e-300] * 6}, id="tiny limits"),
+    pytest.param({("h",): 1e300}, None, id="huge h"),
+    pytest.param(
+        {("robot", "joint_velocity_limits"): [1e-300] * 6},
+        ["body", "robot", "joint_velocity_limits"],
+        id="tiny limits",
+    ),
 ]
 
 
-@pytest.mark.parametrize("changes", EXTREME_DTF_CASES)
+@pytest.mark.parametrize(("changes", "refused_at"), EXTREME_DTF_CASES)
 def test_extreme_numbers_are_not_a_server_error(
-    client: TestClient, dtf_body: dict[str, Any], changes: Changes
+    client: TestClient, dtf_body: dict[str, Any], changes: Changes, refused_at: list[str] | None
 ) -> None:
     response = client.post("/v1/dtf", json=changed(dtf_body, changes))
-    assert response.status_code in (200, 422), response.text
+    if refused_at is None:
+        assert response.status_code == 200, response.text
+        assert response.json()["v_max"] > 0
+    else:
+        assert response.status_code == 422, response.text
+        assert response.json()["detail"][0]["loc"] == refused_at

@@ -147,3 +147,20 @@ def test_bad_velocity_limits(limits: list[float]) -> None:
     with pytest.raises(InvalidInputError) as info:
         get_robot("ur5").with_options(qdot_max=limits)
     assert info.value.field == "robot.joint_velocity_limits"
+
+
+def test_urdf_without_usable_limits_takes_the_given_ones() -> None:
+    """A URDF with a zero velocity limit is refused, unless the request brings limits."""
+    path = example_robot_data_dir() / "panda_description" / "urdf" / "panda.urdf"
+    urdf = path.read_text().replace('velocity="2.175"', 'velocity="0"', 1)
+    frames = {"base_frame": "panda_link0", "tool_frame": "panda_link8"}
+    with pytest.raises(RobotModelError, match="joint_velocity_limits"):
+        robot_from_urdf(urdf, **frames)
+    robot = robot_from_urdf(urdf, **frames, qdot_max=[1.0] * 7)
+    np.testing.assert_array_equal(robot.qdot_max, 1.0)
+
+
+@pytest.mark.parametrize("limit", [1e-7, 1e5, math.inf])
+def test_speed_limits_out_of_range(limit: float) -> None:
+    with pytest.raises(InvalidInputError, match="rad/s"):
+        get_robot("ur5e").with_options(qdot_max=[limit] * 6)

@@ -111,3 +111,14 @@ def test_non_unit_quaternion_is_refused_not_normalised() -> None:
         pose_matrix([0, 0, 0], [0, 0, 0, 1.00001], field="path.waypoints")
     pose = pose_matrix([0, 0, 0], [0, 0, 0, 1.0000005], field="path.waypoints")
     np.testing.assert_allclose(pose[:3, :3], np.eye(3), atol=1e-15)
+
+
+def test_far_positions_are_refused() -> None:
+    """Positions beyond 1 km are an input error (metres were probably meant to be mm)."""
+    poses = np.array([_pose([0.0, 0.0, 0.0]), _pose([1e308, 0.0, 0.0])])
+    with pytest.raises(InvalidInputError, match="metres") as info:
+        task_requirements(poses)
+    assert info.value.waypoint == 1
+    with pytest.raises(InvalidInputError) as placement:
+        Placement(0.0, 2e3, 0.0, 0.0)
+    assert placement.value.field == "placement"
