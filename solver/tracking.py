@@ -105,8 +105,9 @@ def track(
     )
 
 
-# Branches whose mu_path agree to this (relative) are tied: elbow up and down share qd1, qd5 and
-# qd6 exactly, so when one of those joints limits the path they differ only by rounding.
+# Branches whose mu_path agree to this (relative) are tied: the four branches of one shoulder
+# share |qd1|, |qd5| and |qd6| exactly, so when one of those joints limits the path they differ
+# only by rounding.
 TIE_RTOL = 1e-12
 
 

@@ -111,8 +111,8 @@ def test_auto_is_the_best_named_branch(robot_name: str) -> None:
     named = [evaluate_path(robot, path, PLACEMENT, branch=b) for b in BRANCHES]
     feasible = [r.mu_path for r in named if r.feasible]
     assert len(feasible) >= 2
-    # The best, where branches within 1e-12 (elbow up/down limited by joint 1, 5 or 6 move
-    # those joints identically) count as tied and the first in BRANCHES order is taken.
+    # The best, where branches within 1e-12 count as tied and the first in BRANCHES order is
+    # taken (the branches of one shoulder move joints 1, 5 and 6 at the same speeds).
     assert auto.mu_path >= max(feasible) * (1 - 1e-12)
     first_tied = next(
         b

@@ -1,0 +1,39 @@
+"""The README's commands are what CI runs, and its worked example prints what the app answers."""
+
+from __future__ import annotations
+
+import json
+import re
+
+from fastapi.testclient import TestClient
+
+from service.main import app
+from tests.cases import EXAMPLES, ROOT
+
+README = (ROOT / "README.md").read_text()
+
+
+def _quick_start_commands() -> list[str]:
+    block = README.split("## Quick start", 1)[1].split("```sh", 1)[1].split("```", 1)[0]
+    return [line for line in block.splitlines() if line and not line.startswith("#")]
+
+
+def test_quick_start_is_two_commands_and_ci_runs_the_test_one() -> None:
+    commands = _quick_start_commands()
+    assert len(commands) == 2
+    assert "uvicorn service.main:app --host 127.0.0.1 --port 8000" in commands[0]
+    ci_lines = (ROOT / ".ci" / "run").read_text().splitlines()
+    assert commands[1] in ci_lines
+
+
+def test_worked_example_output() -> None:
+    example = README.split("## Worked example", 1)[1]
+    printed = re.search(r"prints\n\n```\n(.*)\n```", example).group(1)
+    request = json.loads((EXAMPLES / "evaluate_request.json").read_text())
+    r = TestClient(app).post("/v1/evaluate", json=request).json()
+    expected = (
+        f"mu_path = {r['mu_path']:.6f} m/s, limited by {r['bottleneck']['joint_name']} "
+        f"at waypoint {r['bottleneck']['waypoint']}"
+    )
+    assert printed == expected
+    assert "@examples/evaluate_request.json" in example
