@@ -18,6 +18,17 @@ class Settings(BaseSettings):
         gt=0,
         description="Largest request body accepted (bytes); a larger one is answered 413.",
     )
+    max_map_cells: int = Field(
+        default=50_000,
+        gt=0,
+        description="Most placements (x * y * yaw values) one /v1/map request may ask for.",
+    )
+    max_map_poses: int = Field(
+        default=20_000_000,
+        gt=0,
+        description="Most placement-waypoint pairs one /v1/map request may ask for (each is 8 IK "
+        "solutions; about 2 million take a second).",
+    )
 
 
 @functools.cache

@@ -3,15 +3,19 @@
 from __future__ import annotations
 
 import math
-from dataclasses import asdict
+from dataclasses import asdict, dataclass
 
 import numpy as np
 
 from service import schemas
+from service.config import Settings
+from solver.capability_map import CapabilityMap, axis_length, grid_axis
 from solver.dtf import DtfResult
 from solver.evaluate import Branch, PathEvaluation
+from solver.exceptions import InvalidInputError
 from solver.robots import Robot, get_robot, robot_from_urdf
 from solver.spatial import Placement, pose_matrix
+from solver.tracking import FEASIBLE, REASONS
 
 
 def robot_from_schema(spec: schemas.Robot) -> Robot:
@@ -143,4 +147,82 @@ def evaluate_response(evaluation: PathEvaluation, robot: Robot) -> schemas.Evalu
         failed_waypoint=ev.failed_waypoint,
         branch=branch,
         waypoints=waypoints,
+    )
+
+
+@dataclass(frozen=True)
+class MapGrid:
+    """The grid values of a map request (m, m, rad)."""
+
+    xs: np.ndarray
+    ys: np.ndarray
+    yaws: np.ndarray
+
+
+def map_grid(grid: schemas.Grid, *, settings: Settings, n_waypoints: int) -> MapGrid:
+    """The grid's values, after checking its size against the settings.
+
+    Raises:
+        InvalidInputError: an axis is malformed, or the grid is over a size limit; the message
+            says the size asked for and the limit.
+    """
+    nx = axis_length(grid.x.min, grid.x.max, grid.x.step, field="grid.x")
+    ny = axis_length(grid.y.min, grid.y.max, grid.y.step, field="grid.y")
+    yaws = grid.yaws()
+    cells = nx * ny * len(yaws)
+    size = f"{nx} x * {ny} y * {len(yaws)} yaw = {cells} placements"
+    if cells > settings.max_map_cells:
+        raise InvalidInputError(
+            "grid", f"{size}; the limit is {settings.max_map_cells} (DTF_MAX_MAP_CELLS)"
+        )
+    if cells * n_waypoints > settings.max_map_poses:
+        raise InvalidInputError(
+            "grid",
+            f"{size} * {n_waypoints} waypoints = {cells * n_waypoints} poses; the limit is "
+            f"{settings.max_map_poses} (DTF_MAX_MAP_POSES)",
+        )
+    return MapGrid(
+        xs=grid_axis(grid.x.min, grid.x.max, grid.x.step, field="grid.x"),
+        ys=grid_axis(grid.y.min, grid.y.max, grid.y.step, field="grid.y"),
+        yaws=np.array(yaws, dtype=float),
+    )
+
+
+def wants_png(accept: str) -> bool:
+    """Whether an Accept header asks for the picture rather than JSON."""
+    media = [part.split(";")[0].strip().lower() for part in accept.split(",")]
+    return "image/png" in media and "application/json" not in media
+
+
+def _extreme(cmap: CapabilityMap, *, best: bool) -> schemas.MapExtreme | None:
+    index = cmap.extreme(best=best)
+    if index is None:
+        return None
+    placement = cmap.placement(index)
+    return schemas.MapExtreme(
+        placement=schemas.Placement(x=placement.x, y=placement.y, z=placement.z, yaw=placement.yaw),
+        mu_path=float(cmap.mu_path[index]),
+    )
+
+
+def map_response(cmap: CapabilityMap) -> schemas.MapResponse:
+    """The JSON answer of ``POST /v1/map``: cells yaw-major, then y, then x."""
+    cells = []
+    for k, j, i in np.ndindex(cmap.mu_path.shape):
+        feasible = cmap.reason[k, j, i] == FEASIBLE
+        cells.append(
+            schemas.MapCell(
+                x=float(cmap.xs[i]),
+                y=float(cmap.ys[j]),
+                yaw=float(cmap.yaws[k]),
+                mu_path=float(cmap.mu_path[k, j, i]) if feasible else None,
+                reason=None if feasible else REASONS[int(cmap.reason[k, j, i])],
+                failed_waypoint=None if feasible else int(cmap.failed_waypoint[k, j, i]),
+            )
+        )
+    return schemas.MapResponse(
+        cells=cells,
+        best=_extreme(cmap, best=True),
+        worst=_extreme(cmap, best=False),
+        feasible_cells=int(np.sum(cmap.reason == FEASIBLE)),
     )

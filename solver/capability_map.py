@@ -28,7 +28,7 @@ from solver.task import task_requirements
 from solver.tracking import FEASIBLE, REASONS, choose_branch, track
 from solver.ur_jacobian import joint_speeds_per_unit_twist
 
-__all__ = ["CapabilityMap", "capability_map", "grid_axis", "REASONS"]
+__all__ = ["REASONS", "CapabilityMap", "axis_length", "capability_map", "grid_axis"]
 
 DEFAULT_CHUNK = 64
 
@@ -79,8 +79,8 @@ class CapabilityMap:
         return int(k), int(j), int(i)
 
 
-def grid_axis(lower: float, upper: float, step: float, *, field: str) -> np.ndarray:
-    """Grid values lower, lower + step, ... up to upper (included when it falls on the grid).
+def axis_length(lower: float, upper: float, step: float, *, field: str) -> int:
+    """How many values :func:`grid_axis` gives, without making them (to check a size first).
 
     Raises:
         InvalidInputError: values not finite, step <= 0 or upper < lower.
@@ -91,7 +91,21 @@ def grid_axis(lower: float, upper: float, step: float, *, field: str) -> np.ndar
         raise InvalidInputError(
             field, f"needs step > 0 and max >= min, got {lower=}, {upper=}, {step=}"
         )
-    count = math.floor((upper - lower) / step + 1e-9) + 1
+    count = (upper - lower) / step + 1e-9
+    if count >= 2**53:
+        raise InvalidInputError(field, f"{count:.3g} grid values: the step is too small")
+    return math.floor(count) + 1
+
+
+def grid_axis(lower: float, upper: float, step: float, *, field: str) -> np.ndarray:
+    """Grid values lower, lower + step, ... up to upper.
+
+    upper is included when it falls on the grid to within 1e-9 of a step.
+
+    Raises:
+        InvalidInputError: values not finite, step <= 0 or upper < lower.
+    """
+    count = axis_length(lower, upper, step, field=field)
     return lower + step * np.arange(count)
 
 

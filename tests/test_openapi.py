@@ -18,4 +18,4 @@ def test_committed_spec_matches_the_app() -> None:
 
 def test_routes_of_this_round_are_in_the_spec() -> None:
     paths = json.loads(SPEC_PATH.read_text())["paths"]
-    assert {"/healthz", "/v1/robots", "/v1/dtf", "/v1/evaluate"} <= set(paths)
+    assert {"/healthz", "/v1/robots", "/v1/dtf", "/v1/evaluate", "/v1/map"} <= set(paths)

@@ -4,9 +4,10 @@ from __future__ import annotations
 
 from fastapi import APIRouter
 
-from service.api.routes import dtf, evaluate, robots
+from service.api.routes import dtf, evaluate, map, robots
 
 api_router = APIRouter(prefix="/v1")
 api_router.include_router(robots.router)
 api_router.include_router(dtf.router)
 api_router.include_router(evaluate.router)
+api_router.include_router(map.router)

@@ -23,6 +23,7 @@ from service.schemas.evaluate import (
     FailureReason,
     WaypointResult,
 )
+from service.schemas.map import Grid, GridAxis, MapCell, MapExtreme, MapRequest, MapResponse
 from service.schemas.robots import HealthResponse, RobotInfo, RobotsResponse
 
 __all__ = [
@@ -35,8 +36,14 @@ __all__ = [
     "EvaluateRequest",
     "EvaluateResponse",
     "FailureReason",
+    "Grid",
+    "GridAxis",
     "HealthResponse",
     "IkPolicy",
+    "MapCell",
+    "MapExtreme",
+    "MapRequest",
+    "MapResponse",
     "Path",
     "Placement",
     "Pose",

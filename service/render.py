@@ -1,0 +1,87 @@
+"""The capability map as a picture (PNG), for a report: one panel per yaw, mu_path in colour."""
+
+from __future__ import annotations
+
+import io
+import math
+
+import matplotlib
+
+matplotlib.use("Agg")  # no display: render to memory
+
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+from matplotlib.lines import Line2D  # noqa: E402
+from matplotlib.patches import Patch  # noqa: E402
+
+from solver.capability_map import CapabilityMap  # noqa: E402
+
+PANEL_INCHES = (4.0, 3.6)
+COLOUR_BAR_INCHES = 1.2
+DPI = 100
+MAX_COLUMNS = 3
+
+
+def figure_pixels(n_panels: int) -> tuple[int, int]:
+    """Width and height (pixels) of the PNG of a map with ``n_panels`` yaw values."""
+    columns = min(n_panels, MAX_COLUMNS)
+    rows = math.ceil(n_panels / MAX_COLUMNS)
+    width = PANEL_INCHES[0] * columns + COLOUR_BAR_INCHES
+    height = PANEL_INCHES[1] * rows
+    return round(width * DPI), round(height * DPI)
+
+
+def render_png(cmap: CapabilityMap, *, title: str) -> bytes:
+    """The map as PNG bytes: colour bar in m/s, infeasible cells blank, best and worst marked."""
+    n_panels = len(cmap.yaws)
+    columns = min(n_panels, MAX_COLUMNS)
+    rows = math.ceil(n_panels / MAX_COLUMNS)
+    width_px, height_px = figure_pixels(n_panels)
+    figure = plt.figure(figsize=(width_px / DPI, height_px / DPI), dpi=DPI, layout="constrained")
+    panels = figure.subplots(rows, columns, squeeze=False)
+    feasible = ~np.isnan(cmap.mu_path)
+    low = float(np.nanmin(cmap.mu_path)) if feasible.any() else 0.0
+    high = float(np.nanmax(cmap.mu_path)) if feasible.any() else 1.0
+    colours = matplotlib.colormaps["viridis"].with_extremes(bad="white")
+    best, worst = cmap.extreme(best=True), cmap.extreme(best=False)
+    half_x = (cmap.xs[1] - cmap.xs[0]) / 2 if len(cmap.xs) > 1 else 0.005
+    half_y = (cmap.ys[1] - cmap.ys[0]) / 2 if len(cmap.ys) > 1 else 0.005
+    extent = (cmap.xs[0] - half_x, cmap.xs[-1] + half_x, cmap.ys[0] - half_y, cmap.ys[-1] + half_y)
+    images = []
+    for k, yaw in enumerate(cmap.yaws):
+        axes = panels[k // columns, k % columns]
+        image = axes.imshow(
+            np.ma.masked_invalid(cmap.mu_path[k]),
+            origin="lower",
+            extent=extent,
+            cmap=colours,
+            vmin=low,
+            vmax=high if high > low else low + 1e-9,
+            interpolation="nearest",
+            aspect="equal",
+        )
+        images.append(image)
+        for index, marker, colour in ((best, "*", "red"), (worst, "X", "black")):
+            if index is not None and index[0] == k:
+                axes.plot(cmap.xs[index[2]], cmap.ys[index[1]], marker, color=colour, ms=12)
+        axes.set_title(f"yaw {math.degrees(float(yaw)):.1f} deg, z = {cmap.z:.3f} m", fontsize=9)
+        axes.set_xlabel("x (m)")
+        axes.set_ylabel("y (m)")
+    for axes in panels.ravel()[n_panels:]:
+        axes.set_axis_off()
+    figure.colorbar(images[0], ax=panels, label="mu_path (m/s)", shrink=0.9)
+    figure.legend(
+        handles=[
+            Line2D([], [], marker="*", color="red", ls="", ms=10, label="best"),
+            Line2D([], [], marker="X", color="black", ls="", ms=8, label="worst"),
+            Patch(facecolor="white", edgecolor="grey", label="infeasible"),
+        ],
+        loc="outside lower right",
+        ncols=3,
+        fontsize=8,
+    )
+    figure.suptitle(title, fontsize=10)
+    buffer = io.BytesIO()
+    figure.savefig(buffer, format="png", dpi=DPI)
+    plt.close(figure)
+    return buffer.getvalue()

@@ -1,0 +1,178 @@
+"""``POST /v1/map``: mu_path over a grid of placements (spec section 6)."""
+
+from __future__ import annotations
+
+from pydantic import ConfigDict, Field, PositiveFloat, field_validator
+from pydantic.config import JsonDict
+
+from service.schemas.common import IkPolicy, Path, Placement, RequestModel, ResponseModel, Robot
+from service.schemas.evaluate import _REQUEST_EXAMPLE, FailureReason
+
+
+class GridAxis(RequestModel):
+    """Values min, min + step, ... up to max (included when it falls on the grid), metres."""
+
+    model_config = ConfigDict(
+        json_schema_extra={"examples": [{"min": -0.25, "max": 0.25, "step": 0.02}]}
+    )
+
+    min: float = Field(description="First value (m).")
+    max: float = Field(description="Last value at most (m); >= min.")
+    step: PositiveFloat = Field(description="Spacing (m), > 0.")
+
+
+class Grid(RequestModel):
+    """Placements to map: x and y on a grid at height z, for one yaw or a list of yaws."""
+
+    model_config = ConfigDict(
+        json_schema_extra={
+            "examples": [
+                {
+                    "x": {"min": -0.25, "max": 0.25, "step": 0.02},
+                    "y": {"min": 0.25, "max": 0.65, "step": 0.02},
+                    "z": 0.1,
+                    "yaw": 0.0,
+                }
+            ]
+        }
+    )
+
+    x: GridAxis = Field(description="Placement x values (m).")
+    y: GridAxis = Field(description="Placement y values (m).")
+    z: float = Field(description="Height of every placement (m).")
+    yaw: float | list[float] = Field(
+        description="Yaw of the workpiece about the base z axis (rad): one value or a list of 1 "
+        "to 360 values, each mapped."
+    )
+
+    @field_validator("yaw")
+    @classmethod
+    def _yaw_list(cls, value: float | list[float]) -> float | list[float]:
+        if isinstance(value, list) and not 1 <= len(value) <= 360:
+            raise ValueError(f"a list of 1 to 360 yaw values is needed, got {len(value)}")
+        return value
+
+    def yaws(self) -> list[float]:
+        """The yaw values as a list (rad)."""
+        return self.yaw if isinstance(self.yaw, list) else [self.yaw]
+
+
+_MAP_REQUEST_EXAMPLE: JsonDict = {
+    "robot": _REQUEST_EXAMPLE["robot"],
+    "path": _REQUEST_EXAMPLE["path"],
+    "grid": {
+        "x": {"min": -0.1, "max": 0.1, "step": 0.1},
+        "y": {"min": 0.35, "max": 0.45, "step": 0.1},
+        "z": 0.1,
+        "yaw": [0.0, 1.5708],
+    },
+    "ik": {"branch": "auto", "max_joint_step": 0.35},
+}
+
+
+class MapRequest(RequestModel):
+    """A robot, a path in the workpiece frame and a grid of workpiece placements."""
+
+    model_config = ConfigDict(json_schema_extra={"examples": [_MAP_REQUEST_EXAMPLE]})
+
+    robot: Robot = Field(description="The arm (a UR arm of the catalogue: the map needs its IK).")
+    path: Path = Field(description="The tool path in the workpiece frame {O}.")
+    grid: Grid = Field(description="The placements to evaluate.")
+    ik: IkPolicy = Field(default_factory=IkPolicy, description="IK branch policy.")
+
+
+class MapCell(ResponseModel):
+    """One placement of the grid and how fast the path runs there."""
+
+    model_config = ConfigDict(
+        json_schema_extra={
+            "examples": [
+                {
+                    "x": 0.0,
+                    "y": 0.35,
+                    "yaw": 0.0,
+                    "mu_path": 0.2913,
+                    "reason": None,
+                    "failed_waypoint": None,
+                },
+                {
+                    "x": 0.9,
+                    "y": 0.9,
+                    "yaw": 0.0,
+                    "mu_path": None,
+                    "reason": "unreachable",
+                    "failed_waypoint": 0,
+                },
+            ]
+        }
+    )
+
+    x: float = Field(description="Placement x (m).")
+    y: float = Field(description="Placement y (m).")
+    yaw: float = Field(description="Placement yaw (rad).")
+    mu_path: float | None = Field(
+        description="Highest constant feed rate (m/s); null when infeasible."
+    )
+    reason: FailureReason | None = Field(
+        description="Why the placement is infeasible; null when feasible."
+    )
+    failed_waypoint: int | None = Field(
+        description="First waypoint that fails; null when feasible."
+    )
+
+
+class MapExtreme(ResponseModel):
+    """The best or worst feasible placement of the grid."""
+
+    model_config = ConfigDict(
+        json_schema_extra={
+            "examples": [
+                {"placement": {"x": 0.0, "y": 0.35, "z": 0.1, "yaw": 0.0}, "mu_path": 0.29}
+            ]
+        }
+    )
+
+    placement: Placement = Field(description="Where the workpiece sits (m, rad).")
+    mu_path: float = Field(description="Its mu_path (m/s).")
+
+
+_CELL: JsonDict = {
+    "x": 0.0,
+    "y": 0.35,
+    "yaw": 0.0,
+    "mu_path": 0.2913,
+    "reason": None,
+    "failed_waypoint": None,
+}
+
+
+class MapResponse(ResponseModel):
+    """mu_path at every placement of the grid, in the order yaw, y, x; the best and the worst."""
+
+    model_config = ConfigDict(
+        json_schema_extra={
+            "examples": [
+                {
+                    "cells": [_CELL],
+                    "best": {
+                        "placement": {"x": 0.0, "y": 0.35, "z": 0.1, "yaw": 0.0},
+                        "mu_path": 0.2913,
+                    },
+                    "worst": {
+                        "placement": {"x": 0.0, "y": 0.35, "z": 0.1, "yaw": 0.0},
+                        "mu_path": 0.2913,
+                    },
+                    "feasible_cells": 1,
+                }
+            ]
+        }
+    )
+
+    cells: list[MapCell] = Field(description="Every placement, yaw-major, then y, then x.")
+    best: MapExtreme | None = Field(
+        description="The feasible cell with the highest mu_path; null if none."
+    )
+    worst: MapExtreme | None = Field(
+        description="The feasible cell with the lowest mu_path; null if none."
+    )
+    feasible_cells: int = Field(description="How many cells are feasible.")

@@ -1,0 +1,150 @@
+"""POST /v1/map: cells equal /v1/evaluate, best/worst, the picture, the size limit."""
+
+from __future__ import annotations
+
+import io
+import json
+from collections.abc import Iterator
+from typing import Any
+
+import matplotlib.image
+import numpy as np
+import pytest
+from fastapi.testclient import TestClient
+
+from service.config import get_settings
+from service.render import figure_pixels
+from tests.cases import EXAMPLES, MAP_EVALUATE_RTOL
+
+
+@pytest.fixture(scope="module")
+def path() -> dict[str, Any]:
+    return json.loads((EXAMPLES / "paths" / "curved_line.json").read_text())
+
+
+def map_body(path: dict[str, Any], **grid: Any) -> dict[str, Any]:
+    default = {
+        "x": {"min": -0.9, "max": 0.9, "step": 0.15},
+        "y": {"min": -0.9, "max": 0.9, "step": 0.15},
+        "z": 0.1,
+        "yaw": [0.0, 2.0],
+    }
+    return {"robot": {"model": "ur5"}, "path": path, "grid": {**default, **grid}}
+
+
+@pytest.fixture(scope="module")
+def answer(client: TestClient, path: dict[str, Any]) -> dict[str, Any]:
+    response = client.post("/v1/map", json=map_body(path))
+    assert response.status_code == 200, response.text
+    return response.json()
+
+
+def test_cells_are_in_yaw_y_x_order(answer: dict[str, Any]) -> None:
+    cells = answer["cells"]
+    assert len(cells) == 2 * 13 * 13
+    assert [(c["yaw"], c["y"], c["x"]) for c in cells] == sorted(
+        (c["yaw"], c["y"], c["x"]) for c in cells
+    )
+    assert answer["feasible_cells"] == sum(c["mu_path"] is not None for c in cells)
+    assert 0 < answer["feasible_cells"] < len(cells)
+
+
+def test_random_cells_equal_evaluate(
+    client: TestClient, answer: dict[str, Any], path: dict[str, Any]
+) -> None:
+    """Issue 3: random cells equal /v1/evaluate at those placements, infeasible ones included."""
+    cells = answer["cells"]
+    rng = np.random.default_rng(5)
+    feasible = [c for c in cells if c["mu_path"] is not None]
+    infeasible = [c for c in cells if c["mu_path"] is None]
+    for cell in [*rng.choice(feasible, 10), *rng.choice(infeasible, 10)]:
+        placement = {"x": cell["x"], "y": cell["y"], "z": 0.1, "yaw": cell["yaw"]}
+        body = {"robot": {"model": "ur5"}, "path": path, "placement": placement}
+        evaluation = client.post("/v1/evaluate", json=body).json()
+        if evaluation["feasible"]:
+            assert cell["mu_path"] == pytest.approx(evaluation["mu_path"], rel=MAP_EVALUATE_RTOL)
+        else:
+            assert cell["mu_path"] is None
+            assert cell["reason"] == evaluation["reason"]
+            assert cell["failed_waypoint"] == evaluation["failed_waypoint"]
+
+
+def test_best_and_worst_are_the_extreme_cells(answer: dict[str, Any]) -> None:
+    values = [c["mu_path"] for c in answer["cells"] if c["mu_path"] is not None]
+    assert answer["best"]["mu_path"] == max(values)
+    assert answer["worst"]["mu_path"] == min(values)
+    best = next(c for c in answer["cells"] if c["mu_path"] == max(values))
+    assert answer["best"]["placement"] == {
+        "x": best["x"],
+        "y": best["y"],
+        "z": 0.1,
+        "yaw": best["yaw"],
+    }
+
+
+@pytest.mark.parametrize("yaws", [[0.0], [0.0, 0.5, 1.0, 1.5]])
+def test_png_decodes_at_the_expected_size(
+    client: TestClient, path: dict[str, Any], yaws: list[float]
+) -> None:
+    response = client.post(
+        "/v1/map",
+        json=map_body(path, yaw=yaws, x={"min": -0.3, "max": 0.3, "step": 0.05}),
+        headers={"accept": "image/png"},
+    )
+    assert response.status_code == 200
+    assert response.headers["content-type"] == "image/png"
+    image = matplotlib.image.imread(io.BytesIO(response.content), format="png")
+    width, height = figure_pixels(len(yaws))
+    assert image.shape[:2] == (height, width)
+    assert np.ptp(image[..., :3]) > 0.5  # not a blank canvas
+
+
+def test_no_feasible_cell(client: TestClient, path: dict[str, Any]) -> None:
+    far = {"min": 5.0, "max": 5.2, "step": 0.1}
+    answer = client.post("/v1/map", json=map_body(path, x=far, yaw=0.0)).json()
+    assert answer["best"] is None and answer["worst"] is None
+    assert {c["reason"] for c in answer["cells"]} == {"unreachable"}
+    png = client.post("/v1/map", json=map_body(path, x=far), headers={"accept": "image/png"})
+    assert png.status_code == 200
+
+
+@pytest.fixture
+def small_limits(monkeypatch: pytest.MonkeyPatch) -> Iterator[None]:
+    monkeypatch.setenv("DTF_MAX_MAP_CELLS", "100")
+    monkeypatch.setenv("DTF_MAX_MAP_POSES", "10000")
+    get_settings.cache_clear()
+    yield
+    get_settings.cache_clear()
+
+
+def test_size_limit_names_the_limit_and_the_size(
+    client: TestClient, path: dict[str, Any], small_limits: None
+) -> None:
+    response = client.post("/v1/map", json=map_body(path))
+    assert response.status_code == 422
+    detail = response.json()["detail"][0]
+    assert detail["loc"] == ["body", "grid"]
+    assert "338 placements" in detail["msg"] and "limit is 100" in detail["msg"]
+    small = {"min": 0.0, "max": 0.8, "step": 0.1}
+    response = client.post("/v1/map", json=map_body(path, x=small, y=small, yaw=0.0))
+    detail = response.json()["detail"][0]
+    assert "81 placements * 133 waypoints = 10773 poses" in detail["msg"]
+    assert "limit is 10000" in detail["msg"]
+
+
+@pytest.mark.parametrize(
+    ("grid", "loc"),
+    [
+        ({"x": {"min": 0.0, "max": 1.0, "step": 0.0}}, ["body", "grid", "x", "step"]),
+        ({"x": {"min": 1.0, "max": 0.0, "step": 0.1}}, ["body", "grid", "x"]),
+        ({"x": {"min": 0.0, "max": 1.0, "step": 1e-300}}, ["body", "grid", "x"]),
+        ({"yaw": []}, ["body", "grid", "yaw"]),
+        ({"z": "high"}, ["body", "grid", "z"]),
+    ],
+)
+def test_bad_grid(
+    client: TestClient, path: dict[str, Any], grid: dict[str, Any], loc: list
+) -> None:
+    response = client.post("/v1/map", json=map_body(path, **grid))
+    assert response.status_code == 422, response.text
+    assert response.json()["detail"][0]["loc"][: len(loc)] == loc
