@@ -71,8 +71,8 @@ def track(
         The first failure of each branch, and the joint paths.
     """
     n_waypoints = q.shape[-1]
-    step = np.diff(q, axis=-1)
-    step = (step + math.pi) % _TWO_PI - math.pi
+    step = np.diff(q, axis=-1)  # in [-2 pi, 2 pi]: one turn at most brings it to [-pi, pi]
+    step -= np.where(step > math.pi, _TWO_PI, np.where(step < -math.pi, -_TWO_PI, 0.0))
     with np.errstate(invalid="ignore"):
         jump = np.any(np.abs(step) > max_joint_step, axis=0)
     first = np.stack(
@@ -85,18 +85,30 @@ def track(
     )
     first[_DISCONTINUOUS] = np.where(jump.any(axis=-1), first[_DISCONTINUOUS], n_waypoints)
     path = np.concatenate([q[..., :1], q[..., :1] + np.cumsum(step, axis=-1)], axis=-1)
-    lower_b = lower.reshape((6,) + (1,) * (q.ndim - 1))
-    upper_b = upper.reshape((6,) + (1,) * (q.ndim - 1))
-    k_low = np.ceil((lower_b - np.minimum.accumulate(path, axis=-1)) / _TWO_PI - _EDGE)
-    k_high = np.floor((upper_b - np.maximum.accumulate(path, axis=-1)) / _TWO_PI + _EDGE)
-    no_fit = np.any(k_low > k_high, axis=0)
+    lower_b = lower.reshape((6,) + (1,) * (q.ndim - 2))
+    upper_b = upper.reshape((6,) + (1,) * (q.ndim - 2))
+    # The copies 2 pi k that fit the whole path: k_low <= k <= k_high, per joint.
+    k_low = np.ceil((lower_b - path.min(axis=-1)) / _TWO_PI - _EDGE)
+    k_high = np.floor((upper_b - path.max(axis=-1)) / _TWO_PI + _EDGE)
     other = first[[_UNREACHABLE, _SINGULAR, _DISCONTINUOUS]].min(axis=0)
-    # Joint limits count only on a path that got through every waypoint otherwise.
-    first[_JOINT_LIMITS] = np.where(other == n_waypoints, _first_true(no_fit), n_waypoints)
+    # Joint limits count only on a path that got through every waypoint otherwise; where no
+    # copy fits the whole path, the running range finds the first waypoint that breaks it.
+    no_fit = np.flatnonzero(np.any(k_low > k_high, axis=0) & (other == n_waypoints))
+    if no_fit.size:
+        flat = path.reshape(6, -1, n_waypoints)[:, no_fit]
+        running_low = np.ceil(
+            (lower[:, None, None] - np.minimum.accumulate(flat, axis=-1)) / _TWO_PI - _EDGE
+        )
+        running_high = np.floor(
+            (upper[:, None, None] - np.maximum.accumulate(flat, axis=-1)) / _TWO_PI + _EDGE
+        )
+        first[_JOINT_LIMITS].reshape(-1)[no_fit] = _first_true(
+            np.any(running_low > running_high, axis=0)
+        )
     failed = first.min(axis=0)
     # argmin takes the lowest code at a tie: unreachable, then singular, then discontinuous.
     reason = np.where(failed < n_waypoints, first.argmin(axis=0), FEASIBLE)
-    shift = np.clip(np.round(-path[..., 0] / _TWO_PI), k_low[..., -1], k_high[..., -1])
+    shift = np.clip(np.round(-path[..., 0] / _TWO_PI), k_low, k_high)
     shifted = path + _TWO_PI * np.nan_to_num(shift)[..., None]
     return Tracked(
         reason=reason,

@@ -22,10 +22,10 @@ Branch labels (the API's names), from the signs chosen above:
   path except through the elbow singularity q3 = 0, so a branch can be followed;
 - wrist ``noflip`` / ``flip``: + / - before acos in q5.
 
-Angles come back in [-pi, pi); each joint of range +-2pi also has a copy 2 pi away
-(:func:`joint_copies`). Shapes: poses (N, 4, 4) with the flange {F} in the base frame {B}
-(metres); solutions (N, 8, 6) in radians, branch index b = 4 shoulder + 2 elbow + wrist with
-0 for left / up / noflip.
+Angles come back in [-pi, pi] (q3, q5 and q6 straight from atan2 may be pi); each joint of
+range +-2pi also has a copy 2 pi away (:func:`joint_copies`). Shapes: poses (N, 4, 4) with the
+flange {F} in the base frame {B} (metres); solutions (N, 8, 6) in radians, branch index
+b = 4 shoulder + 2 elbow + wrist with 0 for left / up / noflip.
 """
 
 from __future__ import annotations
@@ -131,7 +131,7 @@ def solve_batch(dh: UrDh, flange_in_base: np.ndarray) -> tuple[np.ndarray, np.nd
         flange_in_base: shape (N, 4, 4), T_B_F (metres).
 
     Returns:
-        q: shape (N, 8, 6), rad in [-pi, pi), NaN where a branch has no solution;
+        q: shape (N, 8, 6), rad in [-pi, pi], NaN where a branch has no solution;
         status: shape (N, 8), ``OK``, ``UNREACHABLE`` or ``SINGULAR`` (q5 or q3 at 0 or pi, or
         the wrist centre on the shoulder's singular surface; q is still filled there).
     """
@@ -154,7 +154,7 @@ def solve_components(
         position: shape (3, *batch), flange positions in {B} (m).
 
     Returns:
-        q: shape (6, 8, *batch), rad in [-pi, pi), NaN where unreachable;
+        q: shape (6, 8, *batch), rad in [-pi, pi], NaN where unreachable;
         status: shape (8, *batch).
     """
     batch = np.broadcast_shapes(rotation.shape[2:], position.shape[1:])
@@ -171,6 +171,7 @@ def solve_components(
     sign = np.array([1.0, -1.0]).reshape((2, *ones))
     # Shoulder level, shape (2, M): w . z1 = d4 with z1 = (sin q1, -cos q1, 0).
     q1 = np.arctan2(w_y, w_x) + sign * np.arccos(np.clip(ratio1, -1.0, 1.0)) + math.pi / 2
+    q1 = wrap_angle(q1)
     c1, s1 = np.cos(q1), np.sin(q1)
     cos5 = a_x * s1 - a_y * c1  # z5 . z1
     reach5 = np.abs(cos5) <= 1.0 + REACH_TOLERANCE
@@ -220,29 +221,22 @@ def solve_components(
         ]
     )
     # (6, shoulder, wrist, elbow, M) -> (6, shoulder, elbow, wrist, M) -> (6, 8, M)
-    q = wrap_angle(np.swapaxes(q, 2, 3).reshape((6, N_BRANCHES, *batch)))
+    q = np.swapaxes(q, 2, 3).reshape((6, N_BRANCHES, *batch))
+    for joint in (1, 3):  # q1 is wrapped above; q3, q5 and q6 come from atan2, in range
+        q[joint] = wrap_angle(q[joint])
     reach = np.broadcast_to(reach1 & reach5[:, None, None] & reach3[:, :, None], shape)
     reach = np.swapaxes(reach, 1, 2).reshape((N_BRANCHES, *batch))
-    singular = singular_mask(dh, np.moveaxis(q, 0, -1))
+    # det J = a2 a3 sin q3 sin q5 (w . x1): the elbow, wrist and shoulder singularities.
+    lever = w_x * c1 + w_y * s1
+    singular = (
+        (np.abs(lever) < SINGULAR_TOLERANCE)[:, None, None]
+        | (np.abs(sin5) < SINGULAR_TOLERANCE)[:, :, None]
+        | (np.abs(sin3) < SINGULAR_TOLERANCE)
+    )
+    singular = np.swapaxes(singular, 1, 2).reshape((N_BRANCHES, *batch))
     status = np.where(reach, np.where(singular, SINGULAR, OK), UNREACHABLE)
     q[:, ~reach] = np.nan
     return q, status
-
-
-def singular_mask(dh: UrDh, q: np.ndarray) -> np.ndarray:
-    """Where the UR Jacobian is singular, batched: q (..., 6) -> bool (...).
-
-    det J = a2 a3 sin q3 sin q5 (a2 cos q2 + a3 cos(q2 + q3) + d5 sin(q2 + q3 + q4)) up to sign:
-    the elbow, wrist and shoulder singularities.
-    """
-    q2, q3, q4, q5 = q[..., 1], q[..., 2], q[..., 3], q[..., 4]
-    lever = dh.a2 * np.cos(q2) + dh.a3 * np.cos(q2 + q3) + dh.d5 * np.sin(q2 + q3 + q4)
-    mask: np.ndarray = (
-        (np.abs(np.sin(q3)) < SINGULAR_TOLERANCE)
-        | (np.abs(np.sin(q5)) < SINGULAR_TOLERANCE)
-        | (np.abs(lever) < SINGULAR_TOLERANCE)
-    )
-    return mask
 
 
 def joint_copies(q: np.ndarray, *, lower: np.ndarray, upper: np.ndarray) -> np.ndarray:

@@ -1,0 +1,127 @@
+"""Benchmark of the capability map: prints figures, asserts nothing (timing is never a test).
+
+Run from the repository root::
+
+    python bench/run.py           # the ERK-size problem (about a minute, most of it the baseline)
+    python bench/run.py --smoke   # a tiny grid, to check that the script runs (CI)
+
+It prints the vectorised map's time on the ERK 2021 problem (UR5, x = -0.25..0.25 m,
+y = 0.25..0.65 m, step 0.02 m, z = 0.1 m, 133 waypoints, all IK branches), the same map by a
+scalar loop (ur-analytic-ik IK, pinocchio Jacobian and numpy solve per pose and branch) timed
+on a subset in the same run and extrapolated, their ratio, the time per pose and branch, and
+the 8-yaw map against the 1-yaw map.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import time
+from collections.abc import Callable
+from pathlib import Path
+
+import numpy as np
+import ur_analytic_ik
+
+from solver.capability_map import capability_map, grid_axis
+from solver.kinematics import jacobian_in_base
+from solver.robots import Robot, get_robot
+from solver.spatial import Placement, pose_matrix
+from solver.task import task_requirements
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def load_path(name: str) -> np.ndarray:
+    """Waypoint poses of examples/paths/<name>.json, shape (N, 4, 4)."""
+    waypoints = json.loads((ROOT / "examples" / "paths" / f"{name}.json").read_text())["waypoints"]
+    return np.array([pose_matrix(w["position"], w["orientation"], field="w") for w in waypoints])
+
+
+def best_time(run: Callable[[], object], repeats: int) -> float:
+    """The fastest of ``repeats`` runs (s)."""
+    times = []
+    for _ in range(repeats):
+        start = time.perf_counter()
+        run()
+        times.append(time.perf_counter() - start)
+    return min(times)
+
+
+def scalar_cell(robot: Robot, path: np.ndarray, placement: Placement) -> float:
+    """One map cell the plain way: IK, Jacobian and solve per pose and branch.
+
+    Per pose ur-analytic-ik, per solution a pinocchio Jacobian and a 6x6 solve; the best
+    branch's min over waypoints (no tracking: less work than the vectorised map does).
+    """
+    poses = placement.transform_workpiece_to_base() @ path
+    twists = task_requirements(poses).twists()
+    solver = getattr(ur_analytic_ik, robot.name)
+    per_branch: dict[int, float] = {}
+    for i, pose in enumerate(poses):
+        for b, q in enumerate(solver.inverse_kinematics(pose)):
+            joint_speeds = np.linalg.solve(jacobian_in_base(robot, q), twists[i])
+            speed = 1.0 / float(np.max(np.abs(joint_speeds) / robot.qdot_max))
+            per_branch[b] = min(per_branch.get(b, math.inf), speed)
+    return max(per_branch.values(), default=math.nan)
+
+
+def main() -> None:
+    """Print the figures."""
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--smoke", action="store_true", help="tiny grid: check the script runs")
+    args = parser.parse_args()
+    robot = get_robot("ur5")
+    path = load_path("curved_line")
+    if args.smoke:
+        xs, ys = grid_axis(-0.1, 0.1, 0.1, field="x"), grid_axis(0.3, 0.5, 0.1, field="y")
+        repeats, subset = 1, 2
+    else:
+        xs, ys = grid_axis(-0.25, 0.25, 0.02, field="x"), grid_axis(0.25, 0.65, 0.02, field="y")
+        repeats, subset = 5, 12
+    z = 0.1
+    cells = len(xs) * len(ys)
+    pose_branches = cells * len(path) * 8
+
+    def one_yaw() -> object:
+        return capability_map(robot, path, xs=xs, ys=ys, z=z, yaws=np.array([0.0]))
+
+    yaws8 = np.linspace(0.0, 2 * math.pi, 8, endpoint=False)
+
+    def eight_yaws() -> object:
+        return capability_map(robot, path, xs=xs, ys=ys, z=z, yaws=yaws8)
+
+    one_yaw()  # warm up (imports, first allocations)
+    t_map = best_time(one_yaw, repeats)
+    t_map8 = best_time(eight_yaws, max(1, repeats // 2))
+    rng = np.random.default_rng(0)
+    picks = rng.choice(cells, size=subset, replace=False)
+    placements = [Placement(float(xs[p % len(xs)]), float(ys[p // len(xs)]), z, 0.0) for p in picks]
+    start = time.perf_counter()
+    for placement in placements:
+        scalar_cell(robot, path, placement)
+    t_scalar_subset = time.perf_counter() - start
+    t_scalar = t_scalar_subset / subset * cells
+
+    print(
+        f"ERK-size map: UR5, {cells} placements x {len(path)} waypoints x 8 IK branches "
+        f"= {pose_branches:,} pose-branches{' (smoke grid)' if args.smoke else ''}"
+    )
+    print(
+        f"  vectorised map (best of {repeats}):   {t_map:8.3f} s   "
+        f"{t_map / pose_branches * 1e9:6.0f} ns per pose-branch"
+    )
+    print(
+        f"  scalar loop, {subset} cells:           {t_scalar_subset:8.3f} s   "
+        f"-> {cells} cells: {t_scalar:.1f} s (extrapolated)"
+    )
+    print(f"  speed-up over the scalar loop:     {t_scalar / t_map:8.0f}x")
+    print(
+        f"8-yaw map ({8 * cells} placements):     {t_map8:8.3f} s   "
+        f"{t_map8 / t_map:.2f}x the 1-yaw map"
+    )
+
+
+if __name__ == "__main__":
+    main()
