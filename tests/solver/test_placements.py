@@ -1,0 +1,60 @@
+"""mu_path at arbitrary placements (each its own yaw) equals evaluate_path there."""
+
+from __future__ import annotations
+
+import math
+import platform
+
+import numpy as np
+import pytest
+
+from solver._malloc import raise_malloc_thresholds
+from solver.evaluate import evaluate_path
+from solver.exceptions import InvalidInputError
+from solver.ik.ur_analytic import BRANCHES
+from solver.placements import evaluate_placements, prepare_path
+from solver.robots import get_robot
+from solver.spatial import Placement
+from solver.tracking import REASONS
+from tests.cases import MAP_EVALUATE_RTOL
+from tests.solver.test_evaluate import load_path
+
+
+def test_random_placements_equal_evaluate() -> None:
+    robot = get_robot("ur5e")
+    path = load_path("s_curve")
+    rng = np.random.default_rng(8)
+    placements = np.column_stack(
+        [
+            rng.uniform(-0.8, 0.8, 60),
+            rng.uniform(-0.8, 0.8, 60),
+            rng.uniform(-0.2, 0.3, 60),
+            rng.uniform(-math.pi, math.pi, 60),
+        ]
+    )
+    result = evaluate_placements(robot, prepare_path(robot, path), placements, with_speeds=True)
+    feasible = 0
+    for p, row in enumerate(placements):
+        expected = evaluate_path(robot, path, Placement(*row))
+        assert BRANCHES[result.branch[p]] == expected.branch
+        if expected.feasible:
+            feasible += 1
+            assert result.mu_path[p] == pytest.approx(expected.mu_path, rel=MAP_EVALUATE_RTOL)
+            np.testing.assert_allclose(result.v_max[p], expected.v_max, rtol=MAP_EVALUATE_RTOL)
+        else:
+            assert REASONS[result.reason[p]] == expected.reason
+            assert result.failed_waypoint[p] == expected.failed_waypoint
+            assert np.all(np.isnan(result.v_max[p]))
+    assert 10 <= feasible <= 50
+
+
+@pytest.mark.parametrize("placements", [np.zeros((3, 3)), np.array([[0, 0, 0, math.nan]])])
+def test_bad_placements(placements: np.ndarray) -> None:
+    robot = get_robot("ur5")
+    with pytest.raises(InvalidInputError):
+        evaluate_placements(robot, prepare_path(robot, load_path("curved_line")), placements)
+
+
+@pytest.mark.skipif(platform.libc_ver()[0] != "glibc", reason="mallopt is glibc's")
+def test_malloc_thresholds_are_set_on_glibc() -> None:
+    assert raise_malloc_thresholds() is True
