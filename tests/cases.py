@@ -37,3 +37,6 @@ CB_URDF_VS_DH_ATOL = 1e-12
 TWO_PI = 2 * math.pi
 # A capability-map cell against /v1/evaluate at that placement (issue 3): relative.
 MAP_EVALUATE_RTOL = 1e-9
+# An optimum against /v1/evaluate at the reported placement, and the two methods (issue 4).
+OPTIMUM_EVALUATE_RTOL = 1e-6
+OPTIMUM_METHODS_RTOL = 1e-5

@@ -1,0 +1,121 @@
+"""The symmetry of placements about the first joint's axis (spec section 6).
+
+When joint 1 turns about the base z axis, turning a placement about that axis by alpha
+(position rotated, yaw + alpha) only shifts q1 by alpha, so mu_path depends on
+(r, psi) = (sqrt(x^2 + y^2), yaw - atan2(y, x)) alone. The placements of one (r, psi) form an
+arc; :func:`arc_point` picks one of them inside the bounds, deterministically.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from solver.kinematics import jacobian_in_base, tool_pose_in_base
+from solver.robots import Robot
+
+_TWO_PI = 2 * math.pi
+
+
+@dataclass(frozen=True)
+class PlacementBounds:
+    """A box of placements: x, y, yaw ranges (m, m, rad) at height z (m)."""
+
+    x: tuple[float, float]
+    y: tuple[float, float]
+    yaw: tuple[float, float]
+    z: float
+
+    def contains(self, x: float, y: float, yaw: float, *, slack: float = 1e-12) -> bool:
+        """Whether (x, y, yaw) is inside the box (to ``slack``)."""
+        return (
+            self.x[0] - slack <= x <= self.x[1] + slack
+            and self.y[0] - slack <= y <= self.y[1] + slack
+            and self.yaw[0] - slack <= yaw <= self.yaw[1] + slack
+        )
+
+    def centre(self) -> tuple[float, float, float]:
+        """The middle of the box (x, y, yaw)."""
+        return (sum(self.x) / 2, sum(self.y) / 2, sum(self.yaw) / 2)
+
+
+def turns_about_base_z(robot: Robot) -> bool:
+    """Whether joint 1 turns about the base z axis (through the origin) with a full turn to spare.
+
+    Then mu_path depends on (r, psi) only: the shift of q1 fits its limits whenever the path's
+    q1 range is under a turn.
+    """
+    if robot.q_upper[0] - robot.q_lower[0] < 2 * _TWO_PI - 1e-9:
+        return False
+    rng = np.random.default_rng(0)
+    q = rng.uniform(-1.0, 1.0, robot.dof)
+    jacobian = jacobian_in_base(robot, q)
+    point = tool_pose_in_base(robot, q)[:3, 3]
+    axis = jacobian[3:, 0]
+    about_z = np.allclose(np.abs(axis), [0.0, 0.0, 1.0], atol=1e-12)
+    through_origin = np.allclose(jacobian[:3, 0], np.cross(axis, point), atol=1e-12)
+    return bool(about_z and through_origin)
+
+
+def arc_coordinates(x: float, y: float, yaw: float) -> tuple[float, float]:
+    """(r, psi) of a placement: r = |(x, y)| (m), psi = yaw - atan2(y, x) wrapped to [-pi, pi)."""
+    psi = yaw - math.atan2(y, x)
+    return math.hypot(x, y), (psi + math.pi) % _TWO_PI - math.pi
+
+
+def _yaw_in_range(angle: float, bounds: PlacementBounds) -> float | None:
+    """The copy angle + 2 pi k inside the yaw range, the lowest one; None if there is none."""
+    low, high = bounds.yaw
+    value = low + (angle - low) % _TWO_PI
+    return value if value <= high + 1e-12 else None
+
+
+def arc_point(
+    r: float, psi: float, bounds: PlacementBounds, *, near: float
+) -> tuple[float, float, float] | None:
+    """The placement of the arc (r, psi) inside the bounds whose polar angle is nearest ``near``.
+
+    Args:
+        r: m, distance of the placement from the base z axis.
+        psi: rad, yaw minus the polar angle.
+        bounds: the box.
+        near: rad, the polar angle to be near (the start's).
+
+    Returns:
+        (x, y, yaw), or None when no point of the arc is inside the box.
+    """
+    if r < 1e-12:  # the arc is the point (0, 0): only the yaw is left
+        point = _point(0.0, psi, near, bounds)
+        return point
+    critical = []
+    for edge in bounds.x:
+        if abs(edge) <= r:
+            critical += [math.acos(edge / r), -math.acos(edge / r)]
+    for edge in bounds.y:
+        if abs(edge) <= r:
+            critical += [math.asin(edge / r), math.pi - math.asin(edge / r)]
+    if bounds.yaw[1] - bounds.yaw[0] < _TWO_PI:
+        critical += [bounds.yaw[0] - psi, bounds.yaw[1] - psi]
+    # The inside of the arc is a union of pieces between these angles; the point nearest
+    # `near` is `near` itself or an end of a piece.
+    best: tuple[float, tuple[float, float, float]] | None = None
+    for theta in sorted({near % _TWO_PI, *(c % _TWO_PI for c in critical)}):
+        point = _point(r, psi, theta, bounds)
+        distance = abs((theta - near + math.pi) % _TWO_PI - math.pi)
+        if point is not None and (best is None or distance < best[0]):
+            best = (distance, point)
+    return None if best is None else best[1]
+
+
+def _point(
+    r: float, psi: float, theta: float, bounds: PlacementBounds
+) -> tuple[float, float, float] | None:
+    """(x, y, yaw) at polar angle theta if inside the box (edges clamped by 1e-12), else None."""
+    x = min(max(r * math.cos(theta), bounds.x[0]), bounds.x[1])
+    y = min(max(r * math.sin(theta), bounds.y[0]), bounds.y[1])
+    if abs(x - r * math.cos(theta)) > 1e-12 or abs(y - r * math.sin(theta)) > 1e-12:
+        return None
+    yaw = _yaw_in_range(psi + theta, bounds)
+    return None if yaw is None else (x, y, yaw)

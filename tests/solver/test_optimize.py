@@ -1,0 +1,169 @@
+"""Placement optimisation: never below the map, checked by the evaluator, both methods agree."""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+
+import numpy as np
+import pytest
+
+from solver.capability_map import capability_map, grid_axis
+from solver.evaluate import evaluate_path
+from solver.exceptions import InvalidInputError
+from solver.optimize import PlacementOptimum, optimize_placement
+from solver.robots import get_robot
+from solver.spatial import Placement
+from solver.symmetry import PlacementBounds, arc_coordinates, arc_point, turns_about_base_z
+from tests.cases import OPTIMUM_EVALUATE_RTOL, OPTIMUM_METHODS_RTOL
+from tests.solver.test_evaluate import load_path
+
+BOUNDS = PlacementBounds(x=(-0.25, 0.25), y=(0.25, 0.65), yaw=(-math.pi, math.pi), z=0.1)
+CASES = [(r, p) for r in ("ur5", "ur5e") for p in ("curved_line", "s_curve")]
+
+
+@pytest.fixture(scope="module", params=CASES, ids=lambda case: "-".join(case))
+def solved(request: pytest.FixtureRequest) -> dict:
+    robot_name, path_name = request.param
+    robot, path = get_robot(robot_name), load_path(path_name)
+    grid = capability_map(
+        robot,
+        path,
+        xs=grid_axis(*BOUNDS.x, 0.02, field="x"),
+        ys=grid_axis(*BOUNDS.y, 0.02, field="y"),
+        z=BOUNDS.z,
+        yaws=grid_axis(-math.pi, math.pi - 1e-9, math.radians(15), field="yaw"),
+    )
+    return {
+        "robot": robot,
+        "path": path,
+        "best_cell": float(np.nanmax(grid.mu_path)),
+        "casadi": optimize_placement(robot, path, bounds=BOUNDS, method="casadi"),
+        "scipy": optimize_placement(robot, path, bounds=BOUNDS, method="scipy"),
+    }
+
+
+@pytest.mark.parametrize("method", ["casadi", "scipy"])
+def test_optimum_is_feasible_inside_and_what_the_evaluator_says(solved: dict, method: str) -> None:
+    """Issue 4: never below the best cell of a 20 mm / 15 degree map, feasible, inside the
+    bounds, and equal to /v1/evaluate at the reported placement (relative 1e-6)."""
+    optimum: PlacementOptimum = solved[method]
+    assert optimum.mu_path >= solved["best_cell"]
+    placement = optimum.placement
+    assert BOUNDS.contains(placement.x, placement.y, placement.yaw) and placement.z == BOUNDS.z
+    evaluation = evaluate_path(solved["robot"], solved["path"], placement)
+    assert evaluation.feasible
+    assert optimum.mu_path == pytest.approx(evaluation.mu_path, rel=OPTIMUM_EVALUATE_RTOL)
+    assert optimum.evaluation.mu_path == optimum.mu_path
+
+
+def test_methods_agree(solved: dict) -> None:
+    """Issue 4: the two methods agree to 1e-5; the optimum is above the grid's best cell."""
+    casadi, scipy = solved["casadi"], solved["scipy"]
+    assert scipy.mu_path == pytest.approx(casadi.mu_path, rel=OPTIMUM_METHODS_RTOL)
+    # Both report the same point of the optimal arc (the one nearest the start).
+    np.testing.assert_allclose(
+        [scipy.placement.x, scipy.placement.y, scipy.placement.yaw],
+        [casadi.placement.x, casadi.placement.y, casadi.placement.yaw],
+        atol=1e-4,
+    )
+    assert casadi.mu_path > solved["best_cell"] * (1 + 1e-4)  # a grid cell is not enough
+
+
+def test_improvement_percent(solved: dict) -> None:
+    optimum = solved["casadi"]
+    start = evaluate_path(solved["robot"], solved["path"], optimum.start)
+    assert optimum.start == Placement(0.0, 0.45, 0.1, 0.0)  # the centre of the bounds
+    assert optimum.start_mu_path == start.mu_path
+    assert optimum.improvement_percent == pytest.approx(
+        100 * (optimum.mu_path / start.mu_path - 1), rel=1e-12
+    )
+
+
+def test_same_input_same_output() -> None:
+    robot, path = get_robot("ur5e"), load_path("curved_line")
+    first = optimize_placement(robot, path, bounds=BOUNDS, method="casadi")
+    second = optimize_placement(robot, path, bounds=BOUNDS, method="casadi")
+    assert (first.placement, first.mu_path) == (second.placement, second.mu_path)
+
+
+@pytest.mark.parametrize("name", ["ur5", "ur5e", "ur10e"])
+def test_turning_a_placement_about_the_base_axis_keeps_mu_path(name: str) -> None:
+    """Spec section 6: (x, y) turned by alpha with yaw + alpha has the same mu_path."""
+    robot, path = get_robot(name), load_path("s_curve")
+    assert turns_about_base_z(robot)
+    rng = np.random.default_rng(3)
+    checked = 0
+    while checked < 6:
+        x, y, yaw = rng.uniform(-0.6, 0.6), rng.uniform(-0.6, 0.6), rng.uniform(-3, 3)
+        base = evaluate_path(robot, path, Placement(x, y, 0.1, yaw))
+        if not base.feasible:
+            continue
+        checked += 1
+        for alpha in (0.4, -2.0, 3.0):
+            c, s = math.cos(alpha), math.sin(alpha)
+            turned = evaluate_path(
+                robot, path, Placement(c * x - s * y, s * x + c * y, 0.1, yaw + alpha)
+            )
+            assert turned.mu_path == pytest.approx(base.mu_path, rel=1e-9)
+
+
+def test_no_symmetry_without_a_full_turn_of_joint_1() -> None:
+    """With q1 limited to +-pi the shift may not fit: the search runs over x, y and yaw."""
+    robot = get_robot("ur5e")
+    lower, upper = robot.q_lower.copy(), robot.q_upper.copy()
+    lower[0], upper[0] = -math.pi, math.pi
+    limited = dataclasses.replace(robot, q_lower=lower, q_upper=upper)
+    assert not turns_about_base_z(limited)
+    bounds = PlacementBounds(x=(-0.1, 0.1), y=(0.35, 0.5), yaw=(-0.5, 0.5), z=0.1)
+    optimum = optimize_placement(limited, load_path("curved_line"), bounds=bounds)
+    assert not optimum.symmetric
+    grid = capability_map(
+        limited,
+        load_path("curved_line"),
+        xs=grid_axis(-0.1, 0.1, 0.02, field="x"),
+        ys=grid_axis(0.35, 0.5, 0.02, field="y"),
+        z=0.1,
+        yaws=grid_axis(-0.5, 0.5, math.radians(15), field="yaw"),
+    )
+    assert optimum.mu_path >= np.nanmax(grid.mu_path)
+
+
+@pytest.mark.parametrize("seed", range(5))
+def test_arc_point_is_the_nearest_inside_point(seed: int) -> None:
+    rng = np.random.default_rng(seed)
+    bounds = PlacementBounds(x=(-0.3, 0.2), y=(0.1, 0.6), yaw=(-1.0, 2.0), z=0.0)
+    r, psi, near = rng.uniform(0.15, 0.6), rng.uniform(-math.pi, math.pi), rng.uniform(-3, 3)
+    point = arc_point(r, psi, bounds, near=near)
+    thetas = np.linspace(-math.pi, math.pi, 200_001)
+    inside = [
+        t
+        for t in thetas
+        if bounds.contains(r * math.cos(t), r * math.sin(t), 0.0)
+        and any(bounds.yaw[0] <= psi + t + k * 2 * math.pi <= bounds.yaw[1] for k in (-1, 0, 1))
+    ]
+    if not inside:
+        assert point is None
+        return
+    assert point is not None
+    x, y, yaw = point
+    assert bounds.contains(x, y, yaw)
+    assert arc_coordinates(x, y, yaw) == pytest.approx((r, psi), abs=1e-9)
+    distance = min(abs((t - near + math.pi) % (2 * math.pi) - math.pi) for t in inside)
+    theta = math.atan2(y, x)
+    assert abs((theta - near + math.pi) % (2 * math.pi) - math.pi) <= distance + 1e-4
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "field"),
+    [
+        ({"bounds": PlacementBounds(x=(0.3, 0.1), y=(0.2, 0.5), yaw=(0, 1), z=0.1)}, "bounds.x"),
+        ({"bounds": PlacementBounds(x=(0, 0.1), y=(0.2, math.inf), yaw=(0, 1), z=0.1)}, "bounds.y"),
+        ({"bounds": BOUNDS, "start": Placement(2.0, 0.3, 0.1, 0.0)}, "start"),
+        ({"bounds": BOUNDS, "method": "newton"}, "method"),
+    ],
+)
+def test_bad_input(kwargs: dict, field: str) -> None:
+    with pytest.raises(InvalidInputError) as info:
+        optimize_placement(get_robot("ur5"), load_path("curved_line"), **kwargs)
+    assert info.value.field == field
