@@ -13,8 +13,10 @@ from solver.capability_map import CapabilityMap, axis_length, grid_axis
 from solver.dtf import DtfResult
 from solver.evaluate import Branch, PathEvaluation
 from solver.exceptions import InvalidInputError
+from solver.optimize import PlacementOptimum
 from solver.robots import Robot, get_robot, robot_from_urdf
 from solver.spatial import Placement, pose_matrix
+from solver.symmetry import PlacementBounds
 from solver.tracking import FEASIBLE, REASONS
 
 
@@ -225,4 +227,63 @@ def map_response(cmap: CapabilityMap) -> schemas.MapResponse:
         best=_extreme(cmap, best=True),
         worst=_extreme(cmap, best=False),
         feasible_cells=int(np.sum(cmap.reason == FEASIBLE)),
+    )
+
+
+def bounds_of(bounds: schemas.Bounds, *, z: float) -> PlacementBounds:
+    """The solver's placement box (m, m, rad) at height z (m)."""
+    return PlacementBounds(
+        x=(bounds.x[0], bounds.x[1]),
+        y=(bounds.y[0], bounds.y[1]),
+        yaw=(bounds.yaw[0], bounds.yaw[1]),
+        z=z,
+    )
+
+
+def _api_placement(placement: Placement) -> schemas.Placement:
+    return schemas.Placement(x=placement.x, y=placement.y, z=placement.z, yaw=placement.yaw)
+
+
+def optimize_response(
+    optimum: PlacementOptimum | None,
+    robot: Robot,
+    *,
+    bounds: PlacementBounds,
+    start: Placement | None,
+) -> schemas.OptimizeResponse:
+    """The answer of ``POST /v1/optimize`` (``found: false`` when nothing was feasible)."""
+    if optimum is None:
+        if start is None:  # the solver's default start: the centre of the bounds
+            x, y, yaw = bounds.centre()
+            start = Placement(x, y, bounds.z, yaw)
+        return schemas.OptimizeResponse(
+            found=False,
+            placement=None,
+            mu_path=None,
+            evaluation=None,
+            start=schemas.StartInfo(placement=_api_placement(start), mu_path=None),
+            improvement_percent=None,
+            solver=schemas.SolverInfo(
+                name="coarse search",
+                status="no feasible placement inside the bounds",
+                iterations=0,
+                seconds=0.0,
+            ),
+        )
+    report = optimum.solver
+    return schemas.OptimizeResponse(
+        found=True,
+        placement=_api_placement(optimum.placement),
+        mu_path=optimum.mu_path,
+        evaluation=evaluate_response(optimum.evaluation, robot),
+        start=schemas.StartInfo(
+            placement=_api_placement(optimum.start), mu_path=optimum.start_mu_path
+        ),
+        improvement_percent=optimum.improvement_percent,
+        solver=schemas.SolverInfo(
+            name=report.name,
+            status=report.status,
+            iterations=report.iterations,
+            seconds=report.seconds,
+        ),
     )

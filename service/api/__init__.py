@@ -4,10 +4,11 @@ from __future__ import annotations
 
 from fastapi import APIRouter
 
-from service.api.routes import dtf, evaluate, map, robots
+from service.api.routes import dtf, evaluate, map, optimize, robots
 
 api_router = APIRouter(prefix="/v1")
 api_router.include_router(robots.router)
 api_router.include_router(dtf.router)
 api_router.include_router(evaluate.router)
 api_router.include_router(map.router)
+api_router.include_router(optimize.router)

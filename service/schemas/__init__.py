@@ -24,10 +24,18 @@ from service.schemas.evaluate import (
     WaypointResult,
 )
 from service.schemas.map import Grid, GridAxis, MapCell, MapExtreme, MapRequest, MapResponse
+from service.schemas.optimize import (
+    Bounds,
+    OptimizeRequest,
+    OptimizeResponse,
+    SolverInfo,
+    StartInfo,
+)
 from service.schemas.robots import HealthResponse, RobotInfo, RobotsResponse
 
 __all__ = [
     "Bottleneck",
+    "Bounds",
     "Branch",
     "DtfRequest",
     "DtfResponse",
@@ -44,6 +52,8 @@ __all__ = [
     "MapExtreme",
     "MapRequest",
     "MapResponse",
+    "OptimizeRequest",
+    "OptimizeResponse",
     "Path",
     "Placement",
     "Pose",
@@ -52,5 +62,7 @@ __all__ = [
     "Robot",
     "RobotInfo",
     "RobotsResponse",
+    "SolverInfo",
+    "StartInfo",
     "WaypointResult",
 ]

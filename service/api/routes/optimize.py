@@ -1,0 +1,33 @@
+"""``POST /v1/optimize``: the best workpiece placement inside a box (spec section 6)."""
+
+from __future__ import annotations
+
+from fastapi import APIRouter
+
+from service import convert
+from service.errors import ERROR_RESPONSES
+from service.schemas import OptimizeRequest, OptimizeResponse
+from solver.optimize import optimize_placement
+
+router = APIRouter(prefix="/optimize", tags=["optimize"], responses=ERROR_RESPONSES)
+
+
+@router.post("", summary="The placement where the whole path runs fastest")
+def post_optimize(body: OptimizeRequest) -> OptimizeResponse:
+    """Maximise mu_path over (x, y, yaw) inside the bounds; every answer checked by the evaluator.
+
+    No feasible placement inside the bounds is not an error: ``found`` is false.
+    """
+    robot = convert.robot_from_schema(body.robot)
+    waypoints = convert.waypoints_of(body.path)
+    bounds = convert.bounds_of(body.bounds, z=body.z)
+    start = None if body.start is None else convert.placement_of(body.start)
+    optimum = optimize_placement(
+        robot,
+        waypoints,
+        bounds=bounds,
+        start=start,
+        method=body.method,
+        max_joint_step=body.max_joint_step,
+    )
+    return convert.optimize_response(optimum, robot, bounds=bounds, start=start)

@@ -1,0 +1,144 @@
+"""``POST /v1/optimize``: the placement where the path runs fastest (spec section 6)."""
+
+from __future__ import annotations
+
+import math
+from typing import Literal
+
+from pydantic import ConfigDict, Field, PositiveFloat, field_validator
+from pydantic.config import JsonDict
+
+from service.schemas.common import Path, Placement, RequestModel, ResponseModel, Robot
+from service.schemas.evaluate import _REQUEST_EXAMPLE, EvaluateResponse
+
+Range = list[float]
+
+
+class Bounds(RequestModel):
+    """The box the optimum must lie in: x and y (m) and yaw (rad), each as [min, max]."""
+
+    model_config = ConfigDict(
+        json_schema_extra={
+            "examples": [{"x": [-0.25, 0.25], "y": [0.25, 0.65], "yaw": [-math.pi, math.pi]}]
+        }
+    )
+
+    x: Range = Field(min_length=2, max_length=2, description="[min, max] of x (m).")
+    y: Range = Field(min_length=2, max_length=2, description="[min, max] of y (m).")
+    yaw: Range = Field(min_length=2, max_length=2, description="[min, max] of the yaw (rad).")
+
+    @field_validator("x", "y", "yaw")
+    @classmethod
+    def _ordered(cls, value: Range) -> Range:
+        if value[0] > value[1]:
+            raise ValueError(f"min {value[0]} is above max {value[1]}")
+        return value
+
+
+_REQUEST: JsonDict = {
+    "robot": _REQUEST_EXAMPLE["robot"],
+    "path": _REQUEST_EXAMPLE["path"],
+    "bounds": {"x": [-0.25, 0.25], "y": [0.25, 0.65], "yaw": [-3.14159, 3.14159]},
+    "z": 0.1,
+    "method": "casadi",
+}
+
+
+class OptimizeRequest(RequestModel):
+    """A robot, a path in the workpiece frame, and the box of placements to search."""
+
+    model_config = ConfigDict(json_schema_extra={"examples": [_REQUEST]})
+
+    robot: Robot = Field(
+        description="The arm (a UR arm of the catalogue: the search needs its IK)."
+    )
+    path: Path = Field(description="The tool path in the workpiece frame {O}.")
+    bounds: Bounds = Field(description="Where the workpiece may go.")
+    z: float = Field(description="Height of the workpiece frame (m), the table height.")
+    start: Placement | None = Field(
+        default=None,
+        description="Start placement, inside the bounds (default: their centre); reported with "
+        "its mu_path, and the optimum reported is the point of the optimal arc nearest it.",
+    )
+    method: Literal["casadi", "scipy"] = Field(
+        default="casadi",
+        description="casadi: IPOPT from the best cells of a coarse map; scipy: differential "
+        "evolution, then SLSQP.",
+    )
+    max_joint_step: PositiveFloat = Field(
+        default=0.35,
+        description="Largest move of any joint between neighbouring waypoints (rad).",
+    )
+
+
+class StartInfo(ResponseModel):
+    """The start placement and how fast the path runs there."""
+
+    model_config = ConfigDict(
+        json_schema_extra={
+            "examples": [{"placement": {"x": 0, "y": 0.45, "z": 0.1, "yaw": 0}, "mu_path": 0.2937}]
+        }
+    )
+
+    placement: Placement = Field(description="The start (m, rad).")
+    mu_path: float | None = Field(description="Its mu_path (m/s); null when infeasible.")
+
+
+class SolverInfo(ResponseModel):
+    """What the optimiser did."""
+
+    model_config = ConfigDict(
+        json_schema_extra={
+            "examples": [
+                {
+                    "name": "ipopt (casadi)",
+                    "status": "Solve_Succeeded",
+                    "iterations": 55,
+                    "seconds": 0.97,
+                }
+            ]
+        }
+    )
+
+    name: str = Field(description="The method and its solvers.")
+    status: str = Field(description="Status of the solve that gave the answer.")
+    iterations: int = Field(description="Iterations (or generations) of all solves together.")
+    seconds: float = Field(description="Wall time of the whole search (s).")
+
+
+class OptimizeResponse(ResponseModel):
+    """The best placement found, as /v1/evaluate sees it."""
+
+    model_config = ConfigDict(
+        json_schema_extra={
+            "examples": [
+                {
+                    "found": True,
+                    "placement": {"x": 0.0, "y": 0.2994, "z": 0.1, "yaw": 2.1407},
+                    "mu_path": 0.3971,
+                    "evaluation": None,
+                    "start": {
+                        "placement": {"x": 0, "y": 0.45, "z": 0.1, "yaw": 0},
+                        "mu_path": 0.2937,
+                    },
+                    "improvement_percent": 35.19,
+                    "solver": {
+                        "name": "ipopt (casadi)",
+                        "status": "Solve_Succeeded",
+                        "iterations": 55,
+                        "seconds": 0.97,
+                    },
+                }
+            ]
+        }
+    )
+
+    found: bool = Field(description="Whether any placement inside the bounds is feasible.")
+    placement: Placement | None = Field(description="The optimum, inside the bounds (m, rad).")
+    mu_path: float | None = Field(description="mu_path there (m/s), as /v1/evaluate gives it.")
+    evaluation: EvaluateResponse | None = Field(description="/v1/evaluate's answer there.")
+    start: StartInfo = Field(description="The start placement and its mu_path.")
+    improvement_percent: float | None = Field(
+        description="100 (mu_path / start mu_path - 1); null when the start is infeasible."
+    )
+    solver: SolverInfo = Field(description="The method, its status, iterations and time.")

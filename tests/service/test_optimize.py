@@ -1,0 +1,84 @@
+"""POST /v1/optimize: the answer is the evaluator's, with the start and the improvement."""
+
+from __future__ import annotations
+
+import json
+import math
+from typing import Any
+
+import pytest
+from fastapi.testclient import TestClient
+
+from tests.cases import EXAMPLES, OPTIMUM_EVALUATE_RTOL
+
+
+@pytest.fixture(scope="module")
+def body() -> dict[str, Any]:
+    path = json.loads((EXAMPLES / "paths" / "curved_line.json").read_text())
+    return {
+        "robot": {"model": "ur5e"},
+        "path": path,
+        "bounds": {"x": [-0.25, 0.25], "y": [0.25, 0.65], "yaw": [-math.pi, math.pi]},
+        "z": 0.1,
+    }
+
+
+@pytest.fixture(scope="module")
+def answer(client: TestClient, body: dict[str, Any]) -> dict[str, Any]:
+    response = client.post("/v1/optimize", json=body)
+    assert response.status_code == 200, response.text
+    return response.json()
+
+
+def test_answer_is_what_evaluate_says(
+    client: TestClient, body: dict[str, Any], answer: dict[str, Any]
+) -> None:
+    assert answer["found"] is True
+    placement = answer["placement"]
+    assert -0.25 <= placement["x"] <= 0.25 and 0.25 <= placement["y"] <= 0.65
+    evaluate = {"robot": body["robot"], "path": body["path"], "placement": placement}
+    evaluation = client.post("/v1/evaluate", json=evaluate).json()
+    assert answer["mu_path"] == pytest.approx(evaluation["mu_path"], rel=OPTIMUM_EVALUATE_RTOL)
+    assert answer["evaluation"]["mu_path"] == answer["mu_path"]
+    assert answer["solver"]["status"] == "Solve_Succeeded"
+    assert answer["solver"]["iterations"] > 0 and answer["solver"]["seconds"] > 0
+
+
+def test_start_and_improvement(answer: dict[str, Any]) -> None:
+    start = answer["start"]
+    assert start["placement"] == {"x": 0.0, "y": 0.45, "z": 0.1, "yaw": 0.0}
+    expected = 100 * (answer["mu_path"] / start["mu_path"] - 1)
+    assert answer["improvement_percent"] == pytest.approx(expected, rel=1e-12)
+    assert answer["improvement_percent"] > 10
+
+
+def test_scipy_method_on_a_short_path(client: TestClient, body: dict[str, Any]) -> None:
+    short = {**body, "path": {"waypoints": body["path"]["waypoints"][:30]}, "method": "scipy"}
+    answer = client.post("/v1/optimize", json=short).json()
+    casadi = client.post("/v1/optimize", json={**short, "method": "casadi"}).json()
+    assert answer["found"] and answer["solver"]["name"].startswith("differential_evolution")
+    assert answer["mu_path"] == pytest.approx(casadi["mu_path"], rel=1e-5)
+
+
+def test_nothing_feasible_is_not_an_error(client: TestClient, body: dict[str, Any]) -> None:
+    far = {**body, "bounds": {"x": [3.0, 3.2], "y": [3.0, 3.2], "yaw": [0.0, 0.5]}}
+    answer = client.post("/v1/optimize", json=far).json()
+    assert answer["found"] is False and answer["placement"] is None
+    assert answer["start"]["mu_path"] is None and answer["improvement_percent"] is None
+
+
+@pytest.mark.parametrize(
+    ("changes", "loc"),
+    [
+        ({"bounds": {"x": [0.3, 0.1], "y": [0.2, 0.5], "yaw": [0, 1]}}, ["body", "bounds", "x"]),
+        ({"bounds": {"x": [0.1], "y": [0.2, 0.5], "yaw": [0, 1]}}, ["body", "bounds", "x"]),
+        ({"start": {"x": 2.0, "y": 0.3, "z": 0.1, "yaw": 0.0}}, ["body", "start"]),
+        ({"method": "newton"}, ["body", "method"]),
+        ({"max_joint_step": 0.0}, ["body", "max_joint_step"]),
+        ({"z": 5000.0}, ["body", "z"]),
+    ],
+)
+def test_bad_input(client: TestClient, body: dict[str, Any], changes: dict, loc: list) -> None:
+    response = client.post("/v1/optimize", json={**body, **changes})
+    assert response.status_code == 422, response.text
+    assert response.json()["detail"][0]["loc"][: len(loc)] == loc
