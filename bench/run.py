@@ -9,7 +9,9 @@ It prints the vectorised map's time on the ERK 2021 problem (UR5, x = -0.25..0.2
 y = 0.25..0.65 m, step 0.02 m, z = 0.1 m, 133 waypoints, all IK branches), the same map by a
 scalar loop (ur-analytic-ik IK, pinocchio Jacobian and numpy solve per pose and branch) timed
 on a subset in the same run and extrapolated, their ratio, the time per pose and branch, and
-the 8-yaw map against the 1-yaw map.
+the 8-yaw map against the 1-yaw map. Then the placement optimisation of the same problem
+(yaw free): each method's time and optimum, against the best cell of a fine grid (10 mm,
+5 degrees) computed in the same run.
 """
 
 from __future__ import annotations
@@ -26,8 +28,10 @@ import ur_analytic_ik
 
 from solver.capability_map import capability_map, grid_axis
 from solver.kinematics import jacobian_in_base
+from solver.optimize import optimize_placement
 from solver.robots import Robot, get_robot
 from solver.spatial import Placement, pose_matrix
+from solver.symmetry import PlacementBounds
 from solver.task import task_requirements
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -121,6 +125,54 @@ def main() -> None:
         f"8-yaw map ({8 * cells} placements):     {t_map8:8.3f} s   "
         f"{t_map8 / t_map:.2f}x the 1-yaw map"
     )
+    optimisation(robot, path, smoke=args.smoke)
+
+
+def optimisation(robot: Robot, path: np.ndarray, *, smoke: bool) -> None:
+    """Time each method to the optimum; compare with the best cell of a fine grid."""
+    if smoke:
+        bounds = PlacementBounds(x=(-0.05, 0.05), y=(0.4, 0.5), yaw=(-0.2, 0.2), z=0.1)
+        step, yaw_step, methods = 0.05, math.radians(10), ("casadi",)
+    else:
+        bounds = PlacementBounds(x=(-0.25, 0.25), y=(0.25, 0.65), yaw=(-math.pi, math.pi), z=0.1)
+        step, yaw_step, methods = 0.01, math.radians(5), ("casadi", "scipy")
+    print(
+        f"ERK-size optimisation: UR5, x {bounds.x}, y {bounds.y}, yaw "
+        f"({bounds.yaw[0]:.3f}, {bounds.yaw[1]:.3f}), z {bounds.z}"
+    )
+    results = {}
+    for method in methods:
+        start = time.perf_counter()
+        optimum = optimize_placement(robot, path, bounds=bounds, method=method)
+        seconds = time.perf_counter() - start
+        if optimum is None:
+            print(f"  {method:7s} {seconds:7.3f} s   no feasible placement")
+            continue
+        results[method] = optimum.mu_path
+        p = optimum.placement
+        print(
+            f"  {method:7s} {seconds:7.3f} s   mu_path {optimum.mu_path:.6f} m/s at x {p.x:.4f}, "
+            f"y {p.y:.4f}, yaw {p.yaw:.4f}; {optimum.improvement_percent:+.2f} % over the centre "
+            f"of the bounds ({optimum.solver.iterations} iterations)"
+        )
+    yaws = np.arange(bounds.yaw[0], bounds.yaw[1] - 1e-9, yaw_step)
+    start = time.perf_counter()
+    grid = capability_map(
+        robot,
+        path,
+        xs=grid_axis(*bounds.x, step, field="x"),
+        ys=grid_axis(*bounds.y, step, field="y"),
+        z=bounds.z,
+        yaws=yaws,
+    )
+    seconds = time.perf_counter() - start
+    best = float(np.nanmax(grid.mu_path))
+    print(
+        f"  fine grid ({step * 1000:.0f} mm, {math.degrees(yaw_step):.0f} deg, "
+        f"{grid.mu_path.size:,} placements, {seconds:.1f} s): best cell {best:.6f} m/s"
+    )
+    for method, value in results.items():
+        print(f"  {method} optimum vs the fine grid's best cell: {100 * (value / best - 1):+.3f} %")
 
 
 if __name__ == "__main__":
