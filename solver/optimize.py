@@ -219,6 +219,8 @@ def optimize_placement(
     """
     began = time.perf_counter()
     check_bounds(bounds)
+    if method not in ("casadi", "scipy"):
+        raise InvalidInputError("method", f"unknown method {method!r}; use casadi or scipy")
     if start is None:
         start = Placement(*bounds.centre()[:2], bounds.z, bounds.centre()[2])
     if not bounds.contains(start.x, start.y, start.yaw) or start.z != bounds.z:
@@ -236,13 +238,11 @@ def optimize_placement(
             robot, path, prepared, bounds, cells, max_joint_step
         )
         name = "ipopt (casadi), from the coarse map's maxima"
-    elif method == "scipy":
+    else:
         candidates, statuses, iterations = _scipy(
             robot, prepared, bounds, max_joint_step, symmetric
         )
         name = "differential_evolution + SLSQP (scipy)"
-    else:
-        raise InvalidInputError("method", f"unknown method {method!r}; use casadi or scipy")
     best: tuple[float, Placement, PathEvaluation, str] | None = None
     for candidate, status in zip(candidates, statuses, strict=True):
         placement = _place_on_arc(candidate, bounds, near, symmetric)

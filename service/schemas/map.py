@@ -81,20 +81,23 @@ class MapRequest(RequestModel):
     ik: IkPolicy = Field(default_factory=IkPolicy, description="IK branch policy.")
 
 
+_CELL: JsonDict = {
+    "x": 0.0,
+    "y": 0.35,
+    "yaw": 0.0,
+    "mu_path": 0.2913,
+    "reason": None,
+    "failed_waypoint": None,
+}
+
+
 class MapCell(ResponseModel):
     """One placement of the grid and how fast the path runs there."""
 
     model_config = ConfigDict(
         json_schema_extra={
             "examples": [
-                {
-                    "x": 0.0,
-                    "y": 0.35,
-                    "yaw": 0.0,
-                    "mu_path": 0.2913,
-                    "reason": None,
-                    "failed_waypoint": None,
-                },
+                _CELL,
                 {
                     "x": 0.9,
                     "y": 0.9,
@@ -134,16 +137,6 @@ class MapExtreme(ResponseModel):
 
     placement: Placement = Field(description="Where the workpiece sits (m, rad).")
     mu_path: float = Field(description="Its mu_path (m/s).")
-
-
-_CELL: JsonDict = {
-    "x": 0.0,
-    "y": 0.35,
-    "yaw": 0.0,
-    "mu_path": 0.2913,
-    "reason": None,
-    "failed_waypoint": None,
-}
 
 
 class MapResponse(ResponseModel):

@@ -5,10 +5,10 @@ from __future__ import annotations
 import math
 from typing import Literal
 
-from pydantic import ConfigDict, Field, PositiveFloat, field_validator
+from pydantic import ConfigDict, Field, field_validator
 from pydantic.config import JsonDict
 
-from service.schemas.common import Path, Placement, RequestModel, ResponseModel, Robot
+from service.schemas.common import IkPolicy, Path, Placement, RequestModel, ResponseModel, Robot
 from service.schemas.evaluate import _REQUEST_EXAMPLE, EvaluateResponse
 
 Range = list[float]
@@ -41,6 +41,7 @@ _REQUEST: JsonDict = {
     "bounds": {"x": [-0.25, 0.25], "y": [0.25, 0.65], "yaw": [-3.14159, 3.14159]},
     "z": 0.1,
     "method": "casadi",
+    "ik": {"branch": "auto", "max_joint_step": 0.35},
 }
 
 
@@ -65,10 +66,18 @@ class OptimizeRequest(RequestModel):
         description="casadi: IPOPT from the best cells of a coarse map; scipy: differential "
         "evolution, then SLSQP.",
     )
-    max_joint_step: PositiveFloat = Field(
-        default=0.35,
-        description="Largest move of any joint between neighbouring waypoints (rad).",
+    ik: IkPolicy = Field(
+        default_factory=IkPolicy,
+        description="IK policy: max_joint_step as for /v1/evaluate; the branch must be auto "
+        "(each start of the search follows its own branch, the answer uses the best).",
     )
+
+    @field_validator("ik")
+    @classmethod
+    def _auto_branch(cls, value: IkPolicy) -> IkPolicy:
+        if value.branch != "auto":
+            raise ValueError("the optimiser chooses the IK branch itself: branch must be auto")
+        return value
 
 
 class StartInfo(ResponseModel):

@@ -74,7 +74,11 @@ def test_nothing_feasible_is_not_an_error(client: TestClient, body: dict[str, An
         ({"bounds": {"x": [0.1], "y": [0.2, 0.5], "yaw": [0, 1]}}, ["body", "bounds", "x"]),
         ({"start": {"x": 2.0, "y": 0.3, "z": 0.1, "yaw": 0.0}}, ["body", "start"]),
         ({"method": "newton"}, ["body", "method"]),
-        ({"max_joint_step": 0.0}, ["body", "max_joint_step"]),
+        ({"ik": {"max_joint_step": 0.0}}, ["body", "ik", "max_joint_step"]),
+        (
+            {"ik": {"branch": {"shoulder": "left", "elbow": "up", "wrist": "flip"}}},
+            ["body", "ik"],
+        ),
         ({"z": 5000.0}, ["body", "z"]),
     ],
 )

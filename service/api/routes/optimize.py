@@ -28,6 +28,6 @@ def post_optimize(body: OptimizeRequest) -> OptimizeResponse:
         bounds=bounds,
         start=start,
         method=body.method,
-        max_joint_step=body.max_joint_step,
+        max_joint_step=body.ik.max_joint_step,
     )
     return convert.optimize_response(optimum, robot, bounds=bounds, start=start)
