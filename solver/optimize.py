@@ -39,6 +39,7 @@ Method = Literal["casadi", "scipy"]
 COARSE_STEP = 0.02  # m, of the coarse map (r or x, y)
 COARSE_YAW_STEP = math.radians(15)  # rad, of the coarse map (psi or yaw)
 N_STARTS = 4  # IPOPT solves, from the best local maxima of the coarse map
+MAX_COARSE_CELLS = 50_000  # default limit on the coarse map (a box larger is an input error)
 
 
 @dataclass(frozen=True)
@@ -75,11 +76,14 @@ class PlacementOptimum:
     symmetric: bool
 
 
+Point = tuple[float, float, float]  # x (m), y (m), yaw (rad)
+
+
 @dataclass(frozen=True)
 class Cell:
     """A placement (x, y, yaw) with its mu_path and IK branch index."""
 
-    placement: tuple[float, float, float]
+    placement: Point
     mu_path: float
     branch: int
 
@@ -119,47 +123,81 @@ def coarse_cells(
     symmetric: bool,
     near: float,
     max_joint_step: float,
+    max_cells: int = MAX_COARSE_CELLS,
 ) -> list[Cell]:
     """Local maxima of a coarse map over the bounds, best first.
 
     Over (r, psi) at COARSE_STEP x COARSE_YAW_STEP when ``symmetric`` (each cell placed on its
     arc nearest the polar angle ``near``), else over (x, y, yaw).
+
+    Raises:
+        InvalidInputError: the map would have more than ``max_cells`` cells (on ``bounds``).
     """
+    n_psi = round(2 * math.pi / COARSE_YAW_STEP)
     if symmetric:
         corners = [math.hypot(x, y) for x in bounds.x for y in bounds.y]
         inside_x = min(max(0.0, bounds.x[0]), bounds.x[1])
         inside_y = min(max(0.0, bounds.y[0]), bounds.y[1])
         r_low, r_high = math.hypot(inside_x, inside_y), max(corners)
-        radii = r_low + COARSE_STEP * np.arange(math.floor((r_high - r_low) / COARSE_STEP) + 1)
-        psis = -math.pi + COARSE_YAW_STEP * np.arange(round(2 * math.pi / COARSE_YAW_STEP))
-        shape: tuple[int, ...] = (len(psis), len(radii))
-        points = [arc_point(float(r), float(p), bounds, near=near) for p in psis for r in radii]
-        # mu_path is the same all along an arc: evaluate every cell at the polar angle `near`,
-        # so that the cells of one psi share a yaw (the cheap case of evaluate_placements).
-        evaluated = [
-            (float(r * math.cos(near)), float(r * math.sin(near)), float(p + near))
-            for p in psis
-            for r in radii
-        ]
-        periodic: tuple[bool, ...] = (True, False)
+        sizes = [math.floor((r_high - r_low) / COARSE_STEP) + 1, n_psi]
     else:
-        axes = [
-            np.arange(low, high + 1e-12, step)
+        sizes = [
+            math.floor((high - low) / step + 1e-9) + 1
             for (low, high), step in (
                 (bounds.x, COARSE_STEP),
                 (bounds.y, COARSE_STEP),
                 (bounds.yaw, COARSE_YAW_STEP),
             )
         ]
+    if math.prod(sizes) > max_cells:
+        raise InvalidInputError(
+            "bounds",
+            f"the search box needs a coarse map of {math.prod(sizes)} cells "
+            f"({' x '.join(map(str, sizes))} at {COARSE_STEP * 1000:.0f} mm, "
+            f"{math.degrees(COARSE_YAW_STEP):.0f} deg); the limit is {max_cells}",
+        )
+    if symmetric:
+        radii = r_low + COARSE_STEP * np.arange(sizes[0])
+        psis = -math.pi + COARSE_YAW_STEP * np.arange(n_psi)
+        shape: tuple[int, ...] = (len(psis), len(radii))
+        points: list[Point | None] = [
+            arc_point(float(r), float(p), bounds, near=near) for p in psis for r in radii
+        ]
+        # mu_path is the same all along an arc: evaluate every cell at the polar angle `near`,
+        # so that the cells of one psi share a yaw (the cheap case of evaluate_placements),
+        # unless that is farther than any placement may be.
+        evaluated: list[Point | None] = [
+            (float(r * math.cos(near)), float(r * math.sin(near)), float(p + near))
+            if r <= MAX_COORDINATE
+            else None
+            for p in psis
+            for r in radii
+        ]
+        periodic: tuple[bool, ...] = (True, False)
+    else:
+        axes = [
+            low + step * np.arange(size)
+            for (low, _), step, size in zip(
+                (bounds.x, bounds.y, bounds.yaw),
+                (COARSE_STEP, COARSE_STEP, COARSE_YAW_STEP),
+                sizes,
+                strict=True,
+            )
+        ]
         shape = (len(axes[2]), len(axes[1]), len(axes[0]))
-        grid = [(float(x), float(y), float(w)) for w in axes[2] for y in axes[1] for x in axes[0]]
-        points, evaluated = list(grid), grid
+        points = [(float(x), float(y), float(w)) for w in axes[2] for y in axes[1] for x in axes[0]]
+        evaluated = [None] * len(points)
         periodic = (bounds.yaw[1] - bounds.yaw[0] >= 2 * math.pi - 1e-9, False, False)
-    inside = [i for i, p in enumerate(points) if p is not None]
+    inside, rows = [], []
+    for i, point in enumerate(points):
+        at = evaluated[i] or point
+        if point is not None and at is not None:
+            inside.append(i)
+            rows.append([at[0], at[1], bounds.z, at[2]])
     mu = np.full(len(points), np.nan)
     branch = np.zeros(len(points), dtype=int)
     if inside:
-        placements = np.array([[*evaluated[i][:2], bounds.z, evaluated[i][2]] for i in inside])
+        placements = np.array(rows)
         result = evaluate_placements(robot, path, placements, max_joint_step=max_joint_step)
         mu[inside], branch[inside] = result.mu_path, result.branch
     flat = np.ravel_multi_index
@@ -199,6 +237,7 @@ def optimize_placement(
     start: Placement | None = None,
     method: Method = "casadi",
     max_joint_step: float = DEFAULT_MAX_JOINT_STEP,
+    max_coarse_cells: int = MAX_COARSE_CELLS,
 ) -> PlacementOptimum | None:
     """The placement inside ``bounds`` where the path runs fastest.
 
@@ -210,12 +249,15 @@ def optimize_placement(
             mu_path and used to choose the point of the optimal arc.
         method: ``"casadi"`` (IPOPT from the coarse map's maxima) or ``"scipy"``.
         max_joint_step: rad, as for :func:`solver.evaluate.evaluate_path`.
+        max_coarse_cells: the largest coarse map the casadi method may make.
 
     Returns:
-        The optimum, or None when no placement of the coarse search is feasible.
+        The optimum (never below the start), or None when neither the start nor any placement
+        the search tried is feasible.
 
     Raises:
-        InvalidInputError: bad bounds, a start outside them, or an unknown method.
+        InvalidInputError: bad bounds, a start outside them, an unknown method, or a box whose
+            coarse map is over ``max_coarse_cells``.
     """
     began = time.perf_counter()
     check_bounds(bounds)
@@ -232,7 +274,13 @@ def optimize_placement(
     near = math.atan2(start.y, start.x)
     if method == "casadi":
         cells = coarse_cells(
-            robot, prepared, bounds, symmetric=symmetric, near=near, max_joint_step=max_joint_step
+            robot,
+            prepared,
+            bounds,
+            symmetric=symmetric,
+            near=near,
+            max_joint_step=max_joint_step,
+            max_cells=max_coarse_cells,
         )
         candidates, statuses, iterations = _casadi(
             robot, path, prepared, bounds, cells, max_joint_step
@@ -243,6 +291,9 @@ def optimize_placement(
             robot, prepared, bounds, max_joint_step, symmetric
         )
         name = "differential_evolution + SLSQP (scipy)"
+    # The start last: it is the answer only when nothing the solver found is better.
+    candidates = [*candidates, (start.x, start.y, start.yaw)]
+    statuses = [*statuses, "no better placement found than the start"]
     best: tuple[float, Placement, PathEvaluation, str] | None = None
     for candidate, status in zip(candidates, statuses, strict=True):
         placement = _place_on_arc(candidate, bounds, near, symmetric)

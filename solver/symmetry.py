@@ -66,10 +66,14 @@ def arc_coordinates(x: float, y: float, yaw: float) -> tuple[float, float]:
 
 
 def _yaw_in_range(angle: float, bounds: PlacementBounds) -> float | None:
-    """The copy angle + 2 pi k inside the yaw range, the lowest one; None if there is none."""
+    """The copy angle + 2 pi k inside the yaw range nearest its middle; None if there is none."""
     low, high = bounds.yaw
-    value = low + (angle - low) % _TWO_PI
-    return value if value <= high + 1e-12 else None
+    middle = (low + high) / 2
+    value = middle + (angle - middle + math.pi) % _TWO_PI - math.pi
+    for candidate in (value, value - _TWO_PI, value + _TWO_PI):
+        if low - 1e-12 <= candidate <= high + 1e-12:
+            return min(max(candidate, low), high)
+    return None
 
 
 def arc_point(

@@ -80,6 +80,7 @@ def test_nothing_feasible_is_not_an_error(client: TestClient, body: dict[str, An
             ["body", "ik"],
         ),
         ({"z": 5000.0}, ["body", "z"]),
+        ({"bounds": {"x": [-900, 900], "y": [-900, 900], "yaw": [0, 1]}}, ["body", "bounds"]),
     ],
 )
 def test_bad_input(client: TestClient, body: dict[str, Any], changes: dict, loc: list) -> None:

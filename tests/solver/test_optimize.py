@@ -167,3 +167,27 @@ def test_bad_input(kwargs: dict, field: str) -> None:
     with pytest.raises(InvalidInputError) as info:
         optimize_placement(get_robot("ur5"), load_path("curved_line"), **kwargs)
     assert info.value.field == field
+
+
+@pytest.mark.parametrize("method", ["casadi", "scipy"])
+def test_a_box_of_one_placement_answers_it(method: str) -> None:
+    """No coarse cell lands on a zero-width box; the start (its only point) is the answer."""
+    robot, path = get_robot("ur5e"), load_path("curved_line")[:20]
+    bounds = PlacementBounds(x=(0.1, 0.1), y=(0.4, 0.4), yaw=(0.3, 0.3), z=0.1)
+    optimum = optimize_placement(robot, path, bounds=bounds, method=method)
+    expected = evaluate_path(robot, path, Placement(0.1, 0.4, 0.1, 0.3))
+    assert optimum.placement == Placement(0.1, 0.4, 0.1, 0.3)
+    assert optimum.mu_path == expected.mu_path and optimum.improvement_percent == 0.0
+
+
+def test_a_yaw_range_over_a_turn_reports_the_copy_nearest_its_middle() -> None:
+    bounds = PlacementBounds(x=(-0.1, 0.1), y=(0.3, 0.5), yaw=(-10.0, 10.0), z=0.1)
+    optimum = optimize_placement(get_robot("ur5e"), load_path("curved_line")[:30], bounds=bounds)
+    assert -math.pi <= optimum.placement.yaw <= math.pi
+
+
+def test_a_box_too_large_to_search_is_refused_before_any_work() -> None:
+    bounds = PlacementBounds(x=(-900.0, 900.0), y=(-900.0, 900.0), yaw=(0.0, 1.0), z=0.1)
+    with pytest.raises(InvalidInputError, match="limit is 50000") as info:
+        optimize_placement(get_robot("ur5"), load_path("curved_line"), bounds=bounds)
+    assert info.value.field == "bounds"

@@ -5,6 +5,7 @@ from __future__ import annotations
 from fastapi import APIRouter
 
 from service import convert
+from service.deps import SettingsDep
 from service.errors import ERROR_RESPONSES
 from service.schemas import OptimizeRequest, OptimizeResponse
 from solver.optimize import optimize_placement
@@ -13,10 +14,11 @@ router = APIRouter(prefix="/optimize", tags=["optimize"], responses=ERROR_RESPON
 
 
 @router.post("", summary="The placement where the whole path runs fastest")
-def post_optimize(body: OptimizeRequest) -> OptimizeResponse:
+def post_optimize(body: OptimizeRequest, settings: SettingsDep) -> OptimizeResponse:
     """Maximise mu_path over (x, y, yaw) inside the bounds; every answer checked by the evaluator.
 
-    No feasible placement inside the bounds is not an error: ``found`` is false.
+    No feasible placement inside the bounds is not an error: ``found`` is false. A box whose
+    coarse map (20 mm, 15 degrees) would exceed DTF_MAX_MAP_CELLS cells is a 422 on ``bounds``.
     """
     robot = convert.robot_from_schema(body.robot)
     waypoints = convert.waypoints_of(body.path)
@@ -29,5 +31,6 @@ def post_optimize(body: OptimizeRequest) -> OptimizeResponse:
         start=start,
         method=body.method,
         max_joint_step=body.ik.max_joint_step,
+        max_coarse_cells=settings.max_map_cells,
     )
     return convert.optimize_response(optimum, robot, bounds=bounds, start=start)
