@@ -51,7 +51,8 @@ def _unit(vector: np.ndarray | list[float], field: str) -> np.ndarray:
     arr = np.asarray(vector, dtype=float)
     if arr.shape != (3,) or not np.all(np.isfinite(arr)):
         raise InvalidInputError(field, f"needs 3 finite numbers, got {arr.tolist()}")
-    norm = float(np.linalg.norm(arr))
+    with np.errstate(over="ignore"):  # a huge entry gives norm inf, refused just below
+        norm = float(np.linalg.norm(arr))
     if abs(norm - 1.0) > UNIT_TOLERANCE:
         raise InvalidInputError(field, f"norm is {norm!r}; a unit vector is needed")
     return arr

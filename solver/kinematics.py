@@ -20,7 +20,8 @@ def check_configuration(
         field: name of the input, for the error message.
 
     Raises:
-        InvalidInputError: wrong shape or a value that is not finite.
+        InvalidInputError: wrong shape, a value that is not finite, or a joint outside its
+            position limits.
     """
     q_arr = np.asarray(q, dtype=float)
     if q_arr.shape != (robot.dof,):
@@ -28,6 +29,14 @@ def check_configuration(
     bad = np.flatnonzero(~np.isfinite(q_arr))
     if bad.size:
         raise InvalidInputError(field, f"joint {int(bad[0])} is {q_arr[bad[0]]!r}, not finite")
+    outside = np.flatnonzero((q_arr < robot.q_lower - 1e-12) | (q_arr > robot.q_upper + 1e-12))
+    if outside.size:
+        j = int(outside[0])
+        raise InvalidInputError(
+            field,
+            f"joint {j} ({robot.joint_names[j]}) is {q_arr[j]!r} rad, outside its limits "
+            f"[{robot.q_lower[j]!r}, {robot.q_upper[j]!r}]",
+        )
     return q_arr
 
 

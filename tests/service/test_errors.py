@@ -58,6 +58,7 @@ WAYPOINTS = ("path", "waypoints")
 DTF_CASES: list[tuple[str, Changes, Loc]] = [
     ("q not a list", {("q",): "abc"}, ["body", "q"]),
     ("q too short", {("q",): [0.1] * 5}, ["body", "q"]),
+    ("q beyond the joint limits", {("q", 1): 7.0}, ["body", "q"]),
     ("number as a string", {("q", 2): "0.1"}, ["body", "q", 2]),
     ("u_T of 2 numbers", {("u_T",): [1.0, 0.0]}, ["body", "u_T"]),
     ("u_T not unit", {("u_T",): [1.0, 1.0, 0.0]}, ["body", "u_T"]),
