@@ -20,10 +20,11 @@ from solver.dtf import closed_form_batch
 from solver.exceptions import InvalidInputError, NoAnalyticIkError
 from solver.ik.ur_analytic import BRANCHES, Branch, branch_index, solve_components
 from solver.kinematics import jacobian_in_base
-from solver.robots import Robot, UrDh
+from solver.robots import Robot
 from solver.spatial import Placement
 from solver.task import TaskRequirements, task_requirements
 from solver.tracking import FEASIBLE, REASONS, Reason, choose_branch, track
+from solver.ur_dh import UrDh
 
 __all__ = ["Branch", "PathEvaluation", "evaluate_path", "DEFAULT_MAX_JOINT_STEP"]
 

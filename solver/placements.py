@@ -19,10 +19,11 @@ from solver._malloc import raise_malloc_thresholds
 from solver.evaluate import DEFAULT_MAX_JOINT_STEP, check_max_joint_step, require_analytic_ik
 from solver.exceptions import InvalidInputError
 from solver.ik.ur_analytic import Branch, branch_index, solve_components
-from solver.robots import Robot, UrDh
+from solver.robots import Robot
 from solver.spatial import MAX_COORDINATE
 from solver.task import task_requirements
 from solver.tracking import FEASIBLE, choose_branch, track
+from solver.ur_dh import UrDh
 from solver.ur_jacobian import joint_speeds_per_unit_twist
 
 DEFAULT_CHUNK = 32

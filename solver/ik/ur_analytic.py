@@ -37,7 +37,7 @@ from typing import Literal
 
 import numpy as np
 
-from solver.robots import UrDh
+from solver.ur_dh import UrDh
 
 N_BRANCHES = 8
 # A solution whose |sin q5|, |sin q3| or shoulder lever (m) is below this is singular. acos near
