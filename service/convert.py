@@ -196,13 +196,17 @@ def wants_png(accept: str) -> bool:
     return "image/png" in media and "application/json" not in media
 
 
+def _api_placement(placement: Placement) -> schemas.Placement:
+    """The API's placement (m, rad) of a solver placement."""
+    return schemas.Placement(x=placement.x, y=placement.y, z=placement.z, yaw=placement.yaw)
+
+
 def _extreme(cmap: CapabilityMap, *, best: bool) -> schemas.MapExtreme | None:
     index = cmap.extreme(best=best)
     if index is None:
         return None
-    placement = cmap.placement(index)
     return schemas.MapExtreme(
-        placement=schemas.Placement(x=placement.x, y=placement.y, z=placement.z, yaw=placement.yaw),
+        placement=_api_placement(cmap.placement(index)),
         mu_path=float(cmap.mu_path[index]),
     )
 
@@ -238,10 +242,6 @@ def bounds_of(bounds: schemas.Bounds, *, z: float) -> PlacementBounds:
         yaw=(bounds.yaw[0], bounds.yaw[1]),
         z=z,
     )
-
-
-def _api_placement(placement: Placement) -> schemas.Placement:
-    return schemas.Placement(x=placement.x, y=placement.y, z=placement.z, yaw=placement.yaw)
 
 
 def optimize_response(

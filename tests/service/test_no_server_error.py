@@ -12,8 +12,8 @@ from fastapi.testclient import TestClient
 
 from service.main import app
 from service.schemas import DtfRequest, EvaluateRequest, MapRequest, OptimizeRequest
+from tests.service.test_errors import DELETE, changed
 
-DELETE = object()
 VALUES: list[Any] = [
     0,
     -1,
@@ -55,17 +55,10 @@ def _paths(value: Any, prefix: tuple = ()) -> Iterator[tuple]:
 
 
 def _mutate(body: Any, path: tuple, value: Any) -> Any:
+    """``body`` with the value at ``path`` replaced or deleted; the root path swaps the body."""
     if not path:
         return body if value is DELETE else value
-    body = copy.deepcopy(body)
-    parent = body
-    for key in path[:-1]:
-        parent = parent[key]
-    if value is DELETE:
-        del parent[path[-1]]
-    else:
-        parent[path[-1]] = value
-    return body
+    return changed(body, {path: value})
 
 
 @pytest.mark.parametrize("route", sorted(ROUTES))

@@ -12,11 +12,10 @@ from solver.capability_map import capability_map, grid_axis
 from solver.evaluate import evaluate_path
 from solver.exceptions import InvalidInputError
 from solver.ik.ur_analytic import BRANCHES, Branch
-from solver.kinematics import tool_pose_in_base
 from solver.robots import get_robot
 from solver.tracking import REASONS
 from tests.cases import MAP_EVALUATE_RTOL
-from tests.solver.test_evaluate import load_path
+from tests.solver.test_evaluate import load_path, wrist_singular_path
 
 
 def _compare_cells(robot, path, cmap, cells, **kwargs) -> set[str]:
@@ -163,10 +162,7 @@ def test_joint_limit_and_singular_cells_equal_evaluate() -> None:
     assert "joint_limits" in _compare_cells(limited, path, cmap, cells)
     # A path through the wrist singularity at the placement (0, 0, 0, 0).
     robot = get_robot("ur5e")
-    q_path = np.tile([0.3, -1.1, 1.2, -0.4, 0.0, 0.7], (5, 1))
-    q_path[:, 4] = np.linspace(-0.2, 0.2, 5)
-    q_path[:, 0] += np.linspace(0, 0.1, 5)
-    singular_path = np.array([tool_pose_in_base(robot, q) for q in q_path])
+    singular_path = wrist_singular_path(robot)
     kwargs = {"branch": Branch("left", "up", "flip")}
     cmap = capability_map(
         robot,

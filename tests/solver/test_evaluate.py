@@ -166,12 +166,17 @@ def test_two_pi_copy_is_chosen_to_fit_the_limits() -> None:
     np.testing.assert_allclose(result.q, base.q + TWO_PI, atol=1e-12)
 
 
+def wrist_singular_path(robot) -> np.ndarray:
+    """5 poses in {B} on branch (left, up, flip) whose wrist passes q5 = 0 at waypoint 2."""
+    q_path = np.tile([0.3, -1.1, 1.2, -0.4, 0.0, 0.7], (5, 1))
+    q_path[:, 4] = np.linspace(-0.2, 0.2, 5)
+    q_path[:, 0] += np.linspace(0, 0.1, 5)
+    return np.array([tool_pose_in_base(robot, q) for q in q_path])
+
+
 def test_singular_waypoint() -> None:
     robot = get_robot("ur5e")
-    q_path = np.tile([0.3, -1.1, 1.2, -0.4, 0.0, 0.7], (5, 1))
-    q_path[:, 4] = np.linspace(-0.2, 0.2, 5)  # the wrist passes q5 = 0 at waypoint 2
-    q_path[:, 0] += np.linspace(0, 0.1, 5)
-    path = np.array([tool_pose_in_base(robot, q) for q in q_path])
+    path = wrist_singular_path(robot)
     result = evaluate_path(robot, path, Placement(0, 0, 0, 0), branch=Branch("left", "up", "flip"))
     assert (result.reason, result.failed_waypoint) == ("singular", 2)
 
