@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import math
-from dataclasses import asdict, dataclass
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -62,7 +62,7 @@ def branch_of(choice: schemas.Branch | str) -> Branch | None:
     """The solver's branch label; ``None`` for ``"auto"``."""
     if isinstance(choice, str):
         return None
-    return Branch(shoulder=choice.shoulder, elbow=choice.elbow, wrist=choice.wrist)
+    return Branch.named(shoulder=choice.shoulder, elbow=choice.elbow, wrist=choice.wrist)
 
 
 def h_of(h: float | None) -> float:
@@ -140,7 +140,7 @@ def evaluate_response(evaluation: PathEvaluation, robot: Robot) -> schemas.Evalu
             joint=ev.bottleneck_joint,
             joint_name=robot.joint_names[ev.bottleneck_joint],
         )
-    branch = None if ev.branch is None else schemas.Branch.model_validate(asdict(ev.branch))
+    branch = None if ev.branch is None else schemas.Branch.model_validate(ev.branch.as_dict())
     return schemas.EvaluateResponse(
         feasible=ev.feasible,
         mu_path=ev.mu_path,

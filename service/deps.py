@@ -7,7 +7,8 @@ from typing import Annotated
 from fastapi import Depends
 
 from service.config import Settings, get_settings
-from solver.robots import Robot, catalogue
+from solver.families import catalogue
+from solver.robots import Robot
 
 SettingsDep = Annotated[Settings, Depends(get_settings)]
 CatalogueDep = Annotated[dict[str, Robot], Depends(catalogue)]

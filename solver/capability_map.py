@@ -14,7 +14,7 @@ import numpy as np
 
 from solver.evaluate import DEFAULT_MAX_JOINT_STEP
 from solver.exceptions import InvalidInputError
-from solver.ik.ur_analytic import Branch
+from solver.families.base import Branch
 from solver.placements import DEFAULT_CHUNK, evaluate_placements, prepare_path
 from solver.robots import Robot
 from solver.spatial import Placement
@@ -34,7 +34,7 @@ class CapabilityMap:
         mu_path: m/s, NaN where infeasible.
         reason: index into ``REASONS``, -1 where feasible.
         failed_waypoint: the first waypoint that fails, -1 where feasible.
-        branch: index into ``solver.ik.ur_analytic.BRANCHES`` of the branch used.
+        branch: index into the robot family's ``branches`` of the branch used.
         bottleneck_waypoint: where V_max is smallest, -1 where infeasible.
         bottleneck_joint: the joint on its limit there, -1 where infeasible.
     """
@@ -115,7 +115,7 @@ def capability_map(
     """mu_path over the grid xs x ys x yaws at height z (spec section 6).
 
     Args:
-        robot: a UR arm of the catalogue, with its speed limits and TCP.
+        robot: an arm with a kinematics family, with its speed limits and TCP.
         waypoints_in_workpiece: shape (N, 4, 4), T_O_i (metres).
         xs: shape (nx,), m, placement x values.
         ys: shape (ny,), m, placement y values.

@@ -13,7 +13,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from solver.exceptions import InvalidInputError
-from solver.placements import PreparedPath, evaluate_placements
+from solver.pipeline import PreparedPath
+from solver.placements import evaluate_placements
 from solver.robots import Robot
 from solver.spatial import MAX_COORDINATE
 from solver.symmetry import PlacementBounds, arc_point

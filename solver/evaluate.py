@@ -5,30 +5,31 @@ continuously along the path (no branch switch, no joint moving more than ``max_j
 between neighbours, no singular configuration) and within the joint position limits, each joint
 taken with the 2 pi copy that fits (:mod:`solver.tracking`). Then mu_path = min_i V_max(i) is
 the highest constant feed rate at which no joint exceeds its speed limit anywhere on the path.
-This evaluator takes its Jacobians from pinocchio; the capability map shares its IK and
-tracking but not its Jacobians, so the two check each other.
+This is the pipeline of :mod:`solver.pipeline` at one placement, with every waypoint's detail on
+the chosen branch.
 """
 
 from __future__ import annotations
 
-import math
+import dataclasses
 from dataclasses import dataclass
 
 import numpy as np
 
-from solver.dtf import closed_form_batch
-from solver.exceptions import InvalidInputError, NoAnalyticIkError
-from solver.ik.ur_analytic import BRANCHES, Branch, branch_index, solve_components
-from solver.kinematics import jacobian_in_base
+from solver.families.base import Branch
+from solver.pipeline import (
+    DEFAULT_MAX_JOINT_STEP,
+    check_max_joint_step,
+    check_placements,
+    prepare_path,
+    require_family,
+    run_chunk,
+)
 from solver.robots import Robot
 from solver.spatial import Placement
-from solver.task import TaskRequirements, task_requirements
-from solver.tracking import FEASIBLE, REASONS, Reason, choose_branch, track
-from solver.ur_dh import UrDh
+from solver.tracking import FEASIBLE, REASONS, Reason
 
 __all__ = ["Branch", "PathEvaluation", "evaluate_path", "DEFAULT_MAX_JOINT_STEP"]
-
-DEFAULT_MAX_JOINT_STEP = 0.35
 
 
 @dataclass(frozen=True)
@@ -66,33 +67,12 @@ class PathEvaluation:
     limiting_joint: np.ndarray | None = None
 
 
-def check_max_joint_step(max_joint_step: float) -> None:
-    """Raise InvalidInputError unless the step is finite and > 0 (rad)."""
-    if not (math.isfinite(max_joint_step) and max_joint_step > 0.0):
-        raise InvalidInputError("ik.max_joint_step", f"{max_joint_step!r} rad must be > 0")
-
-
-def require_analytic_ik(robot: Robot) -> UrDh:
-    """The robot's DH parameters for the analytic IK; NoAnalyticIkError when it has none."""
-    if robot.dh is None:
-        raise NoAnalyticIkError(
-            "robot", f"path evaluation needs a UR arm with analytic IK; {robot.name!r} has none"
-        )
-    return robot.dh
-
-
-def _speeds(
-    robot: Robot, q_path: np.ndarray, requirements: TaskRequirements
-) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    """DTF along a joint path: V_max, Omega_max, qdot and the limiting joint per waypoint."""
-    jacobians = np.array([jacobian_in_base(robot, q) for q in q_path])
-    speed, qdot, limiting = closed_form_batch(jacobians, requirements.twists(), robot.qdot_max)
-    h = requirements.h
-    pure_rotation = h == 0.0
-    v_max = np.where(pure_rotation, 0.0, speed)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        omega_max = np.where(pure_rotation, speed, np.where(np.isinf(h), 0.0, speed / h))
-    return v_max, omega_max, qdot, limiting
+def _turned(vectors: np.ndarray, yaw: float) -> np.ndarray:
+    """Rz(yaw) v for vectors of shape (N, 3)."""
+    c, s = np.cos(yaw), np.sin(yaw)
+    turn = np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
+    out: np.ndarray = vectors @ turn.T
+    return out
 
 
 def evaluate_path(
@@ -106,7 +86,7 @@ def evaluate_path(
     """mu_path of a path at a placement (spec sections 1-4).
 
     Args:
-        robot: a UR arm of the catalogue (it needs ``robot.dh``), with its speed limits and TCP.
+        robot: an arm with a kinematics family (UR, OPW), with its speed limits and TCP.
         waypoints_in_workpiece: shape (N, 4, 4), T_O_i, tool point poses in {O} (metres).
         placement: where {O} sits in {B}.
         branch: the IK branch to follow; ``None`` is ``auto``, the feasible branch with the
@@ -114,55 +94,53 @@ def evaluate_path(
         max_joint_step: rad, > 0, the largest move of any joint between neighbouring waypoints.
 
     Raises:
-        NoAnalyticIkError: the robot has no analytic IK.
-        InvalidInputError: a bad path or step.
+        NoAnalyticIkError: the robot has no kinematics family.
+        InvalidInputError: a bad path, step or branch name.
         RepeatedWaypointError: two consecutive waypoints are the same pose.
     """
-    dh = require_analytic_ik(robot)
+    family = require_family(robot)
     check_max_joint_step(max_joint_step)
-    workpiece_to_base = placement.transform_workpiece_to_base()
-    poses = workpiece_to_base @ np.asarray(waypoints_in_workpiece, dtype=float)
-    requirements = task_requirements(poses)
-    flange = poses @ np.linalg.inv(robot.transform_tool_to_tcp)
-    q_all, status = solve_components(dh, np.moveaxis(flange[:, :3, :3], 0, -1), flange[:, :3, 3].T)
-    tracked = track(
-        q_all,
-        status,
-        lower=robot.q_lower,
-        upper=robot.q_upper,
-        max_joint_step=max_joint_step,
+    cell = check_placements(np.array([[placement.x, placement.y, placement.z, placement.yaw]]))
+    path = prepare_path(robot, waypoints_in_workpiece)
+    indices = (
+        np.arange(len(family.branches))
+        if branch is None
+        else np.array([family.branch_index(branch)])
     )
-    indices = np.arange(len(BRANCHES)) if branch is None else np.array([branch_index(branch)])
-    feasible = tracked.reason[indices] == FEASIBLE
-    speeds = {int(b): _speeds(robot, tracked.q[:, b].T, requirements) for b in indices[feasible]}
-    mu_branch = np.array([np.min(speeds[b][0]) if b in speeds else np.nan for b in indices])
-    b = int(indices[choose_branch(mu_branch, feasible, tracked.failed_waypoint[indices])])
-    common = {"u_T": requirements.u_T, "u_R": requirements.u_R, "h": requirements.h}
-    if b not in speeds:
-        return PathEvaluation(
-            feasible=False,
-            mu_path=None,
-            bottleneck_waypoint=None,
-            bottleneck_joint=None,
-            reason=REASONS[int(tracked.reason[b])],
-            failed_waypoint=int(tracked.failed_waypoint[b]),
-            branch=BRANCHES[b],
-            **common,
+    run = run_chunk(robot, path, cell, indices, max_joint_step=max_joint_step)
+    pick = int(run.pick[0])
+    reason = int(run.tracked.reason[pick, 0])
+    infeasible = PathEvaluation(
+        feasible=False,
+        mu_path=None,
+        bottleneck_waypoint=None,
+        bottleneck_joint=None,
+        reason=REASONS[reason] if reason != FEASIBLE else None,
+        failed_waypoint=int(run.tracked.failed_waypoint[pick, 0]),
+        branch=family.branches[int(indices[pick])],
+        u_T=_turned(path.u_T, placement.yaw),
+        u_R=_turned(path.u_R, placement.yaw),
+        h=path.h,
+    )
+    if reason != FEASIBLE:
+        return infeasible
+    speed, v_max = run.speed[pick, 0], run.v_max[pick, 0]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        omega_max = np.where(
+            path.pure_rotation, speed, np.where(np.isinf(path.h), 0.0, speed / path.h)
         )
-    v_max, omega_max, qdot, limiting = speeds[b]
+    limiting = run.limiting[pick, 0]
     bottleneck = int(np.argmin(v_max))
-    return PathEvaluation(
+    return dataclasses.replace(
+        infeasible,
         feasible=True,
         mu_path=float(v_max[bottleneck]),
         bottleneck_waypoint=bottleneck,
         bottleneck_joint=int(limiting[bottleneck]),
-        reason=None,
         failed_waypoint=None,
-        branch=BRANCHES[b],
-        q=tracked.q[:, b].T,
+        q=run.tracked.q[:, pick, 0].T,
         v_max=v_max,
         omega_max=omega_max,
-        qdot=qdot,
+        qdot=(run.qd_unit[:, pick, 0] * speed).T,
         limiting_joint=limiting,
-        **common,
     )

@@ -59,4 +59,4 @@ class RobotModelError(SolverError):
 
 
 class NoAnalyticIkError(SolverError):
-    """Path evaluation needs an arm with an analytic IK (a UR arm from the catalogue)."""
+    """Path evaluation needs an arm with a kinematics family (a UR or OPW arm)."""

@@ -28,10 +28,9 @@ import numpy as np
 from solver.coarse_search import MAX_COARSE_CELLS, Cell, coarse_cells
 from solver.evaluate import DEFAULT_MAX_JOINT_STEP, PathEvaluation, evaluate_path
 from solver.exceptions import InvalidInputError
-from solver.ik.ur_analytic import BRANCHES
+from solver.pipeline import PreparedPath, prepare_path, require_family
 from solver.placement_nlp import PlacementNlp
 from solver.placement_scipy import global_search, polish
-from solver.placements import PreparedPath, prepare_path
 from solver.robots import Robot
 from solver.spatial import MAX_COORDINATE, Placement
 from solver.symmetry import PlacementBounds, arc_coordinates, arc_point, turns_about_base_z
@@ -117,7 +116,7 @@ def optimize_placement(
     """The placement inside ``bounds`` where the path runs fastest.
 
     Args:
-        robot: a UR arm of the catalogue, with its speed limits and TCP.
+        robot: an arm with a kinematics family, with its speed limits and TCP.
         waypoints_in_workpiece: shape (N, 4, 4), T_O_i (metres).
         bounds: x, y, yaw ranges and the height z.
         start: the start placement (default: the centre of the bounds), reported with its
@@ -213,7 +212,7 @@ def _casadi(
             robot,
             path,
             Placement(x, y, bounds.z, yaw),
-            branch=BRANCHES[cell.branch],
+            branch=require_family(robot).branches[cell.branch],
             max_joint_step=max_joint_step,
         )
         if at_start.q is None or at_start.qdot is None or at_start.v_max is None:
@@ -249,7 +248,7 @@ def _scipy(
             bounds,
             placement,
             mu_path,
-            BRANCHES[branch],
+            require_family(robot).branches[branch],
             max_joint_step=max_joint_step,
         )
         candidates.append(polished)

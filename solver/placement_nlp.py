@@ -24,7 +24,7 @@ import casadi
 import numpy as np
 
 from solver.casadi_kinematics import symbolic_kinematics
-from solver.placements import PreparedPath
+from solver.pipeline import PreparedPath
 from solver.robots import Robot
 from solver.symmetry import PlacementBounds
 

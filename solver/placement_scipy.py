@@ -12,7 +12,7 @@ from __future__ import annotations
 import numpy as np
 import scipy.optimize
 
-from solver.ik.ur_analytic import Branch
+from solver.families.base import Branch
 from solver.placements import PreparedPath, evaluate_placements
 from solver.robots import Robot
 from solver.symmetry import PlacementBounds

@@ -1,23 +1,16 @@
-"""Robot models: the catalogue of UR arms and robots read from a URDF.
+"""Robot models: a pinocchio chain with its base frame, tool point, limits and IK family.
 
 A :class:`Robot` wraps a pinocchio model with the two frames the method needs: the base frame
 {B} in which poses and twists are expressed, and the tool point {TCP} (the tool frame {F} times
-an optional offset T_F_TCP). For UR arms {B} is the controller's ``base`` frame (the URDF's
-``base_link`` turned by pi about z, and the frame of the DH parameters) and {F} is the flange
-``tool0``.
-
-The CB-series arms (ur3, ur5, ur10) are the example-robot-data URDFs, loaded by path. No URDF
-ships for the e-series, so ur3e, ur5e, ur10e and ur16e are built from their published nominal DH
-parameters (spec section 8).
+an optional offset T_F_TCP), plus the kinematics family that solves its IK (robots.md section 1).
+The catalogue is built by the families (:mod:`solver.families`); this module reads URDFs and
+checks limits.
 """
 
 from __future__ import annotations
 
 import dataclasses
-import functools
 import importlib.metadata
-import math
-import re
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -25,7 +18,8 @@ import numpy as np
 import pinocchio as pin
 
 from solver.exceptions import InvalidInputError, RobotModelError, UnknownRobotError
-from solver.ur_dh import E_SERIES_SPEEDS, UR_DH, UrDh, ur_model_from_dh
+from solver.families import catalogue
+from solver.families.base import KinematicsFamily
 
 # Joint speed limits outside this range (rad/s) are input errors: no arm is that slow or fast,
 # and the LP solver treats bounds past 1e20 as infinite.
@@ -48,7 +42,8 @@ class Robot:
         qdot_max: shape (n,), rad/s, joint speed limits (all > 0).
         transform_tool_to_tcp: shape (4, 4), the tool point in the tool frame, T_F_TCP.
         transform_world_to_base: shape (4, 4), {B} in the model's root frame (fixed).
-        dh: the analytic-IK parameters when the arm is a UR, else ``None``.
+        family: the kinematics family that solves its IK and J^-1 t (robots.md section 1);
+            ``None`` for a robot that only has a pinocchio model (``/v1/dtf`` only).
     """
 
     name: str
@@ -61,7 +56,7 @@ class Robot:
     qdot_max: np.ndarray
     transform_tool_to_tcp: np.ndarray
     transform_world_to_base: np.ndarray
-    dh: UrDh | None = None
+    family: KinematicsFamily | None = None
 
     @property
     def dof(self) -> int:
@@ -141,16 +136,29 @@ def _set_tool_point(model: pin.Model, tool_frame: str, transform_tool_to_tcp: np
         model.addFrame(pin.Frame("tool_point", tool.parentJoint, placement, pin.FrameType.OP_FRAME))
 
 
-def _robot_from_model(
+def robot_from_model(
     name: str,
     model: pin.Model,
     *,
     base_frame: str,
     tool_frame: str,
     qdot_max: np.ndarray | list[float] | None = None,
-    dh: UrDh | None = None,
+    family: KinematicsFamily | None = None,
 ) -> Robot:
-    """Check the frames of ``model`` and wrap it as a :class:`Robot`."""
+    """Check the frames of ``model`` and wrap it as a :class:`Robot`.
+
+    Args:
+        name: name reported for the robot.
+        model: pinocchio model of the chain (1-DOF joints only).
+        base_frame: frame {B}, fixed to the root.
+        tool_frame: the flange frame {F}.
+        qdot_max: shape (n,), rad/s; ``None`` takes the model's velocity limits.
+        family: the kinematics family, when the arm has one.
+
+    Raises:
+        RobotModelError: a frame is missing or moves, a joint is not 1-DOF, or the model's
+            speed limits are unusable and none are given.
+    """
     for field, frame in (("robot.base_frame", base_frame), ("robot.tool_frame", tool_frame)):
         if not model.existFrame(frame):
             names = ", ".join(f.name for f in model.frames if f.name != "universe")
@@ -191,7 +199,7 @@ def _robot_from_model(
         qdot_max=limits,
         transform_tool_to_tcp=np.eye(4),
         transform_world_to_base=transform_world_to_base,
-        dh=dh,
+        family=family,
     )
     return robot
 
@@ -203,6 +211,7 @@ def robot_from_urdf(
     tool_frame: str,
     name: str = "urdf",
     qdot_max: np.ndarray | list[float] | None = None,
+    family: KinematicsFamily | None = None,
 ) -> Robot:
     """Read a serial arm from URDF text.
 
@@ -216,6 +225,7 @@ def robot_from_urdf(
         name: name reported for the robot.
         qdot_max: shape (n,), rad/s, joint speed limits; ``None`` takes the URDF's (which then
             must be usable).
+        family: the kinematics family of the arm, when it has one.
 
     Raises:
         RobotModelError: the URDF cannot be parsed, a frame is missing, or the chain has
@@ -236,8 +246,8 @@ def robot_from_urdf(
     model = pin.buildReducedModel(full, locked, pin.neutral(full)) if locked else full
     if model.nv == 0:
         raise RobotModelError("robot.tool_frame", f"no joint moves frame {tool_frame!r}")
-    return _robot_from_model(
-        name, model, base_frame=base_frame, tool_frame=tool_frame, qdot_max=qdot_max
+    return robot_from_model(
+        name, model, base_frame=base_frame, tool_frame=tool_frame, qdot_max=qdot_max, family=family
     )
 
 
@@ -249,47 +259,6 @@ def example_robot_data_dir() -> Path:
     """
     dist = importlib.metadata.distribution("example-robot-data")
     return Path(str(dist.locate_file("cmeel.prefix/share/example-robot-data/robots")))
-
-
-def _exact_right_angles(urdf: str) -> str:
-    """Restore pi/2 and pi in the joint orientations (rpy) where the UR URDFs round them.
-
-    ``rpy="0.0 1.57079632679 0.0"`` is pi/2 - 5e-12: the chain then misses the DH chain (and the
-    controller) by ~1e-11 m, which near a singularity grows to ~1e-9 relative in J^-1. Joint
-    limits are left as written.
-    """
-    exact = {"1.57079632679": math.pi / 2, "3.14159265359": math.pi}
-
-    def fix(match: re.Match[str]) -> str:
-        values = []
-        for token in match.group(1).split():
-            sign, digits = ("-", token[1:]) if token.startswith("-") else ("", token)
-            values.append(f"{sign}{exact[digits]!r}" if digits in exact else token)
-        return f'rpy="{" ".join(values)}"'
-
-    return re.sub(r'rpy="([^"]*)"', fix, urdf)
-
-
-@functools.cache
-def catalogue() -> dict[str, Robot]:
-    """All robots of the catalogue by name, built once."""
-    robots: dict[str, Robot] = {}
-    for name in ("ur3", "ur5", "ur10"):
-        path = example_robot_data_dir() / "ur_description" / "urdf" / f"{name}_robot.urdf"
-        urdf = _exact_right_angles(path.read_text())
-        robot = robot_from_urdf(urdf, base_frame="base", tool_frame="tool0", name=name)
-        robots[name] = dataclasses.replace(robot, dh=UR_DH[name])
-    for name, speeds in E_SERIES_SPEEDS.items():
-        model = ur_model_from_dh(UR_DH[name])
-        robots[name] = _robot_from_model(
-            name,
-            model,
-            base_frame="base",
-            tool_frame="tool0",
-            qdot_max=np.array(speeds),
-            dh=UR_DH[name],
-        )
-    return robots
 
 
 def get_robot(name: str) -> Robot:

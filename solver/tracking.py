@@ -6,7 +6,7 @@ unwrapped, fits inside its position limits with some 2 pi copy. The first failur
 waypoint; at one waypoint ``unreachable`` comes before ``singular`` before ``discontinuous``,
 and ``joint_limits`` is the first waypoint whose joint range no copy can hold.
 
-Layout: joint axis first, waypoints last: q (6, *batch, W).
+Layout: joint axis first, waypoints last: q (n, *batch, W), for any number of joints n.
 """
 
 from __future__ import annotations
@@ -17,7 +17,7 @@ from typing import Literal
 
 import numpy as np
 
-from solver.ik.ur_analytic import SINGULAR, UNREACHABLE
+from solver.families.base import SINGULAR, UNREACHABLE
 
 Reason = Literal["unreachable", "joint_limits", "singular", "discontinuous"]
 REASONS: tuple[Reason, ...] = ("unreachable", "joint_limits", "singular", "discontinuous")
@@ -34,7 +34,7 @@ class Tracked:
     Attributes:
         reason: shape batch, index into ``REASONS``, or ``FEASIBLE``.
         failed_waypoint: shape batch, the first failing waypoint, or -1.
-        q: shape (6, *batch, W), rad, the continuous joint paths with the 2 pi copy that fits the
+        q: shape (n, *batch, W), rad, the continuous joint paths with the 2 pi copy that fits the
             limits (the first waypoint nearest zero among those that fit); meaningful only where
             feasible.
     """
@@ -61,10 +61,10 @@ def track(
     """Follow IK branches along a path.
 
     Args:
-        q: shape (6, *batch, W), rad in [-pi, pi), each branch's solution at every waypoint.
+        q: shape (n, *batch, W), rad in [-pi, pi], each branch's solution at every waypoint.
         status: shape (*batch, W), the IK status of those solutions.
-        lower: shape (6,), rad, lower position limits.
-        upper: shape (6,), rad, upper position limits.
+        lower: shape (n,), rad, lower position limits.
+        upper: shape (n,), rad, upper position limits.
         max_joint_step: rad, the largest move of any joint between neighbouring waypoints.
 
     Returns:
@@ -85,8 +85,8 @@ def track(
     )
     first[_DISCONTINUOUS] = np.where(jump.any(axis=-1), first[_DISCONTINUOUS], n_waypoints)
     path = np.concatenate([q[..., :1], q[..., :1] + np.cumsum(step, axis=-1)], axis=-1)
-    lower_b = lower.reshape((6,) + (1,) * (q.ndim - 2))
-    upper_b = upper.reshape((6,) + (1,) * (q.ndim - 2))
+    lower_b = lower.reshape((-1,) + (1,) * (q.ndim - 2))
+    upper_b = upper.reshape((-1,) + (1,) * (q.ndim - 2))
     # The copies 2 pi k that fit the whole path: k_low <= k <= k_high, per joint.
     k_low = np.ceil((lower_b - path.min(axis=-1)) / _TWO_PI - _EDGE)
     k_high = np.floor((upper_b - path.max(axis=-1)) / _TWO_PI + _EDGE)
@@ -95,7 +95,7 @@ def track(
     # copy fits the whole path, the running range finds the first waypoint that breaks it.
     no_fit = np.flatnonzero(np.any(k_low > k_high, axis=0) & (other == n_waypoints))
     if no_fit.size:
-        flat = path.reshape(6, -1, n_waypoints)[:, no_fit]
+        flat = path.reshape(len(q), -1, n_waypoints)[:, no_fit]
         running_low = np.ceil(
             (lower[:, None, None] - np.minimum.accumulate(flat, axis=-1)) / _TWO_PI - _EDGE
         )
@@ -128,8 +128,8 @@ def choose_branch(
 ) -> np.ndarray:
     """The ``auto`` branch: the highest mu_path, or the furthest failure when none is feasible.
 
-    Ties (within ``TIE_RTOL``) go to the first branch in ``BRANCHES`` order, so the choice does
-    not depend on rounding.
+    Ties (within ``TIE_RTOL``) go to the first branch in the family's order, so the choice
+    does not depend on rounding.
 
     Args:
         mu_path: shape (B, *batch), m/s (any value where infeasible).

@@ -176,13 +176,16 @@ class Placement(RequestModel):
 
 
 class Branch(RequestModel):
-    """A named inverse-kinematics branch of a UR arm."""
+    """A named inverse-kinematics branch: UR arms shoulder left/right, OPW arms front/back."""
 
     model_config = ConfigDict(
         json_schema_extra={"examples": [{"shoulder": "left", "elbow": "up", "wrist": "noflip"}]}
     )
 
-    shoulder: Literal["left", "right"] = Field(description="Shoulder choice (joint 1).")
+    shoulder: Literal["left", "right", "front", "back"] = Field(
+        description="Shoulder choice (joint 1): left or right for UR arms, front or back for "
+        "OPW arms (GET /v1/robots lists each robot's branches)."
+    )
     elbow: Literal["up", "down"] = Field(description="Elbow choice (joint 3).")
     wrist: Literal["flip", "noflip"] = Field(description="Wrist choice (joint 5).")
 

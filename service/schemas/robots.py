@@ -8,7 +8,7 @@ from pydantic import ConfigDict, Field
 from pydantic.config import JsonDict
 
 from service.schemas.common import ResponseModel
-from solver.ur_dh import UR_JOINT_NAMES
+from solver.families.ur.dh import UR_JOINT_NAMES
 
 _UR5E_EXAMPLE: JsonDict = {
     "name": "ur5e",

@@ -11,7 +11,8 @@ import pytest
 from solver.capability_map import capability_map, grid_axis
 from solver.evaluate import evaluate_path
 from solver.exceptions import InvalidInputError
-from solver.ik.ur_analytic import BRANCHES, Branch
+from solver.families.base import Branch
+from solver.families.ur.ik import BRANCHES
 from solver.robots import get_robot
 from solver.tracking import REASONS
 from tests.cases import MAP_EVALUATE_RTOL
@@ -71,7 +72,10 @@ def test_random_cells_equal_evaluate(robot_name: str, path_name: str) -> None:
 def test_a_named_branch_and_a_small_step() -> None:
     robot = get_robot("ur5e")
     path = load_path("curved_line")
-    kwargs = {"branch": Branch("right", "down", "flip"), "max_joint_step": 0.05}
+    kwargs = {
+        "branch": Branch.named(shoulder="right", elbow="down", wrist="flip"),
+        "max_joint_step": 0.05,
+    }
     cmap = capability_map(
         robot,
         path,
@@ -163,7 +167,7 @@ def test_joint_limit_and_singular_cells_equal_evaluate() -> None:
     # A path through the wrist singularity at the placement (0, 0, 0, 0).
     robot = get_robot("ur5e")
     singular_path = wrist_singular_path(robot)
-    kwargs = {"branch": Branch("left", "up", "flip")}
+    kwargs = {"branch": Branch.named(shoulder="left", elbow="up", wrist="flip")}
     cmap = capability_map(
         robot,
         singular_path,

@@ -13,7 +13,7 @@ from scipy.spatial.transform import Rotation
 
 from solver.evaluate import Branch, evaluate_path
 from solver.exceptions import InvalidInputError, NoAnalyticIkError, RepeatedWaypointError
-from solver.ik.ur_analytic import BRANCHES, wrap_angle
+from solver.families.ur.ik import BRANCHES, wrap_angle
 from solver.kinematics import jacobian_in_base, tool_pose_in_base
 from solver.robots import example_robot_data_dir, get_robot, robot_from_urdf
 from solver.spatial import Placement, pose_matrix
@@ -139,7 +139,9 @@ def test_discontinuous_when_the_step_is_too_small() -> None:
 def test_joint_limits_name_the_first_waypoint_out_of_range() -> None:
     robot = get_robot("ur5e")
     path = load_path("curved_line")
-    free = evaluate_path(robot, path, PLACEMENT, branch=Branch("left", "up", "noflip"))
+    free = evaluate_path(
+        robot, path, PLACEMENT, branch=Branch.named(shoulder="left", elbow="up", wrist="noflip")
+    )
     q1 = free.q[:, 0]
     # Limits on q1 that the first 40 waypoints fit but waypoint 40 leaves, whichever 2 pi copy.
     lower, upper = robot.q_lower.copy(), robot.q_upper.copy()
@@ -150,7 +152,9 @@ def test_joint_limits_name_the_first_waypoint_out_of_range() -> None:
         lower[0], upper[0] = (first.min() + q1[40]) / 2, first.max() + 1e-9
     assert abs(q1[40] - q1[39]) > 1e-6
     limited = dataclasses.replace(robot, q_lower=lower, q_upper=upper)
-    result = evaluate_path(limited, path, PLACEMENT, branch=Branch("left", "up", "noflip"))
+    result = evaluate_path(
+        limited, path, PLACEMENT, branch=Branch.named(shoulder="left", elbow="up", wrist="noflip")
+    )
     assert (result.feasible, result.reason, result.failed_waypoint) == (False, "joint_limits", 40)
 
 
@@ -177,7 +181,12 @@ def wrist_singular_path(robot) -> np.ndarray:
 def test_singular_waypoint() -> None:
     robot = get_robot("ur5e")
     path = wrist_singular_path(robot)
-    result = evaluate_path(robot, path, Placement(0, 0, 0, 0), branch=Branch("left", "up", "flip"))
+    result = evaluate_path(
+        robot,
+        path,
+        Placement(0, 0, 0, 0),
+        branch=Branch.named(shoulder="left", elbow="up", wrist="flip"),
+    )
     assert (result.reason, result.failed_waypoint) == ("singular", 2)
 
 

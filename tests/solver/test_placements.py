@@ -11,7 +11,7 @@ import pytest
 from solver._malloc import raise_malloc_thresholds
 from solver.evaluate import evaluate_path
 from solver.exceptions import InvalidInputError
-from solver.ik.ur_analytic import BRANCHES
+from solver.families.ur.ik import BRANCHES
 from solver.placements import evaluate_placements, prepare_path
 from solver.robots import get_robot
 from solver.spatial import Placement

@@ -10,7 +10,7 @@ import pytest
 import ur_analytic_ik
 
 from solver.exceptions import InvalidInputError, RobotModelError, UnknownRobotError
-from solver.ik.ur_analytic import forward_kinematics_dh
+from solver.families.ur.ik import forward_kinematics_dh
 from solver.kinematics import jacobian_in_base, tool_pose_in_base
 from solver.robots import catalogue, example_robot_data_dir, get_robot, robot_from_urdf
 from tests.cases import CB_URDF_VS_DH_ATOL, E_SERIES, FK_IK_ATOL, UR_MODELS
@@ -60,7 +60,7 @@ def test_fk_equals_ur_analytic_ik(name: str) -> None:
 def test_pinocchio_chain_equals_dh_chain(name: str) -> None:
     robot = get_robot(name)
     q = np.random.default_rng(3).uniform(-math.pi, math.pi, (100, 6))
-    dh_poses = forward_kinematics_dh(robot.dh, q)
+    dh_poses = forward_kinematics_dh(robot.family.dh, q)
     for qi, pose in zip(q, dh_poses, strict=True):
         np.testing.assert_allclose(tool_pose_in_base(robot, qi), pose, atol=CB_URDF_VS_DH_ATOL)
 

@@ -32,12 +32,11 @@ from __future__ import annotations
 
 import itertools
 import math
-from dataclasses import dataclass
-from typing import Literal
 
 import numpy as np
 
-from solver.ur_dh import UrDh
+from solver.families.base import OK, SINGULAR, UNREACHABLE, Branch
+from solver.families.ur.dh import UrDh
 
 N_BRANCHES = 8
 # A solution whose |sin q5|, |sin q3| or shoulder lever (m) is below this is singular. acos near
@@ -47,37 +46,13 @@ SINGULAR_TOLERANCE = 1e-7
 # A cosine computed as 1 + rounding error still has its (singular) solution.
 REACH_TOLERANCE = 1e-10
 
-# Status codes of a (pose, branch) solution.
-OK = 0
-UNREACHABLE = 1
-SINGULAR = 2
-
-
-Shoulder = Literal["left", "right"]
-Elbow = Literal["up", "down"]
-Wrist = Literal["noflip", "flip"]
-
-
-@dataclass(frozen=True)
-class Branch:
-    """Name of an IK branch of a UR arm (the signs are in the module docstring)."""
-
-    shoulder: Shoulder
-    elbow: Elbow
-    wrist: Wrist
-
-
-_SHOULDERS: tuple[Shoulder, ...] = ("left", "right")
-_ELBOWS: tuple[Elbow, ...] = ("up", "down")
-_WRISTS: tuple[Wrist, ...] = ("noflip", "flip")
+_SHOULDERS = ("left", "right")
+_ELBOWS = ("up", "down")
+_WRISTS = ("noflip", "flip")
 BRANCHES: tuple[Branch, ...] = tuple(
-    Branch(s, e, w) for s, e, w in itertools.product(_SHOULDERS, _ELBOWS, _WRISTS)
+    Branch.named(shoulder=s, elbow=e, wrist=w)
+    for s, e, w in itertools.product(_SHOULDERS, _ELBOWS, _WRISTS)
 )
-
-
-def branch_index(label: Branch) -> int:
-    """Index 0..7 of a branch label, as used on axis 1 of :func:`solve_batch`."""
-    return BRANCHES.index(label)
 
 
 def wrap_angle(angle: np.ndarray) -> np.ndarray:

@@ -9,7 +9,6 @@ import pytest
 
 from solver.kinematics import jacobian_in_base, tool_pose_in_base
 from solver.robots import get_robot
-from solver.ur_jacobian import joint_speeds_per_unit_twist
 from tests.cases import UR_MODELS
 
 
@@ -22,7 +21,7 @@ def test_equals_solve_with_pinocchio_jacobian(name: str) -> None:
     q = rng.uniform(-math.pi, math.pi, (300, 6))
     twists = rng.normal(size=(300, 6))
     points = np.array([tool_pose_in_base(robot, qi)[:3, 3] for qi in q])
-    ours = joint_speeds_per_unit_twist(robot.dh, q.T, twists.T, points.T).T
+    ours = robot.family.joint_speeds_per_unit_twist(q.T, twists.T, points.T).T
     for qi, twist, speeds in zip(q, twists, ours, strict=True):
         jacobian = jacobian_in_base(robot, qi)
         expected = np.linalg.solve(jacobian, twist)

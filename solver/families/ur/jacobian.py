@@ -18,7 +18,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from solver.ur_dh import UrDh
+from solver.families.ur.dh import UrDh
 
 
 def joint_speeds_per_unit_twist(

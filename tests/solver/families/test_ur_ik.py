@@ -8,16 +8,8 @@ import numpy as np
 import pytest
 import ur_analytic_ik
 
-from solver.ik.ur_analytic import (
-    BRANCHES,
-    OK,
-    UNREACHABLE,
-    Branch,
-    branch_index,
-    joint_copies,
-    solve_batch,
-    wrap_angle,
-)
+from solver.families.base import OK, UNREACHABLE, Branch
+from solver.families.ur.ik import BRANCHES, joint_copies, solve_batch, wrap_angle
 from solver.kinematics import jacobian_in_base, tool_pose_in_base
 from solver.robots import get_robot
 from tests.cases import FK_IK_ATOL, UR_MODELS
@@ -37,7 +29,7 @@ def test_fk_of_every_solution_is_the_pose(name: str) -> None:
     """Issue 2: FK(IK(T)) = T to 1e-9 for every solution, over 1000 random reachable poses."""
     robot = get_robot(name)
     poses, _ = _random_reachable_poses(name, seed=1)
-    q, status = solve_batch(robot.dh, poses)
+    q, status = solve_batch(robot.family.dh, poses)
     solved = status != UNREACHABLE
     assert solved.sum() >= 4 * N_POSES  # a random pose has 4 to 8 solutions
     worst = 0.0
@@ -51,7 +43,7 @@ def test_every_reference_solution_is_among_ours(name: str) -> None:
     """Issue 2: every solution of ur-analytic-ik is one of ours (or its 2 pi copy)."""
     robot = get_robot(name)
     poses, q_true = _random_reachable_poses(name, seed=2)
-    q, status = solve_batch(robot.dh, poses)
+    q, status = solve_batch(robot.family.dh, poses)
     reference = getattr(ur_analytic_ik, name)
     for i, pose in enumerate(poses):
         theirs = reference.inverse_kinematics(pose)
@@ -65,7 +57,7 @@ def test_every_reference_solution_is_among_ours(name: str) -> None:
 def test_unreachable_pose_has_no_solution() -> None:
     pose = np.eye(4)
     pose[:3, 3] = [2.0, 0.0, 0.3]  # 2 m away: beyond every UR5e
-    q, status = solve_batch(get_robot("ur5e").dh, pose[None])
+    q, status = solve_batch(get_robot("ur5e").family.dh, pose[None])
     assert np.all(status == UNREACHABLE)
     assert np.all(np.isnan(q))
 
@@ -74,7 +66,7 @@ def test_wrist_singular_pose_is_flagged() -> None:
     robot = get_robot("ur5e")
     q_singular = np.array([0.3, -1.1, 1.2, -0.4, 0.0, 0.7])  # q5 = 0: axes 4 and 6 aligned
     assert abs(np.linalg.det(jacobian_in_base(robot, q_singular))) < 1e-12
-    _, status = solve_batch(robot.dh, tool_pose_in_base(robot, q_singular)[None])
+    _, status = solve_batch(robot.family.dh, tool_pose_in_base(robot, q_singular)[None])
     assert np.any(status[0] == 2)
 
 
@@ -82,17 +74,20 @@ def test_branch_labels_are_sign_patterns() -> None:
     """Shoulder, elbow and wrist labels follow the signs documented in the module."""
     robot = get_robot("ur5e")
     poses, _ = _random_reachable_poses("ur5e", seed=4)
-    q, status = solve_batch(robot.dh, poses)
+    q, status = solve_batch(robot.family.dh, poses)
     for b, label in enumerate(BRANCHES):
         ok = status[:, b] == OK
-        assert branch_index(label) == b
-        wrist_sign = 1.0 if label.wrist == "noflip" else -1.0
+        assert robot.family.branch_index(label) == b
+        names = label.as_dict()
+        wrist_sign = 1.0 if names["wrist"] == "noflip" else -1.0
         assert np.all(np.sign(q[ok, b, 4]) == wrist_sign)
-        shoulder_sign = 1.0 if label.shoulder == "left" else -1.0
-        elbow_sign = shoulder_sign if label.elbow == "up" else -shoulder_sign
+        shoulder_sign = 1.0 if names["shoulder"] == "left" else -1.0
+        elbow_sign = shoulder_sign if names["elbow"] == "up" else -shoulder_sign
         assert np.all(np.sign(q[ok, b, 2]) == elbow_sign)
     # The two shoulder solutions of a pose differ in q1 only by the choice of +-acos.
-    assert branch_index(Branch("right", "down", "flip")) == 7
+    assert (
+        robot.family.branch_index(Branch.named(shoulder="right", elbow="down", wrist="flip")) == 7
+    )
 
 
 def test_joint_copies_within_limits() -> None:

@@ -1,0 +1,117 @@
+"""The kinematics-family seam: what a robot family provides to the rest of the solver.
+
+Every route works for every robot; what differs between robots is how inverse kinematics is
+solved and whether J^-1 t has a closed form (robots.md section 1). A family answers both,
+batched and component-first; tracking, DTF, mu_path, maps and optimisers are written once on top
+of this interface and never name a family.
+
+Layout: rotations (3, 3, *batch), positions (3, *batch), joint arrays (dof, ...), solutions
+(dof, n_branches, *batch); waypoints are usually the last batch axis.
+"""
+
+from __future__ import annotations
+
+import abc
+from dataclasses import dataclass
+
+import numpy as np
+
+from solver.exceptions import InvalidInputError
+
+# Status codes of a (pose, branch) IK solution.
+OK = 0
+UNREACHABLE = 1
+SINGULAR = 2
+
+
+@dataclass(frozen=True)
+class Branch:
+    """An IK branch by name: one choice per level, e.g. shoulder=left, elbow=up, wrist=noflip.
+
+    Attributes:
+        choices: (level, choice) pairs in the family's level order.
+    """
+
+    choices: tuple[tuple[str, str], ...]
+
+    @classmethod
+    def named(cls, **choices: str) -> Branch:
+        """A branch from keyword choices, e.g. ``Branch.named(shoulder="left", ...)``."""
+        return cls(tuple(choices.items()))
+
+    def as_dict(self) -> dict[str, str]:
+        """The choices as ``{level: choice}``."""
+        return dict(self.choices)
+
+    def __str__(self) -> str:
+        """``shoulder=left, elbow=up, wrist=noflip``."""
+        return ", ".join(f"{level}={choice}" for level, choice in self.choices)
+
+
+class KinematicsFamily(abc.ABC):
+    """IK and J^-1 t of one kind of arm (UR, OPW, numeric), batched over poses.
+
+    A family object belongs to one robot geometry (its parameters live in the object). The
+    pinocchio model of the robot is the single source of forward kinematics and Jacobians; the
+    family's closed forms are checked against it in tests.
+    """
+
+    #: Short name of the family, reported in answers (``"ur"``, ``"opw"``).
+    name: str
+
+    @property
+    @abc.abstractmethod
+    def dof(self) -> int:
+        """Number of joints."""
+
+    @property
+    @abc.abstractmethod
+    def branches(self) -> tuple[Branch, ...]:
+        """The branch labels, in the order of axis 1 of :meth:`solve` (ties go to the first)."""
+
+    def branch_index(self, label: Branch) -> int:
+        """Index of a named branch on axis 1 of :meth:`solve`.
+
+        Raises:
+            InvalidInputError: on ``ik.branch``, the label is not one of this family's; the
+                message lists the valid names.
+        """
+        for index, known in enumerate(self.branches):
+            if known.as_dict() == label.as_dict():
+                return index
+        valid = "; ".join(f"{{{b}}}" for b in self.branches)
+        raise InvalidInputError(
+            "ik.branch", f"{{{label}}} is not a branch of a {self.name} arm; valid: {valid}"
+        )
+
+    @abc.abstractmethod
+    def solve(self, rotation: np.ndarray, position: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """All IK solutions of a batch of flange poses.
+
+        Args:
+            rotation: shape (3, 3, *batch), R_B_F of the flange (columns: its x, y, z axes);
+                batch axes broadcast with those of ``position``.
+            position: shape (3, *batch), flange positions in {B} (m).
+
+        Returns:
+            q: shape (dof, n_branches, *batch), rad in [-pi, pi] (copies 2 pi away are left to
+            tracking), NaN where a branch has no solution;
+            status: shape (n_branches, *batch), ``OK``, ``UNREACHABLE`` or ``SINGULAR`` (q is
+            still filled where singular).
+        """
+
+    @abc.abstractmethod
+    def joint_speeds_per_unit_twist(
+        self, q: np.ndarray, twist: np.ndarray, tool_point: np.ndarray
+    ) -> np.ndarray:
+        """J(q)^-1 t, batched, with J the Jacobian at ``tool_point`` in {B} axes.
+
+        Args:
+            q: shape (dof, ...), joint positions (rad), non-singular.
+            twist: shape (6, ...) broadcastable to q, [v (m/s); omega (rad/s)] of the tool
+                point, {B} axes.
+            tool_point: shape (3, ...) broadcastable to q, the tool point in {B} (m).
+
+        Returns:
+            shape (dof, ...), joint speeds (rad/s); inf or NaN at an exactly singular q.
+        """

@@ -1,0 +1,211 @@
+"""The path pipeline, written once for every robot family and any dof (robots.md section 1).
+
+requirements -> IK -> tracking -> speeds -> DTF -> branch choice -> bottleneck, for a chunk of
+placements at once. :func:`solver.evaluate.evaluate_path` (one placement, with per-waypoint
+detail) and :func:`solver.placements.evaluate_placements` (the map and the optimisers) both run
+:func:`run_chunk`; only the robot's kinematics family (:mod:`solver.families.base`) knows how IK
+and J^-1 t are solved.
+
+What makes it fast (dtf.md section 9): t_hat is computed once in {O} and only turned by each
+placement's yaw; all placements of a chunk, all waypoints and all IK branches are one set of
+component-first arrays with waypoints last.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from solver.exceptions import InvalidInputError, NoAnalyticIkError
+from solver.families.base import KinematicsFamily
+from solver.robots import Robot
+from solver.spatial import MAX_COORDINATE
+from solver.task import task_requirements
+from solver.tracking import FEASIBLE, Tracked, choose_branch, track
+
+DEFAULT_MAX_JOINT_STEP = 0.35
+
+
+@dataclass(frozen=True)
+class PreparedPath:
+    """A path checked and reduced to what every placement needs, all in {O}.
+
+    Attributes:
+        n_waypoints: N.
+        tool_rotation: shape (N, 3, 3), R_O_i of the tool point.
+        flange_rotation: shape (N, 3, 3), R_O_F of the flange at each waypoint.
+        flange_position: shape (N, 3), m.
+        tool_position: shape (N, 3), m, the tool point.
+        u_T: shape (N, 3). u_R: shape (N, 3). h: shape (N,), m, inf for pure translation.
+        twist: shape (N, 6), t_hat in {O} axes.
+        pure_rotation: shape (N,), where h = 0 (V_max is 0 there).
+    """
+
+    n_waypoints: int
+    tool_rotation: np.ndarray
+    flange_rotation: np.ndarray
+    flange_position: np.ndarray
+    tool_position: np.ndarray
+    u_T: np.ndarray
+    u_R: np.ndarray
+    h: np.ndarray
+    twist: np.ndarray
+    pure_rotation: np.ndarray
+
+
+def prepare_path(robot: Robot, waypoints_in_workpiece: np.ndarray) -> PreparedPath:
+    """Check a path and precompute its placement-independent data.
+
+    Args:
+        robot: the arm (its TCP offset turns tool poses into flange poses).
+        waypoints_in_workpiece: shape (N, 4, 4), T_O_i (metres).
+
+    Raises:
+        InvalidInputError, RepeatedWaypointError: as :func:`solver.task.task_requirements`.
+    """
+    path = np.asarray(waypoints_in_workpiece, dtype=float)
+    requirements = task_requirements(path)  # u_T, u_R turn with the yaw, h does not
+    flange = path @ np.linalg.inv(robot.transform_tool_to_tcp)
+    return PreparedPath(
+        n_waypoints=len(path),
+        tool_rotation=path[:, :3, :3],
+        flange_rotation=flange[:, :3, :3],
+        flange_position=flange[:, :3, 3],
+        tool_position=path[:, :3, 3],
+        u_T=requirements.u_T,
+        u_R=requirements.u_R,
+        h=requirements.h,
+        twist=requirements.twists(),
+        pure_rotation=requirements.h == 0.0,
+    )
+
+
+def check_max_joint_step(max_joint_step: float) -> None:
+    """Raise InvalidInputError unless the step is finite and > 0 (rad)."""
+    if not (math.isfinite(max_joint_step) and max_joint_step > 0.0):
+        raise InvalidInputError("ik.max_joint_step", f"{max_joint_step!r} rad must be > 0")
+
+
+def require_family(robot: Robot) -> KinematicsFamily:
+    """The robot's kinematics family; NoAnalyticIkError when it has none."""
+    if robot.family is None:
+        raise NoAnalyticIkError(
+            "robot",
+            f"path evaluation needs an arm with an IK family (UR or OPW); {robot.name!r} has none",
+        )
+    return robot.family
+
+
+def check_placements(placements: np.ndarray) -> np.ndarray:
+    """Placements as a float array (P, 4) of finite [x, y, z, yaw] within MAX_COORDINATE.
+
+    Raises:
+        InvalidInputError: wrong shape, not finite, or too far.
+    """
+    arr = np.asarray(placements, dtype=float)
+    if arr.ndim != 2 or arr.shape[1] != 4:
+        raise InvalidInputError("placements", f"{arr.shape=}, needs (P, 4): x, y, z, yaw")
+    if not np.all(np.isfinite(arr)) or np.any(np.abs(arr[:, :3]) > MAX_COORDINATE):
+        raise InvalidInputError(
+            "placements", f"need finite values, positions within {MAX_COORDINATE} m"
+        )
+    return arr
+
+
+@dataclass(frozen=True)
+class ChunkResult:
+    """Every branch at every placement of a chunk, and the branch each placement takes.
+
+    B branches, C placements, W waypoints, n joints.
+
+    Attributes:
+        tracked: the branches followed along the path (reason, failed waypoint: (B, C);
+            q: (n, B, C, W), rad).
+        qd_unit: shape (n, B, C, W), J^-1 t_hat (rad/s per m/s; per rad/s where h = 0).
+        speed: shape (B, C, W), 1 / max_j |qd_unit_j| / qdot_max_j: V_max (Omega_max where
+            h = 0); meaningful only on feasible branches.
+        limiting: shape (B, C, W), the joint on its limit.
+        v_max: shape (B, C, W), m/s, 0 where h = 0.
+        mu_path: shape (B, C), m/s, -inf on infeasible branches.
+        pick: shape (C,), the index on axis B of the branch each placement takes (``auto``: the
+            highest mu_path; the furthest failure where none is feasible).
+    """
+
+    tracked: Tracked
+    qd_unit: np.ndarray
+    speed: np.ndarray
+    limiting: np.ndarray
+    v_max: np.ndarray
+    mu_path: np.ndarray
+    pick: np.ndarray
+
+
+def turn_by_yaw(vectors: np.ndarray, yaws: np.ndarray) -> np.ndarray:
+    """Rz(yaw) v for every yaw: vectors (3, ..., W) in {O} -> (3, ..., C, W), C-contiguous.
+
+    Args:
+        vectors: shape (3, ..., W), in {O}.
+        yaws: shape (C,), rad (C = 1 broadcasts one turn over a chunk).
+    """
+    cos, sin = np.cos(yaws)[:, None], np.sin(yaws)[:, None]
+    x, y = vectors[0][..., None, :], vectors[1][..., None, :]
+    z = np.broadcast_to(vectors[2][..., None, :], np.broadcast_shapes(x.shape, cos.shape))
+    return np.stack([cos * x - sin * y, sin * x + cos * y, z])
+
+
+def run_chunk(
+    robot: Robot,
+    path: PreparedPath,
+    placements: np.ndarray,
+    branches: np.ndarray,
+    *,
+    max_joint_step: float,
+) -> ChunkResult:
+    """The pipeline at C placements on the given branches.
+
+    Args:
+        robot: an arm with a kinematics family.
+        path: from :func:`prepare_path` for the same robot.
+        placements: shape (C, 4), [x (m), y (m), z (m), yaw (rad)] of {O} in {B}, checked.
+        branches: shape (B,), indices of the family's branches to follow.
+        max_joint_step: rad, > 0, checked.
+    """
+    family = require_family(robot)
+    yaws = placements[:, 3]
+    if np.all(yaws == yaws[0]):  # one turn for the chunk: broadcast it (less memory to read)
+        yaws = yaws[:1]
+    offset = placements[:, :3].T[:, :, None]  # (3, C, 1)
+    rotation = turn_by_yaw(path.flange_rotation.transpose(1, 2, 0), yaws)  # (3, 3, C, W)
+    flange_position = turn_by_yaw(path.flange_position.T, yaws) + offset
+    tool_position = turn_by_yaw(path.tool_position.T, yaws) + offset
+    twist = np.concatenate(
+        [turn_by_yaw(path.twist[:, :3].T, yaws), turn_by_yaw(path.twist[:, 3:].T, yaws)]
+    )
+    q, status = family.solve(rotation, flange_position)  # (n, B_all, C, W), (B_all, C, W)
+    tracked = track(
+        q[:, branches],
+        status[branches],
+        lower=robot.q_lower,
+        upper=robot.q_upper,
+        max_joint_step=max_joint_step,
+    )
+    qd_unit = family.joint_speeds_per_unit_twist(tracked.q, twist[:, None], tool_position[:, None])
+    ratio = np.abs(qd_unit) / robot.qdot_max.reshape((-1,) + (1,) * (qd_unit.ndim - 1))
+    limiting = ratio.argmax(axis=0)  # (B, C, W)
+    with np.errstate(divide="ignore", invalid="ignore"):  # infeasible branches
+        speed = 1.0 / ratio.max(axis=0)
+    v_max = np.where(path.pure_rotation, 0.0, speed)
+    feasible = tracked.reason == FEASIBLE  # (B, C)
+    mu_path = np.where(feasible, v_max.min(axis=-1), -np.inf)
+    pick = choose_branch(mu_path, feasible, tracked.failed_waypoint)
+    return ChunkResult(
+        tracked=tracked,
+        qd_unit=qd_unit,
+        speed=speed,
+        limiting=limiting,
+        v_max=v_max,
+        mu_path=mu_path,
+        pick=pick,
+    )
