@@ -12,9 +12,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from solver.evaluate import DEFAULT_MAX_JOINT_STEP
 from solver.exceptions import InvalidInputError
 from solver.families.base import Branch
+from solver.pipeline import DEFAULT_MAX_JOINT_STEP, SpinMode
 from solver.placements import DEFAULT_CHUNK, evaluate_placements, prepare_path
 from solver.robots import Robot
 from solver.spatial import Placement
@@ -109,6 +109,7 @@ def capability_map(
     yaws: np.ndarray,
     branch: Branch | None = None,
     max_joint_step: float = DEFAULT_MAX_JOINT_STEP,
+    spin_mode: SpinMode = "fixed",
     chunk: int = DEFAULT_CHUNK,
     progress: Callable[[float], None] | None = None,
 ) -> CapabilityMap:
@@ -123,6 +124,7 @@ def capability_map(
         yaws: shape (nyaw,), rad, placement yaw values.
         branch: the IK branch to follow everywhere; ``None`` is ``auto``.
         max_joint_step: rad, > 0.
+        spin_mode: ``fixed`` or ``free`` (the tool spin rate free, cam.md section 2).
         chunk: placements computed together.
         progress: called with the fraction done (0..1] after each chunk.
 
@@ -141,6 +143,7 @@ def capability_map(
         placements,
         branch=branch,
         max_joint_step=max_joint_step,
+        spin_mode=spin_mode,
         chunk=chunk,
         progress=progress,
     )

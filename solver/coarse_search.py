@@ -13,7 +13,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from solver.exceptions import InvalidInputError
-from solver.pipeline import PreparedPath
+from solver.pipeline import PreparedPath, SpinMode
 from solver.placements import evaluate_placements
 from solver.robots import Robot
 from solver.spatial import MAX_COORDINATE
@@ -59,6 +59,7 @@ def coarse_cells(
     symmetric: bool,
     near: float,
     max_joint_step: float,
+    spin_mode: SpinMode = "fixed",
     max_cells: int = MAX_COARSE_CELLS,
 ) -> list[Cell]:
     """Local maxima of a coarse map over the bounds, best first.
@@ -134,7 +135,9 @@ def coarse_cells(
     branch = np.zeros(len(points), dtype=int)
     if inside:
         placements = np.array(rows)
-        result = evaluate_placements(robot, path, placements, max_joint_step=max_joint_step)
+        result = evaluate_placements(
+            robot, path, placements, max_joint_step=max_joint_step, spin_mode=spin_mode
+        )
         mu[inside], branch[inside] = result.mu_path, result.branch
     flat = np.ravel_multi_index
     cells = []

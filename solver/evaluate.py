@@ -16,9 +16,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from solver.dtf import spin_rate_nearest_zero
 from solver.families.base import Branch
 from solver.pipeline import (
     DEFAULT_MAX_JOINT_STEP,
+    SpinMode,
     check_max_joint_step,
     check_placements,
     prepare_path,
@@ -48,6 +50,8 @@ class PathEvaluation:
         q: shape (N, n), rad. v_max: shape (N,), m/s. omega_max: shape (N,), rad/s.
         qdot: shape (N, n), rad/s at V_max. limiting_joint: shape (N,). These five are
             ``None`` when infeasible.
+        spins: shape (N,), rad, in ``free`` spin mode the spin schedule that realises mu_path
+            (q is then the joint path along it); ``None`` otherwise.
     """
 
     feasible: bool
@@ -65,6 +69,7 @@ class PathEvaluation:
     omega_max: np.ndarray | None = None
     qdot: np.ndarray | None = None
     limiting_joint: np.ndarray | None = None
+    spins: np.ndarray | None = None
 
 
 def _turned(vectors: np.ndarray, yaw: float) -> np.ndarray:
@@ -82,6 +87,7 @@ def evaluate_path(
     *,
     branch: Branch | None = None,
     max_joint_step: float = DEFAULT_MAX_JOINT_STEP,
+    spin_mode: SpinMode = "fixed",
 ) -> PathEvaluation:
     """mu_path of a path at a placement (spec sections 1-4).
 
@@ -91,6 +97,8 @@ def evaluate_path(
         placement: where {O} sits in {B}.
         branch: the IK branch to follow; ``None`` is ``auto``, the feasible branch with the
             highest mu_path.
+        spin_mode: ``fixed`` (the orientations as given) or ``free`` (the tool spin rate free,
+            cam.md section 2).
         max_joint_step: rad, > 0, the largest move of any joint between neighbouring waypoints.
 
     Raises:
@@ -107,7 +115,7 @@ def evaluate_path(
         if branch is None
         else np.array([family.branch_index(branch)])
     )
-    run = run_chunk(robot, path, cell, indices, max_joint_step=max_joint_step)
+    run = run_chunk(robot, path, cell, indices, max_joint_step=max_joint_step, spin_mode=spin_mode)
     pick = int(run.pick[0])
     reason = int(run.tracked.reason[pick, 0])
     infeasible = PathEvaluation(
@@ -131,6 +139,14 @@ def evaluate_path(
         )
     limiting = run.limiting[pick, 0]
     bottleneck = int(np.argmin(v_max))
+    qdot = run.qd_unit[:, pick, 0] * speed
+    spins = None
+    if run.spins is not None and run.qd_spin is not None:
+        spin_rate = spin_rate_nearest_zero(
+            run.qd_unit[:, pick, 0], run.qd_spin[:, pick, 0], robot.qdot_max, speed
+        )
+        qdot = qdot + spin_rate * run.qd_spin[:, pick, 0]
+        spins = run.spins[pick, 0]
     return dataclasses.replace(
         infeasible,
         feasible=True,
@@ -141,6 +157,7 @@ def evaluate_path(
         q=run.tracked.q[:, pick, 0].T,
         v_max=v_max,
         omega_max=omega_max,
-        qdot=(run.qd_unit[:, pick, 0] * speed).T,
+        qdot=qdot.T,
         limiting_joint=limiting,
+        spins=spins,
     )

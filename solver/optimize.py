@@ -28,7 +28,7 @@ import numpy as np
 from solver.coarse_search import MAX_COARSE_CELLS, Cell, coarse_cells
 from solver.evaluate import DEFAULT_MAX_JOINT_STEP, PathEvaluation, evaluate_path
 from solver.exceptions import InvalidInputError
-from solver.pipeline import PreparedPath, prepare_path, require_family
+from solver.pipeline import PreparedPath, SpinMode, prepare_path, require_family
 from solver.placement_nlp import PlacementNlp
 from solver.placement_scipy import global_search, polish
 from solver.robots import Robot
@@ -111,6 +111,7 @@ def optimize_placement(
     start: Placement | None = None,
     method: Method = "casadi",
     max_joint_step: float = DEFAULT_MAX_JOINT_STEP,
+    spin_mode: SpinMode = "fixed",
     max_coarse_cells: int = MAX_COARSE_CELLS,
 ) -> PlacementOptimum | None:
     """The placement inside ``bounds`` where the path runs fastest.
@@ -123,6 +124,8 @@ def optimize_placement(
             mu_path and used to choose the point of the optimal arc.
         method: ``"casadi"`` (IPOPT from the coarse map's maxima) or ``"scipy"``.
         max_joint_step: rad, as for :func:`solver.evaluate.evaluate_path`.
+        spin_mode: ``fixed`` or ``free`` (the tool spin rate free, cam.md section 2), as for
+            :func:`solver.evaluate.evaluate_path`; every method searches in that mode.
         max_coarse_cells: the largest coarse map the casadi method may make.
 
     Returns:
@@ -143,7 +146,9 @@ def optimize_placement(
         raise InvalidInputError("start", f"{start} is outside the bounds {bounds}")
     path = np.asarray(waypoints_in_workpiece, dtype=float)
     prepared = prepare_path(robot, path)
-    start_evaluation = evaluate_path(robot, path, start, max_joint_step=max_joint_step)
+    start_evaluation = evaluate_path(
+        robot, path, start, max_joint_step=max_joint_step, spin_mode=spin_mode
+    )
     symmetric = turns_about_base_z(robot)
     near = math.atan2(start.y, start.x)
     if method == "casadi":
@@ -154,15 +159,16 @@ def optimize_placement(
             symmetric=symmetric,
             near=near,
             max_joint_step=max_joint_step,
+            spin_mode=spin_mode,
             max_cells=max_coarse_cells,
         )
         candidates, statuses, iterations = _casadi(
-            robot, path, prepared, bounds, cells, max_joint_step
+            robot, path, prepared, bounds, cells, max_joint_step, spin_mode
         )
         name = "ipopt (casadi), from the coarse map's maxima"
     else:
         candidates, statuses, iterations = _scipy(
-            robot, prepared, bounds, max_joint_step, symmetric
+            robot, prepared, bounds, max_joint_step, symmetric, spin_mode
         )
         name = "differential_evolution + SLSQP (scipy)"
     # The start last: it is the answer only when nothing the solver found is better.
@@ -171,7 +177,9 @@ def optimize_placement(
     best: tuple[float, Placement, PathEvaluation, str] | None = None
     for candidate, status in zip(candidates, statuses, strict=True):
         placement = _place_on_arc(candidate, bounds, near, symmetric)
-        evaluation = evaluate_path(robot, path, placement, max_joint_step=max_joint_step)
+        evaluation = evaluate_path(
+            robot, path, placement, max_joint_step=max_joint_step, spin_mode=spin_mode
+        )
         if evaluation.mu_path is not None and (best is None or evaluation.mu_path > best[0]):
             best = (evaluation.mu_path, placement, evaluation, status)
     if best is None:
@@ -197,14 +205,26 @@ def _casadi(
     bounds: PlacementBounds,
     cells: list[Cell],
     max_joint_step: float,
+    spin_mode: SpinMode,
 ) -> tuple[list[tuple[float, float, float]], list[str], int]:
-    """Candidates: the best coarse cell, then IPOPT's optimum from each of the best cells."""
+    """Candidates: the best coarse cell, then IPOPT's optimum from each of the best cells.
+
+    In free spin mode each solve starts from the cell's joint path at the given spin with the
+    spin rate 0 (a feasible start at the fixed-spin mu_path), and IPOPT frees the rate.
+    """
     if not cells:
         return [], [], 0
     candidates, statuses = [cells[0].placement], ["best cell of the coarse map"]
     if prepared.pure_rotation.any() or cells[0].mu_path <= 0.0:
         return candidates, ["mu_path is 0 everywhere: the path turns on the spot"], 0
-    nlp = PlacementNlp(robot, prepared, path[:, :3, :3], bounds, max_joint_step=max_joint_step)
+    nlp = PlacementNlp(
+        robot,
+        prepared,
+        path[:, :3, :3],
+        bounds,
+        max_joint_step=max_joint_step,
+        free_spin=spin_mode == "free",
+    )
     iterations = 0
     for cell in cells[:N_STARTS]:
         x, y, yaw = cell.placement
@@ -215,10 +235,11 @@ def _casadi(
             branch=require_family(robot).branches[cell.branch],
             max_joint_step=max_joint_step,
         )
-        if at_start.q is None or at_start.qdot is None or at_start.v_max is None:
+        q, qdot, v_max, speed = at_start.q, at_start.qdot, at_start.v_max, at_start.mu_path
+        if q is None or qdot is None or v_max is None or speed is None:
             continue
-        joint_speeds = at_start.qdot * (cell.mu_path / at_start.v_max)[:, None]
-        result = nlp.solve(cell.placement, cell.mu_path, at_start.q, joint_speeds)
+        joint_speeds = qdot * (speed / v_max)[:, None]
+        result = nlp.solve(cell.placement, speed, q, joint_speeds)
         iterations += result.iterations
         candidates.append(result.placement)
         statuses.append(result.status)
@@ -231,10 +252,16 @@ def _scipy(
     bounds: PlacementBounds,
     max_joint_step: float,
     symmetric: bool,
+    spin_mode: SpinMode,
 ) -> tuple[list[tuple[float, float, float]], list[str], int]:
     """Candidates: the best placement of each basin DE saw, and SLSQP's polish of each."""
     basins, iterations = global_search(
-        robot, prepared, bounds, max_joint_step=max_joint_step, symmetric=symmetric
+        robot,
+        prepared,
+        bounds,
+        max_joint_step=max_joint_step,
+        symmetric=symmetric,
+        spin_mode=spin_mode,
     )
     if not basins:
         return [], [], iterations
@@ -250,6 +277,7 @@ def _scipy(
             mu_path,
             require_family(robot).branches[branch],
             max_joint_step=max_joint_step,
+            spin_mode=spin_mode,
         )
         candidates.append(polished)
         statuses.append(f"SLSQP: {status}")

@@ -15,9 +15,11 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Literal
 
 import numpy as np
 
+from solver.dtf import spin_rate_nearest_zero, two_variable_speed
 from solver.exceptions import InvalidInputError, NoAnalyticIkError
 from solver.families.base import KinematicsFamily
 from solver.robots import Robot
@@ -26,6 +28,9 @@ from solver.task import task_requirements
 from solver.tracking import FEASIBLE, Tracked, choose_branch, track
 
 DEFAULT_MAX_JOINT_STEP = 0.35
+
+SpinMode = Literal["fixed", "free"]
+SPIN_MODES: tuple[SpinMode, ...] = ("fixed", "free")
 
 
 @dataclass(frozen=True)
@@ -124,22 +129,31 @@ class ChunkResult:
         tracked: the branches followed along the path (reason, failed waypoint: (B, C);
             q: (n, B, C, W), rad).
         qd_unit: shape (n, B, C, W), J^-1 t_hat (rad/s per m/s; per rad/s where h = 0).
-        speed: shape (B, C, W), 1 / max_j |qd_unit_j| / qdot_max_j: V_max (Omega_max where
-            h = 0); meaningful only on feasible branches.
+        qd_spin: shape (n, B, C, W), J^-1 [0; z_tool] (rad/s per rad/s of tool spin); only in
+            ``free`` spin mode, else None.
+        speed: shape (B, C, W), the DTF: V_max (Omega_max where h = 0), 1 / max_j |qd_unit_j| /
+            qdot_max_j in ``fixed`` mode, the two-variable LP with the spin rate free in ``free``
+            mode (cam.md section 2); meaningful only on feasible branches.
         limiting: shape (B, C, W), the joint on its limit.
         v_max: shape (B, C, W), m/s, 0 where h = 0.
         mu_path: shape (B, C), m/s, -inf on infeasible branches.
+        spins: shape (B, C, W), rad, the spin schedule that realises mu_path in ``free`` mode
+            (cam.md section 2: at the feed mu_path, the spin rate nearest zero at each waypoint,
+            integrated along the path); None in ``fixed`` mode. ``tracked`` then holds the joint
+            paths along that schedule, so its position limits and steps are checked.
         pick: shape (C,), the index on axis B of the branch each placement takes (``auto``: the
             highest mu_path; the furthest failure where none is feasible).
     """
 
     tracked: Tracked
     qd_unit: np.ndarray
+    qd_spin: np.ndarray | None
     speed: np.ndarray
     limiting: np.ndarray
     v_max: np.ndarray
     mu_path: np.ndarray
     pick: np.ndarray
+    spins: np.ndarray | None = None
 
 
 def turn_by_yaw(vectors: np.ndarray, yaws: np.ndarray) -> np.ndarray:
@@ -162,6 +176,7 @@ def run_chunk(
     branches: np.ndarray,
     *,
     max_joint_step: float,
+    spin_mode: SpinMode = "fixed",
 ) -> ChunkResult:
     """The pipeline at C placements on the given branches.
 
@@ -171,6 +186,8 @@ def run_chunk(
         placements: shape (C, 4), [x (m), y (m), z (m), yaw (rad)] of {O} in {B}, checked.
         branches: shape (B,), indices of the family's branches to follow.
         max_joint_step: rad, > 0, checked.
+        spin_mode: ``fixed`` (the orientations as given) or ``free`` (the tool spin rate is a
+            free variable of the DTF, cam.md section 2).
     """
     family = require_family(robot)
     yaws = placements[:, 3]
@@ -184,28 +201,103 @@ def run_chunk(
         [turn_by_yaw(path.twist[:, :3].T, yaws), turn_by_yaw(path.twist[:, 3:].T, yaws)]
     )
     q, status = family.solve(rotation, flange_position)  # (n, B_all, C, W), (B_all, C, W)
+    # In free mode the position limits hold along the spin schedule, checked there, not here.
+    free = spin_mode == "free"
     tracked = track(
         q[:, branches],
         status[branches],
-        lower=robot.q_lower,
-        upper=robot.q_upper,
+        lower=np.full(robot.dof, -np.inf) if free else robot.q_lower,
+        upper=np.full(robot.dof, np.inf) if free else robot.q_upper,
         max_joint_step=max_joint_step,
     )
     qd_unit = family.joint_speeds_per_unit_twist(tracked.q, twist[:, None], tool_position[:, None])
-    ratio = np.abs(qd_unit) / robot.qdot_max.reshape((-1,) + (1,) * (qd_unit.ndim - 1))
-    limiting = ratio.argmax(axis=0)  # (B, C, W)
-    with np.errstate(divide="ignore", invalid="ignore"):  # infeasible branches
-        speed = 1.0 / ratio.max(axis=0)
+    qd_spin = None
+    if free:
+        tool_z = turn_by_yaw(path.tool_rotation[:, :, 2].T, yaws)
+        spin = np.concatenate([np.zeros_like(tool_z), np.broadcast_to(tool_z, twist[3:].shape)])
+        qd_spin = family.joint_speeds_per_unit_twist(
+            tracked.q, spin[:, None], tool_position[:, None]
+        )
+        speed, limiting = two_variable_speed(qd_unit, qd_spin, robot.qdot_max)
+    else:
+        ratio = np.abs(qd_unit) / robot.qdot_max.reshape((-1,) + (1,) * (qd_unit.ndim - 1))
+        limiting = ratio.argmax(axis=0)  # (B, C, W)
+        with np.errstate(divide="ignore", invalid="ignore"):  # infeasible branches
+            speed = 1.0 / ratio.max(axis=0)
     v_max = np.where(path.pure_rotation, 0.0, speed)
     feasible = tracked.reason == FEASIBLE  # (B, C)
     mu_path = np.where(feasible, v_max.min(axis=-1), -np.inf)
+    spins = None
+    if qd_spin is not None:
+        spins, tracked = _spin_schedule(
+            robot, path, tracked, qd_unit, qd_spin, mu_path, max_joint_step=max_joint_step
+        )
+        feasible = tracked.reason == FEASIBLE
+        mu_path = np.where(feasible, mu_path, -np.inf)
     pick = choose_branch(mu_path, feasible, tracked.failed_waypoint)
     return ChunkResult(
         tracked=tracked,
         qd_unit=qd_unit,
+        qd_spin=qd_spin,
         speed=speed,
         limiting=limiting,
         v_max=v_max,
         mu_path=mu_path,
         pick=pick,
+        spins=spins,
+    )
+
+
+def _spin_schedule(
+    robot: Robot,
+    path: PreparedPath,
+    tracked: Tracked,
+    qd_unit: np.ndarray,
+    qd_spin: np.ndarray,
+    mu_path: np.ndarray,
+    *,
+    max_joint_step: float,
+) -> tuple[np.ndarray, Tracked]:
+    """The spins that realise mu_path in free mode, and the joint paths along them.
+
+    At the feed F = mu_path each waypoint admits an interval of spin rates; the one nearest zero
+    is held over the segment (its duration |dp_i| / F), which gives the spins phi_i. The joints
+    follow q_i + sum_k<i sigma_k dt_k J^-1 [0; z_tool]_k: exact for a straight spindle (only the
+    last joint moves), first order otherwise (cam.md section 2). Those joint paths are tracked
+    again, so the last joint's limits and steps are checked along the schedule.
+
+    Args:
+        robot: the arm.
+        path: the prepared path.
+        tracked: the branches followed at the given spin; q (n, B, C, W).
+        qd_unit: shape (n, B, C, W), J^-1 t_hat.
+        qd_spin: shape (n, B, C, W), J^-1 [0; z_tool].
+        mu_path: shape (B, C), m/s, -inf where infeasible.
+        max_joint_step: rad.
+
+    Returns:
+        spins (B, C, W), rad (0 where infeasible or mu_path = 0), and the tracking of the spun
+        joint paths (where the branch was feasible).
+    """
+    feed = np.where(np.isfinite(mu_path) & (mu_path > 0.0), mu_path, 0.0)[..., None]
+    rate = spin_rate_nearest_zero(qd_unit, qd_spin, robot.qdot_max, feed)
+    length = np.linalg.norm(np.diff(path.tool_position, axis=0), axis=1)  # (W - 1,)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        step = np.where(feed > 0.0, rate[..., :-1] * length / feed, 0.0)  # (B, C, W - 1)
+    zero = np.zeros(step.shape[:-1] + (1,))
+    spins = np.concatenate([zero, np.cumsum(step, axis=-1)], axis=-1)
+    moves = np.cumsum(step * qd_spin[..., :-1], axis=-1)  # (n, B, C, W - 1)
+    moved = np.concatenate([np.zeros(moves.shape[:-1] + (1,)), moves], axis=-1)
+    spun = track(
+        tracked.q + np.nan_to_num(moved),
+        np.zeros(tracked.q.shape[1:], dtype=int),  # every pose was solved: only limits, steps
+        lower=robot.q_lower,
+        upper=robot.q_upper,
+        max_joint_step=max_joint_step,
+    )
+    keep = np.isfinite(mu_path)
+    return spins, Tracked(
+        reason=np.where(keep, spun.reason, tracked.reason),
+        failed_waypoint=np.where(keep, spun.failed_waypoint, tracked.failed_waypoint),
+        q=np.where(keep[None, ..., None], spun.q, tracked.q),
     )

@@ -1,8 +1,10 @@
 """The placement optimum as one smooth NLP in CasADi/IPOPT (spec section 6, the epigraph form).
 
-    maximise s  over (x, y, yaw, s, q_i, qdot_i)
+    maximise s  over (x, y, yaw, s, q_i, qdot_i[, sigma_i])
     subject to  FK(q_i) = T_B_O(x, y, yaw) T_O_i        (tool point pose, every waypoint)
-                J(q_i) qdot_i = s t_hat_i(yaw)           (the task twist at feed rate s)
+                J(q_i) qdot_i = s t_hat_i(yaw) [+ sigma_i [0; z_i(yaw)]]   (the task twist at
+                                                         feed rate s; with the tool spin rate
+                                                         sigma_i free in free spin mode)
                 |qdot_i| <= qdot_max,  q_min <= q_i <= q_max,  |q_{i+1} - q_i| <= max_joint_step
                 (x, y, yaw) inside the bounds
 
@@ -59,6 +61,7 @@ class PlacementNlp:
         bounds: PlacementBounds,
         *,
         max_joint_step: float,
+        free_spin: bool = False,
         ipopt_options: dict[str, object] | None = None,
     ) -> None:
         """Build the problem.
@@ -69,6 +72,8 @@ class PlacementNlp:
             tool_rotation: shape (N, 3, 3), R_O_i of the tool point at every waypoint.
             bounds: the placement box (z is fixed at bounds.z).
             max_joint_step: rad, the evaluator's bound on a joint's move between waypoints.
+            free_spin: the tool spin rate about the tool z axis is a free variable per waypoint
+                (cam.md section 2, the evaluator's ``free`` spin mode).
             ipopt_options: IPOPT options over the defaults (``{"max_iter": 100}``).
 
         The NLP is an MX graph over one waypoint's SX residuals mapped N times: built in about
@@ -78,23 +83,26 @@ class PlacementNlp:
         kinematics = symbolic_kinematics(robot)
         # One waypoint's 12 residuals as an SX function, mapped over the waypoints.
         q, qdot = ca.SX.sym("q", dof), ca.SX.sym("qdot", dof)
-        where, speed_1 = ca.SX.sym("placement", 3), ca.SX.sym("s")
+        where, speed_1, spin_1 = ca.SX.sym("placement", 3), ca.SX.sym("s"), ca.SX.sym("sigma")
         data = ca.SX.sym("waypoint", 3 + 9 + 6)  # p_O, R_O (column-major), t_hat in {O}
         c, s = ca.cos(where[2]), ca.sin(where[2])
         turn = ca.vertcat(ca.horzcat(c, -s, 0), ca.horzcat(s, c, 0), ca.horzcat(0, 0, 1))
         position, rotation, jacobian = kinematics(q)
         target_rotation = turn @ ca.reshape(data[3:12], 3, 3)
         error = target_rotation.T @ rotation
+        spin_twist = ca.vertcat(ca.DM.zeros(3), turn @ data[9:12])  # tool z (column 3 of R_O)
         residual = ca.Function(
             "waypoint_residual",
-            [q, qdot, where, speed_1, data],
+            [q, qdot, where, speed_1, spin_1, data],
             [
                 ca.vertcat(
                     position - (turn @ data[:3] + ca.vertcat(where[0], where[1], bounds.z)),
                     error[2, 1] - error[1, 2],
                     error[0, 2] - error[2, 0],
                     error[1, 0] - error[0, 1],
-                    jacobian @ qdot - speed_1 * ca.vertcat(turn @ data[12:15], turn @ data[15:18]),
+                    jacobian @ qdot
+                    - speed_1 * ca.vertcat(turn @ data[12:15], turn @ data[15:18])
+                    - spin_1 * spin_twist,
                 )
             ],
         )
@@ -109,15 +117,20 @@ class PlacementNlp:
         speed = ca.MX.sym("s")
         joints = ca.MX.sym("q", dof, n)
         joint_speeds = ca.MX.sym("qdot", dof, n)
+        spin_rates = ca.MX.sym("sigma", 1, n) if free_spin else ca.DM.zeros(1, n)
         residuals = residual.map(n)(
             joints,
             joint_speeds,
             ca.repmat(placement, 1, n),
             ca.repmat(speed, 1, n),
+            spin_rates,
             ca.DM(waypoint_data),
         )
         steps = ca.vec(joints[:, 1:] - joints[:, :-1])
         variables = ca.vertcat(placement, speed, ca.vec(joints), ca.vec(joint_speeds))
+        if free_spin:
+            variables = ca.vertcat(variables, ca.vec(spin_rates))
+        self._n_spin = n if free_spin else 0
         equalities = ca.vec(residuals)
         constraints = ca.vertcat(equalities, steps)
         self._n_equalities = int(equalities.numel())
@@ -154,7 +167,7 @@ class PlacementNlp:
             start_speed: its mu_path (m/s), the initial s.
             q_path: shape (N, n), rad, the start's joint path on the branch to follow.
             qdot_path: shape (N, n), rad/s, joint speeds there at feed rate ``start_speed``
-                (a feasible start for the twist constraints).
+                (a feasible start for the twist constraints, with spin rate 0 in free mode).
         """
         robot, bounds, n = self._robot, self._bounds, self._n
         lower = np.concatenate(
@@ -162,6 +175,7 @@ class PlacementNlp:
                 [bounds.x[0], bounds.y[0], bounds.yaw[0], 0.0],
                 np.tile(robot.q_lower + _MARGIN, n),
                 np.tile(-robot.qdot_max, n),
+                np.full(self._n_spin, -np.inf),
             ]
         )
         upper = np.concatenate(
@@ -169,12 +183,15 @@ class PlacementNlp:
                 [bounds.x[1], bounds.y[1], bounds.yaw[1], np.inf],
                 np.tile(robot.q_upper - _MARGIN, n),
                 np.tile(robot.qdot_max, n),
+                np.full(self._n_spin, np.inf),
             ]
         )
         step = self._step - _MARGIN
         lbg = np.concatenate([np.zeros(self._n_equalities), np.full(self._n_steps, -step)])
         ubg = np.concatenate([np.zeros(self._n_equalities), np.full(self._n_steps, step)])
-        guess = np.concatenate([start, [start_speed], q_path.ravel(), qdot_path.ravel()])
+        guess = np.concatenate(
+            [start, [start_speed], q_path.ravel(), qdot_path.ravel(), np.zeros(self._n_spin)]
+        )
         began = time.perf_counter()
         solution = self._solver(x0=guess, lbx=lower, ubx=upper, lbg=lbg, ubg=ubg)
         seconds = time.perf_counter() - began

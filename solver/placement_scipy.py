@@ -13,7 +13,8 @@ import numpy as np
 import scipy.optimize
 
 from solver.families.base import Branch
-from solver.placements import PreparedPath, evaluate_placements
+from solver.pipeline import PreparedPath, SpinMode
+from solver.placements import evaluate_placements
 from solver.robots import Robot
 from solver.symmetry import PlacementBounds
 
@@ -38,6 +39,7 @@ def global_search(
     *,
     max_joint_step: float,
     symmetric: bool,
+    spin_mode: SpinMode = "fixed",
 ) -> tuple[list[tuple[tuple[float, float, float], float, int]], int]:
     """Differential evolution over (x, y, yaw); the best placement of each distinct basin seen.
 
@@ -52,7 +54,11 @@ def global_search(
 
     def objective(points: np.ndarray) -> np.ndarray:  # points: (3, S)
         result = evaluate_placements(
-            robot, path, _placements(points.T, bounds.z), max_joint_step=max_joint_step
+            robot,
+            path,
+            _placements(points.T, bounds.z),
+            max_joint_step=max_joint_step,
+            spin_mode=spin_mode,
         )
         seen.append((points.T.copy(), result.mu_path, result.branch))
         values: np.ndarray = np.where(np.isnan(result.mu_path), INFEASIBLE, -result.mu_path)
@@ -117,6 +123,7 @@ def polish(
     branch: Branch,
     *,
     max_joint_step: float,
+    spin_mode: SpinMode = "fixed",
 ) -> tuple[tuple[float, float, float], str, int]:
     """SLSQP on the epigraph form from a feasible start, on one IK branch.
 
@@ -136,6 +143,7 @@ def polish(
                 _placements(v[:3] + offsets, bounds.z),
                 branch=branch,
                 max_joint_step=max_joint_step,
+                spin_mode=spin_mode,
                 with_speeds=True,
             )
             if result.v_max is None:  # not reached: asked for with_speeds

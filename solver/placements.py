@@ -17,6 +17,7 @@ from solver.families.base import Branch
 from solver.pipeline import (
     DEFAULT_MAX_JOINT_STEP,
     PreparedPath,
+    SpinMode,
     check_max_joint_step,
     check_placements,
     prepare_path,
@@ -61,9 +62,12 @@ def _chunk(
     placements: np.ndarray,
     branches: np.ndarray,
     max_joint_step: float,
+    spin_mode: SpinMode,
 ) -> tuple[np.ndarray, ...]:
     """Evaluate C placements: per placement mu, reason, failed, branch, bottleneck, V_max."""
-    run = run_chunk(robot, path, placements, branches, max_joint_step=max_joint_step)
+    run = run_chunk(
+        robot, path, placements, branches, max_joint_step=max_joint_step, spin_mode=spin_mode
+    )
     pick, columns = run.pick, np.arange(len(placements))
     any_feasible = (run.tracked.reason == FEASIBLE).any(axis=0)
     chosen_v = np.where(any_feasible[:, None], run.v_max[pick, columns], np.nan)  # (C, W)
@@ -86,6 +90,7 @@ def evaluate_placements(
     *,
     branch: Branch | None = None,
     max_joint_step: float = DEFAULT_MAX_JOINT_STEP,
+    spin_mode: SpinMode = "fixed",
     with_speeds: bool = False,
     chunk: int = DEFAULT_CHUNK,
     progress: Callable[[float], None] | None = None,
@@ -97,6 +102,8 @@ def evaluate_placements(
         path: from :func:`prepare_path` for the same robot.
         placements: shape (P, 4), [x (m), y (m), z (m), yaw (rad)] of {O} in {B}.
         branch: the IK branch to follow everywhere; ``None`` is ``auto``.
+        spin_mode: ``fixed`` (the orientations as given) or ``free`` (the tool spin rate free,
+            cam.md section 2).
         max_joint_step: rad, > 0.
         with_speeds: also return V_max at every waypoint.
         chunk: placements computed together.
@@ -121,7 +128,7 @@ def evaluate_placements(
     for run in np.split(np.arange(len(cells)), cuts):
         for start in range(0, len(run), chunk):
             rows = run[start : start + chunk]
-            parts.append(_chunk(robot, path, cells[rows], branches, max_joint_step))
+            parts.append(_chunk(robot, path, cells[rows], branches, max_joint_step, spin_mode))
             if progress is not None:
                 progress((rows[-1] + 1) / len(cells))
     empty = (np.zeros(0), *(np.zeros(0, dtype=int),) * 5, np.zeros((0, path.n_waypoints)))

@@ -40,3 +40,9 @@ MAP_EVALUATE_RTOL = 1e-9
 # An optimum against /v1/evaluate at the reported placement, and the two methods (issue 4).
 OPTIMUM_EVALUATE_RTOL = 1e-6
 OPTIMUM_METHODS_RTOL = 1e-5
+
+# The free-spin two-variable LP against HiGHS with the spin rate free (issue 8): relative.
+FREE_SPIN_LP_RTOL = 1e-9
+# Fixed mode with the free mode's spins against the free mode's mu_path (cam.md section 2: the
+# discretisation error of the schedule, under 1 % on a 133-waypoint path).
+SPIN_SCHEDULE_RTOL = 0.01

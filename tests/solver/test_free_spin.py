@@ -1,0 +1,197 @@
+"""Free tool spin (cam.md section 2): the two-variable LP, the spin schedule, map = evaluate."""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+
+import numpy as np
+import pytest
+import scipy.optimize
+
+from solver.capability_map import capability_map, grid_axis
+from solver.dtf import spin_rate_nearest_zero, two_variable_speed
+from solver.evaluate import evaluate_path
+from solver.kinematics import jacobian_in_base, tool_pose_in_base
+from solver.optimize import optimize_placement
+from solver.robots import get_robot
+from solver.spatial import Placement
+from solver.symmetry import PlacementBounds
+from tests.cases import (
+    FREE_SPIN_LP_RTOL,
+    MAP_EVALUATE_RTOL,
+    OPTIMUM_EVALUATE_RTOL,
+    OPTIMUM_METHODS_RTOL,
+    SPIN_SCHEDULE_RTOL,
+)
+from tests.solver.test_evaluate import load_path
+
+README_PLACEMENT = Placement(0.0, 0.45, 0.1, 0.0)
+
+
+def _free_spin_lp(jacobian: np.ndarray, twist: np.ndarray, axis: np.ndarray, limits: np.ndarray):
+    """HiGHS on max s s.t. J qdot = s t_hat + sigma [0; z], |qdot| <= limits (sigma free)."""
+    n = jacobian.shape[1]
+    cost = np.zeros(n + 2)
+    cost[n] = -1.0
+    spin = np.concatenate([np.zeros(3), axis])
+    a_eq = np.hstack([jacobian, -twist[:, None], -spin[:, None]])
+    bounds = [(-m, m) for m in limits] + [(0.0, None), (None, None)]
+    result = scipy.optimize.linprog(
+        cost,
+        A_eq=a_eq,
+        b_eq=np.zeros(6),
+        bounds=bounds,
+        method="highs",
+        options={"primal_feasibility_tolerance": 1e-10, "dual_feasibility_tolerance": 1e-10},
+    )
+    assert result.status == 0, result.message
+    return float(result.x[n])
+
+
+@pytest.mark.parametrize(("name", "tcp_turn"), [("ur5", 0.0), ("ur5e", 0.0), ("ur5e", 0.7)])
+def test_free_spin_speed_equals_highs(name: str, tcp_turn: float) -> None:
+    """1000 random configurations and directions; an angled, offset tool for tcp_turn != 0."""
+    robot = get_robot(name)
+    if tcp_turn:
+        tcp = np.eye(4)
+        c, s = np.cos(tcp_turn), np.sin(tcp_turn)
+        tcp[:3, :3] = [[1, 0, 0], [0, c, -s], [0, s, c]]
+        tcp[:3, 3] = [0.02, 0.05, 0.15]
+        robot = robot.with_options(transform_tool_to_tcp=tcp)
+    rng = np.random.default_rng(11)
+    a, b, lp = [], [], []
+    while len(lp) < 1000:
+        q = rng.uniform(-np.pi, np.pi, 6)
+        jacobian = jacobian_in_base(robot, q)
+        if np.linalg.cond(jacobian) > 1e4:
+            continue
+        twist = np.concatenate([rng.normal(size=3), rng.normal(size=3) / rng.uniform(0.01, 2.0)])
+        axis = tool_pose_in_base(robot, q)[:3, 2]
+        a.append(np.linalg.solve(jacobian, twist))
+        b.append(np.linalg.solve(jacobian, np.concatenate([np.zeros(3), axis])))
+        lp.append(_free_spin_lp(jacobian, twist, axis, robot.qdot_max))
+    speed, limiting = two_variable_speed(np.array(a).T, np.array(b).T, robot.qdot_max)
+    np.testing.assert_allclose(speed, lp, rtol=FREE_SPIN_LP_RTOL)
+    # At the optimum some spin rate keeps every joint within its limit, the limiting one on it.
+    sigma = spin_rate_nearest_zero(np.array(a).T, np.array(b).T, robot.qdot_max, speed)
+    load = np.abs(speed * np.array(a).T + sigma * np.array(b).T) / robot.qdot_max[:, None]
+    assert np.all(load <= 1 + 1e-9)
+    np.testing.assert_allclose(load[limiting, np.arange(1000)], 1.0, rtol=1e-9)
+
+
+def test_straight_spindle_drops_the_last_joint() -> None:
+    """Tool z on the flange axis: V_max = 1 / max over joints 1-5 of |a_j| / limit_j."""
+    robot = get_robot("ur5")
+    rng = np.random.default_rng(3)
+    q = rng.uniform(-np.pi, np.pi, (200, 6))
+    a = rng.normal(size=(6, 200))
+    b = np.array(
+        [
+            np.linalg.solve(
+                jacobian_in_base(robot, qi),
+                np.concatenate([np.zeros(3), tool_pose_in_base(robot, qi)[:3, 2]]),
+            )
+            for qi in q
+        ]
+    ).T
+    speed, limiting = two_variable_speed(a, b, robot.qdot_max)
+    expected = 1.0 / np.max(np.abs(a[:5]) / robot.qdot_max[:5, None], axis=0)
+    np.testing.assert_allclose(speed, expected, rtol=1e-9)
+    assert np.all(limiting < 5)
+
+
+def test_readme_example_free_spin_schedule_realises_mu_path() -> None:
+    """The issue's figure, and fixed mode with the free mode's spins within 1 %."""
+    robot = get_robot("ur5")
+    path = load_path("curved_line")
+    fixed = evaluate_path(robot, path, README_PLACEMENT)
+    free = evaluate_path(robot, path, README_PLACEMENT, spin_mode="free")
+    assert fixed.mu_path == pytest.approx(0.293729, abs=1e-6)
+    assert free.mu_path == pytest.approx(1.248073, abs=1e-6)  # independent LP: 1.2481
+    assert free.spins is not None and free.q is not None and free.qdot is not None
+    turn = np.zeros((len(path), 4, 4))
+    turn[:, 0, 0] = turn[:, 1, 1] = np.cos(free.spins)
+    turn[:, 1, 0] = np.sin(free.spins)
+    turn[:, 0, 1] = -np.sin(free.spins)
+    turn[:, 2, 2] = turn[:, 3, 3] = 1.0
+    spun = evaluate_path(robot, path @ turn, README_PLACEMENT)
+    assert spun.mu_path is not None
+    assert abs(spun.mu_path / free.mu_path - 1) < SPIN_SCHEDULE_RTOL
+    # The schedule's joint path: within limits, and its joint speeds at V_max within theirs.
+    assert np.all((free.q >= robot.q_lower) & (free.q <= robot.q_upper))
+    assert np.all(np.abs(free.qdot) <= robot.qdot_max * (1 + 1e-9))
+    # The schedule's last joint is the given one turned by the spin (a straight spindle).
+    np.testing.assert_allclose(free.q[:, 5] - fixed.q[:, 5], free.spins, atol=1e-9)
+
+
+def test_last_joint_limits_are_checked_along_the_schedule() -> None:
+    """Limits that hold the spun path but not the given one, then ones 0.05 rad tighter."""
+    robot = get_robot("ur5")
+    path = load_path("curved_line")
+    free = evaluate_path(robot, path, README_PLACEMENT, spin_mode="free")
+    assert free.q is not None
+    lower, upper = robot.q_lower.copy(), robot.q_upper.copy()
+    lower[5], upper[5] = free.q[:, 5].min() - 1e-6, free.q[:, 5].max() + 1e-6
+    fits = dataclasses.replace(robot, q_lower=lower, q_upper=upper)
+    assert evaluate_path(fits, path, README_PLACEMENT).reason == "joint_limits"
+    assert evaluate_path(fits, path, README_PLACEMENT, spin_mode="free").feasible
+    lower[5] += 0.05
+    tight = dataclasses.replace(robot, q_lower=lower, q_upper=upper)
+    result = evaluate_path(tight, path, README_PLACEMENT, spin_mode="free")
+    assert (result.feasible, result.reason) == (False, "joint_limits")
+
+
+def test_free_spin_map_equals_evaluate() -> None:
+    robot = get_robot("ur5")
+    path = load_path("curved_line")
+    xs, ys, yaws = np.array([-0.1, 0.0, 0.15]), np.array([0.35, 0.5]), np.array([0.0, 2.0])
+    cmap = capability_map(robot, path, xs=xs, ys=ys, z=0.1, yaws=yaws, spin_mode="free")
+    for index in np.ndindex(cmap.mu_path.shape):
+        expected = evaluate_path(robot, path, cmap.placement(index), spin_mode="free")
+        if expected.mu_path is None:
+            assert np.isnan(cmap.mu_path[index])
+        else:
+            assert cmap.mu_path[index] == pytest.approx(expected.mu_path, rel=MAP_EVALUATE_RTOL)
+
+
+@pytest.fixture(scope="module")
+def free_optima() -> dict:
+    robot, path = get_robot("ur5"), load_path("curved_line")
+    bounds = PlacementBounds(x=(-0.25, 0.25), y=(0.25, 0.65), yaw=(-math.pi, math.pi), z=0.1)
+    grid = capability_map(
+        robot,
+        path,
+        xs=grid_axis(*bounds.x, 0.02, field="x"),
+        ys=grid_axis(*bounds.y, 0.02, field="y"),
+        z=bounds.z,
+        yaws=grid_axis(-math.pi, math.pi - 1e-9, math.radians(15), field="yaw"),
+        spin_mode="free",
+    )
+    return {
+        "robot": robot,
+        "path": path,
+        "bounds": bounds,
+        "best_cell": float(np.nanmax(grid.mu_path)),
+        "fixed": optimize_placement(robot, path, bounds=bounds),
+        **{
+            method: optimize_placement(robot, path, bounds=bounds, method=method, spin_mode="free")
+            for method in ("casadi", "scipy")
+        },
+    }
+
+
+@pytest.mark.parametrize("method", ["casadi", "scipy"])
+def test_free_spin_optimum(free_optima: dict, method: str) -> None:
+    """At or above the free-spin map's best cell and the fixed-spin optimum; = the evaluator."""
+    optimum = free_optima[method]
+    assert optimum is not None and free_optima["fixed"] is not None
+    assert optimum.mu_path >= free_optima["best_cell"]
+    assert optimum.mu_path >= free_optima["fixed"].mu_path
+    evaluation = evaluate_path(
+        free_optima["robot"], free_optima["path"], optimum.placement, spin_mode="free"
+    )
+    assert optimum.mu_path == pytest.approx(evaluation.mu_path, rel=OPTIMUM_EVALUATE_RTOL)
+    assert optimum.evaluation.spins is not None
+    other = free_optima["scipy" if method == "casadi" else "casadi"]
+    assert optimum.mu_path == pytest.approx(other.mu_path, rel=OPTIMUM_METHODS_RTOL)
