@@ -14,9 +14,12 @@ from solver.dtf import DtfResult
 from solver.evaluate import Branch, PathEvaluation
 from solver.exceptions import InvalidInputError
 from solver.optimize import PlacementOptimum
+from solver.pipeline import SpinMode
 from solver.robots import Robot, get_robot, robot_from_urdf
-from solver.spatial import Placement, pose_matrix
-from solver.symmetry import PlacementBounds
+from solver.search_space import PlacementBounds
+from solver.spatial import Placement, check_position, pose_matrix, spun_waypoints
+from solver.task import task_requirements
+from solver.tool_axis import poses_from_tool_axes
 from solver.tracking import FEASIBLE, REASONS
 
 
@@ -46,16 +49,70 @@ def pose_matrix_of(pose: schemas.Pose, *, field: str) -> np.ndarray:
     return pose_matrix(pose.position, pose.orientation, field=field)
 
 
-def waypoints_of(path: schemas.Path) -> np.ndarray:
-    """T_O_i of every waypoint, shape (N, 4, 4), metres, in the workpiece frame {O}."""
-    return np.array(
-        [pose_matrix_of(pose, field=f"path.waypoints.{i}") for i, pose in enumerate(path.waypoints)]
+@dataclass(frozen=True)
+class PathInput:
+    """A request's path as the solver takes it.
+
+    Attributes:
+        poses: shape (N, 4, 4), T_O_i (m).
+        axis_correction: the largest correction made to a tool axis's length (0 for poses).
+        default_spin_mode: ``free`` for a path given by tool axes, ``fixed`` for poses.
+    """
+
+    poses: np.ndarray
+    axis_correction: float
+    default_spin_mode: SpinMode
+
+
+def path_of(path: schemas.Path) -> PathInput:
+    """The poses of a path in {O}, from whichever form the request used.
+
+    Raises:
+        InvalidInputError, RepeatedWaypointError: naming the field and the waypoint.
+    """
+    if path.waypoints is not None:
+        poses = np.array(
+            [
+                pose_matrix_of(pose, field=f"path.waypoints.{i}")
+                for i, pose in enumerate(path.waypoints)
+            ]
+        )
+        return PathInput(poses=poses, axis_correction=0.0, default_spin_mode="fixed")
+    points = path.tool_axis_waypoints or []
+    field = "path.tool_axis_waypoints"
+    positions = np.array(
+        [check_position(p.position, field=f"{field}.{i}.position") for i, p in enumerate(points)]
     )
+    poses, correction = poses_from_tool_axes(positions, np.array([p.axis for p in points]))
+    task_requirements(poses, field=field)  # names this field, not path.waypoints, on an error
+    return PathInput(poses=poses, axis_correction=correction, default_spin_mode="free")
+
+
+def spun_poses(path: PathInput, spins: list[float] | None) -> np.ndarray:
+    """The path's poses, each turned by its spin about its tool z axis when spins are given.
+
+    Raises:
+        InvalidInputError: on ``spins``, a count that is not the number of waypoints.
+    """
+    if spins is None:
+        return path.poses
+    if len(spins) != len(path.poses):
+        raise InvalidInputError(
+            "spins", f"{len(spins)} spins for {len(path.poses)} waypoints: one per waypoint"
+        )
+    return spun_waypoints(path.poses, np.array(spins, dtype=float))
+
+
+def spin_mode_of(requested: SpinMode | None, path: PathInput) -> SpinMode:
+    """The spin mode asked for, or the path form's default."""
+    return path.default_spin_mode if requested is None else requested
 
 
 def placement_of(placement: schemas.Placement) -> Placement:
     """The solver's placement (m, rad)."""
-    return Placement(x=placement.x, y=placement.y, z=placement.z, yaw=placement.yaw)
+    return Placement(
+        x=placement.x, y=placement.y, z=placement.z, yaw=placement.yaw, spin=placement.spin
+    )
 
 
 def branch_of(choice: schemas.Branch | str) -> Branch | None:
@@ -102,7 +159,21 @@ def robot_info(robot: Robot) -> schemas.RobotInfo:
         qdot_max=robot.qdot_max.tolist(),
         base_frame=robot.base_frame,
         tool_frame=robot.tool_frame,
+        family=None if robot.family is None else robot.family.name,
+        branches=_branch_levels(robot),
     )
+
+
+def _branch_levels(robot: Robot) -> list[schemas.BranchLevel]:
+    """The levels of the robot's IK branches and the choices at each, in branch order."""
+    if robot.family is None:
+        return []
+    choices: dict[str, list[str]] = {}
+    for branch in robot.family.branches:
+        for level, choice in branch.choices:
+            if choice not in choices.setdefault(level, []):
+                choices[level].append(choice)
+    return [schemas.BranchLevel(level=level, choices=names) for level, names in choices.items()]
 
 
 def _optional_list(values: np.ndarray | None, i: int) -> list[float] | None:
@@ -113,7 +184,9 @@ def _optional_float(values: np.ndarray | None, i: int) -> float | None:
     return None if values is None else float(values[i])
 
 
-def evaluate_response(evaluation: PathEvaluation, robot: Robot) -> schemas.EvaluateResponse:
+def evaluate_response(
+    evaluation: PathEvaluation, robot: Robot, *, axis_correction: float = 0.0
+) -> schemas.EvaluateResponse:
     """The response of ``POST /v1/evaluate``."""
     ev = evaluation
     waypoints = []
@@ -149,6 +222,9 @@ def evaluate_response(evaluation: PathEvaluation, robot: Robot) -> schemas.Evalu
         failed_waypoint=ev.failed_waypoint,
         branch=branch,
         waypoints=waypoints,
+        spin_mode=ev.spin_mode,
+        spins=None if ev.spins is None else ev.spins.tolist(),
+        axis_correction=axis_correction,
     )
 
 
@@ -159,6 +235,7 @@ class MapGrid:
     xs: np.ndarray
     ys: np.ndarray
     yaws: np.ndarray
+    spins: np.ndarray
 
 
 def map_grid(grid: schemas.Grid, *, settings: Settings, n_waypoints: int) -> MapGrid:
@@ -170,9 +247,9 @@ def map_grid(grid: schemas.Grid, *, settings: Settings, n_waypoints: int) -> Map
     """
     nx = axis_length(grid.x.min, grid.x.max, grid.x.step, field="grid.x")
     ny = axis_length(grid.y.min, grid.y.max, grid.y.step, field="grid.y")
-    yaws = grid.yaws()
-    cells = nx * ny * len(yaws)
-    size = f"{nx} x * {ny} y * {len(yaws)} yaw = {cells} placements"
+    yaws, spins = grid.yaws(), grid.spins()
+    cells = nx * ny * len(yaws) * len(spins)
+    size = f"{nx} x * {ny} y * {len(yaws)} yaw * {len(spins)} spin = {cells} placements"
     if cells > settings.max_map_cells:
         raise InvalidInputError(
             "grid", f"{size}; the limit is {settings.max_map_cells} (DTF_MAX_MAP_CELLS)"
@@ -187,6 +264,7 @@ def map_grid(grid: schemas.Grid, *, settings: Settings, n_waypoints: int) -> Map
         xs=grid_axis(grid.x.min, grid.x.max, grid.x.step, field="grid.x"),
         ys=grid_axis(grid.y.min, grid.y.max, grid.y.step, field="grid.y"),
         yaws=np.array(yaws, dtype=float),
+        spins=np.array(spins, dtype=float),
     )
 
 
@@ -198,7 +276,9 @@ def wants_png(accept: str) -> bool:
 
 def _api_placement(placement: Placement) -> schemas.Placement:
     """The API's placement (m, rad) of a solver placement."""
-    return schemas.Placement(x=placement.x, y=placement.y, z=placement.z, yaw=placement.yaw)
+    return schemas.Placement(
+        x=placement.x, y=placement.y, z=placement.z, yaw=placement.yaw, spin=placement.spin
+    )
 
 
 def _extreme(cmap: CapabilityMap, *, best: bool) -> schemas.MapExtreme | None:
@@ -211,19 +291,20 @@ def _extreme(cmap: CapabilityMap, *, best: bool) -> schemas.MapExtreme | None:
     )
 
 
-def map_response(cmap: CapabilityMap) -> schemas.MapResponse:
+def map_response(cmap: CapabilityMap, *, spin_mode: SpinMode) -> schemas.MapResponse:
     """The JSON answer of ``POST /v1/map``: cells yaw-major, then y, then x."""
     cells = []
-    for k, j, i in np.ndindex(cmap.mu_path.shape):
-        feasible = cmap.reason[k, j, i] == FEASIBLE
+    for s, k, j, i in np.ndindex(cmap.mu_path.shape):
+        feasible = cmap.reason[s, k, j, i] == FEASIBLE
         cells.append(
             schemas.MapCell(
                 x=float(cmap.xs[i]),
                 y=float(cmap.ys[j]),
                 yaw=float(cmap.yaws[k]),
-                mu_path=float(cmap.mu_path[k, j, i]) if feasible else None,
-                reason=None if feasible else REASONS[int(cmap.reason[k, j, i])],
-                failed_waypoint=None if feasible else int(cmap.failed_waypoint[k, j, i]),
+                spin=float(cmap.spins[s]),
+                mu_path=float(cmap.mu_path[s, k, j, i]) if feasible else None,
+                reason=None if feasible else REASONS[int(cmap.reason[s, k, j, i])],
+                failed_waypoint=None if feasible else int(cmap.failed_waypoint[s, k, j, i]),
             )
         )
     return schemas.MapResponse(
@@ -231,6 +312,7 @@ def map_response(cmap: CapabilityMap) -> schemas.MapResponse:
         best=_extreme(cmap, best=True),
         worst=_extreme(cmap, best=False),
         feasible_cells=int(np.sum(cmap.reason == FEASIBLE)),
+        spin_mode=spin_mode,
     )
 
 
@@ -241,45 +323,27 @@ def bounds_of(bounds: schemas.Bounds, *, z: float) -> PlacementBounds:
         y=(bounds.y[0], bounds.y[1]),
         yaw=(bounds.yaw[0], bounds.yaw[1]),
         z=z,
+        spin=(bounds.spin[0], bounds.spin[1]),
     )
 
 
 def optimize_response(
-    optimum: PlacementOptimum | None,
-    robot: Robot,
-    *,
-    bounds: PlacementBounds,
-    start: Placement | None,
+    optimum: PlacementOptimum, robot: Robot, *, axis_correction: float = 0.0
 ) -> schemas.OptimizeResponse:
     """The answer of ``POST /v1/optimize`` (``found: false`` when nothing was feasible)."""
-    if optimum is None:
-        if start is None:  # the solver's default start: the centre of the bounds
-            x, y, yaw = bounds.centre()
-            start = Placement(x, y, bounds.z, yaw)
-        return schemas.OptimizeResponse(
-            found=False,
-            placement=None,
-            mu_path=None,
-            evaluation=None,
-            start=schemas.StartInfo(placement=_api_placement(start), mu_path=None),
-            improvement_percent=None,
-            solver=schemas.SolverInfo(
-                name="coarse search",
-                status="no feasible placement inside the bounds",
-                iterations=0,
-                seconds=0.0,
-            ),
-        )
     report = optimum.solver
     return schemas.OptimizeResponse(
-        found=True,
-        placement=_api_placement(optimum.placement),
+        found=optimum.found,
+        placement=None if optimum.placement is None else _api_placement(optimum.placement),
         mu_path=optimum.mu_path,
-        evaluation=evaluate_response(optimum.evaluation, robot),
+        evaluation=None
+        if optimum.evaluation is None
+        else evaluate_response(optimum.evaluation, robot, axis_correction=axis_correction),
         start=schemas.StartInfo(
             placement=_api_placement(optimum.start), mu_path=optimum.start_mu_path
         ),
         improvement_percent=optimum.improvement_percent,
+        spins=None if optimum.spins is None else optimum.spins.tolist(),
         solver=schemas.SolverInfo(
             name=report.name,
             status=report.status,

@@ -1,4 +1,4 @@
-"""The capability map as a picture (PNG), for a report: one panel per yaw, mu_path in colour."""
+"""The capability map as a picture (PNG), for a report: one panel per yaw and spin."""
 
 from __future__ import annotations
 
@@ -23,7 +23,7 @@ MAX_COLUMNS = 3
 
 
 def figure_pixels(n_panels: int) -> tuple[int, int]:
-    """Width and height (pixels) of the PNG of a map with ``n_panels`` yaw values."""
+    """Width and height (pixels) of the PNG of a map with ``n_panels`` (yaw, spin) pairs."""
     columns = min(n_panels, MAX_COLUMNS)
     rows = math.ceil(n_panels / MAX_COLUMNS)
     width = PANEL_INCHES[0] * columns + COLOUR_BAR_INCHES
@@ -33,7 +33,7 @@ def figure_pixels(n_panels: int) -> tuple[int, int]:
 
 def render_png(cmap: CapabilityMap, *, title: str) -> bytes:
     """The map as PNG bytes: colour bar in m/s, infeasible cells blank, best and worst marked."""
-    n_panels = len(cmap.yaws)
+    n_panels = len(cmap.spins) * len(cmap.yaws)
     columns = min(n_panels, MAX_COLUMNS)
     rows = math.ceil(n_panels / MAX_COLUMNS)
     width_px, height_px = figure_pixels(n_panels)
@@ -48,10 +48,10 @@ def render_png(cmap: CapabilityMap, *, title: str) -> bytes:
     half_y = (cmap.ys[1] - cmap.ys[0]) / 2 if len(cmap.ys) > 1 else 0.005
     extent = (cmap.xs[0] - half_x, cmap.xs[-1] + half_x, cmap.ys[0] - half_y, cmap.ys[-1] + half_y)
     images = []
-    for k, yaw in enumerate(cmap.yaws):
-        axes = panels[k // columns, k % columns]
+    for panel, (s, k) in enumerate(np.ndindex(len(cmap.spins), len(cmap.yaws))):
+        axes = panels[panel // columns, panel % columns]
         image = axes.imshow(
-            np.ma.masked_invalid(cmap.mu_path[k]),
+            np.ma.masked_invalid(cmap.mu_path[s, k]),
             origin="lower",
             extent=extent,
             cmap=colours,
@@ -62,9 +62,13 @@ def render_png(cmap: CapabilityMap, *, title: str) -> bytes:
         )
         images.append(image)
         for index, marker, colour in ((best, "*", "red"), (worst, "X", "black")):
-            if index is not None and index[0] == k:
-                axes.plot(cmap.xs[index[2]], cmap.ys[index[1]], marker, color=colour, ms=12)
-        axes.set_title(f"yaw {math.degrees(float(yaw)):.1f} deg, z = {cmap.z:.3f} m", fontsize=9)
+            if index is not None and index[:2] == (s, k):
+                axes.plot(cmap.xs[index[3]], cmap.ys[index[2]], marker, color=colour, ms=12)
+        spin = f", spin {math.degrees(float(cmap.spins[s])):.1f} deg" if cmap.spins[s] else ""
+        axes.set_title(
+            f"yaw {math.degrees(float(cmap.yaws[k])):.1f} deg{spin}, z = {cmap.z:.3f} m",
+            fontsize=9,
+        )
         axes.set_xlabel("x (m)")
         axes.set_ylabel("y (m)")
     for axes in panels.ravel()[n_panels:]:

@@ -25,12 +25,13 @@ __all__ = ["REASONS", "CapabilityMap", "axis_length", "capability_map", "grid_ax
 
 @dataclass(frozen=True)
 class CapabilityMap:
-    """mu_path at every placement (x, y, yaw) of a grid at height z.
+    """mu_path at every placement (x, y, yaw) and tool spin of a grid at height z.
 
-    Arrays are indexed [yaw, y, x].
+    Arrays are indexed [spin, yaw, y, x].
 
     Attributes:
         xs: shape (nx,), m. ys: shape (ny,), m. yaws: shape (nyaw,), rad. z: m.
+        spins: shape (nspin,), rad, the constant tool spins (cam.md section 3).
         mu_path: m/s, NaN where infeasible.
         reason: index into ``REASONS``, -1 where feasible.
         failed_waypoint: the first waypoint that fails, -1 where feasible.
@@ -43,6 +44,7 @@ class CapabilityMap:
     ys: np.ndarray
     yaws: np.ndarray
     z: float
+    spins: np.ndarray
     mu_path: np.ndarray
     reason: np.ndarray
     failed_waypoint: np.ndarray
@@ -50,23 +52,28 @@ class CapabilityMap:
     bottleneck_waypoint: np.ndarray
     bottleneck_joint: np.ndarray
 
-    def placement(self, index: tuple[int, int, int]) -> Placement:
-        """The placement of cell [yaw, y, x]."""
-        k, j, i = index
-        return Placement(float(self.xs[i]), float(self.ys[j]), self.z, float(self.yaws[k]))
+    def placement(self, index: tuple[int, ...]) -> Placement:
+        """The placement of cell [spin, yaw, y, x]."""
+        s, k, j, i = index
+        return Placement(
+            float(self.xs[i]),
+            float(self.ys[j]),
+            self.z,
+            float(self.yaws[k]),
+            spin=float(self.spins[s]),
+        )
 
-    def extreme(self, *, best: bool) -> tuple[int, int, int] | None:
-        """Index [yaw, y, x] of the feasible cell with the highest (or lowest) mu_path.
+    def extreme(self, *, best: bool) -> tuple[int, ...] | None:
+        """Index [spin, yaw, y, x] of the feasible cell with the highest (or lowest) mu_path.
 
-        Ties go to the first cell in [yaw, y, x] order; ``None`` when no cell is feasible.
+        Ties go to the first cell in [spin, yaw, y, x] order; ``None`` when none is feasible.
         """
         feasible = ~np.isnan(self.mu_path)
         if not feasible.any():
             return None
         values = np.where(feasible, self.mu_path, -np.inf if best else np.inf)
         flat = int(np.argmax(values) if best else np.argmin(values))
-        k, j, i = np.unravel_index(flat, self.mu_path.shape)
-        return int(k), int(j), int(i)
+        return tuple(int(v) for v in np.unravel_index(flat, self.mu_path.shape))
 
 
 def axis_length(lower: float, upper: float, step: float, *, field: str) -> int:
@@ -107,13 +114,14 @@ def capability_map(
     ys: np.ndarray,
     z: float,
     yaws: np.ndarray,
+    spins: np.ndarray | None = None,
     branch: Branch | None = None,
     max_joint_step: float = DEFAULT_MAX_JOINT_STEP,
     spin_mode: SpinMode = "fixed",
     chunk: int = DEFAULT_CHUNK,
     progress: Callable[[float], None] | None = None,
 ) -> CapabilityMap:
-    """mu_path over the grid xs x ys x yaws at height z (spec section 6).
+    """mu_path over the grid spins x yaws x ys x xs at height z (spec section 6).
 
     Args:
         robot: an arm with a kinematics family, with its speed limits and TCP.
@@ -122,6 +130,7 @@ def capability_map(
         ys: shape (ny,), m, placement y values.
         z: m, the height of every placement.
         yaws: shape (nyaw,), rad, placement yaw values.
+        spins: shape (nspin,), rad, constant tool spins (cam.md section 3); default [0].
         branch: the IK branch to follow everywhere; ``None`` is ``auto``.
         max_joint_step: rad, > 0.
         spin_mode: ``fixed`` or ``free`` (the tool spin rate free, cam.md section 2).
@@ -131,11 +140,19 @@ def capability_map(
     Raises:
         NoAnalyticIkError, InvalidInputError, RepeatedWaypointError: as ``evaluate_path``.
     """
-    xs, ys, yaws = (np.asarray(v, dtype=float) for v in (xs, ys, yaws))
-    shape = (len(yaws), len(ys), len(xs))
-    grid_yaw, grid_y, grid_x = np.meshgrid(yaws, ys, xs, indexing="ij")
+    spins = np.zeros(1) if spins is None else spins
+    xs, ys, yaws, spins = (np.asarray(v, dtype=float) for v in (xs, ys, yaws, spins))
+    shape = (len(spins), len(yaws), len(ys), len(xs))
+    grid_spin, grid_yaw, grid_y, grid_x = np.meshgrid(spins, yaws, ys, xs, indexing="ij")
     placements = np.stack(
-        [grid_x.ravel(), grid_y.ravel(), np.full(grid_x.size, float(z)), grid_yaw.ravel()], axis=1
+        [
+            grid_x.ravel(),
+            grid_y.ravel(),
+            np.full(grid_x.size, float(z)),
+            grid_yaw.ravel(),
+            grid_spin.ravel(),
+        ],
+        axis=1,
     )
     result = evaluate_placements(
         robot,
@@ -152,6 +169,7 @@ def capability_map(
         ys=ys,
         yaws=yaws,
         z=float(z),
+        spins=spins,
         mu_path=result.mu_path.reshape(shape),
         reason=result.reason.reshape(shape),
         failed_waypoint=result.failed_waypoint.reshape(shape),

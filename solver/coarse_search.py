@@ -1,8 +1,9 @@
 """The coarse search of the optimiser: a map over the bounds and its local maxima.
 
 Where joint 1 turns about the base z axis the map is over (r, psi) (:mod:`solver.symmetry`),
-each cell placed on its arc inside the bounds; otherwise over (x, y, yaw). Its local maxima,
-best first, are the starts of the IPOPT solves, each with its IK branch.
+each cell placed on its arc inside the bounds; otherwise over (x, y, yaw). A free tool spin is
+one more dimension of the map. Its local maxima, best first, are the starts of the IPOPT solves,
+each with its IK branch.
 """
 
 from __future__ import annotations
@@ -16,23 +17,32 @@ from solver.exceptions import InvalidInputError
 from solver.pipeline import PreparedPath, SpinMode
 from solver.placements import evaluate_placements
 from solver.robots import Robot
+from solver.search_space import PlacementBounds
 from solver.spatial import MAX_COORDINATE
-from solver.symmetry import PlacementBounds, arc_point
+from solver.symmetry import arc_point
 
 COARSE_STEP = 0.02  # m, of the coarse map (r or x, y)
-COARSE_YAW_STEP = math.radians(15)  # rad, of the coarse map (psi or yaw)
+COARSE_YAW_STEP = math.radians(15)  # rad, of the coarse map (psi, yaw and spin)
 MAX_COARSE_CELLS = 50_000  # default limit on the coarse map (a box larger is an input error)
-
-Point = tuple[float, float, float]  # x (m), y (m), yaw (rad)
 
 
 @dataclass(frozen=True)
 class Cell:
-    """A placement (x, y, yaw) with its mu_path and IK branch index."""
+    """A decision vector [x, y, yaw, spin] with its mu_path and IK branch index."""
 
-    placement: Point
+    vector: np.ndarray
     mu_path: float
     branch: int
+
+
+def _spin_values(bounds: PlacementBounds) -> tuple[np.ndarray, bool]:
+    """The coarse map's spins, and whether they wrap (a whole turn)."""
+    low, high = bounds.spin
+    if high <= low:
+        return np.array([low]), False
+    wraps = high - low >= 2 * math.pi - 1e-9
+    count = math.floor((high - low) / COARSE_YAW_STEP + 1e-9) + (0 if wraps else 1)
+    return low + COARSE_YAW_STEP * np.arange(max(count, 1)), wraps
 
 
 def _local_maxima(values: np.ndarray, periodic: tuple[bool, ...]) -> list[tuple[int, ...]]:
@@ -65,11 +75,13 @@ def coarse_cells(
     """Local maxima of a coarse map over the bounds, best first.
 
     Over (r, psi) at COARSE_STEP x COARSE_YAW_STEP when ``symmetric`` (each cell placed on its
-    arc nearest the polar angle ``near``), else over (x, y, yaw).
+    arc nearest the polar angle ``near``), else over (x, y, yaw); times the spins when the spin
+    is free.
 
     Raises:
         InvalidInputError: the map would have more than ``max_cells`` cells (on ``bounds``).
     """
+    spins, spin_wraps = _spin_values(bounds)
     n_psi = round(2 * math.pi / COARSE_YAW_STEP)
     if symmetric:
         corners = [math.hypot(x, y) for x in bounds.x for y in bounds.y]
@@ -86,6 +98,7 @@ def coarse_cells(
                 (bounds.yaw, COARSE_YAW_STEP),
             )
         ]
+    sizes = [len(spins), *sizes] if len(spins) > 1 else sizes
     if math.prod(sizes) > max_cells:
         raise InvalidInputError(
             "bounds",
@@ -93,17 +106,18 @@ def coarse_cells(
             f"({' x '.join(map(str, sizes))} at {COARSE_STEP * 1000:.0f} mm, "
             f"{math.degrees(COARSE_YAW_STEP):.0f} deg); the limit is {max_cells}",
         )
+    # One spin's cells: where each is reported (inside the box) and where it is evaluated.
+    points: list[tuple[float, float, float] | None]
+    evaluated: list[tuple[float, float, float] | None]
     if symmetric:
-        radii = r_low + COARSE_STEP * np.arange(sizes[0])
+        radii = r_low + COARSE_STEP * np.arange(math.floor((r_high - r_low) / COARSE_STEP) + 1)
         psis = -math.pi + COARSE_YAW_STEP * np.arange(n_psi)
         shape: tuple[int, ...] = (len(psis), len(radii))
-        points: list[Point | None] = [
-            arc_point(float(r), float(p), bounds, near=near) for p in psis for r in radii
-        ]
+        points = [arc_point(float(r), float(p), bounds, near=near) for p in psis for r in radii]
         # mu_path is the same all along an arc: evaluate every cell at the polar angle `near`,
         # so that the cells of one psi share a yaw (the cheap case of evaluate_placements),
         # unless that is farther than any placement may be.
-        evaluated: list[Point | None] = [
+        evaluated = [
             (float(r * math.cos(near)), float(r * math.sin(near)), float(p + near))
             if r <= MAX_COORDINATE
             else None
@@ -113,37 +127,40 @@ def coarse_cells(
         periodic: tuple[bool, ...] = (True, False)
     else:
         axes = [
-            low + step * np.arange(size)
-            for (low, _), step, size in zip(
-                (bounds.x, bounds.y, bounds.yaw),
-                (COARSE_STEP, COARSE_STEP, COARSE_YAW_STEP),
-                sizes,
-                strict=True,
+            low + step * np.arange(math.floor((high - low) / step + 1e-9) + 1)
+            for (low, high), step in (
+                (bounds.x, COARSE_STEP),
+                (bounds.y, COARSE_STEP),
+                (bounds.yaw, COARSE_YAW_STEP),
             )
         ]
         shape = (len(axes[2]), len(axes[1]), len(axes[0]))
         points = [(float(x), float(y), float(w)) for w in axes[2] for y in axes[1] for x in axes[0]]
         evaluated = [None] * len(points)
         periodic = (bounds.yaw[1] - bounds.yaw[0] >= 2 * math.pi - 1e-9, False, False)
-    inside, rows = [], []
-    for i, point in enumerate(points):
-        at = evaluated[i] or point
-        if point is not None and at is not None:
-            inside.append(i)
-            rows.append([at[0], at[1], bounds.z, at[2]])
-    mu = np.full(len(points), np.nan)
-    branch = np.zeros(len(points), dtype=int)
-    if inside:
-        placements = np.array(rows)
+    vectors: list[np.ndarray | None] = []
+    rows = []
+    for spin in spins:
+        for point, where in zip(points, evaluated, strict=True):
+            at = where or point
+            if point is None or at is None:
+                vectors.append(None)
+                continue
+            vectors.append(np.array([*point, spin]))
+            rows.append([at[0], at[1], bounds.z, at[2], spin])
+    full_shape = (len(spins), *shape)
+    mu = np.full(len(vectors), np.nan)
+    branch = np.zeros(len(vectors), dtype=int)
+    inside_index = [i for i, v in enumerate(vectors) if v is not None]
+    if inside_index:
         result = evaluate_placements(
-            robot, path, placements, max_joint_step=max_joint_step, spin_mode=spin_mode
+            robot, path, np.array(rows), max_joint_step=max_joint_step, spin_mode=spin_mode
         )
-        mu[inside], branch[inside] = result.mu_path, result.branch
-    flat = np.ravel_multi_index
+        mu[inside_index], branch[inside_index] = result.mu_path, result.branch
     cells = []
-    for index in _local_maxima(mu.reshape(shape), periodic):
-        k = int(flat(index, shape))
-        point = points[k]
-        if point is not None:
-            cells.append(Cell(point, float(mu[k]), int(branch[k])))
+    for index in _local_maxima(mu.reshape(full_shape), (spin_wraps, *periodic)):
+        k = int(np.ravel_multi_index(index, full_shape))
+        vector = vectors[k]
+        if vector is not None:
+            cells.append(Cell(vector, float(mu[k]), int(branch[k])))
     return cells

@@ -23,6 +23,7 @@ from solver.pipeline import (
     SpinMode,
     check_max_joint_step,
     check_placements,
+    check_spin_mode,
     prepare_path,
     require_family,
     run_chunk,
@@ -50,6 +51,7 @@ class PathEvaluation:
         q: shape (N, n), rad. v_max: shape (N,), m/s. omega_max: shape (N,), rad/s.
         qdot: shape (N, n), rad/s at V_max. limiting_joint: shape (N,). These five are
             ``None`` when infeasible.
+        spin_mode: ``fixed`` or ``free``, as asked.
         spins: shape (N,), rad, in ``free`` spin mode the spin schedule that realises mu_path
             (q is then the joint path along it); ``None`` otherwise.
     """
@@ -69,6 +71,7 @@ class PathEvaluation:
     omega_max: np.ndarray | None = None
     qdot: np.ndarray | None = None
     limiting_joint: np.ndarray | None = None
+    spin_mode: SpinMode = "fixed"
     spins: np.ndarray | None = None
 
 
@@ -94,7 +97,7 @@ def evaluate_path(
     Args:
         robot: an arm with a kinematics family (UR, OPW), with its speed limits and TCP.
         waypoints_in_workpiece: shape (N, 4, 4), T_O_i, tool point poses in {O} (metres).
-        placement: where {O} sits in {B}.
+        placement: where {O} sits in {B}, and the tool spin (cam.md section 3).
         branch: the IK branch to follow; ``None`` is ``auto``, the feasible branch with the
             highest mu_path.
         spin_mode: ``fixed`` (the orientations as given) or ``free`` (the tool spin rate free,
@@ -106,9 +109,10 @@ def evaluate_path(
         InvalidInputError: a bad path, step or branch name.
         RepeatedWaypointError: two consecutive waypoints are the same pose.
     """
+    check_spin_mode(robot, spin_mode)
     family = require_family(robot)
     check_max_joint_step(max_joint_step)
-    cell = check_placements(np.array([[placement.x, placement.y, placement.z, placement.yaw]]))
+    cell = check_placements(placement.as_row()[None])
     path = prepare_path(robot, waypoints_in_workpiece)
     indices = (
         np.arange(len(family.branches))
@@ -129,6 +133,7 @@ def evaluate_path(
         u_T=_turned(path.u_T, placement.yaw),
         u_R=_turned(path.u_R, placement.yaw),
         h=path.h,
+        spin_mode=spin_mode,
     )
     if reason != FEASIBLE:
         return infeasible

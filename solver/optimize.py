@@ -18,6 +18,7 @@ the reported (x, y, yaw) is deterministic.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import time
 from dataclasses import dataclass
@@ -32,11 +33,13 @@ from solver.pipeline import PreparedPath, SpinMode, prepare_path, require_family
 from solver.placement_nlp import PlacementNlp
 from solver.placement_scipy import global_search, polish
 from solver.robots import Robot
-from solver.spatial import MAX_COORDINATE, Placement
-from solver.symmetry import PlacementBounds, arc_coordinates, arc_point, turns_about_base_z
+from solver.search_space import PlacementBounds, vector_of
+from solver.spatial import Placement, spun_waypoints
+from solver.symmetry import arc_coordinates, arc_point, turns_about_base_z
 
 Method = Literal["casadi", "scipy"]
 N_STARTS = 4  # IPOPT solves, from the best local maxima of the coarse map
+Candidate = tuple[np.ndarray, np.ndarray | None]  # decision vector, per-waypoint spins
 
 
 @dataclass(frozen=True)
@@ -51,9 +54,11 @@ class SolverReport:
 
 @dataclass(frozen=True)
 class PlacementOptimum:
-    """The best placement found, as the evaluator sees it.
+    """The best placement found, as the evaluator sees it (qpsolvers' ``Solution``).
 
     Attributes:
+        found: whether any placement the search tried (the start included) is feasible; when
+            not, placement, mu_path and evaluation are None.
         placement: the optimum (inside the bounds).
         mu_path: m/s, the evaluator's mu_path there.
         evaluation: the evaluator's whole answer there.
@@ -61,46 +66,37 @@ class PlacementOptimum:
         improvement_percent: 100 (mu_path / start_mu_path - 1); None without a feasible start.
         solver: what the optimiser did.
         symmetric: whether the search used the (r, psi) symmetry.
+        spins: shape (N,), rad, each waypoint's spin on top of the placement's, when the
+            answer came from the spin-path NLP (cam.md section 4); else None.
     """
 
-    placement: Placement
-    mu_path: float
-    evaluation: PathEvaluation
+    found: bool
+    placement: Placement | None
+    mu_path: float | None
+    evaluation: PathEvaluation | None
     start: Placement
     start_mu_path: float | None
     improvement_percent: float | None
     solver: SolverReport
     symmetric: bool
-
-
-def check_bounds(bounds: PlacementBounds) -> None:
-    """Raise InvalidInputError naming the range that is not finite, reversed or too far."""
-    for name, (low, high) in (("x", bounds.x), ("y", bounds.y), ("yaw", bounds.yaw)):
-        if not (math.isfinite(low) and math.isfinite(high) and low <= high):
-            raise InvalidInputError(f"bounds.{name}", f"needs finite [min, max], got {[low, high]}")
-        if name != "yaw" and max(abs(low), abs(high)) > MAX_COORDINATE:
-            raise InvalidInputError(f"bounds.{name}", f"beyond +-{MAX_COORDINATE} m")
-    if not math.isfinite(bounds.z) or abs(bounds.z) > MAX_COORDINATE:
-        raise InvalidInputError("z", f"{bounds.z!r} m is not a finite height within the cell")
+    spins: np.ndarray | None = None
 
 
 def _place_on_arc(
-    placement: tuple[float, float, float], bounds: PlacementBounds, near: float, symmetric: bool
+    vector: np.ndarray, bounds: PlacementBounds, near: float, symmetric: bool
 ) -> Placement:
     """The candidate, clamped into the box, moved along its arc to the point nearest ``near``.
 
     Solvers may end a hair outside their bounds (IPOPT by its bound relaxation, 1e-8): the
     clamp is what makes every reported placement inside them; the evaluator then judges it.
+    The spin rides along: turning the placement about the base axis leaves it as it is.
     """
-    x, y, yaw = (
-        min(max(value, low), high)
-        for value, (low, high) in zip(placement, (bounds.x, bounds.y, bounds.yaw), strict=True)
-    )
+    x, y, yaw, spin = bounds.clamp(vector)
     if symmetric:
         moved = arc_point(*arc_coordinates(x, y, yaw), bounds, near=near)
         if moved is not None:
             x, y, yaw = moved
-    return Placement(x, y, bounds.z, yaw)
+    return Placement(float(x), float(y), bounds.z, float(yaw), spin=float(spin))
 
 
 def optimize_placement(
@@ -112,38 +108,54 @@ def optimize_placement(
     method: Method = "casadi",
     max_joint_step: float = DEFAULT_MAX_JOINT_STEP,
     spin_mode: SpinMode = "fixed",
+    max_spin_step: float | None = None,
     max_coarse_cells: int = MAX_COARSE_CELLS,
-) -> PlacementOptimum | None:
+) -> PlacementOptimum:
     """The placement inside ``bounds`` where the path runs fastest.
 
     Args:
         robot: an arm with a kinematics family, with its speed limits and TCP.
         waypoints_in_workpiece: shape (N, 4, 4), T_O_i (metres).
-        bounds: x, y, yaw ranges and the height z.
+        bounds: x, y, yaw and spin ranges and the height z (the decision vector).
         start: the start placement (default: the centre of the bounds), reported with its
             mu_path and used to choose the point of the optimal arc.
         method: ``"casadi"`` (IPOPT from the coarse map's maxima) or ``"scipy"``.
         max_joint_step: rad, as for :func:`solver.evaluate.evaluate_path`.
         spin_mode: ``fixed`` or ``free`` (the tool spin rate free, cam.md section 2), as for
             :func:`solver.evaluate.evaluate_path`; every method searches in that mode.
+        max_spin_step: rad, > 0: the casadi method also gives each waypoint its own spin, with
+            steps at most this (cam.md section 4, ``spin_path``); None keeps one spin.
         max_coarse_cells: the largest coarse map the casadi method may make.
 
     Returns:
-        The optimum (never below the start), or None when neither the start nor any placement
-        the search tried is feasible.
+        The optimum (never below the start); ``found`` is False when neither the start nor any
+        placement the search tried is feasible.
 
     Raises:
         InvalidInputError: bad bounds, a start outside them, an unknown method, or a box whose
             coarse map is over ``max_coarse_cells``.
     """
     began = time.perf_counter()
-    check_bounds(bounds)
+    bounds.check()
     if method not in ("casadi", "scipy"):
         raise InvalidInputError("method", f"unknown method {method!r}; use casadi or scipy")
+    if max_spin_step is not None:
+        if method != "casadi" or spin_mode != "fixed":
+            raise InvalidInputError(
+                "spin_path", "a spin path needs method casadi and spin_mode fixed"
+            )
+        if not (math.isfinite(max_spin_step) and max_spin_step > 0.0):
+            raise InvalidInputError(
+                "spin_path.max_spin_step", f"{max_spin_step!r} rad must be finite and > 0"
+            )
     if start is None:
-        start = Placement(*bounds.centre()[:2], bounds.z, bounds.centre()[2])
-    if not bounds.contains(start.x, start.y, start.yaw) or start.z != bounds.z:
-        raise InvalidInputError("start", f"{start} is outside the bounds {bounds}")
+        start = bounds.placement(bounds.centre())
+    if not bounds.contains(vector_of(start)) or start.z != bounds.z:
+        raise InvalidInputError(
+            "start",
+            f"x {start.x:g} m, y {start.y:g} m, z {start.z:g} m, yaw {start.yaw:g} rad, spin "
+            f"{start.spin:g} rad is outside the bounds",
+        )
     path = np.asarray(waypoints_in_workpiece, dtype=float)
     prepared = prepare_path(robot, path)
     start_evaluation = evaluate_path(
@@ -163,7 +175,7 @@ def optimize_placement(
             max_cells=max_coarse_cells,
         )
         candidates, statuses, iterations = _casadi(
-            robot, path, prepared, bounds, cells, max_joint_step, spin_mode
+            robot, path, prepared, bounds, cells, max_joint_step, spin_mode, max_spin_step
         )
         name = "ipopt (casadi), from the coarse map's maxima"
     else:
@@ -172,29 +184,46 @@ def optimize_placement(
         )
         name = "differential_evolution + SLSQP (scipy)"
     # The start last: it is the answer only when nothing the solver found is better.
-    candidates = [*candidates, (start.x, start.y, start.yaw)]
+    candidates = [*candidates, (vector_of(start), None)]
     statuses = [*statuses, "no better placement found than the start"]
-    best: tuple[float, Placement, PathEvaluation, str] | None = None
-    for candidate, status in zip(candidates, statuses, strict=True):
+    best: tuple[float, Placement, PathEvaluation, str, np.ndarray | None] | None = None
+    for (candidate, spins), status in zip(candidates, statuses, strict=True):
         placement = _place_on_arc(candidate, bounds, near, symmetric)
         evaluation = evaluate_path(
-            robot, path, placement, max_joint_step=max_joint_step, spin_mode=spin_mode
+            robot,
+            path if spins is None else spun_waypoints(path, spins),
+            placement,
+            max_joint_step=max_joint_step,
+            spin_mode=spin_mode,
         )
         if evaluation.mu_path is not None and (best is None or evaluation.mu_path > best[0]):
-            best = (evaluation.mu_path, placement, evaluation, status)
+            best = (evaluation.mu_path, placement, evaluation, status, spins)
+    report = SolverReport(name, "", iterations, time.perf_counter() - began)
     if best is None:
-        return None
-    mu_path, placement, evaluation, status = best
+        return PlacementOptimum(
+            found=False,
+            placement=None,
+            mu_path=None,
+            evaluation=None,
+            start=start,
+            start_mu_path=None,
+            improvement_percent=None,
+            solver=dataclasses.replace(report, status="no feasible placement inside the bounds"),
+            symmetric=symmetric,
+        )
+    mu_path, placement, evaluation, status, spins = best
     start_mu = start_evaluation.mu_path
     return PlacementOptimum(
+        found=True,
         placement=placement,
         mu_path=mu_path,
         evaluation=evaluation,
         start=start,
         start_mu_path=start_mu,
         improvement_percent=None if not start_mu else 100.0 * (mu_path / start_mu - 1.0),
-        solver=SolverReport(name, status, iterations, time.perf_counter() - began),
+        solver=dataclasses.replace(report, status=status),
         symmetric=symmetric,
+        spins=spins,
     )
 
 
@@ -206,7 +235,8 @@ def _casadi(
     cells: list[Cell],
     max_joint_step: float,
     spin_mode: SpinMode,
-) -> tuple[list[tuple[float, float, float]], list[str], int]:
+    max_spin_step: float | None,
+) -> tuple[list[Candidate], list[str], int]:
     """Candidates: the best coarse cell, then IPOPT's optimum from each of the best cells.
 
     In free spin mode each solve starts from the cell's joint path at the given spin with the
@@ -214,7 +244,8 @@ def _casadi(
     """
     if not cells:
         return [], [], 0
-    candidates, statuses = [cells[0].placement], ["best cell of the coarse map"]
+    candidates: list[Candidate] = [(cells[0].vector, None)]
+    statuses = ["best cell of the coarse map"]
     if prepared.pure_rotation.any() or cells[0].mu_path <= 0.0:
         return candidates, ["mu_path is 0 everywhere: the path turns on the spot"], 0
     nlp = PlacementNlp(
@@ -224,14 +255,14 @@ def _casadi(
         bounds,
         max_joint_step=max_joint_step,
         free_spin=spin_mode == "free",
+        max_spin_step=max_spin_step,
     )
     iterations = 0
     for cell in cells[:N_STARTS]:
-        x, y, yaw = cell.placement
         at_start = evaluate_path(
             robot,
             path,
-            Placement(x, y, bounds.z, yaw),
+            bounds.placement(cell.vector),
             branch=require_family(robot).branches[cell.branch],
             max_joint_step=max_joint_step,
         )
@@ -239,9 +270,9 @@ def _casadi(
         if q is None or qdot is None or v_max is None or speed is None:
             continue
         joint_speeds = qdot * (speed / v_max)[:, None]
-        result = nlp.solve(cell.placement, speed, q, joint_speeds)
+        result = nlp.solve(cell.vector, speed, q, joint_speeds)
         iterations += result.iterations
-        candidates.append(result.placement)
+        candidates.append((result.vector, result.spins))
         statuses.append(result.status)
     return candidates, statuses, iterations
 
@@ -253,7 +284,7 @@ def _scipy(
     max_joint_step: float,
     symmetric: bool,
     spin_mode: SpinMode,
-) -> tuple[list[tuple[float, float, float]], list[str], int]:
+) -> tuple[list[Candidate], list[str], int]:
     """Candidates: the best placement of each basin DE saw, and SLSQP's polish of each."""
     basins, iterations = global_search(
         robot,
@@ -265,7 +296,8 @@ def _scipy(
     )
     if not basins:
         return [], [], iterations
-    candidates, statuses = [basins[0][0]], ["best placement of differential evolution"]
+    candidates: list[Candidate] = [(basins[0][0], None)]
+    statuses = ["best placement of differential evolution"]
     if prepared.pure_rotation.any() or basins[0][1] <= 0.0:
         return candidates, ["mu_path is 0 everywhere: the path turns on the spot"], iterations
     for placement, mu_path, branch in basins:
@@ -279,7 +311,7 @@ def _scipy(
             max_joint_step=max_joint_step,
             spin_mode=spin_mode,
         )
-        candidates.append(polished)
+        candidates.append((polished, None))
         statuses.append(f"SLSQP: {status}")
         iterations += steps
     return candidates, statuses, iterations

@@ -40,8 +40,9 @@ class PreparedPath:
     Attributes:
         n_waypoints: N.
         tool_rotation: shape (N, 3, 3), R_O_i of the tool point.
-        flange_rotation: shape (N, 3, 3), R_O_F of the flange at each waypoint.
-        flange_position: shape (N, 3), m.
+        tool_to_flange: shape (4, 4), T_TCP_F = T_F_TCP^-1.
+        flange_rotation: shape (N, 3, 3), R_O_F of the flange at each waypoint (spin 0).
+        flange_position: shape (N, 3), m (spin 0).
         tool_position: shape (N, 3), m, the tool point.
         u_T: shape (N, 3). u_R: shape (N, 3). h: shape (N,), m, inf for pure translation.
         twist: shape (N, 6), t_hat in {O} axes.
@@ -50,6 +51,7 @@ class PreparedPath:
 
     n_waypoints: int
     tool_rotation: np.ndarray
+    tool_to_flange: np.ndarray
     flange_rotation: np.ndarray
     flange_position: np.ndarray
     tool_position: np.ndarray
@@ -72,10 +74,12 @@ def prepare_path(robot: Robot, waypoints_in_workpiece: np.ndarray) -> PreparedPa
     """
     path = np.asarray(waypoints_in_workpiece, dtype=float)
     requirements = task_requirements(path)  # u_T, u_R turn with the yaw, h does not
-    flange = path @ np.linalg.inv(robot.transform_tool_to_tcp)
+    tool_to_flange = np.linalg.inv(robot.transform_tool_to_tcp)
+    flange = path @ tool_to_flange
     return PreparedPath(
         n_waypoints=len(path),
         tool_rotation=path[:, :3, :3],
+        tool_to_flange=tool_to_flange,
         flange_rotation=flange[:, :3, :3],
         flange_position=flange[:, :3, 3],
         tool_position=path[:, :3, 3],
@@ -93,6 +97,23 @@ def check_max_joint_step(max_joint_step: float) -> None:
         raise InvalidInputError("ik.max_joint_step", f"{max_joint_step!r} rad must be > 0")
 
 
+def check_spin_mode(robot: Robot, spin_mode: str) -> None:
+    """Raise InvalidInputError on ``spin_mode``: unknown, or free with no last joint to spin.
+
+    A free tool spin needs the last joint to turn the tool, so ``free`` on an arm whose last
+    joint is prismatic is refused.
+    """
+    if spin_mode not in SPIN_MODES:
+        raise InvalidInputError("spin_mode", f"unknown spin mode {spin_mode!r}; use fixed or free")
+    last = robot.model.joints[robot.model.njoints - 1].shortname()
+    prismatic = "Prismatic" in last or last.startswith("JointModelP")
+    if spin_mode == "free" and prismatic:
+        raise InvalidInputError(
+            "spin_mode",
+            f"free spin needs a revolute last joint; {robot.joint_names[-1]!r} is prismatic",
+        )
+
+
 def require_family(robot: Robot) -> KinematicsFamily:
     """The robot's kinematics family; NoAnalyticIkError when it has none."""
     if robot.family is None:
@@ -104,14 +125,19 @@ def require_family(robot: Robot) -> KinematicsFamily:
 
 
 def check_placements(placements: np.ndarray) -> np.ndarray:
-    """Placements as a float array (P, 4) of finite [x, y, z, yaw] within MAX_COORDINATE.
+    """Placements as a float array (P, 5) of finite [x, y, z, yaw, spin] within MAX_COORDINATE.
+
+    The one batched layout of placements (:meth:`solver.spatial.Placement.as_row`); (P, 4)
+    arrays without the spin are taken with spin 0.
 
     Raises:
         InvalidInputError: wrong shape, not finite, or too far.
     """
     arr = np.asarray(placements, dtype=float)
-    if arr.ndim != 2 or arr.shape[1] != 4:
-        raise InvalidInputError("placements", f"{arr.shape=}, needs (P, 4): x, y, z, yaw")
+    if arr.ndim == 2 and arr.shape[1] == 4:
+        arr = np.column_stack([arr, np.zeros(len(arr))])
+    if arr.ndim != 2 or arr.shape[1] != 5:
+        raise InvalidInputError("placements", f"{arr.shape=}, needs (P, 5): x, y, z, yaw, spin")
     if not np.all(np.isfinite(arr)) or np.any(np.abs(arr[:, :3]) > MAX_COORDINATE):
         raise InvalidInputError(
             "placements", f"need finite values, positions within {MAX_COORDINATE} m"
@@ -169,6 +195,17 @@ def turn_by_yaw(vectors: np.ndarray, yaws: np.ndarray) -> np.ndarray:
     return np.stack([cos * x - sin * y, sin * x + cos * y, z])
 
 
+def _flange_at_spin(path: PreparedPath, spin: float) -> tuple[np.ndarray, np.ndarray]:
+    """R_O_F (N, 3, 3) and p_O_F (N, 3) with every tool pose turned by ``spin`` about its z."""
+    if spin == 0.0:
+        return path.flange_rotation, path.flange_position
+    c, s = np.cos(spin), np.sin(spin)
+    turned = path.tool_rotation @ np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
+    rotation = turned @ path.tool_to_flange[:3, :3]
+    position = path.tool_position + turned @ path.tool_to_flange[:3, 3]
+    return rotation, position
+
+
 def run_chunk(
     robot: Robot,
     path: PreparedPath,
@@ -183,7 +220,8 @@ def run_chunk(
     Args:
         robot: an arm with a kinematics family.
         path: from :func:`prepare_path` for the same robot.
-        placements: shape (C, 4), [x (m), y (m), z (m), yaw (rad)] of {O} in {B}, checked.
+        placements: shape (C, 5), [x (m), y (m), z (m), yaw (rad), spin (rad)], checked; one
+            spin for the whole chunk.
         branches: shape (B,), indices of the family's branches to follow.
         max_joint_step: rad, > 0, checked.
         spin_mode: ``fixed`` (the orientations as given) or ``free`` (the tool spin rate is a
@@ -193,9 +231,12 @@ def run_chunk(
     yaws = placements[:, 3]
     if np.all(yaws == yaws[0]):  # one turn for the chunk: broadcast it (less memory to read)
         yaws = yaws[:1]
+    if np.any(placements[:, 4] != placements[0, 4]):
+        raise InvalidInputError("placements", "a chunk must have one spin")
     offset = placements[:, :3].T[:, :, None]  # (3, C, 1)
-    rotation = turn_by_yaw(path.flange_rotation.transpose(1, 2, 0), yaws)  # (3, 3, C, W)
-    flange_position = turn_by_yaw(path.flange_position.T, yaws) + offset
+    flange_rotation, flange_position_o = _flange_at_spin(path, float(placements[0, 4]))
+    rotation = turn_by_yaw(flange_rotation.transpose(1, 2, 0), yaws)  # (3, 3, C, W)
+    flange_position = turn_by_yaw(flange_position_o.T, yaws) + offset
     tool_position = turn_by_yaw(path.tool_position.T, yaws) + offset
     twist = np.concatenate(
         [turn_by_yaw(path.twist[:, :3].T, yaws), turn_by_yaw(path.twist[:, 3:].T, yaws)]

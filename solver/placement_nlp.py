@@ -1,12 +1,17 @@
 """The placement optimum as one smooth NLP in CasADi/IPOPT (spec section 6, the epigraph form).
 
-    maximise s  over (x, y, yaw, s, q_i, qdot_i[, sigma_i])
-    subject to  FK(q_i) = T_B_O(x, y, yaw) T_O_i        (tool point pose, every waypoint)
+    maximise s  over (x, y, yaw, spin, s, q_i, qdot_i[, sigma_i])
+    subject to  FK(q_i) = T_B_O(x, y, yaw) T_O_i Rot_z(spin)   (tool point pose, every waypoint)
                 J(q_i) qdot_i = s t_hat_i(yaw) [+ sigma_i [0; z_i(yaw)]]   (the task twist at
                                                          feed rate s; with the tool spin rate
                                                          sigma_i free in free spin mode)
                 |qdot_i| <= qdot_max,  q_min <= q_i <= q_max,  |q_{i+1} - q_i| <= max_joint_step
-                (x, y, yaw) inside the bounds
+                (x, y, yaw, spin) inside the bounds (a variable with one value is fixed)
+
+With ``max_spin_step`` (cam.md section 4) every waypoint also gets its own spin phi_i on top of
+the placement's (phi_0 = 0), |phi_{i+1} - phi_i| <= max_spin_step, and each segment's t_hat is
+that of the spun poses in closed form: R_{i+1} Rot_z(phi_{i+1} - phi_i) R_i^T, its rotation
+vector by atan2 (exact; the series 1 + s^2 / 6 where the turn is below 1e-10 rad).
 
 min_i V_max(i) is not smooth; this form is, and its optimum is the same. The problem is built
 once per robot and path; each solve starts from a feasible placement and its joint path on one IK
@@ -28,7 +33,7 @@ import numpy as np
 from solver.casadi_kinematics import symbolic_kinematics
 from solver.pipeline import PreparedPath
 from solver.robots import Robot
-from solver.symmetry import PlacementBounds
+from solver.search_space import PlacementBounds
 
 # Margins (rad) kept from the joint limits and the step bound, so that a solution on them
 # passes the evaluator's strict tests.
@@ -40,10 +45,14 @@ ca: Any = casadi
 
 @dataclass(frozen=True)
 class NlpResult:
-    """One IPOPT solve: the placement (x, y, yaw), s, IPOPT's status and iterations."""
+    """One IPOPT solve: the decision vector [x, y, yaw, spin], s, IPOPT's status, iterations.
 
-    placement: tuple[float, float, float]
+    ``spins`` (N,), rad, each waypoint's spin on top of the placement's, with a spin path.
+    """
+
+    vector: np.ndarray
     speed: float
+    spins: np.ndarray | None
     status: str
     success: bool
     iterations: int
@@ -62,6 +71,7 @@ class PlacementNlp:
         *,
         max_joint_step: float,
         free_spin: bool = False,
+        max_spin_step: float | None = None,
         ipopt_options: dict[str, object] | None = None,
     ) -> None:
         """Build the problem.
@@ -74,6 +84,8 @@ class PlacementNlp:
             max_joint_step: rad, the evaluator's bound on a joint's move between waypoints.
             free_spin: the tool spin rate about the tool z axis is a free variable per waypoint
                 (cam.md section 2, the evaluator's ``free`` spin mode).
+            max_spin_step: rad, > 0: a spin per waypoint with steps at most this (cam.md
+                section 4); None keeps the spin constant.
             ipopt_options: IPOPT options over the defaults (``{"max_iter": 100}``).
 
         The NLP is an MX graph over one waypoint's SX residuals mapped N times: built in about
@@ -83,17 +95,18 @@ class PlacementNlp:
         kinematics = symbolic_kinematics(robot)
         # One waypoint's 12 residuals as an SX function, mapped over the waypoints.
         q, qdot = ca.SX.sym("q", dof), ca.SX.sym("qdot", dof)
-        where, speed_1, spin_1 = ca.SX.sym("placement", 3), ca.SX.sym("s"), ca.SX.sym("sigma")
-        data = ca.SX.sym("waypoint", 3 + 9 + 6)  # p_O, R_O (column-major), t_hat in {O}
+        where, speed_1, spin_1 = ca.SX.sym("placement", 4), ca.SX.sym("s"), ca.SX.sym("sigma")
+        phi_1, twist_1 = ca.SX.sym("phi"), ca.SX.sym("twist", 6)  # waypoint spin, t_hat in {O}
+        data = ca.SX.sym("waypoint", 3 + 9)  # p_O, R_O (column-major)
         c, s = ca.cos(where[2]), ca.sin(where[2])
         turn = ca.vertcat(ca.horzcat(c, -s, 0), ca.horzcat(s, c, 0), ca.horzcat(0, 0, 1))
         position, rotation, jacobian = kinematics(q)
-        target_rotation = turn @ ca.reshape(data[3:12], 3, 3)
+        target_rotation = turn @ ca.reshape(data[3:12], 3, 3) @ _turn_z(where[3] + phi_1)
         error = target_rotation.T @ rotation
         spin_twist = ca.vertcat(ca.DM.zeros(3), turn @ data[9:12])  # tool z (column 3 of R_O)
         residual = ca.Function(
             "waypoint_residual",
-            [q, qdot, where, speed_1, spin_1, data],
+            [q, qdot, where, speed_1, spin_1, phi_1, twist_1, data],
             [
                 ca.vertcat(
                     position - (turn @ data[:3] + ca.vertcat(where[0], where[1], bounds.z)),
@@ -101,7 +114,7 @@ class PlacementNlp:
                     error[0, 2] - error[2, 0],
                     error[1, 0] - error[0, 1],
                     jacobian @ qdot
-                    - speed_1 * ca.vertcat(turn @ data[12:15], turn @ data[15:18])
+                    - speed_1 * ca.vertcat(turn @ twist_1[:3], turn @ twist_1[3:])
                     - spin_1 * spin_twist,
                 )
             ],
@@ -110,29 +123,40 @@ class PlacementNlp:
             [
                 path.tool_position,
                 tool_rotation.transpose(0, 2, 1).reshape(n, 9),  # column-major R_O
-                path.twist,
             ]
         ).T
-        placement = ca.MX.sym("placement", 3)  # x, y, yaw
+        placement = ca.MX.sym("placement", 4)  # x, y, yaw, spin
         speed = ca.MX.sym("s")
         joints = ca.MX.sym("q", dof, n)
         joint_speeds = ca.MX.sym("qdot", dof, n)
         spin_rates = ca.MX.sym("sigma", 1, n) if free_spin else ca.DM.zeros(1, n)
+        if max_spin_step is None:
+            spins, twists = ca.DM.zeros(1, n), ca.DM(path.twist.T)
+        else:
+            spins = ca.MX.sym("phi", 1, n)
+            twists = _spun_twists(path, tool_rotation, spins)
         residuals = residual.map(n)(
             joints,
             joint_speeds,
             ca.repmat(placement, 1, n),
             ca.repmat(speed, 1, n),
             spin_rates,
+            spins,
+            twists,
             ca.DM(waypoint_data),
         )
         steps = ca.vec(joints[:, 1:] - joints[:, :-1])
         variables = ca.vertcat(placement, speed, ca.vec(joints), ca.vec(joint_speeds))
         if free_spin:
             variables = ca.vertcat(variables, ca.vec(spin_rates))
-        self._n_spin = n if free_spin else 0
+        self._n_rates = n if free_spin else 0
+        self._n_spins = 0 if max_spin_step is None else n
+        self._spin_step = max_spin_step
         equalities = ca.vec(residuals)
         constraints = ca.vertcat(equalities, steps)
+        if max_spin_step is not None:
+            variables = ca.vertcat(variables, ca.vec(spins))
+            constraints = ca.vertcat(constraints, ca.vec(spins[1:] - spins[:-1]))
         self._n_equalities = int(equalities.numel())
         self._n_steps = int(steps.numel())
         self._dof, self._n = dof, n
@@ -153,9 +177,15 @@ class PlacementNlp:
             "placement", "ipopt", {"x": variables, "f": -speed, "g": constraints}, options
         )
 
+    def _spin_bound(self, value: float) -> np.ndarray:
+        """Bounds of the waypoint spins: phi_0 = 0 (the placement's spin), the others ``value``."""
+        bound = np.full(self._n_spins, value)
+        bound[:1] = 0.0
+        return bound
+
     def solve(
         self,
-        start: tuple[float, float, float],
+        start: np.ndarray,
         start_speed: float,
         q_path: np.ndarray,
         qdot_path: np.ndarray,
@@ -163,7 +193,7 @@ class PlacementNlp:
         """Solve from a feasible start.
 
         Args:
-            start: (x, y, yaw) of the start placement (m, m, rad).
+            start: the start's decision vector [x, y, yaw, spin] (m, m, rad, rad).
             start_speed: its mu_path (m/s), the initial s.
             q_path: shape (N, n), rad, the start's joint path on the branch to follow.
             qdot_path: shape (N, n), rad/s, joint speeds there at feed rate ``start_speed``
@@ -172,25 +202,40 @@ class PlacementNlp:
         robot, bounds, n = self._robot, self._bounds, self._n
         lower = np.concatenate(
             [
-                [bounds.x[0], bounds.y[0], bounds.yaw[0], 0.0],
+                bounds.lower,
+                [0.0],
                 np.tile(robot.q_lower + _MARGIN, n),
                 np.tile(-robot.qdot_max, n),
-                np.full(self._n_spin, -np.inf),
+                np.full(self._n_rates, -np.inf),
+                self._spin_bound(-np.inf),
             ]
         )
         upper = np.concatenate(
             [
-                [bounds.x[1], bounds.y[1], bounds.yaw[1], np.inf],
+                bounds.upper,
+                [np.inf],
                 np.tile(robot.q_upper - _MARGIN, n),
                 np.tile(robot.qdot_max, n),
-                np.full(self._n_spin, np.inf),
+                np.full(self._n_rates, np.inf),
+                self._spin_bound(np.inf),
             ]
         )
         step = self._step - _MARGIN
-        lbg = np.concatenate([np.zeros(self._n_equalities), np.full(self._n_steps, -step)])
-        ubg = np.concatenate([np.zeros(self._n_equalities), np.full(self._n_steps, step)])
+        spin_step = np.full(max(self._n_spins - 1, 0), (self._spin_step or 0.0) - _MARGIN)
+        lbg = np.concatenate(
+            [np.zeros(self._n_equalities), np.full(self._n_steps, -step), -spin_step]
+        )
+        ubg = np.concatenate(
+            [np.zeros(self._n_equalities), np.full(self._n_steps, step), spin_step]
+        )
         guess = np.concatenate(
-            [start, [start_speed], q_path.ravel(), qdot_path.ravel(), np.zeros(self._n_spin)]
+            [
+                start,
+                [start_speed],
+                q_path.ravel(),
+                qdot_path.ravel(),
+                np.zeros(self._n_rates + self._n_spins),
+            ]
         )
         began = time.perf_counter()
         solution = self._solver(x0=guess, lbx=lower, ubx=upper, lbg=lbg, ubg=ubg)
@@ -198,10 +243,53 @@ class PlacementNlp:
         stats = self._solver.stats()
         x = np.asarray(solution["x"]).ravel()
         return NlpResult(
-            placement=(float(x[0]), float(x[1]), float(x[2])),
-            speed=float(x[3]),
+            vector=x[:4].copy(),
+            speed=float(x[4]),
+            spins=x[len(x) - self._n_spins :].copy() if self._n_spins else None,
             status=str(stats["return_status"]),
             success=bool(stats["success"]),
             iterations=int(stats["iter_count"]),
             seconds=seconds,
         )
+
+
+def _turn_z(angle: ca.SX) -> ca.SX:
+    """Rot_z(angle), a 3x3 expression."""
+    c, s = ca.cos(angle), ca.sin(angle)
+    return ca.vertcat(ca.horzcat(c, -s, 0), ca.horzcat(s, c, 0), ca.horzcat(0, 0, 1))
+
+
+def _spun_twists(path: PreparedPath, tool_rotation: np.ndarray, spins: ca.MX) -> ca.MX:
+    """t_hat in {O} (6 x N) of the path with waypoint i turned by spins[i] about its tool z.
+
+    Segment i turns by R_{i+1} Rot_z(phi_{i+1} - phi_i) R_i^T (cam.md section 4); its rotation
+    vector over its length |dp_i| is the angular part, u_T the linear part (the spin moves no
+    tool point). The last waypoint reuses the last segment, as the evaluator does.
+    """
+    now, following = ca.SX.sym("R", 9), ca.SX.sym("R_next", 9)
+    delta, linear, length = ca.SX.sym("delta"), ca.SX.sym("u_T", 3), ca.SX.sym("length")
+    turn = ca.reshape(following, 3, 3) @ _turn_z(delta) @ ca.reshape(now, 3, 3).T
+    axis = 0.5 * ca.vertcat(
+        turn[2, 1] - turn[1, 2], turn[0, 2] - turn[2, 0], turn[1, 0] - turn[0, 1]
+    )
+    sine2 = ca.dot(axis, axis)
+    cosine = (ca.trace(turn) - 1) / 2
+    ratio = ca.if_else(  # angle / sin(angle), evaluated lazily: sqrt is not smooth at 0
+        sine2 < 1e-20, 1 + sine2 / 6, ca.atan2(ca.sqrt(sine2), cosine) / ca.sqrt(sine2), True
+    )
+    segment = ca.Function(
+        "segment_twist",
+        [delta, now, following, linear, length],
+        [ca.vertcat(linear, axis * ratio / length)],
+    )
+    n = path.n_waypoints
+    columns = tool_rotation.transpose(0, 2, 1).reshape(n, 9).T  # column-major R_O, (9, N)
+    lengths = np.linalg.norm(np.diff(path.tool_position, axis=0), axis=1)
+    twists = segment.map(n - 1)(
+        spins[1:] - spins[:-1],
+        ca.DM(columns[:, :-1]),
+        ca.DM(columns[:, 1:]),
+        ca.DM(path.u_T[:-1].T),
+        ca.DM(lengths[None, :]),
+    )
+    return ca.horzcat(twists, twists[:, -1])

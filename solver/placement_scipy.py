@@ -2,9 +2,10 @@
 
 Differential evolution needs no gradients and looks at the whole box; every generation is one
 batch through :func:`solver.placements.evaluate_placements`. The best points of the few best
-distinct basins it saw are then polished by SLSQP on  maximise s  s.t.  V_i(x, y, yaw) >= s
-for every waypoint i, with V_i on the IK branch of that point and its gradient by central
-differences (one batch of 7 placements).
+distinct basins it saw are then polished by SLSQP on  maximise s  s.t.  V_i(v) >= s  for every
+waypoint i, with V_i on the IK branch of that point and its gradient by central differences (one
+batch of placements). Both work on the free variables of the decision vector
+(:mod:`solver.search_space`: x, y, yaw and the tool spin when its range is not one value).
 """
 
 from __future__ import annotations
@@ -16,7 +17,7 @@ from solver.families.base import Branch
 from solver.pipeline import PreparedPath, SpinMode
 from solver.placements import evaluate_placements
 from solver.robots import Robot
-from solver.symmetry import PlacementBounds
+from solver.search_space import PlacementBounds
 
 SEED = 0  # differential evolution is seeded: same input, same output
 POPULATION = 20  # per dimension
@@ -26,10 +27,28 @@ INFEASIBLE = 1.0  # objective of an infeasible placement (feasible ones are -mu_
 N_BASINS = 3  # distinct basins polished
 BASIN_GAP = (0.05, 0.35)  # m and rad (about 20 degrees): placements closer are one basin
 
+Basin = tuple[np.ndarray, float, int]  # decision vector, mu_path, branch index
 
-def _placements(points: np.ndarray, z: float) -> np.ndarray:
-    """(P, 4) placements [x, y, z, yaw] from points (P, 3) [x, y, yaw]."""
-    return np.column_stack([points[:, 0], points[:, 1], np.full(len(points), z), points[:, 2]])
+
+def _full(bounds: PlacementBounds, free_values: np.ndarray) -> np.ndarray:
+    """Decision vectors (P, 4) from the free variables' values (P, F); the rest fixed."""
+    vectors = np.tile(bounds.lower, (len(free_values), 1))
+    vectors[:, bounds.free] = free_values
+    return vectors
+
+
+def _basin_coordinates(vectors: np.ndarray, symmetric: bool) -> tuple[np.ndarray, np.ndarray]:
+    """Coordinates in which basins are BASIN_GAP apart, and their scale (angles as cos, sin)."""
+    x, y, yaw, spin = vectors.T
+    angles = [np.cos(spin), np.sin(spin)]
+    if symmetric:
+        psi = yaw - np.arctan2(y, x)
+        columns = [np.hypot(x, y) / BASIN_GAP[0], np.cos(psi), np.sin(psi), *angles]
+        scale = [1.0] + [1.0 / BASIN_GAP[1]] * 4
+    else:
+        columns = [x / BASIN_GAP[0], y / BASIN_GAP[0], np.cos(yaw), np.sin(yaw), *angles]
+        scale = [1.0, 1.0] + [1.0 / BASIN_GAP[1]] * 4
+    return np.column_stack(columns), np.array(scale)
 
 
 def global_search(
@@ -40,107 +59,95 @@ def global_search(
     max_joint_step: float,
     symmetric: bool,
     spin_mode: SpinMode = "fixed",
-) -> tuple[list[tuple[tuple[float, float, float], float, int]], int]:
-    """Differential evolution over (x, y, yaw); the best placement of each distinct basin seen.
+) -> tuple[list[Basin], int]:
+    """Differential evolution over the free variables; the best point of each distinct basin.
 
     Every placement DE evaluates is kept; the best ones that lie apart (by BASIN_GAP, in
-    (r, psi) when ``symmetric``, else in (x, y, yaw)) are returned, up to N_BASINS: DE settles
-    in one basin, and the landscape has near-equal mirror-image optima.
+    (r, psi) when ``symmetric``, else in (x, y, yaw); spins as angles) are returned, up to
+    N_BASINS: DE settles in one basin, and the landscape has near-equal mirror-image optima.
 
     Returns:
-        ([((x, y, yaw), mu_path, branch index), ...] best first, generations).
+        ([(decision vector, mu_path, branch index), ...] best first, generations).
     """
     seen: list[tuple[np.ndarray, np.ndarray, np.ndarray]] = []
 
-    def objective(points: np.ndarray) -> np.ndarray:  # points: (3, S)
+    def objective(points: np.ndarray) -> np.ndarray:  # points: (F, S)
+        vectors = _full(bounds, points.T)
         result = evaluate_placements(
             robot,
             path,
-            _placements(points.T, bounds.z),
+            bounds.rows(vectors),
             max_joint_step=max_joint_step,
             spin_mode=spin_mode,
         )
-        seen.append((points.T.copy(), result.mu_path, result.branch))
+        seen.append((vectors, result.mu_path, result.branch))
         values: np.ndarray = np.where(np.isnan(result.mu_path), INFEASIBLE, -result.mu_path)
         return values
 
-    found = scipy.optimize.differential_evolution(
-        objective,
-        bounds=[bounds.x, bounds.y, bounds.yaw],
-        popsize=POPULATION,
-        maxiter=GENERATIONS,
-        tol=1e-12,
-        atol=0.0,
-        seed=SEED,
-        polish=False,
-        init="sobol",
-        updating="deferred",
-        vectorized=True,
-    )
-    points = np.concatenate([s[0] for s in seen])
+    free = bounds.free
+    if not free.any():  # nothing to search: the one placement of the box
+        objective(np.zeros((0, 1)))
+        generations = 0
+    else:
+        found = scipy.optimize.differential_evolution(
+            objective,
+            bounds=list(zip(bounds.lower[free], bounds.upper[free], strict=True)),
+            popsize=POPULATION,
+            maxiter=GENERATIONS,
+            tol=1e-12,
+            atol=0.0,
+            seed=SEED,
+            polish=False,
+            init="sobol",
+            updating="deferred",
+            vectorized=True,
+        )
+        generations = int(found.nit)
+    vectors = np.concatenate([s[0] for s in seen])
     mu = np.concatenate([s[1] for s in seen])
     branch = np.concatenate([s[2] for s in seen])
     feasible = np.flatnonzero(~np.isnan(mu))
     order = feasible[np.argsort(-mu[feasible], kind="stable")]
-    if symmetric:
-        radius = np.hypot(points[:, 0], points[:, 1])
-        psi = points[:, 2] - np.arctan2(points[:, 1], points[:, 0])
-        coordinates = np.column_stack([radius / BASIN_GAP[0], np.cos(psi), np.sin(psi)])
-        scale = np.array([1.0, 1.0 / BASIN_GAP[1], 1.0 / BASIN_GAP[1]])
-    else:
-        coordinates = np.column_stack(
-            [
-                points[:, 0] / BASIN_GAP[0],
-                points[:, 1] / BASIN_GAP[0],
-                np.cos(points[:, 2]),
-                np.sin(points[:, 2]),
-            ]
-        )
-        scale = np.array([1.0, 1.0, 1.0 / BASIN_GAP[1], 1.0 / BASIN_GAP[1]])
+    coordinates, scale = _basin_coordinates(vectors, symmetric)
     chosen: list[int] = []
     for i in order:
         if all(np.max(np.abs(coordinates[i] - coordinates[j]) * scale) > 1.0 for j in chosen):
             chosen.append(int(i))
             if len(chosen) == N_BASINS:
                 break
-    basins = [
-        (
-            (float(points[i, 0]), float(points[i, 1]), float(points[i, 2])),
-            float(mu[i]),
-            int(branch[i]),
-        )
-        for i in chosen
-    ]
-    return basins, int(found.nit)
+    return [(vectors[i].copy(), float(mu[i]), int(branch[i])) for i in chosen], generations
 
 
 def polish(
     robot: Robot,
     path: PreparedPath,
     bounds: PlacementBounds,
-    start: tuple[float, float, float],
+    start: np.ndarray,
     start_speed: float,
     branch: Branch,
     *,
     max_joint_step: float,
     spin_mode: SpinMode = "fixed",
-) -> tuple[tuple[float, float, float], str, int]:
-    """SLSQP on the epigraph form from a feasible start, on one IK branch.
+) -> tuple[np.ndarray, str, int]:
+    """SLSQP on the epigraph form over the free variables, from a feasible start, on one branch.
 
     Returns:
-        (x, y, yaw), SLSQP's message, its iterations.
+        the decision vector, SLSQP's message, its iterations.
     """
-    offsets = np.vstack([np.zeros(3), np.eye(3) * DIFFERENCE_STEP, -np.eye(3) * DIFFERENCE_STEP])
+    free = bounds.free
+    n_free = int(free.sum())
+    steps = np.eye(n_free) * DIFFERENCE_STEP
+    offsets = np.vstack([np.zeros(n_free), steps, -steps])
     cache: dict[tuple[float, ...], np.ndarray] = {}
 
     def speeds(v: np.ndarray) -> np.ndarray:
-        """V_max per waypoint at v and at v +- steps: (7, N), NaN where infeasible."""
-        key = tuple(v[:3])
+        """V_max per waypoint at v and at v +- steps: (1 + 2F, N), NaN where infeasible."""
+        key = tuple(v[:n_free])
         if key not in cache:
             result = evaluate_placements(
                 robot,
                 path,
-                _placements(v[:3] + offsets, bounds.z),
+                bounds.rows(_full(bounds, v[:n_free] + offsets)),
                 branch=branch,
                 max_joint_step=max_joint_step,
                 spin_mode=spin_mode,
@@ -153,12 +160,12 @@ def polish(
 
     def margin(v: np.ndarray) -> np.ndarray:
         here = speeds(v)[0]
-        values: np.ndarray = np.where(np.isnan(here), -1.0, here) - v[3]
+        values: np.ndarray = np.where(np.isnan(here), -1.0, here) - v[n_free]
         return values
 
     def margin_gradient(v: np.ndarray) -> np.ndarray:
         table = speeds(v)
-        here, plus, minus = table[0], table[1:4], table[4:7]
+        here, plus, minus = table[0], table[1 : 1 + n_free], table[1 + n_free :]
         central = (plus - minus) / (2 * DIFFERENCE_STEP)
         forward = (plus - here) / DIFFERENCE_STEP
         backward = (here - minus) / DIFFERENCE_STEP
@@ -168,14 +175,18 @@ def polish(
         jacobian: np.ndarray = np.column_stack([np.nan_to_num(gradient.T), -np.ones(len(here))])
         return jacobian
 
+    if n_free == 0:
+        return np.asarray(start, dtype=float), "nothing to polish: every variable is fixed", 0
+    objective_gradient = np.zeros(n_free + 1)
+    objective_gradient[-1] = -1.0
     result = scipy.optimize.minimize(
-        lambda v: -v[3],
-        x0=np.array([*start, start_speed]),
-        jac=lambda v: np.array([0.0, 0.0, 0.0, -1.0]),
-        bounds=[bounds.x, bounds.y, bounds.yaw, (0.0, None)],
+        lambda v: -v[n_free],
+        x0=np.array([*np.asarray(start)[free], start_speed]),
+        jac=lambda v: objective_gradient,
+        bounds=[*zip(bounds.lower[free], bounds.upper[free], strict=True), (0.0, None)],
         constraints=[{"type": "ineq", "fun": margin, "jac": margin_gradient}],
         method="SLSQP",
         options={"ftol": 1e-14, "maxiter": 200},
     )
-    x, y, yaw = (float(v) for v in result.x[:3])
-    return (x, y, yaw), str(result.message), int(result.nit)
+    vector = _full(bounds, result.x[None, :n_free])[0]
+    return vector, str(result.message), int(result.nit)

@@ -20,6 +20,7 @@ from solver.pipeline import (
     SpinMode,
     check_max_joint_step,
     check_placements,
+    check_spin_mode,
     prepare_path,
     require_family,
     run_chunk,
@@ -100,7 +101,8 @@ def evaluate_placements(
     Args:
         robot: an arm with a kinematics family, with its speed limits and TCP.
         path: from :func:`prepare_path` for the same robot.
-        placements: shape (P, 4), [x (m), y (m), z (m), yaw (rad)] of {O} in {B}.
+        placements: shape (P, 5), [x (m), y (m), z (m), yaw (rad), spin (rad)] of {O} in {B}
+            (:meth:`solver.spatial.Placement.as_row`); (P, 4) is taken with spin 0.
         branch: the IK branch to follow everywhere; ``None`` is ``auto``.
         spin_mode: ``fixed`` (the orientations as given) or ``free`` (the tool spin rate free,
             cam.md section 2).
@@ -112,6 +114,7 @@ def evaluate_placements(
     Raises:
         NoAnalyticIkError, InvalidInputError: as :func:`solver.evaluate.evaluate_path`.
     """
+    check_spin_mode(robot, spin_mode)
     family = require_family(robot)
     check_max_joint_step(max_joint_step)
     cells = check_placements(placements)
@@ -121,9 +124,9 @@ def evaluate_placements(
         if branch is None
         else np.array([family.branch_index(branch)])
     )
-    # Chunks of consecutive placements, cut where the yaw changes (a grid's yaw-major order
-    # gives chunks of one yaw each, which are cheaper).
-    cuts = np.flatnonzero(np.diff(cells[:, 3])) + 1
+    # Chunks of consecutive placements, cut where the yaw or the spin changes (a grid's
+    # yaw-major order gives chunks of one yaw each, which are cheaper; a chunk has one spin).
+    cuts = np.flatnonzero(np.any(np.diff(cells[:, 3:5], axis=0) != 0.0, axis=1)) + 1
     parts = []
     for run in np.split(np.arange(len(cells)), cuts):
         for start in range(0, len(run), chunk):

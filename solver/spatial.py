@@ -79,17 +79,35 @@ def pose_matrix(
     return transform
 
 
+def spun_waypoints(waypoints: np.ndarray, spins: np.ndarray) -> np.ndarray:
+    """Each waypoint turned about its own tool z axis: T_O_i Rot_z(spins_i) (cam.md section 4).
+
+    Args:
+        waypoints: shape (N, 4, 4), T_O_i (m).
+        spins: shape (N,), rad.
+    """
+    c, s = np.cos(spins), np.sin(spins)
+    turn = np.zeros((len(spins), 4, 4))
+    turn[:, 0, 0], turn[:, 0, 1], turn[:, 1, 0], turn[:, 1, 1] = c, -s, s, c
+    turn[:, 2, 2] = turn[:, 3, 3] = 1.0
+    spun: np.ndarray = np.asarray(waypoints, dtype=float) @ turn
+    return spun
+
+
 @dataclass(frozen=True)
 class Placement:
-    """Where the workpiece frame {O} sits in the base frame {B} (spec section 1).
+    """Where the workpiece frame {O} sits in the base frame {B} (spec section 1), and the spin.
 
-    T_B_O = Trans(x, y, z) * Rot_z(yaw); x, y, z in metres, yaw in radians.
+    T_B_O = Trans(x, y, z) * Rot_z(yaw); x, y, z in metres, yaw in radians. ``spin`` (rad) turns
+    every waypoint about its own tool z axis, R_i Rot_z(spin) (cam.md section 3): it leaves the
+    task requirements as they are and changes only the IK, as a TCP turned about its z would.
     """
 
     x: float
     y: float
     z: float
     yaw: float
+    spin: float = 0.0
 
     def __post_init__(self) -> None:
         """Check the values.
@@ -98,8 +116,14 @@ class Placement:
             InvalidInputError: a value that is not finite, or a position beyond MAX_COORDINATE.
         """
         check_position([self.x, self.y, self.z], field="placement")
-        if not math.isfinite(self.yaw):
-            raise InvalidInputError("placement.yaw", f"yaw {self.yaw!r} rad is not finite")
+        for name in ("yaw", "spin"):
+            value = getattr(self, name)
+            if not math.isfinite(value):
+                raise InvalidInputError(f"placement.{name}", f"{name} {value!r} rad is not finite")
+
+    def as_row(self) -> np.ndarray:
+        """The placement as one row of the batched layout, [x, y, z, yaw, spin]."""
+        return np.array([self.x, self.y, self.z, self.yaw, self.spin])
 
     def transform_workpiece_to_base(self) -> np.ndarray:
         """T_B_O, shape (4, 4)."""

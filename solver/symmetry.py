@@ -9,36 +9,14 @@ arc; :func:`arc_point` picks one of them inside the bounds, deterministically.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 
 import numpy as np
 
 from solver.kinematics import jacobian_in_base, tool_pose_in_base
 from solver.robots import Robot
+from solver.search_space import PlacementBounds
 
 _TWO_PI = 2 * math.pi
-
-
-@dataclass(frozen=True)
-class PlacementBounds:
-    """A box of placements: x, y, yaw ranges (m, m, rad) at height z (m)."""
-
-    x: tuple[float, float]
-    y: tuple[float, float]
-    yaw: tuple[float, float]
-    z: float
-
-    def contains(self, x: float, y: float, yaw: float, *, slack: float = 1e-12) -> bool:
-        """Whether (x, y, yaw) is inside the box (to ``slack``)."""
-        return (
-            self.x[0] - slack <= x <= self.x[1] + slack
-            and self.y[0] - slack <= y <= self.y[1] + slack
-            and self.yaw[0] - slack <= yaw <= self.yaw[1] + slack
-        )
-
-    def centre(self) -> tuple[float, float, float]:
-        """The middle of the box (x, y, yaw)."""
-        return (sum(self.x) / 2, sum(self.y) / 2, sum(self.yaw) / 2)
 
 
 def turns_about_base_z(robot: Robot) -> bool:

@@ -80,11 +80,12 @@ def check_waypoints(poses: np.ndarray, *, field: str = "path.waypoints") -> np.n
     return arr
 
 
-def task_requirements(poses: np.ndarray) -> TaskRequirements:
+def task_requirements(poses: np.ndarray, *, field: str = "path.waypoints") -> TaskRequirements:
     """Spec section 2: u_T, u_R and h of every waypoint of a path.
 
     Args:
         poses: shape (N, 4, 4), the waypoints (tool point poses), all in one frame.
+        field: name of the input, for error messages.
 
     Returns:
         The requirements in that frame.
@@ -94,7 +95,7 @@ def task_requirements(poses: np.ndarray) -> TaskRequirements:
         RepeatedWaypointError: two consecutive waypoints with the same position and
             orientation; it names the second one.
     """
-    arr = check_waypoints(poses)
+    arr = check_waypoints(poses, field=field)
     displacement = arr[1:, :3, 3] - arr[:-1, :3, 3]
     rotation_vector = np.array(
         [pin.log3(nxt @ cur.T) for cur, nxt in zip(arr[:-1, :3, :3], arr[1:, :3, :3], strict=True)]
@@ -103,7 +104,7 @@ def task_requirements(poses: np.ndarray) -> TaskRequirements:
     angular = np.linalg.norm(rotation_vector, axis=1)
     no_move = (linear < LINEAR_TOLERANCE) & (angular < ANGULAR_TOLERANCE)
     if np.any(no_move):
-        raise RepeatedWaypointError(int(np.argmax(no_move)) + 1)
+        raise RepeatedWaypointError(int(np.argmax(no_move)) + 1, field=field)
     moving = linear >= LINEAR_TOLERANCE
     turning = angular >= ANGULAR_TOLERANCE
     safe_linear = np.where(moving, linear, 1.0)

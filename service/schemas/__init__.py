@@ -13,6 +13,7 @@ from service.schemas.common import (
     RequestModel,
     ResponseModel,
     Robot,
+    ToolAxisWaypoint,
 )
 from service.schemas.dtf import DtfRequest, DtfResponse
 from service.schemas.errors import ErrorDetail, ErrorResponse
@@ -29,14 +30,16 @@ from service.schemas.optimize import (
     OptimizeRequest,
     OptimizeResponse,
     SolverInfo,
+    SpinPath,
     StartInfo,
 )
-from service.schemas.robots import HealthResponse, RobotInfo, RobotsResponse
+from service.schemas.robots import BranchLevel, HealthResponse, RobotInfo, RobotsResponse
 
 __all__ = [
     "Bottleneck",
     "Bounds",
     "Branch",
+    "BranchLevel",
     "DtfRequest",
     "DtfResponse",
     "ErrorDetail",
@@ -63,6 +66,8 @@ __all__ = [
     "RobotInfo",
     "RobotsResponse",
     "SolverInfo",
+    "SpinPath",
     "StartInfo",
+    "ToolAxisWaypoint",
     "WaypointResult",
 ]

@@ -85,7 +85,8 @@ class Robot(RequestModel):
     )
 
     model: str | None = Field(
-        default=None, description="A robot name from GET /v1/robots. Give model or urdf."
+        default=None,
+        description="A robot name from GET /v1/robots. Give exactly one of model or urdf.",
     )
     urdf: str | None = Field(
         default=None,
@@ -133,15 +134,39 @@ class Robot(RequestModel):
 
     @model_validator(mode="after")
     def _model_or_urdf(self) -> Robot:
-        if self.model is None and self.urdf is None:
+        given = [name for name in ("model", "urdf") if getattr(self, name) is not None]
+        if len(given) != 1:
             raise PydanticCustomError(
-                "robot_source", "give model (a name from GET /v1/robots) or urdf"
+                "robot_source",
+                "give exactly one of model (a name from GET /v1/robots) or urdf; got {given}",
+                {"given": ", ".join(given) or "none"},
             )
         return self
 
 
+class ToolAxisWaypoint(RequestModel):
+    """A tool point and the tool axis, as 5-axis CAM writes them (cam.md section 1)."""
+
+    model_config = ConfigDict(
+        json_schema_extra={"examples": [{"position": [0.0, 0.0, 0.0], "axis": [0.0, 0.0, 1.0]}]}
+    )
+
+    position: Vector3 = Field(description="Tool tip [x, y, z] in {O} (m).")
+    axis: Vector3 = Field(
+        description="Tool axis [i, j, k] from the tip towards the holder (tool z = -axis); unit "
+        "to within 1e-3, where it is normalised and the correction reported."
+    )
+
+
+SpinMode = Literal["fixed", "free"]
+
+
 class Path(RequestModel):
-    """Tool point poses in the workpiece frame {O}, in machining order."""
+    """The tool path in the workpiece frame {O}, in machining order: poses or tool axes.
+
+    Give exactly one of ``waypoints`` (full poses) or ``tool_axis_waypoints`` (tool point and
+    axis; the rotation about the axis is the minimal-rotation frame, cam.md section 1).
+    """
 
     model_config = ConfigDict(
         json_schema_extra={
@@ -156,10 +181,32 @@ class Path(RequestModel):
         }
     )
 
-    waypoints: list[Pose] = Field(
+    waypoints: list[Pose] | None = Field(
+        default=None,
         min_length=2,
         description="N >= 2 poses in {O} (m, unit quaternions); consecutive ones distinct.",
     )
+    tool_axis_waypoints: list[ToolAxisWaypoint] | None = Field(
+        default=None,
+        min_length=2,
+        description="N >= 2 tool points and axes in {O} (m); consecutive ones distinct. The "
+        "default spin_mode of such a path is free.",
+    )
+
+    @model_validator(mode="after")
+    def _one_form(self) -> Path:
+        given = [f for f in ("waypoints", "tool_axis_waypoints") if getattr(self, f) is not None]
+        if len(given) != 1:
+            raise PydanticCustomError(
+                "path_form",
+                "give exactly one of waypoints or tool_axis_waypoints; got {given}",
+                {"given": ", ".join(given) or "none"},
+            )
+        return self
+
+    def n_waypoints(self) -> int:
+        """The number of waypoints N."""
+        return len(self.waypoints or self.tool_axis_waypoints or [])
 
 
 class Placement(RequestModel):
@@ -173,6 +220,11 @@ class Placement(RequestModel):
     y: float = Field(description="y of {O} in {B} (m).")
     z: float = Field(description="z of {O} in {B} (m), the table height.")
     yaw: float = Field(description="Rotation of {O} about the z axis of {B} (rad).")
+    spin: float = Field(
+        default=0.0,
+        description="Tool spin (rad): every waypoint turned about its own tool z axis (cam.md "
+        "section 3); it changes the IK, never the task requirements. Default 0.",
+    )
 
 
 class Branch(RequestModel):

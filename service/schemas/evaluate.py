@@ -15,6 +15,7 @@ from service.schemas.common import (
     RequestModel,
     ResponseModel,
     Robot,
+    SpinMode,
 )
 
 _REQUEST_EXAMPLE: JsonDict = {
@@ -54,6 +55,9 @@ _RESPONSE_EXAMPLE: JsonDict = {
     "reason": None,
     "failed_waypoint": None,
     "branch": {"shoulder": "right", "elbow": "down", "wrist": "noflip"},
+    "spin_mode": "fixed",
+    "spins": None,
+    "axis_correction": 0.0,
     "waypoints": [
         _RESPONSE_EXAMPLE_WAYPOINT,
         {
@@ -79,12 +83,24 @@ class EvaluateRequest(RequestModel):
     model_config = ConfigDict(json_schema_extra={"examples": [_REQUEST_EXAMPLE]})
 
     robot: Robot = Field(
-        description="The arm; path evaluation needs analytic IK, so a catalogue (UR) model."
+        description="The arm; path evaluation needs its IK family: a UR or OPW arm (catalogue "
+        "model or opw geometry)."
     )
     path: Path = Field(description="The waypoints, in the workpiece frame {O}.")
     placement: Placement = Field(description="Where {O} sits in the base frame {B}.")
     ik: IkPolicy = Field(
         default_factory=IkPolicy, description="IK branch and continuity bound; default auto."
+    )
+    spin_mode: SpinMode | None = Field(
+        default=None,
+        description="fixed: the orientations as given; free: the tool spin rate about the tool "
+        "axis is free (a spindle, disc or grinder; cam.md section 2). Default: free for "
+        "tool_axis_waypoints, fixed for waypoints.",
+    )
+    spins: list[float] | None = Field(
+        default=None,
+        description="A tool spin per waypoint (rad), added to the placement's: each waypoint "
+        "turned about its own tool z axis (as /v1/optimize's spin_path answers). Default none.",
     )
 
 
@@ -161,5 +177,16 @@ class EvaluateResponse(ResponseModel):
     )
     branch: Branch | None = Field(
         description="IK branch used (when infeasible with auto: the one that got furthest)."
+    )
+    spin_mode: SpinMode = Field(description="The spin mode used (fixed or free).")
+    spins: list[float] | None = Field(
+        default=None,
+        description="In free spin mode, the tool spin (rad) about each waypoint's tool axis that "
+        "realises mu_path (the waypoints' q follow it); null in fixed mode or when infeasible.",
+    )
+    axis_correction: float = Field(
+        default=0.0,
+        description="The largest correction made to a tool axis's length when normalising it "
+        "(dimensionless; 0 when none was needed or the path is given by poses).",
     )
     waypoints: list[WaypointResult] = Field(description="One entry per waypoint, in path order.")

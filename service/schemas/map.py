@@ -5,7 +5,15 @@ from __future__ import annotations
 from pydantic import ConfigDict, Field, PositiveFloat, field_validator
 from pydantic.config import JsonDict
 
-from service.schemas.common import IkPolicy, Path, Placement, RequestModel, ResponseModel, Robot
+from service.schemas.common import (
+    IkPolicy,
+    Path,
+    Placement,
+    RequestModel,
+    ResponseModel,
+    Robot,
+    SpinMode,
+)
 from service.schemas.evaluate import _REQUEST_EXAMPLE, FailureReason
 
 
@@ -45,16 +53,26 @@ class Grid(RequestModel):
         "to 360 values, each mapped."
     )
 
-    @field_validator("yaw")
+    spin: float | list[float] = Field(
+        default=0.0,
+        description="Constant tool spin about each waypoint's tool axis (rad, cam.md section 3): "
+        "one value or a list of 1 to 360 values, each mapped. Default 0.",
+    )
+
+    @field_validator("yaw", "spin")
     @classmethod
-    def _yaw_list(cls, value: float | list[float]) -> float | list[float]:
+    def _value_list(cls, value: float | list[float]) -> float | list[float]:
         if isinstance(value, list) and not 1 <= len(value) <= 360:
-            raise ValueError(f"a list of 1 to 360 yaw values is needed, got {len(value)}")
+            raise ValueError(f"a list of 1 to 360 values is needed, got {len(value)}")
         return value
 
     def yaws(self) -> list[float]:
         """The yaw values as a list (rad)."""
         return self.yaw if isinstance(self.yaw, list) else [self.yaw]
+
+    def spins(self) -> list[float]:
+        """The spin values as a list (rad)."""
+        return self.spin if isinstance(self.spin, list) else [self.spin]
 
 
 _MAP_REQUEST_EXAMPLE: JsonDict = {
@@ -75,10 +93,19 @@ class MapRequest(RequestModel):
 
     model_config = ConfigDict(json_schema_extra={"examples": [_MAP_REQUEST_EXAMPLE]})
 
-    robot: Robot = Field(description="The arm (a UR arm of the catalogue: the map needs its IK).")
+    robot: Robot = Field(
+        description="The arm: a UR or OPW arm (catalogue model or opw geometry); the map needs "
+        "its IK family."
+    )
     path: Path = Field(description="The tool path in the workpiece frame {O}.")
     grid: Grid = Field(description="The placements to evaluate.")
     ik: IkPolicy = Field(default_factory=IkPolicy, description="IK branch policy.")
+    spin_mode: SpinMode | None = Field(
+        default=None,
+        description="fixed: the orientations as given; free: the tool spin rate about the tool "
+        "axis is free (cam.md section 2). Default: free for tool_axis_waypoints, fixed for "
+        "waypoints.",
+    )
 
 
 _CELL: JsonDict = {
@@ -113,6 +140,7 @@ class MapCell(ResponseModel):
     x: float = Field(description="Placement x (m).")
     y: float = Field(description="Placement y (m).")
     yaw: float = Field(description="Placement yaw (rad).")
+    spin: float = Field(default=0.0, description="Tool spin (rad).")
     mu_path: float | None = Field(
         description="Highest constant feed rate (m/s); null when infeasible."
     )
@@ -169,3 +197,4 @@ class MapResponse(ResponseModel):
         description="The feasible cell with the lowest mu_path; null if none."
     )
     feasible_cells: int = Field(description="How many cells are feasible.")
+    spin_mode: SpinMode = Field(default="fixed", description="The spin mode used (fixed or free).")

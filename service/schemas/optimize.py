@@ -8,14 +8,22 @@ from typing import Literal
 from pydantic import ConfigDict, Field, field_validator
 from pydantic.config import JsonDict
 
-from service.schemas.common import IkPolicy, Path, Placement, RequestModel, ResponseModel, Robot
+from service.schemas.common import (
+    IkPolicy,
+    Path,
+    Placement,
+    RequestModel,
+    ResponseModel,
+    Robot,
+    SpinMode,
+)
 from service.schemas.evaluate import _REQUEST_EXAMPLE, EvaluateResponse
 
 Range = list[float]
 
 
 class Bounds(RequestModel):
-    """The box the optimum must lie in: x and y (m) and yaw (rad), each as [min, max]."""
+    """The box the optimum must lie in: x and y (m), yaw and tool spin (rad), as [min, max]."""
 
     model_config = ConfigDict(
         json_schema_extra={
@@ -26,8 +34,16 @@ class Bounds(RequestModel):
     x: Range = Field(min_length=2, max_length=2, description="[min, max] of x (m).")
     y: Range = Field(min_length=2, max_length=2, description="[min, max] of y (m).")
     yaw: Range = Field(min_length=2, max_length=2, description="[min, max] of the yaw (rad).")
+    spin: Range = Field(
+        default=[0.0, 0.0],
+        min_length=2,
+        max_length=2,
+        description="[min, max] of the constant tool spin about each waypoint's tool axis (rad, "
+        "cam.md section 3), at most a turn wide; default [0, 0] (no spin). It matters for an "
+        "angled or offset spindle.",
+    )
 
-    @field_validator("x", "y", "yaw")
+    @field_validator("x", "y", "yaw", "spin")
     @classmethod
     def _ordered(cls, value: Range) -> Range:
         if value[0] > value[1]:
@@ -45,13 +61,24 @@ _REQUEST: JsonDict = {
 }
 
 
+class SpinPath(RequestModel):
+    """A tool spin per waypoint for the casadi method (cam.md section 4)."""
+
+    model_config = ConfigDict(json_schema_extra={"examples": [{"max_spin_step": 0.05}]})
+
+    max_spin_step: float = Field(
+        gt=0.0, description="Largest change of the spin between neighbouring waypoints (rad)."
+    )
+
+
 class OptimizeRequest(RequestModel):
     """A robot, a path in the workpiece frame, and the box of placements to search."""
 
     model_config = ConfigDict(json_schema_extra={"examples": [_REQUEST]})
 
     robot: Robot = Field(
-        description="The arm (a UR arm of the catalogue: the search needs its IK)."
+        description="The arm: a UR or OPW arm (catalogue model or opw geometry); the search "
+        "needs its IK family."
     )
     path: Path = Field(description="The tool path in the workpiece frame {O}.")
     bounds: Bounds = Field(description="Where the workpiece may go.")
@@ -70,6 +97,17 @@ class OptimizeRequest(RequestModel):
         default_factory=IkPolicy,
         description="IK policy: max_joint_step as for /v1/evaluate; the branch must be auto "
         "(each start of the search follows its own branch, the answer uses the best).",
+    )
+    spin_mode: SpinMode | None = Field(
+        default=None,
+        description="fixed: the orientations as given; free: the tool spin rate about the tool "
+        "axis is free (cam.md section 2). Default: free for tool_axis_waypoints, fixed for "
+        "waypoints.",
+    )
+    spin_path: SpinPath | None = Field(
+        default=None,
+        description="With the casadi method and spin_mode fixed: give each waypoint its own "
+        "tool spin, its steps bounded (cam.md section 4); the answer's spins then hold them.",
     )
 
     @field_validator("ik")
@@ -151,3 +189,8 @@ class OptimizeResponse(ResponseModel):
         description="100 (mu_path / start mu_path - 1); null when the start is infeasible."
     )
     solver: SolverInfo = Field(description="The method, its status, iterations and time.")
+    spins: list[float] | None = Field(
+        default=None,
+        description="With spin_path: each waypoint's tool spin (rad) on top of the placement's; "
+        "/v1/evaluate with these spins gives this mu_path. null otherwise.",
+    )

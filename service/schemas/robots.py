@@ -19,7 +19,24 @@ _UR5E_EXAMPLE: JsonDict = {
     "qdot_max": [3.141592653589793] * 6,
     "base_frame": "base",
     "tool_frame": "tool0",
+    "family": "ur",
+    "branches": [
+        {"level": "shoulder", "choices": ["left", "right"]},
+        {"level": "elbow", "choices": ["up", "down"]},
+        {"level": "wrist", "choices": ["noflip", "flip"]},
+    ],
 }
+
+
+class BranchLevel(ResponseModel):
+    """One level of a robot's IK branches and its choices (ik.branch names one per level)."""
+
+    model_config = ConfigDict(
+        json_schema_extra={"examples": [{"level": "shoulder", "choices": ["left", "right"]}]}
+    )
+
+    level: str = Field(description='The level, e.g. "shoulder".')
+    choices: list[str] = Field(description='Its choices, e.g. ["left", "right"].')
 
 
 class HealthResponse(ResponseModel):
@@ -45,6 +62,13 @@ class RobotInfo(ResponseModel):
     )
     base_frame: str = Field(description="Frame {B} that poses and twists are expressed in.")
     tool_frame: str = Field(description="Tool flange frame {F}; a tcp is relative to it.")
+    family: str | None = Field(
+        description="The kinematics family that solves its IK (ur: UR arms; opw: industrial "
+        "arms with a spherical wrist); null for an arm that only has /v1/dtf."
+    )
+    branches: list[BranchLevel] = Field(
+        description="The IK branch levels and their choices, as ik.branch names them."
+    )
 
 
 class RobotsResponse(ResponseModel):

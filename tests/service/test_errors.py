@@ -134,6 +134,11 @@ EVALUATE_CASES: list[tuple[str, Changes, Loc]] = [
         {("ik", "branch"): {"shoulder": "middle", "elbow": "up", "wrist": "flip"}},
         ["body", "ik", "branch"],
     ),
+    (
+        "OPW branch name for a UR arm",
+        {("ik", "branch"): {"shoulder": "front", "elbow": "up", "wrist": "flip"}},
+        ["body", "ik", "branch"],
+    ),
     ("zero joint step", {("ik", "max_joint_step"): 0.0}, ["body", "ik", "max_joint_step"]),
     ("unknown field", {("speed",): 1.0}, ["body", "speed"]),
     ("unknown robot", {("robot", "model"): "kuka"}, ["body", "robot", "model"]),
@@ -170,6 +175,18 @@ def test_evaluate_bad_input(
     client: TestClient, path_body: dict[str, Any], changes: Changes, loc: Loc
 ) -> None:
     assert_names(client.post("/v1/evaluate", json=changed(path_body, changes)), 422, loc)
+
+
+def test_foreign_branch_name_lists_the_valid_ones(
+    client: TestClient, path_body: dict[str, Any]
+) -> None:
+    branch = {"shoulder": "back", "elbow": "down", "wrist": "noflip"}
+    response = client.post("/v1/evaluate", json=changed(path_body, {("ik", "branch"): branch}))
+    assert_names(response, 422, ["body", "ik", "branch"])
+    message = response.json()["detail"][0]["msg"]
+    assert "shoulder=back" in message
+    assert "{shoulder=left, elbow=up, wrist=noflip}" in message
+    assert "{shoulder=right, elbow=down, wrist=flip}" in message
 
 
 def test_one_waypoint_is_refused(client: TestClient, path_body: dict[str, Any]) -> None:

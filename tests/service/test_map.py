@@ -79,6 +79,7 @@ def test_best_and_worst_are_the_extreme_cells(answer: dict[str, Any]) -> None:
         "y": best["y"],
         "z": 0.1,
         "yaw": best["yaw"],
+        "spin": best["spin"],
     }
 
 

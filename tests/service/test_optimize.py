@@ -46,7 +46,7 @@ def test_answer_is_what_evaluate_says(
 
 def test_start_and_improvement(answer: dict[str, Any]) -> None:
     start = answer["start"]
-    assert start["placement"] == {"x": 0.0, "y": 0.45, "z": 0.1, "yaw": 0.0}
+    assert start["placement"] == {"x": 0.0, "y": 0.45, "z": 0.1, "yaw": 0.0, "spin": 0.0}
     expected = 100 * (answer["mu_path"] / start["mu_path"] - 1)
     assert answer["improvement_percent"] == pytest.approx(expected, rel=1e-12)
     assert answer["improvement_percent"] > 10
@@ -81,9 +81,84 @@ def test_nothing_feasible_is_not_an_error(client: TestClient, body: dict[str, An
         ),
         ({"z": 5000.0}, ["body", "z"]),
         ({"bounds": {"x": [-900, 900], "y": [-900, 900], "yaw": [0, 1]}}, ["body", "bounds"]),
+        (
+            {"bounds": {"x": [0, 0.1], "y": [0.3, 0.5], "yaw": [0, 1], "spin": [-3.2, 3.2]}},
+            ["body", "bounds", "spin"],
+        ),
+        (
+            {"bounds": {"x": [0, 0.1], "y": [0.3, 0.5], "yaw": [0, 1], "spin": [1.0, 0.5]}},
+            ["body", "bounds", "spin"],
+        ),
+        (
+            {"start": {"x": 0.0, "y": 0.45, "z": 0.1, "yaw": 0.0, "spin": 0.5}},
+            ["body", "start"],
+        ),
+        ({"spin_mode": "free", "method": "newton"}, ["body", "method"]),
     ],
 )
 def test_bad_input(client: TestClient, body: dict[str, Any], changes: dict, loc: list) -> None:
     response = client.post("/v1/optimize", json={**body, **changes})
     assert response.status_code == 422, response.text
     assert response.json()["detail"][0]["loc"][: len(loc)] == loc
+
+
+def test_spin_bounds_reach_the_answer(client: TestClient, body: dict[str, Any]) -> None:
+    """A spin range is searched and the answer's placement carries its spin, inside the range."""
+    bounds = {"x": [-0.05, 0.05], "y": [0.4, 0.5], "yaw": [-0.3, 0.3], "spin": [0.2, 0.6]}
+    answer = client.post("/v1/optimize", json={**body, "bounds": bounds}).json()
+    assert answer["found"] is True
+    assert 0.2 <= answer["placement"]["spin"] <= 0.6
+    assert answer["start"]["placement"]["spin"] == pytest.approx(0.4)
+    evaluation = client.post(
+        "/v1/evaluate",
+        json={"robot": body["robot"], "path": body["path"], "placement": answer["placement"]},
+    ).json()
+    assert answer["mu_path"] == pytest.approx(evaluation["mu_path"], rel=OPTIMUM_EVALUATE_RTOL)
+
+
+def test_spin_path_answers_spins_that_evaluate_confirms(
+    client: TestClient, body: dict[str, Any]
+) -> None:
+    bounds = {"x": [-0.05, 0.05], "y": [0.4, 0.5], "yaw": [-0.3, 0.3]}
+    request = {**body, "bounds": bounds, "spin_path": {"max_spin_step": 0.05}}
+    answer = client.post("/v1/optimize", json=request).json()
+    assert answer["found"] is True and len(answer["spins"]) == len(body["path"]["waypoints"])
+    steps = [abs(b - a) for a, b in zip(answer["spins"], answer["spins"][1:], strict=False)]
+    assert max(steps) <= 0.05
+    evaluation = client.post(
+        "/v1/evaluate",
+        json={
+            "robot": body["robot"],
+            "path": body["path"],
+            "placement": answer["placement"],
+            "spins": answer["spins"],
+        },
+    ).json()
+    assert answer["mu_path"] == pytest.approx(evaluation["mu_path"], rel=OPTIMUM_EVALUATE_RTOL)
+    constant = client.post("/v1/optimize", json={**body, "bounds": bounds}).json()
+    assert answer["mu_path"] >= constant["mu_path"]
+
+
+@pytest.mark.parametrize(
+    ("changes", "loc"),
+    [
+        ({"spin_path": {"max_spin_step": 0.0}}, ["body", "spin_path", "max_spin_step"]),
+        ({"spin_path": {"max_spin_step": 0.1}, "method": "scipy"}, ["body", "spin_path"]),
+    ],
+)
+def test_bad_spin_path(client: TestClient, body: dict[str, Any], changes: dict, loc: list) -> None:
+    response = client.post("/v1/optimize", json={**body, **changes})
+    assert response.status_code == 422, response.text
+    assert response.json()["detail"][0]["loc"][: len(loc)] == loc
+
+
+def test_spins_of_the_wrong_length_are_refused(client: TestClient, body: dict[str, Any]) -> None:
+    request = {
+        "robot": body["robot"],
+        "path": body["path"],
+        "placement": {"x": 0.0, "y": 0.45, "z": 0.1, "yaw": 0.0},
+        "spins": [0.0, 0.1],
+    }
+    response = client.post("/v1/evaluate", json=request)
+    assert response.status_code == 422, response.text
+    assert response.json()["detail"][0]["loc"] == ["body", "spins"]

@@ -20,21 +20,21 @@ from tests.solver.test_evaluate import load_path, wrist_singular_path
 
 
 def _compare_cells(robot, path, cmap, cells, **kwargs) -> set[str]:
-    """Assert each cell equals evaluate_path there; return the reasons seen."""
+    """Assert each cell [spin, yaw, y, x] equals evaluate_path there; return the reasons seen."""
     seen = set()
-    for k, j, i in cells:
-        expected = evaluate_path(robot, path, cmap.placement((k, j, i)), **kwargs)
+    for index in cells:
+        expected = evaluate_path(robot, path, cmap.placement(index), **kwargs)
         if expected.feasible:
-            assert cmap.mu_path[k, j, i] == pytest.approx(expected.mu_path, rel=MAP_EVALUATE_RTOL)
-            assert cmap.bottleneck_waypoint[k, j, i] == expected.bottleneck_waypoint
-            assert cmap.bottleneck_joint[k, j, i] == expected.bottleneck_joint
+            assert cmap.mu_path[index] == pytest.approx(expected.mu_path, rel=MAP_EVALUATE_RTOL)
+            assert cmap.bottleneck_waypoint[index] == expected.bottleneck_waypoint
+            assert cmap.bottleneck_joint[index] == expected.bottleneck_joint
             seen.add("feasible")
         else:
-            assert math.isnan(cmap.mu_path[k, j, i])
-            assert REASONS[cmap.reason[k, j, i]] == expected.reason
-            assert cmap.failed_waypoint[k, j, i] == expected.failed_waypoint
+            assert math.isnan(cmap.mu_path[index])
+            assert REASONS[cmap.reason[index]] == expected.reason
+            assert cmap.failed_waypoint[index] == expected.failed_waypoint
             seen.add(expected.reason)
-        assert BRANCHES[cmap.branch[k, j, i]] == expected.branch
+        assert BRANCHES[cmap.branch[index]] == expected.branch
     return seen
 
 
@@ -66,7 +66,7 @@ def test_random_cells_equal_evaluate(robot_name: str, path_name: str) -> None:
     picks += [*infeasible[rng.choice(len(infeasible), 10, replace=False)]]
     seen = _compare_cells(robot, path, cmap, [tuple(int(v) for v in p) for p in picks])
     assert {"feasible", "unreachable"} <= seen
-    assert len(picks) >= 35 and shape == (3, 21, 21)
+    assert len(picks) >= 35 and shape == (1, 3, 21, 21)
 
 
 def test_a_named_branch_and_a_small_step() -> None:
@@ -130,7 +130,7 @@ def test_infeasible_everywhere() -> None:
         z=0.0,
         yaws=np.array([0.0]),
     )
-    assert cmap.extreme(best=True) is None and REASONS[cmap.reason[0, 0, 0]] == "unreachable"
+    assert cmap.extreme(best=True) is None and REASONS[cmap.reason[0, 0, 0, 0]] == "unreachable"
 
 
 @pytest.mark.parametrize(
@@ -177,6 +177,6 @@ def test_joint_limit_and_singular_cells_equal_evaluate() -> None:
         yaws=np.array([0.0, 0.2]),
         **kwargs,
     )
-    assert REASONS[cmap.reason[0, 0, 1]] == "singular"
+    assert REASONS[cmap.reason[0, 0, 0, 1]] == "singular"
     cells = [tuple(int(v) for v in c) for c in np.ndindex(cmap.mu_path.shape)]
     assert "singular" in _compare_cells(robot, singular_path, cmap, cells, **kwargs)

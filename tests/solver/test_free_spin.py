@@ -12,11 +12,12 @@ import scipy.optimize
 from solver.capability_map import capability_map, grid_axis
 from solver.dtf import spin_rate_nearest_zero, two_variable_speed
 from solver.evaluate import evaluate_path
+from solver.exceptions import InvalidInputError
 from solver.kinematics import jacobian_in_base, tool_pose_in_base
 from solver.optimize import optimize_placement
-from solver.robots import get_robot
+from solver.robots import get_robot, robot_from_urdf
+from solver.search_space import PlacementBounds
 from solver.spatial import Placement
-from solver.symmetry import PlacementBounds
 from tests.cases import (
     FREE_SPIN_LP_RTOL,
     MAP_EVALUATE_RTOL,
@@ -195,3 +196,27 @@ def test_free_spin_optimum(free_optima: dict, method: str) -> None:
     assert optimum.evaluation.spins is not None
     other = free_optima["scipy" if method == "casadi" else "casadi"]
     assert optimum.mu_path == pytest.approx(other.mu_path, rel=OPTIMUM_METHODS_RTOL)
+
+
+PRISMATIC_TIP = """<robot name="slide">
+  <link name="base"/><link name="l1"/><link name="l2"/><link name="tool"/>
+  <joint name="turn" type="revolute"><parent link="base"/><child link="l1"/>
+    <axis xyz="0 0 1"/><limit lower="-3" upper="3" velocity="2" effort="1"/></joint>
+  <joint name="reach" type="revolute"><parent link="l1"/><child link="l2"/>
+    <origin xyz="0 0 0.3"/><axis xyz="0 1 0"/><limit lower="-3" upper="3" velocity="2" effort="1"/>
+  </joint>
+  <joint name="plunge" type="prismatic"><parent link="l2"/><child link="tool"/>
+    <origin xyz="0.3 0 0"/><axis xyz="0 0 1"/>
+    <limit lower="0" upper="0.1" velocity="0.5" effort="1"/>
+  </joint>
+</robot>"""
+
+
+def test_free_spin_needs_a_revolute_last_joint() -> None:
+    robot = robot_from_urdf(PRISMATIC_TIP, base_frame="base", tool_frame="tool")
+    with pytest.raises(InvalidInputError) as error:
+        evaluate_path(robot, load_path("curved_line"), README_PLACEMENT, spin_mode="free")
+    assert error.value.field == "spin_mode" and "plunge" in error.value.message
+    with pytest.raises(InvalidInputError) as error:
+        evaluate_path(get_robot("ur5"), load_path("curved_line"), README_PLACEMENT, spin_mode="x")
+    assert error.value.field == "spin_mode"

@@ -13,8 +13,9 @@ from solver.evaluate import evaluate_path
 from solver.exceptions import InvalidInputError
 from solver.optimize import PlacementOptimum, optimize_placement
 from solver.robots import get_robot
+from solver.search_space import PlacementBounds, vector_of
 from solver.spatial import Placement
-from solver.symmetry import PlacementBounds, arc_coordinates, arc_point, turns_about_base_z
+from solver.symmetry import arc_coordinates, arc_point, turns_about_base_z
 from tests.cases import OPTIMUM_EVALUATE_RTOL, OPTIMUM_METHODS_RTOL
 from tests.solver.test_evaluate import load_path
 
@@ -50,7 +51,7 @@ def test_optimum_is_feasible_inside_and_what_the_evaluator_says(solved: dict, me
     optimum: PlacementOptimum = solved[method]
     assert optimum.mu_path >= solved["best_cell"]
     placement = optimum.placement
-    assert BOUNDS.contains(placement.x, placement.y, placement.yaw) and placement.z == BOUNDS.z
+    assert BOUNDS.contains(vector_of(placement)) and placement.z == BOUNDS.z
     evaluation = evaluate_path(solved["robot"], solved["path"], placement)
     assert evaluation.feasible
     assert optimum.mu_path == pytest.approx(evaluation.mu_path, rel=OPTIMUM_EVALUATE_RTOL)
@@ -139,7 +140,7 @@ def test_arc_point_is_the_nearest_inside_point(seed: int) -> None:
     inside = [
         t
         for t in thetas
-        if bounds.contains(r * math.cos(t), r * math.sin(t), 0.0)
+        if bounds.contains(np.array([r * math.cos(t), r * math.sin(t), 0.0, 0.0]))
         and any(bounds.yaw[0] <= psi + t + k * 2 * math.pi <= bounds.yaw[1] for k in (-1, 0, 1))
     ]
     if not inside:
@@ -147,7 +148,7 @@ def test_arc_point_is_the_nearest_inside_point(seed: int) -> None:
         return
     assert point is not None
     x, y, yaw = point
-    assert bounds.contains(x, y, yaw)
+    assert bounds.contains(np.array([x, y, yaw, 0.0]))
     assert arc_coordinates(x, y, yaw) == pytest.approx((r, psi), abs=1e-9)
     distance = min(abs((t - near + math.pi) % (2 * math.pi) - math.pi) for t in inside)
     theta = math.atan2(y, x)
@@ -191,3 +192,15 @@ def test_a_box_too_large_to_search_is_refused_before_any_work() -> None:
     with pytest.raises(InvalidInputError, match="limit is 50000") as info:
         optimize_placement(get_robot("ur5"), load_path("curved_line"), bounds=bounds)
     assert info.value.field == "bounds"
+
+
+@pytest.mark.parametrize("method", ["casadi", "scipy"])
+def test_nothing_feasible_is_a_result_with_found_false(method: str) -> None:
+    far = PlacementBounds(x=(3.0, 3.1), y=(3.0, 3.1), yaw=(0.0, 0.3), z=0.1)
+    optimum = optimize_placement(
+        get_robot("ur5"), load_path("curved_line"), bounds=far, method=method
+    )
+    assert optimum.found is False
+    assert (optimum.placement, optimum.mu_path, optimum.evaluation) == (None, None, None)
+    assert optimum.start == far.placement(far.centre()) and optimum.start_mu_path is None
+    assert optimum.solver.status == "no feasible placement inside the bounds"

@@ -16,11 +16,13 @@ router = APIRouter(prefix="/evaluate", tags=["evaluate"], responses=ERROR_RESPON
 def post_evaluate(body: EvaluateRequest) -> EvaluateResponse:
     """An unreachable placement is not an error: it answers ``feasible: false`` with a reason."""
     robot = convert.robot_from_schema(body.robot)
+    path = convert.path_of(body.path)
     evaluation = evaluate_path(
         robot,
-        convert.waypoints_of(body.path),
+        convert.spun_poses(path, body.spins),
         convert.placement_of(body.placement),
         branch=convert.branch_of(body.ik.branch),
         max_joint_step=body.ik.max_joint_step,
+        spin_mode=convert.spin_mode_of(body.spin_mode, path),
     )
-    return convert.evaluate_response(evaluation, robot)
+    return convert.evaluate_response(evaluation, robot, axis_correction=path.axis_correction)

@@ -32,17 +32,21 @@ def post_map(
     m/s, infeasible cells blank, the best and worst placements marked.
     """
     robot = convert.robot_from_schema(body.robot)
-    grid = convert.map_grid(body.grid, settings=settings, n_waypoints=len(body.path.waypoints))
+    grid = convert.map_grid(body.grid, settings=settings, n_waypoints=body.path.n_waypoints())
+    path = convert.path_of(body.path)
+    spin_mode = convert.spin_mode_of(body.spin_mode, path)
     result = capability_map(
         robot,
-        convert.waypoints_of(body.path),
+        path.poses,
         xs=grid.xs,
         ys=grid.ys,
         z=body.grid.z,
         yaws=grid.yaws,
+        spins=grid.spins,
         branch=convert.branch_of(body.ik.branch),
         max_joint_step=body.ik.max_joint_step,
+        spin_mode=spin_mode,
     )
     if convert.wants_png(accept):
         return Response(render_png(result, title=f"{robot.name}: mu_path"), media_type="image/png")
-    return convert.map_response(result)
+    return convert.map_response(result, spin_mode=spin_mode)

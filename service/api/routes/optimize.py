@@ -21,16 +21,18 @@ def post_optimize(body: OptimizeRequest, settings: SettingsDep) -> OptimizeRespo
     coarse map (20 mm, 15 degrees) would exceed DTF_MAX_MAP_CELLS cells is a 422 on ``bounds``.
     """
     robot = convert.robot_from_schema(body.robot)
-    waypoints = convert.waypoints_of(body.path)
+    path = convert.path_of(body.path)
     bounds = convert.bounds_of(body.bounds, z=body.z)
     start = None if body.start is None else convert.placement_of(body.start)
     optimum = optimize_placement(
         robot,
-        waypoints,
+        path.poses,
         bounds=bounds,
         start=start,
         method=body.method,
         max_joint_step=body.ik.max_joint_step,
+        spin_mode=convert.spin_mode_of(body.spin_mode, path),
+        max_spin_step=None if body.spin_path is None else body.spin_path.max_spin_step,
         max_coarse_cells=settings.max_map_cells,
     )
-    return convert.optimize_response(optimum, robot, bounds=bounds, start=start)
+    return convert.optimize_response(optimum, robot, axis_correction=path.axis_correction)
