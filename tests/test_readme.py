@@ -2,8 +2,10 @@
 
 from __future__ import annotations
 
+import importlib
 import json
 import re
+import sys
 
 from fastapi.testclient import TestClient
 
@@ -37,3 +39,22 @@ def test_worked_example_output() -> None:
     )
     assert printed == expected
     assert "@examples/evaluate_request.json" in example
+
+
+def test_five_axis_example_output() -> None:
+    section = README.split("## Five-axis: let the tool spin", 1)[1]
+    printed = re.search(r"prints\n\n```\n(.*?)\n```", section, re.S).group(1)
+    sys.path.insert(0, str(EXAMPLES))
+    try:
+        five_axis = importlib.import_module("five_axis")
+    finally:
+        sys.path.remove(str(EXAMPLES))
+    client = TestClient(app)
+
+    def post(route: str, body: dict) -> dict:
+        response = client.post(route, json=body)
+        assert response.status_code == 200, response.text
+        return response.json()
+
+    assert printed.splitlines() == five_axis.lines(post)
+    assert "python3 examples/five_axis.py" in section
