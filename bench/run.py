@@ -96,6 +96,13 @@ def main() -> None:
     def eight_yaws() -> object:
         return capability_map(robot, path, xs=xs, ys=ys, z=z, yaws=yaws8)
 
+    kr6 = get_robot("kuka_kr6_r700_sixx")
+    opw_xs = grid_axis(0.2, 0.6, 0.02, field="x") if not args.smoke else xs + 0.4
+    opw_ys = grid_axis(-0.25, 0.25, 0.02, field="y") if not args.smoke else ys - 0.4
+
+    def opw_map() -> object:
+        return capability_map(kr6, path, xs=opw_xs, ys=opw_ys, z=z, yaws=np.array([0.0]))
+
     def free_spin() -> object:
         return capability_map(robot, path, xs=xs, ys=ys, z=z, yaws=np.zeros(1), spin_mode="free")
 
@@ -103,6 +110,9 @@ def main() -> None:
     t_map = best_time(one_yaw, repeats)
     t_map8 = best_time(eight_yaws, max(1, repeats // 2))
     t_free = best_time(free_spin, repeats)
+    opw_map()  # warm up (the catalogue's OPW models)
+    t_opw = best_time(opw_map, repeats)
+    opw_cells = len(opw_xs) * len(opw_ys)
     rng = np.random.default_rng(0)
     picks = rng.choice(cells, size=subset, replace=False)
     placements = [Placement(float(xs[p % len(xs)]), float(ys[p // len(xs)]), z, 0.0) for p in picks]
@@ -132,6 +142,15 @@ def main() -> None:
     print(
         f"free-spin map ({cells} placements):  {t_free:8.3f} s   "
         f"{t_free / t_map:.2f}x the fixed-spin map"
+    )
+    print(
+        f"OPW map: KR6 R700 sixx, {opw_cells} placements x {len(path)} waypoints x 8 branches "
+        f"(x {opw_xs[0]:.2f}..{opw_xs[-1]:.2f}, y {opw_ys[0]:.2f}..{opw_ys[-1]:.2f}, z {z})"
+    )
+    print(
+        f"  vectorised map (best of {repeats}):   {t_opw:8.3f} s   "
+        f"{t_opw / (opw_cells * len(path) * 8) * 1e9:6.0f} ns per pose-branch, "
+        f"{t_opw / t_map * cells / opw_cells:.2f}x the UR5 map per placement"
     )
     optimisation(robot, path, smoke=args.smoke)
 

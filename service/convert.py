@@ -13,6 +13,8 @@ from solver.capability_map import CapabilityMap, axis_length, grid_axis
 from solver.dtf import DtfResult
 from solver.evaluate import Branch, PathEvaluation
 from solver.exceptions import InvalidInputError
+from solver.families.opw.catalogue import robot_from_opw
+from solver.families.opw.parameters import OpwParameters
 from solver.optimize import PlacementOptimum
 from solver.pipeline import SpinMode
 from solver.robots import Robot, get_robot, robot_from_urdf
@@ -28,12 +30,32 @@ def robot_from_schema(spec: schemas.Robot) -> Robot:
 
     Raises:
         UnknownRobotError: ``model`` is not in the catalogue.
+        InvalidInputError: an OPW geometry or its limits are out of range.
         RobotModelError: the URDF or its frames do not fit.
         InvalidInputError: ``joint_velocity_limits`` has the wrong length.
     """
     tcp = None if spec.tcp is None else pose_matrix_of(spec.tcp, field="robot.tcp")
     if spec.model is not None:
         robot = get_robot(spec.model).with_options(qdot_max=spec.joint_velocity_limits)
+    elif spec.opw is not None:  # schemas.Robot makes sure both limits are given
+        geometry = spec.opw
+        parameters = OpwParameters(
+            a1=geometry.a1,
+            a2=geometry.a2,
+            b=geometry.b,
+            c1=geometry.c1,
+            c2=geometry.c2,
+            c3=geometry.c3,
+            c4=geometry.c4,
+            offsets=tuple(geometry.offsets),
+            sign_corrections=tuple(geometry.sign_corrections),
+        )
+        robot = robot_from_opw(
+            "opw",
+            parameters,
+            joint_position_limits=np.array(spec.joint_position_limits or [], dtype=float),
+            qdot_max=spec.joint_velocity_limits or [],
+        )
     else:  # schemas.Robot makes sure urdf and both frames are given
         robot = robot_from_urdf(
             spec.urdf or "",

@@ -36,7 +36,7 @@ def _joint_motion(joint: pin.JointModel) -> tuple[str, np.ndarray]:
             return kind, _AXES[name[-1]]
     if name in ("JointModelRevoluteUnaligned", "JointModelPrismaticUnaligned"):
         kind = "revolute" if "Revolute" in name else "prismatic"
-        return kind, np.asarray(joint.axis, dtype=float)
+        return kind, np.asarray(joint.extract().axis, dtype=float)
     raise RobotModelError("robot", f"joint type {name} has no symbolic model here")
 
 

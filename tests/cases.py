@@ -12,6 +12,14 @@ EXAMPLES = ROOT / "examples"
 
 UR_MODELS = ("ur3", "ur5", "ur10", "ur3e", "ur5e", "ur10e", "ur16e")
 E_SERIES = ("ur3e", "ur5e", "ur10e", "ur16e")
+OPW_MODELS = (
+    "kuka_kr6_r700_sixx",
+    "kuka_kr16_2",
+    "abb_irb2400",
+    "abb_irb4600_60_205",
+    "fanuc_m20ia",
+    "fanuc_r2000ic_165f",
+)
 
 # Sensors 2022 Table 3 (task requirements of three UR5e path segments): u_T, u_R, h (m).
 SENSORS_TABLE_3 = {

@@ -7,6 +7,7 @@ its unit, and every model carries an example, so ``/docs`` reads as a manual.
 from service.schemas.common import (
     Branch,
     IkPolicy,
+    OpwGeometry,
     Path,
     Placement,
     Pose,
@@ -55,6 +56,7 @@ __all__ = [
     "MapExtreme",
     "MapRequest",
     "MapResponse",
+    "OpwGeometry",
     "OptimizeRequest",
     "OptimizeResponse",
     "Path",

@@ -67,8 +67,49 @@ class Pose(RequestModel):
         return value
 
 
+class OpwGeometry(RequestModel):
+    """An industrial arm with an ortho-parallel basis and a spherical wrist (OPW, robots.md).
+
+    Brandstotter, Angerer, Hofbaur (2014): seven lengths, and per-joint offsets and sign
+    corrections that map the paper's joint zero and direction to the maker's (the convention of
+    the ROS-Industrial ``opw_parameters_*.yaml`` files and of ``opw_kinematics``).
+    """
+
+    model_config = ConfigDict(
+        json_schema_extra={
+            "examples": [
+                {
+                    "a1": 0.025,
+                    "a2": -0.035,
+                    "b": 0.0,
+                    "c1": 0.4,
+                    "c2": 0.315,
+                    "c3": 0.365,
+                    "c4": 0.08,
+                    "offsets": [0.0, -1.5707963267948966, 0.0, 0.0, 0.0, 0.0],
+                    "sign_corrections": [-1, 1, 1, -1, 1, -1],
+                }
+            ]
+        }
+    )
+
+    a1: float = Field(description="Shoulder offset along x (m), |a1| <= 100.")
+    a2: float = Field(description="Elbow offset (m), |a2| <= 100.")
+    b: float = Field(description="Lateral offset (m), |b| <= 100.")
+    c1: float = Field(description="Height of the shoulder above the base (m), |c1| <= 100.")
+    c2: float = Field(description="Upper arm length (m), 0 < c2 <= 100.")
+    c3: float = Field(description="Forearm length (m), 0 < c3 <= 100.")
+    c4: float = Field(description="Wrist centre to flange (m), |c4| <= 100.")
+    offsets: list[float] = Field(
+        default=[0.0] * 6, description="Joint zero offsets (rad), 6 values. Default: zeros."
+    )
+    sign_corrections: list[int] = Field(
+        default=[1] * 6, description="Joint directions, 6 values, each +1 or -1. Default: ones."
+    )
+
+
 class Robot(RequestModel):
-    """The arm: a catalogue ``model``, or a ``urdf`` with its ``base_frame`` and ``tool_frame``."""
+    """The arm: a catalogue ``model``, a ``urdf`` with its frames, or an ``opw`` geometry."""
 
     model_config = ConfigDict(
         json_schema_extra={
@@ -86,7 +127,7 @@ class Robot(RequestModel):
 
     model: str | None = Field(
         default=None,
-        description="A robot name from GET /v1/robots. Give exactly one of model or urdf.",
+        description="A robot name from GET /v1/robots. Give exactly one of model, urdf, opw.",
     )
     urdf: str | None = Field(
         default=None,
@@ -103,6 +144,17 @@ class Robot(RequestModel):
         default=None,
         validate_default=True,
         description="With urdf only, required: the tool flange frame.",
+    )
+    opw: OpwGeometry | None = Field(
+        default=None,
+        description="An OPW industrial arm of your own (joint angles in the maker's convention, "
+        "{B} the base_link, the tool frame the flange tool0); needs joint_position_limits and "
+        "joint_velocity_limits.",
+    )
+    joint_position_limits: list[list[float]] | None = Field(
+        default=None,
+        description="With opw only, required: [lower, upper] (rad) for each of the 6 joints, "
+        "lower < upper.",
     )
     joint_velocity_limits: list[PositiveFloat] | None = Field(
         default=None,
@@ -134,13 +186,19 @@ class Robot(RequestModel):
 
     @model_validator(mode="after")
     def _model_or_urdf(self) -> Robot:
-        given = [name for name in ("model", "urdf") if getattr(self, name) is not None]
+        given = [name for name in ("model", "urdf", "opw") if getattr(self, name) is not None]
         if len(given) != 1:
             raise PydanticCustomError(
                 "robot_source",
-                "give exactly one of model (a name from GET /v1/robots) or urdf; got {given}",
+                "give exactly one of model (a name from GET /v1/robots), urdf or opw; got {given}",
                 {"given": ", ".join(given) or "none"},
             )
+        if self.opw is not None and self.joint_position_limits is None:
+            raise PydanticCustomError("missing", "opw needs joint_position_limits (rad)")
+        if self.opw is not None and self.joint_velocity_limits is None:
+            raise PydanticCustomError("missing", "opw needs joint_velocity_limits (rad/s)")
+        if self.opw is None and self.joint_position_limits is not None:
+            raise PydanticCustomError("robot_source", "joint_position_limits go with opw only")
         return self
 
 

@@ -15,7 +15,7 @@ if TYPE_CHECKING:
     from solver.robots import Robot
 
 # Modules with a ``robots() -> dict[str, Robot]`` function, in catalogue order.
-CATALOGUE_MODULES = ("solver.families.ur.catalogue",)
+CATALOGUE_MODULES = ("solver.families.ur.catalogue", "solver.families.opw.catalogue")
 
 
 @functools.cache

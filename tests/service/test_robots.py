@@ -4,7 +4,7 @@ import math
 
 from fastapi.testclient import TestClient
 
-from tests.cases import UR_MODELS
+from tests.cases import OPW_MODELS, UR_MODELS
 
 
 def test_healthz(client: TestClient) -> None:
@@ -13,21 +13,41 @@ def test_healthz(client: TestClient) -> None:
     assert response.json() == {"status": "ok"}
 
 
-def test_robots_lists_every_ur_model(client: TestClient) -> None:
+def test_robots_lists_every_ur_and_opw_model(client: TestClient) -> None:
     response = client.get("/v1/robots")
     assert response.status_code == 200
     robots = {robot["name"]: robot for robot in response.json()["robots"]}
-    assert sorted(robots) == sorted(UR_MODELS)
+    assert sorted(robots) == sorted(UR_MODELS + OPW_MODELS)
     for robot in robots.values():
         assert robot["dof"] == 6
         for key in ("joint_names", "q_lower", "q_upper", "qdot_max"):
             assert len(robot[key]) == 6, key
         assert all(low < high for low, high in zip(robot["q_lower"], robot["q_upper"], strict=True))
         assert all(limit > 0 for limit in robot["qdot_max"])
-        assert (robot["base_frame"], robot["tool_frame"]) == ("base", "tool0")
+        ur = robot["name"] in UR_MODELS
+        assert robot["family"] == ("ur" if ur else "opw")
+        assert (robot["base_frame"], robot["tool_frame"]) == (
+            "base" if ur else "base_link",
+            "tool0",
+        )
+        assert robot["branches"] == [
+            {"level": "shoulder", "choices": ["left", "right"] if ur else ["front", "back"]},
+            {"level": "elbow", "choices": ["up", "down"]},
+            {"level": "wrist", "choices": ["noflip", "flip"]},
+        ]
 
 
 def test_robots_velocity_limits_are_the_datasheet_ones(client: TestClient) -> None:
     robots = {robot["name"]: robot for robot in client.get("/v1/robots").json()["robots"]}
     assert robots["ur5e"]["qdot_max"] == [math.pi] * 6
     assert robots["ur10e"]["qdot_max"] == [2 * math.pi / 3] * 2 + [math.pi] * 4
+
+
+def test_opw_limits_are_the_support_packages(client: TestClient) -> None:
+    """Two rows checked by hand against the xacro files (KR6 R700 sixx, IRB 2400)."""
+    robots = {robot["name"]: robot for robot in client.get("/v1/robots").json()["robots"]}
+    kr6 = robots["kuka_kr6_r700_sixx"]
+    assert kr6["joint_names"] == [f"joint_a{i}" for i in range(1, 7)]
+    assert kr6["qdot_max"] == [math.radians(v) for v in (360, 300, 360, 381, 388, 615)]
+    assert kr6["q_lower"][1] == math.radians(-190) and kr6["q_upper"][1] == math.radians(45)
+    assert robots["abb_irb2400"]["qdot_max"] == [2.618, 2.618, 2.618, 6.2832, 6.2832, 7.854]

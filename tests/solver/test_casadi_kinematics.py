@@ -9,7 +9,7 @@ import pytest
 from solver.casadi_kinematics import symbolic_kinematics
 from solver.kinematics import jacobian_in_base, tool_pose_in_base
 from solver.robots import example_robot_data_dir, get_robot, robot_from_urdf
-from tests.cases import UR_MODELS
+from tests.cases import OPW_MODELS, UR_MODELS
 
 
 def _robot(name: str):
@@ -19,7 +19,7 @@ def _robot(name: str):
     return get_robot(name)
 
 
-@pytest.mark.parametrize("name", [*UR_MODELS, "panda"])
+@pytest.mark.parametrize("name", [*UR_MODELS, *OPW_MODELS, "panda"])
 def test_symbolic_chain_equals_pinocchio(name: str) -> None:
     tcp = np.eye(4)
     tcp[:3, :3] = pin.utils.rotate("y", 0.3)

@@ -1,0 +1,88 @@
+"""OPW arms as robots: the catalogue's six arms, and an arm defined in a request."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from solver.exceptions import InvalidInputError
+from solver.families.opw.arms import ARMS
+from solver.families.opw.family import OpwFamily
+from solver.families.opw.model import opw_model
+from solver.families.opw.parameters import OpwParameters
+from solver.robots import Robot, check_speed_limits, robot_from_model
+
+JOINT_NAMES = tuple(f"joint_{i}" for i in range(1, 7))
+
+
+def check_position_limits(limits: np.ndarray | list[list[float]]) -> np.ndarray:
+    """Joint position limits as a (6, 2) array [lower, upper] (rad), after checking them.
+
+    Raises:
+        InvalidInputError: on ``robot.joint_position_limits``: a wrong count, a value that is
+            not finite, or lower >= upper (naming the joint).
+    """
+    field = "robot.joint_position_limits"
+    arr = np.asarray(limits, dtype=float)
+    if arr.shape != (6, 2):
+        raise InvalidInputError(field, f"needs 6 [lower, upper] pairs (rad), got shape {arr.shape}")
+    for j, (low, high) in enumerate(arr):
+        if not (math.isfinite(low) and math.isfinite(high)) or low >= high:
+            raise InvalidInputError(
+                field, f"joint {j + 1}: [{low:g}, {high:g}] rad needs finite lower < upper"
+            )
+    return arr
+
+
+def robot_from_opw(
+    name: str,
+    parameters: OpwParameters,
+    *,
+    joint_position_limits: np.ndarray | list[list[float]],
+    qdot_max: np.ndarray | list[float],
+    joint_names: tuple[str, ...] = JOINT_NAMES,
+) -> Robot:
+    """An OPW arm as a robot: {B} = base_link, the tool frame the flange tool0.
+
+    Args:
+        name: the robot's name.
+        parameters: the geometry (checked when it was made).
+        joint_position_limits: shape (6, 2), rad, [lower, upper] per joint, maker's convention.
+        qdot_max: shape (6,), rad/s.
+        joint_names: the six joint names.
+
+    Raises:
+        InvalidInputError: limits of the wrong count, not finite or not ordered.
+    """
+    limits = check_position_limits(joint_position_limits)
+    speeds = check_speed_limits(qdot_max, joint_names)
+    model = opw_model(
+        parameters,
+        joint_names=joint_names,
+        q_lower=limits[:, 0],
+        q_upper=limits[:, 1],
+        qdot_max=speeds,
+    )
+    return robot_from_model(
+        name,
+        model,
+        base_frame="base_link",
+        tool_frame="tool0",
+        qdot_max=speeds,
+        family=OpwFamily(parameters),
+    )
+
+
+def robots() -> dict[str, Robot]:
+    """The catalogue's OPW arms by name."""
+    return {
+        arm.name: robot_from_opw(
+            arm.name,
+            arm.parameters,
+            joint_position_limits=np.array(arm.position_limits),
+            qdot_max=np.array(arm.velocity_limits),
+            joint_names=arm.joint_names,
+        )
+        for arm in ARMS
+    }
