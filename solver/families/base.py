@@ -12,6 +12,7 @@ Layout: rotations (3, 3, *batch), positions (3, *batch), joint arrays (dof, ...)
 from __future__ import annotations
 
 import abc
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -115,3 +116,41 @@ class KinematicsFamily(abc.ABC):
         Returns:
             shape (dof, ...), joint speeds (rad/s); inf or NaN at an exactly singular q.
         """
+
+
+class ClosedFormFamily(KinematicsFamily):
+    """A six-joint family whose IK and J^-1 t are closed-form functions of its parameters.
+
+    A subclass names the family and gives its branches and its two functions, each taking the
+    parameters first (``solve(parameters, rotation, position)``,
+    ``speeds(parameters, q, twist, tool_point)``), as :mod:`solver.families.ur` and
+    :mod:`solver.families.opw` do.
+    """
+
+    branch_labels: tuple[Branch, ...]
+    solve_function: Callable[..., tuple[np.ndarray, np.ndarray]]
+    speeds_function: Callable[..., np.ndarray]
+
+    def __init__(self, parameters: object) -> None:
+        """Hold the arm's parameters (the geometry the two functions take)."""
+        self.parameters = parameters
+
+    @property
+    def dof(self) -> int:
+        """Six joints."""
+        return 6
+
+    @property
+    def branches(self) -> tuple[Branch, ...]:
+        """The family's branch labels."""
+        return self.branch_labels
+
+    def solve(self, rotation: np.ndarray, position: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """All branches in closed form (see :meth:`KinematicsFamily.solve`)."""
+        return type(self).solve_function(self.parameters, rotation, position)
+
+    def joint_speeds_per_unit_twist(
+        self, q: np.ndarray, twist: np.ndarray, tool_point: np.ndarray
+    ) -> np.ndarray:
+        """J^-1 t in closed form (see :meth:`KinematicsFamily.joint_speeds_per_unit_twist`)."""
+        return type(self).speeds_function(self.parameters, q, twist, tool_point)

@@ -62,7 +62,7 @@ def test_fk_equals_ur_analytic_ik(name: str) -> None:
 def test_pinocchio_chain_equals_dh_chain(name: str) -> None:
     robot = get_robot(name)
     q = np.random.default_rng(3).uniform(-math.pi, math.pi, (100, 6))
-    dh_poses = forward_kinematics_dh(robot.family.dh, q)
+    dh_poses = forward_kinematics_dh(robot.family.parameters, q)
     for qi, pose in zip(q, dh_poses, strict=True):
         np.testing.assert_allclose(tool_pose_in_base(robot, qi), pose, atol=CB_URDF_VS_DH_ATOL)
 

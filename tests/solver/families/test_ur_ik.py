@@ -29,7 +29,7 @@ def test_fk_of_every_solution_is_the_pose(name: str) -> None:
     """Issue 2: FK(IK(T)) = T to 1e-9 for every solution, over 1000 random reachable poses."""
     robot = get_robot(name)
     poses, _ = _random_reachable_poses(name, seed=1)
-    q, status = solve_batch(robot.family.dh, poses)
+    q, status = solve_batch(robot.family.parameters, poses)
     solved = status != UNREACHABLE
     assert solved.sum() >= 4 * N_POSES  # a random pose has 4 to 8 solutions
     worst = 0.0
@@ -43,7 +43,7 @@ def test_every_reference_solution_is_among_ours(name: str) -> None:
     """Issue 2: every solution of ur-analytic-ik is one of ours (or its 2 pi copy)."""
     robot = get_robot(name)
     poses, q_true = _random_reachable_poses(name, seed=2)
-    q, status = solve_batch(robot.family.dh, poses)
+    q, status = solve_batch(robot.family.parameters, poses)
     reference = getattr(ur_analytic_ik, name)
     for i, pose in enumerate(poses):
         theirs = reference.inverse_kinematics(pose)
@@ -57,7 +57,7 @@ def test_every_reference_solution_is_among_ours(name: str) -> None:
 def test_unreachable_pose_has_no_solution() -> None:
     pose = np.eye(4)
     pose[:3, 3] = [2.0, 0.0, 0.3]  # 2 m away: beyond every UR5e
-    q, status = solve_batch(get_robot("ur5e").family.dh, pose[None])
+    q, status = solve_batch(get_robot("ur5e").family.parameters, pose[None])
     assert np.all(status == UNREACHABLE)
     assert np.all(np.isnan(q))
 
@@ -66,7 +66,7 @@ def test_wrist_singular_pose_is_flagged() -> None:
     robot = get_robot("ur5e")
     q_singular = np.array([0.3, -1.1, 1.2, -0.4, 0.0, 0.7])  # q5 = 0: axes 4 and 6 aligned
     assert abs(np.linalg.det(jacobian_in_base(robot, q_singular))) < 1e-12
-    _, status = solve_batch(robot.family.dh, tool_pose_in_base(robot, q_singular)[None])
+    _, status = solve_batch(robot.family.parameters, tool_pose_in_base(robot, q_singular)[None])
     assert np.any(status[0] == 2)
 
 
@@ -74,7 +74,7 @@ def test_branch_labels_are_sign_patterns() -> None:
     """Shoulder, elbow and wrist labels follow the signs documented in the module."""
     robot = get_robot("ur5e")
     poses, _ = _random_reachable_poses("ur5e", seed=4)
-    q, status = solve_batch(robot.family.dh, poses)
+    q, status = solve_batch(robot.family.parameters, poses)
     for b, label in enumerate(BRANCHES):
         ok = status[:, b] == OK
         assert robot.family.branch_index(label) == b
