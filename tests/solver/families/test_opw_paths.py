@@ -130,3 +130,20 @@ def test_optimisers_on_an_opw_arm(optima: dict, method: str) -> None:
     assert optimum.mu_path == pytest.approx(evaluation.mu_path, rel=OPTIMUM_EVALUATE_RTOL)
     other = optima["scipy" if method == "casadi" else "casadi"]
     assert optimum.mu_path == pytest.approx(other.mu_path, rel=OPTIMUM_METHODS_RTOL)
+
+
+def test_free_spin_on_an_opw_arm() -> None:
+    """The two-variable LP serves every family: map = evaluate, and never below fixed spin."""
+    robot, path = get_robot(KR6), load_path("curved_line")
+    xs, ys = np.array([0.35, 0.45, 0.55]), np.array([-0.1, 0.1])
+    free = capability_map(robot, path, xs=xs, ys=ys, z=0.1, yaws=np.zeros(1), spin_mode="free")
+    fixed = capability_map(robot, path, xs=xs, ys=ys, z=0.1, yaws=np.zeros(1))
+    for index in np.ndindex(free.mu_path.shape):
+        expected = evaluate_path(robot, path, free.placement(index), spin_mode="free")
+        if expected.mu_path is None:
+            assert np.isnan(free.mu_path[index])
+            continue
+        assert free.mu_path[index] == pytest.approx(expected.mu_path, rel=MAP_EVALUATE_RTOL)
+        if not np.isnan(fixed.mu_path[index]):
+            assert free.mu_path[index] >= fixed.mu_path[index] * (1 - 1e-12)
+    assert np.isfinite(free.mu_path).sum() >= 3
