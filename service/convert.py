@@ -338,13 +338,13 @@ def map_response(cmap: CapabilityMap, *, spin_mode: SpinMode) -> schemas.MapResp
     )
 
 
-def bounds_of(bounds: schemas.Bounds, *, z: float) -> PlacementBounds:
-    """The solver's placement box (m, m, rad) at height z (m)."""
+def bounds_of(bounds: schemas.Bounds, *, z: float | None) -> PlacementBounds:
+    """The solver's placement box (m, m, rad) at height z (m), or with the height's range."""
     return PlacementBounds(
         x=(bounds.x[0], bounds.x[1]),
         y=(bounds.y[0], bounds.y[1]),
         yaw=(bounds.yaw[0], bounds.yaw[1]),
-        z=z,
+        z=(bounds.z[0], bounds.z[1]) if bounds.z is not None else float(z or 0.0),
         spin=(bounds.spin[0], bounds.spin[1]),
     )
 

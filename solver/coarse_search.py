@@ -2,8 +2,8 @@
 
 Where joint 1 turns about the base z axis the map is over (r, psi) (:mod:`solver.symmetry`),
 each cell placed on its arc inside the bounds; otherwise over (x, y, yaw). A free tool spin is
-one more dimension of the map. Its local maxima, best first, are the starts of the IPOPT solves,
-each with its IK branch.
+one more dimension of the map, and so is a free height z. Its local maxima, best first, are
+the starts of the IPOPT solves, each with its IK branch.
 """
 
 from __future__ import annotations
@@ -28,7 +28,7 @@ MAX_COARSE_CELLS = 50_000  # default limit on the coarse map (a box larger is an
 
 @dataclass(frozen=True)
 class Cell:
-    """A decision vector [x, y, yaw, spin] with its mu_path and IK branch index."""
+    """A decision vector [x, y, yaw, spin, z] with its mu_path and IK branch index."""
 
     vector: np.ndarray
     mu_path: float
@@ -43,6 +43,12 @@ def _spin_values(bounds: PlacementBounds) -> tuple[np.ndarray, bool]:
     wraps = high - low >= 2 * math.pi - 1e-9
     count = math.floor((high - low) / COARSE_YAW_STEP + 1e-9) + (0 if wraps else 1)
     return low + COARSE_YAW_STEP * np.arange(max(count, 1)), wraps
+
+
+def _heights(bounds: PlacementBounds) -> np.ndarray:
+    """The coarse map's heights: z, or its range at COARSE_STEP when z is free."""
+    low, high = bounds.z_range
+    return low + COARSE_STEP * np.arange(math.floor((high - low) / COARSE_STEP + 1e-9) + 1)
 
 
 def _local_maxima(values: np.ndarray, periodic: tuple[bool, ...]) -> list[tuple[int, ...]]:
@@ -82,6 +88,7 @@ def coarse_cells(
         InvalidInputError: the map would have more than ``max_cells`` cells (on ``bounds``).
     """
     spins, spin_wraps = _spin_values(bounds)
+    heights = _heights(bounds)
     n_psi = round(2 * math.pi / COARSE_YAW_STEP)
     if symmetric:
         corners = [math.hypot(x, y) for x in bounds.x for y in bounds.y]
@@ -99,6 +106,7 @@ def coarse_cells(
             )
         ]
     sizes = [len(spins), *sizes] if len(spins) > 1 else sizes
+    sizes = [len(heights), *sizes] if len(heights) > 1 else sizes
     if math.prod(sizes) > max_cells:
         raise InvalidInputError(
             "bounds",
@@ -140,15 +148,16 @@ def coarse_cells(
         periodic = (bounds.yaw[1] - bounds.yaw[0] >= 2 * math.pi - 1e-9, False, False)
     vectors: list[np.ndarray | None] = []
     rows = []
-    for spin in spins:
-        for point, where in zip(points, evaluated, strict=True):
-            at = where or point
-            if point is None or at is None:
-                vectors.append(None)
-                continue
-            vectors.append(np.array([*point, spin]))
-            rows.append([at[0], at[1], bounds.z, at[2], spin])
-    full_shape = (len(spins), *shape)
+    for z in heights:
+        for spin in spins:
+            for point, where in zip(points, evaluated, strict=True):
+                at = where or point
+                if point is None or at is None:
+                    vectors.append(None)
+                    continue
+                vectors.append(np.array([*point, spin, z]))
+                rows.append([at[0], at[1], z, at[2], spin])
+    full_shape = (len(heights), len(spins), *shape)
     mu = np.full(len(vectors), np.nan)
     branch = np.zeros(len(vectors), dtype=int)
     inside_index = [i for i, v in enumerate(vectors) if v is not None]
@@ -158,7 +167,7 @@ def coarse_cells(
         )
         mu[inside_index], branch[inside_index] = result.mu_path, result.branch
     cells = []
-    for index in _local_maxima(mu.reshape(full_shape), (spin_wraps, *periodic)):
+    for index in _local_maxima(mu.reshape(full_shape), (False, spin_wraps, *periodic)):
         k = int(np.ravel_multi_index(index, full_shape))
         vector = vectors[k]
         if vector is not None:

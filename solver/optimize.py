@@ -89,14 +89,14 @@ def _place_on_arc(
 
     Solvers may end a hair outside their bounds (IPOPT by its bound relaxation, 1e-8): the
     clamp is what makes every reported placement inside them; the evaluator then judges it.
-    The spin rides along: turning the placement about the base axis leaves it as it is.
+    The spin and the height ride along: turning the placement about the base axis leaves them.
     """
-    x, y, yaw, spin = bounds.clamp(vector)
+    x, y, yaw, spin, z = bounds.clamp(vector)
     if symmetric:
         moved = arc_point(*arc_coordinates(x, y, yaw), bounds, near=near)
         if moved is not None:
             x, y, yaw = moved
-    return Placement(float(x), float(y), bounds.z, float(yaw), spin=float(spin))
+    return Placement(float(x), float(y), float(z), float(yaw), spin=float(spin))
 
 
 def optimize_placement(
@@ -150,7 +150,7 @@ def optimize_placement(
             )
     if start is None:
         start = bounds.placement(bounds.centre())
-    if not bounds.contains(vector_of(start)) or start.z != bounds.z:
+    if not bounds.contains(vector_of(start)):
         raise InvalidInputError(
             "start",
             f"x {start.x:g} m, y {start.y:g} m, z {start.z:g} m, yaw {start.yaw:g} rad, spin "

@@ -45,7 +45,7 @@ ca: Any = casadi
 
 @dataclass(frozen=True)
 class NlpResult:
-    """One IPOPT solve: the decision vector [x, y, yaw, spin], s, IPOPT's status, iterations.
+    """One IPOPT solve: the decision vector [x, y, yaw, spin, z], s, IPOPT's status, iterations.
 
     ``spins`` (N,), rad, each waypoint's spin on top of the placement's, with a spin path.
     """
@@ -80,7 +80,7 @@ class PlacementNlp:
             robot: the arm.
             path: the prepared path (tool positions and t_hat in {O}).
             tool_rotation: shape (N, 3, 3), R_O_i of the tool point at every waypoint.
-            bounds: the placement box (z is fixed at bounds.z).
+            bounds: the placement box (the decision vector x, y, yaw, spin, z).
             max_joint_step: rad, the evaluator's bound on a joint's move between waypoints.
             free_spin: the tool spin rate about the tool z axis is a free variable per waypoint
                 (cam.md section 2, the evaluator's ``free`` spin mode).
@@ -95,7 +95,7 @@ class PlacementNlp:
         kinematics = symbolic_kinematics(robot)
         # One waypoint's 12 residuals as an SX function, mapped over the waypoints.
         q, qdot = ca.SX.sym("q", dof), ca.SX.sym("qdot", dof)
-        where, speed_1, spin_1 = ca.SX.sym("placement", 4), ca.SX.sym("s"), ca.SX.sym("sigma")
+        where, speed_1, spin_1 = ca.SX.sym("placement", 5), ca.SX.sym("s"), ca.SX.sym("sigma")
         phi_1, twist_1 = ca.SX.sym("phi"), ca.SX.sym("twist", 6)  # waypoint spin, t_hat in {O}
         data = ca.SX.sym("waypoint", 3 + 9)  # p_O, R_O (column-major)
         c, s = ca.cos(where[2]), ca.sin(where[2])
@@ -109,7 +109,7 @@ class PlacementNlp:
             [q, qdot, where, speed_1, spin_1, phi_1, twist_1, data],
             [
                 ca.vertcat(
-                    position - (turn @ data[:3] + ca.vertcat(where[0], where[1], bounds.z)),
+                    position - (turn @ data[:3] + ca.vertcat(where[0], where[1], where[4])),
                     error[2, 1] - error[1, 2],
                     error[0, 2] - error[2, 0],
                     error[1, 0] - error[0, 1],
@@ -125,7 +125,7 @@ class PlacementNlp:
                 tool_rotation.transpose(0, 2, 1).reshape(n, 9),  # column-major R_O
             ]
         ).T
-        placement = ca.MX.sym("placement", 4)  # x, y, yaw, spin
+        placement = ca.MX.sym("placement", 5)  # x, y, yaw, spin, z
         speed = ca.MX.sym("s")
         joints = ca.MX.sym("q", dof, n)
         joint_speeds = ca.MX.sym("qdot", dof, n)
@@ -193,7 +193,7 @@ class PlacementNlp:
         """Solve from a feasible start.
 
         Args:
-            start: the start's decision vector [x, y, yaw, spin] (m, m, rad, rad).
+            start: the start's decision vector [x, y, yaw, spin, z] (m, m, rad, rad, m).
             start_speed: its mu_path (m/s), the initial s.
             q_path: shape (N, n), rad, the start's joint path on the branch to follow.
             qdot_path: shape (N, n), rad/s, joint speeds there at feed rate ``start_speed``
@@ -243,8 +243,8 @@ class PlacementNlp:
         stats = self._solver.stats()
         x = np.asarray(solution["x"]).ravel()
         return NlpResult(
-            vector=x[:4].copy(),
-            speed=float(x[4]),
+            vector=x[:5].copy(),
+            speed=float(x[5]),
             spins=x[len(x) - self._n_spins :].copy() if self._n_spins else None,
             status=str(stats["return_status"]),
             success=bool(stats["success"]),

@@ -31,7 +31,7 @@ Basin = tuple[np.ndarray, float, int]  # decision vector, mu_path, branch index
 
 
 def _full(bounds: PlacementBounds, free_values: np.ndarray) -> np.ndarray:
-    """Decision vectors (P, 4) from the free variables' values (P, F); the rest fixed."""
+    """Decision vectors (P, 5) from the free variables' values (P, F); the rest fixed."""
     vectors = np.tile(bounds.lower, (len(free_values), 1))
     vectors[:, bounds.free] = free_values
     return vectors
@@ -39,16 +39,16 @@ def _full(bounds: PlacementBounds, free_values: np.ndarray) -> np.ndarray:
 
 def _basin_coordinates(vectors: np.ndarray, symmetric: bool) -> tuple[np.ndarray, np.ndarray]:
     """Coordinates in which basins are BASIN_GAP apart, and their scale (angles as cos, sin)."""
-    x, y, yaw, spin = vectors.T
+    x, y, yaw, spin, z = vectors.T
     angles = [np.cos(spin), np.sin(spin)]
     if symmetric:
         psi = yaw - np.arctan2(y, x)
-        columns = [np.hypot(x, y) / BASIN_GAP[0], np.cos(psi), np.sin(psi), *angles]
-        scale = [1.0] + [1.0 / BASIN_GAP[1]] * 4
-    else:
-        columns = [x / BASIN_GAP[0], y / BASIN_GAP[0], np.cos(yaw), np.sin(yaw), *angles]
+        columns = [np.hypot(x, y) / BASIN_GAP[0], z / BASIN_GAP[0], np.cos(psi), np.sin(psi)]
         scale = [1.0, 1.0] + [1.0 / BASIN_GAP[1]] * 4
-    return np.column_stack(columns), np.array(scale)
+    else:
+        columns = [x / BASIN_GAP[0], y / BASIN_GAP[0], z / BASIN_GAP[0], np.cos(yaw), np.sin(yaw)]
+        scale = [1.0, 1.0, 1.0] + [1.0 / BASIN_GAP[1]] * 4
+    return np.column_stack([*columns, *angles]), np.array(scale)
 
 
 def global_search(

@@ -2,8 +2,8 @@
 
 One type for every part of the search (the coarse map, differential evolution, SLSQP, the NLP,
 the symmetry and the answer): a decision vector is an array over ``VARIABLES`` = (x, y, yaw,
-spin), and :class:`PlacementBounds` gives each its range. A variable whose range is a single
-value is fixed (the spin, by default); the others are free. The height z is given (a table).
+spin, z), and :class:`PlacementBounds` gives each its range. A variable whose range is a single
+value is fixed (the spin and the height z, by default: a table); the others are free.
 """
 
 from __future__ import annotations
@@ -16,7 +16,7 @@ import numpy as np
 from solver.exceptions import InvalidInputError
 from solver.spatial import MAX_COORDINATE, Placement
 
-VARIABLES = ("x", "y", "yaw", "spin")  # m, m, rad, rad
+VARIABLES = ("x", "y", "yaw", "spin", "z")  # m, m, rad, rad, m
 _TWO_PI = 2 * math.pi
 
 
@@ -26,43 +26,51 @@ class PlacementBounds:
 
     Attributes:
         x: (min, max), m. y: (min, max), m. yaw: (min, max), rad.
-        z: m, the height of every placement.
+        z: m, the height of every placement; or (min, max), m, to search it too.
         spin: (min, max), rad, the constant tool spin (cam.md section 3); (0, 0) fixes it.
     """
 
     x: tuple[float, float]
     y: tuple[float, float]
     yaw: tuple[float, float]
-    z: float
+    z: float | tuple[float, float]
     spin: tuple[float, float] = (0.0, 0.0)
+
+    @property
+    def z_range(self) -> tuple[float, float]:
+        """(min, max) of the height, m; one value twice when it is fixed."""
+        if isinstance(self.z, tuple):
+            return (float(self.z[0]), float(self.z[1]))
+        return (float(self.z), float(self.z))
+
+    def _range(self, name: str) -> tuple[float, float]:
+        """(min, max) of a variable."""
+        return self.z_range if name == "z" else getattr(self, name)
 
     def check(self) -> None:
         """Raise InvalidInputError naming the range that is not finite, reversed or too wide."""
         for name in VARIABLES:
-            low, high = getattr(self, name)
+            low, high = self._range(name)
+            field = "z" if name == "z" and not isinstance(self.z, tuple) else f"bounds.{name}"
             if not (math.isfinite(low) and math.isfinite(high) and low <= high):
-                raise InvalidInputError(
-                    f"bounds.{name}", f"needs finite [min, max], got {[low, high]}"
-                )
-            if name in ("x", "y") and max(abs(low), abs(high)) > MAX_COORDINATE:
-                raise InvalidInputError(f"bounds.{name}", f"beyond +-{MAX_COORDINATE:g} m")
+                raise InvalidInputError(field, f"needs finite [min, max], got {[low, high]}")
+            if name in ("x", "y", "z") and max(abs(low), abs(high)) > MAX_COORDINATE:
+                raise InvalidInputError(field, f"beyond +-{MAX_COORDINATE:g} m")
         if self.spin[1] - self.spin[0] > _TWO_PI + 1e-12:
             raise InvalidInputError(
                 "bounds.spin",
                 f"{self.spin[1] - self.spin[0]:.6g} rad is wider than a turn (2 pi rad)",
             )
-        if not math.isfinite(self.z) or abs(self.z) > MAX_COORDINATE:
-            raise InvalidInputError("z", f"{self.z!r} m is not a finite height within the cell")
 
     @property
     def lower(self) -> np.ndarray:
         """Shape (4,), the lower bound of each variable."""
-        return np.array([getattr(self, name)[0] for name in VARIABLES])
+        return np.array([self._range(name)[0] for name in VARIABLES])
 
     @property
     def upper(self) -> np.ndarray:
         """Shape (4,), the upper bound of each variable."""
-        return np.array([getattr(self, name)[1] for name in VARIABLES])
+        return np.array([self._range(name)[1] for name in VARIABLES])
 
     @property
     def free(self) -> np.ndarray:
@@ -70,7 +78,7 @@ class PlacementBounds:
         return self.upper > self.lower
 
     def contains(self, vector: np.ndarray, *, slack: float = 1e-12) -> bool:
-        """Whether a decision vector (4,) is inside the box (to ``slack``)."""
+        """Whether a decision vector (5,) is inside the box (to ``slack``)."""
         v = np.asarray(vector, dtype=float)
         return bool(np.all(v >= self.lower - slack) and np.all(v <= self.upper + slack))
 
@@ -85,16 +93,16 @@ class PlacementBounds:
         return middle
 
     def placement(self, vector: np.ndarray) -> Placement:
-        """The placement of a decision vector [x, y, yaw, spin] at height z."""
-        x, y, yaw, spin = (float(v) for v in vector)
-        return Placement(x, y, self.z, yaw, spin=spin)
+        """The placement of a decision vector [x, y, yaw, spin, z]."""
+        x, y, yaw, spin, z = (float(v) for v in vector)
+        return Placement(x, y, z, yaw, spin=spin)
 
     def rows(self, vectors: np.ndarray) -> np.ndarray:
-        """Decision vectors (P, 4) as placement rows (P, 5) [x, y, z, yaw, spin]."""
-        v = np.asarray(vectors, dtype=float).reshape(-1, 4)
-        return np.column_stack([v[:, 0], v[:, 1], np.full(len(v), self.z), v[:, 2], v[:, 3]])
+        """Decision vectors (P, 5) as placement rows (P, 5) [x, y, z, yaw, spin]."""
+        v = np.asarray(vectors, dtype=float).reshape(-1, 5)
+        return v[:, [0, 1, 4, 2, 3]]
 
 
 def vector_of(placement: Placement) -> np.ndarray:
-    """The decision vector [x, y, yaw, spin] of a placement."""
-    return np.array([placement.x, placement.y, placement.yaw, placement.spin])
+    """The decision vector [x, y, yaw, spin, z] of a placement."""
+    return np.array([placement.x, placement.y, placement.yaw, placement.spin, placement.z])

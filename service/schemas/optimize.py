@@ -5,8 +5,9 @@ from __future__ import annotations
 import math
 from typing import Literal
 
-from pydantic import ConfigDict, Field, field_validator
+from pydantic import ConfigDict, Field, field_validator, model_validator
 from pydantic.config import JsonDict
+from pydantic_core import PydanticCustomError
 
 from service.schemas.common import (
     IkPolicy,
@@ -43,10 +44,18 @@ class Bounds(RequestModel):
         "angled or offset spindle.",
     )
 
-    @field_validator("x", "y", "yaw", "spin")
+    z: Range | None = Field(
+        default=None,
+        min_length=2,
+        max_length=2,
+        description="[min, max] of the height (m) to search it too; then the request's z is left "
+        "out. Default: the height is the request's z.",
+    )
+
+    @field_validator("x", "y", "yaw", "spin", "z")
     @classmethod
-    def _ordered(cls, value: Range) -> Range:
-        if value[0] > value[1]:
+    def _ordered(cls, value: Range | None) -> Range | None:
+        if value is not None and value[0] > value[1]:
             raise ValueError(f"min {value[0]} is above max {value[1]}")
         return value
 
@@ -82,7 +91,11 @@ class OptimizeRequest(RequestModel):
     )
     path: Path = Field(description="The tool path in the workpiece frame {O}.")
     bounds: Bounds = Field(description="Where the workpiece may go.")
-    z: float = Field(description="Height of the workpiece frame (m), the table height.")
+    z: float | None = Field(
+        default=None,
+        description="Height of the workpiece frame (m), the table height; required unless "
+        "bounds.z gives a range to search.",
+    )
     start: Placement | None = Field(
         default=None,
         description="Start placement, inside the bounds (default: their centre); reported with "
@@ -109,6 +122,14 @@ class OptimizeRequest(RequestModel):
         description="With the casadi method and spin_mode fixed: give each waypoint its own "
         "tool spin, its steps bounded (cam.md section 4); the answer's spins then hold them.",
     )
+
+    @model_validator(mode="after")
+    def _one_height(self) -> OptimizeRequest:
+        if (self.z is None) == (self.bounds.z is None):
+            raise PydanticCustomError(
+                "height", "give z (a fixed height) or bounds.z (a range to search), not both"
+            )
+        return self
 
     @field_validator("ik")
     @classmethod

@@ -162,3 +162,14 @@ def test_spins_of_the_wrong_length_are_refused(client: TestClient, body: dict[st
     response = client.post("/v1/evaluate", json=request)
     assert response.status_code == 422, response.text
     assert response.json()["detail"][0]["loc"] == ["body", "spins"]
+
+
+def test_height_is_z_or_a_range(client: TestClient, body: dict[str, Any]) -> None:
+    bounds = {"x": [-0.05, 0.05], "y": [0.4, 0.5], "yaw": [-0.3, 0.3], "z": [0.05, 0.15]}
+    free = client.post("/v1/optimize", json={**body, "bounds": bounds, "z": None}).json()
+    assert free["found"] and 0.05 <= free["placement"]["z"] <= 0.15
+    for z in (0.1, None):
+        request = {**body, "bounds": bounds if z else {**bounds, "z": None}, "z": z}
+        response = client.post("/v1/optimize", json=request)
+        assert response.status_code == 422, response.text
+        assert response.json()["detail"][0]["loc"][:1] == ["body"]

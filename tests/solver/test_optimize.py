@@ -140,7 +140,7 @@ def test_arc_point_is_the_nearest_inside_point(seed: int) -> None:
     inside = [
         t
         for t in thetas
-        if bounds.contains(np.array([r * math.cos(t), r * math.sin(t), 0.0, 0.0]))
+        if bounds.contains(np.array([r * math.cos(t), r * math.sin(t), 0.0, 0.0, bounds.z]))
         and any(bounds.yaw[0] <= psi + t + k * 2 * math.pi <= bounds.yaw[1] for k in (-1, 0, 1))
     ]
     if not inside:
@@ -148,7 +148,7 @@ def test_arc_point_is_the_nearest_inside_point(seed: int) -> None:
         return
     assert point is not None
     x, y, yaw = point
-    assert bounds.contains(np.array([x, y, yaw, 0.0]))
+    assert bounds.contains(np.array([x, y, yaw, 0.0, bounds.z]))
     assert arc_coordinates(x, y, yaw) == pytest.approx((r, psi), abs=1e-9)
     distance = min(abs((t - near + math.pi) % (2 * math.pi) - math.pi) for t in inside)
     theta = math.atan2(y, x)
@@ -204,3 +204,32 @@ def test_nothing_feasible_is_a_result_with_found_false(method: str) -> None:
     assert (optimum.placement, optimum.mu_path, optimum.evaluation) == (None, None, None)
     assert optimum.start == far.placement(far.centre()) and optimum.start_mu_path is None
     assert optimum.solver.status == "no feasible placement inside the bounds"
+
+
+@pytest.mark.parametrize("method", ["casadi", "scipy"])
+def test_a_free_height_is_searched(method: str) -> None:
+    """z as a decision variable: inside its range, at or above the best cell of a 20 mm /
+    15 degree map over the box at three heights, and what the evaluator says there."""
+    robot, path = get_robot("ur5"), load_path("curved_line")
+    box = dict(x=(-0.1, 0.1), y=(0.35, 0.55), yaw=(-0.5, 0.5))
+    best_cell = max(
+        np.nanmax(
+            capability_map(
+                robot,
+                path,
+                xs=grid_axis(*box["x"], 0.02, field="x"),
+                ys=grid_axis(*box["y"], 0.02, field="y"),
+                z=z,
+                yaws=grid_axis(*box["yaw"], math.radians(15), field="yaw"),
+            ).mu_path
+        )
+        for z in (0.0, 0.1, 0.2)
+    )
+    free = optimize_placement(
+        robot, path, bounds=PlacementBounds(**box, z=(0.0, 0.2)), method=method
+    )
+    assert free.found and 0.0 <= free.placement.z <= 0.2
+    # mu_path is flat in z near this optimum: a tie with the cell, to IPOPT's tolerance
+    assert free.mu_path >= best_cell * (1 - 1e-9)
+    evaluation = evaluate_path(robot, path, free.placement)
+    assert free.mu_path == pytest.approx(evaluation.mu_path, rel=OPTIMUM_EVALUATE_RTOL)
