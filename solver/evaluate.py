@@ -21,9 +21,8 @@ from solver.families.base import Branch
 from solver.pipeline import (
     DEFAULT_MAX_JOINT_STEP,
     SpinMode,
-    check_max_joint_step,
+    branch_indices,
     check_placements,
-    check_spin_mode,
     prepare_path,
     require_family,
     run_chunk,
@@ -109,16 +108,10 @@ def evaluate_path(
         InvalidInputError: a bad path, step or branch name.
         RepeatedWaypointError: two consecutive waypoints are the same pose.
     """
-    check_spin_mode(robot, spin_mode)
+    indices = branch_indices(robot, branch, max_joint_step=max_joint_step, spin_mode=spin_mode)
     family = require_family(robot)
-    check_max_joint_step(max_joint_step)
     cell = check_placements(placement.as_row()[None])
     path = prepare_path(robot, waypoints_in_workpiece)
-    indices = (
-        np.arange(len(family.branches))
-        if branch is None
-        else np.array([family.branch_index(branch)])
-    )
     run = run_chunk(robot, path, cell, indices, max_joint_step=max_joint_step, spin_mode=spin_mode)
     pick = int(run.pick[0])
     reason = int(run.tracked.reason[pick, 0])

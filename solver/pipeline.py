@@ -21,7 +21,7 @@ import numpy as np
 
 from solver.dtf import spin_rate_nearest_zero, two_variable_speed
 from solver.exceptions import InvalidInputError, NoAnalyticIkError
-from solver.families.base import KinematicsFamily
+from solver.families.base import Branch, KinematicsFamily
 from solver.robots import Robot
 from solver.spatial import MAX_COORDINATE
 from solver.task import task_requirements
@@ -122,6 +122,23 @@ def require_family(robot: Robot) -> KinematicsFamily:
             f"path evaluation needs an arm with an IK family (UR or OPW); {robot.name!r} has none",
         )
     return robot.family
+
+
+def branch_indices(
+    robot: Robot, branch: Branch | None, *, max_joint_step: float, spin_mode: str
+) -> np.ndarray:
+    """Check a path evaluation's options and return the branches to follow (all for ``auto``).
+
+    Raises:
+        InvalidInputError: a bad spin mode, step or branch name; NoAnalyticIkError: the robot
+            has no kinematics family.
+    """
+    check_spin_mode(robot, spin_mode)
+    family = require_family(robot)
+    check_max_joint_step(max_joint_step)
+    if branch is None:
+        return np.arange(len(family.branches))
+    return np.array([family.branch_index(branch)])
 
 
 def check_placements(placements: np.ndarray) -> np.ndarray:

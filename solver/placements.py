@@ -18,11 +18,9 @@ from solver.pipeline import (
     DEFAULT_MAX_JOINT_STEP,
     PreparedPath,
     SpinMode,
-    check_max_joint_step,
+    branch_indices,
     check_placements,
-    check_spin_mode,
     prepare_path,
-    require_family,
     run_chunk,
 )
 from solver.robots import Robot
@@ -114,16 +112,9 @@ def evaluate_placements(
     Raises:
         NoAnalyticIkError, InvalidInputError: as :func:`solver.evaluate.evaluate_path`.
     """
-    check_spin_mode(robot, spin_mode)
-    family = require_family(robot)
-    check_max_joint_step(max_joint_step)
+    branches = branch_indices(robot, branch, max_joint_step=max_joint_step, spin_mode=spin_mode)
     cells = check_placements(placements)
     raise_malloc_thresholds()
-    branches = (
-        np.arange(len(family.branches))
-        if branch is None
-        else np.array([family.branch_index(branch)])
-    )
     # Chunks of consecutive placements, cut where the yaw or the spin changes (a grid's
     # yaw-major order gives chunks of one yaw each, which are cheaper; a chunk has one spin).
     cuts = np.flatnonzero(np.any(np.diff(cells[:, 3:5], axis=0) != 0.0, axis=1)) + 1

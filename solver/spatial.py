@@ -15,6 +15,12 @@ QUATERNION_NORM_TOLERANCE = 1e-6
 MAX_COORDINATE = 1e3
 
 
+def wrap_angle(angle: np.ndarray) -> np.ndarray:
+    """Angles wrapped to [-pi, pi)."""
+    wrapped: np.ndarray = (angle + math.pi) % (2 * math.pi) - math.pi
+    return wrapped
+
+
 def check_position(position: np.ndarray | list[float], *, field: str) -> np.ndarray:
     """A position as a float array of shape (3,), finite and within MAX_COORDINATE (m).
 

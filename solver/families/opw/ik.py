@@ -28,6 +28,7 @@ import numpy as np
 
 from solver.families.base import OK, SINGULAR, UNREACHABLE, Branch
 from solver.families.opw.parameters import OpwParameters
+from solver.spatial import wrap_angle
 
 N_BRANCHES = 8
 # A solution whose |sin theta5|, elbow sine or shoulder lever (m) is below this is singular
@@ -39,11 +40,6 @@ BRANCHES: tuple[Branch, ...] = tuple(
     Branch.named(shoulder=s, elbow=e, wrist=w)
     for s, e, w in itertools.product(("front", "back"), ("up", "down"), ("noflip", "flip"))
 )
-
-
-def _wrap(angle: np.ndarray) -> np.ndarray:
-    """Angles wrapped to [-pi, pi)."""
-    return (angle + math.pi) % (2 * math.pi) - math.pi
 
 
 def solve_components(
@@ -137,7 +133,7 @@ def _solve(
     ).reshape((6, N_BRANCHES, *batch))
     offsets = np.array(p.offsets).reshape((6, 1, *ones))
     signs = np.array(p.sign_corrections, dtype=float).reshape((6, 1, *ones))
-    q = _wrap((q_paper + offsets) * signs)
+    q = wrap_angle((q_paper + offsets) * signs)
     reach = np.broadcast_to((reach_shoulder & reach_arm)[:, None, None], shape)
     reach = reach.reshape((N_BRANCHES, *batch))
     elbow_sine = np.sqrt(np.maximum(1.0 - np.clip(cos_elbow, -1.0, 1.0) ** 2, 0.0))

@@ -37,6 +37,7 @@ import numpy as np
 
 from solver.families.base import OK, SINGULAR, UNREACHABLE, Branch
 from solver.families.ur.dh import UrDh
+from solver.spatial import wrap_angle
 
 N_BRANCHES = 8
 # A solution whose |sin q5|, |sin q3| or shoulder lever (m) is below this is singular. acos near
@@ -53,11 +54,6 @@ BRANCHES: tuple[Branch, ...] = tuple(
     Branch.named(shoulder=s, elbow=e, wrist=w)
     for s, e, w in itertools.product(_SHOULDERS, _ELBOWS, _WRISTS)
 )
-
-
-def wrap_angle(angle: np.ndarray) -> np.ndarray:
-    """Angles wrapped to [-pi, pi)."""
-    return (angle + math.pi) % (2 * math.pi) - math.pi
 
 
 def _inverse(transform: np.ndarray) -> np.ndarray:

@@ -9,9 +9,10 @@ import pytest
 import ur_analytic_ik
 
 from solver.families.base import OK, UNREACHABLE, Branch
-from solver.families.ur.ik import BRANCHES, joint_copies, solve_batch, wrap_angle
+from solver.families.ur.ik import BRANCHES, joint_copies, solve_batch
 from solver.kinematics import jacobian_in_base, tool_pose_in_base
 from solver.robots import get_robot
+from solver.spatial import wrap_angle
 from tests.cases import FK_IK_ATOL, UR_MODELS
 
 N_POSES = 1000
