@@ -23,6 +23,9 @@ from solver.spatial import MAX_COORDINATE
 # A displacement below this (m) or a rotation below this (rad) counts as none.
 LINEAR_TOLERANCE = 1e-9
 ANGULAR_TOLERANCE = 1e-9
+# A segment turning within this of a half turn (rad) has no defined direction of rotation: the
+# rotation vector's sign would come from rounding.
+HALF_TURN_TOLERANCE = 1e-6
 
 
 @dataclass(frozen=True)
@@ -94,6 +97,8 @@ def task_requirements(poses: np.ndarray, *, field: str = "path.waypoints") -> Ta
         InvalidInputError: see :func:`check_waypoints`.
         RepeatedWaypointError: two consecutive waypoints with the same position and
             orientation; it names the second one.
+        InvalidInputError: a segment turning by a half turn (within 1e-6 rad), naming its
+            second waypoint (issue 9: the sign of u_R would come from rounding).
     """
     arr = check_waypoints(poses, field=field)
     displacement = arr[1:, :3, 3] - arr[:-1, :3, 3]
@@ -105,6 +110,16 @@ def task_requirements(poses: np.ndarray, *, field: str = "path.waypoints") -> Ta
     no_move = (linear < LINEAR_TOLERANCE) & (angular < ANGULAR_TOLERANCE)
     if np.any(no_move):
         raise RepeatedWaypointError(int(np.argmax(no_move)) + 1, field=field)
+    half_turn = np.flatnonzero(angular > math.pi - HALF_TURN_TOLERANCE)
+    if half_turn.size:
+        i = int(half_turn[0]) + 1
+        raise InvalidInputError(
+            field,
+            f"the orientation turns by {math.degrees(float(angular[i - 1])):.6f} deg from "
+            f"waypoint {i - 1}: within {HALF_TURN_TOLERANCE:g} rad of a half turn the direction "
+            "of rotation is undefined; add a waypoint between them",
+            waypoint=i,
+        )
     moving = linear >= LINEAR_TOLERANCE
     turning = angular >= ANGULAR_TOLERANCE
     safe_linear = np.where(moving, linear, 1.0)

@@ -399,3 +399,30 @@ def test_extreme_numbers_are_not_a_server_error(
     else:
         assert response.status_code == 422, response.text
         assert response.json()["detail"][0]["loc"] == refused_at
+
+
+def test_a_segment_turning_by_a_half_turn_is_refused(client: TestClient) -> None:
+    """Issue 9's request: the sign of u_R came from rounding, so map and evaluate disagreed."""
+    path = {
+        "waypoints": [
+            {"position": [0, 0, 0], "orientation": [1, 0, 0, 0]},
+            {"position": [0.01, 0, 0], "orientation": [0, 1, 0, 0]},
+        ]
+    }
+    body = {
+        "robot": {"model": "ur5"},
+        "path": path,
+        "placement": {"x": 0.0, "y": 0.4, "z": 0.1, "yaw": 0.15},
+        "ik": {"max_joint_step": 3.5},
+    }
+    response = client.post("/v1/evaluate", json=body)
+    assert_names(response, 422, ["body", "path", "waypoints", 1])
+    assert "half turn" in response.json()["detail"][0]["msg"]
+    optimize = {
+        "robot": {"model": "ur5"},
+        "path": path,
+        "bounds": {"x": [0, 0.02], "y": [0.4, 0.45], "yaw": [0.1, 0.2]},
+        "z": 0.1,
+        "ik": {"max_joint_step": 3.5},
+    }
+    assert_names(client.post("/v1/optimize", json=optimize), 422, ["body", "path", "waypoints", 1])
