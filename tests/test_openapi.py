@@ -20,3 +20,14 @@ def test_routes_are_in_the_spec() -> None:
     paths = json.loads(SPEC_PATH.read_text())["paths"]
     routes = {"/healthz", "/v1/robots", "/v1/dtf", "/v1/evaluate", "/v1/map", "/v1/optimize"}
     assert routes <= set(paths)
+
+
+def test_operation_ids_are_short_and_the_png_is_binary() -> None:
+    """Issue 9: generated clients call dtf(), evaluate(), ... and get bytes for the PNG."""
+    spec = app.openapi()
+    operations = {
+        operation["operationId"] for path in spec["paths"].values() for operation in path.values()
+    }
+    assert operations == {"health", "list_robots", "dtf", "evaluate", "map", "optimize"}
+    png = spec["paths"]["/v1/map"]["post"]["responses"]["200"]["content"]["image/png"]
+    assert png["schema"] == {"type": "string", "format": "binary"}

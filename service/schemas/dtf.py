@@ -41,9 +41,10 @@ class DtfRequest(RequestModel):
         "Required unless h is null.",
     )
     h: float | None = Field(
+        default=None,
         ge=0.0,
-        description="V / Omega (m), >= 0: linear over angular speed. null for pure "
-        "translation, 0 for pure reorientation.",
+        description="V / Omega (m), >= 0: linear over angular speed. null or left out for "
+        "pure translation, 0 for pure reorientation.",
     )
     method: Literal["auto", "closed_form", "lp"] = Field(
         default="auto",

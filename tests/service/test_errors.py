@@ -63,7 +63,6 @@ DTF_CASES: list[tuple[str, Changes, Loc]] = [
     ("u_T of 2 numbers", {("u_T",): [1.0, 0.0]}, ["body", "u_T"]),
     ("u_T not unit", {("u_T",): [1.0, 1.0, 0.0]}, ["body", "u_T"]),
     ("u_R missing with finite h", {("u_R",): DELETE}, ["body", "u_R"]),
-    ("h missing", {("h",): DELETE}, ["body", "h"]),
     ("h negative", {("h",): -0.1}, ["body", "h"]),
     ("unknown method", {("method",): "newton"}, ["body", "method"]),
     (
@@ -426,3 +425,12 @@ def test_a_segment_turning_by_a_half_turn_is_refused(client: TestClient) -> None
         "ik": {"max_joint_step": 3.5},
     }
     assert_names(client.post("/v1/optimize", json=optimize), 422, ["body", "path", "waypoints", 1])
+
+
+def test_h_left_out_is_pure_translation(client: TestClient, dtf_body: dict[str, Any]) -> None:
+    """Issue 9: a generated client need not send h = null for pure translation."""
+    explicit = client.post("/v1/dtf", json={**dtf_body, "h": None, "u_R": None}).json()
+    left_out = changed(dtf_body, {("h",): DELETE, ("u_R",): DELETE})
+    answer = client.post("/v1/dtf", json=left_out)
+    assert answer.status_code == 200, answer.text
+    assert answer.json() == explicit and answer.json()["omega_max"] == 0.0

@@ -13,7 +13,9 @@ from solver.kinematics import check_configuration, jacobian_in_base
 router = APIRouter(prefix="/dtf", tags=["dtf"], responses=ERROR_RESPONSES)
 
 
-@router.post("", summary="Largest tool speed along a direction at one configuration")
+@router.post(
+    "", operation_id="dtf", summary="Largest tool speed along a direction at one configuration"
+)
 def post_dtf(body: DtfRequest) -> DtfResponse:
     """V_max, Omega_max and the joint speeds there, plus Yoshikawa and Chiu for comparison."""
     robot = convert.robot_from_schema(body.robot)

@@ -12,7 +12,9 @@ from solver.evaluate import evaluate_path
 router = APIRouter(prefix="/evaluate", tags=["evaluate"], responses=ERROR_RESPONSES)
 
 
-@router.post("", summary="Feasibility and mu_path of a path at a placement")
+@router.post(
+    "", operation_id="evaluate", summary="Feasibility and mu_path of a path at a placement"
+)
 def post_evaluate(body: EvaluateRequest) -> EvaluateResponse:
     """An unreachable placement is not an error: it answers ``feasible: false`` with a reason."""
     robot = convert.robot_from_schema(body.robot)

@@ -9,7 +9,7 @@ from service.schemas import HealthResponse
 router = APIRouter(tags=["health"])
 
 
-@router.get("/healthz", summary="Liveness check")
-def healthz() -> HealthResponse:
+@router.get("/healthz", operation_id="health", summary="Liveness check")
+async def healthz() -> HealthResponse:
     """Answer ``{"status": "ok"}`` while the service runs."""
     return HealthResponse(status="ok")

@@ -19,9 +19,15 @@ router = APIRouter(prefix="/map", tags=["map"], responses=ERROR_RESPONSES)
 
 @router.post(
     "",
+    operation_id="map",
     summary="mu_path over a grid of placements (JSON, or PNG with Accept: image/png)",
     response_model=MapResponse,
-    responses={200: {"content": {"image/png": {}}, "description": "The map, or its picture."}},
+    responses={
+        200: {
+            "content": {"image/png": {"schema": {"type": "string", "format": "binary"}}},
+            "description": "The map, or its picture.",
+        }
+    },
 )
 def post_map(
     body: MapRequest, settings: SettingsDep, accept: Annotated[str, Header()] = "application/json"

@@ -13,7 +13,7 @@ from solver.optimize import optimize_placement
 router = APIRouter(prefix="/optimize", tags=["optimize"], responses=ERROR_RESPONSES)
 
 
-@router.post("", summary="The placement where the whole path runs fastest")
+@router.post("", operation_id="optimize", summary="The placement where the whole path runs fastest")
 def post_optimize(body: OptimizeRequest, settings: SettingsDep) -> OptimizeResponse:
     """Maximise mu_path over (x, y, yaw) inside the bounds; every answer checked by the evaluator.
 

@@ -11,7 +11,7 @@ from service.schemas import RobotsResponse
 router = APIRouter(prefix="/robots", tags=["robots"])
 
 
-@router.get("", summary="The robot catalogue")
+@router.get("", operation_id="list_robots", summary="The robot catalogue")
 def list_robots(robots: CatalogueDep) -> RobotsResponse:
     """Every robot that ``robot.model`` can name, with its joints and limits."""
     return RobotsResponse(robots=[convert.robot_info(robot) for robot in robots.values()])
