@@ -26,8 +26,31 @@ class Settings(BaseSettings):
     max_map_poses: int = Field(
         default=20_000_000,
         gt=0,
-        description="Most placement-waypoint pairs one /v1/map request may ask for (each is 8 IK "
-        "solutions; about 2 million take a second).",
+        description="Most placement-waypoint pairs one /v1/map request, or the coarse map of one "
+        "/v1/optimize request, may ask for (each is 8 IK solutions; about half a million take a "
+        "second on 2 cores).",
+    )
+    max_path_waypoints: int = Field(
+        default=20_000,
+        gt=0,
+        description="Most waypoints a path of /v1/evaluate or /v1/map may have.",
+    )
+    max_optimize_waypoints: int = Field(
+        default=1_000,
+        gt=0,
+        description="Most waypoints a path of /v1/optimize may have: the NLP has 12 variables and "
+        "12 equations a waypoint (1,000 waypoints take about 30 s).",
+    )
+    max_png_panels: int = Field(
+        default=24,
+        gt=0,
+        description="Most panels (yaw x spin values) a PNG map may have.",
+    )
+    max_solver_seconds: float = Field(
+        default=20.0,
+        gt=0.0,
+        description="Longest time (s) one IPOPT solve of /v1/optimize may take; it then stops "
+        "and its best point so far is judged by the evaluator like any other.",
     )
 
 

@@ -125,6 +125,33 @@ def spun_poses(path: PathInput, spins: list[float] | None) -> np.ndarray:
     return spun_waypoints(path.poses, np.array(spins, dtype=float))
 
 
+def check_path_size(path: schemas.Path, *, limit: int, setting: str) -> None:
+    """Refuse a path with more waypoints than a setting allows, before any work.
+
+    Raises:
+        InvalidInputError: on ``path``, saying the size asked for and the limit.
+    """
+    if path.n_waypoints() > limit:
+        raise InvalidInputError(
+            "path", f"{path.n_waypoints()} waypoints; the limit is {limit} ({setting})"
+        )
+
+
+def check_png_size(grid: MapGrid, *, settings: Settings) -> None:
+    """Refuse a PNG of more panels (yaw x spin values) than the setting allows.
+
+    Raises:
+        InvalidInputError: on ``grid``, saying the size asked for and the limit.
+    """
+    panels = len(grid.yaws) * len(grid.spins)
+    if panels > settings.max_png_panels:
+        raise InvalidInputError(
+            "grid",
+            f"{len(grid.yaws)} yaws * {len(grid.spins)} spins = {panels} PNG panels; the limit "
+            f"is {settings.max_png_panels} (DTF_MAX_PNG_PANELS); ask for JSON for more",
+        )
+
+
 def spin_mode_of(requested: SpinMode | None, path: PathInput) -> SpinMode:
     """The spin mode asked for, or the path form's default."""
     return path.default_spin_mode if requested is None else requested

@@ -77,6 +77,7 @@ def coarse_cells(
     max_joint_step: float,
     spin_mode: SpinMode = "fixed",
     max_cells: int = MAX_COARSE_CELLS,
+    max_poses: int | None = None,
 ) -> list[Cell]:
     """Local maxima of a coarse map over the bounds, best first.
 
@@ -85,7 +86,8 @@ def coarse_cells(
     is free.
 
     Raises:
-        InvalidInputError: the map would have more than ``max_cells`` cells (on ``bounds``).
+        InvalidInputError: the map would have more than ``max_cells`` cells, or more than
+            ``max_poses`` placement-waypoint pairs (on ``bounds``).
     """
     spins, spin_wraps = _spin_values(bounds)
     heights = _heights(bounds)
@@ -113,6 +115,12 @@ def coarse_cells(
             f"the search box needs a coarse map of {math.prod(sizes)} cells "
             f"({' x '.join(map(str, sizes))} at {COARSE_STEP * 1000:.0f} mm, "
             f"{math.degrees(COARSE_YAW_STEP):.0f} deg); the limit is {max_cells}",
+        )
+    if max_poses is not None and math.prod(sizes) * path.n_waypoints > max_poses:
+        raise InvalidInputError(
+            "bounds",
+            f"the search box's coarse map of {math.prod(sizes)} cells * {path.n_waypoints} "
+            f"waypoints = {math.prod(sizes) * path.n_waypoints} poses; the limit is {max_poses}",
         )
     # One spin's cells: where each is reported (inside the box) and where it is evaluated.
     points: list[tuple[float, float, float] | None]

@@ -110,6 +110,8 @@ def optimize_placement(
     spin_mode: SpinMode = "fixed",
     max_spin_step: float | None = None,
     max_coarse_cells: int = MAX_COARSE_CELLS,
+    max_coarse_poses: int | None = None,
+    max_solver_seconds: float | None = None,
 ) -> PlacementOptimum:
     """The placement inside ``bounds`` where the path runs fastest.
 
@@ -126,6 +128,8 @@ def optimize_placement(
         max_spin_step: rad, > 0: the casadi method also gives each waypoint its own spin, with
             steps at most this (cam.md section 4, ``spin_path``); None keeps one spin.
         max_coarse_cells: the largest coarse map the casadi method may make.
+        max_coarse_poses: the most placement-waypoint pairs of that map (None: no limit).
+        max_solver_seconds: the longest one IPOPT solve may take (None: IPOPT's default).
 
     Returns:
         The optimum (never below the start); ``found`` is False when neither the start nor any
@@ -173,9 +177,18 @@ def optimize_placement(
             max_joint_step=max_joint_step,
             spin_mode=spin_mode,
             max_cells=max_coarse_cells,
+            max_poses=max_coarse_poses,
         )
         candidates, statuses, iterations = _casadi(
-            robot, path, prepared, bounds, cells, max_joint_step, spin_mode, max_spin_step
+            robot,
+            path,
+            prepared,
+            bounds,
+            cells,
+            max_joint_step,
+            spin_mode,
+            max_spin_step,
+            max_solver_seconds,
         )
         name = "ipopt (casadi), from the coarse map's maxima"
     else:
@@ -236,6 +249,7 @@ def _casadi(
     max_joint_step: float,
     spin_mode: SpinMode,
     max_spin_step: float | None,
+    max_solver_seconds: float | None,
 ) -> tuple[list[Candidate], list[str], int]:
     """Candidates: the best coarse cell, then IPOPT's optimum from each of the best cells.
 
@@ -256,6 +270,7 @@ def _casadi(
         max_joint_step=max_joint_step,
         free_spin=spin_mode == "free",
         max_spin_step=max_spin_step,
+        ipopt_options=None if max_solver_seconds is None else {"max_cpu_time": max_solver_seconds},
     )
     iterations = 0
     for cell in cells[:N_STARTS]:

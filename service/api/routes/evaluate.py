@@ -5,6 +5,7 @@ from __future__ import annotations
 from fastapi import APIRouter
 
 from service import convert
+from service.deps import SettingsDep
 from service.errors import ERROR_RESPONSES
 from service.schemas import EvaluateRequest, EvaluateResponse
 from solver.evaluate import evaluate_path
@@ -15,8 +16,11 @@ router = APIRouter(prefix="/evaluate", tags=["evaluate"], responses=ERROR_RESPON
 @router.post(
     "", operation_id="evaluate", summary="Feasibility and mu_path of a path at a placement"
 )
-def post_evaluate(body: EvaluateRequest) -> EvaluateResponse:
+def post_evaluate(body: EvaluateRequest, settings: SettingsDep) -> EvaluateResponse:
     """An unreachable placement is not an error: it answers ``feasible: false`` with a reason."""
+    convert.check_path_size(
+        body.path, limit=settings.max_path_waypoints, setting="DTF_MAX_PATH_WAYPOINTS"
+    )
     robot = convert.robot_from_schema(body.robot)
     path = convert.path_of(body.path)
     evaluation = evaluate_path(

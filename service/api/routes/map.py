@@ -37,8 +37,14 @@ def post_map(
     With ``Accept: image/png`` the answer is the colour map: one panel per yaw, colour bar in
     m/s, infeasible cells blank, the best and worst placements marked.
     """
-    robot = convert.robot_from_schema(body.robot)
+    convert.check_path_size(
+        body.path, limit=settings.max_path_waypoints, setting="DTF_MAX_PATH_WAYPOINTS"
+    )
     grid = convert.map_grid(body.grid, settings=settings, n_waypoints=body.path.n_waypoints())
+    png = convert.wants_png(accept)
+    if png:
+        convert.check_png_size(grid, settings=settings)
+    robot = convert.robot_from_schema(body.robot)
     path = convert.path_of(body.path)
     spin_mode = convert.spin_mode_of(body.spin_mode, path)
     result = capability_map(
@@ -53,6 +59,6 @@ def post_map(
         max_joint_step=body.ik.max_joint_step,
         spin_mode=spin_mode,
     )
-    if convert.wants_png(accept):
+    if png:
         return Response(render_png(result, title=f"{robot.name}: mu_path"), media_type="image/png")
     return convert.map_response(result, spin_mode=spin_mode)

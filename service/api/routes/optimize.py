@@ -20,6 +20,9 @@ def post_optimize(body: OptimizeRequest, settings: SettingsDep) -> OptimizeRespo
     No feasible placement inside the bounds is not an error: ``found`` is false. A box whose
     coarse map (20 mm, 15 degrees) would exceed DTF_MAX_MAP_CELLS cells is a 422 on ``bounds``.
     """
+    convert.check_path_size(
+        body.path, limit=settings.max_optimize_waypoints, setting="DTF_MAX_OPTIMIZE_WAYPOINTS"
+    )
     robot = convert.robot_from_schema(body.robot)
     path = convert.path_of(body.path)
     bounds = convert.bounds_of(body.bounds, z=body.z)
@@ -34,5 +37,7 @@ def post_optimize(body: OptimizeRequest, settings: SettingsDep) -> OptimizeRespo
         spin_mode=convert.spin_mode_of(body.spin_mode, path),
         max_spin_step=None if body.spin_path is None else body.spin_path.max_spin_step,
         max_coarse_cells=settings.max_map_cells,
+        max_coarse_poses=settings.max_map_poses,
+        max_solver_seconds=settings.max_solver_seconds,
     )
     return convert.optimize_response(optimum, robot, axis_correction=path.axis_correction)

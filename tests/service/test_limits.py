@@ -1,0 +1,89 @@
+"""Bounded work (issue 9): each request's size checked against a setting before any work."""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Iterator
+from typing import Any
+
+import pytest
+from fastapi.testclient import TestClient
+
+from service.config import get_settings
+from tests.cases import EXAMPLES
+from tests.service.test_errors import assert_names
+
+
+@pytest.fixture
+def setting(monkeypatch: pytest.MonkeyPatch) -> Iterator[Any]:
+    """Set DTF_<NAME> settings for one test, as a deployment would."""
+
+    def set_(**values: Any) -> None:
+        for name, value in values.items():
+            monkeypatch.setenv(f"DTF_{name.upper()}", str(value))
+        get_settings.cache_clear()
+
+    yield set_
+    get_settings.cache_clear()
+
+
+@pytest.fixture(scope="module")
+def request_body() -> dict[str, Any]:
+    return json.loads((EXAMPLES / "evaluate_request.json").read_text())
+
+
+def test_evaluate_path_size(client: TestClient, request_body: dict, setting: Any) -> None:
+    setting(max_path_waypoints=100)
+    response = client.post("/v1/evaluate", json=request_body)
+    assert_names(response, 422, ["body", "path"])
+    message = response.json()["detail"][0]["msg"]
+    assert "133 waypoints" in message and "100 (DTF_MAX_PATH_WAYPOINTS)" in message
+
+
+def test_optimize_path_size_and_coarse_map(
+    client: TestClient, request_body: dict, setting: Any
+) -> None:
+    body = {
+        "robot": request_body["robot"],
+        "path": request_body["path"],
+        "bounds": {"x": [-0.1, 0.1], "y": [0.4, 0.5], "yaw": [-0.3, 0.3]},
+        "z": 0.1,
+    }
+    setting(max_optimize_waypoints=50)
+    assert_names(client.post("/v1/optimize", json=body), 422, ["body", "path"])
+    setting(max_optimize_waypoints=1000, max_map_poses=10_000)
+    response = client.post("/v1/optimize", json=body)
+    assert_names(response, 422, ["body", "bounds"])
+    assert "133 waypoints" in response.json()["detail"][0]["msg"]
+
+
+def test_png_panels(client: TestClient, request_body: dict, setting: Any) -> None:
+    setting(max_png_panels=4)
+    grid = {
+        "x": {"min": 0.0, "max": 0.0, "step": 0.1},
+        "y": {"min": 0.45, "max": 0.45, "step": 0.1},
+        "z": 0.1,
+        "yaw": [0.0, 0.5, 1.0],
+        "spin": [0.0, 0.5],
+    }
+    body = {"robot": request_body["robot"], "path": request_body["path"], "grid": grid}
+    response = client.post("/v1/map", json=body, headers={"accept": "image/png"})
+    assert_names(response, 422, ["body", "grid"])
+    assert "6 PNG panels" in response.json()["detail"][0]["msg"]
+    assert client.post("/v1/map", json=body).status_code == 200  # JSON has no panel limit
+
+
+def test_a_solver_time_limit_still_answers(
+    client: TestClient, request_body: dict, setting: Any
+) -> None:
+    """IPOPT stopped at once: the answer is the best the evaluator saw (the coarse map's)."""
+    setting(max_solver_seconds=1e-4)
+    body = {
+        "robot": request_body["robot"],
+        "path": request_body["path"],
+        "bounds": {"x": [-0.1, 0.1], "y": [0.4, 0.5], "yaw": [-0.3, 0.3]},
+        "z": 0.1,
+    }
+    answer = client.post("/v1/optimize", json=body).json()
+    assert answer["found"] and answer["mu_path"] >= answer["start"]["mu_path"]
+    assert answer["solver"]["status"] != "Solve_Succeeded"
