@@ -317,10 +317,43 @@ def map_grid(grid: schemas.Grid, *, settings: Settings, n_waypoints: int) -> Map
     )
 
 
+def _accept_weights(accept: str) -> dict[str, float]:
+    """Media range -> q-value of an Accept header (RFC 9110 section 12.5.1; q defaults to 1)."""
+    weights: dict[str, float] = {}
+    for part in accept.split(","):
+        media, *parameters = (piece.strip().lower() for piece in part.split(";"))
+        q = 1.0
+        for parameter in parameters:
+            name, _, value = parameter.partition("=")
+            if name.strip() == "q":
+                try:
+                    q = min(max(float(value), 0.0), 1.0)
+                except ValueError:
+                    q = 0.0
+        if media:
+            weights[media] = max(q, weights.get(media, 0.0))
+    return weights
+
+
 def wants_png(accept: str) -> bool:
-    """Whether an Accept header asks for the picture rather than JSON."""
-    media = [part.split(";")[0].strip().lower() for part in accept.split(",")]
-    return "image/png" in media and "application/json" not in media
+    """Whether an Accept header prefers the picture to JSON.
+
+    The most specific range that names each counts (``image/png``, else ``image/*``, else
+    ``*/*``; ``application/json``, else ``application/*``, else ``*/*``); the picture wins on a
+    higher q, or on an equal q when it is named more specifically than JSON. No Accept, or
+    ``*/*`` alone, is JSON.
+    """
+    weights = _accept_weights(accept)
+
+    def weight(*ranges: str) -> tuple[float, int]:
+        for specificity, media in enumerate(ranges):
+            if media in weights:
+                return weights[media], -specificity
+        return 0.0, -len(ranges)
+
+    png = weight("image/png", "image/*", "*/*")
+    json_ = weight("application/json", "application/*", "*/*")
+    return png[0] > 0.0 and png > json_
 
 
 def _api_placement(placement: Placement) -> schemas.Placement:

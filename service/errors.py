@@ -44,6 +44,10 @@ ERROR_RESPONSES: dict[int | str, dict[str, Any]] = {
         "model": ErrorResponse,
         "description": "The body is over the size limit (setting DTF_MAX_BODY_BYTES).",
     },
+    status.HTTP_415_UNSUPPORTED_MEDIA_TYPE: {
+        "model": ErrorResponse,
+        "description": "The body is not declared as JSON (Content-Type application/json).",
+    },
     status.HTTP_422_UNPROCESSABLE_CONTENT: {
         "model": ErrorResponse,
         "description": "Bad input; each detail's loc names the field (and waypoint index).",
@@ -102,12 +106,32 @@ def _too_large(size: int, limit: int) -> JSONResponse:
     return _error_response(status.HTTP_413_CONTENT_TOO_LARGE, [detail])
 
 
-class BodySizeLimitMiddleware:
-    """Answer ``413`` to a request whose body is over ``Settings.max_body_bytes`` (pure ASGI).
+def _not_json(content_type: str) -> JSONResponse:
+    """The ``415`` answer to a body declared as something other than JSON."""
+    shown = content_type if len(content_type) <= 100 else content_type[:100] + "..."
+    detail = ErrorDetail(
+        loc=["header", "content-type"],
+        msg=f"the body must be JSON (content-type application/json), not {shown!r}",
+        type="unsupported_media_type",
+    )
+    return _error_response(status.HTTP_415_UNSUPPORTED_MEDIA_TYPE, [detail])
 
-    A declared ``Content-Length`` over the limit is refused before reading; otherwise the body
-    is read (counting the bytes as they stream in, so a chunked body cannot slip through) and
-    handed on in one piece.
+
+def is_json(content_type: str) -> bool:
+    """Whether a Content-Type names JSON (application/json or a +json type)."""
+    media = content_type.split(";")[0].strip().lower()
+    return media == "application/json" or (
+        media.startswith("application/") and media.endswith("+json")
+    )
+
+
+class BodySizeLimitMiddleware:
+    """Answer ``413`` to a body over ``Settings.max_body_bytes``, ``415`` to one not JSON.
+
+    Pure ASGI. A body declared as something other than JSON is refused unread. A declared
+    ``Content-Length`` over the limit is refused before reading; otherwise the body is read
+    (counting the bytes as they stream in, so a chunked body cannot slip through) and handed
+    on in one piece.
     """
 
     def __init__(self, app: ASGIApp) -> None:
@@ -120,7 +144,16 @@ class BodySizeLimitMiddleware:
             await self.app(scope, receive, send)
             return
         limit = get_settings().max_body_bytes
-        declared = Headers(scope=scope).get("content-length", "")
+        headers = Headers(scope=scope)
+        content_type = headers.get("content-type")
+        if (
+            scope["method"] in ("POST", "PUT", "PATCH")
+            and content_type
+            and not is_json(content_type)
+        ):
+            await _not_json(content_type)(scope, receive, send)
+            return
+        declared = headers.get("content-length", "")
         if declared.isdigit() and int(declared) > limit:
             await _too_large(int(declared), limit)(scope, receive, send)
             return

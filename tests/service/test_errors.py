@@ -13,6 +13,7 @@ import pytest
 from fastapi.testclient import TestClient
 from starlette.types import Message, Receive, Scope, Send
 
+from service.convert import wants_png
 from service.errors import BodySizeLimitMiddleware
 from tests.cases import EXAMPLES
 
@@ -434,3 +435,33 @@ def test_h_left_out_is_pure_translation(client: TestClient, dtf_body: dict[str, 
     answer = client.post("/v1/dtf", json=left_out)
     assert answer.status_code == 200, answer.text
     assert answer.json() == explicit and answer.json()["omega_max"] == 0.0
+
+
+@pytest.mark.parametrize("content_type", ["text/plain", "application/x-www-form-urlencoded"])
+def test_a_body_that_is_not_json_is_415(
+    client: TestClient, dtf_body: dict[str, Any], content_type: str
+) -> None:
+    response = client.post(
+        "/v1/dtf", content=json.dumps(dtf_body), headers={"content-type": content_type}
+    )
+    assert response.status_code == 415, response.text
+    assert response.json()["detail"][0]["loc"] == ["header", "content-type"]
+    charset = {"content-type": "application/json; charset=utf-8"}
+    assert client.post("/v1/dtf", content=json.dumps(dtf_body), headers=charset).status_code == 200
+
+
+@pytest.mark.parametrize(
+    ("accept", "png"),
+    [
+        ("image/png", True),
+        ("*/*", False),
+        ("image/png, application/json;q=0.5", True),
+        ("image/png;q=0.5, application/json", False),
+        ("image/png, */*", True),
+        ("image/*", True),
+        ("image/png;q=0", False),
+        ("text/html", False),
+    ],
+)
+def test_accept_is_parsed_with_q_values(accept: str, png: bool) -> None:
+    assert wants_png(accept) is png
