@@ -19,7 +19,13 @@ from solver.optimize import PlacementOptimum
 from solver.pipeline import SpinMode
 from solver.robots import Robot, get_robot, robot_from_urdf
 from solver.search_space import PlacementBounds
-from solver.spatial import Placement, check_position, pose_matrix, spun_waypoints
+from solver.spatial import (
+    MAX_COORDINATE,
+    Placement,
+    check_position,
+    pose_matrix,
+    spun_waypoints,
+)
 from solver.task import task_requirements
 from solver.tool_axis import poses_from_tool_axes
 from solver.tracking import FEASIBLE, REASONS
@@ -296,6 +302,15 @@ def map_grid(grid: schemas.Grid, *, settings: Settings, n_waypoints: int) -> Map
     """
     nx = axis_length(grid.x.min, grid.x.max, grid.x.step, field="grid.x")
     ny = axis_length(grid.y.min, grid.y.max, grid.y.step, field="grid.y")
+    for field, values in (
+        ("grid.x", (grid.x.min, grid.x.max)),
+        ("grid.y", (grid.y.min, grid.y.max)),
+        ("grid.z", (grid.z,)),
+    ):
+        if max(abs(v) for v in values) > MAX_COORDINATE:
+            raise InvalidInputError(
+                field, f"{max(abs(v) for v in values):.6g} m is beyond +-{MAX_COORDINATE:g} m"
+            )
     yaws, spins = grid.yaws(), grid.spins()
     cells = nx * ny * len(yaws) * len(spins)
     size = f"{nx} x * {ny} y * {len(yaws)} yaw * {len(spins)} spin = {cells} placements"

@@ -51,10 +51,11 @@ def _unit(vector: np.ndarray | list[float], field: str) -> np.ndarray:
     arr = np.asarray(vector, dtype=float)
     if arr.shape != (3,) or not np.all(np.isfinite(arr)):
         raise InvalidInputError(field, f"needs 3 finite numbers, got {arr.tolist()}")
-    with np.errstate(over="ignore"):  # a huge entry gives norm inf, refused just below
-        norm = float(np.linalg.norm(arr))
+    largest = float(np.max(np.abs(arr)))
+    # Scaled first, so that neither 1e-200 nor 1e200 under- or overflows the squares.
+    norm = largest * float(np.linalg.norm(arr / largest)) if largest > 0.0 else 0.0
     if abs(norm - 1.0) > UNIT_TOLERANCE:
-        raise InvalidInputError(field, f"norm is {norm!r}; a unit vector is needed")
+        raise InvalidInputError(field, f"norm is {norm:.6g}; a unit vector is needed")
     return arr
 
 
@@ -76,7 +77,9 @@ def twist_per_unit_speed(
         InvalidInputError: a direction that is not a unit vector, or h < 0 or NaN.
     """
     if not (h >= 0.0):
-        raise InvalidInputError("h", f"h = {h!r} m; it must be >= 0 (or null for pure translation)")
+        raise InvalidInputError(
+            "h", f"h = {h:.6g} m; it must be >= 0 (or null for pure translation)"
+        )
     twist = np.zeros(6)
     if h > 0.0:
         twist[:3] = _unit(np.zeros(3) if u_T is None else u_T, "u_T")
@@ -86,7 +89,7 @@ def twist_per_unit_speed(
             twist[3:] = rotation if h == 0.0 else rotation / h
     if not np.all(np.isfinite(twist)):
         raise InvalidInputError(
-            "h", f"h = {h!r} m is too small to divide by; use 0 for pure reorientation"
+            "h", f"h = {h:.6g} m is too small to divide by; use 0 for pure reorientation"
         )
     return twist
 

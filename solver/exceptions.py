@@ -9,6 +9,12 @@ back as data in the result.
 from __future__ import annotations
 
 
+def quoted(text: str, *, limit: int = 100) -> str:
+    """``text`` in quotes for a message, cut to ``limit`` characters (a request may send 2 MB)."""
+    shown = text if len(text) <= limit else text[:limit] + "..."
+    return repr(shown)
+
+
 class SolverError(Exception):
     """Base class of every input error the solver raises.
 
@@ -50,7 +56,9 @@ class UnknownRobotError(SolverError):
 
     def __init__(self, name: str, known: list[str]) -> None:
         """Name the robot asked for and the ones that exist."""
-        super().__init__("robot.model", f"unknown robot {name!r}; known robots: {', '.join(known)}")
+        super().__init__(
+            "robot.model", f"unknown robot {quoted(name)}; known robots: {', '.join(known)}"
+        )
         self.name = name
 
 

@@ -28,14 +28,16 @@ def check_configuration(
         raise InvalidInputError(field, f"{q_arr.shape=} but the robot has {robot.dof} joints")
     bad = np.flatnonzero(~np.isfinite(q_arr))
     if bad.size:
-        raise InvalidInputError(field, f"joint {int(bad[0])} is {q_arr[bad[0]]!r}, not finite")
+        raise InvalidInputError(
+            field, f"joint {int(bad[0])} is {float(q_arr[bad[0]]):.6g}, not finite"
+        )
     outside = np.flatnonzero((q_arr < robot.q_lower - 1e-12) | (q_arr > robot.q_upper + 1e-12))
     if outside.size:
         j = int(outside[0])
         raise InvalidInputError(
             field,
-            f"joint {j} ({robot.joint_names[j]}) is {q_arr[j]!r} rad, outside its limits "
-            f"[{robot.q_lower[j]!r}, {robot.q_upper[j]!r}]",
+            f"joint {j} ({robot.joint_names[j]}) is {float(q_arr[j]):.6g} rad, outside its "
+            f"limits [{float(robot.q_lower[j]):.6g}, {float(robot.q_upper[j]):.6g}] rad",
         )
     return q_arr
 

@@ -28,7 +28,7 @@ import numpy as np
 
 from solver.coarse_search import MAX_COARSE_CELLS, Cell, coarse_cells
 from solver.evaluate import DEFAULT_MAX_JOINT_STEP, PathEvaluation, evaluate_path
-from solver.exceptions import InvalidInputError
+from solver.exceptions import InvalidInputError, quoted
 from solver.pipeline import PreparedPath, SpinMode, prepare_path, require_family
 from solver.placement_nlp import PlacementNlp
 from solver.placement_scipy import global_search, polish
@@ -142,7 +142,9 @@ def optimize_placement(
     began = time.perf_counter()
     bounds.check()
     if method not in ("casadi", "scipy"):
-        raise InvalidInputError("method", f"unknown method {method!r}; use casadi or scipy")
+        raise InvalidInputError(
+            "method", f"unknown method {quoted(str(method))}; use casadi or scipy"
+        )
     if max_spin_step is not None:
         if method != "casadi" or spin_mode != "fixed":
             raise InvalidInputError(
@@ -150,7 +152,7 @@ def optimize_placement(
             )
         if not (math.isfinite(max_spin_step) and max_spin_step > 0.0):
             raise InvalidInputError(
-                "spin_path.max_spin_step", f"{max_spin_step!r} rad must be finite and > 0"
+                "spin_path.max_spin_step", f"{max_spin_step:.6g} rad must be finite and > 0"
             )
     if start is None:
         start = bounds.placement(bounds.centre())

@@ -20,7 +20,7 @@ from typing import Literal
 import numpy as np
 
 from solver.dtf import spin_rate_nearest_zero, two_variable_speed
-from solver.exceptions import InvalidInputError, NoAnalyticIkError
+from solver.exceptions import InvalidInputError, NoAnalyticIkError, quoted
 from solver.families.base import Branch, KinematicsFamily
 from solver.robots import Robot
 from solver.spatial import MAX_COORDINATE
@@ -94,7 +94,7 @@ def prepare_path(robot: Robot, waypoints_in_workpiece: np.ndarray) -> PreparedPa
 def check_max_joint_step(max_joint_step: float) -> None:
     """Raise InvalidInputError unless the step is finite and > 0 (rad)."""
     if not (math.isfinite(max_joint_step) and max_joint_step > 0.0):
-        raise InvalidInputError("ik.max_joint_step", f"{max_joint_step!r} rad must be > 0")
+        raise InvalidInputError("ik.max_joint_step", f"{max_joint_step:.6g} rad must be > 0")
 
 
 def check_spin_mode(robot: Robot, spin_mode: str) -> None:
@@ -104,7 +104,9 @@ def check_spin_mode(robot: Robot, spin_mode: str) -> None:
     joint is prismatic is refused.
     """
     if spin_mode not in SPIN_MODES:
-        raise InvalidInputError("spin_mode", f"unknown spin mode {spin_mode!r}; use fixed or free")
+        raise InvalidInputError(
+            "spin_mode", f"unknown spin mode {quoted(str(spin_mode))}; use fixed or free"
+        )
     last = robot.model.joints[robot.model.njoints - 1].shortname()
     prismatic = "Prismatic" in last or last.startswith("JointModelP")
     if spin_mode == "free" and prismatic:

@@ -17,7 +17,7 @@ from pathlib import Path
 import numpy as np
 import pinocchio as pin
 
-from solver.exceptions import InvalidInputError, RobotModelError, UnknownRobotError
+from solver.exceptions import InvalidInputError, RobotModelError, UnknownRobotError, quoted
 from solver.families import catalogue
 from solver.families.base import KinematicsFamily
 
@@ -120,7 +120,7 @@ def check_speed_limits(
         j = int(bad[0])
         raise InvalidInputError(
             field,
-            f"joint {j} ({joint_names[j]}) limit {limits[j]!r} rad/s must be > 0, within "
+            f"joint {j} ({joint_names[j]}) limit {float(limits[j]):.6g} rad/s must be > 0, within "
             f"[{MIN_SPEED_LIMIT}, {MAX_SPEED_LIMIT}] rad/s",
         )
     return limits
@@ -162,7 +162,7 @@ def robot_from_model(
     for field, frame in (("robot.base_frame", base_frame), ("robot.tool_frame", tool_frame)):
         if not model.existFrame(frame):
             names = ", ".join(f.name for f in model.frames if f.name != "universe")
-            raise RobotModelError(field, f"no frame {frame!r} in the model; frames: {names}")
+            raise RobotModelError(field, f"no frame {quoted(frame)} in the model; frames: {names}")
     base = model.frames[model.getFrameId(base_frame)]
     if base.parentJoint != 0:
         raise RobotModelError(
@@ -238,14 +238,14 @@ def robot_from_urdf(
     if not full.existFrame(tool_frame):
         names = ", ".join(f.name for f in full.frames if f.name != "universe")
         raise RobotModelError(
-            "robot.tool_frame", f"no frame {tool_frame!r} in the model; frames: {names}"
+            "robot.tool_frame", f"no frame {quoted(tool_frame)} in the model; frames: {names}"
         )
     tool_joint = full.frames[full.getFrameId(tool_frame)].parentJoint
     chain = set(full.supports[tool_joint])
     locked = [j for j in range(1, full.njoints) if j not in chain]
     model = pin.buildReducedModel(full, locked, pin.neutral(full)) if locked else full
     if model.nv == 0:
-        raise RobotModelError("robot.tool_frame", f"no joint moves frame {tool_frame!r}")
+        raise RobotModelError("robot.tool_frame", f"no joint moves frame {quoted(tool_frame)}")
     return robot_from_model(
         name, model, base_frame=base_frame, tool_frame=tool_frame, qdot_max=qdot_max, family=family
     )

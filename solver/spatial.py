@@ -58,7 +58,7 @@ def rotation_from_quaternion(
     norm = float(np.linalg.norm(quat))
     if abs(norm - 1.0) > QUATERNION_NORM_TOLERANCE:
         raise InvalidInputError(
-            field, f"quaternion norm is {norm!r}; a unit quaternion is needed (tolerance 1e-6)"
+            field, f"quaternion norm is {norm:.6g}; a unit quaternion is needed (tolerance 1e-6)"
         )
     x, y, z, w = quat / norm
     return np.array(
@@ -125,7 +125,7 @@ class Placement:
         for name in ("yaw", "spin"):
             value = getattr(self, name)
             if not math.isfinite(value):
-                raise InvalidInputError(f"placement.{name}", f"{name} {value!r} rad is not finite")
+                raise InvalidInputError(f"placement.{name}", f"{name} {value} rad is not finite")
 
     def as_row(self) -> np.ndarray:
         """The placement as one row of the batched layout, [x, y, z, yaw, spin]."""

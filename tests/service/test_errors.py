@@ -465,3 +465,27 @@ def test_a_body_that_is_not_json_is_415(
 )
 def test_accept_is_parsed_with_q_values(accept: str, png: bool) -> None:
     assert wants_png(accept) is png
+
+
+def test_messages_say_plain_numbers_and_cut_echoes(
+    client: TestClient, dtf_body: dict[str, Any], path_body: dict[str, Any]
+) -> None:
+    """Issue 9: no np.float64(...) in messages, a 1e-200 vector's norm is 1e-200, a huge
+    unknown model name is not echoed whole, a far grid names grid.x."""
+    tiny = client.post("/v1/dtf", json={**dtf_body, "u_T": [1e-200, 0.0, 0.0]})
+    assert_names(tiny, 422, ["body", "u_T"])
+    assert "norm is 1e-200" in tiny.json()["detail"][0]["msg"]
+    outside = client.post("/v1/dtf", json={**dtf_body, "q": [9.0, 0, 0, 0, 0, 0]})
+    assert "np.float64" not in outside.text and "9 rad" in outside.text
+    name = "x" * 100_000
+    unknown = client.post("/v1/evaluate", json=changed(path_body, {("robot", "model"): name}))
+    assert_names(unknown, 422, ["body", "robot", "model"])
+    assert len(unknown.content) < 2_000
+    grid = {
+        "x": {"min": 1e10, "max": 1e10, "step": 0.1},
+        "y": {"min": 0.4, "max": 0.4, "step": 0.1},
+        "z": 0.1,
+        "yaw": 0.0,
+    }
+    body = {"robot": path_body["robot"], "path": path_body["path"], "grid": grid}
+    assert_names(client.post("/v1/map", json=body), 422, ["body", "grid", "x"])

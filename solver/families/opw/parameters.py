@@ -42,7 +42,7 @@ class OpwParameters:
         for name in ("a1", "a2", "b", "c1", "c2", "c3", "c4"):
             value = getattr(self, name)
             if not (isinstance(value, int | float) and math.isfinite(value)):
-                raise InvalidInputError(f"robot.opw.{name}", f"{value!r} m is not a finite length")
+                raise InvalidInputError(f"robot.opw.{name}", f"{value} m is not a finite length")
             if abs(value) > MAX_LENGTH:
                 raise InvalidInputError(
                     f"robot.opw.{name}", f"{value} m is beyond +-{MAX_LENGTH:g} m"
