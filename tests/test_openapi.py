@@ -3,7 +3,10 @@
 from __future__ import annotations
 
 import json
+import re
 from pathlib import Path
+
+from fastapi.testclient import TestClient
 
 from service.main import app
 
@@ -31,3 +34,17 @@ def test_operation_ids_are_short_and_the_png_is_binary() -> None:
     assert operations == {"health", "list_robots", "dtf", "evaluate", "map", "optimize"}
     png = spec["paths"]["/v1/map"]["post"]["responses"]["200"]["content"]["image/png"]
     assert png["schema"] == {"type": "string", "format": "binary"}
+
+
+def test_docs_are_served_offline() -> None:
+    """Issue 9: /docs and /redoc load their assets from the app, never from a CDN."""
+    client = TestClient(app)
+    for page in ("/docs", "/redoc"):
+        html = client.get(page).text
+        assets = re.findall(r'(?:src|href)="([^"]+)"', html)
+        assert assets and all(a.startswith("/") for a in assets), (page, assets)
+        for asset in assets:
+            assert client.get(asset).status_code == 200, asset
+    description = app.openapi()["info"]["description"]
+    for route in ("/healthz", "/v1/robots", "/v1/dtf", "/v1/evaluate", "/v1/map", "/v1/optimize"):
+        assert f" {route}`" in description, route
