@@ -273,7 +273,7 @@ def evaluate_response(
         feasible=ev.feasible,
         mu_path=ev.mu_path,
         bottleneck=bottleneck,
-        reason=ev.reason,
+        reason=None if ev.reason is None else schemas.FailureReason(ev.reason),
         failed_waypoint=ev.failed_waypoint,
         branch=branch,
         waypoints=waypoints,
@@ -400,7 +400,9 @@ def map_response(cmap: CapabilityMap, *, spin_mode: SpinMode) -> schemas.MapResp
                 yaw=float(cmap.yaws[k]),
                 spin=float(cmap.spins[s]),
                 mu_path=float(cmap.mu_path[s, k, j, i]) if feasible else None,
-                reason=None if feasible else REASONS[int(cmap.reason[s, k, j, i])],
+                reason=None
+                if feasible
+                else schemas.FailureReason(REASONS[int(cmap.reason[s, k, j, i])]),
                 failed_waypoint=None if feasible else int(cmap.failed_waypoint[s, k, j, i]),
             )
         )

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from typing import Literal
+from enum import StrEnum
 
 from pydantic import ConfigDict, Field
 from pydantic.config import JsonDict
@@ -74,7 +74,15 @@ _RESPONSE_EXAMPLE: JsonDict = {
         },
     ],
 }
-FailureReason = Literal["unreachable", "joint_limits", "singular", "discontinuous"]
+
+
+class FailureReason(StrEnum):
+    """Why a placement is infeasible (one enum for every answer that says so)."""
+
+    UNREACHABLE = "unreachable"
+    JOINT_LIMITS = "joint_limits"
+    SINGULAR = "singular"
+    DISCONTINUOUS = "discontinuous"
 
 
 class EvaluateRequest(RequestModel):

@@ -3,6 +3,8 @@ description, and every example is valid."""
 
 from __future__ import annotations
 
+import enum
+import json
 from typing import Any
 
 import pytest
@@ -25,6 +27,9 @@ COMPONENTS: dict[str, Any] = app.openapi()["components"]["schemas"]
 def test_schema_is_documented(name: str) -> None:
     schema = COMPONENTS[name]
     assert schema.get("description"), name
+    if "enum" in schema:  # an enum component: its values are its documentation
+        assert schema["enum"] and schema["type"] == "string", name
+        return
     assert schema.get("examples"), name
     undocumented = [
         key for key, field in schema["properties"].items() if "description" not in field
@@ -41,4 +46,21 @@ def test_examples_are_valid(model: type[BaseModel]) -> None:
 
 
 def test_every_component_is_exported() -> None:
-    assert set(COMPONENTS) == {model.__name__ for model in MODELS}
+    enums = {
+        name
+        for name in schemas.__all__
+        if isinstance(value := getattr(schemas, name), type) and issubclass(value, enum.Enum)
+    }
+    assert set(COMPONENTS) == {model.__name__ for model in MODELS} | enums
+
+
+def test_failure_reasons_are_one_enum() -> None:
+    """Issue 9: evaluate and map answers share one FailureReason component."""
+    assert COMPONENTS["FailureReason"]["enum"] == [
+        "unreachable",
+        "joint_limits",
+        "singular",
+        "discontinuous",
+    ]
+    text = json.dumps(COMPONENTS)
+    assert text.count('"discontinuous"') == 1
