@@ -41,6 +41,12 @@ class Settings(BaseSettings):
         description="Most waypoints a path of /v1/optimize may have: the NLP has 12 variables and "
         "12 equations a waypoint (1,000 waypoints take about 30 s).",
     )
+    max_detail_waypoints: int = Field(
+        default=2_000,
+        gt=0,
+        description="Up to this many waypoints /v1/evaluate answers every waypoint's detail by "
+        "default; beyond it, the summary unless the request asks for detail: waypoints.",
+    )
     max_png_panels: int = Field(
         default=24,
         gt=0,

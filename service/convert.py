@@ -240,12 +240,16 @@ def _optional_float(values: np.ndarray | None, i: int) -> float | None:
 
 
 def evaluate_response(
-    evaluation: PathEvaluation, robot: Robot, *, axis_correction: float = 0.0
+    evaluation: PathEvaluation,
+    robot: Robot,
+    *,
+    axis_correction: float = 0.0,
+    with_waypoints: bool = True,
 ) -> schemas.EvaluateResponse:
-    """The response of ``POST /v1/evaluate``."""
+    """The response of ``POST /v1/evaluate`` (per-waypoint detail when ``with_waypoints``)."""
     ev = evaluation
     waypoints = []
-    for i in range(ev.h.shape[0]):
+    for i in range(ev.h.shape[0] if with_waypoints else 0):
         limiting = None if ev.limiting_joint is None else int(ev.limiting_joint[i])
         waypoints.append(
             schemas.WaypointResult(
@@ -277,6 +281,7 @@ def evaluate_response(
         failed_waypoint=ev.failed_waypoint,
         branch=branch,
         waypoints=waypoints,
+        detail="waypoints" if with_waypoints else "summary",
         spin_mode=ev.spin_mode,
         spins=None if ev.spins is None else ev.spins.tolist(),
         axis_correction=axis_correction,

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from enum import StrEnum
+from typing import Literal
 
 from pydantic import ConfigDict, Field
 from pydantic.config import JsonDict
@@ -105,6 +106,12 @@ class EvaluateRequest(RequestModel):
         "axis is free (a spindle, disc or grinder; cam.md section 2). Default: free for "
         "tool_axis_waypoints, fixed for waypoints.",
     )
+    detail: Literal["summary", "waypoints"] | None = Field(
+        default=None,
+        description="summary: mu_path, bottleneck and branch only; waypoints: also every "
+        "waypoint's q, task direction and speeds. Default: waypoints up to "
+        "DTF_MAX_DETAIL_WAYPOINTS waypoints (2,000), summary beyond.",
+    )
     spins: list[float] | None = Field(
         default=None,
         description="A tool spin per waypoint (rad), added to the placement's: each waypoint "
@@ -197,4 +204,9 @@ class EvaluateResponse(ResponseModel):
         description="The largest correction made to a tool axis's length when normalising it "
         "(dimensionless; 0 when none was needed or the path is given by poses).",
     )
-    waypoints: list[WaypointResult] = Field(description="One entry per waypoint, in path order.")
+    detail: Literal["summary", "waypoints"] = Field(
+        default="waypoints", description="Whether waypoints holds the per-waypoint detail."
+    )
+    waypoints: list[WaypointResult] = Field(
+        description="One entry per waypoint, in path order; empty when detail is summary."
+    )

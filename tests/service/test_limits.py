@@ -87,3 +87,16 @@ def test_a_solver_time_limit_still_answers(
     answer = client.post("/v1/optimize", json=body).json()
     assert answer["found"] and answer["mu_path"] >= answer["start"]["mu_path"]
     assert answer["solver"]["status"] != "Solve_Succeeded"
+
+
+def test_evaluate_detail_summary(client: TestClient, request_body: dict, setting: Any) -> None:
+    """Issue 9: per-waypoint detail on request, the summary by default beyond a size."""
+    full = client.post("/v1/evaluate", json=request_body).json()
+    assert full["detail"] == "waypoints" and len(full["waypoints"]) == 133
+    summary = client.post("/v1/evaluate", json={**request_body, "detail": "summary"}).json()
+    assert summary["detail"] == "summary" and summary["waypoints"] == []
+    assert summary["mu_path"] == full["mu_path"] and summary["bottleneck"] == full["bottleneck"]
+    setting(max_detail_waypoints=100)
+    assert client.post("/v1/evaluate", json=request_body).json()["detail"] == "summary"
+    asked = client.post("/v1/evaluate", json={**request_body, "detail": "waypoints"}).json()
+    assert len(asked["waypoints"]) == 133

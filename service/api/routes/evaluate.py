@@ -31,4 +31,12 @@ def post_evaluate(body: EvaluateRequest, settings: SettingsDep) -> EvaluateRespo
         max_joint_step=body.ik.max_joint_step,
         spin_mode=convert.spin_mode_of(body.spin_mode, path),
     )
-    return convert.evaluate_response(evaluation, robot, axis_correction=path.axis_correction)
+    detail = body.detail or (
+        "waypoints" if body.path.n_waypoints() <= settings.max_detail_waypoints else "summary"
+    )
+    return convert.evaluate_response(
+        evaluation,
+        robot,
+        axis_correction=path.axis_correction,
+        with_waypoints=detail == "waypoints",
+    )
