@@ -31,8 +31,16 @@ def test_operation_ids_are_short_and_the_png_is_binary() -> None:
     operations = {
         operation["operationId"] for path in spec["paths"].values() for operation in path.values()
     }
-    assert operations == {"health", "list_robots", "dtf", "evaluate", "map", "optimize"}
-    png = spec["paths"]["/v1/map"]["post"]["responses"]["200"]["content"]["image/png"]
+    assert operations == {
+        "health",
+        "list_robots",
+        "dtf",
+        "evaluate",
+        "map",
+        "map_png",
+        "optimize",
+    }
+    png = spec["paths"]["/v1/map/png"]["post"]["responses"]["200"]["content"]["image/png"]
     assert png["schema"] == {"type": "string", "format": "binary"}
 
 

@@ -8,40 +8,25 @@ from fastapi import APIRouter, Header
 from fastapi.responses import Response
 
 from service import convert
+from service.config import Settings
 from service.deps import SettingsDep
 from service.errors import ERROR_RESPONSES
 from service.render import render_png
 from service.schemas import MapRequest, MapResponse
-from solver.capability_map import capability_map
+from solver.capability_map import CapabilityMap, capability_map
+from solver.pipeline import SpinMode
 
-router = APIRouter(prefix="/map", tags=["map"], responses=ERROR_RESPONSES)
+router = APIRouter(prefix="/map", tags=["maps"], responses=ERROR_RESPONSES)
 
 
-@router.post(
-    "",
-    operation_id="map",
-    summary="mu_path over a grid of placements (JSON, or PNG with Accept: image/png)",
-    response_model=MapResponse,
-    responses={
-        200: {
-            "content": {"image/png": {"schema": {"type": "string", "format": "binary"}}},
-            "description": "The map, or its picture.",
-        }
-    },
-)
-def post_map(
-    body: MapRequest, settings: SettingsDep, accept: Annotated[str, Header()] = "application/json"
-) -> MapResponse | Response:
-    """Every placement of the grid with its mu_path (or why it is infeasible), best and worst.
-
-    With ``Accept: image/png`` the answer is the colour map: one panel per yaw, colour bar in
-    m/s, infeasible cells blank, the best and worst placements marked.
-    """
+def _computed_map(
+    body: MapRequest, settings: Settings, *, png: bool
+) -> tuple[CapabilityMap, str, SpinMode]:
+    """The map a request asks for, its size checked first; the robot's name; the spin mode."""
     convert.check_path_size(
         body.path, limit=settings.max_path_waypoints, setting="DTF_MAX_PATH_WAYPOINTS"
     )
     grid = convert.map_grid(body.grid, settings=settings, n_waypoints=body.path.n_waypoints())
-    png = convert.wants_png(accept)
     if png:
         convert.check_png_size(grid, settings=settings)
     robot = convert.robot_from_schema(body.robot)
@@ -59,6 +44,49 @@ def post_map(
         max_joint_step=body.ik.max_joint_step,
         spin_mode=spin_mode,
     )
+    return result, robot.name, spin_mode
+
+
+def _picture(result: CapabilityMap, name: str) -> Response:
+    """The PNG answer."""
+    return Response(render_png(result, title=f"{name}: mu_path"), media_type="image/png")
+
+
+@router.post(
+    "",
+    operation_id="map",
+    summary="mu_path over a grid of placements (JSON; PNG with Accept: image/png)",
+    response_model=MapResponse,
+)
+def post_map(
+    body: MapRequest, settings: SettingsDep, accept: Annotated[str, Header()] = "application/json"
+) -> MapResponse | Response:
+    """Every placement of the grid with its mu_path (or why it is infeasible), best and worst.
+
+    With ``Accept: image/png`` the answer is the colour map (as ``POST /v1/map/png`` gives it,
+    the operation generated clients should use for the picture).
+    """
+    png = convert.wants_png(accept)
+    result, name, spin_mode = _computed_map(body, settings, png=png)
     if png:
-        return Response(render_png(result, title=f"{robot.name}: mu_path"), media_type="image/png")
+        return _picture(result, name)
     return convert.map_response(result, spin_mode=spin_mode)
+
+
+@router.post(
+    "/png",
+    operation_id="map_png",
+    summary="The colour map of a grid of placements, as a PNG",
+    response_class=Response,
+    responses={
+        200: {
+            "content": {"image/png": {"schema": {"type": "string", "format": "binary"}}},
+            "description": "The colour map: one panel per yaw and spin, colour bar in m/s, "
+            "infeasible cells blank, the best and worst placements marked.",
+        }
+    },
+)
+def post_map_png(body: MapRequest, settings: SettingsDep) -> Response:
+    """The map of ``POST /v1/map`` as a picture (generated clients get bytes)."""
+    result, name, _ = _computed_map(body, settings, png=True)
+    return _picture(result, name)
