@@ -287,7 +287,12 @@ def _casadi(
         if q is None or qdot is None or v_max is None or speed is None:
             continue
         joint_speeds = qdot * (speed / v_max)[:, None]
-        result = nlp.solve(cell.vector, speed, q, joint_speeds)
+        try:
+            result = nlp.solve(cell.vector, speed, q, joint_speeds)
+        except RuntimeError as error:  # IPOPT refused this start: the others still count
+            statuses.append(f"IPOPT failed from a start: {str(error).splitlines()[-1][:200]}")
+            candidates.append((cell.vector, None))
+            continue
         iterations += result.iterations
         candidates.append((result.vector, result.spins))
         statuses.append(result.status)

@@ -220,8 +220,8 @@ class PlacementNlp:
                 self._spin_bound(np.inf),
             ]
         )
-        step = self._step - _MARGIN
-        spin_step = np.full(max(self._n_spins - 1, 0), (self._spin_step or 0.0) - _MARGIN)
+        step = _inside(self._step)
+        spin_step = np.full(max(self._n_spins - 1, 0), _inside(self._spin_step or 0.0))
         lbg = np.concatenate(
             [np.zeros(self._n_equalities), np.full(self._n_steps, -step), -spin_step]
         )
@@ -251,6 +251,11 @@ class PlacementNlp:
             iterations=int(stats["iter_count"]),
             seconds=seconds,
         )
+
+
+def _inside(bound: float) -> float:
+    """A step bound less the margin, never below half of it (a bound of 1e-300 stays > 0)."""
+    return bound - min(_MARGIN, bound / 2)
 
 
 def _turn_z(angle: ca.SX) -> ca.SX:

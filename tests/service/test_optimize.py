@@ -173,3 +173,15 @@ def test_height_is_z_or_a_range(client: TestClient, body: dict[str, Any]) -> Non
         response = client.post("/v1/optimize", json=request)
         assert response.status_code == 422, response.text
         assert response.json()["detail"][0]["loc"][:1] == ["body"]
+
+
+def test_a_tiny_spin_step_is_not_a_server_error(client: TestClient, body: dict[str, Any]) -> None:
+    """Found by schemathesis: max_spin_step 5e-324 made IPOPT's step bounds cross (a 500)."""
+    request = {
+        **body,
+        "path": {"waypoints": body["path"]["waypoints"][:2]},
+        "spin_path": {"max_spin_step": 5e-324},
+    }
+    answer = client.post("/v1/optimize", json=request)
+    assert answer.status_code == 200, answer.text
+    assert answer.json()["found"] and answer.json()["mu_path"] >= answer.json()["start"]["mu_path"]
