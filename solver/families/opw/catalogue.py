@@ -16,21 +16,34 @@ from solver.robots import Robot, check_speed_limits, robot_from_model
 JOINT_NAMES = tuple(f"joint_{i}" for i in range(1, 7))
 
 
-def check_position_limits(limits: np.ndarray | list[list[float]]) -> np.ndarray:
+def check_position_limits(
+    limits: np.ndarray | list[list[float]], joint_names: tuple[str, ...] = JOINT_NAMES
+) -> np.ndarray:
     """Joint position limits as a (6, 2) array [lower, upper] (rad), after checking them.
+
+    Args:
+        limits: shape (6, 2), rad, [lower, upper] per joint.
+        joint_names: the six joint names, for the message.
 
     Raises:
         InvalidInputError: on ``robot.joint_position_limits``: a wrong count, a value that is
             not finite, or lower >= upper (naming the joint).
     """
     field = "robot.joint_position_limits"
-    arr = np.asarray(limits, dtype=float)
+    try:
+        arr = np.asarray(limits, dtype=float)
+    except (TypeError, ValueError) as error:
+        raise InvalidInputError(
+            field, f"needs 6 [lower, upper] pairs of numbers: {error}"
+        ) from None
     if arr.shape != (6, 2):
         raise InvalidInputError(field, f"needs 6 [lower, upper] pairs (rad), got shape {arr.shape}")
     for j, (low, high) in enumerate(arr):
         if not (math.isfinite(low) and math.isfinite(high)) or low >= high:
             raise InvalidInputError(
-                field, f"joint {j + 1}: [{low:g}, {high:g}] rad needs finite lower < upper"
+                field,
+                f"joint {j + 1} ({joint_names[j]}): [{low:g}, {high:g}] rad needs finite "
+                "lower < upper",
             )
     return arr
 
@@ -53,9 +66,15 @@ def robot_from_opw(
         joint_names: the six joint names.
 
     Raises:
-        InvalidInputError: limits of the wrong count, not finite or not ordered.
+        InvalidInputError: on ``robot.joint_names``, not six distinct names; on
+            ``robot.joint_position_limits``, limits of the wrong count, not finite or not
+            ordered; on ``robot.joint_velocity_limits``, speed limits out of range.
     """
-    limits = check_position_limits(joint_position_limits)
+    if len(joint_names) != 6 or len(set(joint_names)) != 6:
+        raise InvalidInputError(
+            "robot.joint_names", f"needs 6 distinct names, got {list(joint_names)}"
+        )
+    limits = check_position_limits(joint_position_limits, joint_names)
     speeds = check_speed_limits(qdot_max, joint_names)
     model = opw_model(
         parameters,

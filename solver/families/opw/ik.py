@@ -1,22 +1,39 @@
 """Closed-form inverse kinematics of OPW arms, batched (Brandstotter, Angerer, Hofbaur 2014).
 
 The wrist centre c = p - c4 z_F (z_F the flange z axis) fixes joints 1-3; the wrist then gives
-joints 4-6 as the ZYZ angles of R_0c^T R_F. In the paper's angles theta (q_paper = s q - o for
-the maker's q, sign corrections s, offsets o):
+joints 4-6 as the ZYZ angles of R_0c^T R_F, R_0c = Rz(theta1) Ry(theta2 + theta3). In the
+paper's angles theta (theta = s q - o for the maker's q, sign corrections s, offsets o), with
+lever = sqrt(cx^2 + cy^2 - b^2) the distance of c from axis 1 in the arm's plane:
 
-    theta1 = atan2(cy, cx) - atan2(b, nx1 + a1)           (shoulder front)
-             atan2(cy, cx) + atan2(b, nx1 + a1) - pi      (shoulder back)
+    theta1 = atan2(cy, cx) - atan2(b, lever)                  (shoulder front)
+             atan2(cy, cx) + atan2(b, lever) - pi             (shoulder back)
     theta3 = +-acos((s^2 - c2^2 - k^2) / (2 c2 k)) - atan2(a2, c3),   k^2 = a2^2 + c3^2
-    theta2 = -+acos((s^2 + c2^2 - k^2) / (2 s c2)) + atan2(nx1, cz - c1)     (front; back with
-             nx1 + 2 a1 and the atan2 negated)
-    theta5 = +-atan2(sqrt(1 - m^2), m),  m = z_0c . z_F
-    theta4, theta6 from the wrist's ZYZ angles (+pi and -pi on the flipped wrist)
+    theta2 = -+acos((s^2 + c2^2 - k^2) / (2 s c2)) + atan2(x, cz - c1)
+    theta5 = +-atan2(|z_0c x z_F|, z_0c . z_F)
+    theta4, theta6: the ZYZ angles of R_0c^T R_F (+pi and -pi on the flipped wrist)
 
-Branch labels (mean the same thing at every pose, so a branch can be followed along a path):
-shoulder ``front`` / ``back`` (the two theta1 above), elbow ``up`` / ``down`` (+ / - before the
-acos in theta3), wrist ``noflip`` / ``flip`` (theta5 >= 0 / <= 0). Index b = 4 shoulder +
-2 elbow + wrist with 0 for front / up / noflip. Angles come back in the maker's convention,
-wrapped to [-pi, pi]; tracking adds the 2 pi copies.
+where x = lever - a1 (front) or -(lever + a1) (back) is the wrist centre's reach beyond the
+axis of joint 2 in the arm's plane and s^2 = x^2 + (cz - c1)^2.
+
+Branch labels, each a sign choice above that changes along a path only through a singularity
+(so a branch can be followed):
+
+- shoulder ``front``: joint 1 faces the wrist centre (its x axis points to c, x' = +lever);
+  ``back``: the arm reaches over backwards (x' = -lever). They meet on the shoulder singularity
+  lever = 0 (c on axis 1; with b != 0 the cylinder of radius b around it).
+- elbow ``up``: theta3 + atan2(a2, c3) = +acos >= 0, ``down``: -acos. Seen with x' to the
+  right and z up, the ``up`` elbow is left of the line from joint 2 to c: above it where c is
+  ahead of joint 2 (as on the front shoulder), below it on the back shoulder, whose line points
+  to -x'. They meet where the arm is stretched or folded (acos argument +-1).
+- wrist ``noflip``: theta5 >= 0 (paper's angle; the maker's q5 = s5 (theta5 + o5)); ``flip``:
+  theta5 <= 0, theta4 + pi, theta6 - pi. They meet at the wrist singularity theta5 = 0.
+
+Index b = 4 shoulder + 2 elbow + wrist with 0 for front / up / noflip; opw_kinematics and
+py-opw-kinematics' ``reach`` make the same sign choices but put them in slot 4 wrist + 2 shoulder
++ elbow (tests compare slot by slot). Angles come back in the maker's convention
+(q = s (theta + o)), wrapped to [-pi, pi); tracking adds the 2 pi copies. The work is shared per
+level: joint 1 on (2, *batch), joints 2-3 and the wrist's angles on (2, 2, *batch), the flipped
+wrist as a half turn of those; only the last assembly is (6, 8, *batch).
 """
 
 from __future__ import annotations
@@ -34,6 +51,7 @@ N_BRANCHES = 8
 # A solution whose |sin theta5|, elbow sine or shoulder lever (m) is below this is singular
 # (acos near +-1 resolves angles only to ~1.5e-8, as for UR arms).
 SINGULAR_TOLERANCE = 1e-7
+# A cosine computed as 1 + rounding error still has its (singular) solution.
 REACH_TOLERANCE = 1e-10
 
 BRANCHES: tuple[Branch, ...] = tuple(
@@ -49,12 +67,15 @@ def solve_components(
 
     Args:
         parameters: the arm's geometry.
-        rotation: shape (3, 3, *batch), R_B_F of the flange poses.
+        rotation: shape (3, 3, *batch), R_B_F of the flange (tool0) poses, columns its x, y, z
+            axes in {B} (base_link); batch axes broadcast with those of ``position``.
         position: shape (3, *batch), flange positions in {B} (m).
 
     Returns:
-        q: shape (6, 8, *batch), rad in the maker's convention, NaN where unreachable;
-        status: shape (8, *batch), ``OK``, ``UNREACHABLE`` or ``SINGULAR``.
+        q: shape (6, 8, *batch), rad in the maker's convention, in [-pi, pi), NaN where
+        unreachable;
+        status: shape (8, *batch), ``OK``, ``UNREACHABLE`` or ``SINGULAR`` (shoulder, elbow or
+        wrist singularity; q is still a solution there).
     """
     with np.errstate(invalid="ignore", divide="ignore"):
         return _solve(parameters, rotation, position)
@@ -65,87 +86,85 @@ def _solve(
 ) -> tuple[np.ndarray, np.ndarray]:
     """The body of :func:`solve_components`."""
     batch = np.broadcast_shapes(rotation.shape[2:], position.shape[1:])
-    ones = (1,) * len(batch)
-    cx = position[0] - p.c4 * rotation[0, 2]
-    cy = position[1] - p.c4 * rotation[1, 2]
-    cz = position[2] - p.c4 * rotation[2, 2]
+    r = rotation
+    cx = position[0] - p.c4 * r[0, 2]
+    cy = position[1] - p.c4 * r[1, 2]
+    height = position[2] - p.c4 * r[2, 2] - p.c1
     radial2 = cx * cx + cy * cy - p.b * p.b
-    lever = np.sqrt(np.maximum(radial2, 0.0))  # distance of the wrist centre from axis 1, in-plane
-    reach_shoulder = radial2 >= -REACH_TOLERANCE
-    nx1 = lever - p.a1
-    height = cz - p.c1
+    lever = np.sqrt(np.maximum(radial2, 0.0))
     heading = np.arctan2(cy, cx)
-    side = np.arctan2(p.b, nx1 + p.a1)
-    # Shoulder level (2, *batch): front and back.
+    side = np.arctan2(p.b, lever)
+    # Shoulder level (2, *batch): front, back.
     theta1 = np.stack([heading - side, heading + side - math.pi])
-    forward = np.stack([nx1, nx1 + 2 * p.a1])  # in-plane reach beyond the shoulder offset
-    angle_to = np.stack(
-        [np.arctan2(nx1, height), -np.arctan2(nx1 + 2 * p.a1, height)]
-    )  # the atan2 term of theta2
+    forward = np.stack([lever - p.a1, lever + p.a1])  # |x|: reach beyond joint 2's axis
     s2 = forward * forward + height * height
     k2 = p.a2 * p.a2 + p.c3 * p.c3
-    psi3 = math.atan2(p.a2, p.c3)
     cos_elbow = (s2 - p.c2 * p.c2 - k2) / (2 * p.c2 * math.sqrt(k2))
-    cos_shoulder = (s2 + p.c2 * p.c2 - k2) / (2 * np.sqrt(s2) * p.c2)
-    reach_arm = (np.abs(cos_elbow) <= 1 + REACH_TOLERANCE) & (
-        np.abs(cos_shoulder) <= 1 + REACH_TOLERANCE
+    cos_shoulder = (s2 + p.c2 * p.c2 - k2) / (2 * p.c2 * np.sqrt(s2))
+    reach = (
+        (radial2 >= -REACH_TOLERANCE)
+        & (np.abs(cos_elbow) <= 1 + REACH_TOLERANCE)
+        & (np.abs(cos_shoulder) <= 1 + REACH_TOLERANCE)
     )
-    acos_elbow = np.arccos(np.clip(cos_elbow, -1.0, 1.0))
-    acos_shoulder = np.arccos(np.clip(cos_shoulder, -1.0, 1.0))
-    # Elbow level (2 shoulder, 2 elbow, *batch): "up" takes +acos in theta3 and -acos in
-    # theta2, as the paper pairs them.
-    elbow_sign = np.array([1.0, -1.0]).reshape((1, 2, *ones))
-    theta3 = elbow_sign * acos_elbow[:, None] - psi3
-    theta2 = -elbow_sign * acos_shoulder[:, None] + angle_to[:, None]
-    t1 = theta1[:, None]
-    c1, s1 = np.cos(t1), np.sin(t1)
-    c23, s23 = np.cos(theta2 + theta3), np.sin(theta2 + theta3)
-    r = rotation
-    # Columns of R_0c = Rz(theta1) Ry(theta2 + theta3) dotted with the flange axes.
-    m = r[0, 2] * s23 * c1 + r[1, 2] * s23 * s1 + r[2, 2] * c23  # z_0c . z_F = cos theta5
-    x_z = r[0, 2] * c23 * c1 + r[1, 2] * c23 * s1 - r[2, 2] * s23  # x_0c . z_F
-    y_z = r[1, 2] * c1 - r[0, 2] * s1  # y_0c . z_F
-    z_y = r[0, 1] * s23 * c1 + r[1, 1] * s23 * s1 + r[2, 1] * c23  # z_0c . y_F
-    z_x = r[0, 0] * s23 * c1 + r[1, 0] * s23 * s1 + r[2, 0] * c23  # z_0c . x_F
+    # NaN where unreachable: it flows from theta1 and the acos into every joint.
+    theta1 = np.where(reach, theta1, np.nan)
+    cos_elbow = np.where(reach, np.clip(cos_elbow, -1.0, 1.0), np.nan)
+    acos_elbow = np.arccos(cos_elbow)
+    acos_shoulder = np.arccos(np.where(reach, np.clip(cos_shoulder, -1.0, 1.0), np.nan))
+    angle_to = np.arctan2(forward, height)
+    angle_to[1] *= -1.0  # the back shoulder reaches towards -x'
+    # Elbow level (2 shoulder, 2 elbow, *batch): up takes +acos in theta3, -acos in theta2.
+    psi3 = math.atan2(p.a2, p.c3)
+    theta3 = np.stack([acos_elbow - psi3, -acos_elbow - psi3], axis=1)
+    theta2 = np.stack([angle_to - acos_shoulder, angle_to + acos_shoulder], axis=1)
+    # Flange axes in the arm's plane frame (x' along the arm, y' = axis 2, z), shoulder level.
+    c1, s1 = np.cos(theta1), np.sin(theta1)
+    ux, uy, uz = (r[0, j] * c1 + r[1, j] * s1 for j in range(3))  # x' . x_F, y_F, z_F
+    y_z = r[1, 2] * c1 - r[0, 2] * s1  # y' . z_F
+    angle23 = theta2 + theta3
+    c23, s23 = np.cos(angle23), np.sin(angle23)
+    # Columns of R_0c (x_c = c23 x' - s23 z, z_c = s23 x' + c23 z) dotted with the flange axes.
+    m = s23 * uz[:, None] + c23 * r[2, 2]  # z_c . z_F = cos theta5
+    x_z = c23 * uz[:, None] - s23 * r[2, 2]  # x_c . z_F
+    z_y = s23 * uy[:, None] + c23 * r[2, 1]  # z_c . y_F
+    z_x = s23 * ux[:, None] + c23 * r[2, 0]  # z_c . x_F
+    y_z = np.broadcast_to(y_z[:, None], m.shape)
     sin5 = np.hypot(x_z, y_z)  # exact near 0, where sqrt(1 - m^2) loses half the digits
-    wrist_singular = sin5 < SINGULAR_TOLERANCE
     theta5 = np.arctan2(sin5, m)
     theta4 = np.arctan2(y_z, x_z)
     theta6 = np.arctan2(z_y, -z_x)
-    # At the wrist singularity only theta4 +- theta6 is fixed: take theta6 = 0, and theta4 from
-    # the flange y axis (Rz(theta4) Ry(0 or pi) has y column (-sin theta4, cos theta4, 0)).
-    x_y = r[0, 1] * c23 * c1 + r[1, 1] * c23 * s1 - r[2, 1] * s23  # x_0c . y_F
-    y_y = r[1, 1] * c1 - r[0, 1] * s1  # y_0c . y_F
-    theta4 = np.where(wrist_singular, np.arctan2(-x_y, y_y), theta4)
-    theta6 = np.where(wrist_singular, 0.0, theta6)
-    # Wrist level (..., 2, *batch): noflip theta5 >= 0, flip: -theta5, theta4 + pi, theta6 - pi.
-    flip = np.array([0.0, 1.0]).reshape((1, 1, 2, *ones))
-    shape = (2, 2, 2, *batch)
-    q_paper = np.stack(
-        [
-            np.broadcast_to(t1[:, :, None], shape),
-            np.broadcast_to(theta2[:, :, None], shape),
-            np.broadcast_to(theta3[:, :, None], shape),
-            theta4[:, :, None] + math.pi * flip,
-            theta5[:, :, None] * (1 - 2 * flip),
-            theta6[:, :, None] - math.pi * flip,
-        ]
-    ).reshape((6, N_BRANCHES, *batch))
-    offsets = np.array(p.offsets).reshape((6, 1, *ones))
-    signs = np.array(p.sign_corrections, dtype=float).reshape((6, 1, *ones))
-    q = wrap_angle((q_paper + offsets) * signs)
-    reach = np.broadcast_to((reach_shoulder & reach_arm)[:, None, None], shape)
-    reach = reach.reshape((N_BRANCHES, *batch))
-    elbow_sine = np.sqrt(np.maximum(1.0 - np.clip(cos_elbow, -1.0, 1.0) ** 2, 0.0))
-    singular = (
-        (np.abs(nx1 + p.a1) < SINGULAR_TOLERANCE)[None, None, None]
-        | (elbow_sine < SINGULAR_TOLERANCE)[:, None, None]
-        | wrist_singular[:, :, None]
-    )
-    singular = np.broadcast_to(singular, shape).reshape((N_BRANCHES, *batch))
-    status = np.where(reach, np.where(singular, SINGULAR, OK), UNREACHABLE)
-    q[:, ~reach] = np.nan
-    return q, status
+    wrist_singular = sin5 < SINGULAR_TOLERANCE
+    if wrist_singular.any():
+        # Only theta4 +- theta6 is fixed: take theta6 = 0 and theta4 from the flange y axis
+        # (Rz(theta4) Ry(0 or pi) has y column (-sin theta4, cos theta4, 0)).
+        x_y = c23 * uy[:, None] - s23 * r[2, 1]  # x_c . y_F
+        y_y = np.broadcast_to((r[1, 1] * c1 - r[0, 1] * s1)[:, None], m.shape)  # y' . y_F
+        theta4 = np.where(wrist_singular, np.arctan2(-x_y, y_y), theta4)
+        theta6 = np.where(wrist_singular, 0.0, theta6)
+    # The maker's angles, per level; the flipped wrist's q4 and q6 are half turns of noflip's.
+    o, s = p.offsets, p.sign_corrections
+    q4 = wrap_angle((theta4 + o[3]) * s[3])
+    q6 = wrap_angle((theta6 + o[5]) * s[5])
+    q = np.empty((6, 2, 2, 2, *batch))
+    q[0] = wrap_angle((theta1 + o[0]) * s[0])[:, None, None]
+    q[1] = wrap_angle((theta2 + o[1]) * s[1])[:, :, None]
+    q[2] = wrap_angle((theta3 + o[2]) * s[2])[:, :, None]
+    q[3, :, :, 0], q[3, :, :, 1] = q4, _half_turn(q4)
+    q[4, :, :, 0] = wrap_angle((theta5 + o[4]) * s[4])
+    q[4, :, :, 1] = wrap_angle((o[4] - theta5) * s[4])
+    q[5, :, :, 0], q[5, :, :, 1] = q6, _half_turn(q6)
+    # Singular: c on axis 1 (shoulder), the arm stretched or folded (elbow), theta5 = 0.
+    elbow_singular = 1.0 - cos_elbow * cos_elbow < SINGULAR_TOLERANCE**2
+    singular = wrist_singular | (elbow_singular | (lever < SINGULAR_TOLERANCE))[:, None]
+    status = np.where(reach[:, None], np.where(singular, SINGULAR, OK), UNREACHABLE)
+    status = np.broadcast_to(status[:, :, None], (2, 2, 2, *batch))
+    return q.reshape((6, N_BRANCHES, *batch)), status.reshape((N_BRANCHES, *batch))
+
+
+def _half_turn(angle: np.ndarray) -> np.ndarray:
+    """Angles in [-pi, pi) turned by pi, back in [-pi, pi)."""
+    turned: np.ndarray = np.where(angle >= 0.0, angle - math.pi, angle + math.pi)
+    return turned
 
 
 def forward_kinematics(parameters: OpwParameters, q: np.ndarray) -> np.ndarray:
@@ -154,6 +173,10 @@ def forward_kinematics(parameters: OpwParameters, q: np.ndarray) -> np.ndarray:
     Args:
         parameters: the arm's geometry.
         q: shape (..., 6), rad, maker's convention.
+
+    Returns:
+        shape (..., 4, 4), T_B_F (m): R = Rz(t1) Ry(t2 + t3) Rz(t4) Ry(t5) Rz(t6) and the flange
+        c4 along its z axis from the wrist centre, as opw_kinematics' ``forward``.
     """
     p = parameters
     t = np.asarray(q, dtype=float) * np.array(p.sign_corrections) - np.array(p.offsets)
@@ -175,6 +198,7 @@ def forward_kinematics(parameters: OpwParameters, q: np.ndarray) -> np.ndarray:
 
 
 def _rz(angle: np.ndarray) -> np.ndarray:
+    """Rotations about z, shape (*angle.shape, 3, 3)."""
     c, s = np.cos(angle), np.sin(angle)
     out = np.zeros(np.shape(angle) + (3, 3))
     out[..., 0, 0], out[..., 0, 1], out[..., 1, 0], out[..., 1, 1] = c, -s, s, c
@@ -183,6 +207,7 @@ def _rz(angle: np.ndarray) -> np.ndarray:
 
 
 def _ry(angle: np.ndarray) -> np.ndarray:
+    """Rotations about y, shape (*angle.shape, 3, 3)."""
     c, s = np.cos(angle), np.sin(angle)
     out = np.zeros(np.shape(angle) + (3, 3))
     out[..., 0, 0], out[..., 0, 2], out[..., 2, 0], out[..., 2, 2] = c, s, -s, c

@@ -49,9 +49,10 @@ def _joint_speeds(
     p: OpwParameters, q: np.ndarray, twist: np.ndarray, tool_point: np.ndarray
 ) -> np.ndarray:
     """The body of :func:`joint_speeds_per_unit_twist`."""
+    q = np.asarray(q, dtype=float)
     shape = (6,) + (1,) * (q.ndim - 1)
-    signs = np.array(p.sign_corrections, dtype=float).reshape(shape)
-    theta = q * signs - np.array(p.offsets).reshape(shape)
+    signs = np.array(p.sign_corrections, dtype=float)
+    theta = q * signs.reshape(shape) - np.array(p.offsets).reshape(shape)
     c1, s1 = np.cos(theta[0]), np.sin(theta[0])
     c2, s2 = np.cos(theta[1]), np.sin(theta[1])
     angle23 = theta[1] + theta[2]
@@ -94,5 +95,6 @@ def _joint_speeds(
     qd6 = turned_x / s5
     qd4 = wc_z - c5 * qd6
     paper = np.stack(np.broadcast_arrays(qd1, qd2, qd3, qd4, qd5, qd6))
-    speeds: np.ndarray = paper * signs
+    # The signs again on paper's own axes: twist or tool_point may carry more than q.
+    speeds: np.ndarray = paper * signs.reshape((6,) + (1,) * (paper.ndim - 1))
     return speeds

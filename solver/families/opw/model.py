@@ -4,7 +4,10 @@ The chain follows the paper's frames, with each joint's zero and direction set t
 (the joint axis times its sign correction, the joint placement turned by minus its offset), so
 pinocchio's forward kinematics of the maker's q is the paper's forward formula (tests check it
 against :func:`solver.families.opw.ik.forward_kinematics` and py-opw-kinematics to 1e-12).
-Frames: ``base_link`` {B} at the root, ``tool0`` the flange.
+Frames: ``base_link`` {B} at the root, ``tool0`` the flange: c4 along joint 6's axis from the
+wrist centre, with the axes of the paper's end frame (R = Rz(t1) Ry(t2 + t3) Rz(t4) Ry(t5)
+Rz(t6), so at the paper's zero, arm straight up, tool0's axes are {B}'s), which is what
+opw_kinematics' ``forward`` returns and what the makers' URDFs call tool0.
 """
 
 from __future__ import annotations

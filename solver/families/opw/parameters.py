@@ -23,8 +23,10 @@ class OpwParameters:
 
     Attributes:
         a1, a2, b, c1, c2, c3, c4: the paper's lengths (m); c2 > 0 and c3 > 0.
-        offsets: shape (6,), rad, added to the maker's angle (after its sign) to get the paper's.
-        sign_corrections: shape (6,), each +1 or -1.
+        offsets: shape (6,), rad: the paper's angle is sign_correction * maker's - offset, so
+            the maker's is sign_correction * (paper's + offset) (opw_kinematics' forward and
+            inverse).
+        sign_corrections: shape (6,), each +1 or -1 (py-opw-kinematics' ``flip_axes`` is -1).
     """
 
     a1: float
