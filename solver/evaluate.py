@@ -28,7 +28,7 @@ from solver.pipeline import (
     run_chunk,
 )
 from solver.robots import Robot
-from solver.spatial import Placement
+from solver.spatial import Placement, rotation_about_z
 from solver.tracking import FEASIBLE, REASONS, Reason
 
 __all__ = ["Branch", "PathEvaluation", "evaluate_path", "DEFAULT_MAX_JOINT_STEP"]
@@ -76,9 +76,7 @@ class PathEvaluation:
 
 def _turned(vectors: np.ndarray, yaw: float) -> np.ndarray:
     """Rz(yaw) v for vectors of shape (N, 3)."""
-    c, s = np.cos(yaw), np.sin(yaw)
-    turn = np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
-    out: np.ndarray = vectors @ turn.T
+    out: np.ndarray = vectors @ rotation_about_z(yaw).T
     return out
 
 

@@ -23,7 +23,7 @@ from solver.dtf import spin_rate_nearest_zero, two_variable_speed
 from solver.exceptions import InvalidInputError, NoAnalyticIkError, quoted
 from solver.families.base import Branch, KinematicsFamily
 from solver.robots import Robot
-from solver.spatial import MAX_COORDINATE
+from solver.spatial import MAX_COORDINATE, rotation_about_z
 from solver.task import task_requirements
 from solver.tracking import FEASIBLE, Tracked, choose_branch, track
 
@@ -218,8 +218,7 @@ def _flange_at_spin(path: PreparedPath, spin: float) -> tuple[np.ndarray, np.nda
     """R_O_F (N, 3, 3) and p_O_F (N, 3) with every tool pose turned by ``spin`` about its z."""
     if spin == 0.0:
         return path.flange_rotation, path.flange_position
-    c, s = np.cos(spin), np.sin(spin)
-    turned = path.tool_rotation @ np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
+    turned = path.tool_rotation @ rotation_about_z(spin)
     rotation = turned @ path.tool_to_flange[:3, :3]
     position = path.tool_position + turned @ path.tool_to_flange[:3, 3]
     return rotation, position

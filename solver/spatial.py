@@ -85,6 +85,15 @@ def pose_matrix(
     return transform
 
 
+def rotation_about_z(angle: np.ndarray | float) -> np.ndarray:
+    """Rot_z(angle), batched: shape (*angle.shape, 3, 3)."""
+    c, s = np.cos(angle), np.sin(angle)
+    out = np.zeros(np.shape(angle) + (3, 3))
+    out[..., 0, 0], out[..., 0, 1], out[..., 1, 0], out[..., 1, 1] = c, -s, s, c
+    out[..., 2, 2] = 1.0
+    return out
+
+
 def spun_waypoints(waypoints: np.ndarray, spins: np.ndarray) -> np.ndarray:
     """Each waypoint turned about its own tool z axis: T_O_i Rot_z(spins_i) (cam.md section 4).
 
@@ -92,11 +101,8 @@ def spun_waypoints(waypoints: np.ndarray, spins: np.ndarray) -> np.ndarray:
         waypoints: shape (N, 4, 4), T_O_i (m).
         spins: shape (N,), rad.
     """
-    c, s = np.cos(spins), np.sin(spins)
-    turn = np.zeros((len(spins), 4, 4))
-    turn[:, 0, 0], turn[:, 0, 1], turn[:, 1, 0], turn[:, 1, 1] = c, -s, s, c
-    turn[:, 2, 2] = turn[:, 3, 3] = 1.0
-    spun: np.ndarray = np.asarray(waypoints, dtype=float) @ turn
+    spun = np.array(waypoints, dtype=float)
+    spun[:, :3, :3] = spun[:, :3, :3] @ rotation_about_z(np.asarray(spins, dtype=float))
     return spun
 
 

@@ -14,6 +14,7 @@ from __future__ import annotations
 import numpy as np
 
 from solver.exceptions import InvalidInputError
+from solver.spatial import rotation_about_z
 
 # A direction whose norm is within this of 1 is normalised (and the correction reported);
 # beyond it, it is an input error (cam.md section 6: CAM writes 4-6 decimals, papers print 4).
@@ -108,8 +109,7 @@ def poses_from_tool_axes(
     unit, correction = near_unit(axes, field="path.tool_axis_waypoints")
     rotations = reference_rotations(-unit)
     if spin:
-        c, s = np.cos(spin), np.sin(spin)
-        rotations = rotations @ np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
+        rotations = rotations @ rotation_about_z(spin)
     poses = np.broadcast_to(np.eye(4), (len(unit), 4, 4)).copy()
     poses[:, :3, :3] = rotations
     poses[:, :3, 3] = np.asarray(positions, dtype=float)

@@ -45,7 +45,7 @@ import numpy as np
 
 from solver.families.base import OK, SINGULAR, UNREACHABLE, Branch
 from solver.families.opw.parameters import OpwParameters
-from solver.spatial import wrap_angle
+from solver.spatial import rotation_about_z, wrap_angle
 
 N_BRANCHES = 8
 # A solution whose |sin theta5|, elbow sine or shoulder lever (m) is below this is singular
@@ -189,20 +189,13 @@ def forward_kinematics(parameters: OpwParameters, q: np.ndarray) -> np.ndarray:
         [cx1 * np.cos(t1) - p.b * np.sin(t1), cx1 * np.sin(t1) + p.b * np.cos(t1), cz1 + p.c1],
         axis=-1,
     )
-    rotation = _rz(t1) @ _ry(t2 + t3) @ _rz(t4) @ _ry(t5) @ _rz(t6)
+    rotation = (
+        rotation_about_z(t1) @ _ry(t2 + t3) @ rotation_about_z(t4) @ _ry(t5) @ rotation_about_z(t6)
+    )
     out = np.zeros(t.shape[:-1] + (4, 4))
     out[..., :3, :3] = rotation
     out[..., :3, 3] = centre + p.c4 * rotation[..., :, 2]
     out[..., 3, 3] = 1.0
-    return out
-
-
-def _rz(angle: np.ndarray) -> np.ndarray:
-    """Rotations about z, shape (*angle.shape, 3, 3)."""
-    c, s = np.cos(angle), np.sin(angle)
-    out = np.zeros(np.shape(angle) + (3, 3))
-    out[..., 0, 0], out[..., 0, 1], out[..., 1, 0], out[..., 1, 1] = c, -s, s, c
-    out[..., 2, 2] = 1.0
     return out
 
 
