@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 import scipy.optimize
 
-from solver.capability_map import capability_map, grid_axis
+from solver.capability_map import capability_map
 from solver.dtf import spin_rate_nearest_zero, two_variable_speed
 from solver.evaluate import evaluate_path
 from solver.exceptions import InvalidInputError
@@ -26,6 +26,7 @@ from tests.cases import (
     SPIN_SCHEDULE_RTOL,
 )
 from tests.solver.test_evaluate import load_path
+from tests.solver.test_optimize import best_coarse_cell
 
 README_PLACEMENT = Placement(0.0, 0.45, 0.1, 0.0)
 
@@ -160,20 +161,11 @@ def test_free_spin_map_equals_evaluate() -> None:
 def free_optima() -> dict:
     robot, path = get_robot("ur5"), load_path("curved_line")
     bounds = PlacementBounds(x=(-0.25, 0.25), y=(0.25, 0.65), yaw=(-math.pi, math.pi), z=0.1)
-    grid = capability_map(
-        robot,
-        path,
-        xs=grid_axis(*bounds.x, 0.02, field="x"),
-        ys=grid_axis(*bounds.y, 0.02, field="y"),
-        z=bounds.z,
-        yaws=grid_axis(-math.pi, math.pi - 1e-9, math.radians(15), field="yaw"),
-        spin_mode="free",
-    )
     return {
         "robot": robot,
         "path": path,
         "bounds": bounds,
-        "best_cell": float(np.nanmax(grid.mu_path)),
+        "best_cell": best_coarse_cell(robot, path, bounds, spin_mode="free"),
         "fixed": optimize_placement(robot, path, bounds=bounds),
         **{
             method: optimize_placement(robot, path, bounds=bounds, method=method, spin_mode="free")

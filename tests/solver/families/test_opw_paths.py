@@ -24,6 +24,7 @@ from tests.cases import (
     OPTIMUM_METHODS_RTOL,
 )
 from tests.solver.test_evaluate import load_path
+from tests.solver.test_optimize import best_coarse_cell
 
 KR6 = "kuka_kr6_r700_sixx"
 PLACEMENT = Placement(0.45, 0.0, 0.1, 0.0)
@@ -102,19 +103,11 @@ def test_turning_a_placement_about_the_base_axis_keeps_mu_path() -> None:
 def optima() -> dict:
     robot, path = get_robot(KR6), load_path("curved_line")
     bounds = PlacementBounds(x=(0.3, 0.5), y=(-0.1, 0.1), yaw=(-math.pi, math.pi), z=0.1)
-    grid = capability_map(
-        robot,
-        path,
-        xs=grid_axis(*bounds.x, 0.02, field="x"),
-        ys=grid_axis(*bounds.y, 0.02, field="y"),
-        z=bounds.z,
-        yaws=grid_axis(-math.pi, math.pi - 1e-9, math.radians(15), field="yaw"),
-    )
     return {
         "robot": robot,
         "path": path,
         "bounds": bounds,
-        "best_cell": float(np.nanmax(grid.mu_path)),
+        "best_cell": best_coarse_cell(robot, path, bounds),
         **{
             m: optimize_placement(robot, path, bounds=bounds, method=m) for m in ("casadi", "scipy")
         },
