@@ -9,25 +9,20 @@ import numpy as np
 
 from service import schemas
 from service.config import Settings
+from service.schemas.path import PathInput
 from solver.capability_map import CapabilityMap, axis_length, grid_axis
 from solver.dtf import DtfResult
 from solver.evaluate import Branch, PathEvaluation
 from solver.exceptions import InvalidInputError
-from solver.families.opw.catalogue import robot_from_opw
-from solver.families.opw.parameters import OpwParameters
 from solver.optimize import PlacementOptimum
 from solver.pipeline import SpinMode
-from solver.robots import Robot, get_robot, robot_from_urdf
+from solver.robots import Robot
 from solver.search_space import PlacementBounds
 from solver.spatial import (
     MAX_COORDINATE,
     Placement,
-    check_position,
-    pose_matrix,
     spun_waypoints,
 )
-from solver.task import task_requirements
-from solver.tool_axis import poses_from_tool_axes
 from solver.tracking import FEASIBLE, REASONS
 
 
@@ -35,61 +30,10 @@ def robot_from_schema(spec: schemas.Robot) -> Robot:
     """The solver robot a request names, with its speed limits and tool point.
 
     Raises:
-        UnknownRobotError: ``model`` is not in the catalogue.
-        InvalidInputError: an OPW geometry or its limits are out of range.
+        InvalidInputError: an OPW geometry, its limits or the speed limits are out of range.
         RobotModelError: the URDF or its frames do not fit.
-        InvalidInputError: ``joint_velocity_limits`` has the wrong length.
     """
-    tcp = None if spec.tcp is None else pose_matrix_of(spec.tcp, field="robot.tcp")
-    if spec.model is not None:
-        robot = get_robot(spec.model).with_options(qdot_max=spec.joint_velocity_limits)
-    elif spec.opw is not None:  # schemas.Robot makes sure both limits are given
-        geometry = spec.opw
-        parameters = OpwParameters(
-            a1=geometry.a1,
-            a2=geometry.a2,
-            b=geometry.b,
-            c1=geometry.c1,
-            c2=geometry.c2,
-            c3=geometry.c3,
-            c4=geometry.c4,
-            offsets=tuple(geometry.offsets),
-            sign_corrections=tuple(geometry.sign_corrections),
-        )
-        robot = robot_from_opw(
-            "opw",
-            parameters,
-            joint_position_limits=np.array(spec.joint_position_limits or [], dtype=float),
-            qdot_max=spec.joint_velocity_limits or [],
-        )
-    else:  # schemas.Robot makes sure urdf and both frames are given
-        robot = robot_from_urdf(
-            spec.urdf or "",
-            base_frame=spec.base_frame or "",
-            tool_frame=spec.tool_frame or "",
-            qdot_max=spec.joint_velocity_limits,
-        )
-    return robot.with_options(transform_tool_to_tcp=tcp)
-
-
-def pose_matrix_of(pose: schemas.Pose, *, field: str) -> np.ndarray:
-    """T of a pose, shape (4, 4), metres."""
-    return pose_matrix(pose.position, pose.orientation, field=field)
-
-
-@dataclass(frozen=True)
-class PathInput:
-    """A request's path as the solver takes it.
-
-    Attributes:
-        poses: shape (N, 4, 4), T_O_i (m).
-        axis_correction: the largest correction made to a tool axis's length (0 for poses).
-        default_spin_mode: ``free`` for a path given by tool axes, ``fixed`` for poses.
-    """
-
-    poses: np.ndarray
-    axis_correction: float
-    default_spin_mode: SpinMode
+    return spec.to_solver()
 
 
 def path_of(path: schemas.Path) -> PathInput:
@@ -98,22 +42,7 @@ def path_of(path: schemas.Path) -> PathInput:
     Raises:
         InvalidInputError, RepeatedWaypointError: naming the field and the waypoint.
     """
-    if path.waypoints is not None:
-        poses = np.array(
-            [
-                pose_matrix_of(pose, field=f"path.waypoints.{i}")
-                for i, pose in enumerate(path.waypoints)
-            ]
-        )
-        return PathInput(poses=poses, axis_correction=0.0, default_spin_mode="fixed")
-    points = path.tool_axis_waypoints or []
-    field = "path.tool_axis_waypoints"
-    positions = np.array(
-        [check_position(p.position, field=f"{field}.{i}.position") for i, p in enumerate(points)]
-    )
-    poses, correction = poses_from_tool_axes(positions, np.array([p.axis for p in points]))
-    task_requirements(poses, field=field)  # names this field, not path.waypoints, on an error
-    return PathInput(poses=poses, axis_correction=correction, default_spin_mode="free")
+    return path.to_solver()
 
 
 def spun_poses(path: PathInput, spins: list[float] | None) -> np.ndarray:

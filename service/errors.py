@@ -61,6 +61,15 @@ def _error_response(status_code: int, details: list[ErrorDetail]) -> JSONRespons
     return JSONResponse(status_code=status_code, content=ErrorResponse(detail=details).model_dump())
 
 
+def request_location(loc: tuple[str | int, ...] | list[str | int]) -> list[str | int]:
+    """A pydantic ``loc`` as a path into the request: the union variants' tags left out.
+
+    A ``oneOf`` variant is tagged ``"robot:model"``, ``"path:waypoints"``...; field names never
+    hold a colon, so the tags are the parts that do.
+    """
+    return [part for part in loc if not (isinstance(part, str) and ":" in part)]
+
+
 async def request_validation_error_handler(
     request: Request, error: RequestValidationError
 ) -> JSONResponse:
@@ -69,7 +78,10 @@ async def request_validation_error_handler(
     FastAPI's own answer repeats each offending ``input``, which breaks on the NaN it is
     refusing (JSON has no NaN) and can run to megabytes for a whole path.
     """
-    details = [ErrorDetail(loc=e["loc"], msg=e["msg"], type=e["type"]) for e in error.errors()]
+    details = [
+        ErrorDetail(loc=request_location(e["loc"]), msg=e["msg"], type=e["type"])
+        for e in error.errors()
+    ]
     return _error_response(status.HTTP_422_UNPROCESSABLE_CONTENT, details)
 
 

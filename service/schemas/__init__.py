@@ -5,15 +5,13 @@ its unit, and every model carries an example, so ``/docs`` reads as a manual.
 """
 
 from service.schemas.common import (
+    AutoIkPolicy,
     Branch,
     IkPolicy,
-    OpwGeometry,
-    Path,
     Placement,
     Pose,
     RequestModel,
     ResponseModel,
-    Robot,
     ToolAxisWaypoint,
 )
 from service.schemas.dtf import DtfRequest, DtfResponse
@@ -34,12 +32,16 @@ from service.schemas.optimize import (
     SpinPath,
     StartInfo,
 )
+from service.schemas.path import Path, PathInput, PosePath, ToolAxisPath
+from service.schemas.robot import CatalogueRobot, OpwGeometry, OpwRobot, Robot, UrdfRobot
 from service.schemas.robots import BranchLevel, HealthResponse, RobotInfo, RobotsResponse
 
 __all__ = [
+    "AutoIkPolicy",
     "Bottleneck",
     "Bounds",
     "Branch",
+    "CatalogueRobot",
     "BranchLevel",
     "DtfRequest",
     "DtfResponse",
@@ -57,11 +59,14 @@ __all__ = [
     "MapRequest",
     "MapResponse",
     "OpwGeometry",
+    "OpwRobot",
     "OptimizeRequest",
     "OptimizeResponse",
     "Path",
+    "PathInput",
     "Placement",
     "Pose",
+    "PosePath",
     "RequestModel",
     "ResponseModel",
     "Robot",
@@ -70,6 +75,8 @@ __all__ = [
     "SolverInfo",
     "SpinPath",
     "StartInfo",
+    "ToolAxisPath",
     "ToolAxisWaypoint",
+    "UrdfRobot",
     "WaypointResult",
 ]

@@ -4,9 +4,14 @@ from __future__ import annotations
 
 from typing import Literal
 
-from pydantic import ConfigDict, Field
+from pydantic import ConfigDict, Field, field_validator
+from pydantic_core import PydanticCustomError
 
-from service.schemas.common import RequestModel, ResponseModel, Robot, Vector3
+from service.schemas.common import RequestModel, ResponseModel, UnitVector
+from service.schemas.robot import Robot
+
+MIN_H = 1e-300  # m: below it (subnormal numbers) 1 / h overflows
+MAX_H = 1e300
 
 
 class DtfRequest(RequestModel):
@@ -30,12 +35,12 @@ class DtfRequest(RequestModel):
     q: list[float] = Field(
         min_length=1, description="Joint positions (rad; m for prismatic joints), n values."
     )
-    u_T: Vector3 | None = Field(
+    u_T: UnitVector | None = Field(
         default=None,
         description="Unit direction of the linear tool velocity in {B} (dimensionless). "
         "Required unless h = 0.",
     )
-    u_R: Vector3 | None = Field(
+    u_R: UnitVector | None = Field(
         default=None,
         description="Unit direction of the angular tool velocity in {B} (dimensionless). "
         "Required unless h is null.",
@@ -43,14 +48,30 @@ class DtfRequest(RequestModel):
     h: float | None = Field(
         default=None,
         ge=0.0,
-        description="V / Omega (m), >= 0: linear over angular speed. null or left out for "
-        "pure translation, 0 for pure reorientation.",
+        description="V / Omega (m): linear over angular speed, 0 or within [1e-300, 1e300]. "
+        "null or left out for pure translation, 0 for pure reorientation.",
+        json_schema_extra={
+            "anyOf": [
+                {"type": "number", "enum": [0]},
+                {"type": "number", "minimum": MIN_H, "maximum": MAX_H},
+                {"type": "null"},
+            ]
+        },
     )
     method: Literal["auto", "closed_form", "lp"] = Field(
         default="auto",
         description="closed_form (J^-1, non-singular 6-joint arms), lp (exact for every arm), "
         "or auto: closed_form where it applies, else lp.",
     )
+
+    @field_validator("h")
+    @classmethod
+    def _dividable(cls, value: float | None) -> float | None:
+        if value is not None and value != 0.0 and not MIN_H <= value <= MAX_H:
+            raise PydanticCustomError(
+                "h_range", "h = {h} m; it is 0 or within [1e-300, 1e300]", {"h": value}
+            )
+        return value
 
 
 class DtfResponse(ResponseModel):

@@ -9,15 +9,16 @@ from pydantic import ConfigDict, Field
 from pydantic.config import JsonDict
 
 from service.schemas.common import (
+    Angle,
     Branch,
     IkPolicy,
-    Path,
     Placement,
     RequestModel,
     ResponseModel,
-    Robot,
     SpinMode,
 )
+from service.schemas.path import MAX_PATH_WAYPOINTS, Path
+from service.schemas.robot import Robot
 
 _REQUEST_EXAMPLE: JsonDict = {
     "robot": {"model": "ur5"},
@@ -112,9 +113,12 @@ class EvaluateRequest(RequestModel):
         "waypoint's q, task direction and speeds. Default: waypoints up to "
         "DTF_MAX_DETAIL_WAYPOINTS waypoints (2,000), summary beyond.",
     )
-    spins: list[float] | None = Field(
+    spins: list[Angle] | None = Field(
         default=None,
-        description="A tool spin per waypoint (rad), added to the placement's: each waypoint "
+        min_length=2,
+        max_length=MAX_PATH_WAYPOINTS,
+        description="A tool spin per waypoint, one per waypoint (rad, within 1000), added to the "
+        "placement's: each waypoint "
         "turned about its own tool z axis (as /v1/optimize's spin_path answers). Default none.",
     )
 

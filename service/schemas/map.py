@@ -2,19 +2,28 @@
 
 from __future__ import annotations
 
-from pydantic import ConfigDict, Field, PositiveFloat, field_validator
+from typing import Annotated
+
+from pydantic import ConfigDict, Field
 from pydantic.config import JsonDict
 
 from service.schemas.common import (
+    Angle,
+    Coordinate,
     IkPolicy,
-    Path,
     Placement,
     RequestModel,
     ResponseModel,
-    Robot,
     SpinMode,
 )
 from service.schemas.evaluate import _REQUEST_EXAMPLE, FailureReason
+from service.schemas.path import Path
+from service.schemas.robot import Robot
+from solver.spatial import MAX_COORDINATE
+
+MAX_GRID_VALUES = 360
+MIN_GRID_STEP = 1e-6  # m: a finer grid than a micrometre is no placement a cell can hold
+ValueList = Annotated[list[Angle], Field(min_length=1, max_length=MAX_GRID_VALUES)]
 
 
 class GridAxis(RequestModel):
@@ -24,9 +33,11 @@ class GridAxis(RequestModel):
         json_schema_extra={"examples": [{"min": -0.25, "max": 0.25, "step": 0.02}]}
     )
 
-    min: float = Field(description="First value (m).")
-    max: float = Field(description="Last value at most (m); >= min.")
-    step: PositiveFloat = Field(description="Spacing (m), > 0.")
+    min: Coordinate = Field(description="First value (m), within 1 km.")
+    max: Coordinate = Field(description="Last value at most (m), >= min, within 1 km.")
+    step: float = Field(
+        ge=MIN_GRID_STEP, le=2 * MAX_COORDINATE, description="Spacing (m), at least 1 micrometre."
+    )
 
 
 class Grid(RequestModel):
@@ -47,24 +58,17 @@ class Grid(RequestModel):
 
     x: GridAxis = Field(description="Placement x values (m).")
     y: GridAxis = Field(description="Placement y values (m).")
-    z: float = Field(description="Height of every placement (m).")
-    yaw: float | list[float] = Field(
+    z: Coordinate = Field(description="Height of every placement (m), within 1 km.")
+    yaw: Angle | ValueList = Field(
         description="Yaw of the workpiece about the base z axis (rad): one value or a list of 1 "
         "to 360 values, each mapped."
     )
 
-    spin: float | list[float] = Field(
+    spin: Angle | ValueList = Field(
         default=0.0,
         description="Constant tool spin about each waypoint's tool axis (rad, cam.md section 3): "
         "one value or a list of 1 to 360 values, each mapped. Default 0.",
     )
-
-    @field_validator("yaw", "spin")
-    @classmethod
-    def _value_list(cls, value: float | list[float]) -> float | list[float]:
-        if isinstance(value, list) and not 1 <= len(value) <= 360:
-            raise ValueError(f"a list of 1 to 360 values is needed, got {len(value)}")
-        return value
 
     def yaws(self) -> list[float]:
         """The yaw values as a list (rad)."""

@@ -3,24 +3,27 @@
 from __future__ import annotations
 
 import math
-from typing import Literal
+from typing import Annotated, Literal
 
 from pydantic import ConfigDict, Field, field_validator, model_validator
 from pydantic.config import JsonDict
 from pydantic_core import PydanticCustomError
 
 from service.schemas.common import (
-    IkPolicy,
-    Path,
+    Angle,
+    AutoIkPolicy,
+    Coordinate,
     Placement,
     RequestModel,
     ResponseModel,
-    Robot,
     SpinMode,
 )
 from service.schemas.evaluate import _REQUEST_EXAMPLE, EvaluateResponse
+from service.schemas.path import Path
+from service.schemas.robot import Robot
 
-Range = list[float]
+Range = Annotated[list[Coordinate], Field(min_length=2, max_length=2)]
+AngleRange = Annotated[list[Angle], Field(min_length=2, max_length=2)]
 
 
 class Bounds(RequestModel):
@@ -32,13 +35,11 @@ class Bounds(RequestModel):
         }
     )
 
-    x: Range = Field(min_length=2, max_length=2, description="[min, max] of x (m).")
-    y: Range = Field(min_length=2, max_length=2, description="[min, max] of y (m).")
-    yaw: Range = Field(min_length=2, max_length=2, description="[min, max] of the yaw (rad).")
-    spin: Range = Field(
+    x: Range = Field(description="[min, max] of x (m), within 1 km.")
+    y: Range = Field(description="[min, max] of y (m), within 1 km.")
+    yaw: AngleRange = Field(description="[min, max] of the yaw (rad), within 1000.")
+    spin: AngleRange = Field(
         default=[0.0, 0.0],
-        min_length=2,
-        max_length=2,
         description="[min, max] of the constant tool spin about each waypoint's tool axis (rad, "
         "cam.md section 3), at most a turn wide; default [0, 0] (no spin). It matters for an "
         "angled or offset spindle.",
@@ -46,8 +47,6 @@ class Bounds(RequestModel):
 
     z: Range | None = Field(
         default=None,
-        min_length=2,
-        max_length=2,
         description="[min, max] of the height (m) to search it too; then the request's z is left "
         "out. Default: the height is the request's z.",
     )
@@ -91,9 +90,10 @@ class OptimizeRequest(RequestModel):
     )
     path: Path = Field(description="The tool path in the workpiece frame {O}.")
     bounds: Bounds = Field(description="Where the workpiece may go.")
-    z: float | None = Field(
+    z: Coordinate | None = Field(
         default=None,
-        description="Height of the workpiece frame (m), the table height; required unless "
+        description="Height of the workpiece frame (m), the table height, within 1 km; required "
+        "unless "
         "bounds.z gives a range to search.",
     )
     start: Placement | None = Field(
@@ -106,10 +106,10 @@ class OptimizeRequest(RequestModel):
         description="casadi: IPOPT from the best cells of a coarse map; scipy: differential "
         "evolution, then SLSQP.",
     )
-    ik: IkPolicy = Field(
-        default_factory=IkPolicy,
-        description="IK policy: max_joint_step as for /v1/evaluate; the branch must be auto "
-        "(each start of the search follows its own branch, the answer uses the best).",
+    ik: AutoIkPolicy = Field(
+        default_factory=AutoIkPolicy,
+        description="IK policy: max_joint_step as for /v1/evaluate; the branch is auto (each "
+        "start of the search follows its own branch, the answer uses the best).",
     )
     spin_mode: SpinMode | None = Field(
         default=None,
@@ -130,13 +130,6 @@ class OptimizeRequest(RequestModel):
                 "height", "give z (a fixed height) or bounds.z (a range to search), not both"
             )
         return self
-
-    @field_validator("ik")
-    @classmethod
-    def _auto_branch(cls, value: IkPolicy) -> IkPolicy:
-        if value.branch != "auto":
-            raise ValueError("the optimiser chooses the IK branch itself: branch must be auto")
-        return value
 
 
 class StartInfo(ResponseModel):

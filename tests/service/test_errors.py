@@ -73,7 +73,7 @@ DTF_CASES: list[tuple[str, Changes, Loc]] = [
     ),
     ("unknown field", {("robot", "colour"): "blue"}, ["body", "robot", "colour"]),
     ("robot without model or urdf", {("robot",): {}}, ["body", "robot"]),
-    ("model and urdf", {("robot", "urdf"): "<robot/>"}, ["body", "robot", "urdf"]),
+    ("model and urdf", {("robot", "urdf"): "<robot/>"}, ["body", "robot"]),
     ("frame with model", {("robot", "base_frame"): "base"}, ["body", "robot", "base_frame"]),
     ("unknown robot", {("robot", "model"): "ur99"}, ["body", "robot", "model"]),
     (
@@ -376,13 +376,13 @@ EXTREME_DTF_CASES = [
             ("method",): "lp",
             ("robot", "joint_velocity_limits"): [1e30] * 6,
         },
-        ["body", "robot", "joint_velocity_limits"],
+        ["body", "robot", "joint_velocity_limits", 0],
         id="huge limits, lp",
     ),
     pytest.param({("h",): 1e300}, None, id="huge h"),
     pytest.param(
         {("robot", "joint_velocity_limits"): [1e-300] * 6},
-        ["body", "robot", "joint_velocity_limits"],
+        ["body", "robot", "joint_velocity_limits", 0],
         id="tiny limits",
     ),
 ]

@@ -1,0 +1,265 @@
+"""Schemathesis hooks: the service's rules that JSON Schema cannot state (issue 9).
+
+The committed spec states every rule on one field as JSON Schema (ranges, list lengths, the
+catalogue's names, which keys go together). The rules below relate several fields or need
+arithmetic; the spec states each in words, and these hooks apply them to the schema-valid
+("positive") cases schemathesis generates, so that ``positive_data_acceptance`` checks that the
+service accepts everything the spec and its words allow. Negative cases are left as generated.
+
+Each rule is computed here independently of the service's code:
+
+- unit vectors (quaternions, tool axes, u_T, u_R): normalised, since a norm is arithmetic;
+- [min, max] pairs (bounds, grid axes, joint position limits): put in order;
+- a path's consecutive waypoints distinct, none turning by a half turn;
+- sizes: placements x waypoints, panels, path lengths within the server's settings;
+- cross-field choices: q has one value per joint within its limits (and method auto rather
+  than closed_form, which needs a non-singular Jacobian); u_T given unless h = 0,
+  u_R unless h is null; z or bounds.z; the start inside the bounds; spin_path with casadi and
+  fixed spin; one spin per waypoint; a URDF arm only on /v1/dtf (it has no IK family yet),
+  and only a URDF from example-robot-data with its frames (a random string is not a URDF).
+"""
+
+from __future__ import annotations
+
+import math
+from collections import Counter
+from functools import cache
+from typing import Any
+
+import schemathesis
+from schemathesis import GenerationMode
+
+LIMITS: dict[str, float] = {}
+"""The server's settings, as the test passed them (max_map_cells, max_map_poses, ...)."""
+STATUSES: Counter[tuple[str, str, int]] = Counter()
+"""How many answers of each status each operation gave, with the generation mode."""
+
+OPW_BRANCHES = [
+    {"level": "shoulder", "choices": ["front", "back"]},
+    {"level": "elbow", "choices": ["up", "down"]},
+    {"level": "wrist", "choices": ["noflip", "flip"]},
+]
+"""The branch levels of an OPW arm (robots.md section 3)."""
+UNIT_KEYS = ("orientation", "axis", "u_T", "u_R")
+
+
+@cache
+def catalogue() -> dict[str, dict[str, Any]]:
+    """The service's robots by name, as GET /v1/robots publishes them."""
+    from fastapi.testclient import TestClient
+
+    from service.main import app
+
+    robots = TestClient(app).get("/v1/robots").json()["robots"]
+    return {robot["name"]: robot for robot in robots}
+
+
+def _positive(case: schemathesis.Case) -> bool:
+    return case.meta is None or case.meta.generation.mode == GenerationMode.POSITIVE
+
+
+def _normalise(value: Any) -> Any:
+    """Unit vectors scaled to norm 1 (a zero one replaced), [min, max] pairs ordered."""
+    if isinstance(value, dict):
+        out = {}
+        for key, item in value.items():
+            if key in UNIT_KEYS and isinstance(item, list) and item:
+                norm = math.sqrt(sum(v * v for v in item))
+                item = [v / norm for v in item] if norm > 1e-150 else [0.0] * (len(item) - 1) + [1]
+            elif key in ("min", "max") and isinstance(value.get("min"), float | int):
+                low, high = sorted((value["min"], value["max"]))
+                item = low if key == "min" else high
+            else:
+                item = _normalise(item)
+            out[key] = item
+        if isinstance(out.get("joint_position_limits"), list):
+            out["joint_position_limits"] = [sorted(pair) for pair in out["joint_position_limits"]]
+        if isinstance(out.get("bounds"), dict):
+            out["bounds"] = {k: sorted(v) if v else v for k, v in out["bounds"].items()}
+        return out
+    if isinstance(value, list):
+        return [_normalise(item) for item in value]
+    return value
+
+
+def _waypoints(path: dict[str, Any]) -> list[dict[str, Any]]:
+    return path.get("waypoints") or path.get("tool_axis_waypoints") or []
+
+
+def _same_turn(a: dict[str, Any], b: dict[str, Any]) -> bool:
+    """Whether two waypoints have the same orientation (q and -q are the same rotation)."""
+    if a.get("axis") is not None:
+        return math.dist(a["axis"], b["axis"]) < 1e-6
+    dot = sum(x * y for x, y in zip(a["orientation"], b["orientation"], strict=True))
+    return abs(dot) > 1 - 1e-12  # 2 acos|dot| < 1e-6 rad
+
+
+def _repair_path(path: dict[str, Any], limit: int) -> None:
+    """At most ``limit`` waypoints, consecutive ones distinct, none turning by a half turn."""
+    key = "waypoints" if path.get("waypoints") is not None else "tool_axis_waypoints"
+    points = path[key] = path[key][:limit]
+    for a, b in zip(points, points[1:], strict=False):
+        for unit in ("orientation", "axis"):
+            if a.get(unit) is not None and b.get(unit) is not None:
+                dot = sum(x * y for x, y in zip(a[unit], b[unit], strict=True))
+                # a quaternion turned by a half turn (|dot| = cos(angle / 2) near 0), or a tool
+                # axis turned by more than a right angle (its minimal-rotation frame may then
+                # turn by a half turn)
+                if (unit == "axis" and dot <= 1e-9) or abs(dot) < 1e-5:
+                    b[unit] = list(a[unit])
+        if math.dist(a["position"], b["position"]) < 1e-6 and _same_turn(a, b):
+            b["position"] = [b["position"][0] + (1e-3 if b["position"][0] < 0 else -1e-3)]
+            b["position"] += a["position"][1:]
+
+
+def _count(axis: dict[str, float]) -> float:
+    """How many values a grid axis has, at least (a float: it may overflow to infinity)."""
+    return (axis["max"] - axis["min"]) / axis["step"] + 1
+
+
+def _as_list(value: Any) -> list[Any]:
+    return value if isinstance(value, list) else [value]
+
+
+def _resized(values: list[Any] | None, n: int, fill: Any) -> list[Any]:
+    values = list(values or [])
+    return (values + [fill] * n)[:n]
+
+
+def _repair_robot(body: dict[str, Any]) -> tuple[list[float], list[float]]:
+    """A catalogue arm for a URDF one, one speed limit per joint; its position limits."""
+    robot = body["robot"]
+    if robot.get("urdf") is not None:  # a random string is no URDF: the URDF tests cover them
+        robot = body["robot"] = {"model": "ur5", "tcp": robot.get("tcp")}
+    if robot.get("opw") is not None:
+        pairs = robot["joint_position_limits"] = [
+            [low, high if high > low else low + 1.0] for low, high in robot["joint_position_limits"]
+        ]
+        lower, upper = (list(side) for side in zip(*pairs, strict=True))
+        return lower, upper
+    info = catalogue()[robot["model"]]
+    if robot.get("joint_velocity_limits") is not None:
+        robot["joint_velocity_limits"] = _resized(robot["joint_velocity_limits"], info["dof"], 1.0)
+    return info["q_lower"], info["q_upper"]
+
+
+def _repair_branch(body: dict[str, Any]) -> None:
+    """A named IK branch in the names of the robot's family (UR left/right, OPW front/back)."""
+    branch = (body.get("ik") or {}).get("branch")
+    if not isinstance(branch, dict):
+        return
+    model = body["robot"].get("model")
+    levels = catalogue()[model]["branches"] if model is not None else OPW_BRANCHES
+    for level in levels:
+        if branch.get(level["level"]) not in level["choices"]:
+            branch[level["level"]] = level["choices"][0]
+
+
+def _repair_dtf(body: dict[str, Any], lower: list[float], upper: list[float]) -> None:
+    """q: one value per joint, within its limits; u_T unless h = 0, u_R unless h is null."""
+    q = _resized(body.get("q"), len(lower), 0.0)
+    body["q"] = [min(max(v, lo), hi) for v, lo, hi in zip(q, lower, upper, strict=True)]
+    if body.get("method") == "closed_form":  # valid only where J is not singular: unknown here
+        body["method"] = "auto"
+    h = body.get("h")
+    if h != 0 and body.get("u_T") is None:
+        body["u_T"] = [1.0, 0.0, 0.0]
+    if h is not None and body.get("u_R") is None:
+        body["u_R"] = [0.0, 0.0, 1.0]
+
+
+def _repair_grid(grid: dict[str, Any], n: int, *, png: bool) -> None:
+    """Steps coarse enough that the map is within the server's limits; PNG panels too."""
+    spin = grid.get("spin")
+    if png:  # panels: yaw values x spin values
+        spins = len(_as_list(0.0 if spin is None else spin))
+        if spins > LIMITS["max_png_panels"]:
+            spin = grid["spin"] = spin[: int(LIMITS["max_png_panels"])]
+            spins = len(spin)
+        if isinstance(grid["yaw"], list):
+            grid["yaw"] = grid["yaw"][: int(LIMITS["max_png_panels"] // spins)]
+    panels = len(_as_list(grid["yaw"])) * len(_as_list(0.0 if spin is None else spin))
+    per_axis = math.isqrt(
+        max(1, min(LIMITS["max_map_cells"], LIMITS["max_map_poses"] // n) // panels)
+    )
+    for axis in (grid["x"], grid["y"]):
+        if _count(axis) > per_axis:
+            axis["step"] = max(
+                axis["step"], (axis["max"] - axis["min"]) / max(per_axis - 1, 1) * 1.01
+            )
+
+
+def _repair_optimize(body: dict[str, Any]) -> None:
+    """z or bounds.z; spin_path with casadi and fixed spin only; the start inside the bounds."""
+    bounds = body["bounds"]
+    if body.get("z") is not None and bounds.get("z") is not None:
+        bounds["z"] = None
+    if body.get("z") is None and bounds.get("z") is None:
+        body["z"] = 0.1
+    spin = bounds.get("spin")
+    if spin is not None and spin[1] - spin[0] > 2 * math.pi:
+        bounds["spin"] = [spin[0], spin[0] + 2 * math.pi]
+    free = body.get("spin_mode") == "free" or (
+        body.get("spin_mode") is None and body["path"].get("tool_axis_waypoints") is not None
+    )
+    if body.get("method") == "scipy" or free:
+        body["spin_path"] = None
+    coarse = 1.0
+    for key, step in (("x", 0.02), ("y", 0.02), ("yaw", math.radians(15)), ("z", 0.02)):
+        if bounds.get(key) is not None:
+            coarse *= (bounds[key][1] - bounds[key][0]) / step + 2
+    if coarse > LIMITS["max_map_cells"] / 4:  # the coarse map at 20 mm, 15 deg (a spin too)
+        for key, width in (("x", 0.1), ("y", 0.1), ("yaw", 0.5), ("z", 0.1), ("spin", 0.0)):
+            if bounds.get(key) is not None:
+                low, high = bounds[key]
+                middle = (low + high) / 2
+                bounds[key] = [max(low, middle - width / 2), min(high, middle + width / 2)]
+    start = body.get("start")
+    if start is not None:
+        for key in ("x", "y", "yaw", "spin", "z"):
+            low, high = bounds.get(key) or ([body["z"]] * 2 if key == "z" else [0.0, 0.0])
+            start[key] = min(max(start.get(key) or 0.0, low), high)
+
+
+def map_case(context: Any, case: schemathesis.Case) -> schemathesis.Case:
+    """Give positive cases unit vectors and ordered ranges, and meet the cross-field rules."""
+    if not _positive(case) or not isinstance(case.body, dict):
+        return case
+    body = case.body = _normalise(case.body)
+    route = case.operation.path
+    if isinstance(body.get("robot"), dict):
+        lower, upper = _repair_robot(body)
+        _repair_branch(body)
+        if route == "/v1/dtf":
+            _repair_dtf(body, lower, upper)
+    path = body.get("path")
+    n = 0
+    if isinstance(path, dict) and _waypoints(path):
+        limit = "max_optimize_waypoints" if route == "/v1/optimize" else "max_path_waypoints"
+        _repair_path(path, int(LIMITS[limit]))
+        n = len(_waypoints(path))
+    if route == "/v1/evaluate" and body.get("spins") is not None:
+        body["spins"] = _resized(body["spins"], n, 0.0)
+    if route.startswith("/v1/map") and isinstance(body.get("grid"), dict) and n:
+        _repair_grid(body["grid"], n, png=route.endswith("/png"))
+    if route == "/v1/optimize" and isinstance(body.get("bounds"), dict):
+        _repair_optimize(body)
+    return case
+
+
+def before_add_examples(context: Any, examples: list[schemathesis.Case]) -> None:
+    """The same rules for the cases schemathesis builds from the spec's examples."""
+    examples[:] = [map_case(context, case) for case in examples]
+
+
+def after_call(context: Any, case: schemathesis.Case, response: Any) -> None:
+    """Count the answer's status, per operation and generation mode."""
+    mode = "positive" if _positive(case) else "negative"
+    STATUSES[(case.operation.label, mode, response.status_code)] += 1
+
+
+def register(schema: Any, *, limits: dict[str, float]) -> None:
+    """Apply these hooks to ``schema`` only, for a server with these settings."""
+    LIMITS.update(limits)
+    for hook in (map_case, before_add_examples, after_call):
+        schema.hook(hook)

@@ -1,0 +1,105 @@
+"""The committed OpenAPI spec against a live server, with every schemathesis check (issue 9).
+
+A uvicorn server is started with small work limits (so that a generated request cannot take
+minutes); schemathesis generates requests from ``openapi/openapi.json`` in every phase
+(examples, coverage, fuzzing), seeded, a bounded number per operation, and runs all its checks:
+no server error, documented statuses, content types and headers, responses that match their
+schemas, schema-violating requests rejected (ST201) and schema-valid ones accepted (ST202). The
+rules the spec states in words rather than JSON Schema are in ``tests/contract_hooks.py``.
+
+The figures (cases and statuses per operation) are written to
+``tests/artifacts/contract.txt``; ``.ci/run`` prints them.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import socket
+import subprocess
+import sys
+import time
+import urllib.request
+from collections.abc import Iterator
+
+import hypothesis
+import pytest
+import schemathesis
+
+from tests import contract_hooks
+from tests.cases import ROOT
+
+LIMITS = {
+    "max_map_cells": 2000,
+    "max_map_poses": 200_000,
+    "max_optimize_waypoints": 20,
+    "max_path_waypoints": 500,
+    "max_png_panels": 24,
+}
+"""The live server's work limits: small, so that every generated request answers in seconds."""
+ARTIFACT = ROOT / "tests" / "artifacts" / "contract.txt"
+
+
+def _free_port() -> int:
+    with socket.socket() as probe:
+        probe.bind(("127.0.0.1", 0))
+        return int(probe.getsockname()[1])
+
+
+def start_server(env: dict[str, str]) -> tuple[subprocess.Popen[bytes], str]:
+    """A uvicorn process serving the app on a free port, once it answers /healthz."""
+    port = _free_port()
+    url = f"http://127.0.0.1:{port}"
+    process = subprocess.Popen(
+        [sys.executable, "-m", "uvicorn", "service.main:app", "--port", str(port)],
+        cwd=ROOT,
+        env={**os.environ, **env},
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.DEVNULL,
+    )
+    deadline = time.monotonic() + 60
+    while time.monotonic() < deadline:
+        try:
+            with urllib.request.urlopen(url + "/healthz", timeout=1):
+                return process, url
+        except OSError:
+            time.sleep(0.2)
+    process.kill()
+    raise RuntimeError("the server did not start within 60 s")
+
+
+@pytest.fixture(scope="module")
+def live_url() -> Iterator[str]:
+    """The URL of a live server with the contract limits; the figures written at the end."""
+    env = {f"DTF_{name.upper()}": str(value) for name, value in LIMITS.items()}
+    process, url = start_server({**env, "DTF_MAX_SOLVER_SECONDS": "2"})
+    yield url
+    process.terminate()
+    process.wait(timeout=30)
+    ARTIFACT.parent.mkdir(exist_ok=True)
+    lines = [
+        f"{n:6d}  {status}  {mode:8s}  {label}"
+        for (label, mode, status), n in sorted(contract_hooks.STATUSES.items())
+    ]
+    total = sum(contract_hooks.STATUSES.values())
+    ARTIFACT.write_text(
+        f"schemathesis {schemathesis.__version__}, all checks, seed 1: {total} cases\n"
+        + "\n".join(lines)
+        + "\n"
+    )
+
+
+schema = schemathesis.openapi.from_dict(json.loads((ROOT / "openapi" / "openapi.json").read_text()))
+contract_hooks.register(schema, limits=LIMITS)
+
+
+@schema.parametrize()
+@hypothesis.settings(
+    max_examples=25,
+    deadline=None,
+    derandomize=True,
+    database=None,
+    suppress_health_check=list(hypothesis.HealthCheck),
+)
+def test_the_service_keeps_its_contract(case: schemathesis.Case, live_url: str) -> None:
+    case.call_and_validate(base_url=live_url)
