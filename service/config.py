@@ -24,11 +24,11 @@ class Settings(BaseSettings):
         description="Most placements (x * y * yaw values) one /v1/map request may ask for.",
     )
     max_map_poses: int = Field(
-        default=20_000_000,
+        default=5_000_000,
         gt=0,
         description="Most placement-waypoint pairs one /v1/map request, or the coarse map of one "
-        "/v1/optimize request, may ask for (each is 8 IK solutions; about half a million take a "
-        "second on 2 cores).",
+        "/v1/optimize request, may ask for (each is 8 IK solutions; 2 million took 4 s on the "
+        "2-core development machine, so the default is about 10 s).",
     )
     max_path_waypoints: int = Field(
         default=20_000,

@@ -20,6 +20,7 @@ from starlette.types import ASGIApp, Message, Receive, Scope, Send
 from service.config import get_settings
 from service.schemas import ErrorDetail, ErrorResponse
 from solver.exceptions import SolverError
+from solver.progress import Cancelled
 
 
 def _error_type(error: SolverError) -> str:
@@ -47,6 +48,10 @@ ERROR_RESPONSES: dict[int | str, dict[str, Any]] = {
     status.HTTP_415_UNSUPPORTED_MEDIA_TYPE: {
         "model": ErrorResponse,
         "description": "The body is not declared as JSON (Content-Type application/json).",
+    },
+    status.HTTP_503_SERVICE_UNAVAILABLE: {
+        "model": ErrorResponse,
+        "description": "The work was stopped because the service is shutting down; retry.",
     },
     status.HTTP_422_UNPROCESSABLE_CONTENT: {
         "model": ErrorResponse,
@@ -98,6 +103,16 @@ async def http_error_handler(request: Request, error: StarletteHTTPException) ->
         )
         return _error_response(status.HTTP_422_UNPROCESSABLE_CONTENT, [detail])
     return await http_exception_handler(request, error)
+
+
+async def cancelled_handler(request: Request, error: Cancelled) -> JSONResponse:
+    """Answer work stopped on the way (the client left, or the service is stopping) with 503."""
+    detail = ErrorDetail(
+        loc=[], msg="the work was stopped: the service is shutting down", type="cancelled"
+    )
+    response = _error_response(status.HTTP_503_SERVICE_UNAVAILABLE, [detail])
+    response.headers["Retry-After"] = "5"
+    return response
 
 
 async def solver_error_handler(request: Request, error: SolverError) -> JSONResponse:

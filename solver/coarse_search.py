@@ -16,6 +16,7 @@ import numpy as np
 from solver.exceptions import InvalidInputError
 from solver.pipeline import PreparedPath, SpinMode
 from solver.placements import evaluate_placements
+from solver.progress import Progress
 from solver.robots import Robot
 from solver.search_space import PlacementBounds
 from solver.spatial import MAX_COORDINATE
@@ -78,6 +79,7 @@ def coarse_cells(
     spin_mode: SpinMode = "fixed",
     max_cells: int = MAX_COARSE_CELLS,
     max_poses: int | None = None,
+    progress: Progress | None = None,
 ) -> list[Cell]:
     """Local maxima of a coarse map over the bounds, best first.
 
@@ -171,7 +173,12 @@ def coarse_cells(
     inside_index = [i for i, v in enumerate(vectors) if v is not None]
     if inside_index:
         result = evaluate_placements(
-            robot, path, np.array(rows), max_joint_step=max_joint_step, spin_mode=spin_mode
+            robot,
+            path,
+            np.array(rows),
+            max_joint_step=max_joint_step,
+            spin_mode=spin_mode,
+            progress=progress,
         )
         mu[inside_index], branch[inside_index] = result.mu_path, result.branch
     cells = []

@@ -32,6 +32,7 @@ from solver.exceptions import InvalidInputError, quoted
 from solver.pipeline import PreparedPath, SpinMode, prepare_path, require_family
 from solver.placement_nlp import PlacementNlp
 from solver.placement_scipy import global_search, polish
+from solver.progress import Progress, span
 from solver.robots import Robot
 from solver.search_space import PlacementBounds, vector_of
 from solver.spatial import Placement, spun_waypoints
@@ -112,6 +113,7 @@ def optimize_placement(
     max_coarse_cells: int = MAX_COARSE_CELLS,
     max_coarse_poses: int | None = None,
     max_solver_seconds: float | None = None,
+    progress: Progress | None = None,
 ) -> PlacementOptimum:
     """The placement inside ``bounds`` where the path runs fastest.
 
@@ -130,6 +132,8 @@ def optimize_placement(
         max_coarse_cells: the largest coarse map the casadi method may make.
         max_coarse_poses: the most placement-waypoint pairs of that map (None: no limit).
         max_solver_seconds: the longest one IPOPT solve may take (None: IPOPT's default).
+        progress: called with the fraction done (coarse map or DE, then each solve's
+            iterations); a :class:`solver.progress.Cancelled` it raises stops the search.
 
     Returns:
         The optimum (never below the start); ``found`` is False when neither the start nor any
@@ -180,6 +184,7 @@ def optimize_placement(
             spin_mode=spin_mode,
             max_cells=max_coarse_cells,
             max_poses=max_coarse_poses,
+            progress=span(progress, 0.0, 0.3),
         )
         candidates, statuses, iterations = _casadi(
             robot,
@@ -191,11 +196,12 @@ def optimize_placement(
             spin_mode,
             max_spin_step,
             max_solver_seconds,
+            span(progress, 0.3, 0.95),
         )
         name = "ipopt (casadi), from the coarse map's maxima"
     else:
         candidates, statuses, iterations = _scipy(
-            robot, prepared, bounds, max_joint_step, symmetric, spin_mode
+            robot, prepared, bounds, max_joint_step, symmetric, spin_mode, progress
         )
         name = "differential_evolution + SLSQP (scipy)"
     # The start last: it is the answer only when nothing the solver found is better.
@@ -252,6 +258,7 @@ def _casadi(
     spin_mode: SpinMode,
     max_spin_step: float | None,
     max_solver_seconds: float | None,
+    progress: Progress | None,
 ) -> tuple[list[Candidate], list[str], int]:
     """Candidates: the best coarse cell, then IPOPT's optimum from each of the best cells.
 
@@ -275,7 +282,8 @@ def _casadi(
         ipopt_options=None if max_solver_seconds is None else {"max_cpu_time": max_solver_seconds},
     )
     iterations = 0
-    for cell in cells[:N_STARTS]:
+    starts = cells[:N_STARTS]
+    for k, cell in enumerate(starts):
         at_start = evaluate_path(
             robot,
             path,
@@ -288,7 +296,13 @@ def _casadi(
             continue
         joint_speeds = qdot * (speed / v_max)[:, None]
         try:
-            result = nlp.solve(cell.vector, speed, q, joint_speeds)
+            result = nlp.solve(
+                cell.vector,
+                speed,
+                q,
+                joint_speeds,
+                progress=span(progress, k / len(starts), (k + 1) / len(starts)),
+            )
         except RuntimeError as error:  # IPOPT refused this start: the others still count
             statuses.append(f"IPOPT failed from a start: {str(error).splitlines()[-1][:200]}")
             candidates.append((cell.vector, None))
@@ -306,6 +320,7 @@ def _scipy(
     max_joint_step: float,
     symmetric: bool,
     spin_mode: SpinMode,
+    progress: Progress | None,
 ) -> tuple[list[Candidate], list[str], int]:
     """Candidates: the best placement of each basin DE saw, and SLSQP's polish of each."""
     basins, iterations = global_search(
@@ -315,6 +330,7 @@ def _scipy(
         max_joint_step=max_joint_step,
         symmetric=symmetric,
         spin_mode=spin_mode,
+        progress=span(progress, 0.0, 0.6),
     )
     if not basins:
         return [], [], iterations
@@ -322,7 +338,7 @@ def _scipy(
     statuses = ["best placement of differential evolution"]
     if prepared.pure_rotation.any() or basins[0][1] <= 0.0:
         return candidates, ["mu_path is 0 everywhere: the path turns on the spot"], iterations
-    for placement, mu_path, branch in basins:
+    for k, (placement, mu_path, branch) in enumerate(basins):
         polished, status, steps = polish(
             robot,
             prepared,
@@ -332,6 +348,9 @@ def _scipy(
             require_family(robot).branches[branch],
             max_joint_step=max_joint_step,
             spin_mode=spin_mode,
+            progress=span(
+                progress, 0.6 + 0.35 * k / len(basins), 0.6 + 0.35 * (k + 1) / len(basins)
+            ),
         )
         candidates.append((polished, None))
         statuses.append(f"SLSQP: {status}")

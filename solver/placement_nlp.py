@@ -32,6 +32,7 @@ import numpy as np
 
 from solver.casadi_kinematics import symbolic_kinematics
 from solver.pipeline import PreparedPath
+from solver.progress import Cancelled, Progress
 from solver.robots import Robot
 from solver.search_space import PlacementBounds
 
@@ -41,6 +42,45 @@ _MARGIN = 1e-9
 
 # casadi's bundled stubs reject valid SX/MX expressions (DM + SX, MX in nlpsol): untyped here.
 ca: Any = casadi
+MAX_ITERATIONS = 300
+
+
+class _IterationHook(ca.Callback):  # type: ignore[misc]
+    """IPOPT's call after each iteration: reports progress; a :class:`Cancelled` stops IPOPT."""
+
+    def __init__(self, n_variables: int, n_constraints: int) -> None:
+        ca.Callback.__init__(self)
+        self._sizes = {"x": n_variables, "lam_x": n_variables}
+        self._sizes |= {"g": n_constraints, "lam_g": n_constraints, "f": 1}
+        self.progress: Progress | None = None
+        self.cancelled: Cancelled | None = None
+        self.iteration = 0
+        self.construct("iteration_hook", {})
+
+    def get_n_in(self) -> int:
+        return int(ca.nlpsol_n_out())
+
+    def get_n_out(self) -> int:
+        return 1
+
+    def get_name_in(self, i: int) -> str:
+        return str(ca.nlpsol_out(i))
+
+    def get_name_out(self, i: int) -> str:
+        return "stop"
+
+    def get_sparsity_in(self, i: int) -> Any:
+        size = self._sizes.get(str(ca.nlpsol_out(i)), 0)
+        return ca.Sparsity.dense(size, 1) if size else ca.Sparsity(0, 0)
+
+    def eval(self, arguments: Any) -> list[int]:
+        self.iteration += 1
+        if self.progress is not None and self.cancelled is None:
+            try:
+                self.progress(min(self.iteration / MAX_ITERATIONS, 1.0))
+            except Cancelled as stop:
+                self.cancelled = stop
+        return [1 if self.cancelled is not None else 0]
 
 
 @dataclass(frozen=True)
@@ -167,12 +207,14 @@ class PlacementNlp:
             "ipopt.sb": "yes",
             "ipopt.tol": 1e-10,
             "ipopt.constr_viol_tol": 1e-10,
-            "ipopt.max_iter": 300,
+            "ipopt.max_iter": MAX_ITERATIONS,
             # Every start is feasible and near an optimum: a small barrier parameter from the
             # first iteration (measured: 11-16 iterations instead of 17-280).
             "ipopt.mu_init": 1e-5,
         }
         options.update({f"ipopt.{k}": v for k, v in (ipopt_options or {}).items()})
+        self._hook = _IterationHook(int(variables.numel()), int(constraints.numel()))
+        options["iteration_callback"] = self._hook
         self._solver = ca.nlpsol(
             "placement", "ipopt", {"x": variables, "f": -speed, "g": constraints}, options
         )
@@ -189,6 +231,8 @@ class PlacementNlp:
         start_speed: float,
         q_path: np.ndarray,
         qdot_path: np.ndarray,
+        *,
+        progress: Progress | None = None,
     ) -> NlpResult:
         """Solve from a feasible start.
 
@@ -198,6 +242,8 @@ class PlacementNlp:
             q_path: shape (N, n), rad, the start's joint path on the branch to follow.
             qdot_path: shape (N, n), rad/s, joint speeds there at feed rate ``start_speed``
                 (a feasible start for the twist constraints, with spin rate 0 in free mode).
+            progress: called after each IPOPT iteration; a :class:`Cancelled` it raises stops
+                IPOPT and is raised here.
         """
         robot, bounds, n = self._robot, self._bounds, self._n
         lower = np.concatenate(
@@ -238,7 +284,12 @@ class PlacementNlp:
             ]
         )
         began = time.perf_counter()
-        solution = self._solver(x0=guess, lbx=lower, ubx=upper, lbg=lbg, ubg=ubg)
+        self._hook.progress, self._hook.cancelled, self._hook.iteration = progress, None, 0
+        try:
+            solution = self._solver(x0=guess, lbx=lower, ubx=upper, lbg=lbg, ubg=ubg)
+        finally:
+            if self._hook.cancelled is not None:
+                raise self._hook.cancelled
         seconds = time.perf_counter() - began
         stats = self._solver.stats()
         x = np.asarray(solution["x"]).ravel()

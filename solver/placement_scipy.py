@@ -16,10 +16,12 @@ import scipy.optimize
 from solver.families.base import Branch
 from solver.pipeline import PreparedPath, SpinMode
 from solver.placements import evaluate_placements
+from solver.progress import Progress
 from solver.robots import Robot
 from solver.search_space import PlacementBounds
 
 SEED = 0  # differential evolution is seeded: same input, same output
+POLISH_ITERATIONS = 200  # SLSQP iterations at most from one start
 POPULATION = 20  # per dimension
 GENERATIONS = 60
 DIFFERENCE_STEP = 1e-6  # m and rad, for the polish's gradients
@@ -59,6 +61,7 @@ def global_search(
     max_joint_step: float,
     symmetric: bool,
     spin_mode: SpinMode = "fixed",
+    progress: Progress | None = None,
 ) -> tuple[list[Basin], int]:
     """Differential evolution over the free variables; the best point of each distinct basin.
 
@@ -81,6 +84,8 @@ def global_search(
             spin_mode=spin_mode,
         )
         seen.append((vectors, result.mu_path, result.branch))
+        if progress is not None:
+            progress(len(seen) / (GENERATIONS + 1))
         values: np.ndarray = np.where(np.isnan(result.mu_path), INFEASIBLE, -result.mu_path)
         return values
 
@@ -128,6 +133,7 @@ def polish(
     *,
     max_joint_step: float,
     spin_mode: SpinMode = "fixed",
+    progress: Progress | None = None,
 ) -> tuple[np.ndarray, str, int]:
     """SLSQP on the epigraph form over the free variables, from a feasible start, on one branch.
 
@@ -156,6 +162,8 @@ def polish(
             if result.v_max is None:  # not reached: asked for with_speeds
                 raise RuntimeError("evaluate_placements returned no speeds")
             cache[key] = result.v_max
+            if progress is not None:
+                progress(len(cache) / (POLISH_ITERATIONS + 1))
         return cache[key]
 
     def margin(v: np.ndarray) -> np.ndarray:
@@ -186,7 +194,7 @@ def polish(
         bounds=[*zip(bounds.lower[free], bounds.upper[free], strict=True), (0.0, None)],
         constraints=[{"type": "ineq", "fun": margin, "jac": margin_gradient}],
         method="SLSQP",
-        options={"ftol": 1e-14, "maxiter": 200},
+        options={"ftol": 1e-14, "maxiter": POLISH_ITERATIONS},
     )
     vector = _full(bounds, result.x[None, :n_free])[0]
     return vector, str(result.message), int(result.nit)

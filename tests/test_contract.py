@@ -14,12 +14,6 @@ The figures (cases and statuses per operation) are written to
 from __future__ import annotations
 
 import json
-import os
-import socket
-import subprocess
-import sys
-import time
-import urllib.request
 from collections.abc import Iterator
 
 import hypothesis
@@ -28,6 +22,7 @@ import schemathesis
 
 from tests import contract_hooks
 from tests.cases import ROOT
+from tests.live import start_server
 
 LIMITS = {
     "max_map_cells": 2000,
@@ -38,34 +33,6 @@ LIMITS = {
 }
 """The live server's work limits: small, so that every generated request answers in seconds."""
 ARTIFACT = ROOT / "tests" / "artifacts" / "contract.txt"
-
-
-def _free_port() -> int:
-    with socket.socket() as probe:
-        probe.bind(("127.0.0.1", 0))
-        return int(probe.getsockname()[1])
-
-
-def start_server(env: dict[str, str]) -> tuple[subprocess.Popen[bytes], str]:
-    """A uvicorn process serving the app on a free port, once it answers /healthz."""
-    port = _free_port()
-    url = f"http://127.0.0.1:{port}"
-    process = subprocess.Popen(
-        [sys.executable, "-m", "uvicorn", "service.main:app", "--port", str(port)],
-        cwd=ROOT,
-        env={**os.environ, **env},
-        stdout=subprocess.DEVNULL,
-        stderr=subprocess.DEVNULL,
-    )
-    deadline = time.monotonic() + 60
-    while time.monotonic() < deadline:
-        try:
-            with urllib.request.urlopen(url + "/healthz", timeout=1):
-                return process, url
-        except OSError:
-            time.sleep(0.2)
-    process.kill()
-    raise RuntimeError("the server did not start within 60 s")
 
 
 @pytest.fixture(scope="module")

@@ -4,23 +4,26 @@ from __future__ import annotations
 
 from typing import Annotated
 
-from fastapi import APIRouter, Header
+from fastapi import APIRouter, Header, Request
 from fastapi.responses import Response
 
 from service import convert
+from service.body import body_in_thread, body_openapi
 from service.config import Settings
 from service.deps import SettingsDep
 from service.errors import ERROR_RESPONSES
 from service.render import render_png
 from service.schemas import MapRequest, MapResponse
+from service.work import json_response, run_stoppable
 from solver.capability_map import CapabilityMap, capability_map
 from solver.pipeline import SpinMode
+from solver.progress import Progress
 
 router = APIRouter(prefix="/map", tags=["maps"], responses=ERROR_RESPONSES)
 
 
 def _computed_map(
-    body: MapRequest, settings: Settings, *, png: bool
+    body: MapRequest, settings: Settings, *, png: bool, progress: Progress
 ) -> tuple[CapabilityMap, str, SpinMode]:
     """The map a request asks for, its size checked first; the robot's name; the spin mode."""
     convert.check_path_size(
@@ -43,6 +46,7 @@ def _computed_map(
         branch=convert.branch_of(body.ik.branch),
         max_joint_step=body.ik.max_joint_step,
         spin_mode=spin_mode,
+        progress=progress,
     )
     return result, robot.name, spin_mode
 
@@ -57,9 +61,13 @@ def _picture(result: CapabilityMap, name: str) -> Response:
     operation_id="map",
     summary="mu_path over a grid of placements (JSON; PNG with Accept: image/png)",
     response_model=MapResponse,
+    openapi_extra=body_openapi(MapRequest),
 )
-def post_map(
-    body: MapRequest, settings: SettingsDep, accept: Annotated[str, Header()] = "application/json"
+async def post_map(
+    request: Request,
+    body: Annotated[MapRequest, body_in_thread(MapRequest)],
+    settings: SettingsDep,
+    accept: Annotated[str, Header()] = "application/json",
 ) -> MapResponse | Response:
     """Every placement of the grid with its mu_path (or why it is infeasible), best and worst.
 
@@ -67,10 +75,14 @@ def post_map(
     the operation generated clients should use for the picture).
     """
     png = convert.wants_png(accept)
-    result, name, spin_mode = _computed_map(body, settings, png=png)
-    if png:
-        return _picture(result, name)
-    return convert.map_response(result, spin_mode=spin_mode)
+
+    def work(progress: Progress) -> MapResponse | Response:
+        result, name, spin_mode = _computed_map(body, settings, png=png, progress=progress)
+        if png:
+            return _picture(result, name)
+        return json_response(convert.map_response(result, spin_mode=spin_mode))
+
+    return await run_stoppable(request, work)
 
 
 @router.post(
@@ -85,8 +97,17 @@ def post_map(
             "infeasible cells blank, the best and worst placements marked.",
         }
     },
+    openapi_extra=body_openapi(MapRequest),
 )
-def post_map_png(body: MapRequest, settings: SettingsDep) -> Response:
+async def post_map_png(
+    request: Request,
+    body: Annotated[MapRequest, body_in_thread(MapRequest)],
+    settings: SettingsDep,
+) -> Response:
     """The map of ``POST /v1/map`` as a picture (generated clients get bytes)."""
-    result, name, _ = _computed_map(body, settings, png=True)
-    return _picture(result, name)
+
+    def work(progress: Progress) -> Response:
+        result, name, _ = _computed_map(body, settings, png=True, progress=progress)
+        return _picture(result, name)
+
+    return await run_stoppable(request, work)

@@ -2,24 +2,47 @@
 
 from __future__ import annotations
 
-from fastapi import APIRouter
+from typing import Annotated
+
+from fastapi import APIRouter, Request, Response
 
 from service import convert
+from service.body import body_in_thread, body_openapi
+from service.config import Settings
 from service.deps import SettingsDep
 from service.errors import ERROR_RESPONSES
 from service.schemas import OptimizeRequest, OptimizeResponse
+from service.work import json_response, run_stoppable
 from solver.optimize import optimize_placement
+from solver.progress import Progress
 
 router = APIRouter(prefix="/optimize", tags=["optimize"], responses=ERROR_RESPONSES)
 
 
-@router.post("", operation_id="optimize", summary="The placement where the whole path runs fastest")
-def post_optimize(body: OptimizeRequest, settings: SettingsDep) -> OptimizeResponse:
+@router.post(
+    "",
+    operation_id="optimize",
+    summary="The placement where the whole path runs fastest",
+    response_model=OptimizeResponse,
+    openapi_extra=body_openapi(OptimizeRequest),
+)
+async def post_optimize(
+    request: Request,
+    body: Annotated[OptimizeRequest, body_in_thread(OptimizeRequest)],
+    settings: SettingsDep,
+) -> Response:
     """Maximise mu_path over (x, y, yaw) inside the bounds; every answer checked by the evaluator.
 
     No feasible placement inside the bounds is not an error: ``found`` is false. A box whose
     coarse map (20 mm, 15 degrees) would exceed DTF_MAX_MAP_CELLS cells is a 422 on ``bounds``.
     """
+    return await run_stoppable(
+        request, lambda progress: json_response(_optimum(body, settings, progress))
+    )
+
+
+def _optimum(body: OptimizeRequest, settings: Settings, progress: Progress) -> OptimizeResponse:
+    """The answer of ``POST /v1/optimize``, its size checked first."""
     convert.check_path_size(
         body.path, limit=settings.max_optimize_waypoints, setting="DTF_MAX_OPTIMIZE_WAYPOINTS"
     )
@@ -39,5 +62,6 @@ def post_optimize(body: OptimizeRequest, settings: SettingsDep) -> OptimizeRespo
         max_coarse_cells=settings.max_map_cells,
         max_coarse_poses=settings.max_map_poses,
         max_solver_seconds=settings.max_solver_seconds,
+        progress=progress,
     )
     return convert.optimize_response(optimum, robot, axis_correction=path.axis_correction)

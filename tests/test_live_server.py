@@ -1,0 +1,151 @@
+"""A live server under load (issue 9): /healthz stays fast, a client that leaves stops its work,
+SIGTERM stops the service in seconds.
+
+Each test starts uvicorn as the README does and talks to it over real connections. Work limits
+are lowered where a request at the default limit would take minutes.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import signal
+import statistics
+import threading
+import time
+from collections.abc import Iterator
+from pathlib import Path
+from typing import Any
+
+import httpx
+import pytest
+
+from tests.cases import ROOT
+from tests.live import start_server
+
+EXAMPLE = json.loads((ROOT / "examples" / "evaluate_request.json").read_text())
+N = len(EXAMPLE["path"]["waypoints"])
+MAP_POSES = 2_000_000
+OPTIMIZE_WAYPOINTS = 100
+LIMITS = {
+    "DTF_MAX_MAP_POSES": str(MAP_POSES),
+    "DTF_MAX_OPTIMIZE_WAYPOINTS": str(OPTIMIZE_WAYPOINTS),
+    "DTF_MAX_SOLVER_SECONDS": "3",
+}
+
+
+def grid_of(cells: int, *, yaws: int = 1) -> dict[str, Any]:
+    """A square grid of about ``cells`` placements per yaw around the ERK area."""
+    side = max(int(cells**0.5), 1)
+    step = 0.8 / side
+    axis = {"min": -0.4, "max": -0.4 + step * (side - 1), "step": step}
+    return {
+        "x": axis,
+        "y": {**axis, "min": 0.0, "max": step * (side - 1)},
+        "z": 0.1,
+        "yaw": [0.3 * k for k in range(yaws)],
+    }
+
+
+def line_path(n: int) -> dict[str, Any]:
+    """A straight cut of ``n`` waypoints, 0.1 mm apart, the tool pointing down."""
+    down = [1.0, 0.0, 0.0, 0.0]
+    return {
+        "waypoints": [{"position": [1e-4 * i, 0.0, 0.0], "orientation": down} for i in range(n)]
+    }
+
+
+def at_the_limit() -> dict[str, tuple[str, dict[str, Any]]]:
+    """A request at each route's limit (this server's settings, or the default where none)."""
+    robot = {"model": "ur5"}
+    map_body = {"robot": robot, "path": EXAMPLE["path"], "grid": grid_of(MAP_POSES // N)}
+    png_body = {**map_body, "grid": grid_of(MAP_POSES // N // 24, yaws=24)}
+    long_path = line_path(20_000)
+    optimize_path = line_path(OPTIMIZE_WAYPOINTS)
+    return {
+        "map": ("/v1/map", map_body),
+        "png": ("/v1/map/png", png_body),
+        "evaluate": (
+            "/v1/evaluate",
+            {"robot": robot, "path": long_path, "placement": EXAMPLE["placement"]},
+        ),
+        "optimize": (
+            "/v1/optimize",
+            {
+                "robot": robot,
+                "path": optimize_path,
+                "bounds": {"x": [-0.3, 0.3], "y": [0.3, 0.6], "yaw": [-3.14, 3.14]},
+                "z": 0.1,
+                "method": "scipy",
+            },
+        ),
+    }
+
+
+@pytest.fixture(scope="module")
+def server() -> Iterator[tuple[Any, str]]:
+    process, url = start_server(LIMITS, "--timeout-graceful-shutdown", "2")
+    yield process, url
+    process.kill()
+    process.wait()
+
+
+def _post(url: str, route: str, body: dict[str, Any], answers: list[int]) -> None:
+    answers.append(httpx.post(url + route, json=body, timeout=120).status_code)
+
+
+@pytest.mark.parametrize("name", ["map", "png", "evaluate", "optimize"])
+def test_healthz_stays_fast_while_a_request_at_the_limit_runs(
+    server: tuple[Any, str], name: str
+) -> None:
+    _, url = server
+    route, body = at_the_limit()[name]
+    answers: list[int] = []
+    work = threading.Thread(target=_post, args=(url, route, body, answers))
+    work.start()
+    latencies = []
+    with httpx.Client(base_url=url) as client:
+        while work.is_alive():
+            began = time.perf_counter()
+            assert client.get("/healthz").status_code == 200
+            latencies.append(time.perf_counter() - began)
+            time.sleep(0.02)
+    work.join()
+    assert answers == [200]  # the request at the limit is accepted and answered
+    assert len(latencies) >= 10, "the request ended before /healthz could be measured"
+    assert statistics.median(latencies) < 0.010
+    assert sorted(latencies)[int(0.9 * len(latencies))] < 0.050
+
+
+def _cpu_seconds(pid: int) -> float:
+    """User + system CPU time of a process so far (s), from /proc."""
+    fields = (Path("/proc") / str(pid) / "stat").read_text().rsplit(")", 1)[1].split()
+    return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
+
+
+def test_a_client_that_leaves_stops_its_work(server: tuple[Any, str]) -> None:
+    process, url = server
+    route, body = at_the_limit()["map"]
+    with pytest.raises(httpx.ReadTimeout):
+        httpx.post(url + route, json=body, timeout=0.5)  # a map of about 4 s, left after 0.5 s
+    time.sleep(0.5)
+    before = _cpu_seconds(process.pid)
+    time.sleep(1.0)
+    assert _cpu_seconds(process.pid) - before < 0.2  # idle: the map stopped
+
+
+def test_sigterm_stops_the_service_within_seconds() -> None:
+    process, url = start_server(
+        {"DTF_MAX_MAP_POSES": "40000000"}, "--timeout-graceful-shutdown", "2"
+    )
+    body = {"robot": {"model": "ur5"}, "path": EXAMPLE["path"], "grid": grid_of(40_000)}
+    answers: list[int] = []
+    work = threading.Thread(target=_post, args=(url, "/v1/map", body, answers))
+    work.start()  # about 5 million placement-waypoint pairs: several seconds of work
+    time.sleep(1.0)
+    process.send_signal(signal.SIGTERM)
+    began = time.monotonic()
+    process.wait(timeout=30)
+    work.join()
+    assert time.monotonic() - began < 5.0
+    assert answers in ([503], [])  # told to retry, or the connection closed
