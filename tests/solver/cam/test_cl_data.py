@@ -324,3 +324,17 @@ def test_a_right_angle_turn_names_its_line() -> None:
         path.waypoints_in_workpiece(field="path.cl_data")
     assert caught.value.line == 3
     assert caught.value.waypoint == 1
+
+
+def test_the_cl_examples_are_what_their_script_writes() -> None:
+    import importlib.util
+
+    spec = importlib.util.spec_from_file_location(
+        "make_cam_examples", CAM_EXAMPLES / "make_cam_examples.py"
+    )
+    assert spec is not None and spec.loader is not None
+    script = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(script)
+    assert script.cl_program(inch=False) == (CAM_EXAMPLES / "sweep_mm.cl").read_text()
+    assert script.cl_program(inch=True) == (CAM_EXAMPLES / "sweep_inch.cl").read_text()
+    assert script.three_axis_program() == (CAM_EXAMPLES / "sweep_3axis_mm.cl").read_text()
