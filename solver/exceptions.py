@@ -68,3 +68,28 @@ class RobotModelError(SolverError):
 
 class NoAnalyticIkError(SolverError):
     """Path evaluation needs an arm with a kinematics family (a UR or OPW arm)."""
+
+
+class InvalidLineError(InvalidInputError):
+    """A line of a text file (CL data, a CSV path) that cannot be read as it stands.
+
+    Attributes:
+        line: the line number, from 1 (where the record starts, for a continued record).
+        text: the record or line as read (the message echoes at most 100 characters of it), or
+            ``None`` when it is not at hand.
+    """
+
+    def __init__(
+        self,
+        field: str,
+        message: str,
+        *,
+        line: int,
+        text: str | None = None,
+        waypoint: int | None = None,
+    ) -> None:
+        """Name the line and echo its text."""
+        echo = "" if text is None else f" (in {quoted(text)})"
+        super().__init__(field, f"line {line}: {message}{echo}", waypoint=waypoint)
+        self.line = line
+        self.text = text

@@ -54,3 +54,10 @@ FREE_SPIN_LP_RTOL = 1e-9
 # Fixed mode with the free mode's spins against the free mode's mu_path (cam.md section 2: the
 # discretisation error of the schedule, under 1 % on a 133-waypoint path).
 SPIN_SCHEDULE_RTOL = 0.01
+
+# CAM files (cam.md sections 5, 6 and 8).
+CAM_EXAMPLES = EXAMPLES / "cam"
+# The same program in inches and in millimetres (coordinates exact in both): metres agree to this.
+INCH_MM_ATOL = 1e-12
+# A controller's frame back to the matrix (cam.md section 8): every entry, m for the position.
+FRAME_ROUND_TRIP_ATOL = 1e-9
