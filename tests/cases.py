@@ -12,6 +12,8 @@ EXAMPLES = ROOT / "examples"
 
 UR_MODELS = ("ur3", "ur5", "ur10", "ur3e", "ur5e", "ur10e", "ur16e")
 E_SERIES = ("ur3e", "ur5e", "ur10e", "ur16e")
+# Arms with no analytic IK: example-robot-data URDFs with the numeric family (robots.md 4).
+NUMERIC_MODELS = ("panda", "xarm7", "kinova_jaco2")
 OPW_MODELS = (
     "kuka_kr6_r700_sixx",
     "kuka_kr16_2",
