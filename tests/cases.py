@@ -56,3 +56,9 @@ FREE_SPIN_LP_RTOL = 1e-9
 # Fixed mode with the free mode's spins against the free mode's mu_path (cam.md section 2: the
 # discretisation error of the schedule, under 1 % on a 133-waypoint path).
 SPIN_SCHEDULE_RTOL = 0.01
+
+# UR5 as a plain URDF through the numeric family against the analytic UR family (issue 11):
+# the share of cells where feasibility and, on analytic-feasible cells, mu_path agree, and the
+# relative tolerance of "agree" (numeric never above the analytic value by more).
+NUMERIC_VS_ANALYTIC_AGREEMENT = 0.98
+NUMERIC_VS_ANALYTIC_RTOL = 1e-6
