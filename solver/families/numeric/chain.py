@@ -102,17 +102,24 @@ class SerialChain:
         position = np.broadcast_to(self.base_translation, (m, 3))
         axes = np.empty((m, self.dof, 3))
         origins = np.empty((m, self.dof, 3))
+        cos, sin = np.cos(q), np.sin(q)
         for j in range(self.dof):
-            position = position + rotation @ self.joint_translation[j]
-            rotation = rotation @ self.joint_rotation[j]
-            axes[:, j] = rotation @ self.axis[j]
+            position = position + _times(rotation, self.joint_translation[j])
+            rotation = _times(rotation, self.joint_rotation[j])
+            axis = self.axis[j]
+            axes[:, j] = _times(rotation, axis)
             origins[:, j] = position
-            if self.revolute[j]:
-                rotation = rotation @ _axis_rotation(self.axis[j], q[:, j])
+            if self.revolute[j]:  # Rodrigues: R exp([a] q) = c R + s R [a] + (1 - c) (R a) a^T
+                c, s = cos[:, j, None, None], sin[:, j, None, None]
+                rotation = (
+                    c * rotation
+                    + s * _times(rotation, _skew(axis))
+                    + (1.0 - c) * axes[:, j, :, None] * axis
+                )
             else:
                 position = position + axes[:, j] * q[:, j, None]
-        flange_position = position + rotation @ self.tool_translation
-        return axes, origins, rotation @ self.tool_rotation, flange_position
+        flange_position = position + _times(rotation, self.tool_translation)
+        return axes, origins, _times(rotation, self.tool_rotation), flange_position
 
     def forward(self, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """The flange pose in {B}: rotation (M, 3, 3) and position (M, 3, m), for q (M, n)."""
@@ -141,9 +148,14 @@ class SerialChain:
         return jacobian, rotation, position
 
 
-def _axis_rotation(axis: np.ndarray, angle: np.ndarray) -> np.ndarray:
-    """Rodrigues: rotations (M, 3, 3) by ``angle`` (M,) rad about the unit ``axis`` (3,)."""
-    cos, sin = np.cos(angle)[:, None, None], np.sin(angle)[:, None, None]
-    skew = np.array([[0.0, -axis[2], axis[1]], [axis[2], 0.0, -axis[0]], [-axis[1], axis[0], 0.0]])
-    rotation: np.ndarray = cos * np.eye(3) + sin * skew + (1.0 - cos) * np.outer(axis, axis)
-    return rotation
+def _skew(axis: np.ndarray) -> np.ndarray:
+    """[a], shape (3, 3): [a] v = a x v."""
+    return np.array([[0.0, -axis[2], axis[1]], [axis[2], 0.0, -axis[0]], [-axis[1], axis[0], 0.0]])
+
+
+def _times(rotation: np.ndarray, constant: np.ndarray) -> np.ndarray:
+    """(M, 3, 3) @ (3, 3) or (M, 3, 3) @ (3,) as one 2-D product (BLAS, not M small ones)."""
+    product: np.ndarray = (rotation.reshape(-1, 3) @ constant).reshape(
+        rotation.shape[:-1] + constant.shape[1:]
+    )
+    return product

@@ -186,8 +186,7 @@ class NumericFamily(KinematicsFamily):
         rows = np.flatnonzero(np.isfinite(q_flat).all(axis=-1))
         jacobian, _, _ = self.chain.jacobian(q_flat[rows], point_flat[rows])
         if self.dof == 6:
-            with np.errstate(all="ignore"):
-                speeds[rows] = np.linalg.solve(jacobian, twist_flat[rows, :, None])[..., 0]
+            speeds[rows] = _solve_or_nan(jacobian, twist_flat[rows])
         elif self.dof > 6 and qdot_max is not None:
             speed, qdot = redundant_speed(jacobian, twist_flat[rows], qdot_max)
             with np.errstate(divide="ignore", invalid="ignore"):
@@ -195,3 +194,17 @@ class NumericFamily(KinematicsFamily):
         else:  # fewer than six joints: the least-squares speeds (the twist may be out of reach)
             speeds[rows] = (np.linalg.pinv(jacobian) @ twist_flat[rows, :, None])[..., 0]
         return np.moveaxis(speeds.reshape(*shape, self.dof), -1, 0)
+
+
+def _solve_or_nan(jacobian: np.ndarray, twist: np.ndarray) -> np.ndarray:
+    """J^-1 t for (M, 6, 6) and (M, 6); NaN rows where J is exactly singular."""
+    try:
+        speeds: np.ndarray = np.linalg.solve(jacobian, twist[..., None])[..., 0]
+    except np.linalg.LinAlgError:  # one exactly singular J stops the batch: go one by one
+        speeds = np.full(twist.shape, np.nan)
+        for m in range(len(twist)):
+            try:
+                speeds[m] = np.linalg.solve(jacobian[m], twist[m])
+            except np.linalg.LinAlgError:
+                continue
+    return speeds

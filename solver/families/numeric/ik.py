@@ -182,6 +182,6 @@ def distinct(
 def is_singular(chain: SerialChain, q: np.ndarray) -> np.ndarray:
     """Where the Jacobian of q (M, n) loses rank: sigma_min / sigma_max < SINGULAR_RCOND."""
     jacobian, _, _ = chain.jacobian(q)
-    values = np.linalg.svd(jacobian, compute_uv=False)  # (M, 6), descending
-    singular: np.ndarray = values[:, -1] < SINGULAR_RCOND * values[:, 0]
+    squares = np.linalg.eigvalsh(jacobian @ jacobian.transpose(0, 2, 1))  # sigma^2, ascending
+    singular: np.ndarray = squares[:, 0] < SINGULAR_RCOND**2 * squares[:, -1]
     return singular

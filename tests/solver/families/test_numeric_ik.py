@@ -7,6 +7,7 @@ import pinocchio as pin
 import pytest
 
 from solver.evaluate import evaluate_path
+from solver.exceptions import InvalidInputError
 from solver.families.base import OK, UNREACHABLE
 from solver.families.numeric.family import NumericFamily, seed_count
 from solver.families.numeric.ik import rotation_log
@@ -152,3 +153,14 @@ def test_tracked_path_reaches_every_waypoint(name: str, placement: Placement) ->
         np.testing.assert_allclose(tool_pose_in_base(robot, result.q[i]), poses[i], atol=1e-9)
     assert np.all(result.q >= robot.q_lower - 1e-12) and np.all(result.q <= robot.q_upper + 1e-12)
     assert np.abs(np.diff(result.q, axis=0)).max() <= 0.35
+
+
+def test_free_spin_is_refused_for_a_redundant_arm() -> None:
+    with pytest.raises(InvalidInputError) as info:
+        evaluate_path(
+            get_robot("panda"),
+            load_path("curved_line"),
+            Placement(0.4, 0, 0.1, 0),
+            spin_mode="free",
+        )
+    assert info.value.field == "spin_mode"
