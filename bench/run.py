@@ -9,7 +9,9 @@ It prints the vectorised map's time on the ERK 2021 problem (UR5, x = -0.25..0.2
 y = 0.25..0.65 m, step 0.02 m, z = 0.1 m, 133 waypoints, all IK branches), the same map by a
 scalar loop (ur-analytic-ik IK, pinocchio Jacobian and numpy solve per pose and branch) timed
 on a subset in the same run and extrapolated, their ratio, the time per pose and branch, and
-the 8-yaw map against the 1-yaw map. Then the placement optimisation of the same problem
+the 8-yaw map against the 1-yaw map; the numeric IK family's map on the same grid (UR5 read as a
+plain URDF, checked equal to the analytic map, and the Panda) against the analytic one. Then the
+placement optimisation of the same problem
 (yaw free): each method's time and optimum, against the best cell of a fine grid (10 mm,
 5 degrees) computed in the same run.
 """
@@ -29,7 +31,7 @@ import ur_analytic_ik
 from solver.capability_map import capability_map, grid_axis
 from solver.kinematics import jacobian_in_base
 from solver.optimize import optimize_placement
-from solver.robots import Robot, get_robot
+from solver.robots import Robot, example_robot_data_dir, get_robot, robot_from_urdf
 from solver.search_space import PlacementBounds
 from solver.spatial import Placement, pose_matrix
 from solver.task import task_requirements
@@ -152,7 +154,37 @@ def main() -> None:
         f"{t_opw / (opw_cells * len(path) * 8) * 1e9:6.0f} ns per pose-branch, "
         f"{t_opw / t_map * cells / opw_cells:.2f}x the UR5 map per placement"
     )
+    numeric_maps(path, xs, ys, z, t_map)
     optimisation(robot, path, smoke=args.smoke)
+
+
+def numeric_maps(path: np.ndarray, xs: np.ndarray, ys: np.ndarray, z: float, t_map: float) -> None:
+    """The numeric family's map on the same grid: UR5 as a plain URDF, and the Panda (one run).
+
+    The UR5's URDF is read without a family, so it gets the numeric one (robots.md section 4);
+    its map must equal the analytic one, which is checked here too.
+    """
+    analytic = get_robot("ur5")
+    file = example_robot_data_dir() / "ur_description" / "urdf" / "ur5_robot.urdf"
+    urdf = file.read_text().replace("1.57079632679", repr(math.pi / 2))
+    urdf = urdf.replace("3.14159265359", repr(math.pi))
+    arms = {
+        "UR5 as a URDF": robot_from_urdf(urdf, base_frame="base", tool_frame="tool0"),
+        "Panda": get_robot("panda"),
+    }
+    reference = capability_map(analytic, path, xs=xs, ys=ys, z=z, yaws=np.zeros(1)).mu_path
+    print(f"numeric IK maps ({len(xs) * len(ys)} placements, one run each):")
+    for label, arm in arms.items():
+        start = time.perf_counter()
+        cmap = capability_map(arm, path, xs=xs, ys=ys, z=z, yaws=np.zeros(1))
+        seconds = time.perf_counter() - start
+        line = f"  {label:14s} {seconds:8.3f} s   {seconds / t_map:6.0f}x the analytic UR5 map"
+        if arm.dof == 6:
+            same = np.isclose(cmap.mu_path, reference, rtol=1e-6, atol=0) | (
+                np.isnan(cmap.mu_path) & np.isnan(reference)
+            )
+            line += f"; equal to it on {same.mean():.1%} of the cells"
+        print(line)
 
 
 def optimisation(robot: Robot, path: np.ndarray, *, smoke: bool) -> None:

@@ -53,6 +53,9 @@ class PathEvaluation:
         spin_mode: ``fixed`` or ``free``, as asked.
         spins: shape (N,), rad, in ``free`` spin mode the spin schedule that realises mu_path
             (q is then the joint path along it); ``None`` otherwise.
+        ik_seeds: how many seeds a numeric IK family started from at the first waypoint;
+            ``None`` for an analytic family (which finds every branch).
+        ik_branches_found: how many distinct IK solutions it found there (``None`` likewise).
     """
 
     feasible: bool
@@ -72,6 +75,8 @@ class PathEvaluation:
     limiting_joint: np.ndarray | None = None
     spin_mode: SpinMode = "fixed"
     spins: np.ndarray | None = None
+    ik_seeds: int | None = None
+    ik_branches_found: int | None = None
 
 
 def _turned(vectors: np.ndarray, yaw: float) -> np.ndarray:
@@ -125,6 +130,8 @@ def evaluate_path(
         u_R=_turned(path.u_R, placement.yaw),
         h=path.h,
         spin_mode=spin_mode,
+        ik_seeds=run.ik_seeds,
+        ik_branches_found=None if run.branches_found is None else int(run.branches_found[0]),
     )
     if reason != FEASIBLE:
         return infeasible

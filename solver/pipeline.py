@@ -114,6 +114,11 @@ def check_spin_mode(robot: Robot, spin_mode: str) -> None:
             "spin_mode",
             f"free spin needs a revolute last joint; {robot.joint_names[-1]!r} is prismatic",
         )
+    if spin_mode == "free" and robot.dof != 6:
+        raise InvalidInputError(
+            "spin_mode",
+            f"free spin is solved for six-joint arms; {robot.name!r} has {robot.dof} joints",
+        )
 
 
 def require_family(robot: Robot) -> KinematicsFamily:
@@ -121,7 +126,8 @@ def require_family(robot: Robot) -> KinematicsFamily:
     if robot.family is None:
         raise NoAnalyticIkError(
             "robot",
-            f"path evaluation needs an arm with an IK family (UR or OPW); {robot.name!r} has none",
+            f"path evaluation needs an arm with an IK family (UR, OPW, or numeric for a serial "
+            f"chain of six joints or more); {robot.name!r} has none",
         )
     return robot.family
 
@@ -188,6 +194,9 @@ class ChunkResult:
             paths along that schedule, so its position limits and steps are checked.
         pick: shape (C,), the index on axis B of the branch each placement takes (``auto``: the
             highest mu_path; the furthest failure where none is feasible).
+        ik_seeds: the seeds a numeric family started from (None for an analytic one).
+        branches_found: shape (C,), the distinct IK solutions a numeric family found at the
+            first waypoint (None for an analytic one).
     """
 
     tracked: Tracked
@@ -199,6 +208,8 @@ class ChunkResult:
     mu_path: np.ndarray
     pick: np.ndarray
     spins: np.ndarray | None = None
+    ik_seeds: int | None = None
+    branches_found: np.ndarray | None = None
 
 
 def turn_by_yaw(vectors: np.ndarray, yaws: np.ndarray) -> np.ndarray:
@@ -259,7 +270,8 @@ def run_chunk(
     twist = np.concatenate(
         [turn_by_yaw(path.twist[:, :3].T, yaws), turn_by_yaw(path.twist[:, 3:].T, yaws)]
     )
-    q, status = family.solve(rotation, flange_position)  # (n, B_all, C, W), (B_all, C, W)
+    solutions = family.solve_path(rotation, flange_position)
+    q, status = solutions.q, solutions.status  # (n, B_all, C, W), (B_all, C, W)
     # In free mode the position limits hold along the spin schedule, checked there, not here.
     free = spin_mode == "free"
     tracked = track(
@@ -269,7 +281,11 @@ def run_chunk(
         upper=np.full(robot.dof, np.inf) if free else robot.q_upper,
         max_joint_step=max_joint_step,
     )
-    qd_unit = family.joint_speeds_per_unit_twist(tracked.q, twist[:, None], tool_position[:, None])
+    # For dof > 6 these are the exact DTF LP's joint speeds per unit speed (robots.md section 5),
+    # so the ratio below gives the LP's V_max for every dof.
+    qd_unit = family.joint_speeds_per_unit_twist(
+        tracked.q, twist[:, None], tool_position[:, None], qdot_max=robot.qdot_max
+    )
     qd_spin = None
     if free:
         tool_z = turn_by_yaw(path.tool_rotation[:, :, 2].T, yaws)
@@ -304,6 +320,8 @@ def run_chunk(
         mu_path=mu_path,
         pick=pick,
         spins=spins,
+        ik_seeds=solutions.seeds,
+        branches_found=solutions.branches_found,
     )
 
 

@@ -18,7 +18,7 @@ import numpy as np
 import pinocchio as pin
 
 from solver.exceptions import InvalidInputError, RobotModelError, UnknownRobotError, quoted
-from solver.families import catalogue
+from solver.families import catalogue, default_family
 from solver.families.base import KinematicsFamily
 
 # Joint speed limits outside this range (rad/s) are input errors: no arm is that slow or fast,
@@ -42,8 +42,9 @@ class Robot:
         qdot_max: shape (n,), rad/s, joint speed limits (all > 0).
         transform_tool_to_tcp: shape (4, 4), the tool point in the tool frame, T_F_TCP.
         transform_world_to_base: shape (4, 4), {B} in the model's root frame (fixed).
-        family: the kinematics family that solves its IK and J^-1 t (robots.md section 1);
-            ``None`` for a robot that only has a pinocchio model (``/v1/dtf`` only).
+        family: the kinematics family that solves its IK and J^-1 t (robots.md section 1):
+            an analytic one, or the numeric one for any other serial chain of six joints or
+            more; ``None`` for a shorter chain (``/v1/dtf`` only).
     """
 
     name: str
@@ -153,7 +154,8 @@ def robot_from_model(
         base_frame: frame {B}, fixed to the root.
         tool_frame: the flange frame {F}.
         qdot_max: shape (n,), rad/s; ``None`` takes the model's velocity limits.
-        family: the kinematics family, when the arm has one.
+        family: the kinematics family; ``None`` gives the numeric family to a serial chain of
+            six joints or more (:func:`solver.families.default_family`), and none to others.
 
     Raises:
         RobotModelError: a frame is missing or moves, a joint is not 1-DOF, or the model's
@@ -187,6 +189,8 @@ def robot_from_model(
             raise RobotModelError(
                 "robot.urdf", f"{exc.message}; give robot.joint_velocity_limits (rad/s)"
             ) from exc
+    if family is None:
+        family = default_family(model, base_frame=base_frame, tool_frame=tool_frame)
     _set_tool_point(model, tool_frame, np.eye(4))
     robot = Robot(
         name=name,
@@ -225,7 +229,8 @@ def robot_from_urdf(
         name: name reported for the robot.
         qdot_max: shape (n,), rad/s, joint speed limits; ``None`` takes the URDF's (which then
             must be usable).
-        family: the kinematics family of the arm, when it has one.
+        family: the kinematics family of the arm; ``None`` gives the numeric family to a
+            chain of six joints or more.
 
     Raises:
         RobotModelError: the URDF cannot be parsed, a frame is missing, or the chain has

@@ -12,6 +12,8 @@ EXAMPLES = ROOT / "examples"
 
 UR_MODELS = ("ur3", "ur5", "ur10", "ur3e", "ur5e", "ur10e", "ur16e")
 E_SERIES = ("ur3e", "ur5e", "ur10e", "ur16e")
+# Arms with no analytic IK: example-robot-data URDFs with the numeric family (robots.md 4).
+NUMERIC_MODELS = ("panda", "xarm7", "kinova_jaco2")
 OPW_MODELS = (
     "kuka_kr6_r700_sixx",
     "kuka_kr16_2",
@@ -61,3 +63,9 @@ CAM_EXAMPLES = EXAMPLES / "cam"
 INCH_MM_ATOL = 1e-12
 # A controller's frame back to the matrix (cam.md section 8): every entry, m for the position.
 FRAME_ROUND_TRIP_ATOL = 1e-9
+
+# UR5 as a plain URDF through the numeric family against the analytic UR family (issue 11):
+# the share of cells where feasibility and, on analytic-feasible cells, mu_path agree, and the
+# relative tolerance of "agree" (numeric never above the analytic value by more).
+NUMERIC_VS_ANALYTIC_AGREEMENT = 0.98
+NUMERIC_VS_ANALYTIC_RTOL = 1e-6

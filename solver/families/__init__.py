@@ -12,10 +12,19 @@ import importlib
 from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
+    import pinocchio as pin
+
+    from solver.families.base import KinematicsFamily
     from solver.robots import Robot
 
 # Modules with a ``robots() -> dict[str, Robot]`` function, in catalogue order.
-CATALOGUE_MODULES = ("solver.families.ur.catalogue", "solver.families.opw.catalogue")
+CATALOGUE_MODULES = (
+    "solver.families.ur.catalogue",
+    "solver.families.opw.catalogue",
+    "solver.families.numeric.catalogue",
+)
+# Numeric IK solves six-dimensional poses: it needs at least six joints (robots.md section 4).
+NUMERIC_MIN_DOF = 6
 
 
 @functools.cache
@@ -25,3 +34,21 @@ def catalogue() -> dict[str, Robot]:
     for module in CATALOGUE_MODULES:
         robots.update(importlib.import_module(module).robots())
     return robots
+
+
+def default_family(
+    model: pin.Model, *, base_frame: str, tool_frame: str
+) -> KinematicsFamily | None:
+    """The family of an arm that has no analytic one: numeric IK (robots.md section 4).
+
+    ``None`` when the model has fewer than six joints or is not one serial chain to the tool.
+    """
+    from solver.exceptions import RobotModelError
+    from solver.families.numeric.family import NumericFamily
+
+    if model.nv < NUMERIC_MIN_DOF:
+        return None
+    try:
+        return NumericFamily(model, base_frame=base_frame, tool_frame=tool_frame)
+    except RobotModelError:
+        return None

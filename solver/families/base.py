@@ -26,6 +26,25 @@ SINGULAR = 2
 
 
 @dataclass(frozen=True)
+class PathSolutions:
+    """IK solutions along paths, branch by branch (what :meth:`KinematicsFamily.solve_path` gives).
+
+    Attributes:
+        q: shape (dof, n_branches, *batch, W), rad, NaN where a branch has no solution.
+        status: shape (n_branches, *batch, W), ``OK``, ``UNREACHABLE`` or ``SINGULAR``.
+        seeds: how many seeds a numeric family started from at the first waypoint; ``None``
+            for an analytic family (it returns every branch).
+        branches_found: shape batch, the distinct solutions found at the first waypoint of each
+            path (numeric families); ``None`` for an analytic family.
+    """
+
+    q: np.ndarray
+    status: np.ndarray
+    seeds: int | None = None
+    branches_found: np.ndarray | None = None
+
+
+@dataclass(frozen=True)
 class Branch:
     """An IK branch by name: one choice per level, e.g. shoulder=left, elbow=up, wrist=noflip.
 
@@ -101,17 +120,42 @@ class KinematicsFamily(abc.ABC):
             still filled where singular).
         """
 
+    def solve_path(self, rotation: np.ndarray, position: np.ndarray) -> PathSolutions:
+        """IK solutions along paths: waypoints on the last batch axis, branches followed.
+
+        An analytic family solves every waypoint on its own (its branch labels mean the same
+        thing everywhere), which is this default. A numeric family overrides it: it seeds the
+        first waypoint and follows each solution it found from one waypoint to the next.
+
+        Args:
+            rotation: shape (3, 3, *batch, W), R_B_F of the flange, broadcasting with
+                ``position``.
+            position: shape (3, *batch, W), m in {B}.
+        """
+        q, status = self.solve(rotation, position)
+        return PathSolutions(q=q, status=status)
+
     @abc.abstractmethod
     def joint_speeds_per_unit_twist(
-        self, q: np.ndarray, twist: np.ndarray, tool_point: np.ndarray
+        self,
+        q: np.ndarray,
+        twist: np.ndarray,
+        tool_point: np.ndarray,
+        *,
+        qdot_max: np.ndarray | None = None,
     ) -> np.ndarray:
         """J(q)^-1 t, batched, with J the Jacobian at ``tool_point`` in {B} axes.
+
+        For dof > 6, where J qdot = t has many solutions, the joint speeds of the exact DTF LP
+        (robots.md section 5): qdot* / s* with s* the largest s such that J qdot = s t has a
+        solution within ``qdot_max``; so 1 / max_j |qdot_j| / qdot_max_j is s*, as for dof 6.
 
         Args:
             q: shape (dof, ...), joint positions (rad), non-singular.
             twist: shape (6, ...) broadcastable to q, [v (m/s); omega (rad/s)] of the tool
                 point, {B} axes.
             tool_point: shape (3, ...) broadcastable to q, the tool point in {B} (m).
+            qdot_max: shape (dof,), rad/s, the joint speed limits; needed for dof > 6 only.
 
         Returns:
             shape (dof, ...), joint speeds (rad/s); inf or NaN at an exactly singular q.
@@ -150,7 +194,12 @@ class ClosedFormFamily(KinematicsFamily):
         return type(self).solve_function(self.parameters, rotation, position)
 
     def joint_speeds_per_unit_twist(
-        self, q: np.ndarray, twist: np.ndarray, tool_point: np.ndarray
+        self,
+        q: np.ndarray,
+        twist: np.ndarray,
+        tool_point: np.ndarray,
+        *,
+        qdot_max: np.ndarray | None = None,
     ) -> np.ndarray:
         """J^-1 t in closed form (see :meth:`KinematicsFamily.joint_speeds_per_unit_twist`)."""
         return type(self).speeds_function(self.parameters, q, twist, tool_point)

@@ -218,6 +218,8 @@ def test_input_errors() -> None:
         evaluate_path(get_robot("ur5"), path, PLACEMENT, max_joint_step=0.0)
     assert bad_step.value.field == "ik.max_joint_step"
     panda_urdf = (example_robot_data_dir() / "panda_description/urdf/panda.urdf").read_text()
-    panda = robot_from_urdf(panda_urdf, base_frame="panda_link0", tool_frame="panda_link8")
+    # Five joints cannot solve six-dimensional poses: no family, numeric or other.
+    short = robot_from_urdf(panda_urdf, base_frame="panda_link0", tool_frame="panda_link5")
+    assert short.dof == 5 and short.family is None
     with pytest.raises(NoAnalyticIkError):
-        evaluate_path(panda, path, PLACEMENT)
+        evaluate_path(short, path, PLACEMENT)

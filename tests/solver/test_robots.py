@@ -13,12 +13,20 @@ from solver.exceptions import InvalidInputError, RobotModelError, UnknownRobotEr
 from solver.families.ur.ik import forward_kinematics_dh
 from solver.kinematics import jacobian_in_base, tool_pose_in_base
 from solver.robots import catalogue, example_robot_data_dir, get_robot, robot_from_urdf
-from tests.cases import CB_URDF_VS_DH_ATOL, E_SERIES, FK_IK_ATOL, OPW_MODELS, UR_MODELS
+from tests.cases import (
+    CB_URDF_VS_DH_ATOL,
+    E_SERIES,
+    FK_IK_ATOL,
+    NUMERIC_MODELS,
+    OPW_MODELS,
+    UR_MODELS,
+)
 
 
 def test_catalogue_has_every_ur_and_opw_model() -> None:
-    assert sorted(catalogue()) == sorted(UR_MODELS + OPW_MODELS)
-    for name, robot in catalogue().items():
+    assert sorted(catalogue()) == sorted(UR_MODELS + OPW_MODELS + NUMERIC_MODELS)
+    for name in UR_MODELS + OPW_MODELS:
+        robot = catalogue()[name]
         assert robot.dof == 6
         assert robot.tool_frame == "tool0"
         assert robot.base_frame == ("base" if name in UR_MODELS else "base_link")

@@ -1,0 +1,161 @@
+"""A serial chain read from a pinocchio model, with batched forward kinematics and Jacobians.
+
+The numeric family needs FK and the Jacobian at many configurations at once (placements x seeds
+x branches). Pinocchio computes one configuration per call, so the chain's constant parts are
+read from the pinocchio model once (each joint's placement in its parent, its axis, whether it
+turns or slides; the tool frame's placement; {B} in the root frame) and the product of
+exponentials is evaluated here with numpy over the batch. The tests check it against pinocchio.
+
+Layout: batch first, as numpy's matmul wants it: configurations (M, n), rotations (M, 3, 3),
+positions (M, 3), Jacobians (M, 6, n), all in {B}.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import pinocchio as pin
+
+from solver.exceptions import RobotModelError
+
+
+@dataclass(frozen=True)
+class SerialChain:
+    """The constant geometry of a chain from {B} to the flange {F}.
+
+    Attributes:
+        joint_rotation: shape (n, 3, 3), each joint frame in its parent's at q = 0.
+        joint_translation: shape (n, 3), m, its origin there.
+        axis: shape (n, 3), unit axis of each joint in its own frame.
+        revolute: shape (n,), True for a revolute joint, False for a prismatic one.
+        base_rotation: shape (3, 3), R_B_root. base_translation: shape (3,), m.
+        tool_rotation: shape (3, 3), R_n_F, the flange in the last joint's frame.
+        tool_translation: shape (3,), m.
+    """
+
+    joint_rotation: np.ndarray
+    joint_translation: np.ndarray
+    axis: np.ndarray
+    revolute: np.ndarray
+    base_rotation: np.ndarray
+    base_translation: np.ndarray
+    tool_rotation: np.ndarray
+    tool_translation: np.ndarray
+
+    @property
+    def dof(self) -> int:
+        """Number of joints n."""
+        return len(self.revolute)
+
+    @classmethod
+    def from_model(cls, model: pin.Model, *, base_frame: str, tool_frame: str) -> SerialChain:
+        """Read the chain of ``model`` from ``base_frame`` (fixed to the root) to ``tool_frame``.
+
+        Raises:
+            RobotModelError: the joints are not one serial chain of 1-DOF joints that all move
+                ``tool_frame``.
+        """
+        last = model.frames[model.getFrameId(tool_frame)].parentJoint
+        serial = all(model.parents[j] == j - 1 for j in range(1, model.njoints))
+        if not serial or last != model.njoints - 1 or model.nq != model.njoints - 1:
+            raise RobotModelError(
+                "robot.tool_frame",
+                f"numeric IK needs one serial chain of 1-DOF joints ending at {tool_frame!r}",
+            )
+        data = model.createData()
+        q0 = pin.neutral(model)
+        axes, revolute = [], []
+        for j in range(1, model.njoints):
+            # The joint's motion subspace in its own frame: [v; w] per unit joint speed.
+            motion = pin.computeJointJacobian(model, data, q0, j)[:, model.joints[j].idx_v]
+            turns = bool(np.linalg.norm(motion[3:]) > 0.5)
+            axes.append(motion[3:] if turns else motion[:3])
+            revolute.append(turns)
+        placements = [model.jointPlacements[j] for j in range(1, model.njoints)]
+        pin.framesForwardKinematics(model, data, q0)
+        base = data.oMf[model.getFrameId(base_frame)].inverse()
+        tool = model.frames[model.getFrameId(tool_frame)].placement
+        return cls(
+            joint_rotation=np.array([p.rotation for p in placements]),
+            joint_translation=np.array([p.translation for p in placements]),
+            axis=np.array(axes),
+            revolute=np.array(revolute),
+            base_rotation=base.rotation.copy(),
+            base_translation=base.translation.copy(),
+            tool_rotation=tool.rotation.copy(),
+            tool_translation=tool.translation.copy(),
+        )
+
+    def frames(self, q: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """Every joint frame and the flange in {B}.
+
+        Args:
+            q: shape (M, n), rad (m for prismatic joints).
+
+        Returns:
+            joint axes (M, n, 3) and origins (M, n, 3, m) in {B}; the flange's rotation
+            (M, 3, 3) and position (M, 3, m) in {B}.
+        """
+        m = len(q)
+        rotation = np.broadcast_to(self.base_rotation, (m, 3, 3))
+        position = np.broadcast_to(self.base_translation, (m, 3))
+        axes = np.empty((m, self.dof, 3))
+        origins = np.empty((m, self.dof, 3))
+        cos, sin = np.cos(q), np.sin(q)
+        for j in range(self.dof):
+            position = position + _times(rotation, self.joint_translation[j])
+            rotation = _times(rotation, self.joint_rotation[j])
+            axis = self.axis[j]
+            axes[:, j] = _times(rotation, axis)
+            origins[:, j] = position
+            if self.revolute[j]:  # Rodrigues: R exp([a] q) = c R + s R [a] + (1 - c) (R a) a^T
+                c, s = cos[:, j, None, None], sin[:, j, None, None]
+                rotation = (
+                    c * rotation
+                    + s * _times(rotation, _skew(axis))
+                    + (1.0 - c) * axes[:, j, :, None] * axis
+                )
+            else:
+                position = position + axes[:, j] * q[:, j, None]
+        flange_position = position + _times(rotation, self.tool_translation)
+        return axes, origins, _times(rotation, self.tool_rotation), flange_position
+
+    def forward(self, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """The flange pose in {B}: rotation (M, 3, 3) and position (M, 3, m), for q (M, n)."""
+        _, _, rotation, position = self.frames(q)
+        return rotation, position
+
+    def jacobian(
+        self, q: np.ndarray, point: np.ndarray | None = None
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The geometric Jacobian at a point, {B} axes (pinocchio LOCAL_WORLD_ALIGNED).
+
+        Args:
+            q: shape (M, n), rad.
+            point: shape (M, 3) or (3,), m in {B}; ``None`` is the flange origin.
+
+        Returns:
+            jacobian (M, 6, n), linear rows first; the flange's rotation (M, 3, 3) and
+            position (M, 3, m) in {B}.
+        """
+        axes, origins, rotation, position = self.frames(q)
+        at = position if point is None else np.broadcast_to(point, position.shape)
+        jacobian = np.zeros((len(q), 6, self.dof))
+        turning = np.cross(axes, at[:, None, :] - origins)  # (M, n, 3)
+        jacobian[:, :3] = np.where(self.revolute[:, None], turning, axes).transpose(0, 2, 1)
+        jacobian[:, 3:] = np.where(self.revolute[:, None], axes, 0.0).transpose(0, 2, 1)
+        return jacobian, rotation, position
+
+
+def _skew(axis: np.ndarray) -> np.ndarray:
+    """[a], shape (3, 3): [a] v = a x v."""
+    return np.array([[0.0, -axis[2], axis[1]], [axis[2], 0.0, -axis[0]], [-axis[1], axis[0], 0.0]])
+
+
+def _times(rotation: np.ndarray, constant: np.ndarray) -> np.ndarray:
+    """(M, 3, 3) @ (3, 3) or (M, 3, 3) @ (3,) as one 2-D product (BLAS, not M small ones)."""
+    product: np.ndarray = (rotation.reshape(-1, 3) @ constant).reshape(
+        rotation.shape[:-1] + constant.shape[1:]
+    )
+    return product

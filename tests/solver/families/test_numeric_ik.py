@@ -1,0 +1,166 @@
+"""Numeric IK family: its chain against pinocchio, FK(IK(T)) = T, limits, determinism."""
+
+from __future__ import annotations
+
+import numpy as np
+import pinocchio as pin
+import pytest
+
+from solver.evaluate import evaluate_path
+from solver.exceptions import InvalidInputError
+from solver.families.base import OK, UNREACHABLE
+from solver.families.numeric.family import NumericFamily, seed_count
+from solver.families.numeric.ik import rotation_log
+from solver.families.ur.catalogue import _exact_right_angles
+from solver.kinematics import jacobian_in_base, tool_pose_in_base
+from solver.robots import Robot, example_robot_data_dir, get_robot, robot_from_urdf
+from solver.spatial import Placement, wrap_angle
+from tests.cases import FK_IK_ATOL, NUMERIC_MODELS
+from tests.solver.test_evaluate import load_path
+
+
+def ur5_as_urdf() -> Robot:
+    """The UR5 of example-robot-data as a plain URDF: no family given, so the numeric one."""
+    path = example_robot_data_dir() / "ur_description" / "urdf" / "ur5_robot.urdf"
+    urdf = _exact_right_angles(path.read_text())
+    return robot_from_urdf(urdf, base_frame="base", tool_frame="tool0", name="ur5_urdf")
+
+
+def numeric(robot: Robot) -> NumericFamily:
+    assert isinstance(robot.family, NumericFamily)
+    return robot.family
+
+
+def random_configurations(robot: Robot, count: int, seed: int) -> np.ndarray:
+    """(count, n) joint positions within the limits (a full turn at most for +-2 pi joints)."""
+    lower = np.maximum(robot.q_lower, -np.pi)
+    upper = np.minimum(robot.q_upper, np.pi)
+    lower = np.where(upper - lower < 0.1, robot.q_lower, lower)  # limits beyond [-pi, pi]
+    upper = np.where(upper - lower < 0.1, robot.q_upper, upper)
+    return np.random.default_rng(seed).uniform(lower, upper, (count, robot.dof))
+
+
+ROBOTS = (*NUMERIC_MODELS, "ur5_urdf")
+
+
+def get(name: str) -> Robot:
+    return ur5_as_urdf() if name == "ur5_urdf" else get_robot(name)
+
+
+@pytest.mark.parametrize("name", ROBOTS)
+def test_chain_equals_pinocchio(name: str) -> None:
+    robot = get(name)
+    chain = numeric(robot).chain
+    q = random_configurations(robot, 20, seed=1)
+    rotation, position = chain.forward(q)
+    jacobian, _, _ = chain.jacobian(q, position)
+    for i in range(len(q)):
+        pose = tool_pose_in_base(robot, q[i])  # the tool point is the flange here
+        np.testing.assert_allclose(rotation[i], pose[:3, :3], rtol=0, atol=1e-13)
+        np.testing.assert_allclose(position[i], pose[:3, 3], rtol=0, atol=1e-13)
+        np.testing.assert_allclose(jacobian[i], jacobian_in_base(robot, q[i]), rtol=0, atol=1e-13)
+
+
+def test_rotation_log_equals_pinocchio_up_to_pi() -> None:
+    rng = np.random.default_rng(2)
+    axes = rng.normal(size=(300, 3))
+    axes /= np.linalg.norm(axes, axis=1, keepdims=True)
+    angles = np.concatenate([rng.uniform(0, np.pi, 200), np.pi - np.logspace(-12, -1, 99), [0.0]])
+    vectors = axes * angles[:, None]
+    rotations = np.array([pin.exp3(v) for v in vectors])
+    ours = rotation_log(rotations)
+    theirs = np.array([pin.log3(r) for r in rotations])
+    # At pi exactly, v and -v are the same rotation: compare the rotations there.
+    np.testing.assert_allclose(np.array([pin.exp3(v) for v in ours]), rotations, atol=1e-12)
+    near_pi = angles > np.pi - 1e-6
+    np.testing.assert_allclose(ours[~near_pi], theirs[~near_pi], rtol=0, atol=1e-9)
+
+
+def solve_random_poses(robot: Robot, count: int, seed: int) -> tuple[np.ndarray, ...]:
+    """Poses of random configurations and the family's solutions: q (K, P, n), status (K, P)."""
+    family = numeric(robot)
+    q_true = random_configurations(robot, count, seed)
+    rotation, position = family.chain.forward(q_true)
+    q, status = family.solve(np.moveaxis(rotation, 0, -1), position.T)
+    return q_true, rotation, position, np.moveaxis(q, 0, -1), status
+
+
+@pytest.mark.parametrize("name", ROBOTS)
+def test_every_solution_reaches_the_pose_within_limits(name: str) -> None:
+    robot = get(name)
+    q_true, rotation, position, q, status = solve_random_poses(robot, 40, seed=3)
+    assert q.shape[:2] == (seed_count(robot.dof), 40)
+    found = status == OK
+    assert found.any(axis=0).mean() >= 0.95  # each pose is reachable: nearly always found
+    for k, p in zip(*np.nonzero(found), strict=True):
+        pose = tool_pose_in_base(robot, q[k, p])  # pinocchio, not the family's chain
+        np.testing.assert_allclose(pose[:3, :3], rotation[p], rtol=0, atol=FK_IK_ATOL)
+        np.testing.assert_allclose(pose[:3, 3], position[p], rtol=0, atol=FK_IK_ATOL)
+        # Within the limits with some 2 pi copy (q is given in [-pi, pi)).
+        turns = np.arange(-2, 3)[:, None] * 2 * np.pi
+        copies = q[k, p] + turns
+        inside = (copies >= robot.q_lower - 1e-12) & (copies <= robot.q_upper + 1e-12)
+        assert inside.any(axis=0).all()
+    # The slots after the solutions found are empty; the found ones are distinct.
+    empty = np.isnan(q).any(axis=-1)
+    assert np.all(status[empty] == UNREACHABLE) and np.all(np.isfinite(q[~empty]))
+    assert np.all(np.diff(empty.astype(int), axis=0) >= 0)  # packed to the front
+    for p in range(q.shape[1]):
+        solutions = q[~empty[:, p], p]
+        gaps = wrap_angle(solutions[:, None] - solutions[None])
+        distance = np.linalg.norm(gaps, axis=-1) + np.eye(len(solutions))
+        assert distance.min() > 1e-3
+
+
+@pytest.mark.parametrize("name", ["panda", "ur5_urdf"])
+def test_same_input_same_branches(name: str) -> None:
+    first = solve_random_poses(get(name), 10, seed=4)
+    second = solve_random_poses(get(name), 10, seed=4)
+    for a, b in zip(first, second, strict=True):
+        np.testing.assert_array_equal(a, b)
+    path = load_path("curved_line")[:20]
+    placement = Placement(0.4, 0.0, 0.1, 0.0) if name == "panda" else Placement(0, 0.45, 0.1, 0)
+    one, two = (evaluate_path(get(name), path, placement) for _ in range(2))
+    assert one.branch == two.branch and one.mu_path == two.mu_path
+    np.testing.assert_array_equal(one.q, two.q)
+
+
+def test_ur5_solutions_are_analytic_ones() -> None:
+    """Each numeric solution of the UR5 is one of the 8 analytic ones (ur-analytic-ik, wrapped)."""
+    import ur_analytic_ik
+
+    robot = ur5_as_urdf()
+    q_true, rotation, position, q, status = solve_random_poses(robot, 30, seed=5)
+    for p in range(q.shape[1]):
+        pose = np.eye(4)
+        pose[:3, :3], pose[:3, 3] = rotation[p], position[p]
+        analytic = np.array(ur_analytic_ik.ur5.inverse_kinematics(pose))
+        for k in np.flatnonzero(status[:, p] == OK):
+            gap = np.abs(wrap_angle(analytic - q[k, p])).max(axis=1)
+            assert gap.min() < 1e-6
+
+
+@pytest.mark.parametrize(("name", "placement"), [("panda", Placement(0.4, 0.0, 0.1, 0.0))])
+def test_tracked_path_reaches_every_waypoint(name: str, placement: Placement) -> None:
+    robot = get_robot(name)
+    path = load_path("curved_line")
+    result = evaluate_path(robot, path, placement)
+    assert result.feasible and result.q is not None
+    assert result.ik_seeds == 64 and result.ik_branches_found is not None
+    assert 1 <= result.ik_branches_found <= 64
+    poses = placement.transform_workpiece_to_base() @ path
+    for i in range(len(path)):
+        np.testing.assert_allclose(tool_pose_in_base(robot, result.q[i]), poses[i], atol=1e-9)
+    assert np.all(result.q >= robot.q_lower - 1e-12) and np.all(result.q <= robot.q_upper + 1e-12)
+    assert np.abs(np.diff(result.q, axis=0)).max() <= 0.35
+
+
+def test_free_spin_is_refused_for_a_redundant_arm() -> None:
+    with pytest.raises(InvalidInputError) as info:
+        evaluate_path(
+            get_robot("panda"),
+            load_path("curved_line"),
+            Placement(0.4, 0, 0.1, 0),
+            spin_mode="free",
+        )
+    assert info.value.field == "spin_mode"
