@@ -14,6 +14,7 @@ from solver.capability_map import CapabilityMap, axis_length, grid_axis
 from solver.dtf import DtfResult
 from solver.evaluate import Branch, PathEvaluation
 from solver.exceptions import InvalidInputError
+from solver.feed import FeedCheck
 from solver.optimize import PlacementOptimum
 from solver.pipeline import SpinMode
 from solver.robots import Robot
@@ -168,15 +169,25 @@ def _optional_float(values: np.ndarray | None, i: int) -> float | None:
     return None if values is None else float(values[i])
 
 
+def _numbers_or_none(values: np.ndarray | None, i: int) -> list[float | None] | None:
+    """Row i of values as JSON numbers, None where NaN; None without values."""
+    if values is None:
+        return None
+    return [None if math.isnan(v) else v for v in values[i].tolist()]
+
+
 def evaluate_response(
     evaluation: PathEvaluation,
     robot: Robot,
     *,
     axis_correction: float = 0.0,
     with_waypoints: bool = True,
+    feed: FeedCheck | None = None,
 ) -> schemas.EvaluateResponse:
     """The response of ``POST /v1/evaluate`` (per-waypoint detail when ``with_waypoints``)."""
     ev = evaluation
+    at_feed_qdot = None if feed is None else feed.qdot_at_feed
+    at_feed_use = None if feed is None else feed.use
     waypoints = []
     for i in range(ev.h.shape[0] if with_waypoints else 0):
         limiting = None if ev.limiting_joint is None else int(ev.limiting_joint[i])
@@ -192,6 +203,8 @@ def evaluate_response(
                 qdot=_optional_list(ev.qdot, i),
                 limiting_joint=limiting,
                 limiting_joint_name=None if limiting is None else robot.joint_names[limiting],
+                qdot_at_feed=_numbers_or_none(at_feed_qdot, i),
+                use=_numbers_or_none(at_feed_use, i),
             )
         )
     bottleneck = None
@@ -214,6 +227,9 @@ def evaluate_response(
         spin_mode=ev.spin_mode,
         spins=None if ev.spins is None else ev.spins.tolist(),
         axis_correction=axis_correction,
+        feed_check=None
+        if feed is None
+        else schemas.FeedCheckResult(feed=feed.feed, feasible=feed.feasible, margin=feed.margin),
     )
 
 

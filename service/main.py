@@ -60,7 +60,7 @@ internet.
 
 @contextlib.asynccontextmanager
 async def lifespan(app: FastAPI) -> AsyncIterator[None]:
-    """Hand the GIL round often; on shutdown, stop every running work at its next report.
+    """Hand the GIL round often; on SIGTERM or SIGINT, stop running work at its next report.
 
     Solver work runs in worker threads; between numpy calls it holds the GIL, and by default
     a waiting thread gets it only every 5 ms. The event loop needs it several times per request,
@@ -71,7 +71,6 @@ async def lifespan(app: FastAPI) -> AsyncIterator[None]:
     _stop_work_on(signal.SIGTERM)
     _stop_work_on(signal.SIGINT)
     yield
-    STOPPING.set()
 
 
 def _stop_work_on(signum: signal.Signals) -> None:

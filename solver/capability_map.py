@@ -7,7 +7,7 @@ all cells at once by :mod:`solver.placements`.
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -120,6 +120,7 @@ def capability_map(
     spin_mode: SpinMode = "fixed",
     chunk: int = DEFAULT_CHUNK,
     progress: Callable[[float], None] | None = None,
+    passes: Sequence[tuple[int, int]] | None = None,
 ) -> CapabilityMap:
     """mu_path over the grid spins x yaws x ys x xs at height z (spec section 6).
 
@@ -136,6 +137,8 @@ def capability_map(
         spin_mode: ``fixed`` or ``free`` (the tool spin rate free, cam.md section 2).
         chunk: placements computed together.
         progress: called with the fraction done (0..1] after each chunk.
+        passes: index ranges [start, stop) of the passes of a CAM program (cam.md section
+            5); None: one pass.
 
     Raises:
         NoAnalyticIkError, InvalidInputError, RepeatedWaypointError: as ``evaluate_path``.
@@ -156,7 +159,7 @@ def capability_map(
     )
     result = evaluate_placements(
         robot,
-        prepare_path(robot, waypoints_in_workpiece),
+        prepare_path(robot, waypoints_in_workpiece, passes=passes),
         placements,
         branch=branch,
         max_joint_step=max_joint_step,

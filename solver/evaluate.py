@@ -12,6 +12,7 @@ the chosen branch.
 from __future__ import annotations
 
 import dataclasses
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -93,6 +94,7 @@ def evaluate_path(
     branch: Branch | None = None,
     max_joint_step: float = DEFAULT_MAX_JOINT_STEP,
     spin_mode: SpinMode = "fixed",
+    passes: Sequence[tuple[int, int]] | None = None,
 ) -> PathEvaluation:
     """mu_path of a path at a placement (spec sections 1-4).
 
@@ -104,6 +106,8 @@ def evaluate_path(
             highest mu_path.
         spin_mode: ``fixed`` (the orientations as given) or ``free`` (the tool spin rate free,
             cam.md section 2).
+        passes: index ranges [start, stop) of the passes of a CAM program (cam.md section
+            5); None: one pass.
         max_joint_step: rad, > 0, the largest move of any joint between neighbouring waypoints.
 
     Raises:
@@ -114,7 +118,7 @@ def evaluate_path(
     indices = branch_indices(robot, branch, max_joint_step=max_joint_step, spin_mode=spin_mode)
     family = require_family(robot)
     cell = check_placements(placement.as_row()[None])
-    path = prepare_path(robot, waypoints_in_workpiece)
+    path = prepare_path(robot, waypoints_in_workpiece, passes=passes)
     run = run_chunk(robot, path, cell, indices, max_joint_step=max_joint_step, spin_mode=spin_mode)
     pick = int(run.pick[0])
     reason = int(run.tracked.reason[pick, 0])

@@ -21,6 +21,7 @@ from __future__ import annotations
 import dataclasses
 import math
 import time
+from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Literal
 
@@ -114,6 +115,7 @@ def optimize_placement(
     max_coarse_poses: int | None = None,
     max_solver_seconds: float | None = None,
     progress: Progress | None = None,
+    passes: Sequence[tuple[int, int]] | None = None,
 ) -> PlacementOptimum:
     """The placement inside ``bounds`` where the path runs fastest.
 
@@ -134,6 +136,8 @@ def optimize_placement(
         max_solver_seconds: the longest one IPOPT solve may take (None: IPOPT's default).
         progress: called with the fraction done (coarse map or DE, then each solve's
             iterations); a :class:`solver.progress.Cancelled` it raises stops the search.
+        passes: index ranges [start, stop) of the passes of a CAM program (cam.md section 5);
+            None: one pass. A spin path (``max_spin_step``) needs one pass.
 
     Returns:
         The optimum (never below the start); ``found`` is False when neither the start nor any
@@ -167,9 +171,11 @@ def optimize_placement(
             f"{start.spin:g} rad is outside the bounds",
         )
     path = np.asarray(waypoints_in_workpiece, dtype=float)
-    prepared = prepare_path(robot, path)
+    prepared = prepare_path(robot, path, passes=passes)
+    if max_spin_step is not None and not prepared.segment_in_pass.all():
+        raise InvalidInputError("spin_path", "a spin path needs a program of one pass")
     start_evaluation = evaluate_path(
-        robot, path, start, max_joint_step=max_joint_step, spin_mode=spin_mode
+        robot, path, start, max_joint_step=max_joint_step, spin_mode=spin_mode, passes=passes
     )
     symmetric = turns_about_base_z(robot)
     near = math.atan2(start.y, start.x)
@@ -197,6 +203,7 @@ def optimize_placement(
             max_spin_step,
             max_solver_seconds,
             span(progress, 0.3, 0.95),
+            passes,
         )
         name = "ipopt (casadi), from the coarse map's maxima"
     else:
@@ -216,6 +223,7 @@ def optimize_placement(
             placement,
             max_joint_step=max_joint_step,
             spin_mode=spin_mode,
+            passes=passes,
         )
         if evaluation.mu_path is not None and (best is None or evaluation.mu_path > best[0]):
             best = (evaluation.mu_path, placement, evaluation, status, spins)
@@ -259,6 +267,7 @@ def _casadi(
     max_spin_step: float | None,
     max_solver_seconds: float | None,
     progress: Progress | None,
+    passes: Sequence[tuple[int, int]] | None,
 ) -> tuple[list[Candidate], list[str], int]:
     """Candidates: the best coarse cell, then IPOPT's optimum from each of the best cells.
 
@@ -290,6 +299,7 @@ def _casadi(
             bounds.placement(cell.vector),
             branch=require_family(robot).branches[cell.branch],
             max_joint_step=max_joint_step,
+            passes=passes,
         )
         q, qdot, v_max, speed = at_start.q, at_start.qdot, at_start.v_max, at_start.mu_path
         if q is None or qdot is None or v_max is None or speed is None:

@@ -14,6 +14,7 @@ component-first arrays with waypoints last.
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Literal
 
@@ -24,7 +25,7 @@ from solver.exceptions import InvalidInputError, NoAnalyticIkError, quoted
 from solver.families.base import Branch, KinematicsFamily
 from solver.robots import Robot
 from solver.spatial import MAX_COORDINATE, rotation_about_z
-from solver.task import task_requirements
+from solver.task import TaskRequirements, task_requirements
 from solver.tracking import FEASIBLE, Tracked, choose_branch, track
 
 DEFAULT_MAX_JOINT_STEP = 0.35
@@ -47,6 +48,9 @@ class PreparedPath:
         u_T: shape (N, 3). u_R: shape (N, 3). h: shape (N,), m, inf for pure translation.
         twist: shape (N, 6), t_hat in {O} axes.
         pure_rotation: shape (N,), where h = 0 (V_max is 0 there).
+        segment_in_pass: shape (N - 1,), whether segment i (waypoint i to i + 1) lies within a
+            pass; False where a rapid joins two passes (cam.md section 5): no feed requirement
+            and no joint step bound there, and free spins restart at the next pass.
     """
 
     n_waypoints: int
@@ -60,20 +64,59 @@ class PreparedPath:
     h: np.ndarray
     twist: np.ndarray
     pure_rotation: np.ndarray
+    segment_in_pass: np.ndarray
 
 
-def prepare_path(robot: Robot, waypoints_in_workpiece: np.ndarray) -> PreparedPath:
+def check_passes(
+    passes: Sequence[tuple[int, int]] | None, n_waypoints: int
+) -> list[tuple[int, int]]:
+    """The passes as index ranges [start, stop) covering 0..N in order, each of 2 points or more.
+
+    Raises:
+        InvalidInputError: on ``path.passes``, ranges that do not tile the waypoints.
+    """
+    if passes is None:
+        return [(0, n_waypoints)]
+    ranges = [(int(start), int(stop)) for start, stop in passes]
+    starts = [start for start, _ in ranges]
+    stops = [stop for _, stop in ranges]
+    if not ranges or starts[0] != 0 or stops[-1] != n_waypoints or starts[1:] != stops[:-1]:
+        raise InvalidInputError(
+            "path.passes", f"{ranges} must cover the {n_waypoints} waypoints in order"
+        )
+    short = [k for k, (start, stop) in enumerate(ranges) if stop - start < 2]
+    if short:
+        raise InvalidInputError("path.passes", f"pass {short[0]} has fewer than 2 waypoints")
+    return ranges
+
+
+def prepare_path(
+    robot: Robot,
+    waypoints_in_workpiece: np.ndarray,
+    *,
+    passes: Sequence[tuple[int, int]] | None = None,
+) -> PreparedPath:
     """Check a path and precompute its placement-independent data.
 
     Args:
         robot: the arm (its TCP offset turns tool poses into flange poses).
         waypoints_in_workpiece: shape (N, 4, 4), T_O_i (metres).
+        passes: index ranges [start, stop) of the passes (cam.md section 5), in order and
+            covering every waypoint; None: one pass. The requirements are taken per pass.
 
     Raises:
         InvalidInputError, RepeatedWaypointError: as :func:`solver.task.task_requirements`.
     """
     path = np.asarray(waypoints_in_workpiece, dtype=float)
-    requirements = task_requirements(path)  # u_T, u_R turn with the yaw, h does not
+    ranges = check_passes(passes, len(path))
+    parts = [task_requirements(path[start:stop]) for start, stop in ranges]
+    requirements = TaskRequirements(  # u_T, u_R turn with the yaw, h does not
+        u_T=np.concatenate([part.u_T for part in parts]),
+        u_R=np.concatenate([part.u_R for part in parts]),
+        h=np.concatenate([part.h for part in parts]),
+    )
+    segment_in_pass = np.ones(max(len(path) - 1, 0), dtype=bool)
+    segment_in_pass[[start - 1 for start, _ in ranges[1:]]] = False
     tool_to_flange = np.linalg.inv(robot.transform_tool_to_tcp)
     flange = path @ tool_to_flange
     return PreparedPath(
@@ -88,6 +131,7 @@ def prepare_path(robot: Robot, waypoints_in_workpiece: np.ndarray) -> PreparedPa
         h=requirements.h,
         twist=requirements.twists(),
         pure_rotation=requirements.h == 0.0,
+        segment_in_pass=segment_in_pass,
     )
 
 
@@ -280,6 +324,7 @@ def run_chunk(
         lower=np.full(robot.dof, -np.inf) if free else robot.q_lower,
         upper=np.full(robot.dof, np.inf) if free else robot.q_upper,
         max_joint_step=max_joint_step,
+        segment_checked=path.segment_in_pass,
     )
     # For dof > 6 these are the exact DTF LP's joint speeds per unit speed (robots.md section 5),
     # so the ratio below gives the LP's V_max for every dof.
@@ -361,16 +406,16 @@ def _spin_schedule(
     length = np.linalg.norm(np.diff(path.tool_position, axis=0), axis=1)  # (W - 1,)
     with np.errstate(divide="ignore", invalid="ignore"):
         step = np.where(feed > 0.0, rate[..., :-1] * length / feed, 0.0)  # (B, C, W - 1)
-    zero = np.zeros(step.shape[:-1] + (1,))
-    spins = np.concatenate([zero, np.cumsum(step, axis=-1)], axis=-1)
-    moves = np.cumsum(step * qd_spin[..., :-1], axis=-1)  # (n, B, C, W - 1)
-    moved = np.concatenate([np.zeros(moves.shape[:-1] + (1,)), moves], axis=-1)
+    step = np.where(path.segment_in_pass, step, 0.0)  # each pass starts at the placement's spin
+    spins = cumsum_within_passes(step, path.segment_in_pass)
+    moved = cumsum_within_passes(step * qd_spin[..., :-1], path.segment_in_pass)
     spun = track(
         tracked.q + np.nan_to_num(moved),
         np.zeros(tracked.q.shape[1:], dtype=int),  # every pose was solved: only limits, steps
         lower=robot.q_lower,
         upper=robot.q_upper,
         max_joint_step=max_joint_step,
+        segment_checked=path.segment_in_pass,
     )
     keep = np.isfinite(mu_path)
     return spins, Tracked(
@@ -378,3 +423,20 @@ def _spin_schedule(
         failed_waypoint=np.where(keep, spun.failed_waypoint, tracked.failed_waypoint),
         q=np.where(keep[None, ..., None], spun.q, tracked.q),
     )
+
+
+def cumsum_within_passes(steps: np.ndarray, segment_in_pass: np.ndarray) -> np.ndarray:
+    """Running sums of per-segment steps along the last axis, restarting at 0 at each pass.
+
+    Args:
+        steps: shape (..., W - 1), one value per segment.
+        segment_in_pass: shape (W - 1,), False where a segment joins two passes.
+
+    Returns:
+        shape (..., W): 0 at the first waypoint of every pass.
+    """
+    total = np.concatenate([np.zeros(steps.shape[:-1] + (1,)), np.cumsum(steps, axis=-1)], axis=-1)
+    starts = np.concatenate([[True], ~segment_in_pass])  # (W,), the first waypoint of each pass
+    first = np.maximum.accumulate(np.where(starts, np.arange(len(starts)), 0))
+    result: np.ndarray = total - total[..., first]
+    return result

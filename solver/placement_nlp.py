@@ -185,7 +185,8 @@ class PlacementNlp:
             twists,
             ca.DM(waypoint_data),
         )
-        steps = ca.vec(joints[:, 1:] - joints[:, :-1])
+        within = [int(i) for i in np.flatnonzero(path.segment_in_pass)]  # no bound across rapids
+        steps = ca.vec(joints[:, [i + 1 for i in within]] - joints[:, within])
         variables = ca.vertcat(placement, speed, ca.vec(joints), ca.vec(joint_speeds))
         if free_spin:
             variables = ca.vertcat(variables, ca.vec(spin_rates))

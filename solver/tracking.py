@@ -57,6 +57,7 @@ def track(
     lower: np.ndarray,
     upper: np.ndarray,
     max_joint_step: float,
+    segment_checked: np.ndarray | None = None,
 ) -> Tracked:
     """Follow IK branches along a path.
 
@@ -66,6 +67,8 @@ def track(
         lower: shape (n,), rad, lower position limits.
         upper: shape (n,), rad, upper position limits.
         max_joint_step: rad, the largest move of any joint between neighbouring waypoints.
+        segment_checked: shape (W - 1,), where the step bound applies (None: everywhere); a
+            rapid between two passes is not bounded (the branch and the joint copy carry on).
 
     Returns:
         The first failure of each branch, and the joint paths.
@@ -75,6 +78,8 @@ def track(
     step -= np.where(step > math.pi, _TWO_PI, np.where(step < -math.pi, -_TWO_PI, 0.0))
     with np.errstate(invalid="ignore"):
         jump = np.any(np.abs(step) > max_joint_step, axis=0)
+    if segment_checked is not None:
+        jump &= segment_checked
     first = np.stack(
         [
             _first_true(status == UNREACHABLE),

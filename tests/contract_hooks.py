@@ -15,8 +15,8 @@ Each rule is computed here independently of the service's code:
 - cross-field choices: q has one value per joint within its limits (and method auto rather
   than closed_form, which needs a non-singular Jacobian); u_T given unless h = 0,
   u_R unless h is null; z or bounds.z; the start inside the bounds; spin_path with casadi and
-  fixed spin; one spin per waypoint; a URDF arm only on /v1/dtf (it has no IK family yet),
-  and only a URDF from example-robot-data with its frames (a random string is not a URDF).
+  fixed spin; one spin per waypoint; a catalogue arm for a URDF one and a small valid program
+  for CL data or CSV (a random string is no URDF and no program: their own tests cover them).
 """
 
 from __future__ import annotations
@@ -34,6 +34,8 @@ LIMITS: dict[str, float] = {}
 STATUSES: Counter[tuple[str, str, int]] = Counter()
 """How many answers of each status each operation gave, with the generation mode."""
 
+CL_PROGRAM = "UNITS/MM\nMULTAX/ON\nGOTO/0, 0, 0, 0, 0, 1\nGOTO/5, 0, 0, 0, 0.1, 1\n"
+CSV_PATH = "0,0,0,0,0,1\n5,0,0,0,0.1,1\n"
 OPW_BRANCHES = [
     {"level": "shoulder", "choices": ["front", "back"]},
     {"level": "elbow", "choices": ["up", "down"]},
@@ -233,7 +235,11 @@ def map_case(context: Any, case: schemathesis.Case) -> schemathesis.Case:
         if route == "/v1/dtf":
             _repair_dtf(body, lower, upper)
     path = body.get("path")
-    n = 0
+    if isinstance(path, dict) and path.get("cl_data") is not None:
+        path["cl_data"] = CL_PROGRAM  # a random string is no CL program: the CAM tests cover them
+    if isinstance(path, dict) and path.get("csv") is not None:
+        path["csv"] = CSV_PATH
+    n = 2 if isinstance(path, dict) and (path.get("cl_data") or path.get("csv")) else 0
     if isinstance(path, dict) and _waypoints(path):
         limit = "max_optimize_waypoints" if route == "/v1/optimize" else "max_path_waypoints"
         _repair_path(path, int(LIMITS[limit]))

@@ -115,6 +115,13 @@ def test_every_route_through_typed_models(generated: ModuleType, client: Any) ->
     assert optimum.mu_path >= optimum.start.mu_path
     assert math.isfinite(optimum.solver.seconds)
 
+    program = (EXAMPLES / "cam" / "sweep_mm.cl").read_text()
+    read = _module(generated, f"{api}.paths.import_path").sync(
+        client=client, body=models.PathImportRequest.from_dict({"path": {"cl_data": program}})
+    )
+    assert isinstance(read, models.PathImportResponse)
+    assert read.passes == [[0, 13], [13, 26], [26, 39]] and read.units == "mm"
+
 
 def test_input_errors_arrive_as_typed_error_responses(generated: ModuleType, client: Any) -> None:
     models = _module(generated, "models")

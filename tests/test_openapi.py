@@ -38,6 +38,7 @@ def test_operation_ids_are_short_and_the_png_is_binary() -> None:
         "evaluate",
         "map",
         "map_png",
+        "import_path",
         "optimize",
     }
     png = spec["paths"]["/v1/map/png"]["post"]["responses"]["200"]["content"]["image/png"]

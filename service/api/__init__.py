@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from fastapi import APIRouter
 
-from service.api.routes import dtf, evaluate, map, optimize, robots
+from service.api.routes import dtf, evaluate, map, optimize, paths, robots
 
 api_router = APIRouter(prefix="/v1")
 api_router.include_router(robots.router)
@@ -12,3 +12,4 @@ api_router.include_router(dtf.router)
 api_router.include_router(evaluate.router)
 api_router.include_router(map.router)
 api_router.include_router(optimize.router)
+api_router.include_router(paths.router)

@@ -21,6 +21,7 @@ from service.schemas.evaluate import (
     EvaluateRequest,
     EvaluateResponse,
     FailureReason,
+    FeedCheckResult,
     WaypointResult,
 )
 from service.schemas.map import Grid, GridAxis, MapCell, MapExtreme, MapRequest, MapResponse
@@ -32,7 +33,8 @@ from service.schemas.optimize import (
     SpinPath,
     StartInfo,
 )
-from service.schemas.path import Path, PathInput, PosePath, ToolAxisPath
+from service.schemas.path import ClDataPath, CsvPath, Path, PathInput, PosePath, ToolAxisPath
+from service.schemas.paths_import import ImportedPose, PathImportRequest, PathImportResponse
 from service.schemas.robot import CatalogueRobot, OpwGeometry, OpwRobot, Robot, UrdfRobot
 from service.schemas.robots import BranchLevel, HealthResponse, RobotInfo, RobotsResponse
 
@@ -42,6 +44,8 @@ __all__ = [
     "Bounds",
     "Branch",
     "CatalogueRobot",
+    "ClDataPath",
+    "CsvPath",
     "BranchLevel",
     "DtfRequest",
     "DtfResponse",
@@ -50,9 +54,11 @@ __all__ = [
     "EvaluateRequest",
     "EvaluateResponse",
     "FailureReason",
+    "FeedCheckResult",
     "Grid",
     "GridAxis",
     "HealthResponse",
+    "ImportedPose",
     "IkPolicy",
     "MapCell",
     "MapExtreme",
@@ -63,6 +69,8 @@ __all__ = [
     "OptimizeRequest",
     "OptimizeResponse",
     "Path",
+    "PathImportRequest",
+    "PathImportResponse",
     "PathInput",
     "Placement",
     "Pose",

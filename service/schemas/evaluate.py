@@ -113,6 +113,14 @@ class EvaluateRequest(RequestModel):
         "waypoint's q, task direction and speeds. Default: waypoints up to "
         "DTF_MAX_DETAIL_WAYPOINTS waypoints (2,000), summary beyond.",
     )
+    feed: float | None = Field(
+        default=None,
+        ge=1e-6,
+        le=100.0,
+        description="A feed to check (m/s, 1e-6 to 100): the answer then says whether the path runs at "
+        "it, the margin, and every waypoint's joint speeds and use of their limits at it. "
+        "Default: the program's feed (its highest FEDRAT) for CL data, else none.",
+    )
     spins: list[Angle] | None = Field(
         default=None,
         min_length=2,
@@ -120,6 +128,23 @@ class EvaluateRequest(RequestModel):
         description="A tool spin per waypoint, one per waypoint (rad, within 1000), added to the "
         "placement's: each waypoint "
         "turned about its own tool z axis (as /v1/optimize's spin_path answers). Default none.",
+    )
+
+
+class FeedCheckResult(ResponseModel):
+    """Whether the path runs at the feed (cam.md section 7)."""
+
+    model_config = ConfigDict(
+        json_schema_extra={"examples": [{"feed": 0.025, "feasible": True, "margin": 11.7}]}
+    )
+
+    feed: float = Field(description="The feed F checked (m/s).")
+    feasible: bool = Field(
+        description="Whether the whole path runs at F with every joint within its speed limit "
+        "(mu_path >= F)."
+    )
+    margin: float | None = Field(
+        description="mu_path / F (> 1: room to spare); null when the path is infeasible."
     )
 
 
@@ -157,6 +182,16 @@ class WaypointResult(ResponseModel):
     )
     limiting_joint_name: str | None = Field(
         description="Name of the joint on its speed limit; null when infeasible."
+    )
+    qdot_at_feed: list[float | None] | None = Field(
+        default=None,
+        description="With a feed: the joint speeds at that feed (rad/s), n values (null values "
+        "where the tool only turns); null without a feed or when infeasible.",
+    )
+    use: list[float | None] | None = Field(
+        default=None,
+        description="With a feed: each joint's |qdot| / its limit at that feed (1: on the "
+        "limit), n values; null without a feed or when infeasible.",
     )
 
 
@@ -207,6 +242,11 @@ class EvaluateResponse(ResponseModel):
         default=0.0,
         description="The largest correction made to a tool axis's length when normalising it "
         "(dimensionless; 0 when none was needed or the path is given by poses).",
+    )
+    feed_check: FeedCheckResult | None = Field(
+        default=None,
+        description="With a feed (the request's, or the CL program's FEDRAT): whether the path "
+        "runs at it; null without one.",
     )
     detail: Literal["summary", "waypoints"] = Field(
         default="waypoints", description="Whether waypoints holds the per-waypoint detail."

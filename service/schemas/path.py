@@ -8,12 +8,15 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Annotated
+from typing import Annotated, Literal
 
 import numpy as np
 from pydantic import ConfigDict, Discriminator, Field, Tag
 
 from service.schemas.common import Pose, RequestModel, SpinMode, ToolAxisWaypoint, pose_matrix_of
+from solver.cam.cam_path import CamPath
+from solver.cam.cl_data import read_cl_data
+from solver.cam.csv_path import read_csv_path
 from solver.spatial import check_position
 from solver.task import task_requirements
 from solver.tool_axis import poses_from_tool_axes
@@ -30,11 +33,29 @@ class PathInput:
         poses: shape (N, 4, 4), T_O_i (m).
         axis_correction: the largest correction made to a tool axis's length (0 for poses).
         default_spin_mode: ``free`` for a path given by tool axes, ``fixed`` for poses.
+        passes: index ranges [start, stop) of the passes (cam.md section 5); None: one pass.
+        feed: the program's feed (m/s), its highest FEDRAT; None when it programs none.
+        units: the length unit the path was written in.
     """
 
     poses: np.ndarray
     axis_correction: float
     default_spin_mode: SpinMode
+    passes: tuple[tuple[int, int], ...] | None = None
+    feed: float | None = None
+    units: str = "m"
+
+
+def _from_cam(cam: CamPath, *, field: str) -> PathInput:
+    """The solver's path of a CAM program: its poses, passes, feed and units."""
+    return PathInput(
+        poses=cam.waypoints_in_workpiece(field=field),
+        axis_correction=cam.axis_correction,
+        default_spin_mode=cam.default_spin_mode,
+        passes=cam.passes,
+        feed=cam.feed,
+        units=cam.units,
+    )
 
 
 _RULES = (
@@ -132,7 +153,79 @@ class ToolAxisPath(RequestModel):
         return PathInput(poses=poses, axis_correction=correction, default_spin_mode="free")
 
 
-_FORMS = ("waypoints", "tool_axis_waypoints")
+MAX_CAM_TEXT = 2_000_000
+"""Characters of CL data or CSV at most (a request body is at most 2 MB anyway)."""
+
+
+class ClDataPath(RequestModel):
+    """A CAM program as APT CL data (cam.md section 5): passes split at rapids, feed from FEDRAT."""
+
+    model_config = ConfigDict(
+        json_schema_extra={
+            "examples": [
+                {
+                    "cl_data": "UNITS/MM\nMULTAX/ON\nFEDRAT/MMPM, 1500\n"
+                    "GOTO/0, 0, 0, 0, 0, 1\nGOTO/10, 0, 0, 0, 0, 1\nGOTO/20, 0, 1, 0, 0, 1\n"
+                }
+            ]
+        }
+    )
+
+    cl_data: str = Field(
+        min_length=1,
+        max_length=MAX_CAM_TEXT,
+        description="APT CL data as CAM writes it: UNITS, MULTAX, TLAXIS, GOTO, FEDRAT, RAPID "
+        "(cam.md section 5); records it does not read are a 422 naming the line. Tool axes "
+        "within 1e-3 of unit length are normalised and the correction reported. The default "
+        "spin_mode is free; the default feed of /v1/evaluate is the program's highest FEDRAT.",
+    )
+
+    def n_waypoints(self) -> int:
+        """An upper bound on the number of waypoints: the GOTO records (before parsing)."""
+        return self.cl_data.upper().count("GOTO")
+
+    def to_solver(self) -> PathInput:
+        """The program's poses, passes and feed.
+
+        Raises:
+            InvalidLineError: a record that cannot be read, naming its line.
+        """
+        return _from_cam(read_cl_data(self.cl_data, field="path.cl_data"), field="path.cl_data")
+
+
+class CsvPath(RequestModel):
+    """A path as CSV, one waypoint a line: x,y,z,i,j,k (tool axis) or x,y,z,qx,qy,qz,qw."""
+
+    model_config = ConfigDict(
+        json_schema_extra={
+            "examples": [{"csv": "x,y,z,i,j,k\n0,0,0,0,0,1\n10,0,0,0,0,1\n", "units": "mm"}]
+        }
+    )
+
+    csv: str = Field(
+        min_length=1,
+        max_length=MAX_CAM_TEXT,
+        description="One waypoint a line: x,y,z,i,j,k (a tool axis, tip towards holder) or "
+        "x,y,z,qx,qy,qz,qw (a pose); an optional header line naming those columns. Vectors "
+        "within 1e-3 of unit length are normalised and the correction reported.",
+    )
+    units: Literal["mm", "m"] = Field(description="The unit of x, y, z: mm or m.")
+
+    def n_waypoints(self) -> int:
+        """An upper bound on the number of waypoints: the lines."""
+        return self.csv.count("\n") + 1
+
+    def to_solver(self) -> PathInput:
+        """The path's poses (one pass, no feed).
+
+        Raises:
+            InvalidLineError: a line that cannot be read, naming it.
+        """
+        cam = read_csv_path(self.csv, units=self.units, field="path.csv")
+        return _from_cam(cam, field="path.csv")
+
+
+_FORMS = ("waypoints", "tool_axis_waypoints", "cl_data", "csv")
 
 
 def _path_form(value: object) -> str | None:
@@ -142,18 +235,21 @@ def _path_form(value: object) -> str | None:
         return f"path:{given[0]}" if len(given) == 1 else None
     if isinstance(value, PosePath):
         return "path:waypoints"
-    if isinstance(value, ToolAxisPath):
-        return "path:tool_axis_waypoints"
-    return None
+    for kind, form in ((ToolAxisPath, "tool_axis_waypoints"), (ClDataPath, "cl_data")):
+        if isinstance(value, kind):
+            return f"path:{form}"
+    return "path:csv" if isinstance(value, CsvPath) else None
 
 
 Path = Annotated[
     Annotated[PosePath, Tag("path:waypoints")]
-    | Annotated[ToolAxisPath, Tag("path:tool_axis_waypoints")],
+    | Annotated[ToolAxisPath, Tag("path:tool_axis_waypoints")]
+    | Annotated[ClDataPath, Tag("path:cl_data")]
+    | Annotated[CsvPath, Tag("path:csv")],
     Discriminator(
         _path_form,
         custom_error_type="path_form",
-        custom_error_message="give exactly one of waypoints or tool_axis_waypoints",
+        custom_error_message="give exactly one of waypoints, tool_axis_waypoints, cl_data or csv",
     ),
 ]
-"""The tool path in the workpiece frame {O}, in machining order: poses or tool axes."""
+"""The tool path in {O}, in machining order: poses, tool axes, CL data or CSV."""

@@ -9,6 +9,7 @@ from service.deps import SettingsDep
 from service.errors import ERROR_RESPONSES
 from service.schemas import EvaluateRequest, EvaluateResponse
 from solver.evaluate import evaluate_path
+from solver.feed import check_feed
 
 router = APIRouter(prefix="/evaluate", tags=["evaluate"], responses=ERROR_RESPONSES)
 
@@ -30,13 +31,16 @@ def post_evaluate(body: EvaluateRequest, settings: SettingsDep) -> EvaluateRespo
         branch=convert.branch_of(body.ik.branch),
         max_joint_step=body.ik.max_joint_step,
         spin_mode=convert.spin_mode_of(body.spin_mode, path),
+        passes=path.passes,
     )
     detail = body.detail or (
         "waypoints" if body.path.n_waypoints() <= settings.max_detail_waypoints else "summary"
     )
+    feed = body.feed if body.feed is not None else path.feed
     return convert.evaluate_response(
         evaluation,
         robot,
         axis_correction=path.axis_correction,
         with_waypoints=detail == "waypoints",
+        feed=None if feed is None else check_feed(evaluation, feed, robot.qdot_max),
     )

@@ -47,6 +47,7 @@ def _computed_map(
         max_joint_step=body.ik.max_joint_step,
         spin_mode=spin_mode,
         progress=progress,
+        passes=path.passes,
     )
     return result, robot.name, spin_mode
 

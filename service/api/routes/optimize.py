@@ -63,5 +63,6 @@ def _optimum(body: OptimizeRequest, settings: Settings, progress: Progress) -> O
         max_coarse_poses=settings.max_map_poses,
         max_solver_seconds=settings.max_solver_seconds,
         progress=progress,
+        passes=path.passes,
     )
     return convert.optimize_response(optimum, robot, axis_correction=path.axis_correction)

@@ -1,0 +1,47 @@
+"""``POST /v1/paths/import``: read a path (CL data, CSV, poses, tool axes) and show it back."""
+
+from __future__ import annotations
+
+from typing import Annotated
+
+from fastapi import APIRouter, Request, Response
+
+from service.body import body_in_thread, body_openapi
+from service.errors import ERROR_RESPONSES
+from service.schemas.path import PathInput
+from service.schemas.paths_import import ImportedPose, PathImportRequest, PathImportResponse
+from service.work import json_response, run_stoppable
+from solver.cam.frames import quaternion_wxyz
+
+router = APIRouter(prefix="/paths", tags=["paths"], responses=ERROR_RESPONSES)
+
+
+@router.post(
+    "/import",
+    operation_id="import_path",
+    summary="The path as the service reads it: waypoints, passes, feed, corrections",
+    response_model=PathImportResponse,
+    openapi_extra=body_openapi(PathImportRequest),
+)
+async def post_import(
+    request: Request, body: Annotated[PathImportRequest, body_in_thread(PathImportRequest)]
+) -> Response:
+    """Read a path without computing anything, so a user can look at it first."""
+    return await run_stoppable(request, lambda _: json_response(imported(body.path.to_solver())))
+
+
+def imported(path: PathInput) -> PathImportResponse:
+    """The import answer of a parsed path."""
+    waypoints = []
+    for pose in path.poses:
+        w, x, y, z = quaternion_wxyz(pose[:3, :3])
+        waypoints.append(ImportedPose(position=pose[:3, 3].tolist(), orientation=[x, y, z, w]))
+    passes = path.passes or ((0, len(path.poses)),)
+    return PathImportResponse(
+        waypoints=waypoints,
+        passes=[[start, stop] for start, stop in passes],
+        feed=path.feed,
+        units=path.units,
+        correction=path.axis_correction,
+        spin_mode=path.default_spin_mode,
+    )
