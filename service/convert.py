@@ -10,6 +10,7 @@ import numpy as np
 from service import schemas
 from service.config import Settings
 from service.schemas.path import PathInput
+from solver.cam.frames import frames_of_placement
 from solver.capability_map import CapabilityMap, axis_length, grid_axis
 from solver.dtf import DtfResult
 from solver.evaluate import Branch, PathEvaluation
@@ -321,10 +322,18 @@ def wants_png(accept: str) -> bool:
     return png[0] > 0.0 and png > json_
 
 
-def _api_placement(placement: Placement) -> schemas.Placement:
-    """The API's placement (m, rad) of a solver placement."""
-    return schemas.Placement(
-        x=placement.x, y=placement.y, z=placement.z, yaw=placement.yaw, spin=placement.spin
+def _api_placement(placement: Placement) -> schemas.PlacementResult:
+    """The API's placement (m, rad) of a solver placement, with its controller frames."""
+    frames = frames_of_placement(placement)
+    return schemas.PlacementResult(
+        x=placement.x,
+        y=placement.y,
+        z=placement.z,
+        yaw=placement.yaw,
+        spin=placement.spin,
+        frames=schemas.ControllerFrames(
+            matrix=frames.matrix, ur=frames.ur, kuka=frames.kuka, abb=frames.abb, fanuc=frames.fanuc
+        ),
     )
 
 

@@ -9,7 +9,7 @@ import numpy as np
 
 from solver.exceptions import InvalidInputError
 
-QUATERNION_NORM_TOLERANCE = 1e-6
+QUATERNION_NORM_TOLERANCE = 1e-3  # cam.md section 6: normalised within it, refused beyond
 # Positions and placements farther than this from the origin (m) are input errors: no robot cell
 # is that large, and squares of far larger numbers overflow.
 MAX_COORDINATE = 1e3
@@ -43,14 +43,14 @@ def rotation_from_quaternion(
     """Rotation matrix of a unit quaternion in ROS order (x, y, z, w).
 
     Args:
-        quaternion_xyzw: shape (4,), unit norm to within 1e-6 (it is never normalised past that).
+        quaternion_xyzw: shape (4,), unit norm to within 1e-3 (cam.md section 6), normalised.
         field: name of the input, for the error message.
 
     Returns:
         shape (3, 3), a rotation matrix.
 
     Raises:
-        InvalidInputError: wrong shape, not finite, or a norm off by more than 1e-6.
+        InvalidInputError: wrong shape, not finite, or a norm off by more than 1e-3.
     """
     quat = np.asarray(quaternion_xyzw, dtype=float)
     if quat.shape != (4,) or not np.all(np.isfinite(quat)):
@@ -58,7 +58,9 @@ def rotation_from_quaternion(
     norm = float(np.linalg.norm(quat))
     if abs(norm - 1.0) > QUATERNION_NORM_TOLERANCE:
         raise InvalidInputError(
-            field, f"quaternion norm is {norm:.6g}; a unit quaternion is needed (tolerance 1e-6)"
+            field,
+            f"quaternion norm is {norm:.6g}; a unit quaternion is needed (within 1e-3, then "
+            "normalised)",
         )
     x, y, z, w = quat / norm
     return np.array(

@@ -6,8 +6,9 @@ and refuses NaN and infinities, so bad input of any kind is a ``422`` that names
 
 from __future__ import annotations
 
+import dataclasses
 import math
-from typing import Annotated, Literal
+from typing import Annotated, Any, Literal
 
 import numpy as np
 from pydantic import (
@@ -20,8 +21,10 @@ from pydantic import (
 )
 from pydantic_core import PydanticCustomError
 
+from solver.cam.frames import frames_of_placement
 from solver.evaluate import DEFAULT_MAX_JOINT_STEP
 from solver.spatial import MAX_COORDINATE, QUATERNION_NORM_TOLERANCE, pose_matrix
+from solver.spatial import Placement as SolverPlacement
 
 UNIT_BOUND = 1.001  # a direction typed with 4 decimals may be off its unit norm by up to 1e-3
 
@@ -74,8 +77,8 @@ class Pose(RequestModel):
 
     position: Position = Field(description="Position [x, y, z] (m), each within 1 km.")
     orientation: Quaternion = Field(
-        description="Unit quaternion [qx, qy, qz, qw] (dimensionless, ROS order). A norm off "
-        "by more than 1e-6 is refused, never normalised."
+        description="Unit quaternion [qx, qy, qz, qw] (dimensionless, ROS order). A norm within "
+        "1e-3 of 1 is normalised and the correction reported; beyond, it is refused."
     )
 
     @field_validator("orientation")
@@ -85,7 +88,8 @@ class Pose(RequestModel):
         if abs(norm - 1.0) > QUATERNION_NORM_TOLERANCE:
             raise PydanticCustomError(
                 "unit_quaternion",
-                "quaternion norm is {norm}; a unit quaternion is needed (tolerance 1e-6)",
+                "quaternion norm is {norm}; a unit quaternion is needed (within 1e-3, then "
+                "normalised)",
                 {"norm": norm},
             )
         return value
@@ -193,3 +197,70 @@ class IkPolicy(RequestModel):
         gt=0.0,
         description="Largest move of any joint between neighbouring waypoints (rad), > 0.",
     )
+
+
+class ControllerFrames(ResponseModel):
+    """A placement as robot controllers write a base, user or work-object frame (cam.md 8)."""
+
+    model_config = ConfigDict(
+        json_schema_extra={
+            "examples": [
+                {
+                    "matrix": [[1, 0, 0, 0], [0, 1, 0, 0.45], [0, 0, 1, 0.1], [0, 0, 0, 1]],
+                    "ur": [0.0, 0.45, 0.1, 0.0, 0.0, 0.0],
+                    "kuka": {"X": 0.0, "Y": 450.0, "Z": 100.0, "A": 0.0, "B": 0.0, "C": 0.0},
+                    "abb": [[0.0, 450.0, 100.0], [1.0, 0.0, 0.0, 0.0]],
+                    "fanuc": {"X": 0.0, "Y": 450.0, "Z": 100.0, "W": 0.0, "P": 0.0, "R": 0.0},
+                }
+            ]
+        }
+    )
+
+    matrix: list[list[float]] = Field(description="T_B_O, 4 rows of 4, row-major (m).")
+    ur: list[float] = Field(
+        description="Universal Robots pose [x, y, z, rx, ry, rz]: m, and a rotation vector (rad)."
+    )
+    kuka: dict[str, float] = Field(
+        description="KUKA {X, Y, Z, A, B, C}: mm and deg, R = Rz(A) Ry(B) Rx(C)."
+    )
+    abb: list[list[float]] = Field(
+        description="ABB wobj uframe [[x, y, z], [q1, q2, q3, q4]]: mm, q1 the scalar part."
+    )
+    fanuc: dict[str, float] = Field(
+        description="FANUC {X, Y, Z, W, P, R}: mm and deg, R = Rz(R) Ry(P) Rx(W)."
+    )
+
+
+class PlacementResult(ResponseModel):
+    """A placement in an answer: x, y, z, yaw, spin and the same in controller terms."""
+
+    model_config = ConfigDict(
+        json_schema_extra={
+            "examples": [
+                {
+                    "x": 0.0,
+                    "y": 0.45,
+                    "z": 0.1,
+                    "yaw": 0.0,
+                    "spin": 0.0,
+                    "frames": ControllerFrames.model_config["json_schema_extra"]["examples"][0],  # type: ignore[index]
+                }
+            ]
+        }
+    )
+
+    x: float = Field(description="x of {O} in {B} (m).")
+    y: float = Field(description="y of {O} in {B} (m).")
+    z: float = Field(description="z of {O} in {B} (m), the table height.")
+    yaw: float = Field(description="Rotation of {O} about the z axis of {B} (rad).")
+    spin: float = Field(description="Tool spin about each waypoint's tool axis (rad).")
+    frames: ControllerFrames = Field(
+        description="T_B_O (the workpiece frame in the base frame; the spin is the tool's, not "
+        "the frame's) as controllers write it."
+    )
+
+
+def placement_example(x: float, y: float, z: float, yaw: float) -> dict[str, Any]:
+    """A PlacementResult example (its frames computed, so that they are right)."""
+    frames = frames_of_placement(SolverPlacement(x=x, y=y, z=z, yaw=yaw))
+    return {"x": x, "y": y, "z": z, "yaw": yaw, "spin": 0.0, "frames": dataclasses.asdict(frames)}

@@ -111,6 +111,11 @@ class DtfResponse(ResponseModel):
     yoshikawa: float = Field(
         description="Yoshikawa manipulability sqrt(det(J J^T)) (mixed units), for comparison."
     )
+    correction: float = Field(
+        default=0.0,
+        description="The largest correction made to u_T's or u_R's length (normalised within "
+        "1e-3, cam.md section 6); 0 when they were unit.",
+    )
     chiu: float = Field(
         description="Chiu's directional index [t^T (J J^T)^-1 t]^(-1/2), t = [u_T; u_R / h] "
         "normalised (mixed units), for comparison; 0 when t is out of reach."

@@ -15,7 +15,8 @@ class ErrorDetail(ResponseModel):
             "examples": [
                 {
                     "loc": ["body", "path", "waypoints", 3, "orientation"],
-                    "msg": "quaternion norm is 1.01; a unit quaternion is needed (tolerance 1e-6)",
+                    "msg": "quaternion norm is 1.01; a unit quaternion is needed (within 1e-3, "
+                    "then normalised)",
                     "type": "unit_quaternion",
                 }
             ]

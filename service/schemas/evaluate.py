@@ -117,8 +117,8 @@ class EvaluateRequest(RequestModel):
         default=None,
         ge=1e-6,
         le=100.0,
-        description="A feed to check (m/s, 1e-6 to 100): the answer then says whether the path runs at "
-        "it, the margin, and every waypoint's joint speeds and use of their limits at it. "
+        description="A feed to check (m/s, 1e-6 to 100): the answer then says whether the path "
+        "runs at it, the margin, and every waypoint's joint speeds and use of their limits at it. "
         "Default: the program's feed (its highest FEDRAT) for CL data, else none.",
     )
     spins: list[Angle] | None = Field(

@@ -11,10 +11,11 @@ from service.schemas.common import (
     Angle,
     Coordinate,
     IkPolicy,
-    Placement,
+    PlacementResult,
     RequestModel,
     ResponseModel,
     SpinMode,
+    placement_example,
 )
 from service.schemas.evaluate import _REQUEST_EXAMPLE, FailureReason
 from service.schemas.path import Path
@@ -161,13 +162,11 @@ class MapExtreme(ResponseModel):
 
     model_config = ConfigDict(
         json_schema_extra={
-            "examples": [
-                {"placement": {"x": 0.0, "y": 0.35, "z": 0.1, "yaw": 0.0}, "mu_path": 0.29}
-            ]
+            "examples": [{"placement": placement_example(0.0, 0.35, 0.1, 0.0), "mu_path": 0.29}]
         }
     )
 
-    placement: Placement = Field(description="Where the workpiece sits (m, rad).")
+    placement: PlacementResult = Field(description="Where the workpiece sits (m, rad).")
     mu_path: float = Field(description="Its mu_path (m/s).")
 
 
@@ -180,11 +179,11 @@ class MapResponse(ResponseModel):
                 {
                     "cells": [_CELL],
                     "best": {
-                        "placement": {"x": 0.0, "y": 0.35, "z": 0.1, "yaw": 0.0},
+                        "placement": placement_example(0.0, 0.35, 0.1, 0.0),
                         "mu_path": 0.2913,
                     },
                     "worst": {
-                        "placement": {"x": 0.0, "y": 0.35, "z": 0.1, "yaw": 0.0},
+                        "placement": placement_example(0.0, 0.35, 0.1, 0.0),
                         "mu_path": 0.2913,
                     },
                     "feasible_cells": 1,

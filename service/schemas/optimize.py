@@ -14,9 +14,11 @@ from service.schemas.common import (
     AutoIkPolicy,
     Coordinate,
     Placement,
+    PlacementResult,
     RequestModel,
     ResponseModel,
     SpinMode,
+    placement_example,
 )
 from service.schemas.evaluate import _REQUEST_EXAMPLE, EvaluateResponse
 from service.schemas.path import Path
@@ -137,11 +139,11 @@ class StartInfo(ResponseModel):
 
     model_config = ConfigDict(
         json_schema_extra={
-            "examples": [{"placement": {"x": 0, "y": 0.45, "z": 0.1, "yaw": 0}, "mu_path": 0.2937}]
+            "examples": [{"placement": placement_example(0.0, 0.45, 0.1, 0.0), "mu_path": 0.2937}]
         }
     )
 
-    placement: Placement = Field(description="The start (m, rad).")
+    placement: PlacementResult = Field(description="The start (m, rad).")
     mu_path: float | None = Field(description="Its mu_path (m/s); null when infeasible.")
 
 
@@ -175,11 +177,11 @@ class OptimizeResponse(ResponseModel):
             "examples": [
                 {
                     "found": True,
-                    "placement": {"x": 0.0, "y": 0.2994, "z": 0.1, "yaw": 2.1407},
+                    "placement": placement_example(0.0, 0.2994, 0.1, 2.1407),
                     "mu_path": 0.3971,
                     "evaluation": None,
                     "start": {
-                        "placement": {"x": 0, "y": 0.45, "z": 0.1, "yaw": 0},
+                        "placement": placement_example(0.0, 0.45, 0.1, 0.0),
                         "mu_path": 0.2937,
                     },
                     "improvement_percent": 35.19,
@@ -195,7 +197,9 @@ class OptimizeResponse(ResponseModel):
     )
 
     found: bool = Field(description="Whether any placement inside the bounds is feasible.")
-    placement: Placement | None = Field(description="The optimum, inside the bounds (m, rad).")
+    placement: PlacementResult | None = Field(
+        description="The optimum, inside the bounds (m, rad)."
+    )
     mu_path: float | None = Field(description="mu_path there (m/s), as /v1/evaluate gives it.")
     evaluation: EvaluateResponse | None = Field(description="/v1/evaluate's answer there.")
     start: StartInfo = Field(description="The start placement and its mu_path.")

@@ -102,7 +102,9 @@ class PosePath(RequestModel):
                 for i, pose in enumerate(self.waypoints)
             ]
         )
-        return PathInput(poses=poses, axis_correction=0.0, default_spin_mode="fixed")
+        norms = np.linalg.norm([pose.orientation for pose in self.waypoints], axis=1)
+        correction = float(np.max(np.abs(norms - 1.0)))
+        return PathInput(poses=poses, axis_correction=correction, default_spin_mode="fixed")
 
 
 class ToolAxisPath(RequestModel):

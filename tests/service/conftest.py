@@ -57,3 +57,8 @@ def body_limit(monkeypatch: pytest.MonkeyPatch) -> Iterator[int]:
     get_settings.cache_clear()
     yield 500
     get_settings.cache_clear()
+
+
+def sent_back(placement: dict[str, Any]) -> dict[str, Any]:
+    """An answer's placement as a request takes it: x, y, z, yaw, spin (its frames left out)."""
+    return {key: placement[key] for key in ("x", "y", "z", "yaw", "spin")}

@@ -93,7 +93,7 @@ DTF_CASES: list[tuple[str, Changes, Loc]] = [
     ),
     (
         "non-unit tcp quaternion",
-        {("robot", "tcp"): {"position": [0.0, 0.0, 0.1], "orientation": [0, 0, 0, 1.00001]}},
+        {("robot", "tcp"): {"position": [0.0, 0.0, 0.1], "orientation": [0, 0, 0, 1.002]}},
         ["body", "robot", "tcp", "orientation"],
     ),
 ]
@@ -119,7 +119,7 @@ EVALUATE_CASES: list[tuple[str, Changes, Loc]] = [
     ),
     (
         "non-unit quaternion",
-        {(*WAYPOINTS, 3, "orientation"): [1.0, 0.0, 0.0, 0.01]},
+        {(*WAYPOINTS, 3, "orientation"): [1.0, 0.0, 0.0, 0.1]},
         ["body", "path", "waypoints", 3, "orientation"],
     ),
     (

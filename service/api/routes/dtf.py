@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import math
+
 from fastapi import APIRouter
 
 from service import convert
@@ -26,6 +28,9 @@ def post_dtf(body: DtfRequest) -> DtfResponse:
         jacobian, u_T=body.u_T, u_R=body.u_R, h=h, qdot_max=robot.qdot_max, method=body.method
     )
     twist = twist_per_unit_speed(body.u_T, body.u_R, h)
-    return convert.dtf_response(
+    given = [u for u in (body.u_T, body.u_R) if u is not None]
+    correction = float(max((abs(math.hypot(*u) - 1.0) for u in given), default=0.0))
+    answer = convert.dtf_response(
         result, robot, yoshikawa=yoshikawa(jacobian), chiu=chiu(jacobian, twist)
     )
+    return answer.model_copy(update={"correction": correction})
