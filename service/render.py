@@ -1,4 +1,4 @@
-"""The capability map as a picture (PNG), for a report: one panel per yaw and spin."""
+"""Pictures (PNG): the capability map, one panel per yaw and spin; joint use along a path."""
 
 from __future__ import annotations
 
@@ -15,6 +15,8 @@ from matplotlib.lines import Line2D  # noqa: E402
 from matplotlib.patches import Patch  # noqa: E402
 
 from solver.capability_map import CapabilityMap  # noqa: E402
+from solver.evaluate import PathEvaluation  # noqa: E402
+from solver.feed import FeedCheck  # noqa: E402
 
 PANEL_INCHES = (4.0, 3.6)
 COLOUR_BAR_INCHES = 1.2
@@ -85,6 +87,35 @@ def render_png(cmap: CapabilityMap, *, title: str) -> bytes:
         fontsize=8,
     )
     figure.suptitle(title, fontsize=10)
+    buffer = io.BytesIO()
+    figure.savefig(buffer, format="png", dpi=DPI)
+    plt.close(figure)
+    return buffer.getvalue()
+
+
+def render_joint_use(
+    check: FeedCheck, evaluation: PathEvaluation, joint_names: tuple[str, ...], *, title: str
+) -> bytes:
+    """Each joint's use of its speed limit along the path at the feed, as a PNG (cam.md 7).
+
+    One line per joint, the limit at 1, the bottleneck waypoint and joint marked: the picture
+    the ERK 2021 paper checked in URSim (figs. 3-4).
+    """
+    use = np.abs(check.use) if check.use is not None else np.zeros((0, len(joint_names)))
+    figure, axes = plt.subplots(figsize=(8.0, 4.0), dpi=DPI, layout="constrained")
+    waypoints = np.arange(len(use))
+    for j, name in enumerate(joint_names):
+        axes.plot(waypoints, use[:, j], label=name, lw=1.2)
+    axes.axhline(1.0, color="red", ls="--", lw=1.0, label="limit")
+    if evaluation.bottleneck_waypoint is not None and evaluation.bottleneck_joint is not None:
+        w, j = evaluation.bottleneck_waypoint, evaluation.bottleneck_joint
+        axes.plot(w, use[w, j], "o", color="black", ms=8, label=f"bottleneck: {joint_names[j]}")
+    state = "runs" if check.feasible else "does NOT run"
+    axes.set_title(f"{title}: feed {check.feed:.4g} m/s {state} (margin {check.margin:.3g})")
+    axes.set_xlabel("waypoint")
+    axes.set_ylabel("|qdot| / qdot_max")
+    axes.set_ylim(bottom=0.0)
+    figure.legend(loc="outside right upper", fontsize=8)
     buffer = io.BytesIO()
     figure.savefig(buffer, format="png", dpi=DPI)
     plt.close(figure)

@@ -179,3 +179,17 @@ def test_the_program_feed_is_the_default_and_a_request_feed_wins(client: TestCli
     assert default == pytest.approx(1524.0 / 1000 / 60, rel=1e-12)  # the highest FEDRAT
     assert evaluate(client, {"cl_data": PROGRAM_MM}, feed=0.01)["feed_check"]["feed"] == 0.01
     assert evaluate(client, {"tool_axis_waypoints": PASSES[0]})["feed_check"] is None
+
+
+def test_the_joint_use_picture_at_the_feed(client: TestClient) -> None:
+    body = {"robot": ROBOT, "path": {"cl_data": PROGRAM_MM}, "placement": PLACEMENT}
+    answer = client.post("/v1/evaluate", json=body, headers={"accept": "image/png"})
+    assert answer.status_code == 200, answer.text
+    assert answer.headers["content-type"] == "image/png"
+    assert answer.content.startswith(b"\x89PNG\r\n\x1a\n")
+    far = {**body, "placement": {**PLACEMENT, "x": 5.0}}
+    refused = client.post("/v1/evaluate", json=far, headers={"accept": "image/png"})
+    assert refused.status_code == 422 and refused.json()["detail"][0]["loc"] == [
+        "body",
+        "placement",
+    ]

@@ -1,24 +1,54 @@
-"""``POST /v1/evaluate``: mu_path of a path at one placement (spec sections 2-4)."""
+"""``POST /v1/evaluate``: mu_path of a path at one placement (spec sections 2-4, cam.md 7)."""
 
 from __future__ import annotations
 
-from fastapi import APIRouter
+from typing import Annotated
+
+from fastapi import APIRouter, Header, Request, Response
 
 from service import convert
+from service.body import body_in_thread, body_openapi
+from service.config import Settings
 from service.deps import SettingsDep
 from service.errors import ERROR_RESPONSES
+from service.render import render_joint_use
 from service.schemas import EvaluateRequest, EvaluateResponse
+from service.work import json_response, run_stoppable
 from solver.evaluate import evaluate_path
+from solver.exceptions import InvalidInputError
 from solver.feed import check_feed
 
 router = APIRouter(prefix="/evaluate", tags=["evaluate"], responses=ERROR_RESPONSES)
 
 
 @router.post(
-    "", operation_id="evaluate", summary="Feasibility and mu_path of a path at a placement"
+    "",
+    operation_id="evaluate",
+    summary="Feasibility and mu_path of a path at a placement (PNG of joint use on request)",
+    response_model=EvaluateResponse,
+    openapi_extra=body_openapi(EvaluateRequest),
+    responses={
+        200: {
+            "content": {"image/png": {"schema": {"type": "string", "format": "binary"}}},
+            "description": "JSON; or with Accept: image/png each joint's use of its speed limit "
+            "along the path at the feed (default: mu_path), the limit at 1, the bottleneck "
+            "marked (the ERK 2021 figs. 3-4 picture).",
+        }
+    },
 )
-def post_evaluate(body: EvaluateRequest, settings: SettingsDep) -> EvaluateResponse:
+async def post_evaluate(
+    request: Request,
+    body: Annotated[EvaluateRequest, body_in_thread(EvaluateRequest)],
+    settings: SettingsDep,
+    accept: Annotated[str, Header()] = "application/json",
+) -> Response:
     """An unreachable placement is not an error: it answers ``feasible: false`` with a reason."""
+    png = convert.wants_png(accept)
+    return await run_stoppable(request, lambda _: _answer(body, settings, png=png))
+
+
+def _answer(body: EvaluateRequest, settings: Settings, *, png: bool) -> Response:
+    """The JSON answer, or the PNG of joint use; the path's size checked first."""
     convert.check_path_size(
         body.path, limit=settings.max_path_waypoints, setting="DTF_MAX_PATH_WAYPOINTS"
     )
@@ -33,14 +63,26 @@ def post_evaluate(body: EvaluateRequest, settings: SettingsDep) -> EvaluateRespo
         spin_mode=convert.spin_mode_of(body.spin_mode, path),
         passes=path.passes,
     )
+    feed = body.feed if body.feed is not None else path.feed
+    if png:
+        if evaluation.mu_path is None or evaluation.mu_path <= 0.0:
+            raise InvalidInputError(
+                "placement",
+                f"the path does not run here ({evaluation.reason or 'mu_path is 0'}): no joint "
+                "speeds to draw; ask for JSON to see why",
+            )
+        check = check_feed(evaluation, evaluation.mu_path if feed is None else feed, robot.qdot_max)
+        picture = render_joint_use(check, evaluation, robot.joint_names, title=robot.name)
+        return Response(picture, media_type="image/png")
     detail = body.detail or (
         "waypoints" if body.path.n_waypoints() <= settings.max_detail_waypoints else "summary"
     )
-    feed = body.feed if body.feed is not None else path.feed
-    return convert.evaluate_response(
-        evaluation,
-        robot,
-        axis_correction=path.axis_correction,
-        with_waypoints=detail == "waypoints",
-        feed=None if feed is None else check_feed(evaluation, feed, robot.qdot_max),
+    return json_response(
+        convert.evaluate_response(
+            evaluation,
+            robot,
+            axis_correction=path.axis_correction,
+            with_waypoints=detail == "waypoints",
+            feed=None if feed is None else check_feed(evaluation, feed, robot.qdot_max),
+        )
     )
