@@ -58,3 +58,22 @@ def test_five_axis_example_output() -> None:
 
     assert printed.splitlines() == five_axis.lines(post)
     assert "python3 examples/five_axis.py" in section
+
+
+def test_cam_example_output() -> None:
+    section = README.split("## CAM programs: from a CL file to the controller", 1)[1]
+    printed = re.search(r"prints\n\n```\n(.*?)\n```", section, re.S).group(1)
+    sys.path.insert(0, str(EXAMPLES))
+    try:
+        cam_program = importlib.import_module("cam_program")
+    finally:
+        sys.path.remove(str(EXAMPLES))
+    client = TestClient(app)
+
+    def post(route: str, body: dict) -> dict:
+        response = client.post(route, json=body)
+        assert response.status_code == 200, response.text
+        return response.json()
+
+    assert printed.splitlines() == cam_program.lines(post)
+    assert "python3 examples/cam_program.py" in section
