@@ -12,29 +12,12 @@ from __future__ import annotations
 import json
 import math
 import sys
-import urllib.request
-from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
+from http_post import Post, http_post
+
 HERE = Path(__file__).resolve().parent
-Post = Callable[[str, dict[str, Any]], dict[str, Any]]
-
-
-def http_post(base: str) -> Post:
-    """A function that POSTs a JSON body to ``base + route`` and returns the JSON answer."""
-
-    def post(route: str, body: dict[str, Any]) -> dict[str, Any]:
-        request = urllib.request.Request(
-            base + route,
-            data=json.dumps(body).encode(),
-            headers={"content-type": "application/json"},
-        )
-        with urllib.request.urlopen(request) as answer:
-            result: dict[str, Any] = json.load(answer)
-            return result
-
-    return post
 
 
 def lines(post: Post) -> list[str]:

@@ -41,12 +41,14 @@ def test_worked_example_output() -> None:
     assert "@examples/evaluate_request.json" in example
 
 
-def test_five_axis_example_output() -> None:
-    section = README.split("## Five-axis: let the tool spin", 1)[1]
+def _example_lines(heading: str, module: str) -> tuple[list[str], list[str]]:
+    """What the README says an example prints under ``heading``, and what it prints."""
+    section = README.split(heading, 1)[1]
     printed = re.search(r"prints\n\n```\n(.*?)\n```", section, re.S).group(1)
+    assert f"python3 examples/{module}.py" in section
     sys.path.insert(0, str(EXAMPLES))
     try:
-        five_axis = importlib.import_module("five_axis")
+        example = importlib.import_module(module)
     finally:
         sys.path.remove(str(EXAMPLES))
     client = TestClient(app)
@@ -56,24 +58,16 @@ def test_five_axis_example_output() -> None:
         assert response.status_code == 200, response.text
         return response.json()
 
-    assert printed.splitlines() == five_axis.lines(post)
-    assert "python3 examples/five_axis.py" in section
+    return printed.splitlines(), example.lines(post)
+
+
+def test_five_axis_example_output() -> None:
+    printed, lines = _example_lines("## Five-axis: let the tool spin", "five_axis")
+    assert printed == lines
 
 
 def test_cam_example_output() -> None:
-    section = README.split("## CAM programs: from a CL file to the controller", 1)[1]
-    printed = re.search(r"prints\n\n```\n(.*?)\n```", section, re.S).group(1)
-    sys.path.insert(0, str(EXAMPLES))
-    try:
-        cam_program = importlib.import_module("cam_program")
-    finally:
-        sys.path.remove(str(EXAMPLES))
-    client = TestClient(app)
-
-    def post(route: str, body: dict) -> dict:
-        response = client.post(route, json=body)
-        assert response.status_code == 200, response.text
-        return response.json()
-
-    assert printed.splitlines() == cam_program.lines(post)
-    assert "python3 examples/cam_program.py" in section
+    printed, lines = _example_lines(
+        "## CAM programs: from a CL file to the controller", "cam_program"
+    )
+    assert printed == lines
