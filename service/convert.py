@@ -99,11 +99,23 @@ def placement_of(placement: schemas.Placement) -> Placement:
     )
 
 
-def branch_of(choice: schemas.Branch | str) -> Branch | None:
+def branch_of(choice: schemas.Branch | schemas.NumericBranch | str) -> Branch | None:
     """The solver's branch label; ``None`` for ``"auto"``."""
     if isinstance(choice, str):
         return None
+    if isinstance(choice, schemas.NumericBranch):
+        return Branch.named(solution=str(choice.solution))
     return Branch.named(shoulder=choice.shoulder, elbow=choice.elbow, wrist=choice.wrist)
+
+
+def branch_to_api(branch: Branch | None) -> schemas.Branch | schemas.NumericBranch | None:
+    """The API's branch: named levels, or the numeric family's solution index."""
+    if branch is None:
+        return None
+    choices = branch.as_dict()
+    if set(choices) == {"solution"}:
+        return schemas.NumericBranch(solution=int(choices["solution"]))
+    return schemas.Branch.model_validate(choices)
 
 
 def h_of(h: float | None) -> float:
@@ -201,14 +213,13 @@ def evaluate_response(
             joint=ev.bottleneck_joint,
             joint_name=robot.joint_names[ev.bottleneck_joint],
         )
-    branch = None if ev.branch is None else schemas.Branch.model_validate(ev.branch.as_dict())
     return schemas.EvaluateResponse(
         feasible=ev.feasible,
         mu_path=ev.mu_path,
         bottleneck=bottleneck,
         reason=None if ev.reason is None else schemas.FailureReason(ev.reason),
         failed_waypoint=ev.failed_waypoint,
-        branch=branch,
+        branch=branch_to_api(ev.branch),
         waypoints=waypoints,
         detail="waypoints" if with_waypoints else "summary",
         spin_mode=ev.spin_mode,

@@ -12,6 +12,7 @@ from service.schemas.common import (
     Angle,
     Branch,
     IkPolicy,
+    NumericBranch,
     Placement,
     RequestModel,
     ResponseModel,
@@ -93,8 +94,8 @@ class EvaluateRequest(RequestModel):
     model_config = ConfigDict(json_schema_extra={"examples": [_REQUEST_EXAMPLE]})
 
     robot: Robot = Field(
-        description="The arm; path evaluation needs its IK family: a UR or OPW arm (catalogue "
-        "model or opw geometry)."
+        description="The arm: a catalogue model, an opw geometry, or a URDF chain of 6 joints or "
+        "more (numeric IK)."
     )
     path: Path = Field(description="The waypoints, in the workpiece frame {O}.")
     placement: Placement = Field(description="Where {O} sits in the base frame {B}.")
@@ -194,8 +195,10 @@ class EvaluateResponse(ResponseModel):
     failed_waypoint: int | None = Field(
         description="Index of the first waypoint that fails; null when feasible."
     )
-    branch: Branch | None = Field(
-        description="IK branch used (when infeasible with auto: the one that got furthest)."
+    branch: Branch | NumericBranch | None = Field(
+        description="IK branch used (when infeasible with auto: the one that got furthest): "
+        "named for a UR or OPW arm, a solution index for the numeric family; null when no "
+        "branch reached the first waypoint."
     )
     spin_mode: SpinMode = Field(description="The spin mode used (fixed or free).")
     spins: list[float] | None = Field(
