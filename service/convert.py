@@ -15,7 +15,7 @@ from solver.dtf import DtfResult
 from solver.evaluate import Branch, PathEvaluation
 from solver.exceptions import InvalidInputError
 from solver.optimize import PlacementOptimum
-from solver.pipeline import SpinMode
+from solver.pipeline import SpinMode, require_family
 from solver.robots import Robot
 from solver.search_space import PlacementBounds
 from solver.spatial import (
@@ -220,6 +220,13 @@ def evaluate_response(
         reason=None if ev.reason is None else schemas.FailureReason(ev.reason),
         failed_waypoint=ev.failed_waypoint,
         branch=branch_to_api(ev.branch),
+        ik=schemas.IkInfo.model_validate(
+            {
+                "family": require_family(robot).name,
+                "seeds": ev.ik_seeds,
+                "branches_found": ev.ik_branches_found,
+            }
+        ),
         waypoints=waypoints,
         detail="waypoints" if with_waypoints else "summary",
         spin_mode=ev.spin_mode,

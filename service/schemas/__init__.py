@@ -22,6 +22,7 @@ from service.schemas.evaluate import (
     EvaluateRequest,
     EvaluateResponse,
     FailureReason,
+    IkInfo,
     WaypointResult,
 )
 from service.schemas.map import Grid, GridAxis, MapCell, MapExtreme, MapRequest, MapResponse
@@ -54,6 +55,7 @@ __all__ = [
     "Grid",
     "GridAxis",
     "HealthResponse",
+    "IkInfo",
     "IkPolicy",
     "MapCell",
     "MapExtreme",

@@ -84,6 +84,7 @@ def test_optimize_answer_is_what_evaluate_says(
     assert response.status_code == 200, response.text
     answer = response.json()
     assert answer["found"] and answer["mu_path"] >= answer["start"]["mu_path"]
+    assert answer["evaluation"]["ik"]["family"] == "numeric"
     evaluation = evaluated(client, panda, waypoints, answer["placement"])
     assert answer["mu_path"] == pytest.approx(evaluation["mu_path"], rel=OPTIMUM_EVALUATE_RTOL)
 
@@ -106,3 +107,14 @@ def test_a_numeric_branch_can_be_named(
         "body",
         "ik",
     ]
+
+
+def test_answers_say_the_family_and_what_its_seeds_found(
+    client: TestClient, panda: dict[str, Any], waypoints: list[dict[str, Any]]
+) -> None:
+    ik = evaluated(client, panda, waypoints, PLACEMENT)["ik"]
+    assert ik["family"] == "numeric" and ik["seeds"] == 64
+    assert 1 <= ik["branches_found"] <= 64
+    body = {"robot": {"model": "ur5"}, "path": {"waypoints": waypoints}, "placement": PLACEMENT}
+    analytic = client.post("/v1/evaluate", json=body).json()["ik"]
+    assert analytic == {"family": "ur", "seeds": None, "branches_found": None}
