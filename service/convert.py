@@ -245,8 +245,11 @@ class MapGrid:
     spins: np.ndarray
 
 
-def map_grid(grid: schemas.Grid, *, settings: Settings, n_waypoints: int) -> MapGrid:
+def map_grid(grid: schemas.Grid, *, settings: Settings, n_waypoints: int, robot: Robot) -> MapGrid:
     """The grid's values, after checking its size against the settings.
+
+    The poses are weighed by the robot family's cost (``path_cost``: 1 a pose for a closed-form
+    family, far more for numeric IK), so that DTF_MAX_MAP_POSES bounds the time of every map.
 
     Raises:
         InvalidInputError: an axis is malformed, or the grid is over a size limit; the message
@@ -270,10 +273,15 @@ def map_grid(grid: schemas.Grid, *, settings: Settings, n_waypoints: int) -> Map
         raise InvalidInputError(
             "grid", f"{size}; the limit is {settings.max_map_cells} (DTF_MAX_MAP_CELLS)"
         )
-    if cells * n_waypoints > settings.max_map_poses:
+    poses = cells * n_waypoints
+    family = require_family(robot)
+    work = cells * family.path_cost(n_waypoints)
+    if work > settings.max_map_poses:
+        weighed = "" if work == poses else f", as work {work:.4g} closed-form poses"
+        weighed += "" if work == poses else f" ({family.name} IK)"
         raise InvalidInputError(
             "grid",
-            f"{size} * {n_waypoints} waypoints = {cells * n_waypoints} poses; the limit is "
+            f"{size} * {n_waypoints} waypoints = {poses} poses{weighed}; the limit is "
             f"{settings.max_map_poses} (DTF_MAX_MAP_POSES)",
         )
     return MapGrid(

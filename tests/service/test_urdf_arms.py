@@ -118,3 +118,55 @@ def test_answers_say_the_family_and_what_its_seeds_found(
     body = {"robot": {"model": "ur5"}, "path": {"waypoints": waypoints}, "placement": PLACEMENT}
     analytic = client.post("/v1/evaluate", json=body).json()["ik"]
     assert analytic == {"family": "ur", "seeds": None, "branches_found": None}
+
+
+ERK_GRID = {
+    "x": {"min": -0.25, "max": 0.25, "step": 0.02},
+    "y": {"min": 0.25, "max": 0.65, "step": 0.02},
+    "z": 0.1,
+    "yaw": [0.0],
+}
+
+
+@pytest.fixture(scope="module")
+def erk_path() -> dict[str, Any]:
+    path: dict[str, Any] = json.loads((EXAMPLES / "paths" / "curved_line.json").read_text())
+    return path
+
+
+def test_numeric_map_is_weighed_by_its_cost(
+    client: TestClient, panda: dict[str, Any], erk_path: dict[str, Any]
+) -> None:
+    """The ERK-size map: about 0.13 s analytic, 45 s for the Panda: refused before any work."""
+    body = {"robot": panda, "path": erk_path, "grid": ERK_GRID}
+    response = client.post("/v1/map", json=body)
+    assert response.status_code == 422, response.text
+    [entry] = response.json()["detail"]
+    assert entry["loc"] == ["body", "grid"]
+    assert "546 placements * 133 waypoints = 72618 poses" in entry["msg"]
+    assert "numeric IK" in entry["msg"] and "DTF_MAX_MAP_POSES" in entry["msg"]
+    analytic = client.post("/v1/map", json={**body, "robot": {"model": "ur5"}})
+    assert analytic.status_code == 200, analytic.text
+
+
+@pytest.mark.parametrize("method", ["casadi", "scipy"])
+def test_numeric_optimize_is_weighed_by_its_cost(
+    client: TestClient,
+    panda: dict[str, Any],
+    erk_path: dict[str, Any],
+    waypoints: list[dict[str, Any]],
+    method: str,
+) -> None:
+    """The coarse map (casadi) or the differential evolution (scipy) would take minutes."""
+    body = {
+        "robot": panda,
+        "path": erk_path if method == "casadi" else {"waypoints": waypoints},
+        "bounds": {"x": [-0.25, 0.25], "y": [0.25, 0.65], "yaw": [-3.14, 3.14]},
+        "z": 0.1,
+        "method": method,
+    }
+    response = client.post("/v1/optimize", json=body)
+    assert response.status_code == 422, response.text
+    [entry] = response.json()["detail"]
+    assert entry["loc"] == ["body", "bounds"]
+    assert "numeric IK" in entry["msg"] and "the limit is" in entry["msg"]
