@@ -28,7 +28,19 @@ class Settings(BaseSettings):
         gt=0,
         description="Most placement-waypoint pairs one /v1/map request, or the coarse map of one "
         "/v1/optimize request, may ask for (each is 8 IK solutions; 2 million took 4 s on the "
-        "2-core development machine, so the default is about 10 s).",
+        "2-core development machine, so the default is about 10 s). A pair of a numeric-IK arm "
+        "counts as the work of many (its family's path_cost: about 65 a waypoint for 6 joints, "
+        "400 for 7, plus 3,200 or 6,400 a placement for the seeds), so its limit is about the "
+        "same time.",
+    )
+    max_search_poses: int = Field(
+        default=6_100_000,
+        gt=0,
+        description="Most placement-waypoint pairs, weighed as for DTF_MAX_MAP_POSES, that the "
+        "scipy method's differential evolution of one /v1/optimize request may evaluate (61 "
+        "generations of 20 placements per free variable). The default admits every search of "
+        "a closed-form arm within DTF_MAX_OPTIMIZE_WAYPOINTS (61 * 20 * 5 * 1000); with "
+        "numeric IK it refuses a search that would take much longer.",
     )
     max_path_waypoints: int = Field(
         default=20_000,

@@ -17,7 +17,7 @@ from solver.evaluate import Branch, PathEvaluation
 from solver.exceptions import InvalidInputError
 from solver.feed import FeedCheck
 from solver.optimize import PlacementOptimum
-from solver.pipeline import SpinMode
+from solver.pipeline import SpinMode, require_family
 from solver.robots import Robot
 from solver.search_space import PlacementBounds
 from solver.spatial import (
@@ -101,11 +101,23 @@ def placement_of(placement: schemas.Placement) -> Placement:
     )
 
 
-def branch_of(choice: schemas.Branch | str) -> Branch | None:
+def branch_of(choice: schemas.Branch | schemas.NumericBranch | str) -> Branch | None:
     """The solver's branch label; ``None`` for ``"auto"``."""
     if isinstance(choice, str):
         return None
+    if isinstance(choice, schemas.NumericBranch):
+        return Branch.named(solution=str(choice.solution))
     return Branch.named(shoulder=choice.shoulder, elbow=choice.elbow, wrist=choice.wrist)
+
+
+def branch_to_api(branch: Branch | None) -> schemas.Branch | schemas.NumericBranch | None:
+    """The API's branch: named levels, or the numeric family's solution index."""
+    if branch is None:
+        return None
+    choices = branch.as_dict()
+    if set(choices) == {"solution"}:
+        return schemas.NumericBranch(solution=int(choices["solution"]))
+    return schemas.Branch.model_validate(choices)
 
 
 def h_of(h: float | None) -> float:
@@ -215,14 +227,20 @@ def evaluate_response(
             joint=ev.bottleneck_joint,
             joint_name=robot.joint_names[ev.bottleneck_joint],
         )
-    branch = None if ev.branch is None else schemas.Branch.model_validate(ev.branch.as_dict())
     return schemas.EvaluateResponse(
         feasible=ev.feasible,
         mu_path=ev.mu_path,
         bottleneck=bottleneck,
         reason=None if ev.reason is None else schemas.FailureReason(ev.reason),
         failed_waypoint=ev.failed_waypoint,
-        branch=branch,
+        branch=branch_to_api(ev.branch),
+        ik=schemas.IkInfo.model_validate(
+            {
+                "family": require_family(robot).name,
+                "seeds": ev.ik_seeds,
+                "branches_found": ev.ik_branches_found,
+            }
+        ),
         waypoints=waypoints,
         detail="waypoints" if with_waypoints else "summary",
         spin_mode=ev.spin_mode,
@@ -244,8 +262,11 @@ class MapGrid:
     spins: np.ndarray
 
 
-def map_grid(grid: schemas.Grid, *, settings: Settings, n_waypoints: int) -> MapGrid:
+def map_grid(grid: schemas.Grid, *, settings: Settings, n_waypoints: int, robot: Robot) -> MapGrid:
     """The grid's values, after checking its size against the settings.
+
+    The poses are weighed by the robot family's cost (``path_cost``: 1 a pose for a closed-form
+    family, far more for numeric IK), so that DTF_MAX_MAP_POSES bounds the time of every map.
 
     Raises:
         InvalidInputError: an axis is malformed, or the grid is over a size limit; the message
@@ -269,10 +290,15 @@ def map_grid(grid: schemas.Grid, *, settings: Settings, n_waypoints: int) -> Map
         raise InvalidInputError(
             "grid", f"{size}; the limit is {settings.max_map_cells} (DTF_MAX_MAP_CELLS)"
         )
-    if cells * n_waypoints > settings.max_map_poses:
+    poses = cells * n_waypoints
+    family = require_family(robot)
+    work = cells * family.path_cost(n_waypoints)
+    if work > settings.max_map_poses:
+        weighed = "" if work == poses else f", as work {work:.4g} closed-form poses"
+        weighed += "" if work == poses else f" ({family.name} IK)"
         raise InvalidInputError(
             "grid",
-            f"{size} * {n_waypoints} waypoints = {cells * n_waypoints} poses; the limit is "
+            f"{size} * {n_waypoints} waypoints = {poses} poses{weighed}; the limit is "
             f"{settings.max_map_poses} (DTF_MAX_MAP_POSES)",
         )
     return MapGrid(

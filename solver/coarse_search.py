@@ -14,7 +14,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from solver.exceptions import InvalidInputError
-from solver.pipeline import PreparedPath, SpinMode
+from solver.pipeline import PreparedPath, SpinMode, require_family
 from solver.placements import evaluate_placements
 from solver.progress import Progress
 from solver.robots import Robot
@@ -89,7 +89,8 @@ def coarse_cells(
 
     Raises:
         InvalidInputError: the map would have more than ``max_cells`` cells, or more than
-            ``max_poses`` placement-waypoint pairs (on ``bounds``).
+            ``max_poses`` placement-waypoint pairs (on ``bounds``), each pair weighed by the
+            family's cost (:meth:`KinematicsFamily.path_cost`: 1 for a closed-form family).
     """
     spins, spin_wraps = _spin_values(bounds)
     heights = _heights(bounds)
@@ -118,12 +119,15 @@ def coarse_cells(
             f"({' x '.join(map(str, sizes))} at {COARSE_STEP * 1000:.0f} mm, "
             f"{math.degrees(COARSE_YAW_STEP):.0f} deg); the limit is {max_cells}",
         )
-    if max_poses is not None and math.prod(sizes) * path.n_waypoints > max_poses:
-        raise InvalidInputError(
-            "bounds",
-            f"the search box's coarse map of {math.prod(sizes)} cells * {path.n_waypoints} "
-            f"waypoints = {math.prod(sizes) * path.n_waypoints} poses; the limit is {max_poses}",
-        )
+    poses = math.prod(sizes) * path.n_waypoints
+    family = require_family(robot)
+    work = math.prod(sizes) * family.path_cost(path.n_waypoints)
+    if max_poses is not None and work > max_poses:
+        size = f"the search box's coarse map of {math.prod(sizes)} cells * {path.n_waypoints} "
+        size += f"waypoints = {poses} poses"
+        if work != poses:
+            size += f", as work {work:.4g} closed-form poses ({family.name} IK)"
+        raise InvalidInputError("bounds", f"{size}; the limit is {max_poses}")
     # One spin's cells: where each is reported (inside the box) and where it is evaluated.
     points: list[tuple[float, float, float] | None]
     evaluated: list[tuple[float, float, float] | None]

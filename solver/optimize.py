@@ -32,7 +32,7 @@ from solver.evaluate import DEFAULT_MAX_JOINT_STEP, PathEvaluation, evaluate_pat
 from solver.exceptions import InvalidInputError, quoted
 from solver.pipeline import PreparedPath, SpinMode, prepare_path, require_family
 from solver.placement_nlp import PlacementNlp
-from solver.placement_scipy import global_search, polish
+from solver.placement_scipy import global_search, polish, search_placements
 from solver.progress import Progress, span
 from solver.robots import Robot
 from solver.search_space import PlacementBounds, vector_of
@@ -113,6 +113,7 @@ def optimize_placement(
     max_spin_step: float | None = None,
     max_coarse_cells: int = MAX_COARSE_CELLS,
     max_coarse_poses: int | None = None,
+    max_search_poses: int | None = None,
     max_solver_seconds: float | None = None,
     progress: Progress | None = None,
     passes: Sequence[tuple[int, int]] | None = None,
@@ -132,7 +133,10 @@ def optimize_placement(
         max_spin_step: rad, > 0: the casadi method also gives each waypoint its own spin, with
             steps at most this (cam.md section 4, ``spin_path``); None keeps one spin.
         max_coarse_cells: the largest coarse map the casadi method may make.
-        max_coarse_poses: the most placement-waypoint pairs of that map (None: no limit).
+        max_coarse_poses: the most placement-waypoint pairs of that map (None: no limit), each
+            weighed by the family's cost (:meth:`KinematicsFamily.path_cost`).
+        max_search_poses: the same for the placements the scipy method's differential
+            evolution evaluates (None: no limit).
         max_solver_seconds: the longest one IPOPT solve may take (None: IPOPT's default).
         progress: called with the fraction done (coarse map or DE, then each solve's
             iterations); a :class:`solver.progress.Cancelled` it raises stops the search.
@@ -145,7 +149,8 @@ def optimize_placement(
 
     Raises:
         InvalidInputError: bad bounds, a start outside them, an unknown method, or a box whose
-            coarse map is over ``max_coarse_cells``.
+            coarse map is over ``max_coarse_cells`` or ``max_coarse_poses``, or whose search
+            is over ``max_search_poses`` (on ``bounds``).
     """
     began = time.perf_counter()
     bounds.check()
@@ -171,6 +176,8 @@ def optimize_placement(
             f"{start.spin:g} rad is outside the bounds",
         )
     path = np.asarray(waypoints_in_workpiece, dtype=float)
+    if method == "scipy" and max_search_poses is not None:
+        _check_search_size(robot, bounds, len(path), max_search_poses)
     prepared = prepare_path(robot, path, passes=passes)
     if max_spin_step is not None and not prepared.segment_in_pass.all():
         raise InvalidInputError("spin_path", "a spin path needs a program of one pass")
@@ -254,6 +261,27 @@ def optimize_placement(
         symmetric=symmetric,
         spins=spins,
     )
+
+
+def _check_search_size(
+    robot: Robot, bounds: PlacementBounds, n_waypoints: int, max_poses: int
+) -> None:
+    """Refuse a differential evolution whose weighed work is over ``max_poses``.
+
+    Raises:
+        InvalidInputError: on ``bounds``, saying the size asked for and the limit.
+    """
+    family = require_family(robot)
+    placements = search_placements(bounds)
+    work = placements * family.path_cost(n_waypoints)
+    if work > max_poses:
+        raise InvalidInputError(
+            "bounds",
+            f"the scipy search of {int(bounds.free.sum())} free variables evaluates "
+            f"{placements} placements * {n_waypoints} waypoints = {placements * n_waypoints} "
+            f"poses, as work {work:.4g} closed-form poses ({family.name} IK); the limit is "
+            f"{max_poses}; fix a variable, shorten the path, or use method casadi",
+        )
 
 
 def _casadi(

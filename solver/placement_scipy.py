@@ -32,6 +32,12 @@ BASIN_GAP = (0.05, 0.35)  # m and rad (about 20 degrees): placements closer are 
 Basin = tuple[np.ndarray, float, int]  # decision vector, mu_path, branch index
 
 
+def search_placements(bounds: PlacementBounds) -> int:
+    """How many placements differential evolution evaluates in ``bounds`` (at most)."""
+    n_free = int(bounds.free.sum())
+    return (GENERATIONS + 1) * POPULATION * n_free if n_free else 1
+
+
 def _full(bounds: PlacementBounds, free_values: np.ndarray) -> np.ndarray:
     """Decision vectors (P, 5) from the free variables' values (P, F); the rest fixed."""
     vectors = np.tile(bounds.lower, (len(free_values), 1))

@@ -133,6 +133,11 @@ def _repair_robot(body: dict[str, Any]) -> tuple[list[float], list[float]]:
     robot = body["robot"]
     if robot.get("urdf") is not None:  # a random string is no URDF: the URDF tests cover them
         robot = body["robot"] = {"model": "ur5", "tcp": robot.get("tcp")}
+    model = robot.get("model")
+    if model is not None and catalogue().get(model, {}).get("family") == "numeric":
+        # numeric IK weighs far more against the size limits the repairs below assume; its
+        # routes are covered by tests/service/test_urdf_arms.py
+        robot = body["robot"] = {"model": "ur5", "tcp": robot.get("tcp")}
     if robot.get("opw") is not None:
         pairs = robot["joint_position_limits"] = [
             [low, high if high > low else low + 1.0] for low, high in robot["joint_position_limits"]
@@ -152,9 +157,14 @@ def _repair_branch(body: dict[str, Any]) -> None:
         return
     model = body["robot"].get("model")
     levels = catalogue()[model]["branches"] if model is not None else OPW_BRANCHES
-    for level in levels:
-        if branch.get(level["level"]) not in level["choices"]:
-            branch[level["level"]] = level["choices"][0]
+    named = {
+        level["level"]: branch.get(level["level"])
+        if branch.get(level["level"]) in level["choices"]
+        else level["choices"][0]
+        for level in levels
+    }
+    branch.clear()
+    branch.update(named)
 
 
 def _repair_dtf(body: dict[str, Any], lower: list[float], upper: list[float]) -> None:

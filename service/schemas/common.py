@@ -131,7 +131,10 @@ class Placement(RequestModel):
 
 
 class Branch(RequestModel):
-    """A named inverse-kinematics branch: UR arms shoulder left/right, OPW arms front/back."""
+    """A named inverse-kinematics branch: UR arms shoulder left/right, OPW arms front/back.
+
+    Arms of the numeric family name their branches by index instead (:class:`NumericBranch`).
+    """
 
     model_config = ConfigDict(
         json_schema_extra={"examples": [{"shoulder": "left", "elbow": "up", "wrist": "noflip"}]}
@@ -145,13 +148,39 @@ class Branch(RequestModel):
     wrist: Literal["flip", "noflip"] = Field(description="Wrist choice (joint 5).")
 
 
+MAX_NUMERIC_BRANCHES = 64  # the seeds of the numeric family for seven joints or more
+
+
+class NumericBranch(RequestModel):
+    """A branch of the numeric IK family: the k-th distinct solution found from the seeds.
+
+    It names nothing geometric: the solutions are numbered in seed order at the path's first
+    waypoint, and another placement may number them differently (robots.md section 4).
+    """
+
+    model_config = ConfigDict(json_schema_extra={"examples": [{"solution": 0}]})
+
+    solution: int = Field(
+        ge=0,
+        le=MAX_NUMERIC_BRANCHES - 1,
+        description="Index of the solution (from 0) among the distinct ones found at the first "
+        "waypoint, in seed order; below the seed count (32 for 6 joints, 64 for more).",
+    )
+
+
 def _branch_kind(value: object) -> str:
-    """Tag of an ``ik.branch`` value: ``branch:auto`` for a string, ``branch:named`` otherwise."""
-    return "branch:auto" if isinstance(value, str) else "branch:named"
+    """Tag of an ``ik.branch`` value: auto for a string, numeric with ``solution``, else named."""
+    if isinstance(value, str):
+        return "branch:auto"
+    if isinstance(value, NumericBranch) or (isinstance(value, dict) and "solution" in value):
+        return "branch:numeric"
+    return "branch:named"
 
 
 BranchChoice = Annotated[
-    Annotated[Literal["auto"], Tag("branch:auto")] | Annotated[Branch, Tag("branch:named")],
+    Annotated[Literal["auto"], Tag("branch:auto")]
+    | Annotated[Branch, Tag("branch:named")]
+    | Annotated[NumericBranch, Tag("branch:numeric")],
     Discriminator(_branch_kind),
 ]
 
@@ -190,7 +219,8 @@ class IkPolicy(RequestModel):
     branch: BranchChoice = Field(
         default="auto",
         description='"auto": the feasible branch, continuous along the path, with the highest '
-        "mu_path; or a named branch to follow.",
+        "mu_path; or a branch to follow: named (UR, OPW arms) or by solution index (numeric "
+        "family); GET /v1/robots lists each robot's branches.",
     )
     max_joint_step: float = Field(
         default=DEFAULT_MAX_JOINT_STEP,

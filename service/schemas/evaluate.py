@@ -12,6 +12,7 @@ from service.schemas.common import (
     Angle,
     Branch,
     IkPolicy,
+    NumericBranch,
     Placement,
     RequestModel,
     ResponseModel,
@@ -57,6 +58,7 @@ _RESPONSE_EXAMPLE: JsonDict = {
     "reason": None,
     "failed_waypoint": None,
     "branch": {"shoulder": "right", "elbow": "down", "wrist": "noflip"},
+    "ik": {"family": "ur", "seeds": None, "branches_found": None},
     "spin_mode": "fixed",
     "spins": None,
     "axis_correction": 0.0,
@@ -93,8 +95,8 @@ class EvaluateRequest(RequestModel):
     model_config = ConfigDict(json_schema_extra={"examples": [_REQUEST_EXAMPLE]})
 
     robot: Robot = Field(
-        description="The arm; path evaluation needs its IK family: a UR or OPW arm (catalogue "
-        "model or opw geometry)."
+        description="The arm: a catalogue model, an opw geometry, or a URDF chain of 6 joints or "
+        "more (numeric IK)."
     )
     path: Path = Field(description="The waypoints, in the workpiece frame {O}.")
     placement: Placement = Field(description="Where {O} sits in the base frame {B}.")
@@ -207,6 +209,34 @@ class Bottleneck(ResponseModel):
     joint_name: str = Field(description="Name of that joint.")
 
 
+class IkInfo(ResponseModel):
+    """Which kinematics family solved the IK and, for numeric IK, what its seeds found."""
+
+    model_config = ConfigDict(
+        json_schema_extra={
+            "examples": [
+                {"family": "ur", "seeds": None, "branches_found": None},
+                {"family": "numeric", "seeds": 64, "branches_found": 9},
+            ]
+        }
+    )
+
+    family: Literal["ur", "opw", "numeric"] = Field(
+        description="The family (GET /v1/robots): ur or opw solve in closed form and find every "
+        "branch; numeric solves by damped least squares from fixed seeds (robots.md section 4)."
+    )
+    seeds: int | None = Field(
+        description="Numeric family: how many start configurations (seeds) the IK started from "
+        "at the first waypoint (32 for 6 joints, 64 for more); null for a closed-form family."
+    )
+    branches_found: int | None = Field(
+        description="Numeric family: how many distinct IK solutions within the joint limits the "
+        "seeds found at the first waypoint (count, at most seeds), each one branch followed "
+        "along the path; a numeric family cannot promise it found every branch. null for a "
+        "closed-form family."
+    )
+
+
 class EvaluateResponse(ResponseModel):
     """Feasibility, mu_path and per-waypoint detail of the path at the placement."""
 
@@ -229,9 +259,12 @@ class EvaluateResponse(ResponseModel):
     failed_waypoint: int | None = Field(
         description="Index of the first waypoint that fails; null when feasible."
     )
-    branch: Branch | None = Field(
-        description="IK branch used (when infeasible with auto: the one that got furthest)."
+    branch: Branch | NumericBranch | None = Field(
+        description="IK branch used (when infeasible with auto: the one that got furthest): "
+        "named for a UR or OPW arm, a solution index for the numeric family; null when no "
+        "branch reached the first waypoint."
     )
+    ik: IkInfo = Field(description="The IK family that solved the path, and its seeds.")
     spin_mode: SpinMode = Field(description="The spin mode used (fixed or free).")
     spins: list[float] | None = Field(
         default=None,

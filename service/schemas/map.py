@@ -99,8 +99,8 @@ class MapRequest(RequestModel):
     model_config = ConfigDict(json_schema_extra={"examples": [_MAP_REQUEST_EXAMPLE]})
 
     robot: Robot = Field(
-        description="The arm: a UR or OPW arm (catalogue model or opw geometry); the map needs "
-        "its IK family."
+        description="The arm: a catalogue model, an opw geometry, or a URDF chain of 6 joints or "
+        "more (numeric IK, which costs more per placement: smaller grids are allowed)."
     )
     path: Path = Field(description="The tool path in the workpiece frame {O}.")
     grid: Grid = Field(description="The placements to evaluate.")

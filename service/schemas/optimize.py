@@ -87,8 +87,8 @@ class OptimizeRequest(RequestModel):
     model_config = ConfigDict(json_schema_extra={"examples": [_REQUEST]})
 
     robot: Robot = Field(
-        description="The arm: a UR or OPW arm (catalogue model or opw geometry); the search "
-        "needs its IK family."
+        description="The arm: a catalogue model, an opw geometry, or a URDF chain of 6 joints or "
+        "more (numeric IK, which costs more per placement: smaller bounds are allowed)."
     )
     path: Path = Field(description="The tool path in the workpiece frame {O}.")
     bounds: Bounds = Field(description="Where the workpiece may go.")

@@ -34,13 +34,26 @@ def catalogue_dofs() -> set[int]:
     return {robot.dof for robot in catalogue().values()}
 
 
-def _speed_limits(dof: int | None, *, required: bool, extra: str = "") -> Any:
-    """A ``joint_velocity_limits`` field: n limits within [1e-6, 1e4] rad/s."""
-    count = f"{dof} values" if dof is not None else "one per joint"
+def _speed_limits(dofs: list[int] | None, *, required: bool, extra: str = "") -> Any:
+    """A ``joint_velocity_limits`` field: n limits within [1e-6, 1e4] rad/s.
+
+    Args:
+        dofs: the numbers of joints the arms of this variant may have (the list's length
+            must be one of them); ``None``: any, one per joint of the chain.
+        required: whether the field must be given.
+        extra: a sentence added to the description.
+    """
+    if dofs is None:
+        low, high, count = 1, MAX_JOINTS, "one per joint"
+    elif len(dofs) == 1:
+        low, high, count = dofs[0], dofs[0], f"{dofs[0]} values"
+    else:
+        low, high = min(dofs), max(dofs)
+        count = f"one per joint of the model ({' or '.join(map(str, sorted(dofs)))} values)"
     return Field(
         default=... if required else None,
-        min_length=dof or 1,
-        max_length=dof or MAX_JOINTS,
+        min_length=low,
+        max_length=high,
         description=f"Joint speed limits (rad/s; m/s for prismatic joints), {count}, each within "
         f"[1e-6, 1e4].{extra}",
     )
@@ -63,7 +76,6 @@ class _RobotOptions(RequestModel):
 
 
 _DOFS = sorted(catalogue_dofs())
-_ONE_DOF = _DOFS[0] if len(_DOFS) == 1 else None
 
 
 class CatalogueRobot(_RobotOptions):
@@ -83,7 +95,7 @@ class CatalogueRobot(_RobotOptions):
         json_schema_extra={"enum": list[JsonValue](sorted(catalogue()))},
     )
     joint_velocity_limits: list[SpeedLimit] | None = _speed_limits(
-        _ONE_DOF, required=False, extra=" Default: the model's."
+        _DOFS, required=False, extra=" Default: the model's."
     )
 
     @field_validator("model")
@@ -242,7 +254,7 @@ class OpwRobot(_RobotOptions):
         max_length=6,
         description="[lower, upper] (rad) for each of the 6 joints, lower < upper.",
     )
-    joint_velocity_limits: list[SpeedLimit] = _speed_limits(6, required=True)
+    joint_velocity_limits: list[SpeedLimit] = _speed_limits([6], required=True)
 
     def to_solver(self) -> SolverRobot:
         """The OPW arm, with its limits and tool point."""

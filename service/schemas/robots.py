@@ -64,7 +64,8 @@ class RobotInfo(ResponseModel):
     tool_frame: str = Field(description="Tool flange frame {F}; a tcp is relative to it.")
     family: str | None = Field(
         description="The kinematics family that solves its IK (ur: UR arms; opw: industrial "
-        "arms with a spherical wrist); null for an arm that only has /v1/dtf."
+        "arms with a spherical wrist; numeric: any serial chain of 6 joints or more, solved "
+        "numerically from fixed seeds); null for an arm that only has /v1/dtf."
     )
     branches: list[BranchLevel] = Field(
         description="The IK branch levels and their choices, as ik.branch names them."

@@ -120,6 +120,16 @@ class KinematicsFamily(abc.ABC):
             still filled where singular).
         """
 
+    def path_cost(self, n_waypoints: int) -> float:
+        """Estimated work of one placement of a path of ``n_waypoints`` (IK, tracking, DTF).
+
+        In poses of a closed-form family (all its branches and their DTF): the unit of the
+        service's size limits (``DTF_MAX_MAP_POSES``), so that a request's cost is bounded
+        before any work starts. A closed-form family costs one unit a waypoint, this default;
+        a family that costs more overrides it with measured figures.
+        """
+        return float(n_waypoints)
+
     def solve_path(self, rotation: np.ndarray, position: np.ndarray) -> PathSolutions:
         """IK solutions along paths: waypoints on the last batch axis, branches followed.
 

@@ -280,13 +280,31 @@ def test_bad_urdf_robot(client: TestClient, panda_urdf: str, robot: UrdfRobot, l
     assert_names(client.post("/v1/dtf", json=body), 422, loc)
 
 
-def test_urdf_robot_cannot_evaluate_a_path(
-    client: TestClient, evaluate_body: dict[str, Any], panda_urdf: str
+@pytest.mark.parametrize("route", ["/v1/evaluate", "/v1/map", "/v1/optimize"])
+def test_urdf_chain_of_five_joints_cannot_follow_a_path(
+    client: TestClient, evaluate_body: dict[str, Any], panda_urdf: str, route: str
 ) -> None:
-    robot = {"urdf": panda_urdf, "base_frame": "panda_link0", "tool_frame": "panda_link8"}
-    response = client.post("/v1/evaluate", json={**evaluate_body, "robot": robot})
+    """Numeric IK solves six-dimensional poses: a chain to panda_link5 has five joints."""
+    robot = {"urdf": panda_urdf, "base_frame": "panda_link0", "tool_frame": "panda_link5"}
+    body = {**evaluate_body, "robot": robot}
+    if route != "/v1/evaluate":
+        del body["placement"], body["ik"]
+        body |= (
+            {
+                "grid": {
+                    "x": {"min": 0.0, "max": 0.0, "step": 0.1},
+                    "y": {"min": 0.4, "max": 0.4, "step": 0.1},
+                    "z": 0.1,
+                    "yaw": [0.0],
+                }
+            }
+            if route == "/v1/map"
+            else {"bounds": {"x": [0.0, 0.1], "y": [0.4, 0.5], "yaw": [0.0, 0.0]}, "z": 0.1}
+        )
+    response = client.post(route, json=body)
     assert_names(response, 422, ["body", "robot"])
     assert response.json()["detail"][0]["type"] == "no_analytic_ik"
+    assert "six joints or more" in response.json()["detail"][0]["msg"]
 
 
 @pytest.mark.parametrize(

@@ -2,9 +2,10 @@ from __future__ import annotations
 
 import math
 
+import pytest
 from fastapi.testclient import TestClient
 
-from tests.cases import OPW_MODELS, UR_MODELS
+from tests.cases import NUMERIC_MODELS, OPW_MODELS, UR_MODELS
 
 
 def test_healthz(client: TestClient) -> None:
@@ -17,8 +18,8 @@ def test_robots_lists_every_ur_and_opw_model(client: TestClient) -> None:
     response = client.get("/v1/robots")
     assert response.status_code == 200
     robots = {robot["name"]: robot for robot in response.json()["robots"]}
-    assert sorted(robots) == sorted(UR_MODELS + OPW_MODELS)
-    for robot in robots.values():
+    assert sorted(robots) == sorted(UR_MODELS + OPW_MODELS + NUMERIC_MODELS)
+    for robot in (robots[name] for name in UR_MODELS + OPW_MODELS):
         assert robot["dof"] == 6
         for key in ("joint_names", "q_lower", "q_upper", "qdot_max"):
             assert len(robot[key]) == 6, key
@@ -35,6 +36,17 @@ def test_robots_lists_every_ur_and_opw_model(client: TestClient) -> None:
             {"level": "elbow", "choices": ["up", "down"]},
             {"level": "wrist", "choices": ["noflip", "flip"]},
         ]
+
+
+@pytest.mark.parametrize(("name", "dof"), [("panda", 7), ("xarm7", 7), ("kinova_jaco2", 6)])
+def test_robots_lists_the_numeric_arms(client: TestClient, name: str, dof: int) -> None:
+    robot = {robot["name"]: robot for robot in client.get("/v1/robots").json()["robots"]}[name]
+    assert robot["family"] == "numeric"
+    assert robot["dof"] == dof
+    for key in ("joint_names", "q_lower", "q_upper", "qdot_max"):
+        assert len(robot[key]) == dof, key
+    seeds = 32 if dof == 6 else 64
+    assert robot["branches"] == [{"level": "solution", "choices": [str(k) for k in range(seeds)]}]
 
 
 def test_robots_velocity_limits_are_the_datasheet_ones(client: TestClient) -> None:

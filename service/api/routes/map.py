@@ -29,10 +29,12 @@ def _computed_map(
     convert.check_path_size(
         body.path, limit=settings.max_path_waypoints, setting="DTF_MAX_PATH_WAYPOINTS"
     )
-    grid = convert.map_grid(body.grid, settings=settings, n_waypoints=body.path.n_waypoints())
+    robot = convert.robot_from_schema(body.robot)
+    grid = convert.map_grid(
+        body.grid, settings=settings, n_waypoints=body.path.n_waypoints(), robot=robot
+    )
     if png:
         convert.check_png_size(grid, settings=settings)
-    robot = convert.robot_from_schema(body.robot)
     path = convert.path_of(body.path)
     spin_mode = convert.spin_mode_of(body.spin_mode, path)
     result = capability_map(

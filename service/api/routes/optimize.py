@@ -34,7 +34,9 @@ async def post_optimize(
     """Maximise mu_path over (x, y, yaw) inside the bounds; every answer checked by the evaluator.
 
     No feasible placement inside the bounds is not an error: ``found`` is false. A box whose
-    coarse map (20 mm, 15 degrees) would exceed DTF_MAX_MAP_CELLS cells is a 422 on ``bounds``.
+    coarse map (20 mm, 15 degrees) would exceed DTF_MAX_MAP_CELLS cells, or DTF_MAX_MAP_POSES
+    placement-waypoint pairs weighed by the IK family's cost, or whose scipy search would
+    exceed DTF_MAX_SEARCH_POSES, is a 422 on ``bounds``.
     """
     return await run_stoppable(
         request, lambda progress: json_response(_optimum(body, settings, progress))
@@ -61,6 +63,7 @@ def _optimum(body: OptimizeRequest, settings: Settings, progress: Progress) -> O
         max_spin_step=None if body.spin_path is None else body.spin_path.max_spin_step,
         max_coarse_cells=settings.max_map_cells,
         max_coarse_poses=settings.max_map_poses,
+        max_search_poses=settings.max_search_poses,
         max_solver_seconds=settings.max_solver_seconds,
         progress=progress,
         passes=path.passes,

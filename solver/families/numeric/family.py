@@ -24,6 +24,16 @@ from solver.spatial import wrap_angle
 
 # The Sobol sequence's seed: fixed, so that the same input gives the same branches.
 SOBOL_SEED = 20240611
+# Work of one placement in poses of a closed-form family (KinematicsFamily.path_cost), measured
+# on the 2-core development machine against the analytic UR5 map (3.8 us a pose on the ERK
+# path): seeding the first waypoint (K seeds, up to ik.SEED_ITERATIONS each) and following the
+# branches found to each next waypoint, for the worst catalogue arm of each size.
+# Seeding: the Panda took up to 24 ms a placement (64 seeds; placements of a differential
+# evolution, many seeds unconverged), UR5 as a URDF and the Jaco2 6-12 ms (32 seeds).
+SEED_COST = {6: 3_200.0, 7: 6_400.0}
+# Following: UR5 as a URDF 0.24 ms a waypoint, the Jaco2 0.08 ms; the Panda 0.59 ms, the xArm7
+# (whose +-2 pi joints give many distinct solutions) 1.44 ms.
+TRACK_COST = {6: 65.0, 7: 400.0}
 
 
 def seed_count(dof: int) -> int:
@@ -68,6 +78,16 @@ class NumericFamily(KinematicsFamily):
     def dof(self) -> int:
         """Number of joints."""
         return self.chain.dof
+
+    def path_cost(self, n_waypoints: int) -> float:
+        """Seeding plus following, in closed-form poses (SEED_COST, TRACK_COST).
+
+        Arms of more than seven joints scale the seven-joint figures by (dof / 7)^2 (the
+        Jacobian products and solves grow about so).
+        """
+        size = min(max(self.dof, 6), 7)
+        scale = max(self.dof / 7, 1.0) ** 2
+        return scale * (SEED_COST[size] + max(n_waypoints - 1, 0) * TRACK_COST[size])
 
     @property
     def branches(self) -> tuple[Branch, ...]:

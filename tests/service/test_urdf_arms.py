@@ -1,0 +1,172 @@
+"""Arms of the numeric IK family through the routes: the Panda as a URDF in the request and
+from the catalogue (robots.md section 4)."""
+
+from __future__ import annotations
+
+import json
+from typing import Any
+
+import pytest
+from fastapi.testclient import TestClient
+
+from tests.cases import EXAMPLES, OPTIMUM_EVALUATE_RTOL
+
+PLACEMENT = {"x": 0.0, "y": 0.45, "z": 0.1, "yaw": 0.0}
+
+
+@pytest.fixture(scope="module")
+def waypoints() -> list[dict[str, Any]]:
+    """The first ten waypoints of the example path."""
+    example = json.loads((EXAMPLES / "evaluate_request.json").read_text())
+    waypoints: list[dict[str, Any]] = example["path"]["waypoints"][:10]
+    return waypoints
+
+
+@pytest.fixture(scope="module", params=["urdf", "catalogue"])
+def panda(request: pytest.FixtureRequest, panda_urdf: str) -> dict[str, Any]:
+    """The Panda as a URDF in the request, or as the catalogue's ``panda``."""
+    if request.param == "catalogue":
+        return {"model": "panda"}
+    return {"urdf": panda_urdf, "base_frame": "panda_link0", "tool_frame": "panda_link8"}
+
+
+def evaluated(
+    client: TestClient, robot: dict[str, Any], waypoints: list[dict[str, Any]], placement: Any
+) -> dict[str, Any]:
+    body = {"robot": robot, "path": {"waypoints": waypoints}, "placement": placement}
+    response = client.post("/v1/evaluate", json=body)
+    assert response.status_code == 200, response.text
+    answer: dict[str, Any] = response.json()
+    return answer
+
+
+def test_evaluate(
+    client: TestClient, panda: dict[str, Any], waypoints: list[dict[str, Any]]
+) -> None:
+    answer = evaluated(client, panda, waypoints, PLACEMENT)
+    assert answer["feasible"] and answer["mu_path"] > 0
+    assert set(answer["branch"]) == {"solution"}
+    assert all(len(waypoint["q"]) == 7 for waypoint in answer["waypoints"])
+    assert answer["bottleneck"]["joint_name"].startswith("panda_joint")
+
+
+def test_map_cells_equal_evaluate(
+    client: TestClient, panda: dict[str, Any], waypoints: list[dict[str, Any]]
+) -> None:
+    grid = {
+        "x": {"min": -0.05, "max": 0.05, "step": 0.05},
+        "y": {"min": 0.4, "max": 0.5, "step": 0.1},
+        "z": 0.1,
+        "yaw": [0.0],
+    }
+    body = {"robot": panda, "path": {"waypoints": waypoints}, "grid": grid}
+    response = client.post("/v1/map", json=body)
+    assert response.status_code == 200, response.text
+    answer = response.json()
+    assert len(answer["cells"]) == 6 and answer["feasible_cells"] > 0
+    for cell in answer["cells"][::2]:
+        placement = {key: cell[key] for key in ("x", "y", "yaw")} | {"z": 0.1}
+        evaluation = evaluated(client, panda, waypoints, placement)
+        assert evaluation["mu_path"] == cell["mu_path"]
+
+
+def test_optimize_answer_is_what_evaluate_says(
+    client: TestClient, panda: dict[str, Any], waypoints: list[dict[str, Any]]
+) -> None:
+    body = {
+        "robot": panda,
+        "path": {"waypoints": waypoints},
+        "bounds": {"x": [-0.05, 0.05], "y": [0.4, 0.5], "yaw": [-0.3, 0.3]},
+        "z": 0.1,
+        "method": "casadi",
+    }
+    response = client.post("/v1/optimize", json=body)
+    assert response.status_code == 200, response.text
+    answer = response.json()
+    assert answer["found"] and answer["mu_path"] >= answer["start"]["mu_path"]
+    assert answer["evaluation"]["ik"]["family"] == "numeric"
+    evaluation = evaluated(client, panda, waypoints, answer["placement"])
+    assert answer["mu_path"] == pytest.approx(evaluation["mu_path"], rel=OPTIMUM_EVALUATE_RTOL)
+
+
+def test_a_numeric_branch_can_be_named(
+    client: TestClient, panda: dict[str, Any], waypoints: list[dict[str, Any]]
+) -> None:
+    auto = evaluated(client, panda, waypoints, PLACEMENT)
+    body = {
+        "robot": panda,
+        "path": {"waypoints": waypoints},
+        "placement": PLACEMENT,
+        "ik": {"branch": auto["branch"]},
+    }
+    named = client.post("/v1/evaluate", json=body).json()
+    assert named["branch"] == auto["branch"] and named["mu_path"] == auto["mu_path"]
+    body["ik"] = {"branch": {"shoulder": "left", "elbow": "up", "wrist": "noflip"}}
+    response = client.post("/v1/evaluate", json=body)
+    assert response.status_code == 422 and response.json()["detail"][0]["loc"][:2] == [
+        "body",
+        "ik",
+    ]
+
+
+def test_answers_say_the_family_and_what_its_seeds_found(
+    client: TestClient, panda: dict[str, Any], waypoints: list[dict[str, Any]]
+) -> None:
+    ik = evaluated(client, panda, waypoints, PLACEMENT)["ik"]
+    assert ik["family"] == "numeric" and ik["seeds"] == 64
+    assert 1 <= ik["branches_found"] <= 64
+    body = {"robot": {"model": "ur5"}, "path": {"waypoints": waypoints}, "placement": PLACEMENT}
+    analytic = client.post("/v1/evaluate", json=body).json()["ik"]
+    assert analytic == {"family": "ur", "seeds": None, "branches_found": None}
+
+
+ERK_GRID = {
+    "x": {"min": -0.25, "max": 0.25, "step": 0.02},
+    "y": {"min": 0.25, "max": 0.65, "step": 0.02},
+    "z": 0.1,
+    "yaw": [0.0],
+}
+
+
+@pytest.fixture(scope="module")
+def erk_path() -> dict[str, Any]:
+    path: dict[str, Any] = json.loads((EXAMPLES / "paths" / "curved_line.json").read_text())
+    return path
+
+
+def test_numeric_map_is_weighed_by_its_cost(
+    client: TestClient, panda: dict[str, Any], erk_path: dict[str, Any]
+) -> None:
+    """The ERK-size map: about 0.13 s analytic, 45 s for the Panda: refused before any work."""
+    body = {"robot": panda, "path": erk_path, "grid": ERK_GRID}
+    response = client.post("/v1/map", json=body)
+    assert response.status_code == 422, response.text
+    [entry] = response.json()["detail"]
+    assert entry["loc"] == ["body", "grid"]
+    assert "546 placements * 133 waypoints = 72618 poses" in entry["msg"]
+    assert "numeric IK" in entry["msg"] and "DTF_MAX_MAP_POSES" in entry["msg"]
+    analytic = client.post("/v1/map", json={**body, "robot": {"model": "ur5"}})
+    assert analytic.status_code == 200, analytic.text
+
+
+@pytest.mark.parametrize("method", ["casadi", "scipy"])
+def test_numeric_optimize_is_weighed_by_its_cost(
+    client: TestClient,
+    panda: dict[str, Any],
+    erk_path: dict[str, Any],
+    waypoints: list[dict[str, Any]],
+    method: str,
+) -> None:
+    """The coarse map (casadi) or the differential evolution (scipy) would take minutes."""
+    body = {
+        "robot": panda,
+        "path": erk_path if method == "casadi" else {"waypoints": waypoints},
+        "bounds": {"x": [-0.25, 0.25], "y": [0.25, 0.65], "yaw": [-3.14, 3.14]},
+        "z": 0.1,
+        "method": method,
+    }
+    response = client.post("/v1/optimize", json=body)
+    assert response.status_code == 422, response.text
+    [entry] = response.json()["detail"]
+    assert entry["loc"] == ["body", "bounds"]
+    assert "numeric IK" in entry["msg"] and "the limit is" in entry["msg"]
