@@ -34,8 +34,10 @@ LIMITS: dict[str, float] = {}
 STATUSES: Counter[tuple[str, str, int]] = Counter()
 """How many answers of each status each operation gave, with the generation mode."""
 
-CL_PROGRAM = "UNITS/MM\nMULTAX/ON\nGOTO/0, 0, 0, 0, 0, 1\nGOTO/5, 0, 0, 0, 0.1, 1\n"
-CSV_PATH = "0,0,0,0,0,1\n5,0,0,0,0.1,1\n"
+AXIS_FORMS = ("tool_axis_waypoints", "cl_data", "csv")
+"""Path forms given by tool axes: their default spin_mode is free (CSV_PATH below is one)."""
+CL_PROGRAM = "UNITS/MM\nMULTAX/ON\nGOTO/0, 0, 0, 0, 0, 1\nGOTO/5, 0, 0, 0, 0.6, 0.8\n"
+CSV_PATH = "0,0,0,0,0,1\n5,0,0,0,0.6,0.8\n"
 OPW_BRANCHES = [
     {"level": "shoulder", "choices": ["front", "back"]},
     {"level": "elbow", "choices": ["up", "down"]},
@@ -212,7 +214,8 @@ def _repair_optimize(body: dict[str, Any]) -> None:
     if spin is not None and spin[1] - spin[0] > 2 * math.pi:
         bounds["spin"] = [spin[0], spin[0] + 2 * math.pi]
     free = body.get("spin_mode") == "free" or (
-        body.get("spin_mode") is None and body["path"].get("tool_axis_waypoints") is not None
+        body.get("spin_mode") is None
+        and any(body["path"].get(form) is not None for form in AXIS_FORMS)
     )
     if body.get("method") == "scipy" or free:
         body["spin_path"] = None

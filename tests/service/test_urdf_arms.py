@@ -10,6 +10,7 @@ import pytest
 from fastapi.testclient import TestClient
 
 from tests.cases import EXAMPLES, OPTIMUM_EVALUATE_RTOL
+from tests.service.conftest import sent_back
 
 PLACEMENT = {"x": 0.0, "y": 0.45, "z": 0.1, "yaw": 0.0}
 
@@ -85,7 +86,7 @@ def test_optimize_answer_is_what_evaluate_says(
     answer = response.json()
     assert answer["found"] and answer["mu_path"] >= answer["start"]["mu_path"]
     assert answer["evaluation"]["ik"]["family"] == "numeric"
-    evaluation = evaluated(client, panda, waypoints, answer["placement"])
+    evaluation = evaluated(client, panda, waypoints, sent_back(answer["placement"]))
     assert answer["mu_path"] == pytest.approx(evaluation["mu_path"], rel=OPTIMUM_EVALUATE_RTOL)
 
 

@@ -106,11 +106,15 @@ def test_bad_path(poses: np.ndarray, waypoint: int | None) -> None:
     assert info.value.waypoint == waypoint
 
 
-def test_non_unit_quaternion_is_refused_not_normalised() -> None:
+def test_a_quaternion_off_unit_by_more_than_1e_3_is_refused_within_it_normalised() -> None:
+    """cam.md section 6: papers print 4 decimals, CAM writes 4-6."""
     with pytest.raises(InvalidInputError, match="norm"):
-        pose_matrix([0, 0, 0], [0, 0, 0, 1.00001], field="path.waypoints")
-    pose = pose_matrix([0, 0, 0], [0, 0, 0, 1.0000005], field="path.waypoints")
+        pose_matrix([0, 0, 0], [0, 0, 0, 1.0011], field="path.waypoints")
+    pose = pose_matrix([0, 0, 0], [0, 0, 0, 1.0009], field="path.waypoints")
     np.testing.assert_allclose(pose[:3, :3], np.eye(3), atol=1e-15)
+    half = 0.7071  # cos 45 deg as printed: the turn about z by 90 deg, normalised
+    pose = pose_matrix([0, 0, 0], [0, 0, half, half], field="path.waypoints")
+    np.testing.assert_allclose(pose[:3, :3], [[0, -1, 0], [1, 0, 0], [0, 0, 1]], atol=1e-15)
 
 
 def test_far_positions_are_refused() -> None:
