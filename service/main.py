@@ -40,7 +40,7 @@ Task-oriented workpiece placement for robot machining (Stradovnik & Hace: the De
 Feasibility index, Sensors 2022; the path index mu_path, ERK 2021).
 
 - `GET /healthz`: the service is up.
-- `GET /v1/robots`: the catalogue (UR and OPW industrial arms) with joint limits, kinematics
+- `GET /v1/robots`: the catalogue (UR, OPW industrial and URDF arms) with joint limits, kinematics
   family and IK branch names.
 - `POST /v1/dtf`: the largest tool speed along a task direction at one configuration, with
   every joint within its speed limit.
@@ -50,8 +50,11 @@ Feasibility index, Sensors 2022; the path index mu_path, ERK 2021).
 - `POST /v1/map`: mu_path over a grid of placements (yaws, spins), as JSON or a PNG.
 - `POST /v1/optimize`: the placement (x, y, yaw, and optionally spin and height) inside a box
   where the path runs fastest, checked by the evaluator.
+- `POST /v1/paths/import`: a path (poses, tool axes, APT CL data, CSV) as the service reads it.
 
-SI units throughout (m, rad, s). Paths are poses or tool points with tool axes. Input errors
+Every placement in an answer also comes as a controller frame (UR, KUKA, ABB, FANUC).
+SI units throughout (m, rad, s). Paths are poses, tool points with tool axes, APT CL data or
+CSV (passes split at rapids; /v1/evaluate checks the programmed feed). Input errors
 are `422` with a `detail` list whose `loc` names the field (and waypoint index); oversized
 bodies are `413`; bodies not declared as JSON are `415`. These pages load nothing from the
 internet.
