@@ -21,10 +21,13 @@ from __future__ import annotations
 import argparse
 import json
 import math
+import subprocess
+import sys
 import time
 from collections.abc import Callable
 from pathlib import Path
 
+import httpx
 import numpy as np
 import ur_analytic_ik
 
@@ -156,6 +159,44 @@ def main() -> None:
     )
     numeric_maps(path, xs, ys, z, t_map)
     optimisation(robot, path, smoke=args.smoke)
+    evaluate_over_http(requests=20 if args.smoke else 200)
+
+
+def evaluate_over_http(*, requests: int) -> None:
+    """p50 and p95 of /v1/evaluate of the README example against a live uvicorn (issue 12)."""
+    port = 8731
+    server = subprocess.Popen(
+        [sys.executable, "-m", "uvicorn", "service.main:app", "--port", str(port)],
+        cwd=ROOT,
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.DEVNULL,
+    )
+    url = f"http://127.0.0.1:{port}"
+    try:
+        with httpx.Client(base_url=url, timeout=30) as client:
+            for _ in range(300):  # wait for the server, up to 30 s
+                try:
+                    client.get("/healthz")
+                    break
+                except httpx.TransportError:
+                    time.sleep(0.1)
+            body = json.loads((ROOT / "examples" / "evaluate_request.json").read_text())
+            for _ in range(5):  # warm up
+                client.post("/v1/evaluate", json=body)
+            times = []
+            for _ in range(requests):
+                began = time.perf_counter()
+                client.post("/v1/evaluate", json=body).raise_for_status()
+                times.append(time.perf_counter() - began)
+    finally:
+        server.terminate()
+        server.wait()
+    times.sort()
+    p50, p95 = times[len(times) // 2], times[int(0.95 * (len(times) - 1))]
+    print(
+        f"/v1/evaluate of the README example over HTTP ({requests} requests, keep-alive): "
+        f"p50 {1000 * p50:.1f} ms, p95 {1000 * p95:.1f} ms"
+    )
 
 
 def numeric_maps(path: np.ndarray, xs: np.ndarray, ys: np.ndarray, z: float, t_map: float) -> None:
