@@ -3,6 +3,8 @@
 from __future__ import annotations
 
 import functools
+import os
+from pathlib import Path
 
 from pydantic import Field
 from pydantic_settings import BaseSettings, SettingsConfigDict
@@ -70,6 +72,48 @@ class Settings(BaseSettings):
         description="Longest time (s) one IPOPT solve of /v1/optimize may take; it then stops "
         "and its best point so far is judged by the evaluator like any other.",
     )
+    data_dir: Path = Field(
+        default=Path("var"),
+        description="Where jobs and their results are kept (an SQLite file), created on first "
+        "start.",
+    )
+    workers: int = Field(
+        default_factory=lambda: os.cpu_count() or 1,
+        gt=0,
+        description="Processes that run jobs (default: the number of cores).",
+    )
+    max_queued_jobs: int = Field(
+        default=100,
+        gt=0,
+        description="Most jobs waiting or running at once; one more is answered 429.",
+    )
+    job_ttl: float = Field(
+        default=7 * 24 * 3600.0,
+        gt=0.0,
+        description="How long a finished job and its result are kept (s); default a week.",
+    )
+    job_attempts: int = Field(
+        default=3,
+        gt=0,
+        description="Times a job interrupted by a restart is run before it fails.",
+    )
+    max_job_cells: int = Field(
+        default=2_000_000,
+        gt=0,
+        description="Most placements one map job may ask for (its max_map_cells).",
+    )
+    max_job_poses: int = Field(
+        default=500_000_000,
+        gt=0,
+        description="Most placement-waypoint pairs one map or optimize job may ask for (its "
+        "max_map_poses; about 15 minutes on 2 cores).",
+    )
+
+    def for_jobs(self) -> Settings:
+        """These settings with the job limits in place of the synchronous routes' limits."""
+        return self.model_copy(
+            update={"max_map_cells": self.max_job_cells, "max_map_poses": self.max_job_poses}
+        )
 
 
 @functools.cache

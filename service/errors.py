@@ -15,6 +15,7 @@ from fastapi.exceptions import RequestValidationError
 from fastapi.responses import JSONResponse, Response
 from starlette.datastructures import Headers
 from starlette.exceptions import HTTPException as StarletteHTTPException
+from starlette.routing import Route
 from starlette.types import ASGIApp, Message, Receive, Scope, Send
 
 from service.config import get_settings
@@ -102,6 +103,15 @@ async def http_error_handler(request: Request, error: StarletteHTTPException) ->
             loc=["body"], msg=f"cannot decode the JSON: {cause}", type="json_invalid"
         )
         return _error_response(status.HTTP_422_UNPROCESSABLE_CONTENT, [detail])
+    if error.status_code == 405:  # Allow lists every method of the path, not one route's
+        allowed = sorted(
+            method
+            for route in request.app.routes
+            if isinstance(route, Route) and route.path_regex.match(request.url.path)
+            for method in route.methods or ()
+            if method != "HEAD"
+        )
+        error = StarletteHTTPException(405, error.detail, headers={"Allow": ", ".join(allowed)})
     return await http_exception_handler(request, error)
 
 

@@ -23,6 +23,7 @@ from starlette.exceptions import HTTPException as StarletteHTTPException
 from service.api import api_router
 from service.api.routes import health
 from service.body import BODY_MODELS
+from service.config import get_settings
 from service.errors import (
     BodySizeLimitMiddleware,
     cancelled_handler,
@@ -30,6 +31,7 @@ from service.errors import (
     request_validation_error_handler,
     solver_error_handler,
 )
+from service.jobs.runner import close_runners, get_runner
 from service.work import STOPPING
 from solver.exceptions import SolverError
 from solver.progress import Cancelled
@@ -73,7 +75,9 @@ async def lifespan(app: FastAPI) -> AsyncIterator[None]:
     STOPPING.clear()
     _stop_work_on(signal.SIGTERM)
     _stop_work_on(signal.SIGINT)
+    get_runner(get_settings()).recover()  # jobs a restart interrupted run again
     yield
+    close_runners()
 
 
 def _stop_work_on(signum: signal.Signals) -> None:

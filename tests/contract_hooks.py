@@ -240,8 +240,17 @@ def map_case(context: Any, case: schemathesis.Case) -> schemathesis.Case:
     """Give positive cases unit vectors and ordered ranges, and meet the cross-field rules."""
     if not _positive(case) or not isinstance(case.body, dict):
         return case
-    body = case.body = _normalise(case.body)
+    case.body = _normalise(case.body)
     route = case.operation.path
+    if route == "/v1/jobs" and isinstance(case.body.get("request"), dict):
+        _repair(case.body["request"], f"/v1/{case.body.get('kind')}")  # a job: the route's body
+    else:
+        _repair(case.body, route)
+    return case
+
+
+def _repair(body: dict[str, Any], route: str) -> None:
+    """Meet the rules the spec states in words, for a body of ``route``."""
     if isinstance(body.get("robot"), dict):
         lower, upper = _repair_robot(body)
         _repair_branch(body)
@@ -263,7 +272,6 @@ def map_case(context: Any, case: schemathesis.Case) -> schemathesis.Case:
         _repair_grid(body["grid"], n, png=route.endswith("/png"))
     if route == "/v1/optimize" and isinstance(body.get("bounds"), dict):
         _repair_optimize(body)
-    return case
 
 
 def before_add_examples(context: Any, examples: list[schemathesis.Case]) -> None:

@@ -39,6 +39,11 @@ ARTIFACT = ROOT / "tests" / "artifacts" / "contract.txt"
 def live_url() -> Iterator[str]:
     """The URL of a live server with the contract limits; the figures written at the end."""
     env = {f"DTF_{name.upper()}": str(value) for name, value in LIMITS.items()}
+    env |= {  # jobs: as small as the routes (the hooks size their requests alike), never refused
+        "DTF_MAX_JOB_CELLS": str(LIMITS["max_map_cells"]),
+        "DTF_MAX_JOB_POSES": str(LIMITS["max_map_poses"]),
+        "DTF_MAX_QUEUED_JOBS": "100000",
+    }
     process, url = start_server({**env, "DTF_MAX_SOLVER_SECONDS": "2"})
     yield url
     process.terminate()

@@ -20,6 +20,7 @@ from service.schemas.common import (
 from service.schemas.evaluate import _REQUEST_EXAMPLE, FailureReason
 from service.schemas.path import Path
 from service.schemas.robot import Robot
+from solver.capability_map import axis_length
 from solver.spatial import MAX_COORDINATE
 
 MAX_GRID_VALUES = 360
@@ -70,6 +71,12 @@ class Grid(RequestModel):
         description="Constant tool spin about each waypoint's tool axis (rad, cam.md section 3): "
         "one value or a list of 1 to 360 values, each mapped. Default 0.",
     )
+
+    def n_placements(self) -> int:
+        """How many placements the grid holds (x values x y values x yaws x spins)."""
+        nx = axis_length(self.x.min, self.x.max, self.x.step, field="grid.x")
+        ny = axis_length(self.y.min, self.y.max, self.y.step, field="grid.y")
+        return nx * ny * len(self.yaws()) * len(self.spins())
 
     def yaws(self) -> list[float]:
         """The yaw values as a list (rad)."""

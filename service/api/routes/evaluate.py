@@ -17,6 +17,7 @@ from service.work import json_response, run_stoppable
 from solver.evaluate import evaluate_path
 from solver.exceptions import InvalidInputError
 from solver.feed import check_feed
+from solver.progress import Progress
 
 router = APIRouter(prefix="/evaluate", tags=["evaluate"], responses=ERROR_RESPONSES)
 
@@ -86,3 +87,11 @@ def _answer(body: EvaluateRequest, settings: Settings, *, png: bool) -> Response
             feed=None if feed is None else check_feed(evaluation, feed, robot.qdot_max),
         )
     )
+
+
+def evaluation_of(
+    body: EvaluateRequest, settings: Settings, progress: Progress
+) -> EvaluateResponse:
+    """The JSON answer of ``POST /v1/evaluate`` (an evaluate job's result too)."""
+    answer = _answer(body, settings, png=False)
+    return EvaluateResponse.model_validate_json(bytes(answer.body))

@@ -54,6 +54,12 @@ def _computed_map(
     return result, robot.name, spin_mode
 
 
+def map_of(body: MapRequest, settings: Settings, progress: Progress) -> MapResponse:
+    """The JSON answer of ``POST /v1/map`` (a map job's result too)."""
+    result, _, spin_mode = _computed_map(body, settings, png=False, progress=progress)
+    return convert.map_response(result, spin_mode=spin_mode)
+
+
 def _picture(result: CapabilityMap, name: str) -> Response:
     """The PNG answer."""
     return Response(render_png(result, title=f"{name}: mu_path"), media_type="image/png")

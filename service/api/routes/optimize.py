@@ -39,11 +39,11 @@ async def post_optimize(
     exceed DTF_MAX_SEARCH_POSES, is a 422 on ``bounds``.
     """
     return await run_stoppable(
-        request, lambda progress: json_response(_optimum(body, settings, progress))
+        request, lambda progress: json_response(optimum_of(body, settings, progress))
     )
 
 
-def _optimum(body: OptimizeRequest, settings: Settings, progress: Progress) -> OptimizeResponse:
+def optimum_of(body: OptimizeRequest, settings: Settings, progress: Progress) -> OptimizeResponse:
     """The answer of ``POST /v1/optimize``, its size checked first."""
     convert.check_path_size(
         body.path, limit=settings.max_optimize_waypoints, setting="DTF_MAX_OPTIMIZE_WAYPOINTS"

@@ -1,0 +1,146 @@
+"""``/v1/jobs``: submit long work, watch its progress, read its result, cancel it (api.md)."""
+
+from __future__ import annotations
+
+import time
+from typing import Annotated, Any
+
+import anyio
+from fastapi import APIRouter, HTTPException, Query, Response, status
+from fastapi.responses import JSONResponse
+
+from service import convert
+from service.config import Settings
+from service.deps import SettingsDep
+from service.errors import ERROR_RESPONSES
+from service.jobs.runner import get_runner
+from service.jobs.store import Job
+from service.schemas import ErrorDetail, MapRequest
+from service.schemas.jobs import JobInfo, JobList, JobProgress, JobRequest, JobStatus, MapJob
+from solver.exceptions import InvalidInputError, SolverError
+
+router = APIRouter(prefix="/jobs", tags=["jobs"], responses=ERROR_RESPONSES)
+
+NOT_FOUND: dict[int | str, dict[str, Any]] = {
+    404: {"description": "No job has this id (or it expired)."}
+}
+
+
+def _units(job: Job) -> int:
+    """Units of work of a job: a map's placements, else 100 (percent)."""
+    if job.kind == "map":
+        request = MapRequest.model_validate(job.request)
+        return max(1, request.grid.n_placements())
+    return 100
+
+
+def job_info(job: Job, *, with_result: bool = True) -> JobInfo:
+    """The API's view of a stored job."""
+    total = _units(job)
+    eta = None
+    if job.status == "running" and job.started is not None and job.fraction > 0.0:
+        elapsed = time.time() - job.started
+        eta = elapsed * (1.0 - job.fraction) / job.fraction
+    return JobInfo(
+        id=job.id,
+        kind=job.kind,
+        status=job.status,
+        progress=JobProgress(
+            done=round(job.fraction * total), total=total, fraction=job.fraction, eta_seconds=eta
+        ),
+        created=job.created,
+        started=job.started,
+        finished=job.finished,
+        result=job.result if with_result else None,
+        error=None if job.error is None else [ErrorDetail(**e) for e in job.error],
+    )
+
+
+def _check_size(body: JobRequest, settings: Settings) -> None:
+    """A map job's size against the job limits, before it is queued (422 naming grid)."""
+    if isinstance(body, MapJob):
+        request = body.request
+        convert.check_path_size(
+            request.path, limit=settings.max_path_waypoints, setting="DTF_MAX_PATH_WAYPOINTS"
+        )
+        robot = convert.robot_from_schema(request.robot)
+        try:
+            convert.map_grid(
+                request.grid,
+                settings=settings.for_jobs(),
+                n_waypoints=request.path.n_waypoints(),
+                robot=robot,
+            )
+        except SolverError as error:  # the job limits stand in for the route's settings
+            message = error.message.replace("DTF_MAX_MAP_CELLS", "DTF_MAX_JOB_CELLS")
+            message = message.replace("DTF_MAX_MAP_POSES", "DTF_MAX_JOB_POSES")
+            raise InvalidInputError(f"request.{error.field}", message) from None
+
+
+@router.post(
+    "",
+    operation_id="submit_job",
+    summary="Run a map, optimisation or evaluation as a job",
+    status_code=status.HTTP_202_ACCEPTED,
+    responses={429: {"description": "Too many jobs queued or running; retry later."}},
+)
+async def post_job(body: JobRequest, settings: SettingsDep) -> JSONResponse:
+    """Queue the work; answer 202 with its id and Location.
+
+    Job limits (DTF_MAX_JOB_CELLS, DTF_MAX_JOB_POSES) replace the routes' own; a map's size is
+    checked before it is queued.
+    """
+    runner = get_runner(settings)
+    if runner.store.count_unfinished() >= settings.max_queued_jobs:
+        raise HTTPException(
+            status.HTTP_429_TOO_MANY_REQUESTS,
+            f"{settings.max_queued_jobs} jobs are queued or running (DTF_MAX_QUEUED_JOBS)",
+            headers={"Retry-After": "10"},
+        )
+    await anyio.to_thread.run_sync(_check_size, body, settings)
+    job = runner.store.create(body.kind, body.request.model_dump(mode="json", exclude_unset=True))
+    runner.submit(job.id)
+    info = job_info(job)
+    return JSONResponse(
+        info.model_dump(mode="json"),
+        status_code=status.HTTP_202_ACCEPTED,
+        headers={"Location": f"/v1/jobs/{job.id}"},
+    )
+
+
+@router.get("", operation_id="list_jobs", summary="The jobs, newest first, without results")
+def get_jobs(
+    settings: SettingsDep,
+    job_status: Annotated[JobStatus | None, Query(alias="status")] = None,
+    limit: Annotated[int, Query(ge=1, le=1000)] = 100,
+) -> JobList:
+    """Every job the store holds (finished ones until DTF_JOB_TTL), newest first."""
+    jobs = get_runner(settings).store.jobs(status=job_status, limit=limit)
+    return JobList(jobs=[job_info(job, with_result=False) for job in jobs])
+
+
+@router.get(
+    "/{job_id}", operation_id="get_job", summary="A job's status and result", responses=NOT_FOUND
+)
+def get_job(job_id: str, settings: SettingsDep) -> JobInfo:
+    """Status, progress with ETA, times, and the route's answer once done (or the error)."""
+    job = get_runner(settings).store.get(job_id)
+    if job is None:
+        raise HTTPException(status.HTTP_404_NOT_FOUND, f"no job {job_id[:100]!r}")
+    return job_info(job)
+
+
+@router.delete(
+    "/{job_id}",
+    operation_id="cancel_job",
+    summary="Cancel a queued or running job",
+    status_code=status.HTTP_204_NO_CONTENT,
+    responses=NOT_FOUND,
+)
+def delete_job(job_id: str, settings: SettingsDep) -> Response:
+    """A queued job is cancelled now; a running one stops at its next progress report."""
+    store = get_runner(settings).store
+    if store.get(job_id) is None:
+        raise HTTPException(status.HTTP_404_NOT_FOUND, f"no job {job_id[:100]!r}")
+    store.cancel(job_id)
+    return Response(status_code=status.HTTP_204_NO_CONTENT)

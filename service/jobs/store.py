@@ -1,0 +1,225 @@
+"""Jobs and their results in SQLite, under the service's data directory (api.md "Jobs").
+
+The store is the one place job state lives, shared by the web process and the worker
+processes: a worker reports progress by writing it here, and finds a cancel request here.
+"""
+
+from __future__ import annotations
+
+import json
+import sqlite3
+import time
+import uuid
+from collections.abc import Iterator
+from contextlib import contextmanager
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any, Literal
+
+Status = Literal["queued", "running", "done", "failed", "cancelled"]
+Kind = Literal["map", "optimize", "evaluate"]
+FINISHED = ("done", "failed", "cancelled")
+
+_SCHEMA = """
+CREATE TABLE IF NOT EXISTS jobs (
+    id TEXT PRIMARY KEY,
+    kind TEXT NOT NULL,
+    status TEXT NOT NULL,
+    request TEXT NOT NULL,
+    result TEXT,
+    error TEXT,
+    done REAL NOT NULL DEFAULT 0,
+    created REAL NOT NULL,
+    started REAL,
+    finished REAL,
+    attempts INTEGER NOT NULL DEFAULT 0,
+    cancel INTEGER NOT NULL DEFAULT 0
+);
+CREATE INDEX IF NOT EXISTS jobs_created ON jobs (created);
+"""
+
+
+@dataclass(frozen=True)
+class Job:
+    """One job as stored.
+
+    Attributes:
+        fraction: the fraction of its work done, 0..1.
+        created, started, finished: Unix times (s); None until they happen.
+        result: the route's JSON answer when done; error: a 422-style detail list when failed.
+    """
+
+    id: str
+    kind: Kind
+    status: Status
+    request: dict[str, Any]
+    result: dict[str, Any] | None
+    error: list[dict[str, Any]] | None
+    fraction: float
+    created: float
+    started: float | None
+    finished: float | None
+    attempts: int
+    cancel: bool
+
+
+class JobStore:
+    """Jobs in an SQLite file; each call opens its own connection (safe across processes)."""
+
+    def __init__(self, path: Path) -> None:
+        """Open (and create) the store at ``path``."""
+        path.parent.mkdir(parents=True, exist_ok=True)
+        self.path = path
+        with self._connection() as db:
+            db.executescript(_SCHEMA)
+
+    @contextmanager
+    def _connection(self) -> Iterator[sqlite3.Connection]:
+        db = sqlite3.connect(self.path, timeout=30, isolation_level=None)
+        db.row_factory = sqlite3.Row
+        try:
+            db.execute("PRAGMA journal_mode=WAL")
+            yield db
+        finally:
+            db.close()
+
+    def create(self, kind: Kind, request: dict[str, Any]) -> Job:
+        """A new queued job with a random id."""
+        job_id = str(uuid.uuid4())
+        with self._connection() as db:
+            db.execute(
+                "INSERT INTO jobs (id, kind, status, request, created) VALUES (?, ?, ?, ?, ?)",
+                (job_id, kind, "queued", json.dumps(request), time.time()),
+            )
+        job = self.get(job_id)
+        if job is None:  # just written
+            raise RuntimeError(f"job {job_id} was not stored")
+        return job
+
+    def get(self, job_id: str) -> Job | None:
+        """The job, or None for an unknown id."""
+        with self._connection() as db:
+            row = db.execute("SELECT * FROM jobs WHERE id = ?", (job_id,)).fetchone()
+        return None if row is None else _job(row)
+
+    def jobs(self, *, status: str | None, limit: int) -> list[Job]:
+        """The newest jobs first, optionally of one status."""
+        query, args = "SELECT * FROM jobs", []
+        if status is not None:
+            query, args = query + " WHERE status = ?", [status]
+        with self._connection() as db:
+            rows = db.execute(query + " ORDER BY created DESC LIMIT ?", [*args, limit]).fetchall()
+        return [_job(row) for row in rows]
+
+    def count_unfinished(self) -> int:
+        """Jobs queued or running."""
+        with self._connection() as db:
+            row = db.execute(
+                "SELECT COUNT(*) FROM jobs WHERE status IN ('queued', 'running')"
+            ).fetchone()
+        return int(row[0])
+
+    def start(self, job_id: str) -> bool:
+        """Mark a queued job running (one more attempt); False if it is not queued."""
+        with self._connection() as db:
+            changed = db.execute(
+                "UPDATE jobs SET status = 'running', started = ?, attempts = attempts + 1 "
+                "WHERE id = ? AND status = 'queued' AND cancel = 0",
+                (time.time(), job_id),
+            ).rowcount
+        return bool(changed)
+
+    def progress(self, job_id: str, fraction: float) -> bool:
+        """Record the fraction done; whether a cancel was asked for."""
+        with self._connection() as db:
+            db.execute("UPDATE jobs SET done = ? WHERE id = ?", (fraction, job_id))
+            row = db.execute("SELECT cancel FROM jobs WHERE id = ?", (job_id,)).fetchone()
+        return bool(row is not None and row[0])
+
+    def finish(
+        self,
+        job_id: str,
+        status: Status,
+        *,
+        result: dict[str, Any] | None = None,
+        error: list[dict[str, Any]] | None = None,
+    ) -> None:
+        """Record how a job ended."""
+        with self._connection() as db:
+            db.execute(
+                "UPDATE jobs SET status = ?, result = ?, error = ?, finished = ?, "
+                "done = CASE WHEN ? = 'done' THEN 1 ELSE done END WHERE id = ?",
+                (
+                    status,
+                    None if result is None else json.dumps(result),
+                    None if error is None else json.dumps(error),
+                    time.time(),
+                    status,
+                    job_id,
+                ),
+            )
+
+    def cancel(self, job_id: str) -> None:
+        """Ask a job to stop: a queued one is cancelled now, a running one at its next report."""
+        with self._connection() as db:
+            db.execute("UPDATE jobs SET cancel = 1 WHERE id = ?", (job_id,))
+            db.execute(
+                "UPDATE jobs SET status = 'cancelled', finished = ? WHERE id = ? AND "
+                "status = 'queued'",
+                (time.time(), job_id),
+            )
+
+    def recover(self, *, attempts: int) -> list[str]:
+        """After a restart: jobs left running are queued again (or failed after ``attempts``).
+
+        Returns:
+            The ids of the queued jobs, oldest first, to run.
+        """
+        now = time.time()
+        with self._connection() as db:
+            db.execute(
+                "UPDATE jobs SET status = 'failed', finished = ?, error = ? WHERE "
+                "status = 'running' AND attempts >= ?",
+                (now, json.dumps([_interrupted(attempts)]), attempts),
+            )
+            db.execute("UPDATE jobs SET status = 'queued' WHERE status = 'running'")
+            rows = db.execute(
+                "SELECT id FROM jobs WHERE status = 'queued' ORDER BY created"
+            ).fetchall()
+        return [row[0] for row in rows]
+
+    def expire(self, *, ttl: float) -> int:
+        """Forget finished jobs older than ``ttl`` seconds; how many."""
+        with self._connection() as db:
+            return int(
+                db.execute(
+                    "DELETE FROM jobs WHERE status IN ('done', 'failed', 'cancelled') AND "
+                    "finished < ?",
+                    (time.time() - ttl,),
+                ).rowcount
+            )
+
+
+def _interrupted(attempts: int) -> dict[str, Any]:
+    return {
+        "loc": [],
+        "msg": f"the job was interrupted {attempts} times (service restarts) and is not retried",
+        "type": "interrupted",
+    }
+
+
+def _job(row: sqlite3.Row) -> Job:
+    return Job(
+        id=row["id"],
+        kind=row["kind"],
+        status=row["status"],
+        request=json.loads(row["request"]),
+        result=None if row["result"] is None else json.loads(row["result"]),
+        error=None if row["error"] is None else json.loads(row["error"]),
+        fraction=float(row["done"]),
+        created=row["created"],
+        started=row["started"],
+        finished=row["finished"],
+        attempts=row["attempts"],
+        cancel=bool(row["cancel"]),
+    )

@@ -1,0 +1,104 @@
+"""``/v1/jobs``: long work as persisted jobs with progress and cancel (api.md "Jobs")."""
+
+from __future__ import annotations
+
+from typing import Annotated, Any, Literal
+
+from pydantic import ConfigDict, Discriminator, Field, Tag
+
+from service.schemas.common import RequestModel, ResponseModel
+from service.schemas.errors import ErrorDetail
+from service.schemas.evaluate import EvaluateRequest
+from service.schemas.map import MapRequest
+from service.schemas.optimize import OptimizeRequest
+
+JobStatus = Literal["queued", "running", "done", "failed", "cancelled"]
+
+
+class MapJob(RequestModel):
+    """A map as a job: the body of POST /v1/map, with the job limits."""
+
+    kind: Literal["map"] = Field(description='"map".')
+    request: MapRequest = Field(description="The body POST /v1/map takes.")
+
+
+class OptimizeJob(RequestModel):
+    """An optimisation as a job: the body of POST /v1/optimize."""
+
+    kind: Literal["optimize"] = Field(description='"optimize".')
+    request: OptimizeRequest = Field(description="The body POST /v1/optimize takes.")
+
+
+class EvaluateJob(RequestModel):
+    """An evaluation as a job: the body of POST /v1/evaluate."""
+
+    kind: Literal["evaluate"] = Field(description='"evaluate".')
+    request: EvaluateRequest = Field(description="The body POST /v1/evaluate takes.")
+
+
+def _job_kind(value: object) -> str | None:
+    """Tag of a job: ``job:<kind>`` (the tag is left out of error locs)."""
+    kind = value.get("kind") if isinstance(value, dict) else getattr(value, "kind", None)
+    return f"job:{kind}" if kind in ("map", "optimize", "evaluate") else None
+
+
+JobRequest = Annotated[
+    Annotated[MapJob, Tag("job:map")]
+    | Annotated[OptimizeJob, Tag("job:optimize")]
+    | Annotated[EvaluateJob, Tag("job:evaluate")],
+    Discriminator(_job_kind),
+]
+"""A job: its kind and the route's own request body."""
+
+
+class JobProgress(ResponseModel):
+    """How far a job is."""
+
+    done: int = Field(description="Units of work done (placements for a map, else percent).")
+    total: int = Field(description="Units of work in all.")
+    fraction: float = Field(description="done / total, 0 to 1.")
+    eta_seconds: float | None = Field(
+        description="Estimated seconds to the end, from the rate so far; null before any report."
+    )
+
+
+class JobInfo(ResponseModel):
+    """A job: its status, progress, times and, once finished, its result or error."""
+
+    model_config = ConfigDict(
+        json_schema_extra={
+            "examples": [
+                {
+                    "id": "0b6f3c1e-7f1e-4d0a-9d55-3c5d8b1f2a10",
+                    "kind": "map",
+                    "status": "running",
+                    "progress": {"done": 1200, "total": 5000, "fraction": 0.24, "eta_seconds": 9},
+                    "created": 1764000000.0,
+                    "started": 1764000000.5,
+                    "finished": None,
+                    "result": None,
+                    "error": None,
+                }
+            ]
+        }
+    )
+
+    id: str = Field(description="The job's id (a random UUID).")
+    kind: Literal["map", "optimize", "evaluate"] = Field(description="What the job computes.")
+    status: JobStatus = Field(description="queued, running, done, failed or cancelled.")
+    progress: JobProgress = Field(description="How far it is.")
+    created: float = Field(description="When it was submitted (Unix time, s).")
+    started: float | None = Field(description="When it last started (Unix time, s).")
+    finished: float | None = Field(description="When it ended (Unix time, s).")
+    result: dict[str, Any] | None = Field(
+        default=None, description="When done: the route's own answer (MapResponse, ...)."
+    )
+    error: list[ErrorDetail] | None = Field(
+        default=None, description="When failed: what was wrong, as a 422's detail."
+    )
+
+
+class JobList(ResponseModel):
+    """Jobs, newest first, without their results."""
+
+    jobs: list[JobInfo] = Field(description="The jobs.")

@@ -1,0 +1,30 @@
+"""Settings for every test process: jobs kept in a temporary directory, small and few.
+
+The app reads its settings on first use, after this module has set the environment; the
+in-process tests that reach ``/v1/jobs`` (the schemathesis fuzz) then queue small jobs in one
+worker process, under a directory removed at the end, never under the repository.
+"""
+
+from __future__ import annotations
+
+import os
+import shutil
+import tempfile
+from collections.abc import Iterator
+
+import pytest
+
+_DATA = tempfile.mkdtemp(prefix="dtf-test-jobs-")
+os.environ.setdefault("DTF_DATA_DIR", _DATA)
+os.environ.setdefault("DTF_WORKERS", "1")
+os.environ.setdefault("DTF_MAX_JOB_CELLS", "2000")
+os.environ.setdefault("DTF_MAX_JOB_POSES", "200000")
+
+
+@pytest.fixture(scope="session", autouse=True)
+def _jobs_stop_at_the_end() -> Iterator[None]:
+    yield
+    from service.jobs.runner import close_runners
+
+    close_runners()
+    shutil.rmtree(_DATA, ignore_errors=True)

@@ -1,0 +1,173 @@
+"""Jobs (issue 13): submitted, watched, cancelled, persisted across a restart, on a live server.
+
+Each test starts uvicorn with its own data directory and one worker process, as a user would
+with DTF_DATA_DIR and DTF_WORKERS; the answers of a job are compared with the route's own.
+"""
+
+from __future__ import annotations
+
+import json
+import signal
+import time
+from pathlib import Path
+from typing import Any
+
+import httpx
+import pytest
+
+from tests.cases import ROOT
+from tests.live import start_server
+
+EXAMPLE = json.loads((ROOT / "examples" / "evaluate_request.json").read_text())
+SMALL_GRID = {
+    "x": {"min": -0.1, "max": 0.1, "step": 0.05},
+    "y": {"min": 0.35, "max": 0.55, "step": 0.05},
+    "z": 0.1,
+    "yaw": [0.0, 0.5],
+}
+BIG_GRID = {  # about 200,000 placements: a minute of work, far over the route's limit
+    "x": {"min": -0.5, "max": 0.5, "step": 0.0025},
+    "y": {"min": 0.0, "max": 0.6, "step": 0.0025},
+    "z": 0.1,
+    "yaw": [0.0, 1.0],
+}
+
+
+def map_request(grid: dict[str, Any]) -> dict[str, Any]:
+    return {"robot": EXAMPLE["robot"], "path": EXAMPLE["path"], "grid": grid}
+
+
+def server(data: Path, **settings: str) -> tuple[Any, str]:
+    env = {
+        "DTF_DATA_DIR": str(data),
+        "DTF_WORKERS": "1",
+        "DTF_MAX_JOB_CELLS": "2000000",  # the defaults (the test session's are small)
+        "DTF_MAX_JOB_POSES": "500000000",
+        **settings,
+    }
+    return start_server(env, "--timeout-graceful-shutdown", "2")
+
+
+def wait_for(url: str, job_id: str, done: Any, timeout: float = 60.0) -> dict[str, Any]:
+    """Poll the job until ``done(job)`` holds; the job."""
+    deadline = time.monotonic() + timeout
+    while True:
+        job: dict[str, Any] = httpx.get(f"{url}/v1/jobs/{job_id}").json()
+        if done(job) or time.monotonic() > deadline:
+            return job
+        time.sleep(0.1)
+
+
+def test_a_map_job_answers_what_the_route_answers(tmp_path: Path) -> None:
+    process, url = server(tmp_path)
+    try:
+        submitted = httpx.post(
+            f"{url}/v1/jobs", json={"kind": "map", "request": map_request(SMALL_GRID)}
+        )
+        assert submitted.status_code == 202, submitted.text
+        job_id = submitted.json()["id"]
+        assert submitted.headers["location"] == f"/v1/jobs/{job_id}"
+        job = wait_for(url, job_id, lambda j: j["status"] in ("done", "failed"))
+        assert job["status"] == "done", job
+        assert job["progress"]["fraction"] == 1 and job["progress"]["total"] == 50
+        direct = httpx.post(f"{url}/v1/map", json=map_request(SMALL_GRID), timeout=60).json()
+        assert job["result"] == direct
+        listed = httpx.get(f"{url}/v1/jobs").json()["jobs"]
+        assert [j["id"] for j in listed] == [job_id] and listed[0]["result"] is None
+    finally:
+        process.terminate()
+        process.wait()
+
+
+def test_a_running_job_is_cancelled_within_a_second_or_two(tmp_path: Path) -> None:
+    process, url = server(tmp_path)
+    try:
+        submitted = httpx.post(
+            f"{url}/v1/jobs", json={"kind": "map", "request": map_request(BIG_GRID)}
+        )
+        assert submitted.status_code == 202, submitted.text
+        job_id = submitted.json()["id"]
+        running = wait_for(url, job_id, lambda j: j["progress"]["fraction"] > 0)
+        assert running["status"] == "running" and running["progress"]["eta_seconds"] > 0
+        assert httpx.delete(f"{url}/v1/jobs/{job_id}").status_code == 204
+        asked = time.monotonic()
+        job = wait_for(url, job_id, lambda j: j["status"] != "running", timeout=10)
+        assert job["status"] == "cancelled"
+        assert time.monotonic() - asked < 2.0
+    finally:
+        process.terminate()
+        process.wait()
+
+
+def test_a_restart_runs_an_interrupted_job_again(tmp_path: Path) -> None:
+    process, url = server(tmp_path)
+    submitted = httpx.post(f"{url}/v1/jobs", json={"kind": "map", "request": map_request(BIG_GRID)})
+    job_id = submitted.json()["id"]
+    wait_for(url, job_id, lambda j: j["status"] == "running")
+    process.send_signal(signal.SIGKILL)  # a crash: nothing is told
+    process.wait()
+    process, url = server(tmp_path)
+    try:
+        job = wait_for(
+            url, job_id, lambda j: j["status"] == "running" and j["progress"]["fraction"] > 0
+        )
+        assert job["status"] == "running"  # queued again, and running in the new service
+        httpx.delete(f"{url}/v1/jobs/{job_id}")
+        assert wait_for(url, job_id, lambda j: j["status"] != "running")["status"] == "cancelled"
+    finally:
+        process.terminate()
+        process.wait()
+
+
+def test_bad_jobs_are_refused_before_they_are_queued(tmp_path: Path) -> None:
+    process, url = server(tmp_path, DTF_MAX_QUEUED_JOBS="1", DTF_MAX_JOB_CELLS="100000")
+    try:
+        assert httpx.get(f"{url}/v1/jobs/no-such-job").status_code == 404
+        bad = map_request({**SMALL_GRID, "x": {"min": 0, "max": 1, "step": 0}})
+        refused = httpx.post(f"{url}/v1/jobs", json={"kind": "map", "request": bad})
+        assert refused.status_code == 422
+        assert refused.json()["detail"][0]["loc"] == ["body", "request", "grid", "x", "step"]
+        too_big = httpx.post(
+            f"{url}/v1/jobs", json={"kind": "map", "request": map_request(BIG_GRID)}
+        )
+        assert too_big.status_code == 422
+        detail = too_big.json()["detail"][0]
+        assert detail["loc"] == ["body", "request", "grid"]
+        assert "193282 placements; the limit is 100000 (DTF_MAX_JOB_CELLS)" in detail["msg"]
+        first = httpx.post(
+            f"{url}/v1/jobs",
+            json={
+                "kind": "map",
+                "request": map_request(
+                    {**BIG_GRID, "yaw": 0.0, "x": {"min": -0.1, "max": 0.1, "step": 0.0025}}
+                ),
+            },
+        )
+        assert first.status_code == 202, first.text
+        second = httpx.post(
+            f"{url}/v1/jobs", json={"kind": "map", "request": map_request(SMALL_GRID)}
+        )
+        assert second.status_code == 429 and "retry-after" in second.headers
+        httpx.delete(f"{url}/v1/jobs/{first.json()['id']}")
+    finally:
+        process.terminate()
+        process.wait()
+
+
+@pytest.mark.parametrize("kind", ["evaluate", "optimize"])
+def test_evaluate_and_optimize_jobs(tmp_path: Path, kind: str) -> None:
+    request: dict[str, Any] = {"robot": EXAMPLE["robot"], "path": EXAMPLE["path"]}
+    if kind == "evaluate":
+        request["placement"] = EXAMPLE["placement"]
+    else:
+        request |= {"bounds": {"x": [-0.05, 0.05], "y": [0.4, 0.5], "yaw": [-0.2, 0.2]}, "z": 0.1}
+    process, url = server(tmp_path)
+    try:
+        job_id = httpx.post(f"{url}/v1/jobs", json={"kind": kind, "request": request}).json()["id"]
+        job = wait_for(url, job_id, lambda j: j["status"] in ("done", "failed"))
+        assert job["status"] == "done", job
+        direct = httpx.post(f"{url}/v1/{kind}", json=request, timeout=60).json()
+        assert job["result"]["mu_path"] == pytest.approx(direct["mu_path"], rel=1e-12)
+    finally:
+        process.terminate()
+        process.wait()
