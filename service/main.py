@@ -32,6 +32,7 @@ from service.errors import (
     solver_error_handler,
 )
 from service.jobs.runner import close_runners, get_runner
+from service.metrics import instrument, log_to_stderr
 from service.work import STOPPING
 from solver.exceptions import SolverError
 from solver.progress import Cancelled
@@ -75,6 +76,7 @@ async def lifespan(app: FastAPI) -> AsyncIterator[None]:
     STOPPING.clear()
     _stop_work_on(signal.SIGTERM)
     _stop_work_on(signal.SIGINT)
+    log_to_stderr()
     get_runner(get_settings()).recover()  # jobs a restart interrupted run again
     yield
     close_runners()
@@ -116,6 +118,7 @@ def create_app() -> FastAPI:
     app.include_router(health.router)
     app.include_router(api_router)
     app.add_middleware(BodySizeLimitMiddleware)
+    instrument(app)
     return app
 
 

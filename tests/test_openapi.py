@@ -40,6 +40,11 @@ def test_operation_ids_are_short_and_the_png_is_binary() -> None:
         "map_png",
         "import_path",
         "optimize",
+        "submit_job",
+        "list_jobs",
+        "get_job",
+        "cancel_job",
+        "metrics",
     }
     png = spec["paths"]["/v1/map/png"]["post"]["responses"]["200"]["content"]["image/png"]
     assert png["schema"] == {"type": "string", "format": "binary"}

@@ -20,6 +20,7 @@ from pydantic import ValidationError
 from service.config import Settings
 from service.errors import request_location, solver_error_location
 from service.jobs.store import JobStore
+from service.metrics import log, log_to_stderr
 from solver.exceptions import SolverError
 from solver.progress import Cancelled, Progress
 
@@ -58,9 +59,11 @@ KINDS: dict[str, Work] = {"map": _map, "optimize": _optimize, "evaluate": _evalu
 
 def run_job(store_path: str, job_id: str, settings_json: str) -> None:
     """Run one job to its end, in a worker process; every outcome is written to the store."""
+    log_to_stderr()
     store = JobStore(Path(store_path))
     if not store.start(job_id):
         return  # cancelled while queued, or taken by another worker
+    log.info("job %s running", job_id)
     job = store.get(job_id)
     if job is None:
         return
@@ -78,21 +81,26 @@ def run_job(store_path: str, job_id: str, settings_json: str) -> None:
         result = KINDS[job.kind](job.request, settings, progress)
     except Cancelled:
         store.finish(job_id, "cancelled")
+        log.info("job %s cancelled", job_id)
     except SolverError as error:
         loc = solver_error_location(error)
         detail = {"loc": loc, "msg": error.message, "type": "invalid_input"}
         store.finish(job_id, "failed", error=[detail])
+        log.info("job %s failed: %s", job_id, error.message[:200])
     except ValidationError as error:
         details = [
             {"loc": request_location(("body", *e["loc"])), "msg": e["msg"], "type": e["type"]}
             for e in error.errors()
         ]
         store.finish(job_id, "failed", error=details)
+        log.info("job %s failed: invalid request", job_id)
     except Exception as error:  # noqa: BLE001 - a job must end with a status, whatever happens
         detail = {"loc": [], "msg": f"internal error: {type(error).__name__}", "type": "internal"}
         store.finish(job_id, "failed", error=[detail])
+        log.exception("job %s failed", job_id)
     else:
         store.finish(job_id, "done", result=result)
+        log.info("job %s done", job_id)
 
 
 class JobRunner:

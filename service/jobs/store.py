@@ -188,6 +188,16 @@ class JobStore:
             ).fetchall()
         return [row[0] for row in rows]
 
+    def statistics(self) -> tuple[dict[str, int], list[float]]:
+        """Jobs by status, and the durations (s) of the finished ones that ran."""
+        with self._connection() as db:
+            counts = dict(db.execute("SELECT status, COUNT(*) FROM jobs GROUP BY status"))
+            rows = db.execute(
+                "SELECT finished - started FROM jobs WHERE finished IS NOT NULL AND started IS "
+                "NOT NULL"
+            ).fetchall()
+        return {str(k): int(v) for k, v in counts.items()}, [float(r[0]) for r in rows]
+
     def expire(self, *, ttl: float) -> int:
         """Forget finished jobs older than ``ttl`` seconds; how many."""
         with self._connection() as db:

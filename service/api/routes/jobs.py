@@ -15,6 +15,7 @@ from service.deps import SettingsDep
 from service.errors import ERROR_RESPONSES
 from service.jobs.runner import get_runner
 from service.jobs.store import Job
+from service.metrics import log
 from service.schemas import ErrorDetail, MapRequest
 from service.schemas.jobs import JobInfo, JobList, JobProgress, JobRequest, JobStatus, MapJob
 from solver.exceptions import InvalidInputError, SolverError
@@ -100,6 +101,7 @@ async def post_job(body: JobRequest, settings: SettingsDep) -> JSONResponse:
     await anyio.to_thread.run_sync(_check_size, body, settings)
     job = runner.store.create(body.kind, body.request.model_dump(mode="json", exclude_unset=True))
     runner.submit(job.id)
+    log.info("job %s queued (%s)", job.id, body.kind)
     info = job_info(job)
     return JSONResponse(
         info.model_dump(mode="json"),
@@ -143,4 +145,5 @@ def delete_job(job_id: str, settings: SettingsDep) -> Response:
     if store.get(job_id) is None:
         raise HTTPException(status.HTTP_404_NOT_FOUND, f"no job {job_id[:100]!r}")
     store.cancel(job_id)
+    log.info("job %s cancel asked", job_id)
     return Response(status_code=status.HTTP_204_NO_CONTENT)

@@ -12,6 +12,7 @@ from service.body import body_in_thread, body_openapi
 from service.config import Settings
 from service.deps import SettingsDep
 from service.errors import ERROR_RESPONSES
+from service.metrics import PLACEMENTS
 from service.render import render_png
 from service.schemas import MapRequest, MapResponse
 from service.work import json_response, run_stoppable
@@ -51,6 +52,7 @@ def _computed_map(
         progress=progress,
         passes=path.passes,
     )
+    PLACEMENTS.inc(result.mu_path.size)
     return result, robot.name, spin_mode
 
 

@@ -1,0 +1,69 @@
+"""``GET /metrics``: Prometheus text, from the maintained prometheus-fastapi-instrumentator.
+
+Request counts and latencies per route come from the instrumentator; the service adds the jobs
+by status and the durations of finished jobs (read from the job store at each scrape, since jobs
+run in other processes), and the placements its synchronous maps computed.
+"""
+
+from __future__ import annotations
+
+import logging
+from collections.abc import Iterable
+
+from fastapi import FastAPI
+from fastapi.responses import PlainTextResponse
+from prometheus_client import CONTENT_TYPE_LATEST, REGISTRY, Counter, generate_latest
+from prometheus_client.core import GaugeMetricFamily, SummaryMetricFamily
+from prometheus_client.registry import Collector
+from prometheus_fastapi_instrumentator import Instrumentator
+
+PLACEMENTS = Counter("dtf_placements", "Placements computed by /v1/map (synchronous maps).")
+log = logging.getLogger("dtf.jobs")
+
+
+def log_to_stderr() -> None:
+    """Send the service's own log lines (``dtf.*``, INFO and up) to stderr, once."""
+    logger = logging.getLogger("dtf")
+    if not logger.handlers:
+        handler = logging.StreamHandler()
+        handler.setFormatter(logging.Formatter("%(asctime)s %(name)s %(message)s"))
+        logger.addHandler(handler)
+        logger.setLevel(logging.INFO)
+
+
+class _JobCollector(Collector):
+    """Jobs by status and finished jobs' durations, read from the store at each scrape."""
+
+    def collect(self) -> Iterable[GaugeMetricFamily | SummaryMetricFamily]:
+        from service.config import get_settings
+        from service.jobs.runner import get_runner
+
+        store = get_runner(get_settings()).store
+        by_status = GaugeMetricFamily("dtf_jobs", "Jobs by status.", labels=["status"])
+        counts, durations = store.statistics()
+        for status in ("queued", "running", "done", "failed", "cancelled"):
+            by_status.add_metric([status], counts.get(status, 0))
+        yield by_status
+        summary = SummaryMetricFamily("dtf_job_seconds", "Durations of finished jobs (s).")
+        summary.add_metric([], count_value=len(durations), sum_value=sum(durations))
+        yield summary
+
+
+def instrument(app: FastAPI) -> None:
+    """Count and time every request per route, and answer ``GET /metrics``."""
+    Instrumentator(excluded_handlers=["/metrics"]).instrument(app)
+
+    @app.get(
+        "/metrics",
+        operation_id="metrics",
+        tags=["health"],
+        summary="Prometheus metrics: requests per route, jobs by status, placements",
+        response_class=PlainTextResponse,
+        responses={200: {"content": {"text/plain": {"schema": {"type": "string"}}}}},
+    )
+    def metrics() -> PlainTextResponse:
+        """The Prometheus text exposition of the service's metrics."""
+        return PlainTextResponse(generate_latest(REGISTRY), media_type=CONTENT_TYPE_LATEST)
+
+    if not any(isinstance(c, _JobCollector) for c in getattr(REGISTRY, "_collector_to_names", {})):
+        REGISTRY.register(_JobCollector())
