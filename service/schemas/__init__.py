@@ -28,6 +28,14 @@ from service.schemas.evaluate import (
     IkInfo,
     WaypointResult,
 )
+from service.schemas.jobs import (
+    EvaluateJob,
+    JobInfo,
+    JobList,
+    JobProgress,
+    MapJob,
+    OptimizeJob,
+)
 from service.schemas.map import Grid, GridAxis, MapCell, MapExtreme, MapRequest, MapResponse
 from service.schemas.optimize import (
     Bounds,
@@ -43,6 +51,12 @@ from service.schemas.robot import CatalogueRobot, OpwGeometry, OpwRobot, Robot, 
 from service.schemas.robots import BranchLevel, HealthResponse, RobotInfo, RobotsResponse
 
 __all__ = [
+    "OptimizeJob",
+    "MapJob",
+    "JobProgress",
+    "JobList",
+    "JobInfo",
+    "EvaluateJob",
     "AutoIkPolicy",
     "Bottleneck",
     "Bounds",

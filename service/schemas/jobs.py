@@ -5,11 +5,13 @@ from __future__ import annotations
 from typing import Annotated, Any, Literal
 
 from pydantic import ConfigDict, Discriminator, Field, Tag
+from pydantic.config import JsonDict
 
 from service.schemas.common import RequestModel, ResponseModel
 from service.schemas.errors import ErrorDetail
-from service.schemas.evaluate import EvaluateRequest
-from service.schemas.map import MapRequest
+from service.schemas.evaluate import _REQUEST_EXAMPLE, EvaluateRequest
+from service.schemas.map import _MAP_REQUEST_EXAMPLE, MapRequest
+from service.schemas.optimize import _REQUEST as _OPTIMIZE_EXAMPLE
 from service.schemas.optimize import OptimizeRequest
 
 JobStatus = Literal["queued", "running", "done", "failed", "cancelled"]
@@ -18,6 +20,10 @@ JobStatus = Literal["queued", "running", "done", "failed", "cancelled"]
 class MapJob(RequestModel):
     """A map as a job: the body of POST /v1/map, with the job limits."""
 
+    model_config = ConfigDict(
+        json_schema_extra={"examples": [{"kind": "map", "request": _MAP_REQUEST_EXAMPLE}]}
+    )
+
     kind: Literal["map"] = Field(description='"map".')
     request: MapRequest = Field(description="The body POST /v1/map takes.")
 
@@ -25,12 +31,20 @@ class MapJob(RequestModel):
 class OptimizeJob(RequestModel):
     """An optimisation as a job: the body of POST /v1/optimize."""
 
+    model_config = ConfigDict(
+        json_schema_extra={"examples": [{"kind": "optimize", "request": _OPTIMIZE_EXAMPLE}]}
+    )
+
     kind: Literal["optimize"] = Field(description='"optimize".')
     request: OptimizeRequest = Field(description="The body POST /v1/optimize takes.")
 
 
 class EvaluateJob(RequestModel):
     """An evaluation as a job: the body of POST /v1/evaluate."""
+
+    model_config = ConfigDict(
+        json_schema_extra={"examples": [{"kind": "evaluate", "request": _REQUEST_EXAMPLE}]}
+    )
 
     kind: Literal["evaluate"] = Field(description='"evaluate".')
     request: EvaluateRequest = Field(description="The body POST /v1/evaluate takes.")
@@ -54,6 +68,12 @@ JobRequest = Annotated[
 class JobProgress(ResponseModel):
     """How far a job is."""
 
+    model_config = ConfigDict(
+        json_schema_extra={
+            "examples": [{"done": 1200, "total": 5000, "fraction": 0.24, "eta_seconds": 9.5}]
+        }
+    )
+
     done: int = Field(description="Units of work done (placements for a map, else percent).")
     total: int = Field(description="Units of work in all.")
     fraction: float = Field(description="done / total, 0 to 1.")
@@ -62,26 +82,23 @@ class JobProgress(ResponseModel):
     )
 
 
+_JOB_EXAMPLE: JsonDict = {
+    "id": "0b6f3c1e-7f1e-4d0a-9d55-3c5d8b1f2a10",
+    "kind": "map",
+    "status": "running",
+    "progress": {"done": 1200, "total": 5000, "fraction": 0.24, "eta_seconds": 9},
+    "created": 1764000000.0,
+    "started": 1764000000.5,
+    "finished": None,
+    "result": None,
+    "error": None,
+}
+
+
 class JobInfo(ResponseModel):
     """A job: its status, progress, times and, once finished, its result or error."""
 
-    model_config = ConfigDict(
-        json_schema_extra={
-            "examples": [
-                {
-                    "id": "0b6f3c1e-7f1e-4d0a-9d55-3c5d8b1f2a10",
-                    "kind": "map",
-                    "status": "running",
-                    "progress": {"done": 1200, "total": 5000, "fraction": 0.24, "eta_seconds": 9},
-                    "created": 1764000000.0,
-                    "started": 1764000000.5,
-                    "finished": None,
-                    "result": None,
-                    "error": None,
-                }
-            ]
-        }
-    )
+    model_config = ConfigDict(json_schema_extra={"examples": [_JOB_EXAMPLE]})
 
     id: str = Field(description="The job's id (a random UUID).")
     kind: Literal["map", "optimize", "evaluate"] = Field(description="What the job computes.")
@@ -100,5 +117,7 @@ class JobInfo(ResponseModel):
 
 class JobList(ResponseModel):
     """Jobs, newest first, without their results."""
+
+    model_config = ConfigDict(json_schema_extra={"examples": [{"jobs": [_JOB_EXAMPLE]}]})
 
     jobs: list[JobInfo] = Field(description="The jobs.")
