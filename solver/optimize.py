@@ -33,7 +33,13 @@ from solver.exceptions import InvalidInputError, quoted
 from solver.joint_path import EXACT_POSE_TOLERANCE, evaluate_joint_path
 from solver.pipeline import PreparedPath, SpinMode, prepare_path, require_family
 from solver.placement_nlp import PlacementNlp
-from solver.placement_scipy import global_search, polish, search_placements
+from solver.placement_scipy import (
+    SearchSize,
+    global_search,
+    polish,
+    search_placements,
+    search_size,
+)
 from solver.progress import Progress, span
 from solver.robots import Robot
 from solver.search_space import PlacementBounds, vector_of
@@ -222,8 +228,11 @@ def optimize_placement(
             f"{start.spin:g} rad is outside the bounds",
         )
     path = np.asarray(waypoints_in_workpiece, dtype=float)
-    if method == "scipy" and max_search_poses is not None:
-        _check_search_size(robot, bounds, len(path), max_search_poses)
+    if method == "scipy":
+        cost = require_family(robot).path_cost(len(path))
+        size = search_size(bounds, path_cost=cost, n_waypoints=len(path))
+        if max_search_poses is not None:
+            _check_search_size(robot, bounds, size, len(path), max_search_poses)
     prepared = prepare_path(robot, path, passes=passes)
     if max_spin_step is not None and not prepared.segment_in_pass.all():
         raise InvalidInputError("spin_path", "a spin path needs a program of one pass")
@@ -261,7 +270,7 @@ def optimize_placement(
         name = "ipopt (casadi), from the coarse map's maxima"
     else:
         candidates, iterations = _scipy(
-            robot, prepared, bounds, max_joint_step, symmetric, spin_mode, progress
+            robot, prepared, bounds, max_joint_step, symmetric, spin_mode, size, progress
         )
         name = "differential_evolution + SLSQP (scipy)"
     # The start last: it is the answer only when nothing the solver found is better.
@@ -336,7 +345,7 @@ def optimize_placement(
 
 
 def _check_search_size(
-    robot: Robot, bounds: PlacementBounds, n_waypoints: int, max_poses: int
+    robot: Robot, bounds: PlacementBounds, size: SearchSize, n_waypoints: int, max_poses: int
 ) -> None:
     """Refuse a differential evolution whose weighed work is over ``max_poses``.
 
@@ -344,7 +353,7 @@ def _check_search_size(
         InvalidInputError: on ``bounds``, saying the size asked for and the limit.
     """
     family = require_family(robot)
-    placements = search_placements(bounds)
+    placements = search_placements(bounds, size)
     work = placements * family.path_cost(n_waypoints)
     if work > max_poses:
         raise InvalidInputError(
@@ -439,9 +448,13 @@ def _scipy(
     max_joint_step: float,
     symmetric: bool,
     spin_mode: SpinMode,
+    size: SearchSize,
     progress: Progress | None,
 ) -> tuple[list[Candidate], int]:
-    """Candidates: the best placement of each basin DE saw, and SLSQP's polish of each."""
+    """Candidates: the best placement of each basin DE saw, and SLSQP's polish of each.
+
+    The search is ``size`` (smaller for a family whose placement costs more).
+    """
     basins, iterations = global_search(
         robot,
         prepared,
@@ -449,6 +462,7 @@ def _scipy(
         max_joint_step=max_joint_step,
         symmetric=symmetric,
         spin_mode=spin_mode,
+        size=size,
         progress=span(progress, 0.0, 0.6),
     )
     if not basins:
@@ -467,6 +481,7 @@ def _scipy(
             require_family(robot).branches[branch],
             max_joint_step=max_joint_step,
             spin_mode=spin_mode,
+            size=size,
             progress=span(
                 progress, 0.6 + 0.35 * k / len(basins), 0.6 + 0.35 * (k + 1) / len(basins)
             ),

@@ -182,16 +182,13 @@ def test_numeric_map_is_weighed_by_its_cost(
 
 @pytest.mark.parametrize("method", ["casadi", "scipy"])
 def test_numeric_optimize_is_weighed_by_its_cost(
-    client: TestClient,
-    panda: dict[str, Any],
-    erk_path: dict[str, Any],
-    waypoints: list[dict[str, Any]],
-    method: str,
+    client: TestClient, panda: dict[str, Any], erk_path: dict[str, Any], method: str
 ) -> None:
-    """The coarse map (casadi) or the differential evolution (scipy) would take minutes."""
+    """The coarse map (casadi) or even the smallest differential evolution (scipy, sized by
+    the family's cost) would take minutes on the ERK path."""
     body = {
         "robot": panda,
-        "path": erk_path if method == "casadi" else {"waypoints": waypoints},
+        "path": erk_path,
         "bounds": {"x": [-0.25, 0.25], "y": [0.25, 0.65], "yaw": [-3.14, 3.14]},
         "z": 0.1,
         "method": method,

@@ -12,10 +12,18 @@ from solver.evaluate import evaluate_path
 from solver.exceptions import InvalidInputError
 from solver.joint_path import evaluate_joint_path
 from solver.optimize import PlacementOptimum, optimize_placement
+from solver.placement_scipy import (
+    FULL_SEARCH,
+    MIN_GENERATIONS,
+    MIN_POPULATION,
+    SEARCH_WORK,
+    search_placements,
+    search_size,
+)
 from solver.robots import get_robot
 from solver.search_space import PlacementBounds
 from solver.spatial import Placement, pose_matrix
-from tests.cases import EXAMPLES
+from tests.cases import EXAMPLES, OPTIMUM_EVALUATE_RTOL
 from tests.solver.test_optimize import best_coarse_cell
 
 BOUNDS = PlacementBounds(x=(-0.05, 0.05), y=(0.4, 0.5), yaw=(-0.3, 0.3), z=0.1)
@@ -69,6 +77,33 @@ def test_evaluating_the_answers_joint_path_reproduces_its_mu_path(
         robot, path, casadi.placement, casadi.joint_path, max_joint_step=0.35
     )
     assert evaluation.mu_path == pytest.approx(casadi.mu_path, rel=1e-9)
+
+
+def test_scipy_on_the_panda_reaches_the_coarse_map_and_is_the_evaluators(
+    path: np.ndarray,
+) -> None:
+    """Issue 11: the search sized by the family's cost (about 15 s here, 200 s at full size)."""
+    robot, short = get_robot("panda"), path[:10]
+    optimum = optimize_placement(robot, short, bounds=BOUNDS, method="scipy")
+    assert optimum.found and optimum.placement is not None and optimum.mu_path is not None
+    assert optimum.mu_path >= best_coarse_cell(robot, short, BOUNDS)
+    evaluation = evaluate_path(robot, short, optimum.placement)
+    assert optimum.mu_path == pytest.approx(evaluation.mu_path, rel=OPTIMUM_EVALUATE_RTOL)
+
+
+@pytest.mark.parametrize("n_waypoints", [2, 10, 2000])
+def test_the_scipy_search_is_sized_by_the_familys_cost(n_waypoints: int) -> None:
+    """A closed-form family keeps the full search; the Panda's is smaller, near SEARCH_WORK."""
+    analytic, numeric = get_robot("ur5").family, get_robot("panda").family
+    assert analytic is not None and numeric is not None
+    full = search_size(BOUNDS, path_cost=analytic.path_cost(n_waypoints), n_waypoints=n_waypoints)
+    assert full == FULL_SEARCH
+    cost = numeric.path_cost(n_waypoints)
+    sized = search_size(BOUNDS, path_cost=cost, n_waypoints=n_waypoints)
+    assert search_placements(BOUNDS, sized) < search_placements(BOUNDS, full)
+    assert sized.basins == 1 and sized.polish_iterations < full.polish_iterations
+    floors = (MIN_POPULATION, MIN_GENERATIONS) == (sized.population, sized.generations)
+    assert floors or search_placements(BOUNDS, sized) * cost <= 1.5 * SEARCH_WORK
 
 
 def test_a_tracked_joint_path_evaluates_as_the_tracking_does(path: np.ndarray) -> None:
