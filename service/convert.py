@@ -62,6 +62,22 @@ def spun_poses(path: PathInput, spins: list[float] | None) -> np.ndarray:
     return spun_waypoints(path.poses, np.array(spins, dtype=float))
 
 
+def joint_path_of(rows: list[list[float]], robot: Robot) -> np.ndarray:
+    """A joint path (N, n), rad, from the request's rows.
+
+    Raises:
+        InvalidInputError: on ``joint_path`` and the waypoint, a row without one value a joint.
+    """
+    for i, row in enumerate(rows):
+        if len(row) != robot.dof:
+            raise InvalidInputError(
+                "joint_path",
+                f"{len(row)} values but {robot.name!r} has {robot.dof} joints",
+                waypoint=i,
+            )
+    return np.array(rows, dtype=float)
+
+
 def check_path_size(path: schemas.Path, *, limit: int, setting: str) -> None:
     """Refuse a path with more waypoints than a setting allows, before any work.
 
@@ -428,6 +444,7 @@ def optimize_response(
         ),
         improvement_percent=optimum.improvement_percent,
         spins=None if optimum.spins is None else optimum.spins.tolist(),
+        joint_path=None if optimum.joint_path is None else optimum.joint_path.tolist(),
         solver=schemas.SolverInfo(
             name=report.name,
             status=report.status,

@@ -30,9 +30,16 @@ import numpy as np
 from solver.coarse_search import MAX_COARSE_CELLS, Cell, coarse_cells
 from solver.evaluate import DEFAULT_MAX_JOINT_STEP, PathEvaluation, evaluate_path
 from solver.exceptions import InvalidInputError, quoted
+from solver.joint_path import EXACT_POSE_TOLERANCE, evaluate_joint_path
 from solver.pipeline import PreparedPath, SpinMode, prepare_path, require_family
 from solver.placement_nlp import PlacementNlp
-from solver.placement_scipy import global_search, polish, search_placements
+from solver.placement_scipy import (
+    SearchSize,
+    global_search,
+    polish,
+    search_placements,
+    search_size,
+)
 from solver.progress import Progress, span
 from solver.robots import Robot
 from solver.search_space import PlacementBounds, vector_of
@@ -41,7 +48,24 @@ from solver.symmetry import arc_coordinates, arc_point, turns_about_base_z
 
 Method = Literal["casadi", "scipy"]
 N_STARTS = 4  # IPOPT solves, from the best local maxima of the coarse map
-Candidate = tuple[np.ndarray, np.ndarray | None]  # decision vector, per-waypoint spins
+
+
+@dataclass(frozen=True)
+class Candidate:
+    """What a solver proposes, for the evaluator to judge.
+
+    Attributes:
+        vector: the decision vector [x, y, yaw, spin, z] (m, m, rad, rad, m).
+        status: what the solver said of it.
+        spins: shape (N,), rad, each waypoint's spin on top of the placement's (spin path).
+        joint_path: shape (N, n), rad, the NLP's own joint path for a redundant arm (dof > 6),
+            judged as it is (:mod:`solver.joint_path`) beside the tracked one.
+    """
+
+    vector: np.ndarray
+    status: str
+    spins: np.ndarray | None = None
+    joint_path: np.ndarray | None = None
 
 
 @dataclass(frozen=True)
@@ -70,6 +94,8 @@ class PlacementOptimum:
         symmetric: whether the search used the (r, psi) symmetry.
         spins: shape (N,), rad, each waypoint's spin on top of the placement's, when the
             answer came from the spin-path NLP (cam.md section 4); else None.
+        joint_path: shape (N, n), rad, for a redundant arm (dof > 6) the joint path mu_path is
+            at (the NLP's own, or the tracked one where that is faster); None for dof <= 6.
     """
 
     found: bool
@@ -82,23 +108,49 @@ class PlacementOptimum:
     solver: SolverReport
     symmetric: bool
     spins: np.ndarray | None = None
+    joint_path: np.ndarray | None = None
 
 
 def _place_on_arc(
     vector: np.ndarray, bounds: PlacementBounds, near: float, symmetric: bool
-) -> Placement:
+) -> tuple[Placement, float]:
     """The candidate, clamped into the box, moved along its arc to the point nearest ``near``.
 
     Solvers may end a hair outside their bounds (IPOPT by its bound relaxation, 1e-8): the
     clamp is what makes every reported placement inside them; the evaluator then judges it.
     The spin and the height ride along: turning the placement about the base axis leaves them.
+
+    Returns:
+        the placement, and the turn (rad) about the base z axis that moved it along its arc
+        (joint 1 of a joint path moves by as much).
     """
-    x, y, yaw, spin, z = bounds.clamp(vector)
+    clamped = bounds.clamp(vector)
+    x, y, yaw, spin, z = clamped
     if symmetric:
         moved = arc_point(*arc_coordinates(x, y, yaw), bounds, near=near)
         if moved is not None:
             x, y, yaw = moved
-    return Placement(float(x), float(y), float(z), float(yaw), spin=float(spin))
+    turn = math.atan2(y, x) - math.atan2(clamped[1], clamped[0]) if symmetric else 0.0
+    placement = Placement(float(x), float(y), float(z), float(yaw), spin=float(spin))
+    return placement, (turn + math.pi) % (2 * math.pi) - math.pi
+
+
+def _turned_joint_path(robot: Robot, joint_path: np.ndarray, turn: float) -> np.ndarray:
+    """The joint path with joint 1 turned by ``turn`` (the copy 2 pi k that fits its limits).
+
+    Where joint 1 turns about the base z axis (the symmetry), turning the placement by ``turn``
+    about that axis is reached by the same joint path with q1 + turn.
+    """
+    turned = np.array(joint_path, dtype=float)
+    if turn == 0.0:
+        return turned
+    first = turned[:, 0] + turn
+    for copy in (0.0, -2 * math.pi, 2 * math.pi):
+        if robot.q_lower[0] <= (first + copy).min() and (first + copy).max() <= robot.q_upper[0]:
+            first = first + copy
+            break
+    turned[:, 0] = first
+    return turned
 
 
 def optimize_placement(
@@ -176,8 +228,11 @@ def optimize_placement(
             f"{start.spin:g} rad is outside the bounds",
         )
     path = np.asarray(waypoints_in_workpiece, dtype=float)
-    if method == "scipy" and max_search_poses is not None:
-        _check_search_size(robot, bounds, len(path), max_search_poses)
+    if method == "scipy":
+        cost = require_family(robot).path_cost(len(path))
+        size = search_size(bounds, path_cost=cost, n_waypoints=len(path))
+        if max_search_poses is not None:
+            _check_search_size(robot, bounds, size, len(path), max_search_poses)
     prepared = prepare_path(robot, path, passes=passes)
     if max_spin_step is not None and not prepared.segment_in_pass.all():
         raise InvalidInputError("spin_path", "a spin path needs a program of one pass")
@@ -199,7 +254,7 @@ def optimize_placement(
             max_poses=max_coarse_poses,
             progress=span(progress, 0.0, 0.3),
         )
-        candidates, statuses, iterations = _casadi(
+        candidates, iterations = _casadi(
             robot,
             path,
             prepared,
@@ -214,26 +269,48 @@ def optimize_placement(
         )
         name = "ipopt (casadi), from the coarse map's maxima"
     else:
-        candidates, statuses, iterations = _scipy(
-            robot, prepared, bounds, max_joint_step, symmetric, spin_mode, progress
+        candidates, iterations = _scipy(
+            robot, prepared, bounds, max_joint_step, symmetric, spin_mode, size, progress
         )
         name = "differential_evolution + SLSQP (scipy)"
     # The start last: it is the answer only when nothing the solver found is better.
-    candidates = [*candidates, (vector_of(start), None)]
-    statuses = [*statuses, "no better placement found than the start"]
-    best: tuple[float, Placement, PathEvaluation, str, np.ndarray | None] | None = None
-    for (candidate, spins), status in zip(candidates, statuses, strict=True):
-        placement = _place_on_arc(candidate, bounds, near, symmetric)
-        evaluation = evaluate_path(
-            robot,
-            path if spins is None else spun_waypoints(path, spins),
-            placement,
-            max_joint_step=max_joint_step,
-            spin_mode=spin_mode,
-            passes=passes,
+    candidates = [
+        *candidates,
+        Candidate(vector_of(start), "no better placement found than the start"),
+    ]
+    best: tuple[float, Placement, PathEvaluation, Candidate] | None = None
+    for candidate in candidates:
+        placement, turn = _place_on_arc(candidate.vector, bounds, near, symmetric)
+        waypoints = path if candidate.spins is None else spun_waypoints(path, candidate.spins)
+        judged = []
+        if candidate.joint_path is not None:
+            try:
+                judged.append(
+                    evaluate_joint_path(
+                        robot,
+                        waypoints,
+                        placement,
+                        _turned_joint_path(robot, candidate.joint_path, turn),
+                        max_joint_step=max_joint_step,
+                        passes=passes,
+                        tolerance=EXACT_POSE_TOLERANCE,
+                    )
+                )
+            except InvalidInputError:  # off its poses, limits or steps: only tracking counts
+                pass
+        judged.append(
+            evaluate_path(
+                robot,
+                waypoints,
+                placement,
+                max_joint_step=max_joint_step,
+                spin_mode=spin_mode,
+                passes=passes,
+            )
         )
-        if evaluation.mu_path is not None and (best is None or evaluation.mu_path > best[0]):
-            best = (evaluation.mu_path, placement, evaluation, status, spins)
+        for evaluation in judged:
+            if evaluation.mu_path is not None and (best is None or evaluation.mu_path > best[0]):
+                best = (evaluation.mu_path, placement, evaluation, candidate)
     report = SolverReport(name, "", iterations, time.perf_counter() - began)
     if best is None:
         return PlacementOptimum(
@@ -247,7 +324,10 @@ def optimize_placement(
             solver=dataclasses.replace(report, status="no feasible placement inside the bounds"),
             symmetric=symmetric,
         )
-    mu_path, placement, evaluation, status, spins = best
+    mu_path, placement, evaluation, chosen = best
+    status = chosen.status
+    if chosen.joint_path is not None and evaluation.branch is not None:
+        status += " (at the placement its tracked joint path is faster than its own)"
     start_mu = start_evaluation.mu_path
     return PlacementOptimum(
         found=True,
@@ -259,12 +339,13 @@ def optimize_placement(
         improvement_percent=None if not start_mu else 100.0 * (mu_path / start_mu - 1.0),
         solver=dataclasses.replace(report, status=status),
         symmetric=symmetric,
-        spins=spins,
+        spins=chosen.spins,
+        joint_path=evaluation.q if robot.dof > 6 else None,
     )
 
 
 def _check_search_size(
-    robot: Robot, bounds: PlacementBounds, n_waypoints: int, max_poses: int
+    robot: Robot, bounds: PlacementBounds, size: SearchSize, n_waypoints: int, max_poses: int
 ) -> None:
     """Refuse a differential evolution whose weighed work is over ``max_poses``.
 
@@ -272,7 +353,7 @@ def _check_search_size(
         InvalidInputError: on ``bounds``, saying the size asked for and the limit.
     """
     family = require_family(robot)
-    placements = search_placements(bounds)
+    placements = search_placements(bounds, size)
     work = placements * family.path_cost(n_waypoints)
     if work > max_poses:
         raise InvalidInputError(
@@ -296,18 +377,21 @@ def _casadi(
     max_solver_seconds: float | None,
     progress: Progress | None,
     passes: Sequence[tuple[int, int]] | None,
-) -> tuple[list[Candidate], list[str], int]:
+) -> tuple[list[Candidate], int]:
     """Candidates: the best coarse cell, then IPOPT's optimum from each of the best cells.
+
+    For a redundant arm (dof > 6) each optimum carries the NLP's joint path: IPOPT chose the
+    redundancy too, and the evaluator's tracked joint path would lose that.
 
     In free spin mode each solve starts from the cell's joint path at the given spin with the
     spin rate 0 (a feasible start at the fixed-spin mu_path), and IPOPT frees the rate.
     """
     if not cells:
-        return [], [], 0
-    candidates: list[Candidate] = [(cells[0].vector, None)]
-    statuses = ["best cell of the coarse map"]
+        return [], 0
     if prepared.pure_rotation.any() or cells[0].mu_path <= 0.0:
-        return candidates, ["mu_path is 0 everywhere: the path turns on the spot"], 0
+        zero = "mu_path is 0 everywhere: the path turns on the spot"
+        return [Candidate(cells[0].vector, zero)], 0
+    candidates = [Candidate(cells[0].vector, "best cell of the coarse map")]
     nlp = PlacementNlp(
         robot,
         prepared,
@@ -342,13 +426,19 @@ def _casadi(
                 progress=span(progress, k / len(starts), (k + 1) / len(starts)),
             )
         except RuntimeError as error:  # IPOPT refused this start: the others still count
-            statuses.append(f"IPOPT failed from a start: {str(error).splitlines()[-1][:200]}")
-            candidates.append((cell.vector, None))
+            failure = f"IPOPT failed from a start: {str(error).splitlines()[-1][:200]}"
+            candidates.append(Candidate(cell.vector, failure))
             continue
         iterations += result.iterations
-        candidates.append((result.vector, result.spins))
-        statuses.append(result.status)
-    return candidates, statuses, iterations
+        candidates.append(
+            Candidate(
+                result.vector,
+                result.status,
+                spins=result.spins,
+                joint_path=result.joint_path if robot.dof > 6 else None,
+            )
+        )
+    return candidates, iterations
 
 
 def _scipy(
@@ -358,9 +448,13 @@ def _scipy(
     max_joint_step: float,
     symmetric: bool,
     spin_mode: SpinMode,
+    size: SearchSize,
     progress: Progress | None,
-) -> tuple[list[Candidate], list[str], int]:
-    """Candidates: the best placement of each basin DE saw, and SLSQP's polish of each."""
+) -> tuple[list[Candidate], int]:
+    """Candidates: the best placement of each basin DE saw, and SLSQP's polish of each.
+
+    The search is ``size`` (smaller for a family whose placement costs more).
+    """
     basins, iterations = global_search(
         robot,
         prepared,
@@ -368,14 +462,15 @@ def _scipy(
         max_joint_step=max_joint_step,
         symmetric=symmetric,
         spin_mode=spin_mode,
+        size=size,
         progress=span(progress, 0.0, 0.6),
     )
     if not basins:
-        return [], [], iterations
-    candidates: list[Candidate] = [(basins[0][0], None)]
-    statuses = ["best placement of differential evolution"]
+        return [], iterations
     if prepared.pure_rotation.any() or basins[0][1] <= 0.0:
-        return candidates, ["mu_path is 0 everywhere: the path turns on the spot"], iterations
+        zero = "mu_path is 0 everywhere: the path turns on the spot"
+        return [Candidate(basins[0][0], zero)], iterations
+    candidates = [Candidate(basins[0][0], "best placement of differential evolution")]
     for k, (placement, mu_path, branch) in enumerate(basins):
         polished, status, steps = polish(
             robot,
@@ -386,11 +481,11 @@ def _scipy(
             require_family(robot).branches[branch],
             max_joint_step=max_joint_step,
             spin_mode=spin_mode,
+            size=size,
             progress=span(
                 progress, 0.6 + 0.35 * k / len(basins), 0.6 + 0.35 * (k + 1) / len(basins)
             ),
         )
-        candidates.append((polished, None))
-        statuses.append(f"SLSQP: {status}")
+        candidates.append(Candidate(polished, f"SLSQP: {status}"))
         iterations += steps
-    return candidates, statuses, iterations
+    return candidates, iterations

@@ -88,11 +88,14 @@ class NlpResult:
     """One IPOPT solve: the decision vector [x, y, yaw, spin, z], s, IPOPT's status, iterations.
 
     ``spins`` (N,), rad, each waypoint's spin on top of the placement's, with a spin path.
+    ``joint_path`` (N, n), rad, the q_i of the solution (for dof > 6 it also chose the
+    redundancy).
     """
 
     vector: np.ndarray
     speed: float
     spins: np.ndarray | None
+    joint_path: np.ndarray
     status: str
     success: bool
     iterations: int
@@ -298,6 +301,7 @@ class PlacementNlp:
             vector=x[:5].copy(),
             speed=float(x[5]),
             spins=x[len(x) - self._n_spins :].copy() if self._n_spins else None,
+            joint_path=x[6 : 6 + n * self._dof].reshape(n, self._dof).copy(),
             status=str(stats["return_status"]),
             success=bool(stats["success"]),
             iterations=int(stats["iter_count"]),

@@ -6,9 +6,17 @@ distinct basins it saw are then polished by SLSQP on  maximise s  s.t.  V_i(v) >
 waypoint i, with V_i on the IK branch of that point and its gradient by central differences (one
 batch of placements). Both work on the free variables of the decision vector
 (:mod:`solver.search_space`: x, y, yaw and the tool spin when its range is not one value).
+
+The search's size (population, generations, polish iterations) is the full one for a
+closed-form family, whose placement costs one unit of work a waypoint. A family whose placement
+costs more (:meth:`KinematicsFamily.path_cost`: numeric IK on a short path, about a thousand
+times more) gets a smaller search, so that its work stays near SEARCH_WORK (:func:`search_size`).
 """
 
 from __future__ import annotations
+
+import math
+from dataclasses import dataclass
 
 import numpy as np
 import scipy.optimize
@@ -30,12 +38,67 @@ N_BASINS = 3  # distinct basins polished
 BASIN_GAP = (0.05, 0.35)  # m and rad (about 20 degrees): placements closer are one basin
 
 Basin = tuple[np.ndarray, float, int]  # decision vector, mu_path, branch index
+# Work of a costly family's search, in poses of a closed-form family (the unit of
+# KinematicsFamily.path_cost): about 8 s of work on the 2-core development machine (3.8 us a
+# pose). The Panda on 10 waypoints (path_cost 10,000) then gets the floors below: about 15 s
+# for the whole search instead of about 200 s at the full size.
+SEARCH_WORK = 2e6
+MIN_POPULATION = 5  # per dimension: scipy's least useful population
+MIN_GENERATIONS = 10
+MIN_POLISH_ITERATIONS = 15
 
 
-def search_placements(bounds: PlacementBounds) -> int:
+@dataclass(frozen=True)
+class SearchSize:
+    """The size of the scipy search.
+
+    Attributes:
+        population: differential evolution's population per free variable.
+        generations: its generations at most.
+        polish_iterations: SLSQP's iterations at most from each start.
+        basins: how many distinct basins are polished.
+    """
+
+    population: int = POPULATION
+    generations: int = GENERATIONS
+    polish_iterations: int = POLISH_ITERATIONS
+    basins: int = N_BASINS
+
+
+FULL_SEARCH = SearchSize()
+
+
+def search_size(bounds: PlacementBounds, *, path_cost: float, n_waypoints: int) -> SearchSize:
+    """The search's size for a family whose placement of the path costs ``path_cost``.
+
+    A closed-form family (``path_cost <= n_waypoints``: one unit a waypoint) gets the full
+    search, whatever the path's length. A costlier one gets the full search's work scaled by
+    f = SEARCH_WORK / (full placements * path_cost) (at most 1): the population and the
+    generations each by sqrt(f), so that the placements scale by f, and the polish iterations
+    and the basins polished by f; each no less than its floor (MIN_POPULATION,
+    MIN_GENERATIONS, MIN_POLISH_ITERATIONS, one basin).
+
+    Args:
+        bounds: the box (its free variables are the search's dimensions).
+        path_cost: the family's work for one placement of the path, in closed-form poses.
+        n_waypoints: N.
+    """
+    if path_cost <= n_waypoints:
+        return FULL_SEARCH
+    full = search_placements(bounds, FULL_SEARCH)
+    fraction = min(1.0, SEARCH_WORK / (full * path_cost))
+    return SearchSize(
+        population=max(MIN_POPULATION, round(POPULATION * math.sqrt(fraction))),
+        generations=max(MIN_GENERATIONS, round(GENERATIONS * math.sqrt(fraction))),
+        polish_iterations=max(MIN_POLISH_ITERATIONS, round(POLISH_ITERATIONS * fraction)),
+        basins=max(1, round(N_BASINS * fraction)),
+    )
+
+
+def search_placements(bounds: PlacementBounds, size: SearchSize = FULL_SEARCH) -> int:
     """How many placements differential evolution evaluates in ``bounds`` (at most)."""
     n_free = int(bounds.free.sum())
-    return (GENERATIONS + 1) * POPULATION * n_free if n_free else 1
+    return (size.generations + 1) * size.population * n_free if n_free else 1
 
 
 def _full(bounds: PlacementBounds, free_values: np.ndarray) -> np.ndarray:
@@ -67,13 +130,14 @@ def global_search(
     max_joint_step: float,
     symmetric: bool,
     spin_mode: SpinMode = "fixed",
+    size: SearchSize = FULL_SEARCH,
     progress: Progress | None = None,
 ) -> tuple[list[Basin], int]:
     """Differential evolution over the free variables; the best point of each distinct basin.
 
     Every placement DE evaluates is kept; the best ones that lie apart (by BASIN_GAP, in
     (r, psi) when ``symmetric``, else in (x, y, yaw); spins as angles) are returned, up to
-    N_BASINS: DE settles in one basin, and the landscape has near-equal mirror-image optima.
+    ``size.basins``: DE settles in one basin, and the landscape has near-equal mirror-image optima.
 
     Returns:
         ([(decision vector, mu_path, branch index), ...] best first, generations).
@@ -91,7 +155,7 @@ def global_search(
         )
         seen.append((vectors, result.mu_path, result.branch))
         if progress is not None:
-            progress(len(seen) / (GENERATIONS + 1))
+            progress(len(seen) / (size.generations + 1))
         values: np.ndarray = np.where(np.isnan(result.mu_path), INFEASIBLE, -result.mu_path)
         return values
 
@@ -103,8 +167,8 @@ def global_search(
         found = scipy.optimize.differential_evolution(
             objective,
             bounds=list(zip(bounds.lower[free], bounds.upper[free], strict=True)),
-            popsize=POPULATION,
-            maxiter=GENERATIONS,
+            popsize=size.population,
+            maxiter=size.generations,
             tol=1e-12,
             atol=0.0,
             seed=SEED,
@@ -124,7 +188,7 @@ def global_search(
     for i in order:
         if all(np.max(np.abs(coordinates[i] - coordinates[j]) * scale) > 1.0 for j in chosen):
             chosen.append(int(i))
-            if len(chosen) == N_BASINS:
+            if len(chosen) == size.basins:
                 break
     return [(vectors[i].copy(), float(mu[i]), int(branch[i])) for i in chosen], generations
 
@@ -139,6 +203,7 @@ def polish(
     *,
     max_joint_step: float,
     spin_mode: SpinMode = "fixed",
+    size: SearchSize = FULL_SEARCH,
     progress: Progress | None = None,
 ) -> tuple[np.ndarray, str, int]:
     """SLSQP on the epigraph form over the free variables, from a feasible start, on one branch.
@@ -169,7 +234,7 @@ def polish(
                 raise RuntimeError("evaluate_placements returned no speeds")
             cache[key] = result.v_max
             if progress is not None:
-                progress(len(cache) / (POLISH_ITERATIONS + 1))
+                progress(len(cache) / (size.polish_iterations + 1))
         return cache[key]
 
     def margin(v: np.ndarray) -> np.ndarray:
@@ -200,7 +265,7 @@ def polish(
         bounds=[*zip(bounds.lower[free], bounds.upper[free], strict=True), (0.0, None)],
         constraints=[{"type": "ineq", "fun": margin, "jac": margin_gradient}],
         method="SLSQP",
-        options={"ftol": 1e-14, "maxiter": POLISH_ITERATIONS},
+        options={"ftol": 1e-14, "maxiter": size.polish_iterations},
     )
     vector = _full(bounds, result.x[None, :n_free])[0]
     return vector, str(result.message), int(result.nit)

@@ -3,10 +3,11 @@
 from __future__ import annotations
 
 from enum import StrEnum
-from typing import Literal
+from typing import Annotated, Literal
 
-from pydantic import ConfigDict, Field
+from pydantic import ConfigDict, Field, model_validator
 from pydantic.config import JsonDict
+from pydantic_core import PydanticCustomError
 
 from service.schemas.common import (
     Angle,
@@ -19,7 +20,10 @@ from service.schemas.common import (
     SpinMode,
 )
 from service.schemas.path import MAX_PATH_WAYPOINTS, Path
-from service.schemas.robot import Robot
+from service.schemas.robot import MAX_JOINTS, Robot
+
+JointValues = Annotated[list[Angle], Field(min_length=1, max_length=MAX_JOINTS)]
+"""One configuration: a value per joint (rad, m for prismatic joints), each within 1000."""
 
 _REQUEST_EXAMPLE: JsonDict = {
     "robot": {"model": "ur5"},
@@ -131,6 +135,25 @@ class EvaluateRequest(RequestModel):
         "placement's: each waypoint "
         "turned about its own tool z axis (as /v1/optimize's spin_path answers). Default none.",
     )
+    joint_path: list[JointValues] | None = Field(
+        default=None,
+        min_length=2,
+        max_length=MAX_PATH_WAYPOINTS,
+        description="The configuration at every waypoint to evaluate, instead of the tracked IK "
+        "branch: N rows of n joint values (rad, m for prismatic joints), e.g. /v1/optimize's "
+        "joint_path for a redundant arm. Each row's forward kinematics must reach its waypoint "
+        "within 1e-6 m and 1e-6 rad, within the joint limits and max_joint_step; V_max is then the "
+        "exact DTF LP at those configurations. Needs ik.branch auto and spin_mode fixed; the "
+        "answer's branch is then null. Default none: the IK branches are tracked.",
+    )
+
+    @model_validator(mode="after")
+    def _joint_path_or_branch(self) -> EvaluateRequest:
+        if self.joint_path is not None and self.ik.branch != "auto":
+            raise PydanticCustomError(
+                "joint_path", "give a joint_path or a named ik.branch, not both"
+            )
+        return self
 
 
 class FeedCheckResult(ResponseModel):
@@ -227,13 +250,14 @@ class IkInfo(ResponseModel):
     )
     seeds: int | None = Field(
         description="Numeric family: how many start configurations (seeds) the IK started from "
-        "at the first waypoint (32 for 6 joints, 64 for more); null for a closed-form family."
+        "at the first waypoint (32 for 6 joints, 64 for more); null for a closed-form family, "
+        "or when the request gave the joint_path."
     )
     branches_found: int | None = Field(
         description="Numeric family: how many distinct IK solutions within the joint limits the "
         "seeds found at the first waypoint (count, at most seeds), each one branch followed "
         "along the path; a numeric family cannot promise it found every branch. null for a "
-        "closed-form family."
+        "closed-form family, or when the request gave the joint_path."
     )
 
 
@@ -262,7 +286,7 @@ class EvaluateResponse(ResponseModel):
     branch: Branch | NumericBranch | None = Field(
         description="IK branch used (when infeasible with auto: the one that got furthest): "
         "named for a UR or OPW arm, a solution index for the numeric family; null when no "
-        "branch reached the first waypoint."
+        "branch reached the first waypoint, or when the request gave the joint_path."
     )
     ik: IkInfo = Field(description="The IK family that solved the path, and its seeds.")
     spin_mode: SpinMode = Field(description="The spin mode used (fixed or free).")

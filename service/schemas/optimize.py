@@ -212,3 +212,10 @@ class OptimizeResponse(ResponseModel):
         description="With spin_path: each waypoint's tool spin (rad) on top of the placement's; "
         "/v1/evaluate with these spins gives this mu_path. null otherwise.",
     )
+    joint_path: list[list[float]] | None = Field(
+        default=None,
+        description="For a redundant arm (more than 6 joints): the configuration at every "
+        "waypoint (N rows of n values, rad) that mu_path is at; the casadi method chooses the "
+        "redundancy too, so it may differ from the tracked IK branch. /v1/evaluate with this "
+        "joint_path gives this mu_path. null for six joints.",
+    )

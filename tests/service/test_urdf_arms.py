@@ -32,9 +32,13 @@ def panda(request: pytest.FixtureRequest, panda_urdf: str) -> dict[str, Any]:
 
 
 def evaluated(
-    client: TestClient, robot: dict[str, Any], waypoints: list[dict[str, Any]], placement: Any
+    client: TestClient,
+    robot: dict[str, Any],
+    waypoints: list[dict[str, Any]],
+    placement: Any,
+    **extra: Any,
 ) -> dict[str, Any]:
-    body = {"robot": robot, "path": {"waypoints": waypoints}, "placement": placement}
+    body = {"robot": robot, "path": {"waypoints": waypoints}, "placement": placement, **extra}
     response = client.post("/v1/evaluate", json=body)
     assert response.status_code == 200, response.text
     answer: dict[str, Any] = response.json()
@@ -86,8 +90,34 @@ def test_optimize_answer_is_what_evaluate_says(
     answer = response.json()
     assert answer["found"] and answer["mu_path"] >= answer["start"]["mu_path"]
     assert answer["evaluation"]["ik"]["family"] == "numeric"
-    evaluation = evaluated(client, panda, waypoints, sent_back(answer["placement"]))
-    assert answer["mu_path"] == pytest.approx(evaluation["mu_path"], rel=OPTIMUM_EVALUATE_RTOL)
+    # The casadi method chose the redundancy too: its joint path is the answer's, and
+    # /v1/evaluate with it gives its mu_path; the tracked branches there are no faster.
+    joint_path = answer["joint_path"]
+    assert len(joint_path) == len(waypoints) and {len(q) for q in joint_path} == {7}
+    placement = sent_back(answer["placement"])
+    evaluation = evaluated(client, panda, waypoints, placement, joint_path=joint_path)
+    assert answer["mu_path"] == pytest.approx(evaluation["mu_path"], rel=1e-9)
+    assert evaluation["branch"] is None and evaluation["ik"]["seeds"] is None
+    tracked = evaluated(client, panda, waypoints, placement)
+    assert answer["mu_path"] >= tracked["mu_path"] * (1 - OPTIMUM_EVALUATE_RTOL)
+
+
+def test_a_joint_path_off_its_waypoints_is_refused(
+    client: TestClient, panda: dict[str, Any], waypoints: list[dict[str, Any]]
+) -> None:
+    joint_path = [w["q"] for w in evaluated(client, panda, waypoints, PLACEMENT)["waypoints"]]
+    body = {"robot": panda, "path": {"waypoints": waypoints}, "placement": PLACEMENT}
+    shifted = [q if i != 6 else [q[0] + 1e-3, *q[1:]] for i, q in enumerate(joint_path)]
+    short = [q if i != 2 else q[:6] for i, q in enumerate(joint_path)]
+    for bad, waypoint in ((shifted, 6), (short, 2)):
+        response = client.post("/v1/evaluate", json=body | {"joint_path": bad})
+        assert response.status_code == 422, response.text
+        [entry] = response.json()["detail"]
+        assert entry["loc"] == ["body", "joint_path", waypoint]
+    same = client.post("/v1/evaluate", json=body | {"joint_path": joint_path}).json()
+    assert same["mu_path"] == pytest.approx(
+        evaluated(client, panda, waypoints, PLACEMENT)["mu_path"], rel=1e-12
+    )
 
 
 def test_a_numeric_branch_can_be_named(
@@ -152,16 +182,13 @@ def test_numeric_map_is_weighed_by_its_cost(
 
 @pytest.mark.parametrize("method", ["casadi", "scipy"])
 def test_numeric_optimize_is_weighed_by_its_cost(
-    client: TestClient,
-    panda: dict[str, Any],
-    erk_path: dict[str, Any],
-    waypoints: list[dict[str, Any]],
-    method: str,
+    client: TestClient, panda: dict[str, Any], erk_path: dict[str, Any], method: str
 ) -> None:
-    """The coarse map (casadi) or the differential evolution (scipy) would take minutes."""
+    """The coarse map (casadi) or even the smallest differential evolution (scipy, sized by
+    the family's cost) would take minutes on the ERK path."""
     body = {
         "robot": panda,
-        "path": erk_path if method == "casadi" else {"waypoints": waypoints},
+        "path": erk_path,
         "bounds": {"x": [-0.25, 0.25], "y": [0.25, 0.65], "yaw": [-3.14, 3.14]},
         "z": 0.1,
         "method": method,

@@ -17,6 +17,7 @@ from service.work import json_response, run_stoppable
 from solver.evaluate import evaluate_path
 from solver.exceptions import InvalidInputError
 from solver.feed import check_feed
+from solver.joint_path import evaluate_joint_path
 from solver.progress import Progress
 
 router = APIRouter(prefix="/evaluate", tags=["evaluate"], responses=ERROR_RESPONSES)
@@ -55,15 +56,29 @@ def _answer(body: EvaluateRequest, settings: Settings, *, png: bool) -> Response
     )
     robot = convert.robot_from_schema(body.robot)
     path = convert.path_of(body.path)
-    evaluation = evaluate_path(
-        robot,
-        convert.spun_poses(path, body.spins),
-        convert.placement_of(body.placement),
-        branch=convert.branch_of(body.ik.branch),
-        max_joint_step=body.ik.max_joint_step,
-        spin_mode=convert.spin_mode_of(body.spin_mode, path),
-        passes=path.passes,
-    )
+    poses, placement = convert.spun_poses(path, body.spins), convert.placement_of(body.placement)
+    spin_mode = convert.spin_mode_of(body.spin_mode, path)
+    if body.joint_path is not None:
+        if spin_mode != "fixed":
+            raise InvalidInputError("joint_path", "a joint path is evaluated in spin_mode fixed")
+        evaluation = evaluate_joint_path(
+            robot,
+            poses,
+            placement,
+            convert.joint_path_of(body.joint_path, robot),
+            max_joint_step=body.ik.max_joint_step,
+            passes=path.passes,
+        )
+    else:
+        evaluation = evaluate_path(
+            robot,
+            poses,
+            placement,
+            branch=convert.branch_of(body.ik.branch),
+            max_joint_step=body.ik.max_joint_step,
+            spin_mode=spin_mode,
+            passes=path.passes,
+        )
     feed = body.feed if body.feed is not None else path.feed
     if png:
         if evaluation.mu_path is None or evaluation.mu_path <= 0.0:
