@@ -268,6 +268,9 @@ def evaluate_response(
     )
 
 
+JOBS_HINT = "; POST /v1/jobs runs bigger maps"
+
+
 @dataclass(frozen=True)
 class MapGrid:
     """The grid values of a map request (m, m, rad)."""
@@ -304,7 +307,8 @@ def map_grid(grid: schemas.Grid, *, settings: Settings, n_waypoints: int, robot:
     size = f"{nx} x * {ny} y * {len(yaws)} yaw * {len(spins)} spin = {cells} placements"
     if cells > settings.max_map_cells:
         raise InvalidInputError(
-            "grid", f"{size}; the limit is {settings.max_map_cells} (DTF_MAX_MAP_CELLS)"
+            "grid",
+            f"{size}; the limit is {settings.max_map_cells} (DTF_MAX_MAP_CELLS){JOBS_HINT}",
         )
     poses = cells * n_waypoints
     family = require_family(robot)
@@ -315,7 +319,7 @@ def map_grid(grid: schemas.Grid, *, settings: Settings, n_waypoints: int, robot:
         raise InvalidInputError(
             "grid",
             f"{size} * {n_waypoints} waypoints = {poses} poses{weighed}; the limit is "
-            f"{settings.max_map_poses} (DTF_MAX_MAP_POSES)",
+            f"{settings.max_map_poses} (DTF_MAX_MAP_POSES){JOBS_HINT}",
         )
     return MapGrid(
         xs=grid_axis(grid.x.min, grid.x.max, grid.x.step, field="grid.x"),

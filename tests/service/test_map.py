@@ -127,11 +127,12 @@ def test_size_limit_names_the_limit_and_the_size(
     detail = response.json()["detail"][0]
     assert detail["loc"] == ["body", "grid"]
     assert "338 placements" in detail["msg"] and "limit is 100" in detail["msg"]
+    assert detail["msg"].endswith("POST /v1/jobs runs bigger maps")
     small = {"min": 0.0, "max": 0.8, "step": 0.1}
     response = client.post("/v1/map", json=map_body(path, x=small, y=small, yaw=0.0))
     detail = response.json()["detail"][0]
     assert "81 placements * 133 waypoints = 10773 poses" in detail["msg"]
-    assert "limit is 10000" in detail["msg"]
+    assert "limit is 10000" in detail["msg"] and "POST /v1/jobs" in detail["msg"]
 
 
 @pytest.mark.parametrize(

@@ -75,6 +75,7 @@ def _check_size(body: JobRequest, settings: Settings) -> None:
         except SolverError as error:  # the job limits stand in for the route's settings
             message = error.message.replace("DTF_MAX_MAP_CELLS", "DTF_MAX_JOB_CELLS")
             message = message.replace("DTF_MAX_MAP_POSES", "DTF_MAX_JOB_POSES")
+            message = message.removesuffix(convert.JOBS_HINT)
             raise InvalidInputError(f"request.{error.field}", message) from None
 
 
