@@ -4,9 +4,10 @@ from __future__ import annotations
 
 import functools
 import os
+from dataclasses import dataclass
 from pathlib import Path
 
-from pydantic import Field
+from pydantic import Field, PrivateAttr
 from pydantic_settings import BaseSettings, SettingsConfigDict
 
 
@@ -111,11 +112,44 @@ class Settings(BaseSettings):
         "max_map_poses; about 15 minutes on 2 cores).",
     )
 
+    _for_jobs: bool = PrivateAttr(default=False)
+
     def for_jobs(self) -> Settings:
         """These settings with the job limits in place of the synchronous routes' limits."""
-        return self.model_copy(
+        copy = self.model_copy(
             update={"max_map_cells": self.max_job_cells, "max_map_poses": self.max_job_poses}
         )
+        copy._for_jobs = True
+        return copy
+
+    def map_limits(self) -> MapLimits:
+        """The map size limits in force, named as their settings (a route's or a job's)."""
+        if self._for_jobs:
+            return MapLimits(
+                self.max_map_cells, self.max_map_poses, "DTF_MAX_JOB_CELLS", "DTF_MAX_JOB_POSES", ""
+            )
+        return MapLimits(
+            self.max_map_cells,
+            self.max_map_poses,
+            "DTF_MAX_MAP_CELLS",
+            "DTF_MAX_MAP_POSES",
+            "; POST /v1/jobs runs bigger maps",
+        )
+
+
+@dataclass(frozen=True)
+class MapLimits:
+    """Map size limits: placements and weighed placement-waypoint pairs, with their names.
+
+    Attributes:
+        hint: appended to a refusal (a route's points to /v1/jobs; a job's has none).
+    """
+
+    cells: int
+    poses: int
+    cells_setting: str
+    poses_setting: str
+    hint: str
 
 
 @functools.cache

@@ -268,9 +268,6 @@ def evaluate_response(
     )
 
 
-JOBS_HINT = "; POST /v1/jobs runs bigger maps"
-
-
 @dataclass(frozen=True)
 class MapGrid:
     """The grid values of a map request (m, m, rad)."""
@@ -305,21 +302,21 @@ def map_grid(grid: schemas.Grid, *, settings: Settings, n_waypoints: int, robot:
     yaws, spins = grid.yaws(), grid.spins()
     cells = nx * ny * len(yaws) * len(spins)
     size = f"{nx} x * {ny} y * {len(yaws)} yaw * {len(spins)} spin = {cells} placements"
-    if cells > settings.max_map_cells:
+    limits = settings.map_limits()
+    if cells > limits.cells:
         raise InvalidInputError(
-            "grid",
-            f"{size}; the limit is {settings.max_map_cells} (DTF_MAX_MAP_CELLS){JOBS_HINT}",
+            "grid", f"{size}; the limit is {limits.cells} ({limits.cells_setting}){limits.hint}"
         )
     poses = cells * n_waypoints
     family = require_family(robot)
     work = cells * family.path_cost(n_waypoints)
-    if work > settings.max_map_poses:
+    if work > limits.poses:
         weighed = "" if work == poses else f", as work {work:.4g} closed-form poses"
         weighed += "" if work == poses else f" ({family.name} IK)"
         raise InvalidInputError(
             "grid",
             f"{size} * {n_waypoints} waypoints = {poses} poses{weighed}; the limit is "
-            f"{settings.max_map_poses} (DTF_MAX_MAP_POSES){JOBS_HINT}",
+            f"{limits.poses} ({limits.poses_setting}){limits.hint}",
         )
     return MapGrid(
         xs=grid_axis(grid.x.min, grid.x.max, grid.x.step, field="grid.x"),

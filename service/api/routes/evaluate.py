@@ -12,13 +12,14 @@ from service.config import Settings
 from service.deps import SettingsDep
 from service.errors import ERROR_RESPONSES
 from service.render import render_joint_use
-from service.schemas import EvaluateRequest, EvaluateResponse
+from service.schemas import EvaluateRequest, EvaluateResponse, PathInput
 from service.work import json_response, run_stoppable
-from solver.evaluate import evaluate_path
+from solver.evaluate import PathEvaluation, evaluate_path
 from solver.exceptions import InvalidInputError
 from solver.feed import check_feed
 from solver.joint_path import evaluate_joint_path
 from solver.progress import Progress
+from solver.robots import Robot as SolverRobot
 
 router = APIRouter(prefix="/evaluate", tags=["evaluate"], responses=ERROR_RESPONSES)
 
@@ -49,8 +50,10 @@ async def post_evaluate(
     return await run_stoppable(request, lambda _: _answer(body, settings, png=png))
 
 
-def _answer(body: EvaluateRequest, settings: Settings, *, png: bool) -> Response:
-    """The JSON answer, or the PNG of joint use; the path's size checked first."""
+def _evaluated(
+    body: EvaluateRequest, settings: Settings
+) -> tuple[SolverRobot, PathInput, PathEvaluation, float | None]:
+    """The robot, the path, its evaluation and the feed to check; the path's size checked first."""
     convert.check_path_size(
         body.path, limit=settings.max_path_waypoints, setting="DTF_MAX_PATH_WAYPOINTS"
     )
@@ -80,33 +83,37 @@ def _answer(body: EvaluateRequest, settings: Settings, *, png: bool) -> Response
             passes=path.passes,
         )
     feed = body.feed if body.feed is not None else path.feed
-    if png:
-        if evaluation.mu_path is None or evaluation.mu_path <= 0.0:
-            raise InvalidInputError(
-                "placement",
-                f"the path does not run here ({evaluation.reason or 'mu_path is 0'}): no joint "
-                "speeds to draw; ask for JSON to see why",
-            )
-        check = check_feed(evaluation, evaluation.mu_path if feed is None else feed, robot.qdot_max)
-        picture = render_joint_use(check, evaluation, robot.joint_names, title=robot.name)
-        return Response(picture, media_type="image/png")
-    detail = body.detail or (
-        "waypoints" if body.path.n_waypoints() <= settings.max_detail_waypoints else "summary"
-    )
-    return json_response(
-        convert.evaluate_response(
-            evaluation,
-            robot,
-            axis_correction=path.axis_correction,
-            with_waypoints=detail == "waypoints",
-            feed=None if feed is None else check_feed(evaluation, feed, robot.qdot_max),
+    return robot, path, evaluation, feed
+
+
+def _answer(body: EvaluateRequest, settings: Settings, *, png: bool) -> Response:
+    """The JSON answer, or the PNG of joint use."""
+    if not png:
+        return json_response(evaluation_of(body, settings, lambda _: None))
+    robot, _, evaluation, feed = _evaluated(body, settings)
+    if evaluation.mu_path is None or evaluation.mu_path <= 0.0:
+        raise InvalidInputError(
+            "placement",
+            f"the path does not run here ({evaluation.reason or 'mu_path is 0'}): no joint "
+            "speeds to draw; ask for JSON to see why",
         )
-    )
+    check = check_feed(evaluation, evaluation.mu_path if feed is None else feed, robot.qdot_max)
+    picture = render_joint_use(check, evaluation, robot.joint_names, title=robot.name)
+    return Response(picture, media_type="image/png")
 
 
 def evaluation_of(
     body: EvaluateRequest, settings: Settings, progress: Progress
 ) -> EvaluateResponse:
     """The JSON answer of ``POST /v1/evaluate`` (an evaluate job's result too)."""
-    answer = _answer(body, settings, png=False)
-    return EvaluateResponse.model_validate_json(bytes(answer.body))
+    robot, path, evaluation, feed = _evaluated(body, settings)
+    detail = body.detail or (
+        "waypoints" if body.path.n_waypoints() <= settings.max_detail_waypoints else "summary"
+    )
+    return convert.evaluate_response(
+        evaluation,
+        robot,
+        axis_correction=path.axis_correction,
+        with_waypoints=detail == "waypoints",
+        feed=None if feed is None else check_feed(evaluation, feed, robot.qdot_max),
+    )

@@ -9,7 +9,7 @@ import anyio
 from fastapi import APIRouter, HTTPException, Query, Response, status
 from fastapi.responses import JSONResponse
 
-from service import convert
+from service.api.routes.map import checked_grid
 from service.config import Settings
 from service.deps import SettingsDep
 from service.errors import ERROR_RESPONSES
@@ -60,23 +60,12 @@ def job_info(job: Job, *, with_result: bool = True) -> JobInfo:
 def _check_size(body: JobRequest, settings: Settings) -> None:
     """A map job's size against the job limits, before it is queued (422 naming grid)."""
     if isinstance(body, MapJob):
-        request = body.request
-        convert.check_path_size(
-            request.path, limit=settings.max_path_waypoints, setting="DTF_MAX_PATH_WAYPOINTS"
-        )
-        robot = convert.robot_from_schema(request.robot)
         try:
-            convert.map_grid(
-                request.grid,
-                settings=settings.for_jobs(),
-                n_waypoints=request.path.n_waypoints(),
-                robot=robot,
-            )
-        except SolverError as error:  # the job limits stand in for the route's settings
-            message = error.message.replace("DTF_MAX_MAP_CELLS", "DTF_MAX_JOB_CELLS")
-            message = message.replace("DTF_MAX_MAP_POSES", "DTF_MAX_JOB_POSES")
-            message = message.removesuffix(convert.JOBS_HINT)
-            raise InvalidInputError(f"request.{error.field}", message) from None
+            checked_grid(body.request, settings.for_jobs())
+        except SolverError as error:  # the field is inside the job's request
+            raise InvalidInputError(
+                f"request.{error.field}", error.message, waypoint=error.waypoint
+            ) from None
 
 
 @router.post(

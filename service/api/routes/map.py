@@ -19,14 +19,17 @@ from service.work import json_response, run_stoppable
 from solver.capability_map import CapabilityMap, capability_map
 from solver.pipeline import SpinMode
 from solver.progress import Progress
+from solver.robots import Robot
 
 router = APIRouter(prefix="/map", tags=["maps"], responses=ERROR_RESPONSES)
 
 
-def _computed_map(
-    body: MapRequest, settings: Settings, *, png: bool, progress: Progress
-) -> tuple[CapabilityMap, str, SpinMode]:
-    """The map a request asks for, its size checked first; the robot's name; the spin mode."""
+def checked_grid(body: MapRequest, settings: Settings) -> tuple[Robot, convert.MapGrid]:
+    """The robot and the grid of a map request, its size checked against ``settings``.
+
+    Raises:
+        InvalidInputError: the path or the grid over a limit (the message names the setting).
+    """
     convert.check_path_size(
         body.path, limit=settings.max_path_waypoints, setting="DTF_MAX_PATH_WAYPOINTS"
     )
@@ -34,6 +37,14 @@ def _computed_map(
     grid = convert.map_grid(
         body.grid, settings=settings, n_waypoints=body.path.n_waypoints(), robot=robot
     )
+    return robot, grid
+
+
+def _computed_map(
+    body: MapRequest, settings: Settings, *, png: bool, progress: Progress
+) -> tuple[CapabilityMap, str, SpinMode]:
+    """The map a request asks for, its size checked first; the robot's name; the spin mode."""
+    robot, grid = checked_grid(body, settings)
     if png:
         convert.check_png_size(grid, settings=settings)
     path = convert.path_of(body.path)
