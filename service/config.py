@@ -64,6 +64,12 @@ class Settings(BaseSettings):
         description="Up to this many waypoints /v1/evaluate answers every waypoint's detail by "
         "default; beyond it, the summary unless the request asks for detail: waypoints.",
     )
+    threads: int = Field(
+        default_factory=lambda: os.cpu_count() or 1,
+        gt=0,
+        description="Threads one /v1/map request computes its placements on (default: the "
+        "number of cores).",
+    )
     max_png_panels: int = Field(
         default=24,
         gt=0,
@@ -84,6 +90,11 @@ class Settings(BaseSettings):
         default_factory=lambda: os.cpu_count() or 1,
         gt=0,
         description="Processes that run jobs (default: the number of cores).",
+    )
+    dask_scheduler: str | None = Field(
+        default=None,
+        description="The address of a Dask scheduler (tcp://host:8786) on whose workers the "
+        "jobs' placement tasks run; unset, they run in the local worker processes.",
     )
     max_queued_jobs: int = Field(
         default=100,

@@ -14,6 +14,7 @@ import numpy as np
 
 from solver.exceptions import InvalidInputError
 from solver.families.base import Branch
+from solver.parallel import SERIAL, TaskRunner
 from solver.pipeline import DEFAULT_MAX_JOINT_STEP, SpinMode
 from solver.placements import DEFAULT_CHUNK, evaluate_placements, prepare_path
 from solver.robots import Robot
@@ -121,6 +122,7 @@ def capability_map(
     chunk: int = DEFAULT_CHUNK,
     progress: Callable[[float], None] | None = None,
     passes: Sequence[tuple[int, int]] | None = None,
+    runner: TaskRunner = SERIAL,
 ) -> CapabilityMap:
     """mu_path over the grid spins x yaws x ys x xs at height z (spec section 6).
 
@@ -136,9 +138,11 @@ def capability_map(
         max_joint_step: rad, > 0.
         spin_mode: ``fixed`` or ``free`` (the tool spin rate free, cam.md section 2).
         chunk: placements computed together.
-        progress: called with the fraction done (0..1] after each chunk.
+        progress: called with the fraction done (0..1] as the work goes; it may raise
+            :class:`solver.progress.Cancelled` to stop it.
         passes: index ranges [start, stop) of the passes of a CAM program (cam.md section
             5); None: one pass.
+        runner: where the placements' tasks run (:mod:`solver.parallel`); same answer on any.
 
     Raises:
         NoAnalyticIkError, InvalidInputError, RepeatedWaypointError: as ``evaluate_path``.
@@ -166,6 +170,7 @@ def capability_map(
         spin_mode=spin_mode,
         chunk=chunk,
         progress=progress,
+        runner=runner,
     )
     return CapabilityMap(
         xs=xs,

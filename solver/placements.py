@@ -9,11 +9,13 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass
+from functools import partial
 
 import numpy as np
 
 from solver._malloc import raise_malloc_thresholds
 from solver.families.base import Branch
+from solver.parallel import SERIAL, TaskRunner
 from solver.pipeline import (
     DEFAULT_MAX_JOINT_STEP,
     PreparedPath,
@@ -82,6 +84,37 @@ def _chunk(
     )
 
 
+def _task(
+    robot: Robot,
+    path: PreparedPath,
+    branches: np.ndarray,
+    max_joint_step: float,
+    spin_mode: SpinMode,
+    chunk: int,
+    placements: np.ndarray,
+) -> tuple[np.ndarray, ...]:
+    """Evaluate a task's placements in chunks: the columns of :func:`_chunk`, concatenated."""
+    parts = [
+        _chunk(robot, path, rows, branches, max_joint_step, spin_mode)
+        for rows in _pieces(placements, chunk)
+    ]
+    return tuple(np.concatenate(c) for c in zip(*parts, strict=True))
+
+
+def _pieces(placements: np.ndarray, size: int) -> list[np.ndarray]:
+    """Consecutive rows, at most ``size``, cut where the yaw or the spin changes.
+
+    A grid's yaw-major order gives pieces of one yaw each, which are cheaper; a chunk of the
+    pipeline has one spin.
+    """
+    cuts = np.flatnonzero(np.any(np.diff(placements[:, 3:5], axis=0) != 0.0, axis=1)) + 1
+    return [
+        run[start : start + size]
+        for run in np.split(placements, cuts)
+        for start in range(0, len(run), size)
+    ]
+
+
 def evaluate_placements(
     robot: Robot,
     path: PreparedPath,
@@ -93,6 +126,7 @@ def evaluate_placements(
     with_speeds: bool = False,
     chunk: int = DEFAULT_CHUNK,
     progress: Callable[[float], None] | None = None,
+    runner: TaskRunner = SERIAL,
 ) -> PlacementResults:
     """mu_path of a path at each of P placements.
 
@@ -107,7 +141,9 @@ def evaluate_placements(
         max_joint_step: rad, > 0.
         with_speeds: also return V_max at every waypoint.
         chunk: placements computed together.
-        progress: called with the fraction done (0..1] after each chunk.
+        progress: called with the fraction done (0..1] as tasks complete; it may raise
+            (:class:`solver.progress.Cancelled`) to stop the work.
+        runner: runs the tasks (:mod:`solver.parallel`); every runner gives the same answer.
 
     Raises:
         NoAnalyticIkError, InvalidInputError: as :func:`solver.evaluate.evaluate_path`.
@@ -115,16 +151,16 @@ def evaluate_placements(
     branches = branch_indices(robot, branch, max_joint_step=max_joint_step, spin_mode=spin_mode)
     cells = check_placements(placements)
     raise_malloc_thresholds()
-    # Chunks of consecutive placements, cut where the yaw or the spin changes (a grid's
-    # yaw-major order gives chunks of one yaw each, which are cheaper; a chunk has one spin).
-    cuts = np.flatnonzero(np.any(np.diff(cells[:, 3:5], axis=0) != 0.0, axis=1)) + 1
-    parts = []
-    for run in np.split(np.arange(len(cells)), cuts):
-        for start in range(0, len(run), chunk):
-            rows = run[start : start + chunk]
-            parts.append(_chunk(robot, path, cells[rows], branches, max_joint_step, spin_mode))
-            if progress is not None:
-                progress((rows[-1] + 1) / len(cells))
+    tasks = _pieces(cells, runner.task_size(len(cells), chunk))
+    completed = [0]
+
+    def done(i: int) -> None:
+        completed[0] += len(tasks[i])
+        if progress is not None:
+            progress(completed[0] / len(cells))
+
+    work = partial(_task, robot, path, branches, max_joint_step, spin_mode, chunk)
+    parts = runner.run(work, tasks, done)
     empty = (np.zeros(0), *(np.zeros(0, dtype=int),) * 5, np.zeros((0, path.n_waypoints)))
     columns = [np.concatenate(c) for c in zip(*parts, strict=True)] if parts else list(empty)
     mu, reason, failed, chosen, bottleneck_waypoint, bottleneck_joint, v_max = columns

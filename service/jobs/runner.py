@@ -1,136 +1,159 @@
-"""Jobs run in a local process pool, outside the web process (api.md "Jobs").
+"""The job runner of one service: worker processes fed from the store, watched by a thread.
 
-A worker process takes a job id, reads the job from the store, runs the route's own code with
-the job limits (``Settings.for_jobs``), reports progress to the store (at most every 0.2 s) and
-stops at its next report once a cancel is stored. The web process only submits ids, so
-``/healthz`` and small requests stay fast while jobs run.
+Jobs wait in the store (``service.jobs.store``), which is the queue: a supervisor thread in the
+web process hands the oldest queued job to an idle worker process (``service.jobs.worker``).
+It also watches the running ones: a worker that has not stopped a cancelled job within
+``KILL_AFTER`` seconds is killed and replaced, so a cancel stops the work within a second even
+inside a long solver step, and a worker that dies fails its job instead of hanging it.
 """
 
 from __future__ import annotations
 
 import multiprocessing
+import threading
 import time
 from collections.abc import Callable
-from concurrent.futures import Future, ProcessPoolExecutor
+from dataclasses import dataclass
+from multiprocessing.connection import Connection
+from multiprocessing.process import BaseProcess
 from pathlib import Path
-from typing import Any
-
-from pydantic import ValidationError
 
 from service.config import Settings
-from service.errors import request_location, solver_error_location
 from service.jobs.store import JobStore
-from service.metrics import log, log_to_stderr
-from solver.exceptions import SolverError
-from solver.progress import Cancelled, Progress
+from service.jobs.worker import serve
+from service.metrics import log
 
-REPORT_SECONDS = 0.2
-"""How often a running job writes its progress (and reads a cancel) at most (s)."""
+POLL_SECONDS = 0.05
+"""How often the supervisor looks at the workers and the queue (s)."""
 
-Work = Callable[[dict[str, Any], Settings, Progress], dict[str, Any]]
-
-
-def _map(request: dict[str, Any], settings: Settings, progress: Progress) -> dict[str, Any]:
-    from service.api.routes.map import map_of
-    from service.schemas import MapRequest
-
-    return map_of(MapRequest.model_validate(request), settings, progress).model_dump(mode="json")
+KILL_AFTER = 0.5
+"""How long a worker has to stop a cancelled job before it is killed and replaced (s)."""
 
 
-def _optimize(request: dict[str, Any], settings: Settings, progress: Progress) -> dict[str, Any]:
-    from service.api.routes.optimize import optimum_of
-    from service.schemas import OptimizeRequest
+@dataclass
+class _Worker:
+    """A worker process, the end of its pipe in the web process, and the job it runs."""
 
-    body = OptimizeRequest.model_validate(request)
-    return optimum_of(body, settings, progress).model_dump(mode="json")
-
-
-def _evaluate(request: dict[str, Any], settings: Settings, progress: Progress) -> dict[str, Any]:
-    from service.api.routes.evaluate import evaluation_of
-    from service.schemas import EvaluateRequest
-
-    body = EvaluateRequest.model_validate(request)
-    return evaluation_of(body, settings, progress).model_dump(mode="json")
-
-
-KINDS: dict[str, Work] = {"map": _map, "optimize": _optimize, "evaluate": _evaluate}
-"""The work of each job kind: the route's own code, its answer as JSON."""
-
-
-def run_job(store_path: str, job_id: str, settings_json: str) -> None:
-    """Run one job to its end, in a worker process; every outcome is written to the store."""
-    log_to_stderr()
-    store = JobStore(Path(store_path))
-    if not store.start(job_id):
-        return  # cancelled while queued, or taken by another worker
-    log.info("job %s running", job_id)
-    job = store.get(job_id)
-    if job is None:
-        return
-    settings = Settings.model_validate_json(settings_json).for_jobs()
-    last = [time.monotonic()]
-
-    def progress(fraction: float) -> None:
-        now = time.monotonic()
-        if now - last[0] >= REPORT_SECONDS:
-            last[0] = now
-            if store.progress(job_id, fraction):
-                raise Cancelled
-
-    try:
-        result = KINDS[job.kind](job.request, settings, progress)
-    except Cancelled:
-        store.finish(job_id, "cancelled")
-        log.info("job %s cancelled", job_id)
-    except SolverError as error:
-        loc = solver_error_location(error)
-        detail = {"loc": loc, "msg": error.message, "type": "invalid_input"}
-        store.finish(job_id, "failed", error=[detail])
-        log.info("job %s failed: %s", job_id, error.message[:200])
-    except ValidationError as error:
-        details = [
-            {"loc": request_location(("body", *e["loc"])), "msg": e["msg"], "type": e["type"]}
-            for e in error.errors()
-        ]
-        store.finish(job_id, "failed", error=details)
-        log.info("job %s failed: invalid request", job_id)
-    except Exception as error:  # noqa: BLE001 - a job must end with a status, whatever happens
-        detail = {"loc": [], "msg": f"internal error: {type(error).__name__}", "type": "internal"}
-        store.finish(job_id, "failed", error=[detail])
-        log.exception("job %s failed", job_id)
-    else:
-        store.finish(job_id, "done", result=result)
-        log.info("job %s done", job_id)
+    process: BaseProcess
+    connection: Connection
+    job_id: str | None = None
+    cancel_seen: float | None = None
 
 
 class JobRunner:
-    """The store and the process pool of one service."""
+    """The store and the worker processes of one service."""
 
-    def __init__(self, settings: Settings) -> None:
-        """Open the store under the data directory and start the pool (spawned processes)."""
+    def __init__(self, settings: Settings, *, worker: Callable[..., None] = serve) -> None:
+        """Open the store under the data directory, start the workers and their supervisor.
+
+        Args:
+            settings: the service's settings (data directory, workers, limits).
+            worker: a worker process's life, ``serve`` (another one only in tests).
+        """
         self.settings = settings
+        self._worker = worker
         self.store = JobStore(Path(settings.data_dir) / "jobs.sqlite3")
-        self._pool = ProcessPoolExecutor(
-            max_workers=settings.workers, mp_context=multiprocessing.get_context("spawn")
-        )
+        self._context = multiprocessing.get_context("spawn")
+        self._workers = [self._start_worker() for _ in range(settings.workers)]
+        self._wake = threading.Event()
+        self._stop = threading.Event()
+        self._thread = threading.Thread(target=self._supervise, name="dtf-jobs", daemon=True)
+        self._thread.start()
 
-    def submit(self, job_id: str) -> Future[None]:
-        """Run a stored job in the pool."""
-        return self._pool.submit(
-            run_job, str(self.store.path), job_id, self.settings.model_dump_json()
+    def _start_worker(self) -> _Worker:
+        ours, theirs = self._context.Pipe()
+        process = self._context.Process(
+            target=self._worker,
+            args=(theirs, str(self.store.path), self.settings.model_dump_json()),
+            name="dtf-job-worker",
+            daemon=True,
         )
+        process.start()
+        theirs.close()
+        return _Worker(process, ours)
+
+    def submit(self, job_id: str) -> None:
+        """A job was queued in the store: look for an idle worker now."""
+        self._wake.set()
 
     def recover(self) -> list[str]:
-        """Forget expired jobs, then queue again and run every job a restart interrupted."""
+        """Forget expired jobs, then queue again every job a restart interrupted.
+
+        Returns:
+            The ids queued, oldest first; they run as workers become idle.
+        """
         self.store.expire(ttl=self.settings.job_ttl)
         ids = self.store.recover(attempts=self.settings.job_attempts)
-        for job_id in ids:
-            self.submit(job_id)
+        self._wake.set()
         return ids
 
+    def _supervise(self) -> None:
+        while not self._stop.is_set():
+            self._wake.wait(POLL_SECONDS)
+            self._wake.clear()
+            try:
+                self._watch()
+                self._dispatch()
+            except Exception:  # noqa: BLE001 - the supervisor must outlive any one failure
+                log.exception("job supervisor")
+
+    def _watch(self) -> None:
+        """Free the workers whose job ended; kill those that do not stop a cancelled job."""
+        busy = [w for w in self._workers if w.job_id is not None]
+        cancels = self.store.cancel_asked([w.job_id for w in busy if w.job_id is not None])
+        now = time.monotonic()
+        for i, worker in enumerate(self._workers):
+            job_id = worker.job_id
+            if job_id is None:
+                continue
+            if worker.connection.poll():
+                try:
+                    worker.connection.recv()
+                except (EOFError, OSError):
+                    pass  # died as it answered: handled below
+                else:
+                    self._workers[i] = _Worker(worker.process, worker.connection)
+                    continue
+            if not worker.process.is_alive():
+                message = f"the worker process ended (exit code {worker.process.exitcode})"
+                error = [{"loc": [], "msg": message, "type": "internal"}]
+                self.store.finish(job_id, "failed", error=error, if_running=True)
+                log.error("job %s failed: %s", job_id, message)
+                self._replace(i)
+            elif job_id in cancels:
+                worker.cancel_seen = worker.cancel_seen or now
+                if now - worker.cancel_seen >= KILL_AFTER:
+                    worker.process.kill()
+                    worker.process.join()
+                    self.store.finish(job_id, "cancelled", if_running=True)
+                    log.info("job %s cancelled (its worker was stopped)", job_id)
+                    self._replace(i)
+
+    def _replace(self, i: int) -> None:
+        self._workers[i].connection.close()
+        self._workers[i] = self._start_worker()
+
+    def _dispatch(self) -> None:
+        """Hand the oldest queued jobs to the idle workers."""
+        idle = [w for w in self._workers if w.job_id is None]
+        if not idle:
+            return
+        taken = {w.job_id for w in self._workers if w.job_id is not None}
+        queued = self.store.queued(exclude=taken, limit=len(idle))
+        for worker, job_id in zip(idle[: len(queued)], queued, strict=True):
+            worker.job_id, worker.cancel_seen = job_id, None
+            worker.connection.send(job_id)
+
     def close(self) -> None:
-        """Stop the pool without waiting (unfinished jobs run again after a restart)."""
-        self._pool.shutdown(wait=False, cancel_futures=True)
+        """Stop the supervisor and the workers (unfinished jobs run again after a restart)."""
+        self._stop.set()
+        self._wake.set()
+        self._thread.join(timeout=5)
+        for worker in self._workers:
+            worker.process.kill()
+        for worker in self._workers:
+            worker.process.join(timeout=5)
+            worker.connection.close()
 
 
 _RUNNERS: dict[str, JobRunner] = {}
@@ -145,7 +168,7 @@ def get_runner(settings: Settings) -> JobRunner:
 
 
 def close_runners() -> None:
-    """Stop every runner's pool (the service is shutting down)."""
+    """Stop every runner (the service is shutting down)."""
     for runner in _RUNNERS.values():
         runner.close()
     _RUNNERS.clear()

@@ -143,12 +143,14 @@ class JobStore:
         *,
         result: dict[str, Any] | None = None,
         error: list[dict[str, Any]] | None = None,
+        if_running: bool = False,
     ) -> None:
-        """Record how a job ended."""
+        """Record how a job ended (with ``if_running``, only if it is still running)."""
+        condition = " AND status = 'running'" if if_running else ""
         with self._connection() as db:
             db.execute(
                 "UPDATE jobs SET status = ?, result = ?, error = ?, finished = ?, "
-                "done = CASE WHEN ? = 'done' THEN 1 ELSE done END WHERE id = ?",
+                "done = CASE WHEN ? = 'done' THEN 1 ELSE done END WHERE id = ?" + condition,
                 (
                     status,
                     None if result is None else json.dumps(result),
@@ -159,10 +161,37 @@ class JobStore:
                 ),
             )
 
-    def cancel(self, job_id: str) -> None:
-        """Ask a job to stop: a queued one is cancelled now, a running one at its next report."""
+    def queued(self, *, exclude: set[str], limit: int) -> list[str]:
+        """The ids of the oldest queued jobs not in ``exclude``, at most ``limit``."""
         with self._connection() as db:
-            db.execute("UPDATE jobs SET cancel = 1 WHERE id = ?", (job_id,))
+            rows = db.execute(
+                "SELECT id FROM jobs WHERE status = 'queued' AND cancel = 0 ORDER BY created "
+                "LIMIT ?",
+                (limit + len(exclude),),
+            ).fetchall()
+        return [row[0] for row in rows if row[0] not in exclude][:limit]
+
+    def cancel_asked(self, ids: list[str]) -> set[str]:
+        """Those of ``ids`` whose cancel has been asked for."""
+        if not ids:
+            return set()
+        marks = ", ".join("?" * len(ids))
+        with self._connection() as db:
+            rows = db.execute(
+                f"SELECT id FROM jobs WHERE cancel = 1 AND id IN ({marks})", ids
+            ).fetchall()
+        return {row[0] for row in rows}
+
+    def cancel(self, job_id: str) -> None:
+        """Ask a job to stop: a queued one is cancelled now, a running one soon after.
+
+        A finished job is left as it is.
+        """
+        with self._connection() as db:
+            db.execute(
+                "UPDATE jobs SET cancel = 1 WHERE id = ? AND status IN ('queued', 'running')",
+                (job_id,),
+            )
             db.execute(
                 "UPDATE jobs SET status = 'cancelled', finished = ? WHERE id = ? AND "
                 "status = 'queued'",

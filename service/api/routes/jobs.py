@@ -4,9 +4,10 @@ from __future__ import annotations
 
 import time
 from typing import Annotated, Any
+from uuid import UUID
 
 import anyio
-from fastapi import APIRouter, HTTPException, Query, Response, status
+from fastapi import APIRouter, HTTPException, Path, Query, Response, status
 from fastapi.responses import JSONResponse
 
 from service.api.routes.map import checked_grid
@@ -21,6 +22,8 @@ from service.schemas.jobs import JobInfo, JobList, JobProgress, JobRequest, JobS
 from solver.exceptions import InvalidInputError, SolverError
 
 router = APIRouter(prefix="/jobs", tags=["jobs"], responses=ERROR_RESPONSES)
+
+JobId = Annotated[UUID, Path(description="The job's id, as POST /v1/jobs answered it.")]
 
 NOT_FOUND: dict[int | str, dict[str, Any]] = {
     404: {"description": "No job has this id (or it expired)."}
@@ -114,11 +117,11 @@ def get_jobs(
 @router.get(
     "/{job_id}", operation_id="get_job", summary="A job's status and result", responses=NOT_FOUND
 )
-def get_job(job_id: str, settings: SettingsDep) -> JobInfo:
+def get_job(job_id: JobId, settings: SettingsDep) -> JobInfo:
     """Status, progress with ETA, times, and the route's answer once done (or the error)."""
-    job = get_runner(settings).store.get(job_id)
+    job = get_runner(settings).store.get(str(job_id))
     if job is None:
-        raise HTTPException(status.HTTP_404_NOT_FOUND, f"no job {job_id[:100]!r}")
+        raise HTTPException(status.HTTP_404_NOT_FOUND, f"no job {str(job_id)!r}")
     return job_info(job)
 
 
@@ -129,11 +132,15 @@ def get_job(job_id: str, settings: SettingsDep) -> JobInfo:
     status_code=status.HTTP_204_NO_CONTENT,
     responses=NOT_FOUND,
 )
-def delete_job(job_id: str, settings: SettingsDep) -> Response:
-    """A queued job is cancelled now; a running one stops at its next progress report."""
+def delete_job(job_id: JobId, settings: SettingsDep) -> Response:
+    """A queued job is cancelled now; a running one stops within a second.
+
+    A finished job is left as it is.
+    """
     store = get_runner(settings).store
-    if store.get(job_id) is None:
-        raise HTTPException(status.HTTP_404_NOT_FOUND, f"no job {job_id[:100]!r}")
-    store.cancel(job_id)
+    if store.get(str(job_id)) is None:
+        raise HTTPException(status.HTTP_404_NOT_FOUND, f"no job {str(job_id)!r}")
+    store.cancel(str(job_id))
+    get_runner(settings).submit(str(job_id))  # the supervisor looks at once
     log.info("job %s cancel asked", job_id)
     return Response(status_code=status.HTTP_204_NO_CONTENT)

@@ -17,6 +17,7 @@ from service.render import render_png
 from service.schemas import MapRequest, MapResponse
 from service.work import json_response, run_stoppable
 from solver.capability_map import CapabilityMap, capability_map
+from solver.parallel import TaskRunner, ThreadRunner
 from solver.pipeline import SpinMode
 from solver.progress import Progress
 from solver.robots import Robot
@@ -41,9 +42,17 @@ def checked_grid(body: MapRequest, settings: Settings) -> tuple[Robot, convert.M
 
 
 def _computed_map(
-    body: MapRequest, settings: Settings, *, png: bool, progress: Progress
+    body: MapRequest,
+    settings: Settings,
+    *,
+    png: bool,
+    progress: Progress,
+    runner: TaskRunner | None = None,
 ) -> tuple[CapabilityMap, str, SpinMode]:
-    """The map a request asks for, its size checked first; the robot's name; the spin mode."""
+    """The map a request asks for, its size checked first; the robot's name; the spin mode.
+
+    The placements run on ``runner``, by default on DTF_THREADS threads.
+    """
     robot, grid = checked_grid(body, settings)
     if png:
         convert.check_png_size(grid, settings=settings)
@@ -62,14 +71,19 @@ def _computed_map(
         spin_mode=spin_mode,
         progress=progress,
         passes=path.passes,
+        runner=ThreadRunner(settings.threads) if runner is None else runner,
     )
     PLACEMENTS.inc(result.mu_path.size)
     return result, robot.name, spin_mode
 
 
-def map_of(body: MapRequest, settings: Settings, progress: Progress) -> MapResponse:
-    """The JSON answer of ``POST /v1/map`` (a map job's result too)."""
-    result, _, spin_mode = _computed_map(body, settings, png=False, progress=progress)
+def map_of(
+    body: MapRequest, settings: Settings, progress: Progress, runner: TaskRunner | None = None
+) -> MapResponse:
+    """The JSON answer of ``POST /v1/map`` (a map job's result too, its tasks on ``runner``)."""
+    result, _, spin_mode = _computed_map(
+        body, settings, png=False, progress=progress, runner=runner
+    )
     return convert.map_response(result, spin_mode=spin_mode)
 
 

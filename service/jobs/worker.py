@@ -1,0 +1,161 @@
+"""A job worker: a process of its own that runs the jobs the service hands it, one at a time.
+
+A worker takes a job id, reads the job from the store, runs the route's own code with the job
+limits (``Settings.for_jobs``), writes progress to the store (at most every 0.2 s) and stops at
+its next report once a cancel is stored. Workers run at a lower CPU priority than the web
+process, so ``/healthz`` and small requests stay fast while jobs run.
+"""
+
+from __future__ import annotations
+
+import ctypes
+import ctypes.util
+import functools
+import os
+import signal
+import sys
+import time
+from collections.abc import Callable
+from multiprocessing.connection import Connection
+from pathlib import Path
+from typing import Any
+
+from pydantic import ValidationError
+
+from service.config import Settings
+from service.errors import request_location, solver_error_location
+from service.jobs.store import JobStore
+from service.metrics import log, log_to_stderr
+from solver.exceptions import SolverError
+from solver.parallel import TaskRunner, ThreadRunner
+from solver.progress import Cancelled, Progress
+
+REPORT_SECONDS = 0.2
+"""How often a running job writes its progress (and reads a cancel) at most (s)."""
+
+PR_SET_PDEATHSIG = 1
+"""Linux ``prctl`` option: the signal a process gets when its parent dies."""
+
+NICENESS = 10
+"""How much lower than the web process's a worker's CPU priority is (``os.nice``)."""
+
+Work = Callable[[dict[str, Any], Settings, Progress, TaskRunner], dict[str, Any]]
+
+
+def _map(
+    request: dict[str, Any], settings: Settings, progress: Progress, runner: TaskRunner
+) -> dict[str, Any]:
+    from service.api.routes.map import map_of
+    from service.schemas import MapRequest
+
+    body = MapRequest.model_validate(request)
+    return map_of(body, settings, progress, runner=runner).model_dump(mode="json")
+
+
+def _optimize(
+    request: dict[str, Any], settings: Settings, progress: Progress, runner: TaskRunner
+) -> dict[str, Any]:
+    from service.api.routes.optimize import optimum_of
+    from service.schemas import OptimizeRequest
+
+    body = OptimizeRequest.model_validate(request)
+    return optimum_of(body, settings, progress).model_dump(mode="json")
+
+
+def _evaluate(
+    request: dict[str, Any], settings: Settings, progress: Progress, runner: TaskRunner
+) -> dict[str, Any]:
+    from service.api.routes.evaluate import evaluation_of
+    from service.schemas import EvaluateRequest
+
+    body = EvaluateRequest.model_validate(request)
+    return evaluation_of(body, settings, progress).model_dump(mode="json")
+
+
+KINDS: dict[str, Work] = {"map": _map, "optimize": _optimize, "evaluate": _evaluate}
+"""The work of each job kind: the route's own code, its answer as JSON."""
+
+
+@functools.cache
+def task_runner(dask_scheduler: str | None, workers: int) -> TaskRunner:
+    """Where a job's placement tasks run: the Dask cluster when one is set, else local threads.
+
+    Args:
+        dask_scheduler: the scheduler's address (DTF_DASK_SCHEDULER), or None.
+        workers: the local job processes (DTF_WORKERS); each gets cores / workers threads.
+    """
+    if dask_scheduler is not None:
+        from service.jobs.dask_runner import DaskRunner
+
+        return DaskRunner(dask_scheduler)
+    return ThreadRunner(max(1, (os.cpu_count() or 1) // workers))
+
+
+def run_job(store: JobStore, job_id: str, settings: Settings) -> None:
+    """Run one job to its end; every outcome is written to the store."""
+    if not store.start(job_id):
+        return  # cancelled while queued, or taken by another worker
+    log.info("job %s running", job_id)
+    job = store.get(job_id)
+    if job is None:
+        return
+    last = [time.monotonic()]
+
+    def progress(fraction: float) -> None:
+        now = time.monotonic()
+        if now - last[0] >= REPORT_SECONDS:
+            last[0] = now
+            if store.progress(job_id, fraction):
+                raise Cancelled
+
+    try:
+        runner = task_runner(settings.dask_scheduler, settings.workers)
+        result = KINDS[job.kind](job.request, settings.for_jobs(), progress, runner)
+    except Cancelled:
+        store.finish(job_id, "cancelled")
+        log.info("job %s cancelled", job_id)
+    except SolverError as error:
+        loc = solver_error_location(error)
+        detail = {"loc": loc, "msg": error.message, "type": "invalid_input"}
+        store.finish(job_id, "failed", error=[detail])
+        log.info("job %s failed: %s", job_id, error.message[:200])
+    except ValidationError as error:
+        details = [
+            {"loc": request_location(("body", *e["loc"])), "msg": e["msg"], "type": e["type"]}
+            for e in error.errors()
+        ]
+        store.finish(job_id, "failed", error=details)
+        log.info("job %s failed: invalid request", job_id)
+    except Exception as error:  # noqa: BLE001 - a job must end with a status, whatever happens
+        message = f"internal error: {type(error).__name__}: {str(error)[:500]}"
+        store.finish(job_id, "failed", error=[{"loc": [], "msg": message, "type": "internal"}])
+        log.exception("job %s failed", job_id)
+    else:
+        store.finish(job_id, "done", result=result)
+        log.info("job %s done", job_id)
+
+
+def _die_with_the_service() -> None:
+    """Have Linux kill this worker when the service dies, even by SIGKILL.
+
+    No orphan worker then goes on with a job that the restarted service runs again.
+    """
+    if sys.platform.startswith("linux"):
+        libc = ctypes.CDLL(ctypes.util.find_library("c"), use_errno=True)
+        libc.prctl(PR_SET_PDEATHSIG, signal.SIGKILL)
+
+
+def serve(connection: Connection, store_path: str, settings_json: str) -> None:
+    """A worker process's life: run each job id received, answer it back when it has ended."""
+    _die_with_the_service()
+    os.nice(NICENESS)
+    log_to_stderr()
+    store = JobStore(Path(store_path))
+    settings = Settings.model_validate_json(settings_json)
+    while True:
+        try:
+            job_id = connection.recv()
+        except (EOFError, OSError):
+            return  # the service has gone
+        run_job(store, job_id, settings)
+        connection.send(job_id)

@@ -1,0 +1,113 @@
+"""The job runner without HTTP: failures end as ``failed``, a stuck or dead worker is replaced."""
+
+from __future__ import annotations
+
+import json
+import time
+from collections.abc import Callable, Iterator
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+from service.config import Settings
+from service.jobs import worker
+from service.jobs.runner import KILL_AFTER, JobRunner
+from service.jobs.store import Job, JobStore
+from tests.cases import ROOT
+from tests.service.jobs_workers import stuck
+
+EXAMPLE = json.loads((ROOT / "examples" / "evaluate_request.json").read_text())
+EVALUATE = {k: EXAMPLE[k] for k in ("robot", "path", "placement")}
+BIG_MAP = {  # 40,000 placements: far longer than the test
+    "robot": EXAMPLE["robot"],
+    "path": EXAMPLE["path"],
+    "grid": {
+        "x": {"min": -0.5, "max": 0.5, "step": 0.005},
+        "y": {"min": 0.0, "max": 1.0, "step": 0.005},
+        "z": 0.1,
+        "yaw": 0.0,
+    },
+}
+
+
+def settings(tmp_path: Path, **values: Any) -> Settings:
+    limits = {"max_job_cells": 10**6, "max_job_poses": 10**9}
+    return Settings(data_dir=tmp_path, workers=1, **limits, **values)
+
+
+def wait_for(store: JobStore, job_id: str, done: Callable[[Job], bool]) -> Job:
+    deadline = time.monotonic() + 30
+    while True:
+        job = store.get(job_id)
+        assert job is not None
+        if done(job) or time.monotonic() > deadline:
+            return job
+        time.sleep(0.02)
+
+
+@pytest.fixture
+def runner(tmp_path: Path) -> Iterator[JobRunner]:
+    runner = JobRunner(settings(tmp_path))
+    yield runner
+    runner.close()
+
+
+def test_an_unexpected_exception_fails_the_job_with_its_message(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    def broken(*args: object) -> dict[str, Any]:
+        raise ZeroDivisionError("a bug")
+
+    monkeypatch.setitem(worker.KINDS, "evaluate", broken)
+    store = JobStore(tmp_path / "jobs.sqlite3")
+    job = store.create("evaluate", EVALUATE)
+    worker.run_job(store, job.id, settings(tmp_path))
+    failed = store.get(job.id)
+    assert failed is not None and failed.status == "failed"
+    assert failed.error == [
+        {"loc": [], "msg": "internal error: ZeroDivisionError: a bug", "type": "internal"}
+    ]
+
+
+def test_a_dead_worker_fails_its_job_and_is_replaced(runner: JobRunner) -> None:
+    job = runner.store.create("map", BIG_MAP)
+    runner.submit(job.id)
+    wait_for(runner.store, job.id, lambda j: j.status != "queued")
+    runner._workers[0].process.kill()
+    failed = wait_for(runner.store, job.id, lambda j: j.status != "running")
+    assert failed.status == "failed" and failed.error is not None
+    assert "the worker process ended" in failed.error[0]["msg"]
+    second = runner.store.create("evaluate", EVALUATE)
+    runner.submit(second.id)
+    assert wait_for(runner.store, second.id, lambda j: j.status == "done").status == "done"
+
+
+def test_a_worker_that_ignores_a_cancel_is_killed_and_replaced(tmp_path: Path) -> None:
+    runner = JobRunner(settings(tmp_path), worker=stuck)
+    try:
+        job = runner.store.create("evaluate", EVALUATE)
+        runner.submit(job.id)
+        wait_for(runner.store, job.id, lambda j: j.status == "running")
+        process = runner._workers[0].process
+        runner.store.cancel(job.id)
+        asked = time.monotonic()
+        cancelled = wait_for(runner.store, job.id, lambda j: j.status != "running")
+        assert cancelled.status == "cancelled"
+        assert KILL_AFTER <= time.monotonic() - asked < 1.0
+        assert not process.is_alive()
+        deadline = time.monotonic() + 5
+        while runner._workers[0].process is process and time.monotonic() < deadline:
+            time.sleep(0.01)
+        assert runner._workers[0].process is not process  # replaced
+    finally:
+        runner.close()
+
+
+def test_jobs_run_in_the_order_they_were_queued(runner: JobRunner) -> None:
+    ids = [runner.store.create("evaluate", EVALUATE).id for _ in range(3)]
+    runner.submit(ids[0])
+    jobs = [wait_for(runner.store, i, lambda j: j.status == "done") for i in ids]
+    assert all(j.status == "done" for j in jobs)
+    started = [j.started for j in jobs]
+    assert started == sorted(started)  # type: ignore[type-var]

@@ -1,0 +1,89 @@
+"""Every task runner gives the serial engine's answer; progress is monotone; a cancel stops it."""
+
+from __future__ import annotations
+
+import math
+import threading
+
+import numpy as np
+import pytest
+
+from solver.parallel import SERIAL, ThreadRunner, tasks_of
+from solver.placements import evaluate_placements, prepare_path
+from solver.progress import Cancelled
+from solver.robots import get_robot
+from tests.solver.test_evaluate import load_path
+
+
+def grid_placements() -> np.ndarray:
+    """An 8-yaw grid in yaw-major order, feasible and infeasible cells both."""
+    yaw, y, x = np.meshgrid(
+        np.linspace(-math.pi, math.pi, 8, endpoint=False),
+        np.linspace(0.0, 1.2, 6),
+        np.linspace(-0.9, 0.9, 9),
+        indexing="ij",
+    )
+    return np.column_stack([x.ravel(), y.ravel(), np.full(x.size, 0.1), yaw.ravel()])
+
+
+@pytest.mark.parametrize("threads", [2, 3])
+def test_threads_give_the_serial_answer_and_monotone_progress(threads: int) -> None:
+    robot = get_robot("ur5")
+    path = prepare_path(robot, load_path("s_curve"))
+    placements = grid_placements()
+    serial = evaluate_placements(robot, path, placements, with_speeds=True)
+    fractions: list[float] = []
+    pooled = evaluate_placements(
+        robot,
+        path,
+        placements,
+        with_speeds=True,
+        chunk=8,
+        progress=fractions.append,
+        runner=ThreadRunner(threads),
+    )
+    feasible = ~np.isnan(serial.mu_path)
+    assert 0.2 < feasible.mean() < 0.9
+    np.testing.assert_allclose(pooled.mu_path, serial.mu_path, rtol=1e-12)
+    np.testing.assert_allclose(pooled.v_max, serial.v_max, rtol=1e-12)
+    for name in ("reason", "failed_waypoint", "branch", "bottleneck_waypoint", "bottleneck_joint"):
+        np.testing.assert_array_equal(getattr(pooled, name), getattr(serial, name), err_msg=name)
+    assert fractions == sorted(fractions) and fractions[-1] == 1.0
+    assert len(fractions) >= 8  # a task at most per yaw
+
+
+@pytest.mark.parametrize("runner", [SERIAL, ThreadRunner(2)])
+def test_a_progress_that_raises_stops_the_work(runner: object) -> None:
+    robot = get_robot("ur5")
+    path = prepare_path(robot, load_path("s_curve"))
+    calls: list[float] = []
+
+    def cancel(fraction: float) -> None:
+        calls.append(fraction)
+        raise Cancelled
+
+    with pytest.raises(Cancelled):
+        evaluate_placements(robot, path, grid_placements(), chunk=8, progress=cancel, runner=runner)
+    assert len(calls) == 1 and calls[0] < 0.5
+
+
+def test_a_threaded_run_uses_several_threads() -> None:
+    seen: set[int] = set()
+    barrier = threading.Barrier(2, timeout=5)
+
+    def work(task: int) -> int:
+        seen.add(threading.get_ident())
+        if task < 2:
+            barrier.wait()  # both first tasks must be running at once
+        return task * task
+
+    assert ThreadRunner(2).run(work, list(range(6)), lambda i: None) == [0, 1, 4, 9, 16, 25]
+    assert len(seen) == 2
+
+
+def test_task_sizes_are_whole_chunks_within_the_cap() -> None:
+    assert tasks_of(1000, 32, per_worker=4, workers=2, cap=512) == 128
+    assert tasks_of(10, 32, per_worker=4, workers=2, cap=512) == 32
+    assert tasks_of(10**6, 32, per_worker=4, workers=2, cap=512) == 512
+    with pytest.raises(ValueError, match="threads=0"):
+        ThreadRunner(0)

@@ -1,0 +1,84 @@
+"""Map jobs on a real Dask cluster (``DTF_DASK_SCHEDULER``): same cells, monotone progress, cancel.
+
+A ``LocalCluster`` of two worker processes stands for machines running ``dask worker``; the
+service is a live uvicorn pointed at its scheduler. The cells are compared with the synchronous
+route's, which computes them in the web process.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Iterator
+from pathlib import Path
+from typing import Any
+
+import httpx
+import numpy as np
+import pytest
+from distributed import LocalCluster
+
+from tests.test_jobs import BIG_GRID, GRID_8K, map_request, server, wait_for
+
+
+@pytest.fixture(scope="module")
+def cluster() -> Iterator[LocalCluster]:
+    with LocalCluster(
+        n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None
+    ) as cluster:
+        yield cluster
+
+
+def transitions(cluster: LocalCluster) -> int:
+    """Task state transitions on the scheduler since it started (a task makes several)."""
+    return int(cluster.scheduler.transition_counter)
+
+
+def cells(answer: dict[str, Any]) -> np.ndarray:
+    return np.array([c["mu_path"] if c["mu_path"] is not None else np.nan for c in answer["cells"]])
+
+
+def test_a_map_job_on_dask_gives_the_local_cells(tmp_path: Path, cluster: LocalCluster) -> None:
+    body = map_request(GRID_8K)
+    before = transitions(cluster)
+    process, url = server(
+        tmp_path, DTF_DASK_SCHEDULER=cluster.scheduler_address, DTF_MAX_MAP_POSES="10000000"
+    )
+    try:
+        job_id = httpx.post(f"{url}/v1/jobs", json={"kind": "map", "request": body}).json()["id"]
+        fractions = []
+        while True:
+            job = httpx.get(f"{url}/v1/jobs/{job_id}").json()
+            fractions.append(job["progress"]["fraction"])
+            if job["status"] not in ("queued", "running"):
+                break
+            time.sleep(0.05)
+        assert job["status"] == "done", job
+        assert fractions == sorted(fractions) and fractions[-1] == 1.0
+        assert len(set(fractions)) >= 3  # progress came as the tasks completed
+        assert transitions(cluster) - before >= 8 * 3  # tasks ran on the cluster
+        local = httpx.post(f"{url}/v1/map", json=body, timeout=60).json()
+        np.testing.assert_allclose(cells(job["result"]), cells(local), rtol=1e-12)
+        for key in ("x", "y", "yaw", "reason", "failed_waypoint"):
+            assert [c[key] for c in job["result"]["cells"]] == [c[key] for c in local["cells"]], key
+    finally:
+        process.terminate()
+        process.wait()
+
+
+def test_a_cancelled_job_stops_its_dask_tasks(tmp_path: Path, cluster: LocalCluster) -> None:
+    process, url = server(tmp_path, DTF_DASK_SCHEDULER=cluster.scheduler_address)
+    try:
+        body = {"kind": "map", "request": map_request(BIG_GRID)}
+        job_id = httpx.post(f"{url}/v1/jobs", json=body).json()["id"]
+        wait_for(url, job_id, lambda j: j["progress"]["fraction"] > 0)
+        assert httpx.delete(f"{url}/v1/jobs/{job_id}").status_code == 204
+        asked = time.monotonic()
+        job = wait_for(url, job_id, lambda j: j["status"] != "running", timeout=10)
+        assert job["status"] == "cancelled" and time.monotonic() - asked < 1.0
+        deadline = time.monotonic() + 10
+        while cluster.scheduler.tasks and time.monotonic() < deadline:
+            time.sleep(0.1)
+        assert not cluster.scheduler.tasks  # nothing left queued or running on the cluster
+    finally:
+        process.terminate()
+        process.wait()
