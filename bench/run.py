@@ -29,6 +29,7 @@ from pathlib import Path
 
 import httpx
 import numpy as np
+import parallel  # bench/parallel.py, beside this script
 import ur_analytic_ik
 
 from solver.capability_map import capability_map, grid_axis
@@ -160,6 +161,8 @@ def main() -> None:
     numeric_maps(path, xs, ys, z, t_map)
     optimisation(robot, path, smoke=args.smoke)
     evaluate_over_http(requests=20 if args.smoke else 200)
+    parallel.threads(robot, path, xs, ys, z)
+    parallel.map_job(smoke=args.smoke)
 
 
 def evaluate_over_http(*, requests: int) -> None:

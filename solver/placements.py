@@ -93,7 +93,11 @@ def _task(
     chunk: int,
     placements: np.ndarray,
 ) -> tuple[np.ndarray, ...]:
-    """Evaluate a task's placements in chunks: the columns of :func:`_chunk`, concatenated."""
+    """Evaluate a task's placements in chunks: the columns of :func:`_chunk`, concatenated.
+
+    A task may run in another process (a Dask worker), so it sets the malloc thresholds itself.
+    """
+    raise_malloc_thresholds()
     parts = [
         _chunk(robot, path, rows, branches, max_joint_step, spin_mode)
         for rows in _pieces(placements, chunk)

@@ -1,0 +1,89 @@
+"""Benchmark of where the placement tasks run: one thread, both cores, a Dask cluster.
+
+Called by ``bench/run.py``; prints figures, asserts nothing. The ERK-size 8-yaw map on one
+thread and on a pool of two (``DTF_THREADS``), then a 50,000-placement map job run by the job
+worker's own code (``service.jobs.worker.run_job``) on the local worker (DTF_WORKERS=1: both
+cores as threads) and on a two-worker Dask ``LocalCluster`` (``DTF_DASK_SCHEDULER``), each
+timed from start to the stored result.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+
+from service.config import Settings
+from service.jobs.store import JobStore
+from service.jobs.worker import run_job
+from solver.capability_map import capability_map
+from solver.parallel import SERIAL, ThreadRunner
+from solver.robots import Robot
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def threads(robot: Robot, path: np.ndarray, xs: np.ndarray, ys: np.ndarray, z: float) -> None:
+    """The 8-yaw map on one thread and on two."""
+    yaws = np.linspace(0.0, 2 * math.pi, 8, endpoint=False)
+    times = {}
+    for name, runner in (("1 thread", SERIAL), ("2 threads", ThreadRunner(2))):
+        best = math.inf
+        for _ in range(3):
+            began = time.perf_counter()
+            capability_map(robot, path, xs=xs, ys=ys, z=z, yaws=yaws, runner=runner)
+            best = min(best, time.perf_counter() - began)
+        times[name] = best
+    print(
+        f"8-yaw map ({8 * len(xs) * len(ys)} placements) on 1 thread {times['1 thread']:.3f} s, "
+        f"on 2 threads {times['2 threads']:.3f} s: {times['1 thread'] / times['2 threads']:.2f}x"
+    )
+
+
+def _job_seconds(request: dict[str, object], settings: Settings) -> float:
+    with tempfile.TemporaryDirectory() as data:
+        store = JobStore(Path(data) / "jobs.sqlite3")
+        job = store.create("map", request)
+        began = time.perf_counter()
+        run_job(store, job.id, settings)
+        elapsed = time.perf_counter() - began
+        done = store.get(job.id)
+        if done is None or done.status != "done":
+            raise RuntimeError(f"the benchmark job did not finish: {done}")
+        return elapsed
+
+
+def map_job(*, smoke: bool) -> None:
+    """A 50,000-placement map job on the local worker and on a two-worker Dask cluster."""
+    from distributed import LocalCluster
+
+    example = json.loads((ROOT / "examples" / "evaluate_request.json").read_text())
+    x_step, n_y = (0.05, 10) if smoke else (0.005, 125)  # 200 x 125 x 2 = 50,000 placements
+    request = {
+        "robot": example["robot"],
+        "path": example["path"],
+        "grid": {
+            "x": {"min": -0.5, "max": 0.5 - x_step, "step": x_step},
+            "y": {"min": 0.0, "max": 0.005 * (n_y - 1) + 1e-9, "step": 0.005},
+            "z": 0.1,
+            "yaw": [0.0, 1.0],
+        },
+    }
+    cells = 2 * n_y * round(1.0 / x_step)
+    limits = {"max_job_cells": 10**7, "max_job_poses": 10**10}
+    local = _job_seconds(request, Settings(workers=1, **limits))
+    with LocalCluster(
+        n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None
+    ) as cluster:
+        on_dask = Settings(workers=1, dask_scheduler=cluster.scheduler_address, **limits)
+        _job_seconds(request, on_dask)  # warm up: the workers import the solver
+        dask = _job_seconds(request, on_dask)
+    print(
+        f"map job of {cells:,} placements: local worker (2 threads) {local:.2f} s, "
+        f"two-worker Dask LocalCluster {dask:.2f} s: {local / dask:.2f}x "
+        "(both on this machine's cores: Dask adds machines, not speed on one)"
+    )
