@@ -1,0 +1,54 @@
+"""Conversions between the API's schemas and the solver's objects, one module a resource.
+
+A route and a job call the same functions: ``common`` (robots, paths, placements, branches),
+``robots``, ``dtf``, ``evaluate``, ``maps`` and ``optimize``. The names are gathered here so a
+route reads ``convert.map_response``.
+"""
+
+from __future__ import annotations
+
+from service.convert.common import (
+    api_placement,
+    branch_of,
+    branch_to_api,
+    check_path_size,
+    h_of,
+    h_to_api,
+    joint_path_of,
+    path_of,
+    placement_of,
+    robot_from_schema,
+    spin_mode_of,
+    spun_poses,
+    wants_png,
+)
+from service.convert.dtf import dtf_response
+from service.convert.evaluate import evaluate_response
+from service.convert.maps import MapGrid, check_png_size, map_grid, map_response
+from service.convert.optimize import bounds_of, optimize_response
+from service.convert.robots import robot_info
+
+__all__ = [
+    "MapGrid",
+    "api_placement",
+    "bounds_of",
+    "branch_of",
+    "branch_to_api",
+    "check_path_size",
+    "check_png_size",
+    "dtf_response",
+    "evaluate_response",
+    "h_of",
+    "h_to_api",
+    "joint_path_of",
+    "map_grid",
+    "map_response",
+    "optimize_response",
+    "path_of",
+    "placement_of",
+    "robot_from_schema",
+    "robot_info",
+    "spin_mode_of",
+    "spun_poses",
+    "wants_png",
+]

@@ -1,0 +1,176 @@
+"""Conversions shared by every resource: robots, paths, placements, branches, h."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from service import schemas
+from service.schemas.path import PathInput
+from solver.cam.frames import frames_of_placement
+from solver.evaluate import Branch
+from solver.exceptions import InvalidInputError
+from solver.pipeline import SpinMode
+from solver.robots import Robot
+from solver.spatial import (
+    Placement,
+    spun_waypoints,
+)
+
+
+def robot_from_schema(spec: schemas.Robot) -> Robot:
+    """The solver robot a request names, with its speed limits and tool point.
+
+    Raises:
+        InvalidInputError: an OPW geometry, its limits or the speed limits are out of range.
+        RobotModelError: the URDF or its frames do not fit.
+    """
+    return spec.to_solver()
+
+
+def path_of(path: schemas.Path) -> PathInput:
+    """The poses of a path in {O}, from whichever form the request used.
+
+    Raises:
+        InvalidInputError, RepeatedWaypointError: naming the field and the waypoint.
+    """
+    return path.to_solver()
+
+
+def spun_poses(path: PathInput, spins: list[float] | None) -> np.ndarray:
+    """The path's poses, each turned by its spin about its tool z axis when spins are given.
+
+    Raises:
+        InvalidInputError: on ``spins``, a count that is not the number of waypoints.
+    """
+    if spins is None:
+        return path.poses
+    if len(spins) != len(path.poses):
+        raise InvalidInputError(
+            "spins", f"{len(spins)} spins for {len(path.poses)} waypoints: one per waypoint"
+        )
+    return spun_waypoints(path.poses, np.array(spins, dtype=float))
+
+
+def joint_path_of(rows: list[list[float]], robot: Robot) -> np.ndarray:
+    """A joint path (N, n), rad, from the request's rows.
+
+    Raises:
+        InvalidInputError: on ``joint_path`` and the waypoint, a row without one value a joint.
+    """
+    for i, row in enumerate(rows):
+        if len(row) != robot.dof:
+            raise InvalidInputError(
+                "joint_path",
+                f"{len(row)} values but {robot.name!r} has {robot.dof} joints",
+                waypoint=i,
+            )
+    return np.array(rows, dtype=float)
+
+
+def check_path_size(path: schemas.Path, *, limit: int, setting: str) -> None:
+    """Refuse a path with more waypoints than a setting allows, before any work.
+
+    Raises:
+        InvalidInputError: on ``path``, saying the size asked for and the limit.
+    """
+    if path.n_waypoints() > limit:
+        raise InvalidInputError(
+            "path", f"{path.n_waypoints()} waypoints; the limit is {limit} ({setting})"
+        )
+
+
+def spin_mode_of(requested: SpinMode | None, path: PathInput) -> SpinMode:
+    """The spin mode asked for, or the path form's default."""
+    return path.default_spin_mode if requested is None else requested
+
+
+def placement_of(placement: schemas.Placement) -> Placement:
+    """The solver's placement (m, rad)."""
+    return Placement(
+        x=placement.x, y=placement.y, z=placement.z, yaw=placement.yaw, spin=placement.spin
+    )
+
+
+def branch_of(choice: schemas.Branch | schemas.NumericBranch | str) -> Branch | None:
+    """The solver's branch label; ``None`` for ``"auto"``."""
+    if isinstance(choice, str):
+        return None
+    if isinstance(choice, schemas.NumericBranch):
+        return Branch.named(solution=str(choice.solution))
+    return Branch.named(shoulder=choice.shoulder, elbow=choice.elbow, wrist=choice.wrist)
+
+
+def branch_to_api(branch: Branch | None) -> schemas.Branch | schemas.NumericBranch | None:
+    """The API's branch: named levels, or the numeric family's solution index."""
+    if branch is None:
+        return None
+    choices = branch.as_dict()
+    if set(choices) == {"solution"}:
+        return schemas.NumericBranch(solution=int(choices["solution"]))
+    return schemas.Branch.model_validate(choices)
+
+
+def h_of(h: float | None) -> float:
+    """The solver's h (m): ``math.inf`` for the API's ``null`` (pure translation)."""
+    return math.inf if h is None else h
+
+
+def h_to_api(h: float) -> float | None:
+    """The API's h (m): ``None`` for ``math.inf`` (pure translation)."""
+    return None if math.isinf(h) else float(h)
+
+
+def api_placement(placement: Placement) -> schemas.PlacementResult:
+    """The API's placement (m, rad) of a solver placement, with its controller frames."""
+    frames = frames_of_placement(placement)
+    return schemas.PlacementResult(
+        x=placement.x,
+        y=placement.y,
+        z=placement.z,
+        yaw=placement.yaw,
+        spin=placement.spin,
+        frames=schemas.ControllerFrames(
+            matrix=frames.matrix, ur=frames.ur, kuka=frames.kuka, abb=frames.abb, fanuc=frames.fanuc
+        ),
+    )
+
+
+def _accept_weights(accept: str) -> dict[str, float]:
+    """Media range -> q-value of an Accept header (RFC 9110 section 12.5.1; q defaults to 1)."""
+    weights: dict[str, float] = {}
+    for part in accept.split(","):
+        media, *parameters = (piece.strip().lower() for piece in part.split(";"))
+        q = 1.0
+        for parameter in parameters:
+            name, _, value = parameter.partition("=")
+            if name.strip() == "q":
+                try:
+                    q = min(max(float(value), 0.0), 1.0)
+                except ValueError:
+                    q = 0.0
+        if media:
+            weights[media] = max(q, weights.get(media, 0.0))
+    return weights
+
+
+def wants_png(accept: str) -> bool:
+    """Whether an Accept header prefers the picture to JSON.
+
+    The most specific range that names each counts (``image/png``, else ``image/*``, else
+    ``*/*``; ``application/json``, else ``application/*``, else ``*/*``); the picture wins on a
+    higher q, or on an equal q when it is named more specifically than JSON. No Accept, or
+    ``*/*`` alone, is JSON.
+    """
+    weights = _accept_weights(accept)
+
+    def weight(*ranges: str) -> tuple[float, int]:
+        for specificity, media in enumerate(ranges):
+            if media in weights:
+                return weights[media], -specificity
+        return 0.0, -len(ranges)
+
+    png = weight("image/png", "image/*", "*/*")
+    json_ = weight("application/json", "application/*", "*/*")
+    return png[0] > 0.0 and png > json_

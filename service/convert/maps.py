@@ -1,0 +1,127 @@
+"""``POST /v1/map``: the grid from the request, its size checked; the answer from the map."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from service import schemas
+from service.config import Settings
+from service.convert.common import api_placement
+from solver.capability_map import CapabilityMap, axis_length, grid_axis
+from solver.exceptions import InvalidInputError
+from solver.pipeline import SpinMode, require_family
+from solver.robots import Robot
+from solver.spatial import MAX_COORDINATE
+from solver.tracking import FEASIBLE, REASONS
+
+
+@dataclass(frozen=True)
+class MapGrid:
+    """The grid values of a map request (m, m, rad)."""
+
+    xs: np.ndarray
+    ys: np.ndarray
+    yaws: np.ndarray
+    spins: np.ndarray
+
+
+def map_grid(grid: schemas.Grid, *, settings: Settings, n_waypoints: int, robot: Robot) -> MapGrid:
+    """The grid's values, after checking its size against the settings.
+
+    The poses are weighed by the robot family's cost (``path_cost``: 1 a pose for a closed-form
+    family, far more for numeric IK), so that DTF_MAX_MAP_POSES bounds the time of every map.
+
+    Raises:
+        InvalidInputError: an axis is malformed, or the grid is over a size limit; the message
+            says the size asked for and the limit.
+    """
+    nx = axis_length(grid.x.min, grid.x.max, grid.x.step, field="grid.x")
+    ny = axis_length(grid.y.min, grid.y.max, grid.y.step, field="grid.y")
+    for field, values in (
+        ("grid.x", (grid.x.min, grid.x.max)),
+        ("grid.y", (grid.y.min, grid.y.max)),
+        ("grid.z", (grid.z,)),
+    ):
+        if max(abs(v) for v in values) > MAX_COORDINATE:
+            raise InvalidInputError(
+                field, f"{max(abs(v) for v in values):.6g} m is beyond +-{MAX_COORDINATE:g} m"
+            )
+    yaws, spins = grid.yaws(), grid.spins()
+    cells = nx * ny * len(yaws) * len(spins)
+    size = f"{nx} x * {ny} y * {len(yaws)} yaw * {len(spins)} spin = {cells} placements"
+    limits = settings.map_limits()
+    if cells > limits.cells:
+        raise InvalidInputError(
+            "grid", f"{size}; the limit is {limits.cells} ({limits.cells_setting}){limits.hint}"
+        )
+    poses = cells * n_waypoints
+    family = require_family(robot)
+    work = cells * family.path_cost(n_waypoints)
+    if work > limits.poses:
+        weighed = "" if work == poses else f", as work {work:.4g} closed-form poses"
+        weighed += "" if work == poses else f" ({family.name} IK)"
+        raise InvalidInputError(
+            "grid",
+            f"{size} * {n_waypoints} waypoints = {poses} poses{weighed}; the limit is "
+            f"{limits.poses} ({limits.poses_setting}){limits.hint}",
+        )
+    return MapGrid(
+        xs=grid_axis(grid.x.min, grid.x.max, grid.x.step, field="grid.x"),
+        ys=grid_axis(grid.y.min, grid.y.max, grid.y.step, field="grid.y"),
+        yaws=np.array(yaws, dtype=float),
+        spins=np.array(spins, dtype=float),
+    )
+
+
+def check_png_size(grid: MapGrid, *, settings: Settings) -> None:
+    """Refuse a PNG of more panels (yaw x spin values) than the setting allows.
+
+    Raises:
+        InvalidInputError: on ``grid``, saying the size asked for and the limit.
+    """
+    panels = len(grid.yaws) * len(grid.spins)
+    if panels > settings.max_png_panels:
+        raise InvalidInputError(
+            "grid",
+            f"{len(grid.yaws)} yaws * {len(grid.spins)} spins = {panels} PNG panels; the limit "
+            f"is {settings.max_png_panels} (DTF_MAX_PNG_PANELS); ask for JSON for more",
+        )
+
+
+def _extreme(cmap: CapabilityMap, *, best: bool) -> schemas.MapExtreme | None:
+    index = cmap.extreme(best=best)
+    if index is None:
+        return None
+    return schemas.MapExtreme(
+        placement=api_placement(cmap.placement(index)),
+        mu_path=float(cmap.mu_path[index]),
+    )
+
+
+def map_response(cmap: CapabilityMap, *, spin_mode: SpinMode) -> schemas.MapResponse:
+    """The JSON answer of ``POST /v1/map``: cells yaw-major, then y, then x."""
+    cells = []
+    for s, k, j, i in np.ndindex(cmap.mu_path.shape):
+        feasible = cmap.reason[s, k, j, i] == FEASIBLE
+        cells.append(
+            schemas.MapCell(
+                x=float(cmap.xs[i]),
+                y=float(cmap.ys[j]),
+                yaw=float(cmap.yaws[k]),
+                spin=float(cmap.spins[s]),
+                mu_path=float(cmap.mu_path[s, k, j, i]) if feasible else None,
+                reason=None
+                if feasible
+                else schemas.FailureReason(REASONS[int(cmap.reason[s, k, j, i])]),
+                failed_waypoint=None if feasible else int(cmap.failed_waypoint[s, k, j, i]),
+            )
+        )
+    return schemas.MapResponse(
+        cells=cells,
+        best=_extreme(cmap, best=True),
+        worst=_extreme(cmap, best=False),
+        feasible_cells=int(np.sum(cmap.reason == FEASIBLE)),
+        spin_mode=spin_mode,
+    )
