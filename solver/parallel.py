@@ -87,7 +87,7 @@ class ThreadRunner:
 
         Progress (and a cancel) is seen as tasks complete, so no task may be long.
         """
-        return tasks_of(n_placements, chunk, per_worker=4, workers=self.threads, cap=16 * chunk)
+        return tasks_of(n_placements, chunk, per_worker=4, workers=self.threads, cap=4 * chunk)
 
     def run(
         self, work: Callable[[T], R], tasks: Sequence[T], done: Callable[[int], None]

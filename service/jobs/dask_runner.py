@@ -48,7 +48,7 @@ class DaskRunner:
         Progress and a cancel are seen as tasks complete, so no task may be long.
         """
         threads = sum(self.client().nthreads().values()) or 1
-        return tasks_of(n_placements, chunk, per_worker=8, workers=threads, cap=32 * chunk)
+        return tasks_of(n_placements, chunk, per_worker=8, workers=threads, cap=8 * chunk)
 
     def run(
         self, work: Callable[[T], R], tasks: Sequence[T], done: Callable[[int], None]
