@@ -14,6 +14,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from solver.exceptions import InvalidInputError
+from solver.parallel import SERIAL, TaskRunner
 from solver.pipeline import PreparedPath, SpinMode, require_family
 from solver.placements import evaluate_placements
 from solver.progress import Progress
@@ -80,6 +81,7 @@ def coarse_cells(
     max_cells: int = MAX_COARSE_CELLS,
     max_poses: int | None = None,
     progress: Progress | None = None,
+    runner: TaskRunner = SERIAL,
 ) -> list[Cell]:
     """Local maxima of a coarse map over the bounds, best first.
 
@@ -183,6 +185,7 @@ def coarse_cells(
             max_joint_step=max_joint_step,
             spin_mode=spin_mode,
             progress=progress,
+            runner=runner,
         )
         mu[inside_index], branch[inside_index] = result.mu_path, result.branch
     cells = []

@@ -31,6 +31,7 @@ from solver.coarse_search import MAX_COARSE_CELLS, Cell, coarse_cells
 from solver.evaluate import DEFAULT_MAX_JOINT_STEP, PathEvaluation, evaluate_path
 from solver.exceptions import InvalidInputError, quoted
 from solver.joint_path import EXACT_POSE_TOLERANCE, evaluate_joint_path
+from solver.parallel import SERIAL, TaskRunner
 from solver.pipeline import PreparedPath, SpinMode, prepare_path, require_family
 from solver.placement_nlp import PlacementNlp
 from solver.placement_scipy import (
@@ -169,6 +170,7 @@ def optimize_placement(
     max_solver_seconds: float | None = None,
     progress: Progress | None = None,
     passes: Sequence[tuple[int, int]] | None = None,
+    runner: TaskRunner = SERIAL,
 ) -> PlacementOptimum:
     """The placement inside ``bounds`` where the path runs fastest.
 
@@ -194,6 +196,8 @@ def optimize_placement(
             iterations); a :class:`solver.progress.Cancelled` it raises stops the search.
         passes: index ranges [start, stop) of the passes of a CAM program (cam.md section 5);
             None: one pass. A spin path (``max_spin_step``) needs one pass.
+        runner: where the coarse map's and differential evolution's placements run
+            (:mod:`solver.parallel`); the same optimum on any.
 
     Returns:
         The optimum (never below the start); ``found`` is False when neither the start nor any
@@ -253,6 +257,7 @@ def optimize_placement(
             max_cells=max_coarse_cells,
             max_poses=max_coarse_poses,
             progress=span(progress, 0.0, 0.3),
+            runner=runner,
         )
         candidates, iterations = _casadi(
             robot,
@@ -270,7 +275,7 @@ def optimize_placement(
         name = "ipopt (casadi), from the coarse map's maxima"
     else:
         candidates, iterations = _scipy(
-            robot, prepared, bounds, max_joint_step, symmetric, spin_mode, size, progress
+            robot, prepared, bounds, max_joint_step, symmetric, spin_mode, size, progress, runner
         )
         name = "differential_evolution + SLSQP (scipy)"
     # The start last: it is the answer only when nothing the solver found is better.
@@ -450,6 +455,7 @@ def _scipy(
     spin_mode: SpinMode,
     size: SearchSize,
     progress: Progress | None,
+    runner: TaskRunner,
 ) -> tuple[list[Candidate], int]:
     """Candidates: the best placement of each basin DE saw, and SLSQP's polish of each.
 
@@ -464,6 +470,7 @@ def _scipy(
         spin_mode=spin_mode,
         size=size,
         progress=span(progress, 0.0, 0.6),
+        runner=runner,
     )
     if not basins:
         return [], iterations

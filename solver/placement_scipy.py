@@ -22,6 +22,7 @@ import numpy as np
 import scipy.optimize
 
 from solver.families.base import Branch
+from solver.parallel import SERIAL, TaskRunner
 from solver.pipeline import PreparedPath, SpinMode
 from solver.placements import evaluate_placements
 from solver.progress import Progress
@@ -132,6 +133,7 @@ def global_search(
     spin_mode: SpinMode = "fixed",
     size: SearchSize = FULL_SEARCH,
     progress: Progress | None = None,
+    runner: TaskRunner = SERIAL,
 ) -> tuple[list[Basin], int]:
     """Differential evolution over the free variables; the best point of each distinct basin.
 
@@ -152,6 +154,7 @@ def global_search(
             bounds.rows(vectors),
             max_joint_step=max_joint_step,
             spin_mode=spin_mode,
+            runner=runner,
         )
         seen.append((vectors, result.mu_path, result.branch))
         if progress is not None:

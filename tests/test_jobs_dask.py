@@ -17,7 +17,7 @@ import numpy as np
 import pytest
 from distributed import LocalCluster
 
-from tests.test_jobs import BIG_GRID, GRID_8K, map_request, server, wait_for
+from tests.test_jobs import BIG_GRID, EXAMPLE, GRID_8K, map_request, server, wait_for
 
 
 @pytest.fixture(scope="module")
@@ -79,6 +79,33 @@ def test_a_cancelled_job_stops_its_dask_tasks(tmp_path: Path, cluster: LocalClus
         while cluster.scheduler.tasks and time.monotonic() < deadline:
             time.sleep(0.1)
         assert not cluster.scheduler.tasks  # nothing left queued or running on the cluster
+    finally:
+        process.terminate()
+        process.wait()
+
+
+def test_an_optimize_job_on_dask_finds_the_routes_optimum(
+    tmp_path: Path, cluster: LocalCluster
+) -> None:
+    """The casadi method's coarse map runs on the cluster (the scipy method's differential
+    evolution takes the same runner, but its 60 small batches take a minute on this machine)."""
+    request = {
+        "robot": EXAMPLE["robot"],
+        "path": EXAMPLE["path"],
+        "bounds": {"x": [-0.1, 0.1], "y": [0.35, 0.55], "yaw": [-0.5, 0.5]},
+        "z": 0.1,
+        "method": "casadi",
+    }
+    before = transitions(cluster)
+    process, url = server(tmp_path, DTF_DASK_SCHEDULER=cluster.scheduler_address)
+    try:
+        job_id = httpx.post(f"{url}/v1/jobs", json={"kind": "optimize", "request": request})
+        job = wait_for(url, job_id.json()["id"], lambda j: j["status"] in ("done", "failed"))
+        assert job["status"] == "done", job
+        assert transitions(cluster) - before >= 3  # its placements ran on the cluster
+        direct = httpx.post(f"{url}/v1/optimize", json=request, timeout=120).json()
+        assert job["result"]["mu_path"] == pytest.approx(direct["mu_path"], rel=1e-9)
+        assert job["result"]["placement"] == direct["placement"]
     finally:
         process.terminate()
         process.wait()

@@ -59,7 +59,7 @@ def _optimize(
     from service.schemas import OptimizeRequest
 
     body = OptimizeRequest.model_validate(request)
-    return optimum_of(body, settings, progress).model_dump(mode="json")
+    return optimum_of(body, settings, progress, runner=runner).model_dump(mode="json")
 
 
 def _evaluate(

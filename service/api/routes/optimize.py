@@ -14,6 +14,7 @@ from service.errors import ERROR_RESPONSES
 from service.schemas import OptimizeRequest, OptimizeResponse
 from service.work import json_response, run_stoppable
 from solver.optimize import optimize_placement
+from solver.parallel import TaskRunner, ThreadRunner
 from solver.progress import Progress
 
 router = APIRouter(prefix="/optimize", tags=["optimize"], responses=ERROR_RESPONSES)
@@ -43,7 +44,12 @@ async def post_optimize(
     )
 
 
-def optimum_of(body: OptimizeRequest, settings: Settings, progress: Progress) -> OptimizeResponse:
+def optimum_of(
+    body: OptimizeRequest,
+    settings: Settings,
+    progress: Progress,
+    runner: TaskRunner | None = None,
+) -> OptimizeResponse:
     """The answer of ``POST /v1/optimize``, its size checked first."""
     convert.check_path_size(
         body.path, limit=settings.max_optimize_waypoints, setting="DTF_MAX_OPTIMIZE_WAYPOINTS"
@@ -66,6 +72,7 @@ def optimum_of(body: OptimizeRequest, settings: Settings, progress: Progress) ->
         max_search_poses=settings.max_search_poses,
         max_solver_seconds=settings.max_solver_seconds,
         progress=progress,
+        runner=ThreadRunner(settings.threads) if runner is None else runner,
         passes=path.passes,
     )
     return convert.optimize_response(optimum, robot, axis_correction=path.axis_correction)
