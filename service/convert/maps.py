@@ -8,7 +8,7 @@ import numpy as np
 
 from service import schemas
 from service.config import Settings
-from service.convert.common import api_placement
+from service.convert.common import api_placement, branch_to_api
 from solver.capability_map import CapabilityMap, axis_length, grid_axis
 from solver.exceptions import InvalidInputError
 from solver.pipeline import SpinMode, require_family
@@ -100,8 +100,9 @@ def _extreme(cmap: CapabilityMap, *, best: bool) -> schemas.MapExtreme | None:
     )
 
 
-def map_response(cmap: CapabilityMap, *, spin_mode: SpinMode) -> schemas.MapResponse:
+def map_response(cmap: CapabilityMap, robot: Robot, *, spin_mode: SpinMode) -> schemas.MapResponse:
     """The JSON answer of ``POST /v1/map``: cells yaw-major, then y, then x."""
+    branches = [branch_to_api(b) for b in require_family(robot).branches]
     cells = []
     for s, k, j, i in np.ndindex(cmap.mu_path.shape):
         feasible = cmap.reason[s, k, j, i] == FEASIBLE
@@ -116,6 +117,9 @@ def map_response(cmap: CapabilityMap, *, spin_mode: SpinMode) -> schemas.MapResp
                 if feasible
                 else schemas.FailureReason(REASONS[int(cmap.reason[s, k, j, i])]),
                 failed_waypoint=None if feasible else int(cmap.failed_waypoint[s, k, j, i]),
+                bottleneck_waypoint=int(cmap.bottleneck_waypoint[s, k, j, i]) if feasible else None,
+                bottleneck_joint=int(cmap.bottleneck_joint[s, k, j, i]) if feasible else None,
+                branch=branches[int(cmap.branch[s, k, j, i])] if feasible else None,
             )
         )
     return schemas.MapResponse(

@@ -9,8 +9,10 @@ from pydantic.config import JsonDict
 
 from service.schemas.common import (
     Angle,
+    Branch,
     Coordinate,
     IkPolicy,
+    NumericBranch,
     PlacementResult,
     RequestModel,
     ResponseModel,
@@ -127,6 +129,9 @@ _CELL: JsonDict = {
     "mu_path": 0.2913,
     "reason": None,
     "failed_waypoint": None,
+    "bottleneck_waypoint": 0,
+    "bottleneck_joint": 5,
+    "branch": {"shoulder": "left", "elbow": "up", "wrist": "noflip"},
 }
 
 
@@ -161,6 +166,15 @@ class MapCell(ResponseModel):
     )
     failed_waypoint: int | None = Field(
         description="First waypoint that fails; null when feasible."
+    )
+    bottleneck_waypoint: int | None = Field(
+        default=None, description="Where V_max is smallest along the path; null when infeasible."
+    )
+    bottleneck_joint: int | None = Field(
+        default=None, description="The joint on its speed limit there; null when infeasible."
+    )
+    branch: Branch | NumericBranch | None = Field(
+        default=None, description="The IK branch the path runs on; null when infeasible."
     )
 
 

@@ -64,8 +64,12 @@ def test_random_cells_equal_evaluate(
         evaluation = client.post("/v1/evaluate", json=body).json()
         if evaluation["feasible"]:
             assert cell["mu_path"] == pytest.approx(evaluation["mu_path"], rel=MAP_EVALUATE_RTOL)
+            assert cell["bottleneck_waypoint"] == evaluation["bottleneck"]["waypoint"]
+            assert cell["bottleneck_joint"] == evaluation["bottleneck"]["joint"]
+            assert cell["branch"] == evaluation["branch"]
         else:
             assert cell["mu_path"] is None
+            assert cell["bottleneck_joint"] is None and cell["branch"] is None
             assert cell["reason"] == evaluation["reason"]
             assert cell["failed_waypoint"] == evaluation["failed_waypoint"]
 

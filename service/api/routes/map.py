@@ -48,8 +48,8 @@ def _computed_map(
     png: bool,
     progress: Progress,
     runner: TaskRunner | None = None,
-) -> tuple[CapabilityMap, str, SpinMode]:
-    """The map a request asks for, its size checked first; the robot's name; the spin mode.
+) -> tuple[CapabilityMap, Robot, SpinMode]:
+    """The map a request asks for, its size checked first; the robot; the spin mode.
 
     The placements run on ``runner``, by default on DTF_THREADS threads.
     """
@@ -74,17 +74,17 @@ def _computed_map(
         runner=ThreadRunner(settings.threads) if runner is None else runner,
     )
     PLACEMENTS.inc(result.mu_path.size)
-    return result, robot.name, spin_mode
+    return result, robot, spin_mode
 
 
 def map_of(
     body: MapRequest, settings: Settings, progress: Progress, runner: TaskRunner | None = None
 ) -> MapResponse:
     """The JSON answer of ``POST /v1/map`` (a map job's result too, its tasks on ``runner``)."""
-    result, _, spin_mode = _computed_map(
+    result, robot, spin_mode = _computed_map(
         body, settings, png=False, progress=progress, runner=runner
     )
-    return convert.map_response(result, spin_mode=spin_mode)
+    return convert.map_response(result, robot, spin_mode=spin_mode)
 
 
 def _picture(result: CapabilityMap, name: str) -> Response:
@@ -113,10 +113,10 @@ async def post_map(
     png = convert.wants_png(accept)
 
     def work(progress: Progress) -> MapResponse | Response:
-        result, name, spin_mode = _computed_map(body, settings, png=png, progress=progress)
+        result, robot, spin_mode = _computed_map(body, settings, png=png, progress=progress)
         if png:
-            return _picture(result, name)
-        return json_response(convert.map_response(result, spin_mode=spin_mode))
+            return _picture(result, robot.name)
+        return json_response(convert.map_response(result, robot, spin_mode=spin_mode))
 
     return await run_stoppable(request, work)
 
@@ -143,7 +143,7 @@ async def post_map_png(
     """The map of ``POST /v1/map`` as a picture (generated clients get bytes)."""
 
     def work(progress: Progress) -> Response:
-        result, name, _ = _computed_map(body, settings, png=True, progress=progress)
-        return _picture(result, name)
+        result, robot, _ = _computed_map(body, settings, png=True, progress=progress)
+        return _picture(result, robot.name)
 
     return await run_stoppable(request, work)
