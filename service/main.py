@@ -33,6 +33,7 @@ from service.errors import (
 )
 from service.jobs.runner import close_runners, get_runner
 from service.metrics import instrument, log_to_stderr
+from service.web import mount_page
 from service.work import STOPPING
 from solver.exceptions import SolverError
 from solver.progress import Cancelled
@@ -117,6 +118,7 @@ def create_app() -> FastAPI:
     )
     app.include_router(health.router)
     app.include_router(api_router)
+    mount_page(app)
     app.add_middleware(BodySizeLimitMiddleware)
     instrument(app)
     return app
