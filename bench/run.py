@@ -28,8 +28,9 @@ from collections.abc import Callable
 from pathlib import Path
 
 import httpx
+import memory  # bench/memory.py and bench/parallel.py, beside this script
 import numpy as np
-import parallel  # bench/parallel.py, beside this script
+import parallel
 import ur_analytic_ik
 
 from solver.capability_map import capability_map, grid_axis
@@ -163,6 +164,7 @@ def main() -> None:
     evaluate_over_http(requests=20 if args.smoke else 200)
     parallel.threads(robot, path, xs, ys, z)
     parallel.map_job(smoke=args.smoke)
+    memory.peak_rss(smoke=args.smoke)
 
 
 def evaluate_over_http(*, requests: int) -> None:

@@ -30,8 +30,9 @@ class Settings(BaseSettings):
         default=5_000_000,
         gt=0,
         description="Most placement-waypoint pairs one /v1/map request, or the coarse map of one "
-        "/v1/optimize request, may ask for (each is 8 IK solutions; 2 million took 4 s on the "
-        "2-core development machine, so the default is about 10 s). A pair of a numeric-IK arm "
+        "/v1/optimize request, may ask for (each is 8 IK solutions; the default, 5 million, "
+        "took 10 to 26 s on one thread of the 2-core development machine, depending on the day; "
+        "/v1/map computes on DTF_THREADS threads). A pair of a numeric-IK arm "
         "counts as the work of many (its family's path_cost: about 65 a waypoint for 6 joints, "
         "400 for 7, plus 3,200 or 6,400 a placement for the seeds), so its limit is about the "
         "same time.",

@@ -64,8 +64,13 @@ def _chunk(
     branches: np.ndarray,
     max_joint_step: float,
     spin_mode: SpinMode,
+    with_speeds: bool,
 ) -> tuple[np.ndarray, ...]:
-    """Evaluate C placements: per placement mu, reason, failed, branch, bottleneck, V_max."""
+    """Evaluate C placements: per placement mu, reason, failed, branch, bottleneck, V_max.
+
+    V_max along the path is (C, W) when ``with_speeds``, else (C, 0): a map of millions of
+    placements keeps nothing per waypoint.
+    """
     run = run_chunk(
         robot, path, placements, branches, max_joint_step=max_joint_step, spin_mode=spin_mode
     )
@@ -80,7 +85,7 @@ def _chunk(
         branches[pick],
         np.where(any_feasible, worst, -1),
         np.where(any_feasible, run.limiting[pick, columns, worst], -1),
-        chosen_v,
+        chosen_v if with_speeds else chosen_v[:, :0],
     )
 
 
@@ -90,6 +95,7 @@ def _task(
     branches: np.ndarray,
     max_joint_step: float,
     spin_mode: SpinMode,
+    with_speeds: bool,
     chunk: int,
     placements: np.ndarray,
 ) -> tuple[np.ndarray, ...]:
@@ -99,7 +105,7 @@ def _task(
     """
     raise_malloc_thresholds()
     parts = [
-        _chunk(robot, path, rows, branches, max_joint_step, spin_mode)
+        _chunk(robot, path, rows, branches, max_joint_step, spin_mode, with_speeds)
         for rows in _pieces(placements, chunk)
     ]
     return tuple(np.concatenate(c) for c in zip(*parts, strict=True))
@@ -163,7 +169,7 @@ def evaluate_placements(
         if progress is not None:
             progress(completed[0] / len(cells))
 
-    work = partial(_task, robot, path, branches, max_joint_step, spin_mode, chunk)
+    work = partial(_task, robot, path, branches, max_joint_step, spin_mode, with_speeds, chunk)
     parts = runner.run(work, tasks, done)
     empty = (np.zeros(0), *(np.zeros(0, dtype=int),) * 5, np.zeros((0, path.n_waypoints)))
     columns = [np.concatenate(c) for c in zip(*parts, strict=True)] if parts else list(empty)
