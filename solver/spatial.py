@@ -87,6 +87,54 @@ def pose_matrix(
     return transform
 
 
+def pose_matrices(positions: np.ndarray, quaternions_xyzw: np.ndarray, *, field: str) -> np.ndarray:
+    """:func:`pose_matrix` of N poses at once, shape (N, 4, 4), metres.
+
+    Args:
+        positions: shape (N, 3), m.
+        quaternions_xyzw: shape (N, 4), unit to within 1e-3, normalised.
+        field: name of the input; the error names ``{field}.{i}`` of the first bad pose.
+
+    Raises:
+        InvalidInputError: as :func:`pose_matrix`, for the first pose that fails.
+    """
+    pos = np.asarray(positions, dtype=float)
+    quat = np.asarray(quaternions_xyzw, dtype=float)
+    if pos.ndim != 2 or pos.shape[1:] != (3,) or quat.shape != (len(pos), 4):
+        raise InvalidInputError(field, f"{pos.shape=} and {quat.shape=}, need (N, 3), (N, 4)")
+    with np.errstate(invalid="ignore"):
+        norm = np.linalg.norm(quat, axis=1)
+        bad = (
+            ~np.isfinite(pos).all(axis=1)
+            | (np.abs(pos).max(axis=1, initial=0.0) > MAX_COORDINATE)
+            | ~np.isfinite(quat).all(axis=1)
+            | ~(np.abs(norm - 1.0) <= QUATERNION_NORM_TOLERANCE)
+        )
+    if bad.any():
+        i = int(np.argmax(bad))
+        pose_matrix(pos[i], quat[i], field=f"{field}.{i}")  # raises its error
+    x, y, z, w = (quat / norm[:, None]).T
+    out = np.zeros((len(pos), 4, 4))
+    out[:, 0, 0], out[:, 0, 1], out[:, 0, 2] = (
+        1 - 2 * (y * y + z * z),
+        2 * (x * y - z * w),
+        2 * (x * z + y * w),
+    )
+    out[:, 1, 0], out[:, 1, 1], out[:, 1, 2] = (
+        2 * (x * y + z * w),
+        1 - 2 * (x * x + z * z),
+        2 * (y * z - x * w),
+    )
+    out[:, 2, 0], out[:, 2, 1], out[:, 2, 2] = (
+        2 * (x * z - y * w),
+        2 * (y * z + x * w),
+        1 - 2 * (x * x + y * y),
+    )
+    out[:, :3, 3] = pos
+    out[:, 3, 3] = 1.0
+    return out
+
+
 def rotation_about_z(angle: np.ndarray | float) -> np.ndarray:
     """Rot_z(angle), batched: shape (*angle.shape, 3, 3)."""
     c, s = np.cos(angle), np.sin(angle)

@@ -70,16 +70,25 @@ def check_waypoints(poses: np.ndarray, *, field: str = "path.waypoints") -> np.n
         raise InvalidInputError(field, f"{arr.shape=}, needs (N, 4, 4)")
     if arr.shape[0] < 2:
         raise InvalidInputError(field, f"a path needs at least 2 waypoints, got {arr.shape[0]}")
-    for i, pose in enumerate(arr):
+    with np.errstate(invalid="ignore"):
+        rotations = arr[:, :3, :3]
+        orthonormal = np.abs(np.einsum("nji,njk->nik", rotations, rotations) - np.eye(3))
+        bad = (
+            ~np.isfinite(arr).all(axis=(1, 2))
+            | ~(np.abs(arr[:, :3, 3]).max(axis=1) <= MAX_COORDINATE)
+            | ~(orthonormal.max(axis=(1, 2)) <= 1e-6)
+            | ~(np.linalg.det(np.nan_to_num(rotations)) >= 0)
+        )
+    if bad.any():  # the first bad pose, with the message of the first check it fails
+        i = int(np.argmax(bad))
+        pose = arr[i]
         if not np.all(np.isfinite(pose)):
             raise InvalidInputError(field, "pose has values that are not finite", waypoint=i)
         if np.max(np.abs(pose[:3, 3])) > MAX_COORDINATE:
             raise InvalidInputError(
                 field, f"position is beyond +-{MAX_COORDINATE} m (units are metres)", waypoint=i
             )
-        rotation = pose[:3, :3]
-        if np.abs(rotation.T @ rotation - np.eye(3)).max() > 1e-6 or np.linalg.det(rotation) < 0:
-            raise InvalidInputError(field, "orientation is not a rotation", waypoint=i)
+        raise InvalidInputError(field, "orientation is not a rotation", waypoint=i)
     return arr
 
 

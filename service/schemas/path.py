@@ -13,11 +13,11 @@ from typing import Annotated, Literal
 import numpy as np
 from pydantic import ConfigDict, Discriminator, Field, Tag
 
-from service.schemas.common import Pose, RequestModel, SpinMode, ToolAxisWaypoint, pose_matrix_of
+from service.schemas.common import Pose, RequestModel, SpinMode, ToolAxisWaypoint
 from solver.cam.cam_path import CamPath
 from solver.cam.cl_data import read_cl_data
 from solver.cam.csv_path import read_csv_path
-from solver.spatial import check_position
+from solver.spatial import check_position, pose_matrices
 from solver.task import task_requirements
 from solver.tool_axis import poses_from_tool_axes
 
@@ -96,13 +96,10 @@ class PosePath(RequestModel):
         Raises:
             InvalidInputError: a quaternion that is not unit, naming the waypoint.
         """
-        poses = np.array(
-            [
-                pose_matrix_of(pose, field=f"path.waypoints.{i}")
-                for i, pose in enumerate(self.waypoints)
-            ]
-        )
-        norms = np.linalg.norm([pose.orientation for pose in self.waypoints], axis=1)
+        quaternions = np.array([pose.orientation for pose in self.waypoints], dtype=float)
+        positions = np.array([pose.position for pose in self.waypoints], dtype=float)
+        poses = pose_matrices(positions, quaternions, field="path.waypoints")
+        norms = np.linalg.norm(quaternions, axis=1)
         correction = float(np.max(np.abs(norms - 1.0)))
         return PathInput(poses=poses, axis_correction=correction, default_spin_mode="fixed")
 
