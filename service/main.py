@@ -14,6 +14,8 @@ from collections.abc import AsyncIterator
 from types import FrameType
 from typing import Any
 
+import anyio
+import numpy as np
 from fastapi import FastAPI
 from fastapi.exceptions import RequestValidationError
 from fastapi_offline import FastAPIOffline
@@ -35,8 +37,11 @@ from service.jobs.runner import close_runners, get_runner
 from service.metrics import instrument, log_to_stderr
 from service.web import mount_page
 from service.work import STOPPING
+from solver.evaluate import evaluate_path
 from solver.exceptions import SolverError
+from solver.families import catalogue
 from solver.progress import Cancelled
+from solver.spatial import Placement
 
 GIL_SWITCH_SECONDS = 0.001
 DESCRIPTION = """\
@@ -78,9 +83,22 @@ async def lifespan(app: FastAPI) -> AsyncIterator[None]:
     _stop_work_on(signal.SIGTERM)
     _stop_work_on(signal.SIGINT)
     log_to_stderr()
+    await anyio.to_thread.run_sync(_warm_up)
     get_runner(get_settings()).recover()  # jobs a restart interrupted run again
     yield
     close_runners()
+
+
+def _warm_up() -> None:
+    """Do before serving what the first requests would otherwise pay for, holding the GIL.
+
+    The catalogue reads its URDFs and the first path evaluation imports and sets up its
+    modules: a few hundred milliseconds in which /healthz would wait.
+    """
+    robot = catalogue()["ur5"]
+    waypoints = np.repeat(np.eye(4)[None], 2, axis=0)
+    waypoints[1, 0, 3] = 0.01
+    evaluate_path(robot, waypoints, Placement(0.0, 0.45, 0.1, 0.0))
 
 
 def _stop_work_on(signum: signal.Signals) -> None:

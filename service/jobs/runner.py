@@ -54,7 +54,7 @@ class JobRunner:
         self._worker = worker
         self.store = JobStore(Path(settings.data_dir) / "jobs.sqlite3")
         self._context = multiprocessing.get_context("spawn")
-        self._workers = [self._start_worker() for _ in range(settings.workers)]
+        self._workers: list[_Worker] = []  # started when jobs first wait (each is 250 MB)
         self._wake = threading.Event()
         self._stop = threading.Event()
         self._thread = threading.Thread(target=self._supervise, name="dtf-jobs", daemon=True)
@@ -134,12 +134,14 @@ class JobRunner:
         self._workers[i] = self._start_worker()
 
     def _dispatch(self) -> None:
-        """Hand the oldest queued jobs to the idle workers."""
-        idle = [w for w in self._workers if w.job_id is None]
-        if not idle:
-            return
+        """Hand the oldest queued jobs to the idle workers, starting workers as jobs wait."""
         taken = {w.job_id for w in self._workers if w.job_id is not None}
-        queued = self.store.queued(exclude=taken, limit=len(idle))
+        queued = self.store.queued(exclude=taken, limit=self.settings.workers)
+        idle = [w for w in self._workers if w.job_id is None]
+        while len(idle) < len(queued) and len(self._workers) < self.settings.workers:
+            self._workers.append(self._start_worker())
+            idle.append(self._workers[-1])
+        queued = queued[: len(idle)]
         for worker, job_id in zip(idle[: len(queued)], queued, strict=True):
             worker.job_id, worker.cancel_seen = job_id, None
             worker.connection.send(job_id)
