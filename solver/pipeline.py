@@ -269,7 +269,7 @@ def turn_by_yaw(vectors: np.ndarray, yaws: np.ndarray) -> np.ndarray:
     return np.stack([cos * x - sin * y, sin * x + cos * y, z])
 
 
-def _flange_at_spin(path: PreparedPath, spin: float) -> tuple[np.ndarray, np.ndarray]:
+def flange_at_spin(path: PreparedPath, spin: float) -> tuple[np.ndarray, np.ndarray]:
     """R_O_F (N, 3, 3) and p_O_F (N, 3) with every tool pose turned by ``spin`` about its z."""
     if spin == 0.0:
         return path.flange_rotation, path.flange_position
@@ -307,7 +307,7 @@ def run_chunk(
     if np.any(placements[:, 4] != placements[0, 4]):
         raise InvalidInputError("placements", "a chunk must have one spin")
     offset = placements[:, :3].T[:, :, None]  # (3, C, 1)
-    flange_rotation, flange_position_o = _flange_at_spin(path, float(placements[0, 4]))
+    flange_rotation, flange_position_o = flange_at_spin(path, float(placements[0, 4]))
     rotation = turn_by_yaw(flange_rotation.transpose(1, 2, 0), yaws)  # (3, 3, C, W)
     flange_position = turn_by_yaw(flange_position_o.T, yaws) + offset
     tool_position = turn_by_yaw(path.tool_position.T, yaws) + offset

@@ -15,6 +15,7 @@ import numpy as np
 
 from solver._malloc import raise_malloc_thresholds
 from solver.families.base import Branch
+from solver.map_kernel import limit_modes, map_cells
 from solver.parallel import SERIAL, TaskRunner
 from solver.pipeline import (
     DEFAULT_MAX_JOINT_STEP,
@@ -22,7 +23,9 @@ from solver.pipeline import (
     SpinMode,
     branch_indices,
     check_placements,
+    flange_at_spin,
     prepare_path,
+    require_family,
     run_chunk,
 )
 from solver.robots import Robot
@@ -89,6 +92,52 @@ def _chunk(
     )
 
 
+def _compiled_chunk(
+    robot: Robot,
+    path: PreparedPath,
+    placements: np.ndarray,
+    branches: np.ndarray,
+    max_joint_step: float,
+    with_speeds: bool,
+    kernel: tuple[int, np.ndarray],
+) -> tuple[np.ndarray, ...]:
+    """The columns of :func:`_chunk` by the compiled kernel (:mod:`solver.map_kernel`).
+
+    The placements may have any yaws, and one spin.
+    """
+    n_cells, n_waypoints = len(placements), path.n_waypoints
+    rotation, position = flange_at_spin(path, float(placements[0, 4]))
+    modes, arc = limit_modes(robot.q_lower, robot.q_upper)
+    mu = np.empty(n_cells)
+    codes = [np.empty(n_cells, dtype=np.int64) for _ in range(5)]
+    v_max = np.empty((n_cells, n_waypoints if with_speeds else 0))
+    contiguous = np.ascontiguousarray
+    map_cells(
+        kernel[0],
+        kernel[1],
+        np.cos(placements[:, 3]),
+        np.sin(placements[:, 3]),
+        contiguous(placements[:, :3]),
+        contiguous(rotation),
+        contiguous(position),
+        contiguous(path.tool_position),
+        contiguous(path.twist),
+        contiguous(path.pure_rotation),
+        contiguous(path.segment_in_pass),
+        branches.astype(np.int64),
+        contiguous(robot.q_lower, dtype=float),
+        contiguous(robot.q_upper, dtype=float),
+        modes,
+        arc,
+        contiguous(robot.qdot_max, dtype=float),
+        float(max_joint_step),
+        mu,
+        *codes,
+        v_max,
+    )
+    return (mu, *codes, v_max)
+
+
 def _task(
     robot: Robot,
     path: PreparedPath,
@@ -97,27 +146,38 @@ def _task(
     spin_mode: SpinMode,
     with_speeds: bool,
     chunk: int,
+    compiled: bool,
     placements: np.ndarray,
 ) -> tuple[np.ndarray, ...]:
     """Evaluate a task's placements in chunks: the columns of :func:`_chunk`, concatenated.
 
-    A task may run in another process (a Dask worker), so it sets the malloc thresholds itself.
+    The compiled kernel, where the family has one and the spin is fixed, takes placements of
+    any yaws together; the numpy pipeline takes one yaw at a time. A task may run in another
+    process (a Dask worker), so it sets the malloc thresholds itself.
     """
     raise_malloc_thresholds()
-    parts = [
-        _chunk(robot, path, rows, branches, max_joint_step, spin_mode, with_speeds)
-        for rows in _pieces(placements, chunk)
-    ]
+    kernel = require_family(robot).map_kernel() if compiled and spin_mode == "fixed" else None
+    if kernel is not None:
+        parts = [
+            _compiled_chunk(robot, path, rows, branches, max_joint_step, with_speeds, kernel)
+            for rows in _pieces(placements, chunk, by_yaw=False)
+        ]
+    else:
+        parts = [
+            _chunk(robot, path, rows, branches, max_joint_step, spin_mode, with_speeds)
+            for rows in _pieces(placements, chunk)
+        ]
     return tuple(np.concatenate(c) for c in zip(*parts, strict=True))
 
 
-def _pieces(placements: np.ndarray, size: int) -> list[np.ndarray]:
-    """Consecutive rows, at most ``size``, cut where the yaw or the spin changes.
+def _pieces(placements: np.ndarray, size: int, *, by_yaw: bool = True) -> list[np.ndarray]:
+    """Consecutive rows, at most ``size``, cut where the spin (and, ``by_yaw``, the yaw) changes.
 
-    A grid's yaw-major order gives pieces of one yaw each, which are cheaper; a chunk of the
-    pipeline has one spin.
+    A grid's yaw-major order gives pieces of one yaw each, which are cheaper for the numpy
+    pipeline; a chunk has one spin.
     """
-    cuts = np.flatnonzero(np.any(np.diff(placements[:, 3:5], axis=0) != 0.0, axis=1)) + 1
+    columns = placements[:, 3:5] if by_yaw else placements[:, 4:5]
+    cuts = np.flatnonzero(np.any(np.diff(columns, axis=0) != 0.0, axis=1)) + 1
     return [
         run[start : start + size]
         for run in np.split(placements, cuts)
@@ -137,6 +197,7 @@ def evaluate_placements(
     chunk: int = DEFAULT_CHUNK,
     progress: Callable[[float], None] | None = None,
     runner: TaskRunner = SERIAL,
+    compiled: bool = True,
 ) -> PlacementResults:
     """mu_path of a path at each of P placements.
 
@@ -154,6 +215,8 @@ def evaluate_placements(
         progress: called with the fraction done (0..1] as tasks complete; it may raise
             (:class:`solver.progress.Cancelled`) to stop the work.
         runner: runs the tasks (:mod:`solver.parallel`); every runner gives the same answer.
+        compiled: use the compiled kernel where the family has one and the spin is fixed
+            (:mod:`solver.map_kernel`); False runs the numpy pipeline, the reference.
 
     Raises:
         NoAnalyticIkError, InvalidInputError: as :func:`solver.evaluate.evaluate_path`.
@@ -161,7 +224,7 @@ def evaluate_placements(
     branches = branch_indices(robot, branch, max_joint_step=max_joint_step, spin_mode=spin_mode)
     cells = check_placements(placements)
     raise_malloc_thresholds()
-    tasks = _pieces(cells, runner.task_size(len(cells), chunk))
+    tasks = _pieces(cells, runner.task_size(len(cells), chunk), by_yaw=False)
     completed = [0]
 
     def done(i: int) -> None:
@@ -169,7 +232,9 @@ def evaluate_placements(
         if progress is not None:
             progress(completed[0] / len(cells))
 
-    work = partial(_task, robot, path, branches, max_joint_step, spin_mode, with_speeds, chunk)
+    work = partial(
+        _task, robot, path, branches, max_joint_step, spin_mode, with_speeds, chunk, compiled
+    )
     parts = runner.run(work, tasks, done)
     empty = (np.zeros(0), *(np.zeros(0, dtype=int),) * 5, np.zeros((0, path.n_waypoints)))
     columns = [np.concatenate(c) for c in zip(*parts, strict=True)] if parts else list(empty)

@@ -26,6 +26,7 @@ from service.config import Settings
 from service.errors import request_location, solver_error_location
 from service.jobs.store import JobStore
 from service.metrics import log, log_to_stderr
+from solver import map_kernel
 from solver.exceptions import SolverError
 from solver.parallel import TaskRunner, ThreadRunner
 from solver.progress import Cancelled, Progress
@@ -152,6 +153,7 @@ def serve(connection: Connection, store_path: str, settings_json: str) -> None:
     log_to_stderr()
     store = JobStore(Path(store_path))
     settings = Settings.model_validate_json(settings_json)
+    map_kernel.warm_up()  # before the first job, not in it
     while True:
         try:
             job_id = connection.recv()

@@ -130,6 +130,15 @@ class KinematicsFamily(abc.ABC):
         """
         return float(n_waypoints)
 
+    def map_kernel(self) -> tuple[int, np.ndarray] | None:
+        """The compiled pose kernel's family code and parameters, or None where there is none.
+
+        A family with a pose kernel in :mod:`solver.families.kernels` runs maps in fixed spin
+        through the compiled pipeline (:mod:`solver.map_kernel`); any other family, and every
+        family in free spin, through the numpy pipeline, which is the reference.
+        """
+        return None
+
     def solve_path(self, rotation: np.ndarray, position: np.ndarray) -> PathSolutions:
         """IK solutions along paths: waypoints on the last batch axis, branches followed.
 
@@ -178,12 +187,15 @@ class ClosedFormFamily(KinematicsFamily):
     A subclass names the family and gives its branches and its two functions, each taking the
     parameters first (``solve(parameters, rotation, position)``,
     ``speeds(parameters, q, twist, tool_point)``), as :mod:`solver.families.ur` and
-    :mod:`solver.families.opw` do.
+    :mod:`solver.families.opw` do; and, for the compiled map, its pose kernel's code in
+    :mod:`solver.families.kernels` and the function that makes the kernel's parameters.
     """
 
     branch_labels: tuple[Branch, ...]
     solve_function: Callable[..., tuple[np.ndarray, np.ndarray]]
     speeds_function: Callable[..., np.ndarray]
+    kernel_code: int | None = None
+    kernel_parameters_function: Callable[..., np.ndarray] | None = None
 
     def __init__(self, parameters: object) -> None:
         """Hold the arm's parameters (the geometry the two functions take)."""
@@ -202,6 +214,13 @@ class ClosedFormFamily(KinematicsFamily):
     def solve(self, rotation: np.ndarray, position: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """All branches in closed form (see :meth:`KinematicsFamily.solve`)."""
         return type(self).solve_function(self.parameters, rotation, position)
+
+    def map_kernel(self) -> tuple[int, np.ndarray] | None:
+        """The family's pose kernel code and this arm's kernel parameters (see the base)."""
+        make = type(self).kernel_parameters_function
+        if self.kernel_code is None or make is None:
+            return None
+        return self.kernel_code, make(self.parameters)
 
     def joint_speeds_per_unit_twist(
         self,

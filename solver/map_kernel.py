@@ -1,0 +1,407 @@
+"""The map's compiled kernel: the whole pipeline per placement in one loop (dtf.md section 9).
+
+For the closed-form families in fixed spin, :func:`solver.placements.evaluate_placements` runs
+this kernel instead of the numpy pipeline (:func:`solver.pipeline.run_chunk`), which stays the
+reference it is tested against (tests/solver/test_map_kernel.py: the same reasons, failed
+waypoints, branches and bottlenecks, mu_path to 1e-12). Per placement, waypoint by waypoint:
+
+1. turn the prepared path by the placement's yaw and move it (the same arithmetic as
+   :func:`solver.pipeline.turn_by_yaw`);
+2. IK of the flange pose on all branches and J^-1 t on each (the family's pose kernel,
+   :mod:`solver.families.kernels`), every angle a (cos, sin) pair;
+3. each branch still alive: unreachable, then singular, then the step test
+   cos(dq) >= cos(max_joint_step) against the previous waypoint (no angle, no unwrapping);
+   then its DTF, 1 / max_j |qd_j| / qdot_max_j, and the running minimum;
+4. after the path, position limits: a joint whose limits span 2 pi or more fits when the
+   path's total turning (bounded from the squared chords of the (cos, sin) steps) leaves a
+   full turn of room; a joint with a narrower range fits when every waypoint is inside its
+   arc and no step can cross the arc's gap. Only a branch that neither test clears forms its angles
+   (atan2) and runs the exact test of :func:`solver.tracking.track`;
+5. the branch: :func:`solver.tracking.choose_branch`'s rule.
+
+A branch stops at its first failure and a placement at its last live branch. Why compiled:
+the fused loop keeps one waypoint's values in registers, where numpy makes and reads back an
+array per formula; measured in ``bench/run.py``.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import math
+from pathlib import Path
+
+import numpy as np
+from numba import njit
+
+import solver.families.kernels
+import solver.families.opw.kernel
+import solver.families.ur.kernel
+from solver.families.base import SINGULAR, UNREACHABLE
+from solver.families.kernels import UR_KERNEL, pose_kernel
+from solver.families.ur.dh import UR_DH
+from solver.tracking import FEASIBLE, TIE_RTOL
+
+_UNREACHABLE, _JOINT_LIMITS, _SINGULAR, _DISCONTINUOUS = range(4)  # solver.tracking's codes
+_TWO_PI = 2 * math.pi
+_EDGE = 1e-12  # as solver.tracking
+# Fast tests of the position limits leave this much (rad) to rounding; a branch nearer than
+# that to failing them goes to the exact test.
+_MARGIN = 1e-9
+_NO_LIMIT, _WIDE, _NARROW = 0, 1, 2
+# 2 asin(c / 2) / c, the turn per unit chord, is at most this for chords up to 0.5 (a turn of
+# 0.505 rad) and at most pi / 2 for any chord.
+_CHORD_SMALL = 0.5
+_TURN_PER_CHORD_SMALL = 1.0108
+_UR5 = UR_DH["ur5"]
+
+
+def _drop_stale_compiled_code() -> None:
+    """Delete the cached machine code of the kernel when a pose kernel's source has changed.
+
+    numba's disk cache (``cache=True``, files in ``__pycache__``) is keyed by the source file
+    of the cached function only, but :func:`map_cells` and the families' dispatcher compile the
+    pose kernels into themselves: after an edit of a pose kernel they would load the old code.
+    A marker named by the hash of those sources says which code the cache holds. Where the
+    directories cannot be written (an installed copy), numba caches elsewhere or not at all
+    and nothing is done here.
+    """
+    modules = (solver.families.kernels, solver.families.ur.kernel, solver.families.opw.kernel)
+    sources = b"".join(Path(str(module.__file__)).read_bytes() for module in modules)
+    stamp = hashlib.sha256(sources).hexdigest()[:16]
+    caches = {
+        Path(__file__).parent / "__pycache__": "map_kernel",
+        Path(str(solver.families.kernels.__file__)).parent / "__pycache__": "kernels",
+    }
+    marker = Path(__file__).parent / "__pycache__" / f"map_kernel.sources-{stamp}"
+    try:
+        if marker.exists():
+            return
+        for directory, stem in caches.items():
+            for stale in [*directory.glob(f"{stem}.*.nbi"), *directory.glob(f"{stem}.*.nbc")]:
+                stale.unlink(missing_ok=True)
+        for old in marker.parent.glob("map_kernel.sources-*"):
+            old.unlink(missing_ok=True)
+        marker.parent.mkdir(exist_ok=True)
+        marker.touch()
+    except OSError:
+        return
+
+
+_drop_stale_compiled_code()
+
+
+def limit_modes(lower: np.ndarray, upper: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Per joint: how the kernel tests its position limits, and the arc of a narrow range.
+
+    Returns:
+        modes: shape (n,), 0 no limit, 1 a range of 2 pi or more, 2 a narrower one;
+        arc: shape (n, 3), cos and sin of the range's middle and cos of its half width.
+    """
+    width = upper - lower
+    modes = np.where(~np.isfinite(width), _NO_LIMIT, np.where(width >= _TWO_PI, _WIDE, _NARROW))
+    middle = np.where(np.isfinite(width), (lower + upper) / 2, 0.0)
+    half = np.where(np.isfinite(width), width / 2, 0.0)
+    arc = np.column_stack([np.cos(middle), np.sin(middle), np.cos(half)])
+    return modes.astype(np.int64), arc
+
+
+@njit(cache=True, error_model="numpy", nogil=True)
+def _exact_limits(cq, sq, b, lower, upper):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
+    """The first waypoint whose joint range no 2 pi copy holds (the path's length: none).
+
+    :func:`solver.tracking.track`'s test on one branch: the angles of the pairs, unwrapped by
+    the wrapped steps, the whole path first, then the running range where it fails.
+    """
+    n_waypoints, dof = cq.shape[0], cq.shape[2]
+    path = np.empty((n_waypoints, dof))
+    for j in range(dof):
+        previous = math.atan2(sq[0, b, j], cq[0, b, j])
+        path[0, j] = previous
+        for w in range(1, n_waypoints):
+            angle = math.atan2(sq[w, b, j], cq[w, b, j])
+            step = angle - previous
+            if step > math.pi:
+                step -= _TWO_PI
+            elif step < -math.pi:
+                step += _TWO_PI
+            path[w, j] = path[w - 1, j] + step
+            previous = angle
+    fits = True
+    for j in range(dof):
+        low, high = path[0, j], path[0, j]
+        for w in range(1, n_waypoints):
+            low, high = min(low, path[w, j]), max(high, path[w, j])
+        k_low = math.ceil((lower[j] - low) / _TWO_PI - _EDGE)
+        k_high = math.floor((upper[j] - high) / _TWO_PI + _EDGE)
+        if k_low > k_high:
+            fits = False
+    if fits:
+        return n_waypoints
+    low_run, high_run = path[0].copy(), path[0].copy()
+    for w in range(n_waypoints):
+        for j in range(dof):
+            low_run[j] = min(low_run[j], path[w, j])
+            high_run[j] = max(high_run[j], path[w, j])
+            k_low = math.ceil((lower[j] - low_run[j]) / _TWO_PI - _EDGE)
+            k_high = math.floor((upper[j] - high_run[j]) / _TWO_PI + _EDGE)
+            if k_low > k_high:
+                return w
+    return n_waypoints
+
+
+@njit(cache=True, error_model="numpy", nogil=True)
+def map_cells(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
+    family,
+    par,
+    cos_yaw,
+    sin_yaw,
+    offset,
+    flange_rotation,
+    flange_position,
+    tool_position,
+    twist,
+    pure_rotation,
+    segment_checked,
+    branches,
+    lower,
+    upper,
+    modes,
+    arc,
+    qdot_max,
+    max_joint_step,
+    mu,
+    reason,
+    failed,
+    branch,
+    bottleneck_waypoint,
+    bottleneck_joint,
+    v_out,
+):
+    """Evaluate C placements; the answers go to the arrays after ``max_joint_step``.
+
+    Args:
+        family: the family's kernel code (:mod:`solver.families.kernels`).
+        par: the family's kernel parameters.
+        cos_yaw: shape (C,), cos of each placement's yaw.
+        sin_yaw: shape (C,), its sine.
+        offset: shape (C, 3), each placement's position (m).
+        flange_rotation: shape (W, 3, 3), R_O_F at the chunk's spin.
+        flange_position: shape (W, 3), m, in {O}.
+        tool_position: shape (W, 3), m, in {O}.
+        twist: shape (W, 6), t_hat in {O}.
+        pure_rotation: shape (W,), bool, where h = 0.
+        segment_checked: shape (W - 1,), bool, where the step bound applies.
+        branches: shape (B,), the branch indices to follow.
+        lower: shape (6,), rad, lower position limits.
+        upper: shape (6,), rad, upper position limits.
+        modes: from :func:`limit_modes`.
+        arc: from :func:`limit_modes`.
+        qdot_max: shape (6,), rad/s.
+        max_joint_step: rad.
+        mu: shape (C,), out, m/s, NaN where infeasible.
+        reason: shape (C,), out, as :class:`solver.placements.PlacementResults`.
+        failed: shape (C,), out, the failed waypoint.
+        branch: shape (C,), out, the branch index.
+        bottleneck_waypoint: shape (C,), out.
+        bottleneck_joint: shape (C,), out.
+        v_out: shape (C, W), out, V_max on the chosen branch, or (C, 0) when not wanted.
+    """
+    n_cells = cos_yaw.shape[0]
+    n_waypoints = flange_rotation.shape[0]
+    n_branches = branches.shape[0]
+    n_all = 8
+    dof = 6
+    cq = np.empty((n_waypoints, n_all, dof))
+    sq = np.empty((n_waypoints, n_all, dof))
+    status = np.empty(n_all, dtype=np.int64)
+    need = np.empty(n_all, dtype=np.bool_)
+    qd = np.empty((n_all, dof))
+    rot = np.empty((3, 3))
+    pos = np.empty(3)
+    tw = np.empty(6)
+    tool = np.empty(3)
+    alive = np.empty(n_branches, dtype=np.bool_)
+    why = np.empty(n_branches, dtype=np.int64)
+    where = np.empty(n_branches, dtype=np.int64)
+    slowest = np.empty(n_branches)
+    slowest_at = np.empty(n_branches, dtype=np.int64)
+    slowest_joint = np.empty(n_branches, dtype=np.int64)
+    chords2 = np.empty((n_branches, dof))
+    largest2 = np.empty((n_branches, dof))
+    inside = np.empty((n_branches, dof))
+    speeds = np.empty((n_branches, n_waypoints)) if v_out.shape[1] else np.empty((0, 0))
+    inverse_qdot = 1.0 / qdot_max
+    check_steps = max_joint_step < math.pi
+    cos_step = math.cos(max_joint_step)
+    for c in range(n_cells):
+        ca, sa = cos_yaw[c], sin_yaw[c]
+        alive[:] = True
+        why[:] = FEASIBLE
+        where[:] = -1
+        chords2[:] = 0.0
+        largest2[:] = 0.0
+        inside[:] = np.inf
+        n_alive = n_branches
+        for w in range(n_waypoints):
+            for k in range(3):
+                x, y = flange_rotation[w, 0, k], flange_rotation[w, 1, k]
+                rot[0, k] = ca * x - sa * y
+                rot[1, k] = sa * x + ca * y
+                rot[2, k] = flange_rotation[w, 2, k]
+            x, y = flange_position[w, 0], flange_position[w, 1]
+            pos[0] = ca * x - sa * y + offset[c, 0]
+            pos[1] = sa * x + ca * y + offset[c, 1]
+            pos[2] = flange_position[w, 2] + offset[c, 2]
+            x, y = tool_position[w, 0], tool_position[w, 1]
+            tool[0] = ca * x - sa * y + offset[c, 0]
+            tool[1] = sa * x + ca * y + offset[c, 1]
+            tool[2] = tool_position[w, 2] + offset[c, 2]
+            for k in range(0, 6, 3):
+                x, y = twist[w, k], twist[w, k + 1]
+                tw[k] = ca * x - sa * y
+                tw[k + 1] = sa * x + ca * y
+                tw[k + 2] = twist[w, k + 2]
+            need[:] = False
+            for i in range(n_branches):
+                need[branches[i]] = need[branches[i]] or alive[i]
+            pose_kernel(family, par, rot, pos, tw, tool, need, cq[w], sq[w], status, qd)
+            for i in range(n_branches):
+                if not alive[i]:
+                    continue
+                b = branches[i]
+                code = -1
+                if status[b] == UNREACHABLE:
+                    code = _UNREACHABLE
+                elif status[b] == SINGULAR:
+                    code = _SINGULAR
+                elif w > 0:
+                    checked = check_steps and segment_checked[w - 1]
+                    for j in range(dof):
+                        c0, s0 = cq[w - 1, b, j], sq[w - 1, b, j]
+                        c1, s1 = cq[w, b, j], sq[w, b, j]
+                        if checked and c0 * c1 + s0 * s1 < cos_step:
+                            code = _DISCONTINUOUS
+                            break
+                        if modes[j] != _NO_LIMIT:
+                            chord2 = (c1 - c0) * (c1 - c0) + (s1 - s0) * (s1 - s0)
+                            chords2[i, j] += chord2
+                            largest2[i, j] = max(largest2[i, j], chord2)
+                if code >= 0:
+                    alive[i] = False
+                    why[i] = code
+                    where[i] = w
+                    n_alive -= 1
+                    continue
+                largest = -1.0
+                limiting = 0
+                for j in range(dof):
+                    if modes[j] == _NARROW:
+                        margin = cq[w, b, j] * arc[j, 0] + sq[w, b, j] * arc[j, 1] - arc[j, 2]
+                        inside[i, j] = min(inside[i, j], margin)
+                    ratio = abs(qd[b, j]) * inverse_qdot[j]
+                    if ratio > largest:
+                        largest = ratio
+                        limiting = j
+                speed = 1.0 / largest
+                v = 0.0 if pure_rotation[w] else speed
+                if w == 0 or v < slowest[i]:
+                    slowest[i] = v
+                    slowest_at[i] = w
+                    slowest_joint[i] = limiting
+                if speeds.shape[0]:
+                    speeds[i, w] = v
+            if n_alive == 0:
+                break
+        for i in range(n_branches):
+            if not alive[i]:
+                continue
+            exact = False
+            for j in range(dof):
+                if modes[j] == _NO_LIMIT:
+                    continue
+                # A chord c turns by 2 asin(c / 2) <= factor c; the sum of the chords is at
+                # most sqrt(segments x the sum of their squares) (Cauchy-Schwarz).
+                small = largest2[i, j] <= _CHORD_SMALL * _CHORD_SMALL
+                factor = _TURN_PER_CHORD_SMALL if small else math.pi / 2
+                if modes[j] == _WIDE:
+                    turning = factor * math.sqrt((n_waypoints - 1) * chords2[i, j])
+                    exact = exact or turning > upper[j] - lower[j] - _TWO_PI - _MARGIN
+                else:
+                    largest_step = factor * math.sqrt(largest2[i, j])
+                    gap = _TWO_PI - (upper[j] - lower[j]) - _MARGIN
+                    exact = exact or inside[i, j] <= _MARGIN or largest_step >= gap
+            if exact:
+                first = _exact_limits(cq, sq, branches[i], lower, upper)
+                if first < n_waypoints:
+                    alive[i] = False
+                    why[i] = _JOINT_LIMITS
+                    where[i] = first
+        # solver.tracking.choose_branch: the highest mu_path, ties to the first branch.
+        top = -np.inf
+        for i in range(n_branches):
+            if alive[i] and slowest[i] > top:
+                top = slowest[i]
+        pick = -1
+        for i in range(n_branches):
+            if alive[i] and slowest[i] >= top - TIE_RTOL * abs(top):
+                pick = i
+                break
+        if pick >= 0:
+            mu[c] = slowest[pick]
+            reason[c] = FEASIBLE
+            failed[c] = -1
+            bottleneck_waypoint[c] = slowest_at[pick]
+            bottleneck_joint[c] = slowest_joint[pick]
+            for w in range(v_out.shape[1]):
+                v_out[c, w] = speeds[pick, w]
+        else:
+            furthest = -1
+            for i in range(n_branches):
+                furthest = max(furthest, where[i])
+            for i in range(n_branches):
+                if where[i] == furthest:
+                    pick = i
+                    break
+            mu[c] = np.nan
+            reason[c] = why[pick]
+            failed[c] = where[pick]
+            bottleneck_waypoint[c] = -1
+            bottleneck_joint[c] = -1
+            for w in range(v_out.shape[1]):
+                v_out[c, w] = np.nan
+        branch[c] = branches[pick]
+
+
+def warm_up() -> None:
+    """Compile the kernel, or load it from the disk cache, so that no request pays for it.
+
+    One placement of a two-waypoint UR5 path: the kernel has one signature for every family.
+    """
+    rotation = np.tile(np.diag([1.0, -1.0, -1.0]), (2, 1, 1))
+    position = np.array([[0.0, 0.4, 0.2], [0.01, 0.4, 0.2]])
+    twist = np.tile([1.0, 0.0, 0.0, 0.0, 0.0, 0.0], (2, 1))
+    modes, arc = limit_modes(np.full(6, -_TWO_PI), np.full(6, _TWO_PI))
+    integers = [np.empty(1, dtype=np.int64) for _ in range(5)]
+    map_cells(
+        UR_KERNEL,
+        solver.families.ur.kernel.kernel_parameters(_UR5),
+        np.ones(1),
+        np.zeros(1),
+        np.zeros((1, 3)),
+        rotation,
+        position,
+        position.copy(),
+        twist,
+        np.zeros(2, dtype=np.bool_),
+        np.ones(1, dtype=np.bool_),
+        np.arange(8, dtype=np.int64),
+        np.full(6, -_TWO_PI),
+        np.full(6, _TWO_PI),
+        modes,
+        arc,
+        np.full(6, math.pi),
+        0.35,
+        np.empty(1),
+        *integers,
+        np.empty((1, 0)),
+    )

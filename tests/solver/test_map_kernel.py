@@ -1,0 +1,174 @@
+"""The compiled map kernel equals the numpy pipeline, its reference, cell by cell (issue 12).
+
+Every comparison runs :func:`solver.placements.evaluate_placements` twice on the same
+placements: compiled (the default for UR and OPW arms in fixed spin) and ``compiled=False``
+(the numpy pipeline, itself checked against an LP, pinocchio and independent IK elsewhere).
+mu_path and V_max along the chosen branch agree to 1e-12 relative; the reason, the failed
+waypoint, the branch, the bottleneck waypoint and joint are identical.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+
+import numpy as np
+import pytest
+
+import solver.placements
+from solver.families.base import Branch
+from solver.families.opw.kernel import kernel_parameters
+from solver.kinematics import tool_pose_in_base
+from solver.placements import PlacementResults, evaluate_placements, prepare_path
+from solver.robots import Robot, get_robot
+from solver.tracking import REASONS
+from tests.solver.families.test_opw import build
+from tests.solver.test_evaluate import load_path, wrist_singular_path
+from tests.solver.test_parallel import grid_placements
+
+COLUMNS = ("reason", "failed_waypoint", "branch", "bottleneck_waypoint", "bottleneck_joint")
+
+
+def grid(xs: np.ndarray, ys: np.ndarray, z: float, yaws: np.ndarray) -> np.ndarray:
+    """Placements (P, 4), yaw-major, as a map orders them."""
+    yaw, y, x = np.meshgrid(yaws, ys, xs, indexing="ij")
+    return np.column_stack([x.ravel(), y.ravel(), np.full(x.size, z), yaw.ravel()])
+
+
+def same_cells(
+    robot: Robot, waypoints: np.ndarray, placements: np.ndarray, **options: object
+) -> tuple[PlacementResults, set[str]]:
+    """Assert the kernel's cells equal the reference's; the results and the reasons seen."""
+    path = prepare_path(robot, waypoints, passes=options.pop("passes", None))  # type: ignore[arg-type]
+    compiled = evaluate_placements(robot, path, placements, with_speeds=True, **options)  # type: ignore[arg-type]
+    numpy = evaluate_placements(
+        robot,
+        path,
+        placements,
+        with_speeds=True,
+        compiled=False,
+        **options,  # type: ignore[arg-type]
+    )
+    for name in COLUMNS:
+        np.testing.assert_array_equal(getattr(compiled, name), getattr(numpy, name), err_msg=name)
+    np.testing.assert_array_equal(np.isnan(compiled.mu_path), np.isnan(numpy.mu_path))
+    np.testing.assert_allclose(compiled.mu_path, numpy.mu_path, rtol=1e-12, atol=0.0)
+    np.testing.assert_allclose(compiled.v_max, numpy.v_max, rtol=1e-12, atol=0.0)
+    reasons = {REASONS[r] for r in numpy.reason if r >= 0}
+    if np.isfinite(numpy.mu_path).any():
+        reasons.add("feasible")
+    return compiled, reasons
+
+
+def test_the_compiled_kernel_is_what_runs(monkeypatch: pytest.MonkeyPatch) -> None:
+    """A UR map in fixed spin never touches the numpy pipeline (else the equality is moot)."""
+
+    def refuse(*args: object, **kwargs: object) -> None:
+        raise AssertionError("the numpy pipeline ran")
+
+    monkeypatch.setattr(solver.placements, "run_chunk", refuse)
+    robot = get_robot("ur5")
+    path = prepare_path(robot, load_path("curved_line"))
+    result = evaluate_placements(robot, path, np.array([[0.0, 0.45, 0.1, 0.0]]))
+    assert np.isfinite(result.mu_path[0])
+    with pytest.raises(AssertionError, match="numpy pipeline"):
+        evaluate_placements(robot, path, np.array([[0.0, 0.45, 0.1, 0.0]]), compiled=False)
+
+
+def test_erk_grid() -> None:
+    """The ERK 2021 map: UR5, 546 cells, 133 waypoints, one yaw."""
+    placements = grid(
+        np.arange(-0.25, 0.25 + 1e-9, 0.02), np.arange(0.25, 0.65 + 1e-9, 0.02), 0.1, np.zeros(1)
+    )
+    result, _ = same_cells(get_robot("ur5"), load_path("curved_line"), placements)
+    assert len(placements) == 546 and np.isfinite(result.mu_path).all()
+
+
+def test_eight_yaw_grid() -> None:
+    """8 yaws in one call: the kernel takes mixed yaws, the numpy pipeline one at a time."""
+    placements = grid_placements()
+    rng = np.random.default_rng(3)
+    shuffled = placements[rng.permutation(len(placements))]  # yaws mixed in every chunk
+    _, reasons = same_cells(get_robot("ur5"), load_path("s_curve"), shuffled)
+    assert {"feasible", "unreachable"} <= reasons
+
+
+def test_wide_grid_with_every_reason() -> None:
+    """Unreachable, joint-limit, singular and discontinuous cells, each as the reference says."""
+    seen: set[str] = set()
+    wide = grid(
+        np.linspace(-1.0, 1.0, 11), np.linspace(-1.0, 1.0, 11), 0.1, np.array([0.0, 2.0, -2.5])
+    )
+    for robot in (
+        get_robot("ur5"),
+        # Limits narrower than a turn (the arc test) and exactly a turn (the exact test).
+        dataclasses.replace(
+            get_robot("ur5e"), q_lower=np.full(6, -math.pi / 2), q_upper=np.full(6, math.pi)
+        ),
+        dataclasses.replace(
+            get_robot("ur5e"), q_lower=np.full(6, -math.pi), q_upper=np.full(6, math.pi)
+        ),
+    ):
+        _, reasons = same_cells(robot, load_path("curved_line"), wide)
+        seen |= reasons
+    robot = get_robot("ur5e")
+    singular = grid(np.array([-0.05, 0.0, 0.05]), np.array([0.0, 0.05]), 0.0, np.array([0.0, 0.2]))
+    for branch in (None, Branch.named(shoulder="left", elbow="up", wrist="flip")):
+        result, reasons = same_cells(robot, wrist_singular_path(robot), singular, branch=branch)
+        seen |= reasons
+    assert REASONS[result.reason[1]] == "singular" and result.failed_waypoint[1] == 2
+    assert {"feasible", "unreachable", "joint_limits", "singular", "discontinuous"} <= seen
+
+
+def test_steps_passes_and_one_branch() -> None:
+    """A tight step, no step bound, a rapid between passes, a fixed branch."""
+    robot = get_robot("ur10")
+    waypoints = load_path("s_curve")
+    placements = grid(np.linspace(-0.6, 0.6, 7), np.linspace(0.2, 1.0, 5), 0.2, np.array([0.5]))
+    _, tight = same_cells(robot, waypoints, placements, max_joint_step=0.02)
+    assert "discontinuous" in tight
+    same_cells(robot, waypoints, placements, max_joint_step=4.0)
+    half = len(waypoints) // 2
+    same_cells(robot, waypoints, placements, passes=[(0, half), (half, len(waypoints))])
+    branch = Branch.named(shoulder="right", elbow="down", wrist="noflip")
+    result, _ = same_cells(robot, waypoints, placements, branch=branch)
+    assert set(result.branch) == {robot.family.branch_index(branch)}  # type: ignore[union-attr]
+
+
+@pytest.mark.parametrize("name", ["kuka_kr6_r700_sixx", "abb_irb2400", "offsets_everywhere"])
+def test_opw_arms(name: str) -> None:
+    """OPW: catalogue limits (narrow arcs), offsets and sign corrections, b != 0."""
+    robot = build(name)
+    reach = robot.family.parameters.c2 + robot.family.parameters.c3  # type: ignore[union-attr]
+    span = np.linspace(-1.2 * reach, 1.2 * reach, 9)
+    placements = grid(span, span, 0.1, np.array([0.0, 1.0, -2.0]))
+    _, reasons = same_cells(robot, load_path("curved_line"), placements)
+    assert {"feasible", "unreachable"} <= reasons
+    assert reasons & {"joint_limits", "discontinuous"}
+
+
+def test_opw_singular_wrist() -> None:
+    """An OPW path through theta5 = 0 at waypoint 2 of the placement (0, 0, 0, 0): singular
+    there on the branch it was made on, on each branch as the reference says."""
+    robot = build("kuka_kr6_r700_sixx")
+    family = robot.family
+    assert family is not None
+    p = family.parameters  # type: ignore[attr-defined]
+    theta = np.tile([0.3, -0.2, 0.4, 0.5, 0.0, 0.7], (5, 1))
+    theta[:, 4] = np.linspace(-0.2, 0.2, 5)
+    theta[:, 0] += np.linspace(0.0, 0.1, 5)
+    q = (theta + np.array(p.offsets)) * np.array(p.sign_corrections)
+    waypoints = np.array([tool_pose_in_base(robot, row) for row in q])
+    placements = grid(np.array([-0.02, 0.0]), np.array([0.0, 0.03]), 0.0, np.array([0.0, 0.1]))
+    at_origin = []
+    for branch in family.branches:
+        result, _ = same_cells(robot, waypoints, placements, branch=branch)
+        at_origin.append((REASONS[result.reason[1]], int(result.failed_waypoint[1])))
+    assert ("singular", 2) in at_origin
+
+
+def test_opw_kernel_parameters_carry_offsets_as_pairs() -> None:
+    p = build("offsets_everywhere").family.parameters  # type: ignore[union-attr]
+    values = kernel_parameters(p)
+    np.testing.assert_allclose(values[7:13] + 1j * values[13:19], np.exp(1j * np.array(p.offsets)))
+    np.testing.assert_array_equal(values[19:], p.sign_corrections)
