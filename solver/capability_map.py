@@ -123,6 +123,7 @@ def capability_map(
     progress: Callable[[float], None] | None = None,
     passes: Sequence[tuple[int, int]] | None = None,
     runner: TaskRunner = SERIAL,
+    compiled: bool = True,
 ) -> CapabilityMap:
     """mu_path over the grid spins x yaws x ys x xs at height z (spec section 6).
 
@@ -143,6 +144,8 @@ def capability_map(
         passes: index ranges [start, stop) of the passes of a CAM program (cam.md section
             5); None: one pass.
         runner: where the placements' tasks run (:mod:`solver.parallel`); same answer on any.
+        compiled: the compiled kernel where there is one; False: the numpy pipeline (the
+            reference, :func:`solver.placements.evaluate_placements`).
 
     Raises:
         NoAnalyticIkError, InvalidInputError, RepeatedWaypointError: as ``evaluate_path``.
@@ -171,6 +174,7 @@ def capability_map(
         chunk=chunk,
         progress=progress,
         runner=runner,
+        compiled=compiled,
     )
     return CapabilityMap(
         xs=xs,

@@ -28,8 +28,8 @@ def kernel_parameters(dh: UrDh) -> np.ndarray:
     return np.array([dh.d1, dh.a2, dh.a3, dh.d4, dh.d5, dh.d6])
 
 
-@njit(cache=True, error_model="numpy", nogil=True, inline="always")
-def _unit_pair(x: float, y: float) -> tuple[float, float]:  # type: ignore[misc]  # pragma: no cover - compiled
+@njit(cache=True, error_model="numpy", nogil=True, inline="always")  # type: ignore[untyped-decorator]
+def _unit_pair(x: float, y: float) -> tuple[float, float]:  # pragma: no cover - compiled
     """(cos, sin) of atan2(y, x); (1, 0) where both are 0, as atan2(0, 0) = 0.
 
     sqrt(x^2 + y^2), not math.hypot: libm's hypot costs about 20 ns, which was most of the
