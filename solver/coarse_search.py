@@ -30,11 +30,16 @@ MAX_COARSE_CELLS = 50_000  # default limit on the coarse map (a box larger is an
 
 @dataclass(frozen=True)
 class Cell:
-    """A decision vector [x, y, yaw, spin, z] with its mu_path and IK branch index."""
+    """A decision vector [x, y, yaw, spin, z] with its mu_path and IK branch index.
+
+    ``coarse`` is the coarse map's cell a refined cell climbed from (:func:`refine_cells`),
+    with its mu_path and branch; None for a cell of the coarse map itself.
+    """
 
     vector: np.ndarray
     mu_path: float
     branch: int
+    coarse: Cell | None = None
 
 
 def _spin_values(bounds: PlacementBounds) -> tuple[np.ndarray, bool]:

@@ -31,6 +31,7 @@ from solver.coarse_search import MAX_COARSE_CELLS, Cell, coarse_cells
 from solver.evaluate import DEFAULT_MAX_JOINT_STEP, PathEvaluation, evaluate_path
 from solver.exceptions import InvalidInputError, quoted
 from solver.joint_path import EXACT_POSE_TOLERANCE, evaluate_joint_path
+from solver.local_search import climb, refine_cells
 from solver.parallel import SERIAL, TaskRunner
 from solver.pipeline import PreparedPath, SpinMode, prepare_path, require_family
 from solver.placement_nlp import PlacementNlp
@@ -48,7 +49,9 @@ from solver.spatial import Placement, spun_waypoints
 from solver.symmetry import arc_coordinates, arc_point, turns_about_base_z
 
 Method = Literal["casadi", "scipy"]
-N_STARTS = 4  # IPOPT solves, from the best local maxima of the coarse map
+N_STARTS = 4  # IPOPT solves, from the coarse maxima that refine best
+N_CLIMBS = 2  # Nelder-Mead climbs on mu_path (solver.local_search), from the best refined cells
+CLIMB_STATUS = "Nelder-Mead on mu_path, from a refined cell"  # a climb's candidate status
 
 
 @dataclass(frozen=True)
@@ -256,7 +259,17 @@ def optimize_placement(
             spin_mode=spin_mode,
             max_cells=max_coarse_cells,
             max_poses=max_coarse_poses,
-            progress=span(progress, 0.0, 0.3),
+            progress=span(progress, 0.0, 0.25),
+            runner=runner,
+        )
+        cells = refine_cells(
+            robot,
+            prepared,
+            bounds,
+            cells,
+            max_joint_step=max_joint_step,
+            spin_mode=spin_mode,
+            progress=span(progress, 0.25, 0.3),
             runner=runner,
         )
         candidates, iterations = _casadi(
@@ -383,7 +396,9 @@ def _casadi(
     progress: Progress | None,
     passes: Sequence[tuple[int, int]] | None,
 ) -> tuple[list[Candidate], int]:
-    """Candidates: the best coarse cell, then IPOPT's optimum from each of the best cells.
+    """Candidates: the best refined cell, IPOPT's optimum from the coarse cells whose basins
+    refine best (:func:`solver.local_search.refine_cells`), then Nelder-Mead climbs on mu_path
+    from the best refined cells, which may cross to another branch where IPOPT cannot.
 
     For a redundant arm (dof > 6) each optimum carries the NLP's joint path: IPOPT chose the
     redundancy too, and the evaluator's tracked joint path would lose that.
@@ -396,7 +411,7 @@ def _casadi(
     if prepared.pure_rotation.any() or cells[0].mu_path <= 0.0:
         zero = "mu_path is 0 everywhere: the path turns on the spot"
         return [Candidate(cells[0].vector, zero)], 0
-    candidates = [Candidate(cells[0].vector, "best cell of the coarse map")]
+    candidates = [Candidate(cells[0].vector, "best cell of the coarse map, refined")]
     nlp = PlacementNlp(
         robot,
         prepared,
@@ -408,7 +423,10 @@ def _casadi(
         ipopt_options=None if max_solver_seconds is None else {"max_cpu_time": max_solver_seconds},
     )
     iterations = 0
-    starts = cells[:N_STARTS]
+    # IPOPT starts from the coarse cells whose basins climbed highest; the climbed points
+    # themselves are candidates too.
+    candidates += [Candidate(cell.vector, "a refined coarse maximum") for cell in cells[1:]]
+    starts = [cell.coarse or cell for cell in cells[:N_STARTS]]
     for k, cell in enumerate(starts):
         at_start = evaluate_path(
             robot,
@@ -443,7 +461,27 @@ def _casadi(
                 joint_path=result.joint_path if robot.dof > 6 else None,
             )
         )
+    candidates += _climbs(robot, prepared, bounds, cells, max_joint_step, spin_mode)
     return candidates, iterations
+
+
+def _climbs(
+    robot: Robot,
+    prepared: PreparedPath,
+    bounds: PlacementBounds,
+    cells: list[Cell],
+    max_joint_step: float,
+    spin_mode: SpinMode,
+) -> list[Candidate]:
+    """Nelder-Mead on mu_path from the best N_CLIMBS cells: across branches, to their tops."""
+    candidates = []
+    for cell in cells[:N_CLIMBS]:
+        top = climb(
+            robot, prepared, bounds, cell, max_joint_step=max_joint_step, spin_mode=spin_mode
+        )
+        if top is not None:
+            candidates.append(Candidate(top.vector, CLIMB_STATUS))
+    return candidates
 
 
 def _scipy(
@@ -457,7 +495,8 @@ def _scipy(
     progress: Progress | None,
     runner: TaskRunner,
 ) -> tuple[list[Candidate], int]:
-    """Candidates: the best placement of each basin DE saw, and SLSQP's polish of each.
+    """Candidates: DE's best placement, SLSQP's polish of each basin DE saw (climbed first by
+    the compass search, on the branch it ends on), and Nelder-Mead climbs on mu_path.
 
     The search is ``size`` (smaller for a family whose placement costs more).
     """
@@ -478,6 +517,19 @@ def _scipy(
         zero = "mu_path is 0 everywhere: the path turns on the spot"
         return [Candidate(basins[0][0], zero)], iterations
     candidates = [Candidate(basins[0][0], "best placement of differential evolution")]
+    # Each basin's best point climbed by the compass search (which may change the branch),
+    # then polished on the branch it ends on.
+    refined = refine_cells(
+        robot,
+        prepared,
+        bounds,
+        [Cell(vector, mu, branch) for vector, mu, branch in basins],
+        max_joint_step=max_joint_step,
+        spin_mode=spin_mode,
+        runner=runner,
+    )
+    if refined:
+        basins = [(cell.vector, cell.mu_path, cell.branch) for cell in refined]
     for k, (placement, mu_path, branch) in enumerate(basins):
         polished, status, steps = polish(
             robot,
@@ -495,4 +547,5 @@ def _scipy(
         )
         candidates.append(Candidate(polished, f"SLSQP: {status}"))
         iterations += steps
+    candidates += _climbs(robot, prepared, bounds, refined, max_joint_step, spin_mode)
     return candidates, iterations

@@ -9,6 +9,7 @@ from typing import Any
 import pytest
 from fastapi.testclient import TestClient
 
+from solver.optimize import CLIMB_STATUS
 from tests.cases import EXAMPLES, OPTIMUM_EVALUATE_RTOL
 from tests.service.conftest import sent_back
 
@@ -41,7 +42,9 @@ def test_answer_is_what_evaluate_says(
     evaluation = client.post("/v1/evaluate", json=evaluate).json()
     assert answer["mu_path"] == pytest.approx(evaluation["mu_path"], rel=OPTIMUM_EVALUATE_RTOL)
     assert answer["evaluation"]["mu_path"] == answer["mu_path"]
-    assert answer["solver"]["status"] == "Solve_Succeeded"
+    # IPOPT's optimum, or a Nelder-Mead climb's where it is higher (here by about 1e-10: the
+    # NLP's tolerance), never the start or a failed solve.
+    assert answer["solver"]["status"] in {"Solve_Succeeded", CLIMB_STATUS}
     assert answer["solver"]["iterations"] > 0 and answer["solver"]["seconds"] > 0
 
 
