@@ -50,9 +50,10 @@ def refine_cells(
     progress: Progress | None = None,
     runner: TaskRunner = SERIAL,
 ) -> list[Cell]:
-    """The best ``count`` cells, each climbed by a compass search; best first.
+    """The cells, the best ``count`` of them climbed by a compass search; best first.
 
-    Fewer cells where their work would pass REFINE_WORK, none where one cell's would.
+    Fewer are climbed where their work would pass REFINE_WORK, none where one cell's would
+    (the cells then come back as they were).
 
     A coarse cell's mu_path says how high its basin starts, not how high it goes: on a large
     box the basin that holds the optimum may start at the sixth maximum. Each round moves every
@@ -65,9 +66,10 @@ def refine_cells(
     """
     free = np.flatnonzero(bounds.free)
     per_cell = 2 * len(free) * rounds * require_family(robot).path_cost(path.n_waypoints)
-    cells = cells[: min(count, int(REFINE_WORK // max(per_cell, 1.0)))]
+    count = min(count, int(REFINE_WORK // max(per_cell, 1.0)))
+    rest, cells = cells[count:], cells[:count]
     if not cells:
-        return []
+        return rest
     vectors = np.array([cell.vector for cell in cells])  # (K, 5): x, y, yaw, spin, z
     mu = np.array([cell.mu_path for cell in cells])
     branch = np.array([cell.branch for cell in cells])
@@ -109,8 +111,10 @@ def refine_cells(
         steps[~better] /= 2
         if progress is not None:
             progress((round_ + 1) / rounds)
-    order = np.argsort(-mu, kind="stable")
-    return [Cell(vectors[k], float(mu[k]), int(branch[k]), coarse=cells[k]) for k in order]
+    refined = [
+        Cell(vectors[k], float(mu[k]), int(branch[k]), coarse=cells[k]) for k in range(len(cells))
+    ]
+    return sorted(refined + rest, key=lambda cell: -cell.mu_path)  # stable: ties keep order
 
 
 CLIMB_EVALUATIONS = 600  # Nelder-Mead's placements at most from one start
