@@ -3,25 +3,28 @@
 For the closed-form families in fixed spin, :func:`solver.placements.evaluate_placements` runs
 this kernel instead of the numpy pipeline (:func:`solver.pipeline.run_chunk`), which stays the
 reference it is tested against (tests/solver/test_map_kernel.py: the same reasons, failed
-waypoints, branches and bottlenecks, mu_path to 1e-12). Per placement, waypoint by waypoint:
+waypoints, branches and bottlenecks, mu_path to 1e-12). Per placement, in blocks of 32
+waypoints:
 
 1. turn the prepared path by the placement's yaw and move it (the same arithmetic as
    :func:`solver.pipeline.turn_by_yaw`);
-2. IK of the flange pose on all branches and J^-1 t on each (the family's pose kernel,
-   :mod:`solver.families.kernels`), every angle a (cos, sin) pair;
-3. each branch still alive: unreachable, then singular, then the step test
+2. IK of the flange poses on the branches still alive and J^-1 t on each (the family's pose
+   kernel, :mod:`solver.families.kernels`, level by level), every angle a (cos, sin) pair;
+3. each branch still alive, waypoint by waypoint: unreachable, then singular, then the step test
    cos(dq) >= cos(max_joint_step) against the previous waypoint (no angle, no unwrapping);
    then its DTF, 1 / max_j |qd_j| / qdot_max_j, and the running minimum;
-4. after the path, position limits: a joint whose limits span 2 pi or more fits when the
+4. after the path, position limits: a joint whose limits span more than 2 pi fits when the
    path's total turning (bounded from the squared chords of the (cos, sin) steps) leaves a
-   full turn of room; a joint with a narrower range fits when every waypoint is inside its
-   arc and no step can cross the arc's gap. Only a branch that neither test clears forms its angles
-   (atan2) and runs the exact test of :func:`solver.tracking.track`;
+   full turn of room; a joint whose range is a turn or less fits when every waypoint is
+   inside its arc and no step's short arc passes through the gap opposite. Only a branch
+   that neither test clears forms its angles (atan2) and runs the exact test of
+   :func:`solver.tracking.track`;
 5. the branch: :func:`solver.tracking.choose_branch`'s rule.
 
 A branch stops at its first failure and a placement at its last live branch. Why compiled:
-the fused loop keeps one waypoint's values in registers, where numpy makes and reads back an
-array per formula; measured in ``bench/run.py``.
+the fused loops keep a waypoint's values in registers, where numpy makes and reads back an
+array per formula, and no atan2 is taken (it was a third of the kernel's time while the
+exact limit test still ran on every branch); measured in ``bench/run.py``.
 """
 
 from __future__ import annotations
@@ -37,7 +40,7 @@ import solver.families.kernels
 import solver.families.opw.kernel
 import solver.families.ur.kernel
 from solver.families.base import SINGULAR, UNREACHABLE
-from solver.families.kernels import UR_KERNEL, pose_kernel
+from solver.families.kernels import SCRATCH_ROWS, UR_KERNEL, pose_block
 from solver.families.ur.dh import UR_DH
 from solver.tracking import FEASIBLE, TIE_RTOL
 
@@ -53,6 +56,9 @@ _NO_LIMIT, _WIDE, _NARROW = 0, 1, 2
 _CHORD_SMALL = 0.5
 _TURN_PER_CHORD_SMALL = 1.0108
 _UR5 = UR_DH["ur5"]
+# Waypoints solved together: the pose kernels run level by level over a block, and a block is
+# the unit of the early stop when every branch has failed.
+_BLOCK = 32
 
 
 def _drop_stale_compiled_code() -> None:
@@ -94,11 +100,12 @@ def limit_modes(lower: np.ndarray, upper: np.ndarray) -> tuple[np.ndarray, np.nd
     """Per joint: how the kernel tests its position limits, and the arc of a narrow range.
 
     Returns:
-        modes: shape (n,), 0 no limit, 1 a range of 2 pi or more, 2 a narrower one;
+        modes: shape (n,), 0 no limit, 1 a range of more than 2 pi, 2 one of 2 pi or less;
         arc: shape (n, 3), cos and sin of the range's middle and cos of its half width.
     """
     width = upper - lower
-    modes = np.where(~np.isfinite(width), _NO_LIMIT, np.where(width >= _TWO_PI, _WIDE, _NARROW))
+    wide = width > _TWO_PI + 1e-12
+    modes = np.where(~np.isfinite(width), _NO_LIMIT, np.where(wide, _WIDE, _NARROW))
     middle = np.where(np.isfinite(width), (lower + upper) / 2, 0.0)
     half = np.where(np.isfinite(width), width / 2, 0.0)
     arc = np.column_stack([np.cos(middle), np.sin(middle), np.cos(half)])
@@ -112,13 +119,13 @@ def _exact_limits(cq, sq, b, lower, upper):  # type: ignore[no-untyped-def]  # p
     :func:`solver.tracking.track`'s test on one branch: the angles of the pairs, unwrapped by
     the wrapped steps, the whole path first, then the running range where it fails.
     """
-    n_waypoints, dof = cq.shape[0], cq.shape[2]
+    dof, n_waypoints = cq.shape[1], cq.shape[2]
     path = np.empty((n_waypoints, dof))
     for j in range(dof):
-        previous = math.atan2(sq[0, b, j], cq[0, b, j])
+        previous = math.atan2(sq[b, j, 0], cq[b, j, 0])
         path[0, j] = previous
         for w in range(1, n_waypoints):
-            angle = math.atan2(sq[w, b, j], cq[w, b, j])
+            angle = math.atan2(sq[b, j, w], cq[b, j, w])
             step = angle - previous
             if step > math.pi:
                 step -= _TWO_PI
@@ -211,15 +218,13 @@ def map_cells(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
     n_branches = branches.shape[0]
     n_all = 8
     dof = 6
-    cq = np.empty((n_waypoints, n_all, dof))
-    sq = np.empty((n_waypoints, n_all, dof))
-    status = np.empty(n_all, dtype=np.int64)
+    cq = np.empty((n_all, dof, n_waypoints))
+    sq = np.empty((n_all, dof, n_waypoints))
+    qd = np.empty((n_all, dof, n_waypoints))
+    status = np.empty((n_all, n_waypoints), dtype=np.int64)
+    poses = np.empty((21, n_waypoints))
+    scratch = np.empty((SCRATCH_ROWS, n_waypoints))
     need = np.empty(n_all, dtype=np.bool_)
-    qd = np.empty((n_all, dof))
-    rot = np.empty((3, 3))
-    pos = np.empty(3)
-    tw = np.empty(6)
-    tool = np.empty(3)
     alive = np.empty(n_branches, dtype=np.bool_)
     why = np.empty(n_branches, dtype=np.int64)
     where = np.empty(n_branches, dtype=np.int64)
@@ -229,6 +234,7 @@ def map_cells(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
     chords2 = np.empty((n_branches, dof))
     largest2 = np.empty((n_branches, dof))
     inside = np.empty((n_branches, dof))
+    crossed = np.empty((n_branches, dof), dtype=np.bool_)
     speeds = np.empty((n_branches, n_waypoints)) if v_out.shape[1] else np.empty((0, 0))
     inverse_qdot = 1.0 / qdot_max
     check_steps = max_joint_step < math.pi
@@ -241,75 +247,90 @@ def map_cells(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
         chords2[:] = 0.0
         largest2[:] = 0.0
         inside[:] = np.inf
+        crossed[:] = False
         n_alive = n_branches
-        for w in range(n_waypoints):
-            for k in range(3):
-                x, y = flange_rotation[w, 0, k], flange_rotation[w, 1, k]
-                rot[0, k] = ca * x - sa * y
-                rot[1, k] = sa * x + ca * y
-                rot[2, k] = flange_rotation[w, 2, k]
-            x, y = flange_position[w, 0], flange_position[w, 1]
-            pos[0] = ca * x - sa * y + offset[c, 0]
-            pos[1] = sa * x + ca * y + offset[c, 1]
-            pos[2] = flange_position[w, 2] + offset[c, 2]
-            x, y = tool_position[w, 0], tool_position[w, 1]
-            tool[0] = ca * x - sa * y + offset[c, 0]
-            tool[1] = sa * x + ca * y + offset[c, 1]
-            tool[2] = tool_position[w, 2] + offset[c, 2]
-            for k in range(0, 6, 3):
-                x, y = twist[w, k], twist[w, k + 1]
-                tw[k] = ca * x - sa * y
-                tw[k + 1] = sa * x + ca * y
-                tw[k + 2] = twist[w, k + 2]
+        for w0 in range(0, n_waypoints, _BLOCK):
+            w1 = min(w0 + _BLOCK, n_waypoints)
+            for w in range(w0, w1):
+                for k in range(3):  # R_B_F = Rz(yaw) R_O_F, row by row
+                    x, y = flange_rotation[w, 0, k], flange_rotation[w, 1, k]
+                    poses[k, w] = ca * x - sa * y
+                    poses[3 + k, w] = sa * x + ca * y
+                    poses[6 + k, w] = flange_rotation[w, 2, k]
+                x, y = flange_position[w, 0], flange_position[w, 1]
+                poses[9, w] = ca * x - sa * y + offset[c, 0]
+                poses[10, w] = sa * x + ca * y + offset[c, 1]
+                poses[11, w] = flange_position[w, 2] + offset[c, 2]
+                for k in range(0, 6, 3):
+                    x, y = twist[w, k], twist[w, k + 1]
+                    poses[12 + k, w] = ca * x - sa * y
+                    poses[13 + k, w] = sa * x + ca * y
+                    poses[14 + k, w] = twist[w, k + 2]
+                x, y = tool_position[w, 0], tool_position[w, 1]
+                poses[18, w] = ca * x - sa * y + offset[c, 0]
+                poses[19, w] = sa * x + ca * y + offset[c, 1]
+                poses[20, w] = tool_position[w, 2] + offset[c, 2]
             need[:] = False
             for i in range(n_branches):
                 need[branches[i]] = need[branches[i]] or alive[i]
-            pose_kernel(family, par, rot, pos, tw, tool, need, cq[w], sq[w], status, qd)
+            pose_block(family, par, poses, w0, w1, need, scratch, cq, sq, status, qd)
             for i in range(n_branches):
                 if not alive[i]:
                     continue
                 b = branches[i]
-                code = -1
-                if status[b] == UNREACHABLE:
-                    code = _UNREACHABLE
-                elif status[b] == SINGULAR:
-                    code = _SINGULAR
-                elif w > 0:
-                    checked = check_steps and segment_checked[w - 1]
+                for w in range(w0, w1):
+                    code = -1
+                    if status[b, w] == UNREACHABLE:
+                        code = _UNREACHABLE
+                    elif status[b, w] == SINGULAR:
+                        code = _SINGULAR
+                    elif w > 0:
+                        checked = check_steps and segment_checked[w - 1]
+                        for j in range(dof):
+                            c0, s0 = cq[b, j, w - 1], sq[b, j, w - 1]
+                            c1, s1 = cq[b, j, w], sq[b, j, w]
+                            if checked and c0 * c1 + s0 * s1 < cos_step:
+                                code = _DISCONTINUOUS
+                                break
+                            if modes[j] == _WIDE:
+                                chord2 = (c1 - c0) * (c1 - c0) + (s1 - s0) * (s1 - s0)
+                                chords2[i, j] += chord2
+                                largest2[i, j] = max(largest2[i, j], chord2)
+                            elif modes[j] == _NARROW and not crossed[i, j]:
+                                # Does the step's short arc pass the middle of the gap, the
+                                # angle opposite the range's middle? Where both ends lie on
+                                # the middle's side (u > 0) and the sign of v changes, it
+                                # passes the middle instead; otherwise it may (so: the exact
+                                # test).
+                                u0 = c0 * arc[j, 0] + s0 * arc[j, 1]
+                                v0 = s0 * arc[j, 0] - c0 * arc[j, 1]
+                                u1 = c1 * arc[j, 0] + s1 * arc[j, 1]
+                                v1 = s1 * arc[j, 0] - c1 * arc[j, 1]
+                                crossed[i, j] = v0 * v1 <= 0.0 and (u0 <= 0.0 or u1 <= 0.0)
+                    if code >= 0:
+                        alive[i] = False
+                        why[i] = code
+                        where[i] = w
+                        n_alive -= 1
+                        break
+                    largest = -1.0
+                    limiting = 0
                     for j in range(dof):
-                        c0, s0 = cq[w - 1, b, j], sq[w - 1, b, j]
-                        c1, s1 = cq[w, b, j], sq[w, b, j]
-                        if checked and c0 * c1 + s0 * s1 < cos_step:
-                            code = _DISCONTINUOUS
-                            break
-                        if modes[j] != _NO_LIMIT:
-                            chord2 = (c1 - c0) * (c1 - c0) + (s1 - s0) * (s1 - s0)
-                            chords2[i, j] += chord2
-                            largest2[i, j] = max(largest2[i, j], chord2)
-                if code >= 0:
-                    alive[i] = False
-                    why[i] = code
-                    where[i] = w
-                    n_alive -= 1
-                    continue
-                largest = -1.0
-                limiting = 0
-                for j in range(dof):
-                    if modes[j] == _NARROW:
-                        margin = cq[w, b, j] * arc[j, 0] + sq[w, b, j] * arc[j, 1] - arc[j, 2]
-                        inside[i, j] = min(inside[i, j], margin)
-                    ratio = abs(qd[b, j]) * inverse_qdot[j]
-                    if ratio > largest:
-                        largest = ratio
-                        limiting = j
-                speed = 1.0 / largest
-                v = 0.0 if pure_rotation[w] else speed
-                if w == 0 or v < slowest[i]:
-                    slowest[i] = v
-                    slowest_at[i] = w
-                    slowest_joint[i] = limiting
-                if speeds.shape[0]:
-                    speeds[i, w] = v
+                        if modes[j] == _NARROW:
+                            margin = cq[b, j, w] * arc[j, 0] + sq[b, j, w] * arc[j, 1] - arc[j, 2]
+                            inside[i, j] = min(inside[i, j], margin)
+                        ratio = abs(qd[b, j, w]) * inverse_qdot[j]
+                        if ratio > largest:
+                            largest = ratio
+                            limiting = j
+                    speed = 1.0 / largest
+                    v = 0.0 if pure_rotation[w] else speed
+                    if w == 0 or v < slowest[i]:
+                        slowest[i] = v
+                        slowest_at[i] = w
+                        slowest_joint[i] = limiting
+                    if speeds.shape[0]:
+                        speeds[i, w] = v
             if n_alive == 0:
                 break
         for i in range(n_branches):
@@ -319,17 +340,15 @@ def map_cells(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
             for j in range(dof):
                 if modes[j] == _NO_LIMIT:
                     continue
-                # A chord c turns by 2 asin(c / 2) <= factor c; the sum of the chords is at
-                # most sqrt(segments x the sum of their squares) (Cauchy-Schwarz).
-                small = largest2[i, j] <= _CHORD_SMALL * _CHORD_SMALL
-                factor = _TURN_PER_CHORD_SMALL if small else math.pi / 2
                 if modes[j] == _WIDE:
+                    # A chord c turns by 2 asin(c / 2) <= factor c; the sum of the chords is
+                    # at most sqrt(segments x the sum of their squares) (Cauchy-Schwarz).
+                    small = largest2[i, j] <= _CHORD_SMALL * _CHORD_SMALL
+                    factor = _TURN_PER_CHORD_SMALL if small else math.pi / 2
                     turning = factor * math.sqrt((n_waypoints - 1) * chords2[i, j])
                     exact = exact or turning > upper[j] - lower[j] - _TWO_PI - _MARGIN
-                else:
-                    largest_step = factor * math.sqrt(largest2[i, j])
-                    gap = _TWO_PI - (upper[j] - lower[j]) - _MARGIN
-                    exact = exact or inside[i, j] <= _MARGIN or largest_step >= gap
+                else:  # every waypoint inside the arc, no step through the gap
+                    exact = exact or inside[i, j] <= _MARGIN or crossed[i, j]
             if exact:
                 first = _exact_limits(cq, sq, branches[i], lower, upper)
                 if first < n_waypoints:

@@ -396,9 +396,11 @@ def _casadi(
     progress: Progress | None,
     passes: Sequence[tuple[int, int]] | None,
 ) -> tuple[list[Candidate], int]:
-    """Candidates: the best refined cell, IPOPT's optimum from the coarse cells whose basins
-    refine best (:func:`solver.local_search.refine_cells`), then Nelder-Mead climbs on mu_path
-    from the best refined cells, which may cross to another branch where IPOPT cannot.
+    """Candidates: the best refined cell, IPOPT's optima, Nelder-Mead climbs.
+
+    IPOPT starts from the coarse cells whose basins refine best
+    (:func:`solver.local_search.refine_cells`); the climbs on mu_path start from the best
+    refined cells and may cross to another branch, where IPOPT cannot.
 
     For a redundant arm (dof > 6) each optimum carries the NLP's joint path: IPOPT chose the
     redundancy too, and the evaluator's tracked joint path would lose that.
@@ -495,8 +497,10 @@ def _scipy(
     progress: Progress | None,
     runner: TaskRunner,
 ) -> tuple[list[Candidate], int]:
-    """Candidates: DE's best placement, SLSQP's polish of each basin DE saw (climbed first by
-    the compass search, on the branch it ends on), and Nelder-Mead climbs on mu_path.
+    """Candidates: DE's best placement, SLSQP's polishes, Nelder-Mead climbs on mu_path.
+
+    Each basin DE saw is climbed first by the compass search, then polished by SLSQP on the
+    branch it ends on.
 
     The search is ``size`` (smaller for a family whose placement costs more).
     """

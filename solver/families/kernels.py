@@ -10,20 +10,21 @@ from __future__ import annotations
 
 from numba import njit
 
-from solver.families.opw.kernel import opw_pose
-from solver.families.ur.kernel import ur_pose
+from solver.families.opw import kernel as opw
+from solver.families.ur import kernel as ur
 
 UR_KERNEL = 0
 OPW_KERNEL = 1
+SCRATCH_ROWS = max(ur.SCRATCH_ROWS, opw.SCRATCH_ROWS)  # what every family's kernel may use
 
 
-@njit(cache=True, error_model="numpy", nogil=True, inline="always")
-def pose_kernel(family, par, rot, pos, twist, tool, need, cq, sq, status, qd):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
-    """IK on all branches of one flange pose and J^-1 t on each, for the family ``family``.
+@njit(cache=True, error_model="numpy", nogil=True)
+def pose_block(family, par, poses, w0, w1, need, scratch, cq, sq, status, qd):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
+    """IK on all branches and J^-1 t on each, for waypoints w0..w1, for the family ``family``.
 
-    Arguments after ``family`` as :func:`solver.families.ur.kernel.ur_pose`.
+    Arguments after ``family`` as :func:`solver.families.ur.kernel.ur_block`.
     """
     if family == UR_KERNEL:
-        ur_pose(par, rot, pos, twist, tool, need, cq, sq, status, qd)
+        ur.ur_block(par, poses, w0, w1, need, scratch, cq, sq, status, qd)
     else:
-        opw_pose(par, rot, pos, twist, tool, need, cq, sq, status, qd)
+        opw.opw_block(par, poses, w0, w1, need, scratch, cq, sq, status, qd)

@@ -42,128 +42,160 @@ def _unit_pair(x: float, y: float) -> tuple[float, float]:  # pragma: no cover -
     return x * inverse, y * inverse
 
 
-@njit(cache=True, error_model="numpy", nogil=True, inline="always")
-def ur_pose(par, rot, pos, twist, tool, need, cq, sq, status, qd):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
-    """IK of one flange pose on all eight branches, and J^-1 t on each.
+SCRATCH_ROWS = 29  # rows of the scratch array ur_block needs
+
+
+@njit(cache=True, error_model="numpy", nogil=True)
+def ur_block(par, poses, w0, w1, need, scratch, cq, sq, status, qd):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
+    """IK on all eight branches and J^-1 t on each, for the waypoints w0..w1 of a path.
+
+    Level by level (the shoulder, the wrist, the elbow), each level one loop over the
+    waypoints: short loop bodies whose iterations are independent, which the processor
+    overlaps (one loop body over all levels per waypoint was three times slower).
 
     Args:
         par: shape (6,), the DH lengths.
-        rot: shape (3, 3), R_B_F.
-        pos: shape (3,), p_B_F (m).
-        twist: shape (6,), the tool point's twist per unit speed in {B}.
-        tool: shape (3,), the tool point in {B} (m).
+        poses: shape (21, W): R_B_F row by row (9), p_B_F (3, m), the tool point's twist per
+            unit speed (6) and the tool point (3, m), all in {B}.
+        w0: the first waypoint to solve.
+        w1: one past the last.
         need: shape (8,), bool, the branches wanted; the others are skipped (the out arrays
             keep what they held).
-        cq: shape (8, 6), out: cos of each branch's joint angles.
-        sq: shape (8, 6), out: their sines.
-        status: shape (8,), out: ``OK``, ``UNREACHABLE`` or ``SINGULAR``.
-        qd: shape (8, 6), out: J^-1 t on each branch (meaningless where not ``OK``).
+        scratch: shape (SCRATCH_ROWS, W), work space.
+        cq: shape (8, 6, W), out: cos of each branch's joint angles.
+        sq: shape (8, 6, W), out: their sines.
+        status: shape (8, W), out: ``OK``, ``UNREACHABLE`` or ``SINGULAR``.
+        qd: shape (8, 6, W), out: J^-1 t on each branch (meaningless where not ``OK``).
     """
     d1, a2, a3, d4, d5, d6 = par[0], par[1], par[2], par[3], par[4], par[5]
-    n_x, n_y, n_z = rot[0, 0], rot[1, 0], rot[2, 0]
-    a_x, a_y, a_z = rot[0, 2], rot[1, 2], rot[2, 2]
-    w_x = pos[0] - d6 * a_x
-    w_y = pos[1] - d6 * a_y
-    w_z = pos[2] - d6 * a_z
-    radius = math.sqrt(w_x * w_x + w_y * w_y)
-    ratio1 = d4 / radius
-    reach1 = abs(ratio1) <= 1.0 + REACH_TOLERANCE
-    rc = min(max(ratio1, -1.0), 1.0)
-    rs = math.sqrt(1.0 - rc * rc)
-    c_phi, s_phi = _unit_pair(w_x, w_y)
-    v_x, v_y, v_z, om_x, om_y, om_z = twist[0], twist[1], twist[2], twist[3], twist[4], twist[5]
+    t = scratch
+    for w in range(w0, w1):
+        a_x, a_y, a_z = poses[2, w], poses[5, w], poses[8, w]
+        w_x = poses[9, w] - d6 * a_x
+        w_y = poses[10, w] - d6 * a_y
+        w_z = poses[11, w] - d6 * a_z
+        radius = math.sqrt(w_x * w_x + w_y * w_y)
+        ratio1 = d4 / radius
+        t[7, w] = 1.0 if abs(ratio1) <= 1.0 + REACH_TOLERANCE else 0.0
+        rc = min(max(ratio1, -1.0), 1.0)
+        t[0, w], t[1, w], t[2, w] = w_x, w_y, w_z
+        t[3, w], t[4, w] = rc, math.sqrt(1.0 - rc * rc)
+        t[5, w], t[6, w] = _unit_pair(w_x, w_y)
     for shoulder in range(2):
+        if not need[4 * shoulder : 4 * shoulder + 4].any():
+            continue
         sign = 1.0 if shoulder == 0 else -1.0
-        # q1 = atan2(w_y, w_x) + sign acos(d4 / r) + pi / 2
-        c_pa = c_phi * rc - s_phi * sign * rs
-        s_pa = s_phi * rc + c_phi * sign * rs
-        c1, s1 = -s_pa, c_pa  # products of unit pairs: unit to rounding
-        cos5 = a_x * s1 - a_y * c1
-        reach5 = abs(cos5) <= 1.0 + REACH_TOLERANCE
-        cos5 = min(max(cos5, -1.0), 1.0)
-        cross_z = s1 * a_y + c1 * a_x
-        sin5_size = math.sqrt(a_z * a_z + cross_z * cross_z)
-        lever_ik = w_x * c1 + w_y * s1
+        for w in range(w0, w1):
+            a_x, a_y, a_z = poses[2, w], poses[5, w], poses[8, w]
+            c_phi, s_phi, rc, rs = t[5, w], t[6, w], t[3, w], sign * t[4, w]
+            # q1 = atan2(w_y, w_x) + sign acos(d4 / r) + pi / 2
+            c_pa = c_phi * rc - s_phi * rs
+            s_pa = s_phi * rc + c_phi * rs
+            c1, s1 = -s_pa, c_pa  # products of unit pairs: unit to rounding
+            cos5 = a_x * s1 - a_y * c1
+            t[11, w] = 1.0 if abs(cos5) <= 1.0 + REACH_TOLERANCE else 0.0
+            cross_z = s1 * a_y + c1 * a_x
+            t[8, w], t[9, w] = c1, s1
+            t[10, w] = min(max(cos5, -1.0), 1.0)
+            t[12, w] = cross_z
+            t[13, w] = math.sqrt(a_z * a_z + cross_z * cross_z)
+            t[14, w] = t[0, w] * c1 + t[1, w] * s1
         for wrist in range(2):
-            sin5 = sin5_size if wrist == 0 else -sin5_size
-            wrist_singular = abs(sin5) < SINGULAR_TOLERANCE
-            if wrist_singular:
-                z4_x = n_y * a_z - n_z * a_y
-                z4_y = n_z * a_x - n_x * a_z
-                z4_z = n_x * a_y - n_y * a_x
-            else:
-                inv5 = 1.0 / sin5
-                z4_x = -c1 * a_z * inv5
-                z4_y = -s1 * a_z * inv5
-                z4_z = cross_z * inv5
-            x5_x = -(z4_y * a_z - z4_z * a_y)
-            x5_y = -(z4_z * a_x - z4_x * a_z)
-            x5_z = -(z4_x * a_y - z4_y * a_x)
-            c6, s6 = _unit_pair(
-                n_x * x5_x + n_y * x5_y + n_z * x5_z, -(n_x * z4_x + n_y * z4_y + n_z * z4_z)
-            )
-            c5, s5 = cos5, sin5  # cos5 = z5 . z1, sin5 = |z1 x z5|: a unit pair
-            plane_x = (w_x - d5 * z4_x) * c1 + (w_y - d5 * z4_y) * s1
-            plane_y = w_z - d5 * z4_z - d1
-            c234, s234 = _unit_pair(-z4_z, z4_x * c1 + z4_y * s1)
-            c_to, s_to = _unit_pair(plane_x, plane_y)
-            cos3 = (plane_x * plane_x + plane_y * plane_y - a2 * a2 - a3 * a3) / (2.0 * a2 * a3)
-            reach3 = abs(cos3) <= 1.0 + REACH_TOLERANCE
-            cos3 = min(max(cos3, -1.0), 1.0)
-            sin3_size = math.sqrt(1.0 - cos3 * cos3)
+            first = 4 * shoulder + wrist
+            if not (need[first] or need[first + 2]):
+                continue
+            for w in range(w0, w1):
+                n_x, n_y, n_z = poses[0, w], poses[3, w], poses[6, w]
+                a_x, a_y, a_z = poses[2, w], poses[5, w], poses[8, w]
+                c1, s1, cross_z = t[8, w], t[9, w], t[12, w]
+                sin5 = t[13, w] if wrist == 0 else -t[13, w]
+                wrist_singular = abs(sin5) < SINGULAR_TOLERANCE
+                if wrist_singular:
+                    z4_x = n_y * a_z - n_z * a_y
+                    z4_y = n_z * a_x - n_x * a_z
+                    z4_z = n_x * a_y - n_y * a_x
+                else:
+                    inv5 = 1.0 / sin5
+                    z4_x = -c1 * a_z * inv5
+                    z4_y = -s1 * a_z * inv5
+                    z4_z = cross_z * inv5
+                x5_x = -(z4_y * a_z - z4_z * a_y)
+                x5_y = -(z4_z * a_x - z4_x * a_z)
+                x5_z = -(z4_x * a_y - z4_y * a_x)
+                t[19, w], t[20, w] = _unit_pair(
+                    n_x * x5_x + n_y * x5_y + n_z * x5_z, -(n_x * z4_x + n_y * z4_y + n_z * z4_z)
+                )
+                plane_x = (t[0, w] - d5 * z4_x) * c1 + (t[1, w] - d5 * z4_y) * s1
+                plane_y = t[2, w] - d5 * z4_z - d1
+                t[21, w], t[22, w] = _unit_pair(-z4_z, z4_x * c1 + z4_y * s1)
+                t[23, w], t[24, w] = _unit_pair(plane_x, plane_y)
+                cos3 = (plane_x * plane_x + plane_y * plane_y - a2 * a2 - a3 * a3) / (2.0 * a2 * a3)
+                t[26, w] = 1.0 if abs(cos3) <= 1.0 + REACH_TOLERANCE else 0.0
+                cos3 = min(max(cos3, -1.0), 1.0)
+                t[25, w] = cos3
+                t[27, w] = math.sqrt(1.0 - cos3 * cos3)
+                t[28, w] = sin5
+                t[15, w] = 1.0 if wrist_singular else 0.0
             for elbow in range(2):
                 b = 4 * shoulder + 2 * elbow + wrist
                 if not need[b]:
                     continue
-                sin3 = sign * sin3_size if elbow == 0 else -sign * sin3_size
-                if not (reach1 and reach5 and reach3):
-                    status[b] = UNREACHABLE
-                    continue
-                singular = (
-                    abs(lever_ik) < SINGULAR_TOLERANCE
-                    or wrist_singular
-                    or abs(sin3) < SINGULAR_TOLERANCE
-                )
-                status[b] = SINGULAR if singular else OK
-                c3, s3 = cos3, sin3
-                # q2 = atan2(plane_y, plane_x) - atan2(a3 s3, a2 + a3 c3)
-                c_in, s_in = _unit_pair(a2 + a3 * cos3, a3 * sin3)
-                c2 = c_to * c_in + s_to * s_in
-                s2 = s_to * c_in - c_to * s_in
-                c23 = c2 * c3 - s2 * s3
-                s23 = s2 * c3 + c2 * s3
-                cq[b, 0], sq[b, 0] = c1, s1
-                cq[b, 1], sq[b, 1] = c2, s2
-                cq[b, 2], sq[b, 2] = c3, s3
-                cq[b, 3], sq[b, 3] = c234 * c23 + s234 * s23, s234 * c23 - c234 * s23
-                cq[b, 4], sq[b, 4] = c5, s5
-                cq[b, 5], sq[b, 5] = c6, s6
-                # J^-1 t: solver.families.ur.jacobian, from the pairs.
-                b_x, b_y = a3 * c23, a3 * s23
-                p_x, p_y = a2 * c2 + b_x, a2 * s2 + b_y
-                lever = p_x + d5 * s234
-                wc_x = lever * c1 + d4 * s1
-                wc_y = lever * s1 - d4 * c1
-                wc_z = d1 + p_y - d5 * c234
-                z5_x = -s5 * c234 * c1 + c5 * s1
-                z5_y = -s5 * c234 * s1 - c5 * c1
-                z5_z = -s5 * s234
-                r_x, r_y, r_z = wc_x - tool[0], wc_y - tool[1], wc_z - tool[2]
-                vw_x = v_x + om_y * r_z - om_z * r_y
-                vw_y = v_y + om_z * r_x - om_x * r_z
-                vw_z = v_z + om_x * r_y - om_y * r_x
-                qd1 = -(vw_x * s1 - vw_y * c1) / lever
-                omp_z = om_z - qd1
-                qd5 = om_x * s234 * c1 + om_y * s234 * s1 - omp_z * c234
-                along_z1 = om_x * s1 - om_y * c1
-                along_z5 = om_x * z5_x + om_y * z5_y + omp_z * z5_z
-                sin2 = s5 * s5
-                qd234 = (along_z1 - c5 * along_z5) / sin2
-                qd6 = (along_z5 - c5 * along_z1) / sin2
-                g_x1 = vw_x * c1 + vw_y * s1 - qd1 * (wc_x * s1 - wc_y * c1) - qd234 * d5 * c234
-                g_y1 = vw_z - qd234 * d5 * s234
-                det = p_x * b_y - p_y * b_x
-                qd2 = (g_y1 * b_y + g_x1 * b_x) / det
-                qd3 = -(g_x1 * p_x + g_y1 * p_y) / det
-                qd[b, 0], qd[b, 1], qd[b, 2] = qd1, qd2, qd3
-                qd[b, 3], qd[b, 4], qd[b, 5] = qd234 - qd2 - qd3, qd5, qd6
+                e_sign = sign if elbow == 0 else -sign
+                for w in range(w0, w1):
+                    c1, s1, c5, s5 = t[8, w], t[9, w], t[10, w], t[28, w]
+                    c3, s3 = t[25, w], e_sign * t[27, w]
+                    c234, s234, c_to, s_to = t[21, w], t[22, w], t[23, w], t[24, w]
+                    reach = t[7, w] * t[11, w] * t[26, w] > 0.0
+                    singular = (
+                        abs(t[14, w]) < SINGULAR_TOLERANCE
+                        or t[15, w] > 0.0
+                        or abs(s3) < SINGULAR_TOLERANCE
+                    )
+                    status[b, w] = UNREACHABLE if not reach else (SINGULAR if singular else OK)
+                    # q2 = atan2(plane_y, plane_x) - atan2(a3 s3, a2 + a3 c3)
+                    c_in, s_in = _unit_pair(a2 + a3 * c3, a3 * s3)
+                    c2 = c_to * c_in + s_to * s_in
+                    s2 = s_to * c_in - c_to * s_in
+                    c23 = c2 * c3 - s2 * s3
+                    s23 = s2 * c3 + c2 * s3
+                    cq[b, 0, w], sq[b, 0, w] = c1, s1
+                    cq[b, 1, w], sq[b, 1, w] = c2, s2
+                    cq[b, 2, w], sq[b, 2, w] = c3, s3
+                    cq[b, 3, w] = c234 * c23 + s234 * s23
+                    sq[b, 3, w] = s234 * c23 - c234 * s23
+                    cq[b, 4, w], sq[b, 4, w] = c5, s5
+                    cq[b, 5, w], sq[b, 5, w] = t[19, w], t[20, w]
+                    # J^-1 t: solver.families.ur.jacobian, from the pairs.
+                    v_x, v_y, v_z = poses[12, w], poses[13, w], poses[14, w]
+                    om_x, om_y, om_z = poses[15, w], poses[16, w], poses[17, w]
+                    b_x, b_y = a3 * c23, a3 * s23
+                    p_x, p_y = a2 * c2 + b_x, a2 * s2 + b_y
+                    lever = p_x + d5 * s234
+                    wc_x = lever * c1 + d4 * s1
+                    wc_y = lever * s1 - d4 * c1
+                    wc_z = d1 + p_y - d5 * c234
+                    z5_x = -s5 * c234 * c1 + c5 * s1
+                    z5_y = -s5 * c234 * s1 - c5 * c1
+                    z5_z = -s5 * s234
+                    r_x = wc_x - poses[18, w]
+                    r_y = wc_y - poses[19, w]
+                    r_z = wc_z - poses[20, w]
+                    vw_x = v_x + om_y * r_z - om_z * r_y
+                    vw_y = v_y + om_z * r_x - om_x * r_z
+                    vw_z = v_z + om_x * r_y - om_y * r_x
+                    qd1 = -(vw_x * s1 - vw_y * c1) / lever
+                    omp_z = om_z - qd1
+                    qd5 = om_x * s234 * c1 + om_y * s234 * s1 - omp_z * c234
+                    along_z1 = om_x * s1 - om_y * c1
+                    along_z5 = om_x * z5_x + om_y * z5_y + omp_z * z5_z
+                    sin2 = s5 * s5
+                    qd234 = (along_z1 - c5 * along_z5) / sin2
+                    qd6 = (along_z5 - c5 * along_z1) / sin2
+                    g_x1 = vw_x * c1 + vw_y * s1 - qd1 * (wc_x * s1 - wc_y * c1)
+                    g_x1 -= qd234 * d5 * c234
+                    g_y1 = vw_z - qd234 * d5 * s234
+                    det = p_x * b_y - p_y * b_x
+                    qd2 = (g_y1 * b_y + g_x1 * b_x) / det
+                    qd3 = -(g_x1 * p_x + g_y1 * p_y) / det
+                    qd[b, 0, w], qd[b, 1, w], qd[b, 2, w] = qd1, qd2, qd3
+                    qd[b, 3, w], qd[b, 4, w], qd[b, 5, w] = qd234 - qd2 - qd3, qd5, qd6
