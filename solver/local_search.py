@@ -29,6 +29,10 @@ from solver.progress import Progress
 from solver.robots import Robot
 from solver.search_space import PlacementBounds
 
+# Half the coarse map's step of each variable [x, y, yaw, spin, z]: the first steps of both
+# searches.
+_HALF_STEPS = np.array([COARSE_STEP, COARSE_STEP, COARSE_YAW_STEP, COARSE_YAW_STEP, COARSE_STEP])
+_HALF_STEPS /= 2
 REFINED_CELLS = 16  # the coarse maxima refined before the IPOPT starts are chosen
 REFINE_ROUNDS = 12
 # The refinement's work at most, in poses of a closed-form family (KinematicsFamily.path_cost):
@@ -75,7 +79,7 @@ def refine_cells(
     branch = np.array([cell.branch for cell in cells])
     lower, upper = bounds.lower, bounds.upper
     steps = np.tile(
-        np.array([COARSE_STEP, COARSE_STEP, COARSE_YAW_STEP, COARSE_YAW_STEP, COARSE_STEP]) / 2,
+        _HALF_STEPS,
         (len(cells), 1),
     )
     for round_ in range(rounds):
@@ -167,9 +171,8 @@ def climb(
             best[0] = Cell(vector, mu, int(result.branch[0]))
         return -mu
 
-    steps = np.array([COARSE_STEP, COARSE_STEP, COARSE_YAW_STEP, COARSE_YAW_STEP, COARSE_STEP])
     origin = start.vector[free]
-    simplex = np.vstack([origin, origin + np.diag(steps[free] / 2)])
+    simplex = np.vstack([origin, origin + np.diag(_HALF_STEPS[free])])
     scipy.optimize.minimize(
         negative_mu,
         origin,

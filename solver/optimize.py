@@ -425,9 +425,8 @@ def _casadi(
         ipopt_options=None if max_solver_seconds is None else {"max_cpu_time": max_solver_seconds},
     )
     iterations = 0
-    # IPOPT starts from the coarse cells whose basins climbed highest; the climbed points
-    # themselves are candidates too.
-    candidates += [Candidate(cell.vector, "a refined coarse maximum") for cell in cells[1:]]
+    # IPOPT starts from the coarse cells whose basins climbed highest. (The other refined
+    # cells are below cells[0] and below the climbs: no candidates.)
     starts = [cell.coarse or cell for cell in cells[:N_STARTS]]
     for k, cell in enumerate(starts):
         at_start = evaluate_path(
