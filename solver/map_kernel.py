@@ -31,6 +31,7 @@ from __future__ import annotations
 
 import hashlib
 import math
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -38,6 +39,7 @@ from numba import njit
 
 import solver.families.kernels
 import solver.families.opw.kernel
+import solver.families.pairs
 import solver.families.ur.kernel
 from solver.families.base import SINGULAR, UNREACHABLE
 from solver.families.kernels import SCRATCH_ROWS, UR_KERNEL, pose_block
@@ -65,25 +67,30 @@ def _drop_stale_compiled_code() -> None:
     """Delete the cached machine code of the kernel when a pose kernel's source has changed.
 
     numba's disk cache (``cache=True``, files in ``__pycache__``) is keyed by the source file
-    of the cached function only, but :func:`map_cells` and the families' dispatcher compile the
-    pose kernels into themselves: after an edit of a pose kernel they would load the old code.
-    A marker named by the hash of those sources says which code the cache holds. Where the
+    of the cached function only, but the compiled functions take their callees into themselves
+    (the pose kernels take :mod:`solver.families.pairs`, the dispatcher the pose kernels, this
+    module the dispatcher): after an edit of a callee they would load the old code. A marker
+    named by the hash of all those sources says which code the caches hold; a new hash drops
+    the cached code of every one of them. Where the
     directories cannot be written (an installed copy), numba caches elsewhere or not at all
     and nothing is done here.
     """
-    modules = (solver.families.kernels, solver.families.ur.kernel, solver.families.opw.kernel)
-    sources = b"".join(Path(str(module.__file__)).read_bytes() for module in modules)
-    stamp = hashlib.sha256(sources).hexdigest()[:16]
-    caches = {
-        Path(__file__).parent / "__pycache__": "map_kernel",
-        Path(str(solver.families.kernels.__file__)).parent / "__pycache__": "kernels",
-    }
+    modules = (
+        solver.families.pairs,
+        solver.families.ur.kernel,
+        solver.families.opw.kernel,
+        solver.families.kernels,
+        sys.modules[__name__],
+    )
+    files = [Path(str(module.__file__)) for module in modules]
+    stamp = hashlib.sha256(b"".join(path.read_bytes() for path in files)).hexdigest()[:16]
     marker = Path(__file__).parent / "__pycache__" / f"map_kernel.sources-{stamp}"
     try:
         if marker.exists():
             return
-        for directory, stem in caches.items():
-            for stale in [*directory.glob(f"{stem}.*.nbi"), *directory.glob(f"{stem}.*.nbc")]:
+        for path in files:
+            cache = path.parent / "__pycache__"
+            for stale in [*cache.glob(f"{path.stem}.*.nbi"), *cache.glob(f"{path.stem}.*.nbc")]:
                 stale.unlink(missing_ok=True)
         for old in marker.parent.glob("map_kernel.sources-*"):
             old.unlink(missing_ok=True)
@@ -117,7 +124,8 @@ def _exact_limits(cq, sq, b, lower, upper):  # type: ignore[no-untyped-def]  # p
     """The first waypoint whose joint range no 2 pi copy holds (the path's length: none).
 
     :func:`solver.tracking.track`'s test on one branch: the angles of the pairs, unwrapped by
-    the wrapped steps, the whole path first, then the running range where it fails.
+    the wrapped steps, and the running range of each joint (a range that fits holds every
+    shorter one, so no test of the whole path is needed first).
     """
     dof, n_waypoints = cq.shape[1], cq.shape[2]
     path = np.empty((n_waypoints, dof))
@@ -133,17 +141,6 @@ def _exact_limits(cq, sq, b, lower, upper):  # type: ignore[no-untyped-def]  # p
                 step += _TWO_PI
             path[w, j] = path[w - 1, j] + step
             previous = angle
-    fits = True
-    for j in range(dof):
-        low, high = path[0, j], path[0, j]
-        for w in range(1, n_waypoints):
-            low, high = min(low, path[w, j]), max(high, path[w, j])
-        k_low = math.ceil((lower[j] - low) / _TWO_PI - _EDGE)
-        k_high = math.floor((upper[j] - high) / _TWO_PI + _EDGE)
-        if k_low > k_high:
-            fits = False
-    if fits:
-        return n_waypoints
     low_run, high_run = path[0].copy(), path[0].copy()
     for w in range(n_waypoints):
         for j in range(dof):

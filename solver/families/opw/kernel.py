@@ -1,7 +1,7 @@
 """The OPW family's pose kernel for the compiled map (:mod:`solver.map_kernel`): (cos, sin) pairs.
 
 The same closed forms as :mod:`solver.families.opw.ik` and :mod:`solver.families.opw.jacobian`
-for one flange pose and all eight branches, with every angle kept as its (cos, sin) pair
+for a block of flange poses and all eight branches, with every angle kept as its (cos, sin) pair
 (dtf.md section 9) and the work shared per level: the shoulder (2), the elbow (2 x 2), the
 flipped wrist as a half turn. The singular and reach tests use the same quantities and
 tolerances as the numpy IK; the numpy family is the reference the kernel is tested against.
@@ -20,7 +20,7 @@ from numba import njit
 from solver.families.base import OK, SINGULAR, UNREACHABLE
 from solver.families.opw.ik import REACH_TOLERANCE, SINGULAR_TOLERANCE
 from solver.families.opw.parameters import OpwParameters
-from solver.families.ur.kernel import _unit_pair
+from solver.families.pairs import unit_pair
 
 
 def kernel_parameters(p: OpwParameters) -> np.ndarray:
@@ -45,7 +45,7 @@ def opw_block(par, poses, w0, w1, need, scratch, cq, sq, status, qd):  # type: i
     a1, a2, b, c1_len, c2_len, c3_len, c4 = par[0], par[1], par[2], par[3], par[4], par[5], par[6]
     k2 = a2 * a2 + c3_len * c3_len
     k = math.sqrt(k2)
-    c_psi, s_psi = _unit_pair(c3_len, a2)  # psi3 = atan2(a2, c3)
+    c_psi, s_psi = unit_pair(c3_len, a2)  # psi3 = atan2(a2, c3)
     k_h = math.hypot(a2, c3_len)
     t = scratch
     for w in range(w0, w1):
@@ -56,8 +56,8 @@ def opw_block(par, poses, w0, w1, need, scratch, cq, sq, status, qd):  # type: i
         t[0, w] = poses[11, w] - c4 * poses[8, w] - c1_len  # height
         t[1, w] = radial2
         t[2, w] = lever
-        t[3, w], t[4, w] = _unit_pair(cx, cy)  # heading
-        t[5, w], t[6, w] = _unit_pair(lever, b)  # side
+        t[3, w], t[4, w] = unit_pair(cx, cy)  # heading
+        t[5, w], t[6, w] = unit_pair(lever, b)  # side
     for shoulder in range(2):
         if not need[4 * shoulder : 4 * shoulder + 4].any():
             continue
@@ -82,7 +82,7 @@ def opw_block(par, poses, w0, w1, need, scratch, cq, sq, status, qd):  # type: i
             )
             ce = min(max(cos_elbow, -1.0), 1.0)
             cs = min(max(cos_shoulder, -1.0), 1.0)
-            c_to, s_to = _unit_pair(height, forward)  # angle_to = atan2(forward, height)
+            c_to, s_to = unit_pair(height, forward)  # angle_to = atan2(forward, height)
             t[7, w], t[8, w] = c1, s1
             t[9, w], t[10, w] = ce, math.sqrt(1.0 - ce * ce)
             t[11, w], t[12, w] = cs, math.sqrt(1.0 - cs * cs)
@@ -117,15 +117,15 @@ def opw_block(par, poses, w0, w1, need, scratch, cq, sq, status, qd):  # type: i
                 z_y = s23 * uy + c23 * poses[7, w]
                 z_x = s23 * ux + c23 * poses[6, w]
                 sin5 = math.sqrt(x_z * x_z + y_z * y_z)
-                c5, s5 = _unit_pair(m, sin5)
+                c5, s5 = unit_pair(m, sin5)
                 wrist_singular = sin5 < SINGULAR_TOLERANCE
                 if wrist_singular:
                     x_y = c23 * uy - s23 * poses[7, w]
-                    c4a, s4a = _unit_pair(y_y, -x_y)
+                    c4a, s4a = unit_pair(y_y, -x_y)
                     c6a, s6a = 1.0, 0.0
                 else:
-                    c4a, s4a = _unit_pair(x_z, y_z)
-                    c6a, s6a = _unit_pair(-z_x, z_y)
+                    c4a, s4a = unit_pair(x_z, y_z)
+                    c6a, s6a = unit_pair(-z_x, z_y)
                 if t[15, w] == 0.0:
                     code = UNREACHABLE
                 elif t[16, w] > 0.0 or wrist_singular:

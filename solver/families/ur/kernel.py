@@ -1,12 +1,12 @@
 """The UR family's pose kernel for the compiled map (:mod:`solver.map_kernel`), in (cos, sin) pairs.
 
 The same closed forms as :mod:`solver.families.ur.ik` and :mod:`solver.families.ur.jacobian`,
-for one flange pose and all eight branches at once, with every angle kept as its (cos, sin)
-pair (dtf.md section 9): an atan2 becomes a normalised pair, a sum of angles a complex product,
-acos(x) the pair (x, +-sqrt(1 - x^2)). Work is shared per level: the shoulder (2), the wrist
-(2 x 2) and the elbow (2 x 2 x 2). The singular and reach tests use the same quantities and
-tolerances as the numpy IK, so the statuses agree; the numpy family is the reference the
-kernel is tested against (tests/solver/test_map_kernel.py).
+for a block of flange poses and all eight branches at once, with every angle kept as its
+(cos, sin) pair (dtf.md section 9): an atan2 becomes a normalised pair, a sum of angles a
+complex product, acos(x) the pair (x, +-sqrt(1 - x^2)). Work is shared per level: the
+shoulder (2), the wrist (2 x 2) and the elbow (2 x 2 x 2). The singular and reach tests use
+the same quantities and tolerances as the numpy IK, so the statuses agree; the numpy family
+is the reference the kernel is tested against (tests/solver/test_map_kernel.py).
 
 Parameters (``par``): d1, a2, a3, d4, d5, d6 (m), as :class:`solver.families.ur.dh.UrDh`.
 """
@@ -19,6 +19,7 @@ import numpy as np
 from numba import njit
 
 from solver.families.base import OK, SINGULAR, UNREACHABLE
+from solver.families.pairs import unit_pair
 from solver.families.ur.dh import UrDh
 from solver.families.ur.ik import REACH_TOLERANCE, SINGULAR_TOLERANCE
 
@@ -26,20 +27,6 @@ from solver.families.ur.ik import REACH_TOLERANCE, SINGULAR_TOLERANCE
 def kernel_parameters(dh: UrDh) -> np.ndarray:
     """The kernel's parameter vector of a UR arm."""
     return np.array([dh.d1, dh.a2, dh.a3, dh.d4, dh.d5, dh.d6])
-
-
-@njit(cache=True, error_model="numpy", nogil=True, inline="always")  # type: ignore[untyped-decorator]
-def _unit_pair(x: float, y: float) -> tuple[float, float]:  # pragma: no cover - compiled
-    """(cos, sin) of atan2(y, x); (1, 0) where both are 0, as atan2(0, 0) = 0.
-
-    sqrt(x^2 + y^2), not math.hypot: libm's hypot costs about 20 ns, which was most of the
-    kernel's time; the lengths here are near 1 or metres, far from over- or underflow.
-    """
-    norm2 = x * x + y * y
-    if norm2 == 0.0:
-        return 1.0, 0.0
-    inverse = 1.0 / math.sqrt(norm2)
-    return x * inverse, y * inverse
 
 
 SCRATCH_ROWS = 29  # rows of the scratch array ur_block needs
@@ -80,7 +67,7 @@ def ur_block(par, poses, w0, w1, need, scratch, cq, sq, status, qd):  # type: ig
         rc = min(max(ratio1, -1.0), 1.0)
         t[0, w], t[1, w], t[2, w] = w_x, w_y, w_z
         t[3, w], t[4, w] = rc, math.sqrt(1.0 - rc * rc)
-        t[5, w], t[6, w] = _unit_pair(w_x, w_y)
+        t[5, w], t[6, w] = unit_pair(w_x, w_y)
     for shoulder in range(2):
         if not need[4 * shoulder : 4 * shoulder + 4].any():
             continue
@@ -122,13 +109,13 @@ def ur_block(par, poses, w0, w1, need, scratch, cq, sq, status, qd):  # type: ig
                 x5_x = -(z4_y * a_z - z4_z * a_y)
                 x5_y = -(z4_z * a_x - z4_x * a_z)
                 x5_z = -(z4_x * a_y - z4_y * a_x)
-                t[19, w], t[20, w] = _unit_pair(
+                t[19, w], t[20, w] = unit_pair(
                     n_x * x5_x + n_y * x5_y + n_z * x5_z, -(n_x * z4_x + n_y * z4_y + n_z * z4_z)
                 )
                 plane_x = (t[0, w] - d5 * z4_x) * c1 + (t[1, w] - d5 * z4_y) * s1
                 plane_y = t[2, w] - d5 * z4_z - d1
-                t[21, w], t[22, w] = _unit_pair(-z4_z, z4_x * c1 + z4_y * s1)
-                t[23, w], t[24, w] = _unit_pair(plane_x, plane_y)
+                t[21, w], t[22, w] = unit_pair(-z4_z, z4_x * c1 + z4_y * s1)
+                t[23, w], t[24, w] = unit_pair(plane_x, plane_y)
                 cos3 = (plane_x * plane_x + plane_y * plane_y - a2 * a2 - a3 * a3) / (2.0 * a2 * a3)
                 t[26, w] = 1.0 if abs(cos3) <= 1.0 + REACH_TOLERANCE else 0.0
                 cos3 = min(max(cos3, -1.0), 1.0)
@@ -153,7 +140,7 @@ def ur_block(par, poses, w0, w1, need, scratch, cq, sq, status, qd):  # type: ig
                     )
                     status[b, w] = UNREACHABLE if not reach else (SINGULAR if singular else OK)
                     # q2 = atan2(plane_y, plane_x) - atan2(a3 s3, a2 + a3 c3)
-                    c_in, s_in = _unit_pair(a2 + a3 * c3, a3 * s3)
+                    c_in, s_in = unit_pair(a2 + a3 * c3, a3 * s3)
                     c2 = c_to * c_in + s_to * s_in
                     s2 = s_to * c_in - c_to * s_in
                     c23 = c2 * c3 - s2 * s3
