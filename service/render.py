@@ -22,6 +22,9 @@ PANEL_INCHES = (4.0, 3.6)
 COLOUR_BAR_INCHES = 1.2
 DPI = 100
 MAX_COLUMNS = 3
+TITLE_INCHES = 0.3  # the figure's title, above the panels
+LEGEND_INCHES = 0.3  # the legend, below them
+PANEL_MARGINS_INCHES = (0.75, 0.2, 0.5, 0.3)  # left, right, bottom, top of each panel's axes
 
 
 def figure_pixels(n_panels: int) -> tuple[int, int]:
@@ -33,14 +36,39 @@ def figure_pixels(n_panels: int) -> tuple[int, int]:
     return round(width * DPI), round(height * DPI)
 
 
+def _panel_boxes(rows: int, columns: int) -> list[tuple[float, float, float, float]]:
+    """Each panel's axes box (left, bottom, width, height; figure fractions), row by row.
+
+    Fixed margins in inches, not matplotlib's constrained layout: that layout measured every
+    tick label of every panel and was half the rendering time (0.8 of 1.6 s for six panels).
+    """
+    width, height = PANEL_INCHES[0] * columns + COLOUR_BAR_INCHES, PANEL_INCHES[1] * rows
+    cell_height = (height - TITLE_INCHES - LEGEND_INCHES) / rows
+    left, right, bottom, top = PANEL_MARGINS_INCHES
+    boxes = []
+    for row in range(rows):
+        for column in range(columns):
+            x0 = PANEL_INCHES[0] * column + left
+            y0 = LEGEND_INCHES + cell_height * (rows - 1 - row) + bottom
+            boxes.append(
+                (
+                    x0 / width,
+                    y0 / height,
+                    (PANEL_INCHES[0] - left - right) / width,
+                    (cell_height - bottom - top) / height,
+                )
+            )
+    return boxes
+
+
 def render_png(cmap: CapabilityMap, *, title: str) -> bytes:
     """The map as PNG bytes: colour bar in m/s, infeasible cells blank, best and worst marked."""
     n_panels = len(cmap.spins) * len(cmap.yaws)
     columns = min(n_panels, MAX_COLUMNS)
     rows = math.ceil(n_panels / MAX_COLUMNS)
     width_px, height_px = figure_pixels(n_panels)
-    figure = plt.figure(figsize=(width_px / DPI, height_px / DPI), dpi=DPI, layout="constrained")
-    panels = figure.subplots(rows, columns, squeeze=False)
+    figure = plt.figure(figsize=(width_px / DPI, height_px / DPI), dpi=DPI)
+    boxes = _panel_boxes(rows, columns)
     feasible = ~np.isnan(cmap.mu_path)
     low = float(np.nanmin(cmap.mu_path)) if feasible.any() else 0.0
     high = float(np.nanmax(cmap.mu_path)) if feasible.any() else 1.0
@@ -51,7 +79,7 @@ def render_png(cmap: CapabilityMap, *, title: str) -> bytes:
     extent = (cmap.xs[0] - half_x, cmap.xs[-1] + half_x, cmap.ys[0] - half_y, cmap.ys[-1] + half_y)
     images = []
     for panel, (s, k) in enumerate(np.ndindex(len(cmap.spins), len(cmap.yaws))):
-        axes = panels[panel // columns, panel % columns]
+        axes = figure.add_axes(boxes[panel])
         image = axes.imshow(
             np.ma.masked_invalid(cmap.mu_path[s, k]),
             origin="lower",
@@ -73,20 +101,30 @@ def render_png(cmap: CapabilityMap, *, title: str) -> bytes:
         )
         axes.set_xlabel("x (m)")
         axes.set_ylabel("y (m)")
-    for axes in panels.ravel()[n_panels:]:
-        axes.set_axis_off()
-    figure.colorbar(images[0], ax=panels, label="mu_path (m/s)", shrink=0.9)
+    width_in, height_in = width_px / DPI, height_px / DPI
+    bar_bottom = LEGEND_INCHES + PANEL_MARGINS_INCHES[2]
+    bar = figure.add_axes(
+        (
+            (PANEL_INCHES[0] * columns + 0.15) / width_in,
+            bar_bottom / height_in,
+            0.2 / width_in,
+            (height_in - TITLE_INCHES - PANEL_MARGINS_INCHES[3] - bar_bottom) / height_in,
+        )
+    )
+    figure.colorbar(images[0], cax=bar, label="mu_path (m/s)")
     figure.legend(
         handles=[
             Line2D([], [], marker="*", color="red", ls="", ms=10, label="best"),
             Line2D([], [], marker="X", color="black", ls="", ms=8, label="worst"),
             Patch(facecolor="white", edgecolor="grey", label="infeasible"),
         ],
-        loc="outside lower right",
+        loc="lower right",
         ncols=3,
         fontsize=8,
+        frameon=False,
+        borderaxespad=0.1,
     )
-    figure.suptitle(title, fontsize=10)
+    figure.suptitle(title, fontsize=10, y=1.0 - 0.08 / height_in, va="top")
     buffer = io.BytesIO()
     figure.savefig(buffer, format="png", dpi=DPI)
     plt.close(figure)
