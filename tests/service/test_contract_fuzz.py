@@ -8,6 +8,8 @@ runs; ``tests/test_contract.py`` runs every check on a live server.
 from __future__ import annotations
 
 import json
+import re
+from collections.abc import Callable
 
 import hypothesis
 import schemathesis
@@ -20,13 +22,24 @@ schema = schemathesis.openapi.from_dict(json.loads((ROOT / "openapi" / "openapi.
 schema.app = app  # the committed spec, served by the app in process
 
 
-@schema.parametrize()
-@hypothesis.settings(
-    max_examples=40,
-    phases=[hypothesis.Phase.generate],  # the spec's examples run in tests/test_contract.py
-    deadline=None,
-    derandomize=True,
-    suppress_health_check=list(hypothesis.HealthCheck),
-)
-def test_no_input_is_a_server_error(case: schemathesis.Case) -> None:
-    case.call_and_validate(checks=[not_a_server_error], timeout=120)
+def _fuzz_test(label: str) -> Callable[..., None]:
+    """The test of one operation, under its own test id (pytest-xdist schedules by id)."""
+    method, path = label.split(" ", 1)
+
+    @schema.include(method=method, path=path).parametrize()
+    @hypothesis.settings(
+        max_examples=40,
+        phases=[hypothesis.Phase.generate],  # the spec's examples run in tests/test_contract.py
+        deadline=None,
+        derandomize=True,
+        suppress_health_check=list(hypothesis.HealthCheck),
+    )
+    def test(case: schemathesis.Case) -> None:
+        case.call_and_validate(checks=[not_a_server_error], timeout=120)
+
+    return test
+
+
+for _label in [operation.ok().label for operation in schema.get_all_operations()]:
+    _name = "test_no_input_is_a_server_error_" + re.sub(r"\W+", "_", _label).strip("_").lower()
+    globals()[_name] = _fuzz_test(_label)
