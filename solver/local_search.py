@@ -24,7 +24,7 @@ import scipy.optimize
 from solver.coarse_search import COARSE_STEP, COARSE_YAW_STEP, Cell
 from solver.parallel import SERIAL, TaskRunner
 from solver.pipeline import PreparedPath, SpinMode, require_family
-from solver.placements import evaluate_placements
+from solver.placements import PlacementEvaluator, evaluate_placements
 from solver.progress import Progress
 from solver.robots import Robot
 from solver.search_space import PlacementBounds
@@ -153,17 +153,12 @@ def climb(
     if budget < CLIMB_MIN_EVALUATIONS or not len(free):
         return None
     best = [start]
+    evaluate = PlacementEvaluator(robot, path, max_joint_step=max_joint_step, spin_mode=spin_mode)
 
     def negative_mu(values: np.ndarray) -> float:
         vector = start.vector.copy()
         vector[free] = np.clip(values, bounds.lower[free], bounds.upper[free])
-        result = evaluate_placements(
-            robot,
-            path,
-            vector[None, _PLACEMENT_COLUMNS],
-            max_joint_step=max_joint_step,
-            spin_mode=spin_mode,
-        )
+        result = evaluate(vector[None, _PLACEMENT_COLUMNS])
         mu = float(result.mu_path[0])
         if np.isnan(mu):
             return 1.0

@@ -12,7 +12,7 @@ from solver._malloc import raise_malloc_thresholds
 from solver.evaluate import evaluate_path
 from solver.exceptions import InvalidInputError
 from solver.families.ur.ik import BRANCHES
-from solver.placements import evaluate_placements, prepare_path
+from solver.placements import PlacementEvaluator, evaluate_placements, prepare_path
 from solver.robots import get_robot
 from solver.spatial import Placement
 from solver.tracking import REASONS
@@ -58,3 +58,34 @@ def test_bad_placements(placements: np.ndarray) -> None:
 @pytest.mark.skipif(platform.libc_ver()[0] != "glibc", reason="mallopt is glibc's")
 def test_malloc_thresholds_are_set_on_glibc() -> None:
     assert raise_malloc_thresholds() is True
+
+
+@pytest.mark.parametrize(
+    ("robot_name", "spin_mode"),
+    [("ur5", "fixed"), ("kuka_kr6_r700_sixx", "fixed"), ("ur5", "free")],
+)
+def test_the_placement_evaluator_is_the_numpy_pipeline_one_placement_at_a_time(
+    robot_name: str, spin_mode: str
+) -> None:
+    """The local searches' evaluator, one placement per call, spins changing between calls."""
+    robot = get_robot(robot_name)
+    path = prepare_path(robot, load_path("curved_line"))
+    rng = np.random.default_rng(3)
+    placements = np.column_stack(
+        [
+            rng.uniform(-0.8, 0.8, 24),
+            rng.uniform(-0.8, 0.8, 24),
+            rng.uniform(-0.1, 0.3, 24),
+            rng.uniform(-math.pi, math.pi, 24),
+            np.repeat([0.0, 0.7, 0.0, -1.2], 6),  # a spin asked for again after another
+        ]
+    )
+    reference = evaluate_placements(robot, path, placements, spin_mode=spin_mode, compiled=False)
+    evaluate = PlacementEvaluator(robot, path, spin_mode=spin_mode)
+    answers = [evaluate(row[None]) for row in placements]
+    mu = np.concatenate([a.mu_path for a in answers])
+    np.testing.assert_allclose(mu, reference.mu_path, rtol=1e-12, equal_nan=True)
+    for column in ("reason", "failed_waypoint", "branch", "bottleneck_waypoint"):
+        got = np.concatenate([getattr(a, column) for a in answers])
+        np.testing.assert_array_equal(got, getattr(reference, column))
+    assert 4 <= np.count_nonzero(np.isfinite(mu)) <= 20  # feasible and infeasible cells both
