@@ -5,7 +5,8 @@ FastAPI validates a declared body on the event loop: a 2 MB path (20,000 waypoin
 answered. A route that takes a large body declares it with :func:`body_in_thread` instead: the
 body is validated by pydantic (``model_validate_json``) in a worker thread, errors come back as
 the same ``422`` as FastAPI's, and :func:`body_openapi` keeps the operation's request body in
-the OpenAPI description.
+the OpenAPI description. A body under INLINE_BODY_BYTES (the README example is 19 KB, 0.3 ms)
+is validated on the event loop: the hop to a thread and back would cost more than it.
 """
 
 from __future__ import annotations
@@ -18,6 +19,8 @@ from fastapi.exceptions import RequestValidationError
 from pydantic import BaseModel, ValidationError
 
 M = TypeVar("M", bound=BaseModel)
+INLINE_BODY_BYTES = 32 * 1024
+"""Bodies up to this size are validated on the event loop (about 1 ms at most)."""
 BODY_MODELS: list[type[BaseModel]] = []
 """Every model taken by :func:`body_in_thread`; their schemas go into the OpenAPI components."""
 
@@ -28,6 +31,8 @@ def body_in_thread(model: type[M]) -> Any:
     async def parse(request: Request) -> M:
         raw = await request.body()
         try:
+            if len(raw) <= INLINE_BODY_BYTES:
+                return model.model_validate_json(raw)
             return await anyio.to_thread.run_sync(model.model_validate_json, raw)
         except ValidationError as error:
             errors = [{**e, "loc": ("body", *e["loc"])} for e in error.errors()]
