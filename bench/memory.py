@@ -13,21 +13,33 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
 
+# The child's own peak: VmHWM of /proc/self/status on Linux. getrusage's ru_maxrss would not
+# do there: exec keeps the peak of the forked copy of the parent, so a child of the full
+# benchmark run reported the parent's 730 MiB as its own.
 _CHILD = """
 import json, resource, sys
 import numpy as np
+def peak_mib():
+    try:
+        with open("/proc/self/status") as status:
+            for line in status:
+                if line.startswith("VmHWM:"):
+                    return int(line.split()[1]) / 1024
+    except OSError:
+        pass
+    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
 from solver.capability_map import capability_map
 from service.schemas import EvaluateRequest
 request = EvaluateRequest.model_validate(json.load(open(sys.argv[1])))
 robot, path = request.robot.to_solver(), request.path.to_solver().poses
 capability_map(robot, path, xs=np.zeros(1), ys=np.full(1, 0.45), z=0.1, yaws=np.zeros(1))
-before = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+before = peak_mib()
 cells = int(sys.argv[2])
 side = int(np.ceil(np.sqrt(cells)))
 xs, ys = np.linspace(-0.6, 0.6, side), np.linspace(-0.6, 0.6, side)
 capability_map(robot, path, xs=xs, ys=ys, z=0.1, yaws=np.zeros(1))
-after = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
-print(side * side, len(path), before / 1024, after / 1024)
+after = peak_mib()
+print(side * side, len(path), before, after)
 """
 
 
