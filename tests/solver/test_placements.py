@@ -20,18 +20,23 @@ from tests.cases import MAP_EVALUATE_RTOL
 from tests.solver.test_evaluate import load_path
 
 
+def random_placements(seed: int, n: int, *, z: tuple[float, float]) -> np.ndarray:
+    """n placements (x, y, z, yaw), x and y in +-0.8 m, yaw over a turn; reachable or not."""
+    rng = np.random.default_rng(seed)
+    return np.column_stack(
+        [
+            rng.uniform(-0.8, 0.8, n),
+            rng.uniform(-0.8, 0.8, n),
+            rng.uniform(*z, n),
+            rng.uniform(-math.pi, math.pi, n),
+        ]
+    )
+
+
 def test_random_placements_equal_evaluate() -> None:
     robot = get_robot("ur5e")
     path = load_path("s_curve")
-    rng = np.random.default_rng(8)
-    placements = np.column_stack(
-        [
-            rng.uniform(-0.8, 0.8, 60),
-            rng.uniform(-0.8, 0.8, 60),
-            rng.uniform(-0.2, 0.3, 60),
-            rng.uniform(-math.pi, math.pi, 60),
-        ]
-    )
+    placements = random_placements(8, 60, z=(-0.2, 0.3))
     result = evaluate_placements(robot, prepare_path(robot, path), placements, with_speeds=True)
     feasible = 0
     for p, row in enumerate(placements):
@@ -70,16 +75,8 @@ def test_the_placement_evaluator_is_the_numpy_pipeline_one_placement_at_a_time(
     """The local searches' evaluator, one placement per call, spins changing between calls."""
     robot = get_robot(robot_name)
     path = prepare_path(robot, load_path("curved_line"))
-    rng = np.random.default_rng(3)
-    placements = np.column_stack(
-        [
-            rng.uniform(-0.8, 0.8, 24),
-            rng.uniform(-0.8, 0.8, 24),
-            rng.uniform(-0.1, 0.3, 24),
-            rng.uniform(-math.pi, math.pi, 24),
-            np.repeat([0.0, 0.7, 0.0, -1.2], 6),  # a spin asked for again after another
-        ]
-    )
+    spins = np.repeat([0.0, 0.7, 0.0, -1.2], 6)  # a spin asked for again after another
+    placements = np.column_stack([random_placements(3, 24, z=(-0.1, 0.3)), spins])
     reference = evaluate_placements(robot, path, placements, spin_mode=spin_mode, compiled=False)
     evaluate = PlacementEvaluator(robot, path, spin_mode=spin_mode)
     answers = [evaluate(row[None]) for row in placements]
