@@ -179,21 +179,9 @@ def _run_kernel(
     return (mu, *codes, v_max)
 
 
-def _compiled_chunk(
-    robot: Robot,
-    path: PreparedPath,
-    placements: np.ndarray,
-    branches: np.ndarray,
-    max_joint_step: float,
-    with_speeds: bool,
-    kernel: tuple[int, np.ndarray],
-) -> tuple[np.ndarray, ...]:
-    """The columns of :func:`_chunk` by the compiled kernel (:mod:`solver.map_kernel`).
-
-    The placements may have any yaws, and one spin.
-    """
-    inputs = _kernel_inputs(robot, path, float(placements[0, 4]), kernel)
-    return _run_kernel(inputs, placements, branches, max_joint_step, with_speeds)
+def _kernel_of(robot: Robot, spin_mode: SpinMode) -> tuple[int, np.ndarray] | None:
+    """The compiled kernel of the robot's family: where it has one and the spin is fixed."""
+    return require_family(robot).map_kernel() if spin_mode == "fixed" else None
 
 
 def _task(
@@ -214,12 +202,15 @@ def _task(
     process (a Dask worker), so it sets the malloc thresholds itself.
     """
     raise_malloc_thresholds()
-    kernel = require_family(robot).map_kernel() if compiled and spin_mode == "fixed" else None
+    kernel = _kernel_of(robot, spin_mode) if compiled else None
     if kernel is not None:
-        parts = [
-            _compiled_chunk(robot, path, rows, branches, max_joint_step, with_speeds, kernel)
-            for rows in _pieces(placements, chunk, by_yaw=False)
-        ]
+        inputs: dict[float, _KernelInputs] = {}  # made once per spin, not once per chunk
+        parts = []
+        for rows in _pieces(placements, chunk, by_yaw=False):
+            spin = float(rows[0, 4])
+            if spin not in inputs:
+                inputs[spin] = _kernel_inputs(robot, path, spin, kernel)
+            parts.append(_run_kernel(inputs[spin], rows, branches, max_joint_step, with_speeds))
     else:
         parts = [
             _chunk(robot, path, rows, branches, max_joint_step, spin_mode, with_speeds)
@@ -336,7 +327,7 @@ class PlacementEvaluator:
         self._branches = branch_indices(
             robot, None, max_joint_step=max_joint_step, spin_mode=spin_mode
         )
-        self._kernel = require_family(robot).map_kernel() if spin_mode == "fixed" else None
+        self._kernel = _kernel_of(robot, spin_mode)
         self._last: tuple[float, _KernelInputs] | None = None  # the spin asked for last
 
     def __call__(self, placements: np.ndarray) -> PlacementResults:
