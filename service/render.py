@@ -36,13 +36,16 @@ def figure_pixels(n_panels: int) -> tuple[int, int]:
     return round(width * DPI), round(height * DPI)
 
 
-def _panel_boxes(rows: int, columns: int) -> list[tuple[float, float, float, float]]:
-    """Each panel's axes box (left, bottom, width, height; figure fractions), row by row.
+Box = tuple[float, float, float, float]
+"""An axes box: left, bottom, width, height, as fractions of the figure."""
+
+
+def _layout(rows: int, columns: int, width: float, height: float) -> tuple[list[Box], Box]:
+    """Each panel's axes box, row by row, and the colour bar's, in a figure of width x height in.
 
     Fixed margins in inches, not matplotlib's constrained layout: that layout measured every
     tick label of every panel and was half the rendering time (0.8 of 1.6 s for six panels).
     """
-    width, height = PANEL_INCHES[0] * columns + COLOUR_BAR_INCHES, PANEL_INCHES[1] * rows
     cell_height = (height - TITLE_INCHES - LEGEND_INCHES) / rows
     left, right, bottom, top = PANEL_MARGINS_INCHES
     boxes = []
@@ -58,7 +61,14 @@ def _panel_boxes(rows: int, columns: int) -> list[tuple[float, float, float, flo
                     (cell_height - bottom - top) / height,
                 )
             )
-    return boxes
+    bar_bottom = LEGEND_INCHES + bottom
+    bar = (
+        (PANEL_INCHES[0] * columns + 0.15) / width,
+        bar_bottom / height,
+        0.2 / width,
+        (height - TITLE_INCHES - top - bar_bottom) / height,
+    )
+    return boxes, bar
 
 
 def render_png(cmap: CapabilityMap, *, title: str) -> bytes:
@@ -67,8 +77,9 @@ def render_png(cmap: CapabilityMap, *, title: str) -> bytes:
     columns = min(n_panels, MAX_COLUMNS)
     rows = math.ceil(n_panels / MAX_COLUMNS)
     width_px, height_px = figure_pixels(n_panels)
-    figure = plt.figure(figsize=(width_px / DPI, height_px / DPI), dpi=DPI)
-    boxes = _panel_boxes(rows, columns)
+    width_in, height_in = width_px / DPI, height_px / DPI
+    figure = plt.figure(figsize=(width_in, height_in), dpi=DPI)
+    boxes, bar = _layout(rows, columns, width_in, height_in)
     feasible = ~np.isnan(cmap.mu_path)
     low = float(np.nanmin(cmap.mu_path)) if feasible.any() else 0.0
     high = float(np.nanmax(cmap.mu_path)) if feasible.any() else 1.0
@@ -101,17 +112,7 @@ def render_png(cmap: CapabilityMap, *, title: str) -> bytes:
         )
         axes.set_xlabel("x (m)")
         axes.set_ylabel("y (m)")
-    width_in, height_in = width_px / DPI, height_px / DPI
-    bar_bottom = LEGEND_INCHES + PANEL_MARGINS_INCHES[2]
-    bar = figure.add_axes(
-        (
-            (PANEL_INCHES[0] * columns + 0.15) / width_in,
-            bar_bottom / height_in,
-            0.2 / width_in,
-            (height_in - TITLE_INCHES - PANEL_MARGINS_INCHES[3] - bar_bottom) / height_in,
-        )
-    )
-    figure.colorbar(images[0], cax=bar, label="mu_path (m/s)")
+    figure.colorbar(images[0], cax=figure.add_axes(bar), label="mu_path (m/s)")
     figure.legend(
         handles=[
             Line2D([], [], marker="*", color="red", ls="", ms=10, label="best"),
