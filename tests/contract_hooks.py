@@ -24,6 +24,7 @@ Each rule is computed here independently of the service's code:
 from __future__ import annotations
 
 import math
+import re
 from collections import Counter
 from functools import cache
 from typing import Any
@@ -287,6 +288,19 @@ def after_call(context: Any, case: schemathesis.Case, response: Any) -> None:
     """Count the answer's status, per operation and generation mode."""
     mode = "positive" if _positive(case) else "negative"
     STATUSES[(case.operation.label, mode, response.status_code)] += 1
+
+
+def operations(schema: Any) -> list[tuple[str, str, str]]:
+    """Each operation's method, path and a test-name suffix (``post_v1_map``).
+
+    The contract tests make one test function per operation: schemathesis gives the items of
+    one parametrized function the same test id, so they could not be told apart (pytest-xdist,
+    which schedules by id, ran 1 of 13).
+    """
+    labels = [operation.ok().label for operation in schema.get_all_operations()]
+    return [
+        (*label.split(" ", 1), re.sub(r"\W+", "_", label).strip("_").lower()) for label in labels
+    ]
 
 
 def register(schema: Any, *, limits: dict[str, float]) -> None:

@@ -14,7 +14,6 @@ The figures (cases and statuses per operation) are written to
 from __future__ import annotations
 
 import json
-import re
 from collections.abc import Callable, Iterator
 
 import hypothesis
@@ -66,10 +65,8 @@ schema = schemathesis.openapi.from_dict(json.loads((ROOT / "openapi" / "openapi.
 contract_hooks.register(schema, limits=LIMITS)
 
 
-def _contract_test(label: str) -> Callable[..., None]:
-    """The contract test of one operation: its own test function, so that every operation has
-    its own test id (pytest-xdist schedules tests by id; one id for all of them ran one)."""
-    method, path = label.split(" ", 1)
+def _contract_test(method: str, path: str) -> Callable[..., None]:
+    """The contract test of one operation (one function each: contract_hooks.operations)."""
 
     @schema.include(method=method, path=path).parametrize()
     @hypothesis.settings(
@@ -85,8 +82,5 @@ def _contract_test(label: str) -> Callable[..., None]:
     return test
 
 
-OPERATIONS = [operation.ok().label for operation in schema.get_all_operations()]
-for _label in OPERATIONS:
-    globals()["test_contract_" + re.sub(r"\W+", "_", _label).strip("_").lower()] = _contract_test(
-        _label
-    )
+for _method, _path, _name in contract_hooks.operations(schema):
+    globals()["test_contract_" + _name] = _contract_test(_method, _path)
