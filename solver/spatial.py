@@ -6,6 +6,7 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
+import pinocchio as pin
 
 from solver.exceptions import InvalidInputError
 
@@ -198,3 +199,34 @@ class Placement:
                 [0.0, 0.0, 0.0, 1.0],
             ]
         )
+
+
+# Above this angle (rad) the rotation vector of rotation_vectors comes from pinocchio's log3,
+# whose formula near a half turn reads the diagonal; below it both use the skew part.
+NEAR_HALF_TURN = math.pi - 1e-2
+
+
+def rotation_vectors(rotations: np.ndarray) -> np.ndarray:
+    """log(R) of many rotations at once: the rotation vectors, shape (..., 3), from (..., 3, 3).
+
+    theta = atan2(|w|, (tr R - 1) / 2) with w the skew part's vector (sin(theta) times the
+    axis), and log(R) = w theta / sin(theta) (1 + theta^2 / 6 below 1e-4 rad); near a half
+    turn, where w is small and carries little of the axis, pinocchio's ``log3`` (pose by pose).
+    Measured against exp3 of known rotation vectors: within 1e-15 below 3 rad, as log3 is
+    (tests/solver/test_spatial_batched.py). For the 132 segments of the README example a
+    Python loop of log3 and the products took 0.38 ms, this 0.095 ms with the products.
+    """
+    r = np.asarray(rotations, dtype=float)
+    w = 0.5 * np.stack(
+        [r[..., 2, 1] - r[..., 1, 2], r[..., 0, 2] - r[..., 2, 0], r[..., 1, 0] - r[..., 0, 1]],
+        axis=-1,
+    )
+    sine = np.linalg.norm(w, axis=-1)
+    theta = np.arctan2(sine, (np.trace(r, axis1=-2, axis2=-1) - 1.0) / 2.0)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        ratio = np.where(theta > 1e-4, theta / sine, 1.0 + theta**2 / 6.0)
+    vectors: np.ndarray = ratio[..., None] * w
+    flat_r, flat_v = r.reshape(-1, 3, 3), vectors.reshape(-1, 3)
+    for i in np.flatnonzero(theta.ravel() >= NEAR_HALF_TURN):
+        flat_v[i] = pin.log3(flat_r[i])
+    return vectors

@@ -15,10 +15,9 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-import pinocchio as pin
 
 from solver.exceptions import InvalidInputError, RepeatedWaypointError
-from solver.spatial import MAX_COORDINATE
+from solver.spatial import MAX_COORDINATE, rotation_vectors
 
 # A displacement below this (m) or a rotation below this (rad) counts as none.
 LINEAR_TOLERANCE = 1e-9
@@ -111,8 +110,8 @@ def task_requirements(poses: np.ndarray, *, field: str = "path.waypoints") -> Ta
     """
     arr = check_waypoints(poses, field=field)
     displacement = arr[1:, :3, 3] - arr[:-1, :3, 3]
-    rotation_vector = np.array(
-        [pin.log3(nxt @ cur.T) for cur, nxt in zip(arr[:-1, :3, :3], arr[1:, :3, :3], strict=True)]
+    rotation_vector = rotation_vectors(
+        np.einsum("nij,nkj->nik", arr[1:, :3, :3], arr[:-1, :3, :3])  # R_{i+1} R_i^T
     )
     linear = np.linalg.norm(displacement, axis=1)
     angular = np.linalg.norm(rotation_vector, axis=1)

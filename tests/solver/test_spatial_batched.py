@@ -5,11 +5,12 @@ from __future__ import annotations
 import math
 
 import numpy as np
+import pinocchio as pin
 import pytest
 from scipy.spatial.transform import Rotation
 
 from solver.exceptions import InvalidInputError
-from solver.spatial import pose_matrices, pose_matrix
+from solver.spatial import pose_matrices, pose_matrix, rotation_vectors
 from solver.task import check_waypoints
 
 
@@ -69,3 +70,27 @@ def test_check_waypoints_names_the_first_bad_waypoint() -> None:
         with pytest.raises(InvalidInputError, match=message) as error:
             check_waypoints(bad)
         assert error.value.waypoint == row
+
+
+ANGLES = [1e-12, 1e-7, 1e-4 - 1e-12, 1e-4 + 1e-12, 0.1, 1.0, 3.0, math.pi - 1e-2, math.pi - 1e-6]
+
+
+@pytest.mark.parametrize("angle", ANGLES)
+def test_rotation_vectors_are_the_known_ones_and_log3s(angle: float) -> None:
+    """Geometry: R = exp(theta u) for known unit axes u (scipy builds R); log(R) = theta u."""
+    rng = np.random.default_rng(7)
+    axes = rng.normal(size=(50, 3))
+    axes /= np.linalg.norm(axes, axis=1)[:, None]
+    known = angle * axes
+    rotations = Rotation.from_rotvec(known).as_matrix()
+    vectors = rotation_vectors(rotations)
+    # Near a half turn the skew part holds the axis only to eps / sin(theta): 1e-11 at 1e-2.
+    tolerance = 1e-14 if angle < 3.0 else 1e-11
+    np.testing.assert_allclose(vectors, known, rtol=0, atol=tolerance)
+    np.testing.assert_allclose(
+        vectors, [pin.log3(r) for r in rotations], rtol=0, atol=max(tolerance, 1e-15)
+    )
+    # Batch axes are kept: (5, 10, 3, 3) -> (5, 10, 3), the same vectors.
+    np.testing.assert_array_equal(
+        rotation_vectors(rotations.reshape(5, 10, 3, 3)), vectors.reshape(5, 10, 3)
+    )
