@@ -223,9 +223,9 @@ def rotation_vectors(rotations: np.ndarray) -> np.ndarray:
     )
     sine = np.linalg.norm(w, axis=-1)
     theta = np.arctan2(sine, (np.trace(r, axis1=-2, axis2=-1) - 1.0) / 2.0)
-    with np.errstate(divide="ignore", invalid="ignore"):
+    with np.errstate(divide="ignore", invalid="ignore"):  # a half turn: w = 0, log3 below
         ratio = np.where(theta > 1e-4, theta / sine, 1.0 + theta**2 / 6.0)
-    vectors: np.ndarray = ratio[..., None] * w
+        vectors: np.ndarray = ratio[..., None] * w
     flat_r, flat_v = r.reshape(-1, 3, 3), vectors.reshape(-1, 3)
     for i in np.flatnonzero(theta.ravel() >= NEAR_HALF_TURN):
         flat_v[i] = pin.log3(flat_r[i])

