@@ -46,7 +46,7 @@ class Settings(BaseSettings):
         "generations of 20 placements per free variable for a closed-form arm; a costlier IK "
         "family gets a smaller search, down to 11 generations of 5). The default admits every "
         "search of a closed-form arm within DTF_MAX_OPTIMIZE_WAYPOINTS (61 * 20 * 5 * 1000); "
-        "with numeric IK it admits a short path (the Panda on 10 waypoints: about 15 s) and "
+        "with numeric IK it admits a short path (the Panda on 10 waypoints: about 20 s) and "
         "refuses a search that would take much longer.",
     )
     max_path_waypoints: int = Field(

@@ -41,7 +41,7 @@ BASIN_GAP = (0.05, 0.35)  # m and rad (about 20 degrees): placements closer are 
 Basin = tuple[np.ndarray, float, int]  # decision vector, mu_path, branch index
 # Work of a costly family's search, in poses of a closed-form family (the unit of
 # KinematicsFamily.path_cost): about 8 s of work on the 2-core development machine (3.8 us a
-# pose). The Panda on 10 waypoints (path_cost 10,000) then gets the floors below: about 15 s
+# pose). The Panda on 10 waypoints (path_cost 10,000) then gets the floors below: about 20 s
 # for the whole search instead of about 200 s at the full size.
 SEARCH_WORK = 2e6
 MIN_POPULATION = 5  # per dimension: scipy's least useful population

@@ -82,7 +82,7 @@ def test_evaluating_the_answers_joint_path_reproduces_its_mu_path(
 def test_scipy_on_the_panda_reaches_the_coarse_map_and_is_the_evaluators(
     path: np.ndarray,
 ) -> None:
-    """Issue 11: the search sized by the family's cost (about 15 s here, 200 s at full size)."""
+    """Issue 11: the search sized by the family's cost (about 20 s here, 200 s at full size)."""
     robot, short = get_robot("panda"), path[:10]
     optimum = optimize_placement(robot, short, bounds=BOUNDS, method="scipy")
     assert optimum.found and optimum.placement is not None and optimum.mu_path is not None
