@@ -20,6 +20,9 @@ from service.jobs.store import JobStore
 from tests.cases import ROOT
 from tests.live import start_server
 
+# Response times are bounded here: scripts/run_tests.py runs these alone, after the rest.
+pytestmark = pytest.mark.latency
+
 EXAMPLE = json.loads((ROOT / "examples" / "evaluate_request.json").read_text())
 SMALL_GRID = {
     "x": {"min": -0.1, "max": 0.1, "step": 0.05},

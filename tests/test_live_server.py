@@ -26,6 +26,9 @@ import pytest
 from tests.cases import ROOT
 from tests.live import start_server
 
+# Response times are bounded here: scripts/run_tests.py runs these alone, after the rest.
+pytestmark = pytest.mark.latency
+
 EXAMPLE = json.loads((ROOT / "examples" / "evaluate_request.json").read_text())
 N = len(EXAMPLE["path"]["waypoints"])
 MAP_POSES = 2_000_000
