@@ -522,6 +522,8 @@ def _derivatives(
     sparsity, where_nz = ca.Sparsity.triplet(
         n_g, int(x.numel()), rows.tolist(), cols.tolist(), True
     )
+    if sparsity.nnz() != len(rows):  # each entry its own nonzero, or the reordering is wrong
+        raise RuntimeError("the NLP's Jacobian entries overlap")
     values_r, blocks = first_order(local_all, ca.DM(data_all))
     entries = ca.vertcat(ca.vec(blocks), ca.DM(lin_values))
     order = np.empty(len(rows), dtype=int)
