@@ -65,6 +65,7 @@ def test_a_map_job_on_dask_gives_the_local_cells(tmp_path: Path, cluster: LocalC
         process.wait()
 
 
+@pytest.mark.latency  # a cancel within a second: run alone (scripts/run_tests.py)
 def test_a_cancelled_job_stops_its_dask_tasks(tmp_path: Path, cluster: LocalCluster) -> None:
     process, url = server(tmp_path, DTF_DASK_SCHEDULER=cluster.scheduler_address)
     try:

@@ -83,6 +83,7 @@ def test_a_dead_worker_fails_its_job_and_is_replaced(runner: JobRunner) -> None:
     assert wait_for(runner.store, second.id, lambda j: j.status == "done").status == "done"
 
 
+@pytest.mark.latency  # a cancel within a second: run alone (scripts/run_tests.py)
 def test_a_worker_that_ignores_a_cancel_is_killed_and_replaced(tmp_path: Path) -> None:
     runner = JobRunner(settings(tmp_path), worker=stuck)
     try:
