@@ -76,7 +76,7 @@ def at_the_limit() -> dict[str, tuple[str, dict[str, Any]]]:
         "evaluate": (
             "/v1/evaluate",
             {
-                # Numeric IK, the costliest evaluation of a path of this length (about 9 s):
+                # Numeric IK, the costliest evaluation of a path of this length (about 3 s):
                 # the body's validation, which holds the GIL, is then one /healthz probe of
                 # hundreds. A UR arm's evaluation took 0.6 s, 15 probes: the p90 was the second
                 # worst, and the validation, cut in two by a garbage collection, was two.

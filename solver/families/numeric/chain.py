@@ -141,7 +141,9 @@ class SerialChain:
         """
         axes, origins, rotation, position = self.frames(q)
         at = position if point is None else np.broadcast_to(point, position.shape)
-        jacobian = np.zeros((len(q), 6, self.dof))
+        jacobian = np.empty(
+            (len(q), 6, self.dof)
+        )  # both halves set below; np.zeros releases the GIL
         turning = np.cross(axes, at[:, None, :] - origins)  # (M, n, 3)
         jacobian[:, :3] = np.where(self.revolute[:, None], turning, axes).transpose(0, 2, 1)
         jacobian[:, 3:] = np.where(self.revolute[:, None], axes, 0.0).transpose(0, 2, 1)

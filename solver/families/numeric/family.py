@@ -161,17 +161,9 @@ class NumericFamily(KinematicsFamily):
         q = np.full((n_paths, n_seeds, n_waypoints, self.dof), np.nan)
         q[:, :, 0] = slots
         paths, branches = np.nonzero(np.isfinite(slots[..., 0]))
-        current = slots[paths, branches]
-        for waypoint in range(1, n_waypoints):
-            current, converged = ik.solve(
-                self.chain,
-                current,
-                rotations[paths, waypoint],
-                positions[paths, waypoint],
-                iterations=ik.TRACK_ITERATIONS,
-            )
-            paths, branches, current = paths[converged], branches[converged], current[converged]
-            q[paths, branches, waypoint] = current
+        q[paths, branches] = self._followed(
+            slots[paths, branches], rotations[paths], positions[paths]
+        )
         wrapped, status = self._wrapped_with_status(q)
         return PathSolutions(
             q=wrapped.transpose(3, 1, 0, 2).reshape(self.dof, n_seeds, *batch, n_waypoints),
@@ -179,6 +171,48 @@ class NumericFamily(KinematicsFamily):
             seeds=n_seeds,
             branches_found=count.reshape(batch),
         )
+
+    def _followed(
+        self, start: np.ndarray, rotations: np.ndarray, positions: np.ndarray
+    ) -> np.ndarray:
+        """Each branch followed from its first solution, NaN from the waypoint where it is lost.
+
+        Args:
+            start: shape (M, n), the branches' solutions at the first waypoint.
+            rotations: shape (M, W, 3, 3), R_B_F* of each branch's path.
+            positions: shape (M, W, 3), m in {B}.
+
+        Returns:
+            shape (M, W, n). A lost branch stays in the batch, frozen, until at least half of
+            it is lost and it holds ``ik.COMPACT_MIN_ROWS`` rows, for the reason given there.
+        """
+        n_waypoints = positions.shape[1]
+        track = np.full((len(start), n_waypoints, self.dof), np.nan)
+        rows = np.arange(len(start))  # the branch of each batch row
+        local = track.copy()  # the batch's rows of track
+        local[:, 0] = current = start
+        lost = np.zeros(len(start), dtype=bool)
+        for waypoint in range(1, n_waypoints):
+            if lost.all():
+                break
+            solved, converged = ik.solve(
+                self.chain,
+                current,
+                rotations[:, waypoint],
+                positions[:, waypoint],
+                iterations=ik.TRACK_ITERATIONS,
+                frozen=lost,
+            )
+            lost |= ~converged
+            current = np.where(lost[:, None], current, solved)  # a lost row keeps a finite q
+            local[:, waypoint] = np.where(lost[:, None], np.nan, solved)
+            if len(rows) >= ik.COMPACT_MIN_ROWS and 2 * np.count_nonzero(lost) >= len(rows):
+                track[rows] = local
+                keep = ~lost
+                rows, local, current, lost = rows[keep], local[keep], current[keep], lost[keep]
+                rotations, positions = rotations[keep], positions[keep]
+        track[rows] = local
+        return track
 
     def joint_speeds_per_unit_twist(
         self,

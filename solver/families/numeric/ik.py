@@ -39,6 +39,13 @@ DISTINCT = 1e-3
 # A solution whose Jacobian has sigma_min / sigma_max below this is singular (the analytic
 # families' 1e-7 on |sin q5| and |sin q3|, as a condition number).
 SINGULAR_RCOND = 1e-7
+# Below this many rows, converged problems stay in solve's batch (frozen) instead of being
+# copied out. Copying rows by an index array releases the GIL for a moment (numpy's take and
+# put), and a thread that does that every few hundred microseconds while holding the GIL the
+# rest of the time starves every other thread: a waiting thread asks for the GIL only after a
+# full switch interval with no hand-over, and each brief release is a hand-over. Tracking a
+# 5,000-waypoint path on the Jaco2 kept /healthz waiting 20 to 300 ms at a time.
+COMPACT_MIN_ROWS = 64
 
 
 def rotation_log(rotation: np.ndarray) -> np.ndarray:
@@ -90,8 +97,13 @@ def solve(
     iterations: int,
     lower: np.ndarray | None = None,
     upper: np.ndarray | None = None,
+    frozen: np.ndarray | None = None,
 ) -> tuple[np.ndarray, np.ndarray]:
     """Levenberg-Marquardt from each start to its target, batched.
+
+    A problem's iterates depend on its own row only. Converged rows stay in the batch, frozen,
+    until at most half of it still iterates and it holds at least ``COMPACT_MIN_ROWS`` rows:
+    only then are the rest copied out (see ``COMPACT_MIN_ROWS``).
 
     Args:
         chain: the arm's chain.
@@ -102,28 +114,66 @@ def solve(
         lower: shape (n,), rad; with ``upper``, every iterate is clipped into the box (joint
             limits kept); ``None`` leaves the joints free (tracking checks the limits later).
         upper: shape (n,), rad.
+        frozen: shape (M,), bool: rows left at their start and reported not converged (a
+            tracked branch already lost); ``None`` solves every row.
 
     Returns:
         q: shape (M, n), the last iterate; converged: shape (M,), bool, |e|_inf < TOLERANCE.
     """
     q = np.array(start, dtype=float)
     converged = np.zeros(len(q), dtype=bool)
-    active = np.arange(len(q))
+    iterating = np.ones(len(q), dtype=bool) if frozen is None else ~frozen
+    rows: np.ndarray | None = None  # after a compaction: the problem of each batch row
+    batch_q, batch_rotation, batch_position = q, target_rotation, target_position
     for step in range(iterations + 1):
-        jacobian, rotation, position = chain.jacobian(q[active])
-        error = pose_error(rotation, position, target_rotation[active], target_position[active])
-        done = np.abs(error).max(axis=-1) < TOLERANCE
-        converged[active[done]] = True
-        active, jacobian, error = active[~done], jacobian[~done], error[~done]
-        if active.size == 0 or step == iterations:
+        if not iterating.any():
+            break
+        jacobian, rotation, position = chain.jacobian(batch_q)
+        error = pose_error(rotation, position, batch_rotation, batch_position)
+        iterating &= np.abs(error).max(axis=-1) >= TOLERANCE
+        if not iterating.any() or step == iterations:
             break
         damping = DAMPING_SCALE * 0.5 * np.einsum("mi,mi->m", error, error) + DAMPING_FLOOR
         normal = jacobian @ jacobian.transpose(0, 2, 1) + damping[:, None, None] * np.eye(6)
         dq = (jacobian.transpose(0, 2, 1) @ np.linalg.solve(normal, error[..., None]))[..., 0]
-        moved = q[active] + dq
+        moved = batch_q + dq
         if lower is not None and upper is not None:
             moved = np.clip(moved, lower, upper)
-        q[active] = moved
+        batch_q = np.where(iterating[:, None], moved, batch_q)
+        if len(batch_q) >= COMPACT_MIN_ROWS and 2 * np.count_nonzero(iterating) <= len(batch_q):
+            q, converged = _settle(rows, q, converged, batch_q, iterating, frozen)
+            rows = (np.arange(len(q)) if rows is None else rows)[iterating]
+            batch_q, batch_rotation = batch_q[iterating], batch_rotation[iterating]
+            batch_position, iterating = batch_position[iterating], iterating[iterating]
+    return _settle(rows, q, converged, batch_q, iterating, frozen)
+
+
+def _settle(
+    rows: np.ndarray | None,
+    q: np.ndarray,
+    converged: np.ndarray,
+    batch_q: np.ndarray,
+    iterating: np.ndarray,
+    frozen: np.ndarray | None,
+) -> tuple[np.ndarray, np.ndarray]:
+    """Write the batch's iterates back to their problems: those no longer iterating converged.
+
+    Args:
+        rows: the problem of each batch row; ``None`` while the batch is every problem.
+        q: shape (M, n), the problems' iterates.
+        converged: shape (M,), bool.
+        batch_q: shape (len(batch), n), the batch's iterates.
+        iterating: shape (len(batch),), bool, the batch rows not yet converged.
+        frozen: the rows frozen from the start (never converged); only in the first batch.
+
+    Returns:
+        q (M, n) and converged (M,), updated.
+    """
+    if rows is None:
+        done = ~iterating if frozen is None else ~iterating & ~frozen
+        return batch_q.copy(), done
+    q[rows] = batch_q
+    converged[rows] = ~iterating
     return q, converged
 
 
