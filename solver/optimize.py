@@ -21,8 +21,10 @@ from __future__ import annotations
 import dataclasses
 import math
 import time
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
+from functools import partial
 from typing import Literal
 
 import numpy as np
@@ -284,6 +286,7 @@ def optimize_placement(
             max_solver_seconds,
             span(progress, 0.3, 0.95),
             passes,
+            runner,
         )
         name = "ipopt (casadi), from the coarse map's maxima"
     else:
@@ -395,12 +398,15 @@ def _casadi(
     max_solver_seconds: float | None,
     progress: Progress | None,
     passes: Sequence[tuple[int, int]] | None,
+    runner: TaskRunner,
 ) -> tuple[list[Candidate], int]:
     """Candidates: the best refined cell, IPOPT's optima, Nelder-Mead climbs.
 
     IPOPT starts from the coarse cells whose basins refine best
     (:func:`solver.local_search.refine_cells`); the climbs on mu_path start from the best
-    refined cells and may cross to another branch, where IPOPT cannot.
+    refined cells and may cross to another branch, where IPOPT cannot. They need nothing from
+    IPOPT, so where the runner lets the caller use a second thread they run beside the solves
+    (the map kernel releases the GIL); either way the candidates come in the same order.
 
     For a redundant arm (dof > 6) each optimum carries the NLP's joint path: IPOPT chose the
     redundancy too, and the evaluator's tracked joint path would lose that.
@@ -425,45 +431,64 @@ def _casadi(
         ipopt_options=None if max_solver_seconds is None else {"max_cpu_time": max_solver_seconds},
     )
     iterations = 0
-    # IPOPT starts from the coarse cells whose basins climbed highest. (The other refined
-    # cells are below cells[0] and below the climbs: no candidates.)
-    starts = [cell.coarse or cell for cell in cells[:N_STARTS]]
-    for k, cell in enumerate(starts):
-        at_start = evaluate_path(
-            robot,
-            path,
-            bounds.placement(cell.vector),
-            branch=require_family(robot).branches[cell.branch],
-            max_joint_step=max_joint_step,
-            passes=passes,
-        )
-        q, qdot, v_max, speed = at_start.q, at_start.qdot, at_start.v_max, at_start.mu_path
-        if q is None or qdot is None or v_max is None or speed is None:
-            continue
-        joint_speeds = qdot * (speed / v_max)[:, None]
-        try:
-            result = nlp.solve(
-                cell.vector,
-                speed,
-                q,
-                joint_speeds,
-                progress=span(progress, k / len(starts), (k + 1) / len(starts)),
-            )
-        except RuntimeError as error:  # IPOPT refused this start: the others still count
-            failure = f"IPOPT failed from a start: {str(error).splitlines()[-1][:200]}"
-            candidates.append(Candidate(cell.vector, failure))
-            continue
-        iterations += result.iterations
-        candidates.append(
-            Candidate(
-                result.vector,
-                result.status,
-                spins=result.spins,
-                joint_path=result.joint_path if robot.dof > 6 else None,
-            )
-        )
-    candidates += _climbs(robot, prepared, bounds, cells, max_joint_step, spin_mode)
+    climbs: Callable[[], list[Candidate]] = partial(
+        _climbs, robot, prepared, bounds, cells, max_joint_step, spin_mode
+    )
+    with ThreadPoolExecutor(1, thread_name_prefix="dtf-climbs") as beside:
+        if runner.threads > 1:  # the climbs need nothing from IPOPT: beside its solves
+            climbs = beside.submit(climbs).result
+        # IPOPT starts from the coarse cells whose basins climbed highest. (The other refined
+        # cells are below cells[0] and below the climbs: no candidates.)
+        for k, cell in enumerate(starts := [cell.coarse or cell for cell in cells[:N_STARTS]]):
+            solved = _solve_from(
+                robot, path, nlp, bounds, cell, max_joint_step, passes,
+                span(progress, k / len(starts), (k + 1) / len(starts)),
+            )  # fmt: skip
+            if solved is not None:
+                candidates.append(solved[0])
+                iterations += solved[1]
+        candidates += climbs()
     return candidates, iterations
+
+
+def _solve_from(
+    robot: Robot,
+    path: np.ndarray,
+    nlp: PlacementNlp,
+    bounds: PlacementBounds,
+    cell: Cell,
+    max_joint_step: float,
+    passes: Sequence[tuple[int, int]] | None,
+    progress: Progress | None,
+) -> tuple[Candidate, int] | None:
+    """IPOPT's optimum from the cell's joint path, with its iterations; None where none starts.
+
+    A start IPOPT refuses is a candidate at the cell, with IPOPT's message and no iterations.
+    """
+    at_start = evaluate_path(
+        robot,
+        path,
+        bounds.placement(cell.vector),
+        branch=require_family(robot).branches[cell.branch],
+        max_joint_step=max_joint_step,
+        passes=passes,
+    )
+    q, qdot, v_max, speed = at_start.q, at_start.qdot, at_start.v_max, at_start.mu_path
+    if q is None or qdot is None or v_max is None or speed is None:
+        return None
+    joint_speeds = qdot * (speed / v_max)[:, None]
+    try:
+        result = nlp.solve(cell.vector, speed, q, joint_speeds, progress=progress)
+    except RuntimeError as error:  # IPOPT refused this start: the others still count
+        failure = f"IPOPT failed from a start: {str(error).splitlines()[-1][:200]}"
+        return Candidate(cell.vector, failure), 0
+    candidate = Candidate(
+        result.vector,
+        result.status,
+        spins=result.spins,
+        joint_path=result.joint_path if robot.dof > 6 else None,
+    )
+    return candidate, result.iterations
 
 
 def _climbs(

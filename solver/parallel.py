@@ -24,7 +24,14 @@ R = TypeVar("R")
 
 
 class TaskRunner(Protocol):
-    """Runs independent tasks and returns their results in order."""
+    """Runs independent tasks and returns their results in order.
+
+    Attributes:
+        threads: how many threads of this process the caller's own work may use beside its
+            tasks (1: none beside the calling thread; a cluster's runner says 1).
+    """
+
+    threads: int
 
     def task_size(self, n_placements: int, chunk: int) -> int:
         """Placements per task for a run of ``n_placements`` (a multiple of ``chunk``)."""
@@ -49,6 +56,8 @@ def tasks_of(n_placements: int, chunk: int, *, per_worker: int, workers: int, ca
 
 class SerialRunner:
     """One task after the other in the calling thread, a chunk per task (the reference)."""
+
+    threads = 1
 
     def task_size(self, n_placements: int, chunk: int) -> int:
         """One chunk per task, so progress is reported per chunk."""

@@ -22,6 +22,8 @@ CONNECT_SECONDS = 10.0
 class DaskRunner:
     """Tasks as futures on the cluster of one scheduler; the client is made on first use."""
 
+    threads = 1  # the cluster's threads run the tasks; the caller's own work stays in its thread
+
     def __init__(self, address: str) -> None:
         """A runner on the scheduler at ``address`` (``tcp://host:8786``)."""
         self.address = address

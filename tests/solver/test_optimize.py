@@ -4,14 +4,17 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import threading
 
 import numpy as np
 import pytest
 
+from solver import optimize
 from solver.capability_map import capability_map, grid_axis
 from solver.evaluate import evaluate_path
 from solver.exceptions import InvalidInputError
 from solver.optimize import PlacementOptimum, optimize_placement
+from solver.parallel import SERIAL, TaskRunner, ThreadRunner
 from solver.robots import Robot, get_robot
 from solver.search_space import PlacementBounds, vector_of
 from solver.spatial import Placement
@@ -242,9 +245,30 @@ def test_a_free_height_is_searched(method: str) -> None:
 ERK_OPTIMUM_BEFORE = 0.3971008362281562
 
 
+@pytest.mark.parametrize("runner", [SERIAL, ThreadRunner(2)], ids=["serial", "2 threads"])
 @pytest.mark.parametrize("method", ["casadi", "scipy"])
-def test_the_erk_optimum_is_what_it_was(method: str) -> None:
+def test_the_erk_optimum_is_what_it_was(method: str, runner: TaskRunner) -> None:
     answer = optimize_placement(
-        get_robot("ur5"), load_path("curved_line"), bounds=BOUNDS, method=method
+        get_robot("ur5"), load_path("curved_line"), bounds=BOUNDS, method=method, runner=runner
     )
     assert answer.mu_path == pytest.approx(ERK_OPTIMUM_BEFORE, rel=1e-9)
+
+
+def test_on_two_threads_the_climbs_run_beside_ipopt_and_change_nothing(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    robot, path = get_robot("ur5"), load_path("curved_line")
+    serial = optimize_placement(robot, path, bounds=BOUNDS, method="casadi")
+    threads: list[str] = []
+    climb = optimize.climb
+
+    def recorded(*args: object, **kwargs: object) -> object:
+        threads.append(threading.current_thread().name)
+        return climb(*args, **kwargs)  # type: ignore[arg-type]
+
+    monkeypatch.setattr(optimize, "climb", recorded)
+    pooled = optimize_placement(robot, path, bounds=BOUNDS, method="casadi", runner=ThreadRunner(2))
+    assert len(threads) == optimize.N_CLIMBS
+    assert all(name.startswith("dtf-climbs") for name in threads)
+    assert pooled.placement == serial.placement and pooled.mu_path == serial.mu_path
+    assert pooled.solver.iterations == serial.solver.iterations
