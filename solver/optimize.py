@@ -439,7 +439,8 @@ def _casadi(
             climbs = beside.submit(climbs).result
         # IPOPT starts from the coarse cells whose basins climbed highest. (The other refined
         # cells are below cells[0] and below the climbs: no candidates.)
-        for k, cell in enumerate(starts := [cell.coarse or cell for cell in cells[:N_STARTS]]):
+        starts = [cell.coarse or cell for cell in cells[:N_STARTS]]
+        for k, cell in enumerate(starts):
             solved = _solve_from(
                 robot, path, nlp, bounds, cell, max_joint_step, passes,
                 span(progress, k / len(starts), (k + 1) / len(starts)),

@@ -141,9 +141,8 @@ class SerialChain:
         """
         axes, origins, rotation, position = self.frames(q)
         at = position if point is None else np.broadcast_to(point, position.shape)
-        jacobian = np.empty(
-            (len(q), 6, self.dof)
-        )  # both halves set below; np.zeros releases the GIL
+        # Both halves are set below; np.zeros would release the GIL (see ik.COMPACT_MIN_ROWS).
+        jacobian = np.empty((len(q), 6, self.dof))
         turning = np.cross(axes, at[:, None, :] - origins)  # (M, n, 3)
         jacobian[:, :3] = np.where(self.revolute[:, None], turning, axes).transpose(0, 2, 1)
         jacobian[:, 3:] = np.where(self.revolute[:, None], axes, 0.0).transpose(0, 2, 1)
