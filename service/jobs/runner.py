@@ -72,8 +72,11 @@ class JobRunner:
         theirs.close()
         return _Worker(process, ours)
 
-    def submit(self, job_id: str) -> None:
-        """A job was queued in the store: look for an idle worker now."""
+    def wake(self) -> None:
+        """The store changed (a job queued, a cancel asked): the supervisor looks now.
+
+        Without it the supervisor looks every POLL_SECONDS.
+        """
         self._wake.set()
 
     def recover(self) -> list[str]:

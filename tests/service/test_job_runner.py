@@ -72,14 +72,14 @@ def test_an_unexpected_exception_fails_the_job_with_its_message(
 
 def test_a_dead_worker_fails_its_job_and_is_replaced(runner: JobRunner) -> None:
     job = runner.store.create("map", BIG_MAP)
-    runner.submit(job.id)
+    runner.wake()
     wait_for(runner.store, job.id, lambda j: j.status != "queued")
     runner._workers[0].process.kill()
     failed = wait_for(runner.store, job.id, lambda j: j.status != "running")
     assert failed.status == "failed" and failed.error is not None
     assert "the worker process ended" in failed.error[0]["msg"]
     second = runner.store.create("evaluate", EVALUATE)
-    runner.submit(second.id)
+    runner.wake()
     assert wait_for(runner.store, second.id, lambda j: j.status == "done").status == "done"
 
 
@@ -88,7 +88,7 @@ def test_a_worker_that_ignores_a_cancel_is_killed_and_replaced(tmp_path: Path) -
     runner = JobRunner(settings(tmp_path), worker=stuck)
     try:
         job = runner.store.create("evaluate", EVALUATE)
-        runner.submit(job.id)
+        runner.wake()
         wait_for(runner.store, job.id, lambda j: j.status == "running")
         process = runner._workers[0].process
         runner.store.cancel(job.id)
@@ -107,7 +107,7 @@ def test_a_worker_that_ignores_a_cancel_is_killed_and_replaced(tmp_path: Path) -
 
 def test_jobs_run_in_the_order_they_were_queued(runner: JobRunner) -> None:
     ids = [runner.store.create("evaluate", EVALUATE).id for _ in range(3)]
-    runner.submit(ids[0])
+    runner.wake()
     jobs = [wait_for(runner.store, i, lambda j: j.status == "done") for i in ids]
     assert all(j.status == "done" for j in jobs)
     started = [j.started for j in jobs]

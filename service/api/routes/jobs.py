@@ -93,7 +93,7 @@ async def post_job(body: JobRequest, settings: SettingsDep) -> JSONResponse:
         )
     await anyio.to_thread.run_sync(_check_size, body, settings)
     job = runner.store.create(body.kind, body.request.model_dump(mode="json", exclude_unset=True))
-    runner.submit(job.id)
+    runner.wake()  # an idle worker takes the job now
     log.info("job %s queued (%s)", job.id, body.kind)
     info = job_info(job)
     return JSONResponse(
@@ -141,6 +141,6 @@ def delete_job(job_id: JobId, settings: SettingsDep) -> Response:
     if store.get(str(job_id)) is None:
         raise HTTPException(status.HTTP_404_NOT_FOUND, f"no job {str(job_id)!r}")
     store.cancel(str(job_id))
-    get_runner(settings).submit(str(job_id))  # the supervisor looks at once
+    get_runner(settings).wake()  # the supervisor sees the cancel now
     log.info("job %s cancel asked", job_id)
     return Response(status_code=status.HTTP_204_NO_CONTENT)
