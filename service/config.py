@@ -31,12 +31,12 @@ class Settings(BaseSettings):
         gt=0,
         description="Most placement-waypoint pairs one /v1/map request, or the coarse map of one "
         "/v1/optimize request, may ask for (each is 8 IK solutions; on one thread of the "
-        "2-core development machine the default, 5 million, takes about 5 s for a UR or OPW "
-        "arm in fixed spin, by the compiled kernel, and 10 to 26 s in free spin, depending on "
-        "the day; /v1/map computes on DTF_THREADS threads). A pair of a numeric-IK arm "
-        "counts as the work of many (its family's path_cost: about 65 a waypoint for 6 joints, "
-        "400 for 7, plus 3,200 or 6,400 a placement for the seeds), so its limit is about the "
-        "same time.",
+        "2-core development machine the default, 5 million, takes 1.5 to 5 s for a UR or OPW "
+        "arm in fixed spin, depending on the day, by the compiled kernel, and about 2.3 times "
+        "as long in free spin, by its own; /v1/map computes on DTF_THREADS threads). A pair "
+        "of a numeric-IK arm counts as the work of many (its family's path_cost: about 65 a "
+        "waypoint for 6 joints, 400 for 7, plus 3,200 or 6,400 a placement for the seeds), so "
+        "its limit is about the same time.",
     )
     max_search_poses: int = Field(
         default=6_100_000,
@@ -126,7 +126,7 @@ class Settings(BaseSettings):
         gt=0,
         description="Most placement-waypoint pairs one map or optimize job may ask for (its "
         "max_map_poses; about 6 minutes on 2 cores for a UR or OPW arm in fixed spin, by the "
-        "compiled kernel; the numpy pipeline, in free spin, takes several times longer).",
+        "compiled kernel, on a slow day; free spin takes about 2.3 times as long).",
     )
 
     _for_jobs: bool = PrivateAttr(default=False)

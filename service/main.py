@@ -38,7 +38,7 @@ from service.jobs.runner import close_runners, get_runner
 from service.metrics import instrument, log_to_stderr
 from service.web import mount_page
 from service.work import STOPPING
-from solver import map_kernel
+from solver import free_spin_kernel, map_kernel
 from solver.evaluate import evaluate_path
 from solver.exceptions import SolverError
 from solver.families import catalogue
@@ -100,10 +100,12 @@ def _warm_up() -> None:
     """Do before serving what the first requests would otherwise pay for, holding the GIL.
 
     The catalogue reads its URDFs and the first path evaluation imports and sets up its
-    modules: a few hundred milliseconds in which /healthz would wait. The compiled map kernel
-    is loaded from numba's disk cache, or compiled (about 10 s, once per installation).
+    modules: a few hundred milliseconds in which /healthz would wait. The compiled map kernels
+    (fixed and free spin) are loaded from numba's disk cache, or compiled (about 10 s each,
+    once per installation).
     """
     map_kernel.warm_up()
+    free_spin_kernel.warm_up()
     robot = catalogue()["ur5"]
     waypoints = np.repeat(np.eye(4)[None], 2, axis=0)
     waypoints[1, 0, 3] = 0.01

@@ -57,21 +57,21 @@ _NO_LIMIT, _WIDE, _NARROW = 0, 1, 2
 # 0.505 rad) and at most pi / 2 for any chord.
 _CHORD_SMALL = 0.5
 _TURN_PER_CHORD_SMALL = 1.0108
-_UR5 = UR_DH["ur5"]
+UR5 = UR_DH["ur5"]
 # Waypoints solved together: the pose kernels run level by level over a block, and a block is
 # the unit of the early stop when every branch has failed.
-_BLOCK = 32
+BLOCK = 32
 
 
-def _drop_stale_compiled_code() -> None:
-    """Delete the cached machine code of the kernel when a pose kernel's source has changed.
+def drop_stale_compiled_code(name: str) -> None:
+    """Delete the cached machine code of module ``name``'s kernels when a callee has changed.
 
     numba's disk cache (``cache=True``, files in ``__pycache__``) is keyed by the source file
     of the cached function only, but the compiled functions take their callees into themselves
-    (the pose kernels take :mod:`solver.families.pairs`, the dispatcher the pose kernels, this
-    module the dispatcher): after an edit of a callee they would load the old code. A marker
-    named by the hash of all those sources says which code the caches hold; a new hash drops
-    the cached code of every one of them. Where the
+    (the pose kernels take :mod:`solver.families.pairs`, the dispatcher the pose kernels, the
+    map kernels the dispatcher and this module's helpers): after an edit of a callee they
+    would load the old code. A marker named by the hash of all those sources says which code
+    the caches hold; a new hash drops the cached code of every one of them. Where the
     directories cannot be written (an installed copy), numba caches elsewhere or not at all
     and nothing is done here.
     """
@@ -81,10 +81,12 @@ def _drop_stale_compiled_code() -> None:
         solver.families.opw.kernel,
         solver.families.kernels,
         sys.modules[__name__],
+        *([sys.modules[name]] if name != __name__ else []),
     )
     files = [Path(str(module.__file__)) for module in modules]
     stamp = hashlib.sha256(b"".join(path.read_bytes() for path in files)).hexdigest()[:16]
-    marker = Path(__file__).parent / "__pycache__" / f"map_kernel.sources-{stamp}"
+    stem = files[-1].stem
+    marker = files[-1].parent / "__pycache__" / f"{stem}.sources-{stamp}"
     try:
         if marker.exists():
             return
@@ -92,7 +94,7 @@ def _drop_stale_compiled_code() -> None:
             cache = path.parent / "__pycache__"
             for stale in [*cache.glob(f"{path.stem}.*.nbi"), *cache.glob(f"{path.stem}.*.nbc")]:
                 stale.unlink(missing_ok=True)
-        for old in marker.parent.glob("map_kernel.sources-*"):
+        for old in marker.parent.glob(f"{stem}.sources-*"):
             old.unlink(missing_ok=True)
         marker.parent.mkdir(exist_ok=True)
         marker.touch()
@@ -100,7 +102,7 @@ def _drop_stale_compiled_code() -> None:
         return
 
 
-_drop_stale_compiled_code()
+drop_stale_compiled_code(__name__)
 
 
 def limit_modes(lower: np.ndarray, upper: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -120,18 +122,18 @@ def limit_modes(lower: np.ndarray, upper: np.ndarray) -> tuple[np.ndarray, np.nd
 
 
 @njit(cache=True, error_model="numpy", nogil=True)
-def _exact_limits(cq, sq, b, lower, upper):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
-    """The first waypoint whose joint range no 2 pi copy holds (the path's length: none).
+def unwrapped(cq, sq, b):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
+    """Branch b's joint path (W, 6), rad: the angles of its pairs, unwrapped by the wrapped steps.
 
-    :func:`solver.tracking.track`'s test on one branch: the angles of the pairs, unwrapped by
-    the wrapped steps, and the running range of each joint (a range that fits holds every
-    shorter one, so no test of the whole path is needed first).
+    :func:`solver.tracking.track`'s path: the first waypoint's angle plus the running sum of
+    the steps, each brought into [-pi, pi].
     """
     dof, n_waypoints = cq.shape[1], cq.shape[2]
     path = np.empty((n_waypoints, dof))
     for j in range(dof):
-        previous = math.atan2(sq[b, j, 0], cq[b, j, 0])
-        path[0, j] = previous
+        first = math.atan2(sq[b, j, 0], cq[b, j, 0])
+        previous, total = first, 0.0
+        path[0, j] = first
         for w in range(1, n_waypoints):
             angle = math.atan2(sq[b, j, w], cq[b, j, w])
             step = angle - previous
@@ -139,8 +141,20 @@ def _exact_limits(cq, sq, b, lower, upper):  # type: ignore[no-untyped-def]  # p
                 step -= _TWO_PI
             elif step < -math.pi:
                 step += _TWO_PI
-            path[w, j] = path[w - 1, j] + step
+            total += step
+            path[w, j] = first + total
             previous = angle
+    return path
+
+
+@njit(cache=True, error_model="numpy", nogil=True)
+def first_outside(path, lower, upper):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
+    """The first waypoint of a joint path (W, n) whose range no 2 pi copy holds (W: none).
+
+    :func:`solver.tracking.track`'s test: the running range of each joint (a range that fits
+    holds every shorter one, so no test of the whole path is needed first).
+    """
+    n_waypoints, dof = path.shape
     low_run, high_run = path[0].copy(), path[0].copy()
     for w in range(n_waypoints):
         for j in range(dof):
@@ -151,6 +165,34 @@ def _exact_limits(cq, sq, b, lower, upper):  # type: ignore[no-untyped-def]  # p
             if k_low > k_high:
                 return w
     return n_waypoints
+
+
+@njit(cache=True, error_model="numpy", nogil=True)
+def turned_poses(c, ca, sa, offset, flange_rotation, flange_position, tool_position, twist, poses):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
+    """Fill ``poses`` (21, W) for placement c: the path turned by its yaw and moved.
+
+    Rows: R_B_F row by row (0-8), p_B_F (9-11), t_hat in {B} (12-17), the tool point (18-20);
+    the same arithmetic as :func:`solver.pipeline.turn_by_yaw`.
+    """
+    for w in range(flange_rotation.shape[0]):
+        for k in range(3):  # R_B_F = Rz(yaw) R_O_F, row by row
+            x, y = flange_rotation[w, 0, k], flange_rotation[w, 1, k]
+            poses[k, w] = ca * x - sa * y
+            poses[3 + k, w] = sa * x + ca * y
+            poses[6 + k, w] = flange_rotation[w, 2, k]
+        x, y = flange_position[w, 0], flange_position[w, 1]
+        poses[9, w] = ca * x - sa * y + offset[c, 0]
+        poses[10, w] = sa * x + ca * y + offset[c, 1]
+        poses[11, w] = flange_position[w, 2] + offset[c, 2]
+        for k in range(0, 6, 3):
+            x, y = twist[w, k], twist[w, k + 1]
+            poses[12 + k, w] = ca * x - sa * y
+            poses[13 + k, w] = sa * x + ca * y
+            poses[14 + k, w] = twist[w, k + 2]
+        x, y = tool_position[w, 0], tool_position[w, 1]
+        poses[18, w] = ca * x - sa * y + offset[c, 0]
+        poses[19, w] = sa * x + ca * y + offset[c, 1]
+        poses[20, w] = tool_position[w, 2] + offset[c, 2]
 
 
 @njit(cache=True, error_model="numpy", nogil=True)
@@ -246,27 +288,11 @@ def map_cells(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
         inside[:] = np.inf
         crossed[:] = False
         n_alive = n_branches
-        for w0 in range(0, n_waypoints, _BLOCK):
-            w1 = min(w0 + _BLOCK, n_waypoints)
-            for w in range(w0, w1):
-                for k in range(3):  # R_B_F = Rz(yaw) R_O_F, row by row
-                    x, y = flange_rotation[w, 0, k], flange_rotation[w, 1, k]
-                    poses[k, w] = ca * x - sa * y
-                    poses[3 + k, w] = sa * x + ca * y
-                    poses[6 + k, w] = flange_rotation[w, 2, k]
-                x, y = flange_position[w, 0], flange_position[w, 1]
-                poses[9, w] = ca * x - sa * y + offset[c, 0]
-                poses[10, w] = sa * x + ca * y + offset[c, 1]
-                poses[11, w] = flange_position[w, 2] + offset[c, 2]
-                for k in range(0, 6, 3):
-                    x, y = twist[w, k], twist[w, k + 1]
-                    poses[12 + k, w] = ca * x - sa * y
-                    poses[13 + k, w] = sa * x + ca * y
-                    poses[14 + k, w] = twist[w, k + 2]
-                x, y = tool_position[w, 0], tool_position[w, 1]
-                poses[18, w] = ca * x - sa * y + offset[c, 0]
-                poses[19, w] = sa * x + ca * y + offset[c, 1]
-                poses[20, w] = tool_position[w, 2] + offset[c, 2]
+        turned_poses(
+            c, ca, sa, offset, flange_rotation, flange_position, tool_position, twist, poses
+        )
+        for w0 in range(0, n_waypoints, BLOCK):
+            w1 = min(w0 + BLOCK, n_waypoints)
             need[:] = False
             for i in range(n_branches):
                 need[branches[i]] = need[branches[i]] or alive[i]
@@ -347,7 +373,7 @@ def map_cells(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
                 else:  # every waypoint inside the arc, no step through the gap
                     exact = exact or inside[i, j] <= _MARGIN or crossed[i, j]
             if exact:
-                first = _exact_limits(cq, sq, branches[i], lower, upper)
+                first = first_outside(unwrapped(cq, sq, branches[i]), lower, upper)
                 if first < n_waypoints:
                     alive[i] = False
                     why[i] = _JOINT_LIMITS
@@ -400,7 +426,7 @@ def warm_up() -> None:
     integers = [np.empty(1, dtype=np.int64) for _ in range(5)]
     map_cells(
         UR_KERNEL,
-        solver.families.ur.kernel.kernel_parameters(_UR5),
+        solver.families.ur.kernel.kernel_parameters(UR5),
         np.ones(1),
         np.zeros(1),
         np.zeros((1, 3)),

@@ -15,6 +15,7 @@ import numpy as np
 
 from solver._malloc import raise_malloc_thresholds
 from solver.families.base import Branch
+from solver.free_spin_kernel import free_cells
 from solver.map_kernel import limit_modes, map_cells
 from solver.parallel import SERIAL, TaskRunner
 from solver.pipeline import (
@@ -108,6 +109,8 @@ class _KernelInputs:
     position: np.ndarray  # (W, 3), m, p_O_F at the spin
     tool_position: np.ndarray
     twist: np.ndarray
+    tool_axis: np.ndarray  # (W, 3), z of the tool in {O}: the spin's axis
+    length: np.ndarray  # (W - 1,), m, the segments' lengths
     pure_rotation: np.ndarray
     segment_checked: np.ndarray
     lower: np.ndarray
@@ -131,6 +134,8 @@ def _kernel_inputs(
         position=contiguous(position),
         tool_position=contiguous(path.tool_position),
         twist=contiguous(path.twist),
+        tool_axis=contiguous(path.tool_rotation[:, :, 2]),
+        length=np.linalg.norm(np.diff(path.tool_position, axis=0), axis=1),
         pure_rotation=contiguous(path.pure_rotation),
         segment_checked=contiguous(path.segment_in_pass),
         lower=contiguous(robot.q_lower, dtype=float),
@@ -146,6 +151,7 @@ def _run_kernel(
     placements: np.ndarray,
     branches: np.ndarray,
     max_joint_step: float,
+    spin_mode: SpinMode,
     with_speeds: bool,
 ) -> tuple[np.ndarray, ...]:
     """The columns of :func:`_chunk` by the compiled kernel, at placements of one spin."""
@@ -153,7 +159,7 @@ def _run_kernel(
     mu = np.empty(n_cells)
     codes = [np.empty(n_cells, dtype=np.int64) for _ in range(5)]
     v_max = np.empty((n_cells, n_waypoints if with_speeds else 0))
-    map_cells(
+    placed = (
         inputs.code,
         inputs.parameters,
         np.cos(placements[:, 3]),
@@ -163,25 +169,46 @@ def _run_kernel(
         inputs.position,
         inputs.tool_position,
         inputs.twist,
-        inputs.pure_rotation,
-        inputs.segment_checked,
-        np.ascontiguousarray(branches, dtype=np.int64),
-        inputs.lower,
-        inputs.upper,
-        inputs.modes,
-        inputs.arc,
-        inputs.qdot_max,
-        float(max_joint_step),
-        mu,
-        *codes,
-        v_max,
     )
+    branch_indices = np.ascontiguousarray(branches, dtype=np.int64)
+    if spin_mode == "free":
+        free_cells(
+            *placed,
+            inputs.tool_axis,
+            inputs.length,
+            inputs.pure_rotation,
+            inputs.segment_checked,
+            branch_indices,
+            inputs.lower,
+            inputs.upper,
+            inputs.qdot_max,
+            float(max_joint_step),
+            mu,
+            *codes,
+            v_max,
+        )
+    else:
+        map_cells(
+            *placed,
+            inputs.pure_rotation,
+            inputs.segment_checked,
+            branch_indices,
+            inputs.lower,
+            inputs.upper,
+            inputs.modes,
+            inputs.arc,
+            inputs.qdot_max,
+            float(max_joint_step),
+            mu,
+            *codes,
+            v_max,
+        )
     return (mu, *codes, v_max)
 
 
-def _kernel_of(robot: Robot, spin_mode: SpinMode) -> tuple[int, np.ndarray] | None:
-    """The compiled kernel of the robot's family: where it has one and the spin is fixed."""
-    return require_family(robot).map_kernel() if spin_mode == "fixed" else None
+def _kernel_of(robot: Robot) -> tuple[int, np.ndarray] | None:
+    """The compiled pose kernel of the robot's family, where it has one (either spin mode)."""
+    return require_family(robot).map_kernel()
 
 
 def _task(
@@ -197,12 +224,13 @@ def _task(
 ) -> tuple[np.ndarray, ...]:
     """Evaluate a task's placements in chunks: the columns of :func:`_chunk`, concatenated.
 
-    The compiled kernel, where the family has one and the spin is fixed, or else the numpy
+    The compiled kernel (:mod:`solver.map_kernel`, in free spin :mod:`solver.free_spin_kernel`),
+    where the family has one, or else the numpy
     pipeline, both taking placements of any yaws together. A task may run in another process
     (a Dask worker), so it sets the malloc thresholds itself.
     """
     raise_malloc_thresholds()
-    kernel = _kernel_of(robot, spin_mode) if compiled else None
+    kernel = _kernel_of(robot) if compiled else None
     if kernel is not None:
         inputs: dict[float, _KernelInputs] = {}  # made once per spin, not once per chunk
         parts = []
@@ -210,7 +238,9 @@ def _task(
             spin = float(rows[0, 4])
             if spin not in inputs:
                 inputs[spin] = _kernel_inputs(robot, path, spin, kernel)
-            parts.append(_run_kernel(inputs[spin], rows, branches, max_joint_step, with_speeds))
+            parts.append(
+                _run_kernel(inputs[spin], rows, branches, max_joint_step, spin_mode, with_speeds)
+            )
     else:
         parts = [
             _chunk(robot, path, rows, branches, max_joint_step, spin_mode, with_speeds)
@@ -265,7 +295,7 @@ def evaluate_placements(
         progress: called with the fraction done (0..1] as tasks complete; it may raise
             (:class:`solver.progress.Cancelled`) to stop the work.
         runner: runs the tasks (:mod:`solver.parallel`); every runner gives the same answer.
-        compiled: use the compiled kernel where the family has one and the spin is fixed
+        compiled: use the compiled kernel where the family has one
             (:mod:`solver.map_kernel`); False runs the numpy pipeline, the reference.
 
     Raises:
@@ -304,7 +334,7 @@ class PlacementEvaluator:
     """mu_path of one path at placements asked for one or a few at a time (the local searches).
 
     The same answers as :func:`evaluate_placements` with the same settings: the same compiled
-    kernel, or that function itself where the family has no kernel or the spin is free. The
+    kernel, or that function itself where the family has no kernel. The
     kernel's inputs are made once per spin, not once per call, and no tasks are planned: the
     optimisers' Nelder-Mead climbs ask for one placement at a time, 1,200 times an
     optimisation, and that preparation cost twice the kernel's own time.
@@ -328,7 +358,7 @@ class PlacementEvaluator:
         self._branches = branch_indices(
             robot, None, max_joint_step=max_joint_step, spin_mode=spin_mode
         )
-        self._kernel = _kernel_of(robot, spin_mode)
+        self._kernel = _kernel_of(robot)
         self._last: tuple[float, _KernelInputs] | None = None  # the spin asked for last
 
     def __call__(self, placements: np.ndarray) -> PlacementResults:
@@ -346,6 +376,6 @@ class PlacementEvaluator:
         if self._last is None or self._last[0] != spin:
             self._last = (spin, _kernel_inputs(self._robot, self._path, spin, self._kernel))
         mu, reason, failed, chosen, waypoint, joint, _ = _run_kernel(
-            self._last[1], cells, self._branches, self._max_joint_step, False
+            self._last[1], cells, self._branches, self._max_joint_step, self._spin_mode, False
         )
         return PlacementResults(mu, reason, failed, chosen, waypoint, joint)

@@ -133,9 +133,10 @@ class KinematicsFamily(abc.ABC):
     def map_kernel(self) -> tuple[int, np.ndarray] | None:
         """The compiled pose kernel's family code and parameters, or None where there is none.
 
-        A family with a pose kernel in :mod:`solver.families.kernels` runs maps in fixed spin
-        through the compiled pipeline (:mod:`solver.map_kernel`); any other family, and every
-        family in free spin, through the numpy pipeline, which is the reference.
+        A family with a pose kernel in :mod:`solver.families.kernels` runs maps through the
+        compiled pipeline (:mod:`solver.map_kernel`, in free spin
+        :mod:`solver.free_spin_kernel`); any other family through the numpy pipeline, which is
+        the reference.
         """
         return None
 

@@ -1,0 +1,114 @@
+"""The free-spin map kernel equals the numpy pipeline's free mode, cell by cell.
+
+As tests/solver/test_map_kernel.py, with the tool spin rate free (cam.md section 2): the same
+reasons, failed waypoints, branches and bottlenecks, mu_path and V_max to 1e-12 relative. In
+free spin the position limits are checked on the joint path moved by the spin schedule only,
+so every joint-limit cell here comes from the kernel's second pass.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+
+import numpy as np
+import pytest
+
+import solver.placements
+from solver.families.base import Branch
+from solver.placements import evaluate_placements, prepare_path
+from solver.robots import get_robot
+from tests.solver.families.test_opw import build
+from tests.solver.test_evaluate import load_path, wrist_singular_path
+from tests.solver.test_map_kernel import grid, same_cells
+from tests.solver.test_parallel import grid_placements
+
+FREE = {"spin_mode": "free"}
+EVERY_REASON = {"feasible", "unreachable", "joint_limits", "singular", "discontinuous"}
+
+
+def test_the_free_spin_kernel_is_what_runs(monkeypatch: pytest.MonkeyPatch) -> None:
+    """A UR map in free spin never touches the numpy pipeline (else the equality is moot)."""
+
+    def refuse(*args: object, **kwargs: object) -> None:
+        raise AssertionError("the numpy pipeline ran")
+
+    monkeypatch.setattr(solver.placements, "run_chunk", refuse)
+    robot = get_robot("ur5")
+    path = prepare_path(robot, load_path("curved_line"))
+    cell = np.array([[0.0, 0.45, 0.1, 0.0]])
+    assert np.isfinite(evaluate_placements(robot, path, cell, spin_mode="free").mu_path[0])
+    with pytest.raises(AssertionError, match="numpy pipeline"):
+        evaluate_placements(robot, path, cell, spin_mode="free", compiled=False)
+
+
+def test_erk_grid_and_eight_yaws() -> None:
+    erk = grid(
+        np.arange(-0.25, 0.25 + 1e-9, 0.02), np.arange(0.25, 0.65 + 1e-9, 0.02), 0.1, np.zeros(1)
+    )
+    result, _ = same_cells(get_robot("ur5"), load_path("curved_line"), erk, **FREE)
+    assert np.isfinite(result.mu_path).all()
+    placements = grid_placements()
+    shuffled = placements[np.random.default_rng(3).permutation(len(placements))]
+    _, reasons = same_cells(get_robot("ur5"), load_path("s_curve"), shuffled, **FREE)
+    assert {"feasible", "unreachable"} <= reasons
+
+
+def test_wide_grids_with_every_reason() -> None:
+    seen: set[str] = set()
+    wide = grid(
+        np.linspace(-1.0, 1.0, 11), np.linspace(-1.0, 1.0, 11), 0.1, np.array([0.0, 2.0, -2.5])
+    )
+    ur5e = get_robot("ur5e")
+    for lower, upper in ((-math.pi / 2, math.pi), (-math.pi, math.pi)):  # an arc; one turn
+        robot = dataclasses.replace(ur5e, q_lower=np.full(6, lower), q_upper=np.full(6, upper))
+        _, reasons = same_cells(robot, load_path("curved_line"), wide, **FREE)
+        assert "joint_limits" in reasons
+        seen |= reasons
+    singular = grid(np.array([-0.05, 0.0, 0.05]), np.array([0.0, 0.05]), 0.0, np.array([0.0, 0.2]))
+    branch = Branch.named(shoulder="left", elbow="up", wrist="flip")
+    for choice in (None, branch):
+        _, reasons = same_cells(ur5e, wrist_singular_path(ur5e), singular, branch=choice, **FREE)
+        seen |= reasons
+    assert EVERY_REASON <= seen
+
+
+def test_steps_passes_and_one_branch() -> None:
+    """A tight step, no step bound, passes (each restarts the spin), a fixed branch."""
+    robot = get_robot("ur10")
+    waypoints = load_path("s_curve")
+    placements = grid(np.linspace(-0.6, 0.6, 7), np.linspace(0.2, 1.0, 5), 0.2, np.array([0.5]))
+    _, tight = same_cells(robot, waypoints, placements, max_joint_step=0.02, **FREE)
+    assert "discontinuous" in tight
+    same_cells(robot, waypoints, placements, max_joint_step=4.0, **FREE)
+    half = len(waypoints) // 2
+    passes = [(0, half), (half, len(waypoints))]
+    same_cells(robot, waypoints, placements, passes=passes, **FREE)
+    narrow = dataclasses.replace(
+        get_robot("ur5e"), q_lower=np.full(6, -math.pi / 2), q_upper=np.full(6, math.pi)
+    )
+    wide = grid(np.linspace(-1.0, 1.0, 9), np.linspace(-1.0, 1.0, 9), 0.1, np.array([0.0, 2.0]))
+    _, reasons = same_cells(
+        narrow, load_path("curved_line"), wide, passes=[(0, 60), (60, 133)], **FREE
+    )
+    assert "joint_limits" in reasons
+    fixed = Branch.named(shoulder="right", elbow="down", wrist="noflip")
+    result, _ = same_cells(robot, waypoints, placements, branch=fixed, **FREE)
+    assert set(result.branch) == {robot.family.branch_index(fixed)}  # type: ignore[union-attr]
+
+
+@pytest.mark.parametrize(
+    ("name", "expected"),
+    [
+        ("kuka_kr6_r700_sixx", {"feasible", "unreachable", "joint_limits", "discontinuous"}),
+        ("abb_irb2400", {"feasible", "unreachable", "joint_limits", "discontinuous"}),
+        ("offsets_everywhere", {"feasible", "unreachable", "joint_limits"}),
+    ],
+)
+def test_opw_arms(name: str, expected: set[str]) -> None:
+    robot = build(name)
+    reach = robot.family.parameters.c2 + robot.family.parameters.c3  # type: ignore[union-attr]
+    span = np.linspace(-1.2 * reach, 1.2 * reach, 9)
+    placements = grid(span, span, 0.1, np.array([0.0, 1.0, -2.0]))
+    _, reasons = same_cells(robot, load_path("curved_line"), placements, **FREE)
+    assert expected <= reasons
