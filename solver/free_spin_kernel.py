@@ -36,6 +36,7 @@ from solver.map_kernel import (
     first_outside,
     turned_poses,
     unwrapped,
+    write_cell,
 )
 from solver.tracking import FEASIBLE, TIE_RTOL
 
@@ -309,40 +310,10 @@ def free_cells(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
                 where[i] = at
             elif top == -np.inf:
                 top = slowest[i]
-        # solver.tracking.choose_branch: the highest mu_path, ties to the first branch.
-        top = -np.inf
-        for i in range(n_branches):
-            if alive[i] and slowest[i] > top:
-                top = slowest[i]
-        pick = -1
-        for i in range(n_branches):
-            if alive[i] and slowest[i] >= top - TIE_RTOL * abs(top):
-                pick = i
-                break
-        if pick >= 0:
-            mu[c] = slowest[pick]
-            reason[c] = FEASIBLE
-            failed[c] = -1
-            bottleneck_waypoint[c] = slowest_at[pick]
-            bottleneck_joint[c] = slowest_joint[pick]
-            for w in range(v_out.shape[1]):
-                v_out[c, w] = speeds[pick, w]
-        else:
-            furthest = -1
-            for i in range(n_branches):
-                furthest = max(furthest, where[i])
-            for i in range(n_branches):
-                if where[i] == furthest:
-                    pick = i
-                    break
-            mu[c] = np.nan
-            reason[c] = why[pick]
-            failed[c] = where[pick]
-            bottleneck_waypoint[c] = -1
-            bottleneck_joint[c] = -1
-            for w in range(v_out.shape[1]):
-                v_out[c, w] = np.nan
-        branch[c] = branches[pick]
+        write_cell(
+            c, branches, alive, why, where, slowest, slowest_at, slowest_joint, speeds,
+            mu, reason, failed, branch, bottleneck_waypoint, bottleneck_joint, v_out,
+        )  # fmt: skip
 
 
 def warm_up() -> None:

@@ -196,6 +196,52 @@ def turned_poses(c, ca, sa, offset, flange_rotation, flange_position, tool_posit
 
 
 @njit(cache=True, error_model="numpy", nogil=True)
+def write_cell(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
+    c, branches, alive, why, where, slowest, slowest_at, slowest_joint, speeds,
+    mu, reason, failed, branch, bottleneck_waypoint, bottleneck_joint, v_out,
+):  # fmt: skip
+    """Placement c's answer from its branches: :func:`solver.tracking.choose_branch`'s rule.
+
+    The highest mu_path (``slowest``) among the branches ``alive``, ties to the first; where
+    none is, the one that failed furthest along (``why`` and ``where``, the first at a tie).
+    """
+    n_branches = branches.shape[0]
+    top = -np.inf
+    for i in range(n_branches):
+        if alive[i] and slowest[i] > top:
+            top = slowest[i]
+    pick = -1
+    for i in range(n_branches):
+        if alive[i] and slowest[i] >= top - TIE_RTOL * abs(top):
+            pick = i
+            break
+    if pick >= 0:
+        mu[c] = slowest[pick]
+        reason[c] = FEASIBLE
+        failed[c] = -1
+        bottleneck_waypoint[c] = slowest_at[pick]
+        bottleneck_joint[c] = slowest_joint[pick]
+        for w in range(v_out.shape[1]):
+            v_out[c, w] = speeds[pick, w]
+    else:
+        furthest = -1
+        for i in range(n_branches):
+            furthest = max(furthest, where[i])
+        for i in range(n_branches):
+            if where[i] == furthest:
+                pick = i
+                break
+        mu[c] = np.nan
+        reason[c] = why[pick]
+        failed[c] = where[pick]
+        bottleneck_waypoint[c] = -1
+        bottleneck_joint[c] = -1
+        for w in range(v_out.shape[1]):
+            v_out[c, w] = np.nan
+    branch[c] = branches[pick]
+
+
+@njit(cache=True, error_model="numpy", nogil=True)
 def map_cells(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
     family,
     par,
@@ -378,40 +424,10 @@ def map_cells(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
                     alive[i] = False
                     why[i] = _JOINT_LIMITS
                     where[i] = first
-        # solver.tracking.choose_branch: the highest mu_path, ties to the first branch.
-        top = -np.inf
-        for i in range(n_branches):
-            if alive[i] and slowest[i] > top:
-                top = slowest[i]
-        pick = -1
-        for i in range(n_branches):
-            if alive[i] and slowest[i] >= top - TIE_RTOL * abs(top):
-                pick = i
-                break
-        if pick >= 0:
-            mu[c] = slowest[pick]
-            reason[c] = FEASIBLE
-            failed[c] = -1
-            bottleneck_waypoint[c] = slowest_at[pick]
-            bottleneck_joint[c] = slowest_joint[pick]
-            for w in range(v_out.shape[1]):
-                v_out[c, w] = speeds[pick, w]
-        else:
-            furthest = -1
-            for i in range(n_branches):
-                furthest = max(furthest, where[i])
-            for i in range(n_branches):
-                if where[i] == furthest:
-                    pick = i
-                    break
-            mu[c] = np.nan
-            reason[c] = why[pick]
-            failed[c] = where[pick]
-            bottleneck_waypoint[c] = -1
-            bottleneck_joint[c] = -1
-            for w in range(v_out.shape[1]):
-                v_out[c, w] = np.nan
-        branch[c] = branches[pick]
+        write_cell(
+            c, branches, alive, why, where, slowest, slowest_at, slowest_joint, speeds,
+            mu, reason, failed, branch, bottleneck_waypoint, bottleneck_joint, v_out,
+        )  # fmt: skip
 
 
 def warm_up() -> None:

@@ -20,7 +20,7 @@ from solver.placements import evaluate_placements, prepare_path
 from solver.robots import get_robot
 from tests.solver.families.test_opw import build
 from tests.solver.test_evaluate import load_path, wrist_singular_path
-from tests.solver.test_map_kernel import grid, same_cells
+from tests.solver.test_map_kernel import OPW_CASES, grid, opw_grid, same_cells
 from tests.solver.test_parallel import grid_placements
 
 FREE = {"spin_mode": "free"}
@@ -97,18 +97,8 @@ def test_steps_passes_and_one_branch() -> None:
     assert set(result.branch) == {robot.family.branch_index(fixed)}  # type: ignore[union-attr]
 
 
-@pytest.mark.parametrize(
-    ("name", "expected"),
-    [
-        ("kuka_kr6_r700_sixx", {"feasible", "unreachable", "joint_limits", "discontinuous"}),
-        ("abb_irb2400", {"feasible", "unreachable", "joint_limits", "discontinuous"}),
-        ("offsets_everywhere", {"feasible", "unreachable", "joint_limits"}),
-    ],
-)
+@pytest.mark.parametrize(("name", "expected"), OPW_CASES)
 def test_opw_arms(name: str, expected: set[str]) -> None:
     robot = build(name)
-    reach = robot.family.parameters.c2 + robot.family.parameters.c3  # type: ignore[union-attr]
-    span = np.linspace(-1.2 * reach, 1.2 * reach, 9)
-    placements = grid(span, span, 0.1, np.array([0.0, 1.0, -2.0]))
-    _, reasons = same_cells(robot, load_path("curved_line"), placements, **FREE)
+    _, reasons = same_cells(robot, load_path("curved_line"), opw_grid(robot), **FREE)
     assert expected <= reasons

@@ -135,22 +135,28 @@ def test_steps_passes_and_one_branch() -> None:
     assert set(result.branch) == {robot.family.branch_index(branch)}  # type: ignore[union-attr]
 
 
-@pytest.mark.parametrize(
-    ("name", "expected"),
-    [
-        ("kuka_kr6_r700_sixx", {"feasible", "unreachable", "joint_limits", "discontinuous"}),
-        ("abb_irb2400", {"feasible", "unreachable", "joint_limits", "discontinuous"}),
-        ("offsets_everywhere", {"feasible", "unreachable", "joint_limits"}),
-    ],
-)
+# OPW arms and the reasons their wide grid shows: catalogue limits (narrow arcs), offsets and
+# sign corrections, b != 0.
+OPW_CASES = [
+    ("kuka_kr6_r700_sixx", {"feasible", "unreachable", "joint_limits", "discontinuous"}),
+    ("abb_irb2400", {"feasible", "unreachable", "joint_limits", "discontinuous"}),
+    ("offsets_everywhere", {"feasible", "unreachable", "joint_limits"}),
+]
+
+
+def opw_grid(robot: Robot) -> np.ndarray:
+    """Placements around the arm out to 1.2 times its reach, three yaws."""
+    reach = robot.family.parameters.c2 + robot.family.parameters.c3  # type: ignore[union-attr]
+    span = np.linspace(-1.2 * reach, 1.2 * reach, 9)
+    return grid(span, span, 0.1, np.array([0.0, 1.0, -2.0]))
+
+
+@pytest.mark.parametrize(("name", "expected"), OPW_CASES)
 def test_opw_arms(name: str, expected: set[str]) -> None:
     """OPW: catalogue limits (narrow arcs), offsets and sign corrections, b != 0; singular
     cells in test_opw_singular_wrist."""
     robot = build(name)
-    reach = robot.family.parameters.c2 + robot.family.parameters.c3  # type: ignore[union-attr]
-    span = np.linspace(-1.2 * reach, 1.2 * reach, 9)
-    placements = grid(span, span, 0.1, np.array([0.0, 1.0, -2.0]))
-    _, reasons = same_cells(robot, load_path("curved_line"), placements)
+    _, reasons = same_cells(robot, load_path("curved_line"), opw_grid(robot))
     assert expected <= reasons
 
 
