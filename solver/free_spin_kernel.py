@@ -26,16 +26,16 @@ import math
 import numpy as np
 from numba import njit
 
-import solver.families.ur.kernel
 from solver.families.base import SINGULAR, UNREACHABLE
-from solver.families.kernels import SCRATCH_ROWS, UR_KERNEL, pose_block
+from solver.families.kernels import SCRATCH_ROWS, pose_block
 from solver.map_kernel import (
     BLOCK,
-    UR5,
     drop_stale_compiled_code,
     first_outside,
     turned_poses,
     unwrapped,
+    warm_up_placement,
+    wrapped_step,
     write_cell,
 )
 from solver.tracking import FEASIBLE, TIE_RTOL
@@ -120,29 +120,16 @@ def _spun_failure(  # type: ignore[no-untyped-def]  # pragma: no cover - compile
             elif math.isinf(moved):
                 moved = _HUGE if moved > 0.0 else -_HUGE
             path[w, j] += moved
-    spun = np.empty_like(path)
-    for j in range(dof):
-        total = 0.0
-        spun[0, j] = path[0, j]
-        for w in range(1, n_waypoints):
-            step = path[w, j] - path[w - 1, j]
-            if step > math.pi:
-                step -= _TWO_PI
-            elif step < -math.pi:
-                step += _TWO_PI
-            total += step
-            spun[w, j] = path[0, j] + total
+    spun = np.empty_like(path)  # as track() forms it: the first angle plus the wrapped steps
+    spun[0] = path[0]
+    totals = np.zeros(dof)
     for w in range(1, n_waypoints):
-        if not segment_checked[w - 1]:
-            continue
         for j in range(dof):
-            step = path[w, j] - path[w - 1, j]
-            if step > math.pi:
-                step -= _TWO_PI
-            elif step < -math.pi:
-                step += _TWO_PI
-            if abs(step) > max_joint_step:
+            step = wrapped_step(path[w, j] - path[w - 1, j])
+            if segment_checked[w - 1] and abs(step) > max_joint_step:
                 return _DISCONTINUOUS, w
+            totals[j] += step
+            spun[w, j] = path[0, j] + totals[j]
     at = first_outside(spun, lower, upper)
     if at < n_waypoints:
         return _JOINT_LIMITS, at
@@ -321,20 +308,8 @@ def warm_up() -> None:
 
     One placement of a two-waypoint UR5 path: the kernel has one signature for every family.
     """
-    rotation = np.tile(np.diag([1.0, -1.0, -1.0]), (2, 1, 1))
-    position = np.array([[0.0, 0.4, 0.2], [0.01, 0.4, 0.2]])
-    twist = np.tile([1.0, 0.0, 0.0, 0.0, 0.0, 0.0], (2, 1))
-    integers = [np.empty(1, dtype=np.int64) for _ in range(5)]
     free_cells(
-        UR_KERNEL,
-        solver.families.ur.kernel.kernel_parameters(UR5),
-        np.ones(1),
-        np.zeros(1),
-        np.zeros((1, 3)),
-        rotation,
-        position,
-        position.copy(),
-        twist,
+        *warm_up_placement(),
         np.tile([0.0, 0.0, -1.0], (2, 1)),
         np.full(1, 0.01),
         np.zeros(2, dtype=np.bool_),
@@ -345,6 +320,6 @@ def warm_up() -> None:
         np.full(6, math.pi),
         0.35,
         np.empty(1),
-        *integers,
+        *(np.empty(1, dtype=np.int64) for _ in range(5)),
         np.empty((1, 0)),
     )

@@ -122,6 +122,16 @@ def limit_modes(lower: np.ndarray, upper: np.ndarray) -> tuple[np.ndarray, np.nd
 
 
 @njit(cache=True, error_model="numpy", nogil=True)
+def wrapped_step(step):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
+    """A step between two angles in [-pi, pi] brought into [-pi, pi], as track() does."""
+    if step > math.pi:
+        return step - _TWO_PI
+    if step < -math.pi:
+        return step + _TWO_PI
+    return step
+
+
+@njit(cache=True, error_model="numpy", nogil=True)
 def unwrapped(cq, sq, b):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
     """Branch b's joint path (W, 6), rad: the angles of its pairs, unwrapped by the wrapped steps.
 
@@ -136,12 +146,7 @@ def unwrapped(cq, sq, b):  # type: ignore[no-untyped-def]  # pragma: no cover - 
         path[0, j] = first
         for w in range(1, n_waypoints):
             angle = math.atan2(sq[b, j, w], cq[b, j, w])
-            step = angle - previous
-            if step > math.pi:
-                step -= _TWO_PI
-            elif step < -math.pi:
-                step += _TWO_PI
-            total += step
+            total += wrapped_step(angle - previous)
             path[w, j] = first + total
             previous = angle
     return path
@@ -430,26 +435,24 @@ def map_cells(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
         )  # fmt: skip
 
 
+def warm_up_placement() -> tuple[object, ...]:
+    """The kernels' first nine arguments for one placement of a two-waypoint UR5 path."""
+    rotation = np.tile(np.diag([1.0, -1.0, -1.0]), (2, 1, 1))
+    position = np.array([[0.0, 0.4, 0.2], [0.01, 0.4, 0.2]])
+    twist = np.tile([1.0, 0.0, 0.0, 0.0, 0.0, 0.0], (2, 1))
+    parameters = solver.families.ur.kernel.kernel_parameters(UR5)
+    return (UR_KERNEL, parameters, np.ones(1), np.zeros(1), np.zeros((1, 3)), rotation, position,
+            position.copy(), twist)  # fmt: skip
+
+
 def warm_up() -> None:
     """Compile the kernel, or load it from the disk cache, so that no request pays for it.
 
     One placement of a two-waypoint UR5 path: the kernel has one signature for every family.
     """
-    rotation = np.tile(np.diag([1.0, -1.0, -1.0]), (2, 1, 1))
-    position = np.array([[0.0, 0.4, 0.2], [0.01, 0.4, 0.2]])
-    twist = np.tile([1.0, 0.0, 0.0, 0.0, 0.0, 0.0], (2, 1))
     modes, arc = limit_modes(np.full(6, -_TWO_PI), np.full(6, _TWO_PI))
-    integers = [np.empty(1, dtype=np.int64) for _ in range(5)]
     map_cells(
-        UR_KERNEL,
-        solver.families.ur.kernel.kernel_parameters(UR5),
-        np.ones(1),
-        np.zeros(1),
-        np.zeros((1, 3)),
-        rotation,
-        position,
-        position.copy(),
-        twist,
+        *warm_up_placement(),
         np.zeros(2, dtype=np.bool_),
         np.ones(1, dtype=np.bool_),
         np.arange(8, dtype=np.int64),
@@ -460,6 +463,6 @@ def warm_up() -> None:
         np.full(6, math.pi),
         0.35,
         np.empty(1),
-        *integers,
+        *(np.empty(1, dtype=np.int64) for _ in range(5)),
         np.empty((1, 0)),
     )

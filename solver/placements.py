@@ -170,7 +170,7 @@ def _run_kernel(
         inputs.tool_position,
         inputs.twist,
     )
-    branch_indices = np.ascontiguousarray(branches, dtype=np.int64)
+    followed = np.ascontiguousarray(branches, dtype=np.int64)
     if spin_mode == "free":
         free_cells(
             *placed,
@@ -178,7 +178,7 @@ def _run_kernel(
             inputs.length,
             inputs.pure_rotation,
             inputs.segment_checked,
-            branch_indices,
+            followed,
             inputs.lower,
             inputs.upper,
             inputs.qdot_max,
@@ -192,7 +192,7 @@ def _run_kernel(
             *placed,
             inputs.pure_rotation,
             inputs.segment_checked,
-            branch_indices,
+            followed,
             inputs.lower,
             inputs.upper,
             inputs.modes,
