@@ -3,7 +3,8 @@
 As tests/solver/test_map_kernel.py, with the tool spin rate free (cam.md section 2): the same
 reasons, failed waypoints, branches and bottlenecks, mu_path and V_max to 1e-12 relative. In
 free spin the position limits are checked on the joint path moved by the spin schedule only,
-so every joint-limit cell here comes from the kernel's second pass.
+so every joint-limit cell here comes from the kernel's second pass. That the kernel is what
+runs in free spin is checked in test_map_kernel.py.
 """
 
 from __future__ import annotations
@@ -14,9 +15,7 @@ import math
 import numpy as np
 import pytest
 
-import solver.placements
 from solver.families.base import Branch
-from solver.placements import evaluate_placements, prepare_path
 from solver.robots import get_robot
 from tests.solver.families.test_opw import build
 from tests.solver.test_evaluate import load_path, wrist_singular_path
@@ -25,21 +24,6 @@ from tests.solver.test_parallel import grid_placements
 
 FREE = {"spin_mode": "free"}
 EVERY_REASON = {"feasible", "unreachable", "joint_limits", "singular", "discontinuous"}
-
-
-def test_the_free_spin_kernel_is_what_runs(monkeypatch: pytest.MonkeyPatch) -> None:
-    """A UR map in free spin never touches the numpy pipeline (else the equality is moot)."""
-
-    def refuse(*args: object, **kwargs: object) -> None:
-        raise AssertionError("the numpy pipeline ran")
-
-    monkeypatch.setattr(solver.placements, "run_chunk", refuse)
-    robot = get_robot("ur5")
-    path = prepare_path(robot, load_path("curved_line"))
-    cell = np.array([[0.0, 0.45, 0.1, 0.0]])
-    assert np.isfinite(evaluate_placements(robot, path, cell, spin_mode="free").mu_path[0])
-    with pytest.raises(AssertionError, match="numpy pipeline"):
-        evaluate_placements(robot, path, cell, spin_mode="free", compiled=False)
 
 
 def test_erk_grid_and_eight_yaws() -> None:

@@ -60,8 +60,10 @@ def same_cells(
     return compiled, reasons
 
 
-def test_the_compiled_kernel_is_what_runs(monkeypatch: pytest.MonkeyPatch) -> None:
-    """A UR map in fixed spin never touches the numpy pipeline (else the equality is moot)."""
+@pytest.mark.parametrize("spin_mode", ["fixed", "free"])
+def test_the_compiled_kernel_is_what_runs(monkeypatch: pytest.MonkeyPatch, spin_mode: str) -> None:
+    """A UR map never touches the numpy pipeline, in either spin mode (else the equality is
+    moot): the fixed-spin kernel here, the free-spin one in test_free_spin_kernel.py."""
 
     def refuse(*args: object, **kwargs: object) -> None:
         raise AssertionError("the numpy pipeline ran")
@@ -69,10 +71,11 @@ def test_the_compiled_kernel_is_what_runs(monkeypatch: pytest.MonkeyPatch) -> No
     monkeypatch.setattr(solver.placements, "run_chunk", refuse)
     robot = get_robot("ur5")
     path = prepare_path(robot, load_path("curved_line"))
-    result = evaluate_placements(robot, path, np.array([[0.0, 0.45, 0.1, 0.0]]))
-    assert np.isfinite(result.mu_path[0])
+    cell = np.array([[0.0, 0.45, 0.1, 0.0]])
+    mode = {"spin_mode": spin_mode}
+    assert np.isfinite(evaluate_placements(robot, path, cell, **mode).mu_path[0])  # type: ignore[arg-type]
     with pytest.raises(AssertionError, match="numpy pipeline"):
-        evaluate_placements(robot, path, np.array([[0.0, 0.45, 0.1, 0.0]]), compiled=False)
+        evaluate_placements(robot, path, cell, compiled=False, **mode)  # type: ignore[arg-type]
 
 
 def test_erk_grid() -> None:
