@@ -28,7 +28,7 @@ def peak_mib():
     except OSError:
         pass
     return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
-from solver.capability_map import capability_map
+from solver.path.capability_map import capability_map
 from service.schemas import EvaluateRequest
 request = EvaluateRequest.model_validate(json.load(open(sys.argv[1])))
 robot, path = request.robot.to_solver(), request.path.to_solver().poses

@@ -20,9 +20,9 @@ import numpy as np
 from service.config import Settings
 from service.jobs.store import JobStore
 from service.jobs.worker import run_job
-from solver.capability_map import capability_map
-from solver.parallel import SERIAL, ThreadRunner
-from solver.robots import Robot
+from solver.core.parallel import SERIAL, ThreadRunner
+from solver.core.robots import Robot
+from solver.path.capability_map import capability_map
 
 ROOT = Path(__file__).resolve().parents[1]
 

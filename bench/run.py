@@ -34,14 +34,15 @@ import numpy as np
 import parallel
 import ur_analytic_ik
 
-from solver.capability_map import capability_map, grid_axis
-from solver.kinematics import jacobian_in_base
-from solver.optimize import optimize_placement
-from solver.parallel import SERIAL, ThreadRunner
-from solver.robots import Robot, example_robot_data_dir, get_robot, robot_from_urdf
-from solver.search_space import PlacementBounds
-from solver.spatial import Placement, pose_matrix
-from solver.task import task_requirements
+from solver.core.kinematics import jacobian_in_base
+from solver.core.parallel import SERIAL, ThreadRunner
+from solver.core.robots import Robot, example_robot_data_dir
+from solver.core.spatial import Placement, pose_matrix
+from solver.core.task import task_requirements
+from solver.families import get_robot, robot_from_urdf
+from solver.optimise.optimize import optimize_placement
+from solver.optimise.search_space import PlacementBounds
+from solver.path.capability_map import capability_map, grid_axis
 
 ROOT = Path(__file__).resolve().parents[1]
 

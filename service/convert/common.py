@@ -9,14 +9,14 @@ import numpy as np
 from service import schemas
 from service.schemas.path import PathInput
 from solver.cam.frames import frames_of_placement
-from solver.evaluate import Branch
-from solver.exceptions import InvalidInputError
-from solver.pipeline import SpinMode
-from solver.robots import Robot
-from solver.spatial import (
+from solver.core.exceptions import InvalidInputError
+from solver.core.robots import Robot
+from solver.core.spatial import (
     Placement,
     spun_waypoints,
 )
+from solver.path.evaluate import Branch
+from solver.path.pipeline import SpinMode
 
 
 def robot_from_schema(spec: schemas.Robot) -> Robot:

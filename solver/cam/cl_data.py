@@ -33,7 +33,7 @@ import numpy as np
 
 from solver.cam.cam_path import METRES_PER_UNIT, CamPath, Units, assemble_cam_path
 from solver.cam.reading import checked_position, near_unit_vector, parse_numbers
-from solver.exceptions import InvalidLineError
+from solver.core.exceptions import InvalidLineError
 
 IGNORED = frozenset(
     {

@@ -1,4 +1,4 @@
-"""Local searches on mu_path (solver/local_search.py), and the large box of issue 12.
+"""Local searches on mu_path (solver/optimise/local_search.py), and the large box of issue 12.
 
 On a large box the best placement lies where the best IK branch changes; a method that follows
 one branch stops below it. Each method must reach the better answer there (issue 12: the
@@ -14,12 +14,12 @@ import math
 import numpy as np
 import pytest
 
-from solver.coarse_search import Cell
-from solver.local_search import climb, refine_cells
-from solver.optimize import optimize_placement
-from solver.placements import evaluate_placements, prepare_path
-from solver.robots import get_robot
-from solver.search_space import PlacementBounds
+from solver.families import get_robot
+from solver.optimise.coarse_search import Cell
+from solver.optimise.local_search import climb, refine_cells
+from solver.optimise.optimize import optimize_placement
+from solver.optimise.search_space import PlacementBounds
+from solver.path.placements import evaluate_placements, prepare_path
 from tests.solver.test_evaluate import load_path
 
 LARGE = PlacementBounds(x=(-0.8, 0.8), y=(-0.8, 0.8), yaw=(-math.pi, math.pi), z=0.1)

@@ -9,16 +9,17 @@ import threading
 import numpy as np
 import pytest
 
-from solver import optimize
-from solver.capability_map import capability_map, grid_axis
-from solver.evaluate import evaluate_path
-from solver.exceptions import InvalidInputError
-from solver.optimize import PlacementOptimum, optimize_placement
-from solver.parallel import SERIAL, TaskRunner, ThreadRunner
-from solver.robots import Robot, get_robot
-from solver.search_space import PlacementBounds, vector_of
-from solver.spatial import Placement
-from solver.symmetry import arc_coordinates, arc_point, turns_about_base_z
+from solver.core.exceptions import InvalidInputError
+from solver.core.parallel import SERIAL, TaskRunner, ThreadRunner
+from solver.core.robots import Robot
+from solver.core.spatial import Placement
+from solver.families import get_robot
+from solver.optimise import optimize
+from solver.optimise.optimize import PlacementOptimum, optimize_placement
+from solver.optimise.search_space import PlacementBounds, vector_of
+from solver.optimise.symmetry import arc_coordinates, arc_point, turns_about_base_z
+from solver.path.capability_map import capability_map, grid_axis
+from solver.path.evaluate import evaluate_path
 from tests.cases import OPTIMUM_EVALUATE_RTOL, OPTIMUM_METHODS_RTOL
 from tests.solver.test_evaluate import load_path
 

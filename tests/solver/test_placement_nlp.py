@@ -15,10 +15,10 @@ import casadi
 import numpy as np
 import pytest
 
-from solver.pipeline import prepare_path
-from solver.placement_nlp import PlacementNlp
-from solver.robots import get_robot
-from solver.search_space import PlacementBounds
+from solver.families import get_robot
+from solver.optimise.methods.placement_nlp import PlacementNlp
+from solver.optimise.search_space import PlacementBounds
+from solver.path.pipeline import prepare_path
 from tests.solver.test_evaluate import load_path
 
 BOUNDS = PlacementBounds(x=(-0.25, 0.25), y=(0.25, 0.65), yaw=(-math.pi, math.pi), z=0.1)

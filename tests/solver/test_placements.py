@@ -8,14 +8,14 @@ import platform
 import numpy as np
 import pytest
 
-from solver._malloc import raise_malloc_thresholds
-from solver.evaluate import evaluate_path
-from solver.exceptions import InvalidInputError
+from solver.core.codes import REASONS
+from solver.core.exceptions import InvalidInputError
+from solver.core.malloc import raise_malloc_thresholds
+from solver.core.spatial import Placement
+from solver.families import get_robot
 from solver.families.ur.ik import BRANCHES
-from solver.placements import PlacementEvaluator, evaluate_placements, prepare_path
-from solver.robots import get_robot
-from solver.spatial import Placement
-from solver.tracking import REASONS
+from solver.path.evaluate import evaluate_path
+from solver.path.placements import PlacementEvaluator, evaluate_placements, prepare_path
 from tests.cases import MAP_EVALUATE_RTOL
 from tests.solver.test_evaluate import load_path
 

@@ -8,10 +8,9 @@ from fastapi import APIRouter, Request, Response
 
 from service.body import body_in_thread, body_openapi
 from service.errors import ERROR_RESPONSES
-from service.schemas.path import PathInput
-from service.schemas.paths_import import ImportedPose, PathImportRequest, PathImportResponse
+from service.operations import imported
+from service.schemas.paths_import import PathImportRequest, PathImportResponse
 from service.work import json_response, run_stoppable
-from solver.cam.frames import quaternion_wxyz
 
 router = APIRouter(prefix="/paths", tags=["paths"], responses=ERROR_RESPONSES)
 
@@ -28,20 +27,3 @@ async def post_import(
 ) -> Response:
     """Read a path without computing anything, so a user can look at it first."""
     return await run_stoppable(request, lambda _: json_response(imported(body.path.to_solver())))
-
-
-def imported(path: PathInput) -> PathImportResponse:
-    """The import answer of a parsed path."""
-    waypoints = []
-    for pose in path.poses:
-        w, x, y, z = quaternion_wxyz(pose[:3, :3])
-        waypoints.append(ImportedPose(position=pose[:3, 3].tolist(), orientation=[x, y, z, w]))
-    passes = path.passes or ((0, len(path.poses)),)
-    return PathImportResponse(
-        waypoints=waypoints,
-        passes=[[start, stop] for start, stop in passes],
-        feed=path.feed,
-        units=path.units,
-        correction=path.axis_correction,
-        spin_mode=path.default_spin_mode,
-    )

@@ -9,8 +9,8 @@ import numpy as np
 import pytest
 
 from solver.cam.cl_data import IGNORED, read_cl_data
-from solver.exceptions import InvalidInputError, InvalidLineError
-from solver.tool_axis import poses_from_tool_axes
+from solver.core.exceptions import InvalidInputError, InvalidLineError
+from solver.core.tool_axis import poses_from_tool_axes
 from tests.cases import CAM_EXAMPLES, INCH_MM_ATOL
 
 TWO_CUTS = ["GOTO/0, 0, 0, 0, 0, 1", "GOTO/10, 0, 0, 0, 0, 1"]

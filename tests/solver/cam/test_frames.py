@@ -20,8 +20,8 @@ from solver.cam.frames import (
     matrix_from_rows,
     matrix_from_ur,
 )
-from solver.exceptions import InvalidInputError
-from solver.spatial import Placement
+from solver.core.exceptions import InvalidInputError
+from solver.core.spatial import Placement
 from tests.cases import FRAME_ROUND_TRIP_ATOL
 
 

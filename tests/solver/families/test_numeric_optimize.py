@@ -8,11 +8,10 @@ from collections.abc import Callable
 import numpy as np
 import pytest
 
-from solver.evaluate import evaluate_path
-from solver.exceptions import InvalidInputError
-from solver.joint_path import evaluate_joint_path
-from solver.optimize import PlacementOptimum, optimize_placement
-from solver.placement_scipy import (
+from solver.core.exceptions import InvalidInputError
+from solver.core.spatial import Placement, pose_matrix
+from solver.families import get_robot
+from solver.optimise.methods.placement_scipy import (
     FULL_SEARCH,
     MIN_GENERATIONS,
     MIN_POPULATION,
@@ -20,9 +19,10 @@ from solver.placement_scipy import (
     search_placements,
     search_size,
 )
-from solver.robots import get_robot
-from solver.search_space import PlacementBounds
-from solver.spatial import Placement, pose_matrix
+from solver.optimise.optimize import PlacementOptimum, optimize_placement
+from solver.optimise.search_space import PlacementBounds
+from solver.path.evaluate import evaluate_path
+from solver.path.joint_path import evaluate_joint_path
 from tests.cases import EXAMPLES, OPTIMUM_EVALUATE_RTOL
 from tests.solver.test_optimize import best_coarse_cell
 
