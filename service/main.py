@@ -46,6 +46,7 @@ from solver.families import catalogue
 from solver.kernels import fixed_spin as map_kernel
 from solver.kernels import free_spin as free_spin_kernel
 from solver.path.evaluate import evaluate_path
+from solver.path.problem import PathProblem
 
 GIL_SWITCH_SECONDS = 0.001
 DESCRIPTION = """\
@@ -111,7 +112,7 @@ def _warm_up() -> None:
     robot = catalogue()["ur5"]
     waypoints = np.repeat(np.eye(4)[None], 2, axis=0)
     waypoints[1, 0, 3] = 0.01
-    evaluate_path(robot, waypoints, Placement(0.0, 0.45, 0.1, 0.0))
+    evaluate_path(PathProblem.of(robot, waypoints), Placement(0.0, 0.45, 0.1, 0.0))
 
 
 def _stop_work_on(signum: signal.Signals) -> None:

@@ -13,7 +13,7 @@ from service.convert.common import branch_to_api
 from solver.core.robots import Robot
 from solver.path.evaluate import PathEvaluation
 from solver.path.feed import FeedCheck
-from solver.path.pipeline import require_family
+from solver.path.problem import require_family
 
 _WAYPOINTS = TypeAdapter(list[schemas.WaypointResult])
 

@@ -14,7 +14,7 @@ from solver.core.exceptions import InvalidInputError
 from solver.core.robots import Robot
 from solver.core.spatial import MAX_COORDINATE
 from solver.path.capability_map import CapabilityMap, axis_length, grid_axis
-from solver.path.pipeline import SpinMode, require_family
+from solver.path.problem import SpinMode, require_family
 
 
 @dataclass(frozen=True)

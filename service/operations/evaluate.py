@@ -25,27 +25,14 @@ def _evaluated(
     path = convert.path_of(body.path)
     poses, placement = convert.spun_poses(path, body.spins), convert.placement_of(body.placement)
     spin_mode = convert.spin_mode_of(body.spin_mode, path)
+    problem = convert.problem_of(robot, poses, path, ik=body.ik, spin_mode=spin_mode)
     if body.joint_path is not None:
         if spin_mode != "fixed":
             raise InvalidInputError("joint_path", "a joint path is evaluated in spin_mode fixed")
-        evaluation = evaluate_joint_path(
-            robot,
-            poses,
-            placement,
-            convert.joint_path_of(body.joint_path, robot),
-            max_joint_step=body.ik.max_joint_step,
-            passes=path.passes,
-        )
+        joint_path = convert.joint_path_of(body.joint_path, robot)
+        evaluation = evaluate_joint_path(problem, placement, joint_path)
     else:
-        evaluation = evaluate_path(
-            robot,
-            poses,
-            placement,
-            branch=convert.branch_of(body.ik.branch),
-            max_joint_step=body.ik.max_joint_step,
-            spin_mode=spin_mode,
-            passes=path.passes,
-        )
+        evaluation = evaluate_path(problem, placement)
     feed = body.feed if body.feed is not None else path.feed
     return robot, path, evaluation, feed
 

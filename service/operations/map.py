@@ -10,7 +10,7 @@ from solver.core.parallel import TaskRunner, ThreadRunner
 from solver.core.progress import Progress
 from solver.core.robots import Robot
 from solver.path.capability_map import CapabilityMap, capability_map
-from solver.path.pipeline import SpinMode
+from solver.path.problem import SpinMode
 
 
 def checked_grid(body: MapRequest, settings: Settings) -> tuple[Robot, convert.MapGrid]:
@@ -46,19 +46,15 @@ def computed_map(
         convert.check_png_size(grid, settings=settings)
     path = convert.path_of(body.path)
     spin_mode = convert.spin_mode_of(body.spin_mode, path)
+    problem = convert.problem_of(robot, path.poses, path, ik=body.ik, spin_mode=spin_mode)
     result = capability_map(
-        robot,
-        path.poses,
+        problem,
         xs=grid.xs,
         ys=grid.ys,
         z=body.grid.z,
         yaws=grid.yaws,
         spins=grid.spins,
-        branch=convert.branch_of(body.ik.branch),
-        max_joint_step=body.ik.max_joint_step,
-        spin_mode=spin_mode,
         progress=progress,
-        passes=path.passes,
         runner=ThreadRunner(settings.threads) if runner is None else runner,
     )
     return result, robot, spin_mode

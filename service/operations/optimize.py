@@ -24,14 +24,13 @@ def optimum_of(
     path = convert.path_of(body.path)
     bounds = convert.bounds_of(body.bounds, z=body.z)
     start = None if body.start is None else convert.placement_of(body.start)
+    spin_mode = convert.spin_mode_of(body.spin_mode, path)
+    problem = convert.problem_of(robot, path.poses, path, ik=body.ik, spin_mode=spin_mode)
     optimum = optimize_placement(
-        robot,
-        path.poses,
+        problem,
         bounds=bounds,
         start=start,
         method=body.method,
-        max_joint_step=body.ik.max_joint_step,
-        spin_mode=convert.spin_mode_of(body.spin_mode, path),
         max_spin_step=None if body.spin_path is None else body.spin_path.max_spin_step,
         max_coarse_cells=settings.max_map_cells,
         max_coarse_poses=settings.max_map_poses,
@@ -39,6 +38,5 @@ def optimum_of(
         max_solver_seconds=settings.max_solver_seconds,
         progress=progress,
         runner=ThreadRunner(settings.threads) if runner is None else runner,
-        passes=path.passes,
     )
     return convert.optimize_response(optimum, robot, axis_correction=path.axis_correction)

@@ -23,15 +23,21 @@ import scipy.optimize
 
 from solver.core.parallel import SERIAL, TaskRunner
 from solver.core.progress import Progress
-from solver.core.robots import Robot
+from solver.optimise.candidate import Candidate
 from solver.optimise.coarse_search import COARSE_STEP, COARSE_YAW_STEP, Cell
-from solver.optimise.search_space import PlacementBounds
-from solver.path.pipeline import PreparedPath, SpinMode, require_family
+from solver.optimise.search_space import (
+    N_VARIABLES,
+    PlacementBounds,
+    decision_vector,
+    placement_rows,
+)
 from solver.path.placements import PlacementEvaluator, evaluate_placements
+from solver.path.problem import PathProblem
 
-# Half the coarse map's step of each variable [x, y, yaw, spin, z]: the first steps of both
-# searches.
-_HALF_STEPS = np.array([COARSE_STEP, COARSE_STEP, COARSE_YAW_STEP, COARSE_YAW_STEP, COARSE_STEP])
+# Half the coarse map's step of each variable: the first steps of both searches.
+_HALF_STEPS = decision_vector(
+    x=COARSE_STEP, y=COARSE_STEP, yaw=COARSE_YAW_STEP, spin=COARSE_YAW_STEP, z=COARSE_STEP
+)
 _HALF_STEPS /= 2
 REFINED_CELLS = 16  # the coarse maxima refined before the IPOPT starts are chosen
 REFINE_ROUNDS = 12
@@ -42,13 +48,10 @@ REFINE_WORK = 3e5
 
 
 def refine_cells(
-    robot: Robot,
-    path: PreparedPath,
+    problem: PathProblem,
     bounds: PlacementBounds,
     cells: list[Cell],
     *,
-    max_joint_step: float,
-    spin_mode: SpinMode = "fixed",
     count: int = REFINED_CELLS,
     rounds: int = REFINE_ROUNDS,
     progress: Progress | None = None,
@@ -69,12 +72,13 @@ def refine_cells(
     after each round (and may stop the work there).
     """
     free = np.flatnonzero(bounds.free)
-    per_cell = 2 * len(free) * rounds * require_family(robot).path_cost(path.n_waypoints)
+    n_waypoints = problem.prepared.n_waypoints
+    per_cell = 2 * len(free) * rounds * problem.family.path_cost(n_waypoints)
     count = min(count, int(REFINE_WORK // max(per_cell, 1.0)))
     rest, cells = cells[count:], cells[:count]
     if not cells:
         return rest
-    vectors = np.array([cell.vector for cell in cells])  # (K, 5): x, y, yaw, spin, z
+    vectors = np.array([cell.vector for cell in cells])  # (K, N_VARIABLES)
     mu = np.array([cell.mu_path for cell in cells])
     branch = np.array([cell.branch for cell in cells])
     lower, upper = bounds.lower, bounds.upper
@@ -95,14 +99,9 @@ def refine_cells(
                 moves.append(moved)
         if not moves:
             break
-        trial = np.stack(moves)  # (M, K, 5)
+        trial = np.stack(moves)  # (M, K, N_VARIABLES)
         result = evaluate_placements(
-            robot,
-            path,
-            trial.reshape(-1, 5)[:, _PLACEMENT_COLUMNS],
-            max_joint_step=max_joint_step,
-            spin_mode=spin_mode,
-            runner=runner,
+            problem, placement_rows(trial.reshape(-1, N_VARIABLES)), runner=runner
         )
         values = np.nan_to_num(result.mu_path, nan=-np.inf).reshape(len(moves), len(cells))
         best = values.argmax(axis=0)
@@ -127,18 +126,9 @@ CLIMB_EVALUATIONS = 600  # Nelder-Mead's placements at most from one start
 CLIMB_WORK = 2e5
 CLIMB_MIN_EVALUATIONS = 50
 _TOLERANCE = 1e-7  # m and rad, of Nelder-Mead's simplex
-_PLACEMENT_COLUMNS = [0, 1, 4, 2, 3]  # a vector [x, y, yaw, spin, z] as x, y, z, yaw, spin
 
 
-def climb(
-    robot: Robot,
-    path: PreparedPath,
-    bounds: PlacementBounds,
-    start: Cell,
-    *,
-    max_joint_step: float,
-    spin_mode: SpinMode = "fixed",
-) -> Cell | None:
+def climb(problem: PathProblem, bounds: PlacementBounds, start: Cell) -> Cell | None:
     """Nelder-Mead on mu_path over the free variables, from ``start``, inside the bounds.
 
     The first simplex spans half a coarse step along each free variable. Deterministic.
@@ -148,17 +138,17 @@ def climb(
         leaves fewer than CLIMB_MIN_EVALUATIONS or nothing is free.
     """
     free = np.flatnonzero(bounds.free)
-    cost = require_family(robot).path_cost(path.n_waypoints)
+    cost = problem.family.path_cost(problem.prepared.n_waypoints)
     budget = min(CLIMB_EVALUATIONS, int(CLIMB_WORK // max(cost, 1.0)))
     if budget < CLIMB_MIN_EVALUATIONS or not len(free):
         return None
     best = [start]
-    evaluate = PlacementEvaluator(robot, path, max_joint_step=max_joint_step, spin_mode=spin_mode)
+    evaluate = PlacementEvaluator(problem)
 
     def negative_mu(values: np.ndarray) -> float:
         vector = start.vector.copy()
         vector[free] = np.clip(values, bounds.lower[free], bounds.upper[free])
-        result = evaluate(vector[None, _PLACEMENT_COLUMNS])
+        result = evaluate(placement_rows(vector[None]))
         mu = float(result.mu_path[0])
         if np.isnan(mu):
             return 1.0
@@ -181,3 +171,17 @@ def climb(
         },
     )
     return best[0]
+
+
+N_CLIMBS = 2  # Nelder-Mead climbs on mu_path, from the best refined cells
+CLIMB_STATUS = "Nelder-Mead on mu_path, from a refined cell"  # a climb's candidate status
+
+
+def climbs(problem: PathProblem, bounds: PlacementBounds, cells: list[Cell]) -> list[Candidate]:
+    """Nelder-Mead on mu_path from the best N_CLIMBS cells: across branches, to their tops."""
+    candidates = []
+    for cell in cells[:N_CLIMBS]:
+        top = climb(problem, bounds, cell)
+        if top is not None:
+            candidates.append(Candidate(top.vector, CLIMB_STATUS))
+    return candidates

@@ -7,19 +7,17 @@ all cells at once by :mod:`solver.path.placements`.
 from __future__ import annotations
 
 import math
-from collections.abc import Callable, Sequence
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
 
 from solver.core.codes import REASONS
 from solver.core.exceptions import InvalidInputError
-from solver.core.family import Branch
 from solver.core.parallel import SERIAL, TaskRunner
-from solver.core.robots import Robot
 from solver.core.spatial import Placement
-from solver.path.pipeline import DEFAULT_MAX_JOINT_STEP, SpinMode
-from solver.path.placements import DEFAULT_CHUNK, evaluate_placements, prepare_path
+from solver.path.placements import DEFAULT_CHUNK, evaluate_placements
+from solver.path.problem import PathProblem
 
 __all__ = ["REASONS", "CapabilityMap", "axis_length", "capability_map", "grid_axis"]
 
@@ -108,41 +106,31 @@ def grid_axis(lower: float, upper: float, step: float, *, field: str) -> np.ndar
 
 
 def capability_map(
-    robot: Robot,
-    waypoints_in_workpiece: np.ndarray,
+    problem: PathProblem,
     *,
     xs: np.ndarray,
     ys: np.ndarray,
     z: float,
     yaws: np.ndarray,
     spins: np.ndarray | None = None,
-    branch: Branch | None = None,
-    max_joint_step: float = DEFAULT_MAX_JOINT_STEP,
-    spin_mode: SpinMode = "fixed",
     chunk: int = DEFAULT_CHUNK,
     progress: Callable[[float], None] | None = None,
-    passes: Sequence[tuple[int, int]] | None = None,
     runner: TaskRunner = SERIAL,
     compiled: bool = True,
 ) -> CapabilityMap:
     """mu_path over the grid spins x yaws x ys x xs at height z (spec section 6).
 
     Args:
-        robot: an arm with a kinematics family, with its speed limits and TCP.
-        waypoints_in_workpiece: shape (N, 4, 4), T_O_i (metres).
+        problem: the robot (with a kinematics family), the path with its passes and the
+            options (the branch followed everywhere, the step bound, the spin mode).
         xs: shape (nx,), m, placement x values.
         ys: shape (ny,), m, placement y values.
         z: m, the height of every placement.
         yaws: shape (nyaw,), rad, placement yaw values.
         spins: shape (nspin,), rad, constant tool spins (cam.md section 3); default [0].
-        branch: the IK branch to follow everywhere; ``None`` is ``auto``.
-        max_joint_step: rad, > 0.
-        spin_mode: ``fixed`` or ``free`` (the tool spin rate free, cam.md section 2).
         chunk: placements computed together.
         progress: called with the fraction done (0..1] as the work goes; it may raise
             :class:`solver.core.progress.Cancelled` to stop it.
-        passes: index ranges [start, stop) of the passes of a CAM program (cam.md section
-            5); None: one pass.
         runner: where the placements' tasks run (:mod:`solver.core.parallel`); same answer on any.
         compiled: the compiled kernel where there is one; False: the numpy pipeline (the
             reference, :func:`solver.path.placements.evaluate_placements`).
@@ -150,6 +138,7 @@ def capability_map(
     Raises:
         NoAnalyticIkError, InvalidInputError, RepeatedWaypointError: as ``evaluate_path``.
     """
+    _ = problem.prepared  # the path is checked before the options
     spins = np.zeros(1) if spins is None else spins
     xs, ys, yaws, spins = (np.asarray(v, dtype=float) for v in (xs, ys, yaws, spins))
     shape = (len(spins), len(yaws), len(ys), len(xs))
@@ -165,12 +154,8 @@ def capability_map(
         axis=1,
     )
     result = evaluate_placements(
-        robot,
-        prepare_path(robot, waypoints_in_workpiece, passes=passes),
+        problem,
         placements,
-        branch=branch,
-        max_joint_step=max_joint_step,
-        spin_mode=spin_mode,
         chunk=chunk,
         progress=progress,
         runner=runner,

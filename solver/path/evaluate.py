@@ -12,7 +12,6 @@ detail on the chosen branch.
 from __future__ import annotations
 
 import dataclasses
-from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -20,19 +19,11 @@ import numpy as np
 from solver.core.codes import FEASIBLE, REASONS, Reason
 from solver.core.dtf import spin_rate_nearest_zero
 from solver.core.family import Branch
-from solver.core.robots import Robot
 from solver.core.spatial import Placement, rotation_about_z
-from solver.path.pipeline import (
-    DEFAULT_MAX_JOINT_STEP,
-    SpinMode,
-    branch_indices,
-    check_placements,
-    prepare_path,
-    require_family,
-    run_chunk,
-)
+from solver.path.pipeline import check_placements, run_chunk
+from solver.path.problem import PathProblem, SpinMode
 
-__all__ = ["Branch", "PathEvaluation", "evaluate_path", "DEFAULT_MAX_JOINT_STEP"]
+__all__ = ["Branch", "PathEvaluation", "evaluate_path"]
 
 
 @dataclass(frozen=True)
@@ -86,40 +77,25 @@ def _turned(vectors: np.ndarray, yaw: float) -> np.ndarray:
     return out
 
 
-def evaluate_path(
-    robot: Robot,
-    waypoints_in_workpiece: np.ndarray,
-    placement: Placement,
-    *,
-    branch: Branch | None = None,
-    max_joint_step: float = DEFAULT_MAX_JOINT_STEP,
-    spin_mode: SpinMode = "fixed",
-    passes: Sequence[tuple[int, int]] | None = None,
-) -> PathEvaluation:
+def evaluate_path(problem: PathProblem, placement: Placement) -> PathEvaluation:
     """mu_path of a path at a placement (spec sections 1-4).
 
     Args:
-        robot: an arm with a kinematics family (UR, OPW), with its speed limits and TCP.
-        waypoints_in_workpiece: shape (N, 4, 4), T_O_i, tool point poses in {O} (metres).
+        problem: the robot (with a kinematics family, its speed limits and TCP), the tool
+            path in {O} with its passes, and the options (branch, step bound, spin mode).
         placement: where {O} sits in {B}, and the tool spin (cam.md section 3).
-        branch: the IK branch to follow; ``None`` is ``auto``, the feasible branch with the
-            highest mu_path.
-        spin_mode: ``fixed`` (the orientations as given) or ``free`` (the tool spin rate free,
-            cam.md section 2).
-        passes: index ranges [start, stop) of the passes of a CAM program (cam.md section
-            5); None: one pass.
-        max_joint_step: rad, > 0, the largest move of any joint between neighbouring waypoints.
 
     Raises:
         NoAnalyticIkError: the robot has no kinematics family.
         InvalidInputError: a bad path, step or branch name.
         RepeatedWaypointError: two consecutive waypoints are the same pose.
     """
-    indices = branch_indices(robot, branch, max_joint_step=max_joint_step, spin_mode=spin_mode)
-    family = require_family(robot)
+    indices = problem.branches
+    family = problem.family
     cell = check_placements(placement.as_row()[None])
-    path = prepare_path(robot, waypoints_in_workpiece, passes=passes)
-    run = run_chunk(robot, path, cell, indices, max_joint_step=max_joint_step, spin_mode=spin_mode)
+    path = problem.prepared
+    run = run_chunk(problem, cell)
+    robot, spin_mode = problem.robot, problem.options.spin_mode
     pick = int(run.pick[0])
     reason = int(run.tracked.reason[pick, 0])
     infeasible = PathEvaluation(

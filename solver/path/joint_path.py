@@ -14,16 +14,16 @@ from __future__ import annotations
 
 import dataclasses
 import math
-from collections.abc import Sequence
 
 import numpy as np
 
 from solver.core.exceptions import InvalidInputError
 from solver.core.kinematics import tool_pose_in_base
-from solver.core.robots import Robot
 from solver.core.spatial import Placement, rotation_about_z
 from solver.path.evaluate import PathEvaluation
-from solver.path.pipeline import check_max_joint_step, prepare_path, require_family, turn_by_yaw
+from solver.path.limits import JointMotion, bound_by_limits
+from solver.path.pipeline import turn_by_yaw
+from solver.path.problem import PathProblem
 
 # m and rad: how far forward kinematics of a joint path sent to /v1/evaluate may be from the
 # waypoints (a path printed with 7 digits still passes).
@@ -34,23 +34,20 @@ _EDGE = 1e-12  # rad, slack on the position limits (as tracking allows)
 
 
 def check_joint_path(
-    robot: Robot,
+    problem: PathProblem,
     waypoints_in_base: np.ndarray,
     joint_path: np.ndarray,
     *,
-    max_joint_step: float,
-    segment_in_pass: np.ndarray,
     tolerance: float = POSE_TOLERANCE,
     field: str = "joint_path",
 ) -> np.ndarray:
     """The joint path as a float array, checked against the tool poses it must reach.
 
     Args:
-        robot: the arm.
+        problem: the arm, the passes (the step bound applies within a pass) and the options
+            (the largest move of a joint between neighbours of one pass).
         waypoints_in_base: shape (N, 4, 4), T_B_TCP at every waypoint (m).
         joint_path: shape (N, n), rad (m for prismatic joints).
-        max_joint_step: rad, the largest move of a joint between neighbours of one pass.
-        segment_in_pass: shape (N - 1,), where the step bound applies.
         tolerance: m and rad, the largest position and rotation error of FK(q_i).
         field: the input's name, for the errors.
 
@@ -59,6 +56,8 @@ def check_joint_path(
             a value that is not finite, a joint outside its limits, a step over the bound, or
             FK(q_i) away from waypoint i.
     """
+    robot, max_joint_step = problem.robot, problem.options.max_joint_step
+    segment_in_pass = problem.prepared.segment_in_pass
     q = np.asarray(joint_path, dtype=float)
     n_waypoints = len(waypoints_in_base)
     if q.shape != (n_waypoints, robot.dof):
@@ -104,24 +103,19 @@ def check_joint_path(
 
 
 def evaluate_joint_path(
-    robot: Robot,
-    waypoints_in_workpiece: np.ndarray,
+    problem: PathProblem,
     placement: Placement,
     joint_path: np.ndarray,
     *,
-    max_joint_step: float,
-    passes: Sequence[tuple[int, int]] | None = None,
     tolerance: float = POSE_TOLERANCE,
 ) -> PathEvaluation:
     """mu_path of a path at a placement along the given joint path (fixed spin mode).
 
     Args:
-        robot: an arm with a kinematics family.
-        waypoints_in_workpiece: shape (N, 4, 4), T_O_i (m).
+        problem: an arm with a kinematics family, the path with its passes, the step bound
+            (the options' branch and spin mode are not used: no branch is followed).
         placement: where {O} sits in {B}, and the tool spin.
         joint_path: shape (N, n), rad, the configuration at every waypoint.
-        max_joint_step: rad, > 0.
-        passes: index ranges [start, stop) of the passes of a CAM program; None: one pass.
         tolerance: m and rad, as :func:`check_joint_path`.
 
     Returns:
@@ -132,20 +126,13 @@ def evaluate_joint_path(
         InvalidInputError: a bad path or step, or a joint path that :func:`check_joint_path`
             refuses; NoAnalyticIkError: the robot has no kinematics family.
     """
-    family = require_family(robot)
-    check_max_joint_step(max_joint_step)
-    path = prepare_path(robot, waypoints_in_workpiece, passes=passes)
-    spun = np.array(waypoints_in_workpiece, dtype=float)
+    robot, family = problem.robot, problem.family
+    problem.options.check_step()
+    path = problem.prepared
+    spun = np.array(problem.waypoints, dtype=float)
     spun[:, :3, :3] = spun[:, :3, :3] @ rotation_about_z(placement.spin)
     poses = placement.transform_workpiece_to_base() @ spun
-    q = check_joint_path(
-        robot,
-        poses,
-        joint_path,
-        max_joint_step=max_joint_step,
-        segment_in_pass=path.segment_in_pass,
-        tolerance=tolerance,
-    )
+    q = check_joint_path(problem, poses, joint_path, tolerance=tolerance)
     yaw = np.array([placement.yaw])
     twist = np.concatenate(
         [turn_by_yaw(path.twist[:, :3].T, yaw), turn_by_yaw(path.twist[:, 3:].T, yaw)]
@@ -153,9 +140,7 @@ def evaluate_joint_path(
     qd_unit = family.joint_speeds_per_unit_twist(
         q.T, twist[:, 0], poses[:, :3, 3].T, qdot_max=robot.qdot_max
     )  # (n, N), the same computation as the pipeline's at the tracked joints
-    ratio = np.abs(qd_unit) / robot.qdot_max[:, None]
-    with np.errstate(divide="ignore", invalid="ignore"):
-        speed = 1.0 / ratio.max(axis=0)
+    speed, limiting, _ = bound_by_limits(problem.limits, JointMotion(q=q.T, qd_unit=qd_unit))
     u_T, u_R = _twist_directions(path.u_T, path.u_R, placement.yaw)
     infeasible = PathEvaluation(
         feasible=False,
@@ -177,7 +162,6 @@ def evaluate_joint_path(
         omega_max = np.where(
             path.pure_rotation, speed, np.where(np.isinf(path.h), 0.0, speed / path.h)
         )
-    limiting = ratio.argmax(axis=0)
     bottleneck = int(np.argmin(v_max))
     return dataclasses.replace(
         infeasible,

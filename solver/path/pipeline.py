@@ -1,10 +1,11 @@
 """The path pipeline, written once for every robot family and any dof (robots.md section 1).
 
-requirements -> IK -> tracking -> speeds -> DTF -> branch choice -> bottleneck, for a chunk of
-placements at once. :func:`solver.path.evaluate.evaluate_path` (one placement, with per-waypoint
-detail) and :func:`solver.path.placements.evaluate_placements` (the map and the optimisers) both run
-:func:`run_chunk`; only the robot's kinematics family (:mod:`solver.families.base`) knows how IK
-and J^-1 t are solved.
+requirements -> IK -> tracking -> speeds -> limits -> branch choice -> bottleneck, for a chunk
+of placements at once. :func:`solver.path.evaluate.evaluate_path` (one placement, with
+per-waypoint detail) and :func:`solver.path.placements.evaluate_placements` (the map and the
+optimisers) both run :func:`run_chunk`; only the robot's kinematics family
+(:mod:`solver.core.family`) knows how IK and J^-1 t are solved, and only the problem's limits
+(:mod:`solver.path.limits`, the DTF first) how fast each waypoint may run.
 
 What makes it fast (dtf.md section 9): t_hat is computed once in {O} and only turned by each
 placement's yaw; all placements of a chunk, all waypoints and all IK branches are one set of
@@ -13,185 +14,18 @@ component-first arrays with waypoints last.
 
 from __future__ import annotations
 
-import math
-from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Literal
 
 import numpy as np
 
 from solver.core.codes import FEASIBLE
-from solver.core.dtf import spin_rate_nearest_zero, two_variable_speed
-from solver.core.exceptions import InvalidInputError, NoAnalyticIkError, quoted
-from solver.core.family import Branch, KinematicsFamily
-from solver.core.robots import Robot
+from solver.core.dtf import spin_rate_nearest_zero
+from solver.core.exceptions import InvalidInputError
 from solver.core.spatial import MAX_COORDINATE, rotation_about_z
-from solver.core.task import TaskRequirements, task_requirements
+from solver.path.limits import JointMotion, bound_by_limits
+from solver.path.prepare import PreparedPath
+from solver.path.problem import PathProblem
 from solver.path.tracking import Tracked, choose_branch, track
-
-DEFAULT_MAX_JOINT_STEP = 0.35
-
-SpinMode = Literal["fixed", "free"]
-SPIN_MODES: tuple[SpinMode, ...] = ("fixed", "free")
-
-
-@dataclass(frozen=True)
-class PreparedPath:
-    """A path checked and reduced to what every placement needs, all in {O}.
-
-    Attributes:
-        n_waypoints: N.
-        tool_rotation: shape (N, 3, 3), R_O_i of the tool point.
-        tool_to_flange: shape (4, 4), T_TCP_F = T_F_TCP^-1.
-        flange_rotation: shape (N, 3, 3), R_O_F of the flange at each waypoint (spin 0).
-        flange_position: shape (N, 3), m (spin 0).
-        tool_position: shape (N, 3), m, the tool point.
-        u_T: shape (N, 3). u_R: shape (N, 3). h: shape (N,), m, inf for pure translation.
-        twist: shape (N, 6), t_hat in {O} axes.
-        pure_rotation: shape (N,), where h = 0 (V_max is 0 there).
-        segment_in_pass: shape (N - 1,), whether segment i (waypoint i to i + 1) lies within a
-            pass; False where a rapid joins two passes (cam.md section 5): no feed requirement
-            and no joint step bound there, and free spins restart at the next pass.
-    """
-
-    n_waypoints: int
-    tool_rotation: np.ndarray
-    tool_to_flange: np.ndarray
-    flange_rotation: np.ndarray
-    flange_position: np.ndarray
-    tool_position: np.ndarray
-    u_T: np.ndarray
-    u_R: np.ndarray
-    h: np.ndarray
-    twist: np.ndarray
-    pure_rotation: np.ndarray
-    segment_in_pass: np.ndarray
-
-
-def check_passes(
-    passes: Sequence[tuple[int, int]] | None, n_waypoints: int
-) -> list[tuple[int, int]]:
-    """The passes as index ranges [start, stop) covering 0..N in order, each of 2 points or more.
-
-    Raises:
-        InvalidInputError: on ``path.passes``, ranges that do not tile the waypoints.
-    """
-    if passes is None:
-        return [(0, n_waypoints)]
-    ranges = [(int(start), int(stop)) for start, stop in passes]
-    starts = [start for start, _ in ranges]
-    stops = [stop for _, stop in ranges]
-    if not ranges or starts[0] != 0 or stops[-1] != n_waypoints or starts[1:] != stops[:-1]:
-        raise InvalidInputError(
-            "path.passes", f"{ranges} must cover the {n_waypoints} waypoints in order"
-        )
-    short = [k for k, (start, stop) in enumerate(ranges) if stop - start < 2]
-    if short:
-        raise InvalidInputError("path.passes", f"pass {short[0]} has fewer than 2 waypoints")
-    return ranges
-
-
-def prepare_path(
-    robot: Robot,
-    waypoints_in_workpiece: np.ndarray,
-    *,
-    passes: Sequence[tuple[int, int]] | None = None,
-) -> PreparedPath:
-    """Check a path and precompute its placement-independent data.
-
-    Args:
-        robot: the arm (its TCP offset turns tool poses into flange poses).
-        waypoints_in_workpiece: shape (N, 4, 4), T_O_i (metres).
-        passes: index ranges [start, stop) of the passes (cam.md section 5), in order and
-            covering every waypoint; None: one pass. The requirements are taken per pass.
-
-    Raises:
-        InvalidInputError, RepeatedWaypointError: as :func:`solver.core.task.task_requirements`.
-    """
-    path = np.asarray(waypoints_in_workpiece, dtype=float)
-    ranges = check_passes(passes, len(path))
-    parts = [task_requirements(path[start:stop]) for start, stop in ranges]
-    requirements = TaskRequirements(  # u_T, u_R turn with the yaw, h does not
-        u_T=np.concatenate([part.u_T for part in parts]),
-        u_R=np.concatenate([part.u_R for part in parts]),
-        h=np.concatenate([part.h for part in parts]),
-    )
-    segment_in_pass = np.ones(max(len(path) - 1, 0), dtype=bool)
-    segment_in_pass[[start - 1 for start, _ in ranges[1:]]] = False
-    tool_to_flange = np.linalg.inv(robot.transform_tool_to_tcp)
-    flange = path @ tool_to_flange
-    return PreparedPath(
-        n_waypoints=len(path),
-        tool_rotation=path[:, :3, :3],
-        tool_to_flange=tool_to_flange,
-        flange_rotation=flange[:, :3, :3],
-        flange_position=flange[:, :3, 3],
-        tool_position=path[:, :3, 3],
-        u_T=requirements.u_T,
-        u_R=requirements.u_R,
-        h=requirements.h,
-        twist=requirements.twists(),
-        pure_rotation=requirements.h == 0.0,
-        segment_in_pass=segment_in_pass,
-    )
-
-
-def check_max_joint_step(max_joint_step: float) -> None:
-    """Raise InvalidInputError unless the step is finite and > 0 (rad)."""
-    if not (math.isfinite(max_joint_step) and max_joint_step > 0.0):
-        raise InvalidInputError("ik.max_joint_step", f"{max_joint_step:.6g} rad must be > 0")
-
-
-def check_spin_mode(robot: Robot, spin_mode: str) -> None:
-    """Raise InvalidInputError on ``spin_mode``: unknown, or free with no last joint to spin.
-
-    A free tool spin needs the last joint to turn the tool, so ``free`` on an arm whose last
-    joint is prismatic is refused.
-    """
-    if spin_mode not in SPIN_MODES:
-        raise InvalidInputError(
-            "spin_mode", f"unknown spin mode {quoted(str(spin_mode))}; use fixed or free"
-        )
-    last = robot.model.joints[robot.model.njoints - 1].shortname()
-    prismatic = "Prismatic" in last or last.startswith("JointModelP")
-    if spin_mode == "free" and prismatic:
-        raise InvalidInputError(
-            "spin_mode",
-            f"free spin needs a revolute last joint; {robot.joint_names[-1]!r} is prismatic",
-        )
-    if spin_mode == "free" and robot.dof != 6:
-        raise InvalidInputError(
-            "spin_mode",
-            f"free spin is solved for six-joint arms; {robot.name!r} has {robot.dof} joints",
-        )
-
-
-def require_family(robot: Robot) -> KinematicsFamily:
-    """The robot's kinematics family; NoAnalyticIkError when it has none."""
-    if robot.family is None:
-        raise NoAnalyticIkError(
-            "robot",
-            f"path evaluation needs an arm with an IK family (UR, OPW, or numeric for a serial "
-            f"chain of six joints or more); {robot.name!r} has none",
-        )
-    return robot.family
-
-
-def branch_indices(
-    robot: Robot, branch: Branch | None, *, max_joint_step: float, spin_mode: str
-) -> np.ndarray:
-    """Check a path evaluation's options and return the branches to follow (all for ``auto``).
-
-    Raises:
-        InvalidInputError: a bad spin mode, step or branch name; NoAnalyticIkError: the robot
-            has no kinematics family.
-    """
-    check_spin_mode(robot, spin_mode)
-    family = require_family(robot)
-    check_max_joint_step(max_joint_step)
-    if branch is None:
-        return np.arange(len(family.branches))
-    return np.array([family.branch_index(branch)])
 
 
 def check_placements(placements: np.ndarray) -> np.ndarray:
@@ -280,28 +114,17 @@ def flange_at_spin(path: PreparedPath, spin: float) -> tuple[np.ndarray, np.ndar
     return rotation, position
 
 
-def run_chunk(
-    robot: Robot,
-    path: PreparedPath,
-    placements: np.ndarray,
-    branches: np.ndarray,
-    *,
-    max_joint_step: float,
-    spin_mode: SpinMode = "fixed",
-) -> ChunkResult:
-    """The pipeline at C placements on the given branches.
+def run_chunk(problem: PathProblem, placements: np.ndarray) -> ChunkResult:
+    """The pipeline at C placements on the problem's branches.
 
     Args:
-        robot: an arm with a kinematics family.
-        path: from :func:`prepare_path` for the same robot.
+        problem: the robot (with a kinematics family), the path and the options, checked
+            (:attr:`PathProblem.branches` made).
         placements: shape (C, 5), [x (m), y (m), z (m), yaw (rad), spin (rad)], checked; one
             spin for the whole chunk.
-        branches: shape (B,), indices of the family's branches to follow.
-        max_joint_step: rad, > 0, checked.
-        spin_mode: ``fixed`` (the orientations as given) or ``free`` (the tool spin rate is a
-            free variable of the DTF, cam.md section 2).
     """
-    family = require_family(robot)
+    robot, path, branches = problem.robot, problem.prepared, problem.branches
+    family = problem.family
     yaws = placements[:, 3]
     if np.all(yaws == yaws[0]):  # one turn for the chunk: broadcast it (less memory to read)
         yaws = yaws[:1]
@@ -318,13 +141,13 @@ def run_chunk(
     solutions = family.solve_path(rotation, flange_position)
     q, status = solutions.q, solutions.status  # (n, B_all, C, W), (B_all, C, W)
     # In free mode the position limits hold along the spin schedule, checked there, not here.
-    free = spin_mode == "free"
+    free = problem.options.spin_mode == "free"
     tracked = track(
         q[:, branches],
         status[branches],
         lower=np.full(robot.dof, -np.inf) if free else robot.q_lower,
         upper=np.full(robot.dof, np.inf) if free else robot.q_upper,
-        max_joint_step=max_joint_step,
+        max_joint_step=problem.options.max_joint_step,
         segment_checked=path.segment_in_pass,
     )
     # For dof > 6 these are the exact DTF LP's joint speeds per unit speed (robots.md section 5),
@@ -339,20 +162,14 @@ def run_chunk(
         qd_spin = family.joint_speeds_per_unit_twist(
             tracked.q, spin[:, None], tool_position[:, None]
         )
-        speed, limiting = two_variable_speed(qd_unit, qd_spin, robot.qdot_max)
-    else:
-        ratio = np.abs(qd_unit) / robot.qdot_max.reshape((-1,) + (1,) * (qd_unit.ndim - 1))
-        limiting = ratio.argmax(axis=0)  # (B, C, W)
-        with np.errstate(divide="ignore", invalid="ignore"):  # infeasible branches
-            speed = 1.0 / ratio.max(axis=0)
+    motion = JointMotion(q=tracked.q, qd_unit=qd_unit, qd_spin=qd_spin)
+    speed, limiting, _ = bound_by_limits(problem.limits, motion)  # (B, C, W)
     v_max = np.where(path.pure_rotation, 0.0, speed)
     feasible = tracked.reason == FEASIBLE  # (B, C)
     mu_path = np.where(feasible, v_max.min(axis=-1), -np.inf)
     spins = None
     if qd_spin is not None:
-        spins, tracked = _spin_schedule(
-            robot, path, tracked, qd_unit, qd_spin, mu_path, max_joint_step=max_joint_step
-        )
+        spins, tracked = _spin_schedule(problem, tracked, qd_unit, qd_spin, mu_path)
         feasible = tracked.reason == FEASIBLE
         mu_path = np.where(feasible, mu_path, -np.inf)
     pick = choose_branch(mu_path, feasible, tracked.failed_waypoint)
@@ -372,14 +189,11 @@ def run_chunk(
 
 
 def _spin_schedule(
-    robot: Robot,
-    path: PreparedPath,
+    problem: PathProblem,
     tracked: Tracked,
     qd_unit: np.ndarray,
     qd_spin: np.ndarray,
     mu_path: np.ndarray,
-    *,
-    max_joint_step: float,
 ) -> tuple[np.ndarray, Tracked]:
     """The spins that realise mu_path in free mode, and the joint paths along them.
 
@@ -390,18 +204,17 @@ def _spin_schedule(
     again, so the last joint's limits and steps are checked along the schedule.
 
     Args:
-        robot: the arm.
-        path: the prepared path.
+        problem: the robot, the prepared path and the options.
         tracked: the branches followed at the given spin; q (n, B, C, W).
         qd_unit: shape (n, B, C, W), J^-1 t_hat.
         qd_spin: shape (n, B, C, W), J^-1 [0; z_tool].
         mu_path: shape (B, C), m/s, -inf where infeasible.
-        max_joint_step: rad.
 
     Returns:
         spins (B, C, W), rad (0 where infeasible or mu_path = 0), and the tracking of the spun
         joint paths (where the branch was feasible).
     """
+    robot, path = problem.robot, problem.prepared
     feed = np.where(np.isfinite(mu_path) & (mu_path > 0.0), mu_path, 0.0)[..., None]
     rate = spin_rate_nearest_zero(qd_unit, qd_spin, robot.qdot_max, feed)
     length = np.linalg.norm(np.diff(path.tool_position, axis=0), axis=1)  # (W - 1,)
@@ -415,7 +228,7 @@ def _spin_schedule(
         np.zeros(tracked.q.shape[1:], dtype=int),  # every pose was solved: only limits, steps
         lower=robot.q_lower,
         upper=robot.q_upper,
-        max_joint_step=max_joint_step,
+        max_joint_step=problem.options.max_joint_step,
         segment_checked=path.segment_in_pass,
     )
     keep = np.isfinite(mu_path)

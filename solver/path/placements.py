@@ -14,31 +14,14 @@ from functools import partial
 import numpy as np
 
 from solver.core.codes import FEASIBLE
-from solver.core.family import Branch
 from solver.core.malloc import raise_malloc_thresholds
 from solver.core.parallel import SERIAL, TaskRunner
-from solver.core.robots import Robot
 from solver.kernels.fixed_spin import limit_modes, map_cells
 from solver.kernels.free_spin import free_cells
-from solver.path.pipeline import (
-    DEFAULT_MAX_JOINT_STEP,
-    PreparedPath,
-    SpinMode,
-    branch_indices,
-    check_placements,
-    flange_at_spin,
-    prepare_path,
-    require_family,
-    run_chunk,
-)
+from solver.path.pipeline import check_placements, flange_at_spin, run_chunk
+from solver.path.problem import PathProblem
 
-__all__ = [
-    "PlacementEvaluator",
-    "PlacementResults",
-    "PreparedPath",
-    "evaluate_placements",
-    "prepare_path",
-]
+__all__ = ["PlacementEvaluator", "PlacementResults", "evaluate_placements"]
 
 DEFAULT_CHUNK = 32
 
@@ -68,22 +51,15 @@ class PlacementResults:
 
 
 def _chunk(
-    robot: Robot,
-    path: PreparedPath,
-    placements: np.ndarray,
-    branches: np.ndarray,
-    max_joint_step: float,
-    spin_mode: SpinMode,
-    with_speeds: bool,
+    problem: PathProblem, placements: np.ndarray, with_speeds: bool
 ) -> tuple[np.ndarray, ...]:
     """Evaluate C placements: per placement mu, reason, failed, branch, bottleneck, V_max.
 
     V_max along the path is (C, W) when ``with_speeds``, else (C, 0): a map of millions of
     placements keeps nothing per waypoint.
     """
-    run = run_chunk(
-        robot, path, placements, branches, max_joint_step=max_joint_step, spin_mode=spin_mode
-    )
+    run = run_chunk(problem, placements)
+    branches = problem.branches
     pick, columns = run.pick, np.arange(len(placements))
     any_feasible = (run.tracked.reason == FEASIBLE).any(axis=0)
     chosen_v = np.where(any_feasible[:, None], run.v_max[pick, columns], np.nan)  # (C, W)
@@ -101,7 +77,7 @@ def _chunk(
 
 @dataclass(frozen=True)
 class _KernelInputs:
-    """What the compiled kernel takes of a robot and a path at one spin, made once per spin."""
+    """What the compiled kernel takes of a problem at one spin, made once per spin."""
 
     code: int
     parameters: np.ndarray
@@ -118,12 +94,16 @@ class _KernelInputs:
     modes: np.ndarray
     arc: np.ndarray
     qdot_max: np.ndarray
+    branches: np.ndarray  # the branches followed
+    max_joint_step: float
+    free_spin: bool
 
 
 def _kernel_inputs(
-    robot: Robot, path: PreparedPath, spin: float, kernel: tuple[int, np.ndarray]
+    problem: PathProblem, spin: float, kernel: tuple[int, np.ndarray]
 ) -> _KernelInputs:
-    """The kernel's inputs of ``robot`` and ``path`` at ``spin``, as contiguous arrays."""
+    """The kernel's inputs of the problem's robot and path at ``spin``, as contiguous arrays."""
+    robot, path = problem.robot, problem.prepared
     rotation, position = flange_at_spin(path, spin)
     modes, arc = limit_modes(robot.q_lower, robot.q_upper)
     contiguous = np.ascontiguousarray
@@ -143,16 +123,14 @@ def _kernel_inputs(
         modes=modes,
         arc=arc,
         qdot_max=contiguous(robot.qdot_max, dtype=float),
+        branches=contiguous(problem.branches, dtype=np.int64),
+        max_joint_step=float(problem.options.max_joint_step),
+        free_spin=problem.options.spin_mode == "free",
     )
 
 
 def _run_kernel(
-    inputs: _KernelInputs,
-    placements: np.ndarray,
-    branches: np.ndarray,
-    max_joint_step: float,
-    spin_mode: SpinMode,
-    with_speeds: bool,
+    inputs: _KernelInputs, placements: np.ndarray, with_speeds: bool
 ) -> tuple[np.ndarray, ...]:
     """The columns of :func:`_chunk` by the compiled kernel, at placements of one spin."""
     n_cells, n_waypoints = len(placements), inputs.rotation.shape[0]
@@ -170,8 +148,8 @@ def _run_kernel(
         inputs.tool_position,
         inputs.twist,
     )
-    followed = np.ascontiguousarray(branches, dtype=np.int64)
-    if spin_mode == "free":
+    followed = inputs.branches
+    if inputs.free_spin:
         free_cells(
             *placed,
             inputs.tool_axis,
@@ -182,7 +160,7 @@ def _run_kernel(
             inputs.lower,
             inputs.upper,
             inputs.qdot_max,
-            float(max_joint_step),
+            inputs.max_joint_step,
             mu,
             *codes,
             v_max,
@@ -198,7 +176,7 @@ def _run_kernel(
             inputs.modes,
             inputs.arc,
             inputs.qdot_max,
-            float(max_joint_step),
+            inputs.max_joint_step,
             mu,
             *codes,
             v_max,
@@ -206,17 +184,13 @@ def _run_kernel(
     return (mu, *codes, v_max)
 
 
-def _kernel_of(robot: Robot) -> tuple[int, np.ndarray] | None:
+def _kernel_of(problem: PathProblem) -> tuple[int, np.ndarray] | None:
     """The compiled pose kernel of the robot's family, where it has one (either spin mode)."""
-    return require_family(robot).map_kernel()
+    return problem.family.map_kernel()
 
 
 def _task(
-    robot: Robot,
-    path: PreparedPath,
-    branches: np.ndarray,
-    max_joint_step: float,
-    spin_mode: SpinMode,
+    problem: PathProblem,
     with_speeds: bool,
     chunk: int,
     compiled: bool,
@@ -230,22 +204,17 @@ def _task(
     (a Dask worker), so it sets the malloc thresholds itself.
     """
     raise_malloc_thresholds()
-    kernel = _kernel_of(robot) if compiled else None
+    kernel = _kernel_of(problem) if compiled else None
     if kernel is not None:
         inputs: dict[float, _KernelInputs] = {}  # made once per spin, not once per chunk
         parts = []
         for rows in _pieces(placements, chunk):
             spin = float(rows[0, 4])
             if spin not in inputs:
-                inputs[spin] = _kernel_inputs(robot, path, spin, kernel)
-            parts.append(
-                _run_kernel(inputs[spin], rows, branches, max_joint_step, spin_mode, with_speeds)
-            )
+                inputs[spin] = _kernel_inputs(problem, spin, kernel)
+            parts.append(_run_kernel(inputs[spin], rows, with_speeds))
     else:
-        parts = [
-            _chunk(robot, path, rows, branches, max_joint_step, spin_mode, with_speeds)
-            for rows in _pieces(placements, chunk)
-        ]
+        parts = [_chunk(problem, rows, with_speeds) for rows in _pieces(placements, chunk)]
     return tuple(np.concatenate(c) for c in zip(*parts, strict=True))
 
 
@@ -266,13 +235,9 @@ def _pieces(placements: np.ndarray, size: int) -> list[np.ndarray]:
 
 
 def evaluate_placements(
-    robot: Robot,
-    path: PreparedPath,
+    problem: PathProblem,
     placements: np.ndarray,
     *,
-    branch: Branch | None = None,
-    max_joint_step: float = DEFAULT_MAX_JOINT_STEP,
-    spin_mode: SpinMode = "fixed",
     with_speeds: bool = False,
     chunk: int = DEFAULT_CHUNK,
     progress: Callable[[float], None] | None = None,
@@ -282,14 +247,10 @@ def evaluate_placements(
     """mu_path of a path at each of P placements.
 
     Args:
-        robot: an arm with a kinematics family, with its speed limits and TCP.
-        path: from :func:`prepare_path` for the same robot.
+        problem: the robot (with a kinematics family), the path and the options (the branch
+            followed everywhere, the step bound, the spin mode).
         placements: shape (P, 5), [x (m), y (m), z (m), yaw (rad), spin (rad)] of {O} in {B}
             (:meth:`solver.core.spatial.Placement.as_row`); (P, 4) is taken with spin 0.
-        branch: the IK branch to follow everywhere; ``None`` is ``auto``.
-        spin_mode: ``fixed`` (the orientations as given) or ``free`` (the tool spin rate free,
-            cam.md section 2).
-        max_joint_step: rad, > 0.
         with_speeds: also return V_max at every waypoint.
         chunk: placements computed together.
         progress: called with the fraction done (0..1] as tasks complete; it may raise
@@ -301,7 +262,7 @@ def evaluate_placements(
     Raises:
         NoAnalyticIkError, InvalidInputError: as :func:`solver.path.evaluate.evaluate_path`.
     """
-    branches = branch_indices(robot, branch, max_joint_step=max_joint_step, spin_mode=spin_mode)
+    _ = problem.branches  # the options checked before any work
     cells = check_placements(placements)
     raise_malloc_thresholds()
     tasks = _pieces(cells, runner.task_size(len(cells), chunk))
@@ -312,11 +273,10 @@ def evaluate_placements(
         if progress is not None:
             progress(completed[0] / len(cells))
 
-    work = partial(
-        _task, robot, path, branches, max_joint_step, spin_mode, with_speeds, chunk, compiled
-    )
+    work = partial(_task, problem, with_speeds, chunk, compiled)
     parts = runner.run(work, tasks, done)
-    empty = (np.zeros(0), *(np.zeros(0, dtype=int),) * 5, np.zeros((0, path.n_waypoints)))
+    n_waypoints = problem.prepared.n_waypoints
+    empty = (np.zeros(0), *(np.zeros(0, dtype=int),) * 5, np.zeros((0, n_waypoints)))
     columns = [np.concatenate(c) for c in zip(*parts, strict=True)] if parts else list(empty)
     mu, reason, failed, chosen, bottleneck_waypoint, bottleneck_joint, v_max = columns
     return PlacementResults(
@@ -340,42 +300,24 @@ class PlacementEvaluator:
     optimisation, and that preparation cost twice the kernel's own time.
     """
 
-    def __init__(
-        self,
-        robot: Robot,
-        path: PreparedPath,
-        *,
-        max_joint_step: float = DEFAULT_MAX_JOINT_STEP,
-        spin_mode: SpinMode = "fixed",
-    ) -> None:
-        """An evaluator of ``path`` on ``robot``, on the ``auto`` branch.
+    def __init__(self, problem: PathProblem) -> None:
+        """An evaluator of the problem's path on its robot, on the ``auto`` branch.
 
         Raises:
             NoAnalyticIkError, InvalidInputError: as :func:`evaluate_placements`.
         """
-        self._robot, self._path = robot, path
-        self._max_joint_step, self._spin_mode = max_joint_step, spin_mode
-        self._branches = branch_indices(
-            robot, None, max_joint_step=max_joint_step, spin_mode=spin_mode
-        )
-        self._kernel = _kernel_of(robot)
+        self._problem = problem.with_options(branch=None)
+        _ = self._problem.branches  # the options checked first
+        self._kernel = _kernel_of(self._problem)
         self._last: tuple[float, _KernelInputs] | None = None  # the spin asked for last
 
     def __call__(self, placements: np.ndarray) -> PlacementResults:
         """mu_path at P placements, shape (P, 5) as :func:`evaluate_placements` takes them."""
         cells = check_placements(placements)
         if self._kernel is None or np.any(cells[:, 4] != cells[0, 4]):
-            return evaluate_placements(
-                self._robot,
-                self._path,
-                cells,
-                max_joint_step=self._max_joint_step,
-                spin_mode=self._spin_mode,
-            )
+            return evaluate_placements(self._problem, cells)
         spin = float(cells[0, 4])
         if self._last is None or self._last[0] != spin:
-            self._last = (spin, _kernel_inputs(self._robot, self._path, spin, self._kernel))
-        mu, reason, failed, chosen, waypoint, joint, _ = _run_kernel(
-            self._last[1], cells, self._branches, self._max_joint_step, self._spin_mode, False
-        )
+            self._last = (spin, _kernel_inputs(self._problem, spin, self._kernel))
+        mu, reason, failed, chosen, waypoint, joint, _ = _run_kernel(self._last[1], cells, False)
         return PlacementResults(mu, reason, failed, chosen, waypoint, joint)

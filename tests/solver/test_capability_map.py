@@ -13,9 +13,9 @@ from solver.core.exceptions import InvalidInputError
 from solver.core.family import Branch
 from solver.families import get_robot
 from solver.families.ur.ik import BRANCHES
-from solver.path.capability_map import capability_map, grid_axis
-from solver.path.evaluate import evaluate_path
+from solver.path.capability_map import grid_axis
 from tests.cases import MAP_EVALUATE_RTOL
+from tests.problems import capability_map, evaluate_path
 from tests.solver.test_evaluate import load_path, wrist_singular_path
 
 

@@ -17,8 +17,9 @@ from solver.core.robots import example_robot_data_dir
 from solver.core.spatial import Placement, pose_matrix, wrap_angle
 from solver.families import get_robot, robot_from_urdf
 from solver.families.ur.ik import BRANCHES
-from solver.path.evaluate import Branch, evaluate_path
+from solver.path.evaluate import Branch
 from tests.cases import EXAMPLES, TWO_PI
+from tests.problems import evaluate_path
 
 PLACEMENT = Placement(0.0, 0.45, 0.1, 0.0)
 

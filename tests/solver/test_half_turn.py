@@ -11,11 +11,9 @@ from scipy.spatial.transform import Rotation
 from solver.core.exceptions import InvalidInputError
 from solver.core.task import task_requirements
 from solver.families import get_robot
-from solver.optimise.optimize import optimize_placement
 from solver.optimise.search_space import PlacementBounds
-from solver.path.capability_map import capability_map
-from solver.path.evaluate import evaluate_path
 from tests.cases import MAP_EVALUATE_RTOL
+from tests.problems import capability_map, evaluate_path, optimize_placement
 
 
 def two_waypoints(turn: float) -> np.ndarray:

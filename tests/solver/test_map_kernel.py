@@ -22,7 +22,8 @@ from solver.core.kinematics import tool_pose_in_base
 from solver.core.robots import Robot
 from solver.families import get_robot
 from solver.families.opw.kernel import kernel_parameters
-from solver.path.placements import PlacementResults, evaluate_placements, prepare_path
+from solver.path.placements import PlacementResults
+from tests.problems import evaluate_placements, prepare_path
 from tests.solver.families.test_opw import build
 from tests.solver.test_evaluate import load_path, wrist_singular_path
 from tests.solver.test_parallel import grid_placements

@@ -11,7 +11,7 @@ import pytest
 from solver.core.parallel import SERIAL, ThreadRunner, tasks_of
 from solver.core.progress import Cancelled
 from solver.families import get_robot
-from solver.path.placements import evaluate_placements, prepare_path
+from tests.problems import evaluate_placements, prepare_path
 from tests.solver.test_evaluate import load_path
 
 

@@ -36,14 +36,17 @@ import casadi
 import numpy as np
 
 from solver.core.progress import Cancelled, Progress
-from solver.core.robots import Robot
 from solver.optimise.methods.casadi_kinematics import symbolic_kinematics
-from solver.optimise.search_space import PlacementBounds
-from solver.path.pipeline import PreparedPath
+from solver.optimise.search_space import N_VARIABLES, PlacementBounds, variables_of
+from solver.path.prepare import PreparedPath
+from solver.path.problem import PathProblem
 
 # Margins (rad) kept from the joint limits and the step bound, so that a solution on them
 # passes the evaluator's strict tests.
 _MARGIN = 1e-9
+
+# The decision vector and s lead the NLP's variables.
+_HEAD = N_VARIABLES + 1
 
 # casadi's bundled stubs reject valid SX/MX expressions (DM + SX, MX in nlpsol): untyped here.
 ca: Any = casadi
@@ -96,7 +99,7 @@ class _IterationHook(ca.Callback):  # type: ignore[misc]
 
 @dataclass(frozen=True)
 class NlpResult:
-    """One IPOPT solve: the decision vector [x, y, yaw, spin, z], s, IPOPT's status, iterations.
+    """One IPOPT solve: the decision vector, s, IPOPT's status, iterations.
 
     ``spins`` (N,), rad, each waypoint's spin on top of the placement's, with a spin path.
     ``joint_path`` (N, n), rad, the q_i of the solution (for dof > 6 it also chose the
@@ -118,13 +121,9 @@ class PlacementNlp:
 
     def __init__(
         self,
-        robot: Robot,
-        path: PreparedPath,
-        tool_rotation: np.ndarray,
+        problem: PathProblem,
         bounds: PlacementBounds,
         *,
-        max_joint_step: float,
-        free_spin: bool = False,
         max_spin_step: float | None = None,
         ipopt_options: dict[str, object] | None = None,
         derivatives: bool = True,
@@ -132,13 +131,11 @@ class PlacementNlp:
         """Build the problem.
 
         Args:
-            robot: the arm.
-            path: the prepared path (tool positions and t_hat in {O}).
-            tool_rotation: shape (N, 3, 3), R_O_i of the tool point at every waypoint.
-            bounds: the placement box (the decision vector x, y, yaw, spin, z).
-            max_joint_step: rad, the evaluator's bound on a joint's move between waypoints.
-            free_spin: the tool spin rate about the tool z axis is a free variable per waypoint
-                (cam.md section 2, the evaluator's ``free`` spin mode).
+            problem: the arm, the path (its tool positions, orientations and t_hat in {O})
+                and the options: the evaluator's bound on a joint's move between waypoints,
+                and the spin mode (``free``: the tool spin rate about the tool z axis is a free
+                variable per waypoint, cam.md section 2).
+            bounds: the placement box (the decision vector).
             max_spin_step: rad, > 0: a spin per waypoint with steps at most this (cam.md
                 section 4); None keeps the spin constant.
             ipopt_options: IPOPT options over the defaults (``{"max_iter": 100}``).
@@ -150,41 +147,18 @@ class PlacementNlp:
         0.05 s, where inlining every waypoint in SX took 0.6 s to build (and 2x less per solve);
         the map runs on NLP_THREADS threads.
         """
+        robot, path = problem.robot, problem.prepared
+        tool_rotation = problem.waypoints[:, :3, :3]  # R_O_i of the tool point
+        free_spin = problem.options.spin_mode == "free"
         n, dof = path.n_waypoints, robot.dof
-        kinematics = symbolic_kinematics(robot)
-        # One waypoint's 12 residuals as an SX function, mapped over the waypoints.
-        q, qdot = ca.SX.sym("q", dof), ca.SX.sym("qdot", dof)
-        where, speed_1, spin_1 = ca.SX.sym("placement", 5), ca.SX.sym("s"), ca.SX.sym("sigma")
-        phi_1, twist_1 = ca.SX.sym("phi"), ca.SX.sym("twist", 6)  # waypoint spin, t_hat in {O}
-        data = ca.SX.sym("waypoint", 3 + 9)  # p_O, R_O (column-major)
-        c, s = ca.cos(where[2]), ca.sin(where[2])
-        turn = ca.vertcat(ca.horzcat(c, -s, 0), ca.horzcat(s, c, 0), ca.horzcat(0, 0, 1))
-        position, rotation, jacobian = kinematics(q)
-        target_rotation = turn @ ca.reshape(data[3:12], 3, 3) @ _turn_z(where[3] + phi_1)
-        error = target_rotation.T @ rotation
-        spin_twist = ca.vertcat(ca.DM.zeros(3), turn @ data[9:12])  # tool z (column 3 of R_O)
-        residual = ca.Function(
-            "waypoint_residual",
-            [q, qdot, where, speed_1, spin_1, phi_1, twist_1, data],
-            [
-                ca.vertcat(
-                    position - (turn @ data[:3] + ca.vertcat(where[0], where[1], where[4])),
-                    error[2, 1] - error[1, 2],
-                    error[0, 2] - error[2, 0],
-                    error[1, 0] - error[0, 1],
-                    jacobian @ qdot
-                    - speed_1 * ca.vertcat(turn @ twist_1[:3], turn @ twist_1[3:])
-                    - spin_1 * spin_twist,
-                )
-            ],
-        )
+        residual = _waypoint_residual(symbolic_kinematics(robot), dof)
         waypoint_data = np.column_stack(
             [
                 path.tool_position,
                 tool_rotation.transpose(0, 2, 1).reshape(n, 9),  # column-major R_O
             ]
         ).T
-        placement = ca.MX.sym("placement", 5)  # x, y, yaw, spin, z
+        placement = ca.MX.sym("placement", N_VARIABLES)  # the decision vector
         speed = ca.MX.sym("s")
         joints = ca.MX.sym("q", dof, n)
         joint_speeds = ca.MX.sym("qdot", dof, n)
@@ -220,7 +194,8 @@ class PlacementNlp:
         self._n_equalities = int(equalities.numel())
         self._n_steps = int(steps.numel())
         self._dof, self._n = dof, n
-        self._robot, self._bounds, self._step = robot, bounds, max_joint_step
+        self._robot, self._bounds = robot, bounds
+        self._step = problem.options.max_joint_step
         options = {
             "print_time": False,
             "ipopt.print_level": 0,
@@ -267,7 +242,7 @@ class PlacementNlp:
         """Solve from a feasible start.
 
         Args:
-            start: the start's decision vector [x, y, yaw, spin, z] (m, m, rad, rad, m).
+            start: the start's decision vector (:mod:`solver.optimise.search_space`).
             start_speed: its mu_path (m/s), the initial s.
             q_path: shape (N, n), rad, the start's joint path on the branch to follow.
             qdot_path: shape (N, n), rad/s, joint speeds there at feed rate ``start_speed``
@@ -324,15 +299,52 @@ class PlacementNlp:
         stats = self._solver.stats()
         x = np.asarray(solution["x"]).ravel()
         return NlpResult(
-            vector=x[:5].copy(),
-            speed=float(x[5]),
+            vector=x[:N_VARIABLES].copy(),
+            speed=float(x[N_VARIABLES]),
             spins=x[len(x) - self._n_spins :].copy() if self._n_spins else None,
-            joint_path=x[6 : 6 + n * self._dof].reshape(n, self._dof).copy(),
+            joint_path=x[_HEAD : _HEAD + n * self._dof].reshape(n, self._dof).copy(),
             status=str(stats["return_status"]),
             success=bool(stats["success"]),
             iterations=int(stats["iter_count"]),
             seconds=seconds,
         )
+
+
+def _waypoint_residual(kinematics: Any, dof: int) -> Any:
+    """One waypoint's 12 residuals as an SX function (mapped over the waypoints by the NLP).
+
+    Its arguments: q, qdot, the decision vector, s, the spin rate sigma, the waypoint's spin
+    phi, t_hat in {O} and the waypoint's data (p_O, R_O column-major); its residuals: the tool
+    point's position, its orientation (the skew part of R_target^T R) and J qdot - s t - sigma
+    [0; z_tool], all in {B}.
+    """
+    q, qdot = ca.SX.sym("q", dof), ca.SX.sym("qdot", dof)
+    where = ca.SX.sym("placement", N_VARIABLES)  # the decision vector
+    speed_1, spin_1 = ca.SX.sym("s"), ca.SX.sym("sigma")
+    phi_1, twist_1 = ca.SX.sym("phi"), ca.SX.sym("twist", 6)  # waypoint spin, t_hat in {O}
+    data = ca.SX.sym("waypoint", 3 + 9)  # p_O, R_O (column-major)
+    named = variables_of(where)
+    c, s = ca.cos(named.yaw), ca.sin(named.yaw)
+    turn = ca.vertcat(ca.horzcat(c, -s, 0), ca.horzcat(s, c, 0), ca.horzcat(0, 0, 1))
+    position, rotation, jacobian = kinematics(q)
+    target_rotation = turn @ ca.reshape(data[3:12], 3, 3) @ _turn_z(named.spin + phi_1)
+    error = target_rotation.T @ rotation
+    spin_twist = ca.vertcat(ca.DM.zeros(3), turn @ data[9:12])  # tool z (column 3 of R_O)
+    return ca.Function(
+        "waypoint_residual",
+        [q, qdot, where, speed_1, spin_1, phi_1, twist_1, data],
+        [
+            ca.vertcat(
+                position - (turn @ data[:3] + ca.vertcat(named.x, named.y, named.z)),
+                error[2, 1] - error[1, 2],
+                error[0, 2] - error[2, 0],
+                error[1, 0] - error[0, 1],
+                jacobian @ qdot
+                - speed_1 * ca.vertcat(turn @ twist_1[:3], turn @ twist_1[3:])
+                - spin_1 * spin_twist,
+            )
+        ],
+    )
 
 
 def _inside(bound: float) -> float:
@@ -394,7 +406,7 @@ def _spun_twists(path: PreparedPath, tool_rotation: np.ndarray, spins: ca.MX) ->
 class _Layout:
     """Where a waypoint's variables sit in the decision vector (see PlacementNlp).
 
-    The vector is [placement (5), s, q_0 .. q_{N-1}, qdot_0 .. qdot_{N-1}, (sigma_0 ..
+    The vector is [placement (N_VARIABLES), s, q_0 .. q_{N-1}, qdot_0 .. qdot_{N-1}, (sigma_0 ..
     sigma_{N-1}), (phi_0 .. phi_{N-1})]; waypoint i's own variables are the placement, s, q_i,
     qdot_i, sigma_i in free spin, and with a spin path the spins phi_a, phi_b of the segment
     whose twist it takes (a, b = i, i + 1; the last waypoint takes the last segment's).
@@ -407,15 +419,15 @@ class _Layout:
 
     def local_size(self) -> int:
         """Variables of one waypoint."""
-        return 6 + 2 * self.dof + int(self.free_spin) + 2 * int(self.spin_path)
+        return _HEAD + 2 * self.dof + int(self.free_spin) + 2 * int(self.spin_path)
 
     def indices(self) -> np.ndarray:
         """(N, local_size): the decision vector's index of each waypoint's variables."""
         dof, n = self.dof, self.n
         i = np.arange(n)[:, None]
-        joints = 6 + i * dof + np.arange(dof)
-        columns = [np.tile(np.arange(6), (n, 1)), joints, joints + n * dof]
-        after = 6 + 2 * n * dof
+        joints = _HEAD + i * dof + np.arange(dof)
+        columns = [np.tile(np.arange(_HEAD), (n, 1)), joints, joints + n * dof]
+        after = _HEAD + 2 * n * dof
         if self.free_spin:
             columns.append(after + i)
             after += n
@@ -423,6 +435,34 @@ class _Layout:
             first = np.minimum(i, n - 2)  # the segment a waypoint takes
             columns += [after + first, after + first + 1]
         return np.hstack(columns)
+
+
+def _waypoints_data(
+    path: PreparedPath, tool_rotation: np.ndarray, waypoint_data: np.ndarray, layout: _Layout
+) -> np.ndarray:
+    """Each waypoint's data for its derivatives, shape (len(data), N).
+
+    p_O and R_O, then its twist; or, with a spin path, its segment's two rotations, u_T,
+    length, and whether it is the last waypoint.
+    """
+    n = layout.n
+    if layout.spin_path:
+        columns = tool_rotation.transpose(0, 2, 1).reshape(n, 9)  # column-major R_O
+        first = np.minimum(np.arange(n), n - 2)
+        lengths = np.linalg.norm(np.diff(path.tool_position, axis=0), axis=1)
+        extra = np.column_stack(
+            [
+                columns[first],
+                columns[first + 1],
+                path.u_T[first],
+                lengths[first],
+                (np.arange(n) == n - 1).astype(float),
+            ]
+        )
+    else:
+        extra = path.twist
+    data: np.ndarray = np.vstack([waypoint_data, extra.T])
+    return data
 
 
 def _derivatives(
@@ -451,9 +491,9 @@ def _derivatives(
     """
     dof, n, m = layout.dof, layout.n, layout.local_size()
     local = ca.SX.sym("local", m)
-    where, speed = local[:5], local[5]
-    q, qdot = local[6 : 6 + dof], local[6 + dof : 6 + 2 * dof]
-    rest = 6 + 2 * dof
+    where, speed = local[:N_VARIABLES], local[N_VARIABLES]
+    q, qdot = local[_HEAD : _HEAD + dof], local[_HEAD + dof : _HEAD + 2 * dof]
+    rest = _HEAD + 2 * dof
     rate = local[rest] if layout.free_spin else 0
     rest += int(layout.free_spin)
     data = ca.SX.sym("data", 12 + (23 if layout.spin_path else 6))
@@ -477,23 +517,7 @@ def _derivatives(
         "waypoint_hessian", [local, data, weights], [ca.vertcat(*hessian.nonzeros())]
     ).map(n, "thread", NLP_THREADS)
 
-    # Each waypoint's data and local variables.
-    if layout.spin_path:
-        columns = tool_rotation.transpose(0, 2, 1).reshape(n, 9)  # column-major R_O
-        first = np.minimum(np.arange(n), n - 2)
-        lengths = np.linalg.norm(np.diff(path.tool_position, axis=0), axis=1)
-        extra = np.column_stack(
-            [
-                columns[first],
-                columns[first + 1],
-                path.u_T[first],
-                lengths[first],
-                (np.arange(n) == n - 1).astype(float),
-            ]
-        )
-    else:
-        extra = path.twist
-    data_all = np.vstack([waypoint_data, extra.T])  # (len(data), N)
+    data_all = _waypoints_data(path, tool_rotation, waypoint_data, layout)
     index = layout.indices()  # (N, m)
     x = ca.MX.sym("x", variables.numel())
     p = ca.MX.sym("p", 0)

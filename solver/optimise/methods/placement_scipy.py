@@ -24,10 +24,9 @@ import scipy.optimize
 from solver.core.family import Branch
 from solver.core.parallel import SERIAL, TaskRunner
 from solver.core.progress import Progress
-from solver.core.robots import Robot
-from solver.optimise.search_space import PlacementBounds
-from solver.path.pipeline import PreparedPath, SpinMode
+from solver.optimise.search_space import PlacementBounds, variables_of
 from solver.path.placements import evaluate_placements
+from solver.path.problem import PathProblem
 
 SEED = 0  # differential evolution is seeded: same input, same output
 POLISH_ITERATIONS = 200  # SLSQP iterations at most from one start
@@ -103,7 +102,7 @@ def search_placements(bounds: PlacementBounds, size: SearchSize = FULL_SEARCH) -
 
 
 def _full(bounds: PlacementBounds, free_values: np.ndarray) -> np.ndarray:
-    """Decision vectors (P, 5) from the free variables' values (P, F); the rest fixed."""
+    """Decision vectors (P, N_VARIABLES) from the free variables' values (P, F); the rest fixed."""
     vectors = np.tile(bounds.lower, (len(free_values), 1))
     vectors[:, bounds.free] = free_values
     return vectors
@@ -111,7 +110,7 @@ def _full(bounds: PlacementBounds, free_values: np.ndarray) -> np.ndarray:
 
 def _basin_coordinates(vectors: np.ndarray, symmetric: bool) -> tuple[np.ndarray, np.ndarray]:
     """Coordinates in which basins are BASIN_GAP apart, and their scale (angles as cos, sin)."""
-    x, y, yaw, spin, z = vectors.T
+    x, y, yaw, spin, z = variables_of(vectors.T)
     angles = [np.cos(spin), np.sin(spin)]
     if symmetric:
         psi = yaw - np.arctan2(y, x)
@@ -124,13 +123,10 @@ def _basin_coordinates(vectors: np.ndarray, symmetric: bool) -> tuple[np.ndarray
 
 
 def global_search(
-    robot: Robot,
-    path: PreparedPath,
+    problem: PathProblem,
     bounds: PlacementBounds,
     *,
-    max_joint_step: float,
     symmetric: bool,
-    spin_mode: SpinMode = "fixed",
     size: SearchSize = FULL_SEARCH,
     progress: Progress | None = None,
     runner: TaskRunner = SERIAL,
@@ -148,14 +144,7 @@ def global_search(
 
     def objective(points: np.ndarray) -> np.ndarray:  # points: (F, S)
         vectors = _full(bounds, points.T)
-        result = evaluate_placements(
-            robot,
-            path,
-            bounds.rows(vectors),
-            max_joint_step=max_joint_step,
-            spin_mode=spin_mode,
-            runner=runner,
-        )
+        result = evaluate_placements(problem, bounds.rows(vectors), runner=runner)
         seen.append((vectors, result.mu_path, result.branch))
         if progress is not None:
             progress(len(seen) / (size.generations + 1))
@@ -197,15 +186,12 @@ def global_search(
 
 
 def polish(
-    robot: Robot,
-    path: PreparedPath,
+    problem: PathProblem,
     bounds: PlacementBounds,
     start: np.ndarray,
     start_speed: float,
     branch: Branch,
     *,
-    max_joint_step: float,
-    spin_mode: SpinMode = "fixed",
     size: SearchSize = FULL_SEARCH,
     progress: Progress | None = None,
 ) -> tuple[np.ndarray, str, int]:
@@ -219,19 +205,14 @@ def polish(
     steps = np.eye(n_free) * DIFFERENCE_STEP
     offsets = np.vstack([np.zeros(n_free), steps, -steps])
     cache: dict[tuple[float, ...], np.ndarray] = {}
+    on_branch = problem.with_options(branch=branch)
 
     def speeds(v: np.ndarray) -> np.ndarray:
         """V_max per waypoint at v and at v +- steps: (1 + 2F, N), NaN where infeasible."""
         key = tuple(v[:n_free])
         if key not in cache:
             result = evaluate_placements(
-                robot,
-                path,
-                bounds.rows(_full(bounds, v[:n_free] + offsets)),
-                branch=branch,
-                max_joint_step=max_joint_step,
-                spin_mode=spin_mode,
-                with_speeds=True,
+                on_branch, bounds.rows(_full(bounds, v[:n_free] + offsets)), with_speeds=True
             )
             if result.v_max is None:  # not reached: asked for with_speeds
                 raise RuntimeError("evaluate_placements returned no speeds")

@@ -10,8 +10,8 @@ from solver.core.dtf_redundant import redundant_speed
 from solver.core.kinematics import jacobian_in_base
 from solver.core.spatial import Placement
 from solver.families import get_robot
-from solver.path.evaluate import evaluate_path
 from tests.cases import DTF_LP_RTOL
+from tests.problems import evaluate_path
 from tests.solver.test_evaluate import load_path
 
 

@@ -15,8 +15,8 @@ from solver.families import get_robot, robot_from_urdf
 from solver.families.numeric.family import NumericFamily, seed_count
 from solver.families.numeric.ik import rotation_log
 from solver.families.ur.catalogue import _exact_right_angles
-from solver.path.evaluate import evaluate_path
 from tests.cases import FK_IK_ATOL, NUMERIC_MODELS
+from tests.problems import evaluate_path
 from tests.solver.test_evaluate import load_path
 
 

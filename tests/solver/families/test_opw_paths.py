@@ -13,16 +13,15 @@ from solver.core.family import Branch
 from solver.core.kinematics import jacobian_in_base
 from solver.core.spatial import Placement
 from solver.families import get_robot
-from solver.optimise.optimize import optimize_placement
 from solver.optimise.search_space import PlacementBounds, vector_of
-from solver.path.capability_map import capability_map, grid_axis
-from solver.path.evaluate import evaluate_path
+from solver.path.capability_map import grid_axis
 from tests.cases import (
     DTF_LP_RTOL,
     MAP_EVALUATE_RTOL,
     OPTIMUM_EVALUATE_RTOL,
     OPTIMUM_METHODS_RTOL,
 )
+from tests.problems import capability_map, evaluate_path, optimize_placement
 from tests.solver.test_evaluate import load_path
 from tests.solver.test_optimize import best_coarse_cell
 
