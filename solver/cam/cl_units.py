@@ -12,14 +12,13 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Literal
 
 from solver.cam.cam_path import METRES_PER_UNIT, Units
 from solver.cam.cl_records import Record
+from solver.cam.read_report import UnitsSource
 from solver.cam.reading import parse_number
 from solver.exceptions import InvalidInputError, InvalidLineError
 
-UnitsSource = Literal["stated", "inferred", "request"]
 UNIT_WORDS: dict[str, Units] = {"MM": "mm", "INCHES": "inches", "INCH": "inches"}
 FEED_UNIT_WORDS: dict[str, Units] = {"MMPM": "mm", "IPM": "inches"}
 
@@ -87,7 +86,7 @@ def units_of(
         return UnitsReading(
             "inches",
             "inferred",
-            f"no UNITS record; FEDRAT/IPM (inches per minute) at line {inch_feed.line}",
+            f"no UNITS record; a feed in inches per minute, FEDRAT/IPM at line {inch_feed.line}",
         )
     raise InvalidInputError(units_field, _no_units_message(feeds, field))
 

@@ -3,6 +3,10 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Literal
+
+UnitsSource = Literal["stated", "inferred", "request"]
+"""How a file's length unit was known (solver.cam.cl_units)."""
 
 
 @dataclass(frozen=True)
@@ -37,7 +41,7 @@ class ReadReport:
     """
 
     skipped_records: tuple[SkippedRecord, ...]
-    units_source: str
+    units_source: UnitsSource
     units_note: str
     repeated_points: int
     arcs: int

@@ -6,10 +6,19 @@ from typing import Annotated
 
 from fastapi import APIRouter, Request, Response
 
+from service import convert
 from service.body import body_in_thread, body_openapi
+from service.config import Settings
+from service.deps import SettingsDep
 from service.errors import ERROR_RESPONSES
 from service.schemas.path import PathInput
-from service.schemas.paths_import import ImportedPose, PathImportRequest, PathImportResponse
+from service.schemas.paths_import import (
+    ImportedPose,
+    PassOut,
+    PathImportRequest,
+    PathImportResponse,
+    SkippedRecordOut,
+)
 from service.work import json_response, run_stoppable
 from solver.cam.frames import quaternion_wxyz
 
@@ -24,10 +33,24 @@ router = APIRouter(prefix="/paths", tags=["paths"], responses=ERROR_RESPONSES)
     openapi_extra=body_openapi(PathImportRequest),
 )
 async def post_import(
-    request: Request, body: Annotated[PathImportRequest, body_in_thread(PathImportRequest)]
+    request: Request,
+    body: Annotated[PathImportRequest, body_in_thread(PathImportRequest)],
+    settings: SettingsDep,
 ) -> Response:
-    """Read a path without computing anything, so a user can look at it first."""
-    return await run_stoppable(request, lambda _: json_response(imported(body.path.to_solver())))
+    """Read a path without computing anything, so a user can look at it first.
+
+    The waypoints shown are the ones every route counts against DTF_MAX_PATH_WAYPOINTS: a path
+    this accepts, /v1/evaluate and /v1/map accept too (cam.md section 9).
+    """
+    return await run_stoppable(request, lambda _: json_response(import_of(body, settings)))
+
+
+def import_of(body: PathImportRequest, settings: Settings) -> PathImportResponse:
+    """The answer of ``POST /v1/paths/import``, the path's size checked as every route does."""
+    convert.check_path_size(
+        body.path, limit=settings.max_path_waypoints, setting="DTF_MAX_PATH_WAYPOINTS"
+    )
+    return imported(convert.path_of(body.path))
 
 
 def imported(path: PathInput) -> PathImportResponse:
@@ -37,6 +60,8 @@ def imported(path: PathInput) -> PathImportResponse:
         w, x, y, z = quaternion_wxyz(pose[:3, :3])
         waypoints.append(ImportedPose(position=pose[:3, 3].tolist(), orientation=[x, y, z, w]))
     passes = path.passes or ((0, len(path.poses)),)
+    operations = path.pass_operations or (None,) * len(passes)
+    report = path.report
     return PathImportResponse(
         waypoints=waypoints,
         passes=[[start, stop] for start, stop in passes],
@@ -44,4 +69,23 @@ def imported(path: PathInput) -> PathImportResponse:
         units=path.units,
         correction=path.axis_correction,
         spin_mode=path.default_spin_mode,
+        units_source=path.units_source,
+        units_note=path.units_note,
+        pass_details=[
+            PassOut(start=start, stop=stop, operation=operation, feed=feed)
+            for (start, stop), operation, feed in zip(
+                passes, operations, path.pass_feeds or (path.feed,) * len(passes), strict=True
+            )
+        ],
+        skipped_records=[]
+        if report is None
+        else [
+            SkippedRecordOut(
+                word=s.word, count=s.count, first_line=s.first_line, recognised=s.recognised
+            )
+            for s in report.skipped_records
+        ],
+        repeated_points=0 if report is None else report.repeated_points,
+        one_point_passes=path.one_point_passes,
+        arcs=0 if report is None else report.arcs,
     )
