@@ -20,7 +20,7 @@ from service.schemas.paths_import import (
     SkippedRecordOut,
 )
 from service.work import json_response, run_stoppable
-from solver.cam.frames import quaternion_wxyz
+from solver.cam.frames import quaternions_wxyz
 
 router = APIRouter(prefix="/paths", tags=["paths"], responses=ERROR_RESPONSES)
 
@@ -55,10 +55,11 @@ def import_of(body: PathImportRequest, settings: Settings) -> PathImportResponse
 
 def imported(path: PathInput) -> PathImportResponse:
     """The import answer of a parsed path."""
-    waypoints = []
-    for pose in path.poses:
-        w, x, y, z = quaternion_wxyz(pose[:3, :3])
-        waypoints.append(ImportedPose(position=pose[:3, 3].tolist(), orientation=[x, y, z, w]))
+    quaternions = quaternions_wxyz(path.poses[:, :3, :3])[:, [1, 2, 3, 0]].tolist()
+    waypoints = [
+        ImportedPose.model_construct(position=position, orientation=orientation)
+        for position, orientation in zip(path.poses[:, :3, 3].tolist(), quaternions, strict=True)
+    ]
     passes = path.passes or ((0, len(path.poses)),)
     operations = path.pass_operations or (None,) * len(passes)
     report = path.report
