@@ -87,6 +87,15 @@ def map_of(
     return convert.map_response(result, robot, spin_mode=spin_mode)
 
 
+def map_with_picture(
+    body: MapRequest, settings: Settings, progress: Progress
+) -> tuple[MapResponse, bytes]:
+    """The JSON answer of ``POST /v1/map`` and the picture of ``POST /v1/map/png``, one map."""
+    result, robot, spin_mode = _computed_map(body, settings, png=True, progress=progress)
+    picture = render_png(result, title=f"{robot.name}: mu_path")
+    return convert.map_response(result, robot, spin_mode=spin_mode), picture
+
+
 def _picture(result: CapabilityMap, name: str) -> Response:
     """The PNG answer."""
     return Response(render_png(result, title=f"{name}: mu_path"), media_type="image/png")
