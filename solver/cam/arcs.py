@@ -35,6 +35,8 @@ RADIUS_MISMATCH_ABSOLUTE = 1e-5
 """m."""
 MAX_STEP = math.pi / 2
 """rad: the largest angle between two points of an arc."""
+MAX_ARC_POINTS = 1_000_000
+"""Points one arc may become (more than any route takes): an arc needing more is refused."""
 
 
 def arc_points(
@@ -91,6 +93,14 @@ def arc_points(
     )
     r_most = max(r_start, r_end)
     step = MAX_STEP if tolerance >= r_most else 2.0 * math.acos(1.0 - tolerance / r_most)
+    if not abs(angle) < MAX_ARC_POINTS * min(step, MAX_STEP):
+        raise InvalidLineError(
+            field,
+            f"the arc ({abs(angle):.6g} rad, radius {r_most:.6g} m) needs more than "
+            f"{MAX_ARC_POINTS} points within {tolerance:.3g} m",
+            line=line,
+            text=text,
+        )
     count = max(1, math.ceil(abs(angle) / min(step, MAX_STEP)))
     t = np.arange(1, count + 1) / count
     phi, r = angle * t, r_start + (r_end - r_start) * t

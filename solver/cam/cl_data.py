@@ -72,8 +72,8 @@ def read_cl_data(
         InvalidInputError: no cutting move; no units (on ``units_field``); too many waypoints.
         InvalidLineError: a record that cannot be read or is not applied, naming its line.
     """
-    if not arc_tolerance > 0.0:
-        raise InvalidInputError("path.arc_tolerance", f"{arc_tolerance!r} must be > 0")
+    if not 0.0 < arc_tolerance < float("inf"):
+        raise InvalidInputError("path.arc_tolerance", f"{arc_tolerance!r} must be > 0, finite")
     all_records = list(records(text, field=field))
     if any(r.word == "GOTO" for r in all_records):
         reading = units_of(all_records, requested=units, field=field, units_field=units_field)

@@ -283,6 +283,12 @@ class ClReader:
             text=circle.record.text,
         )
         fractions = np.arange(1, len(points)) / len(points)
+        if float(circle.start_axis @ axis) <= 0.0:
+            raise self.error(
+                "the tool axis turns by a right angle or more along the arc; the reader "
+                "blends it only across smaller turns",
+                circle.record,
+            )
         for t, point in zip(fractions, points[:-1], strict=True):
             blend = (1.0 - t) * circle.start_axis + t * axis
             self.cut(point, blend / np.linalg.norm(blend), circle.record.line)
