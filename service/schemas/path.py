@@ -14,7 +14,7 @@ import numpy as np
 from pydantic import ConfigDict, Discriminator, Field, PrivateAttr, Tag
 
 from service.schemas.common import Pose, RequestModel, SpinMode, ToolAxisWaypoint
-from solver.cam.cam_path import CamPath
+from solver.cam.cam_path import CamPath, Units
 from solver.cam.cl_data import DEFAULT_ARC_TOLERANCE, read_cl_data
 from solver.cam.csv_path import read_csv_path
 from solver.cam.read_report import ReadReport, UnitsSource
@@ -178,7 +178,7 @@ MAX_CAM_TEXT = 2_000_000
 """Characters of CL data or CSV at most (a request body is at most 2 MB anyway)."""
 
 
-CL_UNITS = {"mm": "mm", "inch": "inches"}
+CL_UNITS: dict[str, Units] = {"mm": "mm", "inch": "inches"}
 
 
 class ClDataPath(RequestModel):
@@ -237,7 +237,7 @@ class ClDataPath(RequestModel):
         if self._read is None:
             self._read = read_cl_data(
                 self.cl_data,
-                units=None if self.units is None else CL_UNITS[self.units],  # type: ignore[arg-type]
+                units=None if self.units is None else CL_UNITS[self.units],
                 arc_tolerance=self.arc_tolerance,
                 max_waypoints=MAX_PATH_WAYPOINTS,
                 field="path.cl_data",

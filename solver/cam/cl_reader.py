@@ -212,6 +212,8 @@ class ClReader:
         if len(args) not in (3, 6) or not all(is_number(a) for a in args):
             self.skip(record, recognised=True)
             return
+        if self.circle is not None:
+            raise self.error("FROM comes between a CIRCLE and its end", record)
         values = self.numbers(args, record)
         if len(args) == 6:
             self.local_axis = self.unit_axis(values[3:], record)
@@ -234,6 +236,10 @@ class ClReader:
             raise self.error(f"CIRCLE needs xc, yc, zc, i, j, k[, r, ...]; got {len(args)}", record)
         if self.position is None or self.axis is None or self.circle is not None:
             raise self.error("CIRCLE needs a tool position (a GOTO) before it", record)
+        if self.rapid:
+            raise self.error(
+                "CIRCLE after RAPID: the reader does not interpolate rapid arcs", record
+            )
         values = self.numbers(args, record)
         self.circle = Circle(
             record=record,

@@ -205,3 +205,24 @@ def test_the_waypoint_limit_counts_interpolated_points() -> None:
     assert read_cl_data(text, max_waypoints=n).n_waypoints == n
     with pytest.raises(InvalidInputError, match=f"more than {n - 1} waypoints"):
         read_cl_data(text, max_waypoints=n - 1)
+
+
+@pytest.mark.parametrize(
+    ("records", "line", "words"),
+    [
+        (["RAPID", "CIRCLE/0,0,0,0,0,1", "GOTO/-10,0,0"], 5, "rapid arcs"),
+        (["CIRCLE/0,0,0,0,0,1", "FROM/5,5,5", "GOTO/-10,0,0"], 5, "between a CIRCLE"),
+        (["CIRCLE/0,0,0,0,0,1", "RAPID", "GOTO/-10,0,0"], 5, "between a CIRCLE"),
+        (["CIRCLE/0,0,0,0,0,1", "LOADTL/2", "GOTO/-10,0,0"], 5, "between a CIRCLE"),
+        (["CIRCLE/0,0,0,0,0,1"], 4, "not followed by the GOTO of its end"),
+        (["CIRCLE/0,0,0,0,0,1,3", "GOTO/-10,0,0"], 4, "stated radius"),
+        (["CIRCLE/0,0,0,0,0,1,10,TIMES,2", "GOTO/-10,0,0"], 4, "NX files only"),
+    ],
+)
+def test_arcs_that_cannot_be_followed_name_their_line(
+    records: list[str], line: int, words: str
+) -> None:
+    program = ["UNITS/MM", "GOTO/0,-10,0", "GOTO/10,0,0", *records]
+    with pytest.raises(InvalidLineError, match=words) as caught:
+        read_cl_data("\n".join(program))
+    assert caught.value.line == line
