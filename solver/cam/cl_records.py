@@ -78,6 +78,7 @@ SKIPPED = frozenset(
         "TLDATA",
         "TOLER",
         "TOOLNO",
+        "TPRINT",
     }
 )
 """Words without geometry or feed. ``CUTCOM``: CL points are cutter locations already (the

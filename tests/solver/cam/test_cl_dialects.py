@@ -226,3 +226,51 @@ def test_arcs_that_cannot_be_followed_name_their_line(
     with pytest.raises(InvalidLineError, match=words) as caught:
         read_cl_data("\n".join(program))
     assert caught.value.line == line
+
+
+CATIA = [
+    "$$ -----------------------------------------------------------------",
+    "$$*CATIA0",
+    "$$ Manufacturing Program.1",
+    "PARTNO PART TO BE MILLED",  # 4
+    "$$ OPERATION NAME : Sweeping.1",
+    "MULTAX",
+    "TOOLNO/1,MILL,10.000000,0.000000,50.000000,0.000000",
+    "TPRINT/T1 End Mill D 10,MILL,10.000000",  # 8
+    "LOADTL/1,1",
+    "SPINDL/  70.0000,RPM,CLW",
+    "INTOL  /   0.0100",
+    "OUTTOL /   0.0100",
+    "AUTOPS",
+    "RAPID",
+    "GOTO  /   0.00000,   0.00000, 100.00000, 0.000000, 0.000000, 1.000000",
+    "FEDRAT/  1000.0000,MMPM",
+    "GOTO  /   0.00000,   0.00000,   0.00000, 0.000000, 0.000000, 1.000000",  # 17
+    "GOTO  /  50.00000,   0.00000,   0.00000, 0.000000, 0.600000, 0.800000",
+    "GOTO  /  50.00000,  20.00000,   0.00000",
+    "END",
+    "FINI",
+]
+
+
+def test_catia_program_with_blanks_before_the_slash_reads_with_the_request_units() -> None:
+    path = read_cl_data("\n".join(CATIA), units="mm")
+    np.testing.assert_allclose(path.positions / MM, [[0, 0, 0], [50, 0, 0], [50, 20, 0]])
+    np.testing.assert_allclose(path.axes, [[0, 0, 1], [0, 0.6, 0.8], [0, 0.6, 0.8]])
+    assert path.pass_operations == ("PART TO BE MILLED",)
+    assert path.lines.tolist() == [17, 18, 19]
+    report = path.report
+    assert report is not None
+    assert {s.word: (s.count, s.first_line) for s in report.skipped_records} == {
+        "$$": (4, 1),
+        "TOOLNO": (1, 7),
+        "TPRINT": (1, 8),
+        "SPINDL": (1, 10),
+        "INTOL": (1, 11),
+        "OUTTOL": (1, 12),
+        "AUTOPS": (1, 13),
+        "END": (1, 20),
+        "FINI": (1, 21),
+    }
+    with pytest.raises(InvalidInputError, match="FEDRAT/MMPM at line 16"):
+        read_cl_data("\n".join(CATIA))
