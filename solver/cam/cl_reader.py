@@ -16,6 +16,7 @@ from solver.cam.cl_units import feed_of, stated_units
 from solver.cam.read_report import SkippedRecord
 from solver.cam.reading import checked_position, is_number, near_unit_vector, parse_numbers
 from solver.exceptions import InvalidInputError, InvalidLineError
+from solver.spatial import MAX_COORDINATE
 from solver.task import ANGULAR_TOLERANCE, LINEAR_TOLERANCE
 
 TOOL_CHANGE = frozenset({"LOADTL", "LOAD"})
@@ -199,12 +200,16 @@ class ClReader:
                 f"{self.lines[-1]}); the reader follows a change only between passes",
                 record,
             )
-        self.system = system
+        self.system = PART if system.same_as(PART) else system
 
     def to_part(self, values: np.ndarray, record: Record) -> np.ndarray:
         """A point written in the current system, in the part frame (m), checked."""
-        point = self.system.origin * self.scale + self.system.rotation @ (values * self.scale)
-        return checked_position(point, field=self.field, line=record.line, text=record.text)
+        point = values * self.scale
+        if self.system is not PART:
+            point = self.system.origin * self.scale + self.system.rotation @ point
+        if max(abs(point[0]), abs(point[1]), abs(point[2])) > MAX_COORDINATE:
+            checked_position(point, field=self.field, line=record.line, text=record.text)
+        return point
 
     def read_from(self, record: Record) -> None:
         """``FROM/x, y, z[, i, j, k]``: where the tool starts; free text is skipped."""
@@ -288,26 +293,25 @@ class ClReader:
             line=circle.record.line,
             text=circle.record.text,
         )
-        fractions = np.arange(1, len(points)) / len(points)
         if float(circle.start_axis @ axis) <= 0.0:
             raise self.error(
                 "the tool axis turns by a right angle or more along the arc; the reader "
                 "blends it only across smaller turns",
                 circle.record,
             )
-        for t, point in zip(fractions, points[:-1], strict=True):
-            blend = (1.0 - t) * circle.start_axis + t * axis
-            self.cut(point, blend / np.linalg.norm(blend), circle.record.line)
+        t = (np.arange(1, len(points)) / len(points))[:, None]
+        blends = (1.0 - t) * circle.start_axis + t * axis
+        blends /= np.linalg.norm(blends, axis=1)[:, None]
+        for point, blend in zip(points[:-1], blends, strict=True):
+            self.cut(point, blend, circle.record.line)
 
     def cut(self, position: np.ndarray, axis: np.ndarray, line: int) -> None:
         """A cutting point: dropped and counted where it repeats the tool's position."""
-        if (
-            self.in_pass()
-            and float(np.linalg.norm(position - self.positions[-1])) < LINEAR_TOLERANCE
-            and float(np.linalg.norm(axis - self.axes[-1])) < ANGULAR_TOLERANCE
-        ):
-            self.repeated += 1
-            return
+        if self.in_pass():
+            moved, turned = position - self.positions[-1], axis - self.axes[-1]
+            if moved @ moved < LINEAR_TOLERANCE**2 and turned @ turned < ANGULAR_TOLERANCE**2:
+                self.repeated += 1
+                return
         if self.max_waypoints is not None and len(self.positions) >= self.max_waypoints:
             raise InvalidInputError(
                 "path",
