@@ -65,6 +65,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     except SolverError as error:
         where = ".".join(str(part) for part in solver_error_location(error)[1:])
         print(f"error: {where}: {error.message}", file=sys.stderr)  # noqa: T201
+    except json.JSONDecodeError as error:
+        print(f"error: robot: the file is not JSON ({error})", file=sys.stderr)  # noqa: T201
     except OSError as error:
         print(f"error: {error}", file=sys.stderr)  # noqa: T201
     return INVALID

@@ -153,6 +153,15 @@ def test_invalid_input_names_the_field_and_exits_invalid(
     assert code == INVALID and err.startswith("error: path.cl_data: line 3: ")
 
 
+def test_a_robot_file_that_is_not_json_exits_invalid(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    file = tmp_path / "robot.json"
+    file.write_text("{model: ur5")
+    code, _, err = run(capsys, "evaluate", str(PROGRAM), "--robot", str(file), "--at=0,0.3,0,0")
+    assert code == INVALID and err.startswith("error: robot: the file is not JSON")
+
+
 def test_usage_errors_exit_usage(capsys: pytest.CaptureFixture[str]) -> None:
     with pytest.raises(SystemExit) as caught:
         main(["evaluate", str(PROGRAM), "--robot", "ur5e", "--at", "1,2"])
