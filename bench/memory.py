@@ -28,16 +28,18 @@ def peak_mib():
     except OSError:
         pass
     return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
-from solver.capability_map import capability_map
+from solver.path.capability_map import capability_map
+from solver.path.problem import PathProblem
 from service.schemas import EvaluateRequest
 request = EvaluateRequest.model_validate(json.load(open(sys.argv[1])))
 robot, path = request.robot.to_solver(), request.path.to_solver().poses
-capability_map(robot, path, xs=np.zeros(1), ys=np.full(1, 0.45), z=0.1, yaws=np.zeros(1))
+problem = PathProblem.of(robot, path)
+capability_map(problem, xs=np.zeros(1), ys=np.full(1, 0.45), z=0.1, yaws=np.zeros(1))
 before = peak_mib()
 cells = int(sys.argv[2])
 side = int(np.ceil(np.sqrt(cells)))
 xs, ys = np.linspace(-0.6, 0.6, side), np.linspace(-0.6, 0.6, side)
-capability_map(robot, path, xs=xs, ys=ys, z=0.1, yaws=np.zeros(1))
+capability_map(PathProblem.of(robot, path), xs=xs, ys=ys, z=0.1, yaws=np.zeros(1))
 after = peak_mib()
 print(side * side, len(path), before, after)
 """

@@ -20,9 +20,10 @@ import numpy as np
 from service.config import Settings
 from service.jobs.store import JobStore
 from service.jobs.worker import run_job
-from solver.capability_map import capability_map
-from solver.parallel import SERIAL, ThreadRunner
-from solver.robots import Robot
+from solver.core.parallel import SERIAL, ThreadRunner
+from solver.core.robots import Robot
+from solver.path.capability_map import capability_map
+from solver.path.problem import PathProblem
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -35,7 +36,7 @@ def threads(robot: Robot, path: np.ndarray, xs: np.ndarray, ys: np.ndarray, z: f
         best = math.inf
         for _ in range(3):
             began = time.perf_counter()
-            capability_map(robot, path, xs=xs, ys=ys, z=z, yaws=yaws, runner=runner)
+            capability_map(PathProblem.of(robot, path), xs=xs, ys=ys, z=z, yaws=yaws, runner=runner)
             best = min(best, time.perf_counter() - began)
         times[name] = best
     print(

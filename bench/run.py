@@ -34,14 +34,16 @@ import numpy as np
 import parallel
 import ur_analytic_ik
 
-from solver.capability_map import capability_map, grid_axis
-from solver.kinematics import jacobian_in_base
-from solver.optimize import optimize_placement
-from solver.parallel import SERIAL, ThreadRunner
-from solver.robots import Robot, example_robot_data_dir, get_robot, robot_from_urdf
-from solver.search_space import PlacementBounds
-from solver.spatial import Placement, pose_matrix
-from solver.task import task_requirements
+from solver.core.kinematics import jacobian_in_base
+from solver.core.parallel import SERIAL, ThreadRunner
+from solver.core.robots import Robot, example_robot_data_dir
+from solver.core.spatial import Placement, pose_matrix
+from solver.core.task import task_requirements
+from solver.families import get_robot, robot_from_urdf
+from solver.optimise.optimize import optimize_placement
+from solver.optimise.search_space import PlacementBounds
+from solver.path.capability_map import capability_map, grid_axis
+from solver.path.problem import PathOptions, PathProblem
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -98,12 +100,12 @@ def main() -> None:
     pose_branches = cells * len(path) * 8
 
     def one_yaw() -> object:
-        return capability_map(robot, path, xs=xs, ys=ys, z=z, yaws=np.array([0.0]))
+        return capability_map(PathProblem.of(robot, path), xs=xs, ys=ys, z=z, yaws=np.array([0.0]))
 
     yaws8 = np.linspace(0.0, 2 * math.pi, 8, endpoint=False)
 
     def eight_yaws() -> object:
-        return capability_map(robot, path, xs=xs, ys=ys, z=z, yaws=yaws8)
+        return capability_map(PathProblem.of(robot, path), xs=xs, ys=ys, z=z, yaws=yaws8)
 
     kr6 = get_robot("kuka_kr6_r700_sixx")
     opw_xs = grid_axis(0.2, 0.6, 0.02, field="x") if not args.smoke else xs + 0.4
@@ -111,16 +113,22 @@ def main() -> None:
 
     def opw_map(compiled: bool = True) -> object:
         return capability_map(
-            kr6, path, xs=opw_xs, ys=opw_ys, z=z, yaws=np.array([0.0]), compiled=compiled
+            PathProblem.of(kr6, path),
+            xs=opw_xs,
+            ys=opw_ys,
+            z=z,
+            yaws=np.array([0.0]),
+            compiled=compiled,
         )
 
     def numpy_map() -> object:
-        return capability_map(robot, path, xs=xs, ys=ys, z=z, yaws=np.zeros(1), compiled=False)
+        return capability_map(
+            PathProblem.of(robot, path), xs=xs, ys=ys, z=z, yaws=np.zeros(1), compiled=False
+        )
 
     def free_spin(compiled: bool = True) -> object:
-        return capability_map(
-            robot, path, xs=xs, ys=ys, z=z, yaws=np.zeros(1), spin_mode="free", compiled=compiled
-        )
+        free = PathProblem.of(robot, path, PathOptions(spin_mode="free"))
+        return capability_map(free, xs=xs, ys=ys, z=z, yaws=np.zeros(1), compiled=compiled)
 
     one_yaw()  # warm up (imports, first allocations)
     t_map = best_time(one_yaw, repeats)
@@ -267,11 +275,13 @@ def numeric_maps(path: np.ndarray, xs: np.ndarray, ys: np.ndarray, z: float, t_m
         "UR5 as a URDF": robot_from_urdf(urdf, base_frame="base", tool_frame="tool0"),
         "Panda": get_robot("panda"),
     }
-    reference = capability_map(analytic, path, xs=xs, ys=ys, z=z, yaws=np.zeros(1)).mu_path
+    reference = capability_map(
+        PathProblem.of(analytic, path), xs=xs, ys=ys, z=z, yaws=np.zeros(1)
+    ).mu_path
     print(f"numeric IK maps ({len(xs) * len(ys)} placements, one run each):")
     for label, arm in arms.items():
         start = time.perf_counter()
-        cmap = capability_map(arm, path, xs=xs, ys=ys, z=z, yaws=np.zeros(1))
+        cmap = capability_map(PathProblem.of(arm, path), xs=xs, ys=ys, z=z, yaws=np.zeros(1))
         seconds = time.perf_counter() - start
         line = f"  {label:14s} {seconds:8.3f} s   {seconds / t_map:6.0f}x the analytic UR5 map"
         if arm.dof == 6:
@@ -302,7 +312,7 @@ def optimisation(robot: Robot, path: np.ndarray, *, smoke: bool) -> None:
             for _ in range(repeats):  # the best of a few, as for the maps
                 start = time.perf_counter()
                 optimum = optimize_placement(
-                    robot, path, bounds=bounds, method=method, runner=runner
+                    PathProblem.of(robot, path), bounds=bounds, method=method, runner=runner
                 )
                 times.append(time.perf_counter() - start)
             seconds[threads] = min(times)
@@ -324,8 +334,7 @@ def optimisation(robot: Robot, path: np.ndarray, *, smoke: bool) -> None:
     yaws = np.arange(bounds.yaw[0], bounds.yaw[1] - 1e-9, yaw_step)
     start = time.perf_counter()
     grid = capability_map(
-        robot,
-        path,
+        PathProblem.of(robot, path),
         xs=grid_axis(*bounds.x, step, field="x"),
         ys=grid_axis(*bounds.y, step, field="y"),
         z=bounds.z,

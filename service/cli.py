@@ -2,7 +2,8 @@
 
 CAM systems call programs, not web services. Each subcommand builds the request body the API
 takes, validates it with the same schemas (from JSON, as the service parses a body) and calls
-the same route helpers, so ``--json`` prints exactly what the route answers:
+the same use cases as the routes (:mod:`service.operations`), so ``--json`` prints exactly what
+the route answers:
 
 - ``import PROGRAM``: what ``POST /v1/paths/import`` reads;
 - ``evaluate PROGRAM --robot R --at X,Y,Z,YAW``: mu_path and the feed check at a placement;
@@ -29,16 +30,14 @@ from typing import Any, TypeVar
 
 from pydantic import BaseModel, ValidationError
 
-from service.api.routes.evaluate import evaluation_of
-from service.api.routes.map import map_with_picture
-from service.api.routes.optimize import optimum_of
-from service.api.routes.paths import import_of
+from service import convert
 from service.cli_text import ProgressBar, evaluation_text, import_text, map_text, optimum_text
 from service.config import get_settings
 from service.errors import solver_error_location
+from service.operations import computed_map, evaluation_of, import_of, map_png, optimum_of
 from service.schemas import EvaluateRequest, MapRequest, OptimizeRequest
 from service.schemas.paths_import import PathImportRequest
-from solver.exceptions import SolverError
+from solver.core.exceptions import SolverError
 
 OK = 0
 """The answer was printed (and the path runs, for evaluate, map and optimise)."""
@@ -137,8 +136,9 @@ def _map(args: argparse.Namespace) -> int:
         body["spin_mode"] = args.spin_mode
     request = _validated(MapRequest, body)
     with ProgressBar(enabled=args.progress) as bar:
-        answer, picture = map_with_picture(request, get_settings(), bar)
-    Path(args.png).write_bytes(picture)
+        result, robot, spin_mode = computed_map(request, get_settings(), png=True, progress=bar)
+    answer = convert.map_response(result, robot, spin_mode=spin_mode)
+    Path(args.png).write_bytes(map_png(result, robot))
     _print(answer, args, lambda: map_text(answer, args.png))
     return OK if answer.feasible_cells else INFEASIBLE
 

@@ -7,8 +7,8 @@ from typing import Annotated
 from fastapi import Depends
 
 from service.config import Settings, get_settings
+from solver.core.robots import Robot
 from solver.families import catalogue
-from solver.robots import Robot
 
 
 async def _settings() -> Settings:

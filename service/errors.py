@@ -20,8 +20,8 @@ from starlette.types import ASGIApp, Message, Receive, Scope, Send
 
 from service.config import get_settings
 from service.schemas import ErrorDetail, ErrorResponse
-from solver.exceptions import SolverError
-from solver.progress import Cancelled
+from solver.core.exceptions import SolverError
+from solver.core.progress import Cancelled
 
 
 def _error_type(error: SolverError) -> str:

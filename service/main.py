@@ -35,15 +35,18 @@ from service.errors import (
     solver_error_handler,
 )
 from service.jobs.runner import close_runners, get_runner
-from service.metrics import instrument, log_to_stderr
+from service.logs import log_to_stderr
+from service.metrics import instrument
 from service.web import mount_page
 from service.work import STOPPING
-from solver import free_spin_kernel, map_kernel
-from solver.evaluate import evaluate_path
-from solver.exceptions import SolverError
+from solver.core.exceptions import SolverError
+from solver.core.progress import Cancelled
+from solver.core.spatial import Placement
 from solver.families import catalogue
-from solver.progress import Cancelled
-from solver.spatial import Placement
+from solver.kernels import fixed_spin as map_kernel
+from solver.kernels import free_spin as free_spin_kernel
+from solver.path.evaluate import evaluate_path
+from solver.path.problem import PathProblem
 
 GIL_SWITCH_SECONDS = 0.001
 DESCRIPTION = """\
@@ -109,7 +112,7 @@ def _warm_up() -> None:
     robot = catalogue()["ur5"]
     waypoints = np.repeat(np.eye(4)[None], 2, axis=0)
     waypoints[1, 0, 3] = 0.01
-    evaluate_path(robot, waypoints, Placement(0.0, 0.45, 0.1, 0.0))
+    evaluate_path(PathProblem.of(robot, waypoints), Placement(0.0, 0.45, 0.1, 0.0))
 
 
 def _stop_work_on(signum: signal.Signals) -> None:
@@ -149,7 +152,7 @@ def create_app() -> FastAPI:
     app.include_router(api_router)
     mount_page(app)
     app.add_middleware(BodySizeLimitMiddleware)
-    instrument(app)
+    instrument(app, job_store=lambda: get_runner(get_settings()).store)
     return app
 
 

@@ -7,8 +7,8 @@ run in other processes), and the placements its synchronous maps computed.
 
 from __future__ import annotations
 
-import logging
-from collections.abc import Iterable
+from collections.abc import Callable, Iterable
+from typing import Protocol
 
 from fastapi import FastAPI
 from fastapi.responses import PlainTextResponse
@@ -18,27 +18,26 @@ from prometheus_client.registry import Collector
 from prometheus_fastapi_instrumentator import Instrumentator
 
 PLACEMENTS = Counter("dtf_placements", "Placements computed by /v1/map (synchronous maps).")
-log = logging.getLogger("dtf.jobs")
 
 
-def log_to_stderr() -> None:
-    """Send the service's own log lines (``dtf.*``, INFO and up) to stderr, once."""
-    logger = logging.getLogger("dtf")
-    if not logger.handlers:
-        handler = logging.StreamHandler()
-        handler.setFormatter(logging.Formatter("%(asctime)s %(name)s %(message)s"))
-        logger.addHandler(handler)
-        logger.setLevel(logging.INFO)
+class JobStatistics(Protocol):
+    """What the collector reads from the job store (:class:`service.jobs.store.JobStore`)."""
+
+    def statistics(self) -> tuple[dict[str, int], list[float]]:
+        """Jobs by status, and the durations of finished jobs (s)."""
+        ...
 
 
 class _JobCollector(Collector):
     """Jobs by status and finished jobs' durations, read from the store at each scrape."""
 
-    def collect(self) -> Iterable[GaugeMetricFamily | SummaryMetricFamily]:
-        from service.config import get_settings
-        from service.jobs.runner import get_runner
+    def __init__(self, store: Callable[[], JobStatistics]) -> None:
+        """Read the store that ``store()`` gives at each scrape (opened on first use)."""
+        self.store = store
 
-        store = get_runner(get_settings()).store
+    def collect(self) -> Iterable[GaugeMetricFamily | SummaryMetricFamily]:
+        """The two job metrics."""
+        store = self.store()
         by_status = GaugeMetricFamily("dtf_jobs", "Jobs by status.", labels=["status"])
         counts, durations = store.statistics()
         for status in ("queued", "running", "done", "failed", "cancelled"):
@@ -49,8 +48,13 @@ class _JobCollector(Collector):
         yield summary
 
 
-def instrument(app: FastAPI) -> None:
-    """Count and time every request per route, and answer ``GET /metrics``."""
+def instrument(app: FastAPI, *, job_store: Callable[[], JobStatistics]) -> None:
+    """Count and time every request per route, and answer ``GET /metrics``.
+
+    Args:
+        app: the application.
+        job_store: gives the job store to read at each scrape (the service's runner's).
+    """
     Instrumentator(excluded_handlers=["/metrics"]).instrument(app)
 
     @app.get(
@@ -66,4 +70,4 @@ def instrument(app: FastAPI) -> None:
         return PlainTextResponse(generate_latest(REGISTRY), media_type=CONTENT_TYPE_LATEST)
 
     if not any(isinstance(c, _JobCollector) for c in getattr(REGISTRY, "_collector_to_names", {})):
-        REGISTRY.register(_JobCollector())
+        REGISTRY.register(_JobCollector(job_store))

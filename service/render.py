@@ -14,9 +14,9 @@ import numpy as np  # noqa: E402
 from matplotlib.lines import Line2D  # noqa: E402
 from matplotlib.patches import Patch  # noqa: E402
 
-from solver.capability_map import CapabilityMap  # noqa: E402
-from solver.evaluate import PathEvaluation  # noqa: E402
-from solver.feed import FeedCheck  # noqa: E402
+from solver.path.capability_map import CapabilityMap  # noqa: E402
+from solver.path.evaluate import PathEvaluation  # noqa: E402
+from solver.path.feed import FeedCheck  # noqa: E402
 
 PANEL_INCHES = (4.0, 3.6)
 COLOUR_BAR_INCHES = 1.2

@@ -3,7 +3,7 @@
 A route hands its work to :func:`run_stoppable`: the work runs in a worker thread with a
 progress callback, while the request's task watches the connection. When the client
 disconnects, or the request task is cancelled (uvicorn's graceful-shutdown timeout on SIGTERM),
-the callback raises :class:`solver.progress.Cancelled` at the work's next report (after a chunk
+the callback raises :class:`solver.core.progress.Cancelled` at the work's next report (after a chunk
 of placements, a DE generation or an IPOPT iteration), so no thread keeps computing for nobody.
 """
 
@@ -20,7 +20,7 @@ import anyio
 from fastapi import Request, Response
 from pydantic import BaseModel
 
-from solver.progress import Cancelled, Progress
+from solver.core.progress import Cancelled, Progress
 
 T = TypeVar("T")
 WATCH_SECONDS = 0.1

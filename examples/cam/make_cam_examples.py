@@ -130,7 +130,7 @@ def three_axis_program() -> str:
 
 def main() -> None:
     """Write every example file."""
-    from solver.tool_axis import poses_from_tool_axes  # run from the repository root
+    from solver.core.tool_axis import poses_from_tool_axes  # run from the repository root
 
     (HERE / "sweep_mm.cl").write_text(cl_program(inch=False))
     (HERE / "sweep_inch.cl").write_text(cl_program(inch=True))

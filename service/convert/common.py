@@ -9,14 +9,14 @@ import numpy as np
 from service import schemas
 from service.schemas.path import PathInput
 from solver.cam.frames import frames_of_placement
-from solver.evaluate import Branch
-from solver.exceptions import InvalidInputError
-from solver.pipeline import SpinMode
-from solver.robots import Robot
-from solver.spatial import (
+from solver.core.exceptions import InvalidInputError
+from solver.core.family import Branch
+from solver.core.robots import Robot
+from solver.core.spatial import (
     Placement,
     spun_waypoints,
 )
+from solver.path.problem import PathOptions, PathProblem, SpinMode
 
 
 def robot_from_schema(spec: schemas.Robot) -> Robot:
@@ -84,6 +84,29 @@ def check_path_size(path: schemas.Path, *, limit: int, setting: str) -> None:
 def spin_mode_of(requested: SpinMode | None, path: PathInput) -> SpinMode:
     """The spin mode asked for, or the path form's default."""
     return path.default_spin_mode if requested is None else requested
+
+
+def problem_of(
+    robot: Robot,
+    poses: np.ndarray,
+    path: PathInput,
+    *,
+    ik: schemas.IkPolicy | schemas.AutoIkPolicy,
+    spin_mode: SpinMode,
+) -> PathProblem:
+    """The solver's problem: the robot along ``poses``, with the request's IK and spin mode.
+
+    Args:
+        robot: the request's robot.
+        poses: shape (N, 4, 4), the path's poses in {O} (or those spun by a request's spins).
+        path: the path as read (its passes).
+        ik: the request's IK policy (branch, max_joint_step).
+        spin_mode: the spin mode (:func:`spin_mode_of`).
+    """
+    options = PathOptions(
+        branch=branch_of(ik.branch), max_joint_step=ik.max_joint_step, spin_mode=spin_mode
+    )
+    return PathProblem.of(robot, poses, options, passes=path.passes)
 
 
 def placement_of(placement: schemas.Placement) -> Placement:

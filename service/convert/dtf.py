@@ -3,8 +3,8 @@
 from __future__ import annotations
 
 from service import schemas
-from solver.dtf import DtfResult
-from solver.robots import Robot
+from solver.core.dtf import DtfResult
+from solver.core.robots import Robot
 
 
 def dtf_response(

@@ -10,10 +10,10 @@ from pydantic import TypeAdapter
 
 from service import schemas
 from service.convert.common import branch_to_api
-from solver.evaluate import PathEvaluation
-from solver.feed import FeedCheck
-from solver.pipeline import require_family
-from solver.robots import Robot
+from solver.core.robots import Robot
+from solver.path.evaluate import PathEvaluation
+from solver.path.feed import FeedCheck
+from solver.path.problem import require_family
 
 _WAYPOINTS = TypeAdapter(list[schemas.WaypointResult])
 

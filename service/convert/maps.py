@@ -9,12 +9,12 @@ import numpy as np
 from service import schemas
 from service.config import Settings
 from service.convert.common import api_placement, branch_to_api
-from solver.capability_map import CapabilityMap, axis_length, grid_axis
-from solver.exceptions import InvalidInputError
-from solver.pipeline import SpinMode, require_family
-from solver.robots import Robot
-from solver.spatial import MAX_COORDINATE
-from solver.tracking import FEASIBLE, REASONS
+from solver.core.codes import FEASIBLE, REASONS
+from solver.core.exceptions import InvalidInputError
+from solver.core.robots import Robot
+from solver.core.spatial import MAX_COORDINATE
+from solver.path.capability_map import CapabilityMap, axis_length, grid_axis
+from solver.path.problem import SpinMode, require_family
 
 
 @dataclass(frozen=True)

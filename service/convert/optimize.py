@@ -5,9 +5,9 @@ from __future__ import annotations
 from service import schemas
 from service.convert.common import api_placement
 from service.convert.evaluate import evaluate_response
-from solver.optimize import PlacementOptimum
-from solver.robots import Robot
-from solver.search_space import PlacementBounds
+from solver.core.robots import Robot
+from solver.optimise.optimize import PlacementOptimum
+from solver.optimise.search_space import PlacementBounds
 
 
 def bounds_of(bounds: schemas.Bounds, *, z: float | None) -> PlacementBounds:

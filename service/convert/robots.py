@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from service import schemas
-from solver.robots import Robot
+from solver.core.robots import Robot
 
 
 def robot_info(robot: Robot) -> schemas.RobotInfo:

@@ -1,4 +1,4 @@
-"""Placement tasks on a Dask cluster (``DTF_DASK_SCHEDULER``), behind :mod:`solver.parallel`.
+"""Placement tasks on a Dask cluster (``DTF_DASK_SCHEDULER``), behind :mod:`solver.core.parallel`.
 
 Dask's ``distributed`` is the standard engine for numpy work across machines; it is imported
 only when a scheduler is set. The workers must have this package installed (README, "Jobs on a
@@ -10,7 +10,7 @@ from __future__ import annotations
 from collections.abc import Callable, Sequence
 from typing import Any, TypeVar
 
-from solver.parallel import tasks_of
+from solver.core.parallel import tasks_of
 
 T = TypeVar("T")
 R = TypeVar("R")

@@ -21,7 +21,7 @@ from pathlib import Path
 from service.config import Settings
 from service.jobs.store import JobStore
 from service.jobs.worker import serve
-from service.metrics import log
+from service.logs import log
 
 POLL_SECONDS = 0.05
 """How often the supervisor looks at the workers and the queue (s)."""

@@ -25,11 +25,13 @@ from pydantic import ValidationError
 from service.config import Settings
 from service.errors import request_location, solver_error_location
 from service.jobs.store import JobStore
-from service.metrics import log, log_to_stderr
-from solver import map_kernel
-from solver.exceptions import SolverError
-from solver.parallel import TaskRunner, ThreadRunner
-from solver.progress import Cancelled, Progress
+from service.logs import log, log_to_stderr
+from service.operations import evaluation_of, map_of, optimum_of
+from service.schemas import EvaluateRequest, MapRequest, OptimizeRequest
+from solver.core.exceptions import SolverError
+from solver.core.parallel import TaskRunner, ThreadRunner
+from solver.core.progress import Cancelled, Progress
+from solver.kernels import fixed_spin as map_kernel
 
 REPORT_SECONDS = 0.2
 """How often a running job writes its progress (and reads a cancel) at most (s)."""
@@ -46,9 +48,6 @@ Work = Callable[[dict[str, Any], Settings, Progress, TaskRunner], dict[str, Any]
 def _map(
     request: dict[str, Any], settings: Settings, progress: Progress, runner: TaskRunner
 ) -> dict[str, Any]:
-    from service.api.routes.map import map_of
-    from service.schemas import MapRequest
-
     body = MapRequest.model_validate(request)
     return map_of(body, settings, progress, runner=runner).model_dump(mode="json")
 
@@ -56,9 +55,6 @@ def _map(
 def _optimize(
     request: dict[str, Any], settings: Settings, progress: Progress, runner: TaskRunner
 ) -> dict[str, Any]:
-    from service.api.routes.optimize import optimum_of
-    from service.schemas import OptimizeRequest
-
     body = OptimizeRequest.model_validate(request)
     return optimum_of(body, settings, progress, runner=runner).model_dump(mode="json")
 
@@ -66,9 +62,6 @@ def _optimize(
 def _evaluate(
     request: dict[str, Any], settings: Settings, progress: Progress, runner: TaskRunner
 ) -> dict[str, Any]:
-    from service.api.routes.evaluate import evaluation_of
-    from service.schemas import EvaluateRequest
-
     body = EvaluateRequest.model_validate(request)
     return evaluation_of(body, settings, progress).model_dump(mode="json")
 

@@ -22,9 +22,9 @@ from pydantic import (
 from pydantic_core import PydanticCustomError
 
 from solver.cam.frames import frames_of_placement
-from solver.evaluate import DEFAULT_MAX_JOINT_STEP
-from solver.spatial import MAX_COORDINATE, QUATERNION_NORM_TOLERANCE, pose_matrix
-from solver.spatial import Placement as SolverPlacement
+from solver.core.spatial import MAX_COORDINATE, QUATERNION_NORM_TOLERANCE, pose_matrix
+from solver.core.spatial import Placement as SolverPlacement
+from solver.path.problem import DEFAULT_MAX_JOINT_STEP
 
 UNIT_BOUND = 1.001  # a direction typed with 4 decimals may be off its unit norm by up to 1e-3
 

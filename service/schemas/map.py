@@ -22,8 +22,8 @@ from service.schemas.common import (
 from service.schemas.evaluate import _REQUEST_EXAMPLE, FailureReason
 from service.schemas.path import Path
 from service.schemas.robot import Robot
-from solver.capability_map import axis_length
-from solver.spatial import MAX_COORDINATE
+from solver.core.spatial import MAX_COORDINATE
+from solver.path.capability_map import axis_length
 
 MAX_GRID_VALUES = 360
 MIN_GRID_STEP = 1e-6  # m: a finer grid than a micrometre is no placement a cell can hold

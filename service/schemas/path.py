@@ -18,9 +18,9 @@ from solver.cam.cam_path import CamPath, Units
 from solver.cam.cl_data import DEFAULT_ARC_TOLERANCE, read_cl_data
 from solver.cam.csv_path import read_csv_path
 from solver.cam.read_report import ReadReport, UnitsSource
-from solver.spatial import check_position, pose_matrices
-from solver.task import task_requirements
-from solver.tool_axis import poses_from_tool_axes
+from solver.core.spatial import check_position, pose_matrices
+from solver.core.task import task_requirements
+from solver.core.tool_axis import poses_from_tool_axes
 
 MAX_PATH_WAYPOINTS = 20_000
 """The most waypoints any route takes (DTF_MAX_PATH_WAYPOINTS may lower it, never raise it)."""

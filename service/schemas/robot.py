@@ -16,11 +16,11 @@ from pydantic.config import JsonValue
 from pydantic_core import PydanticCustomError
 
 from service.schemas.common import Angle, Pose, RequestModel, pose_matrix_of, shown
-from solver.families import catalogue
+from solver.core.robots import MAX_SPEED_LIMIT, MIN_SPEED_LIMIT
+from solver.core.robots import Robot as SolverRobot
+from solver.families import catalogue, robot_from_urdf
 from solver.families.opw.catalogue import robot_from_opw
 from solver.families.opw.parameters import MAX_LENGTH, OpwParameters
-from solver.robots import MAX_SPEED_LIMIT, MIN_SPEED_LIMIT, robot_from_urdf
-from solver.robots import Robot as SolverRobot
 
 SpeedLimit = Annotated[float, Field(ge=MIN_SPEED_LIMIT, le=MAX_SPEED_LIMIT)]
 Length = Annotated[float, Field(ge=-MAX_LENGTH, le=MAX_LENGTH)]

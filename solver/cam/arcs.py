@@ -23,8 +23,8 @@ import math
 
 import numpy as np
 
-from solver.exceptions import InvalidLineError
-from solver.task import LINEAR_TOLERANCE
+from solver.core.exceptions import InvalidLineError
+from solver.core.task import LINEAR_TOLERANCE
 
 HALF_TURN = 1e-3
 """rad: an arc this close to a half turn has no shorter way."""

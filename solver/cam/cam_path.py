@@ -14,10 +14,10 @@ from typing import Literal
 import numpy as np
 
 from solver.cam.read_report import ReadReport
-from solver.exceptions import InvalidInputError, InvalidLineError
-from solver.spatial import rotation_about_z
-from solver.task import ANGULAR_TOLERANCE, LINEAR_TOLERANCE
-from solver.tool_axis import poses_from_tool_axes
+from solver.core.exceptions import InvalidInputError, InvalidLineError
+from solver.core.spatial import rotation_about_z
+from solver.core.task import ANGULAR_TOLERANCE, LINEAR_TOLERANCE
+from solver.core.tool_axis import poses_from_tool_axes
 
 Units = Literal["mm", "inches", "m"]
 METRES_PER_UNIT: dict[str, float] = {"mm": 1e-3, "inches": 0.0254, "m": 1.0}

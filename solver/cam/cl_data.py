@@ -34,7 +34,7 @@ from solver.cam.cl_reader import ClReader
 from solver.cam.cl_records import SKIPPED, records
 from solver.cam.cl_units import UnitsReading, units_of
 from solver.cam.read_report import ReadReport
-from solver.exceptions import InvalidInputError
+from solver.core.exceptions import InvalidInputError
 
 DEFAULT_ARC_TOLERANCE = 1e-5
 """m: 0.01 mm, the chordal tolerance arcs are interpolated to by default."""

@@ -15,9 +15,9 @@ from solver.cam.cl_systems import PART, CoordinateSystem, csys, msys
 from solver.cam.cl_units import feed_of, stated_units
 from solver.cam.read_report import SkippedRecord
 from solver.cam.reading import checked_position, is_number, near_unit_vector, parse_numbers
-from solver.exceptions import InvalidInputError, InvalidLineError
-from solver.spatial import MAX_COORDINATE
-from solver.task import ANGULAR_TOLERANCE, LINEAR_TOLERANCE
+from solver.core.exceptions import InvalidInputError, InvalidLineError
+from solver.core.spatial import MAX_COORDINATE
+from solver.core.task import ANGULAR_TOLERANCE, LINEAR_TOLERANCE
 
 TOOL_CHANGE = frozenset({"LOADTL", "LOAD"})
 """Words of a tool change: a new pass."""

@@ -27,7 +27,7 @@ import re
 from collections.abc import Iterator
 from dataclasses import dataclass
 
-from solver.exceptions import InvalidLineError
+from solver.core.exceptions import InvalidLineError
 
 READ = frozenset(
     {

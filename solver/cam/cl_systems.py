@@ -16,8 +16,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from solver.exceptions import InvalidLineError
-from solver.tool_axis import NEAR_UNIT_TOLERANCE
+from solver.core.exceptions import InvalidLineError
+from solver.core.tool_axis import NEAR_UNIT_TOLERANCE
 
 
 @dataclass(frozen=True)

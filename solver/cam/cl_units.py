@@ -17,7 +17,7 @@ from solver.cam.cam_path import METRES_PER_UNIT, Units
 from solver.cam.cl_records import Record
 from solver.cam.read_report import UnitsSource
 from solver.cam.reading import parse_number
-from solver.exceptions import InvalidInputError, InvalidLineError
+from solver.core.exceptions import InvalidInputError, InvalidLineError
 
 UNIT_WORDS: dict[str, Units] = {"MM": "mm", "INCHES": "inches", "INCH": "inches"}
 FEED_UNIT_WORDS: dict[str, Units] = {"MMPM": "mm", "IPM": "inches"}

@@ -15,8 +15,8 @@ import math
 
 from solver.cam.cam_path import METRES_PER_UNIT, CamPath, Units, assemble_cam_path
 from solver.cam.reading import checked_position, is_number, near_unit_vector, parse_numbers
-from solver.exceptions import InvalidInputError, InvalidLineError
-from solver.spatial import rotation_from_quaternion
+from solver.core.exceptions import InvalidInputError, InvalidLineError
+from solver.core.spatial import rotation_from_quaternion
 
 _UNITS: dict[str, Units] = {"mm": "mm", "inch": "inches", "m": "m"}
 HEADERS = {

@@ -27,8 +27,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from solver.exceptions import InvalidInputError
-from solver.spatial import Placement, check_position, rotation_from_quaternion
+from solver.core.exceptions import InvalidInputError
+from solver.core.spatial import Placement, check_position, rotation_from_quaternion
 
 GIMBAL_LOCK_TOLERANCE = 1e-12  # |cos B| below this: B = +-90 degrees, C (or W) set to 0
 ROTATION_TOLERANCE = 1e-9  # |R^T R - I| of a transform accepted as rigid

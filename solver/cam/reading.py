@@ -12,9 +12,9 @@ import re
 
 import numpy as np
 
-from solver.exceptions import InvalidLineError
-from solver.spatial import MAX_COORDINATE
-from solver.tool_axis import NEAR_UNIT_TOLERANCE
+from solver.core.exceptions import InvalidLineError
+from solver.core.spatial import MAX_COORDINATE
+from solver.core.tool_axis import NEAR_UNIT_TOLERANCE
 
 _NUMBER = re.compile(r"[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?")
 

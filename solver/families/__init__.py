@@ -1,4 +1,4 @@
-"""Robot kinematics families behind one seam (:mod:`solver.families.base`), and their registry.
+"""Robot kinematics families behind one seam (:mod:`solver.core.family`), and their registry.
 
 Each family lives in its own folder with its parameters, IK, J^-1 t and catalogue entries. This
 registry is the one place that names them: a new family adds its catalogue module here, and no
@@ -9,13 +9,14 @@ from __future__ import annotations
 
 import functools
 import importlib
-from typing import TYPE_CHECKING
 
-if TYPE_CHECKING:
-    import pinocchio as pin
+import numpy as np
+import pinocchio as pin
 
-    from solver.families.base import KinematicsFamily
-    from solver.robots import Robot
+from solver.core.exceptions import RobotModelError, UnknownRobotError
+from solver.core.family import KinematicsFamily
+from solver.core.robots import Robot, chain_from_urdf, robot_from_model
+from solver.families.numeric.family import NumericFamily
 
 # Modules with a ``robots() -> dict[str, Robot]`` function, in catalogue order.
 CATALOGUE_MODULES = (
@@ -43,12 +44,58 @@ def default_family(
 
     ``None`` when the model has fewer than six joints or is not one serial chain to the tool.
     """
-    from solver.exceptions import RobotModelError
-    from solver.families.numeric.family import NumericFamily
-
     if model.nv < NUMERIC_MIN_DOF:
         return None
     try:
         return NumericFamily(model, base_frame=base_frame, tool_frame=tool_frame)
     except RobotModelError:
         return None
+
+
+def get_robot(name: str) -> Robot:
+    """The catalogue robot ``name``.
+
+    Raises:
+        UnknownRobotError: no robot of that name.
+    """
+    robots = catalogue()
+    if name not in robots:
+        raise UnknownRobotError(name, sorted(robots))
+    return robots[name]
+
+
+def robot_from_urdf(
+    urdf: str,
+    *,
+    base_frame: str,
+    tool_frame: str,
+    name: str = "urdf",
+    qdot_max: np.ndarray | list[float] | None = None,
+    family: KinematicsFamily | None = None,
+) -> Robot:
+    """Read a serial arm from URDF text, with its kinematics family.
+
+    The chain is the one from the root to ``tool_frame``
+    (:func:`solver.core.robots.chain_from_urdf`: other joints are locked at their neutral
+    position).
+
+    Args:
+        urdf: the URDF document.
+        base_frame: link or frame that poses are expressed in; fixed to the root.
+        tool_frame: link or frame of the tool flange.
+        name: name reported for the robot.
+        qdot_max: shape (n,), rad/s, joint speed limits; ``None`` takes the URDF's (which then
+            must be usable).
+        family: the kinematics family of the arm; ``None`` gives the numeric family to a
+            chain of six joints or more (:func:`default_family`), and none to others.
+
+    Raises:
+        RobotModelError: the URDF cannot be parsed, a frame is missing, or the chain has
+            joints other than 1-DOF revolute or prismatic ones.
+    """
+    model = chain_from_urdf(urdf, tool_frame=tool_frame)
+    if family is None and model.existFrame(base_frame) and model.existFrame(tool_frame):
+        family = default_family(model, base_frame=base_frame, tool_frame=tool_frame)
+    return robot_from_model(
+        name, model, base_frame=base_frame, tool_frame=tool_frame, qdot_max=qdot_max, family=family
+    )

@@ -9,7 +9,7 @@ from typing import Any
 import pytest
 from fastapi.testclient import TestClient
 
-from solver.optimize import CLIMB_STATUS
+from solver.optimise.local_search import CLIMB_STATUS
 from tests.cases import EXAMPLES, OPTIMUM_EVALUATE_RTOL
 from tests.service.conftest import sent_back
 

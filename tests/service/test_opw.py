@@ -11,8 +11,8 @@ import pytest
 from fastapi.testclient import TestClient
 from scipy.spatial.transform import Rotation
 
-from solver.kinematics import tool_pose_in_base
-from solver.robots import get_robot
+from solver.core.kinematics import tool_pose_in_base
+from solver.families import get_robot
 from tests.cases import EXAMPLES, MAP_EVALUATE_RTOL
 from tests.service.test_errors import assert_names
 

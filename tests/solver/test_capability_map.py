@@ -8,14 +8,14 @@ import math
 import numpy as np
 import pytest
 
-from solver.capability_map import capability_map, grid_axis
-from solver.evaluate import evaluate_path
-from solver.exceptions import InvalidInputError
-from solver.families.base import Branch
+from solver.core.codes import REASONS
+from solver.core.exceptions import InvalidInputError
+from solver.core.family import Branch
+from solver.families import get_robot
 from solver.families.ur.ik import BRANCHES
-from solver.robots import get_robot
-from solver.tracking import REASONS
+from solver.path.capability_map import grid_axis
 from tests.cases import MAP_EVALUATE_RTOL
+from tests.problems import capability_map, evaluate_path
 from tests.solver.test_evaluate import load_path, wrist_singular_path
 
 

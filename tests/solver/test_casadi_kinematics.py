@@ -6,9 +6,10 @@ import numpy as np
 import pinocchio as pin
 import pytest
 
-from solver.casadi_kinematics import symbolic_kinematics
-from solver.kinematics import jacobian_in_base, tool_pose_in_base
-from solver.robots import example_robot_data_dir, get_robot, robot_from_urdf
+from solver.core.kinematics import jacobian_in_base, tool_pose_in_base
+from solver.core.robots import example_robot_data_dir
+from solver.families import get_robot, robot_from_urdf
+from solver.optimise.methods.casadi_kinematics import symbolic_kinematics
 from tests.cases import OPW_MODELS, UR_MODELS
 
 

@@ -8,14 +8,12 @@ import math
 import numpy as np
 import pytest
 
-from solver.capability_map import capability_map
-from solver.evaluate import evaluate_path
-from solver.exceptions import InvalidInputError
-from solver.optimize import optimize_placement
-from solver.robots import get_robot
-from solver.search_space import PlacementBounds
-from solver.spatial import Placement, spun_waypoints
+from solver.core.exceptions import InvalidInputError
+from solver.core.spatial import Placement, spun_waypoints
+from solver.families import get_robot
+from solver.optimise.search_space import PlacementBounds
 from tests.cases import MAP_EVALUATE_RTOL, OPTIMUM_EVALUATE_RTOL, OPTIMUM_METHODS_RTOL
+from tests.problems import capability_map, evaluate_path, optimize_placement
 from tests.solver.test_evaluate import load_path
 
 

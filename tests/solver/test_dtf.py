@@ -9,7 +9,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from solver.dtf import (
+from solver.core.dtf import (
     chiu,
     closed_form_batch,
     decomposed_speed,
@@ -18,9 +18,10 @@ from solver.dtf import (
     twist_per_unit_speed,
     yoshikawa,
 )
-from solver.exceptions import InvalidInputError
-from solver.kinematics import jacobian_in_base
-from solver.robots import example_robot_data_dir, get_robot, robot_from_urdf
+from solver.core.exceptions import InvalidInputError
+from solver.core.kinematics import jacobian_in_base
+from solver.core.robots import example_robot_data_dir
+from solver.families import get_robot, robot_from_urdf
 from tests.cases import DTF_LP_RTOL, SENSORS_TABLE_3, unit
 
 N_CASES = 1000

@@ -11,13 +11,15 @@ import scipy.optimize
 import ur_analytic_ik
 from scipy.spatial.transform import Rotation
 
-from solver.evaluate import Branch, evaluate_path
-from solver.exceptions import InvalidInputError, NoAnalyticIkError, RepeatedWaypointError
+from solver.core.exceptions import InvalidInputError, NoAnalyticIkError, RepeatedWaypointError
+from solver.core.kinematics import jacobian_in_base, tool_pose_in_base
+from solver.core.robots import example_robot_data_dir
+from solver.core.spatial import Placement, pose_matrix, wrap_angle
+from solver.families import get_robot, robot_from_urdf
 from solver.families.ur.ik import BRANCHES
-from solver.kinematics import jacobian_in_base, tool_pose_in_base
-from solver.robots import example_robot_data_dir, get_robot, robot_from_urdf
-from solver.spatial import Placement, pose_matrix, wrap_angle
+from solver.path.evaluate import Branch
 from tests.cases import EXAMPLES, TWO_PI
+from tests.problems import evaluate_path
 
 PLACEMENT = Placement(0.0, 0.45, 0.1, 0.0)
 

@@ -9,15 +9,12 @@ import numpy as np
 import pytest
 import scipy.optimize
 
-from solver.capability_map import capability_map
-from solver.dtf import spin_rate_nearest_zero, two_variable_speed
-from solver.evaluate import evaluate_path
-from solver.exceptions import InvalidInputError
-from solver.kinematics import jacobian_in_base, tool_pose_in_base
-from solver.optimize import optimize_placement
-from solver.robots import get_robot, robot_from_urdf
-from solver.search_space import PlacementBounds
-from solver.spatial import Placement
+from solver.core.dtf import spin_rate_nearest_zero, two_variable_speed
+from solver.core.exceptions import InvalidInputError
+from solver.core.kinematics import jacobian_in_base, tool_pose_in_base
+from solver.core.spatial import Placement
+from solver.families import get_robot, robot_from_urdf
+from solver.optimise.search_space import PlacementBounds
 from tests.cases import (
     FREE_SPIN_LP_RTOL,
     MAP_EVALUATE_RTOL,
@@ -25,6 +22,7 @@ from tests.cases import (
     OPTIMUM_METHODS_RTOL,
     SPIN_SCHEDULE_RTOL,
 )
+from tests.problems import capability_map, evaluate_path, optimize_placement
 from tests.solver.test_evaluate import load_path
 from tests.solver.test_optimize import best_coarse_cell
 

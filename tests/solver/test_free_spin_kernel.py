@@ -15,8 +15,8 @@ import math
 import numpy as np
 import pytest
 
-from solver.families.base import Branch
-from solver.robots import get_robot
+from solver.core.family import Branch
+from solver.families import get_robot
 from tests.solver.families.test_opw import build
 from tests.solver.test_evaluate import load_path, wrist_singular_path
 from tests.solver.test_map_kernel import OPW_CASES, grid, opw_grid, same_cells

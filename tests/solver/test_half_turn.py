@@ -8,14 +8,12 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
-from solver.capability_map import capability_map
-from solver.evaluate import evaluate_path
-from solver.exceptions import InvalidInputError
-from solver.optimize import optimize_placement
-from solver.robots import get_robot
-from solver.search_space import PlacementBounds
-from solver.task import task_requirements
+from solver.core.exceptions import InvalidInputError
+from solver.core.task import task_requirements
+from solver.families import get_robot
+from solver.optimise.search_space import PlacementBounds
 from tests.cases import MAP_EVALUATE_RTOL
+from tests.problems import capability_map, evaluate_path, optimize_placement
 
 
 def two_waypoints(turn: float) -> np.ndarray:

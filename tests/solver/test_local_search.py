@@ -1,4 +1,4 @@
-"""Local searches on mu_path (solver/local_search.py), and the large box of issue 12.
+"""Local searches on mu_path (solver/optimise/local_search.py), and the large box of issue 12.
 
 On a large box the best placement lies where the best IK branch changes; a method that follows
 one branch stops below it. Each method must reach the better answer there (issue 12: the
@@ -14,12 +14,11 @@ import math
 import numpy as np
 import pytest
 
-from solver.coarse_search import Cell
-from solver.local_search import climb, refine_cells
-from solver.optimize import optimize_placement
-from solver.placements import evaluate_placements, prepare_path
-from solver.robots import get_robot
-from solver.search_space import PlacementBounds
+from solver.families import get_robot
+from solver.optimise.coarse_search import Cell
+from solver.optimise.local_search import climb, refine_cells
+from solver.optimise.search_space import PlacementBounds
+from tests.problems import evaluate_placements, optimize_placement, prepare_path
 from tests.solver.test_evaluate import load_path
 
 LARGE = PlacementBounds(x=(-0.8, 0.8), y=(-0.8, 0.8), yaw=(-math.pi, math.pi), z=0.1)
@@ -73,7 +72,7 @@ def test_refine_never_lowers_a_cell_and_stays_inside() -> None:
     starts = np.array([[0.3, 0.2, 0.0, 0.0, 0.1], [-0.1, 0.25, 0.4, 0.0, 0.1]])
     mu = mu_at(robot, path, starts)
     cells = [Cell(v, float(m), 0) for v, m in zip(starts, mu, strict=True)]
-    refined = refine_cells(robot, path, bounds, cells, max_joint_step=0.35)
+    refined = refine_cells(path.with_options(max_joint_step=0.35), bounds, cells)
     assert len(refined) == 2
     values = mu_at(robot, path, np.array([c.vector for c in refined]))
     np.testing.assert_allclose(values, [c.mu_path for c in refined], rtol=1e-12)
@@ -89,8 +88,8 @@ def test_climb_is_never_worse_and_deterministic() -> None:
     start_vector = np.array([0.1, 0.45, 0.0, 0.0, 0.1])
     start = Cell(start_vector, float(mu_at(robot, path, start_vector[None])[0]), 0)
     bounds = PlacementBounds(x=(-0.25, 0.25), y=(0.25, 0.65), yaw=(-1.0, 1.0), z=0.1)
-    first = climb(robot, path, bounds, start, max_joint_step=0.35)
-    again = climb(robot, path, bounds, start, max_joint_step=0.35)
+    first = climb(path.with_options(max_joint_step=0.35), bounds, start)
+    again = climb(path.with_options(max_joint_step=0.35), bounds, start)
     assert first is not None and again is not None
     assert first.mu_path > start.mu_path
     np.testing.assert_array_equal(first.vector, again.vector)
@@ -103,5 +102,5 @@ def test_a_costly_family_is_not_climbed() -> None:
     path = prepare_path(robot, load_path("curved_line")[:10])
     start = Cell(np.array([0.4, 0.0, 0.0, 0.0, 0.1]), 0.1, 0)
     bounds = PlacementBounds(x=(0.3, 0.5), y=(-0.1, 0.1), yaw=(0.0, 0.0), z=0.1)
-    assert climb(robot, path, bounds, start, max_joint_step=0.35) is None
-    assert refine_cells(robot, path, bounds, [start], max_joint_step=0.35) == [start]
+    assert climb(path.with_options(max_joint_step=0.35), bounds, start) is None
+    assert refine_cells(path.with_options(max_joint_step=0.35), bounds, [start]) == [start]

@@ -1,6 +1,6 @@
 """The compiled map kernel equals the numpy pipeline, its reference, cell by cell (issue 12).
 
-Every comparison runs :func:`solver.placements.evaluate_placements` twice on the same
+Every comparison runs :func:`solver.path.placements.evaluate_placements` twice on the same
 placements: compiled (the default for UR and OPW arms in fixed spin) and ``compiled=False``
 (the numpy pipeline, itself checked against an LP, pinocchio and independent IK elsewhere).
 mu_path and V_max along the chosen branch agree to 1e-12 relative; the reason, the failed
@@ -15,13 +15,15 @@ import math
 import numpy as np
 import pytest
 
-import solver.placements
-from solver.families.base import Branch
+import solver.path.placements
+from solver.core.codes import REASONS
+from solver.core.family import Branch
+from solver.core.kinematics import tool_pose_in_base
+from solver.core.robots import Robot
+from solver.families import get_robot
 from solver.families.opw.kernel import kernel_parameters
-from solver.kinematics import tool_pose_in_base
-from solver.placements import PlacementResults, evaluate_placements, prepare_path
-from solver.robots import Robot, get_robot
-from solver.tracking import REASONS
+from solver.path.placements import PlacementResults
+from tests.problems import evaluate_placements, prepare_path
 from tests.solver.families.test_opw import build
 from tests.solver.test_evaluate import load_path, wrist_singular_path
 from tests.solver.test_parallel import grid_placements
@@ -68,7 +70,7 @@ def test_the_compiled_kernel_is_what_runs(monkeypatch: pytest.MonkeyPatch, spin_
     def refuse(*args: object, **kwargs: object) -> None:
         raise AssertionError("the numpy pipeline ran")
 
-    monkeypatch.setattr(solver.placements, "run_chunk", refuse)
+    monkeypatch.setattr(solver.path.placements, "run_chunk", refuse)
     robot = get_robot("ur5")
     path = prepare_path(robot, load_path("curved_line"))
     cell = np.array([[0.0, 0.45, 0.1, 0.0]])

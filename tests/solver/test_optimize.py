@@ -9,17 +9,18 @@ import threading
 import numpy as np
 import pytest
 
-from solver import optimize
-from solver.capability_map import capability_map, grid_axis
-from solver.evaluate import evaluate_path
-from solver.exceptions import InvalidInputError
-from solver.optimize import PlacementOptimum, optimize_placement
-from solver.parallel import SERIAL, TaskRunner, ThreadRunner
-from solver.robots import Robot, get_robot
-from solver.search_space import PlacementBounds, vector_of
-from solver.spatial import Placement
-from solver.symmetry import arc_coordinates, arc_point, turns_about_base_z
+from solver.core.exceptions import InvalidInputError
+from solver.core.parallel import SERIAL, TaskRunner, ThreadRunner
+from solver.core.robots import Robot
+from solver.core.spatial import Placement
+from solver.families import get_robot
+from solver.optimise import local_search
+from solver.optimise.optimize import PlacementOptimum
+from solver.optimise.search_space import PlacementBounds, vector_of
+from solver.optimise.symmetry import arc_coordinates, arc_point, turns_about_base_z
+from solver.path.capability_map import grid_axis
 from tests.cases import OPTIMUM_EVALUATE_RTOL, OPTIMUM_METHODS_RTOL
+from tests.problems import capability_map, evaluate_path, optimize_placement
 from tests.solver.test_evaluate import load_path
 
 BOUNDS = PlacementBounds(x=(-0.25, 0.25), y=(0.25, 0.65), yaw=(-math.pi, math.pi), z=0.1)
@@ -260,15 +261,15 @@ def test_on_two_threads_the_climbs_run_beside_ipopt_and_change_nothing(
     robot, path = get_robot("ur5"), load_path("curved_line")
     serial = optimize_placement(robot, path, bounds=BOUNDS, method="casadi")
     threads: list[str] = []
-    climb = optimize.climb
+    climb = local_search.climb
 
     def recorded(*args: object, **kwargs: object) -> object:
         threads.append(threading.current_thread().name)
         return climb(*args, **kwargs)  # type: ignore[arg-type]
 
-    monkeypatch.setattr(optimize, "climb", recorded)
+    monkeypatch.setattr(local_search, "climb", recorded)
     pooled = optimize_placement(robot, path, bounds=BOUNDS, method="casadi", runner=ThreadRunner(2))
-    assert len(threads) == optimize.N_CLIMBS
+    assert len(threads) == local_search.N_CLIMBS
     assert all(name.startswith("dtf-climbs") for name in threads)
     assert pooled.placement == serial.placement and pooled.mu_path == serial.mu_path
     assert pooled.solver.iterations == serial.solver.iterations

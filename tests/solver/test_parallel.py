@@ -8,10 +8,10 @@ import threading
 import numpy as np
 import pytest
 
-from solver.parallel import SERIAL, ThreadRunner, tasks_of
-from solver.placements import evaluate_placements, prepare_path
-from solver.progress import Cancelled
-from solver.robots import get_robot
+from solver.core.parallel import SERIAL, ThreadRunner, tasks_of
+from solver.core.progress import Cancelled
+from solver.families import get_robot
+from tests.problems import evaluate_placements, prepare_path
 from tests.solver.test_evaluate import load_path
 
 

@@ -15,10 +15,10 @@ import casadi
 import numpy as np
 import pytest
 
-from solver.pipeline import prepare_path
-from solver.placement_nlp import PlacementNlp
-from solver.robots import get_robot
-from solver.search_space import PlacementBounds
+from solver.families import get_robot
+from solver.optimise.methods.placement_nlp import PlacementNlp
+from solver.optimise.search_space import PlacementBounds
+from tests.problems import problem
 from tests.solver.test_evaluate import load_path
 
 BOUNDS = PlacementBounds(x=(-0.25, 0.25), y=(0.25, 0.65), yaw=(-math.pi, math.pi), z=0.1)
@@ -39,17 +39,11 @@ def _dense(matrix: casadi.DM) -> np.ndarray:
 def test_assembled_derivatives_equal_casadis_own(form: str) -> None:
     name, options, passes = FORMS[form]
     robot, path = get_robot(name), load_path("curved_line")[:9]
-    prepared = prepare_path(robot, path, passes=passes)
+    options = dict(options)
+    spin_mode = "free" if options.pop("free_spin", False) else "fixed"
+    posed = problem(robot, path, passes=passes, max_joint_step=0.3, spin_mode=spin_mode)
     built = {
-        own: PlacementNlp(
-            robot,
-            prepared,
-            path[:, :3, :3],
-            BOUNDS,
-            max_joint_step=0.3,
-            derivatives=own,
-            **options,
-        )._solver
+        own: PlacementNlp(posed, BOUNDS, derivatives=own, **options)._solver
         for own in (True, False)
     }
     jacobians = {own: solver.get_function("nlp_jac_g") for own, solver in built.items()}

@@ -8,15 +8,15 @@ import platform
 import numpy as np
 import pytest
 
-from solver._malloc import raise_malloc_thresholds
-from solver.evaluate import evaluate_path
-from solver.exceptions import InvalidInputError
+from solver.core.codes import REASONS
+from solver.core.exceptions import InvalidInputError
+from solver.core.malloc import raise_malloc_thresholds
+from solver.core.spatial import Placement
+from solver.families import get_robot
 from solver.families.ur.ik import BRANCHES
-from solver.placements import PlacementEvaluator, evaluate_placements, prepare_path
-from solver.robots import get_robot
-from solver.spatial import Placement
-from solver.tracking import REASONS
+from solver.path.placements import PlacementEvaluator
 from tests.cases import MAP_EVALUATE_RTOL
+from tests.problems import evaluate_path, evaluate_placements, prepare_path
 from tests.solver.test_evaluate import load_path
 
 
@@ -78,7 +78,7 @@ def test_the_placement_evaluator_is_the_numpy_pipeline_one_placement_at_a_time(
     spins = np.repeat([0.0, 0.7, 0.0, -1.2], 6)  # a spin asked for again after another
     placements = np.column_stack([random_placements(3, 24, z=(-0.1, 0.3)), spins])
     reference = evaluate_placements(robot, path, placements, spin_mode=spin_mode, compiled=False)
-    evaluate = PlacementEvaluator(robot, path, spin_mode=spin_mode)
+    evaluate = PlacementEvaluator(path.with_options(spin_mode=spin_mode))
     answers = [evaluate(row[None]) for row in placements]
     mu = np.concatenate([a.mu_path for a in answers])
     np.testing.assert_allclose(mu, reference.mu_path, rtol=1e-12, equal_nan=True)

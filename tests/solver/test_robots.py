@@ -9,10 +9,11 @@ import pinocchio as pin
 import pytest
 import ur_analytic_ik
 
-from solver.exceptions import InvalidInputError, RobotModelError, UnknownRobotError
+from solver.core.exceptions import InvalidInputError, RobotModelError, UnknownRobotError
+from solver.core.kinematics import jacobian_in_base, tool_pose_in_base
+from solver.core.robots import example_robot_data_dir
+from solver.families import catalogue, get_robot, robot_from_urdf
 from solver.families.ur.ik import forward_kinematics_dh
-from solver.kinematics import jacobian_in_base, tool_pose_in_base
-from solver.robots import catalogue, example_robot_data_dir, get_robot, robot_from_urdf
 from tests.cases import (
     CB_URDF_VS_DH_ATOL,
     E_SERIES,

@@ -9,9 +9,9 @@ import pinocchio as pin
 import pytest
 from scipy.spatial.transform import Rotation
 
-from solver.exceptions import InvalidInputError
-from solver.spatial import pose_matrices, pose_matrix, rotation_vectors
-from solver.task import check_waypoints
+from solver.core.exceptions import InvalidInputError
+from solver.core.spatial import pose_matrices, pose_matrix, rotation_vectors
+from solver.core.task import check_waypoints
 
 
 def random_poses(n: int, seed: int) -> tuple[np.ndarray, np.ndarray]:

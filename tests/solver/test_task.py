@@ -8,9 +8,9 @@ import numpy as np
 import pinocchio as pin
 import pytest
 
-from solver.exceptions import InvalidInputError, RepeatedWaypointError
-from solver.spatial import Placement, pose_matrix
-from solver.task import task_requirements
+from solver.core.exceptions import InvalidInputError, RepeatedWaypointError
+from solver.core.spatial import Placement, pose_matrix
+from solver.core.task import task_requirements
 
 
 def _pose(position, rotation=None) -> np.ndarray:

@@ -6,9 +6,9 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
-from solver.exceptions import InvalidInputError
-from solver.task import task_requirements
-from solver.tool_axis import near_unit, poses_from_tool_axes
+from solver.core.exceptions import InvalidInputError
+from solver.core.task import task_requirements
+from solver.core.tool_axis import near_unit, poses_from_tool_axes
 
 
 def _tilting_about_y(angles: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -9,8 +9,8 @@ from fastapi import APIRouter
 from service import convert
 from service.errors import ERROR_RESPONSES
 from service.schemas import DtfRequest, DtfResponse
-from solver.dtf import chiu, dtf, twist_per_unit_speed, yoshikawa
-from solver.kinematics import check_configuration, jacobian_in_base
+from solver.core.dtf import chiu, dtf, twist_per_unit_speed, yoshikawa
+from solver.core.kinematics import check_configuration, jacobian_in_base
 
 router = APIRouter(prefix="/dtf", tags=["dtf"], responses=ERROR_RESPONSES)
 

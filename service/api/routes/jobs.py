@@ -10,16 +10,16 @@ import anyio
 from fastapi import APIRouter, HTTPException, Path, Query, Response, status
 from fastapi.responses import JSONResponse
 
-from service.api.routes.map import checked_grid
 from service.config import Settings
 from service.deps import SettingsDep
 from service.errors import ERROR_RESPONSES
 from service.jobs.runner import get_runner
 from service.jobs.store import Job
-from service.metrics import log
+from service.logs import log
+from service.operations import checked_grid
 from service.schemas import ErrorDetail, MapRequest
 from service.schemas.jobs import JobInfo, JobList, JobProgress, JobRequest, JobStatus, MapJob
-from solver.exceptions import InvalidInputError, SolverError
+from solver.core.exceptions import InvalidInputError, SolverError
 
 router = APIRouter(prefix="/jobs", tags=["jobs"], responses=ERROR_RESPONSES)
 

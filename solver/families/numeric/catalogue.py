@@ -18,7 +18,8 @@ from __future__ import annotations
 
 import re
 
-from solver.robots import Robot, example_robot_data_dir, robot_from_urdf
+from solver.core.robots import Robot, example_robot_data_dir
+from solver.families import robot_from_urdf
 
 # name: (file under example-robot-data's robots/, base frame, flange)
 ARMS = {

@@ -17,7 +17,7 @@ from dataclasses import dataclass
 import numpy as np
 import pinocchio as pin
 
-from solver.exceptions import RobotModelError
+from solver.core.exceptions import RobotModelError
 
 
 @dataclass(frozen=True)

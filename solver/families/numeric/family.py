@@ -8,7 +8,7 @@ gives the same branches. A numeric family cannot promise that it found every bra
 how many it found.
 
 J^-1 t: a batched 6 x 6 solve for six joints; for more, the joint speeds of the exact DTF LP
-(:mod:`solver.dtf_redundant`), which the pipeline's ratio turns into V_max unchanged.
+(:mod:`solver.core.dtf_redundant`), which the pipeline's ratio turns into V_max unchanged.
 """
 
 from __future__ import annotations
@@ -16,11 +16,12 @@ from __future__ import annotations
 import numpy as np
 import pinocchio as pin
 
-from solver.dtf_redundant import redundant_speed
-from solver.families.base import OK, SINGULAR, UNREACHABLE, Branch, KinematicsFamily, PathSolutions
+from solver.core.codes import OK, SINGULAR, UNREACHABLE
+from solver.core.dtf_redundant import redundant_speed
+from solver.core.family import Branch, KinematicsFamily, PathSolutions
+from solver.core.spatial import wrap_angle
 from solver.families.numeric import ik
 from solver.families.numeric.chain import SerialChain
-from solver.spatial import wrap_angle
 
 # The Sobol sequence's seed: fixed, so that the same input gives the same branches.
 SOBOL_SEED = 20240611

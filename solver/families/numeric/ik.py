@@ -20,8 +20,8 @@ import math
 
 import numpy as np
 
+from solver.core.spatial import wrap_angle
 from solver.families.numeric.chain import SerialChain
-from solver.spatial import wrap_angle
 
 # A problem is solved when every component of e is below this (m and rad): FK(IK(T)) then equals
 # T to ~1e-12, well inside the 1e-9 the tests ask for.

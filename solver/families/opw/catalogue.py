@@ -6,12 +6,12 @@ import math
 
 import numpy as np
 
-from solver.exceptions import InvalidInputError
+from solver.core.exceptions import InvalidInputError
+from solver.core.robots import Robot, check_speed_limits, robot_from_model
 from solver.families.opw.arms import ARMS
 from solver.families.opw.family import OpwFamily
 from solver.families.opw.model import opw_model
 from solver.families.opw.parameters import OpwParameters
-from solver.robots import Robot, check_speed_limits, robot_from_model
 
 JOINT_NAMES = tuple(f"joint_{i}" for i in range(1, 7))
 

@@ -43,9 +43,10 @@ import math
 
 import numpy as np
 
-from solver.families.base import OK, SINGULAR, UNREACHABLE, Branch
+from solver.core.codes import OK, SINGULAR, UNREACHABLE
+from solver.core.family import Branch
+from solver.core.spatial import rotation_about_z, wrap_angle
 from solver.families.opw.parameters import OpwParameters
-from solver.spatial import rotation_about_z, wrap_angle
 
 N_BRANCHES = 8
 # A solution whose |sin theta5|, elbow sine or shoulder lever (m) is below this is singular

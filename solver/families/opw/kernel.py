@@ -1,4 +1,4 @@
-"""The OPW family's pose kernel for the compiled map (:mod:`solver.map_kernel`): (cos, sin) pairs.
+"""The OPW family's pose kernel for the compiled maps (:mod:`solver.kernels`): (cos, sin) pairs.
 
 The same closed forms as :mod:`solver.families.opw.ik` and :mod:`solver.families.opw.jacobian`
 for a block of flange poses and all eight branches, with every angle kept as its (cos, sin) pair
@@ -17,7 +17,7 @@ import math
 import numpy as np
 from numba import njit
 
-from solver.families.base import OK, SINGULAR, UNREACHABLE
+from solver.core.codes import OK, SINGULAR, UNREACHABLE
 from solver.families.opw.ik import REACH_TOLERANCE, SINGULAR_TOLERANCE
 from solver.families.opw.parameters import OpwParameters
 from solver.families.pairs import unit_pair

@@ -12,7 +12,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from solver.exceptions import InvalidInputError
+from solver.core.exceptions import InvalidInputError
 
 MAX_LENGTH = 100.0  # m: no arm is bigger; beyond it a request is a typo
 

@@ -13,9 +13,10 @@ import re
 
 import numpy as np
 
+from solver.core.robots import Robot, example_robot_data_dir, robot_from_model
+from solver.families import robot_from_urdf
 from solver.families.ur.dh import E_SERIES_SPEEDS, UR_DH, ur_model_from_dh
 from solver.families.ur.family import UrFamily
-from solver.robots import Robot, example_robot_data_dir, robot_from_model, robot_from_urdf
 
 
 def _exact_right_angles(urdf: str) -> str:

@@ -35,9 +35,10 @@ import math
 
 import numpy as np
 
-from solver.families.base import OK, SINGULAR, UNREACHABLE, Branch
+from solver.core.codes import OK, SINGULAR, UNREACHABLE
+from solver.core.family import Branch
+from solver.core.spatial import wrap_angle
 from solver.families.ur.dh import UrDh
-from solver.spatial import wrap_angle
 
 N_BRANCHES = 8
 # A solution whose |sin q5|, |sin q3| or shoulder lever (m) is below this is singular. acos near

@@ -1,4 +1,4 @@
-"""The UR family's pose kernel for the compiled map (:mod:`solver.map_kernel`), in (cos, sin) pairs.
+"""The UR family's pose kernel for the compiled maps (:mod:`solver.kernels`), in (cos, sin) pairs.
 
 The same closed forms as :mod:`solver.families.ur.ik` and :mod:`solver.families.ur.jacobian`,
 for a block of flange poses and all eight branches at once, with every angle kept as its
@@ -18,7 +18,7 @@ import math
 import numpy as np
 from numba import njit
 
-from solver.families.base import OK, SINGULAR, UNREACHABLE
+from solver.core.codes import OK, SINGULAR, UNREACHABLE
 from solver.families.pairs import unit_pair
 from solver.families.ur.dh import UrDh
 from solver.families.ur.ik import REACH_TOLERANCE, SINGULAR_TOLERANCE

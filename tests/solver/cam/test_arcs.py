@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 from solver.cam.arcs import arc_points
-from solver.exceptions import InvalidLineError
+from solver.core.exceptions import InvalidLineError
 
 WHERE = {"field": "path.cl_data", "line": 7, "text": "CIRCLE/..."}
 

@@ -11,8 +11,8 @@ import pytest
 from solver.cam.cam_path import CamPath
 from solver.cam.cl_data import IGNORED
 from solver.cam.cl_data import read_cl_data as read_program
-from solver.exceptions import InvalidInputError, InvalidLineError
-from solver.tool_axis import poses_from_tool_axes
+from solver.core.exceptions import InvalidInputError, InvalidLineError
+from solver.core.tool_axis import poses_from_tool_axes
 from tests.cases import CAM_EXAMPLES, INCH_MM_ATOL
 
 TWO_CUTS = ["GOTO/0, 0, 0, 0, 0, 1", "GOTO/10, 0, 0, 0, 0, 1"]

@@ -16,7 +16,7 @@ import pytest
 
 from solver.cam.cl_data import read_cl_data
 from solver.cam.read_report import SkippedRecord
-from solver.exceptions import InvalidInputError, InvalidLineError
+from solver.core.exceptions import InvalidInputError, InvalidLineError
 from tests.solver.cam.dialects import NX_LISTING, SOLIDWORKS
 
 INCH = 0.0254

@@ -13,7 +13,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from solver.cam.cl_data import read_cl_data
-from solver.exceptions import SolverError
+from solver.core.exceptions import SolverError
 
 WORDS = [
     "GOTO", "CIRCLE", "FEDRAT", "RAPID", "UNITS", "UNIT", "MULTAX", "TLAXIS", "MSYS", "CSYS",

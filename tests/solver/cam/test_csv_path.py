@@ -8,7 +8,7 @@ from scipy.spatial.transform import Rotation
 
 from solver.cam.cl_data import read_cl_data
 from solver.cam.csv_path import read_csv_path
-from solver.exceptions import InvalidInputError, InvalidLineError
+from solver.core.exceptions import InvalidInputError, InvalidLineError
 from tests.cases import CAM_EXAMPLES, INCH_MM_ATOL
 
 # The pose CSV prints 9 decimals of metres and of the quaternion.

@@ -22,8 +22,8 @@ from solver.cam.frames import (
     quaternion_wxyz,
     quaternions_wxyz,
 )
-from solver.exceptions import InvalidInputError
-from solver.spatial import Placement
+from solver.core.exceptions import InvalidInputError
+from solver.core.spatial import Placement
 from tests.cases import FRAME_ROUND_TRIP_ATOL
 
 

@@ -11,11 +11,12 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from solver.core.kinematics import tool_pose_in_base
+from solver.core.robots import Robot
+from solver.core.spatial import Placement
+from solver.families import get_robot
 from solver.families.numeric import ik
 from solver.families.numeric.family import NumericFamily
-from solver.kinematics import tool_pose_in_base
-from solver.robots import Robot, get_robot
-from solver.spatial import Placement
 from tests.cases import FK_IK_ATOL
 from tests.solver.test_evaluate import load_path
 

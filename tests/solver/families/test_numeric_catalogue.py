@@ -7,7 +7,7 @@ import math
 import numpy as np
 import pytest
 
-from solver.robots import get_robot
+from solver.families import get_robot
 from tests.cases import NUMERIC_MODELS
 
 DEG = math.pi / 180

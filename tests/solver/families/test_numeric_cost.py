@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import pytest
 
+from solver.families import get_robot
 from solver.families.numeric.family import SEED_COST, TRACK_COST
-from solver.robots import get_robot
 from tests.cases import NUMERIC_MODELS, OPW_MODELS, UR_MODELS
 
 

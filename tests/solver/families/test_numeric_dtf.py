@@ -5,13 +5,13 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from solver.dtf import lp_speed
-from solver.dtf_redundant import redundant_speed
-from solver.evaluate import evaluate_path
-from solver.kinematics import jacobian_in_base
-from solver.robots import get_robot
-from solver.spatial import Placement
+from solver.core.dtf import lp_speed
+from solver.core.dtf_redundant import redundant_speed
+from solver.core.kinematics import jacobian_in_base
+from solver.core.spatial import Placement
+from solver.families import get_robot
 from tests.cases import DTF_LP_RTOL
+from tests.problems import evaluate_path
 from tests.solver.test_evaluate import load_path
 
 

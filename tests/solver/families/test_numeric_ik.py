@@ -6,16 +6,17 @@ import numpy as np
 import pinocchio as pin
 import pytest
 
-from solver.evaluate import evaluate_path
-from solver.exceptions import InvalidInputError
-from solver.families.base import OK, UNREACHABLE
+from solver.core.codes import OK, UNREACHABLE
+from solver.core.exceptions import InvalidInputError
+from solver.core.kinematics import jacobian_in_base, tool_pose_in_base
+from solver.core.robots import Robot, example_robot_data_dir
+from solver.core.spatial import Placement, wrap_angle
+from solver.families import get_robot, robot_from_urdf
 from solver.families.numeric.family import NumericFamily, seed_count
 from solver.families.numeric.ik import rotation_log
 from solver.families.ur.catalogue import _exact_right_angles
-from solver.kinematics import jacobian_in_base, tool_pose_in_base
-from solver.robots import Robot, example_robot_data_dir, get_robot, robot_from_urdf
-from solver.spatial import Placement, wrap_angle
 from tests.cases import FK_IK_ATOL, NUMERIC_MODELS
+from tests.problems import evaluate_path
 from tests.solver.test_evaluate import load_path
 
 

@@ -8,11 +8,10 @@ from collections.abc import Callable
 import numpy as np
 import pytest
 
-from solver.evaluate import evaluate_path
-from solver.exceptions import InvalidInputError
-from solver.joint_path import evaluate_joint_path
-from solver.optimize import PlacementOptimum, optimize_placement
-from solver.placement_scipy import (
+from solver.core.exceptions import InvalidInputError
+from solver.core.spatial import Placement, pose_matrix
+from solver.families import get_robot
+from solver.optimise.methods.placement_scipy import (
     FULL_SEARCH,
     MIN_GENERATIONS,
     MIN_POPULATION,
@@ -20,10 +19,11 @@ from solver.placement_scipy import (
     search_placements,
     search_size,
 )
-from solver.robots import get_robot
-from solver.search_space import PlacementBounds
-from solver.spatial import Placement, pose_matrix
+from solver.optimise.optimize import PlacementOptimum
+from solver.optimise.search_space import PlacementBounds
+from solver.path.joint_path import evaluate_joint_path
 from tests.cases import EXAMPLES, OPTIMUM_EVALUATE_RTOL
+from tests.problems import evaluate_path, optimize_placement, problem
 from tests.solver.test_optimize import best_coarse_cell
 
 BOUNDS = PlacementBounds(x=(-0.05, 0.05), y=(0.4, 0.5), yaw=(-0.3, 0.3), z=0.1)
@@ -74,7 +74,7 @@ def test_evaluating_the_answers_joint_path_reproduces_its_mu_path(
     assert casadi.placement is not None and casadi.joint_path is not None
     assert casadi.joint_path.shape == (N_WAYPOINTS, 7)
     evaluation = evaluate_joint_path(
-        robot, path, casadi.placement, casadi.joint_path, max_joint_step=0.35
+        problem(robot, path, max_joint_step=0.35), casadi.placement, casadi.joint_path
     )
     assert evaluation.mu_path == pytest.approx(casadi.mu_path, rel=1e-9)
 
@@ -110,7 +110,7 @@ def test_a_tracked_joint_path_evaluates_as_the_tracking_does(path: np.ndarray) -
     robot = get_robot("panda")
     tracked = evaluate_path(robot, path, PLACEMENT)
     assert tracked.q is not None and tracked.v_max is not None
-    given = evaluate_joint_path(robot, path, PLACEMENT, tracked.q, max_joint_step=0.35)
+    given = evaluate_joint_path(problem(robot, path, max_joint_step=0.35), PLACEMENT, tracked.q)
     assert given.mu_path == pytest.approx(tracked.mu_path, rel=1e-12)
     np.testing.assert_allclose(given.v_max, tracked.v_max, rtol=1e-12)
     assert given.bottleneck_joint == tracked.bottleneck_joint
@@ -137,6 +137,6 @@ def test_a_bad_joint_path_is_refused_naming_the_waypoint(
     tracked = evaluate_path(robot, path, PLACEMENT)
     assert tracked.q is not None
     with pytest.raises(InvalidInputError) as error:
-        evaluate_joint_path(robot, path, PLACEMENT, change(tracked.q), max_joint_step=0.35)
+        evaluate_joint_path(problem(robot, path, max_joint_step=0.35), PLACEMENT, change(tracked.q))
     assert error.value.field == "joint_path" and error.value.waypoint == waypoint
     assert words in error.value.message

@@ -8,9 +8,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from solver.capability_map import capability_map, grid_axis
-from solver.robots import get_robot
+from solver.families import get_robot
+from solver.path.capability_map import grid_axis
 from tests.cases import NUMERIC_VS_ANALYTIC_AGREEMENT, NUMERIC_VS_ANALYTIC_RTOL
+from tests.problems import capability_map
 from tests.solver.families.test_numeric_ik import ur5_as_urdf
 from tests.solver.test_evaluate import load_path
 

@@ -18,13 +18,13 @@ import py_opw_kinematics
 import pytest
 from scipy.spatial.transform import RigidTransform
 
-from solver.families.base import OK, SINGULAR, UNREACHABLE
+from solver.core.codes import OK, SINGULAR, UNREACHABLE
+from solver.core.kinematics import tool_pose_in_base
+from solver.core.robots import Robot
 from solver.families.opw.arms import ARMS
 from solver.families.opw.catalogue import robot_from_opw
 from solver.families.opw.ik import forward_kinematics, solve_components
 from solver.families.opw.parameters import OpwParameters
-from solver.kinematics import tool_pose_in_base
-from solver.robots import Robot
 from tests.cases import FK_IK_ATOL
 
 N_POSES = 1000

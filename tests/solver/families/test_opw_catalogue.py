@@ -7,12 +7,13 @@ import math
 import numpy as np
 import pytest
 
-from solver.exceptions import InvalidInputError
-from solver.families.base import UNREACHABLE, Branch
+from solver.core.codes import UNREACHABLE
+from solver.core.exceptions import InvalidInputError
+from solver.core.family import Branch
+from solver.core.kinematics import tool_pose_in_base
 from solver.families.opw.arms import ARMS, OpwArm
 from solver.families.opw.catalogue import robot_from_opw, robots
 from solver.families.opw.parameters import OpwParameters
-from solver.kinematics import tool_pose_in_base
 from tests.cases import FK_IK_ATOL
 from tests.solver.families.test_opw import ROWS
 

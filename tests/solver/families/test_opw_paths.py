@@ -7,22 +7,21 @@ import math
 import numpy as np
 import pytest
 
-from solver.capability_map import capability_map, grid_axis
-from solver.dtf import lp_speed
-from solver.evaluate import evaluate_path
-from solver.families.base import Branch
-from solver.kinematics import jacobian_in_base
-from solver.optimize import optimize_placement
-from solver.robots import get_robot
-from solver.search_space import PlacementBounds, vector_of
-from solver.spatial import Placement
-from solver.tracking import REASONS
+from solver.core.codes import REASONS
+from solver.core.dtf import lp_speed
+from solver.core.family import Branch
+from solver.core.kinematics import jacobian_in_base
+from solver.core.spatial import Placement
+from solver.families import get_robot
+from solver.optimise.search_space import PlacementBounds, vector_of
+from solver.path.capability_map import grid_axis
 from tests.cases import (
     DTF_LP_RTOL,
     MAP_EVALUATE_RTOL,
     OPTIMUM_EVALUATE_RTOL,
     OPTIMUM_METHODS_RTOL,
 )
+from tests.problems import capability_map, evaluate_path, optimize_placement
 from tests.solver.test_evaluate import load_path
 from tests.solver.test_optimize import best_coarse_cell
 

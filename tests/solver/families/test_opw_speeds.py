@@ -9,9 +9,9 @@ import numpy as np
 import pinocchio as pin
 import pytest
 
-from solver.dtf import lp_speed
-from solver.kinematics import jacobian_in_base, tool_pose_in_base
-from solver.robots import Robot
+from solver.core.dtf import lp_speed
+from solver.core.kinematics import jacobian_in_base, tool_pose_in_base
+from solver.core.robots import Robot
 from tests.cases import DTF_LP_RTOL
 from tests.solver.families.test_opw import GEOMETRIES, build, maker
 

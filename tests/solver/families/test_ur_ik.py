@@ -8,11 +8,12 @@ import numpy as np
 import pytest
 import ur_analytic_ik
 
-from solver.families.base import OK, UNREACHABLE, Branch
+from solver.core.codes import OK, UNREACHABLE
+from solver.core.family import Branch
+from solver.core.kinematics import jacobian_in_base, tool_pose_in_base
+from solver.core.spatial import wrap_angle
+from solver.families import get_robot
 from solver.families.ur.ik import BRANCHES, joint_copies, solve_batch
-from solver.kinematics import jacobian_in_base, tool_pose_in_base
-from solver.robots import get_robot
-from solver.spatial import wrap_angle
 from tests.cases import FK_IK_ATOL, UR_MODELS
 
 N_POSES = 1000

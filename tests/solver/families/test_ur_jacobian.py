@@ -7,8 +7,8 @@ import math
 import numpy as np
 import pytest
 
-from solver.kinematics import jacobian_in_base, tool_pose_in_base
-from solver.robots import get_robot
+from solver.core.kinematics import jacobian_in_base, tool_pose_in_base
+from solver.families import get_robot
 from tests.cases import UR_MODELS
 
 

@@ -1,0 +1,17 @@
+"""The service's own log lines (``dtf.*``): one logger for the jobs, sent to stderr once."""
+
+from __future__ import annotations
+
+import logging
+
+log = logging.getLogger("dtf.jobs")
+
+
+def log_to_stderr() -> None:
+    """Send the service's own log lines (``dtf.*``, INFO and up) to stderr, once."""
+    logger = logging.getLogger("dtf")
+    if not logger.handlers:
+        handler = logging.StreamHandler()
+        handler.setFormatter(logging.Formatter("%(asctime)s %(name)s %(message)s"))
+        logger.addHandler(handler)
+        logger.setLevel(logging.INFO)

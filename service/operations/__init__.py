@@ -1,0 +1,24 @@
+"""The use cases the routes and the job workers share (spec/architecture.md section 1).
+
+Each takes a validated request schema and the settings, checks the request's size, converts it,
+calls the solver and converts the answer back: a route adds HTTP (the body, the ``Accept``
+header, cancellation when the client leaves) and a job worker adds the store, but the answer is
+the same code's.
+"""
+
+from service.operations.evaluate import evaluation_of, joint_use_png
+from service.operations.map import checked_grid, computed_map, map_of, map_png
+from service.operations.optimize import optimum_of
+from service.operations.paths import import_of, imported
+
+__all__ = [
+    "checked_grid",
+    "computed_map",
+    "evaluation_of",
+    "import_of",
+    "imported",
+    "joint_use_png",
+    "map_of",
+    "map_png",
+    "optimum_of",
+]

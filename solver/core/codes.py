@@ -1,0 +1,27 @@
+"""Codes shared by the numpy pipeline and its compiled twins (one place for both).
+
+An IK solution's status (what a family's ``solve`` gives per pose and branch), and why a branch
+or a placement fails along a path (dtf.md section 4): an index into :data:`REASONS`, or
+:data:`FEASIBLE`. The compiled kernels use the same integers, so a kernel cell equals a numpy
+cell code for code.
+"""
+
+from __future__ import annotations
+
+from typing import Literal
+
+# Status of a (pose, branch) IK solution.
+OK = 0
+UNREACHABLE = 1
+SINGULAR = 2
+
+Reason = Literal["unreachable", "joint_limits", "singular", "discontinuous"]
+REASONS: tuple[Reason, ...] = ("unreachable", "joint_limits", "singular", "discontinuous")
+FEASIBLE = -1  # reason code of a feasible branch
+# The index of each reason in REASONS.
+REASON_UNREACHABLE, REASON_JOINT_LIMITS, REASON_SINGULAR, REASON_DISCONTINUOUS = range(4)
+# Branches whose mu_path is within this relative tolerance of the best tie; the first in the
+# family's order is chosen (dtf.md section 4).
+TIE_RTOL = 1e-12
+# Slack (rad) when fitting a joint's 2 pi copy inside its limits.
+EDGE = 1e-12

@@ -1,0 +1,331 @@
+"""The Decomposed Twist Feasibility (DTF) index at one configuration (spec section 3).
+
+Given the task direction (u_T, u_R) and the ratio h = V / Omega of a path segment, the DTF is the
+largest linear tool speed V_max such that the twist [V u_T; (V / h) u_R] needs no joint faster
+than its limit. For a non-singular 6-DOF arm it has a closed form (Sensors 2022 eq. 30); for every
+arm it is the optimum of a linear programme, solved here with HiGHS.
+
+Shapes: a Jacobian is (6, n), linear rows first, at the tool point with {B} axes
+(LOCAL_WORLD_ALIGNED); joint speeds are rad/s; batched functions put the batch axes first.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Literal
+
+import numpy as np
+import scipy.optimize
+
+from solver.core.exceptions import InvalidInputError
+
+UNIT_TOLERANCE = 1e-3  # cam.md section 6: a direction within it is normalised, beyond refused
+# Below this reciprocal condition number a 6x6 Jacobian is treated as singular and the LP is used.
+SINGULAR_RCOND = 1e-12
+
+Method = Literal["auto", "closed_form", "lp"]
+
+
+@dataclass(frozen=True)
+class DtfResult:
+    """The DTF at one configuration.
+
+    Attributes:
+        v_max: largest feasible linear tool speed (m/s); 0 for pure reorientation (h = 0).
+        omega_max: the angular speed that goes with it, V_max / h (rad/s); 0 for h = inf.
+        qdot: shape (n,), rad/s, the joint speeds at that maximum; one sits on its limit.
+        limiting_joint: index of the joint on its limit.
+        method: ``"closed_form"`` (J^-1) or ``"lp"`` (the linear programme).
+    """
+
+    v_max: float
+    omega_max: float
+    qdot: np.ndarray
+    limiting_joint: int
+    method: Literal["closed_form", "lp"]
+
+
+def _unit(vector: np.ndarray | list[float], field: str) -> np.ndarray:
+    """``vector`` normalised, if it is a finite 3-vector of unit norm to 1e-3 (cam.md section 6).
+
+    Papers print 4 decimals and CAM writes 4-6: the Sensors 2022 table 4 directions typed as
+    printed are off unit by up to about 1e-4.
+    """
+    arr = np.asarray(vector, dtype=float)
+    if arr.shape != (3,) or not np.all(np.isfinite(arr)):
+        raise InvalidInputError(field, f"needs 3 finite numbers, got {arr.tolist()}")
+    largest = float(np.max(np.abs(arr)))
+    # Scaled first, so that neither 1e-200 nor 1e200 under- or overflows the squares.
+    norm = largest * float(np.linalg.norm(arr / largest)) if largest > 0.0 else 0.0
+    if abs(norm - 1.0) > UNIT_TOLERANCE:
+        raise InvalidInputError(
+            field, f"norm is {norm:.6g}; a unit vector is needed (within 1e-3, then normalised)"
+        )
+    return arr / norm
+
+
+def twist_per_unit_speed(
+    u_T: np.ndarray | list[float] | None, u_R: np.ndarray | list[float] | None, h: float
+) -> np.ndarray:
+    """Task twist direction t_hat = [u_T; u_R / h] (spec section 3).
+
+    Args:
+        u_T: shape (3,), unit direction of the linear velocity in {B}; unused when h = 0.
+        u_R: shape (3,), unit direction of the angular velocity in {B}; unused when h = inf.
+        h: V / Omega in metres (>= 0); ``math.inf`` for pure translation, 0 for pure
+            reorientation, in which case the twist is per unit angular speed, [0; u_R].
+
+    Returns:
+        shape (6,): [m/s; rad/s] per m/s of linear speed (per rad/s when h = 0).
+
+    Raises:
+        InvalidInputError: a direction that is not a unit vector, or h < 0 or NaN.
+    """
+    if not (h >= 0.0):
+        raise InvalidInputError(
+            "h", f"h = {h:.6g} m; it must be >= 0 (or null for pure translation)"
+        )
+    twist = np.zeros(6)
+    if h > 0.0:
+        twist[:3] = _unit(np.zeros(3) if u_T is None else u_T, "u_T")
+    if math.isfinite(h):
+        rotation = _unit(np.zeros(3) if u_R is None else u_R, "u_R")
+        with np.errstate(over="ignore"):
+            twist[3:] = rotation if h == 0.0 else rotation / h
+    if not np.all(np.isfinite(twist)):
+        raise InvalidInputError(
+            "h", f"h = {h:.6g} m is too small to divide by; use 0 for pure reorientation"
+        )
+    return twist
+
+
+def closed_form_batch(
+    jacobian: np.ndarray, twist: np.ndarray, qdot_max: np.ndarray
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Spec section 3, closed form, batched: qd = J^-1 t_hat, speed = 1 / ||W qd||_inf.
+
+    Args:
+        jacobian: shape (..., 6, 6), non-singular, {B} axes at the tool point.
+        twist: shape (..., 6), t_hat per unit speed.
+        qdot_max: shape (6,), rad/s.
+
+    Returns:
+        speed: shape (...), the largest feasible speed (m/s, or rad/s for h = 0);
+        qdot: shape (..., 6), rad/s at that speed; limiting: shape (...), the joint on its limit.
+    """
+    qd_unit = np.linalg.solve(jacobian, twist[..., None])[..., 0]
+    ratio = np.abs(qd_unit) / qdot_max
+    limiting = np.argmax(ratio, axis=-1)
+    worst = np.take_along_axis(ratio, limiting[..., None], axis=-1)[..., 0]
+    with np.errstate(divide="ignore"):
+        speed = 1.0 / worst
+    return speed, qd_unit * speed[..., None], limiting
+
+
+def two_variable_speed(
+    a: np.ndarray, b: np.ndarray, qdot_max: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
+    """The exact two-variable LP, batched: max s s.t. |s a_j + sigma b_j| <= qdot_max_j.
+
+    robots.md section 5 (a = J^+ t_hat, b a null-space vector of a 7-joint arm) and cam.md
+    section 2 (a = J^-1 t_hat, b = J^-1 [0; z_tool], sigma the free tool spin rate). For fixed s,
+    joint j allows sigma in an interval of centre -s a_j / b_j and half-width m_j / |b_j|; all
+    intervals meet exactly when every two do (one dimension), and two meet while
+    s <= (m_j |b_k| + m_k |b_j|) / |a_j b_k - a_k b_j|. So the optimum is the least of these over
+    the pairs j < k: exact, with no vertex search (a joint with b_j = 0 gives m_j / |a_j| in
+    every pair, as the one-variable closed form does).
+
+    Args:
+        a: shape (n, ...), joint speeds per unit s (rad/s per m/s).
+        b: shape (n, ...), joint speeds per unit sigma.
+        qdot_max: shape (n,), rad/s, > 0.
+
+    Returns:
+        speed: shape (...), the optimum s (inf where nothing bounds it, NaN where a or b is);
+        limiting: shape (...), the joint on its limit that bounds s: of the binding pair, the
+        one sigma helps less (smaller |b_j| / qdot_max_j; for a straight spindle, never the
+        spindle joint).
+    """
+    limits = np.asarray(qdot_max, dtype=float).reshape((-1,) + (1,) * (a.ndim - 1))
+    rows, cols = np.triu_indices(len(a), k=1)
+    abs_b = np.abs(b)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        bound = (limits[rows] * abs_b[cols] + limits[cols] * abs_b[rows]) / np.abs(
+            a[rows] * b[cols] - a[cols] * b[rows]
+        )
+        help_ = abs_b / limits
+    nan = np.isnan(bound)
+    pair = np.where(nan, np.inf, bound).argmin(axis=0)
+    speed = np.take_along_axis(np.where(nan, np.inf, bound), pair[None], axis=0)[0]
+    speed = np.where(np.isnan(a).any(axis=0) | np.isnan(b).any(axis=0), np.nan, speed)
+    first, second = rows[pair], cols[pair]
+    first_help = np.take_along_axis(help_, first[None], axis=0)[0]
+    second_help = np.take_along_axis(help_, second[None], axis=0)[0]
+    limiting = np.where(first_help <= second_help, first, second)
+    return speed, limiting
+
+
+def spin_rate_nearest_zero(
+    a: np.ndarray, b: np.ndarray, qdot_max: np.ndarray, speed: np.ndarray
+) -> np.ndarray:
+    """The sigma nearest 0 with |speed a_j + sigma b_j| <= qdot_max_j for every joint j.
+
+    At the optimum of :func:`two_variable_speed` the interval of sigma is a point, which rounding
+    can make empty, and a joint with b_j near 0 bounds it by (noise) / b_j: so the interval is
+    taken at speed (1 - 1e-12), where it is a short interval, and the joints are then within
+    their limits to about 1e-12.
+
+    Args:
+        a: shape (n, ...), joint speeds per unit s, as for :func:`two_variable_speed`.
+        b: shape (n, ...), joint speeds per unit sigma.
+        qdot_max: shape (n,), rad/s.
+        speed: shape (...), at most the optimum of :func:`two_variable_speed`.
+
+    Returns:
+        shape (...), sigma (0 where no joint constrains it or the inputs are not finite).
+    """
+    limits = np.asarray(qdot_max, dtype=float).reshape((-1,) + (1,) * (a.ndim - 1))
+    inside = np.asarray(speed) * (1.0 - 1e-12)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        one = (-limits - inside * a) / b
+        other = (limits - inside * a) / b
+    low = np.where(b == 0.0, -np.inf, np.minimum(one, other)).max(axis=0)
+    high = np.where(b == 0.0, np.inf, np.maximum(one, other)).min(axis=0)
+    sigma = np.where(low > high, (low + high) / 2, np.clip(0.0, low, high))
+    return np.where(np.isfinite(sigma), sigma, 0.0)
+
+
+def decomposed_speed(
+    jacobian: np.ndarray, u_T: np.ndarray, u_R: np.ndarray, h: float, qdot_max: np.ndarray
+) -> float:
+    """Sensors 2022 eq. (30): V_max = || W (J~_T^+ u_T + h^-1 J~_R^+ u_R) ||_inf^-1.
+
+    J~_T = J_T P_R is the translational Jacobian restricted to the null space of J_R (P_R the
+    projector onto it), and J~_R = J_R P_T likewise (eq. 23); for a non-singular 6x6 J their
+    pseudo-inverses are the two column blocks of J^-1.
+
+    Args:
+        jacobian: shape (6, 6), non-singular.
+        u_T: shape (3,), unit linear direction in {B}.
+        u_R: shape (3,), unit angular direction in {B}.
+        h: V / Omega (m), > 0 (inf allowed).
+        qdot_max: shape (6,), rad/s.
+    """
+    j_t, j_r = jacobian[:3], jacobian[3:]
+    eye = np.eye(jacobian.shape[1])
+    project_null_r = eye - np.linalg.pinv(j_r) @ j_r
+    project_null_t = eye - np.linalg.pinv(j_t) @ j_t
+    joint_speeds = np.linalg.pinv(j_t @ project_null_r) @ u_T
+    if math.isfinite(h):
+        joint_speeds = joint_speeds + np.linalg.pinv(j_r @ project_null_t) @ (u_R / h)
+    return float(1.0 / np.max(np.abs(joint_speeds) / qdot_max))
+
+
+def lp_speed(
+    jacobian: np.ndarray, twist: np.ndarray, *, qdot_max: np.ndarray
+) -> tuple[float, np.ndarray]:
+    """Spec section 3, exact for every n: max s s.t. J qdot = s t_hat, |qdot| <= qdot_max.
+
+    Args:
+        jacobian: shape (6, n).
+        twist: shape (6,), t_hat.
+        qdot_max: shape (n,), rad/s.
+
+    Returns:
+        The optimum s and the joint speeds qdot there, shape (n,).
+    """
+    # Solved in scaled variables, x = qdot / qdot_max in [-1, 1] and t / max|t|, so that a tiny h
+    # (u_R / h large) or unusual limits do not reach HiGHS as extreme coefficients.
+    n = jacobian.shape[1]
+    scale = float(np.max(np.abs(twist)))
+    cost = np.zeros(n + 1)
+    cost[-1] = -1.0
+    a_eq = np.hstack([jacobian * qdot_max, -twist[:, None] / scale])
+    bounds = [(-1.0, 1.0)] * n + [(0.0, None)]
+    result = scipy.optimize.linprog(
+        cost,
+        A_eq=a_eq,
+        b_eq=np.zeros(6),
+        bounds=bounds,
+        method="highs",
+        options={"primal_feasibility_tolerance": 1e-10, "dual_feasibility_tolerance": 1e-10},
+    )
+    if result.status != 0:  # The origin is always feasible and s is bounded: not expected.
+        raise RuntimeError(f"HiGHS failed on the DTF LP: {result.message}")
+    return float(result.x[-1]) / scale, np.asarray(result.x[:n]) * qdot_max
+
+
+def dtf(
+    jacobian: np.ndarray,
+    *,
+    u_T: np.ndarray | list[float] | None,
+    u_R: np.ndarray | list[float] | None,
+    h: float,
+    qdot_max: np.ndarray | list[float],
+    method: Method = "auto",
+) -> DtfResult:
+    """The DTF index: Sensors 2022 eq. (29)-(33), ERK 2021 eq. (18).
+
+    ``auto`` uses the closed form for a non-singular 6x6 Jacobian and the LP otherwise (redundant
+    arms, singular configurations).
+
+    Args:
+        jacobian: shape (6, n), {B} axes at the tool point, linear rows first.
+        u_T: shape (3,), unit linear direction; unused when h = 0.
+        u_R: shape (3,), unit angular direction; unused when h = inf.
+        h: V / Omega (m), >= 0; ``math.inf`` for pure translation, 0 for pure reorientation.
+        qdot_max: shape (n,), rad/s, > 0.
+        method: ``"auto"``, ``"closed_form"`` or ``"lp"``.
+
+    Raises:
+        InvalidInputError: bad directions, h, limits, or ``closed_form`` asked for where J is not
+            square and invertible.
+    """
+    jac = np.asarray(jacobian, dtype=float)
+    limits = np.asarray(qdot_max, dtype=float)
+    n = jac.shape[1] if jac.ndim == 2 else -1
+    if jac.shape != (6, n) or not np.all(np.isfinite(jac)):
+        raise InvalidInputError("jacobian", f"{jac.shape=}, needs (6, n) finite values")
+    if limits.shape != (n,) or not np.all(np.isfinite(limits)) or np.any(limits <= 0):
+        raise InvalidInputError("qdot_max", f"{limits.shape=}, needs ({n},) values > 0")
+    twist = twist_per_unit_speed(u_T, u_R, h)
+    square_regular = n == 6 and np.linalg.cond(jac) * SINGULAR_RCOND < 1.0
+    if method == "closed_form" and not square_regular:
+        raise InvalidInputError(
+            "method", "closed_form needs a non-singular 6x6 Jacobian; use lp or auto"
+        )
+    if method == "closed_form" or (method == "auto" and square_regular):
+        speed_arr, qdot_arr, limiting_arr = closed_form_batch(jac, twist, limits)
+        speed, qdot, limiting = float(speed_arr), qdot_arr, int(limiting_arr)
+        used: Literal["closed_form", "lp"] = "closed_form"
+    else:
+        speed, qdot = lp_speed(jac, twist, qdot_max=limits)
+        limiting = int(np.argmax(np.abs(qdot) / limits))
+        used = "lp"
+    if h == 0.0:
+        return DtfResult(0.0, speed, qdot, limiting, used)
+    omega = 0.0 if math.isinf(h) else speed / h
+    return DtfResult(speed, omega, qdot, limiting, used)
+
+
+def yoshikawa(jacobian: np.ndarray) -> float:
+    """Yoshikawa's manipulability w = sqrt(det(J J^T)) (Sensors 2022 eq. 4)."""
+    jac = np.asarray(jacobian, dtype=float)
+    return float(math.sqrt(max(np.linalg.det(jac @ jac.T), 0.0)))
+
+
+def chiu(jacobian: np.ndarray, twist_direction: np.ndarray) -> float:
+    """Chiu's velocity transmission ratio [t^T (J J^T)^-1 t]^(-1/2), t = t_hat / |t_hat|.
+
+    Sensors 2022 eq. (6). It mixes metres and radians in one norm, which is why DTF exists;
+    reported for comparison only. 0 when t is outside the range of J.
+    """
+    jac = np.asarray(jacobian, dtype=float)
+    t = np.asarray(twist_direction, dtype=float)
+    t = t / np.max(np.abs(t))  # first, so that the norm cannot overflow
+    t = t / np.linalg.norm(t)
+    solution, _, rank, _ = np.linalg.lstsq(jac @ jac.T, t, rcond=None)
+    if rank < 6 and np.linalg.norm(jac @ np.linalg.pinv(jac) @ t - t) > 1e-9:
+        return 0.0
+    return float(1.0 / math.sqrt(float(t @ solution)))

@@ -1,0 +1,121 @@
+"""Who runs the placement engine's tasks: in turn, on a thread pool, or on a cluster.
+
+:func:`solver.path.placements.evaluate_placements` cuts its placements into tasks of consecutive
+rows and hands them to a :class:`TaskRunner`. A runner returns the results in task order, so
+every runner gives the same answer; it only decides where and how many at once. A runner calls
+``done(i)`` as task ``i`` completes; when ``done`` raises (a progress callback raising
+:class:`solver.core.progress.Cancelled`), the runner drops the tasks not yet started and re-raises.
+
+The service adds a runner on a Dask cluster (``service/jobs/dask_runner.py``) behind the same
+protocol; the solver never imports Dask.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Sequence
+from concurrent.futures import FIRST_COMPLETED, Future, ThreadPoolExecutor, wait
+from typing import Protocol, TypeVar
+
+__all__ = ["SERIAL", "SerialRunner", "TaskRunner", "ThreadRunner"]
+
+T = TypeVar("T")
+R = TypeVar("R")
+
+
+class TaskRunner(Protocol):
+    """Runs independent tasks and returns their results in order.
+
+    Attributes:
+        threads: how many threads of this process the caller's own work may use beside its
+            tasks (1: none beside the calling thread; a cluster's runner says 1).
+    """
+
+    threads: int
+
+    def task_size(self, n_placements: int, chunk: int) -> int:
+        """Placements per task for a run of ``n_placements`` (a multiple of ``chunk``)."""
+        ...
+
+    def run(
+        self, work: Callable[[T], R], tasks: Sequence[T], done: Callable[[int], None]
+    ) -> list[R]:
+        """``[work(t) for t in tasks]``, calling ``done(i)`` as task ``i`` completes.
+
+        Raises:
+            Whatever ``done`` raises, after the tasks not yet started are dropped.
+        """
+        ...
+
+
+def tasks_of(n_placements: int, chunk: int, *, per_worker: int, workers: int, cap: int) -> int:
+    """A task size giving each worker about ``per_worker`` tasks, in whole chunks, at most cap."""
+    size = math.ceil(n_placements / max(1, per_worker * workers))
+    return max(chunk, min(cap, math.ceil(size / chunk) * chunk))
+
+
+class SerialRunner:
+    """One task after the other in the calling thread, a chunk per task (the reference)."""
+
+    threads = 1
+
+    def task_size(self, n_placements: int, chunk: int) -> int:
+        """One chunk per task, so progress is reported per chunk."""
+        return chunk
+
+    def run(
+        self, work: Callable[[T], R], tasks: Sequence[T], done: Callable[[int], None]
+    ) -> list[R]:
+        """The tasks in turn."""
+        results = []
+        for i, task in enumerate(tasks):
+            results.append(work(task))
+            done(i)
+        return results
+
+
+SERIAL = SerialRunner()
+"""The default runner."""
+
+
+class ThreadRunner:
+    """Tasks on a pool of threads (numpy releases the GIL in its array loops).
+
+    Args:
+        threads: threads at most, >= 1.
+    """
+
+    def __init__(self, threads: int) -> None:
+        """A runner on ``threads`` threads (made per run, so a runner holds no threads)."""
+        if threads < 1:
+            raise ValueError(f"{threads=} must be >= 1")
+        self.threads = threads
+
+    def task_size(self, n_placements: int, chunk: int) -> int:
+        """About four tasks per thread, so the threads finish together; each short.
+
+        Progress (and a cancel) is seen as tasks complete, so no task may be long.
+        """
+        return tasks_of(n_placements, chunk, per_worker=4, workers=self.threads, cap=4 * chunk)
+
+    def run(
+        self, work: Callable[[T], R], tasks: Sequence[T], done: Callable[[int], None]
+    ) -> list[R]:
+        """The tasks on the pool; each completion reported as it happens."""
+        if self.threads == 1 or len(tasks) <= 1:
+            return SERIAL.run(work, tasks, done)
+        with ThreadPoolExecutor(self.threads, thread_name_prefix="dtf-task") as pool:
+            futures = [pool.submit(work, task) for task in tasks]
+            index = {future: i for i, future in enumerate(futures)}
+            pending: set[Future[R]] = set(futures)
+            try:
+                while pending:
+                    finished, pending = wait(pending, return_when=FIRST_COMPLETED)
+                    for future in finished:
+                        future.result()  # a task's exception, raised here
+                        done(index[future])
+            except BaseException:
+                for future in pending:
+                    future.cancel()
+                raise
+            return [future.result() for future in futures]

@@ -1,0 +1,248 @@
+"""Robot models: a pinocchio chain with its base frame, tool point, limits and IK family.
+
+A :class:`Robot` wraps a pinocchio model with the two frames the method needs: the base frame
+{B} in which poses and twists are expressed, and the tool point {TCP} (the tool frame {F} times
+an optional offset T_F_TCP), plus the kinematics family that solves its IK (robots.md section 1).
+The catalogue, and the numeric family a URDF arm gets by default, are the families' registry's
+(:mod:`solver.families`, a layer above); this module reads URDFs, builds robots and checks
+limits.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import importlib.metadata
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+import pinocchio as pin
+
+from solver.core.exceptions import InvalidInputError, RobotModelError, quoted
+from solver.core.family import KinematicsFamily
+
+# Joint speed limits outside this range (rad/s) are input errors: no arm is that slow or fast,
+# and the LP solver treats bounds past 1e20 as infinite.
+MIN_SPEED_LIMIT = 1e-6
+MAX_SPEED_LIMIT = 1e4
+
+
+@dataclass(frozen=True, eq=False)
+class Robot:
+    """A serial arm with its base frame, tool point and joint limits.
+
+    Attributes:
+        name: catalogue name, or ``"urdf"`` for a robot read from a request.
+        model: pinocchio model; its frame ``tool_point_frame`` is the tool point {TCP}.
+        base_frame: name of the frame {B} poses and twists are expressed in.
+        tool_frame: name of the tool frame {F} (the flange for UR arms).
+        joint_names: names of the n joints, in configuration order.
+        q_lower: shape (n,), rad, lower joint position limits.
+        q_upper: shape (n,), rad, upper joint position limits.
+        qdot_max: shape (n,), rad/s, joint speed limits (all > 0).
+        transform_tool_to_tcp: shape (4, 4), the tool point in the tool frame, T_F_TCP.
+        transform_world_to_base: shape (4, 4), {B} in the model's root frame (fixed).
+        family: the kinematics family that solves its IK and J^-1 t (robots.md section 1):
+            an analytic one, or the numeric one for any other serial chain of six joints or
+            more; ``None`` for a shorter chain (``/v1/dtf`` only).
+    """
+
+    name: str
+    model: pin.Model
+    base_frame: str
+    tool_frame: str
+    joint_names: tuple[str, ...]
+    q_lower: np.ndarray
+    q_upper: np.ndarray
+    qdot_max: np.ndarray
+    transform_tool_to_tcp: np.ndarray
+    transform_world_to_base: np.ndarray
+    family: KinematicsFamily | None = None
+
+    @property
+    def dof(self) -> int:
+        """Number of joints n."""
+        return len(self.joint_names)
+
+    @property
+    def tool_point_frame(self) -> int:
+        """Pinocchio frame id of the tool point {TCP}."""
+        return int(self.model.getFrameId("tool_point"))
+
+    def with_options(
+        self,
+        *,
+        qdot_max: np.ndarray | list[float] | None = None,
+        transform_tool_to_tcp: np.ndarray | None = None,
+    ) -> Robot:
+        """Return a copy with other joint speed limits and/or another tool point.
+
+        Args:
+            qdot_max: shape (n,), rad/s, each finite and > 0; ``None`` keeps the model's.
+            transform_tool_to_tcp: shape (4, 4), T_F_TCP; ``None`` keeps the current one.
+
+        Raises:
+            InvalidInputError: a limit has the wrong shape, is not finite or is <= 0.
+        """
+        robot = self
+        if qdot_max is not None:
+            limits = check_speed_limits(qdot_max, self.joint_names)
+            robot = dataclasses.replace(robot, qdot_max=limits)
+        if transform_tool_to_tcp is not None:
+            tcp = np.asarray(transform_tool_to_tcp, dtype=float)
+            model = pin.Model(robot.model)
+            _set_tool_point(model, robot.tool_frame, tcp)
+            robot = dataclasses.replace(robot, model=model, transform_tool_to_tcp=tcp.copy())
+        return robot
+
+
+def check_speed_limits(
+    qdot_max: np.ndarray | list[float], joint_names: tuple[str, ...]
+) -> np.ndarray:
+    """Joint speed limits as a float array, after checking them.
+
+    Args:
+        qdot_max: shape (n,), rad/s, each in [MIN_SPEED_LIMIT, MAX_SPEED_LIMIT].
+        joint_names: the n joint names, for the message.
+
+    Raises:
+        InvalidInputError: wrong length, not finite, or out of range.
+    """
+    limits = np.array(qdot_max, dtype=float)
+    field = "robot.joint_velocity_limits"
+    if limits.shape != (len(joint_names),):
+        raise InvalidInputError(
+            field, f"{limits.shape=} but the robot has {len(joint_names)} joints"
+        )
+    bad = np.flatnonzero(
+        ~np.isfinite(limits) | (limits < MIN_SPEED_LIMIT) | (limits > MAX_SPEED_LIMIT)
+    )
+    if bad.size:
+        j = int(bad[0])
+        raise InvalidInputError(
+            field,
+            f"joint {j} ({joint_names[j]}) limit {float(limits[j]):.6g} rad/s must be > 0, within "
+            f"[{MIN_SPEED_LIMIT}, {MAX_SPEED_LIMIT}] rad/s",
+        )
+    return limits
+
+
+def _set_tool_point(model: pin.Model, tool_frame: str, transform_tool_to_tcp: np.ndarray) -> None:
+    """Add (or move) the frame ``tool_point`` = tool frame * T_F_TCP in ``model``."""
+    tool = model.frames[model.getFrameId(tool_frame)]
+    placement = tool.placement * pin.SE3(transform_tool_to_tcp)
+    if model.existFrame("tool_point"):
+        model.frames[model.getFrameId("tool_point")].placement = placement
+    else:
+        model.addFrame(pin.Frame("tool_point", tool.parentJoint, placement, pin.FrameType.OP_FRAME))
+
+
+def robot_from_model(
+    name: str,
+    model: pin.Model,
+    *,
+    base_frame: str,
+    tool_frame: str,
+    qdot_max: np.ndarray | list[float] | None = None,
+    family: KinematicsFamily | None,
+) -> Robot:
+    """Check the frames of ``model`` and wrap it as a :class:`Robot`.
+
+    Args:
+        name: name reported for the robot.
+        model: pinocchio model of the chain (1-DOF joints only).
+        base_frame: frame {B}, fixed to the root.
+        tool_frame: the flange frame {F}.
+        qdot_max: shape (n,), rad/s; ``None`` takes the model's velocity limits.
+        family: the kinematics family; ``None`` for none (``/v1/dtf`` only). The registry's
+            :func:`solver.families.default_family` gives the numeric one to a serial chain of
+            six joints or more.
+
+    Raises:
+        RobotModelError: a frame is missing or moves, a joint is not 1-DOF, or the model's
+            speed limits are unusable and none are given.
+    """
+    for field, frame in (("robot.base_frame", base_frame), ("robot.tool_frame", tool_frame)):
+        if not model.existFrame(frame):
+            names = ", ".join(f.name for f in model.frames if f.name != "universe")
+            raise RobotModelError(field, f"no frame {quoted(frame)} in the model; frames: {names}")
+    base = model.frames[model.getFrameId(base_frame)]
+    if base.parentJoint != 0:
+        raise RobotModelError(
+            "robot.base_frame",
+            f"frame {base_frame!r} moves with joint {model.names[base.parentJoint]!r}; "
+            "the base frame must be fixed to the root",
+        )
+    if any(model.joints[j].nq != 1 or model.joints[j].nv != 1 for j in range(1, model.njoints)):
+        raise RobotModelError(
+            "robot.urdf", "only revolute and prismatic joints are supported between base and tool"
+        )
+    data = model.createData()
+    pin.framesForwardKinematics(model, data, pin.neutral(model))
+    transform_world_to_base = data.oMf[model.getFrameId(base_frame)].homogeneous.copy()
+    joint_names = tuple(model.names[1:])
+    if qdot_max is not None:
+        limits = check_speed_limits(qdot_max, joint_names)
+    else:
+        try:
+            limits = check_speed_limits(model.velocityLimit, joint_names)
+        except InvalidInputError as exc:
+            raise RobotModelError(
+                "robot.urdf", f"{exc.message}; give robot.joint_velocity_limits (rad/s)"
+            ) from exc
+    _set_tool_point(model, tool_frame, np.eye(4))
+    robot = Robot(
+        name=name,
+        model=model,
+        base_frame=base_frame,
+        tool_frame=tool_frame,
+        joint_names=joint_names,
+        q_lower=model.lowerPositionLimit.copy(),
+        q_upper=model.upperPositionLimit.copy(),
+        qdot_max=limits,
+        transform_tool_to_tcp=np.eye(4),
+        transform_world_to_base=transform_world_to_base,
+        family=family,
+    )
+    return robot
+
+
+def chain_from_urdf(urdf: str, *, tool_frame: str) -> pin.Model:
+    """Read the serial chain from the root to ``tool_frame`` out of URDF text.
+
+    Joints that do not move the tool frame (grippers, fingers) are locked at their neutral
+    position, so the model is the chain from the root to ``tool_frame``.
+
+    Args:
+        urdf: the URDF document.
+        tool_frame: link or frame of the tool flange.
+
+    Raises:
+        RobotModelError: the URDF cannot be parsed, the frame is missing or no joint moves it.
+    """
+    try:
+        full = pin.buildModelFromXML(urdf)
+    except (RuntimeError, ValueError) as exc:
+        raise RobotModelError("robot.urdf", f"cannot parse the URDF: {exc}") from exc
+    if not full.existFrame(tool_frame):
+        names = ", ".join(f.name for f in full.frames if f.name != "universe")
+        raise RobotModelError(
+            "robot.tool_frame", f"no frame {quoted(tool_frame)} in the model; frames: {names}"
+        )
+    tool_joint = full.frames[full.getFrameId(tool_frame)].parentJoint
+    chain = set(full.supports[tool_joint])
+    locked = [j for j in range(1, full.njoints) if j not in chain]
+    model = pin.buildReducedModel(full, locked, pin.neutral(full)) if locked else full
+    if model.nv == 0:
+        raise RobotModelError("robot.tool_frame", f"no joint moves frame {quoted(tool_frame)}")
+    return model
+
+
+def example_robot_data_dir() -> Path:
+    """Folder of the robot descriptions the ``example-robot-data`` wheel installs.
+
+    The wheel ships URDFs only (its Python loader is another package, which we do not use), so
+    files are found through the distribution's metadata.
+    """
+    dist = importlib.metadata.distribution("example-robot-data")
+    return Path(str(dist.locate_file("cmeel.prefix/share/example-robot-data/robots")))

@@ -1,0 +1,332 @@
+"""The map's compiled kernel in free spin: the pipeline's free mode per placement, in one loop.
+
+cam.md section 2. For the closed-form families with the tool spin rate free,
+:func:`solver.path.placements.evaluate_placements` runs this kernel instead of the numpy pipeline
+(:func:`solver.path.pipeline.run_chunk` with ``spin_mode="free"``), which stays the reference it is
+tested against (tests/solver/test_free_spin_kernel.py). Per placement:
+
+1. the path turned by the yaw and moved (:func:`solver.kernels.fixed_spin.turned_poses`); IK and
+   J^-1 t_hat on the branches still alive, then J^-1 [0; z_tool] (the family's pose kernel run
+   a second time with the spin twist), blocks of waypoints as in :mod:`solver.kernels.fixed_spin`;
+2. each branch: unreachable, singular, then the step test against the previous waypoint, no
+   position limits (they hold along the spin schedule); V_max by the exact two-variable LP
+   (:func:`solver.core.dtf.two_variable_speed`) and its running minimum, mu_path;
+3. each branch still feasible, fastest first, until one holds (and those tied with it): the
+   spin rate nearest zero at the feed mu_path
+   (:func:`solver.core.dtf.spin_rate_nearest_zero`), the joints moved by the spin
+   (:func:`solver.path.pipeline._spin_schedule`), and that joint path tracked again with the
+   position limits and the step test (:func:`solver.path.tracking.track`);
+4. the branch: :func:`solver.path.tracking.choose_branch`'s rule.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+from solver.core.codes import (
+    FEASIBLE,
+    REASON_DISCONTINUOUS,
+    REASON_JOINT_LIMITS,
+    REASON_SINGULAR,
+    REASON_UNREACHABLE,
+    SINGULAR,
+    TIE_RTOL,
+    UNREACHABLE,
+)
+from solver.families.kernels import SCRATCH_ROWS, pose_block
+from solver.kernels.fixed_spin import (
+    BLOCK,
+    drop_stale_compiled_code,
+    first_outside,
+    turned_poses,
+    unwrapped,
+    warm_up_placement,
+    wrapped_step,
+    write_cell,
+)
+
+_TWO_PI = 2 * math.pi
+_INSIDE = 1.0 - 1e-12  # as solver.core.dtf.spin_rate_nearest_zero
+_HUGE = np.finfo(np.float64).max  # numpy.nan_to_num's value for inf
+
+drop_stale_compiled_code(__name__)
+
+
+@njit(cache=True, error_model="numpy", nogil=True)
+def _two_variable_speed(qd, qs, b, w, qdot_max):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
+    """The largest s with |s a_j + sigma b_j| <= qdot_max_j, and the joint on its limit.
+
+    :func:`solver.core.dtf.two_variable_speed` at one waypoint (a = qd[b, :, w], b = qs[b, :, w]):
+    the least pair bound, the first pair at a tie, of the pair the joint sigma helps less.
+    """
+    best = np.inf
+    first, second = 0, 1
+    dof = qd.shape[1]
+    for j in range(dof):
+        for k in range(j + 1, dof):
+            bound = (qdot_max[j] * abs(qs[b, k, w]) + qdot_max[k] * abs(qs[b, j, w])) / abs(
+                qd[b, j, w] * qs[b, k, w] - qd[b, k, w] * qs[b, j, w]
+            )
+            if bound < best:  # a NaN bound (0 / 0) is no bound
+                best = bound
+                first, second = j, k
+    help_first = abs(qs[b, first, w]) / qdot_max[first]
+    help_second = abs(qs[b, second, w]) / qdot_max[second]
+    return best, first if help_first <= help_second else second
+
+
+@njit(cache=True, error_model="numpy", nogil=True)
+def _spin_rate(qd, qs, b, w, qdot_max, feed):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
+    """:func:`solver.core.dtf.spin_rate_nearest_zero` at one waypoint, at the feed."""
+    inside = feed * _INSIDE
+    low, high = -np.inf, np.inf
+    for j in range(qd.shape[1]):
+        if qs[b, j, w] == 0.0:
+            continue
+        one = (-qdot_max[j] - inside * qd[b, j, w]) / qs[b, j, w]
+        other = (qdot_max[j] - inside * qd[b, j, w]) / qs[b, j, w]
+        low = max(low, min(one, other))
+        high = min(high, max(one, other))
+    sigma = (low + high) / 2 if low > high else min(max(0.0, low), high)
+    return sigma if math.isfinite(sigma) else 0.0
+
+
+@njit(cache=True, error_model="numpy", nogil=True)
+def _spun_failure(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
+    path, qd, qs, b, feed, length, segment_checked, lower, upper, qdot_max, max_joint_step
+):
+    """The reason code and waypoint where branch b's joint path, moved by the spin, fails.
+
+    ``path`` (W, 6) is the branch's tracked joint path; it is overwritten by the spun one,
+    q_i + sum_k<i sigma_k dt_k J^-1 [0; z_tool]_k, each pass restarting the sum
+    (:func:`solver.path.pipeline.cumsum_within_passes`; a rapid moves no spin). That path is then
+    tracked as :func:`solver.path.tracking.track` does: the step test, then the position limits.
+
+    Returns:
+        (FEASIBLE, -1) where it holds.
+    """
+    n_waypoints, dof = path.shape
+    steps = np.empty(max(n_waypoints - 1, 0))
+    for w in range(n_waypoints - 1):
+        step = 0.0
+        if feed > 0.0:
+            step = _spin_rate(qd, qs, b, w, qdot_max, feed) * length[w] / feed
+        steps[w] = step if segment_checked[w] else 0.0
+    for j in range(dof):
+        total, start = 0.0, 0.0
+        for w in range(1, n_waypoints):
+            total += steps[w - 1] * qs[b, j, w - 1]
+            if not segment_checked[w - 1]:
+                start = total  # w starts a pass
+            moved = total - start
+            if math.isnan(moved):  # as numpy.nan_to_num
+                moved = 0.0
+            elif math.isinf(moved):
+                moved = _HUGE if moved > 0.0 else -_HUGE
+            path[w, j] += moved
+    spun = np.empty_like(path)  # as track() forms it: the first angle plus the wrapped steps
+    spun[0] = path[0]
+    totals = np.zeros(dof)
+    for w in range(1, n_waypoints):
+        for j in range(dof):
+            step = wrapped_step(path[w, j] - path[w - 1, j])
+            if segment_checked[w - 1] and abs(step) > max_joint_step:
+                return REASON_DISCONTINUOUS, w
+            totals[j] += step
+            spun[w, j] = path[0, j] + totals[j]
+    at = first_outside(spun, lower, upper)
+    if at < n_waypoints:
+        return REASON_JOINT_LIMITS, at
+    return FEASIBLE, -1
+
+
+@njit(cache=True, error_model="numpy", nogil=True)
+def free_cells(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
+    family,
+    par,
+    cos_yaw,
+    sin_yaw,
+    offset,
+    flange_rotation,
+    flange_position,
+    tool_position,
+    twist,
+    tool_axis,
+    length,
+    pure_rotation,
+    segment_checked,
+    branches,
+    lower,
+    upper,
+    qdot_max,
+    max_joint_step,
+    mu,
+    reason,
+    failed,
+    branch,
+    bottleneck_waypoint,
+    bottleneck_joint,
+    v_out,
+):
+    """Evaluate C placements in free spin; the answers go to the arrays after ``max_joint_step``.
+
+    Args:
+        family: the family's kernel code (:mod:`solver.families.kernels`).
+        par: the family's kernel parameters.
+        cos_yaw: shape (C,), cos of each placement's yaw.
+        sin_yaw: shape (C,), its sine.
+        offset: shape (C, 3), each placement's position (m).
+        flange_rotation: shape (W, 3, 3), R_O_F at the chunk's spin.
+        flange_position: shape (W, 3), m, in {O}.
+        tool_position: shape (W, 3), m, in {O}.
+        twist: shape (W, 6), t_hat in {O}.
+        tool_axis: shape (W, 3), z of the tool in {O}.
+        length: shape (W - 1,), m, the segments' lengths.
+        pure_rotation: shape (W,), bool, where h = 0.
+        segment_checked: shape (W - 1,), bool, where the step bound applies (within a pass).
+        branches: shape (B,), the branch indices to follow.
+        lower: shape (6,), rad, lower position limits.
+        upper: shape (6,), rad, upper position limits.
+        qdot_max: shape (6,), rad/s.
+        max_joint_step: rad.
+        mu: shape (C,), out, m/s, NaN where infeasible.
+        reason: shape (C,), out, as :class:`solver.path.placements.PlacementResults`.
+        failed: shape (C,), out, the failed waypoint.
+        branch: shape (C,), out, the branch index.
+        bottleneck_waypoint: shape (C,), out.
+        bottleneck_joint: shape (C,), out.
+        v_out: shape (C, W), out, V_max on the chosen branch, or (C, 0) when not wanted.
+    """
+    n_cells = cos_yaw.shape[0]
+    n_waypoints = flange_rotation.shape[0]
+    n_branches = branches.shape[0]
+    n_all, dof = 8, 6
+    cq = np.empty((n_all, dof, n_waypoints))
+    sq = np.empty((n_all, dof, n_waypoints))
+    qd = np.empty((n_all, dof, n_waypoints))  # J^-1 t_hat
+    qs = np.empty((n_all, dof, n_waypoints))  # J^-1 [0; z_tool]
+    status = np.empty((n_all, n_waypoints), dtype=np.int64)
+    poses = np.empty((21, n_waypoints))
+    spin_poses = np.empty((21, n_waypoints))
+    scratch = np.empty((SCRATCH_ROWS, n_waypoints))
+    need = np.empty(n_all, dtype=np.bool_)
+    alive = np.empty(n_branches, dtype=np.bool_)
+    checked = np.empty(n_branches, dtype=np.bool_)
+    why = np.empty(n_branches, dtype=np.int64)
+    where = np.empty(n_branches, dtype=np.int64)
+    slowest = np.empty(n_branches)
+    slowest_at = np.empty(n_branches, dtype=np.int64)
+    slowest_joint = np.empty(n_branches, dtype=np.int64)
+    speeds = np.empty((n_branches, n_waypoints)) if v_out.shape[1] else np.empty((0, 0))
+    check_steps = max_joint_step < math.pi
+    cos_step = math.cos(max_joint_step)
+    for c in range(n_cells):
+        ca, sa = cos_yaw[c], sin_yaw[c]
+        turned_poses(
+            c, ca, sa, offset, flange_rotation, flange_position, tool_position, twist, poses
+        )
+        spin_poses[:] = poses
+        for w in range(n_waypoints):  # the spin twist [0; z_tool] in {B}
+            x, y = tool_axis[w, 0], tool_axis[w, 1]
+            spin_poses[12, w] = 0.0
+            spin_poses[13, w] = 0.0
+            spin_poses[14, w] = 0.0
+            spin_poses[15, w] = ca * x - sa * y
+            spin_poses[16, w] = sa * x + ca * y
+            spin_poses[17, w] = tool_axis[w, 2]
+        alive[:] = True
+        why[:] = FEASIBLE
+        where[:] = -1
+        n_alive = n_branches
+        for w0 in range(0, n_waypoints, BLOCK):
+            w1 = min(w0 + BLOCK, n_waypoints)
+            need[:] = False
+            for i in range(n_branches):
+                need[branches[i]] = need[branches[i]] or alive[i]
+            pose_block(family, par, spin_poses, w0, w1, need, scratch, cq, sq, status, qs)
+            pose_block(family, par, poses, w0, w1, need, scratch, cq, sq, status, qd)
+            for i in range(n_branches):
+                if not alive[i]:
+                    continue
+                b = branches[i]
+                for w in range(w0, w1):
+                    code = -1
+                    if status[b, w] == UNREACHABLE:
+                        code = REASON_UNREACHABLE
+                    elif status[b, w] == SINGULAR:
+                        code = REASON_SINGULAR
+                    elif w > 0 and check_steps and segment_checked[w - 1]:
+                        for j in range(dof):
+                            c0, s0 = cq[b, j, w - 1], sq[b, j, w - 1]
+                            c1, s1 = cq[b, j, w], sq[b, j, w]
+                            if c0 * c1 + s0 * s1 < cos_step:
+                                code = REASON_DISCONTINUOUS
+                                break
+                    if code >= 0:
+                        alive[i] = False
+                        why[i] = code
+                        where[i] = w
+                        n_alive -= 1
+                        break
+                    speed, limiting = _two_variable_speed(qd, qs, b, w, qdot_max)
+                    v = 0.0 if pure_rotation[w] else speed
+                    if w == 0 or v < slowest[i]:
+                        slowest[i] = v
+                        slowest_at[i] = w
+                        slowest_joint[i] = limiting
+                    if speeds.shape[0]:
+                        speeds[i, w] = v
+            if n_alive == 0:
+                break
+        # The spin schedule's tracking, from the fastest branch down: once one holds, a slower
+        # branch can be chosen only if tied with it, so the rest need not be tracked again.
+        checked[:] = False
+        top = -np.inf
+        while True:
+            i = -1
+            for k in range(n_branches):
+                if alive[k] and not checked[k] and (i < 0 or slowest[k] > slowest[i]):
+                    i = k
+            if i < 0 or slowest[i] < top - TIE_RTOL * abs(top):
+                break
+            checked[i] = True
+            feed = slowest[i] if slowest[i] > 0.0 and math.isfinite(slowest[i]) else 0.0
+            code, at = _spun_failure(
+                unwrapped(cq, sq, branches[i]), qd, qs, branches[i], feed, length,
+                segment_checked, lower, upper, qdot_max, max_joint_step,
+            )  # fmt: skip
+            if code != FEASIBLE:
+                alive[i] = False
+                why[i] = code
+                where[i] = at
+            elif top == -np.inf:
+                top = slowest[i]
+        write_cell(
+            c, branches, alive, why, where, slowest, slowest_at, slowest_joint, speeds,
+            mu, reason, failed, branch, bottleneck_waypoint, bottleneck_joint, v_out,
+        )  # fmt: skip
+
+
+def warm_up() -> None:
+    """Compile the kernel, or load it from the disk cache, so that no request pays for it.
+
+    One placement of a two-waypoint UR5 path: the kernel has one signature for every family.
+    """
+    free_cells(
+        *warm_up_placement(),
+        np.tile([0.0, 0.0, -1.0], (2, 1)),
+        np.full(1, 0.01),
+        np.zeros(2, dtype=np.bool_),
+        np.ones(1, dtype=np.bool_),
+        np.arange(8, dtype=np.int64),
+        np.full(6, -_TWO_PI),
+        np.full(6, _TWO_PI),
+        np.full(6, math.pi),
+        0.35,
+        np.empty(1),
+        *(np.empty(1, dtype=np.int64) for _ in range(5)),
+        np.empty((1, 0)),
+    )

@@ -1,0 +1,224 @@
+"""The coarse search of the optimiser: a map over the bounds and its local maxima.
+
+Where joint 1 turns about the base z axis the map is over (r, psi)
+(:mod:`solver.optimise.symmetry`), each cell placed on its arc inside the bounds; otherwise over
+(x, y, yaw). A free tool spin is one more dimension of the map, and so is a free height z. Its
+local maxima, best first, are the starts of the IPOPT solves, each with its IK branch.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from solver.core.exceptions import InvalidInputError
+from solver.core.parallel import SERIAL, TaskRunner
+from solver.core.progress import Progress
+from solver.core.spatial import MAX_COORDINATE
+from solver.optimise.search_space import PlacementBounds, decision_vector
+from solver.optimise.symmetry import arc_point
+from solver.path.placements import evaluate_placements
+from solver.path.problem import PathProblem
+
+COARSE_STEP = 0.02  # m, of the coarse map (r or x, y)
+COARSE_YAW_STEP = math.radians(15)  # rad, of the coarse map (psi, yaw and spin)
+MAX_COARSE_CELLS = 50_000  # default limit on the coarse map (a box larger is an input error)
+
+
+@dataclass(frozen=True)
+class Cell:
+    """A decision vector (:mod:`solver.optimise.search_space`), its mu_path and IK branch index.
+
+    ``coarse`` is the coarse map's cell a refined cell climbed from (:func:`refine_cells`),
+    with its mu_path and branch; None for a cell of the coarse map itself.
+    """
+
+    vector: np.ndarray
+    mu_path: float
+    branch: int
+    coarse: Cell | None = None
+
+
+def _spin_values(bounds: PlacementBounds) -> tuple[np.ndarray, bool]:
+    """The coarse map's spins, and whether they wrap (a whole turn)."""
+    low, high = bounds.spin
+    if high <= low:
+        return np.array([low]), False
+    wraps = high - low >= 2 * math.pi - 1e-9
+    count = math.floor((high - low) / COARSE_YAW_STEP + 1e-9) + (0 if wraps else 1)
+    return low + COARSE_YAW_STEP * np.arange(max(count, 1)), wraps
+
+
+def _heights(bounds: PlacementBounds) -> np.ndarray:
+    """The coarse map's heights: z, or its range at COARSE_STEP when z is free."""
+    low, high = bounds.z_range
+    return low + COARSE_STEP * np.arange(math.floor((high - low) / COARSE_STEP + 1e-9) + 1)
+
+
+def _local_maxima(values: np.ndarray, periodic: tuple[bool, ...]) -> list[tuple[int, ...]]:
+    """Indices of cells not below any neighbour (NaN never is one), best first."""
+    padded = np.where(np.isnan(values), -np.inf, values)
+    is_max = np.isfinite(padded)
+    for axis, wraps in enumerate(periodic):
+        for shift in (1, -1):
+            neighbour = np.roll(padded, shift, axis=axis)
+            if not wraps:
+                edge = [slice(None)] * values.ndim
+                edge[axis] = slice(0, 1) if shift == 1 else slice(-1, None)
+                neighbour[tuple(edge)] = -np.inf
+            is_max &= padded >= neighbour
+    order = np.argsort(-padded[is_max], kind="stable")
+    return [tuple(int(i) for i in idx) for idx in np.argwhere(is_max)[order]]
+
+
+def _map_sizes(
+    bounds: PlacementBounds, *, symmetric: bool, n_spins: int, n_heights: int
+) -> tuple[list[int], tuple[float, float]]:
+    """The coarse map's sizes, its largest axes first, and (r_low, r_high) when symmetric."""
+    n_psi = round(2 * math.pi / COARSE_YAW_STEP)
+    radii = (0.0, 0.0)
+    if symmetric:
+        corners = [math.hypot(x, y) for x in bounds.x for y in bounds.y]
+        inside_x = min(max(0.0, bounds.x[0]), bounds.x[1])
+        inside_y = min(max(0.0, bounds.y[0]), bounds.y[1])
+        radii = (math.hypot(inside_x, inside_y), max(corners))
+        sizes = [math.floor((radii[1] - radii[0]) / COARSE_STEP) + 1, n_psi]
+    else:
+        sizes = [
+            math.floor((high - low) / step + 1e-9) + 1
+            for (low, high), step in (
+                (bounds.x, COARSE_STEP),
+                (bounds.y, COARSE_STEP),
+                (bounds.yaw, COARSE_YAW_STEP),
+            )
+        ]
+    sizes = [n_spins, *sizes] if n_spins > 1 else sizes
+    sizes = [n_heights, *sizes] if n_heights > 1 else sizes
+    return sizes, radii
+
+
+def _check_map_size(
+    problem: PathProblem, sizes: list[int], *, max_cells: int, max_poses: int | None
+) -> None:
+    """Refuse a coarse map over ``max_cells`` cells or ``max_poses`` weighed poses (on bounds)."""
+    if math.prod(sizes) > max_cells:
+        raise InvalidInputError(
+            "bounds",
+            f"the search box needs a coarse map of {math.prod(sizes)} cells "
+            f"({' x '.join(map(str, sizes))} at {COARSE_STEP * 1000:.0f} mm, "
+            f"{math.degrees(COARSE_YAW_STEP):.0f} deg); the limit is {max_cells}",
+        )
+    n_waypoints = problem.prepared.n_waypoints
+    poses = math.prod(sizes) * n_waypoints
+    family = problem.family
+    work = math.prod(sizes) * family.path_cost(n_waypoints)
+    if max_poses is not None and work > max_poses:
+        size = f"the search box's coarse map of {math.prod(sizes)} cells * {n_waypoints} "
+        size += f"waypoints = {poses} poses"
+        if work != poses:
+            size += f", as work {work:.4g} closed-form poses ({family.name} IK)"
+        raise InvalidInputError("bounds", f"{size}; the limit is {max_poses}")
+
+
+_Point = tuple[float, float, float] | None  # (x, y, yaw) of a cell, None outside the box
+
+
+def _one_spin_cells(
+    bounds: PlacementBounds, radii: tuple[float, float], *, symmetric: bool, near: float
+) -> tuple[list[_Point], list[_Point], tuple[int, ...], tuple[bool, ...]]:
+    """One spin's cells, where each is reported and where it is evaluated.
+
+    Returns:
+        the cells' (x, y, yaw) inside the box (None: no point of the cell is), where each is
+        evaluated (None: there), the cells' shape and which of its axes wrap.
+    """
+    if symmetric:
+        r_low, r_high = radii
+        n_psi = round(2 * math.pi / COARSE_YAW_STEP)
+        radius = r_low + COARSE_STEP * np.arange(math.floor((r_high - r_low) / COARSE_STEP) + 1)
+        psis = -math.pi + COARSE_YAW_STEP * np.arange(n_psi)
+        points = [arc_point(float(r), float(p), bounds, near=near) for p in psis for r in radius]
+        # mu_path is the same all along an arc: evaluate every cell at the polar angle `near`,
+        # so that the cells of one psi share a yaw (the cheap case of evaluate_placements),
+        # unless that is farther than any placement may be.
+        evaluated: list[_Point] = [
+            (float(r * math.cos(near)), float(r * math.sin(near)), float(p + near))
+            if r <= MAX_COORDINATE
+            else None
+            for p in psis
+            for r in radius
+        ]
+        return points, evaluated, (len(psis), len(radius)), (True, False)
+    axes = [
+        low + step * np.arange(math.floor((high - low) / step + 1e-9) + 1)
+        for (low, high), step in (
+            (bounds.x, COARSE_STEP),
+            (bounds.y, COARSE_STEP),
+            (bounds.yaw, COARSE_YAW_STEP),
+        )
+    ]
+    shape = (len(axes[2]), len(axes[1]), len(axes[0]))
+    points = [(float(x), float(y), float(w)) for w in axes[2] for y in axes[1] for x in axes[0]]
+    periodic = (bounds.yaw[1] - bounds.yaw[0] >= 2 * math.pi - 1e-9, False, False)
+    return points, [None] * len(points), shape, periodic
+
+
+def coarse_cells(
+    problem: PathProblem,
+    bounds: PlacementBounds,
+    *,
+    symmetric: bool,
+    near: float,
+    max_cells: int = MAX_COARSE_CELLS,
+    max_poses: int | None = None,
+    progress: Progress | None = None,
+    runner: TaskRunner = SERIAL,
+) -> list[Cell]:
+    """Local maxima of a coarse map over the bounds, best first.
+
+    Over (r, psi) at COARSE_STEP x COARSE_YAW_STEP when ``symmetric`` (each cell placed on its
+    arc nearest the polar angle ``near``), else over (x, y, yaw); times the spins when the spin
+    is free. Every cell on the problem's branch policy (``auto``, for the optimisers).
+
+    Raises:
+        InvalidInputError: the map would have more than ``max_cells`` cells, or more than
+            ``max_poses`` placement-waypoint pairs (on ``bounds``), each pair weighed by the
+            family's cost (:meth:`KinematicsFamily.path_cost`: 1 for a closed-form family).
+    """
+    spins, spin_wraps = _spin_values(bounds)
+    heights = _heights(bounds)
+    sizes, radii = _map_sizes(
+        bounds, symmetric=symmetric, n_spins=len(spins), n_heights=len(heights)
+    )
+    _check_map_size(problem, sizes, max_cells=max_cells, max_poses=max_poses)
+    points, evaluated, shape, periodic = _one_spin_cells(
+        bounds, radii, symmetric=symmetric, near=near
+    )
+    vectors: list[np.ndarray | None] = []
+    rows = []
+    for z in heights:
+        for spin in spins:
+            for point, where in zip(points, evaluated, strict=True):
+                at = where or point
+                if point is None or at is None:
+                    vectors.append(None)
+                    continue
+                x, y, yaw = point
+                vectors.append(decision_vector(x=x, y=y, yaw=yaw, spin=spin, z=z))
+                rows.append([at[0], at[1], z, at[2], spin])  # a placement row
+    full_shape = (len(heights), len(spins), *shape)
+    mu = np.full(len(vectors), np.nan)
+    branch = np.zeros(len(vectors), dtype=int)
+    inside_index = [i for i, v in enumerate(vectors) if v is not None]
+    if inside_index:
+        result = evaluate_placements(problem, np.array(rows), progress=progress, runner=runner)
+        mu[inside_index], branch[inside_index] = result.mu_path, result.branch
+    cells = []
+    for index in _local_maxima(mu.reshape(full_shape), (False, spin_wraps, *periodic)):
+        k = int(np.ravel_multi_index(index, full_shape))
+        vector = vectors[k]
+        if vector is not None:
+            cells.append(Cell(vector, float(mu[k]), int(branch[k])))
+    return cells

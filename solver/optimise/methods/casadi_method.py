@@ -1,0 +1,121 @@
+"""The ``casadi`` method: IPOPT from the coarse map's maxima, beside Nelder-Mead climbs.
+
+A coarse map finds the local maxima (over (r, psi) where the first joint turns about the base
+z axis, over (x, y, yaw) otherwise; :mod:`solver.optimise.coarse_search`); the compass search
+ranks their basins (:func:`solver.optimise.local_search.refine_cells`); from the best few, each
+on its own IK branch, IPOPT solves the epigraph NLP of
+:mod:`solver.optimise.methods.placement_nlp`, and Nelder-Mead climbs mu_path itself from the
+best refined cells (which may cross to another branch, where IPOPT cannot).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from concurrent.futures import ThreadPoolExecutor
+from functools import partial
+
+from solver.core.progress import Progress, span
+from solver.optimise.candidate import ZERO_SPEED, Candidate, Search
+from solver.optimise.coarse_search import Cell, coarse_cells
+from solver.optimise.local_search import climbs, refine_cells
+from solver.optimise.methods.placement_nlp import PlacementNlp
+from solver.optimise.search_space import PlacementBounds
+from solver.path.evaluate import evaluate_path
+from solver.path.problem import PathProblem
+
+DESCRIPTION = "ipopt (casadi), from the coarse map's maxima"
+N_STARTS = 4  # IPOPT solves, from the coarse maxima that refine best
+
+
+def search(
+    problem: PathProblem, bounds: PlacementBounds, settings: Search
+) -> tuple[list[Candidate], int]:
+    """Candidates: the best refined cell, IPOPT's optima, Nelder-Mead climbs; IPOPT's iterations.
+
+    IPOPT starts from the coarse cells whose basins refine best; the climbs on mu_path start
+    from the best refined cells. They need nothing from IPOPT, so where the runner lets the
+    caller use a second thread they run beside the solves (the map kernel releases the GIL);
+    either way the candidates come in the same order.
+
+    For a redundant arm (dof > 6) each optimum carries the NLP's joint path: IPOPT chose the
+    redundancy too, and the evaluator's tracked joint path would lose that.
+
+    In free spin mode each solve starts from the cell's joint path at the given spin with the
+    spin rate 0 (a feasible start at the fixed-spin mu_path), and IPOPT frees the rate.
+    """
+    progress, runner = settings.progress, settings.runner
+    cells = coarse_cells(
+        problem,
+        bounds,
+        symmetric=settings.symmetric,
+        near=settings.near,
+        max_cells=settings.max_coarse_cells,
+        max_poses=settings.max_coarse_poses,
+        progress=span(progress, 0.0, 0.25),
+        runner=runner,
+    )
+    cells = refine_cells(problem, bounds, cells, progress=span(progress, 0.25, 0.3), runner=runner)
+    if not cells:
+        return [], 0
+    if problem.prepared.pure_rotation.any() or cells[0].mu_path <= 0.0:
+        return [Candidate(cells[0].vector, ZERO_SPEED)], 0
+    candidates = [Candidate(cells[0].vector, "best cell of the coarse map, refined")]
+    seconds = settings.max_solver_seconds
+    nlp = PlacementNlp(
+        problem,
+        bounds,
+        max_spin_step=settings.max_spin_step,
+        ipopt_options=None if seconds is None else {"max_cpu_time": seconds},
+    )
+    iterations = 0
+    climbed: Callable[[], list[Candidate]] = partial(climbs, problem, bounds, cells)
+    solves = span(progress, 0.3, 0.95)
+    with ThreadPoolExecutor(1, thread_name_prefix="dtf-climbs") as beside:
+        if runner.threads > 1:  # the climbs need nothing from IPOPT: beside its solves
+            climbed = beside.submit(climbed).result
+        # IPOPT starts from the coarse cells whose basins climbed highest. (The other refined
+        # cells are below cells[0] and below the climbs: no candidates.)
+        starts = [cell.coarse or cell for cell in cells[:N_STARTS]]
+        for k, cell in enumerate(starts):
+            part = span(solves, k / len(starts), (k + 1) / len(starts))
+            solved = _solve_from(problem, nlp, bounds, cell, part)
+            if solved is not None:
+                candidates.append(solved[0])
+                iterations += solved[1]
+        candidates += climbed()
+    return candidates, iterations
+
+
+def _solve_from(
+    problem: PathProblem,
+    nlp: PlacementNlp,
+    bounds: PlacementBounds,
+    cell: Cell,
+    progress: Progress | None,
+) -> tuple[Candidate, int] | None:
+    """IPOPT's optimum from the cell's joint path, with its iterations; None where none starts.
+
+    The start is the cell's joint path on its branch in fixed spin (in free spin the NLP frees
+    the rate from 0). A start IPOPT refuses is a candidate at the cell, with IPOPT's message and
+    no iterations.
+    """
+    branch = problem.family.branches[cell.branch]
+    at_start = evaluate_path(
+        problem.with_options(branch=branch, spin_mode="fixed"), bounds.placement(cell.vector)
+    )
+    q, qdot, v_max, speed = at_start.q, at_start.qdot, at_start.v_max, at_start.mu_path
+    if q is None or qdot is None or v_max is None or speed is None:
+        return None
+    joint_speeds = qdot * (speed / v_max)[:, None]
+    try:
+        result = nlp.solve(cell.vector, speed, q, joint_speeds, progress=progress)
+    except RuntimeError as error:  # IPOPT refused this start: the others still count
+        failure = f"IPOPT failed from a start: {str(error).splitlines()[-1][:200]}"
+        return Candidate(cell.vector, failure), 0
+    candidate = Candidate(
+        result.vector,
+        result.status,
+        spins=result.spins,
+        joint_path=result.joint_path if problem.robot.dof > 6 else None,
+    )
+    return candidate, result.iterations

@@ -1,0 +1,255 @@
+"""The scipy placement search: differential evolution, then SLSQP on the epigraph form.
+
+Differential evolution needs no gradients and looks at the whole box; every generation is one
+batch through :func:`solver.path.placements.evaluate_placements`. The best points of the few best
+distinct basins it saw are then polished by SLSQP on  maximise s  s.t.  V_i(v) >= s  for every
+waypoint i, with V_i on the IK branch of that point and its gradient by central differences (one
+batch of placements). Both work on the free variables of the decision vector
+(:mod:`solver.optimise.search_space`: x, y, yaw and the tool spin when its range is not one value).
+
+The search's size (population, generations, polish iterations) is the full one for a
+closed-form family, whose placement costs one unit of work a waypoint. A family whose placement
+costs more (:meth:`KinematicsFamily.path_cost`: numeric IK on a short path, about a thousand
+times more) gets a smaller search, so that its work stays near SEARCH_WORK (:func:`search_size`).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.optimize
+
+from solver.core.family import Branch
+from solver.core.parallel import SERIAL, TaskRunner
+from solver.core.progress import Progress
+from solver.optimise.search_space import PlacementBounds, variables_of
+from solver.path.placements import evaluate_placements
+from solver.path.problem import PathProblem
+
+SEED = 0  # differential evolution is seeded: same input, same output
+POLISH_ITERATIONS = 200  # SLSQP iterations at most from one start
+POPULATION = 20  # per dimension
+GENERATIONS = 60
+DIFFERENCE_STEP = 1e-6  # m and rad, for the polish's gradients
+INFEASIBLE = 1.0  # objective of an infeasible placement (feasible ones are -mu_path <= 0)
+N_BASINS = 3  # distinct basins polished
+BASIN_GAP = (0.05, 0.35)  # m and rad (about 20 degrees): placements closer are one basin
+
+Basin = tuple[np.ndarray, float, int]  # decision vector, mu_path, branch index
+# Work of a costly family's search, in poses of a closed-form family (the unit of
+# KinematicsFamily.path_cost): about 8 s of work on the 2-core development machine (3.8 us a
+# pose). The Panda on 10 waypoints (path_cost 10,000) then gets the floors below: about 20 s
+# for the whole search instead of about 200 s at the full size.
+SEARCH_WORK = 2e6
+MIN_POPULATION = 5  # per dimension: scipy's least useful population
+MIN_GENERATIONS = 10
+MIN_POLISH_ITERATIONS = 15
+
+
+@dataclass(frozen=True)
+class SearchSize:
+    """The size of the scipy search.
+
+    Attributes:
+        population: differential evolution's population per free variable.
+        generations: its generations at most.
+        polish_iterations: SLSQP's iterations at most from each start.
+        basins: how many distinct basins are polished.
+    """
+
+    population: int = POPULATION
+    generations: int = GENERATIONS
+    polish_iterations: int = POLISH_ITERATIONS
+    basins: int = N_BASINS
+
+
+FULL_SEARCH = SearchSize()
+
+
+def search_size(bounds: PlacementBounds, *, path_cost: float, n_waypoints: int) -> SearchSize:
+    """The search's size for a family whose placement of the path costs ``path_cost``.
+
+    A closed-form family (``path_cost <= n_waypoints``: one unit a waypoint) gets the full
+    search, whatever the path's length. A costlier one gets the full search's work scaled by
+    f = SEARCH_WORK / (full placements * path_cost) (at most 1): the population and the
+    generations each by sqrt(f), so that the placements scale by f, and the polish iterations
+    and the basins polished by f; each no less than its floor (MIN_POPULATION,
+    MIN_GENERATIONS, MIN_POLISH_ITERATIONS, one basin).
+
+    Args:
+        bounds: the box (its free variables are the search's dimensions).
+        path_cost: the family's work for one placement of the path, in closed-form poses.
+        n_waypoints: N.
+    """
+    if path_cost <= n_waypoints:
+        return FULL_SEARCH
+    full = search_placements(bounds, FULL_SEARCH)
+    fraction = min(1.0, SEARCH_WORK / (full * path_cost))
+    return SearchSize(
+        population=max(MIN_POPULATION, round(POPULATION * math.sqrt(fraction))),
+        generations=max(MIN_GENERATIONS, round(GENERATIONS * math.sqrt(fraction))),
+        polish_iterations=max(MIN_POLISH_ITERATIONS, round(POLISH_ITERATIONS * fraction)),
+        basins=max(1, round(N_BASINS * fraction)),
+    )
+
+
+def search_placements(bounds: PlacementBounds, size: SearchSize = FULL_SEARCH) -> int:
+    """How many placements differential evolution evaluates in ``bounds`` (at most)."""
+    n_free = int(bounds.free.sum())
+    return (size.generations + 1) * size.population * n_free if n_free else 1
+
+
+def _full(bounds: PlacementBounds, free_values: np.ndarray) -> np.ndarray:
+    """Decision vectors (P, N_VARIABLES) from the free variables' values (P, F); the rest fixed."""
+    vectors = np.tile(bounds.lower, (len(free_values), 1))
+    vectors[:, bounds.free] = free_values
+    return vectors
+
+
+def _basin_coordinates(vectors: np.ndarray, symmetric: bool) -> tuple[np.ndarray, np.ndarray]:
+    """Coordinates in which basins are BASIN_GAP apart, and their scale (angles as cos, sin)."""
+    x, y, yaw, spin, z = variables_of(vectors.T)
+    angles = [np.cos(spin), np.sin(spin)]
+    if symmetric:
+        psi = yaw - np.arctan2(y, x)
+        columns = [np.hypot(x, y) / BASIN_GAP[0], z / BASIN_GAP[0], np.cos(psi), np.sin(psi)]
+        scale = [1.0, 1.0] + [1.0 / BASIN_GAP[1]] * 4
+    else:
+        columns = [x / BASIN_GAP[0], y / BASIN_GAP[0], z / BASIN_GAP[0], np.cos(yaw), np.sin(yaw)]
+        scale = [1.0, 1.0, 1.0] + [1.0 / BASIN_GAP[1]] * 4
+    return np.column_stack([*columns, *angles]), np.array(scale)
+
+
+def global_search(
+    problem: PathProblem,
+    bounds: PlacementBounds,
+    *,
+    symmetric: bool,
+    size: SearchSize = FULL_SEARCH,
+    progress: Progress | None = None,
+    runner: TaskRunner = SERIAL,
+) -> tuple[list[Basin], int]:
+    """Differential evolution over the free variables; the best point of each distinct basin.
+
+    Every placement DE evaluates is kept; the best ones that lie apart (by BASIN_GAP, in
+    (r, psi) when ``symmetric``, else in (x, y, yaw); spins as angles) are returned, up to
+    ``size.basins``: DE settles in one basin, and the landscape has near-equal mirror-image optima.
+
+    Returns:
+        ([(decision vector, mu_path, branch index), ...] best first, generations).
+    """
+    seen: list[tuple[np.ndarray, np.ndarray, np.ndarray]] = []
+
+    def objective(points: np.ndarray) -> np.ndarray:  # points: (F, S)
+        vectors = _full(bounds, points.T)
+        result = evaluate_placements(problem, bounds.rows(vectors), runner=runner)
+        seen.append((vectors, result.mu_path, result.branch))
+        if progress is not None:
+            progress(len(seen) / (size.generations + 1))
+        values: np.ndarray = np.where(np.isnan(result.mu_path), INFEASIBLE, -result.mu_path)
+        return values
+
+    free = bounds.free
+    if not free.any():  # nothing to search: the one placement of the box
+        objective(np.zeros((0, 1)))
+        generations = 0
+    else:
+        found = scipy.optimize.differential_evolution(
+            objective,
+            bounds=list(zip(bounds.lower[free], bounds.upper[free], strict=True)),
+            popsize=size.population,
+            maxiter=size.generations,
+            tol=1e-12,
+            atol=0.0,
+            seed=SEED,
+            polish=False,
+            init="sobol",
+            updating="deferred",
+            vectorized=True,
+        )
+        generations = int(found.nit)
+    vectors = np.concatenate([s[0] for s in seen])
+    mu = np.concatenate([s[1] for s in seen])
+    branch = np.concatenate([s[2] for s in seen])
+    feasible = np.flatnonzero(~np.isnan(mu))
+    order = feasible[np.argsort(-mu[feasible], kind="stable")]
+    coordinates, scale = _basin_coordinates(vectors, symmetric)
+    chosen: list[int] = []
+    for i in order:
+        if all(np.max(np.abs(coordinates[i] - coordinates[j]) * scale) > 1.0 for j in chosen):
+            chosen.append(int(i))
+            if len(chosen) == size.basins:
+                break
+    return [(vectors[i].copy(), float(mu[i]), int(branch[i])) for i in chosen], generations
+
+
+def polish(
+    problem: PathProblem,
+    bounds: PlacementBounds,
+    start: np.ndarray,
+    start_speed: float,
+    branch: Branch,
+    *,
+    size: SearchSize = FULL_SEARCH,
+    progress: Progress | None = None,
+) -> tuple[np.ndarray, str, int]:
+    """SLSQP on the epigraph form over the free variables, from a feasible start, on one branch.
+
+    Returns:
+        the decision vector, SLSQP's message, its iterations.
+    """
+    free = bounds.free
+    n_free = int(free.sum())
+    steps = np.eye(n_free) * DIFFERENCE_STEP
+    offsets = np.vstack([np.zeros(n_free), steps, -steps])
+    cache: dict[tuple[float, ...], np.ndarray] = {}
+    on_branch = problem.with_options(branch=branch)
+
+    def speeds(v: np.ndarray) -> np.ndarray:
+        """V_max per waypoint at v and at v +- steps: (1 + 2F, N), NaN where infeasible."""
+        key = tuple(v[:n_free])
+        if key not in cache:
+            result = evaluate_placements(
+                on_branch, bounds.rows(_full(bounds, v[:n_free] + offsets)), with_speeds=True
+            )
+            if result.v_max is None:  # not reached: asked for with_speeds
+                raise RuntimeError("evaluate_placements returned no speeds")
+            cache[key] = result.v_max
+            if progress is not None:
+                progress(len(cache) / (size.polish_iterations + 1))
+        return cache[key]
+
+    def margin(v: np.ndarray) -> np.ndarray:
+        here = speeds(v)[0]
+        values: np.ndarray = np.where(np.isnan(here), -1.0, here) - v[n_free]
+        return values
+
+    def margin_gradient(v: np.ndarray) -> np.ndarray:
+        table = speeds(v)
+        here, plus, minus = table[0], table[1 : 1 + n_free], table[1 + n_free :]
+        central = (plus - minus) / (2 * DIFFERENCE_STEP)
+        forward = (plus - here) / DIFFERENCE_STEP
+        backward = (here - minus) / DIFFERENCE_STEP
+        gradient = np.where(
+            np.isnan(central), np.where(np.isnan(forward), backward, forward), central
+        )
+        jacobian: np.ndarray = np.column_stack([np.nan_to_num(gradient.T), -np.ones(len(here))])
+        return jacobian
+
+    if n_free == 0:
+        return np.asarray(start, dtype=float), "nothing to polish: every variable is fixed", 0
+    objective_gradient = np.zeros(n_free + 1)
+    objective_gradient[-1] = -1.0
+    result = scipy.optimize.minimize(
+        lambda v: -v[n_free],
+        x0=np.array([*np.asarray(start)[free], start_speed]),
+        jac=lambda v: objective_gradient,
+        bounds=[*zip(bounds.lower[free], bounds.upper[free], strict=True), (0.0, None)],
+        constraints=[{"type": "ineq", "fun": margin, "jac": margin_gradient}],
+        method="SLSQP",
+        options={"ftol": 1e-14, "maxiter": size.polish_iterations},
+    )
+    vector = _full(bounds, result.x[None, :n_free])[0]
+    return vector, str(result.message), int(result.nit)

@@ -1,0 +1,291 @@
+"""The best placement of a path: maximise mu_path over the decision vector in a box (spec s. 6).
+
+The methods are a registry (:mod:`solver.optimise.methods`): ``casadi`` (IPOPT from the coarse
+map's maxima, :mod:`solver.optimise.methods.casadi_method`) and ``scipy`` (differential
+evolution and SLSQP, :mod:`solver.optimise.methods.scipy_method`). Whatever a method returns is
+only a candidate: the answer is the candidate (or the best coarse cell, so never less than the
+map) with the highest mu_path by :func:`solver.path.evaluate.evaluate_path`, and the reported
+placement and mu_path are the evaluator's. Where the symmetry holds, every candidate is first
+moved along its arc to the point nearest the start (inside the bounds), so the reported
+(x, y, yaw) is deterministic.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import time
+from dataclasses import dataclass
+
+import numpy as np
+
+from solver.core.exceptions import InvalidInputError
+from solver.core.parallel import SERIAL, TaskRunner
+from solver.core.progress import Progress
+from solver.core.robots import Robot
+from solver.core.spatial import Placement, spun_waypoints
+from solver.optimise.candidate import Candidate, Search
+from solver.optimise.coarse_search import MAX_COARSE_CELLS
+from solver.optimise.methods import Method, method_named
+from solver.optimise.search_space import PlacementBounds, variables_of, vector_of
+from solver.optimise.symmetry import arc_coordinates, arc_point, turns_about_base_z
+from solver.path.evaluate import PathEvaluation, evaluate_path
+from solver.path.joint_path import EXACT_POSE_TOLERANCE, evaluate_joint_path
+from solver.path.problem import PathProblem
+
+
+@dataclass(frozen=True)
+class SolverReport:
+    """What the optimiser did: its name, the status of the winning solve, iterations, seconds."""
+
+    name: str
+    status: str
+    iterations: int
+    seconds: float
+
+
+@dataclass(frozen=True)
+class PlacementOptimum:
+    """The best placement found, as the evaluator sees it (qpsolvers' ``Solution``).
+
+    Attributes:
+        found: whether any placement the search tried (the start included) is feasible; when
+            not, placement, mu_path and evaluation are None.
+        placement: the optimum (inside the bounds).
+        mu_path: m/s, the evaluator's mu_path there.
+        evaluation: the evaluator's whole answer there.
+        start: the start placement; start_mu_path its mu_path (None when infeasible).
+        improvement_percent: 100 (mu_path / start_mu_path - 1); None without a feasible start.
+        solver: what the optimiser did.
+        symmetric: whether the search used the (r, psi) symmetry.
+        spins: shape (N,), rad, each waypoint's spin on top of the placement's, when the
+            answer came from the spin-path NLP (cam.md section 4); else None.
+        joint_path: shape (N, n), rad, for a redundant arm (dof > 6) the joint path mu_path is
+            at (the NLP's own, or the tracked one where that is faster); None for dof <= 6.
+    """
+
+    found: bool
+    placement: Placement | None
+    mu_path: float | None
+    evaluation: PathEvaluation | None
+    start: Placement
+    start_mu_path: float | None
+    improvement_percent: float | None
+    solver: SolverReport
+    symmetric: bool
+    spins: np.ndarray | None = None
+    joint_path: np.ndarray | None = None
+
+
+def _place_on_arc(
+    vector: np.ndarray, bounds: PlacementBounds, near: float, symmetric: bool
+) -> tuple[Placement, float]:
+    """The candidate, clamped into the box, moved along its arc to the point nearest ``near``.
+
+    Solvers may end a hair outside their bounds (IPOPT by its bound relaxation, 1e-8): the
+    clamp is what makes every reported placement inside them; the evaluator then judges it.
+    The spin and the height ride along: turning the placement about the base axis leaves them.
+
+    Returns:
+        the placement, and the turn (rad) about the base z axis that moved it along its arc
+        (joint 1 of a joint path moves by as much).
+    """
+    clamped = bounds.clamp(vector)
+    x, y, yaw, spin, z = variables_of(clamped)
+    if symmetric:
+        moved = arc_point(*arc_coordinates(x, y, yaw), bounds, near=near)
+        if moved is not None:
+            x, y, yaw = moved
+    given = variables_of(clamped)
+    turn = math.atan2(y, x) - math.atan2(given.y, given.x) if symmetric else 0.0
+    placement = Placement(float(x), float(y), float(z), float(yaw), spin=float(spin))
+    return placement, (turn + math.pi) % (2 * math.pi) - math.pi
+
+
+def _turned_joint_path(robot: Robot, joint_path: np.ndarray, turn: float) -> np.ndarray:
+    """The joint path with joint 1 turned by ``turn`` (the copy 2 pi k that fits its limits).
+
+    Where joint 1 turns about the base z axis (the symmetry), turning the placement by ``turn``
+    about that axis is reached by the same joint path with q1 + turn.
+    """
+    turned = np.array(joint_path, dtype=float)
+    if turn == 0.0:
+        return turned
+    first = turned[:, 0] + turn
+    for copy in (0.0, -2 * math.pi, 2 * math.pi):
+        if robot.q_lower[0] <= (first + copy).min() and (first + copy).max() <= robot.q_upper[0]:
+            first = first + copy
+            break
+    turned[:, 0] = first
+    return turned
+
+
+def optimize_placement(
+    problem: PathProblem,
+    *,
+    bounds: PlacementBounds,
+    start: Placement | None = None,
+    method: str = "casadi",
+    max_spin_step: float | None = None,
+    max_coarse_cells: int = MAX_COARSE_CELLS,
+    max_coarse_poses: int | None = None,
+    max_search_poses: int | None = None,
+    max_solver_seconds: float | None = None,
+    progress: Progress | None = None,
+    runner: TaskRunner = SERIAL,
+) -> PlacementOptimum:
+    """The placement inside ``bounds`` where the path runs fastest.
+
+    Args:
+        problem: an arm with a kinematics family (its speed limits and TCP), the path with its
+            passes and the options (the step bound; the spin mode, in which every method
+            searches). The branch is the optimisers' to choose: the options' must be ``auto``.
+        bounds: x, y, yaw and spin ranges and the height z (the decision vector).
+        start: the start placement (default: the centre of the bounds), reported with its
+            mu_path and used to choose the point of the optimal arc.
+        method: a name in :data:`solver.optimise.methods.METHODS` (``"casadi"``: IPOPT from
+            the coarse map's maxima; ``"scipy"``).
+        max_spin_step: rad, > 0: the casadi method also gives each waypoint its own spin, with
+            steps at most this (cam.md section 4, ``spin_path``); None keeps one spin. A spin
+            path needs one pass.
+        max_coarse_cells: the largest coarse map the casadi method may make.
+        max_coarse_poses: the most placement-waypoint pairs of that map (None: no limit), each
+            weighed by the family's cost (:meth:`KinematicsFamily.path_cost`).
+        max_search_poses: the same for the placements the scipy method's differential
+            evolution evaluates (None: no limit).
+        max_solver_seconds: the longest one IPOPT solve may take (None: IPOPT's default).
+        progress: called with the fraction done (coarse map or DE, then each solve's
+            iterations); a :class:`solver.core.progress.Cancelled` it raises stops the search.
+        runner: where the coarse map's and differential evolution's placements run
+            (:mod:`solver.core.parallel`); the same optimum on any.
+
+    Returns:
+        The optimum (never below the start); ``found`` is False when neither the start nor any
+        placement the search tried is feasible.
+
+    Raises:
+        InvalidInputError: bad bounds, a start outside them, an unknown method, a branch
+            other than auto, or a box whose coarse map is over ``max_coarse_cells`` or
+            ``max_coarse_poses``, or whose search is over ``max_search_poses`` (on ``bounds``).
+    """
+    began = time.perf_counter()
+    bounds.check()
+    chosen_method = method_named(method)
+    if problem.options.branch is not None:
+        raise InvalidInputError("ik.branch", "the optimisers choose the branch: it must be auto")
+    if max_spin_step is not None:
+        _check_spin_path(max_spin_step, chosen_method, problem)
+    if start is None:
+        start = bounds.placement(bounds.centre())
+    if not bounds.contains(vector_of(start)):
+        raise InvalidInputError(
+            "start",
+            f"x {start.x:g} m, y {start.y:g} m, z {start.z:g} m, yaw {start.yaw:g} rad, spin "
+            f"{start.spin:g} rad is outside the bounds",
+        )
+    settings = Search(
+        symmetric=turns_about_base_z(problem.robot),
+        near=math.atan2(start.y, start.x),
+        max_spin_step=max_spin_step,
+        max_coarse_cells=max_coarse_cells,
+        max_coarse_poses=max_coarse_poses,
+        max_search_poses=max_search_poses,
+        max_solver_seconds=max_solver_seconds,
+        progress=progress,
+        runner=runner,
+    )
+    chosen_method.check(problem, bounds, settings)
+    prepared = problem.prepared  # the path is checked before the options (evaluate_path's)
+    if max_spin_step is not None and not prepared.segment_in_pass.all():
+        raise InvalidInputError("spin_path", "a spin path needs a program of one pass")
+    start_evaluation = evaluate_path(problem, start)
+    candidates, iterations = chosen_method.search(problem, bounds, settings)
+    # The start last: it is the answer only when nothing the solver found is better.
+    candidates = [
+        *candidates,
+        Candidate(vector_of(start), "no better placement found than the start"),
+    ]
+    best = _best_candidate(problem, bounds, candidates, settings)
+    report = SolverReport(chosen_method.description, "", iterations, time.perf_counter() - began)
+    if best is None:
+        return PlacementOptimum(
+            found=False,
+            placement=None,
+            mu_path=None,
+            evaluation=None,
+            start=start,
+            start_mu_path=None,
+            improvement_percent=None,
+            solver=dataclasses.replace(report, status="no feasible placement inside the bounds"),
+            symmetric=settings.symmetric,
+        )
+    mu_path, placement, evaluation, chosen = best
+    status = chosen.status
+    if chosen.joint_path is not None and evaluation.branch is not None:
+        status += " (at the placement its tracked joint path is faster than its own)"
+    start_mu = start_evaluation.mu_path
+    return PlacementOptimum(
+        found=True,
+        placement=placement,
+        mu_path=mu_path,
+        evaluation=evaluation,
+        start=start,
+        start_mu_path=start_mu,
+        improvement_percent=None if not start_mu else 100.0 * (mu_path / start_mu - 1.0),
+        solver=dataclasses.replace(report, status=status),
+        symmetric=settings.symmetric,
+        spins=chosen.spins,
+        joint_path=evaluation.q if problem.robot.dof > 6 else None,
+    )
+
+
+def _check_spin_path(max_spin_step: float, method: Method, problem: PathProblem) -> None:
+    """Raise InvalidInputError on ``spin_path``: no spin paths in the method, or a bad step.
+
+    A spin path needs a method that gives one (casadi), fixed spin, and a finite step > 0.
+    """
+    if not method.spin_path or problem.options.spin_mode != "fixed":
+        raise InvalidInputError("spin_path", "a spin path needs method casadi and spin_mode fixed")
+    if not (math.isfinite(max_spin_step) and max_spin_step > 0.0):
+        raise InvalidInputError(
+            "spin_path.max_spin_step", f"{max_spin_step:.6g} rad must be finite and > 0"
+        )
+
+
+def _best_candidate(
+    problem: PathProblem,
+    bounds: PlacementBounds,
+    candidates: list[Candidate],
+    settings: Search,
+) -> tuple[float, Placement, PathEvaluation, Candidate] | None:
+    """The candidate the evaluator finds fastest (the first of equals), or None if none runs.
+
+    Each is clamped into the bounds and moved along its arc (:func:`_place_on_arc`); one with
+    its own joint path (a redundant arm's NLP) is judged along that path too.
+    """
+    best: tuple[float, Placement, PathEvaluation, Candidate] | None = None
+    for candidate in candidates:
+        placement, turn = _place_on_arc(candidate.vector, bounds, settings.near, settings.symmetric)
+        judged_problem = problem
+        if candidate.spins is not None:
+            judged_problem = problem.with_waypoints(
+                spun_waypoints(problem.waypoints, candidate.spins)
+            )
+        judged = []
+        if candidate.joint_path is not None:
+            try:
+                judged.append(
+                    evaluate_joint_path(
+                        judged_problem,
+                        placement,
+                        _turned_joint_path(problem.robot, candidate.joint_path, turn),
+                        tolerance=EXACT_POSE_TOLERANCE,
+                    )
+                )
+            except InvalidInputError:  # off its poses, limits or steps: only tracking counts
+                pass
+        judged.append(evaluate_path(judged_problem, placement))
+        for evaluation in judged:
+            if evaluation.mu_path is not None and (best is None or evaluation.mu_path > best[0]):
+                best = (evaluation.mu_path, placement, evaluation, candidate)
+    return best

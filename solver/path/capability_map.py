@@ -1,0 +1,176 @@
+"""Capability map: mu_path over a grid of placements (spec section 6).
+
+Every cell is what :func:`solver.path.evaluate.evaluate_path` gives at that placement, computed for
+all cells at once by :mod:`solver.path.placements`.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+
+from solver.core.codes import REASONS
+from solver.core.exceptions import InvalidInputError
+from solver.core.parallel import SERIAL, TaskRunner
+from solver.core.spatial import Placement
+from solver.path.placements import DEFAULT_CHUNK, evaluate_placements
+from solver.path.problem import PathProblem
+
+__all__ = ["REASONS", "CapabilityMap", "axis_length", "capability_map", "grid_axis"]
+
+
+@dataclass(frozen=True)
+class CapabilityMap:
+    """mu_path at every placement (x, y, yaw) and tool spin of a grid at height z.
+
+    Arrays are indexed [spin, yaw, y, x].
+
+    Attributes:
+        xs: shape (nx,), m. ys: shape (ny,), m. yaws: shape (nyaw,), rad. z: m.
+        spins: shape (nspin,), rad, the constant tool spins (cam.md section 3).
+        mu_path: m/s, NaN where infeasible.
+        reason: index into ``REASONS``, -1 where feasible.
+        failed_waypoint: the first waypoint that fails, -1 where feasible.
+        branch: index into the robot family's ``branches`` of the branch used.
+        bottleneck_waypoint: where V_max is smallest, -1 where infeasible.
+        bottleneck_joint: the joint on its limit there, -1 where infeasible.
+    """
+
+    xs: np.ndarray
+    ys: np.ndarray
+    yaws: np.ndarray
+    z: float
+    spins: np.ndarray
+    mu_path: np.ndarray
+    reason: np.ndarray
+    failed_waypoint: np.ndarray
+    branch: np.ndarray
+    bottleneck_waypoint: np.ndarray
+    bottleneck_joint: np.ndarray
+
+    def placement(self, index: tuple[int, ...]) -> Placement:
+        """The placement of cell [spin, yaw, y, x]."""
+        s, k, j, i = index
+        return Placement(
+            float(self.xs[i]),
+            float(self.ys[j]),
+            self.z,
+            float(self.yaws[k]),
+            spin=float(self.spins[s]),
+        )
+
+    def extreme(self, *, best: bool) -> tuple[int, ...] | None:
+        """Index [spin, yaw, y, x] of the feasible cell with the highest (or lowest) mu_path.
+
+        Ties go to the first cell in [spin, yaw, y, x] order; ``None`` when none is feasible.
+        """
+        feasible = ~np.isnan(self.mu_path)
+        if not feasible.any():
+            return None
+        values = np.where(feasible, self.mu_path, -np.inf if best else np.inf)
+        flat = int(np.argmax(values) if best else np.argmin(values))
+        return tuple(int(v) for v in np.unravel_index(flat, self.mu_path.shape))
+
+
+def axis_length(lower: float, upper: float, step: float, *, field: str) -> int:
+    """How many values :func:`grid_axis` gives, without making them (to check a size first).
+
+    Raises:
+        InvalidInputError: values not finite, step <= 0 or upper < lower.
+    """
+    if not all(math.isfinite(v) for v in (lower, upper, step)):
+        raise InvalidInputError(field, "min, max and step must be finite")
+    if step <= 0 or upper < lower:
+        raise InvalidInputError(
+            field, f"needs step > 0 and max >= min, got {lower=}, {upper=}, {step=}"
+        )
+    count = (upper - lower) / step + 1e-9
+    if count >= 2**53:
+        raise InvalidInputError(field, f"{count:.3g} grid values: the step is too small")
+    return math.floor(count) + 1
+
+
+def grid_axis(lower: float, upper: float, step: float, *, field: str) -> np.ndarray:
+    """Grid values lower, lower + step, ... up to upper.
+
+    upper is included when it falls on the grid to within 1e-9 of a step.
+
+    Raises:
+        InvalidInputError: values not finite, step <= 0 or upper < lower.
+    """
+    count = axis_length(lower, upper, step, field=field)
+    return lower + step * np.arange(count)
+
+
+def capability_map(
+    problem: PathProblem,
+    *,
+    xs: np.ndarray,
+    ys: np.ndarray,
+    z: float,
+    yaws: np.ndarray,
+    spins: np.ndarray | None = None,
+    chunk: int = DEFAULT_CHUNK,
+    progress: Callable[[float], None] | None = None,
+    runner: TaskRunner = SERIAL,
+    compiled: bool = True,
+) -> CapabilityMap:
+    """mu_path over the grid spins x yaws x ys x xs at height z (spec section 6).
+
+    Args:
+        problem: the robot (with a kinematics family), the path with its passes and the
+            options (the branch followed everywhere, the step bound, the spin mode).
+        xs: shape (nx,), m, placement x values.
+        ys: shape (ny,), m, placement y values.
+        z: m, the height of every placement.
+        yaws: shape (nyaw,), rad, placement yaw values.
+        spins: shape (nspin,), rad, constant tool spins (cam.md section 3); default [0].
+        chunk: placements computed together.
+        progress: called with the fraction done (0..1] as the work goes; it may raise
+            :class:`solver.core.progress.Cancelled` to stop it.
+        runner: where the placements' tasks run (:mod:`solver.core.parallel`); same answer on any.
+        compiled: the compiled kernel where there is one; False: the numpy pipeline (the
+            reference, :func:`solver.path.placements.evaluate_placements`).
+
+    Raises:
+        NoAnalyticIkError, InvalidInputError, RepeatedWaypointError: as ``evaluate_path``.
+    """
+    _ = problem.prepared  # the path is checked before the options
+    spins = np.zeros(1) if spins is None else spins
+    xs, ys, yaws, spins = (np.asarray(v, dtype=float) for v in (xs, ys, yaws, spins))
+    shape = (len(spins), len(yaws), len(ys), len(xs))
+    grid_spin, grid_yaw, grid_y, grid_x = np.meshgrid(spins, yaws, ys, xs, indexing="ij")
+    placements = np.stack(
+        [
+            grid_x.ravel(),
+            grid_y.ravel(),
+            np.full(grid_x.size, float(z)),
+            grid_yaw.ravel(),
+            grid_spin.ravel(),
+        ],
+        axis=1,
+    )
+    result = evaluate_placements(
+        problem,
+        placements,
+        chunk=chunk,
+        progress=progress,
+        runner=runner,
+        compiled=compiled,
+    )
+    return CapabilityMap(
+        xs=xs,
+        ys=ys,
+        yaws=yaws,
+        z=float(z),
+        spins=spins,
+        mu_path=result.mu_path.reshape(shape),
+        reason=result.reason.reshape(shape),
+        failed_waypoint=result.failed_waypoint.reshape(shape),
+        branch=result.branch.reshape(shape),
+        bottleneck_waypoint=result.bottleneck_waypoint.reshape(shape),
+        bottleneck_joint=result.bottleneck_joint.reshape(shape),
+    )

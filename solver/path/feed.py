@@ -1,0 +1,65 @@
+"""Can a path run at a programmed feed? (cam.md section 7, the ERK 2021 figs. 3-4 check).
+
+At a feed F the joint speeds at waypoint i are those at V_max_i scaled by F / V_max_i: the DTF's
+joint speeds are per unit of tool speed (and, in free spin mode, the spin rate scales with
+them), so each joint's use of its limit scales the same way, and the largest use along the path
+is F / mu_path, at the bottleneck.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from solver.core.exceptions import InvalidInputError
+from solver.path.evaluate import PathEvaluation
+
+
+@dataclass(frozen=True)
+class FeedCheck:
+    """The path at feed F.
+
+    Attributes:
+        feed: F (m/s).
+        feasible: whether the path runs at F with every joint within its limit (mu_path >= F).
+        margin: mu_path / F (> 1: room to spare); ``None`` when the path is infeasible.
+        qdot_at_feed: shape (N, n), rad/s, the joint speeds at F; ``None`` when infeasible. NaN
+            rows where the tool only turns (V_max = 0: no feed there).
+        use: shape (N, n), |qdot_at_feed| / qdot_max, dimensionless (1: on the limit).
+    """
+
+    feed: float
+    feasible: bool
+    margin: float | None
+    qdot_at_feed: np.ndarray | None
+    use: np.ndarray | None
+
+
+def check_feed(evaluation: PathEvaluation, feed: float, qdot_max: np.ndarray) -> FeedCheck:
+    """The joint speeds and limit use of an evaluated path at feed ``feed``.
+
+    Args:
+        evaluation: from :func:`solver.path.evaluate.evaluate_path`.
+        feed: F, m/s, finite and > 0.
+        qdot_max: shape (n,), rad/s, the joint speed limits the evaluation used.
+
+    Raises:
+        InvalidInputError: on ``feed``, not finite or not > 0.
+    """
+    if not (math.isfinite(feed) and feed > 0.0):
+        raise InvalidInputError("feed", f"{feed:.6g} m/s must be finite and > 0")
+    ev = evaluation
+    if ev.mu_path is None or ev.qdot is None or ev.v_max is None:
+        return FeedCheck(feed, False, None, None, None)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        scale = np.where(ev.v_max > 0.0, feed / ev.v_max, np.nan)
+    qdot_at_feed = ev.qdot * scale[:, None]
+    return FeedCheck(
+        feed=feed,
+        feasible=ev.mu_path >= feed,
+        margin=ev.mu_path / feed,
+        qdot_at_feed=qdot_at_feed,
+        use=np.abs(qdot_at_feed) / qdot_max,
+    )

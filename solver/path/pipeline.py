@@ -1,0 +1,256 @@
+"""The path pipeline, written once for every robot family and any dof (robots.md section 1).
+
+requirements -> IK -> tracking -> speeds -> limits -> branch choice -> bottleneck, for a chunk
+of placements at once. :func:`solver.path.evaluate.evaluate_path` (one placement, with
+per-waypoint detail) and :func:`solver.path.placements.evaluate_placements` (the map and the
+optimisers) both run :func:`run_chunk`; only the robot's kinematics family
+(:mod:`solver.core.family`) knows how IK and J^-1 t are solved, and only the problem's limits
+(:mod:`solver.path.limits`, the DTF first) how fast each waypoint may run.
+
+What makes it fast (dtf.md section 9): t_hat is computed once in {O} and only turned by each
+placement's yaw; all placements of a chunk, all waypoints and all IK branches are one set of
+component-first arrays with waypoints last.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from solver.core.codes import FEASIBLE
+from solver.core.dtf import spin_rate_nearest_zero
+from solver.core.exceptions import InvalidInputError
+from solver.core.spatial import MAX_COORDINATE, rotation_about_z
+from solver.path.limits import JointMotion, bound_by_limits
+from solver.path.prepare import PreparedPath
+from solver.path.problem import PathProblem
+from solver.path.tracking import Tracked, choose_branch, track
+
+
+def check_placements(placements: np.ndarray) -> np.ndarray:
+    """Placements as a float array (P, 5) of finite [x, y, z, yaw, spin] within MAX_COORDINATE.
+
+    The one batched layout of placements (:meth:`solver.core.spatial.Placement.as_row`); (P, 4)
+    arrays without the spin are taken with spin 0.
+
+    Raises:
+        InvalidInputError: wrong shape, not finite, or too far.
+    """
+    arr = np.asarray(placements, dtype=float)
+    if arr.ndim == 2 and arr.shape[1] == 4:
+        arr = np.column_stack([arr, np.zeros(len(arr))])
+    if arr.ndim != 2 or arr.shape[1] != 5:
+        raise InvalidInputError("placements", f"{arr.shape=}, needs (P, 5): x, y, z, yaw, spin")
+    if not np.all(np.isfinite(arr)) or np.any(np.abs(arr[:, :3]) > MAX_COORDINATE):
+        raise InvalidInputError(
+            "placements", f"need finite values, positions within {MAX_COORDINATE} m"
+        )
+    return arr
+
+
+@dataclass(frozen=True)
+class ChunkResult:
+    """Every branch at every placement of a chunk, and the branch each placement takes.
+
+    B branches, C placements, W waypoints, n joints.
+
+    Attributes:
+        tracked: the branches followed along the path (reason, failed waypoint: (B, C);
+            q: (n, B, C, W), rad).
+        qd_unit: shape (n, B, C, W), J^-1 t_hat (rad/s per m/s; per rad/s where h = 0).
+        qd_spin: shape (n, B, C, W), J^-1 [0; z_tool] (rad/s per rad/s of tool spin); only in
+            ``free`` spin mode, else None.
+        speed: shape (B, C, W), the DTF: V_max (Omega_max where h = 0), 1 / max_j |qd_unit_j| /
+            qdot_max_j in ``fixed`` mode, the two-variable LP with the spin rate free in ``free``
+            mode (cam.md section 2); meaningful only on feasible branches.
+        limiting: shape (B, C, W), the joint on its limit.
+        v_max: shape (B, C, W), m/s, 0 where h = 0.
+        mu_path: shape (B, C), m/s, -inf on infeasible branches.
+        spins: shape (B, C, W), rad, the spin schedule that realises mu_path in ``free`` mode
+            (cam.md section 2: at the feed mu_path, the spin rate nearest zero at each waypoint,
+            integrated along the path); None in ``fixed`` mode. ``tracked`` then holds the joint
+            paths along that schedule, so its position limits and steps are checked.
+        pick: shape (C,), the index on axis B of the branch each placement takes (``auto``: the
+            highest mu_path; the furthest failure where none is feasible).
+        ik_seeds: the seeds a numeric family started from (None for an analytic one).
+        branches_found: shape (C,), the distinct IK solutions a numeric family found at the
+            first waypoint (None for an analytic one).
+    """
+
+    tracked: Tracked
+    qd_unit: np.ndarray
+    qd_spin: np.ndarray | None
+    speed: np.ndarray
+    limiting: np.ndarray
+    v_max: np.ndarray
+    mu_path: np.ndarray
+    pick: np.ndarray
+    spins: np.ndarray | None = None
+    ik_seeds: int | None = None
+    branches_found: np.ndarray | None = None
+
+
+def turn_by_yaw(vectors: np.ndarray, yaws: np.ndarray) -> np.ndarray:
+    """Rz(yaw) v for every yaw: vectors (3, ..., W) in {O} -> (3, ..., C, W), C-contiguous.
+
+    Args:
+        vectors: shape (3, ..., W), in {O}.
+        yaws: shape (C,), rad (C = 1 broadcasts one turn over a chunk).
+    """
+    cos, sin = np.cos(yaws)[:, None], np.sin(yaws)[:, None]
+    x, y = vectors[0][..., None, :], vectors[1][..., None, :]
+    z = np.broadcast_to(vectors[2][..., None, :], np.broadcast_shapes(x.shape, cos.shape))
+    return np.stack([cos * x - sin * y, sin * x + cos * y, z])
+
+
+def flange_at_spin(path: PreparedPath, spin: float) -> tuple[np.ndarray, np.ndarray]:
+    """R_O_F (N, 3, 3) and p_O_F (N, 3) with every tool pose turned by ``spin`` about its z."""
+    if spin == 0.0:
+        return path.flange_rotation, path.flange_position
+    turned = path.tool_rotation @ rotation_about_z(spin)
+    rotation = turned @ path.tool_to_flange[:3, :3]
+    position = path.tool_position + turned @ path.tool_to_flange[:3, 3]
+    return rotation, position
+
+
+def run_chunk(problem: PathProblem, placements: np.ndarray) -> ChunkResult:
+    """The pipeline at C placements on the problem's branches.
+
+    Args:
+        problem: the robot (with a kinematics family), the path and the options, checked
+            (:attr:`PathProblem.branches` made).
+        placements: shape (C, 5), [x (m), y (m), z (m), yaw (rad), spin (rad)], checked; one
+            spin for the whole chunk.
+    """
+    robot, path, branches = problem.robot, problem.prepared, problem.branches
+    family = problem.family
+    yaws = placements[:, 3]
+    if np.all(yaws == yaws[0]):  # one turn for the chunk: broadcast it (less memory to read)
+        yaws = yaws[:1]
+    if np.any(placements[:, 4] != placements[0, 4]):
+        raise InvalidInputError("placements", "a chunk must have one spin")
+    offset = placements[:, :3].T[:, :, None]  # (3, C, 1)
+    flange_rotation, flange_position_o = flange_at_spin(path, float(placements[0, 4]))
+    rotation = turn_by_yaw(flange_rotation.transpose(1, 2, 0), yaws)  # (3, 3, C, W)
+    flange_position = turn_by_yaw(flange_position_o.T, yaws) + offset
+    tool_position = turn_by_yaw(path.tool_position.T, yaws) + offset
+    twist = np.concatenate(
+        [turn_by_yaw(path.twist[:, :3].T, yaws), turn_by_yaw(path.twist[:, 3:].T, yaws)]
+    )
+    solutions = family.solve_path(rotation, flange_position)
+    q, status = solutions.q, solutions.status  # (n, B_all, C, W), (B_all, C, W)
+    # In free mode the position limits hold along the spin schedule, checked there, not here.
+    free = problem.options.spin_mode == "free"
+    tracked = track(
+        q[:, branches],
+        status[branches],
+        lower=np.full(robot.dof, -np.inf) if free else robot.q_lower,
+        upper=np.full(robot.dof, np.inf) if free else robot.q_upper,
+        max_joint_step=problem.options.max_joint_step,
+        segment_checked=path.segment_in_pass,
+    )
+    # For dof > 6 these are the exact DTF LP's joint speeds per unit speed (robots.md section 5),
+    # so the ratio below gives the LP's V_max for every dof.
+    qd_unit = family.joint_speeds_per_unit_twist(
+        tracked.q, twist[:, None], tool_position[:, None], qdot_max=robot.qdot_max
+    )
+    qd_spin = None
+    if free:
+        tool_z = turn_by_yaw(path.tool_rotation[:, :, 2].T, yaws)
+        spin = np.concatenate([np.zeros_like(tool_z), np.broadcast_to(tool_z, twist[3:].shape)])
+        qd_spin = family.joint_speeds_per_unit_twist(
+            tracked.q, spin[:, None], tool_position[:, None]
+        )
+    motion = JointMotion(q=tracked.q, qd_unit=qd_unit, qd_spin=qd_spin)
+    speed, limiting, _ = bound_by_limits(problem.limits, motion)  # (B, C, W)
+    v_max = np.where(path.pure_rotation, 0.0, speed)
+    feasible = tracked.reason == FEASIBLE  # (B, C)
+    mu_path = np.where(feasible, v_max.min(axis=-1), -np.inf)
+    spins = None
+    if qd_spin is not None:
+        spins, tracked = _spin_schedule(problem, tracked, qd_unit, qd_spin, mu_path)
+        feasible = tracked.reason == FEASIBLE
+        mu_path = np.where(feasible, mu_path, -np.inf)
+    pick = choose_branch(mu_path, feasible, tracked.failed_waypoint)
+    return ChunkResult(
+        tracked=tracked,
+        qd_unit=qd_unit,
+        qd_spin=qd_spin,
+        speed=speed,
+        limiting=limiting,
+        v_max=v_max,
+        mu_path=mu_path,
+        pick=pick,
+        spins=spins,
+        ik_seeds=solutions.seeds,
+        branches_found=solutions.branches_found,
+    )
+
+
+def _spin_schedule(
+    problem: PathProblem,
+    tracked: Tracked,
+    qd_unit: np.ndarray,
+    qd_spin: np.ndarray,
+    mu_path: np.ndarray,
+) -> tuple[np.ndarray, Tracked]:
+    """The spins that realise mu_path in free mode, and the joint paths along them.
+
+    At the feed F = mu_path each waypoint admits an interval of spin rates; the one nearest zero
+    is held over the segment (its duration |dp_i| / F), which gives the spins phi_i. The joints
+    follow q_i + sum_k<i sigma_k dt_k J^-1 [0; z_tool]_k: exact for a straight spindle (only the
+    last joint moves), first order otherwise (cam.md section 2). Those joint paths are tracked
+    again, so the last joint's limits and steps are checked along the schedule.
+
+    Args:
+        problem: the robot, the prepared path and the options.
+        tracked: the branches followed at the given spin; q (n, B, C, W).
+        qd_unit: shape (n, B, C, W), J^-1 t_hat.
+        qd_spin: shape (n, B, C, W), J^-1 [0; z_tool].
+        mu_path: shape (B, C), m/s, -inf where infeasible.
+
+    Returns:
+        spins (B, C, W), rad (0 where infeasible or mu_path = 0), and the tracking of the spun
+        joint paths (where the branch was feasible).
+    """
+    robot, path = problem.robot, problem.prepared
+    feed = np.where(np.isfinite(mu_path) & (mu_path > 0.0), mu_path, 0.0)[..., None]
+    rate = spin_rate_nearest_zero(qd_unit, qd_spin, robot.qdot_max, feed)
+    length = np.linalg.norm(np.diff(path.tool_position, axis=0), axis=1)  # (W - 1,)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        step = np.where(feed > 0.0, rate[..., :-1] * length / feed, 0.0)  # (B, C, W - 1)
+    step = np.where(path.segment_in_pass, step, 0.0)  # each pass starts at the placement's spin
+    spins = cumsum_within_passes(step, path.segment_in_pass)
+    moved = cumsum_within_passes(step * qd_spin[..., :-1], path.segment_in_pass)
+    spun = track(
+        tracked.q + np.nan_to_num(moved),
+        np.zeros(tracked.q.shape[1:], dtype=int),  # every pose was solved: only limits, steps
+        lower=robot.q_lower,
+        upper=robot.q_upper,
+        max_joint_step=problem.options.max_joint_step,
+        segment_checked=path.segment_in_pass,
+    )
+    keep = np.isfinite(mu_path)
+    return spins, Tracked(
+        reason=np.where(keep, spun.reason, tracked.reason),
+        failed_waypoint=np.where(keep, spun.failed_waypoint, tracked.failed_waypoint),
+        q=np.where(keep[None, ..., None], spun.q, tracked.q),
+    )
+
+
+def cumsum_within_passes(steps: np.ndarray, segment_in_pass: np.ndarray) -> np.ndarray:
+    """Running sums of per-segment steps along the last axis, restarting at 0 at each pass.
+
+    Args:
+        steps: shape (..., W - 1), one value per segment.
+        segment_in_pass: shape (W - 1,), False where a segment joins two passes.
+
+    Returns:
+        shape (..., W): 0 at the first waypoint of every pass.
+    """
+    total = np.concatenate([np.zeros(steps.shape[:-1] + (1,)), np.cumsum(steps, axis=-1)], axis=-1)
+    starts = np.concatenate([[True], ~segment_in_pass])  # (W,), the first waypoint of each pass
+    first = np.maximum.accumulate(np.where(starts, np.arange(len(starts)), 0))
+    result: np.ndarray = total - total[..., first]
+    return result

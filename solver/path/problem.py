@@ -1,0 +1,185 @@
+"""One problem object: a robot, a path and the options of its evaluation, checked once.
+
+A request becomes a frozen :class:`PathProblem` (qpsolvers' ``Problem``): the robot, the tool
+path in {O} with its passes, and :class:`PathOptions` (the branch policy, the joint step bound,
+the spin mode; later options are fields here too). Every solver entry point takes the problem,
+not loose settings: :func:`solver.path.evaluate.evaluate_path`,
+:func:`solver.path.placements.evaluate_placements`,
+:func:`solver.path.capability_map.capability_map`,
+:func:`solver.optimise.optimize.optimize_placement`. The limits on the path index are the
+problem's too (:mod:`solver.path.limits`), so the pipeline loops over them and never names one.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import functools
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from typing import Literal
+
+import numpy as np
+
+from solver.core.exceptions import InvalidInputError, NoAnalyticIkError, quoted
+from solver.core.family import Branch, KinematicsFamily
+from solver.core.robots import Robot
+from solver.path.limits import JointSpeedLimit, Limit
+from solver.path.prepare import PreparedPath, prepare_path
+
+DEFAULT_MAX_JOINT_STEP = 0.35
+
+SpinMode = Literal["fixed", "free"]
+SPIN_MODES: tuple[SpinMode, ...] = ("fixed", "free")
+
+
+@dataclass(frozen=True)
+class PathOptions:
+    """How a path is evaluated (dtf.md section 4, cam.md section 2).
+
+    Attributes:
+        branch: the IK branch to follow; ``None`` is ``auto``, the feasible branch with the
+            highest mu_path.
+        max_joint_step: rad, > 0, the largest move of any joint between neighbouring
+            waypoints of one pass.
+        spin_mode: ``fixed`` (the orientations as given) or ``free`` (the tool spin rate a free
+            variable of the DTF).
+    """
+
+    branch: Branch | None = None
+    max_joint_step: float = DEFAULT_MAX_JOINT_STEP
+    spin_mode: SpinMode = "fixed"
+
+    def check(self, robot: Robot) -> np.ndarray:
+        """Check the options against ``robot``; the branches to follow (all for ``auto``).
+
+        Raises:
+            InvalidInputError: a bad spin mode, step or branch name; NoAnalyticIkError: the
+                robot has no kinematics family.
+        """
+        check_spin_mode(robot, self.spin_mode)
+        family = require_family(robot)
+        self.check_step()
+        if self.branch is None:
+            return np.arange(len(family.branches))
+        return np.array([family.branch_index(self.branch)])
+
+    def check_step(self) -> None:
+        """Raise InvalidInputError on ``ik.max_joint_step`` unless it is finite and > 0 (rad)."""
+        if not (math.isfinite(self.max_joint_step) and self.max_joint_step > 0.0):
+            raise InvalidInputError(
+                "ik.max_joint_step", f"{self.max_joint_step:.6g} rad must be > 0"
+            )
+
+
+@dataclass(frozen=True, eq=False)
+class PathProblem:
+    """A robot, a tool path and the options of its evaluation.
+
+    The path's placement-independent data (:attr:`prepared`) and the options' check
+    (:attr:`branches`) are made once, on first use, in the order the evaluation needs them (a
+    request with several faults reports the same one as before).
+
+    Attributes:
+        robot: an arm with a kinematics family, with its speed limits and TCP.
+        waypoints: shape (N, 4, 4), T_O_i, tool point poses in {O} (m).
+        options: how the path is evaluated.
+        passes: index ranges [start, stop) of the passes of a CAM program (cam.md section 5);
+            None: one pass.
+    """
+
+    robot: Robot
+    waypoints: np.ndarray
+    options: PathOptions = field(default_factory=PathOptions)
+    passes: tuple[tuple[int, int], ...] | None = None
+
+    def __post_init__(self) -> None:
+        """Hold the waypoints as a float array and the passes as a tuple."""
+        object.__setattr__(self, "waypoints", np.asarray(self.waypoints, dtype=float))
+        if self.passes is not None:
+            passes = tuple((int(start), int(stop)) for start, stop in self.passes)
+            object.__setattr__(self, "passes", passes)
+
+    @classmethod
+    def of(
+        cls,
+        robot: Robot,
+        waypoints: np.ndarray,
+        options: PathOptions | None = None,
+        *,
+        passes: Sequence[tuple[int, int]] | None = None,
+    ) -> PathProblem:
+        """The problem of ``robot`` along ``waypoints`` (default options)."""
+        passes_tuple = None if passes is None else tuple(passes)
+        return cls(robot, waypoints, options or PathOptions(), passes_tuple)
+
+    @property
+    def family(self) -> KinematicsFamily:
+        """The robot's kinematics family; NoAnalyticIkError when it has none."""
+        return require_family(self.robot)
+
+    @functools.cached_property
+    def branches(self) -> np.ndarray:
+        """The options checked: indices of the family's branches to follow (all for auto)."""
+        return self.options.check(self.robot)
+
+    @functools.cached_property
+    def prepared(self) -> PreparedPath:
+        """The path checked and reduced to what every placement needs (in {O})."""
+        return prepare_path(self.robot, self.waypoints, passes=self.passes)
+
+    @functools.cached_property
+    def limits(self) -> tuple[Limit, ...]:
+        """The limits on the path index: the joint speed limits (the DTF) first."""
+        return (JointSpeedLimit(self.robot.qdot_max),)
+
+    def with_options(self, **changes: object) -> PathProblem:
+        """The same robot and path with some options changed (e.g. ``branch=...``).
+
+        The prepared path and the limits, which no option changes, are shared.
+        """
+        options = dataclasses.replace(self.options, **changes)  # type: ignore[arg-type]
+        other = dataclasses.replace(self, options=options)
+        for shared in ("prepared", "limits"):
+            if shared in self.__dict__:
+                other.__dict__[shared] = self.__dict__[shared]
+        return other
+
+    def with_waypoints(self, waypoints: np.ndarray) -> PathProblem:
+        """The same robot, passes and options along other waypoints (e.g. spun ones)."""
+        return dataclasses.replace(self, waypoints=waypoints)
+
+
+def check_spin_mode(robot: Robot, spin_mode: str) -> None:
+    """Raise InvalidInputError on ``spin_mode``: unknown, or free with no last joint to spin.
+
+    A free tool spin needs the last joint to turn the tool, so ``free`` on an arm whose last
+    joint is prismatic is refused.
+    """
+    if spin_mode not in SPIN_MODES:
+        raise InvalidInputError(
+            "spin_mode", f"unknown spin mode {quoted(str(spin_mode))}; use fixed or free"
+        )
+    last = robot.model.joints[robot.model.njoints - 1].shortname()
+    prismatic = "Prismatic" in last or last.startswith("JointModelP")
+    if spin_mode == "free" and prismatic:
+        raise InvalidInputError(
+            "spin_mode",
+            f"free spin needs a revolute last joint; {robot.joint_names[-1]!r} is prismatic",
+        )
+    if spin_mode == "free" and robot.dof != 6:
+        raise InvalidInputError(
+            "spin_mode",
+            f"free spin is solved for six-joint arms; {robot.name!r} has {robot.dof} joints",
+        )
+
+
+def require_family(robot: Robot) -> KinematicsFamily:
+    """The robot's kinematics family; NoAnalyticIkError when it has none."""
+    if robot.family is None:
+        raise NoAnalyticIkError(
+            "robot",
+            f"path evaluation needs an arm with an IK family (UR, OPW, or numeric for a serial "
+            f"chain of six joints or more); {robot.name!r} has none",
+        )
+    return robot.family

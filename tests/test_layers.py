@@ -1,0 +1,34 @@
+"""The house's layers (spec/architecture.md section 1): no import cycle anywhere.
+
+``lint-imports`` (in ``.ci/run``, contracts in pyproject.toml) holds the layers' order; this
+test holds what a layers contract does not see: a cycle between two modules of one layer, with
+imports made inside functions counted too (grimp reads every import statement).
+"""
+
+from __future__ import annotations
+
+import grimp
+import pytest
+
+
+@pytest.fixture(scope="module")
+def graph() -> grimp.ImportGraph:
+    return grimp.build_graph("solver", "service")
+
+
+def test_no_module_imports_back_what_imports_it(graph: grimp.ImportGraph) -> None:
+    cycles = []
+    for importer in sorted(graph.modules):
+        for imported in sorted(graph.find_modules_directly_imported_by(importer)):
+            back = graph.find_shortest_chain(importer=imported, imported=importer)
+            if back is not None:
+                cycles.append((importer, *back))
+    assert cycles == []
+
+
+def test_the_graph_sees_imports_inside_functions(graph: grimp.ImportGraph) -> None:
+    # solver.families.catalogue() imports its catalogue modules by name (importlib, not seen);
+    # the Dask runner is imported inside a function of the job worker (an optional extra).
+    assert "service.jobs.dask_runner" in graph.find_modules_directly_imported_by(
+        "service.jobs.worker"
+    )
