@@ -18,6 +18,7 @@ from solver.cam.cam_path import CamPath, Units
 from solver.cam.cl_data import DEFAULT_ARC_TOLERANCE, read_cl_data
 from solver.cam.csv_path import read_csv_path
 from solver.cam.read_report import ReadReport, UnitsSource
+from solver.cam.reading import is_number
 from solver.core.spatial import check_position, pose_matrices
 from solver.core.task import task_requirements
 from solver.core.tool_axis import poses_from_tool_axes
@@ -277,8 +278,10 @@ class CsvPath(RequestModel):
     units: Literal["mm", "inch", "m"] = Field(description="The unit of x, y, z: mm, inch or m.")
 
     def n_waypoints(self) -> int:
-        """An upper bound on the number of waypoints: the lines."""
-        return self.csv.count("\n") + 1
+        """The number of waypoints as read: the non-blank lines after any header (cam.md 9)."""
+        rows = [row for row in self.csv.splitlines() if row.strip()]
+        header = bool(rows) and not all(is_number(cell) for cell in rows[0].split(","))
+        return len(rows) - int(header)
 
     def to_solver(self) -> PathInput:
         """The path's poses (one pass, no feed).

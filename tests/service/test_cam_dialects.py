@@ -158,3 +158,16 @@ def test_an_nx_listing_that_import_accepts_evaluates(client: TestClient) -> None
     answer = client.post("/v1/evaluate", json=body)
     assert answer.status_code == 200, answer.text
     assert answer.json()["feed_check"]["feed"] == pytest.approx(10 * INCH / 60, rel=1e-12)
+
+
+def test_a_csv_counts_its_waypoints_not_its_lines(client: TestClient, setting: Any) -> None:
+    setting(max_path_waypoints=3)
+    csv = "x,y,z,i,j,k\n\n0,0,0,0,0,1\n1,0,0,0,0,1\n\n2,0,0,0,0,1\n\n"  # 7 lines, 3 waypoints
+    path = {"csv": csv, "units": "mm"}
+    assert len(imported(client, path)["waypoints"]) == 3
+    body = {"robot": {"model": "ur5"}, "path": path, "placement": PLACEMENT}
+    assert client.post("/v1/evaluate", json=body).status_code == 200
+    more = {"csv": csv + "3,0,0,0,0,1\n", "units": "mm"}
+    answer = client.post("/v1/paths/import", json={"path": more})
+    assert answer.status_code == 422
+    assert "4 waypoints; the limit is 3" in answer.json()["detail"][0]["msg"]
