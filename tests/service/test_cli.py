@@ -175,6 +175,7 @@ def test_a_progress_bar_only_when_asked(capsys: pytest.CaptureFixture[str]) -> N
     assert quiet[2] == ""
     shown = run(capsys, *args, "--png", "/dev/null", "--progress")
     assert quiet[0] == shown[0] == OK and quiet[1] == shown[1]
+    assert "\r[" in shown[2] and "%" in shown[2]  # drawn on stderr, stdout untouched
 
 
 def test_the_command_runs_as_a_process(tmp_path: Path) -> None:
