@@ -7,8 +7,10 @@ import json
 import re
 import sys
 
+import pytest
 from fastapi.testclient import TestClient
 
+from service.cli import OK, main
 from service.main import app
 from tests.cases import EXAMPLES, ROOT
 
@@ -71,3 +73,15 @@ def test_cam_example_output() -> None:
         "## CAM programs: from a CL file to the controller", "cam_program"
     )
     assert printed == lines
+
+
+def test_cam_command_line_output(capsys: pytest.CaptureFixture[str]) -> None:
+    """The NX listing through ``dtf-place``: the README shows what the commands print."""
+    section = README.split("### CL files as CAM systems write them", 1)[1]
+    block = section.split("```sh\n", 1)[1].split("```", 1)[0]
+    commands = [line.split() for line in block.splitlines() if line]
+    printed = re.search(r"print\n\n```\n(.*?)\n```", section, re.S).group(1)
+    assert all(command[0] == "dtf-place" for command in commands)
+    for command in commands:
+        assert main(command[1:]) == OK
+    assert capsys.readouterr().out.rstrip("\n") == printed

@@ -9,12 +9,13 @@ the same code's.
 from service.operations.evaluate import evaluation_of, joint_use_png
 from service.operations.map import checked_grid, computed_map, map_of, map_png
 from service.operations.optimize import optimum_of
-from service.operations.paths import imported
+from service.operations.paths import import_of, imported
 
 __all__ = [
     "checked_grid",
     "computed_map",
     "evaluation_of",
+    "import_of",
     "imported",
     "joint_use_png",
     "map_of",

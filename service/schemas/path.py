@@ -11,12 +11,14 @@ from dataclasses import dataclass
 from typing import Annotated, Literal
 
 import numpy as np
-from pydantic import ConfigDict, Discriminator, Field, Tag
+from pydantic import ConfigDict, Discriminator, Field, PrivateAttr, Tag
 
 from service.schemas.common import Pose, RequestModel, SpinMode, ToolAxisWaypoint
-from solver.cam.cam_path import CamPath
-from solver.cam.cl_data import read_cl_data
+from solver.cam.cam_path import CamPath, Units
+from solver.cam.cl_data import DEFAULT_ARC_TOLERANCE, read_cl_data
 from solver.cam.csv_path import read_csv_path
+from solver.cam.read_report import ReadReport, UnitsSource
+from solver.cam.reading import is_number
 from solver.core.spatial import check_position, pose_matrices
 from solver.core.task import task_requirements
 from solver.core.tool_axis import poses_from_tool_axes
@@ -36,6 +38,14 @@ class PathInput:
         passes: index ranges [start, stop) of the passes (cam.md section 5); None: one pass.
         feed: the program's feed (m/s), its highest FEDRAT; None when it programs none.
         units: the length unit the path was written in.
+        units_source: how the units were known: ``stated``, ``inferred`` (CL data, from an
+            inch feed) or ``request`` (the request's units, or metres by the API).
+        units_note: the evidence for the units.
+        pass_operations: each pass's operation name (CL data), ``None`` where none is named;
+            empty for other forms.
+        pass_feeds: each pass's highest feed (m/s) or ``None``; empty for poses and axes.
+        one_point_passes: passes of one point dropped (CL data).
+        report: what the CL reader skipped, dropped and inferred; ``None`` for other forms.
     """
 
     poses: np.ndarray
@@ -44,10 +54,17 @@ class PathInput:
     passes: tuple[tuple[int, int], ...] | None = None
     feed: float | None = None
     units: str = "m"
+    units_source: UnitsSource = "request"
+    units_note: str = "the API's unit (m)"
+    pass_operations: tuple[str | None, ...] = ()
+    pass_feeds: tuple[float | None, ...] = ()
+    one_point_passes: int = 0
+    report: ReadReport | None = None
 
 
-def _from_cam(cam: CamPath, *, field: str) -> PathInput:
-    """The solver's path of a CAM program: its poses, passes, feed and units."""
+def _from_cam(cam: CamPath, *, field: str, units_note: str) -> PathInput:
+    """The solver's path of a CAM program: its poses, passes, feed, units and read report."""
+    report = cam.report
     return PathInput(
         poses=cam.waypoints_in_workpiece(field=field),
         axis_correction=cam.axis_correction,
@@ -55,6 +72,12 @@ def _from_cam(cam: CamPath, *, field: str) -> PathInput:
         passes=cam.passes,
         feed=cam.feed,
         units=cam.units,
+        units_source="request" if report is None else report.units_source,
+        units_note=units_note if report is None else report.units_note,
+        pass_operations=cam.pass_operations,
+        pass_feeds=cam.pass_feeds,
+        one_point_passes=cam.one_point_passes,
+        report=report,
     )
 
 
@@ -156,8 +179,15 @@ MAX_CAM_TEXT = 2_000_000
 """Characters of CL data or CSV at most (a request body is at most 2 MB anyway)."""
 
 
+CL_UNITS: dict[str, Units] = {"mm": "mm", "inch": "inches"}
+
+
 class ClDataPath(RequestModel):
-    """A CAM program as APT CL data (cam.md section 5): passes split at rapids, feed from FEDRAT."""
+    """A CAM program as APT CL data (cam.md sections 5 and 9), as CAM systems write it.
+
+    NX, SolidWorks CAM, CATIA or Mastercam: passes split at rapids, tool changes and
+    operations; feed from FEDRAT.
+    """
 
     model_config = ConfigDict(
         json_schema_extra={
@@ -173,23 +203,60 @@ class ClDataPath(RequestModel):
     cl_data: str = Field(
         min_length=1,
         max_length=MAX_CAM_TEXT,
-        description="APT CL data as CAM writes it: UNITS, MULTAX, TLAXIS, GOTO, FEDRAT, RAPID "
-        "(cam.md section 5); records it does not read are a 422 naming the line. Tool axes "
-        "within 1e-3 of unit length are normalised and the correction reported. The default "
-        "spin_mode is free; the default feed of /v1/evaluate is the program's highest FEDRAT.",
+        description="APT CL data as CAM writes it (cam.md sections 5 and 9): GOTO (3 numbers "
+        "keep the last tool axis), CIRCLE arcs, FEDRAT, RAPID, UNITS/UNIT, MSYS/CSYS, TOOL PATH "
+        "and tool changes. Records without geometry or feed are skipped and counted (see "
+        "/v1/paths/import); a record that would move the tool in a way not applied is a 422 "
+        "naming its line. Tool axes within 1e-3 of unit length are normalised and the "
+        "correction reported. The default spin_mode is free; the default feed of /v1/evaluate "
+        "is the program's highest FEDRAT.",
     )
+    units: Literal["mm", "inch"] | None = Field(
+        default=None,
+        description="The length unit, for a program that states none (no UNITS or UNIT record "
+        "and no FEDRAT/IPM, from which inches are inferred). A program that states none and "
+        "is sent without units is a 422 on path.units; units that contradict the program's "
+        "UNITS record are a 422 too.",
+    )
+    arc_tolerance: float = Field(
+        default=DEFAULT_ARC_TOLERANCE,
+        ge=1e-7,
+        le=1e-3,
+        description="m: CIRCLE arcs are interpolated by points whose chords stay this close to "
+        "the arc (default 1e-5 m = 0.01 mm).",
+    )
+    _read: CamPath | None = PrivateAttr(default=None)
+
+    def cam_path(self) -> CamPath:
+        """The program as read, once (the waypoint count and the poses come from one reading).
+
+        Raises:
+            InvalidLineError: a record that cannot be read, naming its line.
+            InvalidInputError: no units (on ``path.units``), or more waypoints than any route
+                takes (on ``path``).
+        """
+        if self._read is None:
+            self._read = read_cl_data(
+                self.cl_data,
+                units=None if self.units is None else CL_UNITS[self.units],
+                arc_tolerance=self.arc_tolerance,
+                max_waypoints=MAX_PATH_WAYPOINTS,
+                field="path.cl_data",
+                units_field="path.units",
+            )
+        return self._read
 
     def n_waypoints(self) -> int:
-        """An upper bound on the number of waypoints: the GOTO records (before parsing)."""
-        return self.cl_data.upper().count("GOTO")
+        """The number of waypoints as read: what /v1/paths/import shows (cam.md section 9)."""
+        return self.cam_path().n_waypoints
 
     def to_solver(self) -> PathInput:
-        """The program's poses, passes and feed.
+        """The program's poses, passes, feed, units and what was skipped.
 
         Raises:
             InvalidLineError: a record that cannot be read, naming its line.
         """
-        return _from_cam(read_cl_data(self.cl_data, field="path.cl_data"), field="path.cl_data")
+        return _from_cam(self.cam_path(), field="path.cl_data", units_note="")
 
 
 class CsvPath(RequestModel):
@@ -208,11 +275,13 @@ class CsvPath(RequestModel):
         "x,y,z,qx,qy,qz,qw (a pose); an optional header line naming those columns. Vectors "
         "within 1e-3 of unit length are normalised and the correction reported.",
     )
-    units: Literal["mm", "m"] = Field(description="The unit of x, y, z: mm or m.")
+    units: Literal["mm", "inch", "m"] = Field(description="The unit of x, y, z: mm, inch or m.")
 
     def n_waypoints(self) -> int:
-        """An upper bound on the number of waypoints: the lines."""
-        return self.csv.count("\n") + 1
+        """The number of waypoints as read: the non-blank lines after any header (cam.md 9)."""
+        rows = [row for row in self.csv.splitlines() if row.strip()]
+        header = bool(rows) and not all(is_number(cell) for cell in rows[0].split(","))
+        return len(rows) - int(header)
 
     def to_solver(self) -> PathInput:
         """The path's poses (one pass, no feed).
@@ -221,7 +290,7 @@ class CsvPath(RequestModel):
             InvalidLineError: a line that cannot be read, naming it.
         """
         cam = read_csv_path(self.csv, units=self.units, field="path.csv")
-        return _from_cam(cam, field="path.csv")
+        return _from_cam(cam, field="path.csv", units_note=f"the request's units ({self.units})")
 
 
 _FORMS = ("waypoints", "tool_axis_waypoints", "cl_data", "csv")

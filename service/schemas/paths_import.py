@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from typing import Literal
+
 from pydantic import ConfigDict, Field
 
 from service.schemas.common import RequestModel, ResponseModel, SpinMode
@@ -37,6 +39,29 @@ class ImportedPose(ResponseModel):
     )
 
 
+class SkippedRecordOut(ResponseModel):
+    """Records of one word skipped: they carry no geometry and no feed (cam.md section 9)."""
+
+    word: str = Field(description="The major word (PAINT, TLDATA; $$ for comments).")
+    count: int = Field(description="How many records of this word the file has.")
+    first_line: int = Field(description="The line of the first one, from 1.")
+    recognised: bool = Field(
+        description="false for a word the reader does not know: check that it moves nothing."
+    )
+
+
+class PassOut(ResponseModel):
+    """One pass: its range of waypoints and the operation it belongs to."""
+
+    start: int = Field(description="Its first waypoint's index.")
+    stop: int = Field(description="One past its last waypoint's index.")
+    operation: str | None = Field(
+        description="The operation's name in the file (NX TOOL PATH, PARTNO, PPRINT); null "
+        "where the file names none."
+    )
+    feed: float | None = Field(description="Its highest programmed feed (m/s), or null.")
+
+
 class PathImportResponse(ResponseModel):
     """The path read: its waypoints, passes, feed and the corrections made."""
 
@@ -53,6 +78,17 @@ class PathImportResponse(ResponseModel):
                     "units": "mm",
                     "correction": 0.0,
                     "spin_mode": "free",
+                    "units_source": "stated",
+                    "units_note": "UNITS/MM at line 1",
+                    "pass_details": [
+                        {"start": 0, "stop": 2, "operation": "FACE_MILL", "feed": 0.025}
+                    ],
+                    "skipped_records": [
+                        {"word": "PAINT", "count": 3, "first_line": 4, "recognised": True}
+                    ],
+                    "repeated_points": 0,
+                    "one_point_passes": 0,
+                    "arcs": 0,
                 }
             ]
         }
@@ -72,3 +108,21 @@ class PathImportResponse(ResponseModel):
         "(normalised within 1e-3); 0 when none was needed."
     )
     spin_mode: SpinMode = Field(description="The default spin_mode of this path form.")
+    units_source: Literal["stated", "inferred", "request"] = Field(
+        description="How the units were known: stated by the file (UNITS, UNIT), inferred "
+        "(no UNITS record, but FEDRAT/IPM: inches), or from the request (its units; metres for "
+        "poses and tool-axis waypoints)."
+    )
+    units_note: str = Field(description="The evidence for the units, e.g. 'UNITS/MM at line 3'.")
+    pass_details: list[PassOut] = Field(
+        description="Each pass, in the order of passes, with its operation and feed."
+    )
+    skipped_records: list[SkippedRecordOut] = Field(
+        description="CL data: the records skipped (no geometry, no feed), one entry a word, in "
+        "the order first met; empty for other forms."
+    )
+    repeated_points: int = Field(
+        description="CL data: GOTOs to where the tool already was, dropped."
+    )
+    one_point_passes: int = Field(description="CL data: passes of a single point, dropped.")
+    arcs: int = Field(description="CL data: CIRCLE moves interpolated into waypoints.")

@@ -13,6 +13,7 @@ from typing import Literal
 
 import numpy as np
 
+from solver.cam.read_report import ReadReport
 from solver.core.exceptions import InvalidInputError, InvalidLineError
 from solver.core.spatial import rotation_about_z
 from solver.core.task import ANGULAR_TOLERANCE, LINEAR_TOLERANCE
@@ -44,6 +45,10 @@ class CamPath:
         units: the length unit the file was written in.
         axis_correction: the largest | |v| - 1 | of the axes or quaternions normalised
             (cam.md section 6).
+        pass_operations: the operation each pass belongs to (its name in the file), one per
+            pass, ``None`` where the file names none; empty for a reader without operations.
+        one_point_passes: passes of one point dropped (cam.md section 9).
+        report: what a CL reader skipped, counted and inferred; ``None`` for a CSV.
     """
 
     positions: np.ndarray
@@ -54,6 +59,9 @@ class CamPath:
     feeds: np.ndarray
     units: Units
     axis_correction: float
+    pass_operations: tuple[str | None, ...] = ()
+    one_point_passes: int = 0
+    report: ReadReport | None = None
 
     @property
     def n_waypoints(self) -> int:
@@ -138,6 +146,8 @@ def assemble_cam_path(
     units: Units,
     axis_correction: float,
     field: str,
+    operations: Sequence[str | None] | None = None,
+    drop_one_point_passes: bool = False,
 ) -> CamPath:
     """A CamPath from the cutting moves a reader collected, checked.
 
@@ -150,20 +160,29 @@ def assemble_cam_path(
         units: the length unit of the file.
         axis_correction: the largest correction made to a unit vector's length.
         field: the input's name, for the errors.
+        operations: the operation in force at each point, or ``None``.
+        drop_one_point_passes: drop a pass of one point and count it (CL data, cam.md
+            section 9) instead of refusing it.
 
     Raises:
         InvalidInputError: no cutting move at all.
-        InvalidLineError: a pass of one point; a point that repeats the one before it in its
-            pass (same position and direction), naming its line.
+        InvalidLineError: a pass of one point (unless dropped); a point that repeats the one
+            before it in its pass (same position and direction), naming its line.
     """
+    passes = _passes(pass_ids)
+    dropped = 0
+    if drop_one_point_passes:
+        keep = [i for start, stop in passes if stop - start >= 2 for i in range(start, stop)]
+        dropped = sum(1 for start, stop in passes if stop - start < 2)
+        positions, directions = [positions[i] for i in keep], [directions[i] for i in keep]
+        pass_ids, lines = [pass_ids[i] for i in keep], [lines[i] for i in keep]
+        arrival_feeds = [arrival_feeds[i] for i in keep]
+        operations = None if operations is None else [operations[i] for i in keep]
+        passes = _passes(pass_ids)
     if not positions:
         raise InvalidInputError(
             field, "no cutting move: a path needs at least one pass of 2 or more points"
         )
-    ids = np.asarray(pass_ids)
-    cuts = np.flatnonzero(np.diff(ids)) + 1
-    bounds = np.concatenate([[0], cuts, [len(ids)]])
-    passes = tuple((int(a), int(b)) for a, b in zip(bounds[:-1], bounds[1:], strict=True))
     for number, (start, stop) in enumerate(passes):
         if stop - start < 2:
             raise InvalidLineError(
@@ -190,7 +209,19 @@ def assemble_cam_path(
         feeds=feeds,
         units=units,
         axis_correction=axis_correction,
+        pass_operations=() if operations is None else tuple(operations[a] for a, _ in passes),
+        one_point_passes=dropped,
     )
+
+
+def _passes(pass_ids: Sequence[int]) -> tuple[tuple[int, int], ...]:
+    """The index ranges of the runs of equal pass ids."""
+    if not pass_ids:
+        return ()
+    ids = np.asarray(pass_ids)
+    cuts = np.flatnonzero(np.diff(ids)) + 1
+    bounds = np.concatenate([[0], cuts, [len(ids)]])
+    return tuple((int(a), int(b)) for a, b in zip(bounds[:-1], bounds[1:], strict=True))
 
 
 def _check_repeats(

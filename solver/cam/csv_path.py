@@ -2,21 +2,23 @@
 
 Each line is ``x, y, z, i, j, k`` (the tool tip and the tool axis, tip towards holder) or
 ``x, y, z, qx, qy, qz, qw`` (the tool pose, quaternion scalar last), every line alike; lengths
-are in the ``units`` the caller gives (``mm`` or ``m``). The first line may be a header; it must
-then name the columns, ``x,y,z,i,j,k`` or ``x,y,z,qx,qy,qz,qw`` (any case, blanks allowed), so
-that a file written in another order (``qw`` first) is refused rather than misread. Blank lines
-are skipped. Axes and quaternions within 1e-3 of unit are normalised (cam.md section 6).
+are in the ``units`` the caller gives (``mm``, ``inch`` or ``m``). The first line may be a
+header; it must then name the columns, ``x,y,z,i,j,k`` or ``x,y,z,qx,qy,qz,qw`` (any case,
+blanks allowed), so that a file written in another order (``qw`` first) is refused rather than
+misread. Blank lines are skipped. Axes and quaternions within 1e-3 of unit are normalised
+(cam.md section 6).
 """
 
 from __future__ import annotations
 
 import math
 
-from solver.cam.cam_path import METRES_PER_UNIT, CamPath, assemble_cam_path
+from solver.cam.cam_path import METRES_PER_UNIT, CamPath, Units, assemble_cam_path
 from solver.cam.reading import checked_position, is_number, near_unit_vector, parse_numbers
 from solver.core.exceptions import InvalidInputError, InvalidLineError
 from solver.core.spatial import rotation_from_quaternion
 
+_UNITS: dict[str, Units] = {"mm": "mm", "inch": "inches", "m": "m"}
 HEADERS = {
     6: ("x", "y", "z", "i", "j", "k"),
     7: ("x", "y", "z", "qx", "qy", "qz", "qw"),
@@ -28,22 +30,24 @@ def read_csv_path(text: str, *, units: str, field: str = "path.csv") -> CamPath:
 
     Args:
         text: the file.
-        units: ``mm`` or ``m``, the unit of x, y, z.
+        units: ``mm``, ``inch`` or ``m``, the unit of x, y, z.
         field: the input's name, for the errors.
 
     Returns:
         The path in metres: tool axes for 6 columns, rotations for 7.
 
     Raises:
-        InvalidInputError: units other than mm or m; fewer than 2 waypoints.
+        InvalidInputError: units other than mm, inch or m; fewer than 2 waypoints.
         InvalidLineError: a header that does not name the columns, a line with another count
             of numbers, a number that is malformed or not finite, an axis or quaternion off unit
             by more than 1e-3, a position beyond 1 km, or a waypoint repeating the one before
             it; each names its line.
     """
-    if units not in ("mm", "m"):
-        raise InvalidInputError("units", f"units {units!r}: a CSV path is in mm or m")
-    scale = METRES_PER_UNIT[units]
+    if units not in _UNITS:
+        raise InvalidInputError(
+            "units", f"units {units!r}: a CSV path is in mm or m (metric) or inch"
+        )
+    scale = METRES_PER_UNIT[_UNITS[units]]
     rows = [(n, raw.strip()) for n, raw in enumerate(text.splitlines(), start=1) if raw.strip()]
     columns = None
     if rows and not all(is_number(cell) for cell in rows[0][1].split(",")):
@@ -79,7 +83,7 @@ def read_csv_path(text: str, *, units: str, field: str = "path.csv") -> CamPath:
         pass_ids=[0] * len(positions),
         lines=lines,
         arrival_feeds=[math.nan] * len(positions),
-        units="mm" if units == "mm" else "m",
+        units=_UNITS[units],
         axis_correction=correction,
         field=field,
     )

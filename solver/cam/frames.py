@@ -151,6 +151,45 @@ def quaternion_wxyz(rotation: np.ndarray) -> np.ndarray:
     return quat
 
 
+def quaternions_wxyz(rotations: np.ndarray) -> np.ndarray:
+    """:func:`quaternion_wxyz` of many rotations at once, shape (N, 3, 3) -> (N, 4).
+
+    The same branches and the same sign rule, row by row, without a Python call per rotation
+    (an imported program has up to 20,000 waypoints).
+    """
+    m = np.asarray(rotations, dtype=float)
+    diag = np.diagonal(m, axis1=1, axis2=2)
+    trace = diag.sum(axis=1)
+    quats = np.empty((len(m), 4))
+    by_trace = trace > diag.max(axis=1)
+    t = m[by_trace]
+    s = 2.0 * np.sqrt(1.0 + trace[by_trace])
+    quats[by_trace] = np.column_stack(
+        [
+            s / 4,
+            (t[:, 2, 1] - t[:, 1, 2]) / s,
+            (t[:, 0, 2] - t[:, 2, 0]) / s,
+            (t[:, 1, 0] - t[:, 0, 1]) / s,
+        ]
+    )
+    largest = np.argmax(diag, axis=1)
+    for i in range(3):
+        rows = ~by_trace & (largest == i)
+        j, k = (i + 1) % 3, (i + 2) % 3
+        r = m[rows]
+        s = 2.0 * np.sqrt(1.0 + r[:, i, i] - r[:, j, j] - r[:, k, k])
+        quats[rows, 0] = (r[:, k, j] - r[:, j, k]) / s
+        quats[rows, 1 + i] = s / 4
+        quats[rows, 1 + j] = (r[:, j, i] + r[:, i, j]) / s
+        quats[rows, 1 + k] = (r[:, k, i] + r[:, i, k]) / s
+    quats /= np.linalg.norm(quats, axis=1)[:, None]
+    vector = quats[:, 1:]
+    lead = vector[np.arange(len(quats)), np.argmax(np.abs(vector), axis=1)]
+    flip = (quats[:, 0] < 0.0) | ((quats[:, 0] == 0.0) & (lead < 0.0))
+    quats[flip] = -quats[flip]
+    return quats
+
+
 def rotation_vector(rotation: np.ndarray) -> np.ndarray:
     """The rotation vector (axis times angle, rad) of a rotation, length in [0, pi], (3,)."""
     w, *v = quaternion_wxyz(rotation)

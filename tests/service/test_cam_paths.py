@@ -128,11 +128,11 @@ def test_import_shows_the_program(client: TestClient) -> None:
     ("text", "line"),
     [
         ("UNITS/MM\nMULTAX/ON\nCIRCLE/0, 0, 0, 0, 0, 1, 5\n", 3),
-        ("UNITS/MM\nMULTAX/ON\nGOTO/0, 0, 0, 0, 0, 1\nWIBBLE/3\n", 4),
+        ("UNITS/MM\nMULTAX/ON\nGOTO/0, 0, 0, 0, 0, 1\nGODLTA/3\n", 4),
         ("UNITS/MM\nMULTAX/ON\nGOTO/0, 0, 0, 0, 0\n", 3),
         ("UNITS/MM\nFEDRAT/0\nGOTO/0, 0, 0\nGOTO/1, 0, 0\n", 2),
     ],
-    ids=["circle", "unknown record", "goto of 5 numbers", "zero feed"],
+    ids=["circle without its end", "record not applied", "goto of 5 numbers", "zero feed"],
 )
 def test_a_record_that_cannot_be_read_is_a_422_naming_its_line(
     client: TestClient, text: str, line: int

@@ -214,3 +214,51 @@ def test_the_pages_examples_are_the_repositorys() -> None:
     assert json.loads((static / "readme_path.json").read_text()) == EXAMPLE_PATH
     cl = (ROOT / "examples" / "cam" / "sweep_mm.cl").read_text()
     assert (static / "sweep_mm.cl").read_text() == cl
+
+
+def test_the_page_shows_what_the_import_read(page: Page, url: str) -> None:
+    """Units and how they were known, each pass's operation, the skipped records (issue 25)."""
+    page.select_option("#path-example", "nx_slot_plate.cls")
+    page.wait_for_function(
+        "document.getElementById('import').dataset.waypoints && "
+        "document.getElementById('import-units').textContent.startsWith('inches')",
+        timeout=30_000,
+    )
+    program = (ROOT / "examples" / "cam" / "nx_slot_plate.cls").read_text()
+    api = httpx.post(f"{url}/v1/paths/import", json={"path": {"cl_data": program}}).json()
+    assert page.get_attribute("#import", "data-waypoints") == str(len(api["waypoints"]))
+    assert page.text_content("#import-units") == (
+        f"{api['units']} ({api['units_source']}: {api['units_note']})"
+    )
+    operations = page.locator("#import-passes tbody tr td:nth-child(3)").all_text_contents()
+    assert operations == [p["operation"] for p in api["pass_details"]]
+    skipped = page.locator("#import-skipped li").all_text_contents()
+    assert skipped == [
+        f"{s['word']}: {s['count']} (first at line {s['first_line']})"
+        for s in api["skipped_records"]
+    ]
+    assert (ROOT / "service" / "web" / "static" / "examples" / "nx_slot_plate.cls").read_text() == (
+        program
+    )
+
+
+def test_a_program_without_units_asks_for_them_beside_the_field(page: Page, url: str) -> None:
+    page.set_input_files(
+        "#path-file",
+        files=[
+            {"name": "bare.cl", "mimeType": "text/plain", "buffer": b"GOTO/0,0,0\nGOTO/9,0,0\n"}
+        ],
+    )
+    error = page.locator('.field[data-loc="path.units"] .error')
+    error.wait_for(state="visible", timeout=30_000)
+    page.wait_for_function(
+        "document.querySelector('.field[data-loc=\"path.units\"] .error').textContent",
+        timeout=30_000,
+    )
+    assert "states no units" in (error.text_content() or "")
+    page.select_option("#path-units", "mm")
+    page.wait_for_function("document.getElementById('import').dataset.waypoints", timeout=30_000)
+    assert (
+        page.text_content("#import-units")
+        == "mm (request: the request's units (the file states none))"
+    )

@@ -6,7 +6,9 @@ const $ = (id) => document.getElementById(id);
 const REASON_COLOURS = {
   unreachable: "#e0e0e0", joint_limits: "#f4a6c0", singular: "#555555", discontinuous: "#ffb74d",
 };
-const state = { robots: [], path: null, map: null, grid: null, job: null, cursor: null };
+const state = {
+  robots: [], path: null, source: null, map: null, grid: null, job: null, cursor: null,
+};
 
 // ---- inputs -------------------------------------------------------------------------------
 function numbers(text) {
@@ -53,20 +55,56 @@ function showLimits() {
 async function loadExample() {
   const name = $("path-example").value;
   const text = await (await fetch(`/ui/examples/${name}`)).text();
-  setPath(name, text);
+  await setPath(name, text);
 }
 
 function setPath(name, text) {
   const lower = name.toLowerCase();
+  state.source = { name, text };
+  const units = $("path-units").value;
   if (lower.endsWith(".json")) {
     const value = JSON.parse(text);
     state.path = value.path ?? value;
   } else if (lower.endsWith(".csv")) {
-    state.path = { csv: text, units: "mm" };
+    state.path = { csv: text, units: units || "mm" };
   } else {
     state.path = { cl_data: text };
+    if (units === "mm" || units === "inch") state.path.units = units;
   }
   $("path-info").textContent = `${name} loaded`;
+  return showImport();
+}
+
+// What the service read: units and how they were known, passes and operations, skipped records.
+async function showImport() {
+  clearErrors();
+  const box = $("import");
+  delete box.dataset.waypoints;
+  for (const id of ["import-summary", "import-units"]) $(id).textContent = "";
+  $("import-passes").tBodies[0].textContent = "";
+  $("import-skipped").textContent = "";
+  const read = await api("POST", "/v1/paths/import", { path: state.path }).catch(() => null);
+  if (!read) return;
+  const dropped = read.repeated_points + read.one_point_passes;
+  $("import-summary").textContent = `${read.waypoints.length} waypoints in ${read.passes.length} passes`
+    + (read.arcs ? `, ${read.arcs} arcs interpolated` : "")
+    + (dropped ? `; dropped ${read.repeated_points} repeated points, ${read.one_point_passes} one-point passes` : "");
+  $("import-units").textContent = `${read.units} (${read.units_source}: ${read.units_note})`;
+  const rows = $("import-passes").tBodies[0];
+  read.pass_details.forEach((p, k) => {
+    const row = rows.insertRow();
+    const feed = p.feed == null ? "-" : (p.feed * 60000).toFixed(1);
+    for (const value of [k + 1, `${p.start}-${p.stop - 1}`, p.operation ?? "-", feed]) {
+      row.insertCell().textContent = value;
+    }
+  });
+  for (const s of read.skipped_records) {
+    const item = document.createElement("li");
+    item.textContent = `${s.word}: ${s.count} (first at line ${s.first_line})`
+      + (s.recognised ? "" : " - not recognised: check that it moves nothing");
+    $("import-skipped").appendChild(item);
+  }
+  box.dataset.waypoints = String(read.waypoints.length);
 }
 
 // ---- API calls and errors ------------------------------------------------------------------
@@ -381,7 +419,10 @@ async function start() {
   $("path-example").addEventListener("change", loadExample);
   $("path-file").addEventListener("change", async () => {
     const file = $("path-file").files[0];
-    if (file) setPath(file.name, await file.text());
+    if (file) await setPath(file.name, await file.text());
+  });
+  $("path-units").addEventListener("change", () => {
+    if (state.source) setPath(state.source.name, state.source.text);
   });
   $("inputs").addEventListener("submit", runMap);
   $("cancel").addEventListener("click", cancelMap);

@@ -41,10 +41,13 @@ def test_pose_csv_example_gives_the_parallel_transport_poses() -> None:
     )
 
 
-@pytest.mark.parametrize(("units", "scale"), [("mm", 1e-3), ("m", 1.0)])
-def test_units(units: str, scale: float) -> None:
+@pytest.mark.parametrize(
+    ("units", "scale", "name"), [("mm", 1e-3, "mm"), ("m", 1.0, "m"), ("inch", 0.0254, "inches")]
+)
+def test_units(units: str, scale: float, name: str) -> None:
     path = read_csv_path("1,2,3,0,0,1\n4,5,6,0,0,1\n", units=units)
     np.testing.assert_allclose(path.positions, np.array([[1, 2, 3], [4, 5, 6]]) * scale)
+    assert path.units == name
 
 
 def test_quaternion_form_against_scipy() -> None:

@@ -19,6 +19,8 @@ from solver.cam.frames import (
     matrix_from_kuka,
     matrix_from_rows,
     matrix_from_ur,
+    quaternion_wxyz,
+    quaternions_wxyz,
 )
 from solver.core.exceptions import InvalidInputError
 from solver.core.spatial import Placement
@@ -193,3 +195,16 @@ def test_bad_controller_frames_are_refused(
     with pytest.raises(InvalidInputError) as caught:
         convert(value)
     assert caught.value.field == field
+
+
+def test_many_quaternions_at_once_equal_one_at_a_time() -> None:
+    """The batched form (imports of 20,000 waypoints) takes the same branch and sign row by row."""
+    rng = np.random.default_rng(25)
+    turns = [np.eye(3), np.diag([1.0, -1.0, -1.0]), np.diag([-1.0, 1.0, -1.0])]
+    rotations = np.concatenate([Rotation.random(500, random_state=rng).as_matrix(), turns])
+    batched = quaternions_wxyz(rotations)
+    single = np.array([quaternion_wxyz(r) for r in rotations])
+    np.testing.assert_allclose(batched, single, rtol=0, atol=1e-15)
+    scipy_wxyz = np.roll(Rotation.from_matrix(rotations).as_quat(), 1, axis=1)
+    np.testing.assert_allclose(np.abs(np.sum(batched * scipy_wxyz, axis=1)), 1.0, atol=1e-12)
+    assert np.all(batched[:, 0] >= 0.0)

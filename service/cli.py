@@ -1,0 +1,246 @@
+"""``dtf-place``: the service's answers on the command line, in-process, for CAM post-processors.
+
+CAM systems call programs, not web services. Each subcommand builds the request body the API
+takes, validates it with the same schemas (from JSON, as the service parses a body) and calls
+the same use cases as the routes (:mod:`service.operations`), so ``--json`` prints exactly what
+the route answers:
+
+- ``import PROGRAM``: what ``POST /v1/paths/import`` reads;
+- ``evaluate PROGRAM --robot R --at X,Y,Z,YAW``: mu_path and the feed check at a placement;
+- ``map PROGRAM --robot R --x MIN:MAX:STEP --y ... --z Z --png FILE``: the capability map;
+- ``optimise PROGRAM --robot R --x MIN:MAX --y MIN:MAX``: the best placement and its
+  controller frames.
+
+PROGRAM is CL data, or a CSV when its name ends in ``.csv`` (``--units`` then required). R is a
+catalogue name (``ur5e``) or a JSON file holding the API's ``robot`` object. Settings come from
+the environment as for the service (``DTF_*``). Exit codes: :data:`OK` (0), :data:`USAGE` (2),
+:data:`INVALID` (3), :data:`INFEASIBLE` (4); 1 is Python's own, for a crash. Errors name the
+field (and waypoint, line) as the API does.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import sys
+from collections.abc import Callable, Sequence
+from pathlib import Path
+from typing import Any, TypeVar
+
+from pydantic import BaseModel, ValidationError
+
+from service import convert
+from service.cli_text import ProgressBar, evaluation_text, import_text, map_text, optimum_text
+from service.config import get_settings
+from service.errors import solver_error_location
+from service.operations import computed_map, evaluation_of, import_of, map_png, optimum_of
+from service.schemas import EvaluateRequest, MapRequest, OptimizeRequest
+from service.schemas.paths_import import PathImportRequest
+from solver.core.exceptions import SolverError
+
+OK = 0
+"""The answer was printed (and the path runs, for evaluate, map and optimise)."""
+INFEASIBLE = 4
+"""The answer was printed, and it says no: the path does not run at the placement (or at its
+programmed feed), no cell of the map is feasible, or no placement in the bounds is."""
+USAGE = 2
+"""The command line is wrong (argparse's code)."""
+INVALID = 3
+"""The input is refused, as the API refuses it with a 422: the message names the field."""
+
+Model = TypeVar("Model", bound=BaseModel)
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Run one subcommand; return its exit code."""
+    args = _parser().parse_args(argv)
+    try:
+        return int(args.run(args))
+    except ValidationError as error:
+        for item in error.errors():
+            where = ".".join(str(part) for part in item["loc"])
+            print(f"error: {where}: {item['msg']}", file=sys.stderr)  # noqa: T201
+    except SolverError as error:
+        where = ".".join(str(part) for part in solver_error_location(error)[1:])
+        print(f"error: {where}: {error.message}", file=sys.stderr)  # noqa: T201
+    except json.JSONDecodeError as error:
+        print(f"error: robot: the file is not JSON ({error})", file=sys.stderr)  # noqa: T201
+    except OSError as error:
+        print(f"error: {error}", file=sys.stderr)  # noqa: T201
+    return INVALID
+
+
+def _path(args: argparse.Namespace) -> dict[str, Any]:
+    """The request's ``path`` object of the program file."""
+    text = Path(args.program).read_text(encoding="utf-8", errors="replace")
+    if args.program.lower().endswith(".csv"):
+        return {"csv": text, "units": args.units}
+    path: dict[str, Any] = {"cl_data": text}
+    if args.units is not None:
+        path["units"] = args.units
+    if args.arc_tolerance is not None:
+        path["arc_tolerance"] = args.arc_tolerance
+    return path
+
+
+def _robot(name: str) -> Any:
+    """The request's ``robot``: a JSON file's object, or a catalogue model name."""
+    file = Path(name)
+    if name.lower().endswith(".json") and file.is_file():
+        return json.loads(file.read_text(encoding="utf-8"))
+    return {"model": name}
+
+
+def _validated(model: type[Model], body: dict[str, Any]) -> Model:
+    """The body validated from JSON, as the service validates a request."""
+    return model.model_validate_json(json.dumps(body))
+
+
+def _print(answer: BaseModel, args: argparse.Namespace, text: Callable[[], str]) -> None:
+    """The answer as the API's JSON (``--json``), or as text."""
+    print(answer.model_dump_json(indent=2) if args.json else text())  # noqa: T201
+
+
+def _import(args: argparse.Namespace) -> int:
+    body = _validated(PathImportRequest, {"path": _path(args)})
+    answer = import_of(body, get_settings())
+    _print(answer, args, lambda: import_text(answer, args.program))
+    return OK
+
+
+def _evaluate(args: argparse.Namespace) -> int:
+    x, y, z, yaw = args.at
+    body: dict[str, Any] = {
+        "robot": _robot(args.robot),
+        "path": _path(args),
+        "placement": {"x": x, "y": y, "z": z, "yaw": yaw, "spin": args.spin},
+        "detail": "summary",
+    }
+    if args.spin_mode is not None:
+        body["spin_mode"] = args.spin_mode
+    if args.feed is not None:
+        body["feed"] = args.feed
+    request = _validated(EvaluateRequest, body)
+    with ProgressBar(enabled=args.progress) as bar:
+        answer = evaluation_of(request, get_settings(), bar)
+    _print(answer, args, lambda: evaluation_text(answer))
+    runs = answer.feasible and (answer.feed_check is None or answer.feed_check.feasible)
+    return OK if runs else INFEASIBLE
+
+
+def _map(args: argparse.Namespace) -> int:
+    grid = {"x": args.x, "y": args.y, "z": args.z, "yaw": args.yaw}
+    body: dict[str, Any] = {"robot": _robot(args.robot), "path": _path(args), "grid": grid}
+    if args.spin_mode is not None:
+        body["spin_mode"] = args.spin_mode
+    request = _validated(MapRequest, body)
+    with ProgressBar(enabled=args.progress) as bar:
+        result, robot, spin_mode = computed_map(request, get_settings(), png=True, progress=bar)
+    answer = convert.map_response(result, robot, spin_mode=spin_mode)
+    Path(args.png).write_bytes(map_png(result, robot))
+    _print(answer, args, lambda: map_text(answer, args.png))
+    return OK if answer.feasible_cells else INFEASIBLE
+
+
+def _optimise(args: argparse.Namespace) -> int:
+    bounds = {"x": args.x, "y": args.y, "yaw": args.yaw}
+    body: dict[str, Any] = {
+        "robot": _robot(args.robot),
+        "path": _path(args),
+        "bounds": bounds,
+        "z": args.z,
+        "method": args.method,
+    }
+    if args.spin_mode is not None:
+        body["spin_mode"] = args.spin_mode
+    request = _validated(OptimizeRequest, body)
+    with ProgressBar(enabled=args.progress) as bar:
+        answer = optimum_of(request, get_settings(), bar)
+    _print(answer, args, lambda: optimum_text(answer))
+    return OK if answer.found else INFEASIBLE
+
+
+def _numbers(count: int, separator: str) -> Callable[[str], list[float]]:
+    """An argparse type: ``count`` numbers joined by ``separator``."""
+
+    def parse(text: str) -> list[float]:
+        try:
+            values = [float(part) for part in text.split(separator)]
+        except ValueError:
+            values = []
+        if len(values) != count:
+            raise argparse.ArgumentTypeError(
+                f"{text!r}: {count} numbers separated by {separator!r}"
+            )
+        return values
+
+    return parse
+
+
+def _axis(text: str) -> dict[str, float]:
+    """A grid axis ``MIN:MAX:STEP`` (m)."""
+    low, high, step = _numbers(3, ":")(text)
+    return {"min": low, "max": high, "step": step}
+
+
+def _parser() -> argparse.ArgumentParser:
+    """The command line."""
+    parser = argparse.ArgumentParser(
+        prog="dtf-place",
+        description="Workpiece placement for robot machining, from a CL or CSV program: "
+        "the import, mu_path at a placement, the capability map, the best placement. "
+        f"Exit codes: {OK} ok, {INFEASIBLE} infeasible, {USAGE} usage, {INVALID} invalid input.",
+    )
+    commands = parser.add_subparsers(required=True, metavar="COMMAND")
+    common = argparse.ArgumentParser(add_help=False)
+    common.add_argument("program", help="CL data (NX, SolidWorks CAM, CATIA, ...) or a .csv")
+    common.add_argument(
+        "--units",
+        choices=["mm", "inch", "m"],
+        help="the program's length unit, where it states none",
+    )
+    common.add_argument("--arc-tolerance", type=float, help="m, chordal (default 1e-5)")
+    common.add_argument("--json", action="store_true", help="print the API's JSON answer")
+    solving = argparse.ArgumentParser(add_help=False, parents=[common])
+    solving.add_argument("--robot", required=True, help="a catalogue name or a robot JSON file")
+    solving.add_argument("--spin-mode", choices=["fixed", "free"])
+    solving.add_argument(
+        "--progress",
+        action=argparse.BooleanOptionalAction,
+        default=sys.stderr.isatty(),
+        help="a progress bar on stderr (default: when stderr is a terminal)",
+    )
+    run = commands.add_parser("import", parents=[common], help="what the program reads as")
+    run.set_defaults(run=_import)
+    run = commands.add_parser("evaluate", parents=[solving], help="mu_path at a placement")
+    run.add_argument("--at", type=_numbers(4, ","), required=True, metavar="X,Y,Z,YAW")
+    run.add_argument("--spin", type=float, default=0.0, help="rad, a constant tool spin")
+    run.add_argument("--feed", type=float, help="m/s to check (default: the program's FEDRAT)")
+    run.set_defaults(run=_evaluate)
+    run = commands.add_parser("map", parents=[solving], help="the capability map, as a PNG")
+    run.add_argument("--x", type=_axis, required=True, metavar="MIN:MAX:STEP")
+    run.add_argument("--y", type=_axis, required=True, metavar="MIN:MAX:STEP")
+    run.add_argument("--z", type=float, default=0.0, help="m, the table height")
+    run.add_argument("--yaw", type=float, default=0.0, help="rad")
+    run.add_argument("--png", required=True, help="the file to write the map to")
+    run.set_defaults(run=_map)
+    run = commands.add_parser(
+        "optimise", aliases=["optimize"], parents=[solving], help="the best placement"
+    )
+    run.add_argument("--x", type=_numbers(2, ":"), required=True, metavar="MIN:MAX")
+    run.add_argument("--y", type=_numbers(2, ":"), required=True, metavar="MIN:MAX")
+    run.add_argument("--yaw", type=_numbers(2, ":"), default=[-math.pi, math.pi], metavar="MIN:MAX")
+    run.add_argument("--z", type=float, default=0.0, help="m, the table height")
+    run.add_argument("--method", choices=["scipy", "casadi"], default="scipy")
+    run.set_defaults(run=_optimise)
+    return parser
+
+
+def main_exit() -> None:
+    """The console script ``dtf-place``: :func:`main`'s code as the process's exit status."""
+    sys.exit(main())
+
+
+if __name__ == "__main__":
+    main_exit()

@@ -1,0 +1,152 @@
+"""What ``dtf-place`` prints for people (``--json`` prints the API's answers instead)."""
+
+from __future__ import annotations
+
+import sys
+import time
+from types import TracebackType
+
+from service.schemas import EvaluateResponse, MapResponse, OptimizeResponse, PlacementResult
+from service.schemas.paths_import import PathImportResponse
+
+_MM_PER_MIN = 60e3
+"""mm/min per m/s."""
+
+
+def _fixed(value: float, digits: int) -> str:
+    """``value`` with ``digits`` decimals, never ``-0.00``."""
+    return f"{round(value, digits) + 0.0:.{digits}f}"
+
+
+def _feed(feed: float | None) -> str:
+    """A feed in mm/min, or a dash."""
+    return "-" if feed is None else f"{feed * _MM_PER_MIN:.1f} mm/min"
+
+
+def import_text(answer: PathImportResponse, name: str) -> str:
+    """The import summary: counts, units and how known, passes and operations, skipped."""
+    lines = [
+        f"program: {name}",
+        f"waypoints: {len(answer.waypoints)} in {len(answer.passes)} passes "
+        f"({answer.arcs} arcs interpolated; dropped: {answer.repeated_points} repeated point(s), "
+        f"{answer.one_point_passes} one-point pass(es))",
+        f"units: {answer.units} ({answer.units_source}: {answer.units_note})",
+        f"feed: {_feed(answer.feed)} (the highest programmed)",
+        "passes:",
+    ]
+    for number, part in enumerate(answer.pass_details, start=1):
+        lines.append(
+            f"  {number:3d}  waypoints {part.start}-{part.stop - 1}  "
+            f"{part.operation or '-'}  {_feed(part.feed)}"
+        )
+    if answer.skipped_records:
+        lines.append("skipped records (no geometry, no feed):")
+    for record in answer.skipped_records:
+        known = "" if record.recognised else "  (not recognised: check it moves nothing)"
+        lines.append(f"  {record.word}: {record.count} (first at line {record.first_line}){known}")
+    return "\n".join(lines)
+
+
+def evaluation_text(answer: EvaluateResponse) -> str:
+    """mu_path, the bottleneck and the feed check, or why the path does not run."""
+    if not answer.feasible:
+        where = "" if answer.failed_waypoint is None else f" at waypoint {answer.failed_waypoint}"
+        return f"infeasible: {answer.reason}{where}"
+    lines = [f"mu_path: {answer.mu_path:.4f} m/s (spin {answer.spin_mode})"]
+    if answer.bottleneck is not None:
+        lines.append(
+            f"bottleneck: waypoint {answer.bottleneck.waypoint}, joint "
+            f"{answer.bottleneck.joint_name}"
+        )
+    check = answer.feed_check
+    if check is not None:
+        verdict = "runs" if check.feasible else "does not run"
+        margin = "" if check.margin is None else f", margin {check.margin:.3f}"
+        lines.append(f"feed {_feed(check.feed)}: {verdict}{margin}")
+    return "\n".join(lines)
+
+
+def _placement(placement: PlacementResult) -> list[str]:
+    """A placement and its controller frames."""
+    frames = placement.frames
+    ur = ", ".join(_fixed(v, 5) for v in frames.ur)
+    kuka = ", ".join(f"{k} {_fixed(v, 2)}" for k, v in frames.kuka.items())
+    fanuc = ", ".join(f"{k} {_fixed(v, 2)}" for k, v in frames.fanuc.items())
+    (position, quaternion) = frames.abb
+    abb = (
+        f"[[{', '.join(_fixed(v, 2) for v in position)}], "
+        f"[{', '.join(_fixed(v, 6) for v in quaternion)}]]"
+    )
+    return [
+        f"placement: x {placement.x:.4f} m, y {placement.y:.4f} m, z {placement.z:.4f} m, "
+        f"yaw {placement.yaw:.4f} rad, spin {placement.spin:.4f} rad",
+        f"  UR base pose (m, rad): [{ur}]",
+        f"  KUKA base (mm, deg): {kuka}",
+        f"  ABB wobj uframe (mm): {abb}",
+        f"  FANUC user frame (mm, deg): {fanuc}",
+    ]
+
+
+def map_text(answer: MapResponse, png: str) -> str:
+    """The map's size, its best placement, the picture's file."""
+    lines = [f"map: {answer.feasible_cells} of {len(answer.cells)} placements feasible; {png}"]
+    if answer.best is not None:
+        lines.append(f"best: mu_path {answer.best.mu_path:.4f} m/s")
+        lines += _placement(answer.best.placement)
+    return "\n".join(lines)
+
+
+def optimum_text(answer: OptimizeResponse) -> str:
+    """The optimum with its controller frames, or that none is feasible."""
+    if not answer.found or answer.placement is None or answer.mu_path is None:
+        return "no feasible placement inside the bounds"
+    gain = answer.improvement_percent
+    lines = [
+        f"optimum: mu_path {answer.mu_path:.4f} m/s"
+        + ("" if gain is None else f" ({gain:+.1f} % over the start)"),
+        *_placement(answer.placement),
+    ]
+    check = None if answer.evaluation is None else answer.evaluation.feed_check
+    if check is not None:
+        lines.append(f"feed {_feed(check.feed)}: {'runs' if check.feasible else 'does not run'}")
+    return "\n".join(lines)
+
+
+class ProgressBar:
+    """A progress callback drawing a bar on stderr (when enabled), cleared at the end."""
+
+    WIDTH = 30
+    """Characters of the bar."""
+    EVERY = 0.1
+    """s between redraws."""
+
+    def __init__(self, *, enabled: bool) -> None:
+        """Draw only when ``enabled`` (stderr a terminal, by default)."""
+        self.enabled = enabled
+        self.drawn = 0.0
+
+    def __call__(self, fraction: float) -> None:
+        """Report progress in [0, 1]."""
+        now = time.monotonic()
+        if not self.enabled or now - self.drawn < self.EVERY:
+            return
+        self.drawn = now
+        done = int(self.WIDTH * min(max(fraction, 0.0), 1.0))
+        bar = "#" * done + "-" * (self.WIDTH - done)
+        sys.stderr.write(f"\r[{bar}] {100 * fraction:5.1f} %")
+        sys.stderr.flush()
+
+    def __enter__(self) -> ProgressBar:
+        """The callback."""
+        return self
+
+    def __exit__(
+        self,
+        kind: type[BaseException] | None,
+        error: BaseException | None,
+        trace: TracebackType | None,
+    ) -> None:
+        """Clear the bar's line."""
+        if self.enabled and self.drawn:
+            sys.stderr.write("\r" + " " * (self.WIDTH + 12) + "\r")
+            sys.stderr.flush()
