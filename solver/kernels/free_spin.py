@@ -5,9 +5,9 @@ cam.md section 2. For the closed-form families with the tool spin rate free,
 (:func:`solver.path.pipeline.run_chunk` with ``spin_mode="free"``), which stays the reference it is
 tested against (tests/solver/test_free_spin_kernel.py). Per placement:
 
-1. the path turned by the yaw and moved (:func:`solver.kernels.fixed_spin.turned_poses`); IK and
+1. the path turned by the yaw and moved (:func:`solver.kernels.cell.turned_poses`); IK and
    J^-1 t_hat on the branches still alive, then J^-1 [0; z_tool] (the family's pose kernel run
-   a second time with the spin twist), blocks of waypoints as in :mod:`solver.kernels.fixed_spin`;
+   a second time with the spin twist), blocks of waypoints as in :mod:`solver.kernels.cell`;
 2. each branch: unreachable, singular, then the step test against the previous waypoint, no
    position limits (they hold along the spin schedule); V_max by the exact two-variable LP
    (:func:`solver.core.dtf.two_variable_speed`) and its running minimum, mu_path;
@@ -37,16 +37,9 @@ from solver.core.codes import (
     UNREACHABLE,
 )
 from solver.families.kernels import SCRATCH_ROWS, pose_block
-from solver.kernels.fixed_spin import (
-    BLOCK,
-    drop_stale_compiled_code,
-    first_outside,
-    turned_poses,
-    unwrapped,
-    warm_up_placement,
-    wrapped_step,
-    write_cell,
-)
+from solver.kernels.cache import drop_stale_compiled_code
+from solver.kernels.cell import BLOCK, turned_poses, warm_up_placement, write_cell
+from solver.kernels.positions import first_outside, unwrapped, wrapped_step
 
 _TWO_PI = 2 * math.pi
 _INSIDE = 1.0 - 1e-12  # as solver.core.dtf.spin_rate_nearest_zero
