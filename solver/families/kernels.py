@@ -16,6 +16,8 @@ from solver.families.ur import kernel as ur
 UR_KERNEL = 0
 OPW_KERNEL = 1
 SCRATCH_ROWS = max(ur.SCRATCH_ROWS, opw.SCRATCH_ROWS)  # what every family's kernel may use
+# The pose kernels' out arrays are (N_BRANCHES, N_JOINTS, W): six-joint arms, eight branches.
+N_BRANCHES, N_JOINTS = 8, 6
 
 
 @njit(cache=True, error_model="numpy", nogil=True)

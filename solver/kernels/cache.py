@@ -11,6 +11,7 @@ import solver.families.opw.kernel
 import solver.families.pairs
 import solver.families.ur.kernel
 import solver.kernels.cell
+import solver.kernels.limits
 import solver.kernels.positions
 
 
@@ -32,6 +33,7 @@ def drop_stale_compiled_code(name: str) -> None:
         solver.families.opw.kernel,
         solver.families.kernels,
         solver.kernels.positions,
+        solver.kernels.limits,
         solver.kernels.cell,
         sys.modules[name],
     )

@@ -15,14 +15,78 @@ import numpy as np
 from numba import njit
 
 import solver.families.ur.kernel
-from solver.core.codes import FEASIBLE, TIE_RTOL
-from solver.families.kernels import UR_KERNEL
+from solver.core.codes import (
+    FEASIBLE,
+    TIE_RTOL,
+)
+from solver.families.kernels import N_BRANCHES, N_JOINTS, SCRATCH_ROWS, UR_KERNEL
 from solver.families.ur.dh import UR_DH
 
 UR5 = UR_DH["ur5"]
 # Waypoints solved together: the pose kernels run level by level over a block, and a block is
 # the unit of the early stop when every branch has failed.
 BLOCK = 32
+
+
+@njit(cache=True, error_model="numpy", nogil=True, inline="always")
+def pose_work(n_waypoints):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
+    """The arrays of a path of W waypoints that :func:`solver.families.kernels.pose_block` fills.
+
+    Returns:
+        cq, sq, qd: shape (8, 6, W), the joints' (cos, sin) pairs and J^-1 t per branch;
+        status: shape (8, W); poses: shape (21, W), as :func:`turned_poses`; scratch; need:
+        shape (8,), bool, the branches to solve.
+    """
+    cq = np.empty((N_BRANCHES, N_JOINTS, n_waypoints))
+    sq = np.empty((N_BRANCHES, N_JOINTS, n_waypoints))
+    qd = np.empty((N_BRANCHES, N_JOINTS, n_waypoints))
+    status = np.empty((N_BRANCHES, n_waypoints), dtype=np.int64)
+    poses = np.empty((21, n_waypoints))
+    scratch = np.empty((SCRATCH_ROWS, n_waypoints))
+    need = np.empty(N_BRANCHES, dtype=np.bool_)
+    return cq, sq, qd, status, poses, scratch, need
+
+
+@njit(cache=True, error_model="numpy", nogil=True, inline="always")
+def branch_work(n_branches, n_waypoints, keep_speeds):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
+    """Per branch followed: alive, why and where it failed, its mu_path and where it binds.
+
+    Returns:
+        alive, why, where, slowest (mu_path so far), slowest_at, slowest_joint: shape (B,);
+        speeds: shape (B, W), V_max per waypoint, or (0, 0) when not ``keep_speeds``.
+    """
+    alive = np.empty(n_branches, dtype=np.bool_)
+    why = np.empty(n_branches, dtype=np.int64)
+    where = np.empty(n_branches, dtype=np.int64)
+    slowest = np.empty(n_branches)
+    slowest_at = np.empty(n_branches, dtype=np.int64)
+    slowest_joint = np.empty(n_branches, dtype=np.int64)
+    speeds = np.empty((n_branches, n_waypoints)) if keep_speeds else np.empty((0, 0))
+    return alive, why, where, slowest, slowest_at, slowest_joint, speeds
+
+
+@njit(cache=True, error_model="numpy", nogil=True, inline="always")
+def start_cell(alive, why, where):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
+    """Every branch alive, none failed, before a placement."""
+    alive[:] = True
+    why[:] = FEASIBLE
+    where[:] = -1
+
+
+@njit(cache=True, error_model="numpy", nogil=True, inline="always")
+def wanted_branches(branches, alive, need):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
+    """Mark in ``need`` (8,) the branch indices of ``branches`` that are still ``alive``."""
+    need[:] = False
+    for i in range(branches.shape[0]):
+        need[branches[i]] = need[branches[i]] or alive[i]
+
+
+@njit(cache=True, error_model="numpy", nogil=True, inline="always")
+def fail(i, code, w, alive, why, where):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
+    """Branch row i fails for reason ``code`` at waypoint w."""
+    alive[i] = False
+    why[i] = code
+    where[i] = w
 
 
 @njit(cache=True, error_model="numpy", nogil=True)
@@ -97,6 +161,11 @@ def write_cell(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
         for w in range(v_out.shape[1]):
             v_out[c, w] = np.nan
     branch[c] = branches[pick]
+
+
+def warm_up_answers() -> tuple[np.ndarray, ...]:
+    """The kernels' seven answer arrays for one placement, V_max not wanted."""
+    return (np.empty(1), *(np.empty(1, dtype=np.int64) for _ in range(5)), np.empty((1, 0)))
 
 
 def warm_up_placement() -> tuple[object, ...]:

@@ -35,7 +35,6 @@ import numpy as np
 from numba import njit
 
 from solver.core.codes import (
-    FEASIBLE,
     REASON_DISCONTINUOUS,
     REASON_JOINT_LIMITS,
     REASON_SINGULAR,
@@ -43,20 +42,25 @@ from solver.core.codes import (
     SINGULAR,
     UNREACHABLE,
 )
-from solver.families.kernels import SCRATCH_ROWS, pose_block
+from solver.families.kernels import N_JOINTS, pose_block
 from solver.kernels.cache import drop_stale_compiled_code
-from solver.kernels.cell import BLOCK, turned_poses, warm_up_placement, write_cell
-from solver.kernels.positions import NARROW, NO_LIMIT, WIDE, first_outside, unwrapped
+from solver.kernels.cell import (
+    BLOCK,
+    branch_work,
+    fail,
+    pose_work,
+    start_cell,
+    turned_poses,
+    wanted_branches,
+    warm_up_answers,
+    warm_up_placement,
+    write_cell,
+)
+from solver.kernels.limits import joint_speed_bound
+from solver.kernels.positions import NARROW, WIDE, first_outside_pairs
 from solver.kernels.positions import limit_modes as limit_modes  # placements.py imports it here
 
 _TWO_PI = 2 * math.pi
-# Fast tests of the position limits leave this much (rad) to rounding; a branch nearer than
-# that to failing them goes to the exact test.
-_MARGIN = 1e-9
-# 2 asin(c / 2) / c, the turn per unit chord, is at most this for chords up to 0.5 (a turn of
-# 0.505 rad) and at most pi / 2 for any chord.
-_CHORD_SMALL = 0.5
-_TURN_PER_CHORD_SMALL = 1.0108
 
 drop_stale_compiled_code(__name__)
 
@@ -121,47 +125,31 @@ def map_cells(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
     n_cells = cos_yaw.shape[0]
     n_waypoints = flange_rotation.shape[0]
     n_branches = branches.shape[0]
-    n_all = 8
-    dof = 6
-    cq = np.empty((n_all, dof, n_waypoints))
-    sq = np.empty((n_all, dof, n_waypoints))
-    qd = np.empty((n_all, dof, n_waypoints))
-    status = np.empty((n_all, n_waypoints), dtype=np.int64)
-    poses = np.empty((21, n_waypoints))
-    scratch = np.empty((SCRATCH_ROWS, n_waypoints))
-    need = np.empty(n_all, dtype=np.bool_)
-    alive = np.empty(n_branches, dtype=np.bool_)
-    why = np.empty(n_branches, dtype=np.int64)
-    where = np.empty(n_branches, dtype=np.int64)
-    slowest = np.empty(n_branches)
-    slowest_at = np.empty(n_branches, dtype=np.int64)
-    slowest_joint = np.empty(n_branches, dtype=np.int64)
-    chords2 = np.empty((n_branches, dof))
-    largest2 = np.empty((n_branches, dof))
-    inside = np.empty((n_branches, dof))
-    crossed = np.empty((n_branches, dof), dtype=np.bool_)
-    speeds = np.empty((n_branches, n_waypoints)) if v_out.shape[1] else np.empty((0, 0))
+    cq, sq, qd, status, poses, scratch, need = pose_work(n_waypoints)
+    alive, why, where, slowest, slowest_at, slowest_joint, speeds = branch_work(
+        n_branches, n_waypoints, v_out.shape[1] > 0
+    )
+    chords2 = np.empty((n_branches, N_JOINTS))
+    largest2 = np.empty((n_branches, N_JOINTS))
+    inside = np.empty((n_branches, N_JOINTS))
+    crossed = np.empty((n_branches, N_JOINTS), dtype=np.bool_)
     inverse_qdot = 1.0 / qdot_max
     check_steps = max_joint_step < math.pi
     cos_step = math.cos(max_joint_step)
     for c in range(n_cells):
-        ca, sa = cos_yaw[c], sin_yaw[c]
-        alive[:] = True
-        why[:] = FEASIBLE
-        where[:] = -1
+        start_cell(alive, why, where)
         chords2[:] = 0.0
         largest2[:] = 0.0
         inside[:] = np.inf
         crossed[:] = False
         n_alive = n_branches
         turned_poses(
-            c, ca, sa, offset, flange_rotation, flange_position, tool_position, twist, poses
-        )
+            c, cos_yaw[c], sin_yaw[c], offset, flange_rotation, flange_position, tool_position,
+            twist, poses,
+        )  # fmt: skip
         for w0 in range(0, n_waypoints, BLOCK):
             w1 = min(w0 + BLOCK, n_waypoints)
-            need[:] = False
-            for i in range(n_branches):
-                need[branches[i]] = need[branches[i]] or alive[i]
+            wanted_branches(branches, alive, need)
             pose_block(family, par, poses, w0, w1, need, scratch, cq, sq, status, qd)
             for i in range(n_branches):
                 if not alive[i]:
@@ -175,7 +163,7 @@ def map_cells(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
                         code = REASON_SINGULAR
                     elif w > 0:
                         checked = check_steps and segment_checked[w - 1]
-                        for j in range(dof):
+                        for j in range(N_JOINTS):
                             c0, s0 = cq[b, j, w - 1], sq[b, j, w - 1]
                             c1, s1 = cq[b, j, w], sq[b, j, w]
                             if checked and c0 * c1 + s0 * s1 < cos_step:
@@ -202,17 +190,11 @@ def map_cells(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
                         where[i] = w
                         n_alive -= 1
                         break
-                    largest = -1.0
-                    limiting = 0
-                    for j in range(dof):
+                    for j in range(N_JOINTS):
                         if modes[j] == NARROW:
                             margin = cq[b, j, w] * arc[j, 0] + sq[b, j, w] * arc[j, 1] - arc[j, 2]
                             inside[i, j] = min(inside[i, j], margin)
-                        ratio = abs(qd[b, j, w]) * inverse_qdot[j]
-                        if ratio > largest:
-                            largest = ratio
-                            limiting = j
-                    speed = 1.0 / largest
+                    speed, limiting = joint_speed_bound(qd, b, w, inverse_qdot)
                     v = 0.0 if pure_rotation[w] else speed
                     if w == 0 or v < slowest[i]:
                         slowest[i] = v
@@ -225,25 +207,11 @@ def map_cells(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
         for i in range(n_branches):
             if not alive[i]:
                 continue
-            exact = False
-            for j in range(dof):
-                if modes[j] == NO_LIMIT:
-                    continue
-                if modes[j] == WIDE:
-                    # A chord c turns by 2 asin(c / 2) <= factor c; the sum of the chords is
-                    # at most sqrt(segments x the sum of their squares) (Cauchy-Schwarz).
-                    small = largest2[i, j] <= _CHORD_SMALL * _CHORD_SMALL
-                    factor = _TURN_PER_CHORD_SMALL if small else math.pi / 2
-                    turning = factor * math.sqrt((n_waypoints - 1) * chords2[i, j])
-                    exact = exact or turning > upper[j] - lower[j] - _TWO_PI - _MARGIN
-                else:  # every waypoint inside the arc, no step through the gap
-                    exact = exact or inside[i, j] <= _MARGIN or crossed[i, j]
-            if exact:
-                first = first_outside(unwrapped(cq, sq, branches[i]), lower, upper)
-                if first < n_waypoints:
-                    alive[i] = False
-                    why[i] = REASON_JOINT_LIMITS
-                    where[i] = first
+            first = first_outside_pairs(
+                cq, sq, branches[i], i, lower, upper, modes, chords2, largest2, inside, crossed
+            )
+            if first < n_waypoints:
+                fail(i, REASON_JOINT_LIMITS, first, alive, why, where)
         write_cell(
             c, branches, alive, why, where, slowest, slowest_at, slowest_joint, speeds,
             mu, reason, failed, branch, bottleneck_waypoint, bottleneck_joint, v_out,
@@ -267,7 +235,5 @@ def warm_up() -> None:
         arc,
         np.full(6, math.pi),
         0.35,
-        np.empty(1),
-        *(np.empty(1, dtype=np.int64) for _ in range(5)),
-        np.empty((1, 0)),
+        *warm_up_answers(),
     )

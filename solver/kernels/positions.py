@@ -16,9 +16,17 @@ import numpy as np
 from numba import njit
 
 from solver.core.codes import EDGE
+from solver.families.kernels import N_JOINTS
 
 _TWO_PI = 2 * math.pi
 NO_LIMIT, WIDE, NARROW = 0, 1, 2
+# Fast tests of the position limits leave this much (rad) to rounding; a branch nearer than
+# that to failing them goes to the exact test.
+_MARGIN = 1e-9
+# 2 asin(c / 2) / c, the turn per unit chord, is at most this for chords up to 0.5 (a turn of
+# 0.505 rad) and at most pi / 2 for any chord.
+_CHORD_SMALL = 0.5
+_TURN_PER_CHORD_SMALL = 1.0108
 
 
 def limit_modes(lower: np.ndarray, upper: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -85,4 +93,34 @@ def first_outside(path, lower, upper):  # type: ignore[no-untyped-def]  # pragma
             k_high = math.floor((upper[j] - high_run[j]) / _TWO_PI + EDGE)
             if k_low > k_high:
                 return w
+    return n_waypoints
+
+
+@njit(cache=True, error_model="numpy", nogil=True)
+def first_outside_pairs(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
+    cq, sq, b, i, lower, upper, modes, chords2, largest2, inside, crossed
+):
+    """The first waypoint where branch b's path leaves its position limits (W: none).
+
+    The fast tests on the sums of row i that the kernel keeps along the path (``chords2`` and
+    ``largest2`` of the wide joints' steps, ``inside`` and ``crossed`` of the narrow ones, shape
+    (B, n)); only where they do not clear every joint, the angles and the exact test
+    (:func:`first_outside`).
+    """
+    n_waypoints = cq.shape[2]
+    exact = False
+    for j in range(N_JOINTS):
+        if modes[j] == NO_LIMIT:
+            continue
+        if modes[j] == WIDE:
+            # A chord c turns by 2 asin(c / 2) <= factor c; the sum of the chords is at most
+            # sqrt(segments x the sum of their squares) (Cauchy-Schwarz).
+            small = largest2[i, j] <= _CHORD_SMALL * _CHORD_SMALL
+            factor = _TURN_PER_CHORD_SMALL if small else math.pi / 2
+            turning = factor * math.sqrt((n_waypoints - 1) * chords2[i, j])
+            exact = exact or turning > upper[j] - lower[j] - _TWO_PI - _MARGIN
+        else:  # every waypoint inside the arc, no step through the gap
+            exact = exact or inside[i, j] <= _MARGIN or crossed[i, j]
+    if exact:
+        return first_outside(unwrapped(cq, sq, b), lower, upper)
     return n_waypoints
