@@ -6,13 +6,10 @@ import hashlib
 import sys
 from pathlib import Path
 
-import solver.families.kernels
-import solver.families.opw.kernel
-import solver.families.pairs
-import solver.families.ur.kernel
 import solver.kernels.cell
 import solver.kernels.limits
 import solver.kernels.positions
+from solver.families.kernels import KERNEL_SOURCES
 
 
 def drop_stale_compiled_code(name: str) -> None:
@@ -20,18 +17,16 @@ def drop_stale_compiled_code(name: str) -> None:
 
     numba's disk cache (``cache=True``, files in ``__pycache__``) is keyed by the source file
     of the cached function only, but the compiled functions take their callees into themselves
-    (the pose kernels take :mod:`solver.families.pairs`, the dispatcher the pose kernels, the
-    map kernels the dispatcher and the helpers of :mod:`solver.kernels`): after an edit of a
+    (the dispatcher :func:`solver.families.kernels.pose_block` the families' pose kernels,
+    whose modules it lists in :data:`~solver.families.kernels.KERNEL_SOURCES`, and the map
+    kernels the dispatcher and the helpers of :mod:`solver.kernels`): after an edit of a
     callee they would load the old code. A marker named by the hash of all those sources says
     which code the caches hold; a new hash drops the cached code of every one of them. Where
     the directories cannot be written (an installed copy), numba caches elsewhere or not at all
     and nothing is done here.
     """
     modules = (
-        solver.families.pairs,
-        solver.families.ur.kernel,
-        solver.families.opw.kernel,
-        solver.families.kernels,
+        *KERNEL_SOURCES,
         solver.kernels.positions,
         solver.kernels.limits,
         solver.kernels.cell,

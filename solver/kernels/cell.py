@@ -14,15 +14,12 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-import solver.families.ur.kernel
 from solver.core.codes import (
     FEASIBLE,
     TIE_RTOL,
 )
-from solver.families.kernels import N_BRANCHES, N_JOINTS, SCRATCH_ROWS, UR_KERNEL
-from solver.families.ur.dh import UR_DH
+from solver.families.kernels import N_BRANCHES, N_JOINTS, SCRATCH_ROWS, warm_up_arm
 
-UR5 = UR_DH["ur5"]
 # Waypoints solved together: the pose kernels run level by level over a block, and a block is
 # the unit of the early stop when every branch has failed.
 BLOCK = 32
@@ -169,10 +166,13 @@ def warm_up_answers() -> tuple[np.ndarray, ...]:
 
 
 def warm_up_placement() -> tuple[object, ...]:
-    """The kernels' first nine arguments for one placement of a two-waypoint UR5 path."""
+    """The kernels' first nine arguments for one placement of a two-waypoint path.
+
+    The arm is the families' warm-up arm (:func:`solver.families.kernels.warm_up_arm`).
+    """
     rotation = np.tile(np.diag([1.0, -1.0, -1.0]), (2, 1, 1))
     position = np.array([[0.0, 0.4, 0.2], [0.01, 0.4, 0.2]])
     twist = np.tile([1.0, 0.0, 0.0, 0.0, 0.0, 0.0], (2, 1))
-    parameters = solver.families.ur.kernel.kernel_parameters(UR5)
-    return (UR_KERNEL, parameters, np.ones(1), np.zeros(1), np.zeros((1, 3)), rotation, position,
+    code, parameters = warm_up_arm()
+    return (code, parameters, np.ones(1), np.zeros(1), np.zeros((1, 3)), rotation, position,
             position.copy(), twist)  # fmt: skip

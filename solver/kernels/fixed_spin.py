@@ -221,7 +221,8 @@ def map_cells(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
 def warm_up() -> None:
     """Compile the kernel, or load it from the disk cache, so that no request pays for it.
 
-    One placement of a two-waypoint UR5 path: the kernel has one signature for every family.
+    One placement of a two-waypoint path of the families' warm-up arm (a UR5): the kernel has
+    one signature for every family.
     """
     modes, arc = limit_modes(np.full(6, -_TWO_PI), np.full(6, _TWO_PI))
     map_cells(

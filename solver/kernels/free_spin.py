@@ -279,7 +279,8 @@ def free_cells(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
 def warm_up() -> None:
     """Compile the kernel, or load it from the disk cache, so that no request pays for it.
 
-    One placement of a two-waypoint UR5 path: the kernel has one signature for every family.
+    One placement of a two-waypoint path of the families' warm-up arm (a UR5): the kernel has
+    one signature for every family.
     """
     free_cells(
         *warm_up_placement(),
