@@ -3,19 +3,40 @@
 A compiled function cannot take another compiled function as an argument and still be cached
 on disk (numba recompiles it in every process), so the families' pose kernels are reached
 through this one dispatcher on a family code. A new closed-form family adds its kernel here
-and names its code in its :class:`solver.families.base.ClosedFormFamily` subclass.
+(and its module to :data:`KERNEL_SOURCES`) and names its code in its
+:class:`solver.families.base.ClosedFormFamily` subclass. The map kernels
+(:mod:`solver.kernels`) import this module and no family.
 """
 
 from __future__ import annotations
 
+import sys
+from types import ModuleType
+
+import numpy as np
 from numba import njit
 
+from solver.families import pairs
 from solver.families.opw import kernel as opw
 from solver.families.ur import kernel as ur
+from solver.families.ur.dh import UR_DH
 
 UR_KERNEL = 0
 OPW_KERNEL = 1
 SCRATCH_ROWS = max(ur.SCRATCH_ROWS, opw.SCRATCH_ROWS)  # what every family's kernel may use
+# The pose kernels' out arrays are (N_BRANCHES, N_JOINTS, W): six-joint arms, eight branches.
+N_BRANCHES, N_JOINTS = 8, 6
+# The modules whose compiled code :func:`pose_block` takes into itself, callees first: a map
+# kernel's disk cache is stale when one of them changes (solver.kernels.cache).
+KERNEL_SOURCES: tuple[ModuleType, ...] = (pairs, ur, opw, sys.modules[__name__])
+
+
+def warm_up_arm() -> tuple[int, np.ndarray]:
+    """A UR5's kernel code and parameters: what the map kernels compile on before a request.
+
+    Any arm will do, as the kernels have one signature for every family.
+    """
+    return UR_KERNEL, ur.kernel_parameters(UR_DH["ur5"])
 
 
 @njit(cache=True, error_model="numpy", nogil=True)

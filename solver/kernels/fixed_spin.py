@@ -6,251 +6,68 @@ reference it is tested against (tests/solver/test_map_kernel.py: the same reason
 waypoints, branches and bottlenecks, mu_path to 1e-12). Per placement, in blocks of 32
 waypoints:
 
-1. turn the prepared path by the placement's yaw and move it (the same arithmetic as
+1. turn the prepared path by the placement's yaw and move it
+   (:func:`solver.kernels.cell.turned_poses`, the arithmetic of
    :func:`solver.path.pipeline.turn_by_yaw`);
 2. IK of the flange poses on the branches still alive and J^-1 t on each (the family's pose
    kernel, :mod:`solver.families.kernels`, level by level), every angle a (cos, sin) pair;
 3. each branch still alive, waypoint by waypoint: unreachable, then singular, then the step test
    cos(dq) >= cos(max_joint_step) against the previous waypoint (no angle, no unwrapping);
-   then its DTF, 1 / max_j |qd_j| / qdot_max_j, and the running minimum;
-4. after the path, position limits: a joint whose limits span more than 2 pi fits when the
-   path's total turning (bounded from the squared chords of the (cos, sin) steps) leaves a
-   full turn of room; a joint whose range is a turn or less fits when every waypoint is
-   inside its arc and no step's short arc passes through the gap opposite. Only a branch
-   that neither test clears forms its angles (atan2) and runs the exact test of
-   :func:`solver.path.tracking.track`;
-5. the branch: :func:`solver.path.tracking.choose_branch`'s rule.
+   then its DTF, 1 / max_j |qd_j| / qdot_max_j (:func:`solver.kernels.limits.joint_speed_bound`),
+   and the running minimum;
+4. after the path, position limits (:func:`solver.kernels.positions.first_outside_pairs`): a
+   joint whose limits span more than 2 pi fits when the path's total turning (bounded from the
+   squared chords of the (cos, sin) steps) leaves a full turn of room; a joint whose range is a
+   turn or less fits when every waypoint is inside its arc and no step's short arc passes
+   through the gap opposite. Only a branch that neither test clears forms its angles (atan2)
+   and runs the exact test of :func:`solver.path.tracking.track`;
+5. the branch: :func:`solver.path.tracking.choose_branch`'s rule
+   (:func:`solver.kernels.cell.write_cell`).
 
 A branch stops at its first failure and a placement at its last live branch. Why compiled:
 the fused loops keep a waypoint's values in registers, where numpy makes and reads back an
 array per formula, and no atan2 is taken (it was a third of the kernel's time while the
-exact limit test still ran on every branch); measured in ``bench/run.py``.
+exact limit test still ran on every branch); measured in ``bench/run.py``. The per-waypoint
+body of step 3 is written out here rather than called from shared helpers, and the step test
+folded with the sums of the fast position tests: under numba that is what keeps the loop fast
+(calls there made the map 1.2x to 3x slower).
 """
 
 from __future__ import annotations
 
-import hashlib
 import math
-import sys
-from pathlib import Path
 
 import numpy as np
 from numba import njit
 
-import solver.families.kernels
-import solver.families.opw.kernel
-import solver.families.pairs
-import solver.families.ur.kernel
 from solver.core.codes import (
-    EDGE,
-    FEASIBLE,
     REASON_DISCONTINUOUS,
     REASON_JOINT_LIMITS,
     REASON_SINGULAR,
     REASON_UNREACHABLE,
     SINGULAR,
-    TIE_RTOL,
     UNREACHABLE,
 )
-from solver.families.kernels import SCRATCH_ROWS, UR_KERNEL, pose_block
-from solver.families.ur.dh import UR_DH
+from solver.families.kernels import N_JOINTS, pose_block
+from solver.kernels.cache import drop_stale_compiled_code
+from solver.kernels.cell import (
+    BLOCK,
+    branch_work,
+    fail,
+    pose_work,
+    start_cell,
+    turned_poses,
+    wanted_branches,
+    warm_up_answers,
+    warm_up_placement,
+    write_cell,
+)
+from solver.kernels.limits import joint_speed_bound
+from solver.kernels.positions import NARROW, WIDE, first_outside_pairs, limit_modes
 
 _TWO_PI = 2 * math.pi
-# Fast tests of the position limits leave this much (rad) to rounding; a branch nearer than
-# that to failing them goes to the exact test.
-_MARGIN = 1e-9
-_NO_LIMIT, _WIDE, _NARROW = 0, 1, 2
-# 2 asin(c / 2) / c, the turn per unit chord, is at most this for chords up to 0.5 (a turn of
-# 0.505 rad) and at most pi / 2 for any chord.
-_CHORD_SMALL = 0.5
-_TURN_PER_CHORD_SMALL = 1.0108
-UR5 = UR_DH["ur5"]
-# Waypoints solved together: the pose kernels run level by level over a block, and a block is
-# the unit of the early stop when every branch has failed.
-BLOCK = 32
-
-
-def drop_stale_compiled_code(name: str) -> None:
-    """Delete the cached machine code of module ``name``'s kernels when a callee has changed.
-
-    numba's disk cache (``cache=True``, files in ``__pycache__``) is keyed by the source file
-    of the cached function only, but the compiled functions take their callees into themselves
-    (the pose kernels take :mod:`solver.families.pairs`, the dispatcher the pose kernels, the
-    map kernels the dispatcher and this module's helpers): after an edit of a callee they
-    would load the old code. A marker named by the hash of all those sources says which code
-    the caches hold; a new hash drops the cached code of every one of them. Where the
-    directories cannot be written (an installed copy), numba caches elsewhere or not at all
-    and nothing is done here.
-    """
-    modules = (
-        solver.families.pairs,
-        solver.families.ur.kernel,
-        solver.families.opw.kernel,
-        solver.families.kernels,
-        sys.modules[__name__],
-        *([sys.modules[name]] if name != __name__ else []),
-    )
-    files = [Path(str(module.__file__)) for module in modules]
-    stamp = hashlib.sha256(b"".join(path.read_bytes() for path in files)).hexdigest()[:16]
-    stem = files[-1].stem
-    marker = files[-1].parent / "__pycache__" / f"{stem}.sources-{stamp}"
-    try:
-        if marker.exists():
-            return
-        for path in files:
-            cache = path.parent / "__pycache__"
-            for stale in [*cache.glob(f"{path.stem}.*.nbi"), *cache.glob(f"{path.stem}.*.nbc")]:
-                stale.unlink(missing_ok=True)
-        for old in marker.parent.glob(f"{stem}.sources-*"):
-            old.unlink(missing_ok=True)
-        marker.parent.mkdir(exist_ok=True)
-        marker.touch()
-    except OSError:
-        return
-
 
 drop_stale_compiled_code(__name__)
-
-
-def limit_modes(lower: np.ndarray, upper: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Per joint: how the kernel tests its position limits, and the arc of a narrow range.
-
-    Returns:
-        modes: shape (n,), 0 no limit, 1 a range of more than 2 pi, 2 one of 2 pi or less;
-        arc: shape (n, 3), cos and sin of the range's middle and cos of its half width.
-    """
-    width = upper - lower
-    wide = width > _TWO_PI + 1e-12
-    modes = np.where(~np.isfinite(width), _NO_LIMIT, np.where(wide, _WIDE, _NARROW))
-    middle = np.where(np.isfinite(width), (lower + upper) / 2, 0.0)
-    half = np.where(np.isfinite(width), width / 2, 0.0)
-    arc = np.column_stack([np.cos(middle), np.sin(middle), np.cos(half)])
-    return modes.astype(np.int64), arc
-
-
-@njit(cache=True, error_model="numpy", nogil=True)
-def wrapped_step(step):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
-    """A step between two angles in [-pi, pi] brought into [-pi, pi], as track() does."""
-    if step > math.pi:
-        return step - _TWO_PI
-    if step < -math.pi:
-        return step + _TWO_PI
-    return step
-
-
-@njit(cache=True, error_model="numpy", nogil=True)
-def unwrapped(cq, sq, b):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
-    """Branch b's joint path (W, 6), rad: the angles of its pairs, unwrapped by the wrapped steps.
-
-    :func:`solver.path.tracking.track`'s path: the first waypoint's angle plus the running sum of
-    the steps, each brought into [-pi, pi].
-    """
-    dof, n_waypoints = cq.shape[1], cq.shape[2]
-    path = np.empty((n_waypoints, dof))
-    for j in range(dof):
-        first = math.atan2(sq[b, j, 0], cq[b, j, 0])
-        previous, total = first, 0.0
-        path[0, j] = first
-        for w in range(1, n_waypoints):
-            angle = math.atan2(sq[b, j, w], cq[b, j, w])
-            total += wrapped_step(angle - previous)
-            path[w, j] = first + total
-            previous = angle
-    return path
-
-
-@njit(cache=True, error_model="numpy", nogil=True)
-def first_outside(path, lower, upper):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
-    """The first waypoint of a joint path (W, n) whose range no 2 pi copy holds (W: none).
-
-    :func:`solver.path.tracking.track`'s test: the running range of each joint (a range that fits
-    holds every shorter one, so no test of the whole path is needed first).
-    """
-    n_waypoints, dof = path.shape
-    low_run, high_run = path[0].copy(), path[0].copy()
-    for w in range(n_waypoints):
-        for j in range(dof):
-            low_run[j] = min(low_run[j], path[w, j])
-            high_run[j] = max(high_run[j], path[w, j])
-            k_low = math.ceil((lower[j] - low_run[j]) / _TWO_PI - EDGE)
-            k_high = math.floor((upper[j] - high_run[j]) / _TWO_PI + EDGE)
-            if k_low > k_high:
-                return w
-    return n_waypoints
-
-
-@njit(cache=True, error_model="numpy", nogil=True)
-def turned_poses(c, ca, sa, offset, flange_rotation, flange_position, tool_position, twist, poses):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
-    """Fill ``poses`` (21, W) for placement c: the path turned by its yaw and moved.
-
-    Rows: R_B_F row by row (0-8), p_B_F (9-11), t_hat in {B} (12-17), the tool point (18-20);
-    the same arithmetic as :func:`solver.path.pipeline.turn_by_yaw`.
-    """
-    for w in range(flange_rotation.shape[0]):
-        for k in range(3):  # R_B_F = Rz(yaw) R_O_F, row by row
-            x, y = flange_rotation[w, 0, k], flange_rotation[w, 1, k]
-            poses[k, w] = ca * x - sa * y
-            poses[3 + k, w] = sa * x + ca * y
-            poses[6 + k, w] = flange_rotation[w, 2, k]
-        x, y = flange_position[w, 0], flange_position[w, 1]
-        poses[9, w] = ca * x - sa * y + offset[c, 0]
-        poses[10, w] = sa * x + ca * y + offset[c, 1]
-        poses[11, w] = flange_position[w, 2] + offset[c, 2]
-        for k in range(0, 6, 3):
-            x, y = twist[w, k], twist[w, k + 1]
-            poses[12 + k, w] = ca * x - sa * y
-            poses[13 + k, w] = sa * x + ca * y
-            poses[14 + k, w] = twist[w, k + 2]
-        x, y = tool_position[w, 0], tool_position[w, 1]
-        poses[18, w] = ca * x - sa * y + offset[c, 0]
-        poses[19, w] = sa * x + ca * y + offset[c, 1]
-        poses[20, w] = tool_position[w, 2] + offset[c, 2]
-
-
-@njit(cache=True, error_model="numpy", nogil=True)
-def write_cell(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
-    c, branches, alive, why, where, slowest, slowest_at, slowest_joint, speeds,
-    mu, reason, failed, branch, bottleneck_waypoint, bottleneck_joint, v_out,
-):  # fmt: skip
-    """Placement c's answer from its branches: :func:`solver.path.tracking.choose_branch`'s rule.
-
-    The highest mu_path (``slowest``) among the branches ``alive``, ties to the first; where
-    none is, the one that failed furthest along (``why`` and ``where``, the first at a tie).
-    """
-    n_branches = branches.shape[0]
-    top = -np.inf
-    for i in range(n_branches):
-        if alive[i] and slowest[i] > top:
-            top = slowest[i]
-    pick = -1
-    for i in range(n_branches):
-        if alive[i] and slowest[i] >= top - TIE_RTOL * abs(top):
-            pick = i
-            break
-    if pick >= 0:
-        mu[c] = slowest[pick]
-        reason[c] = FEASIBLE
-        failed[c] = -1
-        bottleneck_waypoint[c] = slowest_at[pick]
-        bottleneck_joint[c] = slowest_joint[pick]
-        for w in range(v_out.shape[1]):
-            v_out[c, w] = speeds[pick, w]
-    else:
-        furthest = -1
-        for i in range(n_branches):
-            furthest = max(furthest, where[i])
-        for i in range(n_branches):
-            if where[i] == furthest:
-                pick = i
-                break
-        mu[c] = np.nan
-        reason[c] = why[pick]
-        failed[c] = where[pick]
-        bottleneck_waypoint[c] = -1
-        bottleneck_joint[c] = -1
-        for w in range(v_out.shape[1]):
-            v_out[c, w] = np.nan
-    branch[c] = branches[pick]
 
 
 @njit(cache=True, error_model="numpy", nogil=True)
@@ -298,8 +115,8 @@ def map_cells(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
         branches: shape (B,), the branch indices to follow.
         lower: shape (6,), rad, lower position limits.
         upper: shape (6,), rad, upper position limits.
-        modes: from :func:`limit_modes`.
-        arc: from :func:`limit_modes`.
+        modes: from :func:`solver.kernels.positions.limit_modes`.
+        arc: from :func:`solver.kernels.positions.limit_modes`.
         qdot_max: shape (6,), rad/s.
         max_joint_step: rad.
         mu: shape (C,), out, m/s, NaN where infeasible.
@@ -313,47 +130,31 @@ def map_cells(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
     n_cells = cos_yaw.shape[0]
     n_waypoints = flange_rotation.shape[0]
     n_branches = branches.shape[0]
-    n_all = 8
-    dof = 6
-    cq = np.empty((n_all, dof, n_waypoints))
-    sq = np.empty((n_all, dof, n_waypoints))
-    qd = np.empty((n_all, dof, n_waypoints))
-    status = np.empty((n_all, n_waypoints), dtype=np.int64)
-    poses = np.empty((21, n_waypoints))
-    scratch = np.empty((SCRATCH_ROWS, n_waypoints))
-    need = np.empty(n_all, dtype=np.bool_)
-    alive = np.empty(n_branches, dtype=np.bool_)
-    why = np.empty(n_branches, dtype=np.int64)
-    where = np.empty(n_branches, dtype=np.int64)
-    slowest = np.empty(n_branches)
-    slowest_at = np.empty(n_branches, dtype=np.int64)
-    slowest_joint = np.empty(n_branches, dtype=np.int64)
-    chords2 = np.empty((n_branches, dof))
-    largest2 = np.empty((n_branches, dof))
-    inside = np.empty((n_branches, dof))
-    crossed = np.empty((n_branches, dof), dtype=np.bool_)
-    speeds = np.empty((n_branches, n_waypoints)) if v_out.shape[1] else np.empty((0, 0))
+    cq, sq, qd, status, poses, scratch, need = pose_work(n_waypoints)
+    alive, why, where, slowest, slowest_at, slowest_joint, speeds = branch_work(
+        n_branches, n_waypoints, v_out.shape[1] > 0
+    )
+    chords2 = np.empty((n_branches, N_JOINTS))
+    largest2 = np.empty((n_branches, N_JOINTS))
+    inside = np.empty((n_branches, N_JOINTS))
+    crossed = np.empty((n_branches, N_JOINTS), dtype=np.bool_)
     inverse_qdot = 1.0 / qdot_max
     check_steps = max_joint_step < math.pi
     cos_step = math.cos(max_joint_step)
     for c in range(n_cells):
-        ca, sa = cos_yaw[c], sin_yaw[c]
-        alive[:] = True
-        why[:] = FEASIBLE
-        where[:] = -1
+        start_cell(alive, why, where)
         chords2[:] = 0.0
         largest2[:] = 0.0
         inside[:] = np.inf
         crossed[:] = False
         n_alive = n_branches
         turned_poses(
-            c, ca, sa, offset, flange_rotation, flange_position, tool_position, twist, poses
-        )
+            c, cos_yaw[c], sin_yaw[c], offset, flange_rotation, flange_position, tool_position,
+            twist, poses,
+        )  # fmt: skip
         for w0 in range(0, n_waypoints, BLOCK):
             w1 = min(w0 + BLOCK, n_waypoints)
-            need[:] = False
-            for i in range(n_branches):
-                need[branches[i]] = need[branches[i]] or alive[i]
+            wanted_branches(branches, alive, need)
             pose_block(family, par, poses, w0, w1, need, scratch, cq, sq, status, qd)
             for i in range(n_branches):
                 if not alive[i]:
@@ -367,17 +168,17 @@ def map_cells(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
                         code = REASON_SINGULAR
                     elif w > 0:
                         checked = check_steps and segment_checked[w - 1]
-                        for j in range(dof):
+                        for j in range(N_JOINTS):
                             c0, s0 = cq[b, j, w - 1], sq[b, j, w - 1]
                             c1, s1 = cq[b, j, w], sq[b, j, w]
                             if checked and c0 * c1 + s0 * s1 < cos_step:
                                 code = REASON_DISCONTINUOUS
                                 break
-                            if modes[j] == _WIDE:
+                            if modes[j] == WIDE:
                                 chord2 = (c1 - c0) * (c1 - c0) + (s1 - s0) * (s1 - s0)
                                 chords2[i, j] += chord2
                                 largest2[i, j] = max(largest2[i, j], chord2)
-                            elif modes[j] == _NARROW and not crossed[i, j]:
+                            elif modes[j] == NARROW and not crossed[i, j]:
                                 # Does the step's short arc pass the middle of the gap, the
                                 # angle opposite the range's middle? Where both ends lie on
                                 # the middle's side (u > 0) and the sign of v changes, it
@@ -394,17 +195,11 @@ def map_cells(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
                         where[i] = w
                         n_alive -= 1
                         break
-                    largest = -1.0
-                    limiting = 0
-                    for j in range(dof):
-                        if modes[j] == _NARROW:
+                    for j in range(N_JOINTS):
+                        if modes[j] == NARROW:
                             margin = cq[b, j, w] * arc[j, 0] + sq[b, j, w] * arc[j, 1] - arc[j, 2]
                             inside[i, j] = min(inside[i, j], margin)
-                        ratio = abs(qd[b, j, w]) * inverse_qdot[j]
-                        if ratio > largest:
-                            largest = ratio
-                            limiting = j
-                    speed = 1.0 / largest
+                    speed, limiting = joint_speed_bound(qd, b, w, inverse_qdot)
                     v = 0.0 if pure_rotation[w] else speed
                     if w == 0 or v < slowest[i]:
                         slowest[i] = v
@@ -417,45 +212,22 @@ def map_cells(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
         for i in range(n_branches):
             if not alive[i]:
                 continue
-            exact = False
-            for j in range(dof):
-                if modes[j] == _NO_LIMIT:
-                    continue
-                if modes[j] == _WIDE:
-                    # A chord c turns by 2 asin(c / 2) <= factor c; the sum of the chords is
-                    # at most sqrt(segments x the sum of their squares) (Cauchy-Schwarz).
-                    small = largest2[i, j] <= _CHORD_SMALL * _CHORD_SMALL
-                    factor = _TURN_PER_CHORD_SMALL if small else math.pi / 2
-                    turning = factor * math.sqrt((n_waypoints - 1) * chords2[i, j])
-                    exact = exact or turning > upper[j] - lower[j] - _TWO_PI - _MARGIN
-                else:  # every waypoint inside the arc, no step through the gap
-                    exact = exact or inside[i, j] <= _MARGIN or crossed[i, j]
-            if exact:
-                first = first_outside(unwrapped(cq, sq, branches[i]), lower, upper)
-                if first < n_waypoints:
-                    alive[i] = False
-                    why[i] = REASON_JOINT_LIMITS
-                    where[i] = first
+            first = first_outside_pairs(
+                cq, sq, branches[i], i, lower, upper, modes, chords2, largest2, inside, crossed
+            )
+            if first < n_waypoints:
+                fail(i, REASON_JOINT_LIMITS, first, alive, why, where)
         write_cell(
             c, branches, alive, why, where, slowest, slowest_at, slowest_joint, speeds,
             mu, reason, failed, branch, bottleneck_waypoint, bottleneck_joint, v_out,
         )  # fmt: skip
 
 
-def warm_up_placement() -> tuple[object, ...]:
-    """The kernels' first nine arguments for one placement of a two-waypoint UR5 path."""
-    rotation = np.tile(np.diag([1.0, -1.0, -1.0]), (2, 1, 1))
-    position = np.array([[0.0, 0.4, 0.2], [0.01, 0.4, 0.2]])
-    twist = np.tile([1.0, 0.0, 0.0, 0.0, 0.0, 0.0], (2, 1))
-    parameters = solver.families.ur.kernel.kernel_parameters(UR5)
-    return (UR_KERNEL, parameters, np.ones(1), np.zeros(1), np.zeros((1, 3)), rotation, position,
-            position.copy(), twist)  # fmt: skip
-
-
 def warm_up() -> None:
     """Compile the kernel, or load it from the disk cache, so that no request pays for it.
 
-    One placement of a two-waypoint UR5 path: the kernel has one signature for every family.
+    One placement of a two-waypoint path of the families' warm-up arm (a UR5): the kernel has
+    one signature for every family.
     """
     modes, arc = limit_modes(np.full(6, -_TWO_PI), np.full(6, _TWO_PI))
     map_cells(
@@ -469,7 +241,5 @@ def warm_up() -> None:
         arc,
         np.full(6, math.pi),
         0.35,
-        np.empty(1),
-        *(np.empty(1, dtype=np.int64) for _ in range(5)),
-        np.empty((1, 0)),
+        *warm_up_answers(),
     )

@@ -5,12 +5,13 @@ cam.md section 2. For the closed-form families with the tool spin rate free,
 (:func:`solver.path.pipeline.run_chunk` with ``spin_mode="free"``), which stays the reference it is
 tested against (tests/solver/test_free_spin_kernel.py). Per placement:
 
-1. the path turned by the yaw and moved (:func:`solver.kernels.fixed_spin.turned_poses`); IK and
+1. the path turned by the yaw and moved (:func:`solver.kernels.cell.turned_poses`); IK and
    J^-1 t_hat on the branches still alive, then J^-1 [0; z_tool] (the family's pose kernel run
-   a second time with the spin twist), blocks of waypoints as in :mod:`solver.kernels.fixed_spin`;
+   a second time with the spin twist), blocks of waypoints as in :mod:`solver.kernels.cell`;
 2. each branch: unreachable, singular, then the step test against the previous waypoint, no
    position limits (they hold along the spin schedule); V_max by the exact two-variable LP
-   (:func:`solver.core.dtf.two_variable_speed`) and its running minimum, mu_path;
+   (:func:`solver.kernels.limits.two_variable_speed`, as
+   :func:`solver.core.dtf.two_variable_speed`) and its running minimum, mu_path;
 3. each branch still feasible, fastest first, until one holds (and those tied with it): the
    spin rate nearest zero at the feed mu_path
    (:func:`solver.core.dtf.spin_rate_nearest_zero`), the joints moved by the spin
@@ -36,17 +37,22 @@ from solver.core.codes import (
     TIE_RTOL,
     UNREACHABLE,
 )
-from solver.families.kernels import SCRATCH_ROWS, pose_block
-from solver.kernels.fixed_spin import (
+from solver.families.kernels import N_JOINTS, pose_block
+from solver.kernels.cache import drop_stale_compiled_code
+from solver.kernels.cell import (
     BLOCK,
-    drop_stale_compiled_code,
-    first_outside,
+    branch_work,
+    fail,
+    pose_work,
+    start_cell,
     turned_poses,
-    unwrapped,
+    wanted_branches,
+    warm_up_answers,
     warm_up_placement,
-    wrapped_step,
     write_cell,
 )
+from solver.kernels.limits import two_variable_speed
+from solver.kernels.positions import first_outside, unwrapped, wrapped_step
 
 _TWO_PI = 2 * math.pi
 _INSIDE = 1.0 - 1e-12  # as solver.core.dtf.spin_rate_nearest_zero
@@ -56,34 +62,11 @@ drop_stale_compiled_code(__name__)
 
 
 @njit(cache=True, error_model="numpy", nogil=True)
-def _two_variable_speed(qd, qs, b, w, qdot_max):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
-    """The largest s with |s a_j + sigma b_j| <= qdot_max_j, and the joint on its limit.
-
-    :func:`solver.core.dtf.two_variable_speed` at one waypoint (a = qd[b, :, w], b = qs[b, :, w]):
-    the least pair bound, the first pair at a tie, of the pair the joint sigma helps less.
-    """
-    best = np.inf
-    first, second = 0, 1
-    dof = qd.shape[1]
-    for j in range(dof):
-        for k in range(j + 1, dof):
-            bound = (qdot_max[j] * abs(qs[b, k, w]) + qdot_max[k] * abs(qs[b, j, w])) / abs(
-                qd[b, j, w] * qs[b, k, w] - qd[b, k, w] * qs[b, j, w]
-            )
-            if bound < best:  # a NaN bound (0 / 0) is no bound
-                best = bound
-                first, second = j, k
-    help_first = abs(qs[b, first, w]) / qdot_max[first]
-    help_second = abs(qs[b, second, w]) / qdot_max[second]
-    return best, first if help_first <= help_second else second
-
-
-@njit(cache=True, error_model="numpy", nogil=True)
 def _spin_rate(qd, qs, b, w, qdot_max, feed):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
     """:func:`solver.core.dtf.spin_rate_nearest_zero` at one waypoint, at the feed."""
     inside = feed * _INSIDE
     low, high = -np.inf, np.inf
-    for j in range(qd.shape[1]):
+    for j in range(N_JOINTS):
         if qs[b, j, w] == 0.0:
             continue
         one = (-qdot_max[j] - inside * qd[b, j, w]) / qs[b, j, w]
@@ -203,24 +186,13 @@ def free_cells(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
     n_cells = cos_yaw.shape[0]
     n_waypoints = flange_rotation.shape[0]
     n_branches = branches.shape[0]
-    n_all, dof = 8, 6
-    cq = np.empty((n_all, dof, n_waypoints))
-    sq = np.empty((n_all, dof, n_waypoints))
-    qd = np.empty((n_all, dof, n_waypoints))  # J^-1 t_hat
-    qs = np.empty((n_all, dof, n_waypoints))  # J^-1 [0; z_tool]
-    status = np.empty((n_all, n_waypoints), dtype=np.int64)
-    poses = np.empty((21, n_waypoints))
-    spin_poses = np.empty((21, n_waypoints))
-    scratch = np.empty((SCRATCH_ROWS, n_waypoints))
-    need = np.empty(n_all, dtype=np.bool_)
-    alive = np.empty(n_branches, dtype=np.bool_)
+    cq, sq, qd, status, poses, scratch, need = pose_work(n_waypoints)  # qd: J^-1 t_hat
+    qs = np.empty_like(qd)  # J^-1 [0; z_tool]
+    spin_poses = np.empty_like(poses)
+    alive, why, where, slowest, slowest_at, slowest_joint, speeds = branch_work(
+        n_branches, n_waypoints, v_out.shape[1] > 0
+    )
     checked = np.empty(n_branches, dtype=np.bool_)
-    why = np.empty(n_branches, dtype=np.int64)
-    where = np.empty(n_branches, dtype=np.int64)
-    slowest = np.empty(n_branches)
-    slowest_at = np.empty(n_branches, dtype=np.int64)
-    slowest_joint = np.empty(n_branches, dtype=np.int64)
-    speeds = np.empty((n_branches, n_waypoints)) if v_out.shape[1] else np.empty((0, 0))
     check_steps = max_joint_step < math.pi
     cos_step = math.cos(max_joint_step)
     for c in range(n_cells):
@@ -237,15 +209,11 @@ def free_cells(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
             spin_poses[15, w] = ca * x - sa * y
             spin_poses[16, w] = sa * x + ca * y
             spin_poses[17, w] = tool_axis[w, 2]
-        alive[:] = True
-        why[:] = FEASIBLE
-        where[:] = -1
+        start_cell(alive, why, where)
         n_alive = n_branches
         for w0 in range(0, n_waypoints, BLOCK):
             w1 = min(w0 + BLOCK, n_waypoints)
-            need[:] = False
-            for i in range(n_branches):
-                need[branches[i]] = need[branches[i]] or alive[i]
+            wanted_branches(branches, alive, need)
             pose_block(family, par, spin_poses, w0, w1, need, scratch, cq, sq, status, qs)
             pose_block(family, par, poses, w0, w1, need, scratch, cq, sq, status, qd)
             for i in range(n_branches):
@@ -259,7 +227,7 @@ def free_cells(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
                     elif status[b, w] == SINGULAR:
                         code = REASON_SINGULAR
                     elif w > 0 and check_steps and segment_checked[w - 1]:
-                        for j in range(dof):
+                        for j in range(N_JOINTS):
                             c0, s0 = cq[b, j, w - 1], sq[b, j, w - 1]
                             c1, s1 = cq[b, j, w], sq[b, j, w]
                             if c0 * c1 + s0 * s1 < cos_step:
@@ -271,7 +239,7 @@ def free_cells(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
                         where[i] = w
                         n_alive -= 1
                         break
-                    speed, limiting = _two_variable_speed(qd, qs, b, w, qdot_max)
+                    speed, limiting = two_variable_speed(qd, qs, b, w, qdot_max)
                     v = 0.0 if pure_rotation[w] else speed
                     if w == 0 or v < slowest[i]:
                         slowest[i] = v
@@ -299,9 +267,7 @@ def free_cells(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
                 segment_checked, lower, upper, qdot_max, max_joint_step,
             )  # fmt: skip
             if code != FEASIBLE:
-                alive[i] = False
-                why[i] = code
-                where[i] = at
+                fail(i, code, at, alive, why, where)
             elif top == -np.inf:
                 top = slowest[i]
         write_cell(
@@ -313,7 +279,8 @@ def free_cells(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
 def warm_up() -> None:
     """Compile the kernel, or load it from the disk cache, so that no request pays for it.
 
-    One placement of a two-waypoint UR5 path: the kernel has one signature for every family.
+    One placement of a two-waypoint path of the families' warm-up arm (a UR5): the kernel has
+    one signature for every family.
     """
     free_cells(
         *warm_up_placement(),
@@ -326,7 +293,5 @@ def warm_up() -> None:
         np.full(6, _TWO_PI),
         np.full(6, math.pi),
         0.35,
-        np.empty(1),
-        *(np.empty(1, dtype=np.int64) for _ in range(5)),
-        np.empty((1, 0)),
+        *warm_up_answers(),
     )

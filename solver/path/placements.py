@@ -16,8 +16,9 @@ import numpy as np
 from solver.core.codes import FEASIBLE
 from solver.core.malloc import raise_malloc_thresholds
 from solver.core.parallel import SERIAL, TaskRunner
-from solver.kernels.fixed_spin import limit_modes, map_cells
+from solver.kernels.fixed_spin import map_cells
 from solver.kernels.free_spin import free_cells
+from solver.kernels.positions import limit_modes
 from solver.path.pipeline import check_placements, flange_at_spin, run_chunk
 from solver.path.problem import PathProblem
 

@@ -1,0 +1,51 @@
+"""numba's disk cache of the compiled kernels, and the marker that says when it is stale."""
+
+from __future__ import annotations
+
+import hashlib
+import sys
+from pathlib import Path
+
+import solver.kernels.cell
+import solver.kernels.limits
+import solver.kernels.positions
+from solver.families.kernels import KERNEL_SOURCES
+
+
+def drop_stale_compiled_code(name: str) -> None:
+    """Delete the cached machine code of module ``name``'s kernels when a callee has changed.
+
+    numba's disk cache (``cache=True``, files in ``__pycache__``) is keyed by the source file
+    of the cached function only, but the compiled functions take their callees into themselves
+    (the dispatcher :func:`solver.families.kernels.pose_block` the families' pose kernels,
+    whose modules it lists in :data:`~solver.families.kernels.KERNEL_SOURCES`, and the map
+    kernels the dispatcher and the helpers of :mod:`solver.kernels`): after an edit of a
+    callee they would load the old code. A marker named by the hash of all those sources says
+    which code the caches hold; a new hash drops the cached code of every one of them. Where
+    the directories cannot be written (an installed copy), numba caches elsewhere or not at all
+    and nothing is done here.
+    """
+    modules = (
+        *KERNEL_SOURCES,
+        solver.kernels.positions,
+        solver.kernels.limits,
+        solver.kernels.cell,
+        sys.modules[name],
+    )
+    files = [Path(str(module.__file__)) for module in modules]
+    stamp = hashlib.sha256(b"".join(path.read_bytes() for path in files)).hexdigest()[:16]
+    stem = files[-1].stem
+    marker = files[-1].parent / "__pycache__" / f"{stem}.sources-{stamp}"
+    try:
+        if marker.exists():
+            return
+        for path in files:
+            cache = path.parent / "__pycache__"
+            for stale in [*cache.glob(f"{path.stem}.*.nbi"), *cache.glob(f"{path.stem}.*.nbc")]:
+                stale.unlink(missing_ok=True)
+        for old in marker.parent.glob(f"{stem}.sources-*"):
+            old.unlink(missing_ok=True)
+        marker.parent.mkdir(exist_ok=True)
+        marker.touch()
+    except OSError:
+        return

@@ -1,0 +1,178 @@
+"""The cell skeleton both map kernels share: one placement's poses, tests and answer.
+
+A map kernel (:mod:`solver.kernels.fixed_spin`, :mod:`solver.kernels.free_spin`) evaluates a
+placement, a cell of the map, as the numpy pipeline does (dtf.md section 9): the path turned by
+the placement's yaw and moved (:func:`turned_poses`); the family's pose kernel over blocks of
+:data:`BLOCK` waypoints; per branch the IK and step tests and the running minimum of the speed
+bound; then the branch, by :func:`solver.path.tracking.choose_branch`'s rule, written to the
+answer arrays (:func:`write_cell`). What differs between the kernels (the speed bound, the
+position limits' tests, the spin schedule) stays in each.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+from solver.core.codes import (
+    FEASIBLE,
+    TIE_RTOL,
+)
+from solver.families.kernels import N_BRANCHES, N_JOINTS, SCRATCH_ROWS, warm_up_arm
+
+# Waypoints solved together: the pose kernels run level by level over a block, and a block is
+# the unit of the early stop when every branch has failed.
+BLOCK = 32
+
+
+@njit(cache=True, error_model="numpy", nogil=True, inline="always")
+def pose_work(n_waypoints):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
+    """The arrays of a path of W waypoints that :func:`solver.families.kernels.pose_block` fills.
+
+    Returns:
+        cq, sq, qd: shape (8, 6, W), the joints' (cos, sin) pairs and J^-1 t per branch;
+        status: shape (8, W); poses: shape (21, W), as :func:`turned_poses`; scratch; need:
+        shape (8,), bool, the branches to solve.
+    """
+    cq = np.empty((N_BRANCHES, N_JOINTS, n_waypoints))
+    sq = np.empty((N_BRANCHES, N_JOINTS, n_waypoints))
+    qd = np.empty((N_BRANCHES, N_JOINTS, n_waypoints))
+    status = np.empty((N_BRANCHES, n_waypoints), dtype=np.int64)
+    poses = np.empty((21, n_waypoints))
+    scratch = np.empty((SCRATCH_ROWS, n_waypoints))
+    need = np.empty(N_BRANCHES, dtype=np.bool_)
+    return cq, sq, qd, status, poses, scratch, need
+
+
+@njit(cache=True, error_model="numpy", nogil=True, inline="always")
+def branch_work(n_branches, n_waypoints, keep_speeds):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
+    """Per branch followed: alive, why and where it failed, its mu_path and where it binds.
+
+    Returns:
+        alive, why, where, slowest (mu_path so far), slowest_at, slowest_joint: shape (B,);
+        speeds: shape (B, W), V_max per waypoint, or (0, 0) when not ``keep_speeds``.
+    """
+    alive = np.empty(n_branches, dtype=np.bool_)
+    why = np.empty(n_branches, dtype=np.int64)
+    where = np.empty(n_branches, dtype=np.int64)
+    slowest = np.empty(n_branches)
+    slowest_at = np.empty(n_branches, dtype=np.int64)
+    slowest_joint = np.empty(n_branches, dtype=np.int64)
+    speeds = np.empty((n_branches, n_waypoints)) if keep_speeds else np.empty((0, 0))
+    return alive, why, where, slowest, slowest_at, slowest_joint, speeds
+
+
+@njit(cache=True, error_model="numpy", nogil=True, inline="always")
+def start_cell(alive, why, where):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
+    """Every branch alive, none failed, before a placement."""
+    alive[:] = True
+    why[:] = FEASIBLE
+    where[:] = -1
+
+
+@njit(cache=True, error_model="numpy", nogil=True, inline="always")
+def wanted_branches(branches, alive, need):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
+    """Mark in ``need`` (8,) the branch indices of ``branches`` that are still ``alive``."""
+    need[:] = False
+    for i in range(branches.shape[0]):
+        need[branches[i]] = need[branches[i]] or alive[i]
+
+
+@njit(cache=True, error_model="numpy", nogil=True, inline="always")
+def fail(i, code, w, alive, why, where):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
+    """Branch row i fails for reason ``code`` at waypoint w."""
+    alive[i] = False
+    why[i] = code
+    where[i] = w
+
+
+@njit(cache=True, error_model="numpy", nogil=True)
+def turned_poses(c, ca, sa, offset, flange_rotation, flange_position, tool_position, twist, poses):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
+    """Fill ``poses`` (21, W) for placement c: the path turned by its yaw and moved.
+
+    Rows: R_B_F row by row (0-8), p_B_F (9-11), t_hat in {B} (12-17), the tool point (18-20);
+    the same arithmetic as :func:`solver.path.pipeline.turn_by_yaw`.
+    """
+    for w in range(flange_rotation.shape[0]):
+        for k in range(3):  # R_B_F = Rz(yaw) R_O_F, row by row
+            x, y = flange_rotation[w, 0, k], flange_rotation[w, 1, k]
+            poses[k, w] = ca * x - sa * y
+            poses[3 + k, w] = sa * x + ca * y
+            poses[6 + k, w] = flange_rotation[w, 2, k]
+        x, y = flange_position[w, 0], flange_position[w, 1]
+        poses[9, w] = ca * x - sa * y + offset[c, 0]
+        poses[10, w] = sa * x + ca * y + offset[c, 1]
+        poses[11, w] = flange_position[w, 2] + offset[c, 2]
+        for k in range(0, 6, 3):
+            x, y = twist[w, k], twist[w, k + 1]
+            poses[12 + k, w] = ca * x - sa * y
+            poses[13 + k, w] = sa * x + ca * y
+            poses[14 + k, w] = twist[w, k + 2]
+        x, y = tool_position[w, 0], tool_position[w, 1]
+        poses[18, w] = ca * x - sa * y + offset[c, 0]
+        poses[19, w] = sa * x + ca * y + offset[c, 1]
+        poses[20, w] = tool_position[w, 2] + offset[c, 2]
+
+
+@njit(cache=True, error_model="numpy", nogil=True)
+def write_cell(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
+    c, branches, alive, why, where, slowest, slowest_at, slowest_joint, speeds,
+    mu, reason, failed, branch, bottleneck_waypoint, bottleneck_joint, v_out,
+):  # fmt: skip
+    """Placement c's answer from its branches: :func:`solver.path.tracking.choose_branch`'s rule.
+
+    The highest mu_path (``slowest``) among the branches ``alive``, ties to the first; where
+    none is, the one that failed furthest along (``why`` and ``where``, the first at a tie).
+    """
+    n_branches = branches.shape[0]
+    top = -np.inf
+    for i in range(n_branches):
+        if alive[i] and slowest[i] > top:
+            top = slowest[i]
+    pick = -1
+    for i in range(n_branches):
+        if alive[i] and slowest[i] >= top - TIE_RTOL * abs(top):
+            pick = i
+            break
+    if pick >= 0:
+        mu[c] = slowest[pick]
+        reason[c] = FEASIBLE
+        failed[c] = -1
+        bottleneck_waypoint[c] = slowest_at[pick]
+        bottleneck_joint[c] = slowest_joint[pick]
+        for w in range(v_out.shape[1]):
+            v_out[c, w] = speeds[pick, w]
+    else:
+        furthest = -1
+        for i in range(n_branches):
+            furthest = max(furthest, where[i])
+        for i in range(n_branches):
+            if where[i] == furthest:
+                pick = i
+                break
+        mu[c] = np.nan
+        reason[c] = why[pick]
+        failed[c] = where[pick]
+        bottleneck_waypoint[c] = -1
+        bottleneck_joint[c] = -1
+        for w in range(v_out.shape[1]):
+            v_out[c, w] = np.nan
+    branch[c] = branches[pick]
+
+
+def warm_up_answers() -> tuple[np.ndarray, ...]:
+    """The kernels' seven answer arrays for one placement, V_max not wanted."""
+    return (np.empty(1), *(np.empty(1, dtype=np.int64) for _ in range(5)), np.empty((1, 0)))
+
+
+def warm_up_placement() -> tuple[object, ...]:
+    """The kernels' first nine arguments for one placement of a two-waypoint path.
+
+    The arm is the families' warm-up arm (:func:`solver.families.kernels.warm_up_arm`).
+    """
+    rotation = np.tile(np.diag([1.0, -1.0, -1.0]), (2, 1, 1))
+    position = np.array([[0.0, 0.4, 0.2], [0.01, 0.4, 0.2]])
+    twist = np.tile([1.0, 0.0, 0.0, 0.0, 0.0, 0.0], (2, 1))
+    code, parameters = warm_up_arm()
+    return (code, parameters, np.ones(1), np.zeros(1), np.zeros((1, 3)), rotation, position,
+            position.copy(), twist)  # fmt: skip

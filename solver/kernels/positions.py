@@ -1,0 +1,126 @@
+"""Position limits of a joint path in (cos, sin) pairs, for both map kernels (dtf.md section 9).
+
+The fast tests need no angle: a joint whose limits span more than 2 pi fits when the path's
+total turning (bounded from the squared chords of the (cos, sin) steps) leaves a full turn of
+room; a joint whose range is a turn or less fits when every waypoint is inside its arc and no
+step's short arc passes through the gap opposite. A branch that neither test clears forms its
+angles (atan2, :func:`unwrapped`) and runs the exact test of :func:`solver.path.tracking.track`
+(:func:`first_outside`).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+from solver.core.codes import EDGE
+from solver.families.kernels import N_JOINTS
+
+_TWO_PI = 2 * math.pi
+NO_LIMIT, WIDE, NARROW = 0, 1, 2
+# Fast tests of the position limits leave this much (rad) to rounding; a branch nearer than
+# that to failing them goes to the exact test.
+_MARGIN = 1e-9
+# 2 asin(c / 2) / c, the turn per unit chord, is at most this for chords up to 0.5 (a turn of
+# 0.505 rad) and at most pi / 2 for any chord.
+_CHORD_SMALL = 0.5
+_TURN_PER_CHORD_SMALL = 1.0108
+
+
+def limit_modes(lower: np.ndarray, upper: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Per joint: how the kernel tests its position limits, and the arc of a narrow range.
+
+    Returns:
+        modes: shape (n,), 0 no limit, 1 a range of more than 2 pi, 2 one of 2 pi or less;
+        arc: shape (n, 3), cos and sin of the range's middle and cos of its half width.
+    """
+    width = upper - lower
+    wide = width > _TWO_PI + 1e-12
+    modes = np.where(~np.isfinite(width), NO_LIMIT, np.where(wide, WIDE, NARROW))
+    middle = np.where(np.isfinite(width), (lower + upper) / 2, 0.0)
+    half = np.where(np.isfinite(width), width / 2, 0.0)
+    arc = np.column_stack([np.cos(middle), np.sin(middle), np.cos(half)])
+    return modes.astype(np.int64), arc
+
+
+@njit(cache=True, error_model="numpy", nogil=True)
+def wrapped_step(step):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
+    """A step between two angles in [-pi, pi] brought into [-pi, pi], as track() does."""
+    if step > math.pi:
+        return step - _TWO_PI
+    if step < -math.pi:
+        return step + _TWO_PI
+    return step
+
+
+@njit(cache=True, error_model="numpy", nogil=True)
+def unwrapped(cq, sq, b):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
+    """Branch b's joint path (W, 6), rad: the angles of its pairs, unwrapped by the wrapped steps.
+
+    :func:`solver.path.tracking.track`'s path: the first waypoint's angle plus the running sum of
+    the steps, each brought into [-pi, pi].
+    """
+    dof, n_waypoints = cq.shape[1], cq.shape[2]
+    path = np.empty((n_waypoints, dof))
+    for j in range(dof):
+        first = math.atan2(sq[b, j, 0], cq[b, j, 0])
+        previous, total = first, 0.0
+        path[0, j] = first
+        for w in range(1, n_waypoints):
+            angle = math.atan2(sq[b, j, w], cq[b, j, w])
+            total += wrapped_step(angle - previous)
+            path[w, j] = first + total
+            previous = angle
+    return path
+
+
+@njit(cache=True, error_model="numpy", nogil=True)
+def first_outside(path, lower, upper):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
+    """The first waypoint of a joint path (W, n) whose range no 2 pi copy holds (W: none).
+
+    :func:`solver.path.tracking.track`'s test: the running range of each joint (a range that fits
+    holds every shorter one, so no test of the whole path is needed first).
+    """
+    n_waypoints, dof = path.shape
+    low_run, high_run = path[0].copy(), path[0].copy()
+    for w in range(n_waypoints):
+        for j in range(dof):
+            low_run[j] = min(low_run[j], path[w, j])
+            high_run[j] = max(high_run[j], path[w, j])
+            k_low = math.ceil((lower[j] - low_run[j]) / _TWO_PI - EDGE)
+            k_high = math.floor((upper[j] - high_run[j]) / _TWO_PI + EDGE)
+            if k_low > k_high:
+                return w
+    return n_waypoints
+
+
+@njit(cache=True, error_model="numpy", nogil=True)
+def first_outside_pairs(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
+    cq, sq, b, i, lower, upper, modes, chords2, largest2, inside, crossed
+):
+    """The first waypoint where branch b's path leaves its position limits (W: none).
+
+    The fast tests on the sums of row i that the kernel keeps along the path (``chords2`` and
+    ``largest2`` of the wide joints' steps, ``inside`` and ``crossed`` of the narrow ones, shape
+    (B, n)); only where they do not clear every joint, the angles and the exact test
+    (:func:`first_outside`).
+    """
+    n_waypoints = cq.shape[2]
+    exact = False
+    for j in range(N_JOINTS):
+        if modes[j] == NO_LIMIT:
+            continue
+        if modes[j] == WIDE:
+            # A chord c turns by 2 asin(c / 2) <= factor c; the sum of the chords is at most
+            # sqrt(segments x the sum of their squares) (Cauchy-Schwarz).
+            small = largest2[i, j] <= _CHORD_SMALL * _CHORD_SMALL
+            factor = _TURN_PER_CHORD_SMALL if small else math.pi / 2
+            turning = factor * math.sqrt((n_waypoints - 1) * chords2[i, j])
+            exact = exact or turning > upper[j] - lower[j] - _TWO_PI - _MARGIN
+        else:  # every waypoint inside the arc, no step through the gap
+            exact = exact or inside[i, j] <= _MARGIN or crossed[i, j]
+    if exact:
+        return first_outside(unwrapped(cq, sq, b), lower, upper)
+    return n_waypoints
