@@ -46,7 +46,13 @@ from service.schemas.optimize import (
     StartInfo,
 )
 from service.schemas.path import ClDataPath, CsvPath, Path, PathInput, PosePath, ToolAxisPath
-from service.schemas.paths_import import ImportedPose, PathImportRequest, PathImportResponse
+from service.schemas.paths_import import (
+    ImportedPose,
+    PassOut,
+    PathImportRequest,
+    PathImportResponse,
+    SkippedRecordOut,
+)
 from service.schemas.robot import CatalogueRobot, OpwGeometry, OpwRobot, Robot, UrdfRobot
 from service.schemas.robots import BranchLevel, HealthResponse, RobotInfo, RobotsResponse
 
@@ -79,6 +85,8 @@ __all__ = [
     "HealthResponse",
     "IkInfo",
     "ImportedPose",
+    "PassOut",
+    "SkippedRecordOut",
     "IkPolicy",
     "MapCell",
     "MapExtreme",

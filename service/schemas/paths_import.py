@@ -42,6 +42,12 @@ class ImportedPose(ResponseModel):
 class SkippedRecordOut(ResponseModel):
     """Records of one word skipped: they carry no geometry and no feed (cam.md section 9)."""
 
+    model_config = ConfigDict(
+        json_schema_extra={
+            "examples": [{"word": "PAINT", "count": 31, "first_line": 5, "recognised": True}]
+        }
+    )
+
     word: str = Field(description="The major word (PAINT, TLDATA; $$ for comments).")
     count: int = Field(description="How many records of this word the file has.")
     first_line: int = Field(description="The line of the first one, from 1.")
@@ -52,6 +58,12 @@ class SkippedRecordOut(ResponseModel):
 
 class PassOut(ResponseModel):
     """One pass: its range of waypoints and the operation it belongs to."""
+
+    model_config = ConfigDict(
+        json_schema_extra={
+            "examples": [{"start": 0, "stop": 108, "operation": "CAVITY_MILL", "feed": 0.004233}]
+        }
+    )
 
     start: int = Field(description="Its first waypoint's index.")
     stop: int = Field(description="One past its last waypoint's index.")
