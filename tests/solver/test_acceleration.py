@@ -17,8 +17,9 @@ import toppra
 from solver.core.exceptions import InvalidInputError
 from solver.core.spatial import Placement, pose_matrix
 from solver.families import get_robot
+from solver.optimise.methods.placement_nlp import PlacementNlp
 from solver.optimise.optimize import optimize_placement
-from solver.optimise.search_space import PlacementBounds
+from solver.optimise.search_space import PlacementBounds, decision_vector, variables_of
 from solver.path.capability_map import capability_map
 from solver.path.evaluate import PathEvaluation, evaluate_path
 from solver.path.problem import PathOptions, PathProblem
@@ -275,3 +276,31 @@ def test_bad_blend_length_names_the_field(blend: float) -> None:
     with pytest.raises(InvalidInputError) as error:
         evaluate_path(problem, PLACEMENT)
     assert error.value.field == "ik.blend_length"
+
+
+def test_nlp_rows_hold_the_joint_accelerations() -> None:
+    """IPOPT's optimum keeps |D_ij| s^2 <= a_j (D_i written here from its own joint path)."""
+    problem = PathProblem.of(ur5(10.0), WAYPOINTS)
+    bounds = PlacementBounds(x=(-0.1, 0.1), y=(0.35, 0.55), yaw=(-0.3, 0.3), z=0.1)
+    start = evaluate_path(problem, PLACEMENT)
+    assert start.branch is not None and start.q is not None and start.feed_index is not None
+    assert start.qdot is not None and start.v_max is not None
+    speed = start.feed_index
+    nlp = PlacementNlp(problem, bounds)
+    result = nlp.solve(
+        decision_vector(x=0.0, y=0.45, yaw=0.0, spin=0.0, z=0.1),
+        speed,
+        start.q,
+        start.qdot * (speed / start.v_max)[:, None],
+    )
+    assert result.success
+    assert result.speed > speed  # the optimum runs faster than the start
+    second = independent_second_difference(
+        result.joint_path, WAYPOINTS[:, :3, 3], [(0, len(WAYPOINTS))], 0.002
+    )
+    use = np.nanmax(np.abs(second) * result.speed**2 / 10.0)
+    assert use == pytest.approx(1.0, abs=1e-6)  # the acceleration rows bind at the optimum
+    named = variables_of(result.vector)
+    placed = Placement(float(named.x), float(named.y), float(named.z), float(named.yaw))
+    again = evaluate_path(problem.with_options(branch=start.branch), placed)
+    assert again.feed_index == pytest.approx(result.speed, rel=1e-6)
