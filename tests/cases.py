@@ -82,3 +82,9 @@ SECOND_DIFFERENCE_RTOL = 1e-9
 # cubic spline of q(s)), and the time-optimal cycle time against toppra's on that spline.
 TOPPRA_FEED_RTOL = 0.01
 TOPPRA_TIME_RTOL = 0.02
+# The README example at 10 rad/s^2: L / mu_acc (motion.md section 4 gives 1.338 s).
+README_CONSTANT_FEED_TIME_10 = 1.338
+README_CONSTANT_FEED_TIME_ATOL = 5e-4
+# The pass at mu_acc with its ramps against toppra with the feed capped at mu_acc (a virtual
+# joint q = s limited to mu_acc m/s), on toppra's spline: relative.
+TOPPRA_RAMP_RTOL = 0.01
