@@ -80,9 +80,10 @@ def render_png(cmap: CapabilityMap, *, title: str) -> bytes:
     width_in, height_in = width_px / DPI, height_px / DPI
     figure = plt.figure(figsize=(width_in, height_in), dpi=DPI)
     boxes, bar = _layout(rows, columns, width_in, height_in)
-    feasible = ~np.isnan(cmap.mu_path)
-    low = float(np.nanmin(cmap.mu_path)) if feasible.any() else 0.0
-    high = float(np.nanmax(cmap.mu_path)) if feasible.any() else 1.0
+    colour_of = cmap.feed_index  # mu_acc with acceleration limits, else mu_path
+    feasible = ~np.isnan(colour_of)
+    low = float(np.nanmin(colour_of)) if feasible.any() else 0.0
+    high = float(np.nanmax(colour_of)) if feasible.any() else 1.0
     colours = matplotlib.colormaps["viridis"].with_extremes(bad="white")
     best, worst = cmap.extreme(best=True), cmap.extreme(best=False)
     half_x = (cmap.xs[1] - cmap.xs[0]) / 2 if len(cmap.xs) > 1 else 0.005
@@ -92,7 +93,7 @@ def render_png(cmap: CapabilityMap, *, title: str) -> bytes:
     for panel, (s, k) in enumerate(np.ndindex(len(cmap.spins), len(cmap.yaws))):
         axes = figure.add_axes(boxes[panel])
         image = axes.imshow(
-            np.ma.masked_invalid(cmap.mu_path[s, k]),
+            np.ma.masked_invalid(colour_of[s, k]),
             origin="lower",
             extent=extent,
             cmap=colours,
@@ -112,7 +113,8 @@ def render_png(cmap: CapabilityMap, *, title: str) -> bytes:
         )
         axes.set_xlabel("x (m)")
         axes.set_ylabel("y (m)")
-    figure.colorbar(images[0], cax=figure.add_axes(bar), label="mu_path (m/s)")
+    label = "mu_path (m/s)" if cmap.mu_acc is None else "mu_acc (m/s)"
+    figure.colorbar(images[0], cax=figure.add_axes(bar), label=label)
     figure.legend(
         handles=[
             Line2D([], [], marker="*", color="red", ls="", ms=10, label="best"),
