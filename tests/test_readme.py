@@ -71,3 +71,10 @@ def test_cam_example_output() -> None:
         "## CAM programs: from a CL file to the controller", "cam_program"
     )
     assert printed == lines
+
+
+def test_acceleration_example_output() -> None:
+    printed, lines = _example_lines(
+        "## Joint accelerations: the feed the arm can really run", "accelerations"
+    )
+    assert printed == lines
