@@ -43,7 +43,9 @@ def _evaluated(
 
 
 def joint_use_png(body: EvaluateRequest, settings: Settings) -> bytes:
-    """The PNG of each joint's use of its speed limit at the feed (default: mu_path).
+    """The PNG of each joint's use of its speed (and acceleration) limit at the feed.
+
+    The feed defaults to mu_path, or mu_acc with acceleration limits.
 
     Raises:
         InvalidInputError: on ``placement``, the path does not run there.
@@ -56,7 +58,9 @@ def joint_use_png(body: EvaluateRequest, settings: Settings) -> bytes:
             f"the path does not run here ({evaluation.reason or 'mu_path is 0'}): no joint "
             "speeds to draw; ask for JSON to see why",
         )
-    check = check_feed(evaluation, index if feed is None else feed, robot.qdot_max)
+    check = check_feed(
+        evaluation, index if feed is None else feed, robot.qdot_max, qddot_max=robot.qddot_max
+    )
     return render_joint_use(check, evaluation, robot.joint_names, title=robot.name)
 
 

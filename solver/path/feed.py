@@ -30,6 +30,9 @@ class FeedCheck:
         qdot_at_feed: shape (N, n), rad/s, the joint speeds at F; ``None`` when infeasible. NaN
             rows where the tool only turns (V_max = 0: no feed there).
         use: shape (N, n), |qdot_at_feed| / qdot_max, dimensionless (1: on the limit).
+        acceleration_use: shape (N, n), with acceleration limits |D_i| F^2 / qddot_max at a
+            constant feed F (motion.md section 2; NaN within the blend length of a pass end);
+            ``None`` without them or when infeasible.
     """
 
     feed: float
@@ -37,15 +40,23 @@ class FeedCheck:
     margin: float | None
     qdot_at_feed: np.ndarray | None
     use: np.ndarray | None
+    acceleration_use: np.ndarray | None = None
 
 
-def check_feed(evaluation: PathEvaluation, feed: float, qdot_max: np.ndarray) -> FeedCheck:
+def check_feed(
+    evaluation: PathEvaluation,
+    feed: float,
+    qdot_max: np.ndarray,
+    *,
+    qddot_max: np.ndarray | None = None,
+) -> FeedCheck:
     """The joint speeds and limit use of an evaluated path at feed ``feed``.
 
     Args:
         evaluation: from :func:`solver.path.evaluate.evaluate_path`.
         feed: F, m/s, finite and > 0.
         qdot_max: shape (n,), rad/s, the joint speed limits the evaluation used.
+        qddot_max: shape (n,), rad/s^2, its acceleration limits (None: none).
 
     Raises:
         InvalidInputError: on ``feed``, not finite or not > 0.
@@ -59,10 +70,15 @@ def check_feed(evaluation: PathEvaluation, feed: float, qdot_max: np.ndarray) ->
         scale = np.where(ev.v_max > 0.0, feed / ev.v_max, np.nan)
     qdot_at_feed = ev.qdot * scale[:, None]
     index = ev.mu_path if ev.acceleration is None else ev.acceleration.mu_acc
+    acceleration_use = None
+    acc = ev.acceleration
+    if acc is not None and qddot_max is not None and acc.mu_acc > 0.0:
+        acceleration_use = np.abs(acc.qdd) * (feed / acc.mu_acc) ** 2 / qddot_max
     return FeedCheck(
         feed=feed,
         feasible=index >= feed,
         margin=index / feed,
         qdot_at_feed=qdot_at_feed,
         use=np.abs(qdot_at_feed) / qdot_max,
+        acceleration_use=acceleration_use,
     )

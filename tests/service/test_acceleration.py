@@ -3,10 +3,12 @@
 from __future__ import annotations
 
 import copy
+import io
 import json
 from pathlib import Path
 from typing import Any
 
+import matplotlib.image
 import pytest
 from fastapi.testclient import TestClient
 
@@ -241,3 +243,15 @@ def test_jobs_answer_what_the_routes_answer(client: TestClient, tmp_path: Path, 
     done = store.get(job.id)
     assert done is not None and done.status == "done", done
     assert done.result == post(client, f"/v1/{kind}", request)
+
+
+def test_joint_use_picture_has_the_acceleration_panel(client: TestClient) -> None:
+    pictures = {}
+    for name, body in (("without", EXAMPLE), ("with", limited(EXAMPLE))):
+        answer = client.post("/v1/evaluate", json=body, headers={"accept": "image/png"})
+        assert answer.status_code == 200, answer.text
+        pictures[name] = matplotlib.image.imread(io.BytesIO(answer.content))
+    assert pictures["with"].shape[1] == pictures["without"].shape[1]
+    assert pictures["with"].shape[0] == pytest.approx(
+        pictures["without"].shape[0] * 7 / 4, rel=0.01
+    )

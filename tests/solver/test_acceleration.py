@@ -22,6 +22,7 @@ from solver.optimise.optimize import optimize_placement
 from solver.optimise.search_space import PlacementBounds, decision_vector, variables_of
 from solver.path.capability_map import capability_map
 from solver.path.evaluate import PathEvaluation, evaluate_path
+from solver.path.feed import check_feed
 from solver.path.problem import PathOptions, PathProblem
 from tests.cases import (
     EXAMPLES,
@@ -304,3 +305,18 @@ def test_nlp_rows_hold_the_joint_accelerations() -> None:
     placed = Placement(float(named.x), float(named.y), float(named.z), float(named.yaw))
     again = evaluate_path(problem.with_options(branch=start.branch), placed)
     assert again.feed_index == pytest.approx(result.speed, rel=1e-6)
+
+
+def test_feed_check_uses_both_limits() -> None:
+    """At F = mu_acc the binding joint uses its whole acceleration limit, and no joint more."""
+    robot = ur5(10.0)
+    evaluation = evaluate_path(PathProblem.of(robot, WAYPOINTS), PLACEMENT)
+    acc = evaluation.acceleration
+    assert acc is not None and robot.qddot_max is not None
+    at = check_feed(evaluation, acc.mu_acc, robot.qdot_max, qddot_max=robot.qddot_max)
+    assert at.feasible and at.acceleration_use is not None and at.use is not None
+    assert np.nanmax(at.acceleration_use) == pytest.approx(1.0, rel=1e-12)
+    assert at.acceleration_use[acc.waypoint, acc.joint] == pytest.approx(1.0, rel=1e-12)
+    assert np.nanmax(at.use) <= 1.0
+    faster = check_feed(evaluation, acc.mu_acc * 1.01, robot.qdot_max, qddot_max=robot.qddot_max)
+    assert not faster.feasible and faster.margin == pytest.approx(1 / 1.01, rel=1e-12)
