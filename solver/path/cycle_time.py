@@ -177,6 +177,26 @@ class _GridPath(toppra.interpolator.AbstractGeometricPath):  # type: ignore[misc
         return np.array([self._s[0], self._s[-1]])
 
 
+MIN_GRID = 64  # grid points a pass at least: a pass of few waypoints is subdivided
+
+
+def _refined(s: np.ndarray, *values: np.ndarray) -> tuple[np.ndarray, ...]:
+    """The grid with at least MIN_GRID points (the waypoints kept), values linear in between.
+
+    Rest to rest needs room to speed up: on a grid of two points the feed could never leave 0.
+    """
+    if len(s) >= MIN_GRID:
+        return (s, *values)
+    fine = np.union1d(s, np.linspace(0.0, s[-1], MIN_GRID))
+    return (
+        fine,
+        *(
+            np.column_stack([np.interp(fine, s, v[:, j]) for j in range(v.shape[1])])
+            for v in values
+        ),
+    )
+
+
 def pass_time(
     q: np.ndarray,
     positions: np.ndarray,
@@ -195,6 +215,7 @@ def pass_time(
     """
     s = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(positions, axis=0), axis=1))])
     q_s, q_ss = blended_derivatives(q, s, blend_length)
+    s, q, q_s, q_ss = _refined(s, q, q_s, q_ss)
     cap = np.minimum(_largest_squared_speeds(q_s, q_ss, *limits), mu_acc**2)
     up = _ramp_from_rest(s, q_s, q_ss, cap, limits[1])
     down = _ramp_from_rest(s[-1] - s[::-1], -q_s[::-1], q_ss[::-1], cap[::-1], limits[1])[::-1]
@@ -226,8 +247,9 @@ def cycle_time(problem: PathProblem, evaluation: PathEvaluation) -> CycleTime | 
             path, :func:`solver.path.joint_path.evaluate_joint_path`).
 
     Returns:
-        None without acceleration limits, where the path is infeasible, or where mu_acc is 0
-        (the tool turns on the spot: no feed, no finite time).
+        None without acceleration limits, where the path is infeasible, where mu_acc is 0
+        (the tool turns on the spot: no feed, no finite time), or where a figure is not
+        finite (toppra found no profile).
     """
     robot, acc = problem.robot, evaluation.acceleration
     if acc is None or evaluation.q is None or robot.qddot_max is None or acc.mu_acc <= 0.0:
@@ -239,6 +261,8 @@ def cycle_time(problem: PathProblem, evaluation: PathEvaluation) -> CycleTime | 
         figures = pass_time(
             evaluation.q[start:stop], positions[start:stop], acc.mu_acc, limits, acc.blend_length
         )
+        if not all(math.isfinite(figure) for figure in figures):
+            return None
         passes.append(PassTime(start, stop, *figures))
     return CycleTime(
         constant_feed_time=sum(p.constant_feed_time for p in passes),

@@ -87,8 +87,9 @@ def test_readme_example_at_10() -> None:
     assert times.time_optimal <= times.ramp_time
 
 
-def test_passes_add_up() -> None:
-    passes = [(0, 60), (60, 133)]
+@pytest.mark.parametrize("passes", [[(0, 60), (60, 133)], [(0, 2), (2, 5), (5, 133)]])
+def test_passes_add_up(passes: list[tuple[int, int]]) -> None:
+    """Totals are the passes' sums; a pass of two waypoints still gets finite times."""
     _, evaluation, times = evaluated(WAYPOINTS, np.full(6, 10.0), passes)
     assert times is not None and evaluation.acceleration is not None
     assert [(p.start, p.stop) for p in times.passes] == passes
@@ -103,6 +104,8 @@ def test_passes_add_up() -> None:
         assert p.constant_feed_time == pytest.approx(
             length / evaluation.acceleration.mu_acc, rel=1e-12
         )
+        assert 0.0 < p.constant_feed_time < p.ramp_time < 10 * p.constant_feed_time + 1.0
+        assert 0.0 < p.time_optimal < 10 * p.ramp_time
 
 
 def test_none_without_acceleration_limits() -> None:
