@@ -23,6 +23,8 @@ from solver.optimise.search_space import PlacementBounds, decision_vector, varia
 from solver.path.capability_map import capability_map
 from solver.path.evaluate import PathEvaluation, evaluate_path
 from solver.path.feed import check_feed
+from solver.path.joint_path import evaluate_joint_path
+from solver.path.placements import evaluate_placements
 from solver.path.problem import PathOptions, PathProblem
 from tests.cases import (
     EXAMPLES,
@@ -320,3 +322,31 @@ def test_feed_check_uses_both_limits() -> None:
     assert np.nanmax(at.use) <= 1.0
     faster = check_feed(evaluation, acc.mu_acc * 1.01, robot.qdot_max, qddot_max=robot.qddot_max)
     assert not faster.feasible and faster.margin == pytest.approx(1 / 1.01, rel=1e-12)
+
+
+def test_a_given_joint_path_gets_the_same_mu_acc() -> None:
+    """evaluate_joint_path (the redundant arms' judge) along the tracked path: the same mu_acc."""
+    problem = PathProblem.of(ur5(10.0), WAYPOINTS)
+    tracked = evaluate_path(problem, PLACEMENT)
+    assert tracked.q is not None and tracked.acceleration is not None
+    given = evaluate_joint_path(problem, PLACEMENT, tracked.q)
+    assert given.acceleration is not None
+    assert given.acceleration.mu_acc == pytest.approx(tracked.acceleration.mu_acc, rel=1e-9)
+    assert (given.acceleration.waypoint, given.acceleration.joint) == (
+        tracked.acceleration.waypoint,
+        tracked.acceleration.joint,
+    )
+
+
+@pytest.mark.parametrize("spin_mode", ["fixed", "free"])
+def test_compiled_maps_fall_back_to_the_pipeline(spin_mode: str) -> None:
+    """With acceleration limits the kernels (mu_path only) are not used: the same cells."""
+    problem = PathProblem.of(ur5(10.0), WAYPOINTS, PathOptions(spin_mode=spin_mode))  # type: ignore[arg-type]
+    cells = np.array([[x, 0.45, 0.1, yaw, 0.0] for x in (-0.1, 0.0, 0.1) for yaw in (0.0, 0.3)])
+    compiled = evaluate_placements(problem, cells, compiled=True)
+    reference = evaluate_placements(problem, cells, compiled=False)
+    assert compiled.mu_acc is not None and reference.mu_acc is not None
+    np.testing.assert_array_equal(compiled.mu_acc, reference.mu_acc)
+    np.testing.assert_array_equal(compiled.mu_path, reference.mu_path)
+    without = evaluate_placements(PathProblem.of(ur5(None), WAYPOINTS), cells)
+    assert without.mu_acc is None and without.limited_by is None
