@@ -10,7 +10,8 @@ y = 0.25..0.65 m, step 0.02 m, z = 0.1 m, 133 waypoints, all IK branches), the s
 scalar loop (ur-analytic-ik IK, pinocchio Jacobian and numpy solve per pose and branch) timed
 on a subset in the same run and extrapolated, their ratio, the time per pose and branch, and
 the 8-yaw map against the 1-yaw map; the numeric IK family's map on the same grid (UR5 read as a
-plain URDF, checked equal to the analytic map, and the Panda) against the analytic one. Then the
+plain URDF, checked equal to the analytic map, and the Panda) against the analytic one; the map
+and the optimisers with joint acceleration limits (``bench/acceleration.py``). Then the
 placement optimisation of the same problem
 (yaw free): each method's time and optimum, against the best cell of a fine grid (10 mm,
 5 degrees) computed in the same run.
@@ -29,10 +30,11 @@ from collections.abc import Callable
 from pathlib import Path
 
 import httpx
-import memory  # bench/memory.py and bench/parallel.py, beside this script
+import memory  # bench/memory.py, bench/parallel.py and bench/acceleration.py, beside this script
 import numpy as np
 import parallel
 import ur_analytic_ik
+from acceleration import acceleration_lines
 
 from solver.core.kinematics import jacobian_in_base
 from solver.core.parallel import SERIAL, ThreadRunner
@@ -192,6 +194,7 @@ def main() -> None:
         f"{t_opw_numpy / opw_pose_branches * 1e9:6.0f} ns per pose-branch, "
         f"{t_opw_numpy / t_opw:.2f}x the kernel"
     )
+    acceleration_lines(robot, path, xs, ys, z, repeats=repeats, smoke=args.smoke)
     numeric_maps(path, xs, ys, z, t_map)
     optimisation(robot, path, smoke=args.smoke)
     evaluate_over_http(requests=20 if args.smoke else 200)

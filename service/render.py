@@ -11,6 +11,7 @@ matplotlib.use("Agg")  # no display: render to memory
 
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
+from matplotlib.axes import Axes  # noqa: E402
 from matplotlib.lines import Line2D  # noqa: E402
 from matplotlib.patches import Patch  # noqa: E402
 
@@ -80,9 +81,10 @@ def render_png(cmap: CapabilityMap, *, title: str) -> bytes:
     width_in, height_in = width_px / DPI, height_px / DPI
     figure = plt.figure(figsize=(width_in, height_in), dpi=DPI)
     boxes, bar = _layout(rows, columns, width_in, height_in)
-    feasible = ~np.isnan(cmap.mu_path)
-    low = float(np.nanmin(cmap.mu_path)) if feasible.any() else 0.0
-    high = float(np.nanmax(cmap.mu_path)) if feasible.any() else 1.0
+    colour_of = cmap.feed_index  # mu_acc with acceleration limits, else mu_path
+    feasible = ~np.isnan(colour_of)
+    low = float(np.nanmin(colour_of)) if feasible.any() else 0.0
+    high = float(np.nanmax(colour_of)) if feasible.any() else 1.0
     colours = matplotlib.colormaps["viridis"].with_extremes(bad="white")
     best, worst = cmap.extreme(best=True), cmap.extreme(best=False)
     half_x = (cmap.xs[1] - cmap.xs[0]) / 2 if len(cmap.xs) > 1 else 0.005
@@ -92,7 +94,7 @@ def render_png(cmap: CapabilityMap, *, title: str) -> bytes:
     for panel, (s, k) in enumerate(np.ndindex(len(cmap.spins), len(cmap.yaws))):
         axes = figure.add_axes(boxes[panel])
         image = axes.imshow(
-            np.ma.masked_invalid(cmap.mu_path[s, k]),
+            np.ma.masked_invalid(colour_of[s, k]),
             origin="lower",
             extent=extent,
             cmap=colours,
@@ -112,7 +114,8 @@ def render_png(cmap: CapabilityMap, *, title: str) -> bytes:
         )
         axes.set_xlabel("x (m)")
         axes.set_ylabel("y (m)")
-    figure.colorbar(images[0], cax=figure.add_axes(bar), label="mu_path (m/s)")
+    label = "mu_path (m/s)" if cmap.mu_acc is None else "mu_acc (m/s)"
+    figure.colorbar(images[0], cax=figure.add_axes(bar), label=label)
     figure.legend(
         handles=[
             Line2D([], [], marker="*", color="red", ls="", ms=10, label="best"),
@@ -132,16 +135,38 @@ def render_png(cmap: CapabilityMap, *, title: str) -> bytes:
     return buffer.getvalue()
 
 
+def _acceleration_panel(axes: Axes, use: np.ndarray, evaluation: PathEvaluation) -> None:
+    """Each joint's |qdd| / qddot_max along the path (NaN gaps at the pass ends)."""
+    waypoints = np.arange(len(use))
+    for j in range(use.shape[1]):
+        axes.plot(waypoints, use[:, j], lw=1.2)
+    axes.axhline(1.0, color="red", ls="--", lw=1.0)
+    acc = evaluation.acceleration
+    if acc is not None and acc.limited_by == "acceleration":
+        axes.plot(acc.waypoint, use[acc.waypoint, acc.joint], "s", color="black", ms=7)
+    axes.set_xlabel("waypoint")
+    axes.set_ylabel("|qdd| / qddot_max")
+    axes.set_ylim(bottom=0.0)
+
+
 def render_joint_use(
     check: FeedCheck, evaluation: PathEvaluation, joint_names: tuple[str, ...], *, title: str
 ) -> bytes:
     """Each joint's use of its speed limit along the path at the feed, as a PNG (cam.md 7).
 
     One line per joint, the limit at 1, the bottleneck waypoint and joint marked: the picture
-    the ERK 2021 paper checked in URSim (figs. 3-4).
+    the ERK 2021 paper checked in URSim (figs. 3-4). With acceleration limits a second panel
+    below shows each joint's use of its acceleration limit at that constant feed
+    (motion.md section 2), the waypoint where mu_acc binds marked.
     """
     use = np.abs(check.use) if check.use is not None else np.zeros((0, len(joint_names)))
-    figure, axes = plt.subplots(figsize=(8.0, 4.0), dpi=DPI, layout="constrained")
+    if check.acceleration_use is not None:
+        figure, (axes, below) = plt.subplots(
+            2, 1, figsize=(8.0, 7.0), dpi=DPI, layout="constrained", sharex=True
+        )
+        _acceleration_panel(below, check.acceleration_use, evaluation)
+    else:
+        figure, axes = plt.subplots(figsize=(8.0, 4.0), dpi=DPI, layout="constrained")
     waypoints = np.arange(len(use))
     for j, name in enumerate(joint_names):
         axes.plot(waypoints, use[:, j], label=name, lw=1.2)

@@ -69,3 +69,22 @@ FRAME_ROUND_TRIP_ATOL = 1e-9
 # relative tolerance of "agree" (numeric never above the analytic value by more).
 NUMERIC_VS_ANALYTIC_AGREEMENT = 0.98
 NUMERIC_VS_ANALYTIC_RTOL = 1e-6
+
+# Joint accelerations at a constant feed (issue 24, motion.md section 2). The README example
+# (UR5, examples/evaluate_request.json at x 0, y 0.45, z 0.1, yaw 0, blend 2 mm): mu_acc at
+# every joint limited to a (rad/s^2), as motion.md gives it (6 digits), wrist_3 at waypoint 57.
+README_MU_ACC = {10.0: 0.238835, 3.0: 0.130816}
+README_MU_ACC_ATOL = 5e-7
+README_MU_ACC_WAYPOINT, README_MU_ACC_JOINT = 57, 5
+# D_i written in the test from the answer's joint path and arc lengths (motion.md section 5).
+SECOND_DIFFERENCE_RTOL = 1e-9
+# A smooth analytic path at 2,000 points: mu_acc against toppra's largest constant feed (its
+# cubic spline of q(s)), and the time-optimal cycle time against toppra's on that spline.
+TOPPRA_FEED_RTOL = 0.01
+TOPPRA_TIME_RTOL = 0.02
+# The README example at 10 rad/s^2: L / mu_acc (motion.md section 4 gives 1.338 s).
+README_CONSTANT_FEED_TIME_10 = 1.338
+README_CONSTANT_FEED_TIME_ATOL = 5e-4
+# The pass at mu_acc with its ramps against toppra with the feed capped at mu_acc (a virtual
+# joint q = s limited to mu_acc m/s), on toppra's spline: relative.
+TOPPRA_RAMP_RTOL = 0.01

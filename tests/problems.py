@@ -21,7 +21,7 @@ from solver.path import capability_map as capability
 from solver.path import evaluate, placements
 from solver.path.problem import PathOptions, PathProblem
 
-OPTIONS = ("branch", "max_joint_step", "spin_mode")
+OPTIONS = ("branch", "max_joint_step", "spin_mode", "blend_length")
 
 
 def problem(

@@ -85,3 +85,10 @@ def test_cam_command_line_output(capsys: pytest.CaptureFixture[str]) -> None:
     for command in commands:
         assert main(command[1:]) == OK
     assert capsys.readouterr().out.rstrip("\n") == printed
+
+
+def test_acceleration_example_output() -> None:
+    printed, lines = _example_lines(
+        "## Joint accelerations: the feed the arm can really run", "accelerations"
+    )
+    assert printed == lines

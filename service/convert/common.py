@@ -100,11 +100,14 @@ def problem_of(
         robot: the request's robot.
         poses: shape (N, 4, 4), the path's poses in {O} (or those spun by a request's spins).
         path: the path as read (its passes).
-        ik: the request's IK policy (branch, max_joint_step).
+        ik: the request's IK policy (branch, max_joint_step, blend_length).
         spin_mode: the spin mode (:func:`spin_mode_of`).
     """
     options = PathOptions(
-        branch=branch_of(ik.branch), max_joint_step=ik.max_joint_step, spin_mode=spin_mode
+        branch=branch_of(ik.branch),
+        max_joint_step=ik.max_joint_step,
+        spin_mode=spin_mode,
+        blend_length=ik.blend_length,
     )
     return PathProblem.of(robot, poses, options, passes=path.passes)
 

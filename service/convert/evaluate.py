@@ -11,7 +11,8 @@ from pydantic import TypeAdapter
 from service import schemas
 from service.convert.common import branch_to_api
 from solver.core.robots import Robot
-from solver.path.evaluate import PathEvaluation
+from solver.path.cycle_time import CycleTime
+from solver.path.evaluate import AccelerationIndex, PathEvaluation
 from solver.path.feed import FeedCheck
 from solver.path.problem import require_family
 
@@ -28,6 +29,56 @@ def _rows_or_none(values: np.ndarray | None, n: int) -> list[Any]:
     if values is None:
         return [None] * n
     return [[None if math.isnan(v) else v for v in row] for row in values.tolist()]
+
+
+def _whole_rows(values: np.ndarray | None, n: int) -> list[Any]:
+    """The rows of values as lists, None for a row of NaN (None each without values)."""
+    if values is None:
+        return [None] * n
+    return [None if math.isnan(row[0]) else row for row in values.tolist()]
+
+
+def acceleration_to_api(
+    acceleration: AccelerationIndex | None, robot: Robot
+) -> schemas.AccelerationResult | None:
+    """The answer's ``acceleration`` object (None without acceleration limits)."""
+    if acceleration is None:
+        return None
+    return schemas.AccelerationResult(
+        mu_acc=acceleration.mu_acc,
+        limited_by="acceleration" if acceleration.limited_by == "acceleration" else "speed",
+        waypoint=acceleration.waypoint,
+        joint=acceleration.joint,
+        joint_name=robot.joint_names[acceleration.joint],
+        blend_length=acceleration.blend_length,
+    )
+
+
+def cycle_time_to_api(times: CycleTime | None) -> schemas.CycleTimeResult | None:
+    """The answer's ``cycle_time`` object (None without it)."""
+    if times is None:
+        return None
+    passes = [
+        schemas.PassCycleTime(
+            start=p.start,
+            stop=p.stop,
+            length=p.length,
+            constant_feed_time=p.constant_feed_time,
+            ramp_up_length=p.ramp_up_length,
+            ramp_up_time=p.ramp_up_time,
+            ramp_down_length=p.ramp_down_length,
+            ramp_down_time=p.ramp_down_time,
+            ramp=p.ramp_time,
+            time_optimal=p.time_optimal,
+        )
+        for p in times.passes
+    ]
+    return schemas.CycleTimeResult(
+        constant_feed_time=times.constant_feed_time,
+        ramp=times.ramp_time,
+        time_optimal=times.time_optimal,
+        passes=passes,
+    )
 
 
 def _waypoints(
@@ -53,6 +104,7 @@ def _waypoints(
         "limiting_joint_name": [None if j is None else robot.joint_names[j] for j in limiting],
         "qdot_at_feed": _rows_or_none(None if feed is None else feed.qdot_at_feed, n),
         "use": _rows_or_none(None if feed is None else feed.use, n),
+        "qdd_at_mu_acc": _whole_rows(None if ev.acceleration is None else ev.acceleration.qdd, n),
     }
     rows = [dict(zip(columns, row, strict=True)) for row in zip(*columns.values(), strict=True)]
     return _WAYPOINTS.validate_python(rows)
@@ -65,6 +117,7 @@ def evaluate_response(
     axis_correction: float = 0.0,
     with_waypoints: bool = True,
     feed: FeedCheck | None = None,
+    cycle_time: CycleTime | None = None,
 ) -> schemas.EvaluateResponse:
     """The response of ``POST /v1/evaluate`` (per-waypoint detail when ``with_waypoints``)."""
     ev = evaluation
@@ -94,6 +147,8 @@ def evaluate_response(
         spin_mode=ev.spin_mode,
         spins=None if ev.spins is None else ev.spins.tolist(),
         axis_correction=axis_correction,
+        acceleration=acceleration_to_api(ev.acceleration, robot),
+        cycle_time=cycle_time_to_api(cycle_time),
         feed_check=None
         if feed is None
         else schemas.FeedCheckResult(feed=feed.feed, feasible=feed.feasible, margin=feed.margin),

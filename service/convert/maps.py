@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Any, Literal
 
 import numpy as np
 
@@ -97,7 +98,23 @@ def _extreme(cmap: CapabilityMap, *, best: bool) -> schemas.MapExtreme | None:
     return schemas.MapExtreme(
         placement=api_placement(cmap.placement(index)),
         mu_path=float(cmap.mu_path[index]),
+        mu_acc=None if cmap.mu_acc is None else float(cmap.mu_acc[index]),
     )
+
+
+_LIMITED_BY: tuple[Literal["speed", "acceleration"], ...] = ("speed", "acceleration")
+
+
+def _acceleration_columns(
+    cmap: CapabilityMap, index: tuple[int, ...], feasible: bool
+) -> dict[str, Any]:
+    """A cell's mu_acc and what binds it (empty without acceleration limits or when infeasible)."""
+    if cmap.mu_acc is None or cmap.limited_by is None or not feasible:
+        return {}
+    return {
+        "mu_acc": float(cmap.mu_acc[index]),
+        "limited_by": _LIMITED_BY[min(int(cmap.limited_by[index]), 1)],
+    }
 
 
 def map_response(cmap: CapabilityMap, robot: Robot, *, spin_mode: SpinMode) -> schemas.MapResponse:
@@ -120,6 +137,7 @@ def map_response(cmap: CapabilityMap, robot: Robot, *, spin_mode: SpinMode) -> s
                 bottleneck_waypoint=int(cmap.bottleneck_waypoint[s, k, j, i]) if feasible else None,
                 bottleneck_joint=int(cmap.bottleneck_joint[s, k, j, i]) if feasible else None,
                 branch=branches[int(cmap.branch[s, k, j, i])] if feasible else None,
+                **_acceleration_columns(cmap, (s, k, j, i), bool(feasible)),
             )
         )
     return schemas.MapResponse(

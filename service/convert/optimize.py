@@ -30,6 +30,7 @@ def optimize_response(
         found=optimum.found,
         placement=None if optimum.placement is None else api_placement(optimum.placement),
         mu_path=optimum.mu_path,
+        mu_acc=optimum.mu_acc,
         evaluation=None
         if optimum.evaluation is None
         else evaluate_response(optimum.evaluation, robot, axis_correction=axis_correction),

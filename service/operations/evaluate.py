@@ -9,15 +9,20 @@ from service.schemas import EvaluateRequest, EvaluateResponse, PathInput
 from solver.core.exceptions import InvalidInputError
 from solver.core.progress import Progress
 from solver.core.robots import Robot as SolverRobot
+from solver.path.cycle_time import cycle_time
 from solver.path.evaluate import PathEvaluation, evaluate_path
 from solver.path.feed import check_feed
 from solver.path.joint_path import evaluate_joint_path
+from solver.path.problem import PathProblem
 
 
 def _evaluated(
     body: EvaluateRequest, settings: Settings
-) -> tuple[SolverRobot, PathInput, PathEvaluation, float | None]:
-    """The robot, the path, its evaluation and the feed to check; the path's size checked first."""
+) -> tuple[SolverRobot, PathInput, PathEvaluation, float | None, PathProblem]:
+    """The robot, the path, its evaluation, the feed to check and the problem.
+
+    The path's size is checked first.
+    """
     convert.check_path_size(
         body.path, limit=settings.max_path_waypoints, setting="DTF_MAX_PATH_WAYPOINTS"
     )
@@ -34,23 +39,28 @@ def _evaluated(
     else:
         evaluation = evaluate_path(problem, placement)
     feed = body.feed if body.feed is not None else path.feed
-    return robot, path, evaluation, feed
+    return robot, path, evaluation, feed, problem
 
 
 def joint_use_png(body: EvaluateRequest, settings: Settings) -> bytes:
-    """The PNG of each joint's use of its speed limit at the feed (default: mu_path).
+    """The PNG of each joint's use of its speed (and acceleration) limit at the feed.
+
+    The feed defaults to mu_path, or mu_acc with acceleration limits.
 
     Raises:
         InvalidInputError: on ``placement``, the path does not run there.
     """
-    robot, _, evaluation, feed = _evaluated(body, settings)
-    if evaluation.mu_path is None or evaluation.mu_path <= 0.0:
+    robot, _, evaluation, feed, _ = _evaluated(body, settings)
+    index = evaluation.feed_index  # mu_acc with acceleration limits
+    if index is None or index <= 0.0:
         raise InvalidInputError(
             "placement",
             f"the path does not run here ({evaluation.reason or 'mu_path is 0'}): no joint "
             "speeds to draw; ask for JSON to see why",
         )
-    check = check_feed(evaluation, evaluation.mu_path if feed is None else feed, robot.qdot_max)
+    check = check_feed(
+        evaluation, index if feed is None else feed, robot.qdot_max, qddot_max=robot.qddot_max
+    )
     return render_joint_use(check, evaluation, robot.joint_names, title=robot.name)
 
 
@@ -58,7 +68,7 @@ def evaluation_of(
     body: EvaluateRequest, settings: Settings, progress: Progress
 ) -> EvaluateResponse:
     """The JSON answer of ``POST /v1/evaluate`` (an evaluate job's result too)."""
-    robot, path, evaluation, feed = _evaluated(body, settings)
+    robot, path, evaluation, feed, problem = _evaluated(body, settings)
     detail = body.detail or (
         "waypoints" if body.path.n_waypoints() <= settings.max_detail_waypoints else "summary"
     )
@@ -68,4 +78,5 @@ def evaluation_of(
         axis_correction=path.axis_correction,
         with_waypoints=detail == "waypoints",
         feed=None if feed is None else check_feed(evaluation, feed, robot.qdot_max),
+        cycle_time=cycle_time(problem, evaluation),
     )

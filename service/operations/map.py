@@ -72,4 +72,5 @@ def map_of(
 
 def map_png(result: CapabilityMap, robot: Robot) -> bytes:
     """The colour map of a computed map, as PNG bytes."""
-    return render_png(result, title=f"{robot.name}: mu_path")
+    index = "mu_path" if result.mu_acc is None else "mu_acc"
+    return render_png(result, title=f"{robot.name}: {index}")

@@ -37,6 +37,7 @@ from service.schemas.jobs import (
     OptimizeJob,
 )
 from service.schemas.map import Grid, GridAxis, MapCell, MapExtreme, MapRequest, MapResponse
+from service.schemas.motion import AccelerationResult, CycleTimeResult, PassCycleTime
 from service.schemas.optimize import (
     Bounds,
     OptimizeRequest,
@@ -57,6 +58,9 @@ from service.schemas.robot import CatalogueRobot, OpwGeometry, OpwRobot, Robot, 
 from service.schemas.robots import BranchLevel, HealthResponse, RobotInfo, RobotsResponse
 
 __all__ = [
+    "AccelerationResult",
+    "CycleTimeResult",
+    "PassCycleTime",
     "OptimizeJob",
     "MapJob",
     "JobProgress",

@@ -24,7 +24,7 @@ from pydantic_core import PydanticCustomError
 from solver.cam.frames import frames_of_placement
 from solver.core.spatial import MAX_COORDINATE, QUATERNION_NORM_TOLERANCE, pose_matrix
 from solver.core.spatial import Placement as SolverPlacement
-from solver.path.problem import DEFAULT_MAX_JOINT_STEP
+from solver.path.problem import DEFAULT_BLEND_LENGTH, DEFAULT_MAX_JOINT_STEP
 
 UNIT_BOUND = 1.001  # a direction typed with 4 decimals may be off its unit norm by up to 1e-3
 
@@ -202,6 +202,15 @@ class AutoIkPolicy(RequestModel):
         gt=0.0,
         description="Largest move of any joint between neighbouring waypoints (rad), > 0.",
     )
+    blend_length: float = Field(
+        default=DEFAULT_BLEND_LENGTH,
+        gt=0.0,
+        le=1000.0,
+        description="The length (m) over which the controller rounds a corner of the path (a "
+        "zone of radius blend_length / 2: ABB z1, KUKA $APO.CDIS = 1, UR blend radius 1 mm), "
+        "> 0; the joint accelerations at a constant feed are taken over it (motion.md section "
+        "2). Used only with robot.joint_acceleration_limits.",
+    )
 
 
 class IkPolicy(RequestModel):
@@ -226,6 +235,15 @@ class IkPolicy(RequestModel):
         default=DEFAULT_MAX_JOINT_STEP,
         gt=0.0,
         description="Largest move of any joint between neighbouring waypoints (rad), > 0.",
+    )
+    blend_length: float = Field(
+        default=DEFAULT_BLEND_LENGTH,
+        gt=0.0,
+        le=1000.0,
+        description="The length (m) over which the controller rounds a corner of the path (a "
+        "zone of radius blend_length / 2: ABB z1, KUKA $APO.CDIS = 1, UR blend radius 1 mm), "
+        "> 0; the joint accelerations at a constant feed are taken over it (motion.md section "
+        "2). Used only with robot.joint_acceleration_limits.",
     )
 
 

@@ -19,6 +19,7 @@ from service.schemas.common import (
     ResponseModel,
     SpinMode,
 )
+from service.schemas.motion import AccelerationResult, CycleTimeResult
 from service.schemas.path import MAX_PATH_WAYPOINTS, Path
 from service.schemas.robot import MAX_JOINTS, Robot
 
@@ -166,10 +167,12 @@ class FeedCheckResult(ResponseModel):
     feed: float = Field(description="The feed F checked (m/s).")
     feasible: bool = Field(
         description="Whether the whole path runs at F with every joint within its speed limit "
-        "(mu_path >= F)."
+        "(mu_path >= F), and within its acceleration limit when the robot has them "
+        "(mu_acc >= F)."
     )
     margin: float | None = Field(
-        description="mu_path / F (> 1: room to spare); null when the path is infeasible."
+        description="mu_path / F, or mu_acc / F with acceleration limits (> 1: room to "
+        "spare); null when the path is infeasible."
     )
 
 
@@ -217,6 +220,12 @@ class WaypointResult(ResponseModel):
         default=None,
         description="With a feed: each joint's |qdot| / its limit at that feed (1: on the "
         "limit), n values; null without a feed or when infeasible.",
+    )
+    qdd_at_mu_acc: list[float] | None = Field(
+        default=None,
+        description="With joint acceleration limits: the joint accelerations at the constant "
+        "feed mu_acc, D_i mu_acc^2 (rad/s^2), n values; null without them, when infeasible, or "
+        "at a waypoint within the blend length of a pass end (not constrained).",
     )
 
 
@@ -299,6 +308,18 @@ class EvaluateResponse(ResponseModel):
         default=0.0,
         description="The largest correction made to a tool axis's length when normalising it "
         "(dimensionless; 0 when none was needed or the path is given by poses).",
+    )
+    acceleration: AccelerationResult | None = Field(
+        default=None,
+        description="With robot.joint_acceleration_limits: mu_acc, the constant feed the joint "
+        "speed and acceleration limits allow, and what binds it (motion.md section 2); null "
+        "without them or when infeasible. mu_path keeps its meaning (speed limits only).",
+    )
+    cycle_time: CycleTimeResult | None = Field(
+        default=None,
+        description="With robot.joint_acceleration_limits: the cycle time at mu_acc, with the "
+        "ramps at the pass ends, and the time-optimal one (s, motion.md section 4); null "
+        "without them, when infeasible, or when mu_acc is 0.",
     )
     feed_check: FeedCheckResult | None = Field(
         default=None,

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from typing import Annotated
+from typing import Annotated, Literal
 
 from pydantic import ConfigDict, Field
 from pydantic.config import JsonDict
@@ -176,6 +176,17 @@ class MapCell(ResponseModel):
     branch: Branch | NumericBranch | None = Field(
         default=None, description="The IK branch the path runs on; null when infeasible."
     )
+    mu_acc: float | None = Field(
+        default=None,
+        description="With robot.joint_acceleration_limits: the constant feed the joint speed "
+        "and acceleration limits allow (m/s, as /v1/evaluate's acceleration.mu_acc); the "
+        "map's colour and what best and worst rank. null without them or when infeasible.",
+    )
+    limited_by: Literal["speed", "acceleration"] | None = Field(
+        default=None,
+        description="With joint acceleration limits: what binds mu_acc there; null without them "
+        "or when infeasible.",
+    )
 
 
 class MapExtreme(ResponseModel):
@@ -189,6 +200,11 @@ class MapExtreme(ResponseModel):
 
     placement: PlacementResult = Field(description="Where the workpiece sits (m, rad).")
     mu_path: float = Field(description="Its mu_path (m/s).")
+    mu_acc: float | None = Field(
+        default=None,
+        description="With joint acceleration limits its mu_acc (m/s), which ranks the cells; "
+        "null without them.",
+    )
 
 
 class MapResponse(ResponseModel):

@@ -201,10 +201,16 @@ class OptimizeResponse(ResponseModel):
         description="The optimum, inside the bounds (m, rad)."
     )
     mu_path: float | None = Field(description="mu_path there (m/s), as /v1/evaluate gives it.")
+    mu_acc: float | None = Field(
+        default=None,
+        description="With robot.joint_acceleration_limits: mu_acc there (m/s), as /v1/evaluate "
+        "gives it: what the search maximised (motion.md section 3). null without them.",
+    )
     evaluation: EvaluateResponse | None = Field(description="/v1/evaluate's answer there.")
     start: StartInfo = Field(description="The start placement and its mu_path.")
     improvement_percent: float | None = Field(
-        description="100 (mu_path / start mu_path - 1); null when the start is infeasible."
+        description="100 (mu_path / start mu_path - 1), with joint acceleration limits of "
+        "mu_acc; null when the start is infeasible."
     )
     solver: SolverInfo = Field(description="The method, its status, iterations and time.")
     spins: list[float] | None = Field(

@@ -16,13 +16,19 @@ from pydantic.config import JsonValue
 from pydantic_core import PydanticCustomError
 
 from service.schemas.common import Angle, Pose, RequestModel, pose_matrix_of, shown
-from solver.core.robots import MAX_SPEED_LIMIT, MIN_SPEED_LIMIT
+from solver.core.robots import (
+    MAX_ACCELERATION_LIMIT,
+    MAX_SPEED_LIMIT,
+    MIN_ACCELERATION_LIMIT,
+    MIN_SPEED_LIMIT,
+)
 from solver.core.robots import Robot as SolverRobot
 from solver.families import catalogue, robot_from_urdf
 from solver.families.opw.catalogue import robot_from_opw
 from solver.families.opw.parameters import MAX_LENGTH, OpwParameters
 
 SpeedLimit = Annotated[float, Field(ge=MIN_SPEED_LIMIT, le=MAX_SPEED_LIMIT)]
+AccelerationLimit = Annotated[float, Field(ge=MIN_ACCELERATION_LIMIT, le=MAX_ACCELERATION_LIMIT)]
 Length = Annotated[float, Field(ge=-MAX_LENGTH, le=MAX_LENGTH)]
 PositiveLength = Annotated[float, Field(gt=0.0, le=MAX_LENGTH)]
 JointRange = Annotated[list[Angle], Field(min_length=2, max_length=2)]
@@ -60,16 +66,28 @@ def _speed_limits(dofs: list[int] | None, *, required: bool, extra: str = "") ->
 
 
 class _RobotOptions(RequestModel):
-    """What every robot variant may add: its tool point."""
+    """What every robot variant may add: its tool point and joint acceleration limits."""
 
     tcp: Pose | None = Field(
         default=None,
         description="Tool point relative to the tool frame (m, unit quaternion). Default: "
         "identity, the tool point is the tool frame.",
     )
+    joint_acceleration_limits: list[AccelerationLimit] | None = Field(
+        default=None,
+        min_length=1,
+        max_length=MAX_JOINTS,
+        description="Joint acceleration limits (rad/s^2; m/s^2 for prismatic joints), one per "
+        "joint, each within [1e-6, 1e8]. With them the answers add mu_acc, the constant feed "
+        "the joint accelerations allow over the blend length (ik.blend_length; motion.md), and "
+        "the cycle time. Default: none (the catalogue gives none: no public source we know of "
+        "gives its arms' acceleration limits).",
+    )
 
     def _with_tcp(self, robot: SolverRobot) -> SolverRobot:
-        """The robot with this request's tool point."""
+        """The robot with this request's tool point and acceleration limits."""
+        if self.joint_acceleration_limits is not None:
+            robot = robot.with_options(qddot_max=self.joint_acceleration_limits)
         if self.tcp is None:
             return robot
         return robot.with_options(transform_tool_to_tcp=pose_matrix_of(self.tcp, field="robot.tcp"))

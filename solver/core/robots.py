@@ -25,6 +25,9 @@ from solver.core.family import KinematicsFamily
 # and the LP solver treats bounds past 1e20 as infinite.
 MIN_SPEED_LIMIT = 1e-6
 MAX_SPEED_LIMIT = 1e4
+# Joint acceleration limits outside this range (rad/s^2) are input errors likewise (motion.md).
+MIN_ACCELERATION_LIMIT = 1e-6
+MAX_ACCELERATION_LIMIT = 1e8
 
 
 @dataclass(frozen=True, eq=False)
@@ -45,6 +48,8 @@ class Robot:
         family: the kinematics family that solves its IK and J^-1 t (robots.md section 1):
             an analytic one, or the numeric one for any other serial chain of six joints or
             more; ``None`` for a shorter chain (``/v1/dtf`` only).
+        qddot_max: shape (n,), rad/s^2, joint acceleration limits (all > 0), or ``None``: no
+            acceleration limits, the path index is mu_path alone (motion.md section 1).
     """
 
     name: str
@@ -58,6 +63,7 @@ class Robot:
     transform_tool_to_tcp: np.ndarray
     transform_world_to_base: np.ndarray
     family: KinematicsFamily | None = None
+    qddot_max: np.ndarray | None = None
 
     @property
     def dof(self) -> int:
@@ -74,12 +80,15 @@ class Robot:
         *,
         qdot_max: np.ndarray | list[float] | None = None,
         transform_tool_to_tcp: np.ndarray | None = None,
+        qddot_max: np.ndarray | list[float] | None = None,
     ) -> Robot:
-        """Return a copy with other joint speed limits and/or another tool point.
+        """Return a copy with other joint speed or acceleration limits and/or another tool point.
 
         Args:
             qdot_max: shape (n,), rad/s, each finite and > 0; ``None`` keeps the model's.
             transform_tool_to_tcp: shape (4, 4), T_F_TCP; ``None`` keeps the current one.
+            qddot_max: shape (n,), rad/s^2, each finite and > 0; ``None`` keeps the current
+                ones (none for a model that has none).
 
         Raises:
             InvalidInputError: a limit has the wrong shape, is not finite or is <= 0.
@@ -88,6 +97,9 @@ class Robot:
         if qdot_max is not None:
             limits = check_speed_limits(qdot_max, self.joint_names)
             robot = dataclasses.replace(robot, qdot_max=limits)
+        if qddot_max is not None:
+            accelerations = check_acceleration_limits(qddot_max, self.joint_names)
+            robot = dataclasses.replace(robot, qddot_max=accelerations)
         if transform_tool_to_tcp is not None:
             tcp = np.asarray(transform_tool_to_tcp, dtype=float)
             model = pin.Model(robot.model)
@@ -123,6 +135,38 @@ def check_speed_limits(
             field,
             f"joint {j} ({joint_names[j]}) limit {float(limits[j]):.6g} rad/s must be > 0, within "
             f"[{MIN_SPEED_LIMIT}, {MAX_SPEED_LIMIT}] rad/s",
+        )
+    return limits
+
+
+def check_acceleration_limits(
+    qddot_max: np.ndarray | list[float], joint_names: tuple[str, ...]
+) -> np.ndarray:
+    """Joint acceleration limits as a float array, after checking them (motion.md section 1).
+
+    Args:
+        qddot_max: shape (n,), rad/s^2, each in [MIN_ACCELERATION_LIMIT, MAX_ACCELERATION_LIMIT].
+        joint_names: the n joint names, for the message.
+
+    Raises:
+        InvalidInputError: on ``robot.joint_acceleration_limits``, naming the joint: wrong
+            length, not finite, or out of range.
+    """
+    limits = np.array(qddot_max, dtype=float)
+    field = "robot.joint_acceleration_limits"
+    if limits.shape != (len(joint_names),):
+        raise InvalidInputError(
+            field, f"{limits.shape=} but the robot has {len(joint_names)} joints"
+        )
+    bad = np.flatnonzero(
+        ~np.isfinite(limits) | (limits < MIN_ACCELERATION_LIMIT) | (limits > MAX_ACCELERATION_LIMIT)
+    )
+    if bad.size:
+        j = int(bad[0])
+        raise InvalidInputError(
+            field,
+            f"joint {j} ({joint_names[j]}) limit {float(limits[j]):.6g} rad/s^2 must be > 0, "
+            f"within [{MIN_ACCELERATION_LIMIT}, {MAX_ACCELERATION_LIMIT}] rad/s^2",
         )
     return limits
 

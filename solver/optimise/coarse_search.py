@@ -31,6 +31,8 @@ MAX_COARSE_CELLS = 50_000  # default limit on the coarse map (a box larger is an
 class Cell:
     """A decision vector (:mod:`solver.optimise.search_space`), its mu_path and IK branch index.
 
+    ``mu_path`` is the index searched: mu_acc where the robot has acceleration limits.
+
     ``coarse`` is the coarse map's cell a refined cell climbed from (:func:`refine_cells`),
     with its mu_path and branch; None for a cell of the coarse map itself.
     """
@@ -214,7 +216,7 @@ def coarse_cells(
     inside_index = [i for i, v in enumerate(vectors) if v is not None]
     if inside_index:
         result = evaluate_placements(problem, np.array(rows), progress=progress, runner=runner)
-        mu[inside_index], branch[inside_index] = result.mu_path, result.branch
+        mu[inside_index], branch[inside_index] = result.feed_index, result.branch
     cells = []
     for index in _local_maxima(mu.reshape(full_shape), (False, spin_wraps, *periodic)):
         k = int(np.ravel_multi_index(index, full_shape))

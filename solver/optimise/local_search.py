@@ -103,7 +103,7 @@ def refine_cells(
         result = evaluate_placements(
             problem, placement_rows(trial.reshape(-1, N_VARIABLES)), runner=runner
         )
-        values = np.nan_to_num(result.mu_path, nan=-np.inf).reshape(len(moves), len(cells))
+        values = np.nan_to_num(result.feed_index, nan=-np.inf).reshape(len(moves), len(cells))
         best = values.argmax(axis=0)
         best_value = values[best, np.arange(len(cells))]
         better = best_value > mu
@@ -149,7 +149,7 @@ def climb(problem: PathProblem, bounds: PlacementBounds, start: Cell) -> Cell | 
         vector = start.vector.copy()
         vector[free] = np.clip(values, bounds.lower[free], bounds.upper[free])
         result = evaluate(placement_rows(vector[None]))
-        mu = float(result.mu_path[0])
+        mu = float(result.feed_index[0])
         if np.isnan(mu):
             return 1.0
         if mu > best[0].mu_path:

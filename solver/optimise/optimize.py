@@ -1,5 +1,8 @@
 """The best placement of a path: maximise mu_path over the decision vector in a box (spec s. 6).
 
+With joint acceleration limits the index maximised is mu_acc (motion.md section 3): every
+method's candidates are judged by the evaluator's ``feed_index``.
+
 The methods are a registry (:mod:`solver.optimise.methods`): ``casadi`` (IPOPT from the coarse
 map's maxima, :mod:`solver.optimise.methods.casadi_method`) and ``scipy`` (differential
 evolution and SLSQP, :mod:`solver.optimise.methods.scipy_method`). Whatever a method returns is
@@ -55,13 +58,16 @@ class PlacementOptimum:
         mu_path: m/s, the evaluator's mu_path there.
         evaluation: the evaluator's whole answer there.
         start: the start placement; start_mu_path its mu_path (None when infeasible).
-        improvement_percent: 100 (mu_path / start_mu_path - 1); None without a feasible start.
+        improvement_percent: 100 (index / start index - 1), the index mu_acc with
+            acceleration limits, else mu_path; None without a feasible start.
         solver: what the optimiser did.
         symmetric: whether the search used the (r, psi) symmetry.
         spins: shape (N,), rad, each waypoint's spin on top of the placement's, when the
             answer came from the spin-path NLP (cam.md section 4); else None.
         joint_path: shape (N, n), rad, for a redundant arm (dof > 6) the joint path mu_path is
             at (the NLP's own, or the tracked one where that is faster); None for dof <= 6.
+        mu_acc: m/s, with acceleration limits the evaluator's mu_acc there (what the search
+            maximised, motion.md section 3); None without them.
     """
 
     found: bool
@@ -75,6 +81,7 @@ class PlacementOptimum:
     symmetric: bool
     spins: np.ndarray | None = None
     joint_path: np.ndarray | None = None
+    mu_acc: float | None = None
 
 
 def _place_on_arc(
@@ -219,19 +226,20 @@ def optimize_placement(
             solver=dataclasses.replace(report, status="no feasible placement inside the bounds"),
             symmetric=settings.symmetric,
         )
-    mu_path, placement, evaluation, chosen = best
+    index, placement, evaluation, chosen = best
     status = chosen.status
     if chosen.joint_path is not None and evaluation.branch is not None:
         status += " (at the placement its tracked joint path is faster than its own)"
-    start_mu = start_evaluation.mu_path
+    start_mu = start_evaluation.feed_index
     return PlacementOptimum(
         found=True,
         placement=placement,
-        mu_path=mu_path,
+        mu_path=evaluation.mu_path,
+        mu_acc=None if evaluation.acceleration is None else index,
         evaluation=evaluation,
         start=start,
-        start_mu_path=start_mu,
-        improvement_percent=None if not start_mu else 100.0 * (mu_path / start_mu - 1.0),
+        start_mu_path=start_evaluation.mu_path,
+        improvement_percent=None if not start_mu else 100.0 * (index / start_mu - 1.0),
         solver=dataclasses.replace(report, status=status),
         symmetric=settings.symmetric,
         spins=chosen.spins,
@@ -286,6 +294,7 @@ def _best_candidate(
                 pass
         judged.append(evaluate_path(judged_problem, placement))
         for evaluation in judged:
-            if evaluation.mu_path is not None and (best is None or evaluation.mu_path > best[0]):
-                best = (evaluation.mu_path, placement, evaluation, candidate)
+            index = evaluation.feed_index  # mu_acc with acceleration limits, else mu_path
+            if index is not None and (best is None or index > best[0]):
+                best = (index, placement, evaluation, candidate)
     return best

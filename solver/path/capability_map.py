@@ -37,6 +37,10 @@ class CapabilityMap:
         branch: index into the robot family's ``branches`` of the branch used.
         bottleneck_waypoint: where V_max is smallest, -1 where infeasible.
         bottleneck_joint: the joint on its limit there, -1 where infeasible.
+        mu_acc: m/s, the acceleration-limited index (motion.md section 2), NaN where
+            infeasible; None without acceleration limits. The map's colour when given.
+        limited_by: what binds mu_acc: 0 speed, 1 acceleration, -1 where infeasible (None
+            likewise); acc_waypoint, acc_joint: where, and which joint (-1 where infeasible).
     """
 
     xs: np.ndarray
@@ -50,6 +54,15 @@ class CapabilityMap:
     branch: np.ndarray
     bottleneck_waypoint: np.ndarray
     bottleneck_joint: np.ndarray
+    mu_acc: np.ndarray | None = None
+    limited_by: np.ndarray | None = None
+    acc_waypoint: np.ndarray | None = None
+    acc_joint: np.ndarray | None = None
+
+    @property
+    def feed_index(self) -> np.ndarray:
+        """mu_acc where acceleration limits are given, else mu_path (the map's colour)."""
+        return self.mu_path if self.mu_acc is None else self.mu_acc
 
     def placement(self, index: tuple[int, ...]) -> Placement:
         """The placement of cell [spin, yaw, y, x]."""
@@ -63,14 +76,16 @@ class CapabilityMap:
         )
 
     def extreme(self, *, best: bool) -> tuple[int, ...] | None:
-        """Index [spin, yaw, y, x] of the feasible cell with the highest (or lowest) mu_path.
+        """Index [spin, yaw, y, x] of the feasible cell with the highest (or lowest) index.
+
+        The index is :attr:`feed_index`: mu_acc with acceleration limits, else mu_path.
 
         Ties go to the first cell in [spin, yaw, y, x] order; ``None`` when none is feasible.
         """
         feasible = ~np.isnan(self.mu_path)
         if not feasible.any():
             return None
-        values = np.where(feasible, self.mu_path, -np.inf if best else np.inf)
+        values = np.where(feasible, self.feed_index, -np.inf if best else np.inf)
         flat = int(np.argmax(values) if best else np.argmin(values))
         return tuple(int(v) for v in np.unravel_index(flat, self.mu_path.shape))
 
@@ -173,4 +188,13 @@ def capability_map(
         branch=result.branch.reshape(shape),
         bottleneck_waypoint=result.bottleneck_waypoint.reshape(shape),
         bottleneck_joint=result.bottleneck_joint.reshape(shape),
+        **{
+            name: None if value is None else value.reshape(shape)
+            for name, value in (
+                ("mu_acc", result.mu_acc),
+                ("limited_by", result.limited_by),
+                ("acc_waypoint", result.acc_waypoint),
+                ("acc_joint", result.acc_joint),
+            )
+        },
     )

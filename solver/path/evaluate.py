@@ -20,10 +20,35 @@ from solver.core.codes import FEASIBLE, REASONS, Reason
 from solver.core.dtf import spin_rate_nearest_zero
 from solver.core.family import Branch
 from solver.core.spatial import Placement, rotation_about_z
+from solver.path.limits import JointAccelerationLimit, JointMotion, bound_by_limits
 from solver.path.pipeline import check_placements, run_chunk
 from solver.path.problem import PathProblem, SpinMode
 
-__all__ = ["Branch", "PathEvaluation", "evaluate_path"]
+__all__ = ["AccelerationIndex", "Branch", "PathEvaluation", "acceleration_index", "evaluate_path"]
+
+
+@dataclass(frozen=True)
+class AccelerationIndex:
+    """mu_acc of a feasible path: the constant feed its joint accelerations allow (motion.md s. 2).
+
+    Attributes:
+        mu_acc: m/s, min(mu_path, min_i V_acc,i).
+        limited_by: ``"speed"`` (mu_acc = mu_path) or ``"acceleration"``.
+        waypoint: where it binds (the bottleneck of mu_path when the speed limits bind).
+        joint: the joint that binds there.
+        blend_length: b, m.
+        v_acc: shape (N,), m/s, V_acc,i; inf where unconstrained (within b of a pass end, or
+            D_i = 0).
+        qdd: shape (N, n), rad/s^2, D_i mu_acc^2; NaN at the waypoints within b of a pass end.
+    """
+
+    mu_acc: float
+    limited_by: str
+    waypoint: int
+    joint: int
+    blend_length: float
+    v_acc: np.ndarray
+    qdd: np.ndarray
 
 
 @dataclass(frozen=True)
@@ -69,6 +94,51 @@ class PathEvaluation:
     spins: np.ndarray | None = None
     ik_seeds: int | None = None
     ik_branches_found: int | None = None
+    acceleration: AccelerationIndex | None = None
+
+    @property
+    def feed_index(self) -> float | None:
+        """The constant feed the arm can run: mu_acc with acceleration limits, else mu_path.
+
+        What the optimisers maximise and the map colours (motion.md section 3).
+        """
+        return self.mu_path if self.acceleration is None else self.acceleration.mu_acc
+
+
+def acceleration_index(
+    problem: PathProblem, q: np.ndarray, mu_path: float, bottleneck: tuple[int, int]
+) -> AccelerationIndex | None:
+    """mu_acc along a feasible joint path (motion.md section 2); None without final-path limits.
+
+    Args:
+        problem: the robot, the path and the options (the blend length).
+        q: shape (N, n), rad, the final tracked joint path (in free spin along the spins).
+        mu_path: m/s, its mu_path.
+        bottleneck: (waypoint, joint) of mu_path.
+    """
+    limits = problem.final_path_limits
+    if not limits:
+        return None
+    motion = JointMotion(q=q.T, qd_unit=np.zeros_like(q.T))
+    bound, joint, binding = bound_by_limits(limits, motion)  # (N,)
+    worst = int(np.argmin(bound)) if len(bound) else 0
+    accelerated = len(bound) > 0 and bound[worst] < mu_path
+    mu_acc = float(bound[worst]) if accelerated else mu_path
+    qdd = np.full(q.shape, np.nan)
+    blend = problem.options.blend_length
+    for limit in limits:
+        if isinstance(limit, JointAccelerationLimit):
+            stencil, blend = limit.stencil, limit.stencil.blend_length
+            qdd[stencil.waypoints] = stencil.second_difference(q.T).T * mu_acc**2
+    return AccelerationIndex(
+        mu_acc=mu_acc,
+        limited_by=limits[int(binding[worst])].name if accelerated else "speed",
+        waypoint=worst if accelerated else bottleneck[0],
+        joint=int(joint[worst]) if accelerated else bottleneck[1],
+        blend_length=blend,
+        v_acc=bound,
+        qdd=qdd,
+    )
 
 
 def _turned(vectors: np.ndarray, yaw: float) -> np.ndarray:
@@ -130,14 +200,19 @@ def evaluate_path(problem: PathProblem, placement: Placement) -> PathEvaluation:
         )
         qdot = qdot + spin_rate * run.qd_spin[:, pick, 0]
         spins = run.spins[pick, 0]
+    q = run.tracked.q[:, pick, 0].T
+    mu_path = float(v_max[bottleneck])
     return dataclasses.replace(
         infeasible,
         feasible=True,
-        mu_path=float(v_max[bottleneck]),
+        mu_path=mu_path,
         bottleneck_waypoint=bottleneck,
         bottleneck_joint=int(limiting[bottleneck]),
         failed_waypoint=None,
-        q=run.tracked.q[:, pick, 0].T,
+        acceleration=acceleration_index(
+            problem, q, mu_path, (bottleneck, int(limiting[bottleneck]))
+        ),
+        q=q,
         v_max=v_max,
         omega_max=omega_max,
         qdot=qdot.T,

@@ -20,7 +20,7 @@ import numpy as np
 from solver.core.exceptions import InvalidInputError
 from solver.core.kinematics import tool_pose_in_base
 from solver.core.spatial import Placement, rotation_about_z
-from solver.path.evaluate import PathEvaluation
+from solver.path.evaluate import PathEvaluation, acceleration_index
 from solver.path.limits import JointMotion, bound_by_limits
 from solver.path.pipeline import turn_by_yaw
 from solver.path.problem import PathProblem
@@ -140,7 +140,9 @@ def evaluate_joint_path(
     qd_unit = family.joint_speeds_per_unit_twist(
         q.T, twist[:, 0], poses[:, :3, 3].T, qdot_max=robot.qdot_max
     )  # (n, N), the same computation as the pipeline's at the tracked joints
-    speed, limiting, _ = bound_by_limits(problem.limits, JointMotion(q=q.T, qd_unit=qd_unit))
+    speed, limiting, _ = bound_by_limits(
+        problem.waypoint_limits, JointMotion(q=q.T, qd_unit=qd_unit)
+    )
     u_T, u_R = _twist_directions(path.u_T, path.u_R, placement.yaw)
     infeasible = PathEvaluation(
         feasible=False,
@@ -163,10 +165,14 @@ def evaluate_joint_path(
             path.pure_rotation, speed, np.where(np.isinf(path.h), 0.0, speed / path.h)
         )
     bottleneck = int(np.argmin(v_max))
+    mu_path = float(v_max[bottleneck])
     return dataclasses.replace(
         infeasible,
         feasible=True,
-        mu_path=float(v_max[bottleneck]),
+        mu_path=mu_path,
+        acceleration=acceleration_index(
+            problem, q, mu_path, (bottleneck, int(limiting[bottleneck]))
+        ),
         bottleneck_waypoint=bottleneck,
         bottleneck_joint=int(limiting[bottleneck]),
         q=q,

@@ -6,6 +6,13 @@ least bound over the problem's limits (:func:`bound_by_limits`) without naming a
 limits, the DTF of Sensors 2022, are the first limit; joint accelerations (motion.md) and the
 cell (cell.md) are the next, each a class of its own here. The compiled kernels compute the same
 bound in their own hook (:mod:`solver.kernels`), tested cell by cell against this one.
+
+A limit is of one of two kinds (:attr:`Limit.on_final_path`): a *waypoint* limit bounds V_max,
+the feed at each waypoint by its joint speeds per unit feed, whose minimum is mu_path; a
+*final-path* limit bounds a constant feed along the final tracked joint path (in free spin, the
+path along the spin schedule that realises mu_path), and min(mu_path, its bounds) is the index
+the arm can run at: joint accelerations (:class:`JointAccelerationLimit`, motion.md section 2)
+give mu_acc.
 """
 
 from __future__ import annotations
@@ -41,6 +48,9 @@ class Limit(abc.ABC):
 
     #: Short name, reported where the limit binds (``"speed"``).
     name: str
+    #: False: it bounds V_max at each waypoint (mu_path); True: it bounds a constant feed along
+    #: the final tracked joint path (mu_acc), and V_max keeps its meaning.
+    on_final_path: bool = False
 
     @abc.abstractmethod
     def speed_bound(self, motion: JointMotion) -> tuple[np.ndarray, np.ndarray]:
@@ -82,6 +92,120 @@ class JointSpeedLimit(Limit):
         with np.errstate(divide="ignore", invalid="ignore"):  # infeasible branches
             speed = 1.0 / ratio.max(axis=0)
         return speed, limiting
+
+
+@dataclass(frozen=True)
+class BlendStencil:
+    """The second difference over the blend length as weights of waypoints (motion.md s. 2).
+
+    D_i = (q(s_i + b) - 2 q_i + q(s_i - b)) / b^2, q(s) the piecewise-linear interpolation of
+    the q_i in the tool point's arc length s within a pass, at every waypoint with s_i - b >= 0
+    and s_i + b <= s_end of its pass: a sum of five waypoints' q with fixed weights. The
+    indices and weights depend on the path only (not on the placement): made once per problem,
+    used by the pipeline and by the NLP's rows.
+
+    Attributes:
+        blend_length: b, m, > 0.
+        waypoints: shape (K,), the constrained waypoints i.
+        index: shape (K, 5), the waypoints whose q make D_i: around s_i - b, i, around s_i + b.
+        weight: shape (K, 5), 1/m^2, their weights (each row sums to 0).
+    """
+
+    blend_length: float
+    waypoints: np.ndarray
+    index: np.ndarray
+    weight: np.ndarray
+
+    @classmethod
+    def of_path(
+        cls, tool_position: np.ndarray, segment_in_pass: np.ndarray, blend_length: float
+    ) -> BlendStencil:
+        """The stencil of a path.
+
+        Args:
+            tool_position: shape (N, 3), m, the tool point p_i (in any fixed frame).
+            segment_in_pass: shape (N - 1,), False where a rapid joins two passes.
+            blend_length: b, m, > 0.
+        """
+        b = float(blend_length)
+        n = len(tool_position)
+        length = np.linalg.norm(np.diff(tool_position, axis=0), axis=1)
+        starts = np.concatenate([[0], np.flatnonzero(~segment_in_pass) + 1, [n]])
+        rows: list[np.ndarray] = []
+        weights: list[np.ndarray] = []
+        kept: list[np.ndarray] = []
+        for start, stop in zip(starts[:-1], starts[1:], strict=True):
+            s = np.concatenate([[0.0], np.cumsum(length[start : stop - 1])])
+            inside = np.flatnonzero((s - b >= 0.0) & (s + b <= s[-1]))
+            if not inside.size or stop - start < 2:
+                continue
+            below, w_below = _interpolation(s, s[inside] - b)
+            above, w_above = _interpolation(s, s[inside] + b)
+            rows.append(start + np.column_stack([below, below + 1, inside, above, above + 1]))
+            weights.append(
+                np.column_stack(
+                    [1.0 - w_below, w_below, np.full(len(inside), -2.0), 1.0 - w_above, w_above]
+                )
+                / b**2
+            )
+            kept.append(start + inside)
+        if not kept:
+            return cls(b, np.zeros(0, dtype=np.int64), np.zeros((0, 5), np.int64), np.zeros((0, 5)))
+        return cls(b, np.concatenate(kept), np.concatenate(rows), np.concatenate(weights))
+
+    def second_difference(self, q: np.ndarray) -> np.ndarray:
+        """D at the constrained waypoints: q (n, ..., W) -> (n, ..., K), rad/m^2."""
+        second: np.ndarray = np.einsum("...km,km->...k", q[..., self.index], self.weight)
+        return second
+
+
+def _interpolation(s: np.ndarray, target: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The segment k of the arc lengths ``s`` (ascending) holding each target, and its weight.
+
+    q(target) = (1 - w) q_k + w q_{k+1}; k is the last waypoint with s_k <= target (the last
+    segment at the end), w in [0, 1].
+    """
+    k = np.clip(np.searchsorted(s, target, side="right") - 1, 0, len(s) - 2)
+    span = s[k + 1] - s[k]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        w = np.where(span > 0.0, (target - s[k]) / span, 1.0)
+    return k, np.clip(w, 0.0, 1.0)
+
+
+class JointAccelerationLimit(Limit):
+    """Joint acceleration limits at a constant feed (motion.md section 2).
+
+    At feed v the joint accelerations are D_i v^2, so V_acc,i = min_j sqrt(a_j / |D_ij|)
+    (infinite where D_ij = 0, and at the waypoints within b of a pass end).
+    """
+
+    name = "acceleration"
+    on_final_path = True
+
+    def __init__(self, qddot_max: np.ndarray, stencil: BlendStencil) -> None:
+        """Hold the limits and the path's stencil.
+
+        Args:
+            qddot_max: shape (n,), rad/s^2, each joint's acceleration limit (> 0).
+            stencil: the path's second difference over the blend length.
+        """
+        self.qddot_max = np.asarray(qddot_max, dtype=float)
+        self.stencil = stencil
+
+    def speed_bound(self, motion: JointMotion) -> tuple[np.ndarray, np.ndarray]:
+        """V_acc at every waypoint, and the joint that binds (see :meth:`Limit.speed_bound`)."""
+        q = motion.q
+        speed = np.full(q.shape[1:], np.inf)
+        joint = np.zeros(q.shape[1:], dtype=np.int64)
+        if not self.stencil.waypoints.size:
+            return speed, joint
+        second = self.stencil.second_difference(q)  # (n, ..., K)
+        ratio = np.abs(second) / self.qddot_max.reshape((-1,) + (1,) * (second.ndim - 1))
+        worst = ratio.max(axis=0)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            speed[..., self.stencil.waypoints] = 1.0 / np.sqrt(worst)
+        joint[..., self.stencil.waypoints] = ratio.argmax(axis=0)
+        return speed, joint
 
 
 def bound_by_limits(

@@ -76,6 +76,13 @@ class ChunkResult:
         ik_seeds: the seeds a numeric family started from (None for an analytic one).
         branches_found: shape (C,), the distinct IK solutions a numeric family found at the
             first waypoint (None for an analytic one).
+        v_final: shape (B, C, W), m/s, the least bound of the problem's final-path limits
+            (:attr:`PathProblem.final_path_limits`: V_acc,i of motion.md section 2) along the
+            final tracked joint paths, inf where none bounds; None without such limits.
+        final_limiting: shape (B, C, W), the joint that binds it (None likewise).
+        final_binding: shape (B, C, W), which of the final-path limits binds (None likewise).
+        mu_acc: shape (B, C), m/s, min(mu_path, min_i v_final), -inf on infeasible branches;
+            None without final-path limits. With it, ``pick`` takes the highest mu_acc.
     """
 
     tracked: Tracked
@@ -89,6 +96,10 @@ class ChunkResult:
     spins: np.ndarray | None = None
     ik_seeds: int | None = None
     branches_found: np.ndarray | None = None
+    v_final: np.ndarray | None = None
+    final_limiting: np.ndarray | None = None
+    final_binding: np.ndarray | None = None
+    mu_acc: np.ndarray | None = None
 
 
 def turn_by_yaw(vectors: np.ndarray, yaws: np.ndarray) -> np.ndarray:
@@ -163,7 +174,7 @@ def run_chunk(problem: PathProblem, placements: np.ndarray) -> ChunkResult:
             tracked.q, spin[:, None], tool_position[:, None]
         )
     motion = JointMotion(q=tracked.q, qd_unit=qd_unit, qd_spin=qd_spin)
-    speed, limiting, _ = bound_by_limits(problem.limits, motion)  # (B, C, W)
+    speed, limiting, _ = bound_by_limits(problem.waypoint_limits, motion)  # (B, C, W)
     v_max = np.where(path.pure_rotation, 0.0, speed)
     feasible = tracked.reason == FEASIBLE  # (B, C)
     mu_path = np.where(feasible, v_max.min(axis=-1), -np.inf)
@@ -172,7 +183,9 @@ def run_chunk(problem: PathProblem, placements: np.ndarray) -> ChunkResult:
         spins, tracked = _spin_schedule(problem, tracked, qd_unit, qd_spin, mu_path)
         feasible = tracked.reason == FEASIBLE
         mu_path = np.where(feasible, mu_path, -np.inf)
-    pick = choose_branch(mu_path, feasible, tracked.failed_waypoint)
+    final = _final_path_bounds(problem, tracked, qd_unit, qd_spin, mu_path, feasible)
+    mu_acc = final[3]
+    pick = choose_branch(mu_path if mu_acc is None else mu_acc, feasible, tracked.failed_waypoint)
     return ChunkResult(
         tracked=tracked,
         qd_unit=qd_unit,
@@ -185,7 +198,37 @@ def run_chunk(problem: PathProblem, placements: np.ndarray) -> ChunkResult:
         spins=spins,
         ik_seeds=solutions.seeds,
         branches_found=solutions.branches_found,
+        v_final=final[0],
+        final_limiting=final[1],
+        final_binding=final[2],
+        mu_acc=mu_acc,
     )
+
+
+_NoBounds = tuple[None, None, None, None]
+
+
+def _final_path_bounds(
+    problem: PathProblem,
+    tracked: Tracked,
+    qd_unit: np.ndarray,
+    qd_spin: np.ndarray | None,
+    mu_path: np.ndarray,
+    feasible: np.ndarray,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray] | _NoBounds:
+    """The final-path limits along the final joint paths: bound, joint, limit, and mu_acc.
+
+    mu_acc = min(mu_path, min_i bound_i) (motion.md section 2), -inf where infeasible; all
+    None when the problem has no final-path limits.
+    """
+    limits = problem.final_path_limits
+    if not limits:
+        return None, None, None, None
+    motion = JointMotion(q=tracked.q, qd_unit=qd_unit, qd_spin=qd_spin)
+    bound, joint, binding = bound_by_limits(limits, motion)  # (B, C, W)
+    lowest = bound.min(axis=-1) if bound.shape[-1] else np.full(mu_path.shape, np.inf)
+    mu_acc = np.where(feasible, np.minimum(mu_path, lowest), -np.inf)
+    return bound, joint, binding, mu_acc
 
 
 def _spin_schedule(

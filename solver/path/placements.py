@@ -16,10 +16,8 @@ import numpy as np
 from solver.core.codes import FEASIBLE
 from solver.core.malloc import raise_malloc_thresholds
 from solver.core.parallel import SERIAL, TaskRunner
-from solver.kernels.fixed_spin import map_cells
-from solver.kernels.free_spin import free_cells
-from solver.kernels.positions import limit_modes
-from solver.path.pipeline import check_placements, flange_at_spin, run_chunk
+from solver.path.kernel_cells import KernelInputs, kernel_inputs, kernel_of, run_kernel
+from solver.path.pipeline import check_placements, run_chunk
 from solver.path.problem import PathProblem
 
 __all__ = ["PlacementEvaluator", "PlacementResults", "evaluate_placements"]
@@ -40,6 +38,15 @@ class PlacementResults:
         bottleneck_joint: shape (P,), -1 where infeasible.
         v_max: shape (P, N), m/s, V_max at every waypoint on the branch used (NaN where
             infeasible); only when asked for.
+        mu_acc: shape (P,), m/s, min(mu_path, min_i V_acc,i) on the final joint path (motion.md
+            section 2), NaN where infeasible; None without acceleration limits.
+        limited_by: shape (P,), what binds mu_acc: 0 the speed limits (mu_acc = mu_path),
+            k + 1 the problem's k-th final-path limit (1: acceleration), -1 where infeasible;
+            None without acceleration limits.
+        acc_waypoint: shape (P,), where mu_acc binds (-1 where infeasible); None likewise.
+        acc_joint: shape (P,), the joint that binds there (-1 where infeasible); None likewise.
+        v_acc: shape (P, N), m/s, the final-path bound at every waypoint (inf where
+            unconstrained, NaN where infeasible); only when asked for, with such limits.
     """
 
     mu_path: np.ndarray
@@ -49,6 +56,27 @@ class PlacementResults:
     bottleneck_waypoint: np.ndarray
     bottleneck_joint: np.ndarray
     v_max: np.ndarray | None = None
+    mu_acc: np.ndarray | None = None
+    limited_by: np.ndarray | None = None
+    acc_waypoint: np.ndarray | None = None
+    acc_joint: np.ndarray | None = None
+    v_acc: np.ndarray | None = None
+
+    @property
+    def feed_index(self) -> np.ndarray:
+        """mu_acc where acceleration limits are given, else mu_path: what the optimisers climb."""
+        return self.mu_path if self.mu_acc is None else self.mu_acc
+
+    @property
+    def feed_bounds(self) -> np.ndarray | None:
+        """Per waypoint, the least of V_max and the final-path bound (whose minimum is the index).
+
+        Only when asked for (``with_speeds``); V_max alone without final-path limits.
+        """
+        if self.v_max is None or self.v_acc is None:
+            return self.v_max
+        least: np.ndarray = np.fmin(self.v_max, self.v_acc)
+        return least
 
 
 def _chunk(
@@ -57,7 +85,7 @@ def _chunk(
     """Evaluate C placements: per placement mu, reason, failed, branch, bottleneck, V_max.
 
     V_max along the path is (C, W) when ``with_speeds``, else (C, 0): a map of millions of
-    placements keeps nothing per waypoint.
+    placements keeps nothing per waypoint. Then the acceleration columns of :func:`_acc_columns`.
     """
     run = run_chunk(problem, placements)
     branches = problem.branches
@@ -65,7 +93,7 @@ def _chunk(
     any_feasible = (run.tracked.reason == FEASIBLE).any(axis=0)
     chosen_v = np.where(any_feasible[:, None], run.v_max[pick, columns], np.nan)  # (C, W)
     worst = np.nan_to_num(chosen_v, nan=np.inf).argmin(axis=-1)
-    return (
+    speed_columns = (
         np.where(any_feasible, run.mu_path[pick, columns], np.nan),
         run.tracked.reason[pick, columns],
         run.tracked.failed_waypoint[pick, columns],
@@ -74,120 +102,26 @@ def _chunk(
         np.where(any_feasible, run.limiting[pick, columns, worst], -1),
         chosen_v if with_speeds else chosen_v[:, :0],
     )
-
-
-@dataclass(frozen=True)
-class _KernelInputs:
-    """What the compiled kernel takes of a problem at one spin, made once per spin."""
-
-    code: int
-    parameters: np.ndarray
-    rotation: np.ndarray  # (W, 3, 3), R_O_F at the spin
-    position: np.ndarray  # (W, 3), m, p_O_F at the spin
-    tool_position: np.ndarray
-    twist: np.ndarray
-    tool_axis: np.ndarray  # (W, 3), z of the tool in {O}: the spin's axis
-    length: np.ndarray  # (W - 1,), m, the segments' lengths
-    pure_rotation: np.ndarray
-    segment_checked: np.ndarray
-    lower: np.ndarray
-    upper: np.ndarray
-    modes: np.ndarray
-    arc: np.ndarray
-    qdot_max: np.ndarray
-    branches: np.ndarray  # the branches followed
-    max_joint_step: float
-    free_spin: bool
-
-
-def _kernel_inputs(
-    problem: PathProblem, spin: float, kernel: tuple[int, np.ndarray]
-) -> _KernelInputs:
-    """The kernel's inputs of the problem's robot and path at ``spin``, as contiguous arrays."""
-    robot, path = problem.robot, problem.prepared
-    rotation, position = flange_at_spin(path, spin)
-    modes, arc = limit_modes(robot.q_lower, robot.q_upper)
-    contiguous = np.ascontiguousarray
-    return _KernelInputs(
-        code=kernel[0],
-        parameters=kernel[1],
-        rotation=contiguous(rotation),
-        position=contiguous(position),
-        tool_position=contiguous(path.tool_position),
-        twist=contiguous(path.twist),
-        tool_axis=contiguous(path.tool_rotation[:, :, 2]),
-        length=np.linalg.norm(np.diff(path.tool_position, axis=0), axis=1),
-        pure_rotation=contiguous(path.pure_rotation),
-        segment_checked=contiguous(path.segment_in_pass),
-        lower=contiguous(robot.q_lower, dtype=float),
-        upper=contiguous(robot.q_upper, dtype=float),
-        modes=modes,
-        arc=arc,
-        qdot_max=contiguous(robot.qdot_max, dtype=float),
-        branches=contiguous(problem.branches, dtype=np.int64),
-        max_joint_step=float(problem.options.max_joint_step),
-        free_spin=problem.options.spin_mode == "free",
+    bound, joint, binding = run.v_final, run.final_limiting, run.final_binding
+    if run.mu_acc is None or bound is None or joint is None or binding is None:
+        return speed_columns + _no_acc_columns(len(placements), with_speeds * chosen_v.shape[1])
+    final_v = np.where(any_feasible[:, None], bound[pick, columns], np.nan)  # (C, W)
+    low = np.nan_to_num(final_v, nan=np.inf).argmin(axis=-1)
+    accelerated = any_feasible & (final_v[columns, low] < speed_columns[0])
+    acc_columns = (
+        np.where(any_feasible, run.mu_acc[pick, columns], np.nan),
+        np.where(any_feasible, np.where(accelerated, binding[pick, columns, low] + 1, 0), -1),
+        np.where(accelerated, low, speed_columns[4]),
+        np.where(accelerated, joint[pick, columns, low], speed_columns[5]),
+        final_v if with_speeds else final_v[:, :0],
     )
+    return speed_columns + acc_columns
 
 
-def _run_kernel(
-    inputs: _KernelInputs, placements: np.ndarray, with_speeds: bool
-) -> tuple[np.ndarray, ...]:
-    """The columns of :func:`_chunk` by the compiled kernel, at placements of one spin."""
-    n_cells, n_waypoints = len(placements), inputs.rotation.shape[0]
-    mu = np.empty(n_cells)
-    codes = [np.empty(n_cells, dtype=np.int64) for _ in range(5)]
-    v_max = np.empty((n_cells, n_waypoints if with_speeds else 0))
-    placed = (
-        inputs.code,
-        inputs.parameters,
-        np.cos(placements[:, 3]),
-        np.sin(placements[:, 3]),
-        np.ascontiguousarray(placements[:, :3]),
-        inputs.rotation,
-        inputs.position,
-        inputs.tool_position,
-        inputs.twist,
-    )
-    followed = inputs.branches
-    if inputs.free_spin:
-        free_cells(
-            *placed,
-            inputs.tool_axis,
-            inputs.length,
-            inputs.pure_rotation,
-            inputs.segment_checked,
-            followed,
-            inputs.lower,
-            inputs.upper,
-            inputs.qdot_max,
-            inputs.max_joint_step,
-            mu,
-            *codes,
-            v_max,
-        )
-    else:
-        map_cells(
-            *placed,
-            inputs.pure_rotation,
-            inputs.segment_checked,
-            followed,
-            inputs.lower,
-            inputs.upper,
-            inputs.modes,
-            inputs.arc,
-            inputs.qdot_max,
-            inputs.max_joint_step,
-            mu,
-            *codes,
-            v_max,
-        )
-    return (mu, *codes, v_max)
-
-
-def _kernel_of(problem: PathProblem) -> tuple[int, np.ndarray] | None:
-    """The compiled pose kernel of the robot's family, where it has one (either spin mode)."""
-    return problem.family.map_kernel()
+def _no_acc_columns(n_cells: int, n_waypoints: int) -> tuple[np.ndarray, ...]:
+    """The acceleration columns of a chunk without final-path limits (never reported)."""
+    missing = np.full(n_cells, -1, dtype=np.int64)
+    return (np.full(n_cells, np.nan), missing, missing, missing, np.zeros((n_cells, n_waypoints)))
 
 
 def _task(
@@ -205,15 +139,16 @@ def _task(
     (a Dask worker), so it sets the malloc thresholds itself.
     """
     raise_malloc_thresholds()
-    kernel = _kernel_of(problem) if compiled else None
+    kernel = kernel_of(problem) if compiled else None
     if kernel is not None:
-        inputs: dict[float, _KernelInputs] = {}  # made once per spin, not once per chunk
+        inputs: dict[float, KernelInputs] = {}  # made once per spin, not once per chunk
         parts = []
         for rows in _pieces(placements, chunk):
             spin = float(rows[0, 4])
             if spin not in inputs:
-                inputs[spin] = _kernel_inputs(problem, spin, kernel)
-            parts.append(_run_kernel(inputs[spin], rows, with_speeds))
+                inputs[spin] = kernel_inputs(problem, spin, kernel)
+            speed_columns = run_kernel(inputs[spin], rows, with_speeds)
+            parts.append(speed_columns + _no_acc_columns(len(rows), speed_columns[-1].shape[1]))
     else:
         parts = [_chunk(problem, rows, with_speeds) for rows in _pieces(placements, chunk)]
     return tuple(np.concatenate(c) for c in zip(*parts, strict=True))
@@ -278,8 +213,18 @@ def evaluate_placements(
     parts = runner.run(work, tasks, done)
     n_waypoints = problem.prepared.n_waypoints
     empty = (np.zeros(0), *(np.zeros(0, dtype=int),) * 5, np.zeros((0, n_waypoints)))
+    empty += _no_acc_columns(0, n_waypoints)
     columns = [np.concatenate(c) for c in zip(*parts, strict=True)] if parts else list(empty)
-    mu, reason, failed, chosen, bottleneck_waypoint, bottleneck_joint, v_max = columns
+    return _results(problem, columns, with_speeds)
+
+
+def _results(
+    problem: PathProblem, columns: list[np.ndarray], with_speeds: bool
+) -> PlacementResults:
+    """The results of the columns of :func:`_chunk` (the acceleration ones where limits are)."""
+    mu, reason, failed, chosen, bottleneck_waypoint, bottleneck_joint, v_max = columns[:7]
+    mu_acc, limited_by, acc_waypoint, acc_joint, v_acc = columns[7:]
+    accelerations = bool(problem.final_path_limits)
     return PlacementResults(
         mu_path=mu,
         reason=reason,
@@ -288,6 +233,11 @@ def evaluate_placements(
         bottleneck_waypoint=bottleneck_waypoint,
         bottleneck_joint=bottleneck_joint,
         v_max=v_max if with_speeds else None,
+        mu_acc=mu_acc if accelerations else None,
+        limited_by=limited_by if accelerations else None,
+        acc_waypoint=acc_waypoint if accelerations else None,
+        acc_joint=acc_joint if accelerations else None,
+        v_acc=v_acc if accelerations and with_speeds else None,
     )
 
 
@@ -309,8 +259,8 @@ class PlacementEvaluator:
         """
         self._problem = problem.with_options(branch=None)
         _ = self._problem.branches  # the options checked first
-        self._kernel = _kernel_of(self._problem)
-        self._last: tuple[float, _KernelInputs] | None = None  # the spin asked for last
+        self._kernel = kernel_of(self._problem)
+        self._last: tuple[float, KernelInputs] | None = None  # the spin asked for last
 
     def __call__(self, placements: np.ndarray) -> PlacementResults:
         """mu_path at P placements, shape (P, 5) as :func:`evaluate_placements` takes them."""
@@ -319,6 +269,6 @@ class PlacementEvaluator:
             return evaluate_placements(self._problem, cells)
         spin = float(cells[0, 4])
         if self._last is None or self._last[0] != spin:
-            self._last = (spin, _kernel_inputs(self._problem, spin, self._kernel))
-        mu, reason, failed, chosen, waypoint, joint, _ = _run_kernel(self._last[1], cells, False)
-        return PlacementResults(mu, reason, failed, chosen, waypoint, joint)
+            self._last = (spin, kernel_inputs(self._problem, spin, self._kernel))
+        columns = [*run_kernel(self._last[1], cells, False), *_no_acc_columns(len(cells), 0)]
+        return _results(self._problem, columns, False)

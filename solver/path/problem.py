@@ -24,10 +24,11 @@ import numpy as np
 from solver.core.exceptions import InvalidInputError, NoAnalyticIkError, quoted
 from solver.core.family import Branch, KinematicsFamily
 from solver.core.robots import Robot
-from solver.path.limits import JointSpeedLimit, Limit
+from solver.path.limits import BlendStencil, JointAccelerationLimit, JointSpeedLimit, Limit
 from solver.path.prepare import PreparedPath, prepare_path
 
 DEFAULT_MAX_JOINT_STEP = 0.35
+DEFAULT_BLEND_LENGTH = 0.002  # m, the corner zone of motion.md section 1 (ABB z1, UR 1 mm)
 
 SpinMode = Literal["fixed", "free"]
 SPIN_MODES: tuple[SpinMode, ...] = ("fixed", "free")
@@ -44,11 +45,14 @@ class PathOptions:
             waypoints of one pass.
         spin_mode: ``fixed`` (the orientations as given) or ``free`` (the tool spin rate a free
             variable of the DTF).
+        blend_length: m, > 0 and finite, the length b over which a controller rounds a corner
+            (motion.md section 1); used only with joint acceleration limits.
     """
 
     branch: Branch | None = None
     max_joint_step: float = DEFAULT_MAX_JOINT_STEP
     spin_mode: SpinMode = "fixed"
+    blend_length: float = DEFAULT_BLEND_LENGTH
 
     def check(self, robot: Robot) -> np.ndarray:
         """Check the options against ``robot``; the branches to follow (all for ``auto``).
@@ -65,10 +69,17 @@ class PathOptions:
         return np.array([family.branch_index(self.branch)])
 
     def check_step(self) -> None:
-        """Raise InvalidInputError on ``ik.max_joint_step`` unless it is finite and > 0 (rad)."""
+        """Raise InvalidInputError on ``ik.max_joint_step`` unless it is finite and > 0 (rad).
+
+        And on ``ik.blend_length`` unless it is finite and > 0 (m).
+        """
         if not (math.isfinite(self.max_joint_step) and self.max_joint_step > 0.0):
             raise InvalidInputError(
                 "ik.max_joint_step", f"{self.max_joint_step:.6g} rad must be > 0"
+            )
+        if not (math.isfinite(self.blend_length) and self.blend_length > 0.0):
+            raise InvalidInputError(
+                "ik.blend_length", f"{self.blend_length:.6g} m must be finite and > 0"
             )
 
 
@@ -130,19 +141,43 @@ class PathProblem:
 
     @functools.cached_property
     def limits(self) -> tuple[Limit, ...]:
-        """The limits on the path index: the joint speed limits (the DTF) first."""
-        return (JointSpeedLimit(self.robot.qdot_max),)
+        """The limits on the path index: the joint speed limits (the DTF) first.
+
+        Then, where the robot has acceleration limits, :class:`JointAccelerationLimit` on the
+        path's blend stencil (made here, once per problem and blend length).
+        """
+        limits: list[Limit] = [JointSpeedLimit(self.robot.qdot_max)]
+        if self.robot.qddot_max is not None:
+            path = self.prepared
+            stencil = BlendStencil.of_path(
+                path.tool_position, path.segment_in_pass, self.options.blend_length
+            )
+            limits.append(JointAccelerationLimit(self.robot.qddot_max, stencil))
+        return tuple(limits)
+
+    @property
+    def waypoint_limits(self) -> tuple[Limit, ...]:
+        """The limits that bound V_max at each waypoint (their least bound's minimum: mu_path)."""
+        return tuple(limit for limit in self.limits if not limit.on_final_path)
+
+    @property
+    def final_path_limits(self) -> tuple[Limit, ...]:
+        """The limits on a constant feed along the final joint path (mu_acc); () for none."""
+        return tuple(limit for limit in self.limits if limit.on_final_path)
 
     def with_options(self, **changes: object) -> PathProblem:
         """The same robot and path with some options changed (e.g. ``branch=...``).
 
-        The prepared path and the limits, which no option changes, are shared.
+        The prepared path is shared, and so are the limits unless the blend length changed.
         """
         options = dataclasses.replace(self.options, **changes)  # type: ignore[arg-type]
         other = dataclasses.replace(self, options=options)
-        for shared in ("prepared", "limits"):
-            if shared in self.__dict__:
-                other.__dict__[shared] = self.__dict__[shared]
+        shared = ["prepared"]
+        if options.blend_length == self.options.blend_length:
+            shared.append("limits")
+        for name in shared:
+            if name in self.__dict__:
+                other.__dict__[name] = self.__dict__[name]
         return other
 
     def with_waypoints(self, waypoints: np.ndarray) -> PathProblem:

@@ -28,6 +28,7 @@ FORMS = {
     "spin path": ("ur5e", {"max_spin_step": 0.1}, None),
     "seven joints": ("panda", {}, None),
     "two passes": ("ur5", {}, [(0, 4), (4, 9)]),
+    "accelerations": ("ur5", {"accelerations": 10.0}, None),
 }
 
 
@@ -41,7 +42,11 @@ def test_assembled_derivatives_equal_casadis_own(form: str) -> None:
     robot, path = get_robot(name), load_path("curved_line")[:9]
     options = dict(options)
     spin_mode = "free" if options.pop("free_spin", False) else "fixed"
-    posed = problem(robot, path, passes=passes, max_joint_step=0.3, spin_mode=spin_mode)
+    if "accelerations" in options:
+        robot = robot.with_options(qddot_max=[options.pop("accelerations")] * robot.dof)
+    posed = problem(
+        robot, path, passes=passes, max_joint_step=0.3, spin_mode=spin_mode, blend_length=0.003
+    )
     built = {
         own: PlacementNlp(posed, BOUNDS, derivatives=own, **options)._solver
         for own in (True, False)

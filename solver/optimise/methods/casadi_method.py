@@ -103,7 +103,8 @@ def _solve_from(
     at_start = evaluate_path(
         problem.with_options(branch=branch, spin_mode="fixed"), bounds.placement(cell.vector)
     )
-    q, qdot, v_max, speed = at_start.q, at_start.qdot, at_start.v_max, at_start.mu_path
+    # With acceleration limits the NLP's rows hold at mu_acc, not at mu_path: start there.
+    q, qdot, v_max, speed = at_start.q, at_start.qdot, at_start.v_max, at_start.feed_index
     if q is None or qdot is None or v_max is None or speed is None:
         return None
     joint_speeds = qdot * (speed / v_max)[:, None]

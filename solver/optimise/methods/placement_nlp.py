@@ -38,6 +38,7 @@ import numpy as np
 from solver.core.progress import Cancelled, Progress
 from solver.optimise.methods.casadi_kinematics import symbolic_kinematics
 from solver.optimise.search_space import N_VARIABLES, PlacementBounds, variables_of
+from solver.path.limits import JointAccelerationLimit
 from solver.path.prepare import PreparedPath
 from solver.path.problem import PathProblem
 
@@ -191,6 +192,8 @@ class PlacementNlp:
         if max_spin_step is not None:
             variables = ca.vertcat(variables, ca.vec(spins))
             constraints = ca.vertcat(constraints, ca.vec(spins[1:] - spins[:-1]))
+        accelerations, self._acceleration_bound = _acceleration_rows(problem, joints, speed)
+        constraints = ca.vertcat(constraints, accelerations)
         self._n_equalities = int(equalities.numel())
         self._n_steps = int(steps.numel())
         self._dof, self._n = dof, n
@@ -219,6 +222,7 @@ class PlacementNlp:
                 variables=variables,
                 constraints=constraints,
                 layout=_Layout(dof, n, free_spin, max_spin_step is not None),
+                n_nonlinear=len(self._acceleration_bound),
             )
         self._solver = ca.nlpsol(
             "placement", "ipopt", {"x": variables, "f": -speed, "g": constraints}, options
@@ -274,10 +278,20 @@ class PlacementNlp:
         step = _inside(self._step)
         spin_step = np.full(max(self._n_spins - 1, 0), _inside(self._spin_step or 0.0))
         lbg = np.concatenate(
-            [np.zeros(self._n_equalities), np.full(self._n_steps, -step), -spin_step]
+            [
+                np.zeros(self._n_equalities),
+                np.full(self._n_steps, -step),
+                -spin_step,
+                -self._acceleration_bound,
+            ]
         )
         ubg = np.concatenate(
-            [np.zeros(self._n_equalities), np.full(self._n_steps, step), spin_step]
+            [
+                np.zeros(self._n_equalities),
+                np.full(self._n_steps, step),
+                spin_step,
+                self._acceleration_bound,
+            ]
         )
         guess = np.concatenate(
             [
@@ -345,6 +359,36 @@ def _waypoint_residual(kinematics: Any, dof: int) -> Any:
             )
         ],
     )
+
+
+def _acceleration_rows(
+    problem: PathProblem, joints: ca.MX, speed: ca.MX
+) -> tuple[ca.MX, np.ndarray]:
+    """The rows D_ij s^2 of joint acceleration limits, and their bounds a_j (motion.md s. 3).
+
+    D_i is linear in the joint values: the blend stencil's weights of five waypoints' q
+    (:class:`solver.path.limits.BlendStencil`, path-only), so each row is |D_ij| s^2 <= a_j,
+    as -a_j <= D_ij s^2 <= a_j. None (no rows) without acceleration limits.
+
+    Returns:
+        the rows (dof K, column-major over the K constrained waypoints) and their bounds
+        (rad/s^2), both empty without acceleration limits.
+    """
+    for limit in problem.final_path_limits:
+        if isinstance(limit, JointAccelerationLimit) and limit.stencil.waypoints.size:
+            stencil, n = limit.stencil, problem.prepared.n_waypoints
+            k = len(stencil.waypoints)
+            columns = np.repeat(np.arange(k), stencil.index.shape[1])
+            # One entry per (waypoint, constrained waypoint): repeated indices summed.
+            keys, where = np.unique(stencil.index.ravel() * k + columns, return_inverse=True)
+            values = np.zeros(len(keys))
+            np.add.at(values, where, stencil.weight.ravel())
+            weights = ca.DM.triplet(
+                (keys // k).tolist(), (keys % k).tolist(), values.tolist(), n, k
+            )  # (N, K)
+            second = ca.mtimes(joints, weights)  # (dof, K): D_i of every joint
+            return ca.vec(second) * speed**2, np.tile(limit.qddot_max, len(stencil.waypoints))
+    return ca.MX(0, 1), np.zeros(0)
 
 
 def _inside(bound: float) -> float:
@@ -474,6 +518,7 @@ def _derivatives(
     variables: Any,
     constraints: Any,
     layout: _Layout,
+    n_nonlinear: int = 0,
 ) -> tuple[Any, Any]:
     """IPOPT's constraint Jacobian and Lagrangian Hessian, a waypoint at a time.
 
@@ -484,6 +529,9 @@ def _derivatives(
     nothing in the Hessian, constant Jacobian entries. casadi's own differentiation of the MX
     graph colours the whole Jacobian and Hessian and sweeps it once per colour: about 15 ms
     each per IPOPT iteration on the ERK problem, where this takes a fraction of it.
+
+    The last ``n_nonlinear`` constraints (the joint acceleration rows, D_ij s^2, each of a few
+    q and s) are differentiated by casadi and appended.
 
     Returns:
         ``jac_g`` (x, p) -> (g, dg/dx) and ``hess_lag`` (x, p, lam_f, lam_g) -> the upper
@@ -523,12 +571,13 @@ def _derivatives(
     p = ca.MX.sym("p", 0)
     lam_f = ca.MX.sym("lam_f")
     n_g = int(constraints.numel())
+    n_head = n_g - n_nonlinear  # the residuals and the linear rows
     lam_g = ca.MX.sym("lam_g", n_g)
     local_all = ca.reshape(x[index.ravel().tolist()], m, n)  # column i: waypoint i
     n_res = 12 * n
 
     # The Jacobian: the residual blocks, then the linear rows (constant entries).
-    steps = constraints[n_res:]
+    steps = constraints[n_res:n_head]
     linear = ca.Function("linear", [variables], [steps])
     # The linear rows' Jacobian does not depend on x: its sparsity and values, once.
     linear_jacobian = ca.Function("linear_jacobian", [variables], [ca.jacobian(steps, variables)])(
@@ -544,7 +593,7 @@ def _derivatives(
     )
     cols = np.concatenate([index[:, jac_cols].ravel(), np.asarray(lin_cols, dtype=int)])
     sparsity, where_nz = ca.Sparsity.triplet(
-        n_g, int(x.numel()), rows.tolist(), cols.tolist(), True
+        n_head, int(x.numel()), rows.tolist(), cols.tolist(), True
     )
     if sparsity.nnz() != len(rows):  # each entry its own nonzero, or the reordering is wrong
         raise RuntimeError("the NLP's Jacobian entries overlap")
@@ -554,6 +603,13 @@ def _derivatives(
     order[np.asarray(where_nz)] = np.arange(len(rows))
     jacobian_all = ca.MX(sparsity, entries[order.tolist()])
     g = ca.vertcat(ca.vec(values_r), linear(x))
+    tail = constraints[n_head:]
+    tail_weights = ca.MX.sym("lam_tail", n_nonlinear)
+    if n_nonlinear:
+        tail_first = ca.Function("tail", [variables], [tail, ca.jacobian(tail, variables)])
+        tail_value, tail_jacobian = tail_first(x)
+        g = ca.vertcat(g, tail_value)
+        jacobian_all = ca.vertcat(jacobian_all, tail_jacobian)
     jac_g = ca.Function("nlp_jac_g", [x, p], [g, jacobian_all], ["x", "p"], ["g", "jac_g_x"])
 
     # The Hessian: each waypoint's upper triangle, the shared entries summed.
@@ -570,6 +626,13 @@ def _derivatives(
         1.0,
     )
     hessian_all = ca.MX(pattern, ca.mtimes(summing, ca.vec(hess_blocks)))
+    if n_nonlinear:
+        tail_second = ca.Function(
+            "tail_hessian",
+            [variables, tail_weights],
+            [ca.triu(ca.hessian(ca.dot(tail_weights, tail), variables)[0])],
+        )
+        hessian_all = hessian_all + tail_second(x, lam_g[n_head:])
     hess_lag = ca.Function(
         "nlp_hess_l",
         [x, p, lam_f, lam_g],

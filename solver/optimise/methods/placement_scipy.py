@@ -145,10 +145,10 @@ def global_search(
     def objective(points: np.ndarray) -> np.ndarray:  # points: (F, S)
         vectors = _full(bounds, points.T)
         result = evaluate_placements(problem, bounds.rows(vectors), runner=runner)
-        seen.append((vectors, result.mu_path, result.branch))
+        seen.append((vectors, result.feed_index, result.branch))
         if progress is not None:
             progress(len(seen) / (size.generations + 1))
-        values: np.ndarray = np.where(np.isnan(result.mu_path), INFEASIBLE, -result.mu_path)
+        values: np.ndarray = np.where(np.isnan(result.feed_index), INFEASIBLE, -result.feed_index)
         return values
 
     free = bounds.free
@@ -214,9 +214,10 @@ def polish(
             result = evaluate_placements(
                 on_branch, bounds.rows(_full(bounds, v[:n_free] + offsets)), with_speeds=True
             )
-            if result.v_max is None:  # not reached: asked for with_speeds
+            bounds_per_waypoint = result.feed_bounds  # V_max, or with V_acc the least of both
+            if bounds_per_waypoint is None:  # not reached: asked for with_speeds
                 raise RuntimeError("evaluate_placements returned no speeds")
-            cache[key] = result.v_max
+            cache[key] = bounds_per_waypoint
             if progress is not None:
                 progress(len(cache) / (size.polish_iterations + 1))
         return cache[key]

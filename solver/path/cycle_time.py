@@ -1,0 +1,272 @@
+"""The cycle time of a path under joint speed and acceleration limits (motion.md section 4).
+
+Each pass starts and ends at rest. Three figures a pass, and their totals:
+
+- ``constant_feed_time``: L / mu_acc, L the pass's tool-point length;
+- the ramps: the arc length and time the feed needs to reach mu_acc from rest at the pass's
+  start (and, mirrored, to stop at its end), the feed raised at each waypoint as fast as every
+  joint's speed and acceleration limit lets it (a forward integration on the waypoints' grid),
+  and the pass's time at mu_acc with those ramps;
+- ``time_optimal``: the shortest time rest to rest with the feed free along the pass, by toppra
+  (TOPP-RA, Pham & Pham, T-RO 2018) on the same grid.
+
+All three run on one blended joint path, the one mu_acc is defined on: at waypoint i of a pass,
+q_s,i = (q(s_i + b) - q(s_i - b)) / (2 b) and q_ss,i = (q(s_i + b) - 2 q_i + q(s_i - b)) / b^2,
+q(s) the piecewise-linear interpolation of the tracked joint path in the tool point's arc length
+(continued along the first and last segment beyond the pass ends). At the waypoints where mu_acc
+is defined q_ss,i is its D_i, so the constant feed mu_acc keeps every joint within its
+acceleration limit there. Along the path, a joint's speed is q_s sdot and its acceleration
+q_s sddot + q_ss sdot^2.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+import toppra
+import toppra.algorithm
+import toppra.constraint
+
+from solver.path.evaluate import PathEvaluation
+from solver.path.prepare import check_passes
+from solver.path.problem import PathProblem
+
+
+@dataclass(frozen=True)
+class PassTime:
+    """The cycle time of one pass (s), and its ramps.
+
+    Attributes:
+        start: the pass's first waypoint. stop: one past its last.
+        length: L, m, the tool point's arc length.
+        constant_feed_time: L / mu_acc, s.
+        ramp_up_length: m, from rest to mu_acc at the start (L / 2 at most where the pass is too
+            short to reach it); ramp_up_time: s, the time that takes.
+        ramp_down_length: m, from mu_acc to rest at the end; ramp_down_time: s.
+        ramp_time: s, the pass at mu_acc with its ramps.
+        time_optimal: s, the time-optimal feed profile rest to rest (toppra).
+    """
+
+    start: int
+    stop: int
+    length: float
+    constant_feed_time: float
+    ramp_up_length: float
+    ramp_up_time: float
+    ramp_down_length: float
+    ramp_down_time: float
+    ramp_time: float
+    time_optimal: float
+
+
+@dataclass(frozen=True)
+class CycleTime:
+    """The cycle time of a path: totals over its passes (s), and each pass."""
+
+    constant_feed_time: float
+    ramp_time: float
+    time_optimal: float
+    passes: tuple[PassTime, ...]
+
+
+def blended_derivatives(
+    q: np.ndarray, s: np.ndarray, blend_length: float
+) -> tuple[np.ndarray, np.ndarray]:
+    """q_s and q_ss of one pass's blended joint path at its waypoints (see the module).
+
+    Args:
+        q: shape (M, n), rad, the joint path of the pass.
+        s: shape (M,), m, the arc lengths from the pass start (ascending, s_0 = 0).
+        blend_length: b, m.
+
+    Returns:
+        q_s (M, n), rad/m, and q_ss (M, n), rad/m^2.
+    """
+    b = blend_length
+
+    def at(target: np.ndarray) -> np.ndarray:
+        """The joint path at arc lengths, continued along the end segments beyond the pass."""
+        values = np.column_stack([np.interp(target, s, q[:, j]) for j in range(q.shape[1])])
+        first = (q[1] - q[0]) / max(s[1] - s[0], 1e-300)
+        last = (q[-1] - q[-2]) / max(s[-1] - s[-2], 1e-300)
+        values += np.minimum(target, 0.0)[:, None] * first
+        values += np.maximum(target - s[-1], 0.0)[:, None] * last
+        return values
+
+    ahead, behind = at(s + b), at(s - b)
+    return (ahead - behind) / (2 * b), (ahead - 2 * q + behind) / b**2
+
+
+def _largest_squared_speeds(
+    q_s: np.ndarray, q_ss: np.ndarray, qdot_max: np.ndarray, qddot_max: np.ndarray
+) -> np.ndarray:
+    """The largest sdot^2 (M,) at each waypoint the speed and acceleration limits allow.
+
+    The acceleration limits at sddot = 0: |q_ss sdot^2| <= a.
+    """
+    with np.errstate(divide="ignore"):
+        speed = np.min((qdot_max / np.abs(q_s)) ** 2, axis=1)
+        acceleration = np.min(qddot_max / np.abs(q_ss), axis=1)
+    result: np.ndarray = np.minimum(speed, acceleration)
+    return result
+
+
+def _ramp_from_rest(
+    s: np.ndarray, q_s: np.ndarray, q_ss: np.ndarray, cap: np.ndarray, qddot_max: np.ndarray
+) -> np.ndarray:
+    """sdot^2 (M,) from rest at s_0, each step the largest acceleration every joint allows.
+
+    x_{i+1} = min(cap_{i+1}, x_i + 2 (s_{i+1} - s_i) u_i), u_i the largest sddot with
+    |q_s,ij u + q_ss,ij x_i| <= a_j for every joint (x_i <= cap_i makes u = 0 feasible).
+    """
+    x = np.zeros(len(s))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        for i in range(len(s) - 1):
+            room = np.where(q_s[i] > 0.0, qddot_max, -qddot_max) - q_ss[i] * x[i]
+            bounds = np.where(q_s[i] != 0.0, room / q_s[i], np.inf)
+            u = max(float(np.min(bounds)), 0.0)
+            x[i + 1] = min(cap[i + 1], x[i] + 2.0 * (s[i + 1] - s[i]) * u)
+    return x
+
+
+def _time(s: np.ndarray, x: np.ndarray) -> float:
+    """The time (s) of the squared speeds ``x`` on the grid ``s``, sddot constant a segment."""
+    speed = np.sqrt(np.maximum(x, 0.0))
+    sums = speed[1:] + speed[:-1]
+    with np.errstate(divide="ignore"):
+        return float(np.sum(np.where(sums > 0.0, 2.0 * np.diff(s) / sums, np.inf)))
+
+
+def _time_optimal(
+    s: np.ndarray, q: np.ndarray, q_s: np.ndarray, q_ss: np.ndarray, limits: tuple[np.ndarray, ...]
+) -> float:
+    """The time-optimal rest-to-rest time (s) by toppra, on the grid ``s`` of the blended path."""
+    qdot_max, qddot_max = limits
+    path = _GridPath(s, q, q_s, q_ss)
+    constraints = [
+        toppra.constraint.JointVelocityConstraint(np.column_stack([-qdot_max, qdot_max])),
+        toppra.constraint.JointAccelerationConstraint(np.column_stack([-qddot_max, qddot_max])),
+    ]
+    instance = toppra.algorithm.TOPPRA(constraints, path, gridpoints=s)
+    _, sd, _ = instance.compute_parameterization(0.0, 0.0)
+    if sd is None:  # toppra found no feasible profile (not expected: rest is feasible)
+        return math.nan
+    return _time(s, np.asarray(sd, dtype=float) ** 2)
+
+
+class _GridPath(toppra.interpolator.AbstractGeometricPath):  # type: ignore[misc]
+    """The blended joint path as toppra sees it: q, q_s, q_ss at the grid, linear in between."""
+
+    def __init__(self, s: np.ndarray, q: np.ndarray, q_s: np.ndarray, q_ss: np.ndarray) -> None:
+        self._s, self._values = s, (q, q_s, q_ss)
+
+    def __call__(self, path_positions: float | np.ndarray, order: int = 0) -> np.ndarray:
+        values = self._values[order]
+        at = np.atleast_1d(np.asarray(path_positions, dtype=float))
+        out = np.column_stack([np.interp(at, self._s, values[:, j]) for j in range(self.dof)])
+        return out if np.ndim(path_positions) else out[0]
+
+    @property
+    def dof(self) -> int:
+        return int(self._values[0].shape[1])
+
+    @property
+    def path_interval(self) -> np.ndarray:
+        return np.array([self._s[0], self._s[-1]])
+
+
+MIN_GRID = 64  # grid points a pass at least: a pass of few waypoints is subdivided
+
+
+def _refined(s: np.ndarray, *values: np.ndarray) -> tuple[np.ndarray, ...]:
+    """The grid with at least MIN_GRID points (the waypoints kept), values linear in between.
+
+    Rest to rest needs room to speed up: on a grid of two points the feed could never leave 0.
+    """
+    if len(s) >= MIN_GRID:
+        return (s, *values)
+    fine = np.union1d(s, np.linspace(0.0, s[-1], MIN_GRID))
+    return (
+        fine,
+        *(
+            np.column_stack([np.interp(fine, s, v[:, j]) for j in range(v.shape[1])])
+            for v in values
+        ),
+    )
+
+
+def pass_time(
+    q: np.ndarray,
+    positions: np.ndarray,
+    mu_acc: float,
+    limits: tuple[np.ndarray, np.ndarray],
+    blend_length: float,
+) -> tuple[float, ...]:
+    """One pass's figures, in :class:`PassTime`'s order from ``length`` on.
+
+    Args:
+        q: shape (M, n), rad, the pass's joint path.
+        positions: shape (M, 3), m, its tool points.
+        mu_acc: m/s, > 0.
+        limits: qdot_max (n,), rad/s, and qddot_max (n,), rad/s^2.
+        blend_length: b, m.
+    """
+    s = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(positions, axis=0), axis=1))])
+    q_s, q_ss = blended_derivatives(q, s, blend_length)
+    s, q, q_s, q_ss = _refined(s, q, q_s, q_ss)
+    cap = np.minimum(_largest_squared_speeds(q_s, q_ss, *limits), mu_acc**2)
+    up = _ramp_from_rest(s, q_s, q_ss, cap, limits[1])
+    down = _ramp_from_rest(s[-1] - s[::-1], -q_s[::-1], q_ss[::-1], cap[::-1], limits[1])[::-1]
+    profile = np.minimum(up, down)
+    top = mu_acc**2 * (1.0 - 1e-12)
+    reached = np.flatnonzero(profile >= top)
+    first = int(reached[0]) if reached.size else int(np.argmax(profile))
+    last = int(reached[-1]) if reached.size else first
+    length = float(s[-1])
+    return (
+        length,
+        length / mu_acc,
+        float(s[first]),
+        _time(s[: first + 1], profile[: first + 1]),
+        float(s[-1] - s[last]),
+        _time(s[last:], profile[last:]),
+        _time(s, profile),
+        _time_optimal(s, q, q_s, q_ss, limits),
+    )
+
+
+def cycle_time(problem: PathProblem, evaluation: PathEvaluation) -> CycleTime | None:
+    """The cycle time of an evaluated path (motion.md section 4).
+
+    Args:
+        problem: the robot (its speed and acceleration limits), the path with its passes and
+            the options (the blend length) of the evaluation.
+        evaluation: :func:`solver.path.evaluate.evaluate_path` of the problem (or of a joint
+            path, :func:`solver.path.joint_path.evaluate_joint_path`).
+
+    Returns:
+        None without acceleration limits, where the path is infeasible, where mu_acc is 0
+        (the tool turns on the spot: no feed, no finite time), or where a figure is not
+        finite (toppra found no profile).
+    """
+    robot, acc = problem.robot, evaluation.acceleration
+    if acc is None or evaluation.q is None or robot.qddot_max is None or acc.mu_acc <= 0.0:
+        return None
+    limits = (robot.qdot_max, robot.qddot_max)
+    positions = problem.prepared.tool_position
+    passes = []
+    for start, stop in check_passes(problem.passes, len(positions)):
+        figures = pass_time(
+            evaluation.q[start:stop], positions[start:stop], acc.mu_acc, limits, acc.blend_length
+        )
+        if not all(math.isfinite(figure) for figure in figures):
+            return None
+        passes.append(PassTime(start, stop, *figures))
+    return CycleTime(
+        constant_feed_time=sum(p.constant_feed_time for p in passes),
+        ramp_time=sum(p.ramp_time for p in passes),
+        time_optimal=sum(p.time_optimal for p in passes),
+        passes=tuple(passes),
+    )
