@@ -150,8 +150,9 @@ def _repair_robot(body: dict[str, Any]) -> tuple[list[float], list[float]]:
         lower, upper = (list(side) for side in zip(*pairs, strict=True))
         return lower, upper
     info = catalogue()[robot["model"]]
-    if robot.get("joint_velocity_limits") is not None:
-        robot["joint_velocity_limits"] = _resized(robot["joint_velocity_limits"], info["dof"], 1.0)
+    for limits in ("joint_velocity_limits", "joint_acceleration_limits"):  # one per joint
+        if robot.get(limits) is not None:
+            robot[limits] = _resized(robot[limits], info["dof"], 1.0)
     return info["q_lower"], info["q_upper"]
 
 

@@ -273,6 +273,14 @@ class OpwRobot(_RobotOptions):
         description="[lower, upper] (rad) for each of the 6 joints, lower < upper.",
     )
     joint_velocity_limits: list[SpeedLimit] = _speed_limits([6], required=True)
+    joint_acceleration_limits: list[AccelerationLimit] | None = Field(
+        default=None,
+        min_length=6,
+        max_length=6,
+        description="Joint acceleration limits (rad/s^2), 6, each within [1e-6, 1e8]. With them "
+        "the answers add mu_acc, the constant feed the joint accelerations allow over the blend "
+        "length (ik.blend_length; motion.md), and the cycle time. Default: none.",
+    )
 
     def to_solver(self) -> SolverRobot:
         """The OPW arm, with its limits and tool point."""
