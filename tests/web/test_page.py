@@ -505,3 +505,22 @@ def test_the_acceleration_page_reads_at_1280_and_800_px(
     page.screenshot(path=str(ARTIFACTS / f"web-accelerations-{width}.png"), full_page=True)
     page.close()
     assert overflow <= 0  # nothing wider than the window
+
+
+def test_a_zero_blend_length_shows_the_apis_error_beside_the_field(page: Page, url: str) -> None:
+    fill(page, {**SMALL, "acc-limits": ACC, "blend-length": "0"})
+    page.click("#run")
+    selector = ".field[data-loc='ik.blend_length'] .error"
+    page.wait_for_function(f'document.querySelector("{selector}").textContent !== ""')
+    body = {
+        "kind": "map",
+        "request": {
+            "robot": UR5_ACC,
+            "path": EXAMPLE_PATH,
+            "grid": grid_of(SMALL),
+            "ik": {"blend_length": 0.0},
+        },
+    }
+    detail = httpx.post(f"{url}/v1/jobs", json=body).json()["detail"]
+    assert [d["loc"][2:] for d in detail] == [["ik", "blend_length"]]
+    assert page.text_content(selector) == detail[0]["msg"]
