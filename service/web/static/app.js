@@ -309,7 +309,7 @@ function describe(c) {
 function cellKey(c) { return `${c.x} ${c.y} ${c.yaw} ${c.spin}`; }
 
 // A map cell says whether acceleration binds, not where: the summary evaluation of the cell
-// hovered (or under the cursor) gives it, asked once per cell and kept.
+// hovered (or under the keyboard cursor) gives it, asked once per cell and kept.
 function askWhere(c) {
   if (c.mu_acc == null || c.limited_by !== "acceleration" || state.whereAcc.has(cellKey(c))) return;
   state.whereAcc.set(cellKey(c), null);
@@ -330,7 +330,9 @@ function showTip(c) {
   state.tipCell = c;
   delete tip.dataset.where;
   tip.textContent = describe(c);
-  askWhere(c);
+  // Asked once the pointer rests on the cell: a sweep over a large map sends no request a cell.
+  clearTimeout(state.whereTimer);
+  state.whereTimer = setTimeout(() => { if (state.tipCell === c) askWhere(c); }, 150);
 }
 
 function hover(canvas, event) {
