@@ -8,6 +8,7 @@ API's own answer to the same body, fetched here with httpx. Each test saves a sc
 from __future__ import annotations
 
 import json
+import math
 import shutil
 from collections.abc import Iterator
 from pathlib import Path
@@ -262,3 +263,264 @@ def test_a_program_without_units_asks_for_them_beside_the_field(page: Page, url:
         page.text_content("#import-units")
         == "mm (request: the request's units (the file states none))"
     )
+
+
+# ---- joint accelerations (issue 24): mu_acc, what binds, the cycle time ------------------------
+ACC = "10, 10, 10, 10, 10, 10"
+UR5_ACC = {"model": "ur5", "joint_acceleration_limits": [10.0] * 6}
+STOPS = [(68, 1, 84), (59, 82, 139), (33, 145, 140), (94, 201, 98), (253, 231, 37)]
+
+
+def page_colour(fraction: float) -> tuple[int, int, int]:
+    """The page's colour scale (app.js ``colour``), written again: dark blue, green, yellow."""
+    t = min(max(fraction, 0.0), 1.0) * (len(STOPS) - 1)
+    k = min(int(t), len(STOPS) - 2)
+    mix = [
+        math.floor(a + (b - a) * (t - k) + 0.5) for a, b in zip(STOPS[k], STOPS[k + 1], strict=True)
+    ]
+    return mix[0], mix[1], mix[2]
+
+
+def pixel(page: Page, panel: int, cell: dict[str, Any], api: dict[str, Any]) -> tuple[int, ...]:
+    """The colour the page painted at the centre of a cell of a panel."""
+    xs = sorted({c["x"] for c in api["cells"]})
+    ys = sorted({c["y"] for c in api["cells"]})
+    i, j = xs.index(cell["x"]), ys.index(cell["y"])
+    rgba = page.evaluate(
+        """([panel, i, j, ny]) => {
+            const canvas = document.querySelectorAll('.panel canvas')[panel];
+            const size = Number(canvas.dataset.cell);
+            const at = [i * size + size / 2, (ny - 1 - j) * size + size / 2];
+            return [...canvas.getContext('2d').getImageData(at[0], at[1], 1, 1).data];
+        }""",
+        [panel, i, j, len(ys)],
+    )
+    return tuple(rgba[:3])
+
+
+def run_acceleration_map(page: Page, url: str, blend: str = "0.002") -> dict[str, Any]:
+    """The small map from the page with every joint at 10 rad/s^2; the API's map of that body."""
+    fill(page, {**SMALL, "acc-limits": ACC, "blend-length": blend})
+    page.click("#run")
+    page.wait_for_function("document.getElementById('summary').dataset.cells", timeout=120_000)
+    body = {
+        "robot": UR5_ACC,
+        "path": EXAMPLE_PATH,
+        "grid": grid_of(SMALL),
+        "ik": {"blend_length": float(blend)},
+    }
+    answer = httpx.post(f"{url}/v1/map", json=body, timeout=120)
+    assert answer.status_code == 200, answer.text
+    return answer.json()
+
+
+def evaluate_api(url: str, cell: dict[str, Any], **extra: Any) -> dict[str, Any]:
+    placement = {"x": cell["x"], "y": cell["y"], "z": 0.1, "yaw": cell["yaw"], "spin": 0.0}
+    body = {"robot": UR5_ACC, "path": EXAMPLE_PATH, "placement": placement, **extra}
+    answer = httpx.post(f"{url}/v1/evaluate", json=body, timeout=60)
+    assert answer.status_code == 200, answer.text
+    return dict(answer.json())
+
+
+def test_acceleration_limits_colour_the_map_by_mu_acc_and_the_hover_says_what_binds(
+    page: Page, url: str
+) -> None:
+    api = run_acceleration_map(page, url)
+    feasible = [c for c in api["cells"] if c["mu_path"] is not None]
+    assert feasible and all(c["mu_acc"] is not None for c in feasible)
+    assert page.get_attribute("#summary", "data-key") == "mu_acc"
+    assert page.text_content("#cb-label") == "mu_acc (m/s)"
+    low, high = min(c["mu_acc"] for c in feasible), max(c["mu_acc"] for c in feasible)
+    assert page.text_content("#cb-min") == f"{low:.3f} m/s"
+    assert page.text_content("#cb-max") == f"{high:.3f} m/s"
+    best = api["best"]
+    assert page.text_content("#best-mu") == (
+        f"mu_acc {best['mu_acc']:.6f} m/s (mu_path {best['mu_path']:.6f} m/s)"
+    )
+    by_acceleration = sum(c["limited_by"] == "acceleration" for c in feasible)
+    assert f"limited by acceleration in {by_acceleration} cells" in (
+        page.text_content("#summary") or ""
+    )
+    per_panel = len(api["cells"]) // 2
+    panel_cells = [c for c in api["cells"][:per_panel] if c["mu_path"] is not None]
+    speed_low = min(c["mu_path"] for c in feasible)
+    speed_high = max(c["mu_path"] for c in feasible)
+    # A cell whose mu_acc colour differs from its mu_path colour: the page paints the former.
+    cell = next(
+        c
+        for c in panel_cells
+        if c["limited_by"] == "acceleration"
+        and page_colour((c["mu_acc"] - low) / (high - low))
+        != page_colour((c["mu_path"] - speed_low) / (speed_high - speed_low))
+    )
+    assert pixel(page, 0, cell, api) == page_colour((cell["mu_acc"] - low) / (high - low))
+    point = cell_point(page, 0, cell, api)
+    page.mouse.move(point["x"], point["y"])
+    page.wait_for_selector("#tooltip[data-where='1']", timeout=30_000)
+    tooltip = page.text_content("#tooltip") or ""
+    assert f"mu_path {cell['mu_path']:.6f} m/s" in tooltip
+    assert f"mu_acc {cell['mu_acc']:.6f} m/s, limited by acceleration" in tooltip
+    acc = evaluate_api(url, cell, detail="summary")["acceleration"]
+    assert acc["mu_acc"] == cell["mu_acc"] and acc["limited_by"] == "acceleration"
+    assert (
+        f"where: joint {acc['joint'] + 1} ({acc['joint_name']}), waypoint {acc['waypoint']}"
+        in tooltip
+    )
+
+
+def test_a_clicked_cell_shows_mu_acc_the_acceleration_use_and_the_cycle_times(
+    page: Page, url: str
+) -> None:
+    api = run_acceleration_map(page, url, blend="0.004")
+    per_panel = len(api["cells"]) // 2
+    cell = next(c for c in api["cells"][:per_panel] if c["limited_by"] == "acceleration")
+    point = cell_point(page, 0, cell, api)
+    page.mouse.click(point["x"], point["y"])
+    page.wait_for_selector("#plot[data-drawn='1']", timeout=60_000)
+    answer = evaluate_api(url, cell, feed=0.1, ik={"blend_length": 0.004})
+    acc, times = answer["acceleration"], answer["cycle_time"]
+    # The blend length reached the API: at the default 2 mm mu_acc is another figure.
+    default = evaluate_api(url, cell, detail="summary")["acceleration"]
+    assert default["mu_acc"] != acc["mu_acc"]
+    assert acc["mu_acc"] == cell["mu_acc"] and acc["blend_length"] == 0.004
+    text = page.text_content("#acceleration") or ""
+    assert text.startswith(f"mu_acc {acc['mu_acc']:.6f} m/s (blend 4.000 mm): ")
+    assert (
+        f"joint {acc['joint'] + 1} ({acc['joint_name']}) binds at waypoint {acc['waypoint']}"
+        in text
+    )
+    assert page.text_content("#cycle-time") == (
+        f"cycle time: {times['constant_feed_time']:.3f} s at the constant feed mu_acc, "
+        f"{times['ramp']:.3f} s with the ramps at the pass ends, "
+        f"{times['time_optimal']:.3f} s time-optimal (feed free along the path)"
+    )
+    # The plot's third panel: |D_i| F^2 / a_j from the API's qdd_at_mu_acc = D_i mu_acc^2.
+    scale = (0.1 / acc["mu_acc"]) ** 2 / 10.0
+    rows = [w["qdd_at_mu_acc"] for w in answer["waypoints"] if w["qdd_at_mu_acc"] is not None]
+    assert rows and len(rows) < len(answer["waypoints"])  # none within the blend of the ends
+    peak = max(abs(v) * scale for row in rows for v in row)
+    assert page.get_attribute("#plot", "data-panels") == "3"
+    assert page.get_attribute("#plot", "data-acceleration-use") == f"{peak:.6f}"
+    assert f"the largest acceleration use is {100 * peak:.1f} %" in text
+
+
+def test_without_acceleration_limits_the_page_shows_mu_path_only(page: Page, url: str) -> None:
+    api = run_small_map(page, url)
+    assert page.get_attribute("#summary", "data-key") == "mu_path"
+    assert page.text_content("#cb-label") == "mu_path (m/s)"
+    cell = next(c for c in api["cells"] if c["mu_path"] is not None)
+    assert cell["mu_acc"] is None
+    page.mouse.click(**cell_point(page, 0, cell, api))
+    page.wait_for_selector("#plot[data-drawn='1']", timeout=60_000)
+    assert page.text_content("#acceleration") == ""
+    assert page.text_content("#cycle-time") == ""
+    assert page.get_attribute("#plot", "data-panels") == "2"
+
+
+def test_the_optimum_shows_its_mu_acc(page: Page, url: str) -> None:
+    run_acceleration_map(page, url)
+    page.click("#optimize")
+    page.wait_for_selector(".panel canvas[data-optimum='1']", timeout=300_000)
+    body = {
+        "robot": UR5_ACC,
+        "path": EXAMPLE_PATH,
+        "method": "casadi",
+        "z": 0.1,
+        "bounds": {"x": [-0.1, 0.1], "y": [0.3, 0.5], "yaw": [0.0, 1.5]},
+        "ik": {"blend_length": 0.002},
+    }
+    api = httpx.post(f"{url}/v1/optimize", json=body, timeout=300).json()
+    assert api["mu_acc"] is not None
+    assert page.text_content("#opt-acc") == f"{api['mu_acc']:.6f} m/s"
+    assert page.text_content("#opt-mu") == f"{api['mu_path']:.6f} m/s"
+    assert page.is_visible("#opt-acc-line")
+    acc = api["evaluation"]["acceleration"]
+    assert page.text_content("#opt-acc-binds") == (
+        f"(+{api['improvement_percent']:.2f} % over the start's mu_acc) the acceleration of "
+        f"joint {acc['joint'] + 1} ({acc['joint_name']}) binds at waypoint {acc['waypoint']}"
+    )
+    assert page.text_content("#opt-improvement") == (
+        f"(the start's mu_path: {api['start']['mu_path']:.6f} m/s)"
+    )
+
+
+@pytest.mark.parametrize("typed", ["10, 10, 10", "10, 10, ten, 10, 10, 10"])
+def test_acceleration_limits_the_api_refuses_show_its_error_beside_the_field(
+    page: Page, url: str, typed: str
+) -> None:
+    fill(page, {**SMALL, "acc-limits": typed})
+    page.click("#run")
+    selector = ".field[data-loc='robot.joint_acceleration_limits'] .error"
+    page.wait_for_function(f'document.querySelector("{selector}").textContent !== ""')
+    limits = [float(v) if v.strip() != "ten" else None for v in typed.split(",")]
+    body = {
+        "kind": "map",
+        "request": {
+            "robot": {"model": "ur5", "joint_acceleration_limits": limits},
+            "path": EXAMPLE_PATH,
+            "grid": grid_of(SMALL),
+            "ik": {"blend_length": 0.002},
+        },
+    }
+    answer = httpx.post(f"{url}/v1/jobs", json=body)
+    assert answer.status_code == 422
+    detail = answer.json()["detail"]
+    assert [d["loc"][2:4] for d in detail] == [["robot", "joint_acceleration_limits"]]
+    assert page.text_content(selector) == detail[0]["msg"]
+    assert page.text_content("#form-error") == ""
+    assert page.get_attribute("#summary", "data-cells") is None  # no map ran
+
+
+def test_a_pasted_robot_brings_its_own_acceleration_limits(page: Page, url: str) -> None:
+    robot = {"model": "ur5", "joint_acceleration_limits": [5.0] * 6}
+    page.click("details summary")
+    page.fill("#robot-json", json.dumps(robot))
+    assert page.is_disabled("#acc-limits") and page.is_disabled("#limits input >> nth=0")
+    assert page.is_visible("#own-robot-note")
+    fill(page, SMALL)
+    page.click("#run")
+    page.wait_for_function("document.getElementById('summary').dataset.cells", timeout=120_000)
+    body = {"robot": robot, "path": EXAMPLE_PATH, "grid": grid_of(SMALL)}
+    api = httpx.post(f"{url}/v1/map", json=body, timeout=120).json()
+    best = api["best"]
+    assert page.text_content("#best-mu") == (
+        f"mu_acc {best['mu_acc']:.6f} m/s (mu_path {best['mu_path']:.6f} m/s)"
+    )
+
+
+@pytest.mark.parametrize("width", [1280, 800])
+def test_the_acceleration_page_reads_at_1280_and_800_px(
+    browser: Browser, url: str, width: int
+) -> None:
+    page = browser.new_page(viewport={"width": width, "height": 900})
+    page.goto(url + "/")
+    page.wait_for_selector("body[data-ready='1']", timeout=30_000)
+    api = run_acceleration_map(page, url)
+    cell = next(c for c in api["cells"] if c["limited_by"] == "acceleration")
+    page.locator(".panel canvas").nth(0).scroll_into_view_if_needed()
+    page.mouse.click(**cell_point(page, 0, cell, api))
+    page.wait_for_selector("#plot[data-drawn='1']", timeout=60_000)
+    overflow = page.evaluate("document.documentElement.scrollWidth - window.innerWidth")
+    ARTIFACTS.mkdir(exist_ok=True)
+    page.screenshot(path=str(ARTIFACTS / f"web-accelerations-{width}.png"), full_page=True)
+    page.close()
+    assert overflow <= 0  # nothing wider than the window
+
+
+def test_a_zero_blend_length_shows_the_apis_error_beside_the_field(page: Page, url: str) -> None:
+    fill(page, {**SMALL, "acc-limits": ACC, "blend-length": "0"})
+    page.click("#run")
+    selector = ".field[data-loc='ik.blend_length'] .error"
+    page.wait_for_function(f'document.querySelector("{selector}").textContent !== ""')
+    body = {
+        "kind": "map",
+        "request": {
+            "robot": UR5_ACC,
+            "path": EXAMPLE_PATH,
+            "grid": grid_of(SMALL),
+            "ik": {"blend_length": 0.0},
+        },
+    }
+    detail = httpx.post(f"{url}/v1/jobs", json=body).json()["detail"]
+    assert [d["loc"][2:] for d in detail] == [["ik", "blend_length"]]
+    assert page.text_content(selector) == detail[0]["msg"]

@@ -1,5 +1,6 @@
-// The DTF placement page: a map job with progress and cancel, the colour map, a cell's joint
-// speeds, the optimum. Plain JavaScript; it calls only this service's API.
+// The DTF placement page: a map job with progress and cancel, the colour map (mu_path, or mu_acc
+// with joint acceleration limits), a cell's joint speeds and accelerations, the cycle time, the
+// optimum. Plain JavaScript; it calls only this service's API.
 "use strict";
 
 const $ = (id) => document.getElementById(id);
@@ -17,12 +18,29 @@ function numbers(text) {
 
 function robotBody() {
   const own = $("robot-json").value.trim();
-  if (own) return JSON.parse(own);
+  if (own) return JSON.parse(own);  // a pasted robot object carries its own limits
   const robot = { model: $("robot-model").value };
   const info = state.robots.find((r) => r.name === robot.model);
   const limits = [...$("limits").querySelectorAll("input")].map((i) => Number(i.value));
   if (info && limits.some((v, k) => v !== info.qdot_max[k])) robot.joint_velocity_limits = limits;
+  // Empty: none. Otherwise every entry is sent as typed (a wrong count or a word is the API's
+  // error beside the field, never dropped here): Number("x") is NaN, sent as null.
+  const acc = $("acc-limits").value.trim();
+  if (acc) robot.joint_acceleration_limits = acc.split(",").map((v) => (v.trim() === "" ? null : Number(v)));
   return robot;
+}
+
+function ikBody() {
+  return { blend_length: Number($("blend-length").value) };
+}
+
+// A pasted robot object brings its own limits: the catalogue's fields are then greyed out.
+function showOwnRobot() {
+  const own = $("robot-json").value.trim() !== "";
+  for (const input of [...$("limits").querySelectorAll("input"), $("acc-limits"), $("robot-model")]) {
+    input.disabled = own;
+  }
+  $("own-robot-note").hidden = !own;
 }
 
 function gridBody() {
@@ -35,7 +53,7 @@ function gridBody() {
 }
 
 function mapBody() {
-  return { robot: robotBody(), path: state.path, grid: gridBody() };
+  return { robot: robotBody(), path: state.path, grid: gridBody(), ik: ikBody() };
 }
 
 function showLimits() {
@@ -148,7 +166,7 @@ async function runMap(event) {
   try { body = mapBody(); } catch (error) { showErrors([{ loc: ["robot"], msg: String(error) }]); return; }
   const job = await api("POST", "/v1/jobs", { kind: "map", request: body }).catch(() => null);
   if (!job) return;
-  state.job = job.id; state.grid = body.grid;
+  state.job = job.id; state.grid = body.grid; state.mapBody = body;
   $("cancel").disabled = false; $("run").disabled = true;
   await watch(job.id);
 }
@@ -183,18 +201,28 @@ function colour(fraction) {  // dark blue -> green -> yellow
   return `rgb(${mix.join(",")})`;
 }
 
+// The map's colour: mu_acc when the request gave acceleration limits (the API then fills it in
+// every feasible cell and ranks best and worst by it), else mu_path.
 function drawMap(answer) {
   state.map = answer;
+  state.whereAcc = new Map();
   const cells = answer.cells;
+  const key = cells.some((c) => c.mu_acc != null) ? "mu_acc" : "mu_path";
   const xs = [...new Set(cells.map((c) => c.x))];
   const ys = [...new Set(cells.map((c) => c.y))];
-  const feasible = cells.filter((c) => c.mu_path !== null).map((c) => c.mu_path);
+  const feasible = cells.filter((c) => c.mu_path !== null).map((c) => c[key]);
   const low = Math.min(...feasible), high = Math.max(...feasible);
   const size = Math.min(24, Math.max(2, Math.floor(480 / Math.max(xs.length, ys.length))));
-  state.scale = { low, high, xs, ys, size };
-  $("summary").textContent = `${cells.length} cells, ${answer.feasible_cells} feasible`;
+  state.scale = { low, high, xs, ys, size, key };
+  const byAcc = cells.filter((c) => c.limited_by === "acceleration").length;
+  $("summary").textContent = `${cells.length} cells, ${answer.feasible_cells} feasible`
+    + (key === "mu_acc" ? `; colour: mu_acc, limited by acceleration in ${byAcc} cells, by speed in ${answer.feasible_cells - byAcc}` : "");
   $("summary").dataset.cells = String(cells.length);
-  $("best-mu").textContent = answer.best ? answer.best.mu_path.toFixed(6) + " m/s" : "none feasible";
+  $("summary").dataset.key = key;
+  $("cb-label").textContent = `${key} (m/s)`;
+  $("best-mu").textContent = !answer.best ? "none feasible"
+    : key === "mu_acc" ? `mu_acc ${answer.best.mu_acc.toFixed(6)} m/s (mu_path ${answer.best.mu_path.toFixed(6)} m/s)`
+    : answer.best.mu_path.toFixed(6) + " m/s";
   $("best-where").textContent = answer.best
     ? `at x ${answer.best.placement.x.toFixed(3)} m, y ${answer.best.placement.y.toFixed(3)} m, yaw ${answer.best.placement.yaw.toFixed(3)} rad` : "";
   $("cb-min").textContent = feasible.length ? `${low.toFixed(3)} m/s` : "";
@@ -222,21 +250,21 @@ function drawMap(answer) {
     panels.appendChild(figure);
     paintPanel(canvas);
     canvas.addEventListener("mousemove", (e) => hover(canvas, e));
-    canvas.addEventListener("mouseleave", () => { $("tooltip").hidden = true; });
+    canvas.addEventListener("mouseleave", () => { $("tooltip").hidden = true; state.tipCell = null; });
     canvas.addEventListener("click", (e) => { const c = cellAt(canvas, e); if (c) evaluateCell(c); });
     canvas.addEventListener("keydown", (e) => keys(canvas, e));
   }
 }
 
 function paintPanel(canvas) {
-  const { low, high, xs, ys } = state.scale;
+  const { low, high, xs, ys, key } = state.scale;
   const g = canvas.getContext("2d");
   const first = Number(canvas.dataset.first);
   for (let k = 0; k < xs.length * ys.length; k++) {
     const c = state.map.cells[first + k];
     const i = k % xs.length, j = Math.floor(k / xs.length);
     g.fillStyle = c.mu_path === null ? REASON_COLOURS[c.reason]
-      : colour(high > low ? (c.mu_path - low) / (high - low) : 1);
+      : colour(high > low ? (c[key] - low) / (high - low) : 1);
     g.fillRect(i * state.scale.size, (ys.length - 1 - j) * state.scale.size, state.scale.size, state.scale.size);
   }
   if (state.cursor && state.cursor.canvas === canvas) {
@@ -263,16 +291,55 @@ function describe(c) {
   } else {
     lines.push(`mu_path ${c.mu_path.toFixed(6)} m/s`);
     lines.push(`bottleneck: joint ${c.bottleneck_joint + 1}, waypoint ${c.bottleneck_waypoint}`);
+    if (c.mu_acc != null) {
+      lines.push(`mu_acc ${c.mu_acc.toFixed(6)} m/s, limited by ${c.limited_by}`);
+      if (c.limited_by === "speed") {
+        lines.push(`where: the speed bottleneck (joint ${c.bottleneck_joint + 1}, waypoint ${c.bottleneck_waypoint})`);
+      } else {
+        const where = state.whereAcc.get(cellKey(c));
+        lines.push(where ? `where: joint ${where.joint + 1} (${where.joint_name}), waypoint ${where.waypoint}`
+          : "where: asking the API…");
+      }
+    }
     lines.push(`branch ${Object.values(c.branch || {}).join("/")}`);
   }
   return lines.join("\n");
 }
 
+function cellKey(c) { return `${c.x} ${c.y} ${c.yaw} ${c.spin}`; }
+
+// A map cell says whether acceleration binds, not where: the summary evaluation of the cell
+// hovered (or under the keyboard cursor) gives it, asked once per cell and kept.
+function askWhere(c) {
+  if (c.mu_acc == null || c.limited_by !== "acceleration" || state.whereAcc.has(cellKey(c))) return;
+  state.whereAcc.set(cellKey(c), null);
+  const body = { ...state.mapBody, placement: placementOf(c), detail: "summary" };
+  delete body.grid;
+  api("POST", "/v1/evaluate", body).then((answer) => {
+    state.whereAcc.set(cellKey(c), answer.acceleration);
+    if (state.tipCell === c) { $("tooltip").textContent = describe(c); $("tooltip").dataset.where = "1"; }
+  }).catch(() => state.whereAcc.delete(cellKey(c)));
+}
+
+function placementOf(c) {
+  return { x: c.x, y: c.y, z: state.grid.z, yaw: c.yaw, spin: c.spin };
+}
+
+function showTip(c) {
+  const tip = $("tooltip");
+  state.tipCell = c;
+  delete tip.dataset.where;
+  tip.textContent = describe(c);
+  // Asked once the pointer rests on the cell: a sweep over a large map sends no request a cell.
+  clearTimeout(state.whereTimer);
+  state.whereTimer = setTimeout(() => { if (state.tipCell === c) askWhere(c); }, 150);
+}
+
 function hover(canvas, event) {
   const c = cellAt(canvas, event);
   const tip = $("tooltip");
-  if (!c) { tip.hidden = true; return; }
-  tip.textContent = describe(c);
+  if (!c) { tip.hidden = true; state.tipCell = null; return; }
+  if (state.tipCell !== c) showTip(c);
   tip.style.left = `${event.clientX + 12}px`; tip.style.top = `${event.clientY + 12}px`;
   tip.hidden = false;
 }
@@ -288,7 +355,7 @@ function keys(canvas, event) {
     cur.j = Math.min(Math.max(cur.j + moves[event.key][1], 0), ys.length - 1);
     state.cursor = cur;
     document.querySelectorAll(".panel canvas").forEach(paintPanel);
-    $("tooltip").textContent = describe(cell());
+    showTip(cell());
   } else if (event.key === "Enter") {
     event.preventDefault();
     state.cursor = cur;
@@ -301,8 +368,9 @@ async function evaluateCell(c) {
   clearErrors();
   const body = {
     robot: robotBody(), path: state.path,
-    placement: { x: c.x, y: c.y, z: state.grid.z, yaw: c.yaw, spin: c.spin },
+    placement: placementOf(c),
     feed: Number($("feed").value),
+    ik: ikBody(),
   };
   const answer = await api("POST", "/v1/evaluate", body).catch(() => null);
   if (!answer) return;
@@ -313,16 +381,52 @@ async function evaluateCell(c) {
   $("bottleneck").textContent = b ? `bottleneck: waypoint ${b.waypoint}, joint ${b.joint + 1} (${b.joint_name})` : "";
   $("bottleneck").dataset.waypoint = b ? String(b.waypoint) : "";
   $("bottleneck").dataset.joint = b ? String(b.joint) : "";
-  plot(answer);
+  showAcceleration(answer, body);
+  plot(answer, body);
 }
 
-function plot(answer) {
+// mu_acc, what binds it and where; the cycle time at mu_acc, with the ramps, time-optimal.
+function showAcceleration(answer, body) {
+  const acc = answer.acceleration, t = answer.cycle_time;
+  const line = $("acceleration");
+  line.textContent = "";
+  if (acc) {
+    const where = acc.limited_by === "speed" ? "a speed limit binds (the bottleneck above)"
+      : `the acceleration limit of joint ${acc.joint + 1} (${acc.joint_name}) binds at waypoint ${acc.waypoint}`;
+    const use = accelerationUse(answer, body);
+    const peak = use ? Math.max(...use.flatMap((row) => (row ? row : [])), 0) : null;
+    line.textContent = `mu_acc ${acc.mu_acc.toFixed(6)} m/s (blend ${(1000 * acc.blend_length).toFixed(3)} mm): ${where}`
+      + (peak === null ? "" : `; at ${body.feed} m/s the largest acceleration use is ${(100 * peak).toFixed(1)} %`)
+      + (answer.feed_check ? (answer.feed_check.feasible ? " (the feed runs)" : " (the feed does NOT run)") : "");
+  }
+  $("cycle-time").textContent = t
+    ? `cycle time: ${t.constant_feed_time.toFixed(3)} s at the constant feed mu_acc, ${t.ramp.toFixed(3)} s with the ramps at the pass ends, ${t.time_optimal.toFixed(3)} s time-optimal (feed free along the path)`
+    : (acc ? "cycle time: none (mu_acc is 0)" : "");
+}
+
+// Each joint's use of its acceleration limit at the constant feed F: |D_i| F^2 / a_j, from the
+// answer's qdd_at_mu_acc = D_i mu_acc^2 (motion.md section 2; null near the pass ends).
+function accelerationUse(answer, body) {
+  const acc = answer.acceleration;
+  const limits = body.robot.joint_acceleration_limits;
+  if (!acc || !(acc.mu_acc > 0) || !Array.isArray(limits)) return null;
+  const scale = (body.feed / acc.mu_acc) ** 2;
+  return answer.waypoints.map((p) => (p.qdd_at_mu_acc
+    ? p.qdd_at_mu_acc.map((v, j) => (Math.abs(v) * scale) / limits[j]) : null));
+}
+
+function plot(answer, body) {
   const canvas = $("plot");
+  const accUse = answer.feasible ? accelerationUse(answer, body) : null;
+  canvas.height = accUse ? 480 : 320;
   const g = canvas.getContext("2d");
   g.clearRect(0, 0, canvas.width, canvas.height);
+  delete canvas.dataset.accelerationUse;
+  canvas.dataset.panels = accUse ? "3" : "2";
   const points = answer.waypoints;
   if (!answer.feasible || !points.length) return;
-  const left = 50, width = canvas.width - 70, top = 10, height = (canvas.height - 60) / 2;
+  const panels = accUse ? 3 : 2;
+  const left = 50, width = canvas.width - 70, top = 10, height = (canvas.height - 30 * panels) / panels;
   const xOf = (k) => left + (width * k) / Math.max(points.length - 1, 1);
   const axes = (y0, label, max) => {
     g.strokeStyle = "#444"; g.strokeRect(left, y0, width, height);
@@ -343,6 +447,35 @@ function plot(answer) {
     points.forEach((p, k) => { const u = Math.min(p.use[j] ?? 0, 1.2); const y = useTop + height * (1 - u); k ? g.lineTo(xOf(k), y) : g.moveTo(xOf(k), y); });
     g.stroke();
     g.fillStyle = colours[j % colours.length]; g.fillText(`joint ${j + 1}`, left + width - 60, useTop + 14 + 13 * j);
+  }
+  let bottom = useTop + height;
+  if (accUse) {  // the third panel: the joints' use of their acceleration limits at the feed
+    const accTop = useTop + height + 30;
+    bottom = accTop + height;
+    const peak = Math.max(...accUse.flatMap((row) => (row ? row.filter(Number.isFinite) : [])), 0);
+    const ceiling = Math.max(1, Math.min(peak, 2));
+    axes(accTop, "joint use of its acceleration limit at the feed (none within the blend of a pass end)", ceiling);
+    g.strokeStyle = "#b00020"; g.setLineDash([2, 2]); g.beginPath();
+    g.moveTo(left, accTop + height * (1 - 1 / ceiling)); g.lineTo(left + width, accTop + height * (1 - 1 / ceiling)); g.stroke(); g.setLineDash([]);
+    for (let j = 0; j < joints; j++) {
+      g.strokeStyle = colours[j % colours.length]; g.beginPath();
+      let open = false;
+      accUse.forEach((row, k) => {
+        if (!row) { open = false; return; }
+        const y = accTop + height * (1 - Math.min(row[j], ceiling) / ceiling);
+        if (open) g.lineTo(xOf(k), y); else g.moveTo(xOf(k), y);
+        open = true;
+      });
+      g.stroke();
+    }
+    const acc = answer.acceleration;
+    if (acc.limited_by === "acceleration") {
+      const x = xOf(acc.waypoint);
+      g.strokeStyle = "#000"; g.setLineDash([4, 3]); g.beginPath();
+      g.moveTo(x, accTop); g.lineTo(x, bottom); g.stroke(); g.setLineDash([]);
+      g.fillStyle = "#000"; g.fillText(`mu_acc binds (joint ${acc.joint + 1})`, Math.min(x + 4, left + width - 130), accTop - 6);
+    }
+    canvas.dataset.accelerationUse = peak.toFixed(6);
   }
   if (answer.bottleneck) {
     const x = xOf(answer.bottleneck.waypoint);
@@ -368,17 +501,32 @@ async function optimize() {
   clearErrors();
   const grid = gridBody();
   const body = {
-    robot: robotBody(), path: state.path, method: $("method").value, z: grid.z,
+    robot: robotBody(), path: state.path, method: $("method").value, z: grid.z, ik: ikBody(),
     bounds: { x: [grid.x.min, grid.x.max], y: [grid.y.min, grid.y.max],
       yaw: [Math.min(...grid.yaw), Math.max(...grid.yaw)] },
   };
   $("opt-mu").textContent = "optimising…";
+  $("opt-acc-line").hidden = true;
+  for (const id of ["opt-acc", "opt-acc-binds", "opt-improvement", "opt-where"]) $(id).textContent = "";
   const answer = await api("POST", "/v1/optimize", body).catch(() => null);
   if (!answer) { $("opt-mu").textContent = ""; return; }
   if (!answer.found) { $("opt-mu").textContent = "no feasible placement"; return; }
   const p = answer.placement;
   $("opt-mu").textContent = `${answer.mu_path.toFixed(6)} m/s`;
-  $("opt-improvement").textContent = `(+${answer.improvement_percent.toFixed(2)} % over the start, ${answer.start.mu_path === null ? "infeasible" : answer.start.mu_path.toFixed(6) + " m/s"})`;
+  const start = answer.start.mu_path === null ? "infeasible" : answer.start.mu_path.toFixed(6) + " m/s";
+  // improvement_percent is of mu_acc with acceleration limits (what the search maximised), so
+  // it goes on the mu_acc line then; the start's mu_path is all the answer gives of the start.
+  const gain = answer.improvement_percent === null ? "" : `+${answer.improvement_percent.toFixed(2)} %`;
+  $("opt-improvement").textContent = answer.mu_acc == null
+    ? `(${gain}${gain ? " " : ""}over the start, ${start})` : `(the start's mu_path: ${start})`;
+  if (answer.mu_acc != null) {
+    const acc = answer.evaluation && answer.evaluation.acceleration;
+    $("opt-acc").textContent = `${answer.mu_acc.toFixed(6)} m/s`;
+    $("opt-acc-binds").textContent = (gain ? `(${gain} over the start's mu_acc) ` : "")
+      + (!acc ? "" : acc.limited_by === "speed" ? "a speed limit binds"
+        : `the acceleration of joint ${acc.joint + 1} (${acc.joint_name}) binds at waypoint ${acc.waypoint}`);
+    $("opt-acc-line").hidden = false;
+  }
   $("opt-where").textContent = `x ${p.x.toFixed(4)} m, y ${p.y.toFixed(4)} m, z ${p.z} m, yaw ${p.yaw.toFixed(4)} rad`;
   const frames = $("frames");
   frames.textContent = "";
@@ -416,6 +564,7 @@ async function start() {
   if (state.robots.some((r) => r.name === "ur5")) select.value = "ur5";
   showLimits();
   select.addEventListener("change", showLimits);
+  $("robot-json").addEventListener("input", showOwnRobot);
   $("path-example").addEventListener("change", loadExample);
   $("path-file").addEventListener("change", async () => {
     const file = $("path-file").files[0];
