@@ -108,6 +108,39 @@ class Robot:
         return robot
 
 
+def _checked_limits(
+    values: np.ndarray | list[float],
+    joint_names: tuple[str, ...],
+    *,
+    field: str,
+    unit: str,
+    lower: float,
+    upper: float,
+) -> np.ndarray:
+    """Per-joint limits as a float array: one per joint, finite, within [lower, upper].
+
+    Raises:
+        InvalidInputError: on ``field``, naming the count or the joint at fault.
+    """
+    limits = np.array(values, dtype=float)
+    if limits.shape != (len(joint_names),):
+        count = limits.size if limits.ndim == 1 else f"an array of shape {limits.shape} of"
+        raise InvalidInputError(
+            field,
+            f"{count} values for the {len(joint_names)} joints ({', '.join(joint_names)}): "
+            "give one per joint, in this order",
+        )
+    bad = np.flatnonzero(~np.isfinite(limits) | (limits < lower) | (limits > upper))
+    if bad.size:
+        j = int(bad[0])
+        raise InvalidInputError(
+            field,
+            f"joint {j} ({joint_names[j]}) limit {float(limits[j]):.6g} {unit} must be > 0, "
+            f"within [{lower}, {upper}] {unit}",
+        )
+    return limits
+
+
 def check_speed_limits(
     qdot_max: np.ndarray | list[float], joint_names: tuple[str, ...]
 ) -> np.ndarray:
@@ -118,25 +151,17 @@ def check_speed_limits(
         joint_names: the n joint names, for the message.
 
     Raises:
-        InvalidInputError: wrong length, not finite, or out of range.
+        InvalidInputError: on ``robot.joint_velocity_limits``: wrong length, not finite, or
+            out of range.
     """
-    limits = np.array(qdot_max, dtype=float)
-    field = "robot.joint_velocity_limits"
-    if limits.shape != (len(joint_names),):
-        raise InvalidInputError(
-            field, f"{limits.shape=} but the robot has {len(joint_names)} joints"
-        )
-    bad = np.flatnonzero(
-        ~np.isfinite(limits) | (limits < MIN_SPEED_LIMIT) | (limits > MAX_SPEED_LIMIT)
+    return _checked_limits(
+        qdot_max,
+        joint_names,
+        field="robot.joint_velocity_limits",
+        unit="rad/s",
+        lower=MIN_SPEED_LIMIT,
+        upper=MAX_SPEED_LIMIT,
     )
-    if bad.size:
-        j = int(bad[0])
-        raise InvalidInputError(
-            field,
-            f"joint {j} ({joint_names[j]}) limit {float(limits[j]):.6g} rad/s must be > 0, within "
-            f"[{MIN_SPEED_LIMIT}, {MAX_SPEED_LIMIT}] rad/s",
-        )
-    return limits
 
 
 def check_acceleration_limits(
@@ -152,23 +177,14 @@ def check_acceleration_limits(
         InvalidInputError: on ``robot.joint_acceleration_limits``, naming the joint: wrong
             length, not finite, or out of range.
     """
-    limits = np.array(qddot_max, dtype=float)
-    field = "robot.joint_acceleration_limits"
-    if limits.shape != (len(joint_names),):
-        raise InvalidInputError(
-            field, f"{limits.shape=} but the robot has {len(joint_names)} joints"
-        )
-    bad = np.flatnonzero(
-        ~np.isfinite(limits) | (limits < MIN_ACCELERATION_LIMIT) | (limits > MAX_ACCELERATION_LIMIT)
+    return _checked_limits(
+        qddot_max,
+        joint_names,
+        field="robot.joint_acceleration_limits",
+        unit="rad/s^2",
+        lower=MIN_ACCELERATION_LIMIT,
+        upper=MAX_ACCELERATION_LIMIT,
     )
-    if bad.size:
-        j = int(bad[0])
-        raise InvalidInputError(
-            field,
-            f"joint {j} ({joint_names[j]}) limit {float(limits[j]):.6g} rad/s^2 must be > 0, "
-            f"within [{MIN_ACCELERATION_LIMIT}, {MAX_ACCELERATION_LIMIT}] rad/s^2",
-        )
-    return limits
 
 
 def _set_tool_point(model: pin.Model, tool_frame: str, transform_tool_to_tcp: np.ndarray) -> None:
