@@ -19,6 +19,7 @@ from starlette.routing import Route
 from starlette.types import ASGIApp, Message, Receive, Scope, Send
 
 from service.config import get_settings
+from service.jobs.job import JobStoreUnavailable
 from service.schemas import ErrorDetail, ErrorResponse
 from solver.core.exceptions import SolverError
 from solver.core.progress import Cancelled
@@ -122,6 +123,24 @@ async def cancelled_handler(request: Request, error: Cancelled) -> JSONResponse:
     )
     response = _error_response(status.HTTP_503_SERVICE_UNAVAILABLE, [detail])
     response.headers["Retry-After"] = "5"
+    return response
+
+
+STORE_RETRY_SECONDS = 30
+"""The Retry-After of a 503 answered while the job store cannot be used (s)."""
+
+
+async def job_store_unavailable_handler(
+    request: Request, error: JobStoreUnavailable
+) -> JSONResponse:
+    """Answer a job route (or /metrics) with 503 while the job store cannot be used.
+
+    The compute routes never touch the store, so they stay up; the detail says what is wrong
+    with the file, for the operator.
+    """
+    detail = ErrorDetail(loc=[], msg=error.reason, type="job_store_unavailable")
+    response = _error_response(status.HTTP_503_SERVICE_UNAVAILABLE, [detail])
+    response.headers["Retry-After"] = str(STORE_RETRY_SECONDS)
     return response
 
 

@@ -35,8 +35,17 @@ class _JobCollector(Collector):
         """Read the store that ``store()`` gives at each scrape (opened on first use)."""
         self.store = store
 
+    def describe(self) -> Iterable[GaugeMetricFamily | SummaryMetricFamily]:
+        """The two job metrics, without values: registering the collector reads no store."""
+        yield GaugeMetricFamily("dtf_jobs", "Jobs by status.", labels=["status"])
+        yield SummaryMetricFamily("dtf_job_seconds", "Durations of finished jobs (s).")
+
     def collect(self) -> Iterable[GaugeMetricFamily | SummaryMetricFamily]:
-        """The two job metrics."""
+        """The two job metrics.
+
+        A store that cannot be used raises its ``JobStoreUnavailable``: ``/metrics`` then
+        answers 503 saying why, like the job routes (no partial scrape that reads as no jobs).
+        """
         store = self.store()
         by_status = GaugeMetricFamily("dtf_jobs", "Jobs by status.", labels=["status"])
         counts, durations = store.statistics()

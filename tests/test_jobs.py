@@ -245,3 +245,50 @@ def test_evaluate_and_optimize_jobs(tmp_path: Path, kind: str) -> None:
     finally:
         process.terminate()
         process.wait()
+
+
+def assert_store_unavailable(answer: httpx.Response, reason: str) -> None:
+    assert answer.status_code == 503, answer.text
+    assert answer.headers["content-type"] == "application/json"
+    assert answer.headers["retry-after"] == "30"
+    (detail,) = answer.json()["detail"]
+    assert detail["type"] == "job_store_unavailable" and reason in detail["msg"], detail
+
+
+def test_a_corrupt_store_takes_down_the_jobs_not_the_service(tmp_path: Path) -> None:
+    (tmp_path / "jobs.sqlite3").write_bytes(b"not a database" * 100)
+    process, url = server(tmp_path)  # it used to exit at startup
+    try:
+        assert httpx.get(f"{url}/healthz").status_code == 200
+        assert httpx.post(f"{url}/v1/evaluate", json=EXAMPLE, timeout=60).status_code == 200
+        for answer in (
+            httpx.get(f"{url}/v1/jobs"),
+            httpx.get(f"{url}/metrics"),
+            httpx.post(f"{url}/v1/jobs", json={"kind": "map", "request": map_request(SMALL_GRID)}),
+        ):
+            assert_store_unavailable(answer, "file is not a database")
+        assert process.poll() is None
+    finally:
+        process.terminate()
+        process.wait()
+
+
+def test_a_store_corrupted_or_deleted_while_serving_answers_503(tmp_path: Path) -> None:
+    process, url = server(tmp_path)
+    try:
+        body = {"kind": "map", "request": map_request(SMALL_GRID)}
+        job_id = httpx.post(f"{url}/v1/jobs", json=body).json()["id"]
+        wait_for(url, job_id, lambda j: j["status"] == "done")
+        store = tmp_path / "jobs.sqlite3"
+        with store.open("r+b") as file:
+            file.write(b"garbage!" * 512)
+        for answer in (httpx.get(f"{url}/v1/jobs/{job_id}"), httpx.get(f"{url}/metrics")):
+            assert_store_unavailable(answer, "cannot be used")
+        for file in tmp_path.glob("jobs.sqlite3*"):
+            file.unlink()
+        assert_store_unavailable(httpx.get(f"{url}/v1/jobs"), "was deleted while the service ran")
+        assert not store.exists()  # not silently made again, empty
+        assert httpx.get(f"{url}/healthz").status_code == 200 and process.poll() is None
+    finally:
+        process.terminate()
+        process.wait()

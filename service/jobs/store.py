@@ -2,23 +2,36 @@
 
 The store is the one place job state lives, shared by the web process and the worker
 processes: a worker reports progress by writing it here, and finds a cancel request here.
+
+The file is opened on first use, not when the store is made: importing the service creates
+nothing. Whatever goes wrong with the file (corrupt, replaced or deleted while the service runs,
+unreadable) is one exception, :class:`JobStoreUnavailable`, which the service answers with 503:
+the job routes are down, the compute routes are not.
 """
 
 from __future__ import annotations
 
 import json
+import os
 import sqlite3
+import threading
 import time
 import uuid
 from collections.abc import Iterator
 from contextlib import contextmanager
-from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Literal
+from typing import Any
 
-Status = Literal["queued", "running", "done", "failed", "cancelled"]
-Kind = Literal["map", "optimize", "evaluate"]
-FINISHED = ("done", "failed", "cancelled")
+from service.jobs.job import (
+    FINISHED,
+    Job,
+    JobStoreUnavailable,
+    Kind,
+    Status,
+    job_of_row,
+)
+
+__all__ = ["FINISHED", "Job", "JobStore", "JobStoreUnavailable", "Kind", "Status"]
 
 _SCHEMA = """
 CREATE TABLE IF NOT EXISTS jobs (
@@ -39,49 +52,80 @@ CREATE INDEX IF NOT EXISTS jobs_created ON jobs (created);
 """
 
 
-@dataclass(frozen=True)
-class Job:
-    """One job as stored.
+class JobStore:
+    """Jobs in an SQLite file; each call opens its own connection (safe across processes).
 
-    Attributes:
-        fraction: the fraction of its work done, 0..1.
-        created, started, finished: Unix times (s); None until they happen.
-        result: the route's JSON answer when done; error: a 422-style detail list when failed.
+    The file is made by the web process's store (``create=True``) on its first use; the worker
+    processes' stores never make one, so a file deleted under a running service is found out
+    (503) rather than silently replaced by an empty one. Which file it is (device and inode) is
+    kept at the first use, so a file replaced under the running service is found out too.
     """
 
-    id: str
-    kind: Kind
-    status: Status
-    request: dict[str, Any]
-    result: dict[str, Any] | None
-    error: list[dict[str, Any]] | None
-    fraction: float
-    created: float
-    started: float | None
-    finished: float | None
-    attempts: int
-    cancel: bool
-
-
-class JobStore:
-    """Jobs in an SQLite file; each call opens its own connection (safe across processes)."""
-
-    def __init__(self, path: Path) -> None:
-        """Open (and create) the store at ``path``."""
-        path.parent.mkdir(parents=True, exist_ok=True)
+    def __init__(self, path: Path, *, create: bool = True) -> None:
+        """A store at ``path``, opened on first use (``create``: make the file if missing)."""
         self.path = path
-        with self._connection() as db:
-            db.executescript(_SCHEMA)
+        self._create = create
+        self._identity: tuple[int, int] | None = None
+        self._lock = threading.Lock()
+
+    def _unavailable(self, what: str) -> JobStoreUnavailable:
+        return JobStoreUnavailable(f"the job store {str(self.path)!r} {what}")
+
+    def _open(self) -> None:
+        """First use: make the directory, the file and the table; note which file it is."""
+        with self._lock:
+            if self._identity is not None:
+                return
+            try:
+                if self._create:
+                    self.path.parent.mkdir(parents=True, exist_ok=True)
+                with self._connect(create=self._create) as db:
+                    db.executescript(_SCHEMA)
+                status = os.stat(self.path)
+            except (sqlite3.Error, OSError) as error:
+                raise self._unavailable(f"cannot be used: {error}") from error
+            self._identity = (status.st_dev, status.st_ino)
+
+    def _check_identity(self) -> None:
+        """The file is the one first opened: not deleted, not replaced."""
+        try:
+            status = os.stat(self.path)
+        except FileNotFoundError:
+            raise self._unavailable(
+                "was deleted while the service ran, and its jobs with it; restart the service "
+                "to start a new, empty store"
+            ) from None
+        except OSError as error:
+            raise self._unavailable(f"cannot be used: {error}") from error
+        if (status.st_dev, status.st_ino) != self._identity:
+            raise self._unavailable(
+                "was replaced by another file while the service ran; restart the service to "
+                "use the new file"
+            )
 
     @contextmanager
-    def _connection(self) -> Iterator[sqlite3.Connection]:
-        db = sqlite3.connect(self.path, timeout=30, isolation_level=None)
+    def _connect(self, *, create: bool) -> Iterator[sqlite3.Connection]:
+        mode = "rwc" if create else "rw"
+        uri = f"{self.path.absolute().as_uri()}?mode={mode}"
+        db = sqlite3.connect(uri, uri=True, timeout=30, isolation_level=None)
         db.row_factory = sqlite3.Row
         try:
             db.execute("PRAGMA journal_mode=WAL")
             yield db
         finally:
             db.close()
+
+    @contextmanager
+    def _connection(self) -> Iterator[sqlite3.Connection]:
+        """A connection to the store's file; any SQLite or OS error is JobStoreUnavailable."""
+        if self._identity is None:
+            self._open()
+        self._check_identity()
+        try:
+            with self._connect(create=False) as db:
+                yield db
+        except (sqlite3.Error, OSError) as error:
+            raise self._unavailable(f"cannot be used: {error}") from error
 
     def create(self, kind: Kind, request: dict[str, Any]) -> Job:
         """A new queued job with a random id."""
@@ -100,7 +144,7 @@ class JobStore:
         """The job, or None for an unknown id."""
         with self._connection() as db:
             row = db.execute("SELECT * FROM jobs WHERE id = ?", (job_id,)).fetchone()
-        return None if row is None else _job(row)
+        return None if row is None else job_of_row(row)
 
     def jobs(self, *, status: str | None, limit: int) -> list[Job]:
         """The newest jobs first, optionally of one status."""
@@ -109,7 +153,7 @@ class JobStore:
             query, args = query + " WHERE status = ?", [status]
         with self._connection() as db:
             rows = db.execute(query + " ORDER BY created DESC LIMIT ?", [*args, limit]).fetchall()
-        return [_job(row) for row in rows]
+        return [job_of_row(row) for row in rows]
 
     def count_unfinished(self) -> int:
         """Jobs queued or running."""
@@ -245,20 +289,3 @@ def _interrupted(attempts: int) -> dict[str, Any]:
         "msg": f"the job was interrupted {attempts} times (service restarts) and is not retried",
         "type": "interrupted",
     }
-
-
-def _job(row: sqlite3.Row) -> Job:
-    return Job(
-        id=row["id"],
-        kind=row["kind"],
-        status=row["status"],
-        request=json.loads(row["request"]),
-        result=None if row["result"] is None else json.loads(row["result"]),
-        error=None if row["error"] is None else json.loads(row["error"]),
-        fraction=float(row["done"]),
-        created=row["created"],
-        started=row["started"],
-        finished=row["finished"],
-        attempts=row["attempts"],
-        cancel=bool(row["cancel"]),
-    )

@@ -24,7 +24,7 @@ from pydantic import ValidationError
 
 from service.config import Settings
 from service.errors import request_location, solver_error_location
-from service.jobs.store import JobStore
+from service.jobs.store import JobStore, JobStoreUnavailable
 from service.logs import log, log_to_stderr
 from service.operations import evaluation_of, map_of, optimum_of
 from service.schemas import EvaluateRequest, MapRequest, OptimizeRequest
@@ -144,7 +144,7 @@ def serve(connection: Connection, store_path: str, settings_json: str) -> None:
     _die_with_the_service()
     os.nice(NICENESS)
     log_to_stderr()
-    store = JobStore(Path(store_path))
+    store = JobStore(Path(store_path), create=False)  # never a new, empty file
     settings = Settings.model_validate_json(settings_json)
     map_kernel.warm_up()  # before the first job, not in it
     while True:
@@ -152,5 +152,8 @@ def serve(connection: Connection, store_path: str, settings_json: str) -> None:
             job_id = connection.recv()
         except (EOFError, OSError):
             return  # the service has gone
-        run_job(store, job_id, settings)
+        try:
+            run_job(store, job_id, settings)
+        except JobStoreUnavailable as error:  # the supervisor reports it (once)
+            log.warning("job %s not run: %s", job_id, error)
         connection.send(job_id)

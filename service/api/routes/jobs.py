@@ -1,4 +1,7 @@
-"""``/v1/jobs``: submit long work, watch its progress, read its result, cancel it (api.md)."""
+"""``/v1/jobs``: submit long work, watch its progress, read its result, cancel it (api.md).
+
+While the job store cannot be used, every route here answers 503 saying why.
+"""
 
 from __future__ import annotations
 
@@ -17,11 +20,24 @@ from service.jobs.runner import get_runner
 from service.jobs.store import Job
 from service.logs import log
 from service.operations import checked_grid
-from service.schemas import ErrorDetail, MapRequest
+from service.schemas import ErrorDetail, ErrorResponse, MapRequest
 from service.schemas.jobs import JobInfo, JobList, JobProgress, JobRequest, JobStatus, MapJob
 from solver.core.exceptions import InvalidInputError, SolverError
 
-router = APIRouter(prefix="/jobs", tags=["jobs"], responses=ERROR_RESPONSES)
+JOB_RESPONSES: dict[int | str, dict[str, Any]] = {
+    **ERROR_RESPONSES,
+    status.HTTP_503_SERVICE_UNAVAILABLE: {
+        "model": ErrorResponse,
+        "description": "The job store cannot be used (corrupt, replaced or deleted file: the "
+        "detail says which), or the service is shutting down; retry after Retry-After. The "
+        "compute routes are not affected.",
+        "headers": {
+            "Retry-After": {"description": "Seconds to wait.", "schema": {"type": "integer"}}
+        },
+    },
+}
+
+router = APIRouter(prefix="/jobs", tags=["jobs"], responses=JOB_RESPONSES)
 
 JobId = Annotated[UUID, Path(description="The job's id, as POST /v1/jobs answered it.")]
 
