@@ -25,7 +25,7 @@ from solver.core.exceptions import SolverError
 from solver.core.progress import Cancelled
 
 
-def _error_type(error: SolverError) -> str:
+def solver_error_type(error: SolverError) -> str:
     """``RepeatedWaypointError`` -> ``"repeated_waypoint"``."""
     name = type(error).__name__.removesuffix("Error")
     return re.sub(r"(?<!^)(?=[A-Z])", "_", name).lower()
@@ -147,7 +147,7 @@ async def job_store_unavailable_handler(
 async def solver_error_handler(request: Request, error: SolverError) -> JSONResponse:
     """Answer a solver input error with ``422`` naming the field (and waypoint)."""
     detail = ErrorDetail(
-        loc=solver_error_location(error), msg=error.message, type=_error_type(error)
+        loc=solver_error_location(error), msg=error.message, type=solver_error_type(error)
     )
     return _error_response(status.HTTP_422_UNPROCESSABLE_CONTENT, [detail])
 

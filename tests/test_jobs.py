@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import json
 import signal
+import threading
 import time
 import uuid
 from pathlib import Path
@@ -289,6 +290,32 @@ def test_a_store_corrupted_or_deleted_while_serving_answers_503(tmp_path: Path) 
         assert_store_unavailable(httpx.get(f"{url}/v1/jobs"), "was deleted while the service ran")
         assert not store.exists()  # not silently made again, empty
         assert httpx.get(f"{url}/healthz").status_code == 200 and process.poll() is None
+    finally:
+        process.terminate()
+        process.wait()
+
+
+def test_64_concurrent_submissions_queue_no_more_than_the_limit(tmp_path: Path) -> None:
+    process, url = server(tmp_path, DTF_MAX_QUEUED_JOBS="10")
+    try:
+        body = {"kind": "map", "request": map_request(BIG_GRID)}  # a minute each: none ends
+        codes: list[int] = []
+        start = threading.Barrier(64)
+
+        def submit() -> None:
+            start.wait()
+            codes.append(httpx.post(f"{url}/v1/jobs", json=body, timeout=60).status_code)
+
+        threads = [threading.Thread(target=submit) for _ in range(64)]
+        for thread in threads:
+            thread.start()
+        for thread in threads:
+            thread.join()
+        assert sorted(set(codes)) == [202, 429] and codes.count(202) == 10, codes
+        jobs = httpx.get(f"{url}/v1/jobs").json()["jobs"]
+        assert len(jobs) == 10
+        for job in jobs:
+            httpx.delete(f"{url}/v1/jobs/{job['id']}")
     finally:
         process.terminate()
         process.wait()

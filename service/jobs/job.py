@@ -1,4 +1,4 @@
-"""A stored job, and the store's refusal when its file cannot be used (``service.jobs.store``)."""
+"""A stored job, and the two ways the job store refuses (``service.jobs.store``)."""
 
 from __future__ import annotations
 
@@ -23,6 +23,15 @@ class JobStoreUnavailable(Exception):
         """Keep the reason."""
         super().__init__(reason)
         self.reason = reason
+
+
+class QueueFull(Exception):
+    """As many jobs as the limit are queued or running; no job was added."""
+
+    def __init__(self, limit: int) -> None:
+        """Keep the limit."""
+        super().__init__(f"{limit} jobs are queued or running")
+        self.limit = limit
 
 
 @dataclass(frozen=True)

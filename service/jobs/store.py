@@ -27,11 +27,12 @@ from service.jobs.job import (
     Job,
     JobStoreUnavailable,
     Kind,
+    QueueFull,
     Status,
     job_of_row,
 )
 
-__all__ = ["FINISHED", "Job", "JobStore", "JobStoreUnavailable", "Kind", "Status"]
+__all__ = ["FINISHED", "Job", "JobStore", "JobStoreUnavailable", "Kind", "QueueFull", "Status"]
 
 _SCHEMA = """
 CREATE TABLE IF NOT EXISTS jobs (
@@ -127,18 +128,39 @@ class JobStore:
         except (sqlite3.Error, OSError) as error:
             raise self._unavailable(f"cannot be used: {error}") from error
 
-    def create(self, kind: Kind, request: dict[str, Any]) -> Job:
-        """A new queued job with a random id."""
+    def create(self, kind: Kind, request: dict[str, Any], *, limit: int | None = None) -> Job:
+        """A new queued job with a random id.
+
+        Args:
+            kind: what the job computes.
+            request: the route's body, as JSON.
+            limit: at most this many jobs queued or running, counted in the insert's own
+                transaction (so that concurrent submissions cannot pass it together).
+
+        Raises:
+            QueueFull: ``limit`` jobs are queued or running already.
+        """
         job_id = str(uuid.uuid4())
         with self._connection() as db:
-            db.execute(
-                "INSERT INTO jobs (id, kind, status, request, created) VALUES (?, ?, ?, ?, ?)",
-                (job_id, kind, "queued", json.dumps(request), time.time()),
-            )
-        job = self.get(job_id)
-        if job is None:  # just written
-            raise RuntimeError(f"job {job_id} was not stored")
-        return job
+            db.execute("BEGIN IMMEDIATE")  # the write lock, before the count
+            try:
+                if limit is not None:
+                    row = db.execute(
+                        "SELECT COUNT(*) FROM jobs WHERE status IN ('queued', 'running')"
+                    ).fetchone()
+                    if int(row[0]) >= limit:
+                        raise QueueFull(limit)
+                db.execute(
+                    "INSERT INTO jobs (id, kind, status, request, created) VALUES (?, ?, ?, ?, ?)",
+                    (job_id, kind, "queued", json.dumps(request), time.time()),
+                )
+                row = db.execute("SELECT * FROM jobs WHERE id = ?", (job_id,)).fetchone()
+                db.execute("COMMIT")
+            except BaseException:
+                if db.in_transaction:
+                    db.execute("ROLLBACK")
+                raise
+        return job_of_row(row)
 
     def get(self, job_id: str) -> Job | None:
         """The job, or None for an unknown id."""
@@ -154,14 +176,6 @@ class JobStore:
         with self._connection() as db:
             rows = db.execute(query + " ORDER BY created DESC LIMIT ?", [*args, limit]).fetchall()
         return [job_of_row(row) for row in rows]
-
-    def count_unfinished(self) -> int:
-        """Jobs queued or running."""
-        with self._connection() as db:
-            row = db.execute(
-                "SELECT COUNT(*) FROM jobs WHERE status IN ('queued', 'running')"
-            ).fetchone()
-        return int(row[0])
 
     def start(self, job_id: str) -> bool:
         """Mark a queued job running (one more attempt); False if it is not queued."""

@@ -23,7 +23,7 @@ from typing import Any
 from pydantic import ValidationError
 
 from service.config import Settings
-from service.errors import request_location, solver_error_location
+from service.errors import request_location, solver_error_location, solver_error_type
 from service.jobs.store import JobStore, JobStoreUnavailable
 from service.logs import log, log_to_stderr
 from service.operations import evaluation_of, map_of, optimum_of
@@ -110,7 +110,7 @@ def run_job(store: JobStore, job_id: str, settings: Settings) -> None:
         log.info("job %s cancelled", job_id)
     except SolverError as error:
         loc = solver_error_location(error)
-        detail = {"loc": loc, "msg": error.message, "type": "invalid_input"}
+        detail = {"loc": loc, "msg": error.message, "type": solver_error_type(error)}
         store.finish(job_id, "failed", error=[detail])
         log.info("job %s failed: %s", job_id, error.message[:200])
     except ValidationError as error:

@@ -1,4 +1,4 @@
-"""``/v1/jobs`` in process: 503 on a bad store, the compute routes up."""
+"""``/v1/jobs`` in process: checked as the routes check, 503 on a bad store."""
 
 from __future__ import annotations
 
@@ -17,6 +17,46 @@ from service.main import app
 from tests.cases import ROOT
 
 EXAMPLE = json.loads((ROOT / "examples" / "evaluate_request.json").read_text())
+GRID = {"x": {"min": -0.1, "max": 0.1, "step": 0.1}, "y": 0.45, "z": 0.1, "yaw": 0.0}
+BAD_PATHS = [  # each refused by the route itself, not by the schema (invalid_line, ...)
+    {"csv": "x,y,z\n1,2\n", "units": "mm"},
+    {"cl_data": "GOTO/0,0,0\nNOT A RECORD\n"},
+    {"waypoints": [EXAMPLE["path"]["waypoints"][0]] * 2},  # a repeated waypoint
+]
+
+
+def route_body(kind: str, path: dict[str, Any]) -> dict[str, Any]:
+    body: dict[str, Any] = {"robot": EXAMPLE["robot"], "path": path}
+    if kind == "evaluate":
+        body["placement"] = EXAMPLE["placement"]
+    elif kind == "map":
+        body["grid"] = {**GRID, "y": {"min": 0.4, "max": 0.5, "step": 0.1}}
+    else:
+        body |= {"bounds": {"x": [-0.05, 0.05], "y": [0.4, 0.5], "yaw": [-0.2, 0.2]}, "z": 0.1}
+    return body
+
+
+@pytest.mark.parametrize("kind", ["evaluate", "map", "optimize"])
+@pytest.mark.parametrize("path", BAD_PATHS, ids=["csv", "cl_data", "repeated"])
+def test_a_job_is_refused_at_submit_as_its_route_refuses_it(
+    client: TestClient, kind: str, path: dict[str, Any]
+) -> None:
+    body = route_body(kind, path)
+    direct = client.post(f"/v1/{kind}", json=body)
+    assert direct.status_code == 422, direct.text
+    submitted = client.post("/v1/jobs", json={"kind": kind, "request": body})
+    assert submitted.status_code == 422, submitted.text
+    (expected,), (detail,) = direct.json()["detail"], submitted.json()["detail"]
+    assert detail == {**expected, "loc": ["body", "request", *expected["loc"][1:]]}
+
+
+def test_an_optimize_job_with_a_start_outside_its_bounds_is_refused(client: TestClient) -> None:
+    body = route_body("optimize", EXAMPLE["path"]) | {
+        "start": {"x": 1.0, "y": 0.45, "z": 0.1, "yaw": 0.0}
+    }
+    submitted = client.post("/v1/jobs", json={"kind": "optimize", "request": body})
+    assert submitted.status_code == 422, submitted.text
+    assert submitted.json()["detail"][0]["loc"] == ["body", "request", "start"]
 
 
 def evaluate_body() -> dict[str, Any]:

@@ -139,3 +139,14 @@ def test_a_corrupt_store_is_logged_once_and_the_supervisor_backs_off(tmp_path: P
     finally:
         log.removeHandler(handler)
         runner.close()
+
+
+def test_a_job_error_keeps_its_real_type(tmp_path: Path) -> None:
+    store = JobStore(tmp_path / "jobs.sqlite3")
+    body = {**EVALUATE, "path": {"csv": "x,y,z\n1,2\n", "units": "mm"}}  # not checked at submit
+    job = store.create("evaluate", body)
+    worker.run_job(store, job.id, settings(tmp_path))
+    failed = store.get(job.id)
+    assert failed is not None and failed.status == "failed" and failed.error is not None
+    assert failed.error[0]["type"] == "invalid_line"
+    assert failed.error[0]["loc"][:3] == ["body", "path", "csv"]

@@ -1,4 +1,4 @@
-"""The job store on its own: opened lazily, a bad file refused with its reason."""
+"""The job store on its own: opened lazily, a bad file refused with its reason, an atomic limit."""
 
 from __future__ import annotations
 
@@ -6,11 +6,12 @@ import json
 import os
 import subprocess
 import sys
+import threading
 from pathlib import Path
 
 import pytest
 
-from service.jobs.store import JobStore, JobStoreUnavailable
+from service.jobs.store import JobStore, JobStoreUnavailable, QueueFull
 from tests.cases import ROOT
 
 EXAMPLE = json.loads((ROOT / "examples" / "evaluate_request.json").read_text())
@@ -94,3 +95,27 @@ def test_a_replaced_file_is_found_out(tmp_path: Path) -> None:
     os.replace(tmp_path / "other.sqlite3", path)
     with pytest.raises(JobStoreUnavailable, match="was replaced by another file"):
         store.jobs(status=None, limit=10)
+
+
+def test_the_queue_limit_holds_against_64_concurrent_submissions(tmp_path: Path) -> None:
+    store = JobStore(tmp_path / "jobs.sqlite3")
+    store.get("open-it")  # the table made before the race
+    outcomes: list[str] = []
+    start = threading.Barrier(64)
+
+    def submit() -> None:
+        start.wait()
+        try:
+            store.create("evaluate", EVALUATE, limit=10)
+        except QueueFull:
+            outcomes.append("full")
+        else:
+            outcomes.append("queued")
+
+    threads = [threading.Thread(target=submit) for _ in range(64)]
+    for thread in threads:
+        thread.start()
+    for thread in threads:
+        thread.join()
+    assert outcomes.count("queued") == 10 and outcomes.count("full") == 54
+    assert len(store.jobs(status="queued", limit=100)) == 10

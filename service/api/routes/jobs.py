@@ -5,6 +5,7 @@ While the job store cannot be used, every route here answers 503 saying why.
 
 from __future__ import annotations
 
+import functools
 import time
 from typing import Annotated, Any
 from uuid import UUID
@@ -13,16 +14,14 @@ import anyio
 from fastapi import APIRouter, HTTPException, Path, Query, Response, status
 from fastapi.responses import JSONResponse
 
-from service.config import Settings
 from service.deps import SettingsDep
 from service.errors import ERROR_RESPONSES
+from service.jobs.checks import check_job
 from service.jobs.runner import get_runner
-from service.jobs.store import Job
+from service.jobs.store import Job, QueueFull
 from service.logs import log
-from service.operations import checked_grid
 from service.schemas import ErrorDetail, ErrorResponse, MapRequest
-from service.schemas.jobs import JobInfo, JobList, JobProgress, JobRequest, JobStatus, MapJob
-from solver.core.exceptions import InvalidInputError, SolverError
+from service.schemas.jobs import JobInfo, JobList, JobProgress, JobRequest, JobStatus
 
 JOB_RESPONSES: dict[int | str, dict[str, Any]] = {
     **ERROR_RESPONSES,
@@ -76,17 +75,6 @@ def job_info(job: Job, *, with_result: bool = True) -> JobInfo:
     )
 
 
-def _check_size(body: JobRequest, settings: Settings) -> None:
-    """A map job's size against the job limits, before it is queued (422 naming grid)."""
-    if isinstance(body, MapJob):
-        try:
-            checked_grid(body.request, settings.for_jobs())
-        except SolverError as error:  # the field is inside the job's request
-            raise InvalidInputError(
-                f"request.{error.field}", error.message, waypoint=error.waypoint
-            ) from None
-
-
 @router.post(
     "",
     operation_id="submit_job",
@@ -97,18 +85,26 @@ def _check_size(body: JobRequest, settings: Settings) -> None:
 async def post_job(body: JobRequest, settings: SettingsDep) -> JSONResponse:
     """Queue the work; answer 202 with its id and Location.
 
-    Job limits (DTF_MAX_JOB_CELLS, DTF_MAX_JOB_POSES) replace the routes' own; a map's size is
-    checked before it is queued.
+    The request is checked as its route checks it before it is queued (the robot, the path as
+    read, the options, the grid, the bounds), with the route's error types, a field inside the
+    job (``request.path.csv``); job limits (DTF_MAX_JOB_CELLS, DTF_MAX_JOB_POSES) replace the
+    routes' own. The queue's limit (DTF_MAX_QUEUED_JOBS) is counted in the insert's transaction.
     """
+    await anyio.to_thread.run_sync(check_job, body, settings)
     runner = get_runner(settings)
-    if runner.store.count_unfinished() >= settings.max_queued_jobs:
+    request = body.request.model_dump(mode="json", exclude_unset=True)
+    try:
+        job = await anyio.to_thread.run_sync(
+            functools.partial(
+                runner.store.create, body.kind, request, limit=settings.max_queued_jobs
+            )
+        )
+    except QueueFull:
         raise HTTPException(
             status.HTTP_429_TOO_MANY_REQUESTS,
             f"{settings.max_queued_jobs} jobs are queued or running (DTF_MAX_QUEUED_JOBS)",
             headers={"Retry-After": "10"},
-        )
-    await anyio.to_thread.run_sync(_check_size, body, settings)
-    job = runner.store.create(body.kind, body.request.model_dump(mode="json", exclude_unset=True))
+        ) from None
     runner.wake()  # an idle worker takes the job now
     log.info("job %s queued (%s)", job.id, body.kind)
     info = job_info(job)
