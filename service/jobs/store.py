@@ -188,11 +188,11 @@ class JobStore:
         return bool(changed)
 
     def progress(self, job_id: str, fraction: float) -> bool:
-        """Record the fraction done; whether a cancel was asked for."""
+        """Record the fraction done; whether to stop (a cancel was asked, or the job deleted)."""
         with self._connection() as db:
             db.execute("UPDATE jobs SET done = ? WHERE id = ?", (fraction, job_id))
             row = db.execute("SELECT cancel FROM jobs WHERE id = ?", (job_id,)).fetchone()
-        return bool(row is not None and row[0])
+        return bool(row is None or row[0])
 
     def finish(
         self,
@@ -230,15 +230,15 @@ class JobStore:
         return [row[0] for row in rows if row[0] not in exclude][:limit]
 
     def cancel_asked(self, ids: list[str]) -> set[str]:
-        """Those of ``ids`` whose cancel has been asked for."""
+        """Those of ``ids`` whose cancel has been asked for, or that were deleted."""
         if not ids:
             return set()
         marks = ", ".join("?" * len(ids))
         with self._connection() as db:
             rows = db.execute(
-                f"SELECT id FROM jobs WHERE cancel = 1 AND id IN ({marks})", ids
+                f"SELECT id FROM jobs WHERE cancel = 0 AND id IN ({marks})", ids
             ).fetchall()
-        return {row[0] for row in rows}
+        return set(ids) - {row[0] for row in rows}
 
     def cancel(self, job_id: str) -> None:
         """Ask a job to stop: a queued one is cancelled now, a running one soon after.
@@ -255,6 +255,15 @@ class JobStore:
                 "status = 'queued'",
                 (time.time(), job_id),
             )
+
+    def delete(self, job_id: str) -> bool:
+        """Forget a job; whether it existed.
+
+        A running job's worker finds it gone at its next progress report and stops, as after a
+        cancel (the supervisor stops a worker that does not).
+        """
+        with self._connection() as db:
+            return bool(db.execute("DELETE FROM jobs WHERE id = ?", (job_id,)).rowcount)
 
     def recover(self, *, attempts: int) -> list[str]:
         """After a restart: jobs left running are queued again (or failed after ``attempts``).

@@ -1,8 +1,9 @@
-"""``/v1/jobs`` in process: checked as the routes check, 503 on a bad store."""
+"""``/v1/jobs`` in process: checked as the routes check, 503 on a bad store, delete and cancel."""
 
 from __future__ import annotations
 
 import json
+import time
 import uuid
 from collections.abc import Iterator
 from pathlib import Path
@@ -59,8 +60,29 @@ def test_an_optimize_job_with_a_start_outside_its_bounds_is_refused(client: Test
     assert submitted.json()["detail"][0]["loc"] == ["body", "request", "start"]
 
 
-def evaluate_body() -> dict[str, Any]:
-    return {k: EXAMPLE[k] for k in ("robot", "path", "placement")}
+def wait_for(client: TestClient, job_id: str, done: Any) -> dict[str, Any]:
+    deadline = time.monotonic() + 60
+    while True:
+        job: dict[str, Any] = client.get(f"/v1/jobs/{job_id}").json()
+        if done(job) or time.monotonic() > deadline:
+            return job
+        time.sleep(0.05)
+
+
+def test_delete_removes_a_job_and_cancel_keeps_it(client: TestClient) -> None:
+    job = {"kind": "map", "request": route_body("map", EXAMPLE["path"])}
+    first = client.post("/v1/jobs", json=job).json()["id"]
+    assert client.delete(f"/v1/jobs/{first}").status_code == 204
+    assert client.get(f"/v1/jobs/{first}").status_code == 404
+    assert client.delete(f"/v1/jobs/{first}").status_code == 404
+    assert first not in [j["id"] for j in client.get("/v1/jobs").json()["jobs"]]
+    second = client.post("/v1/jobs", json=job).json()["id"]
+    cancelled = client.post(f"/v1/jobs/{second}/cancel")
+    assert cancelled.status_code == 200, cancelled.text
+    assert cancelled.json()["id"] == second
+    ended = wait_for(client, second, lambda j: j["status"] not in ("queued", "running"))
+    assert ended["status"] in ("cancelled", "done")  # done if it ended before the cancel
+    assert client.post(f"/v1/jobs/{uuid.uuid4()}/cancel").status_code == 404
 
 
 @pytest.fixture
@@ -81,11 +103,12 @@ def corrupt_store(tmp_path: Path) -> Iterator[Path]:
 def test_a_corrupt_store_takes_down_the_job_routes_only(
     client: TestClient, corrupt_store: Path
 ) -> None:
-    job = {"kind": "evaluate", "request": evaluate_body()}
+    job = {"kind": "evaluate", "request": route_body("evaluate", EXAMPLE["path"])}
     for method, url, body in [
         ("GET", "/v1/jobs", None),
         ("GET", f"/v1/jobs/{uuid.uuid4()}", None),
         ("POST", "/v1/jobs", job),
+        ("POST", f"/v1/jobs/{uuid.uuid4()}/cancel", None),
         ("DELETE", f"/v1/jobs/{uuid.uuid4()}", None),
     ]:
         answer = client.request(method, url, json=body)

@@ -141,6 +141,18 @@ def test_a_corrupt_store_is_logged_once_and_the_supervisor_backs_off(tmp_path: P
         runner.close()
 
 
+def test_a_job_deleted_while_it_runs_frees_its_worker(runner: JobRunner) -> None:
+    job = runner.store.create("map", BIG_MAP)
+    runner.wake()
+    wait_for(runner.store, job.id, lambda j: j.status == "running" and j.fraction > 0)
+    assert runner.store.delete(job.id)
+    runner.wake()
+    second = runner.store.create("evaluate", EVALUATE)
+    runner.wake()
+    assert wait_for(runner.store, second.id, lambda j: j.status == "done").status == "done"
+    assert runner.store.get(job.id) is None  # its worker's last writes made nothing again
+
+
 def test_a_job_error_keeps_its_real_type(tmp_path: Path) -> None:
     store = JobStore(tmp_path / "jobs.sqlite3")
     body = {**EVALUATE, "path": {"csv": "x,y,z\n1,2\n", "units": "mm"}}  # not checked at submit

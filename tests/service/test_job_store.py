@@ -54,7 +54,7 @@ def test_a_corrupt_file_makes_the_store_unavailable_with_its_reason(
     for call in (
         lambda: store.get("x"),
         lambda: store.jobs(status=None, limit=10),
-        lambda: store.create("evaluate", EVALUATE),
+        lambda: store.create("evaluate", EVALUATE, limit=10),
         store.statistics,
     ):
         with pytest.raises(JobStoreUnavailable) as raised:
@@ -119,3 +119,13 @@ def test_the_queue_limit_holds_against_64_concurrent_submissions(tmp_path: Path)
         thread.join()
     assert outcomes.count("queued") == 10 and outcomes.count("full") == 54
     assert len(store.jobs(status="queued", limit=100)) == 10
+
+
+def test_a_deleted_job_is_gone_and_its_worker_is_told_to_stop(tmp_path: Path) -> None:
+    store = JobStore(tmp_path / "jobs.sqlite3")
+    job = store.create("evaluate", EVALUATE)
+    assert store.start(job.id)
+    assert store.delete(job.id) and store.get(job.id) is None
+    assert not store.delete(job.id)
+    assert store.progress(job.id, 0.5)  # a worker stops at its next report
+    assert store.cancel_asked([job.id]) == {job.id}  # the supervisor stops one that does not

@@ -1,5 +1,8 @@
 """``/v1/jobs``: submit long work, watch its progress, read its result, cancel it (api.md).
 
+Cancel and delete are two operations: ``POST /v1/jobs/{id}/cancel`` stops the work and keeps
+the job (status ``cancelled``, readable until DTF_JOB_TTL, as the page shows it);
+``DELETE /v1/jobs/{id}`` cancels it too and forgets it, so that a ``GET`` afterwards is 404.
 While the job store cannot be used, every route here answers 503 saying why.
 """
 
@@ -137,22 +140,46 @@ def get_job(job_id: JobId, settings: SettingsDep) -> JobInfo:
     return job_info(job)
 
 
+@router.post(
+    "/{job_id}/cancel",
+    operation_id="cancel_job",
+    summary="Cancel a queued or running job, keeping it",
+    responses=NOT_FOUND,
+)
+def cancel_job(job_id: JobId, settings: SettingsDep) -> JobInfo:
+    """A queued job is cancelled now; a running one stops within a second.
+
+    The job stays (``cancelled`` once stopped, readable until DTF_JOB_TTL); a finished job is
+    left as it is. The answer is the job after the cancel was asked.
+    """
+    runner = get_runner(settings)
+    if runner.store.get(str(job_id)) is None:
+        raise HTTPException(status.HTTP_404_NOT_FOUND, f"no job {str(job_id)!r}")
+    runner.store.cancel(str(job_id))
+    runner.wake()  # the supervisor sees the cancel now
+    log.info("job %s cancel asked", job_id)
+    job = runner.store.get(str(job_id))
+    if job is None:  # deleted meanwhile
+        raise HTTPException(status.HTTP_404_NOT_FOUND, f"no job {str(job_id)!r}")
+    return job_info(job)
+
+
 @router.delete(
     "/{job_id}",
-    operation_id="cancel_job",
-    summary="Cancel a queued or running job",
+    operation_id="delete_job",
+    summary="Delete a job, cancelling it first",
     status_code=status.HTTP_204_NO_CONTENT,
     responses=NOT_FOUND,
 )
 def delete_job(job_id: JobId, settings: SettingsDep) -> Response:
-    """A queued job is cancelled now; a running one stops within a second.
+    """Cancel the job (its work stops within a second) and forget it and its result.
 
-    A finished job is left as it is.
+    Afterwards the id is unknown (404), as for a job that expired.
     """
-    store = get_runner(settings).store
-    if store.get(str(job_id)) is None:
+    runner = get_runner(settings)
+    runner.store.cancel(str(job_id))
+    if not runner.store.delete(str(job_id)):
         raise HTTPException(status.HTTP_404_NOT_FOUND, f"no job {str(job_id)!r}")
-    store.cancel(str(job_id))
-    get_runner(settings).wake()  # the supervisor sees the cancel now
-    log.info("job %s cancel asked", job_id)
+    runner.wake()  # the supervisor stops a running job's worker now
+    log.info("job %s deleted", job_id)
     return Response(status_code=status.HTTP_204_NO_CONTENT)
