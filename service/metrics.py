@@ -17,6 +17,8 @@ from prometheus_client.core import GaugeMetricFamily, SummaryMetricFamily
 from prometheus_client.registry import Collector
 from prometheus_fastapi_instrumentator import Instrumentator
 
+from service.schemas import ErrorResponse
+
 PLACEMENTS = Counter("dtf_placements", "Placements computed by /v1/map (synchronous maps).")
 
 
@@ -72,7 +74,14 @@ def instrument(app: FastAPI, *, job_store: Callable[[], JobStatistics]) -> None:
         tags=["health"],
         summary="Prometheus metrics: requests per route, jobs by status, placements",
         response_class=PlainTextResponse,
-        responses={200: {"content": {"text/plain": {"schema": {"type": "string"}}}}},
+        responses={
+            200: {"content": {"text/plain": {"schema": {"type": "string"}}}},
+            503: {
+                "model": ErrorResponse,
+                "description": "The job store cannot be used (the detail says why); the job "
+                "metrics cannot be read, retry after Retry-After.",
+            },
+        },
     )
     def metrics() -> PlainTextResponse:
         """The Prometheus text exposition of the service's metrics."""

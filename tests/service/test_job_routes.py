@@ -120,3 +120,10 @@ def test_a_corrupt_store_takes_down_the_job_routes_only(
     assert client.get("/healthz").status_code == 200
     evaluated = client.post("/v1/evaluate", json=job["request"])
     assert evaluated.status_code == 200, evaluated.text
+
+
+def test_the_spec_declares_the_503_of_the_job_routes_and_metrics(client: TestClient) -> None:
+    paths = client.get("/openapi.json").json()["paths"]
+    for path, method in [("/v1/jobs", "post"), ("/v1/jobs/{job_id}", "get"), ("/metrics", "get")]:
+        declared = paths[path][method]["responses"]["503"]
+        assert "job store" in declared["description"], (path, declared)
