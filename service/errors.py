@@ -19,12 +19,13 @@ from starlette.routing import Route
 from starlette.types import ASGIApp, Message, Receive, Scope, Send
 
 from service.config import get_settings
+from service.jobs.job import JobStoreUnavailable
 from service.schemas import ErrorDetail, ErrorResponse
 from solver.core.exceptions import SolverError
 from solver.core.progress import Cancelled
 
 
-def _error_type(error: SolverError) -> str:
+def solver_error_type(error: SolverError) -> str:
     """``RepeatedWaypointError`` -> ``"repeated_waypoint"``."""
     name = type(error).__name__.removesuffix("Error")
     return re.sub(r"(?<!^)(?=[A-Z])", "_", name).lower()
@@ -125,10 +126,28 @@ async def cancelled_handler(request: Request, error: Cancelled) -> JSONResponse:
     return response
 
 
+STORE_RETRY_SECONDS = 30
+"""The Retry-After of a 503 answered while the job store cannot be used (s)."""
+
+
+async def job_store_unavailable_handler(
+    request: Request, error: JobStoreUnavailable
+) -> JSONResponse:
+    """Answer a job route (or /metrics) with 503 while the job store cannot be used.
+
+    The compute routes never touch the store, so they stay up; the detail says what is wrong
+    with the file, for the operator.
+    """
+    detail = ErrorDetail(loc=[], msg=error.reason, type="job_store_unavailable")
+    response = _error_response(status.HTTP_503_SERVICE_UNAVAILABLE, [detail])
+    response.headers["Retry-After"] = str(STORE_RETRY_SECONDS)
+    return response
+
+
 async def solver_error_handler(request: Request, error: SolverError) -> JSONResponse:
     """Answer a solver input error with ``422`` naming the field (and waypoint)."""
     detail = ErrorDetail(
-        loc=solver_error_location(error), msg=error.message, type=_error_type(error)
+        loc=solver_error_location(error), msg=error.message, type=solver_error_type(error)
     )
     return _error_response(status.HTTP_422_UNPROCESSABLE_CONTENT, [detail])
 

@@ -31,11 +31,13 @@ from service.errors import (
     BodySizeLimitMiddleware,
     cancelled_handler,
     http_error_handler,
+    job_store_unavailable_handler,
     request_validation_error_handler,
     solver_error_handler,
 )
 from service.jobs.runner import close_runners, get_runner
-from service.logs import log_to_stderr
+from service.jobs.store import JobStoreUnavailable
+from service.logs import log, log_to_stderr
 from service.metrics import instrument
 from service.web import mount_page
 from service.work import STOPPING
@@ -94,7 +96,10 @@ async def lifespan(app: FastAPI) -> AsyncIterator[None]:
     await anyio.to_thread.run_sync(_warm_up)
     gc.collect()
     gc.freeze()  # what startup made lives on: full collections no longer walk it
-    get_runner(get_settings()).recover()  # jobs a restart interrupted run again
+    try:
+        get_runner(get_settings()).recover()  # jobs a restart interrupted run again
+    except JobStoreUnavailable as error:  # the job routes answer 503; the rest serves
+        log.error("jobs are unavailable: %s", error)
     yield
     close_runners()
 
@@ -145,6 +150,7 @@ def create_app() -> FastAPI:
             StarletteHTTPException: http_error_handler,
             SolverError: solver_error_handler,
             Cancelled: cancelled_handler,
+            JobStoreUnavailable: job_store_unavailable_handler,
         },
         lifespan=lifespan,
     )

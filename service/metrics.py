@@ -17,6 +17,8 @@ from prometheus_client.core import GaugeMetricFamily, SummaryMetricFamily
 from prometheus_client.registry import Collector
 from prometheus_fastapi_instrumentator import Instrumentator
 
+from service.schemas import ErrorResponse
+
 PLACEMENTS = Counter("dtf_placements", "Placements computed by /v1/map (synchronous maps).")
 
 
@@ -35,8 +37,17 @@ class _JobCollector(Collector):
         """Read the store that ``store()`` gives at each scrape (opened on first use)."""
         self.store = store
 
+    def describe(self) -> Iterable[GaugeMetricFamily | SummaryMetricFamily]:
+        """The two job metrics, without values: registering the collector reads no store."""
+        yield GaugeMetricFamily("dtf_jobs", "Jobs by status.", labels=["status"])
+        yield SummaryMetricFamily("dtf_job_seconds", "Durations of finished jobs (s).")
+
     def collect(self) -> Iterable[GaugeMetricFamily | SummaryMetricFamily]:
-        """The two job metrics."""
+        """The two job metrics.
+
+        A store that cannot be used raises its ``JobStoreUnavailable``: ``/metrics`` then
+        answers 503 saying why, like the job routes (no partial scrape that reads as no jobs).
+        """
         store = self.store()
         by_status = GaugeMetricFamily("dtf_jobs", "Jobs by status.", labels=["status"])
         counts, durations = store.statistics()
@@ -63,7 +74,14 @@ def instrument(app: FastAPI, *, job_store: Callable[[], JobStatistics]) -> None:
         tags=["health"],
         summary="Prometheus metrics: requests per route, jobs by status, placements",
         response_class=PlainTextResponse,
-        responses={200: {"content": {"text/plain": {"schema": {"type": "string"}}}}},
+        responses={
+            200: {"content": {"text/plain": {"schema": {"type": "string"}}}},
+            503: {
+                "model": ErrorResponse,
+                "description": "The job store cannot be used (the detail says why); the job "
+                "metrics cannot be read, retry after Retry-After.",
+            },
+        },
     )
     def metrics() -> PlainTextResponse:
         """The Prometheus text exposition of the service's metrics."""

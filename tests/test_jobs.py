@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import json
 import signal
+import threading
 import time
 import uuid
 from pathlib import Path
@@ -114,7 +115,7 @@ def test_a_running_50000_placement_map_is_cancelled_within_a_second(tmp_path: Pa
         assert submitted.json()["progress"]["total"] == 50_000
         running = wait_for(url, job_id, lambda j: j["progress"]["fraction"] > 0)
         assert running["status"] == "running" and running["progress"]["eta_seconds"] > 0
-        assert httpx.delete(f"{url}/v1/jobs/{job_id}").status_code == 204
+        assert httpx.post(f"{url}/v1/jobs/{job_id}/cancel").status_code == 200
         asked = time.monotonic()
         job = wait_for(url, job_id, lambda j: j["status"] != "running", timeout=10)
         assert job["status"] == "cancelled"
@@ -181,7 +182,7 @@ def test_health_stays_fast_while_four_map_jobs_run(tmp_path: Path) -> None:
         assert running == ["running"] * 4  # they ran all along
         assert max(times) < 0.050, sorted(times)[-5:]
         for job_id in ids:
-            httpx.delete(f"{url}/v1/jobs/{job_id}")
+            assert httpx.delete(f"{url}/v1/jobs/{job_id}").status_code == 204
     finally:
         process.terminate()
         process.wait()
@@ -242,6 +243,79 @@ def test_evaluate_and_optimize_jobs(tmp_path: Path, kind: str) -> None:
         assert job["status"] == "done", job
         direct = httpx.post(f"{url}/v1/{kind}", json=request, timeout=60).json()
         assert job["result"]["mu_path"] == pytest.approx(direct["mu_path"], rel=1e-12)
+    finally:
+        process.terminate()
+        process.wait()
+
+
+def assert_store_unavailable(answer: httpx.Response, reason: str) -> None:
+    assert answer.status_code == 503, answer.text
+    assert answer.headers["content-type"] == "application/json"
+    assert answer.headers["retry-after"] == "30"
+    (detail,) = answer.json()["detail"]
+    assert detail["type"] == "job_store_unavailable" and reason in detail["msg"], detail
+
+
+def test_a_corrupt_store_takes_down_the_jobs_not_the_service(tmp_path: Path) -> None:
+    (tmp_path / "jobs.sqlite3").write_bytes(b"not a database" * 100)
+    process, url = server(tmp_path)  # it used to exit at startup
+    try:
+        assert httpx.get(f"{url}/healthz").status_code == 200
+        assert httpx.post(f"{url}/v1/evaluate", json=EXAMPLE, timeout=60).status_code == 200
+        for answer in (
+            httpx.get(f"{url}/v1/jobs"),
+            httpx.get(f"{url}/metrics"),
+            httpx.post(f"{url}/v1/jobs", json={"kind": "map", "request": map_request(SMALL_GRID)}),
+        ):
+            assert_store_unavailable(answer, "file is not a database")
+        assert process.poll() is None
+    finally:
+        process.terminate()
+        process.wait()
+
+
+def test_a_store_corrupted_or_deleted_while_serving_answers_503(tmp_path: Path) -> None:
+    process, url = server(tmp_path)
+    try:
+        body = {"kind": "map", "request": map_request(SMALL_GRID)}
+        job_id = httpx.post(f"{url}/v1/jobs", json=body).json()["id"]
+        wait_for(url, job_id, lambda j: j["status"] == "done")
+        store = tmp_path / "jobs.sqlite3"
+        with store.open("r+b") as file:
+            file.write(b"garbage!" * 512)
+        for answer in (httpx.get(f"{url}/v1/jobs/{job_id}"), httpx.get(f"{url}/metrics")):
+            assert_store_unavailable(answer, "cannot be used")
+        for file in tmp_path.glob("jobs.sqlite3*"):
+            file.unlink()
+        assert_store_unavailable(httpx.get(f"{url}/v1/jobs"), "was deleted while the service ran")
+        assert not store.exists()  # not silently made again, empty
+        assert httpx.get(f"{url}/healthz").status_code == 200 and process.poll() is None
+    finally:
+        process.terminate()
+        process.wait()
+
+
+def test_64_concurrent_submissions_queue_no_more_than_the_limit(tmp_path: Path) -> None:
+    process, url = server(tmp_path, DTF_MAX_QUEUED_JOBS="10")
+    try:
+        body = {"kind": "map", "request": map_request(BIG_GRID)}  # a minute each: none ends
+        codes: list[int] = []
+        start = threading.Barrier(64)
+
+        def submit() -> None:
+            start.wait()
+            codes.append(httpx.post(f"{url}/v1/jobs", json=body, timeout=60).status_code)
+
+        threads = [threading.Thread(target=submit) for _ in range(64)]
+        for thread in threads:
+            thread.start()
+        for thread in threads:
+            thread.join()
+        assert sorted(set(codes)) == [202, 429] and codes.count(202) == 10, codes
+        jobs = httpx.get(f"{url}/v1/jobs").json()["jobs"]
+        assert len(jobs) == 10
+        for job in jobs:
+            assert httpx.delete(f"{url}/v1/jobs/{job['id']}").status_code == 204
     finally:
         process.terminate()
         process.wait()

@@ -72,7 +72,7 @@ def test_a_cancelled_job_stops_its_dask_tasks(tmp_path: Path, cluster: LocalClus
         body = {"kind": "map", "request": map_request(BIG_GRID)}
         job_id = httpx.post(f"{url}/v1/jobs", json=body).json()["id"]
         wait_for(url, job_id, lambda j: j["progress"]["fraction"] > 0)
-        assert httpx.delete(f"{url}/v1/jobs/{job_id}").status_code == 204
+        assert httpx.post(f"{url}/v1/jobs/{job_id}/cancel").status_code == 200
         asked = time.monotonic()
         job = wait_for(url, job_id, lambda j: j["status"] != "running", timeout=10)
         assert job["status"] == "cancelled" and time.monotonic() - asked < 1.0

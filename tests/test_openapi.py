@@ -44,6 +44,7 @@ def test_operation_ids_are_short_and_the_png_is_binary() -> None:
         "list_jobs",
         "get_job",
         "cancel_job",
+        "delete_job",
         "metrics",
     }
     png = spec["paths"]["/v1/map/png"]["post"]["responses"]["200"]["content"]["image/png"]

@@ -5,6 +5,10 @@ web process hands the oldest queued job to an idle worker process (``service.job
 It also watches the running ones: a worker that has not stopped a cancelled job within
 ``KILL_AFTER`` seconds is killed and replaced, so a cancel stops the work within a second even
 inside a long solver step, and a worker that dies fails its job instead of hanging it.
+
+When the store cannot be used (``JobStoreUnavailable``: a corrupt, replaced or deleted file),
+the supervisor logs it once and looks again less and less often (up to ``MAX_BACKOFF``), and
+logs once more when the store is back; the web process and its compute routes go on.
 """
 
 from __future__ import annotations
@@ -19,7 +23,7 @@ from multiprocessing.process import BaseProcess
 from pathlib import Path
 
 from service.config import Settings
-from service.jobs.store import JobStore
+from service.jobs.store import JobStore, JobStoreUnavailable
 from service.jobs.worker import serve
 from service.logs import log
 
@@ -28,6 +32,9 @@ POLL_SECONDS = 0.05
 
 KILL_AFTER = 0.5
 """How long a worker has to stop a cancelled job before it is killed and replaced (s)."""
+
+MAX_BACKOFF = 5.0
+"""The longest wait between two looks at a store that is failing (s)."""
 
 
 @dataclass
@@ -44,7 +51,9 @@ class JobRunner:
     """The store and the worker processes of one service."""
 
     def __init__(self, settings: Settings, *, worker: Callable[..., None] = serve) -> None:
-        """Open the store under the data directory, start the workers and their supervisor.
+        """The store under the data directory (opened on first use), and the supervisor.
+
+        Worker processes are started when jobs first wait.
 
         Args:
             settings: the service's settings (data directory, workers, limits).
@@ -91,14 +100,26 @@ class JobRunner:
         return ids
 
     def _supervise(self) -> None:
+        """Watch and dispatch every POLL_SECONDS; after a failure, log once and back off."""
+        delay, failing = POLL_SECONDS, False
         while not self._stop.is_set():
-            self._wake.wait(POLL_SECONDS)
+            self._wake.wait(delay)
             self._wake.clear()
             try:
                 self._watch()
                 self._dispatch()
+            except JobStoreUnavailable as error:
+                if not failing:
+                    log.error("jobs wait: %s (a look every %g s at most)", error, MAX_BACKOFF)
+                failing, delay = True, min(2.0 * delay, MAX_BACKOFF)
             except Exception:  # noqa: BLE001 - the supervisor must outlive any one failure
-                log.exception("job supervisor")
+                if not failing:
+                    log.exception("job supervisor (looking again every %g s at most)", MAX_BACKOFF)
+                failing, delay = True, min(2.0 * delay, MAX_BACKOFF)
+            else:
+                if failing:
+                    log.warning("job supervisor: the store answers again; jobs run")
+                failing, delay = False, POLL_SECONDS
 
     def _watch(self) -> None:
         """Free the workers whose job ended; kill those that do not stop a cancelled job."""

@@ -23,8 +23,8 @@ from typing import Any
 from pydantic import ValidationError
 
 from service.config import Settings
-from service.errors import request_location, solver_error_location
-from service.jobs.store import JobStore
+from service.errors import request_location, solver_error_location, solver_error_type
+from service.jobs.store import JobStore, JobStoreUnavailable
 from service.logs import log, log_to_stderr
 from service.operations import evaluation_of, map_of, optimum_of
 from service.schemas import EvaluateRequest, MapRequest, OptimizeRequest
@@ -110,7 +110,7 @@ def run_job(store: JobStore, job_id: str, settings: Settings) -> None:
         log.info("job %s cancelled", job_id)
     except SolverError as error:
         loc = solver_error_location(error)
-        detail = {"loc": loc, "msg": error.message, "type": "invalid_input"}
+        detail = {"loc": loc, "msg": error.message, "type": solver_error_type(error)}
         store.finish(job_id, "failed", error=[detail])
         log.info("job %s failed: %s", job_id, error.message[:200])
     except ValidationError as error:
@@ -144,7 +144,7 @@ def serve(connection: Connection, store_path: str, settings_json: str) -> None:
     _die_with_the_service()
     os.nice(NICENESS)
     log_to_stderr()
-    store = JobStore(Path(store_path))
+    store = JobStore(Path(store_path), create=False)  # never a new, empty file
     settings = Settings.model_validate_json(settings_json)
     map_kernel.warm_up()  # before the first job, not in it
     while True:
@@ -152,5 +152,8 @@ def serve(connection: Connection, store_path: str, settings_json: str) -> None:
             job_id = connection.recv()
         except (EOFError, OSError):
             return  # the service has gone
-        run_job(store, job_id, settings)
+        try:
+            run_job(store, job_id, settings)
+        except JobStoreUnavailable as error:  # the supervisor reports it (once)
+            log.warning("job %s not run: %s", job_id, error)
         connection.send(job_id)

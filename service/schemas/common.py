@@ -112,6 +112,38 @@ class ToolAxisWaypoint(RequestModel):
 SpinMode = Literal["fixed", "free"]
 
 
+class ControllerFrames(ResponseModel):
+    """A placement as robot controllers write a base, user or work-object frame (cam.md 8)."""
+
+    model_config = ConfigDict(
+        json_schema_extra={
+            "examples": [
+                {
+                    "matrix": [[1, 0, 0, 0], [0, 1, 0, 0.45], [0, 0, 1, 0.1], [0, 0, 0, 1]],
+                    "ur": [0.0, 0.45, 0.1, 0.0, 0.0, 0.0],
+                    "kuka": {"X": 0.0, "Y": 450.0, "Z": 100.0, "A": 0.0, "B": 0.0, "C": 0.0},
+                    "abb": [[0.0, 450.0, 100.0], [1.0, 0.0, 0.0, 0.0]],
+                    "fanuc": {"X": 0.0, "Y": 450.0, "Z": 100.0, "W": 0.0, "P": 0.0, "R": 0.0},
+                }
+            ]
+        }
+    )
+
+    matrix: list[list[float]] = Field(description="T_B_O, 4 rows of 4, row-major (m).")
+    ur: list[float] = Field(
+        description="Universal Robots pose [x, y, z, rx, ry, rz]: m, and a rotation vector (rad)."
+    )
+    kuka: dict[str, float] = Field(
+        description="KUKA {X, Y, Z, A, B, C}: mm and deg, R = Rz(A) Ry(B) Rx(C)."
+    )
+    abb: list[list[float]] = Field(
+        description="ABB wobj uframe [[x, y, z], [q1, q2, q3, q4]]: mm, q1 the scalar part."
+    )
+    fanuc: dict[str, float] = Field(
+        description="FANUC {X, Y, Z, W, P, R}: mm and deg, R = Rz(R) Ry(P) Rx(W)."
+    )
+
+
 class Placement(RequestModel):
     """Where the workpiece frame {O} sits in the base frame {B}: Trans(x, y, z) Rot_z(yaw)."""
 
@@ -127,6 +159,15 @@ class Placement(RequestModel):
         default=0.0,
         description="Tool spin (rad): every waypoint turned about its own tool z axis (cam.md "
         "section 3); it changes the IK, never the task requirements. Default 0.",
+    )
+    frames: ControllerFrames | None = Field(
+        default=None,
+        exclude=True,
+        json_schema_extra={"readOnly": True},
+        description="Read-only, ignored on input: the controller frames an answer's placement "
+        "carries (PlacementResult.frames) are derived from x, y, z and yaw, so a placement taken "
+        "from an answer is accepted as it is and evaluated at its x, y, z, yaw and spin; to move "
+        "it, change those (editing frames changes nothing).",
     )
 
 
@@ -244,38 +285,6 @@ class IkPolicy(RequestModel):
         "zone of radius blend_length / 2: ABB z1, KUKA $APO.CDIS = 1, UR blend radius 1 mm), "
         "> 0; the joint accelerations at a constant feed are taken over it (motion.md section "
         "2). Used only with robot.joint_acceleration_limits.",
-    )
-
-
-class ControllerFrames(ResponseModel):
-    """A placement as robot controllers write a base, user or work-object frame (cam.md 8)."""
-
-    model_config = ConfigDict(
-        json_schema_extra={
-            "examples": [
-                {
-                    "matrix": [[1, 0, 0, 0], [0, 1, 0, 0.45], [0, 0, 1, 0.1], [0, 0, 0, 1]],
-                    "ur": [0.0, 0.45, 0.1, 0.0, 0.0, 0.0],
-                    "kuka": {"X": 0.0, "Y": 450.0, "Z": 100.0, "A": 0.0, "B": 0.0, "C": 0.0},
-                    "abb": [[0.0, 450.0, 100.0], [1.0, 0.0, 0.0, 0.0]],
-                    "fanuc": {"X": 0.0, "Y": 450.0, "Z": 100.0, "W": 0.0, "P": 0.0, "R": 0.0},
-                }
-            ]
-        }
-    )
-
-    matrix: list[list[float]] = Field(description="T_B_O, 4 rows of 4, row-major (m).")
-    ur: list[float] = Field(
-        description="Universal Robots pose [x, y, z, rx, ry, rz]: m, and a rotation vector (rad)."
-    )
-    kuka: dict[str, float] = Field(
-        description="KUKA {X, Y, Z, A, B, C}: mm and deg, R = Rz(A) Ry(B) Rx(C)."
-    )
-    abb: list[list[float]] = Field(
-        description="ABB wobj uframe [[x, y, z], [q1, q2, q3, q4]]: mm, q1 the scalar part."
-    )
-    fanuc: dict[str, float] = Field(
-        description="FANUC {X, Y, Z, W, P, R}: mm and deg, R = Rz(R) Ry(P) Rx(W)."
     )
 
 

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import logging
 import time
 from collections.abc import Callable, Iterator
 from pathlib import Path
@@ -13,7 +14,8 @@ import pytest
 from service.config import Settings
 from service.jobs import worker
 from service.jobs.runner import KILL_AFTER, JobRunner
-from service.jobs.store import Job, JobStore
+from service.jobs.store import Job, JobStore, JobStoreUnavailable
+from service.logs import log
 from tests.cases import ROOT
 from tests.service.jobs_workers import stuck
 
@@ -112,3 +114,51 @@ def test_jobs_run_in_the_order_they_were_queued(runner: JobRunner) -> None:
     assert all(j.status == "done" for j in jobs)
     started = [j.started for j in jobs]
     assert started == sorted(started)  # type: ignore[type-var]
+
+
+def test_a_corrupt_store_is_logged_once_and_the_supervisor_backs_off(tmp_path: Path) -> None:
+    (tmp_path / "jobs.sqlite3").write_bytes(b"not a database" * 100)
+    records: list[logging.LogRecord] = []
+    handler = logging.Handler()
+    handler.emit = records.append  # type: ignore[method-assign]
+    log.addHandler(handler)
+    runner = JobRunner(settings(tmp_path))
+    try:
+        time.sleep(2.0)  # 40 looks at POLL_SECONDS; with the back-off, 5 or 6
+        errors = [r for r in records if r.levelno >= logging.ERROR]
+        assert len(errors) == 1, [r.getMessage() for r in errors]
+        assert "jobs.sqlite3" in errors[0].getMessage() and errors[0].exc_info is None
+        assert runner._thread.is_alive()
+        with pytest.raises(JobStoreUnavailable):
+            runner.recover()
+        (tmp_path / "jobs.sqlite3").unlink()  # the operator moves the bad file away
+        job = runner.store.create("evaluate", EVALUATE)
+        runner.wake()
+        assert wait_for(runner.store, job.id, lambda j: j.status == "done").status == "done"
+        assert any("answers again" in r.getMessage() for r in records)
+    finally:
+        log.removeHandler(handler)
+        runner.close()
+
+
+def test_a_job_deleted_while_it_runs_frees_its_worker(runner: JobRunner) -> None:
+    job = runner.store.create("map", BIG_MAP)
+    runner.wake()
+    wait_for(runner.store, job.id, lambda j: j.status == "running" and j.fraction > 0)
+    assert runner.store.delete(job.id)
+    runner.wake()
+    second = runner.store.create("evaluate", EVALUATE)
+    runner.wake()
+    assert wait_for(runner.store, second.id, lambda j: j.status == "done").status == "done"
+    assert runner.store.get(job.id) is None  # its worker's last writes made nothing again
+
+
+def test_a_job_error_keeps_its_real_type(tmp_path: Path) -> None:
+    store = JobStore(tmp_path / "jobs.sqlite3")
+    body = {**EVALUATE, "path": {"csv": "x,y,z\n1,2\n", "units": "mm"}}  # not checked at submit
+    job = store.create("evaluate", body)
+    worker.run_job(store, job.id, settings(tmp_path))
+    failed = store.get(job.id)
+    assert failed is not None and failed.status == "failed" and failed.error is not None
+    assert failed.error[0]["type"] == "invalid_line"
+    assert failed.error[0]["loc"][:3] == ["body", "path", "csv"]

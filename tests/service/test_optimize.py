@@ -48,6 +48,35 @@ def test_answer_is_what_evaluate_says(
     assert answer["solver"]["iterations"] > 0 and answer["solver"]["seconds"] > 0
 
 
+@pytest.mark.parametrize("which", ["optimum", "start"])
+def test_an_answers_placement_sent_back_as_it_is_is_accepted(
+    client: TestClient, body: dict[str, Any], answer: dict[str, Any], which: str
+) -> None:
+    placement = answer["placement"] if which == "optimum" else answer["start"]["placement"]
+    assert "frames" in placement  # as the answer carries it: frames are read-only input
+    mu_path = answer["mu_path"] if which == "optimum" else answer["start"]["mu_path"]
+    evaluate = {"robot": body["robot"], "path": body["path"], "placement": placement}
+    response = client.post("/v1/evaluate", json=evaluate)
+    assert response.status_code == 200, response.text
+    assert response.json()["mu_path"] == pytest.approx(mu_path, rel=OPTIMUM_EVALUATE_RTOL)
+    again = client.post("/v1/optimize", json={**body, "start": placement})
+    assert again.status_code == 200, again.text
+
+
+def test_frames_on_input_are_ignored_as_the_schema_says(
+    client: TestClient, body: dict[str, Any], answer: dict[str, Any]
+) -> None:
+    placement = answer["placement"]
+    moved = {**placement, "frames": {**placement["frames"], "ur": [9.0, 9.0, 9.0, 0, 0, 0]}}
+    evaluate = {"robot": body["robot"], "path": body["path"]}
+    original = client.post("/v1/evaluate", json={**evaluate, "placement": placement}).json()
+    edited = client.post("/v1/evaluate", json={**evaluate, "placement": moved}).json()
+    assert edited["mu_path"] == original["mu_path"]  # x, y, z, yaw, spin say where it is
+    schema = client.get("/openapi.json").json()["components"]["schemas"]["Placement"]
+    frames = schema["properties"]["frames"]
+    assert frames["readOnly"] is True and "ignored on input" in frames["description"]
+
+
 def test_start_and_improvement(answer: dict[str, Any]) -> None:
     start = answer["start"]
     assert sent_back(start["placement"]) == {"x": 0.0, "y": 0.45, "z": 0.1, "yaw": 0.0, "spin": 0.0}

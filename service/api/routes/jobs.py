@@ -1,7 +1,14 @@
-"""``/v1/jobs``: submit long work, watch its progress, read its result, cancel it (api.md)."""
+"""``/v1/jobs``: submit long work, watch its progress, read its result, cancel it (api.md).
+
+Cancel and delete are two operations: ``POST /v1/jobs/{id}/cancel`` stops the work and keeps
+the job (status ``cancelled``, readable until DTF_JOB_TTL, as the page shows it);
+``DELETE /v1/jobs/{id}`` cancels it too and forgets it, so that a ``GET`` afterwards is 404.
+While the job store cannot be used, every route here answers 503 saying why.
+"""
 
 from __future__ import annotations
 
+import functools
 import time
 from typing import Annotated, Any
 from uuid import UUID
@@ -10,18 +17,29 @@ import anyio
 from fastapi import APIRouter, HTTPException, Path, Query, Response, status
 from fastapi.responses import JSONResponse
 
-from service.config import Settings
 from service.deps import SettingsDep
 from service.errors import ERROR_RESPONSES
+from service.jobs.checks import check_job
 from service.jobs.runner import get_runner
-from service.jobs.store import Job
+from service.jobs.store import Job, QueueFull
 from service.logs import log
-from service.operations import checked_grid
-from service.schemas import ErrorDetail, MapRequest
-from service.schemas.jobs import JobInfo, JobList, JobProgress, JobRequest, JobStatus, MapJob
-from solver.core.exceptions import InvalidInputError, SolverError
+from service.schemas import ErrorDetail, ErrorResponse, MapRequest
+from service.schemas.jobs import JobInfo, JobList, JobProgress, JobRequest, JobStatus
 
-router = APIRouter(prefix="/jobs", tags=["jobs"], responses=ERROR_RESPONSES)
+JOB_RESPONSES: dict[int | str, dict[str, Any]] = {
+    **ERROR_RESPONSES,
+    status.HTTP_503_SERVICE_UNAVAILABLE: {
+        "model": ErrorResponse,
+        "description": "The job store cannot be used (corrupt, replaced or deleted file: the "
+        "detail says which), or the service is shutting down; retry after Retry-After. The "
+        "compute routes are not affected.",
+        "headers": {
+            "Retry-After": {"description": "Seconds to wait.", "schema": {"type": "integer"}}
+        },
+    },
+}
+
+router = APIRouter(prefix="/jobs", tags=["jobs"], responses=JOB_RESPONSES)
 
 JobId = Annotated[UUID, Path(description="The job's id, as POST /v1/jobs answered it.")]
 
@@ -60,17 +78,6 @@ def job_info(job: Job, *, with_result: bool = True) -> JobInfo:
     )
 
 
-def _check_size(body: JobRequest, settings: Settings) -> None:
-    """A map job's size against the job limits, before it is queued (422 naming grid)."""
-    if isinstance(body, MapJob):
-        try:
-            checked_grid(body.request, settings.for_jobs())
-        except SolverError as error:  # the field is inside the job's request
-            raise InvalidInputError(
-                f"request.{error.field}", error.message, waypoint=error.waypoint
-            ) from None
-
-
 @router.post(
     "",
     operation_id="submit_job",
@@ -81,18 +88,26 @@ def _check_size(body: JobRequest, settings: Settings) -> None:
 async def post_job(body: JobRequest, settings: SettingsDep) -> JSONResponse:
     """Queue the work; answer 202 with its id and Location.
 
-    Job limits (DTF_MAX_JOB_CELLS, DTF_MAX_JOB_POSES) replace the routes' own; a map's size is
-    checked before it is queued.
+    The request is checked as its route checks it before it is queued (the robot, the path as
+    read, the options, the grid, the bounds), with the route's error types, a field inside the
+    job (``request.path.csv``); job limits (DTF_MAX_JOB_CELLS, DTF_MAX_JOB_POSES) replace the
+    routes' own. The queue's limit (DTF_MAX_QUEUED_JOBS) is counted in the insert's transaction.
     """
+    await anyio.to_thread.run_sync(check_job, body, settings)
     runner = get_runner(settings)
-    if runner.store.count_unfinished() >= settings.max_queued_jobs:
+    request = body.request.model_dump(mode="json", exclude_unset=True)
+    try:
+        job = await anyio.to_thread.run_sync(
+            functools.partial(
+                runner.store.create, body.kind, request, limit=settings.max_queued_jobs
+            )
+        )
+    except QueueFull:
         raise HTTPException(
             status.HTTP_429_TOO_MANY_REQUESTS,
             f"{settings.max_queued_jobs} jobs are queued or running (DTF_MAX_QUEUED_JOBS)",
             headers={"Retry-After": "10"},
-        )
-    await anyio.to_thread.run_sync(_check_size, body, settings)
-    job = runner.store.create(body.kind, body.request.model_dump(mode="json", exclude_unset=True))
+        ) from None
     runner.wake()  # an idle worker takes the job now
     log.info("job %s queued (%s)", job.id, body.kind)
     info = job_info(job)
@@ -125,22 +140,46 @@ def get_job(job_id: JobId, settings: SettingsDep) -> JobInfo:
     return job_info(job)
 
 
+@router.post(
+    "/{job_id}/cancel",
+    operation_id="cancel_job",
+    summary="Cancel a queued or running job, keeping it",
+    responses=NOT_FOUND,
+)
+def cancel_job(job_id: JobId, settings: SettingsDep) -> JobInfo:
+    """A queued job is cancelled now; a running one stops within a second.
+
+    The job stays (``cancelled`` once stopped, readable until DTF_JOB_TTL); a finished job is
+    left as it is. The answer is the job after the cancel was asked.
+    """
+    runner = get_runner(settings)
+    if runner.store.get(str(job_id)) is None:
+        raise HTTPException(status.HTTP_404_NOT_FOUND, f"no job {str(job_id)!r}")
+    runner.store.cancel(str(job_id))
+    runner.wake()  # the supervisor sees the cancel now
+    log.info("job %s cancel asked", job_id)
+    job = runner.store.get(str(job_id))
+    if job is None:  # deleted meanwhile
+        raise HTTPException(status.HTTP_404_NOT_FOUND, f"no job {str(job_id)!r}")
+    return job_info(job)
+
+
 @router.delete(
     "/{job_id}",
-    operation_id="cancel_job",
-    summary="Cancel a queued or running job",
+    operation_id="delete_job",
+    summary="Delete a job, cancelling it first",
     status_code=status.HTTP_204_NO_CONTENT,
     responses=NOT_FOUND,
 )
 def delete_job(job_id: JobId, settings: SettingsDep) -> Response:
-    """A queued job is cancelled now; a running one stops within a second.
+    """Cancel the job (its work stops within a second) and forget it and its result.
 
-    A finished job is left as it is.
+    Afterwards the id is unknown (404), as for a job that expired.
     """
-    store = get_runner(settings).store
-    if store.get(str(job_id)) is None:
+    runner = get_runner(settings)
+    runner.store.cancel(str(job_id))
+    if not runner.store.delete(str(job_id)):
         raise HTTPException(status.HTTP_404_NOT_FOUND, f"no job {str(job_id)!r}")
-    store.cancel(str(job_id))
-    get_runner(settings).wake()  # the supervisor sees the cancel now
-    log.info("job %s cancel asked", job_id)
+    runner.wake()  # the supervisor stops a running job's worker now
+    log.info("job %s deleted", job_id)
     return Response(status_code=status.HTTP_204_NO_CONTENT)

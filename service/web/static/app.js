@@ -189,7 +189,7 @@ async function watch(id) {
 }
 
 async function cancelMap() {
-  if (state.job) await api("DELETE", `/v1/jobs/${state.job}`);
+  if (state.job) await api("POST", `/v1/jobs/${state.job}/cancel`);  // DELETE would forget it
 }
 
 // ---- the colour map ------------------------------------------------------------------------

@@ -1,0 +1,129 @@
+"""``/v1/jobs`` in process: checked as the routes check, 503 on a bad store, delete and cancel."""
+
+from __future__ import annotations
+
+import json
+import time
+import uuid
+from collections.abc import Iterator
+from pathlib import Path
+from typing import Any
+
+import pytest
+from fastapi.testclient import TestClient
+
+from service.config import Settings
+from service.deps import _settings
+from service.main import app
+from tests.cases import ROOT
+
+EXAMPLE = json.loads((ROOT / "examples" / "evaluate_request.json").read_text())
+GRID = {"x": {"min": -0.1, "max": 0.1, "step": 0.1}, "y": 0.45, "z": 0.1, "yaw": 0.0}
+BAD_PATHS = [  # each refused by the route itself, not by the schema (invalid_line, ...)
+    {"csv": "x,y,z\n1,2\n", "units": "mm"},
+    {"cl_data": "GOTO/0,0,0\nNOT A RECORD\n"},
+    {"waypoints": [EXAMPLE["path"]["waypoints"][0]] * 2},  # a repeated waypoint
+]
+
+
+def route_body(kind: str, path: dict[str, Any]) -> dict[str, Any]:
+    body: dict[str, Any] = {"robot": EXAMPLE["robot"], "path": path}
+    if kind == "evaluate":
+        body["placement"] = EXAMPLE["placement"]
+    elif kind == "map":
+        body["grid"] = {**GRID, "y": {"min": 0.4, "max": 0.5, "step": 0.1}}
+    else:
+        body |= {"bounds": {"x": [-0.05, 0.05], "y": [0.4, 0.5], "yaw": [-0.2, 0.2]}, "z": 0.1}
+    return body
+
+
+@pytest.mark.parametrize("kind", ["evaluate", "map", "optimize"])
+@pytest.mark.parametrize("path", BAD_PATHS, ids=["csv", "cl_data", "repeated"])
+def test_a_job_is_refused_at_submit_as_its_route_refuses_it(
+    client: TestClient, kind: str, path: dict[str, Any]
+) -> None:
+    body = route_body(kind, path)
+    direct = client.post(f"/v1/{kind}", json=body)
+    assert direct.status_code == 422, direct.text
+    submitted = client.post("/v1/jobs", json={"kind": kind, "request": body})
+    assert submitted.status_code == 422, submitted.text
+    (expected,), (detail,) = direct.json()["detail"], submitted.json()["detail"]
+    assert detail == {**expected, "loc": ["body", "request", *expected["loc"][1:]]}
+
+
+def test_an_optimize_job_with_a_start_outside_its_bounds_is_refused(client: TestClient) -> None:
+    body = route_body("optimize", EXAMPLE["path"]) | {
+        "start": {"x": 1.0, "y": 0.45, "z": 0.1, "yaw": 0.0}
+    }
+    submitted = client.post("/v1/jobs", json={"kind": "optimize", "request": body})
+    assert submitted.status_code == 422, submitted.text
+    assert submitted.json()["detail"][0]["loc"] == ["body", "request", "start"]
+
+
+def wait_for(client: TestClient, job_id: str, done: Any) -> dict[str, Any]:
+    deadline = time.monotonic() + 60
+    while True:
+        job: dict[str, Any] = client.get(f"/v1/jobs/{job_id}").json()
+        if done(job) or time.monotonic() > deadline:
+            return job
+        time.sleep(0.05)
+
+
+def test_delete_removes_a_job_and_cancel_keeps_it(client: TestClient) -> None:
+    job = {"kind": "map", "request": route_body("map", EXAMPLE["path"])}
+    first = client.post("/v1/jobs", json=job).json()["id"]
+    assert client.delete(f"/v1/jobs/{first}").status_code == 204
+    assert client.get(f"/v1/jobs/{first}").status_code == 404
+    assert client.delete(f"/v1/jobs/{first}").status_code == 404
+    assert first not in [j["id"] for j in client.get("/v1/jobs").json()["jobs"]]
+    second = client.post("/v1/jobs", json=job).json()["id"]
+    cancelled = client.post(f"/v1/jobs/{second}/cancel")
+    assert cancelled.status_code == 200, cancelled.text
+    assert cancelled.json()["id"] == second
+    ended = wait_for(client, second, lambda j: j["status"] not in ("queued", "running"))
+    assert ended["status"] in ("cancelled", "done")  # done if it ended before the cancel
+    assert client.post(f"/v1/jobs/{uuid.uuid4()}/cancel").status_code == 404
+
+
+@pytest.fixture
+def corrupt_store(tmp_path: Path) -> Iterator[Path]:
+    """The app with its jobs in ``tmp_path``, whose store file is not a database."""
+    path = tmp_path / "jobs.sqlite3"
+    path.write_bytes(b"not a database" * 100)
+    settings = Settings(data_dir=tmp_path, workers=1)
+
+    async def corrupt() -> Settings:
+        return settings
+
+    app.dependency_overrides[_settings] = corrupt
+    yield path
+    app.dependency_overrides.pop(_settings)
+
+
+def test_a_corrupt_store_takes_down_the_job_routes_only(
+    client: TestClient, corrupt_store: Path
+) -> None:
+    job = {"kind": "evaluate", "request": route_body("evaluate", EXAMPLE["path"])}
+    for method, url, body in [
+        ("GET", "/v1/jobs", None),
+        ("GET", f"/v1/jobs/{uuid.uuid4()}", None),
+        ("POST", "/v1/jobs", job),
+        ("POST", f"/v1/jobs/{uuid.uuid4()}/cancel", None),
+        ("DELETE", f"/v1/jobs/{uuid.uuid4()}", None),
+    ]:
+        answer = client.request(method, url, json=body)
+        assert answer.status_code == 503, (method, url, answer.text)
+        assert answer.headers["retry-after"] == "30"
+        (detail,) = answer.json()["detail"]
+        assert detail["type"] == "job_store_unavailable"
+        assert str(corrupt_store) in detail["msg"] and "file is not a database" in detail["msg"]
+    assert client.get("/healthz").status_code == 200
+    evaluated = client.post("/v1/evaluate", json=job["request"])
+    assert evaluated.status_code == 200, evaluated.text
+
+
+def test_the_spec_declares_the_503_of_the_job_routes_and_metrics(client: TestClient) -> None:
+    paths = client.get("/openapi.json").json()["paths"]
+    for path, method in [("/v1/jobs", "post"), ("/v1/jobs/{job_id}", "get"), ("/metrics", "get")]:
+        declared = paths[path][method]["responses"]["503"]
+        assert "job store" in declared["description"], (path, declared)

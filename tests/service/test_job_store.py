@@ -1,0 +1,131 @@
+"""The job store on its own: opened lazily, a bad file refused with its reason, an atomic limit."""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+import threading
+from pathlib import Path
+
+import pytest
+
+from service.jobs.store import JobStore, JobStoreUnavailable, QueueFull
+from tests.cases import ROOT
+
+EXAMPLE = json.loads((ROOT / "examples" / "evaluate_request.json").read_text())
+EVALUATE = {k: EXAMPLE[k] for k in ("robot", "path", "placement")}
+
+
+def test_importing_the_app_creates_no_store_and_starts_no_thread(tmp_path: Path) -> None:
+    script = (
+        "import threading, os, service.main\n"
+        "print(sorted(t.name for t in threading.enumerate()))\n"
+        "print(os.path.exists('var'))\n"
+    )
+    env = {k: v for k, v in os.environ.items() if not k.startswith("DTF_")}
+    env["PYTHONPATH"] = str(ROOT)
+    done = subprocess.run(
+        [sys.executable, "-c", script], cwd=tmp_path, env=env, capture_output=True, text=True
+    )
+    assert done.returncode == 0, done.stderr
+    threads, var = done.stdout.splitlines()
+    assert threads == "['MainThread']"
+    assert var == "False" and list(tmp_path.iterdir()) == []
+
+
+def test_a_store_opens_its_file_on_first_use(tmp_path: Path) -> None:
+    store = JobStore(tmp_path / "data" / "jobs.sqlite3")
+    assert not (tmp_path / "data").exists()
+    assert store.get("no-such-job") is None
+    assert (tmp_path / "data" / "jobs.sqlite3").is_file()
+
+
+@pytest.mark.parametrize(
+    "content", [b"this is not a database" * 100, b"SQLite format 3\x00" + b"\xff" * 4000]
+)
+def test_a_corrupt_file_makes_the_store_unavailable_with_its_reason(
+    tmp_path: Path, content: bytes
+) -> None:
+    path = tmp_path / "jobs.sqlite3"
+    path.write_bytes(content)
+    store = JobStore(path)
+    for call in (
+        lambda: store.get("x"),
+        lambda: store.jobs(status=None, limit=10),
+        lambda: store.create("evaluate", EVALUATE, limit=10),
+        store.statistics,
+    ):
+        with pytest.raises(JobStoreUnavailable) as raised:
+            call()
+        assert str(path) in raised.value.reason and "cannot be used" in raised.value.reason
+
+
+def test_a_file_corrupted_while_in_use_makes_the_store_unavailable(tmp_path: Path) -> None:
+    path = tmp_path / "jobs.sqlite3"
+    store = JobStore(path)
+    job = store.create("evaluate", EVALUATE)
+    with path.open("r+b") as file:  # the same file (inode), its content overwritten
+        file.write(b"garbage!" * 512)
+    with pytest.raises(JobStoreUnavailable, match="cannot be used"):
+        store.get(job.id)
+
+
+def test_a_deleted_file_is_found_out_not_silently_made_again(tmp_path: Path) -> None:
+    path = tmp_path / "jobs.sqlite3"
+    store = JobStore(path)
+    job = store.create("evaluate", EVALUATE)
+    for file in tmp_path.iterdir():  # the database and its WAL files
+        file.unlink()
+    with pytest.raises(JobStoreUnavailable, match="was deleted while the service ran"):
+        store.get(job.id)
+    worker_store = JobStore(path, create=False)  # a worker process's
+    with pytest.raises(JobStoreUnavailable, match="cannot be used"):
+        worker_store.get(job.id)
+    assert list(tmp_path.iterdir()) == []  # no new, empty store that loses the jobs quietly
+
+
+def test_a_replaced_file_is_found_out(tmp_path: Path) -> None:
+    path = tmp_path / "jobs.sqlite3"
+    store = JobStore(path)
+    store.create("evaluate", EVALUATE)
+    other = JobStore(tmp_path / "other.sqlite3")
+    other.create("map", EVALUATE)
+    os.replace(tmp_path / "other.sqlite3", path)
+    with pytest.raises(JobStoreUnavailable, match="was replaced by another file"):
+        store.jobs(status=None, limit=10)
+
+
+def test_the_queue_limit_holds_against_64_concurrent_submissions(tmp_path: Path) -> None:
+    store = JobStore(tmp_path / "jobs.sqlite3")
+    store.get("open-it")  # the table made before the race
+    outcomes: list[str] = []
+    start = threading.Barrier(64)
+
+    def submit() -> None:
+        start.wait()
+        try:
+            store.create("evaluate", EVALUATE, limit=10)
+        except QueueFull:
+            outcomes.append("full")
+        else:
+            outcomes.append("queued")
+
+    threads = [threading.Thread(target=submit) for _ in range(64)]
+    for thread in threads:
+        thread.start()
+    for thread in threads:
+        thread.join()
+    assert outcomes.count("queued") == 10 and outcomes.count("full") == 54
+    assert len(store.jobs(status="queued", limit=100)) == 10
+
+
+def test_a_deleted_job_is_gone_and_its_worker_is_told_to_stop(tmp_path: Path) -> None:
+    store = JobStore(tmp_path / "jobs.sqlite3")
+    job = store.create("evaluate", EVALUATE)
+    assert store.start(job.id)
+    assert store.delete(job.id) and store.get(job.id) is None
+    assert not store.delete(job.id)
+    assert store.progress(job.id, 0.5)  # a worker stops at its next report
+    assert store.cancel_asked([job.id]) == {job.id}  # the supervisor stops one that does not
