@@ -33,11 +33,11 @@ from pydantic import BaseModel, ValidationError
 from service import convert
 from service.cli_text import ProgressBar, evaluation_text, import_text, map_text, optimum_text
 from service.config import get_settings
-from service.errors import solver_error_location
+from service.errors import request_location, solver_error_location
 from service.operations import computed_map, evaluation_of, import_of, map_png, optimum_of
 from service.schemas import EvaluateRequest, MapRequest, OptimizeRequest
 from service.schemas.paths_import import PathImportRequest
-from solver.core.exceptions import SolverError
+from solver.core.exceptions import InvalidInputError, SolverError
 
 OK = 0
 """The answer was printed (and the path runs, for evaluate, map and optimise)."""
@@ -59,7 +59,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         return int(args.run(args))
     except ValidationError as error:
         for item in error.errors():
-            where = ".".join(str(part) for part in item["loc"])
+            where = ".".join(str(part) for part in request_location(item["loc"]))
             print(f"error: {where}: {item['msg']}", file=sys.stderr)  # noqa: T201
     except SolverError as error:
         where = ".".join(str(part) for part in solver_error_location(error)[1:])
@@ -75,6 +75,9 @@ def _path(args: argparse.Namespace) -> dict[str, Any]:
     """The request's ``path`` object of the program file."""
     text = Path(args.program).read_text(encoding="utf-8", errors="replace")
     if args.program.lower().endswith(".csv"):
+        if args.units is None:  # a CSV says nothing of its units: never assumed
+            message = "a CSV states no units: give --units mm, inch or m"
+            raise InvalidInputError("path.units", message)
         return {"csv": text, "units": args.units}
     path: dict[str, Any] = {"cl_data": text}
     if args.units is not None:

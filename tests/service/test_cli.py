@@ -153,6 +153,21 @@ def test_invalid_input_names_the_field_and_exits_invalid(
     assert code == INVALID and err.startswith("error: path.cl_data: line 3: ")
 
 
+def test_a_csv_needs_its_units_and_errors_name_the_api_field(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    table = tmp_path / "fan.csv"
+    table.write_text("x,y,z,i,j,k\n100,0,0,0,0,1\n110,0,0,0,0,1\n")
+    code, out, err = run(capsys, "import", str(table))
+    assert (code, out) == (INVALID, "")
+    assert err.startswith("error: path.units: ") and "--units" in err
+    program = tmp_path / "line.cl"
+    program.write_text("UNITS/MM\nGOTO/0,0,0\nGOTO/1,0,0\n")
+    code, _, err = run(capsys, "import", "--arc-tolerance", "-1", str(program))
+    assert code == INVALID  # the location as the API gives it, without the union's tags
+    assert err.startswith("error: path.arc_tolerance: ")
+
+
 def test_a_robot_file_that_is_not_json_exits_invalid(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
