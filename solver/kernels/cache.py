@@ -6,6 +6,7 @@ import hashlib
 import sys
 from pathlib import Path
 
+import solver.kernels.accelerations
 import solver.kernels.cell
 import solver.kernels.limits
 import solver.kernels.positions
@@ -30,6 +31,7 @@ def drop_stale_compiled_code(name: str) -> None:
         solver.kernels.positions,
         solver.kernels.limits,
         solver.kernels.cell,
+        solver.kernels.accelerations,
         sys.modules[name],
     )
     files = [Path(str(module.__file__)) for module in modules]

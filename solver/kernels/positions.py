@@ -124,3 +124,23 @@ def first_outside_pairs(  # type: ignore[no-untyped-def]  # pragma: no cover - c
     if exact:
         return first_outside(unwrapped(cq, sq, b), lower, upper)
     return n_waypoints
+
+
+@njit(cache=True, error_model="numpy", nogil=True)
+def shift_to_copy(path, lower, upper):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
+    """Move each joint of a feasible path (W, n) to the 2 pi copy that track() reports, in place.
+
+    :func:`solver.path.tracking.track`'s ``shifted``: of the copies 2 pi k that fit the whole
+    path, the one whose first waypoint is nearest zero (k rounded half to even, as numpy.round).
+    """
+    for j in range(path.shape[1]):
+        low, high = path[0, j], path[0, j]
+        for w in range(path.shape[0]):
+            low = min(low, path[w, j])
+            high = max(high, path[w, j])
+        k_low = np.ceil((lower[j] - low) / _TWO_PI - EDGE)
+        k_high = np.floor((upper[j] - high) / _TWO_PI + EDGE)
+        shift = min(max(np.rint(-path[0, j] / _TWO_PI), k_low), k_high)
+        if shift != 0.0:
+            for w in range(path.shape[0]):
+                path[w, j] += _TWO_PI * shift
