@@ -19,7 +19,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from solver.core.codes import FEASIBLE
+from solver.core.codes import ACC_TIE_RTOL, FEASIBLE
 from solver.kernels.limits import acceleration_bound
 
 
@@ -62,16 +62,20 @@ def next_fastest(alive, taken, slowest, top, tie):  # type: ignore[no-untyped-de
 
 @njit(cache=True, error_model="numpy", nogil=True)
 def branch_mu_acc(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
-    i, path, slowest, index, weight, waypoints, qddot_max, feed, acc_at, acc_joint, acc_speeds
-):
+    i, path, slowest, index, weight, waypoints, qddot_max, feed, acc_at, acc_joint, acc_speeds,
+    top,
+):  # fmt: skip
     """mu_acc of branch row i along its final joint path (W, 6), kept in ``feed[i]``.
 
     :func:`solver.path.pipeline._final_path_bounds`: min(mu_path, the least V_acc); where
     V_acc binds (below mu_path), its waypoint and joint go to ``acc_at`` and ``acc_joint``.
-    Returns mu_acc.
+    Where V_acc falls below ``top`` (the highest mu_acc so far) and is not tied with it, the
+    branch cannot be chosen and the rest of its path is not looked at (its ``feed`` is then
+    such a V_acc, low enough for the choice). Returns mu_acc.
     """
     row = acc_speeds[i] if acc_speeds.shape[1] else acc_speeds[0, :0]
-    least, at, joint = acceleration_bound(path, index, weight, waypoints, qddot_max, row)
+    floor = top - ACC_TIE_RTOL * abs(top) if top > 0.0 and np.isfinite(top) else 0.0
+    least, at, joint = acceleration_bound(path, index, weight, waypoints, qddot_max, row, floor)
     feed[i] = min(slowest[i], least)
     acc_at[i] = at
     acc_joint[i] = joint

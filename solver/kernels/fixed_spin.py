@@ -22,8 +22,8 @@ waypoints:
    through the gap opposite. Only a branch that neither test clears forms its angles (atan2)
    and runs the exact test of :func:`solver.path.tracking.track`;
 5. with joint acceleration limits, mu_acc of the branches that can be chosen, fastest first,
-   along their tracked joint paths (the angles, atan2, in the 2 pi copy of
-   :func:`solver.path.tracking.track`; :mod:`solver.kernels.accelerations`);
+   along their joint paths (:func:`solver.kernels.positions.relative_path`: the steps'
+   angles from the pairs, by a series where small; :mod:`solver.kernels.accelerations`);
 6. the branch: :func:`solver.path.tracking.choose_branch`'s rule, by mu_acc where it is
    computed (:func:`solver.kernels.cell.write_cell`).
 
@@ -75,8 +75,7 @@ from solver.kernels.positions import (
     WIDE,
     first_outside_pairs,
     limit_modes,
-    shift_to_copy,
-    unwrapped,
+    relative_path,
 )
 
 _TWO_PI = 2 * math.pi
@@ -259,11 +258,10 @@ def map_cells(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
             top = -np.inf
             i = next_fastest(alive, taken, slowest, top, ACC_TIE_RTOL)
             while i >= 0:
-                path = unwrapped(cq, sq, branches[i])
-                shift_to_copy(path, lower, upper)
+                path = relative_path(cq, sq, branches[i], False)
                 top = max(top, branch_mu_acc(
                     i, path, slowest, stencil_index, stencil_weight, stencil_waypoints,
-                    qddot_max, feed, acc_at, acc_by, acc_speeds,
+                    qddot_max, feed, acc_at, acc_by, acc_speeds, top,
                 ))  # fmt: skip
                 i = next_fastest(alive, taken, slowest, top, ACC_TIE_RTOL)
         pick = write_cell(

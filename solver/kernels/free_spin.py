@@ -58,7 +58,7 @@ from solver.kernels.cell import (
     write_cell,
 )
 from solver.kernels.limits import two_variable_speed
-from solver.kernels.positions import first_outside, shift_to_copy, unwrapped, wrapped_step
+from solver.kernels.positions import first_outside, relative_path, shift_to_copy, wrapped_step
 
 _TWO_PI = 2 * math.pi
 _INSIDE = 1.0 - 1e-12  # as solver.core.dtf.spin_rate_nearest_zero
@@ -288,7 +288,7 @@ def free_cells(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
         while i >= 0:
             rate = slowest[i] if slowest[i] > 0.0 and math.isfinite(slowest[i]) else 0.0
             code, at = _spun_failure(
-                unwrapped(cq, sq, branches[i]), qd, qs, branches[i], rate, length,
+                relative_path(cq, sq, branches[i], True), qd, qs, branches[i], rate, length,
                 segment_checked, lower, upper, qdot_max, max_joint_step, spun,
             )  # fmt: skip
             if code != FEASIBLE:
@@ -297,7 +297,7 @@ def free_cells(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
                 shift_to_copy(spun, lower, upper)
                 top = max(top, branch_mu_acc(
                     i, spun, slowest, stencil_index, stencil_weight, stencil_waypoints,
-                    qddot_max, feed, acc_at, acc_by, acc_speeds,
+                    qddot_max, feed, acc_at, acc_by, acc_speeds, top,
                 ))  # fmt: skip
             else:
                 top = max(top, slowest[i])

@@ -62,7 +62,7 @@ def two_variable_speed(qd, qs, b, w, qdot_max):  # type: ignore[no-untyped-def] 
 
 
 @njit(cache=True, error_model="numpy", nogil=True)
-def acceleration_bound(path, index, weight, waypoints, qddot_max, v_row):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
+def acceleration_bound(path, index, weight, waypoints, qddot_max, v_row, floor):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
     """Joint accelerations at a constant feed: the least V_acc,i over a final joint path.
 
     :class:`solver.path.limits.JointAccelerationLimit` on one branch: at each constrained
@@ -79,14 +79,18 @@ def acceleration_bound(path, index, weight, waypoints, qddot_max, v_row):  # typ
         qddot_max: shape (6,), rad/s^2.
         v_row: shape (W,), out, V_acc at every waypoint (inf where unconstrained), or shape
             (0,) when not wanted.
+        floor: m/s; at the first waypoint whose V_acc is below it the rest is not looked at
+            (that V_acc, its waypoint and joint are returned): the branch cannot be chosen.
+            0 to look at every waypoint.
 
     Returns:
         The least V_acc (m/s; inf where nothing bounds it), its waypoint and joint (-1, -1
         where nothing does).
     """
+    ceiling = 1.0 / (floor * floor) if floor > 0.0 else np.inf  # worst above it: V < floor
     if v_row.shape[0]:
         v_row[:] = np.inf
-    best, at, joint = np.inf, -1, -1
+    largest, at, joint = -1.0, -1, -1
     for k in range(waypoints.shape[0]):
         worst = -1.0
         limiting = 0
@@ -98,9 +102,10 @@ def acceleration_bound(path, index, weight, waypoints, qddot_max, v_row):  # typ
             if ratio > worst:
                 worst = ratio
                 limiting = j
-        v = 1.0 / math.sqrt(worst)
         if v_row.shape[0]:
-            v_row[waypoints[k]] = v
-        if v < best:
-            best, at, joint = v, waypoints[k], limiting
-    return best, at, joint
+            v_row[waypoints[k]] = 1.0 / math.sqrt(worst)
+        if worst > largest:  # V_acc = 1 / sqrt(worst) below the least so far
+            largest, at, joint = worst, waypoints[k], limiting
+            if worst > ceiling and 1.0 / math.sqrt(worst) < floor:
+                break
+    return (1.0 / math.sqrt(largest) if at >= 0 else np.inf), at, joint
