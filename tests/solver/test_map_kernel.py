@@ -34,9 +34,17 @@ from tests.solver.test_parallel import grid_placements
 
 COLUMNS = ("reason", "failed_waypoint", "branch", "bottleneck_waypoint", "bottleneck_joint")
 ACC_COLUMNS = ("limited_by", "acc_waypoint", "acc_joint")
-# Joint acceleration limits the comparisons run with (rad/s^2): None (none), binding on
-# nearly every cell, and so large that the speed limits bind (mu_acc = mu_path).
-ACCELERATIONS = [None, 10.0, 3.0, 1e6]
+# Joint acceleration limits the comparisons run with (rad/s^2, every joint's): None (none),
+# binding on nearly every cell, so large that the speed limits bind (mu_acc = mu_path), and
+# one per joint (each joint's limit its own).
+ACCELERATIONS: list[float | tuple[float, ...] | None] = [
+    None,
+    10.0,
+    3.0,
+    1e6,
+    (12.0, 10.0, 14.0, 30.0, 8.0, 6.0),
+]
+Accelerations = float | tuple[float, ...] | None
 
 
 def grid(xs: np.ndarray, ys: np.ndarray, z: float, yaws: np.ndarray) -> np.ndarray:
@@ -50,11 +58,13 @@ def same_cells(
 ) -> tuple[PlacementResults, set[str]]:
     """Assert the kernel's cells equal the reference's; the results and the reasons seen.
 
-    ``accelerations`` (rad/s^2, every joint; None: no limits) among the options.
+    ``accelerations`` (rad/s^2, every joint's or one per joint; None: no limits) among the
+    options.
     """
     acceleration = options.pop("accelerations", None)
     if acceleration is not None:
-        robot = robot.with_options(qddot_max=[acceleration] * robot.dof)
+        limits = np.broadcast_to(np.asarray(acceleration, dtype=float), (robot.dof,))
+        robot = robot.with_options(qddot_max=list(limits))
     path = prepare_path(robot, waypoints, passes=options.pop("passes", None))  # type: ignore[arg-type]
     compiled = evaluate_placements(robot, path, placements, with_speeds=True, **options)  # type: ignore[arg-type]
     numpy = evaluate_placements(
@@ -73,7 +83,8 @@ def same_cells(
     if acceleration is None:
         assert compiled.mu_acc is None and numpy.mu_acc is None
     else:
-        same_acceleration_cells(compiled, numpy, float(acceleration), path.options.blend_length)
+        lowest = float(np.min(acceleration))  # type: ignore[call-overload]
+        same_acceleration_cells(compiled, numpy, lowest, path.options.blend_length)
     reasons = {REASONS[r] for r in numpy.reason if r >= 0}
     if np.isfinite(numpy.mu_path).any():
         reasons.add("feasible")
@@ -84,7 +95,8 @@ def same_acceleration_cells(
     compiled: PlacementResults, numpy: PlacementResults, acceleration: float, blend: float
 ) -> None:
     """Assert the acceleration columns agree: discrete ones identical, mu_acc and V_acc to the
-    rounding of the joint angles through D_i (on 1 / V^2, which is linear in |D|)."""
+    rounding of the joint angles through D_i (on 1 / V^2, which is linear in |D|; ``acceleration``
+    the lowest joint limit)."""
     for name in ACC_COLUMNS:
         np.testing.assert_array_equal(getattr(compiled, name), getattr(numpy, name), err_msg=name)
     assert compiled.mu_acc is not None and numpy.mu_acc is not None
@@ -123,7 +135,7 @@ def test_the_compiled_kernel_is_what_runs(
 
 
 @pytest.mark.parametrize("accelerations", ACCELERATIONS)
-def test_erk_grid(accelerations: float | None) -> None:
+def test_erk_grid(accelerations: Accelerations) -> None:
     """The ERK 2021 map: UR5, 546 cells, 133 waypoints, one yaw."""
     placements = grid(
         np.arange(-0.25, 0.25 + 1e-9, 0.02), np.arange(0.25, 0.65 + 1e-9, 0.02), 0.1, np.zeros(1)
@@ -133,7 +145,7 @@ def test_erk_grid(accelerations: float | None) -> None:
     assert len(placements) == 546 and np.isfinite(result.mu_path).all()
     if accelerations is not None:  # the limits bind on every cell, or (1e6) on none
         assert result.limited_by is not None
-        assert set(result.limited_by) == {0 if accelerations > 100.0 else 1}
+        assert set(result.limited_by) == {0 if np.min(accelerations) > 100.0 else 1}
 
 
 @pytest.mark.parametrize("accelerations", [None, 10.0])
@@ -178,7 +190,7 @@ def test_wide_grid_with_every_reason(accelerations: float | None) -> None:
 
 
 @pytest.mark.parametrize("accelerations", ACCELERATIONS)
-def test_steps_passes_and_one_branch(accelerations: float | None) -> None:
+def test_steps_passes_and_one_branch(accelerations: Accelerations) -> None:
     """A tight step, no step bound, a rapid between passes, a fixed branch."""
     robot = get_robot("ur10")
     waypoints = load_path("s_curve")
