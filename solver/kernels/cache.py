@@ -10,6 +10,7 @@ import solver.kernels.accelerations
 import solver.kernels.cell
 import solver.kernels.limits
 import solver.kernels.positions
+import solver.kernels.spin_schedule
 from solver.families.kernels import KERNEL_SOURCES
 
 
@@ -32,6 +33,7 @@ def drop_stale_compiled_code(name: str) -> None:
         solver.kernels.limits,
         solver.kernels.cell,
         solver.kernels.accelerations,
+        solver.kernels.spin_schedule,
         sys.modules[name],
     )
     files = [Path(str(module.__file__)) for module in modules]
