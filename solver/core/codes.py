@@ -23,5 +23,9 @@ REASON_UNREACHABLE, REASON_JOINT_LIMITS, REASON_SINGULAR, REASON_DISCONTINUOUS =
 # Branches whose mu_path is within this relative tolerance of the best tie; the first in the
 # family's order is chosen (dtf.md section 4).
 TIE_RTOL = 1e-12
+# The same for mu_acc (motion.md section 2): D_i divides the joint angles' last bits by b^2, so
+# mu_acc is known to a few 1e-12 only (at b = 2 mm, 10 rad/s^2 and 0.24 m/s a bit of q moves it
+# by up to 2.6e-12), and the wrist-flip branches, whose q6 differ by pi, tie to that rounding.
+ACC_TIE_RTOL = 1e-9
 # Slack (rad) when fitting a joint's 2 pi copy inside its limits.
 EDGE = 1e-12

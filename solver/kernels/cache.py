@@ -6,9 +6,11 @@ import hashlib
 import sys
 from pathlib import Path
 
+import solver.kernels.accelerations
 import solver.kernels.cell
 import solver.kernels.limits
 import solver.kernels.positions
+import solver.kernels.spin_schedule
 from solver.families.kernels import KERNEL_SOURCES
 
 
@@ -30,6 +32,8 @@ def drop_stale_compiled_code(name: str) -> None:
         solver.kernels.positions,
         solver.kernels.limits,
         solver.kernels.cell,
+        solver.kernels.accelerations,
+        solver.kernels.spin_schedule,
         sys.modules[name],
     )
     files = [Path(str(module.__file__)) for module in modules]

@@ -14,10 +14,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from solver.core.codes import (
-    FEASIBLE,
-    TIE_RTOL,
-)
+from solver.core.codes import FEASIBLE
 from solver.families.kernels import N_BRANCHES, N_JOINTS, SCRATCH_ROWS, warm_up_arm
 
 # Waypoints solved together: the pose kernels run level by level over a block, and a block is
@@ -116,22 +113,24 @@ def turned_poses(c, ca, sa, offset, flange_rotation, flange_position, tool_posit
 
 @njit(cache=True, error_model="numpy", nogil=True)
 def write_cell(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
-    c, branches, alive, why, where, slowest, slowest_at, slowest_joint, speeds,
+    c, branches, alive, why, where, feed, tie, slowest, slowest_at, slowest_joint, speeds,
     mu, reason, failed, branch, bottleneck_waypoint, bottleneck_joint, v_out,
 ):  # fmt: skip
     """Placement c's answer from its branches: :func:`solver.path.tracking.choose_branch`'s rule.
 
-    The highest mu_path (``slowest``) among the branches ``alive``, ties to the first; where
-    none is, the one that failed furthest along (``why`` and ``where``, the first at a tie).
+    The highest ``feed`` (mu_path, ``slowest``; mu_acc with acceleration limits) among the
+    branches ``alive``, ties (within the relative ``tie``: ``TIE_RTOL``, for mu_acc
+    ``ACC_TIE_RTOL``) to the first; where none is, the one that failed furthest along
+    (``why`` and ``where``, the first at a tie). Returns the row of the branch chosen.
     """
     n_branches = branches.shape[0]
     top = -np.inf
     for i in range(n_branches):
-        if alive[i] and slowest[i] > top:
-            top = slowest[i]
+        if alive[i] and feed[i] > top:
+            top = feed[i]
     pick = -1
     for i in range(n_branches):
-        if alive[i] and slowest[i] >= top - TIE_RTOL * abs(top):
+        if alive[i] and feed[i] >= top - tie * abs(top):
             pick = i
             break
     if pick >= 0:
@@ -158,11 +157,20 @@ def write_cell(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
         for w in range(v_out.shape[1]):
             v_out[c, w] = np.nan
     branch[c] = branches[pick]
+    return pick
 
 
 def warm_up_answers() -> tuple[np.ndarray, ...]:
-    """The kernels' seven answer arrays for one placement, V_max not wanted."""
-    return (np.empty(1), *(np.empty(1, dtype=np.int64) for _ in range(5)), np.empty((1, 0)))
+    """The kernels' twelve answer arrays for one placement, V_max and accelerations not wanted."""
+    speeds = (np.empty(1), *(np.empty(1, dtype=np.int64) for _ in range(5)), np.empty((1, 0)))
+    integer = np.empty(0, dtype=np.int64)
+    return (*speeds, np.empty(0), integer, integer, integer, np.empty((1, 0)))
+
+
+def warm_up_accelerations() -> tuple[np.ndarray, ...]:
+    """The kernels' acceleration inputs without acceleration limits: qddot_max and stencil."""
+    return (np.empty(0), np.zeros((0, 5), dtype=np.int64), np.zeros((0, 5)),
+            np.zeros(0, dtype=np.int64))  # fmt: skip
 
 
 def warm_up_placement() -> tuple[object, ...]:

@@ -21,8 +21,11 @@ waypoints:
    turn or less fits when every waypoint is inside its arc and no step's short arc passes
    through the gap opposite. Only a branch that neither test clears forms its angles (atan2)
    and runs the exact test of :func:`solver.path.tracking.track`;
-5. the branch: :func:`solver.path.tracking.choose_branch`'s rule
-   (:func:`solver.kernels.cell.write_cell`).
+5. with joint acceleration limits, mu_acc of the branches that can be chosen, fastest first,
+   along their joint paths (:func:`solver.kernels.positions.relative_path`: the steps'
+   angles from the pairs, by a series where small; :mod:`solver.kernels.accelerations`);
+6. the branch: :func:`solver.path.tracking.choose_branch`'s rule, by mu_acc where it is
+   computed (:func:`solver.kernels.cell.write_cell`).
 
 A branch stops at its first failure and a placement at its last live branch. Why compiled:
 the fused loops keep a waypoint's values in registers, where numpy makes and reads back an
@@ -41,14 +44,17 @@ import numpy as np
 from numba import njit
 
 from solver.core.codes import (
+    ACC_TIE_RTOL,
     REASON_DISCONTINUOUS,
     REASON_JOINT_LIMITS,
     REASON_SINGULAR,
     REASON_UNREACHABLE,
     SINGULAR,
+    TIE_RTOL,
     UNREACHABLE,
 )
 from solver.families.kernels import N_JOINTS, pose_block
+from solver.kernels.accelerations import acc_work, branch_mu_acc, next_fastest, write_acc
 from solver.kernels.cache import drop_stale_compiled_code
 from solver.kernels.cell import (
     BLOCK,
@@ -58,12 +64,19 @@ from solver.kernels.cell import (
     start_cell,
     turned_poses,
     wanted_branches,
+    warm_up_accelerations,
     warm_up_answers,
     warm_up_placement,
     write_cell,
 )
 from solver.kernels.limits import joint_speed_bound
-from solver.kernels.positions import NARROW, WIDE, first_outside_pairs, limit_modes
+from solver.kernels.positions import (
+    NARROW,
+    WIDE,
+    first_outside_pairs,
+    limit_modes,
+    relative_path,
+)
 
 _TWO_PI = 2 * math.pi
 
@@ -90,6 +103,10 @@ def map_cells(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
     arc,
     qdot_max,
     max_joint_step,
+    qddot_max,
+    stencil_index,
+    stencil_weight,
+    stencil_waypoints,
     mu,
     reason,
     failed,
@@ -97,6 +114,11 @@ def map_cells(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
     bottleneck_waypoint,
     bottleneck_joint,
     v_out,
+    mu_acc,
+    limited_by,
+    acc_waypoint,
+    acc_joint,
+    v_acc,
 ):
     """Evaluate C placements; the answers go to the arrays after ``max_joint_step``.
 
@@ -119,6 +141,11 @@ def map_cells(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
         arc: from :func:`solver.kernels.positions.limit_modes`.
         qdot_max: shape (6,), rad/s.
         max_joint_step: rad.
+        qddot_max: shape (6,), rad/s^2, or (0,) without acceleration limits (then the blend
+            stencil and the acceleration answers are not read).
+        stencil_index: shape (K, 5), :class:`solver.path.limits.BlendStencil`'s ``index``.
+        stencil_weight: shape (K, 5), its ``weight``.
+        stencil_waypoints: shape (K,), its ``waypoints``.
         mu: shape (C,), out, m/s, NaN where infeasible.
         reason: shape (C,), out, as :class:`solver.path.placements.PlacementResults`.
         failed: shape (C,), out, the failed waypoint.
@@ -126,6 +153,12 @@ def map_cells(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
         bottleneck_waypoint: shape (C,), out.
         bottleneck_joint: shape (C,), out.
         v_out: shape (C, W), out, V_max on the chosen branch, or (C, 0) when not wanted.
+        mu_acc: shape (C,), out, m/s, as :class:`solver.path.placements.PlacementResults`;
+            written only with acceleration limits, as the next three.
+        limited_by: shape (C,), out, 0 the speed limits bind, 1 the accelerations, -1 none.
+        acc_waypoint: shape (C,), out, where mu_acc binds.
+        acc_joint: shape (C,), out, the joint that binds there.
+        v_acc: shape (C, W), out, V_acc on the chosen branch, or (C, 0) when not wanted.
     """
     n_cells = cos_yaw.shape[0]
     n_waypoints = flange_rotation.shape[0]
@@ -138,6 +171,8 @@ def map_cells(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
     largest2 = np.empty((n_branches, N_JOINTS))
     inside = np.empty((n_branches, N_JOINTS))
     crossed = np.empty((n_branches, N_JOINTS), dtype=np.bool_)
+    accelerations = qddot_max.shape[0] > 0
+    feed, acc_at, acc_by, taken, acc_speeds = acc_work(n_branches, n_waypoints, v_acc.shape[1] > 0)
     inverse_qdot = 1.0 / qdot_max
     check_steps = max_joint_step < math.pi
     cos_step = math.cos(max_joint_step)
@@ -217,10 +252,28 @@ def map_cells(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
             )
             if first < n_waypoints:
                 fail(i, REASON_JOINT_LIMITS, first, alive, why, where)
-        write_cell(
-            c, branches, alive, why, where, slowest, slowest_at, slowest_joint, speeds,
+        if accelerations:
+            feed[:] = slowest
+            taken[:] = False
+            top = -np.inf
+            i = next_fastest(alive, taken, slowest, top, ACC_TIE_RTOL)
+            while i >= 0:
+                path = relative_path(cq, sq, branches[i], False)
+                top = max(top, branch_mu_acc(
+                    i, path, slowest, stencil_index, stencil_weight, stencil_waypoints,
+                    qddot_max, feed, acc_at, acc_by, acc_speeds, top,
+                ))  # fmt: skip
+                i = next_fastest(alive, taken, slowest, top, ACC_TIE_RTOL)
+        pick = write_cell(
+            c, branches, alive, why, where, feed if accelerations else slowest,
+            ACC_TIE_RTOL if accelerations else TIE_RTOL, slowest, slowest_at, slowest_joint, speeds,
             mu, reason, failed, branch, bottleneck_waypoint, bottleneck_joint, v_out,
         )  # fmt: skip
+        if accelerations:
+            write_acc(
+                c, pick, reason, slowest, slowest_at, slowest_joint, feed, acc_at, acc_by,
+                acc_speeds, mu_acc, limited_by, acc_waypoint, acc_joint, v_acc,
+            )  # fmt: skip
 
 
 def warm_up() -> None:
@@ -241,5 +294,6 @@ def warm_up() -> None:
         arc,
         np.full(6, math.pi),
         0.35,
+        *warm_up_accelerations(),
         *warm_up_answers(),
     )

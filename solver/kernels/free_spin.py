@@ -16,8 +16,12 @@ tested against (tests/solver/test_free_spin_kernel.py). Per placement:
    spin rate nearest zero at the feed mu_path
    (:func:`solver.core.dtf.spin_rate_nearest_zero`), the joints moved by the spin
    (:func:`solver.path.pipeline._spin_schedule`), and that joint path tracked again with the
-   position limits and the step test (:func:`solver.path.tracking.track`);
-4. the branch: :func:`solver.path.tracking.choose_branch`'s rule.
+   position limits and the step test (:func:`solver.path.tracking.track`), in
+   :mod:`solver.kernels.spin_schedule`;
+4. with joint acceleration limits, mu_acc along the spun joint path of each branch that holds
+   (:mod:`solver.kernels.accelerations`), and the branches tracked again until no slower one
+   can be chosen;
+5. the branch: :func:`solver.path.tracking.choose_branch`'s rule, by mu_acc where computed.
 """
 
 from __future__ import annotations
@@ -28,9 +32,9 @@ import numpy as np
 from numba import njit
 
 from solver.core.codes import (
+    ACC_TIE_RTOL,
     FEASIBLE,
     REASON_DISCONTINUOUS,
-    REASON_JOINT_LIMITS,
     REASON_SINGULAR,
     REASON_UNREACHABLE,
     SINGULAR,
@@ -38,6 +42,7 @@ from solver.core.codes import (
     UNREACHABLE,
 )
 from solver.families.kernels import N_JOINTS, pose_block
+from solver.kernels.accelerations import acc_work, branch_mu_acc, next_fastest, write_acc
 from solver.kernels.cache import drop_stale_compiled_code
 from solver.kernels.cell import (
     BLOCK,
@@ -47,83 +52,17 @@ from solver.kernels.cell import (
     start_cell,
     turned_poses,
     wanted_branches,
+    warm_up_accelerations,
     warm_up_answers,
     warm_up_placement,
     write_cell,
 )
 from solver.kernels.limits import two_variable_speed
-from solver.kernels.positions import first_outside, unwrapped, wrapped_step
+from solver.kernels.positions import relative_path, shift_to_copy
+from solver.kernels.spin_schedule import spun_failure
 
 _TWO_PI = 2 * math.pi
-_INSIDE = 1.0 - 1e-12  # as solver.core.dtf.spin_rate_nearest_zero
-_HUGE = np.finfo(np.float64).max  # numpy.nan_to_num's value for inf
-
 drop_stale_compiled_code(__name__)
-
-
-@njit(cache=True, error_model="numpy", nogil=True)
-def _spin_rate(qd, qs, b, w, qdot_max, feed):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
-    """:func:`solver.core.dtf.spin_rate_nearest_zero` at one waypoint, at the feed."""
-    inside = feed * _INSIDE
-    low, high = -np.inf, np.inf
-    for j in range(N_JOINTS):
-        if qs[b, j, w] == 0.0:
-            continue
-        one = (-qdot_max[j] - inside * qd[b, j, w]) / qs[b, j, w]
-        other = (qdot_max[j] - inside * qd[b, j, w]) / qs[b, j, w]
-        low = max(low, min(one, other))
-        high = min(high, max(one, other))
-    sigma = (low + high) / 2 if low > high else min(max(0.0, low), high)
-    return sigma if math.isfinite(sigma) else 0.0
-
-
-@njit(cache=True, error_model="numpy", nogil=True)
-def _spun_failure(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
-    path, qd, qs, b, feed, length, segment_checked, lower, upper, qdot_max, max_joint_step
-):
-    """The reason code and waypoint where branch b's joint path, moved by the spin, fails.
-
-    ``path`` (W, 6) is the branch's tracked joint path; it is overwritten by the spun one,
-    q_i + sum_k<i sigma_k dt_k J^-1 [0; z_tool]_k, each pass restarting the sum
-    (:func:`solver.path.pipeline.cumsum_within_passes`; a rapid moves no spin). That path is then
-    tracked as :func:`solver.path.tracking.track` does: the step test, then the position limits.
-
-    Returns:
-        (FEASIBLE, -1) where it holds.
-    """
-    n_waypoints, dof = path.shape
-    steps = np.empty(max(n_waypoints - 1, 0))
-    for w in range(n_waypoints - 1):
-        step = 0.0
-        if feed > 0.0:
-            step = _spin_rate(qd, qs, b, w, qdot_max, feed) * length[w] / feed
-        steps[w] = step if segment_checked[w] else 0.0
-    for j in range(dof):
-        total, start = 0.0, 0.0
-        for w in range(1, n_waypoints):
-            total += steps[w - 1] * qs[b, j, w - 1]
-            if not segment_checked[w - 1]:
-                start = total  # w starts a pass
-            moved = total - start
-            if math.isnan(moved):  # as numpy.nan_to_num
-                moved = 0.0
-            elif math.isinf(moved):
-                moved = _HUGE if moved > 0.0 else -_HUGE
-            path[w, j] += moved
-    spun = np.empty_like(path)  # as track() forms it: the first angle plus the wrapped steps
-    spun[0] = path[0]
-    totals = np.zeros(dof)
-    for w in range(1, n_waypoints):
-        for j in range(dof):
-            step = wrapped_step(path[w, j] - path[w - 1, j])
-            if segment_checked[w - 1] and abs(step) > max_joint_step:
-                return REASON_DISCONTINUOUS, w
-            totals[j] += step
-            spun[w, j] = path[0, j] + totals[j]
-    at = first_outside(spun, lower, upper)
-    if at < n_waypoints:
-        return REASON_JOINT_LIMITS, at
-    return FEASIBLE, -1
 
 
 @njit(cache=True, error_model="numpy", nogil=True)
@@ -146,6 +85,10 @@ def free_cells(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
     upper,
     qdot_max,
     max_joint_step,
+    qddot_max,
+    stencil_index,
+    stencil_weight,
+    stencil_waypoints,
     mu,
     reason,
     failed,
@@ -153,6 +96,11 @@ def free_cells(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
     bottleneck_waypoint,
     bottleneck_joint,
     v_out,
+    mu_acc,
+    limited_by,
+    acc_waypoint,
+    acc_joint,
+    v_acc,
 ):
     """Evaluate C placements in free spin; the answers go to the arrays after ``max_joint_step``.
 
@@ -175,6 +123,11 @@ def free_cells(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
         upper: shape (6,), rad, upper position limits.
         qdot_max: shape (6,), rad/s.
         max_joint_step: rad.
+        qddot_max: shape (6,), rad/s^2, or (0,) without acceleration limits.
+        stencil_index: shape (K, 5), the blend stencil's waypoints (as
+            :func:`solver.kernels.fixed_spin.map_cells` takes it).
+        stencil_weight: shape (K, 5), their weights.
+        stencil_waypoints: shape (K,), the constrained waypoints.
         mu: shape (C,), out, m/s, NaN where infeasible.
         reason: shape (C,), out, as :class:`solver.path.placements.PlacementResults`.
         failed: shape (C,), out, the failed waypoint.
@@ -182,6 +135,11 @@ def free_cells(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
         bottleneck_waypoint: shape (C,), out.
         bottleneck_joint: shape (C,), out.
         v_out: shape (C, W), out, V_max on the chosen branch, or (C, 0) when not wanted.
+        mu_acc: shape (C,), out, as :func:`solver.kernels.fixed_spin.map_cells` fills it.
+        limited_by: shape (C,), out, likewise.
+        acc_waypoint: shape (C,), out, likewise.
+        acc_joint: shape (C,), out, likewise.
+        v_acc: shape (C, W), out, V_acc on the chosen branch, or (C, 0) when not wanted.
     """
     n_cells = cos_yaw.shape[0]
     n_waypoints = flange_rotation.shape[0]
@@ -192,7 +150,10 @@ def free_cells(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
     alive, why, where, slowest, slowest_at, slowest_joint, speeds = branch_work(
         n_branches, n_waypoints, v_out.shape[1] > 0
     )
-    checked = np.empty(n_branches, dtype=np.bool_)
+    spun = np.empty((n_waypoints, N_JOINTS))
+    accelerations = qddot_max.shape[0] > 0
+    keep_acc = v_acc.shape[1] > 0
+    feed, acc_at, acc_by, checked, acc_speeds = acc_work(n_branches, n_waypoints, keep_acc)
     check_steps = max_joint_step < math.pi
     cos_step = math.cos(max_joint_step)
     for c in range(n_cells):
@@ -250,30 +211,39 @@ def free_cells(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
             if n_alive == 0:
                 break
         # The spin schedule's tracking, from the fastest branch down: once one holds, a slower
-        # branch can be chosen only if tied with it, so the rest need not be tracked again.
+        # branch can be chosen only if tied with it (by mu_acc <= mu_path with acceleration
+        # limits), so the rest need not be tracked again.
         checked[:] = False
+        feed[:] = slowest
         top = -np.inf
-        while True:
-            i = -1
-            for k in range(n_branches):
-                if alive[k] and not checked[k] and (i < 0 or slowest[k] > slowest[i]):
-                    i = k
-            if i < 0 or slowest[i] < top - TIE_RTOL * abs(top):
-                break
-            checked[i] = True
-            feed = slowest[i] if slowest[i] > 0.0 and math.isfinite(slowest[i]) else 0.0
-            code, at = _spun_failure(
-                unwrapped(cq, sq, branches[i]), qd, qs, branches[i], feed, length,
-                segment_checked, lower, upper, qdot_max, max_joint_step,
+        tie = ACC_TIE_RTOL if accelerations else TIE_RTOL
+        i = next_fastest(alive, checked, slowest, top, tie)
+        while i >= 0:
+            rate = slowest[i] if slowest[i] > 0.0 and math.isfinite(slowest[i]) else 0.0
+            code, at = spun_failure(
+                relative_path(cq, sq, branches[i], True), qd, qs, branches[i], rate, length,
+                segment_checked, lower, upper, qdot_max, max_joint_step, spun,
             )  # fmt: skip
             if code != FEASIBLE:
                 fail(i, code, at, alive, why, where)
-            elif top == -np.inf:
-                top = slowest[i]
-        write_cell(
-            c, branches, alive, why, where, slowest, slowest_at, slowest_joint, speeds,
+            elif accelerations:
+                shift_to_copy(spun, lower, upper)
+                top = max(top, branch_mu_acc(
+                    i, spun, slowest, stencil_index, stencil_weight, stencil_waypoints,
+                    qddot_max, feed, acc_at, acc_by, acc_speeds, top,
+                ))  # fmt: skip
+            else:
+                top = max(top, slowest[i])
+            i = next_fastest(alive, checked, slowest, top, tie)
+        pick = write_cell(
+            c, branches, alive, why, where, feed, tie, slowest, slowest_at, slowest_joint, speeds,
             mu, reason, failed, branch, bottleneck_waypoint, bottleneck_joint, v_out,
         )  # fmt: skip
+        if accelerations:
+            write_acc(
+                c, pick, reason, slowest, slowest_at, slowest_joint, feed, acc_at, acc_by,
+                acc_speeds, mu_acc, limited_by, acc_waypoint, acc_joint, v_acc,
+            )  # fmt: skip
 
 
 def warm_up() -> None:
@@ -293,5 +263,6 @@ def warm_up() -> None:
         np.full(6, _TWO_PI),
         np.full(6, math.pi),
         0.35,
+        *warm_up_accelerations(),
         *warm_up_answers(),
     )

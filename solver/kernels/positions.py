@@ -124,3 +124,62 @@ def first_outside_pairs(  # type: ignore[no-untyped-def]  # pragma: no cover - c
     if exact:
         return first_outside(unwrapped(cq, sq, b), lower, upper)
     return n_waypoints
+
+
+@njit(cache=True, error_model="numpy", nogil=True)
+def shift_to_copy(path, lower, upper):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
+    """Move each joint of a feasible path (W, n) to the 2 pi copy that track() reports, in place.
+
+    :func:`solver.path.tracking.track`'s ``shifted``: of the copies 2 pi k that fit the whole
+    path, the one whose first waypoint is nearest zero (k rounded half to even, as numpy.round).
+    """
+    for j in range(path.shape[1]):
+        low, high = path[0, j], path[0, j]
+        for w in range(path.shape[0]):
+            low = min(low, path[w, j])
+            high = max(high, path[w, j])
+        k_low = np.ceil((lower[j] - low) / _TWO_PI - EDGE)
+        k_high = np.floor((upper[j] - high) / _TWO_PI + EDGE)
+        shift = min(max(np.rint(-path[0, j] / _TWO_PI), k_low), k_high)
+        if shift != 0.0:
+            for w in range(path.shape[0]):
+                path[w, j] += _TWO_PI * shift
+
+
+# asin(x) = x (1 + x^2 / 6 + 3 x^4 / 40 + ...): its terms to x^15, exact to rounding for
+# |x| <= _SERIES (the next term is below 1e-16 of the sum).
+_SERIES = 0.125
+_ASIN = (1.0, 1.0 / 6.0, 3.0 / 40.0, 5.0 / 112.0, 35.0 / 1152.0, 63.0 / 2816.0, 231.0 / 13312.0,
+         143.0 / 10240.0)  # fmt: skip
+
+
+@njit(cache=True, error_model="numpy", nogil=True)
+def relative_path(cq, sq, b, first):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
+    """Branch b's joint path (W, 6), rad: from its first angle (or 0), the sum of its steps.
+
+    Each step is the angle between neighbouring (cos, sin) pairs, in [-pi, pi] as
+    :func:`wrapped_step` gives it: asin of their cross product by its series where the step is
+    small (no atan2), atan2 of cross and dot products otherwise. With ``first`` the path starts
+    at the first waypoint's angle, as :func:`unwrapped`'s (to rounding); without, at 0: it then
+    differs from track()'s 2 pi copy by a constant per joint, which a second difference does
+    not see.
+    """
+    dof, n_waypoints = cq.shape[1], cq.shape[2]
+    path = np.empty((n_waypoints, dof))
+    for j in range(dof):
+        path[0, j] = math.atan2(sq[b, j, 0], cq[b, j, 0]) if first else 0.0
+    for w in range(1, n_waypoints):
+        for j in range(dof):
+            c0, s0, c1, s1 = cq[b, j, w - 1], sq[b, j, w - 1], cq[b, j, w], sq[b, j, w]
+            cross = c0 * s1 - s0 * c1
+            dot = c0 * c1 + s0 * s1
+            if dot > 0.0 and abs(cross) <= _SERIES:
+                x2 = cross * cross
+                series = _ASIN[7]
+                for term in range(6, -1, -1):
+                    series = series * x2 + _ASIN[term]
+                step = cross * series
+            else:
+                step = math.atan2(cross, dot)
+            path[w, j] = path[w - 1, j] + step
+    return path

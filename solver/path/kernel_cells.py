@@ -3,8 +3,8 @@
 :func:`solver.path.placements.evaluate_placements` runs a problem's placements through the
 compiled kernel of its family (:mod:`solver.kernels.fixed_spin`, in free spin
 :mod:`solver.kernels.free_spin`) where :func:`kernel_of` gives one, else through the numpy
-pipeline. The kernels compute mu_path only: a problem with final-path limits (joint
-accelerations, motion.md) runs the numpy pipeline until they have a hook for those.
+pipeline. With joint acceleration limits (motion.md) the kernels take the limits and the path's
+blend stencil too, and give the acceleration columns as the numpy pipeline does.
 """
 
 from __future__ import annotations
@@ -16,6 +16,7 @@ import numpy as np
 from solver.kernels.fixed_spin import map_cells
 from solver.kernels.free_spin import free_cells
 from solver.kernels.positions import limit_modes
+from solver.path.limits import JointAccelerationLimit
 from solver.path.pipeline import flange_at_spin
 from solver.path.problem import PathProblem
 
@@ -42,6 +43,10 @@ class KernelInputs:
     branches: np.ndarray  # the branches followed
     max_joint_step: float
     free_spin: bool
+    qddot_max: np.ndarray  # (6,), rad/s^2, or (0,) without acceleration limits
+    stencil_index: np.ndarray  # (K, 5), the blend stencil (K = 0 without limits)
+    stencil_weight: np.ndarray  # (K, 5), 1/m^2
+    stencil_waypoints: np.ndarray  # (K,)
 
 
 def kernel_inputs(
@@ -52,6 +57,14 @@ def kernel_inputs(
     rotation, position = flange_at_spin(path, spin)
     modes, arc = limit_modes(robot.q_lower, robot.q_upper)
     contiguous = np.ascontiguousarray
+    qddot_max = np.zeros(0)
+    index, weight, waypoints = np.zeros((0, 5), np.int64), np.zeros((0, 5)), np.zeros(0, np.int64)
+    for limit in problem.final_path_limits:
+        if isinstance(limit, JointAccelerationLimit):
+            qddot_max = contiguous(limit.qddot_max, dtype=float)
+            index = contiguous(limit.stencil.index, dtype=np.int64)
+            weight = contiguous(limit.stencil.weight, dtype=float)
+            waypoints = contiguous(limit.stencil.waypoints, dtype=np.int64)
     return KernelInputs(
         code=kernel[0],
         parameters=kernel[1],
@@ -71,20 +84,37 @@ def kernel_inputs(
         branches=contiguous(problem.branches, dtype=np.int64),
         max_joint_step=float(problem.options.max_joint_step),
         free_spin=problem.options.spin_mode == "free",
+        qddot_max=qddot_max,
+        stencil_index=index,
+        stencil_weight=weight,
+        stencil_waypoints=waypoints,
     )
 
 
 def run_kernel(
     inputs: KernelInputs, placements: np.ndarray, with_speeds: bool
 ) -> tuple[np.ndarray, ...]:
-    """The speed columns of :func:`solver.path.placements._chunk` by the compiled kernel.
+    """The columns of :func:`solver.path.placements._chunk` by the compiled kernel.
 
-    At placements of one spin: mu, reason, failed, branch, bottleneck waypoint and joint, V_max.
+    At placements of one spin: mu, reason, failed, branch, bottleneck waypoint and joint, V_max;
+    then mu_acc, what binds it, its waypoint and joint, V_acc (as the numpy pipeline gives them
+    with acceleration limits; :func:`no_acc_columns` without).
     """
     n_cells, n_waypoints = len(placements), inputs.rotation.shape[0]
     mu = np.empty(n_cells)
     codes = [np.empty(n_cells, dtype=np.int64) for _ in range(5)]
     v_max = np.empty((n_cells, n_waypoints if with_speeds else 0))
+    accelerations = inputs.qddot_max.shape[0] > 0
+    acc_cells = n_cells if accelerations else 0
+    mu_acc = np.empty(acc_cells)
+    acc_codes = [np.empty(acc_cells, dtype=np.int64) for _ in range(3)]
+    v_acc = np.empty((n_cells, n_waypoints if with_speeds and accelerations else 0))
+    stencil = (
+        inputs.qddot_max,
+        inputs.stencil_index,
+        inputs.stencil_weight,
+        inputs.stencil_waypoints,
+    )
     placed = (
         inputs.code,
         inputs.parameters,
@@ -109,9 +139,13 @@ def run_kernel(
             inputs.upper,
             inputs.qdot_max,
             inputs.max_joint_step,
+            *stencil,
             mu,
             *codes,
             v_max,
+            mu_acc,
+            *acc_codes,
+            v_acc,
         )
     else:
         map_cells(
@@ -125,20 +159,32 @@ def run_kernel(
             inputs.arc,
             inputs.qdot_max,
             inputs.max_joint_step,
+            *stencil,
             mu,
             *codes,
             v_max,
+            mu_acc,
+            *acc_codes,
+            v_acc,
         )
-    return (mu, *codes, v_max)
+    if not accelerations:
+        return (mu, *codes, v_max, *no_acc_columns(n_cells, v_max.shape[1]))
+    return (mu, *codes, v_max, mu_acc, *acc_codes, v_acc)
+
+
+def no_acc_columns(n_cells: int, n_waypoints: int) -> tuple[np.ndarray, ...]:
+    """The acceleration columns of a chunk without final-path limits (never reported)."""
+    missing = np.full(n_cells, -1, dtype=np.int64)
+    return (np.full(n_cells, np.nan), missing, missing, missing, np.zeros((n_cells, n_waypoints)))
 
 
 def kernel_of(problem: PathProblem) -> tuple[int, np.ndarray] | None:
     """The compiled pose kernel of the robot's family, where it has one (either spin mode).
 
-    None where the problem has final-path limits (joint accelerations): the kernels compute
-    mu_path only, and until they have a hook for those limits such problems run the numpy
-    pipeline (the reference the kernels are tested against), at its speed.
+    With or without joint acceleration limits: the kernels compute mu_acc as the numpy pipeline
+    does (:mod:`solver.kernels.accelerations`). None where a final-path limit other than the
+    joint accelerations is given (no kernel has its hook): the numpy pipeline runs.
     """
-    if problem.final_path_limits:
+    if any(not isinstance(limit, JointAccelerationLimit) for limit in problem.final_path_limits):
         return None
     return problem.family.map_kernel()

@@ -18,7 +18,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from solver.core.codes import FEASIBLE
+from solver.core.codes import ACC_TIE_RTOL, FEASIBLE
 from solver.core.dtf import spin_rate_nearest_zero
 from solver.core.exceptions import InvalidInputError
 from solver.core.spatial import MAX_COORDINATE, rotation_about_z
@@ -185,7 +185,10 @@ def run_chunk(problem: PathProblem, placements: np.ndarray) -> ChunkResult:
         mu_path = np.where(feasible, mu_path, -np.inf)
     final = _final_path_bounds(problem, tracked, qd_unit, qd_spin, mu_path, feasible)
     mu_acc = final[3]
-    pick = choose_branch(mu_path if mu_acc is None else mu_acc, feasible, tracked.failed_waypoint)
+    if mu_acc is None:
+        pick = choose_branch(mu_path, feasible, tracked.failed_waypoint)
+    else:
+        pick = choose_branch(mu_acc, feasible, tracked.failed_waypoint, ACC_TIE_RTOL)
     return ChunkResult(
         tracked=tracked,
         qd_unit=qd_unit,

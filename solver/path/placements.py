@@ -16,7 +16,13 @@ import numpy as np
 from solver.core.codes import FEASIBLE
 from solver.core.malloc import raise_malloc_thresholds
 from solver.core.parallel import SERIAL, TaskRunner
-from solver.path.kernel_cells import KernelInputs, kernel_inputs, kernel_of, run_kernel
+from solver.path.kernel_cells import (
+    KernelInputs,
+    kernel_inputs,
+    kernel_of,
+    no_acc_columns,
+    run_kernel,
+)
 from solver.path.pipeline import check_placements, run_chunk
 from solver.path.problem import PathProblem
 
@@ -104,7 +110,7 @@ def _chunk(
     )
     bound, joint, binding = run.v_final, run.final_limiting, run.final_binding
     if run.mu_acc is None or bound is None or joint is None or binding is None:
-        return speed_columns + _no_acc_columns(len(placements), with_speeds * chosen_v.shape[1])
+        return speed_columns + no_acc_columns(len(placements), with_speeds * chosen_v.shape[1])
     final_v = np.where(any_feasible[:, None], bound[pick, columns], np.nan)  # (C, W)
     low = np.nan_to_num(final_v, nan=np.inf).argmin(axis=-1)
     accelerated = any_feasible & (final_v[columns, low] < speed_columns[0])
@@ -116,12 +122,6 @@ def _chunk(
         final_v if with_speeds else final_v[:, :0],
     )
     return speed_columns + acc_columns
-
-
-def _no_acc_columns(n_cells: int, n_waypoints: int) -> tuple[np.ndarray, ...]:
-    """The acceleration columns of a chunk without final-path limits (never reported)."""
-    missing = np.full(n_cells, -1, dtype=np.int64)
-    return (np.full(n_cells, np.nan), missing, missing, missing, np.zeros((n_cells, n_waypoints)))
 
 
 def _task(
@@ -147,8 +147,7 @@ def _task(
             spin = float(rows[0, 4])
             if spin not in inputs:
                 inputs[spin] = kernel_inputs(problem, spin, kernel)
-            speed_columns = run_kernel(inputs[spin], rows, with_speeds)
-            parts.append(speed_columns + _no_acc_columns(len(rows), speed_columns[-1].shape[1]))
+            parts.append(run_kernel(inputs[spin], rows, with_speeds))
     else:
         parts = [_chunk(problem, rows, with_speeds) for rows in _pieces(placements, chunk)]
     return tuple(np.concatenate(c) for c in zip(*parts, strict=True))
@@ -213,7 +212,7 @@ def evaluate_placements(
     parts = runner.run(work, tasks, done)
     n_waypoints = problem.prepared.n_waypoints
     empty = (np.zeros(0), *(np.zeros(0, dtype=int),) * 5, np.zeros((0, n_waypoints)))
-    empty += _no_acc_columns(0, n_waypoints)
+    empty += no_acc_columns(0, n_waypoints)
     columns = [np.concatenate(c) for c in zip(*parts, strict=True)] if parts else list(empty)
     return _results(problem, columns, with_speeds)
 
@@ -270,5 +269,5 @@ class PlacementEvaluator:
         spin = float(cells[0, 4])
         if self._last is None or self._last[0] != spin:
             self._last = (spin, kernel_inputs(self._problem, spin, self._kernel))
-        columns = [*run_kernel(self._last[1], cells, False), *_no_acc_columns(len(cells), 0)]
+        columns = list(run_kernel(self._last[1], cells, False))
         return _results(self._problem, columns, False)

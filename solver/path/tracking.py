@@ -134,24 +134,28 @@ def track(
 
 
 def choose_branch(
-    mu_path: np.ndarray, feasible: np.ndarray, failed_waypoint: np.ndarray
+    mu_path: np.ndarray,
+    feasible: np.ndarray,
+    failed_waypoint: np.ndarray,
+    tie_rtol: float = TIE_RTOL,
 ) -> np.ndarray:
     """The ``auto`` branch: the highest mu_path, or the furthest failure when none is feasible.
 
-    Ties (within ``TIE_RTOL``) go to the first branch in the family's order, so the choice
+    Ties (within ``tie_rtol``) go to the first branch in the family's order, so the choice
     does not depend on rounding.
 
     Args:
-        mu_path: shape (B, *batch), m/s (any value where infeasible).
+        mu_path: shape (B, *batch), m/s (any value where infeasible); or mu_acc.
         feasible: shape (B, *batch), bool.
         failed_waypoint: shape (B, *batch), the first failing waypoint where infeasible.
+        tie_rtol: ``TIE_RTOL`` for mu_path, ``ACC_TIE_RTOL`` for mu_acc.
 
     Returns:
         shape batch, the index of the chosen branch on axis 0.
     """
     values = np.where(feasible, mu_path, -np.inf)
     top = values.max(axis=0)
-    tied = feasible & (values >= top - TIE_RTOL * np.abs(top))
+    tied = feasible & (values >= top - tie_rtol * np.abs(top))
     furthest = np.where(feasible, -1, failed_waypoint).max(axis=0)
     fallback = ~feasible & (failed_waypoint == furthest)
     chosen: np.ndarray = np.where(

@@ -37,6 +37,7 @@ from tests.cases import (
     SECOND_DIFFERENCE_RTOL,
     TOPPRA_FEED_RTOL,
 )
+from tests.solver.test_map_kernel import same_acceleration_cells
 
 README = json.loads((EXAMPLES / "evaluate_request.json").read_text())
 WAYPOINTS = np.array(
@@ -339,14 +340,16 @@ def test_a_given_joint_path_gets_the_same_mu_acc() -> None:
 
 
 @pytest.mark.parametrize("spin_mode", ["fixed", "free"])
-def test_compiled_maps_fall_back_to_the_pipeline(spin_mode: str) -> None:
-    """With acceleration limits the kernels (mu_path only) are not used: the same cells."""
+def test_compiled_maps_equal_the_pipeline(spin_mode: str) -> None:
+    """With acceleration limits the compiled kernels run (tests/solver/test_map_kernel.py) and
+    give the pipeline's cells on the README path too."""
     problem = PathProblem.of(ur5(10.0), WAYPOINTS, PathOptions(spin_mode=spin_mode))  # type: ignore[arg-type]
     cells = np.array([[x, 0.45, 0.1, yaw, 0.0] for x in (-0.1, 0.0, 0.1) for yaw in (0.0, 0.3)])
-    compiled = evaluate_placements(problem, cells, compiled=True)
-    reference = evaluate_placements(problem, cells, compiled=False)
-    assert compiled.mu_acc is not None and reference.mu_acc is not None
-    np.testing.assert_array_equal(compiled.mu_acc, reference.mu_acc)
-    np.testing.assert_array_equal(compiled.mu_path, reference.mu_path)
+    compiled = evaluate_placements(problem, cells, with_speeds=True)
+    reference = evaluate_placements(problem, cells, with_speeds=True, compiled=False)
+    same_acceleration_cells(compiled, reference, 10.0, problem.options.blend_length)
+    np.testing.assert_array_equal(compiled.branch, reference.branch)
+    np.testing.assert_allclose(compiled.mu_path, reference.mu_path, rtol=1e-12, atol=0.0)
+    assert reference.limited_by is not None and set(reference.limited_by) == {1}
     without = evaluate_placements(PathProblem.of(ur5(None), WAYPOINTS), cells)
     assert without.mu_acc is None and without.limited_by is None

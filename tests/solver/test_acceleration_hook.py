@@ -1,0 +1,117 @@
+"""The kernels' acceleration hook against the numpy limit, on the same joint paths.
+
+:func:`solver.kernels.limits.acceleration_bound` is what both map kernels call for mu_acc; the
+kernel comparisons (test_map_kernel.py, test_free_spin_kernel.py) see it through joint angles
+that differ from the pipeline's in the last bits, so exact ties and the early stop are checked
+here, on paths the hook and :class:`solver.path.limits.JointAccelerationLimit` share; and the
+fixed-spin kernel's joint path (:func:`solver.kernels.positions.relative_path`) against
+track()'s.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from solver.kernels.limits import acceleration_bound
+from solver.kernels.positions import relative_path
+from solver.path.limits import BlendStencil, JointAccelerationLimit, JointMotion
+
+
+def numpy_bound(path: np.ndarray, limit: JointAccelerationLimit) -> tuple[np.ndarray, int, int]:
+    """V_acc per waypoint by the numpy limit, and where the least binds (the pipeline's rule)."""
+    q = path.T
+    speed, joint = limit.speed_bound(JointMotion(q=q, qd_unit=np.zeros_like(q)))
+    low = int(np.argmin(speed))
+    return speed, low, int(joint[low])
+
+
+def hook(
+    path: np.ndarray, limit: JointAccelerationLimit, floor: float = 0.0
+) -> tuple[float, int, int, np.ndarray]:
+    """The hook's least V_acc, waypoint, joint, and V_acc per waypoint."""
+    stencil = limit.stencil
+    row = np.empty(len(path))
+    least, at, joint = acceleration_bound(
+        np.ascontiguousarray(path),
+        stencil.index,
+        stencil.weight,
+        stencil.waypoints,
+        limit.qddot_max,
+        row,
+        floor,
+    )
+    return least, at, joint, row
+
+
+@pytest.mark.parametrize("seed", range(5))
+def test_random_paths_equal_the_numpy_limit(seed: int) -> None:
+    """Random tool points (uneven spacing, two passes) and joint paths: the same numbers."""
+    rng = np.random.default_rng(seed)
+    n = 80
+    tool = np.cumsum(rng.uniform(0.0002, 0.002, (n, 3)), axis=0)
+    in_pass = np.ones(n - 1, dtype=bool)
+    in_pass[40] = False
+    limit = JointAccelerationLimit(
+        rng.uniform(2.0, 30.0, 6), BlendStencil.of_path(tool, in_pass, 0.002)
+    )
+    path = np.cumsum(rng.normal(0.0, 0.01, (n, 6)), axis=0) + rng.uniform(-3.0, 3.0, 6)
+    least, at, joint, row = hook(path, limit)
+    speed, low, limiting = numpy_bound(path, limit)
+    np.testing.assert_allclose(row, speed, rtol=1e-12, atol=0.0)
+    assert least == pytest.approx(speed.min(), rel=1e-12)
+    assert (at, joint) == (low, limiting)
+
+
+def test_ties_go_to_the_first_waypoint_and_joint() -> None:
+    """q = s^2 on points 0.25 m apart with b = 0.5 m: D = 2 exactly everywhere, on two joints
+    alike: the least V_acc at the first constrained waypoint, on the first of the two joints."""
+    s = np.arange(12) * 0.25
+    tool = np.column_stack([s, np.zeros(12), np.zeros(12)])
+    limit = JointAccelerationLimit(
+        np.full(6, 4.0), BlendStencil.of_path(tool, np.ones(11, dtype=bool), 0.5)
+    )
+    zero = np.zeros(12)
+    for first, second in ((0, 1), (2, 5), (3, 4)):
+        path = np.column_stack([zero] * 6)
+        path[:, first] = s**2
+        path[:, second] = -(s**2) + 1.0
+        least, at, joint, row = hook(path, limit)
+        speed, low, limiting = numpy_bound(path, limit)
+        assert least == 1.0 / np.sqrt(0.5) and np.all(row[limit.stencil.waypoints] == least)
+        assert (at, joint) == (limit.stencil.waypoints[0], first) == (low, limiting)
+
+
+def test_the_early_stop_returns_the_first_waypoint_below_the_floor() -> None:
+    """A floor above the least V_acc: the first waypoint whose V_acc is below it, no further."""
+    s = np.arange(40) * 0.25
+    tool = np.column_stack([s, np.zeros(40), np.zeros(40)])
+    limit = JointAccelerationLimit(
+        np.full(6, 4.0), BlendStencil.of_path(tool, np.ones(39, dtype=bool), 0.5)
+    )
+    path = np.zeros((40, 6))
+    path[:, 2] = np.cumsum(np.cumsum(np.linspace(0.0, 1.0, 40)))  # D grows along the path
+    speed, low, _ = numpy_bound(path, limit)
+    floor = float(np.sort(speed)[20])  # the 21st lowest
+    least, at, joint, _ = hook(path, limit, floor=floor)
+    below = np.flatnonzero(speed < floor)
+    assert at == below[0] != low and least == speed[at] < floor and joint == 2
+    assert hook(path, limit)[:3] == (speed[low], low, 2)
+
+
+@pytest.mark.parametrize("largest_step", [0.02, 0.3, 3.0])
+def test_relative_path_is_the_unwrapped_path(largest_step: float) -> None:
+    """The fixed-spin kernel's joint path from its (cos, sin) pairs (steps by the asin series
+    where small, atan2 otherwise) against track()'s: the first angle plus the wrapped steps."""
+    rng = np.random.default_rng(7)
+    angles = np.cumsum(rng.uniform(-largest_step, largest_step, (2, 6, 100)), axis=-1)
+    angles = np.angle(np.exp(1j * angles))  # in [-pi, pi], as IK gives them
+    cq, sq = np.cos(angles), np.sin(angles)
+    step = np.diff(angles, axis=-1)
+    step -= np.where(step > np.pi, 2 * np.pi, np.where(step < -np.pi, -2 * np.pi, 0.0))
+    expected = np.concatenate([angles[..., :1], angles[..., :1] + np.cumsum(step, axis=-1)], -1)
+    for b in range(2):
+        np.testing.assert_allclose(relative_path(cq, sq, b, True), expected[b].T, atol=1e-13)
+        np.testing.assert_allclose(
+            relative_path(cq, sq, b, False), (expected[b] - expected[b, :, :1]).T, atol=1e-13
+        )
