@@ -509,6 +509,45 @@ def _waypoints_data(
     return data
 
 
+def _tail_derivatives(
+    variables: Any, tail: Any, x: Any, weights: Any
+) -> tuple[Any, Any, Any] | None:
+    """The last constraints' values, Jacobian and weighted Hessian (upper triangle) at ``x``.
+
+    They are the joint acceleration rows (few, each of a few waypoints' variables), left to
+    casadi's differentiation; None where there are none.
+    """
+    count = int(tail.numel())
+    if not count:
+        return None
+    symbols = ca.MX.sym("lam_tail", count)
+    first = ca.Function("tail", [variables], [tail, ca.jacobian(tail, variables)])
+    second = ca.Function(
+        "tail_hessian",
+        [variables, symbols],
+        [ca.triu(ca.hessian(ca.dot(symbols, tail), variables)[0])],
+    )
+    value, jacobian = first(x)
+    return value, jacobian, second(x, weights)
+
+
+def _scattered_hessian(blocks: Any, a: np.ndarray, b: np.ndarray, n_x: int) -> Any:
+    """The waypoints' Hessian entries as one upper triangle (n_x x n_x), shared places summed.
+
+    ``blocks`` holds the entries at rows ``a`` and columns ``b`` of the NLP's variables; the
+    entries of the placement and s, which every waypoint has, add up.
+    """
+    upper_rows, upper_cols = np.minimum(a, b), np.maximum(a, b)
+    pattern, target = ca.Sparsity.triplet(n_x, n_x, upper_rows.tolist(), upper_cols.tolist(), True)
+    summing = ca.DM(
+        ca.Sparsity.triplet(
+            pattern.nnz(), len(upper_rows), list(target), list(range(len(upper_rows)))
+        ),
+        1.0,
+    )
+    return ca.MX(pattern, ca.mtimes(summing, ca.vec(blocks)))
+
+
 def _derivatives(
     residual: Any,
     path: PreparedPath,
@@ -603,36 +642,19 @@ def _derivatives(
     order[np.asarray(where_nz)] = np.arange(len(rows))
     jacobian_all = ca.MX(sparsity, entries[order.tolist()])
     g = ca.vertcat(ca.vec(values_r), linear(x))
-    tail = constraints[n_head:]
-    tail_weights = ca.MX.sym("lam_tail", n_nonlinear)
-    if n_nonlinear:
-        tail_first = ca.Function("tail", [variables], [tail, ca.jacobian(tail, variables)])
-        tail_value, tail_jacobian = tail_first(x)
-        g = ca.vertcat(g, tail_value)
-        jacobian_all = ca.vertcat(jacobian_all, tail_jacobian)
+    tail = _tail_derivatives(variables, constraints[n_head:], x, lam_g[n_head:])
+    if tail is not None:
+        g = ca.vertcat(g, tail[0])
+        jacobian_all = ca.vertcat(jacobian_all, tail[1])
     jac_g = ca.Function("nlp_jac_g", [x, p], [g, jacobian_all], ["x", "p"], ["g", "jac_g_x"])
 
     # The Hessian: each waypoint's upper triangle, the shared entries summed.
     hess_blocks = second_order(local_all, ca.DM(data_all), ca.reshape(lam_g[:n_res], 12, n))
-    a = index[:, hess_rows].ravel()
-    b = index[:, hess_cols].ravel()
-    upper_rows, upper_cols = np.minimum(a, b), np.maximum(a, b)
-    n_x = int(x.numel())
-    pattern, target = ca.Sparsity.triplet(n_x, n_x, upper_rows.tolist(), upper_cols.tolist(), True)
-    summing = ca.DM(
-        ca.Sparsity.triplet(
-            pattern.nnz(), len(upper_rows), list(target), list(range(len(upper_rows)))
-        ),
-        1.0,
+    hessian_all = _scattered_hessian(
+        hess_blocks, index[:, hess_rows].ravel(), index[:, hess_cols].ravel(), int(x.numel())
     )
-    hessian_all = ca.MX(pattern, ca.mtimes(summing, ca.vec(hess_blocks)))
-    if n_nonlinear:
-        tail_second = ca.Function(
-            "tail_hessian",
-            [variables, tail_weights],
-            [ca.triu(ca.hessian(ca.dot(tail_weights, tail), variables)[0])],
-        )
-        hessian_all = hessian_all + tail_second(x, lam_g[n_head:])
+    if tail is not None:
+        hessian_all = hessian_all + tail[2]
     hess_lag = ca.Function(
         "nlp_hess_l",
         [x, p, lam_f, lam_g],
