@@ -20,6 +20,7 @@ import pinocchio as pin
 
 from solver.core.exceptions import InvalidInputError, RobotModelError, quoted
 from solver.core.family import KinematicsFamily
+from solver.core.urdf_structure import mimic_joints, root_links
 
 # Joint speed limits outside this range (rad/s) are input errors: no arm is that slow or fast,
 # and the LP solver treats bounds past 1e20 as infinite.
@@ -283,6 +284,14 @@ def chain_from_urdf(urdf: str, *, tool_frame: str) -> pin.Model:
     try:
         full = pin.buildModelFromXML(urdf)
     except (RuntimeError, ValueError) as exc:
+        roots = root_links(urdf)
+        if len(roots) > 1:  # pinocchio says why on stderr only
+            raise RobotModelError(
+                "robot.urdf",
+                f"cannot parse the URDF: {len(roots)} root links ({', '.join(map(quoted, roots))})"
+                ": every link but one must be a joint's child; remove the stray link or attach "
+                "it with a fixed joint",
+            ) from exc
         raise RobotModelError("robot.urdf", f"cannot parse the URDF: {exc}") from exc
     if not full.existFrame(tool_frame):
         names = ", ".join(f.name for f in full.frames if f.name != "universe")
@@ -292,6 +301,17 @@ def chain_from_urdf(urdf: str, *, tool_frame: str) -> pin.Model:
     tool_joint = full.frames[full.getFrameId(tool_frame)].parentJoint
     chain = set(full.supports[tool_joint])
     locked = [j for j in range(1, full.njoints) if j not in chain]
+    mimics = mimic_joints(urdf)
+    coupled = [full.names[j] for j in sorted(chain) if full.names[j] in mimics]
+    if coupled:
+        mimic = mimics[coupled[0]]
+        raise RobotModelError(
+            "robot.urdf",
+            f"joint {quoted(mimic.joint)} mimics {quoted(mimic.leader)} (q = "
+            f"{mimic.multiplier:g} q_leader + {mimic.offset:g}) between the base and the tool: "
+            "coupled joints are not modelled yet, and reading it as a free joint would give "
+            "joint paths the arm cannot run",
+        )
     model = pin.buildReducedModel(full, locked, pin.neutral(full)) if locked else full
     if model.nv == 0:
         raise RobotModelError("robot.tool_frame", f"no joint moves frame {quoted(tool_frame)}")

@@ -1,0 +1,61 @@
+"""What pinocchio's URDF parser leaves unsaid: a document's root links and its mimic joints.
+
+pinocchio refuses a URDF with two root links with "The XML stream does not contain a valid URDF
+model", the cause going to the server's stderr only; and it reads a ``<mimic>`` joint as a free
+joint of its own, so an arm whose joints are coupled (ABB IRB 5400's joint5b follows joint5)
+would be answered with joint paths that break the coupling. This module reads the document's
+structure itself, so that both are said in the answer (robots.md section 4).
+"""
+
+from __future__ import annotations
+
+import xml.etree.ElementTree as ElementTree
+from dataclasses import dataclass
+
+
+@dataclass(frozen=True)
+class Mimic:
+    """A joint that follows another: q = multiplier * q_leader + offset (URDF ``<mimic>``)."""
+
+    joint: str
+    leader: str
+    multiplier: float
+    offset: float
+
+
+def _tree(urdf: str) -> ElementTree.Element | None:
+    """The document's root element, or None where it is no XML at all."""
+    try:
+        return ElementTree.fromstring(urdf)
+    except ElementTree.ParseError:
+        return None
+
+
+def root_links(urdf: str) -> list[str]:
+    """The links no joint has as its child, in the document's order (one for a valid arm)."""
+    root = _tree(urdf)
+    if root is None:
+        return []
+    links = [link.get("name", "") for link in root.iter("link")]
+    children = {
+        child.get("link", "") for joint in root.iter("joint") for child in joint.iter("child")
+    }
+    return [name for name in links if name not in children]
+
+
+def mimic_joints(urdf: str) -> dict[str, Mimic]:
+    """The document's mimic joints by name."""
+    root = _tree(urdf)
+    mimics: dict[str, Mimic] = {}
+    if root is None:
+        return mimics
+    for joint in root.iter("joint"):
+        for mimic in joint.iter("mimic"):
+            name = joint.get("name", "")
+            mimics[name] = Mimic(
+                joint=name,
+                leader=mimic.get("joint", ""),
+                multiplier=float(mimic.get("multiplier", "1") or 1.0),
+                offset=float(mimic.get("offset", "0") or 0.0),
+            )
+    return mimics

@@ -1,0 +1,56 @@
+"""A URDF's structure said in the answer: two root links, and mimic joints in the chain.
+
+The fixtures are the UR5 URDF of example-robot-data, edited as the published files that showed
+each case (a ROS 2 generated UR5e with a stray ``world`` link; ABB IRB 5400's joint5b, a mimic
+of joint5 between base and tool).
+"""
+
+from __future__ import annotations
+
+import pytest
+
+from solver.core.exceptions import RobotModelError
+from solver.core.robots import example_robot_data_dir
+from solver.core.urdf_structure import mimic_joints, root_links
+from solver.families import catalogue, robot_from_urdf
+
+UR5 = (example_robot_data_dir() / "ur_description" / "urdf" / "ur5_robot.urdf").read_text()
+FRAMES = {"base_frame": "base", "tool_frame": "tool0"}
+
+
+def with_mimic(joint: str, leader: str) -> str:
+    start = UR5.index(f'<joint name="{joint}"')
+    end = UR5.index("</joint>", start)
+    mimic = f'<mimic joint="{leader}" multiplier="-1" offset="0.5"/>\n  '
+    return UR5[:end] + mimic + UR5[end:]
+
+
+def test_the_ur5_has_one_root_and_no_mimic() -> None:
+    assert root_links(UR5) == ["world"]  # example-robot-data's UR5 hangs off its own world
+    assert mimic_joints(UR5) == {}
+
+
+def test_two_root_links_are_named_in_the_error() -> None:
+    urdf = UR5.replace("</robot>", '  <link name="stray"/>\n</robot>')
+    with pytest.raises(RobotModelError) as error:
+        robot_from_urdf(urdf, **FRAMES)
+    assert error.value.field == "robot.urdf"
+    assert "2 root links ('world', 'stray')" in error.value.message
+
+
+def test_a_mimic_joint_between_base_and_tool_is_refused_naming_both_joints() -> None:
+    urdf = with_mimic("elbow_joint", "shoulder_lift_joint")
+    assert mimic_joints(urdf)["elbow_joint"].multiplier == -1.0
+    with pytest.raises(RobotModelError) as error:
+        robot_from_urdf(urdf, **FRAMES)
+    assert error.value.field == "robot.urdf"
+    message = error.value.message
+    assert "'elbow_joint' mimics 'shoulder_lift_joint'" in message
+    assert "q = -1 q_leader + 0.5" in message
+
+
+def test_a_mimic_joint_off_the_chain_is_locked_as_before() -> None:
+    # The Panda's second finger mimics the first: both are locked, the arm reads as before.
+    panda = (example_robot_data_dir() / "panda_description" / "urdf" / "panda.urdf").read_text()
+    assert any(m.leader == "panda_finger_joint1" for m in mimic_joints(panda).values())
+    assert catalogue()["panda"].dof == 7
