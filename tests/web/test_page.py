@@ -18,7 +18,7 @@ import httpx
 import pytest
 from playwright.sync_api import Browser, Page, sync_playwright
 
-from tests.cases import ROOT
+from tests.cases import MAP_EVALUATE_RTOL, ROOT
 from tests.live import start_server
 
 CHROMIUM = shutil.which("chromium") or "/usr/bin/chromium"
@@ -361,7 +361,8 @@ def test_acceleration_limits_colour_the_map_by_mu_acc_and_the_hover_says_what_bi
     assert f"mu_path {cell['mu_path']:.6f} m/s" in tooltip
     assert f"mu_acc {cell['mu_acc']:.6f} m/s, limited by acceleration" in tooltip
     acc = evaluate_api(url, cell, detail="summary")["acceleration"]
-    assert acc["mu_acc"] == cell["mu_acc"] and acc["limited_by"] == "acceleration"
+    assert acc["mu_acc"] == pytest.approx(cell["mu_acc"], rel=MAP_EVALUATE_RTOL)
+    assert acc["limited_by"] == "acceleration"
     assert (
         f"where: joint {acc['joint'] + 1} ({acc['joint_name']}), waypoint {acc['waypoint']}"
         in tooltip
@@ -382,7 +383,8 @@ def test_a_clicked_cell_shows_mu_acc_the_acceleration_use_and_the_cycle_times(
     # The blend length reached the API: at the default 2 mm mu_acc is another figure.
     default = evaluate_api(url, cell, detail="summary")["acceleration"]
     assert default["mu_acc"] != acc["mu_acc"]
-    assert acc["mu_acc"] == cell["mu_acc"] and acc["blend_length"] == 0.004
+    assert acc["mu_acc"] == pytest.approx(cell["mu_acc"], rel=MAP_EVALUATE_RTOL)
+    assert acc["blend_length"] == 0.004
     text = page.text_content("#acceleration") or ""
     assert text.startswith(f"mu_acc {acc['mu_acc']:.6f} m/s (blend 4.000 mm): ")
     assert (
