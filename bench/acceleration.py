@@ -11,9 +11,9 @@ optimum evaluated with the limits.
 from __future__ import annotations
 
 import time
-from collections.abc import Callable
 
 import numpy as np
+from timing import best_time
 
 from solver.core.robots import Robot
 from solver.optimise.optimize import optimize_placement
@@ -23,15 +23,6 @@ from solver.path.evaluate import evaluate_path
 from solver.path.problem import PathOptions, PathProblem
 
 LIMIT = 10.0  # rad/s^2, every joint
-
-
-def _best(run: Callable[[], object], repeats: int) -> float:
-    times = []
-    for _ in range(repeats):
-        start = time.perf_counter()
-        run()
-        times.append(time.perf_counter() - start)
-    return min(times)
 
 
 def acceleration_lines(
@@ -61,9 +52,9 @@ def acceleration_lines(
 
         run_map(robot)
         run_map(limited)  # warm up
-        t_without = _best(lambda: run_map(robot), repeats)
-        t_with = _best(lambda: run_map(limited), repeats)
-        t_numpy = _best(lambda: run_map(limited, compiled=False), 1)
+        t_without = best_time(lambda: run_map(robot), repeats)
+        t_with = best_time(lambda: run_map(limited), repeats)
+        t_numpy = best_time(lambda: run_map(limited, compiled=False), 1)
         print(
             f"  {spin_mode:5s} spin, compiled kernel: with the limits {t_with:7.3f} s, without "
             f"{t_without:7.3f} s: {t_with / t_without:.2f}x (goal <= 1.3x); the numpy pipeline "

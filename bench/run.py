@@ -26,7 +26,6 @@ import math
 import subprocess
 import sys
 import time
-from collections.abc import Callable
 from pathlib import Path
 
 import httpx
@@ -35,6 +34,7 @@ import numpy as np
 import parallel
 import ur_analytic_ik
 from acceleration import acceleration_lines
+from timing import best_time
 
 from solver.core.kinematics import jacobian_in_base
 from solver.core.parallel import SERIAL, ThreadRunner
@@ -54,16 +54,6 @@ def load_path(name: str) -> np.ndarray:
     """Waypoint poses of examples/paths/<name>.json, shape (N, 4, 4)."""
     waypoints = json.loads((ROOT / "examples" / "paths" / f"{name}.json").read_text())["waypoints"]
     return np.array([pose_matrix(w["position"], w["orientation"], field="w") for w in waypoints])
-
-
-def best_time(run: Callable[[], object], repeats: int) -> float:
-    """The fastest of ``repeats`` runs (s)."""
-    times = []
-    for _ in range(repeats):
-        start = time.perf_counter()
-        run()
-        times.append(time.perf_counter() - start)
-    return min(times)
 
 
 def scalar_cell(robot: Robot, path: np.ndarray, placement: Placement) -> float:

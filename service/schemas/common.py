@@ -226,6 +226,19 @@ BranchChoice = Annotated[
 ]
 
 
+def _blend_length() -> Any:
+    """The ``ik.blend_length`` field of both IK policies (motion.md section 1)."""
+    return Field(
+        default=DEFAULT_BLEND_LENGTH,
+        gt=0.0,
+        le=1000.0,
+        description="The length (m) over which the controller rounds a corner of the path (a "
+        "zone of radius blend_length / 2: ABB z1, KUKA $APO.CDIS = 1, UR blend radius 1 mm), "
+        "> 0; the joint accelerations at a constant feed are taken over it (motion.md section "
+        "2). Used only with robot.joint_acceleration_limits.",
+    )
+
+
 class AutoIkPolicy(RequestModel):
     """How inverse kinematics is followed along the path when the route chooses the branch."""
 
@@ -243,15 +256,7 @@ class AutoIkPolicy(RequestModel):
         gt=0.0,
         description="Largest move of any joint between neighbouring waypoints (rad), > 0.",
     )
-    blend_length: float = Field(
-        default=DEFAULT_BLEND_LENGTH,
-        gt=0.0,
-        le=1000.0,
-        description="The length (m) over which the controller rounds a corner of the path (a "
-        "zone of radius blend_length / 2: ABB z1, KUKA $APO.CDIS = 1, UR blend radius 1 mm), "
-        "> 0; the joint accelerations at a constant feed are taken over it (motion.md section "
-        "2). Used only with robot.joint_acceleration_limits.",
-    )
+    blend_length: float = _blend_length()
 
 
 class IkPolicy(RequestModel):
@@ -277,15 +282,7 @@ class IkPolicy(RequestModel):
         gt=0.0,
         description="Largest move of any joint between neighbouring waypoints (rad), > 0.",
     )
-    blend_length: float = Field(
-        default=DEFAULT_BLEND_LENGTH,
-        gt=0.0,
-        le=1000.0,
-        description="The length (m) over which the controller rounds a corner of the path (a "
-        "zone of radius blend_length / 2: ABB z1, KUKA $APO.CDIS = 1, UR blend radius 1 mm), "
-        "> 0; the joint accelerations at a constant feed are taken over it (motion.md section "
-        "2). Used only with robot.joint_acceleration_limits.",
-    )
+    blend_length: float = _blend_length()
 
 
 class PlacementResult(ResponseModel):
