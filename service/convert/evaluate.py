@@ -140,6 +140,7 @@ def evaluate_response(
                 "family": require_family(robot).name,
                 "seeds": ev.ik_seeds,
                 "branches_found": ev.ik_branches_found,
+                "recognised": require_family(robot).recognised,
             }
         ),
         waypoints=_waypoints(ev, robot, feed) if with_waypoints else [],

@@ -63,7 +63,7 @@ _RESPONSE_EXAMPLE: JsonDict = {
     "reason": None,
     "failed_waypoint": None,
     "branch": {"shoulder": "right", "elbow": "down", "wrist": "noflip"},
-    "ik": {"family": "ur", "seeds": None, "branches_found": None},
+    "ik": {"family": "ur", "seeds": None, "branches_found": None, "recognised": None},
     "spin_mode": "fixed",
     "spins": None,
     "axis_correction": 0.0,
@@ -247,8 +247,8 @@ class IkInfo(ResponseModel):
     model_config = ConfigDict(
         json_schema_extra={
             "examples": [
-                {"family": "ur", "seeds": None, "branches_found": None},
-                {"family": "numeric", "seeds": 64, "branches_found": 9},
+                {"family": "ur", "seeds": None, "branches_found": None, "recognised": None},
+                {"family": "numeric", "seeds": 64, "branches_found": 9, "recognised": None},
             ]
         }
     )
@@ -267,6 +267,13 @@ class IkInfo(ResponseModel):
         "seeds found at the first waypoint (count, at most seeds), each one branch followed "
         "along the path; a numeric family cannot promise it found every branch. null for a "
         "closed-form family, or when the request gave the joint_path."
+    )
+    recognised: str | None = Field(
+        default=None,
+        description="Set when the family was read off a URDF's geometry rather than named: a URDF "
+        "whose chain is an OPW arm's (forward kinematics equal at random configurations) is "
+        "solved in closed form, every branch found; the sentence gives the fitted parameters. "
+        "null for a catalogue or OPW robot, and for numeric IK.",
     )
 
 

@@ -73,6 +73,9 @@ class KinematicsFamily(abc.ABC):
 
     #: Short name of the family, reported in answers (``"ur"``, ``"opw"``).
     name: str
+    #: How the family was chosen, when not by the caller: a sentence for the answer (an OPW arm
+    #: recognised in a URDF's chain, :mod:`solver.families.recognise`); ``None`` otherwise.
+    recognised: str | None = None
 
     @property
     @abc.abstractmethod

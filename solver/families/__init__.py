@@ -16,7 +16,9 @@ import pinocchio as pin
 from solver.core.exceptions import RobotModelError, UnknownRobotError
 from solver.core.family import KinematicsFamily
 from solver.core.robots import Robot, chain_from_urdf, robot_from_model
+from solver.families.numeric.chain import SerialChain
 from solver.families.numeric.family import NumericFamily
+from solver.families.recognise import recognised_family
 
 # Modules with a ``robots() -> dict[str, Robot]`` function, in catalogue order.
 CATALOGUE_MODULES = (
@@ -40,14 +42,20 @@ def catalogue() -> dict[str, Robot]:
 def default_family(
     model: pin.Model, *, base_frame: str, tool_frame: str
 ) -> KinematicsFamily | None:
-    """The family of an arm that has no analytic one: numeric IK (robots.md section 4).
+    """The family of an arm given without one: analytic where its chain is recognised, else numeric.
 
-    ``None`` when the model has fewer than six joints or is not one serial chain to the tool.
+    A chain that is an OPW arm's gets the closed form (:mod:`solver.families.recognise`, which
+    says so in the family's ``recognised``); any other serial chain numeric IK (robots.md
+    section 4). ``None`` when the model has fewer than six joints or is not one serial chain
+    to the tool.
     """
     if model.nv < NUMERIC_MIN_DOF:
         return None
     try:
-        return NumericFamily(model, base_frame=base_frame, tool_frame=tool_frame)
+        chain = SerialChain.from_model(model, base_frame=base_frame, tool_frame=tool_frame)
+        return recognised_family(chain) or NumericFamily(
+            model, base_frame=base_frame, tool_frame=tool_frame
+        )
     except RobotModelError:
         return None
 

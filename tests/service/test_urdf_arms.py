@@ -148,7 +148,7 @@ def test_answers_say_the_family_and_what_its_seeds_found(
     assert 1 <= ik["branches_found"] <= 64
     body = {"robot": {"model": "ur5"}, "path": {"waypoints": waypoints}, "placement": PLACEMENT}
     analytic = client.post("/v1/evaluate", json=body).json()["ik"]
-    assert analytic == {"family": "ur", "seeds": None, "branches_found": None}
+    assert analytic == {"family": "ur", "seeds": None, "branches_found": None, "recognised": None}
 
 
 ERK_GRID = {

@@ -1,0 +1,117 @@
+"""An OPW arm given as a URDF is recognised and mapped as the catalogue's OPW arm (issue 27).
+
+Each catalogue arm's URDF is written in the test from its parameters, ROS-Industrial style
+(:mod:`tests.solver.families.opw_urdf`): link frames parallel to the base, joint origins slid
+along their axes. The registry must read the OPW parameters off its chain and map it with the
+closed form; the map must equal the catalogue arm's cell for cell. A chain that is almost an
+OPW arm (a wrist whose axes miss each other by 1 mm) keeps numeric IK.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from solver.core.codes import UNREACHABLE
+from solver.core.kinematics import tool_pose_in_base
+from solver.core.robots import Robot
+from solver.families import get_robot, robot_from_urdf
+from solver.families.opw.arms import ARMS, OpwArm
+from solver.families.opw.ik import forward_kinematics
+from solver.families.opw.parameters import OpwParameters
+from solver.path.capability_map import grid_axis
+from tests.cases import FK_IK_ATOL, MAP_EVALUATE_RTOL
+from tests.problems import capability_map
+from tests.solver.families.opw_urdf import opw_urdf
+from tests.solver.test_evaluate import load_path
+
+
+def urdf_robot(arm: OpwArm, parameters: OpwParameters | None = None) -> Robot:
+    """The arm from a URDF written from its (or the given) parameters, limits and speeds."""
+    text = opw_urdf(
+        parameters or arm.parameters,
+        limits=np.array(arm.position_limits),
+        speeds=np.array(arm.velocity_limits),
+        joint_names=arm.joint_names,
+        slide_seed=len(arm.name),
+    )
+    return robot_from_urdf(text, base_frame="base_link", tool_frame="tool0", name=arm.name)
+
+
+@pytest.mark.parametrize("arm", ARMS, ids=[a.name for a in ARMS])
+def test_the_urdf_is_recognised_and_solved_in_closed_form(arm: OpwArm) -> None:
+    """The fitted family's IK reproduces poses of the URDF's own model (pinocchio FK)."""
+    robot = urdf_robot(arm)
+    assert robot.family is not None and robot.family.name == "opw"
+    assert robot.family.recognised is not None and "OPW arm" in robot.family.recognised
+    rng = np.random.default_rng(7)
+    q = rng.uniform(
+        np.maximum(robot.q_lower, -math.pi), np.minimum(robot.q_upper, math.pi), (40, 6)
+    )
+    poses = np.array([tool_pose_in_base(robot, qi) for qi in q])
+    # The URDF written in the test is the arm: its FK is the paper's formula with the table's row.
+    np.testing.assert_allclose(poses, forward_kinematics(arm.parameters, q), atol=FK_IK_ATOL)
+    solutions, status = robot.family.solve(np.moveaxis(poses[:, :3, :3], 0, -1), poses[:, :3, 3].T)
+    assert np.count_nonzero(status != UNREACHABLE) >= 40 * 4
+    for b, i in zip(*np.nonzero(status != UNREACHABLE), strict=True):
+        pose = tool_pose_in_base(robot, solutions[:, b, i])
+        np.testing.assert_allclose(pose, poses[i], atol=FK_IK_ATOL)
+
+
+@pytest.mark.parametrize("arm", ARMS, ids=[a.name for a in ARMS])
+def test_the_urdf_map_equals_the_opw_map_cell_for_cell(arm: OpwArm) -> None:
+    """An ERK-size map (546 cells, the ERK path's 133 waypoints), scaled to the arm's reach."""
+    reach = arm.parameters.c2 + arm.parameters.c3
+    maps = [
+        capability_map(
+            robot,
+            load_path("curved_line"),
+            xs=grid_axis(0.2 * reach, 0.7 * reach, 0.02 * reach, field="x"),
+            ys=grid_axis(-0.2 * reach, 0.2 * reach, 0.02 * reach, field="y"),
+            z=0.1 * reach,
+            yaws=np.zeros(1),
+        )
+        for robot in (get_robot(arm.name), urdf_robot(arm))
+    ]
+    expected, answer = maps
+    assert expected.mu_path.size == 546
+    assert np.isfinite(expected.mu_path).sum() >= 50
+    np.testing.assert_allclose(answer.mu_path, expected.mu_path, rtol=MAP_EVALUATE_RTOL)
+    np.testing.assert_array_equal(answer.reason, expected.reason)
+    np.testing.assert_array_equal(answer.failed_waypoint, expected.failed_waypoint)
+    np.testing.assert_array_equal(answer.bottleneck_joint, expected.bottleneck_joint)
+    catalogue_branches = get_robot(arm.name).family.branches
+    ours = urdf_robot(arm).family.branches
+    feasible = np.isfinite(expected.mu_path)
+    assert [ours[b] for b in answer.branch[feasible]] == [
+        catalogue_branches[b] for b in expected.branch[feasible]
+    ]
+
+
+def test_a_wrist_that_is_not_spherical_keeps_numeric_ik() -> None:
+    """A 1 mm offset between the wrist's axes (not an OPW arm) is not taken for one."""
+    arm = ARMS[0]
+    robot = urdf_robot(arm)
+    text = opw_urdf(
+        arm.parameters,
+        limits=np.array(arm.position_limits),
+        speeds=np.array(arm.velocity_limits),
+        joint_names=arm.joint_names,
+    )
+    # Move joint 5's origin 1 mm off joint 4's axis (across it): the wrist centre is gone.
+    head, _, tail = text.partition(f"<joint name='{arm.joint_names[4]}'")
+    origin_start = tail.index("xyz='") + len("xyz='")
+    origin_end = tail.index("'", origin_start)
+    values = [float(v) for v in tail[origin_start:origin_end].split()]
+    values[2] += 1e-3  # joint 4's axis is along x at q = 0, joint 5's along y
+    tail = tail[:origin_start] + " ".join(map(repr, values)) + tail[origin_end:]
+    moved = robot_from_urdf(
+        head + f"<joint name='{arm.joint_names[4]}'" + tail,
+        base_frame="base_link",
+        tool_frame="tool0",
+    )
+    assert robot.family is not None and robot.family.name == "opw"
+    assert moved.family is not None and moved.family.name == "numeric"
+    assert moved.family.recognised is None
