@@ -18,7 +18,15 @@ import numpy as np
 import pytest
 from fastapi.testclient import TestClient
 
+from solver.cam.csv_path import read_csv_path
+from solver.core.robots import chain_from_urdf
+from solver.core.spatial import Placement
+from solver.core.tool_axis import poses_from_tool_axes
+from solver.families import robot_from_urdf
+from solver.families.numeric.family import NumericFamily
 from solver.families.opw.parameters import OpwParameters
+from solver.path.evaluate import evaluate_path
+from solver.path.problem import PathOptions, PathProblem
 from tests.cases import MAP_EVALUATE_RTOL
 from tests.solver.families.opw_urdf import opw_urdf
 
@@ -76,3 +84,31 @@ def test_the_m10ia_urdf_answers_as_its_opw_parameters(client: TestClient) -> Non
     assert answer["branch"] == expected["branch"]
     assert answer["ik"]["family"] == "opw" and "OPW arm" in answer["ik"]["recognised"]
     assert expected["ik"]["recognised"] is None
+
+
+def test_numeric_ik_from_the_covering_seeds_finds_the_opw_answer_too() -> None:
+    """The same URDF with the numeric family forced: its seeds find the branch the closed form
+    takes, and the same mu_path (32 Sobol seeds lost it on the published path)."""
+    urdf = opw_urdf(
+        M10IA,
+        limits=np.array(M10IA_LIMITS),
+        speeds=np.array(M10IA_SPEEDS),
+        joint_names=tuple(f"joint_{i}" for i in range(1, 7)),
+    )
+    chain = chain_from_urdf(urdf, tool_frame="tool0")
+    frames = {"base_frame": "base_link", "tool_frame": "tool0"}
+    cam = read_csv_path(fan_csv(), units="mm")
+    assert cam.axes is not None
+    poses, _ = poses_from_tool_axes(cam.positions, cam.axes)
+    placement = Placement(**PLACEMENT)
+    answers = [
+        evaluate_path(PathProblem.of(robot, poses, PathOptions()), placement)
+        for robot in (
+            robot_from_urdf(urdf, **frames),
+            robot_from_urdf(urdf, **frames, family=NumericFamily(chain, **frames)),
+        )
+    ]
+    analytic, numeric = answers
+    assert analytic.feasible and numeric.feasible
+    assert numeric.mu_path == pytest.approx(analytic.mu_path, rel=1e-9)
+    assert numeric.ik_branches_found is not None and numeric.ik_branches_found >= 4

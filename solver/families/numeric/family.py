@@ -1,7 +1,8 @@
 """Any serial arm as a kinematics family: numeric IK from fixed seeds, J^-1 t by a batched solve.
 
-robots.md section 4. At the first waypoint of a path the IK starts from a fixed scrambled Sobol
-set of seeds over the joint box (K = 32 for six joints, 64 for seven or more), keeps every
+robots.md section 4. At the first waypoint of a path the IK starts from a fixed set of seeds
+covering the joint box (a fractional factorial design at each joint's quartiles,
+:func:`solver.families.numeric.ik.seeds`; K = 32 for six joints, 64 for seven or more), keeps every
 distinct solution within the joint limits as a branch, labelled by its index in seed order, and
 follows each branch to the next waypoint from its solution at the previous one. The same input
 gives the same branches. A numeric family cannot promise that it found every branch: it reports
@@ -23,8 +24,6 @@ from solver.core.spatial import wrap_angle
 from solver.families.numeric import ik
 from solver.families.numeric.chain import SerialChain
 
-# The Sobol sequence's seed: fixed, so that the same input gives the same branches.
-SOBOL_SEED = 20240611
 # Work of one placement in poses of a closed-form family (KinematicsFamily.path_cost), measured
 # on the 2-core development machine against the analytic UR5 map (3.8 us a pose on the ERK
 # path): seeding the first waypoint (K seeds, up to ik.SEED_ITERATIONS each) and following the
@@ -52,16 +51,13 @@ class NumericFamily(KinematicsFamily):
 
     name = "numeric"
 
-    def __init__(
-        self, model: pin.Model, *, base_frame: str, tool_frame: str, seed: int = SOBOL_SEED
-    ) -> None:
+    def __init__(self, model: pin.Model, *, base_frame: str, tool_frame: str) -> None:
         """Read the chain and fix the seeds.
 
         Args:
             model: pinocchio model whose joints (1-DOF, one serial chain) all move the tool.
             base_frame: {B}, fixed to the root.
             tool_frame: the flange {F}.
-            seed: the Sobol sequence's seed.
 
         Raises:
             RobotModelError: the model is not such a chain.
@@ -71,7 +67,7 @@ class NumericFamily(KinematicsFamily):
         self.upper = model.upperPositionLimit.copy()
         count = seed_count(self.chain.dof)
         self.seeds = ik.seeds(
-            count, lower=self.lower, upper=self.upper, revolute=self.chain.revolute, seed=seed
+            count, lower=self.lower, upper=self.upper, revolute=self.chain.revolute
         )
         self._branches = tuple(Branch.named(solution=str(k)) for k in range(count))
 

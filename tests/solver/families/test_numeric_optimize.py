@@ -62,8 +62,9 @@ def test_the_nlp_answer_beats_every_tracked_branch_at_its_placement(
     tracked = evaluate_path(get_robot("panda"), path, casadi.placement)
     assert tracked.mu_path is not None
     assert casadi.mu_path >= tracked.mu_path
-    # On this path the redundancy the NLP picks is worth more than 1 % over the tracked one.
-    assert casadi.mu_path > tracked.mu_path * 1.01
+    # On this path the redundancy the NLP picks is worth more than the tracked one: 0.78 %
+    # since the seeds cover the joint ranges (issue 27; 1 % before, when they found less).
+    assert casadi.mu_path > tracked.mu_path * 1.005
     assert casadi.solver.status == "Solve_Succeeded"
 
 
