@@ -75,6 +75,13 @@ class Settings(BaseSettings):
         description="Threads one /v1/map request computes its placements on (default: the "
         "number of cores).",
     )
+    max_urdf_joints: int = Field(
+        default=64,
+        gt=0,
+        description="Most joints (of any type, counted in the document before it is parsed) a "
+        "URDF robot may have. An arm with its gripper has about 10 to 20; a 200-joint chain "
+        "took 4 to 14 s to read and seed.",
+    )
     max_png_panels: int = Field(
         default=24,
         gt=0,

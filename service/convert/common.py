@@ -7,6 +7,7 @@ import math
 import numpy as np
 
 from service import schemas
+from service.config import get_settings
 from service.schemas.path import PathInput
 from solver.cam.frames import frames_of_placement
 from solver.core.exceptions import InvalidInputError
@@ -16,16 +17,30 @@ from solver.core.spatial import (
     Placement,
     spun_waypoints,
 )
+from solver.core.urdf_structure import joint_count
 from solver.path.problem import PathOptions, PathProblem, SpinMode
 
 
-def robot_from_schema(spec: schemas.Robot) -> Robot:
+def robot_from_schema(spec: schemas.Robot, *, max_urdf_joints: int | None = None) -> Robot:
     """The solver robot a request names, with its speed limits and tool point.
 
+    Args:
+        spec: the request's robot.
+        max_urdf_joints: most joints a URDF may have; ``None`` reads DTF_MAX_URDF_JOINTS.
+
     Raises:
-        InvalidInputError: an OPW geometry, its limits or the speed limits are out of range.
+        InvalidInputError: an OPW geometry, its limits or the speed limits are out of range;
+            on ``robot.urdf``, a URDF of more joints than the limit (counted before parsing).
         RobotModelError: the URDF or its frames do not fit.
     """
+    if isinstance(spec, schemas.UrdfRobot):
+        limit = get_settings().max_urdf_joints if max_urdf_joints is None else max_urdf_joints
+        count = joint_count(spec.urdf)
+        if count > limit:
+            raise InvalidInputError(
+                "robot.urdf",
+                f"the URDF has {count} joints, more than DTF_MAX_URDF_JOINTS = {limit}",
+            )
     return spec.to_solver()
 
 

@@ -20,6 +20,7 @@ import pinocchio as pin
 
 from solver.core.exceptions import InvalidInputError, RobotModelError, quoted
 from solver.core.family import KinematicsFamily
+from solver.core.native_stderr import first_error, native_stderr
 from solver.core.urdf_structure import mimic_joints, root_links
 
 # Joint speed limits outside this range (rad/s) are input errors: no arm is that slow or fast,
@@ -27,6 +28,8 @@ from solver.core.urdf_structure import mimic_joints, root_links
 MIN_SPEED_LIMIT = 1e-6
 MAX_SPEED_LIMIT = 1e4
 # Joint acceleration limits outside this range (rad/s^2) are input errors likewise (motion.md).
+# A refused URDF's message names at most this many of its root links.
+ROOTS_NAMED = 5
 MIN_ACCELERATION_LIMIT = 1e-6
 MAX_ACCELERATION_LIMIT = 1e8
 
@@ -198,6 +201,16 @@ def _set_tool_point(model: pin.Model, tool_frame: str, transform_tool_to_tcp: np
         model.addFrame(pin.Frame("tool_point", tool.parentJoint, placement, pin.FrameType.OP_FRAME))
 
 
+def frame_names(model: pin.Model, *, limit: int = 100) -> str:
+    """The model's frame names for a message: at most ``limit``, each cut to ``limit`` characters.
+
+    A URDF in a request may name a link with megabytes.
+    """
+    names = [f.name for f in model.frames if f.name != "universe"]
+    shown = [name if len(name) <= limit else name[:limit] + "..." for name in names[:limit]]
+    return ", ".join(shown) + (f", ... ({len(names)} frames)" if len(names) > limit else "")
+
+
 def robot_from_model(
     name: str,
     model: pin.Model,
@@ -225,7 +238,7 @@ def robot_from_model(
     """
     for field, frame in (("robot.base_frame", base_frame), ("robot.tool_frame", tool_frame)):
         if not model.existFrame(frame):
-            names = ", ".join(f.name for f in model.frames if f.name != "universe")
+            names = frame_names(model)
             raise RobotModelError(field, f"no frame {quoted(frame)} in the model; frames: {names}")
     base = model.frames[model.getFrameId(base_frame)]
     if base.parentJoint != 0:
@@ -281,20 +294,28 @@ def chain_from_urdf(urdf: str, *, tool_frame: str) -> pin.Model:
     Raises:
         RobotModelError: the URDF cannot be parsed, the frame is missing or no joint moves it.
     """
-    try:
-        full = pin.buildModelFromXML(urdf)
-    except (RuntimeError, ValueError) as exc:
+    error: Exception | None = None
+    with native_stderr() as said:
+        try:
+            full = pin.buildModelFromXML(urdf)
+        except (RuntimeError, ValueError) as exc:
+            error = exc
+    if error is not None:
         roots = root_links(urdf)
         if len(roots) > 1:  # pinocchio says why on stderr only
+            named_roots = ", ".join(map(quoted, roots[:ROOTS_NAMED])) + (
+                ", ..." if len(roots) > ROOTS_NAMED else ""
+            )
             raise RobotModelError(
                 "robot.urdf",
-                f"cannot parse the URDF: {len(roots)} root links ({', '.join(map(quoted, roots))})"
+                f"cannot parse the URDF: {len(roots)} root links ({named_roots})"
                 ": every link but one must be a joint's child; remove the stray link or attach "
                 "it with a fixed joint",
-            ) from exc
-        raise RobotModelError("robot.urdf", f"cannot parse the URDF: {exc}") from exc
+            ) from error
+        reason = first_error(said[0]) or quoted(str(error))
+        raise RobotModelError("robot.urdf", f"cannot parse the URDF: {reason}") from error
     if not full.existFrame(tool_frame):
-        names = ", ".join(f.name for f in full.frames if f.name != "universe")
+        names = frame_names(full)
         raise RobotModelError(
             "robot.tool_frame", f"no frame {quoted(tool_frame)} in the model; frames: {names}"
         )

@@ -43,6 +43,12 @@ def root_links(urdf: str) -> list[str]:
     return [name for name in links if name not in children]
 
 
+def joint_count(urdf: str) -> int:
+    """How many ``<joint>`` elements the document's robot has (0 where it is no XML)."""
+    root = _tree(urdf)
+    return 0 if root is None else sum(1 for _ in root.iter("joint"))
+
+
 def mimic_joints(urdf: str) -> dict[str, Mimic]:
     """The document's mimic joints by name."""
     root = _tree(urdf)

@@ -1,0 +1,113 @@
+"""URDFs the service refuses, and why (issue 27): the joint count limit, the parser's reason
+cut to 100 characters, and a mimic joint between base and tool named in the 422.
+
+Fixtures are example-robot-data's UR5 URDF edited in the test.
+"""
+
+from __future__ import annotations
+
+import re
+from collections.abc import Iterator
+from typing import Any
+
+import pytest
+from fastapi.testclient import TestClient
+
+from service.config import get_settings
+from solver.core.robots import example_robot_data_dir
+
+UR5 = (example_robot_data_dir() / "ur_description" / "urdf" / "ur5_robot.urdf").read_text()
+UR5_JOINTS = len(re.findall(r"<joint\s", UR5))
+LONG = "L" * 5000
+
+
+def ur5_with_fixed_links(extra: int) -> str:
+    """The UR5 with ``extra`` links hung on tool0 by fixed joints."""
+    links = "".join(
+        f'<link name="extra_{k}"/><joint name="extra_joint_{k}" type="fixed">'
+        f'<parent link="tool0"/><child link="extra_{k}"/></joint>'
+        for k in range(extra)
+    )
+    return UR5.replace("</robot>", links + "</robot>")
+
+
+def refusal(client: TestClient, body: dict[str, Any], urdf: str) -> dict[str, Any]:
+    body["robot"] = {"urdf": urdf, "base_frame": "base", "tool_frame": "tool0"}
+    response = client.post("/v1/evaluate", json=body)
+    assert response.status_code == 422, response.text
+    detail: dict[str, Any] = response.json()["detail"][0]
+    assert detail["loc"] == ["body", "robot", "urdf"]
+    return detail
+
+
+@pytest.fixture
+def joint_limit(monkeypatch: pytest.MonkeyPatch) -> Iterator[int]:
+    """DTF_MAX_URDF_JOINTS = 20, set through the environment as a deployment would."""
+    monkeypatch.setenv("DTF_MAX_URDF_JOINTS", "20")
+    get_settings.cache_clear()
+    yield 20
+    get_settings.cache_clear()
+
+
+def test_a_urdf_over_the_joint_limit_is_refused_naming_the_setting(
+    client: TestClient, evaluate_body: dict[str, Any], joint_limit: int
+) -> None:
+    at_limit = ur5_with_fixed_links(joint_limit - UR5_JOINTS)
+    evaluate_body["robot"] = {"urdf": at_limit, "base_frame": "base", "tool_frame": "tool0"}
+    assert client.post("/v1/evaluate", json=evaluate_body).status_code == 200
+    over = ur5_with_fixed_links(joint_limit - UR5_JOINTS + 1)
+    detail = refusal(client, evaluate_body, over)
+    assert f"{joint_limit + 1} joints" in detail["msg"] and "DTF_MAX_URDF_JOINTS" in detail["msg"]
+
+
+def test_a_200_joint_urdf_is_refused_by_default(
+    client: TestClient, evaluate_body: dict[str, Any]
+) -> None:
+    detail = refusal(client, evaluate_body, ur5_with_fixed_links(200 - UR5_JOINTS))
+    assert "200 joints" in detail["msg"]
+    assert f"DTF_MAX_URDF_JOINTS = {get_settings().max_urdf_joints}" in detail["msg"]
+
+
+@pytest.mark.parametrize(
+    ("edit", "reason"),
+    [
+        (
+            lambda urdf: urdf.replace('lower="-6.28318530718"', 'lower="abc"', 1),
+            "joint [shoulder_pan_joint]: lower value (abc) is not a valid float",
+        ),
+        (
+            lambda urdf: urdf.replace('<parent link="base_link"/>', f'<parent link="{LONG}"/>', 1),
+            "Failed to build tree: parent link [LLLL",
+        ),
+    ],
+    ids=["not-a-float", "5000-character-link-name"],
+)
+def test_a_refused_urdf_carries_the_parsers_reason_cut_to_100_characters(
+    client: TestClient, evaluate_body: dict[str, Any], edit: Any, reason: str
+) -> None:
+    edited = edit(UR5)
+    assert edited != UR5
+    message = refusal(client, evaluate_body, edited)["msg"]
+    assert message.startswith("cannot parse the URDF: ") and reason in message
+    assert len(message) <= len("cannot parse the URDF: ") + 100 + len("...")
+
+
+def test_a_missing_frame_does_not_echo_a_5000_character_link_name(
+    client: TestClient, evaluate_body: dict[str, Any]
+) -> None:
+    renamed = UR5.replace('"base_link"', f'"{LONG}"')
+    evaluate_body["robot"] = {"urdf": renamed, "base_frame": "base", "tool_frame": "nowhere"}
+    response = client.post("/v1/evaluate", json=evaluate_body)
+    assert response.status_code == 422
+    message = response.json()["detail"][0]["msg"]
+    assert "'nowhere'" in message and LONG not in message and "L" * 100 + "..." in message
+
+
+def test_a_mimic_joint_in_the_chain_is_a_422_naming_it(
+    client: TestClient, evaluate_body: dict[str, Any]
+) -> None:
+    start = UR5.index('<joint name="wrist_2_joint"')
+    end = UR5.index("</joint>", start)
+    coupled = UR5[:end] + '<mimic joint="wrist_1_joint" multiplier="-1"/>' + UR5[end:]
+    message = refusal(client, evaluate_body, coupled)["msg"]
+    assert "'wrist_2_joint' mimics 'wrist_1_joint'" in message
