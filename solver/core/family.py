@@ -153,6 +153,24 @@ class KinematicsFamily(abc.ABC):
         q, status = self.solve(rotation, position)
         return PathSolutions(q=q, status=status)
 
+    def null_space(self, q: np.ndarray, tool_point: np.ndarray) -> np.ndarray:
+        """A unit vector spanning the null space of J(q), batched (seven-joint arms).
+
+        The free spin of a seven-joint arm is a three-variable LP whose third variable moves
+        the joints along it (:func:`solver.core.dtf_redundant.spin_speed`).
+
+        Args:
+            q: shape (dof, ...), rad.
+            tool_point: shape (3, ...) broadcastable to q, m in {B}.
+
+        Returns:
+            shape (dof, ...), NaN where q is not finite.
+
+        Raises:
+            NotImplementedError: the family has no null space (six joints).
+        """
+        raise NotImplementedError(f"a {self.name} arm of {self.dof} joints has no null space")
+
     @abc.abstractmethod
     def joint_speeds_per_unit_twist(
         self,

@@ -18,6 +18,7 @@ import numpy as np
 
 from solver.core.codes import FEASIBLE, REASONS, Reason
 from solver.core.dtf import spin_rate_nearest_zero
+from solver.core.dtf_redundant import spin_rate_at_feed
 from solver.core.family import Branch
 from solver.core.spatial import Placement, rotation_about_z
 from solver.path.limits import JointAccelerationLimit, JointMotion, bound_by_limits
@@ -195,10 +196,14 @@ def evaluate_path(problem: PathProblem, placement: Placement) -> PathEvaluation:
     qdot = run.qd_unit[:, pick, 0] * speed
     spins = None
     if run.spins is not None and run.qd_spin is not None:
-        spin_rate = spin_rate_nearest_zero(
-            run.qd_unit[:, pick, 0], run.qd_spin[:, pick, 0], robot.qdot_max, speed
-        )
-        qdot = qdot + spin_rate * run.qd_spin[:, pick, 0]
+        a, c = run.qd_unit[:, pick, 0], run.qd_spin[:, pick, 0]
+        if run.qd_null is None:
+            spin_rate = spin_rate_nearest_zero(a, c, robot.qdot_max, speed)
+        else:  # seven joints: the spin LP's null-space rate too
+            b = run.qd_null[:, pick, 0]
+            spin_rate, null_rate = spin_rate_at_feed(a, c, b, robot.qdot_max, speed)
+            qdot = qdot + null_rate * b
+        qdot = qdot + spin_rate * c
         spins = run.spins[pick, 0]
     q = run.tracked.q[:, pick, 0].T
     mu_path = float(v_max[bottleneck])

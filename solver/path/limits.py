@@ -23,6 +23,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from solver.core.dtf import two_variable_speed
+from solver.core.dtf_redundant import spin_speed
 
 
 @dataclass(frozen=True)
@@ -36,11 +37,14 @@ class JointMotion:
         qd_unit: shape (n, ...), J^-1 t_hat (rad/s per m/s of feed; per rad/s where h = 0).
         qd_spin: shape (n, ...), J^-1 [0; z_tool] (rad/s per rad/s of tool spin) when the spin
             rate is free (cam.md section 2); None in fixed spin.
+        qd_null: shape (n, ...), a unit vector spanning the null space of J, for a seven-joint
+            arm whose spin rate is free (the LP's third variable); None otherwise.
     """
 
     q: np.ndarray
     qd_unit: np.ndarray
     qd_spin: np.ndarray | None = None
+    qd_null: np.ndarray | None = None
 
 
 class Limit(abc.ABC):
@@ -69,7 +73,8 @@ class Limit(abc.ABC):
 class JointSpeedLimit(Limit):
     """Joint speed limits: the DTF, 1 / max_j |qd_j| / qdot_max_j (Sensors 2022 eq. (30)).
 
-    With the spin rate free, the exact two-variable LP (:func:`solver.core.dtf.two_variable_speed`).
+    With the spin rate free, the exact two-variable LP (:func:`solver.core.dtf.two_variable_speed`),
+    and for seven joints the three-variable one (:func:`solver.core.dtf_redundant.spin_speed`).
     """
 
     name = "speed"
@@ -85,6 +90,8 @@ class JointSpeedLimit(Limit):
     def speed_bound(self, motion: JointMotion) -> tuple[np.ndarray, np.ndarray]:
         """The DTF at every waypoint, and the joint on its limit (see :meth:`Limit.speed_bound`)."""
         qd_unit = motion.qd_unit
+        if motion.qd_spin is not None and motion.qd_null is not None:
+            return spin_speed(qd_unit, motion.qd_spin, motion.qd_null, self.qdot_max)
         if motion.qd_spin is not None:
             return two_variable_speed(qd_unit, motion.qd_spin, self.qdot_max)
         ratio = np.abs(qd_unit) / self.qdot_max.reshape((-1,) + (1,) * (qd_unit.ndim - 1))

@@ -20,6 +20,7 @@ import numpy as np
 
 from solver.core.codes import ACC_TIE_RTOL, FEASIBLE
 from solver.core.dtf import spin_rate_nearest_zero
+from solver.core.dtf_redundant import spin_rate_at_feed
 from solver.core.exceptions import InvalidInputError
 from solver.core.spatial import MAX_COORDINATE, rotation_about_z
 from solver.path.limits import JointMotion, bound_by_limits
@@ -61,6 +62,8 @@ class ChunkResult:
         qd_unit: shape (n, B, C, W), J^-1 t_hat (rad/s per m/s; per rad/s where h = 0).
         qd_spin: shape (n, B, C, W), J^-1 [0; z_tool] (rad/s per rad/s of tool spin); only in
             ``free`` spin mode, else None.
+        qd_null: shape (n, B, C, W), a unit null-space vector of J of a seven-joint arm in
+            ``free`` spin mode (the spin LP's third variable), else None.
         speed: shape (B, C, W), the DTF: V_max (Omega_max where h = 0), 1 / max_j |qd_unit_j| /
             qdot_max_j in ``fixed`` mode, the two-variable LP with the spin rate free in ``free``
             mode (cam.md section 2); meaningful only on feasible branches.
@@ -96,6 +99,7 @@ class ChunkResult:
     spins: np.ndarray | None = None
     ik_seeds: int | None = None
     branches_found: np.ndarray | None = None
+    qd_null: np.ndarray | None = None
     v_final: np.ndarray | None = None
     final_limiting: np.ndarray | None = None
     final_binding: np.ndarray | None = None
@@ -166,21 +170,23 @@ def run_chunk(problem: PathProblem, placements: np.ndarray) -> ChunkResult:
     qd_unit = family.joint_speeds_per_unit_twist(
         tracked.q, twist[:, None], tool_position[:, None], qdot_max=robot.qdot_max
     )
-    qd_spin = None
+    qd_spin = qd_null = None
     if free:
         tool_z = turn_by_yaw(path.tool_rotation[:, :, 2].T, yaws)
         spin = np.concatenate([np.zeros_like(tool_z), np.broadcast_to(tool_z, twist[3:].shape)])
         qd_spin = family.joint_speeds_per_unit_twist(
             tracked.q, spin[:, None], tool_position[:, None]
-        )
-    motion = JointMotion(q=tracked.q, qd_unit=qd_unit, qd_spin=qd_spin)
+        )  # the least-norm solution for more than six joints
+        if robot.dof > 6:
+            qd_null = family.null_space(tracked.q, tool_position[:, None])
+    motion = JointMotion(q=tracked.q, qd_unit=qd_unit, qd_spin=qd_spin, qd_null=qd_null)
     speed, limiting, _ = bound_by_limits(problem.waypoint_limits, motion)  # (B, C, W)
     v_max = np.where(path.pure_rotation, 0.0, speed)
     feasible = tracked.reason == FEASIBLE  # (B, C)
     mu_path = np.where(feasible, v_max.min(axis=-1), -np.inf)
     spins = None
     if qd_spin is not None:
-        spins, tracked = _spin_schedule(problem, tracked, qd_unit, qd_spin, mu_path)
+        spins, tracked = _spin_schedule(problem, tracked, motion, qd_spin, mu_path)
         feasible = tracked.reason == FEASIBLE
         mu_path = np.where(feasible, mu_path, -np.inf)
     final = _final_path_bounds(problem, tracked, qd_unit, qd_spin, mu_path, feasible)
@@ -193,6 +199,7 @@ def run_chunk(problem: PathProblem, placements: np.ndarray) -> ChunkResult:
         tracked=tracked,
         qd_unit=qd_unit,
         qd_spin=qd_spin,
+        qd_null=qd_null,
         speed=speed,
         limiting=limiting,
         v_max=v_max,
@@ -237,7 +244,7 @@ def _final_path_bounds(
 def _spin_schedule(
     problem: PathProblem,
     tracked: Tracked,
-    qd_unit: np.ndarray,
+    motion: JointMotion,
     qd_spin: np.ndarray,
     mu_path: np.ndarray,
 ) -> tuple[np.ndarray, Tracked]:
@@ -252,8 +259,11 @@ def _spin_schedule(
     Args:
         problem: the robot, the prepared path and the options.
         tracked: the branches followed at the given spin; q (n, B, C, W).
-        qd_unit: shape (n, B, C, W), J^-1 t_hat.
-        qd_spin: shape (n, B, C, W), J^-1 [0; z_tool].
+        motion: their joint speeds per unit feed (qd_unit) and, for seven joints, the null
+            space of J (qd_null), each (n, B, C, W). A seven-joint arm's spin rate is that of
+            the three-variable LP (:func:`solver.core.dtf_redundant.spin_rate_at_feed`), and
+            its joints follow the spin by the least-norm qd_spin.
+        qd_spin: shape (n, B, C, W), J^-1 [0; z_tool] (the least-norm one for seven joints).
         mu_path: shape (B, C), m/s, -inf where infeasible.
 
     Returns:
@@ -262,7 +272,11 @@ def _spin_schedule(
     """
     robot, path = problem.robot, problem.prepared
     feed = np.where(np.isfinite(mu_path) & (mu_path > 0.0), mu_path, 0.0)[..., None]
-    rate = spin_rate_nearest_zero(qd_unit, qd_spin, robot.qdot_max, feed)
+    qd_unit = motion.qd_unit
+    if motion.qd_null is None:
+        rate = spin_rate_nearest_zero(qd_unit, qd_spin, robot.qdot_max, feed)
+    else:
+        rate, _ = spin_rate_at_feed(qd_unit, qd_spin, motion.qd_null, robot.qdot_max, feed)
     length = np.linalg.norm(np.diff(path.tool_position, axis=0), axis=1)  # (W - 1,)
     with np.errstate(divide="ignore", invalid="ignore"):
         step = np.where(feed > 0.0, rate[..., :-1] * length / feed, 0.0)  # (B, C, W - 1)

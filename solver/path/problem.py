@@ -202,10 +202,11 @@ def check_spin_mode(robot: Robot, spin_mode: str) -> None:
             "spin_mode",
             f"free spin needs a revolute last joint; {robot.joint_names[-1]!r} is prismatic",
         )
-    if spin_mode == "free" and robot.dof != 6:
+    if spin_mode == "free" and robot.dof not in (6, 7):
         raise InvalidInputError(
             "spin_mode",
-            f"free spin is solved for six-joint arms; {robot.name!r} has {robot.dof} joints",
+            f"free spin is solved for six- and seven-joint arms; {robot.name!r} has "
+            f"{robot.dof} joints",
         )
 
 

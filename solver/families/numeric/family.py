@@ -224,11 +224,8 @@ class NumericFamily(KinematicsFamily):
         See :meth:`KinematicsFamily.joint_speeds_per_unit_twist`. Only configurations with
         finite joints are computed; the others come back NaN.
 
-        Raises:
-            ValueError: dof > 6 and no ``qdot_max``.
+        For dof > 6 without ``qdot_max``, the least-norm J^+ t (the free spin's direction).
         """
-        if self.dof > 6 and qdot_max is None:
-            raise ValueError(f"the DTF LP of a {self.dof}-joint arm needs qdot_max")
         shape = np.broadcast_shapes(q.shape[1:], twist.shape[1:], tool_point.shape[1:])
         q_flat = np.moveaxis(np.broadcast_to(q, (self.dof, *shape)), 0, -1).reshape(-1, self.dof)
         twist_flat = np.moveaxis(np.broadcast_to(twist, (6, *shape)), 0, -1).reshape(-1, 6)
@@ -242,9 +239,20 @@ class NumericFamily(KinematicsFamily):
             speed, qdot = redundant_speed(jacobian, twist_flat[rows], qdot_max)
             with np.errstate(divide="ignore", invalid="ignore"):
                 speeds[rows] = qdot / speed[:, None]
-        else:  # fewer than six joints: the least-squares speeds (the twist may be out of reach)
+        else:  # fewer than six joints: least squares; more, without limits: the least norm
             speeds[rows] = (np.linalg.pinv(jacobian) @ twist_flat[rows, :, None])[..., 0]
         return np.moveaxis(speeds.reshape(*shape, self.dof), -1, 0)
+
+    def null_space(self, q: np.ndarray, tool_point: np.ndarray) -> np.ndarray:
+        """The last right singular vector of J at the tool point (see the base), batched."""
+        shape = np.broadcast_shapes(q.shape[1:], tool_point.shape[1:])
+        q_flat = np.moveaxis(np.broadcast_to(q, (self.dof, *shape)), 0, -1).reshape(-1, self.dof)
+        point_flat = np.moveaxis(np.broadcast_to(tool_point, (3, *shape)), 0, -1).reshape(-1, 3)
+        null = np.full(q_flat.shape, np.nan)
+        rows = np.flatnonzero(np.isfinite(q_flat).all(axis=-1))
+        jacobian, _, _ = self.chain.jacobian(q_flat[rows], point_flat[rows])
+        null[rows] = np.linalg.svd(jacobian)[2][:, -1]
+        return np.moveaxis(null.reshape(*shape, self.dof), -1, 0)
 
 
 def _solve_or_nan(jacobian: np.ndarray, twist: np.ndarray) -> np.ndarray:

@@ -1,0 +1,121 @@
+"""Free spin on a seven-joint arm (issue 27): the spin rate a variable of the redundant LP.
+
+For seven joints the DTF with the tool spin free is max s s.t. J qdot = s t_hat + sigma [0; z],
+|qdot| <= qdot_max, with sigma free (cam.md section 2, dtf.md section 3): three variables
+(s, sigma, and the null-space rate). The known answers are that LP written here for HiGHS
+(scipy.optimize.linprog) on pinocchio's Jacobian of the Panda.
+"""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+import scipy.linalg
+import scipy.optimize
+
+from solver.core.dtf_redundant import spin_rate_at_feed, spin_speed
+from solver.core.kinematics import jacobian_in_base, tool_pose_in_base
+from solver.core.spatial import Placement, pose_matrix
+from solver.families import get_robot
+from tests.cases import EXAMPLES, FREE_SPIN_LP_RTOL
+from tests.problems import evaluate_path
+
+PLACEMENT = Placement(0.0, 0.45, 0.1, 0.0)
+
+
+def spin_lp(jacobian: np.ndarray, twist: np.ndarray, axis: np.ndarray, limits: np.ndarray) -> float:
+    """HiGHS on max s s.t. J qdot - s t_hat - sigma [0; z] = 0, |qdot| <= limits, sigma free."""
+    n = jacobian.shape[1]
+    cost = np.zeros(n + 2)
+    cost[n] = -1.0
+    a_eq = np.hstack([jacobian, -twist[:, None], -np.concatenate([np.zeros(3), axis])[:, None]])
+    result = scipy.optimize.linprog(
+        cost,
+        A_eq=a_eq,
+        b_eq=np.zeros(6),
+        bounds=[(-m, m) for m in limits] + [(0.0, None), (None, None)],
+        method="highs",
+        options={"primal_feasibility_tolerance": 1e-10, "dual_feasibility_tolerance": 1e-10},
+    )
+    assert result.status == 0, result.message
+    return float(result.x[n])
+
+
+def test_the_three_variable_lp_equals_highs_and_its_joint_speeds_are_within_limits() -> None:
+    robot = get_robot("panda")
+    rng = np.random.default_rng(27)
+    a, c, b, lp, jacobians, twists, axes = [], [], [], [], [], [], []
+    while len(lp) < 300:
+        q = rng.uniform(robot.q_lower, robot.q_upper)
+        jacobian = jacobian_in_base(robot, q)
+        if np.linalg.cond(jacobian) > 1e4:
+            continue
+        twist = np.concatenate([rng.normal(size=3), rng.normal(size=3) / rng.uniform(0.01, 2.0)])
+        axis = tool_pose_in_base(robot, q)[:3, 2]
+        pinv = np.linalg.pinv(jacobian)
+        a.append(pinv @ twist)
+        c.append(pinv @ np.concatenate([np.zeros(3), axis]))
+        b.append(scipy.linalg.null_space(jacobian)[:, 0])
+        lp.append(spin_lp(jacobian, twist, axis, robot.qdot_max))
+        jacobians.append(jacobian), twists.append(twist), axes.append(axis)
+    a_, c_, b_ = (np.array(v).T for v in (a, c, b))
+    speed, limiting = spin_speed(a_, c_, b_, robot.qdot_max)
+    np.testing.assert_allclose(speed, lp, rtol=FREE_SPIN_LP_RTOL)
+    sigma, lam = spin_rate_at_feed(a_, c_, b_, robot.qdot_max, speed)
+    qdot = speed * a_ + sigma * c_ + lam * b_
+    load = np.abs(qdot) / robot.qdot_max[:, None]
+    assert np.all(load <= 1 + 1e-9)
+    np.testing.assert_allclose(load[limiting, np.arange(300)], 1.0, rtol=1e-6)
+    for m in range(0, 300, 30):  # J qdot = s t_hat + sigma [0; z]
+        spin = np.concatenate([np.zeros(3), axes[m]])
+        expected = speed[m] * twists[m] + sigma[m] * spin
+        np.testing.assert_allclose(jacobians[m] @ qdot[:, m], expected, atol=1e-9)
+    # A free spin is never slower than the fixed one (sigma = 0 is a choice).
+    fixed = np.array([
+        scipy.optimize.linprog(
+            np.r_[np.zeros(7), -1.0],
+            A_eq=np.hstack([jacobians[m], -twists[m][:, None]]),
+            b_eq=np.zeros(6),
+            bounds=[(-v, v) for v in robot.qdot_max] + [(0.0, None)],
+            method="highs",
+        ).x[7]
+        for m in range(0, 300, 30)
+    ])  # fmt: skip
+    assert np.all(speed[::30] >= fixed * (1 - 1e-9))
+
+
+@pytest.fixture(scope="module")
+def path() -> np.ndarray:
+    """The first ten waypoints of the example path, (10, 4, 4)."""
+    waypoints = json.loads((EXAMPLES / "evaluate_request.json").read_text())["path"]["waypoints"]
+    return np.array(
+        [pose_matrix(w["position"], w["orientation"], field="w") for w in waypoints[:10]]
+    )
+
+
+def test_the_pandas_free_spin_path_runs_at_the_lp_of_each_waypoint(path: np.ndarray) -> None:
+    """V_max at every waypoint = the test's LP at the tracked joint path; mu_path its least."""
+    robot = get_robot("panda")
+    free = evaluate_path(robot, path, PLACEMENT, spin_mode="free")
+    assert free.feasible and free.v_max is not None and free.qdot is not None
+    assert free.spins is not None and free.branch is not None
+    fixed = evaluate_path(robot, path, PLACEMENT, branch=free.branch)  # the same branch's q
+    assert fixed.feasible and fixed.q is not None and fixed.mu_path is not None
+    twists = np.column_stack(
+        [free.u_T, free.u_R / np.where(np.isinf(free.h), np.inf, free.h)[:, None]]
+    )
+    expected = [
+        spin_lp(
+            jacobian_in_base(robot, q),
+            twist,
+            tool_pose_in_base(robot, q)[:3, 2],
+            robot.qdot_max,
+        )
+        for q, twist in zip(fixed.q, twists, strict=True)
+    ]
+    np.testing.assert_allclose(free.v_max, expected, rtol=FREE_SPIN_LP_RTOL)
+    assert free.mu_path == pytest.approx(min(expected), rel=FREE_SPIN_LP_RTOL)
+    assert free.mu_path > fixed.mu_path
+    assert np.all(np.abs(free.qdot) <= robot.qdot_max * (1 + 1e-9))
