@@ -156,12 +156,20 @@ def test_tracked_path_reaches_every_waypoint(name: str, placement: Placement) ->
     assert np.abs(np.diff(result.q, axis=0)).max() <= 0.35
 
 
-def test_free_spin_is_refused_for_a_redundant_arm() -> None:
+def test_free_spin_is_refused_beyond_seven_joints() -> None:
+    """Seven joints have the three-variable spin LP (test_free_spin_redundant.py); eight not."""
+    panda = (example_robot_data_dir() / "panda_description" / "urdf" / "panda.urdf").read_text()
+    extra = (
+        '<link name="extra"/><joint name="extra_joint" type="revolute">'
+        '<parent link="panda_link8"/><child link="extra"/><origin xyz="0 0 0.05"/>'
+        '<axis xyz="1 0 0"/><limit lower="-2" upper="2" velocity="2" effort="1"/></joint>'
+    )
+    robot = robot_from_urdf(
+        panda.replace("</robot>", extra + "</robot>"),
+        base_frame="panda_link0",
+        tool_frame="extra",
+    )
+    assert robot.dof == 8
     with pytest.raises(InvalidInputError) as info:
-        evaluate_path(
-            get_robot("panda"),
-            load_path("curved_line"),
-            Placement(0.4, 0, 0.1, 0),
-            spin_mode="free",
-        )
-    assert info.value.field == "spin_mode"
+        evaluate_path(robot, load_path("curved_line"), Placement(0.4, 0, 0.1, 0), spin_mode="free")
+    assert info.value.field == "spin_mode" and "8 joints" in info.value.message
