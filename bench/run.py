@@ -38,10 +38,11 @@ from timing import best_time
 
 from solver.core.kinematics import jacobian_in_base
 from solver.core.parallel import SERIAL, ThreadRunner
-from solver.core.robots import Robot, example_robot_data_dir
+from solver.core.robots import Robot, chain_from_urdf, example_robot_data_dir
 from solver.core.spatial import Placement, pose_matrix
 from solver.core.task import task_requirements
 from solver.families import get_robot, robot_from_urdf
+from solver.families.numeric.family import NumericFamily
 from solver.optimise.optimize import optimize_placement
 from solver.optimise.search_space import PlacementBounds
 from solver.path.capability_map import capability_map, grid_axis
@@ -257,15 +258,19 @@ def evaluate_over_http(*, requests: int) -> None:
 def numeric_maps(path: np.ndarray, xs: np.ndarray, ys: np.ndarray, z: float, t_map: float) -> None:
     """The numeric family's map on the same grid: UR5 as a plain URDF, and the Panda (one run).
 
-    The UR5's URDF is read without a family, so it gets the numeric one (robots.md section 4);
-    its map must equal the analytic one, which is checked here too.
+    The UR5's URDF is given the numeric family (robots.md section 4); its map must equal the
+    analytic one, which is checked here too. Read without a family it is recognised as a UR arm
+    (solver.families.recognise): that line shows what a user sending the URDF gets.
     """
     analytic = get_robot("ur5")
     file = example_robot_data_dir() / "ur_description" / "urdf" / "ur5_robot.urdf"
     urdf = file.read_text().replace("1.57079632679", repr(math.pi / 2))
     urdf = urdf.replace("3.14159265359", repr(math.pi))
+    frames = {"base_frame": "base", "tool_frame": "tool0"}
+    numeric = NumericFamily(chain_from_urdf(urdf, tool_frame="tool0"), **frames)
     arms = {
-        "UR5 as a URDF": robot_from_urdf(urdf, base_frame="base", tool_frame="tool0"),
+        "UR5 as a URDF": robot_from_urdf(urdf, **frames, family=numeric),
+        "UR5 recognised": robot_from_urdf(urdf, **frames),
         "Panda": get_robot("panda"),
     }
     reference = capability_map(

@@ -9,7 +9,7 @@ import pytest
 from solver.core.codes import OK, UNREACHABLE
 from solver.core.exceptions import InvalidInputError
 from solver.core.kinematics import jacobian_in_base, tool_pose_in_base
-from solver.core.robots import Robot, example_robot_data_dir
+from solver.core.robots import Robot, chain_from_urdf, example_robot_data_dir
 from solver.core.spatial import Placement, wrap_angle
 from solver.families import get_robot, robot_from_urdf
 from solver.families.numeric.family import NumericFamily, seed_count
@@ -21,10 +21,16 @@ from tests.solver.test_evaluate import load_path
 
 
 def ur5_as_urdf() -> Robot:
-    """The UR5 of example-robot-data as a plain URDF: no family given, so the numeric one."""
+    """The UR5 of example-robot-data as a plain URDF with the numeric family.
+
+    Given no family, the registry would recognise it as a UR arm (solver.families.recognise);
+    these tests are about numeric IK, so it is given the numeric family.
+    """
     path = example_robot_data_dir() / "ur_description" / "urdf" / "ur5_robot.urdf"
     urdf = _exact_right_angles(path.read_text())
-    return robot_from_urdf(urdf, base_frame="base", tool_frame="tool0", name="ur5_urdf")
+    frames = {"base_frame": "base", "tool_frame": "tool0"}
+    family = NumericFamily(chain_from_urdf(urdf, tool_frame="tool0"), **frames)
+    return robot_from_urdf(urdf, **frames, name="ur5_urdf", family=family)
 
 
 def numeric(robot: Robot) -> NumericFamily:
