@@ -115,3 +115,29 @@ def test_a_wrist_that_is_not_spherical_keeps_numeric_ik() -> None:
     assert robot.family is not None and robot.family.name == "opw"
     assert moved.family is not None and moved.family.name == "numeric"
     assert moved.family.recognised is None
+
+
+@pytest.mark.parametrize("seed", [1, 2, 3, 4])
+def test_any_offsets_signs_and_lateral_offset_are_recognised(seed: int) -> None:
+    """Random geometry (b != 0, a1 and a2 of either sign), offsets and sign corrections."""
+    rng = np.random.default_rng(seed)
+    a1, a2, b = rng.uniform(-0.3, 0.3, 3)
+    c1, c2, c3, c4 = rng.uniform(0.1, 1.0, 4)
+    parameters = OpwParameters(
+        a1, a2, b, c1, c2, c3, c4,
+        offsets=tuple(rng.uniform(-math.pi, math.pi, 6)),
+        sign_corrections=tuple(int(s) for s in rng.choice([-1, 1], 6)),
+    )  # fmt: skip
+    arm = ARMS[seed % len(ARMS)]
+    robot = urdf_robot(arm, parameters)
+    assert robot.family is not None and robot.family.name == "opw"
+    q = rng.uniform(-math.pi, math.pi, (30, 6))
+    poses = np.array([tool_pose_in_base(robot, qi) for qi in q])
+    np.testing.assert_allclose(poses, forward_kinematics(parameters, q), atol=FK_IK_ATOL)
+    solutions, status = robot.family.solve(np.moveaxis(poses[:, :3, :3], 0, -1), poses[:, :3, 3].T)
+    for b_, i in zip(*np.nonzero(status != UNREACHABLE), strict=True):
+        pose = tool_pose_in_base(robot, solutions[:, b_, i])
+        np.testing.assert_allclose(pose, poses[i], atol=FK_IK_ATOL)
+    # Each pose's own q is one of its branches (to a turn): the closed form missed none.
+    turned = np.angle(np.exp(1j * (solutions - q.T[:, None, :])))  # (6, 8, 30), wrapped
+    assert np.all(np.nanmin(np.abs(turned).max(axis=0), axis=0) < 1e-6)
