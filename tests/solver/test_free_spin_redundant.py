@@ -19,8 +19,8 @@ from solver.core.dtf_redundant import spin_rate_at_feed, spin_speed
 from solver.core.kinematics import jacobian_in_base, tool_pose_in_base
 from solver.core.spatial import Placement, pose_matrix
 from solver.families import get_robot
-from tests.cases import EXAMPLES, FREE_SPIN_LP_RTOL
-from tests.problems import evaluate_path
+from tests.cases import EXAMPLES, FREE_SPIN_LP_RTOL, MAP_EVALUATE_RTOL
+from tests.problems import capability_map, evaluate_path
 
 PLACEMENT = Placement(0.0, 0.45, 0.1, 0.0)
 
@@ -119,3 +119,20 @@ def test_the_pandas_free_spin_path_runs_at_the_lp_of_each_waypoint(path: np.ndar
     assert free.mu_path == pytest.approx(min(expected), rel=FREE_SPIN_LP_RTOL)
     assert free.mu_path > fixed.mu_path
     assert np.all(np.abs(free.qdot) <= robot.qdot_max * (1 + 1e-9))
+
+
+def test_a_free_spin_map_of_the_panda_equals_evaluate(path: np.ndarray) -> None:
+    robot = get_robot("panda")
+    cmap = capability_map(
+        robot,
+        path,
+        xs=np.array([-0.05, 0.05]),
+        ys=np.array([0.4, 0.5]),
+        z=0.1,
+        yaws=np.zeros(1),
+        spin_mode="free",
+    )
+    for index in np.ndindex(cmap.mu_path.shape):
+        expected = evaluate_path(robot, path, cmap.placement(index), spin_mode="free")
+        assert expected.feasible and expected.mu_path is not None
+        assert cmap.mu_path[index] == pytest.approx(expected.mu_path, rel=MAP_EVALUATE_RTOL)
