@@ -146,4 +146,5 @@ def map_response(cmap: CapabilityMap, robot: Robot, *, spin_mode: SpinMode) -> s
         worst=_extreme(cmap, best=False),
         feasible_cells=int(np.sum(cmap.reason == FEASIBLE)),
         spin_mode=spin_mode,
+        recognised=require_family(robot).recognised,
     )

@@ -238,3 +238,8 @@ class MapResponse(ResponseModel):
     )
     feasible_cells: int = Field(description="How many cells are feasible.")
     spin_mode: SpinMode = Field(default="fixed", description="The spin mode used (fixed or free).")
+    recognised: str | None = Field(
+        default=None,
+        description="Set when the robot is a URDF whose chain was recognised as an OPW or UR arm "
+        "and solved in closed form (as /v1/evaluate's ik.recognised); null otherwise.",
+    )

@@ -84,6 +84,12 @@ def test_the_m10ia_urdf_answers_as_its_opw_parameters(client: TestClient) -> Non
     assert answer["branch"] == expected["branch"]
     assert answer["ik"]["family"] == "opw" and "OPW arm" in answer["ik"]["recognised"]
     assert expected["ik"]["recognised"] is None
+    axis = {"min": -0.2, "max": -0.2, "step": 0.1}
+    grid = {"x": {"min": 0.85, "max": 0.95, "step": 0.05}, "y": axis, "z": 0.3, "yaw": [math.pi]}
+    body = {"robot": robot, "path": {"csv": fan_csv(), "units": "mm"}, "grid": grid}
+    response = client.post("/v1/map", json=body)
+    assert response.status_code == 200, response.text
+    assert "OPW arm" in response.json()["recognised"]
 
 
 def test_numeric_ik_from_the_covering_seeds_finds_the_opw_answer_too() -> None:
