@@ -4,8 +4,8 @@ A :class:`Robot` wraps a pinocchio model with the two frames the method needs: t
 {B} in which poses and twists are expressed, and the tool point {TCP} (the tool frame {F} times
 an optional offset T_F_TCP), plus the kinematics family that solves its IK (robots.md section 1).
 The catalogue, and the numeric family a URDF arm gets by default, are the families' registry's
-(:mod:`solver.families`, a layer above); this module reads URDFs, builds robots and checks
-limits.
+(:mod:`solver.families`, a layer above); this module builds robots and checks limits, and
+re-exports :func:`solver.core.urdf_chain.chain_from_urdf`, which reads URDFs.
 """
 
 from __future__ import annotations
@@ -20,16 +20,23 @@ import pinocchio as pin
 
 from solver.core.exceptions import InvalidInputError, RobotModelError, quoted
 from solver.core.family import KinematicsFamily
-from solver.core.native_stderr import first_error, native_stderr
-from solver.core.urdf_structure import mimic_joints, root_links
+from solver.core.urdf_chain import chain_from_urdf, frame_names
+
+__all__ = [
+    "Robot",
+    "chain_from_urdf",
+    "check_acceleration_limits",
+    "check_speed_limits",
+    "example_robot_data_dir",
+    "frame_names",
+    "robot_from_model",
+]
 
 # Joint speed limits outside this range (rad/s) are input errors: no arm is that slow or fast,
 # and the LP solver treats bounds past 1e20 as infinite.
 MIN_SPEED_LIMIT = 1e-6
 MAX_SPEED_LIMIT = 1e4
 # Joint acceleration limits outside this range (rad/s^2) are input errors likewise (motion.md).
-# A refused URDF's message names at most this many of its root links.
-ROOTS_NAMED = 5
 MIN_ACCELERATION_LIMIT = 1e-6
 MAX_ACCELERATION_LIMIT = 1e8
 
@@ -201,16 +208,6 @@ def _set_tool_point(model: pin.Model, tool_frame: str, transform_tool_to_tcp: np
         model.addFrame(pin.Frame("tool_point", tool.parentJoint, placement, pin.FrameType.OP_FRAME))
 
 
-def frame_names(model: pin.Model, *, limit: int = 100) -> str:
-    """The model's frame names for a message: at most ``limit``, each cut to ``limit`` characters.
-
-    A URDF in a request may name a link with megabytes.
-    """
-    names = [f.name for f in model.frames if f.name != "universe"]
-    shown = [name if len(name) <= limit else name[:limit] + "..." for name in names[:limit]]
-    return ", ".join(shown) + (f", ... ({len(names)} frames)" if len(names) > limit else "")
-
-
 def robot_from_model(
     name: str,
     model: pin.Model,
@@ -279,64 +276,6 @@ def robot_from_model(
         family=family,
     )
     return robot
-
-
-def chain_from_urdf(urdf: str, *, tool_frame: str) -> pin.Model:
-    """Read the serial chain from the root to ``tool_frame`` out of URDF text.
-
-    Joints that do not move the tool frame (grippers, fingers) are locked at their neutral
-    position, so the model is the chain from the root to ``tool_frame``.
-
-    Args:
-        urdf: the URDF document.
-        tool_frame: link or frame of the tool flange.
-
-    Raises:
-        RobotModelError: the URDF cannot be parsed, the frame is missing or no joint moves it.
-    """
-    error: Exception | None = None
-    with native_stderr() as said:
-        try:
-            full = pin.buildModelFromXML(urdf)
-        except (RuntimeError, ValueError) as exc:
-            error = exc
-    if error is not None:
-        roots = root_links(urdf)
-        if len(roots) > 1:  # pinocchio says why on stderr only
-            named_roots = ", ".join(map(quoted, roots[:ROOTS_NAMED])) + (
-                ", ..." if len(roots) > ROOTS_NAMED else ""
-            )
-            raise RobotModelError(
-                "robot.urdf",
-                f"cannot parse the URDF: {len(roots)} root links ({named_roots})"
-                ": every link but one must be a joint's child; remove the stray link or attach "
-                "it with a fixed joint",
-            ) from error
-        reason = first_error(said[0]) or quoted(str(error))
-        raise RobotModelError("robot.urdf", f"cannot parse the URDF: {reason}") from error
-    if not full.existFrame(tool_frame):
-        names = frame_names(full)
-        raise RobotModelError(
-            "robot.tool_frame", f"no frame {quoted(tool_frame)} in the model; frames: {names}"
-        )
-    tool_joint = full.frames[full.getFrameId(tool_frame)].parentJoint
-    chain = set(full.supports[tool_joint])
-    locked = [j for j in range(1, full.njoints) if j not in chain]
-    mimics = mimic_joints(urdf)
-    coupled = [full.names[j] for j in sorted(chain) if full.names[j] in mimics]
-    if coupled:
-        mimic = mimics[coupled[0]]
-        raise RobotModelError(
-            "robot.urdf",
-            f"joint {quoted(mimic.joint)} mimics {quoted(mimic.leader)} (q = "
-            f"{mimic.multiplier:g} q_leader + {mimic.offset:g}) between the base and the tool: "
-            "coupled joints are not modelled yet, and reading it as a free joint would give "
-            "joint paths the arm cannot run",
-        )
-    model = pin.buildReducedModel(full, locked, pin.neutral(full)) if locked else full
-    if model.nv == 0:
-        raise RobotModelError("robot.tool_frame", f"no joint moves frame {quoted(tool_frame)}")
-    return model
 
 
 def example_robot_data_dir() -> Path:

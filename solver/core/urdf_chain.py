@@ -1,0 +1,86 @@
+"""A URDF document read into the pinocchio chain from its root to the tool frame.
+
+pinocchio's parser (urdfdom) is run with its stderr captured (:mod:`solver.core.native_stderr`)
+so that a refusal carries its reason; what pinocchio leaves unsaid (two root links, mimic joints
+between base and tool) is read from the document itself (:mod:`solver.core.urdf_structure`).
+Names in messages are cut (a request may send a name of megabytes).
+"""
+
+from __future__ import annotations
+
+import pinocchio as pin
+
+from solver.core.exceptions import RobotModelError, quoted
+from solver.core.native_stderr import first_error, native_stderr
+from solver.core.urdf_structure import mimic_joints, root_links
+
+# A refused URDF's message names at most this many of its root links.
+ROOTS_NAMED = 5
+
+
+def frame_names(model: pin.Model, *, limit: int = 100) -> str:
+    """The model's frame names for a message: at most ``limit``, each cut to ``limit`` characters.
+
+    A URDF in a request may name a link with megabytes.
+    """
+    names = [f.name for f in model.frames if f.name != "universe"]
+    shown = [name if len(name) <= limit else name[:limit] + "..." for name in names[:limit]]
+    return ", ".join(shown) + (f", ... ({len(names)} frames)" if len(names) > limit else "")
+
+
+def chain_from_urdf(urdf: str, *, tool_frame: str) -> pin.Model:
+    """Read the serial chain from the root to ``tool_frame`` out of URDF text.
+
+    Joints that do not move the tool frame (grippers, fingers) are locked at their neutral
+    position, so the model is the chain from the root to ``tool_frame``.
+
+    Args:
+        urdf: the URDF document.
+        tool_frame: link or frame of the tool flange.
+
+    Raises:
+        RobotModelError: the URDF cannot be parsed, the frame is missing or no joint moves it.
+    """
+    error: Exception | None = None
+    with native_stderr() as said:
+        try:
+            full = pin.buildModelFromXML(urdf)
+        except (RuntimeError, ValueError) as exc:
+            error = exc
+    if error is not None:
+        roots = root_links(urdf)
+        if len(roots) > 1:  # pinocchio says why on stderr only
+            named_roots = ", ".join(map(quoted, roots[:ROOTS_NAMED])) + (
+                ", ..." if len(roots) > ROOTS_NAMED else ""
+            )
+            raise RobotModelError(
+                "robot.urdf",
+                f"cannot parse the URDF: {len(roots)} root links ({named_roots})"
+                ": every link but one must be a joint's child; remove the stray link or attach "
+                "it with a fixed joint",
+            ) from error
+        reason = first_error(said[0]) or quoted(str(error))
+        raise RobotModelError("robot.urdf", f"cannot parse the URDF: {reason}") from error
+    if not full.existFrame(tool_frame):
+        names = frame_names(full)
+        raise RobotModelError(
+            "robot.tool_frame", f"no frame {quoted(tool_frame)} in the model; frames: {names}"
+        )
+    tool_joint = full.frames[full.getFrameId(tool_frame)].parentJoint
+    chain = set(full.supports[tool_joint])
+    locked = [j for j in range(1, full.njoints) if j not in chain]
+    mimics = mimic_joints(urdf)
+    coupled = [full.names[j] for j in sorted(chain) if full.names[j] in mimics]
+    if coupled:
+        mimic = mimics[coupled[0]]
+        raise RobotModelError(
+            "robot.urdf",
+            f"joint {quoted(mimic.joint)} mimics {quoted(mimic.leader)} (q = "
+            f"{mimic.multiplier:g} q_leader + {mimic.offset:g}) between the base and the tool: "
+            "coupled joints are not modelled yet, and reading it as a free joint would give "
+            "joint paths the arm cannot run",
+        )
+    model = pin.buildReducedModel(full, locked, pin.neutral(full)) if locked else full
+    if model.nv == 0:
+        raise RobotModelError("robot.tool_frame", f"no joint moves frame {quoted(tool_frame)}")
+    return model
