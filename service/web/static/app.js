@@ -188,6 +188,7 @@ async function showImport(name) {
   const passes = read.passes.length;
   $("import-summary").textContent = `${read.waypoints.length} waypoints in ${passes} ${passes === 1 ? "pass" : "passes"}`
     + `, ${fixed(1000 * pathLength(read), 1)} mm of path`
+    + `; tool spin ${read.spin_mode} by default`
     + (read.arcs ? `, ${read.arcs} arcs interpolated` : "")
     + (dropped ? `; dropped ${read.repeated_points} repeated points, ${read.one_point_passes} one-point passes` : "");
   $("import-units").textContent = `${read.units} (${read.units_source}: ${read.units_note})`;
@@ -228,6 +229,8 @@ function showErrors(details, aliases = {}) {
       field = document.querySelector(`.field[data-loc="${loc.slice(0, n).join(".")}"]`);
     }
     const target = field ? field.querySelector(".error") : $("form-error");
+    const folded = target.closest("details");
+    if (folded) folded.open = true;  // an error inside a folded section is seen
     const msg = field || !loc.length ? d.msg : `${loc.join(".")}: ${d.msg}`;
     if (!target.textContent.split(" | ").includes(msg)) {
       target.textContent = (target.textContent ? target.textContent + " | " : "") + msg;
