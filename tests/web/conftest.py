@@ -49,3 +49,9 @@ def page(browser: Browser, url: str, request: pytest.FixtureRequest) -> Iterator
     ARTIFACTS.mkdir(exist_ok=True)
     page.screenshot(path=str(ARTIFACTS / f"web-{request.node.name}.png"), full_page=True)
     page.close()
+
+
+def snapshot(page: Page, name: str) -> None:
+    """A screenshot of the page as it is now, ``tests/artifacts/web-<name>.png``."""
+    ARTIFACTS.mkdir(exist_ok=True)
+    page.screenshot(path=str(ARTIFACTS / f"web-{name}.png"), full_page=True)

@@ -18,7 +18,7 @@ import pytest
 from playwright.sync_api import Browser, Page
 
 from tests.cases import ROOT
-from tests.web.conftest import ARTIFACTS
+from tests.web.conftest import ARTIFACTS, snapshot
 from tests.web.test_page import EXAMPLE_PATH, SMALL, cell_point, fill, grid_of, run_small_map
 
 README = (ROOT / "README.md").read_text()
@@ -83,6 +83,7 @@ def test_a_csv_states_no_units_so_the_page_asks_and_a_metres_csv_reads_as_metres
         "line_m.csv: a CSV file states no units; choose mm, inch or m here"
     )
     assert page.get_attribute("#import", "data-waypoints") is None  # not read as mm
+    snapshot(page, "csv-asks-for-units")
     page.select_option("#path-units", "m")
     page.wait_for_function("document.getElementById('import').dataset.waypoints", timeout=30_000)
     assert page.text_content("#import-units") == "m (request: the request's units (m))"
@@ -157,6 +158,7 @@ def test_stale_results_go_when_a_new_job_starts_and_beside_a_new_error(
     assert page.text_content("#best-mu") == ""
     assert page.get_attribute("#plot", "data-drawn") is None
     assert page.text_content("#cell-summary", timeout=1000).startswith("Click")
+    snapshot(page, "stale-cleared-during-a-new-job")
     page.click("#cancel")
     page.wait_for_function(
         "document.getElementById('job-status').textContent.startsWith('cancelled')",
@@ -220,6 +222,7 @@ def test_spin_free_and_any_yaw_reach_the_readmes_free_spin_figures(page: Page, u
     assert free and fixed
     assert summary.startswith(f"x 0.0000 m, y 0.4500 m, yaw 0.0000 rad: mu_path {free[1]} m/s")
     assert f"spin free: {free[2]} over the spin fixed ({fixed[1]} m/s)" in summary
+    snapshot(page, "spin-free-cell-gain")
 
     page.check("#opt-any-yaw")
     assert page.is_disabled("#opt-yaw-min") and page.is_disabled("#opt-yaw-max")
@@ -303,6 +306,7 @@ def test_a_urdf_file_is_taken_as_written_and_a_missing_frame_says_so_once(
     assert error_beside(page, "robot.tool_frame") == "Field required"
     assert page.text_content(".field[data-loc='robot'] .error") == ""
     assert page.text_content("#form-error") == ""
+    snapshot(page, "urdf-missing-tool-frame")
     page.fill("#tool-frame", "tool0")
     page.click("#run")
     page.wait_for_function("document.getElementById('summary').dataset.cells", timeout=120_000)
