@@ -367,3 +367,24 @@ def test_no_request_of_the_page_fails_and_the_icon_is_served(
     assert failed == []
     icon = httpx.get(f"{url}/favicon.ico")
     assert icon.status_code == 200 and icon.headers["content-type"] == "image/svg+xml"
+
+
+def test_an_empty_feed_is_left_unset_and_a_zero_feed_is_the_apis_error_beside_it(
+    page: Page, url: str
+) -> None:
+    api = run_small_map(page, url)
+    cell = next(c for c in api["cells"] if c["mu_path"] is not None)
+    page.fill("#feed", "")
+    page.mouse.click(**cell_point(page, 0, cell, api))
+    page.wait_for_selector("#plot[data-drawn='1']", timeout=60_000)
+    assert (page.text_content("#cell-summary") or "").endswith(
+        f"mu_path {cell['mu_path']:.6f} m/s; no feed to check"
+    )
+    page.fill("#feed", "0")
+    page.mouse.click(**cell_point(page, 0, cell, api))
+    placement = {"x": cell["x"], "y": cell["y"], "z": 0.1, "yaw": cell["yaw"], "spin": 0.0}
+    body = {"robot": {"model": "ur5"}, "path": EXAMPLE_PATH, "placement": placement, "feed": 0}
+    detail = httpx.post(f"{url}/v1/evaluate", json=body).json()["detail"]
+    assert [d["loc"] for d in detail] == [["body", "feed"]]
+    assert error_beside(page, "feed") == detail[0]["msg"]
+    assert page.get_attribute("#plot", "data-drawn") is None  # the previous cell's plot is gone

@@ -530,8 +530,12 @@ async function evaluateCell(c) {
   const answer = await api("POST", "/v1/evaluate", body).catch(() => null);
   if (!answer) { clearCell(); return; }
   const where = `x ${metres(c.x)}, y ${metres(c.y)}, yaw ${radians(c.yaw)}`;
+  // The feed checked: the field's, else the program's (CL data), else none (the field empty).
+  body.feed = answer.feed_check ? answer.feed_check.feed : undefined;
+  const use = body.feed === undefined ? "; no feed to check"
+    : `; at ${body.feed} m/s the largest joint use is ${(100 * body.feed / answer.mu_path).toFixed(1)} %`;
   $("cell-summary").textContent = answer.feasible
-    ? `${where}: mu_path ${answer.mu_path.toFixed(6)} m/s; at ${body.feed} m/s the largest joint use is ${(100 * answer.feed_check.feed / answer.mu_path).toFixed(1)} %`
+    ? `${where}: mu_path ${answer.mu_path.toFixed(6)} m/s${use}`
     : `${where}: infeasible (${answer.reason} at waypoint ${answer.failed_waypoint})`;
   if (answer.feasible && answer.spin_mode === "free") await compareFixedSpin(body, answer);
   const b = answer.bottleneck;

@@ -7,7 +7,7 @@
 function accelerationUse(answer, body) {
   const acc = answer.acceleration;
   const limits = body.robot.joint_acceleration_limits;
-  if (!acc || !(acc.mu_acc > 0) || !Array.isArray(limits)) return null;
+  if (!acc || !(acc.mu_acc > 0) || !(body.feed > 0) || !Array.isArray(limits)) return null;
   const scale = (body.feed / acc.mu_acc) ** 2;
   return answer.waypoints.map((p) => (p.qdd_at_mu_acc
     ? p.qdd_at_mu_acc.map((v, j) => (Math.abs(v) * scale) / limits[j]) : null));
