@@ -23,3 +23,8 @@ def mount_page(app: FastAPI) -> None:
     @app.get("/", include_in_schema=False)
     async def page() -> FileResponse:
         return FileResponse(STATIC / "index.html", media_type="text/html")
+
+    @app.get("/favicon.ico", include_in_schema=False)
+    async def favicon() -> FileResponse:
+        """The page's icon, for the browsers and bookmarks that ask for it at the root."""
+        return FileResponse(STATIC / "favicon.svg", media_type="image/svg+xml")

@@ -9,20 +9,15 @@ from __future__ import annotations
 
 import json
 import math
-import shutil
-from collections.abc import Iterator
-from pathlib import Path
 from typing import Any
 
 import httpx
 import pytest
-from playwright.sync_api import Browser, Page, sync_playwright
+from playwright.sync_api import Browser, Page
 
 from tests.cases import MAP_EVALUATE_RTOL, ROOT
-from tests.live import start_server
+from tests.web.conftest import ARTIFACTS
 
-CHROMIUM = shutil.which("chromium") or "/usr/bin/chromium"
-ARTIFACTS = ROOT / "tests" / "artifacts"
 EXAMPLE_PATH = json.loads((ROOT / "examples" / "evaluate_request.json").read_text())["path"]
 SMALL = {
     "x-min": "-0.1",
@@ -35,41 +30,6 @@ SMALL = {
     "yaws": "0, 1.5",
     "spins": "0",
 }
-
-
-@pytest.fixture(scope="module")
-def url(tmp_path_factory: pytest.TempPathFactory) -> Iterator[str]:
-    env = {
-        "DTF_DATA_DIR": str(tmp_path_factory.mktemp("web-jobs")),
-        "DTF_WORKERS": "1",
-        "DTF_MAX_JOB_CELLS": "2000000",
-        "DTF_MAX_JOB_POSES": "500000000",
-    }
-    process, url = start_server(env, "--timeout-graceful-shutdown", "2")
-    yield url
-    process.terminate()
-    process.wait()
-
-
-@pytest.fixture(scope="module")
-def browser() -> Iterator[Browser]:
-    if not Path(CHROMIUM).exists():
-        pytest.fail(f"no chromium at {CHROMIUM}: .ci/run installs it with apt-get")
-    with sync_playwright() as playwright:
-        browser = playwright.chromium.launch(executable_path=CHROMIUM, headless=True)
-        yield browser
-        browser.close()
-
-
-@pytest.fixture
-def page(browser: Browser, url: str, request: pytest.FixtureRequest) -> Iterator[Page]:
-    page = browser.new_page(viewport={"width": 1400, "height": 1600})
-    page.goto(url + "/")
-    page.wait_for_selector("body[data-ready='1']", timeout=30_000)
-    yield page
-    ARTIFACTS.mkdir(exist_ok=True)
-    page.screenshot(path=str(ARTIFACTS / f"web-{request.node.name}.png"), full_page=True)
-    page.close()
 
 
 def fill(page: Page, values: dict[str, str]) -> None:
@@ -187,7 +147,7 @@ def test_optimise_marks_the_apis_optimum(page: Page, url: str) -> None:
     assert grid["yaw"] == [0.0, 1.5]
     api = httpx.post(f"{url}/v1/optimize", json=body, timeout=120).json()
     assert page.text_content("#opt-mu") == f"{api['mu_path']:.6f} m/s"
-    assert "kuka" in (page.text_content("#frames") or "")
+    assert page.locator("#frames tr[data-controller='kuka'] code").count() == 1
 
 
 def test_a_zero_step_shows_the_apis_error_beside_the_field(page: Page, url: str) -> None:
@@ -475,7 +435,7 @@ def test_acceleration_limits_the_api_refuses_show_its_error_beside_the_field(
 
 def test_a_pasted_robot_brings_its_own_acceleration_limits(page: Page, url: str) -> None:
     robot = {"model": "ur5", "joint_acceleration_limits": [5.0] * 6}
-    page.click("details summary")
+    page.click("#own-json summary")
     page.fill("#robot-json", json.dumps(robot))
     assert page.is_disabled("#acc-limits") and page.is_disabled("#limits input >> nth=0")
     assert page.is_visible("#own-robot-note")

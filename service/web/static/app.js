@@ -1,6 +1,8 @@
 // The DTF placement page: a map job with progress and cancel, the colour map (mu_path, or mu_acc
 // with joint acceleration limits), a cell's joint speeds and accelerations, the cycle time, the
-// optimum. Plain JavaScript; it calls only this service's API.
+// optimum. Plain JavaScript; it calls only this service's API. Its other scripts, loaded before
+// it: format.js (rounding, controller frames), axes.js (the panels' axes), plot.js (the clicked
+// placement's plot), optimum.js (the optimiser).
 "use strict";
 
 const $ = (id) => document.getElementById(id);
@@ -8,7 +10,8 @@ const REASON_COLOURS = {
   unreachable: "#e0e0e0", joint_limits: "#f4a6c0", singular: "#555555", discontinuous: "#ffb74d",
 };
 const state = {
-  robots: [], path: null, source: null, map: null, grid: null, job: null, cursor: null,
+  robots: [], path: null, pathProblem: "no path loaded yet", source: null, map: null, grid: null,
+  job: null, cursor: null,
 };
 
 // ---- inputs -------------------------------------------------------------------------------
@@ -16,18 +19,55 @@ function numbers(text) {
   return text.split(",").map((v) => v.trim()).filter((v) => v !== "").map(Number);
 }
 
+// A number field's value; an empty field is left out of the body (undefined), never read as 0,
+// so that the API says beside it that it is required.
+function value(id) {
+  const text = $(id).value.trim();
+  return text === "" ? undefined : Number(text);
+}
+
+function spinMode() { return $("spin-mode").value || undefined; }
+
 function robotBody() {
   const own = $("robot-json").value.trim();
   if (own) return JSON.parse(own);  // a pasted robot object carries its own limits
+  // Empty: none. Otherwise every entry is sent as typed (a wrong count or a word is the API's
+  // error beside the field, never dropped here): Number("x") is NaN, sent as null.
+  const acc = $("acc-limits").value.trim();
+  const accLimits = acc ? acc.split(",").map((v) => (v.trim() === "" ? null : Number(v))) : null;
+  if ($("urdf").value.trim()) {  // the URDF as written; a frame left empty is the API's error
+    const robot = { urdf: $("urdf").value };
+    const base = $("base-frame").value.trim(), tool = $("tool-frame").value.trim();
+    if (base) robot.base_frame = base;
+    if (tool) robot.tool_frame = tool;
+    if (accLimits) robot.joint_acceleration_limits = accLimits;
+    return robot;
+  }
   const robot = { model: $("robot-model").value };
   const info = state.robots.find((r) => r.name === robot.model);
   const limits = [...$("limits").querySelectorAll("input")].map((i) => Number(i.value));
   if (info && limits.some((v, k) => v !== info.qdot_max[k])) robot.joint_velocity_limits = limits;
-  // Empty: none. Otherwise every entry is sent as typed (a wrong count or a word is the API's
-  // error beside the field, never dropped here): Number("x") is NaN, sent as null.
-  const acc = $("acc-limits").value.trim();
-  if (acc) robot.joint_acceleration_limits = acc.split(",").map((v) => (v.trim() === "" ? null : Number(v)));
+  if (accLimits) robot.joint_acceleration_limits = accLimits;
   return robot;
+}
+
+// The links of a URDF, for the frame fields' suggestions; the base and tool frames filled in
+// when the chain's root, and its tip, are each a single link (and the field is empty).
+function readUrdfLinks() {
+  const list = $("urdf-links");
+  list.textContent = "";
+  const doc = new DOMParser().parseFromString($("urdf").value, "application/xml");
+  if (doc.querySelector("parsererror")) return;  // the API names what is wrong with it
+  const links = [...doc.querySelectorAll("robot > link")].map((l) => l.getAttribute("name"));
+  const joints = [...doc.querySelectorAll("robot > joint")];
+  const children = new Set(joints.map((j) => j.querySelector("child")?.getAttribute("link")));
+  const parents = new Set(joints.map((j) => j.querySelector("parent")?.getAttribute("link")));
+  const roots = links.filter((l) => !children.has(l)), tips = links.filter((l) => !parents.has(l));
+  for (const name of [...roots, ...links.filter((l) => !roots.includes(l))]) {
+    list.appendChild(Object.assign(document.createElement("option"), { value: name }));
+  }
+  if (roots.length === 1 && !$("base-frame").value.trim()) $("base-frame").value = roots[0];
+  if (tips.length === 1 && !$("tool-frame").value.trim()) $("tool-frame").value = tips[0];
 }
 
 function ikBody() {
@@ -37,23 +77,25 @@ function ikBody() {
 // A pasted robot object brings its own limits: the catalogue's fields are then greyed out.
 function showOwnRobot() {
   const own = $("robot-json").value.trim() !== "";
-  for (const input of [...$("limits").querySelectorAll("input"), $("acc-limits"), $("robot-model")]) {
-    input.disabled = own;
+  const urdf = !own && $("urdf").value.trim() !== "";
+  for (const input of [...$("limits").querySelectorAll("input"), $("robot-model")]) {
+    input.disabled = own || urdf;
   }
+  $("acc-limits").disabled = own;
   $("own-robot-note").hidden = !own;
+  $("urdf-note").hidden = !urdf;
 }
 
 function gridBody() {
   const axis = (name) => ({
-    min: Number($(`${name}-min`).value), max: Number($(`${name}-max`).value),
-    step: Number($(`${name}-step`).value),
+    min: value(`${name}-min`), max: value(`${name}-max`), step: value(`${name}-step`),
   });
-  return { x: axis("x"), y: axis("y"), z: Number($("z").value),
+  return { x: axis("x"), y: axis("y"), z: value("z"),
     yaw: numbers($("yaws").value), spin: numbers($("spins").value) };
 }
 
 function mapBody() {
-  return { robot: robotBody(), path: state.path, grid: gridBody(), ik: ikBody() };
+  return { robot: robotBody(), path: state.path, grid: gridBody(), ik: ikBody(), spin_mode: spinMode() };
 }
 
 function showLimits() {
@@ -76,35 +118,79 @@ async function loadExample() {
   await setPath(name, text);
 }
 
+// A new path: every result of the old one goes, and nothing runs until the new one is read.
+// A file that cannot be read (JSON that is not JSON, a CSV without units) says so beside the
+// field and leaves no path at all, never the previous one.
 function setPath(name, text) {
   const lower = name.toLowerCase();
   state.source = { name, text };
+  state.path = null;
+  clearResults();
+  clearImport();
+  clearErrors();
   const units = $("path-units").value;
+  let problem = null, loc = ["path"];
   if (lower.endsWith(".json")) {
-    const value = JSON.parse(text);
-    state.path = value.path ?? value;
+    let parsed;
+    try { parsed = JSON.parse(text); } catch (error) { problem = `${name} is not JSON: ${error.message}`; }
+    if (!problem && (parsed === null || typeof parsed !== "object")) problem = `${name} holds no path object`;
+    if (!problem) state.path = parsed.path ?? parsed;
   } else if (lower.endsWith(".csv")) {
-    state.path = { csv: text, units: units || "mm" };
+    if (units) state.path = { csv: text, units };
+    else { problem = `${name}: a CSV file states no units; choose mm, inch or m here`; loc = ["path", "units"]; }
   } else {
     state.path = { cl_data: text };
-    if (units === "mm" || units === "inch") state.path.units = units;
+    if (units) state.path.units = units;  // "m" too: the API says that CL data takes mm or inch
+  }
+  if (problem) {
+    state.pathProblem = problem;
+    $("path-info").textContent = `${name}: not read, no path`;
+    showErrors([{ loc, msg: problem }]);
+    return Promise.resolve();
   }
   $("path-info").textContent = `${name} loaded`;
-  return showImport();
+  return showImport(name);
 }
 
-// What the service read: units and how they were known, passes and operations, skipped records.
-async function showImport() {
-  clearErrors();
+function clearImport() {
   const box = $("import");
   delete box.dataset.waypoints;
   for (const id of ["import-summary", "import-units"]) $(id).textContent = "";
   $("import-passes").tBodies[0].textContent = "";
   $("import-skipped").textContent = "";
-  const read = await api("POST", "/v1/paths/import", { path: state.path }).catch(() => null);
-  if (!read) return;
+}
+
+// The length of a read path (m): the sum of its segments within each pass.
+function pathLength(read) {
+  let length = 0;
+  for (const [start, stop] of read.passes) {
+    for (let k = start + 1; k < stop; k++) {
+      const a = read.waypoints[k - 1].position, b = read.waypoints[k].position;
+      length += Math.hypot(b[0] - a[0], b[1] - a[1], b[2] - a[2]);
+    }
+  }
+  return length;
+}
+
+// What the service read: units and how they were known, passes and operations, skipped records.
+async function showImport(name) {
+  const path = state.path;
+  let read = null;
+  try { read = await api("POST", "/v1/paths/import", { path }); } catch (error) {
+    if (state.path === path) {  // refused: no path until one is read
+      state.path = null;
+      state.pathProblem = `${name} was not read: ${error.message}`;
+      $("path-info").textContent = `${name}: not read, no path`;
+    }
+    return;
+  }
+  if (state.path !== path) return;  // another path came meanwhile
+  const box = $("import");
   const dropped = read.repeated_points + read.one_point_passes;
-  $("import-summary").textContent = `${read.waypoints.length} waypoints in ${read.passes.length} passes`
+  const passes = read.passes.length;
+  $("import-summary").textContent = `${read.waypoints.length} waypoints in ${passes} ${passes === 1 ? "pass" : "passes"}`
+    + `, ${fixed(1000 * pathLength(read), 1)} mm of path`
+    + `; tool spin ${read.spin_mode} by default`
     + (read.arcs ? `, ${read.arcs} arcs interpolated` : "")
     + (dropped ? `; dropped ${read.repeated_points} repeated points, ${read.one_point_passes} one-point passes` : "");
   $("import-units").textContent = `${read.units} (${read.units_source}: ${read.units_note})`;
@@ -130,19 +216,31 @@ function clearErrors() {
   document.querySelectorAll(".error").forEach((e) => { e.textContent = ""; });
 }
 
-function showErrors(details) {
+// Each error beside the field its loc names (the longest prefix that is a field on the page,
+// after `aliases` renames a loc's head: the optimiser's bounds are the grid's fields); one the
+// page has no field for goes under the buttons, prefixed with its loc.
+function showErrors(details, aliases = {}) {
   for (const d of details) {
-    const loc = d.loc.filter((p) => p !== "body" && p !== "request");
+    let loc = d.loc.filter((p) => p !== "body" && p !== "request").map(String);
+    for (const [from, to] of Object.entries(aliases)) {
+      const head = from.split(".");
+      if (head.every((p, k) => loc[k] === p)) { loc = [...to.split("."), ...loc.slice(head.length)]; break; }
+    }
     let field = null;
     for (let n = loc.length; n > 0 && !field; n--) {
       field = document.querySelector(`.field[data-loc="${loc.slice(0, n).join(".")}"]`);
     }
     const target = field ? field.querySelector(".error") : $("form-error");
-    target.textContent = (target.textContent ? target.textContent + " " : "") + d.msg;
+    const folded = target.closest("details");
+    if (folded) folded.open = true;  // an error inside a folded section is seen
+    const msg = field || !loc.length ? d.msg : `${loc.join(".")}: ${d.msg}`;
+    if (!target.textContent.split(" | ").includes(msg)) {
+      target.textContent = (target.textContent ? target.textContent + " | " : "") + msg;
+    }
   }
 }
 
-async function api(method, url, body) {
+async function api(method, url, body, aliases = {}) {
   const response = await fetch(url, {
     method, headers: body ? { "Content-Type": "application/json" } : {},
     body: body ? JSON.stringify(body) : undefined,
@@ -152,20 +250,70 @@ async function api(method, url, body) {
   if (!response.ok) {
     const detail = Array.isArray(answer.detail) ? answer.detail
       : [{ loc: [], msg: String(answer.detail) }];
-    showErrors(detail);
-    throw new Error(`${response.status}`);
+    showErrors(detail, aliases);
+    throw new Error(detail.map((d) => d.msg).join("; "));
   }
   return answer;
+}
+
+// ---- stale results go ----------------------------------------------------------------------
+function clearMap() {
+  state.map = null; state.optimum = null; state.cursor = null; state.tipCell = null;
+  $("panels").textContent = "";
+  $("tooltip").hidden = true;
+  for (const id of ["summary", "best-mu", "best-where", "cb-label", "cb-min", "cb-max"]) $(id).textContent = "";
+  delete $("summary").dataset.cells;
+  delete $("summary").dataset.key;
+  const bar = $("colourbar-canvas");
+  bar.getContext("2d").clearRect(0, 0, bar.width, bar.height);
+  $("colourbar").hidden = true;
+  $("best-line").hidden = true;
+}
+
+function clearCell() {
+  $("cell-summary").textContent = "Click (or press Enter on) a cell to see V_max along the path and each joint's use of its limit at the feed.";
+  for (const id of ["bottleneck", "acceleration", "cycle-time"]) $(id).textContent = "";
+  const canvas = $("plot");
+  canvas.getContext("2d").clearRect(0, 0, canvas.width, canvas.height);
+  delete canvas.dataset.drawn;
+}
+
+function clearOptimum() {
+  for (const id of ["opt-mu", "opt-acc", "opt-acc-binds", "opt-improvement", "opt-where"]) $(id).textContent = "";
+  $("opt-acc-line").hidden = true;
+  $("opt-mu-line").hidden = true;
+  $("frames").tBodies[0].textContent = "";
+  $("frames").hidden = true;
+  if (state.optimum) {
+    state.optimum = null;
+    document.querySelectorAll(".panel canvas").forEach((c) => { delete c.dataset.optimum; paintPanel(c); });
+  }
+}
+
+function clearResults() {
+  clearOptimum(); clearMap(); clearCell();
+  $("bar").value = 0; $("eta").textContent = "";
+  $("job-status").textContent = "no map yet";
+}
+
+// Nothing runs without a path: the reason there is none goes beside the path field.
+function havePath() {
+  if (state.path) return true;
+  showErrors([{ loc: ["path"], msg: `No path to run: ${state.pathProblem}` }]);
+  return false;
 }
 
 // ---- the map job ---------------------------------------------------------------------------
 async function runMap(event) {
   event.preventDefault();
   clearErrors();
+  clearResults();
+  if (!havePath()) return;
   let body;
   try { body = mapBody(); } catch (error) { showErrors([{ loc: ["robot"], msg: String(error) }]); return; }
+  $("job-status").textContent = "submitting the map…";
   const job = await api("POST", "/v1/jobs", { kind: "map", request: body }).catch(() => null);
-  if (!job) return;
+  if (!job) { $("job-status").textContent = "no map: see the errors above"; return; }
   state.job = job.id; state.grid = body.grid; state.mapBody = body;
   $("cancel").disabled = false; $("run").disabled = true;
   await watch(job.id);
@@ -181,7 +329,7 @@ async function watch(id) {
     if (!["queued", "running"].includes(job.status)) {
       $("cancel").disabled = true; $("run").disabled = false; state.job = null;
       if (job.status === "done") drawMap(job.result);
-      if (job.status === "failed") showErrors(job.error);
+      if (job.status === "failed") { showErrors(job.error); $("job-status").textContent += " (see the errors above)"; }
       return;
     }
     await new Promise((resolve) => setTimeout(resolve, 200));
@@ -212,7 +360,7 @@ function drawMap(answer) {
   const ys = [...new Set(cells.map((c) => c.y))];
   const feasible = cells.filter((c) => c.mu_path !== null).map((c) => c[key]);
   const low = Math.min(...feasible), high = Math.max(...feasible);
-  const size = Math.min(24, Math.max(2, Math.floor(480 / Math.max(xs.length, ys.length))));
+  const size = Math.min(48, Math.max(2, Math.floor(480 / Math.max(xs.length, ys.length))));
   state.scale = { low, high, xs, ys, size, key };
   const byAcc = cells.filter((c) => c.limited_by === "acceleration").length;
   $("summary").textContent = `${cells.length} cells, ${answer.feasible_cells} feasible`
@@ -224,7 +372,9 @@ function drawMap(answer) {
     : key === "mu_acc" ? `mu_acc ${answer.best.mu_acc.toFixed(6)} m/s (mu_path ${answer.best.mu_path.toFixed(6)} m/s)`
     : answer.best.mu_path.toFixed(6) + " m/s";
   $("best-where").textContent = answer.best
-    ? `at x ${answer.best.placement.x.toFixed(3)} m, y ${answer.best.placement.y.toFixed(3)} m, yaw ${answer.best.placement.yaw.toFixed(3)} rad` : "";
+    ? `at x ${metres(answer.best.placement.x)}, y ${metres(answer.best.placement.y)}, yaw ${radians(answer.best.placement.yaw)}` : "";
+  $("colourbar").hidden = false;
+  $("best-line").hidden = false;
   $("cb-min").textContent = feasible.length ? `${low.toFixed(3)} m/s` : "";
   $("cb-max").textContent = feasible.length ? `${high.toFixed(3)} m/s` : "";
   const bar = $("colourbar-canvas").getContext("2d");
@@ -243,10 +393,11 @@ function drawMap(answer) {
     canvas.dataset.nx = String(xs.length); canvas.dataset.ny = String(ys.length);
     canvas.dataset.cell = String(state.scale.size);
     const head = panelCells[0];
-    canvas.setAttribute("aria-label", `map at yaw ${head.yaw} rad, spin ${head.spin} rad`);
-    const caption = document.createElement("figcaption");
-    caption.textContent = `yaw ${head.yaw.toFixed(3)} rad, spin ${head.spin.toFixed(3)} rad`;
-    figure.append(canvas, caption);
+    const spin = `spin ${radians(head.spin)}${answer.spin_mode === "free" ? " + free rate" : ""}`;
+    const title = `yaw ${radians(head.yaw)} (${fixed((head.yaw * 180) / Math.PI, 2)} deg), ${spin}`;
+    canvas.setAttribute("aria-label", `map at ${title}`);
+    figure.dataset.title = title;
+    figure.append(withAxes(canvas, xs, ys, state.scale.size, title));
     panels.appendChild(figure);
     paintPanel(canvas);
     canvas.addEventListener("mousemove", (e) => hover(canvas, e));
@@ -366,23 +517,45 @@ function keys(canvas, event) {
 // ---- one placement: V_max and joint use along the path ---------------------------------------
 async function evaluateCell(c) {
   clearErrors();
+  clearCell();
+  if (!havePath()) return;
   const body = {
     robot: robotBody(), path: state.path,
     placement: placementOf(c),
-    feed: Number($("feed").value),
+    feed: value("feed"),
     ik: ikBody(),
+    spin_mode: state.mapBody ? state.mapBody.spin_mode : spinMode(),
   };
+  $("cell-summary").textContent = "evaluating…";
   const answer = await api("POST", "/v1/evaluate", body).catch(() => null);
-  if (!answer) return;
+  if (!answer) { clearCell(); return; }
+  const where = `x ${metres(c.x)}, y ${metres(c.y)}, yaw ${radians(c.yaw)}`;
+  // The feed checked: the field's, else the program's (CL data), else none (the field empty).
+  body.feed = answer.feed_check ? answer.feed_check.feed : undefined;
+  const use = body.feed === undefined ? "; no feed to check"
+    : `; at ${body.feed} m/s the largest joint use is ${(100 * body.feed / answer.mu_path).toFixed(1)} %`;
   $("cell-summary").textContent = answer.feasible
-    ? `x ${c.x} m, y ${c.y} m, yaw ${c.yaw} rad: mu_path ${answer.mu_path.toFixed(6)} m/s; at ${body.feed} m/s the largest joint use is ${(100 * answer.feed_check.feed / answer.mu_path).toFixed(1)} %`
-    : `x ${c.x} m, y ${c.y} m, yaw ${c.yaw} rad: infeasible (${answer.reason} at waypoint ${answer.failed_waypoint})`;
+    ? `${where}: mu_path ${answer.mu_path.toFixed(6)} m/s${use}`
+    : `${where}: infeasible (${answer.reason} at waypoint ${answer.failed_waypoint})`;
+  if (answer.feasible && answer.spin_mode === "free") await compareFixedSpin(body, answer);
   const b = answer.bottleneck;
   $("bottleneck").textContent = b ? `bottleneck: waypoint ${b.waypoint}, joint ${b.joint + 1} (${b.joint_name})` : "";
   $("bottleneck").dataset.waypoint = b ? String(b.waypoint) : "";
   $("bottleneck").dataset.joint = b ? String(b.joint) : "";
   showAcceleration(answer, body);
   plot(answer, body);
+}
+
+// With the spin free, what it is worth: mu_path with the spin fixed at the same placement.
+async function compareFixedSpin(body, answer) {
+  const summary = { ...body, spin_mode: "fixed", detail: "summary" };
+  delete summary.feed;
+  const fixedSpin = await api("POST", "/v1/evaluate", summary).catch(() => null);
+  if (!fixedSpin) return;
+  const gain = fixedSpin.feasible ? 100 * (answer.mu_path / fixedSpin.mu_path - 1) : 0;
+  $("cell-summary").textContent += fixedSpin.feasible
+    ? `; spin free: ${gain >= 0 ? "+" : ""}${fixed(gain, 0)} % over the spin fixed (${fixedSpin.mu_path.toFixed(6)} m/s)`
+    : `; with the spin fixed the path is infeasible here (${fixedSpin.reason})`;
 }
 
 // mu_acc, what binds it and where; the cycle time at mu_acc, with the ramps, time-optimal.
@@ -404,153 +577,6 @@ function showAcceleration(answer, body) {
     : (acc ? "cycle time: none (mu_acc is 0)" : "");
 }
 
-// Each joint's use of its acceleration limit at the constant feed F: |D_i| F^2 / a_j, from the
-// answer's qdd_at_mu_acc = D_i mu_acc^2 (motion.md section 2; null near the pass ends).
-function accelerationUse(answer, body) {
-  const acc = answer.acceleration;
-  const limits = body.robot.joint_acceleration_limits;
-  if (!acc || !(acc.mu_acc > 0) || !Array.isArray(limits)) return null;
-  const scale = (body.feed / acc.mu_acc) ** 2;
-  return answer.waypoints.map((p) => (p.qdd_at_mu_acc
-    ? p.qdd_at_mu_acc.map((v, j) => (Math.abs(v) * scale) / limits[j]) : null));
-}
-
-function plot(answer, body) {
-  const canvas = $("plot");
-  const accUse = answer.feasible ? accelerationUse(answer, body) : null;
-  canvas.height = accUse ? 480 : 320;
-  const g = canvas.getContext("2d");
-  g.clearRect(0, 0, canvas.width, canvas.height);
-  delete canvas.dataset.accelerationUse;
-  canvas.dataset.panels = accUse ? "3" : "2";
-  const points = answer.waypoints;
-  if (!answer.feasible || !points.length) return;
-  const panels = accUse ? 3 : 2;
-  const left = 50, width = canvas.width - 70, top = 10, height = (canvas.height - 30 * panels) / panels;
-  const xOf = (k) => left + (width * k) / Math.max(points.length - 1, 1);
-  const axes = (y0, label, max) => {
-    g.strokeStyle = "#444"; g.strokeRect(left, y0, width, height);
-    g.fillStyle = "#222"; g.font = "12px sans-serif";
-    g.fillText(label, left + 4, y0 + 14); g.fillText(max.toFixed(2), 4, y0 + 10); g.fillText("0", 30, y0 + height);
-  };
-  const vmax = Math.max(...points.map((p) => p.v_max ?? 0));
-  axes(top, "V_max (m/s) along the path", vmax);
-  g.strokeStyle = "#1565c0"; g.beginPath();
-  points.forEach((p, k) => { const y = top + height * (1 - (p.v_max ?? 0) / vmax); k ? g.lineTo(xOf(k), y) : g.moveTo(xOf(k), y); });
-  g.stroke();
-  const useTop = top + height + 30;
-  axes(useTop, "joint use of its limit at the feed (1 = on the limit)", 1);
-  const colours = ["#e53935", "#8e24aa", "#3949ab", "#00897b", "#7cb342", "#fb8c00", "#6d4c41"];
-  const joints = points[0].use ? points[0].use.length : 0;
-  for (let j = 0; j < joints; j++) {
-    g.strokeStyle = colours[j % colours.length]; g.beginPath();
-    points.forEach((p, k) => { const u = Math.min(p.use[j] ?? 0, 1.2); const y = useTop + height * (1 - u); k ? g.lineTo(xOf(k), y) : g.moveTo(xOf(k), y); });
-    g.stroke();
-    g.fillStyle = colours[j % colours.length]; g.fillText(`joint ${j + 1}`, left + width - 60, useTop + 14 + 13 * j);
-  }
-  let bottom = useTop + height;
-  if (accUse) {  // the third panel: the joints' use of their acceleration limits at the feed
-    const accTop = useTop + height + 30;
-    bottom = accTop + height;
-    const peak = Math.max(...accUse.flatMap((row) => (row ? row.filter(Number.isFinite) : [])), 0);
-    const ceiling = Math.max(1, Math.min(peak, 2));
-    axes(accTop, "joint use of its acceleration limit at the feed (none within the blend of a pass end)", ceiling);
-    g.strokeStyle = "#b00020"; g.setLineDash([2, 2]); g.beginPath();
-    g.moveTo(left, accTop + height * (1 - 1 / ceiling)); g.lineTo(left + width, accTop + height * (1 - 1 / ceiling)); g.stroke(); g.setLineDash([]);
-    for (let j = 0; j < joints; j++) {
-      g.strokeStyle = colours[j % colours.length]; g.beginPath();
-      let open = false;
-      accUse.forEach((row, k) => {
-        if (!row) { open = false; return; }
-        const y = accTop + height * (1 - Math.min(row[j], ceiling) / ceiling);
-        if (open) g.lineTo(xOf(k), y); else g.moveTo(xOf(k), y);
-        open = true;
-      });
-      g.stroke();
-    }
-    const acc = answer.acceleration;
-    if (acc.limited_by === "acceleration") {
-      const x = xOf(acc.waypoint);
-      g.strokeStyle = "#000"; g.setLineDash([4, 3]); g.beginPath();
-      g.moveTo(x, accTop); g.lineTo(x, bottom); g.stroke(); g.setLineDash([]);
-      g.fillStyle = "#000"; g.fillText(`mu_acc binds (joint ${acc.joint + 1})`, Math.min(x + 4, left + width - 130), accTop - 6);
-    }
-    canvas.dataset.accelerationUse = peak.toFixed(6);
-  }
-  if (answer.bottleneck) {
-    const x = xOf(answer.bottleneck.waypoint);
-    g.strokeStyle = "#b00020"; g.setLineDash([4, 3]); g.beginPath();
-    g.moveTo(x, top); g.lineTo(x, useTop + height); g.stroke(); g.setLineDash([]);
-    g.fillStyle = "#b00020"; g.fillText(`bottleneck (joint ${answer.bottleneck.joint + 1})`, Math.min(x + 4, left + width - 130), top + height + 20);
-  }
-  canvas.dataset.drawn = "1";
-}
-
-// ---- the optimum ---------------------------------------------------------------------------
-function drawMarker(canvas, p) {
-  const { xs, ys } = state.scale;
-  const dx = xs.length > 1 ? xs[1] - xs[0] : 1, dy = ys.length > 1 ? ys[1] - ys[0] : 1;
-  const px = ((p.x - xs[0]) / dx + 0.5) * state.scale.size, py = (ys.length - 0.5 - (p.y - ys[0]) / dy) * state.scale.size;
-  const g = canvas.getContext("2d");
-  g.strokeStyle = "#d50000"; g.lineWidth = 3; g.beginPath();
-  g.moveTo(px - 7, py - 7); g.lineTo(px + 7, py + 7); g.moveTo(px + 7, py - 7); g.lineTo(px - 7, py + 7);
-  g.stroke();
-}
-
-async function optimize() {
-  clearErrors();
-  const grid = gridBody();
-  const body = {
-    robot: robotBody(), path: state.path, method: $("method").value, z: grid.z, ik: ikBody(),
-    bounds: { x: [grid.x.min, grid.x.max], y: [grid.y.min, grid.y.max],
-      yaw: [Math.min(...grid.yaw), Math.max(...grid.yaw)] },
-  };
-  $("opt-mu").textContent = "optimising…";
-  $("opt-acc-line").hidden = true;
-  for (const id of ["opt-acc", "opt-acc-binds", "opt-improvement", "opt-where"]) $(id).textContent = "";
-  const answer = await api("POST", "/v1/optimize", body).catch(() => null);
-  if (!answer) { $("opt-mu").textContent = ""; return; }
-  if (!answer.found) { $("opt-mu").textContent = "no feasible placement"; return; }
-  const p = answer.placement;
-  $("opt-mu").textContent = `${answer.mu_path.toFixed(6)} m/s`;
-  const start = answer.start.mu_path === null ? "infeasible" : answer.start.mu_path.toFixed(6) + " m/s";
-  // improvement_percent is of mu_acc with acceleration limits (what the search maximised), so
-  // it goes on the mu_acc line then; the start's mu_path is all the answer gives of the start.
-  const gain = answer.improvement_percent === null ? "" : `+${answer.improvement_percent.toFixed(2)} %`;
-  $("opt-improvement").textContent = answer.mu_acc == null
-    ? `(${gain}${gain ? " " : ""}over the start, ${start})` : `(the start's mu_path: ${start})`;
-  if (answer.mu_acc != null) {
-    const acc = answer.evaluation && answer.evaluation.acceleration;
-    $("opt-acc").textContent = `${answer.mu_acc.toFixed(6)} m/s`;
-    $("opt-acc-binds").textContent = (gain ? `(${gain} over the start's mu_acc) ` : "")
-      + (!acc ? "" : acc.limited_by === "speed" ? "a speed limit binds"
-        : `the acceleration of joint ${acc.joint + 1} (${acc.joint_name}) binds at waypoint ${acc.waypoint}`);
-    $("opt-acc-line").hidden = false;
-  }
-  $("opt-where").textContent = `x ${p.x.toFixed(4)} m, y ${p.y.toFixed(4)} m, z ${p.z} m, yaw ${p.yaw.toFixed(4)} rad`;
-  const frames = $("frames");
-  frames.textContent = "";
-  for (const [name, value] of Object.entries(p.frames)) {
-    if (name === "matrix") continue;
-    const row = document.createElement("p");
-    const code = document.createElement("code");
-    code.textContent = `${name}: ${JSON.stringify(value)}`;
-    const copy = document.createElement("button");
-    copy.type = "button"; copy.textContent = `Copy ${name}`;
-    copy.addEventListener("click", () => navigator.clipboard && navigator.clipboard.writeText(JSON.stringify(value)));
-    row.append(code, copy);
-    frames.appendChild(row);
-  }
-  const canvases = [...document.querySelectorAll(".panel canvas")];
-  if (state.map && canvases.length) {  // the panel whose yaw is nearest the optimum's
-    const yaws = canvases.map((c) => state.map.cells[Number(c.dataset.first)].yaw);
-    const k = yaws.reduce((best, y, i) => (Math.abs(y - p.yaw) < Math.abs(yaws[best] - p.yaw) ? i : best), 0);
-    state.optimum = { canvas: canvases[k], placement: p };
-    canvases.forEach(paintPanel);
-    canvases[k].dataset.optimum = "1";
-  }
-}
-
 // ---- start ---------------------------------------------------------------------------------
 async function start() {
   const answer = await api("GET", "/v1/robots");
@@ -565,11 +591,25 @@ async function start() {
   showLimits();
   select.addEventListener("change", showLimits);
   $("robot-json").addEventListener("input", showOwnRobot);
+  $("urdf").addEventListener("input", showOwnRobot);
+  $("urdf").addEventListener("change", readUrdfLinks);
+  $("urdf-file").addEventListener("change", async () => {
+    const file = $("urdf-file").files[0];
+    if (!file) return;
+    $("urdf").value = await file.text();
+    readUrdfLinks();
+    showOwnRobot();
+  });
+  $("yaws").addEventListener("input", showYawRange);
+  $("opt-any-yaw").addEventListener("change", showYawRange);
+  showYawRange();
+  clearResults();
   $("path-example").addEventListener("change", loadExample);
   $("path-file").addEventListener("change", async () => {
     const file = $("path-file").files[0];
     if (file) await setPath(file.name, await file.text());
   });
+  $("path-file").addEventListener("click", () => { $("path-file").value = ""; });  // the same file again
   $("path-units").addEventListener("change", () => {
     if (state.source) setPath(state.source.name, state.source.text);
   });

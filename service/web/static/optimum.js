@@ -1,0 +1,100 @@
+// The optimum: the search within the grid's x and y bounds and the optimiser's yaw range, its
+// figures, its controller frames (format.js) and its marker on the nearest panel.
+"use strict";
+
+function drawMarker(canvas, p) {
+  const { xs, ys } = state.scale;
+  const dx = xs.length > 1 ? xs[1] - xs[0] : 1, dy = ys.length > 1 ? ys[1] - ys[0] : 1;
+  const px = ((p.x - xs[0]) / dx + 0.5) * state.scale.size, py = (ys.length - 0.5 - (p.y - ys[0]) / dy) * state.scale.size;
+  const g = canvas.getContext("2d");
+  g.strokeStyle = "#d50000"; g.lineWidth = 3; g.beginPath();
+  g.moveTo(px - 7, py - 7); g.lineTo(px + 7, py + 7); g.moveTo(px + 7, py - 7); g.lineTo(px - 7, py + 7);
+  g.stroke();
+}
+
+// The optimiser's yaw range: any yaw, the two fields, or (a field empty) the yaws' range.
+function yawRange(grid) {
+  if ($("opt-any-yaw").checked) return [-Math.PI, Math.PI];
+  const low = value("opt-yaw-min"), high = value("opt-yaw-max");
+  const yaws = grid.yaw.length ? grid.yaw : [undefined];
+  return [low ?? Math.min(...yaws), high ?? Math.max(...yaws)];
+}
+
+function showYawRange() {
+  const any = $("opt-any-yaw").checked;
+  const yaws = numbers($("yaws").value).filter(Number.isFinite);
+  for (const [id, pick] of [["opt-yaw-min", Math.min], ["opt-yaw-max", Math.max]]) {
+    $(id).disabled = any;
+    $(id).placeholder = yaws.length ? String(pick(...yaws)) : "";
+  }
+}
+
+// The optimiser's bounds are the grid's fields (and the yaw range's): its errors go there.
+const BOUND_FIELDS = {
+  "bounds.x.0": "grid.x.min", "bounds.x.1": "grid.x.max", "bounds.y.0": "grid.y.min",
+  "bounds.y.1": "grid.y.max", "bounds.x": "grid.x.min", "bounds.y": "grid.y.min", z: "grid.z",
+};
+
+async function optimize() {
+  clearErrors();
+  clearOptimum();
+  if (!havePath()) return;
+  const grid = gridBody();
+  if (grid.z === undefined) {  // the API would take it for a search over the height
+    showErrors([{ loc: ["grid", "z"], msg: "Field required: the optimiser searches at this height" }]);
+    return;
+  }
+  const body = {
+    robot: robotBody(), path: state.path, method: $("method").value, z: grid.z, ik: ikBody(),
+    bounds: { x: [grid.x.min, grid.x.max], y: [grid.y.min, grid.y.max], yaw: yawRange(grid) },
+    spin_mode: spinMode(),
+  };
+  $("opt-mu").textContent = "optimising…";
+  $("opt-mu-line").hidden = false;
+  const answer = await api("POST", "/v1/optimize", body, BOUND_FIELDS).catch(() => null);
+  if (!answer) { $("opt-mu").textContent = "no optimum: see the errors above"; return; }
+  if (!answer.found) { $("opt-mu").textContent = "no feasible placement"; return; }
+  const p = answer.placement;
+  $("opt-mu").textContent = `${answer.mu_path.toFixed(6)} m/s`;
+  const start = answer.start.mu_path === null ? "infeasible" : answer.start.mu_path.toFixed(6) + " m/s";
+  // improvement_percent is of mu_acc with acceleration limits (what the search maximised), so
+  // it goes on the mu_acc line then; the start's mu_path is all the answer gives of the start.
+  const gain = answer.improvement_percent === null ? "" : `+${answer.improvement_percent.toFixed(2)} %`;
+  $("opt-improvement").textContent = answer.mu_acc == null
+    ? `(${gain}${gain ? " " : ""}over the start, ${start})` : `(the start's mu_path: ${start})`;
+  if (answer.mu_acc != null) {
+    const acc = answer.evaluation && answer.evaluation.acceleration;
+    $("opt-acc").textContent = `${answer.mu_acc.toFixed(6)} m/s`;
+    $("opt-acc-binds").textContent = (gain ? `(${gain} over the start's mu_acc) ` : "")
+      + (!acc ? "" : acc.limited_by === "speed" ? "a speed limit binds"
+        : `the acceleration of joint ${acc.joint + 1} (${acc.joint_name}) binds at waypoint ${acc.waypoint}`);
+    $("opt-acc-line").hidden = false;
+  }
+  $("opt-where").textContent = `x ${metres(p.x)}, y ${metres(p.y)}, z ${metres(p.z)}, yaw ${radians(p.yaw)} (${fixed((p.yaw * 180) / Math.PI, 2)} deg)`
+    + (answer.evaluation && answer.evaluation.spin_mode === "free" ? ", spin free" : `, spin ${radians(p.spin)}`);
+  const rows = $("frames").tBodies[0];
+  for (const frame of CONTROLLER_FRAMES) {
+    const row = rows.insertRow();
+    row.dataset.controller = frame.key;
+    const text = frame.text(p.frames[frame.key]);
+    row.insertCell().textContent = frame.name;
+    const code = document.createElement("code");
+    code.textContent = text;
+    row.insertCell().appendChild(code);
+    row.insertCell().textContent = frame.units;
+    const copy = document.createElement("button");
+    copy.type = "button"; copy.textContent = "Copy";
+    copy.setAttribute("aria-label", `Copy the ${frame.name} frame`);
+    copy.addEventListener("click", () => navigator.clipboard && navigator.clipboard.writeText(text));
+    row.insertCell().appendChild(copy);
+  }
+  $("frames").hidden = false;
+  const canvases = [...document.querySelectorAll(".panel canvas")];
+  if (state.map && canvases.length) {  // the panel whose yaw is nearest the optimum's
+    const yaws = canvases.map((c) => state.map.cells[Number(c.dataset.first)].yaw);
+    const k = yaws.reduce((best, y, i) => (Math.abs(y - p.yaw) < Math.abs(yaws[best] - p.yaw) ? i : best), 0);
+    state.optimum = { canvas: canvases[k], placement: p };
+    canvases.forEach(paintPanel);
+    canvases[k].dataset.optimum = "1";
+  }
+}

@@ -1,0 +1,57 @@
+"""The live server and the browser the page's tests share (Debian's chromium, headless)."""
+
+from __future__ import annotations
+
+import shutil
+from collections.abc import Iterator
+from pathlib import Path
+
+import pytest
+from playwright.sync_api import Browser, Page, sync_playwright
+
+from tests.cases import ROOT
+from tests.live import start_server
+
+CHROMIUM = shutil.which("chromium") or "/usr/bin/chromium"
+ARTIFACTS = ROOT / "tests" / "artifacts"
+
+
+@pytest.fixture(scope="session")
+def url(tmp_path_factory: pytest.TempPathFactory) -> Iterator[str]:
+    env = {
+        "DTF_DATA_DIR": str(tmp_path_factory.mktemp("web-jobs")),
+        "DTF_WORKERS": "1",
+        "DTF_MAX_JOB_CELLS": "2000000",
+        "DTF_MAX_JOB_POSES": "500000000",
+    }
+    process, url = start_server(env, "--timeout-graceful-shutdown", "2")
+    yield url
+    process.terminate()
+    process.wait()
+
+
+@pytest.fixture(scope="session")
+def browser() -> Iterator[Browser]:
+    if not Path(CHROMIUM).exists():
+        pytest.fail(f"no chromium at {CHROMIUM}: .ci/run installs it with apt-get")
+    with sync_playwright() as playwright:
+        browser = playwright.chromium.launch(executable_path=CHROMIUM, headless=True)
+        yield browser
+        browser.close()
+
+
+@pytest.fixture
+def page(browser: Browser, url: str, request: pytest.FixtureRequest) -> Iterator[Page]:
+    page = browser.new_page(viewport={"width": 1400, "height": 1600})
+    page.goto(url + "/")
+    page.wait_for_selector("body[data-ready='1']", timeout=30_000)
+    yield page
+    ARTIFACTS.mkdir(exist_ok=True)
+    page.screenshot(path=str(ARTIFACTS / f"web-{request.node.name}.png"), full_page=True)
+    page.close()
+
+
+def snapshot(page: Page, name: str) -> None:
+    """A screenshot of the page as it is now, ``tests/artifacts/web-<name>.png``."""
+    ARTIFACTS.mkdir(exist_ok=True)
+    page.screenshot(path=str(ARTIFACTS / f"web-{name}.png"), full_page=True)
