@@ -153,7 +153,7 @@ def free_cells(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
     spun = np.empty((n_waypoints, N_JOINTS))
     accelerations = qddot_max.shape[0] > 0
     keep_acc = v_acc.shape[1] > 0
-    feed, acc_at, acc_by, checked, acc_speeds = acc_work(n_branches, n_waypoints, keep_acc)
+    feed, acc_at, acc_by, checked, acc_speeds, _, _ = acc_work(n_branches, n_waypoints, keep_acc)
     check_steps = max_joint_step < math.pi
     cos_step = math.cos(max_joint_step)
     for c in range(n_cells):

@@ -5,7 +5,10 @@ kernel comparisons (test_map_kernel.py, test_free_spin_kernel.py) see it through
 that differ from the pipeline's in the last bits, so exact ties and the early stop are checked
 here, on paths the hook and :class:`solver.path.limits.JointAccelerationLimit` share; and the
 fixed-spin kernel's joint path (:func:`solver.kernels.positions.relative_path`) against
-track()'s.
+track()'s. The fixed-spin kernel forms D from the path's steps
+(:func:`solver.kernels.limits.step_stencil`, :func:`solver.kernels.limits.acceleration_at`):
+equal to the numpy limit, and to the bit between joint paths whose steps are equal or opposite
+(what lets the kernel leave a branch tied with an earlier one).
 """
 
 from __future__ import annotations
@@ -13,7 +16,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from solver.kernels.limits import acceleration_bound
+from solver.kernels.accelerations import pair_steps
+from solver.kernels.limits import acceleration_at, acceleration_bound, step_stencil
 from solver.kernels.positions import relative_path
 from solver.path.limits import BlendStencil, JointAccelerationLimit, JointMotion
 
@@ -115,3 +119,91 @@ def test_relative_path_is_the_unwrapped_path(largest_step: float) -> None:
         np.testing.assert_allclose(
             relative_path(cq, sq, b, False), (expected[b] - expected[b, :, :1]).T, atol=1e-13
         )
+
+
+def step_form(path: np.ndarray, limit: JointAccelerationLimit) -> tuple[np.ndarray, np.ndarray]:
+    """max_j |D_j| / a_j and its joint at every stencil row, from the path's steps."""
+    stencil = limit.stencil
+    steps = np.zeros_like(path)
+    steps[1:] = np.diff(path, axis=0)
+    c = step_stencil(stencil.index, stencil.weight)
+    rows = [
+        acceleration_at(
+            steps,
+            stencil.index[k, 0],
+            stencil.index[k, -1] - stencil.index[k, 0],
+            c,
+            k,
+            limit.qddot_max,
+        )
+        for k in range(len(stencil.waypoints))
+    ]
+    return np.array([r[0] for r in rows]), np.array([r[1] for r in rows])
+
+
+@pytest.mark.parametrize("seed", range(5))
+def test_the_step_form_equals_the_numpy_limit(seed: int) -> None:
+    """Random tool points (uneven spacing, several points within b, two passes) and joint
+    paths: V_acc and its joint from the steps equal the numpy limit's from the angles."""
+    rng = np.random.default_rng(seed)
+    n = 90
+    tool = np.cumsum(rng.uniform(0.0001, 0.003, (n, 3)), axis=0)
+    in_pass = np.ones(n - 1, dtype=bool)
+    in_pass[45] = False
+    limit = JointAccelerationLimit(
+        rng.uniform(2.0, 30.0, 6), BlendStencil.of_path(tool, in_pass, 0.002)
+    )
+    path = np.cumsum(rng.normal(0.0, 0.01, (n, 6)), axis=0) + rng.uniform(-3.0, 3.0, 6)
+    ratio, joint = step_form(path, limit)
+    speed, _, _ = numpy_bound(path, limit)
+    _, joints = limit.speed_bound(JointMotion(q=path.T, qd_unit=np.zeros_like(path.T)))
+    waypoints = limit.stencil.waypoints
+    np.testing.assert_allclose(1.0 / np.sqrt(ratio), speed[waypoints], rtol=1e-12, atol=0.0)
+    np.testing.assert_array_equal(joint, joints[waypoints])
+
+
+def test_the_step_form_is_exact_on_a_parabola() -> None:
+    """q = s^2 on points 0.25 m apart with b = 0.5 m: D = 2 exactly at every row."""
+    s = np.arange(12) * 0.25
+    tool = np.column_stack([s, np.zeros(12), np.zeros(12)])
+    limit = JointAccelerationLimit(
+        np.full(6, 4.0), BlendStencil.of_path(tool, np.ones(11, dtype=bool), 0.5)
+    )
+    path = np.zeros((12, 6))
+    path[:, 3] = s**2
+    path[:, 4] = -(s**2)
+    ratio, joint = step_form(path, limit)
+    assert np.all(ratio == 0.5) and np.all(joint == 3)
+
+
+def test_a_joint_moved_by_pi_or_mirrored_gives_the_same_bits() -> None:
+    """A joint path, the same moved by pi (a UR's wrist_3 on the other wrist) and its mirror
+    image, as (cos, sin) pairs: the kernel's steps (:func:`pair_steps`) and then the ratios
+    at every row are the same to the bit, as the angles' size does not enter D."""
+    rng = np.random.default_rng(3)
+    n = 60
+    tool = np.cumsum(rng.uniform(0.001, 0.003, (n, 3)), axis=0)
+    limit = JointAccelerationLimit(
+        np.full(6, 10.0), BlendStencil.of_path(tool, np.ones(n - 1, dtype=bool), 0.002)
+    )
+    angles = np.cumsum(rng.normal(0.0, 0.05, (6, n)), axis=1) + rng.uniform(-3.0, 3.0, (6, 1))
+    cq = np.stack([np.cos(angles), -np.cos(angles), np.cos(angles)])
+    sq = np.stack([np.sin(angles), -np.sin(angles), -np.sin(angles)])
+    index = limit.stencil.index
+    c = step_stencil(index, limit.stencil.weight)
+    rows = []
+    for b in range(3):
+        steps = np.zeros((n, 6))
+        pair_steps(cq, sq, b, 0, n - 1, steps)
+        rows.append(
+            [
+                acceleration_at(
+                    steps, index[k, 0], index[k, -1] - index[k, 0], c, k, limit.qddot_max
+                )
+                for k in range(len(index))
+            ]
+        )
+    assert rows[0] == rows[1] == rows[2]
+    speed, _, _ = numpy_bound(angles.T.copy(), limit)
+    ratio = np.array([r[0] for r in rows[0]])
+    np.testing.assert_allclose(1.0 / np.sqrt(ratio), speed[limit.stencil.waypoints], rtol=1e-12)
