@@ -257,8 +257,10 @@ def map_cells(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
                 fail(i, REASON_JOINT_LIMITS, first, alive, why, where)
         if accelerations:
             cell_mu_acc(
-                alive, slowest, branches, cq, sq, stencil_index, steps_c, stencil_waypoints,
-                qddot_max, feed, acc_at, acc_by, acc_speeds, probes, steps,
+                alive, why, where, slowest, branches, cq, sq, qd, qd, False, inverse_qdot,
+                segment_checked, lower, upper, qdot_max, max_joint_step, steps, stencil_index,
+                steps_c, stencil_waypoints, qddot_max, feed, acc_at, acc_by, acc_speeds, probes,
+                steps,
             )  # fmt: skip
         pick = write_cell(
             c, branches, alive, why, where, feed if accelerations else slowest,
