@@ -155,7 +155,10 @@ class BlendStencil:
 
     def second_difference(self, q: np.ndarray) -> np.ndarray:
         """D at the constrained waypoints: q (n, ..., W) -> (n, ..., K), rad/m^2."""
-        second: np.ndarray = np.einsum("...km,km->...k", q[..., self.index], self.weight)
+        around = q[..., self.index]  # (n, ..., K, 5)
+        second: np.ndarray = np.einsum(
+            "...km,km->...k", around[..., 1:] - around[..., :1], self.weight[:, 1:]
+        )
         return second
 
 
