@@ -14,12 +14,12 @@ _PASS_EXAMPLE: JsonDict = {  # the README example at 10 rad/s^2
     "stop": 133,
     "length": 0.319629,
     "constant_feed_time": 1.338283,
-    "ramp_up_length": 0.011593,
-    "ramp_up_time": 0.077826,
-    "ramp_down_length": 0.005773,
-    "ramp_down_time": 0.047849,
-    "ramp": 1.391248,
-    "time_optimal": 1.250841,
+    "ramp_up_length": 0.011651,
+    "ramp_up_time": 0.078054,
+    "ramp_down_length": 0.005719,
+    "ramp_down_time": 0.047624,
+    "ramp": 1.391231,
+    "time_optimal": 1.254539,
 }
 
 
@@ -90,8 +90,8 @@ class CycleTimeResult(ResponseModel):
             "examples": [
                 {
                     "constant_feed_time": 1.338283,
-                    "ramp": 1.391248,
-                    "time_optimal": 1.250841,
+                    "ramp": 1.391231,
+                    "time_optimal": 1.254539,
                     "passes": [_PASS_EXAMPLE],
                 }
             ]
