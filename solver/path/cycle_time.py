@@ -153,12 +153,21 @@ def _largest_squared_speeds(
 
 
 def _ramp_from_rest(
-    s: np.ndarray, q_s: np.ndarray, q_ss: np.ndarray, cap: np.ndarray, qddot_max: np.ndarray
-) -> np.ndarray:
+    s: np.ndarray,
+    q_s: np.ndarray,
+    q_ss: np.ndarray,
+    cap: np.ndarray,
+    qddot_max: np.ndarray,
+    until: float = math.inf,
+) -> tuple[np.ndarray, int]:
     """sdot^2 (M,) from rest at s_0, each step the largest acceleration every joint allows.
 
     x_{i+1} = min(cap_{i+1}, x_i + 2 (s_{i+1} - s_i) u_i), u_i the largest sddot with
     |q_s,ij u + q_ss,ij x_i| <= a_j for every joint (x_i <= cap_i makes u = 0 feasible).
+    It stops at the first point where x reaches ``until`` (the rest of x left 0).
+
+    Returns:
+        x, and that point (-1 where x never reaches ``until``).
     """
     x = np.zeros(len(s))
     with np.errstate(divide="ignore", invalid="ignore"):
@@ -167,7 +176,9 @@ def _ramp_from_rest(
             bounds = np.where(q_s[i] != 0.0, room / q_s[i], np.inf)
             u = max(float(np.min(bounds)), 0.0)
             x[i + 1] = min(cap[i + 1], x[i] + 2.0 * (s[i + 1] - s[i]) * u)
-    return x
+            if x[i + 1] >= until:
+                return x, i + 1
+    return x, -1
 
 
 def _time(s: np.ndarray, x: np.ndarray) -> float:
@@ -239,13 +250,20 @@ def pass_time(
         np.minimum(*(_largest_squared_speeds(q_s, c, *limits) for c in (q_ss, before))),
         mu_acc**2,
     )
-    up = _ramp_from_rest(s, q_s, q_ss, cap, limits[1])
-    down = _ramp_from_rest(s[-1] - s[::-1], -q_s[::-1], q_ss[::-1], cap[::-1], limits[1])[::-1]
-    profile = np.minimum(up, down)
     top = mu_acc**2 * (1.0 - 1e-12)
-    reached = np.flatnonzero(profile >= top)
-    first = int(reached[0]) if reached.size else int(np.argmax(profile))
-    last = int(reached[-1]) if reached.size else first
+    backward = (s[-1] - s[::-1], -q_s[::-1], q_ss[::-1], cap[::-1], limits[1])
+    up, first = _ramp_from_rest(s, q_s, q_ss, cap, limits[1], until=top)
+    down, from_end = _ramp_from_rest(*backward, until=top)
+    last = len(s) - 1 - from_end
+    if first >= 0 and from_end >= 0 and first < last:  # the feed reaches mu_acc between ramps
+        cruise = np.full(last - first - 1, top)
+        profile = np.concatenate([up[: first + 1], cruise, down[::-1][last:]])
+    else:  # the ramps meet: the feed turns back wherever the two profiles cross
+        profile = np.minimum(_ramp_from_rest(s, q_s, q_ss, cap, limits[1])[0],
+                             _ramp_from_rest(*backward)[0][::-1])  # fmt: skip
+        reached = np.flatnonzero(profile >= top)
+        first = int(reached[0]) if reached.size else int(np.argmax(profile))
+        last = int(reached[-1]) if reached.size else first
     length = float(s[-1])
     up_time = _time(s[: first + 1], profile[: first + 1])
     down_time = _time(s[last:], profile[last:])
