@@ -35,7 +35,9 @@ def optimize_response(
         if optimum.evaluation is None
         else evaluate_response(optimum.evaluation, robot, axis_correction=axis_correction),
         start=schemas.StartInfo(
-            placement=api_placement(optimum.start), mu_path=optimum.start_mu_path
+            placement=api_placement(optimum.start),
+            mu_path=optimum.start_mu_path,
+            mu_acc=optimum.start_mu_acc,
         ),
         improvement_percent=optimum.improvement_percent,
         spins=None if optimum.spins is None else optimum.spins.tolist(),

@@ -14,12 +14,12 @@ _PASS_EXAMPLE: JsonDict = {  # the README example at 10 rad/s^2
     "stop": 133,
     "length": 0.319629,
     "constant_feed_time": 1.338283,
-    "ramp_up_length": 0.015516,
-    "ramp_up_time": 0.093947,
-    "ramp_down_length": 0.007716,
-    "ramp_down_time": 0.056165,
-    "ramp": 1.391123,
-    "time_optimal": 1.328127,
+    "ramp_up_length": 0.011651,
+    "ramp_up_time": 0.078054,
+    "ramp_down_length": 0.005719,
+    "ramp_down_time": 0.047624,
+    "ramp": 1.391231,
+    "time_optimal": 1.254539,
 }
 
 
@@ -77,7 +77,8 @@ class PassCycleTime(ResponseModel):
     time_optimal: float = Field(
         description="The shortest time rest to rest with the feed free along the pass (s): "
         "time-optimal path parameterisation under the joint speed and acceleration limits "
-        "(toppra), on the same blended joint path."
+        "(toppra), on the same blended joint path: parabolic blends of length b around the "
+        "waypoints, straight in between, where the feed may rise again."
     )
 
 
@@ -89,8 +90,8 @@ class CycleTimeResult(ResponseModel):
             "examples": [
                 {
                     "constant_feed_time": 1.338283,
-                    "ramp": 1.391123,
-                    "time_optimal": 1.328127,
+                    "ramp": 1.391231,
+                    "time_optimal": 1.254539,
                     "passes": [_PASS_EXAMPLE],
                 }
             ]

@@ -145,6 +145,11 @@ class StartInfo(ResponseModel):
 
     placement: PlacementResult = Field(description="The start (m, rad).")
     mu_path: float | None = Field(description="Its mu_path (m/s); null when infeasible.")
+    mu_acc: float | None = Field(
+        default=None,
+        description="With robot.joint_acceleration_limits: its mu_acc (m/s), what "
+        "improvement_percent compares with; null without them or when infeasible.",
+    )
 
 
 class SolverInfo(ResponseModel):
@@ -207,7 +212,7 @@ class OptimizeResponse(ResponseModel):
         "gives it: what the search maximised (motion.md section 3). null without them.",
     )
     evaluation: EvaluateResponse | None = Field(description="/v1/evaluate's answer there.")
-    start: StartInfo = Field(description="The start placement and its mu_path.")
+    start: StartInfo = Field(description="The start placement, its mu_path and mu_acc.")
     improvement_percent: float | None = Field(
         description="100 (mu_path / start mu_path - 1), with joint acceleration limits of "
         "mu_acc; null when the start is infeasible."

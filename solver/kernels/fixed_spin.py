@@ -21,9 +21,10 @@ waypoints:
    turn or less fits when every waypoint is inside its arc and no step's short arc passes
    through the gap opposite. Only a branch that neither test clears forms its angles (atan2)
    and runs the exact test of :func:`solver.path.tracking.track`;
-5. with joint acceleration limits, mu_acc of the branches that can be chosen, fastest first,
-   along their joint paths (:func:`solver.kernels.positions.relative_path`: the steps'
-   angles from the pairs, by a series where small; :mod:`solver.kernels.accelerations`);
+5. with joint acceleration limits, mu_acc of the branches the choice can take, from their
+   joint paths' steps (:func:`solver.kernels.positions.pair_step`: the angle between
+   neighbouring pairs, by a series where small), each branch left as soon as a waypoint
+   shows it cannot be chosen (:func:`solver.kernels.accelerations.cell_mu_acc`);
 6. the branch: :func:`solver.path.tracking.choose_branch`'s rule, by mu_acc where it is
    computed (:func:`solver.kernels.cell.write_cell`).
 
@@ -54,7 +55,7 @@ from solver.core.codes import (
     UNREACHABLE,
 )
 from solver.families.kernels import N_JOINTS, pose_block
-from solver.kernels.accelerations import acc_work, branch_mu_acc, next_fastest, write_acc
+from solver.kernels.accelerations import acc_work, cell_mu_acc, write_acc
 from solver.kernels.cache import drop_stale_compiled_code
 from solver.kernels.cell import (
     BLOCK,
@@ -69,13 +70,12 @@ from solver.kernels.cell import (
     warm_up_placement,
     write_cell,
 )
-from solver.kernels.limits import joint_speed_bound
+from solver.kernels.limits import joint_speed_bound, step_stencil
 from solver.kernels.positions import (
     NARROW,
     WIDE,
     first_outside_pairs,
     limit_modes,
-    relative_path,
 )
 
 _TWO_PI = 2 * math.pi
@@ -172,7 +172,10 @@ def map_cells(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
     inside = np.empty((n_branches, N_JOINTS))
     crossed = np.empty((n_branches, N_JOINTS), dtype=np.bool_)
     accelerations = qddot_max.shape[0] > 0
-    feed, acc_at, acc_by, taken, acc_speeds = acc_work(n_branches, n_waypoints, v_acc.shape[1] > 0)
+    feed, acc_at, acc_by, _, acc_speeds, probes, steps = acc_work(
+        n_branches, n_waypoints, v_acc.shape[1] > 0
+    )
+    steps_c = step_stencil(stencil_index, stencil_weight)
     inverse_qdot = 1.0 / qdot_max
     check_steps = max_joint_step < math.pi
     cos_step = math.cos(max_joint_step)
@@ -253,17 +256,12 @@ def map_cells(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
             if first < n_waypoints:
                 fail(i, REASON_JOINT_LIMITS, first, alive, why, where)
         if accelerations:
-            feed[:] = slowest
-            taken[:] = False
-            top = -np.inf
-            i = next_fastest(alive, taken, slowest, top, ACC_TIE_RTOL)
-            while i >= 0:
-                path = relative_path(cq, sq, branches[i], False)
-                top = max(top, branch_mu_acc(
-                    i, path, slowest, stencil_index, stencil_weight, stencil_waypoints,
-                    qddot_max, feed, acc_at, acc_by, acc_speeds, top,
-                ))  # fmt: skip
-                i = next_fastest(alive, taken, slowest, top, ACC_TIE_RTOL)
+            cell_mu_acc(
+                alive, why, where, slowest, branches, cq, sq, qd, qd, False, inverse_qdot,
+                segment_checked, lower, upper, qdot_max, max_joint_step, steps, stencil_index,
+                steps_c, stencil_waypoints, qddot_max, feed, acc_at, acc_by, acc_speeds, probes,
+                steps,
+            )  # fmt: skip
         pick = write_cell(
             c, branches, alive, why, where, feed if accelerations else slowest,
             ACC_TIE_RTOL if accelerations else TIE_RTOL, slowest, slowest_at, slowest_joint, speeds,

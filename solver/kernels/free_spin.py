@@ -12,15 +12,15 @@ tested against (tests/solver/test_free_spin_kernel.py). Per placement:
    position limits (they hold along the spin schedule); V_max by the exact two-variable LP
    (:func:`solver.kernels.limits.two_variable_speed`, as
    :func:`solver.core.dtf.two_variable_speed`) and its running minimum, mu_path;
-3. each branch still feasible, fastest first, until one holds (and those tied with it): the
-   spin rate nearest zero at the feed mu_path
+3. without acceleration limits, each branch still feasible, fastest first, until one holds
+   (and those tied with it): the spin rate nearest zero at the feed mu_path
    (:func:`solver.core.dtf.spin_rate_nearest_zero`), the joints moved by the spin
    (:func:`solver.path.pipeline._spin_schedule`), and that joint path tracked again with the
    position limits and the step test (:func:`solver.path.tracking.track`), in
    :mod:`solver.kernels.spin_schedule`;
-4. with joint acceleration limits, mu_acc along the spun joint path of each branch that holds
-   (:mod:`solver.kernels.accelerations`), and the branches tracked again until no slower one
-   can be chosen;
+4. with joint acceleration limits, the branches in their order, each tracked along its spin
+   schedule and its mu_acc formed from the spun path's steps, unless a waypoint shows that
+   it cannot be chosen (:func:`solver.kernels.accelerations.cell_mu_acc`);
 5. the branch: :func:`solver.path.tracking.choose_branch`'s rule, by mu_acc where computed.
 """
 
@@ -42,7 +42,7 @@ from solver.core.codes import (
     UNREACHABLE,
 )
 from solver.families.kernels import N_JOINTS, pose_block
-from solver.kernels.accelerations import acc_work, branch_mu_acc, next_fastest, write_acc
+from solver.kernels.accelerations import acc_work, cell_mu_acc, next_fastest, write_acc
 from solver.kernels.cache import drop_stale_compiled_code
 from solver.kernels.cell import (
     BLOCK,
@@ -57,8 +57,8 @@ from solver.kernels.cell import (
     warm_up_placement,
     write_cell,
 )
-from solver.kernels.limits import two_variable_speed
-from solver.kernels.positions import relative_path, shift_to_copy
+from solver.kernels.limits import step_stencil, two_variable_speed
+from solver.kernels.positions import relative_path
 from solver.kernels.spin_schedule import spun_failure
 
 _TWO_PI = 2 * math.pi
@@ -153,7 +153,10 @@ def free_cells(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
     spun = np.empty((n_waypoints, N_JOINTS))
     accelerations = qddot_max.shape[0] > 0
     keep_acc = v_acc.shape[1] > 0
-    feed, acc_at, acc_by, checked, acc_speeds = acc_work(n_branches, n_waypoints, keep_acc)
+    feed, acc_at, acc_by, checked, acc_speeds, probes, steps = acc_work(
+        n_branches, n_waypoints, keep_acc
+    )
+    steps_c = step_stencil(stencil_index, stencil_weight)
     check_steps = max_joint_step < math.pi
     cos_step = math.cos(max_joint_step)
     for c in range(n_cells):
@@ -210,31 +213,34 @@ def free_cells(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
                         speeds[i, w] = v
             if n_alive == 0:
                 break
-        # The spin schedule's tracking, from the fastest branch down: once one holds, a slower
-        # branch can be chosen only if tied with it (by mu_acc <= mu_path with acceleration
-        # limits), so the rest need not be tracked again.
-        checked[:] = False
-        feed[:] = slowest
-        top = -np.inf
-        tie = ACC_TIE_RTOL if accelerations else TIE_RTOL
-        i = next_fastest(alive, checked, slowest, top, tie)
-        while i >= 0:
-            rate = slowest[i] if slowest[i] > 0.0 and math.isfinite(slowest[i]) else 0.0
-            code, at = spun_failure(
-                relative_path(cq, sq, branches[i], True), qd, qs, branches[i], rate, length,
-                segment_checked, lower, upper, qdot_max, max_joint_step, spun,
+        if accelerations:
+            tie = ACC_TIE_RTOL
+            cell_mu_acc(
+                alive, why, where, slowest, branches, cq, sq, qd, qs, True, length,
+                segment_checked, lower, upper, qdot_max, max_joint_step, spun, stencil_index,
+                steps_c, stencil_waypoints, qddot_max, feed, acc_at, acc_by, acc_speeds, probes,
+                steps,
             )  # fmt: skip
-            if code != FEASIBLE:
-                fail(i, code, at, alive, why, where)
-            elif accelerations:
-                shift_to_copy(spun, lower, upper)
-                top = max(top, branch_mu_acc(
-                    i, spun, slowest, stencil_index, stencil_weight, stencil_waypoints,
-                    qddot_max, feed, acc_at, acc_by, acc_speeds, top,
-                ))  # fmt: skip
-            else:
-                top = max(top, slowest[i])
+        else:
+            # The spin schedule's tracking, from the fastest branch down: once one holds, a
+            # slower branch can be chosen only if tied with it, so the rest need not be
+            # tracked again.
+            tie = TIE_RTOL
+            checked[:] = False
+            feed[:] = slowest
+            top = -np.inf
             i = next_fastest(alive, checked, slowest, top, tie)
+            while i >= 0:
+                rate = slowest[i] if slowest[i] > 0.0 and math.isfinite(slowest[i]) else 0.0
+                code, at = spun_failure(
+                    relative_path(cq, sq, branches[i], True), qd, qs, branches[i], rate, length,
+                    segment_checked, lower, upper, qdot_max, max_joint_step, spun,
+                )  # fmt: skip
+                if code != FEASIBLE:
+                    fail(i, code, at, alive, why, where)
+                else:
+                    top = max(top, slowest[i])
+                i = next_fastest(alive, checked, slowest, top, tie)
         pick = write_cell(
             c, branches, alive, why, where, feed, tie, slowest, slowest_at, slowest_joint, speeds,
             mu, reason, failed, branch, bottleneck_waypoint, bottleneck_joint, v_out,

@@ -3,16 +3,15 @@
 The kernels' side of the limits seam (``spec/architecture.md`` section 3): at one waypoint of
 one branch, the largest feed speed a limit allows and the joint that binds it. The map kernels
 take every waypoint's bound from here and never compute one themselves. A final-path limit
-(joint accelerations, ``motion.md`` section 2) has its hook here too: over a branch's final
-joint path, the least bound and where it binds (:func:`acceleration_bound`, called through
-:mod:`solver.kernels.accelerations`). The numpy pipeline's limits are :mod:`solver.path.limits`;
-a hook equals its numpy limit number for number (tests/solver/test_map_kernel.py,
-test_free_spin_kernel.py).
+(joint accelerations, ``motion.md`` section 2) has its hook here too: the bound at one waypoint
+of a branch's final joint path, from the path's steps (:func:`step_stencil`,
+:func:`acceleration_at`, called through :mod:`solver.kernels.accelerations`). The numpy
+pipeline's limits are :mod:`solver.path.limits`; a hook equals its numpy limit number for
+number (tests/solver/test_map_kernel.py, test_free_spin_kernel.py,
+test_acceleration_hook.py).
 """
 
 from __future__ import annotations
-
-import math
 
 import numpy as np
 from numba import njit
@@ -62,50 +61,58 @@ def two_variable_speed(qd, qs, b, w, qdot_max):  # type: ignore[no-untyped-def] 
 
 
 @njit(cache=True, error_model="numpy", nogil=True)
-def acceleration_bound(path, index, weight, waypoints, qddot_max, v_row, floor):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
-    """Joint accelerations at a constant feed: the least V_acc,i over a final joint path.
+def step_stencil(index, weight):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
+    """The blend stencil on the joint path's steps: D_k = sum_t c[k, t] steps[index[k, 0] + 1 + t].
 
-    :class:`solver.path.limits.JointAccelerationLimit` on one branch: at each constrained
-    waypoint k, D = sum_m weight[k, m] q[index[k, m]] (the blend stencil,
-    :class:`solver.path.limits.BlendStencil`) and V_acc = 1 / sqrt(max_j |D_j| / qddot_max_j),
-    the first joint at a tie; the least V_acc over the path, the first waypoint at a tie.
+    The weights of a row sum to 0, so D_k = sum_m weight[k, m] (q[index[k, m]] -
+    q[index[k, 0]]), and each difference is a sum of the steps between: the step w has the
+    weight of every stencil waypoint at or after it. D so formed sees neither the angles' size
+    nor the weights' rounding (the steps are small), and two joint paths whose steps are equal
+    or opposite have equal |D|, to the bit.
 
     Args:
-        path: shape (W, 6), rad, the branch's final tracked joint path (its 2 pi copy as
-            :func:`solver.path.tracking.track` takes it; in free spin along the spin schedule).
-        index: shape (K, 5), the stencil's waypoints.
+        index: shape (K, 5), the stencil's waypoints (ascending along a row).
         weight: shape (K, 5), 1/m^2, their weights.
-        waypoints: shape (K,), ascending, the constrained waypoints.
-        qddot_max: shape (6,), rad/s^2.
-        v_row: shape (W,), out, V_acc at every waypoint (inf where unconstrained), or shape
-            (0,) when not wanted.
-        floor: m/s; at the first waypoint whose V_acc is below it the rest is not looked at
-            (that V_acc, its waypoint and joint are returned): the branch cannot be chosen.
-            0 to look at every waypoint.
 
     Returns:
-        The least V_acc (m/s; inf where nothing bounds it), its waypoint and joint (-1, -1
-        where nothing does).
+        c: shape (K, S), 1/m^2, S the longest row's span index[k, 4] - index[k, 0] (the rest
+        of a shorter row 0).
     """
-    ceiling = 1.0 / (floor * floor) if floor > 0.0 else np.inf  # worst above it: V < floor
-    if v_row.shape[0]:
-        v_row[:] = np.inf
-    largest, at, joint = -1.0, -1, -1
-    for k in range(waypoints.shape[0]):
-        worst = -1.0
-        limiting = 0
-        for j in range(path.shape[1]):
-            second = 0.0
-            for m in range(index.shape[1]):
-                second += path[index[k, m], j] * weight[k, m]
-            ratio = abs(second) / qddot_max[j]
-            if ratio > worst:
-                worst = ratio
-                limiting = j
-        if v_row.shape[0]:
-            v_row[waypoints[k]] = 1.0 / math.sqrt(worst)
-        if worst > largest:  # V_acc = 1 / sqrt(worst) below the least so far
-            largest, at, joint = worst, waypoints[k], limiting
-            if worst > ceiling and 1.0 / math.sqrt(worst) < floor:
-                break
-    return (1.0 / math.sqrt(largest) if at >= 0 else np.inf), at, joint
+    span = 0
+    for k in range(index.shape[0]):
+        span = max(span, index[k, -1] - index[k, 0])
+    c = np.zeros((index.shape[0], span))
+    for k in range(index.shape[0]):
+        for m in range(1, index.shape[1]):
+            for w in range(index[k, 0] + 1, index[k, m] + 1):
+                c[k, w - index[k, 0] - 1] += weight[k, m]
+    return c
+
+
+@njit(cache=True, error_model="numpy", nogil=True, inline="always")
+def acceleration_at(steps, start, span, c, k, qddot_max):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
+    """Joint accelerations at a constant feed at stencil row k: max_j |D_j| / qddot_max_j, and j.
+
+    :class:`solver.path.limits.JointAccelerationLimit` at one waypoint, from the joint path's
+    steps (:func:`step_stencil`); V_acc = 1 / sqrt of the ratio; the first joint at a tie.
+
+    Args:
+        steps: shape (W, 6), rad, steps[w] = q_w - q_(w-1), read from start + 1 to
+            start + span.
+        start: index[k, 0] of the stencil.
+        span: index[k, 4] - index[k, 0].
+        c: from :func:`step_stencil`.
+        k: the stencil's row.
+        qddot_max: shape (6,), rad/s^2.
+    """
+    worst = -1.0
+    limiting = 0
+    for j in range(steps.shape[1]):
+        second = 0.0
+        for t in range(span):
+            second += c[k, t] * steps[start + 1 + t, j]
+        ratio = abs(second) / qddot_max[j]
+        if ratio > worst:
+            worst = ratio
+            limiting = j
+    return worst, limiting

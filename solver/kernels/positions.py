@@ -153,16 +153,32 @@ _ASIN = (1.0, 1.0 / 6.0, 3.0 / 40.0, 5.0 / 112.0, 35.0 / 1152.0, 63.0 / 2816.0, 
          143.0 / 10240.0)  # fmt: skip
 
 
+@njit(cache=True, error_model="numpy", nogil=True, inline="always")
+def pair_step(c0, s0, c1, s1):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
+    """The angle from the (cos, sin) pair (c0, s0) to (c1, s1), in [-pi, pi].
+
+    As :func:`wrapped_step` gives it: asin of their cross product by its series where the step
+    is small (no atan2), atan2 of cross and dot products otherwise.
+    """
+    cross = c0 * s1 - s0 * c1
+    dot = c0 * c1 + s0 * s1
+    if dot > 0.0 and abs(cross) <= _SERIES:
+        x2 = cross * cross
+        series = _ASIN[7]
+        for term in range(6, -1, -1):
+            series = series * x2 + _ASIN[term]
+        return cross * series
+    return math.atan2(cross, dot)
+
+
 @njit(cache=True, error_model="numpy", nogil=True)
 def relative_path(cq, sq, b, first):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
     """Branch b's joint path (W, 6), rad: from its first angle (or 0), the sum of its steps.
 
-    Each step is the angle between neighbouring (cos, sin) pairs, in [-pi, pi] as
-    :func:`wrapped_step` gives it: asin of their cross product by its series where the step is
-    small (no atan2), atan2 of cross and dot products otherwise. With ``first`` the path starts
-    at the first waypoint's angle, as :func:`unwrapped`'s (to rounding); without, at 0: it then
-    differs from track()'s 2 pi copy by a constant per joint, which a second difference does
-    not see.
+    Each step is the angle between neighbouring (cos, sin) pairs (:func:`pair_step`). With
+    ``first`` the path starts at the first waypoint's angle, as :func:`unwrapped`'s (to
+    rounding); without, at 0: it then differs from track()'s 2 pi copy by a constant per joint,
+    which a second difference does not see.
     """
     dof, n_waypoints = cq.shape[1], cq.shape[2]
     path = np.empty((n_waypoints, dof))
@@ -170,16 +186,6 @@ def relative_path(cq, sq, b, first):  # type: ignore[no-untyped-def]  # pragma: 
         path[0, j] = math.atan2(sq[b, j, 0], cq[b, j, 0]) if first else 0.0
     for w in range(1, n_waypoints):
         for j in range(dof):
-            c0, s0, c1, s1 = cq[b, j, w - 1], sq[b, j, w - 1], cq[b, j, w], sq[b, j, w]
-            cross = c0 * s1 - s0 * c1
-            dot = c0 * c1 + s0 * s1
-            if dot > 0.0 and abs(cross) <= _SERIES:
-                x2 = cross * cross
-                series = _ASIN[7]
-                for term in range(6, -1, -1):
-                    series = series * x2 + _ASIN[term]
-                step = cross * series
-            else:
-                step = math.atan2(cross, dot)
+            step = pair_step(cq[b, j, w - 1], sq[b, j, w - 1], cq[b, j, w], sq[b, j, w])
             path[w, j] = path[w - 1, j] + step
     return path

@@ -68,6 +68,8 @@ class PlacementOptimum:
             at (the NLP's own, or the tracked one where that is faster); None for dof <= 6.
         mu_acc: m/s, with acceleration limits the evaluator's mu_acc there (what the search
             maximised, motion.md section 3); None without them.
+        start_mu_acc: m/s, with acceleration limits the start's mu_acc (what
+            ``improvement_percent`` compares with); None without them or a feasible start.
     """
 
     found: bool
@@ -82,6 +84,7 @@ class PlacementOptimum:
     spins: np.ndarray | None = None
     joint_path: np.ndarray | None = None
     mu_acc: float | None = None
+    start_mu_acc: float | None = None
 
 
 def _place_on_arc(
@@ -244,6 +247,9 @@ def optimize_placement(
         symmetric=settings.symmetric,
         spins=chosen.spins,
         joint_path=evaluation.q if problem.robot.dof > 6 else None,
+        start_mu_acc=None
+        if start_evaluation.acceleration is None
+        else start_evaluation.acceleration.mu_acc,
     )
 
 

@@ -161,8 +161,15 @@ class BlendStencil:
         return cls(b, np.concatenate(kept), np.concatenate(rows), np.concatenate(weights))
 
     def second_difference(self, q: np.ndarray) -> np.ndarray:
-        """D at the constrained waypoints: q (n, ..., W) -> (n, ..., K), rad/m^2."""
-        second: np.ndarray = np.einsum("...km,km->...k", q[..., self.index], self.weight)
+        """D at the constrained waypoints: q (n, ..., W) -> (n, ..., K), rad/m^2.
+
+        Formed as sum_m weight_m (q_m - q_0) (a row's weights sum to 0): the weights' rounding
+        then does not multiply the angles' size.
+        """
+        around = q[..., self.index]  # (n, ..., K, 5)
+        second: np.ndarray = np.einsum(
+            "...km,km->...k", around[..., 1:] - around[..., :1], self.weight[:, 1:]
+        )
         return second
 
 

@@ -148,6 +148,34 @@ def test_optimum_maximises_mu_acc(client: TestClient) -> None:
     )
     assert answer["evaluation"]["acceleration"]["mu_acc"] == answer["mu_acc"]
     assert answer["mu_acc"] >= README_MU_ACC[10.0]  # at least the start's
+    # The start (the centre of the bounds: the README example) reports the index the
+    # improvement is measured in: mu_acc, as /v1/evaluate gives it there.
+    start = post(
+        client,
+        "/v1/evaluate",
+        {
+            "robot": body["robot"],
+            "path": body["path"],
+            "placement": sent_back(answer["start"]["placement"]),
+        },
+    )
+    assert answer["start"]["mu_acc"] == pytest.approx(start["acceleration"]["mu_acc"], rel=1e-12)
+    assert answer["start"]["mu_path"] == pytest.approx(start["mu_path"], rel=1e-12)
+    assert answer["start"]["mu_acc"] < answer["start"]["mu_path"]
+    assert answer["improvement_percent"] == pytest.approx(
+        100.0 * (answer["mu_acc"] / answer["start"]["mu_acc"] - 1.0), rel=1e-9
+    )
+
+
+def test_the_start_has_no_mu_acc_without_limits(client: TestClient) -> None:
+    body = {
+        "robot": {"model": "ur5"},
+        "path": EXAMPLE["path"],
+        "bounds": {"x": [-0.05, 0.05], "y": [0.4, 0.5], "yaw": [-0.2, 0.2]},
+        "z": 0.1,
+    }
+    answer = post(client, "/v1/optimize", body)
+    assert answer["start"]["mu_acc"] is None and answer["start"]["mu_path"] > 0.0
 
 
 @pytest.mark.parametrize(
