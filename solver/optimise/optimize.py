@@ -68,6 +68,9 @@ class PlacementOptimum:
             at (the NLP's own, or the tracked one where that is faster); None for dof <= 6.
         mu_acc: m/s, with acceleration limits the evaluator's mu_acc there (what the search
             maximised, motion.md section 3); None without them.
+        active_waypoints: the waypoints in the final active set of the local solve that gave
+            the answer (:mod:`solver.optimise.active_set`); None where the answer came from the
+            whole path or from no local solve.
     """
 
     found: bool
@@ -82,6 +85,7 @@ class PlacementOptimum:
     spins: np.ndarray | None = None
     joint_path: np.ndarray | None = None
     mu_acc: float | None = None
+    active_waypoints: int | None = None
 
 
 def _place_on_arc(
@@ -140,6 +144,7 @@ def optimize_placement(
     max_solver_seconds: float | None = None,
     progress: Progress | None = None,
     runner: TaskRunner = SERIAL,
+    active_set: bool = True,
 ) -> PlacementOptimum:
     """The placement inside ``bounds`` where the path runs fastest.
 
@@ -165,6 +170,9 @@ def optimize_placement(
             iterations); a :class:`solver.core.progress.Cancelled` it raises stops the search.
         runner: where the coarse map's and differential evolution's placements run
             (:mod:`solver.core.parallel`); the same optimum on any.
+        active_set: the local solves (IPOPT, SLSQP) work on the waypoints that bind, the whole
+            path checked after each (:mod:`solver.optimise.active_set`); False solves the
+            whole path, the reference (the same optimum, issue 23).
 
     Returns:
         The optimum (never below the start); ``found`` is False when neither the start nor any
@@ -200,6 +208,7 @@ def optimize_placement(
         max_solver_seconds=max_solver_seconds,
         progress=progress,
         runner=runner,
+        active_set=active_set,
     )
     chosen_method.check(problem, bounds, settings)
     prepared = problem.prepared  # the path is checked before the options (evaluate_path's)
@@ -244,6 +253,7 @@ def optimize_placement(
         symmetric=settings.symmetric,
         spins=chosen.spins,
         joint_path=evaluation.q if problem.robot.dof > 6 else None,
+        active_waypoints=None if chosen.rows is None else len(chosen.rows),
     )
 
 
