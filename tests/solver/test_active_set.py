@@ -29,6 +29,7 @@ from tests.solver.families.test_opw_paths import KR6
 from tests.solver.test_acceleration import WAYPOINTS, ur5
 from tests.solver.test_constant_spin import angled_spindle
 from tests.solver.test_evaluate import load_path
+from tests.solver.test_half_turn import two_waypoints
 
 ACTIVE_SET_RTOL = 1e-9  # issue 23: the active-set answer equals the whole problem's
 BOX = PlacementBounds(x=(-0.25, 0.25), y=(0.25, 0.65), yaw=(-math.pi, math.pi), z=0.1)
@@ -36,8 +37,12 @@ SMALL = dict(x=(-0.1, 0.1), y=(0.35, 0.55))
 
 
 def _problems() -> dict[str, tuple[PathProblem, PlacementBounds]]:
-    """Every problem an optimiser test solves (the module that solves it in brackets)."""
-    curved, s_curve = load_path("curved_line"), load_path("s_curve")
+    """Every problem an optimiser test solves (the module that solves it in comments).
+
+    The Panda's (test_numeric_optimize) is left out: a redundant arm's solves run on the whole
+    path (its answer carries the NLP's joint path), with or without ``active_set``.
+    """
+    curved = load_path("curved_line")
     return {
         # test_optimize: two arms, two paths, the box of issue 4
         **{
@@ -72,8 +77,11 @@ def _problems() -> dict[str, tuple[PathProblem, PlacementBounds]]:
             problem(get_robot("ur5e").with_options(transform_tool_to_tcp=angled_spindle()), curved),
             PlacementBounds(**SMALL, yaw=(-math.pi, math.pi), z=0.0, spin=(-math.pi, math.pi)),
         ),
-        # test_half_turn is a box of a hundredth of a turn on its own path: below
-        "s_curve short": (problem(get_robot("ur5e"), s_curve[:40]), BOX),
+        # test_half_turn: two waypoints 2e-3 rad short of a half turn
+        "half turn": (
+            problem(get_robot("ur5"), two_waypoints(math.pi - 2e-3), max_joint_step=3.5),
+            PlacementBounds(x=(0.0, 0.02), y=(0.4, 0.45), yaw=(0.1, 0.2), z=0.1),
+        ),
     }
 
 
