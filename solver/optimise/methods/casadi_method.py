@@ -71,10 +71,18 @@ def search(
     seconds = settings.max_solver_seconds
     options: dict[str, object] | None = None if seconds is None else {"max_cpu_time": seconds}
 
+    whole: list[PlacementNlp] = []  # the whole problem's NLP, built once for every start
+
     def nlp_of(posed: PathProblem) -> PlacementNlp:
-        return PlacementNlp(
+        """The NLP of the problem (built once) or of one of its active sets."""
+        if posed is problem and whole:
+            return whole[0]
+        nlp = PlacementNlp(
             posed, bounds, max_spin_step=settings.max_spin_step, ipopt_options=options
         )
+        if posed is problem:
+            whole.append(nlp)
+        return nlp
 
     iterations = 0
     climbed: Callable[[], list[Candidate]] = partial(climbs, problem, bounds, cells)
