@@ -11,7 +11,8 @@ scalar loop (ur-analytic-ik IK, pinocchio Jacobian and numpy solve per pose and 
 on a subset in the same run and extrapolated, their ratio, the time per pose and branch, and
 the 8-yaw map against the 1-yaw map; the numeric IK family's map on the same grid (UR5 read as a
 plain URDF, checked equal to the analytic map, and the Panda) against the analytic one; the map
-and the optimisers with joint acceleration limits (``bench/acceleration.py``). Then the
+and the optimisers with joint acceleration limits (``bench/acceleration.py``); the optimisation of
+published-size programs on active sets (``bench/active_set.py``). Then the
 placement optimisation of the same problem
 (yaw free): each method's time and optimum, against the best cell of a fine grid (10 mm,
 5 degrees) computed in the same run.
@@ -29,11 +30,12 @@ import time
 from pathlib import Path
 
 import httpx
-import memory  # bench/memory.py, bench/parallel.py and bench/acceleration.py, beside this script
+import memory  # bench/memory.py, parallel.py, acceleration.py, active_set.py, beside this script
 import numpy as np
 import parallel
 import ur_analytic_ik
 from acceleration import acceleration_lines
+from active_set import active_set_lines
 from timing import best_time
 
 from solver.core.kinematics import jacobian_in_base
@@ -188,6 +190,7 @@ def main() -> None:
     acceleration_lines(robot, path, xs, ys, z, repeats=repeats, smoke=args.smoke)
     numeric_maps(path, xs, ys, z, t_map)
     optimisation(robot, path, smoke=args.smoke)
+    active_set_lines(smoke=args.smoke)
     evaluate_over_http(requests=20 if args.smoke else 200)
     parallel.threads(robot, path, xs, ys, z)
     parallel.map_job(smoke=args.smoke)

@@ -28,12 +28,15 @@ class Candidate:
         spins: shape (N,), rad, each waypoint's spin on top of the placement's (spin path).
         joint_path: shape (N, n), rad, the NLP's own joint path for a redundant arm (dof > 6),
             judged as it is (:mod:`solver.path.joint_path`) beside the tracked one.
+        rows: the whole-path waypoints of the active set the local solve ended on
+            (:mod:`solver.optimise.active_set`); None where it solved the whole path or none.
     """
 
     vector: np.ndarray
     status: str
     spins: np.ndarray | None = None
     joint_path: np.ndarray | None = None
+    rows: np.ndarray | None = None
 
 
 @dataclass(frozen=True)
@@ -52,6 +55,8 @@ class Search:
         max_solver_seconds: the longest one IPOPT solve may take (None: IPOPT's default).
         progress: called with the fraction done; a ``Cancelled`` it raises stops the search.
         runner: where the placements of maps and generations run; the same answer on any.
+        active_set: the local solves work on the waypoints that bind
+            (:mod:`solver.optimise.active_set`); False solves the whole path (the reference).
     """
 
     symmetric: bool
@@ -63,3 +68,4 @@ class Search:
     max_solver_seconds: float | None = None
     progress: Progress | None = None
     runner: TaskRunner = SERIAL
+    active_set: bool = True

@@ -17,9 +17,9 @@ from solver.core.exceptions import InvalidInputError
 from solver.core.parallel import SERIAL, TaskRunner
 from solver.core.progress import Progress
 from solver.core.spatial import MAX_COORDINATE
+from solver.optimise.coarse_rows import map_values, mapped_waypoints
 from solver.optimise.search_space import PlacementBounds, decision_vector
 from solver.optimise.symmetry import arc_point
-from solver.path.placements import evaluate_placements
 from solver.path.problem import PathProblem
 
 COARSE_STEP = 0.02  # m, of the coarse map (r or x, y)
@@ -112,13 +112,16 @@ def _check_map_size(
             f"({' x '.join(map(str, sizes))} at {COARSE_STEP * 1000:.0f} mm, "
             f"{math.degrees(COARSE_YAW_STEP):.0f} deg); the limit is {max_cells}",
         )
-    n_waypoints = problem.prepared.n_waypoints
+    n_waypoints = mapped_waypoints(problem.prepared.n_waypoints)
     poses = math.prod(sizes) * n_waypoints
     family = problem.family
     work = math.prod(sizes) * family.path_cost(n_waypoints)
     if max_poses is not None and work > max_poses:
         size = f"the search box's coarse map of {math.prod(sizes)} cells * {n_waypoints} "
         size += f"waypoints = {poses} poses"
+        if n_waypoints < problem.prepared.n_waypoints:
+            size += f" (a program of {problem.prepared.n_waypoints} waypoints is mapped on "
+            size += f"{n_waypoints} at most)"
         if work != poses:
             size += f", as work {work:.4g} closed-form poses ({family.name} IK)"
         raise InvalidInputError("bounds", f"{size}; the limit is {max_poses}")
@@ -182,7 +185,10 @@ def coarse_cells(
 
     Over (r, psi) at COARSE_STEP x COARSE_YAW_STEP when ``symmetric`` (each cell placed on its
     arc nearest the polar angle ``near``), else over (x, y, yaw); times the spins when the spin
-    is free. Every cell on the problem's branch policy (``auto``, for the optimisers).
+    is free. Every cell on the problem's branch policy (``auto``, for the optimisers). A
+    program longer than :data:`solver.optimise.coarse_rows.MAX_MAP_ROWS` is mapped on the
+    waypoints that bind its best cells, and only those cells, verified on the whole path, are
+    returned (:mod:`solver.optimise.coarse_rows`).
 
     Raises:
         InvalidInputError: the map would have more than ``max_cells`` cells, or more than
@@ -214,11 +220,22 @@ def coarse_cells(
     mu = np.full(len(vectors), np.nan)
     branch = np.zeros(len(vectors), dtype=int)
     inside_index = [i for i, v in enumerate(vectors) if v is not None]
+    periodic_axes = (False, spin_wraps, *periodic)
     if inside_index:
-        result = evaluate_placements(problem, np.array(rows), progress=progress, runner=runner)
+        position = np.full(len(vectors), -1)
+        position[inside_index] = np.arange(len(inside_index))
+
+        def maxima(values: np.ndarray) -> list[int]:
+            """The local maxima of the map with ``values`` inside, as indices of ``rows``."""
+            full = np.full(len(vectors), np.nan)
+            full[inside_index] = values
+            found = _local_maxima(full.reshape(full_shape), periodic_axes)
+            return [int(position[np.ravel_multi_index(i, full_shape)]) for i in found]
+
+        result = map_values(problem, np.array(rows), maxima, progress=progress, runner=runner)
         mu[inside_index], branch[inside_index] = result.feed_index, result.branch
     cells = []
-    for index in _local_maxima(mu.reshape(full_shape), (False, spin_wraps, *periodic)):
+    for index in _local_maxima(mu.reshape(full_shape), periodic_axes):
         k = int(np.ravel_multi_index(index, full_shape))
         vector = vectors[k]
         if vector is not None:

@@ -70,6 +70,9 @@ class PlacementOptimum:
             maximised, motion.md section 3); None without them.
         start_mu_acc: m/s, with acceleration limits the start's mu_acc (what
             ``improvement_percent`` compares with); None without them or a feasible start.
+        active_waypoints: the waypoints in the final active set of the local solve that gave
+            the answer (:mod:`solver.optimise.active_set`); None where the answer came from the
+            whole path or from no local solve.
     """
 
     found: bool
@@ -85,6 +88,7 @@ class PlacementOptimum:
     joint_path: np.ndarray | None = None
     mu_acc: float | None = None
     start_mu_acc: float | None = None
+    active_waypoints: int | None = None
 
 
 def _place_on_arc(
@@ -143,6 +147,7 @@ def optimize_placement(
     max_solver_seconds: float | None = None,
     progress: Progress | None = None,
     runner: TaskRunner = SERIAL,
+    active_set: bool = True,
 ) -> PlacementOptimum:
     """The placement inside ``bounds`` where the path runs fastest.
 
@@ -168,6 +173,9 @@ def optimize_placement(
             iterations); a :class:`solver.core.progress.Cancelled` it raises stops the search.
         runner: where the coarse map's and differential evolution's placements run
             (:mod:`solver.core.parallel`); the same optimum on any.
+        active_set: the local solves (IPOPT, SLSQP) work on the waypoints that bind, the whole
+            path checked after each (:mod:`solver.optimise.active_set`); False solves the
+            whole path, the reference (the same optimum, issue 23).
 
     Returns:
         The optimum (never below the start); ``found`` is False when neither the start nor any
@@ -203,6 +211,7 @@ def optimize_placement(
         max_solver_seconds=max_solver_seconds,
         progress=progress,
         runner=runner,
+        active_set=active_set,
     )
     chosen_method.check(problem, bounds, settings)
     prepared = problem.prepared  # the path is checked before the options (evaluate_path's)
@@ -250,6 +259,7 @@ def optimize_placement(
         start_mu_acc=None
         if start_evaluation.acceleration is None
         else start_evaluation.acceleration.mu_acc,
+        active_waypoints=None if chosen.rows is None else len(chosen.rows),
     )
 
 

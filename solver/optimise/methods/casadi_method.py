@@ -14,11 +14,19 @@ from collections.abc import Callable
 from concurrent.futures import ThreadPoolExecutor
 from functools import partial
 
+import numpy as np
+
 from solver.core.progress import Progress, span
+from solver.optimise.active_set import (
+    MAX_ROUNDS,
+    first_rows,
+    solve_on_active_set,
+    whole_path_bounds,
+)
 from solver.optimise.candidate import ZERO_SPEED, Candidate, Search
 from solver.optimise.coarse_search import Cell, coarse_cells
 from solver.optimise.local_search import climbs, refine_cells
-from solver.optimise.methods.placement_nlp import PlacementNlp
+from solver.optimise.methods.placement_nlp import NlpResult, PlacementNlp
 from solver.optimise.search_space import PlacementBounds
 from solver.path.evaluate import evaluate_path
 from solver.path.problem import PathProblem
@@ -61,12 +69,21 @@ def search(
         return [Candidate(cells[0].vector, ZERO_SPEED)], 0
     candidates = [Candidate(cells[0].vector, "best cell of the coarse map, refined")]
     seconds = settings.max_solver_seconds
-    nlp = PlacementNlp(
-        problem,
-        bounds,
-        max_spin_step=settings.max_spin_step,
-        ipopt_options=None if seconds is None else {"max_cpu_time": seconds},
-    )
+    options: dict[str, object] | None = None if seconds is None else {"max_cpu_time": seconds}
+
+    whole: list[PlacementNlp] = []  # the whole problem's NLP, built once for every start
+
+    def nlp_of(posed: PathProblem) -> PlacementNlp:
+        """The NLP of the problem (built once) or of one of its active sets."""
+        if posed is problem and whole:
+            return whole[0]
+        nlp = PlacementNlp(
+            posed, bounds, max_spin_step=settings.max_spin_step, ipopt_options=options
+        )
+        if posed is problem:
+            whole.append(nlp)
+        return nlp
+
     iterations = 0
     climbed: Callable[[], list[Candidate]] = partial(climbs, problem, bounds, cells)
     solves = span(progress, 0.3, 0.95)
@@ -78,7 +95,7 @@ def search(
         starts = [cell.coarse or cell for cell in cells[:N_STARTS]]
         for k, cell in enumerate(starts):
             part = span(solves, k / len(starts), (k + 1) / len(starts))
-            solved = _solve_from(problem, nlp, bounds, cell, part)
+            solved = _solve_from(problem, nlp_of, bounds, cell, part, settings)
             if solved is not None:
                 candidates.append(solved[0])
                 iterations += solved[1]
@@ -86,18 +103,31 @@ def search(
     return candidates, iterations
 
 
+def uses_active_set(problem: PathProblem, settings: Search) -> bool:
+    """Whether the solves run on active sets (:mod:`solver.optimise.active_set`).
+
+    Not with a spin path (each segment's twist couples neighbouring waypoints' spins) nor for a
+    redundant arm (its answer carries the NLP's joint path along the whole path): those solve
+    the whole path.
+    """
+    return settings.active_set and settings.max_spin_step is None and problem.robot.dof <= 6
+
+
 def _solve_from(
     problem: PathProblem,
-    nlp: PlacementNlp,
+    nlp_of: Callable[[PathProblem], PlacementNlp],
     bounds: PlacementBounds,
     cell: Cell,
     progress: Progress | None,
+    settings: Search,
 ) -> tuple[Candidate, int] | None:
     """IPOPT's optimum from the cell's joint path, with its iterations; None where none starts.
 
     The start is the cell's joint path on its branch in fixed spin (in free spin the NLP frees
     the rate from 0). A start IPOPT refuses is a candidate at the cell, with IPOPT's message and
-    no iterations.
+    no iterations. Where :func:`uses_active_set`, IPOPT solves on the waypoints that bind, the
+    whole path checked after each solve (:func:`solver.optimise.active_set.solve_on_active_set`);
+    the candidate carries the final set.
     """
     branch = problem.family.branches[cell.branch]
     at_start = evaluate_path(
@@ -108,15 +138,39 @@ def _solve_from(
     if q is None or qdot is None or v_max is None or speed is None:
         return None
     joint_speeds = qdot * (speed / v_max)[:, None]
+    if not uses_active_set(problem, settings):
+        try:
+            result = nlp_of(problem).solve(cell.vector, speed, q, joint_speeds, progress=progress)
+        except RuntimeError as error:  # IPOPT refused this start: the others still count
+            return _refused(cell, error), 0
+        candidate = Candidate(
+            result.vector,
+            result.status,
+            spins=result.spins,
+            joint_path=result.joint_path if problem.robot.dof > 6 else None,
+        )
+        return candidate, result.iterations
+    solves: list[NlpResult] = []
+
+    def solve(subset: PathProblem, rows: np.ndarray) -> tuple[np.ndarray, NlpResult]:
+        round_ = span(progress, len(solves) / MAX_ROUNDS, (len(solves) + 1) / MAX_ROUNDS)
+        solved = nlp_of(subset).solve(
+            cell.vector, speed, q[rows], joint_speeds[rows], progress=round_
+        )
+        solves.append(solved)
+        return solved.vector, solved
+
+    speeds, failing = whole_path_bounds(problem, bounds, cell.vector, branch)
+    first = first_rows(problem, speeds, failing)
     try:
-        result = nlp.solve(cell.vector, speed, q, joint_speeds, progress=progress)
-    except RuntimeError as error:  # IPOPT refused this start: the others still count
-        failure = f"IPOPT failed from a start: {str(error).splitlines()[-1][:200]}"
-        return Candidate(cell.vector, failure), 0
-    candidate = Candidate(
-        result.vector,
-        result.status,
-        spins=result.spins,
-        joint_path=result.joint_path if problem.robot.dof > 6 else None,
-    )
-    return candidate, result.iterations
+        looped = solve_on_active_set(problem, bounds, branch, first, solve)
+    except RuntimeError as error:
+        return _refused(cell, error), sum(s.iterations for s in solves)
+    result = looped.solved
+    candidate = Candidate(result.vector, result.status, spins=result.spins, rows=looped.rows)
+    return candidate, sum(s.iterations for s in solves)
+
+
+def _refused(cell: Cell, error: RuntimeError) -> Candidate:
+    """The candidate of a start IPOPT refused: the cell, with IPOPT's message."""
+    return Candidate(cell.vector, f"IPOPT failed from a start: {str(error).splitlines()[-1][:200]}")

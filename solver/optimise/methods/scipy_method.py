@@ -8,8 +8,17 @@ on (:mod:`solver.optimise.methods.placement_scipy`); Nelder-Mead climbs mu_path 
 
 from __future__ import annotations
 
+import numpy as np
+
 from solver.core.exceptions import InvalidInputError
-from solver.core.progress import span
+from solver.core.family import Branch
+from solver.core.progress import Progress, span
+from solver.optimise.active_set import (
+    MAX_ROUNDS,
+    first_rows,
+    solve_on_active_set,
+    whole_path_bounds,
+)
 from solver.optimise.candidate import ZERO_SPEED, Candidate, Search
 from solver.optimise.coarse_search import Cell
 from solver.optimise.local_search import climbs, refine_cells
@@ -93,18 +102,50 @@ def search(
     if refined:
         basins = [(cell.vector, cell.mu_path, cell.branch) for cell in refined]
     for k, (placement, mu_path, branch) in enumerate(basins):
-        polished, status, steps = polish(
-            problem,
-            bounds,
-            placement,
-            mu_path,
-            problem.family.branches[branch],
-            size=size,
-            progress=span(
-                progress, 0.6 + 0.35 * k / len(basins), 0.6 + 0.35 * (k + 1) / len(basins)
-            ),
+        part = span(progress, 0.6 + 0.35 * k / len(basins), 0.6 + 0.35 * (k + 1) / len(basins))
+        on_branch = problem.family.branches[branch]
+        candidate, steps = _polished(
+            problem, bounds, placement, mu_path, on_branch, size, part, settings
         )
-        candidates.append(Candidate(polished, f"SLSQP: {status}"))
+        candidates.append(candidate)
         iterations += steps
     candidates += climbs(problem, bounds, refined)
     return candidates, iterations
+
+
+def _polished(
+    problem: PathProblem,
+    bounds: PlacementBounds,
+    placement: np.ndarray,
+    mu_path: float,
+    branch: Branch,
+    size: SearchSize,
+    progress: Progress | None,
+    settings: Search,
+) -> tuple[Candidate, int]:
+    """SLSQP's polish from a basin's point, with its iterations.
+
+    On the active set of the point's binding waypoints (:mod:`solver.optimise.active_set`)
+    unless ``settings.active_set`` is off or the arm is redundant; the candidate then carries
+    the final set.
+    """
+    if not settings.active_set or problem.robot.dof > 6:
+        polished, status, steps = polish(
+            problem, bounds, placement, mu_path, branch, size=size, progress=progress
+        )
+        return Candidate(polished, f"SLSQP: {status}"), steps
+    steps_made: list[int] = []
+
+    def solve(subset: PathProblem, rows: np.ndarray) -> tuple[np.ndarray, tuple[np.ndarray, str]]:
+        round_ = span(progress, len(steps_made) / MAX_ROUNDS, (len(steps_made) + 1) / MAX_ROUNDS)
+        polished, status, steps = polish(
+            subset, bounds, placement, mu_path, branch, size=size, progress=round_
+        )
+        steps_made.append(steps)
+        return polished, (polished, status)
+
+    speeds, failing = whole_path_bounds(problem, bounds, placement, branch)
+    first = first_rows(problem, speeds, failing)
+    looped = solve_on_active_set(problem, bounds, branch, first, solve)
+    vector, status = looped.solved
+    return Candidate(vector, f"SLSQP: {status}", rows=looped.rows), sum(steps_made)
