@@ -87,6 +87,25 @@ class SerialChain:
             tool_translation=tool.translation.copy(),
         )
 
+    def packed(self) -> tuple[np.ndarray, ...]:
+        """The geometry as the compiled chain takes it (:mod:`~.chain_kernel`, :mod:`~.ik_kernel`).
+
+        Contiguous float arrays (revolute a bool array) in the order of the attributes above.
+        """
+        return tuple(
+            np.ascontiguousarray(a, dtype=bool if a is self.revolute else float)
+            for a in (
+                self.joint_rotation,
+                self.joint_translation,
+                self.axis,
+                self.revolute,
+                self.base_rotation,
+                self.base_translation,
+                self.tool_rotation,
+                self.tool_translation,
+            )
+        )
+
     def frames(self, q: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         """Every joint frame and the flange in {B}.
 

@@ -20,7 +20,7 @@ from solver.core.codes import OK, SINGULAR, UNREACHABLE
 from solver.core.dtf_redundant import redundant_speed
 from solver.core.family import Branch, KinematicsFamily, PathSolutions
 from solver.core.spatial import wrap_angle
-from solver.families.numeric import ik
+from solver.families.numeric import chain_kernel, ik, ik_kernel
 from solver.families.numeric.chain import SerialChain
 
 # The Sobol sequence's seed: fixed, so that the same input gives the same branches.
@@ -53,7 +53,13 @@ class NumericFamily(KinematicsFamily):
     name = "numeric"
 
     def __init__(
-        self, model: pin.Model, *, base_frame: str, tool_frame: str, seed: int = SOBOL_SEED
+        self,
+        model: pin.Model,
+        *,
+        base_frame: str,
+        tool_frame: str,
+        seed: int = SOBOL_SEED,
+        compiled: bool = True,
     ) -> None:
         """Read the chain and fix the seeds.
 
@@ -62,6 +68,9 @@ class NumericFamily(KinematicsFamily):
             base_frame: {B}, fixed to the root.
             tool_frame: the flange {F}.
             seed: the Sobol sequence's seed.
+            compiled: solve with the compiled chain (:mod:`solver.families.numeric.ik_kernel`);
+                False: with the numpy chain and :mod:`solver.families.numeric.ik`, the
+                reference it is tested against.
 
         Raises:
             RobotModelError: the model is not such a chain.
@@ -74,6 +83,8 @@ class NumericFamily(KinematicsFamily):
             count, lower=self.lower, upper=self.upper, revolute=self.chain.revolute, seed=seed
         )
         self._branches = tuple(Branch.named(solution=str(k)) for k in range(count))
+        self.compiled = compiled
+        self._packed = self.chain.packed()
 
     @property
     def dof(self) -> int:
@@ -115,6 +126,30 @@ class NumericFamily(KinematicsFamily):
         q = q.reshape(n_poses, n_seeds, self.dof)
         return ik.distinct(q, converged.reshape(n_poses, n_seeds), self.chain.revolute)
 
+    def _compiled(
+        self, rotations: np.ndarray, positions: np.ndarray
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """:func:`ik_kernel.solve_paths` at rotations (P, W, 3, 3) and positions (P, W, 3).
+
+        Returns:
+            q (n, K, P, W), rad, wrapped, NaN in slots without a solution; status (K, P, W);
+            count (P,), the distinct solutions found at the first waypoints.
+        """
+        settings = np.array(
+            [ik.SEED_ITERATIONS, ik.TRACK_ITERATIONS, ik.DISTINCT, ik.SINGULAR_RCOND], dtype=float
+        )
+        constants = np.array([ik.TOLERANCE, ik.DAMPING_SCALE, ik.DAMPING_FLOOR])
+        result: tuple[np.ndarray, np.ndarray, np.ndarray] = ik_kernel.solve_paths(
+            self._packed,
+            self.seeds,
+            (self.lower, self.upper),
+            np.ascontiguousarray(rotations, dtype=float),
+            np.ascontiguousarray(positions, dtype=float),
+            settings,
+            constants,
+        )
+        return result
+
     def _wrapped_with_status(self, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Revolute joints wrapped to [-pi, pi) and the status of each solution, q (..., n)."""
         flat = q.reshape(-1, self.dof)
@@ -134,7 +169,12 @@ class NumericFamily(KinematicsFamily):
         batch = np.broadcast_shapes(rotation.shape[2:], position.shape[1:])
         rotation_flat = np.moveaxis(np.broadcast_to(rotation, (3, 3, *batch)), (0, 1), (-2, -1))
         position_flat = np.moveaxis(np.broadcast_to(position, (3, *batch)), 0, -1)
-        slots, _ = self._seeded(rotation_flat.reshape(-1, 3, 3), position_flat.reshape(-1, 3))
+        rotation_flat, position_flat = rotation_flat.reshape(-1, 3, 3), position_flat.reshape(-1, 3)
+        if self.compiled:  # a path of one waypoint: the seeding alone
+            q_k, status_k, _ = self._compiled(rotation_flat[:, None], position_flat[:, None])
+            q_shape = (self.dof, len(self.seeds), *batch)
+            return q_k.reshape(q_shape), status_k.reshape(q_shape[1:])
+        slots, _ = self._seeded(rotation_flat, position_flat)
         q, status = self._wrapped_with_status(slots)  # (P, K, n), (P, K)
         q = np.moveaxis(q.reshape(*batch, len(self.seeds), self.dof), (-1, -2), (0, 1))
         return q, np.moveaxis(status.reshape(*batch, len(self.seeds)), -1, 0)
@@ -158,6 +198,14 @@ class NumericFamily(KinematicsFamily):
         positions = np.moveaxis(np.broadcast_to(position, (3, *shape)), 0, -1)
         positions = positions.reshape(-1, n_waypoints, 3)
         n_paths, n_seeds = len(positions), len(self.seeds)
+        if self.compiled:
+            q_k, status_k, count_k = self._compiled(rotations, positions)
+            return PathSolutions(
+                q=q_k.reshape(self.dof, n_seeds, *batch, n_waypoints),
+                status=status_k.reshape(n_seeds, *batch, n_waypoints),
+                seeds=n_seeds,
+                branches_found=count_k.reshape(batch),
+            )
         slots, count = self._seeded(rotations[:, 0], positions[:, 0])
         q = np.full((n_paths, n_seeds, n_waypoints, self.dof), np.nan)
         q[:, :, 0] = slots
@@ -239,7 +287,19 @@ class NumericFamily(KinematicsFamily):
         point_flat = np.moveaxis(np.broadcast_to(tool_point, (3, *shape)), 0, -1).reshape(-1, 3)
         speeds = np.full(q_flat.shape, np.nan)
         rows = np.flatnonzero(np.isfinite(q_flat).all(axis=-1))
-        jacobian, _, _ = self.chain.jacobian(q_flat[rows], point_flat[rows])
+        if self.compiled and self.dof == 6:
+            speeds = chain_kernel.speeds_per_twist(
+                self._packed, *(np.ascontiguousarray(a) for a in (q_flat, twist_flat, point_flat))
+            )
+            return np.moveaxis(speeds.reshape(*shape, self.dof), -1, 0)
+        if self.compiled:
+            jacobian = chain_kernel.jacobians(
+                self._packed,
+                np.ascontiguousarray(q_flat[rows]),
+                np.ascontiguousarray(point_flat[rows]),
+            )
+        else:
+            jacobian, _, _ = self.chain.jacobian(q_flat[rows], point_flat[rows])
         if self.dof == 6:
             speeds[rows] = _solve_or_nan(jacobian, twist_flat[rows])
         elif self.dof > 6 and qdot_max is not None:
