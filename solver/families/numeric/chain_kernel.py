@@ -17,10 +17,39 @@ of the work arrays between them.
 
 from __future__ import annotations
 
+import hashlib
 import math
+from pathlib import Path
 
 import numpy as np
 from numba import njit
+
+
+def drop_stale_cache(module_file: Path) -> None:
+    """Drop the cached machine code of a module whose compiled code takes this module's in.
+
+    numba keys a function's disk cache by its own source file, but the IK and redundant-speed
+    kernels take this chain's code into themselves: after an edit of this module they would
+    load the old code. A marker named by the hash of both sources says which code the cache
+    holds (as :mod:`solver.kernels.cache` does for the map kernels); where the directory
+    cannot be written, nothing is done.
+
+    Args:
+        module_file: the source file of the module whose cache to check.
+    """
+    sources = Path(__file__).read_bytes() + module_file.read_bytes()
+    cache = module_file.parent / "__pycache__"
+    marker = cache / f"{module_file.stem}.sources-{hashlib.sha256(sources).hexdigest()[:16]}"
+    try:
+        if marker.exists():
+            return
+        for pattern in ("*.nbi", "*.nbc", "sources-*"):
+            for stale in cache.glob(f"{module_file.stem}.{pattern}"):
+                stale.unlink(missing_ok=True)
+        cache.mkdir(exist_ok=True)
+        marker.touch()
+    except OSError:
+        return
 
 
 @njit(cache=True, nogil=True, error_model="numpy", inline="always")

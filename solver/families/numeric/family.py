@@ -20,7 +20,7 @@ from solver.core.codes import OK, SINGULAR, UNREACHABLE
 from solver.core.dtf_redundant import redundant_speed
 from solver.core.family import Branch, KinematicsFamily, PathSolutions
 from solver.core.spatial import wrap_angle
-from solver.families.numeric import chain_kernel, ik, ik_kernel
+from solver.families.numeric import chain_kernel, ik, ik_kernel, redundant_kernel
 from solver.families.numeric.chain import SerialChain
 
 # The Sobol sequence's seed: fixed, so that the same input gives the same branches.
@@ -292,6 +292,13 @@ class NumericFamily(KinematicsFamily):
                 self._packed, *(np.ascontiguousarray(a) for a in (q_flat, twist_flat, point_flat))
             )
             return np.moveaxis(speeds.reshape(*shape, self.dof), -1, 0)
+        if self.compiled and self.dof == 7 and qdot_max is not None:
+            speeds, irregular = redundant_kernel.redundant_speeds(
+                self._packed,
+                *(np.ascontiguousarray(a) for a in (q_flat, twist_flat, point_flat)),
+                np.asarray(qdot_max, dtype=float),
+            )
+            rows = np.flatnonzero(irregular)  # J near rank loss: numpy's SVD or the LP decides
         if self.compiled:
             jacobian = chain_kernel.jacobians(
                 self._packed,

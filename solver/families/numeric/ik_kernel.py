@@ -10,7 +10,6 @@ Every function releases the GIL (``nogil``).
 
 from __future__ import annotations
 
-import hashlib
 import math
 from pathlib import Path
 
@@ -18,38 +17,18 @@ import numpy as np
 from numba import njit
 
 from solver.core.codes import OK, SINGULAR, UNREACHABLE
-from solver.families.numeric import chain_kernel
-from solver.families.numeric.chain_kernel import frames, jacobian_at, lu_solve, workspace
+from solver.families.numeric.chain_kernel import (
+    drop_stale_cache,
+    frames,
+    jacobian_at,
+    lu_solve,
+    workspace,
+)
 
 _TWO_PI = 2.0 * math.pi
 
 
-def _drop_stale_cache() -> None:
-    """Drop this module's cached machine code when the chain kernel's source has changed.
-
-    numba keys a function's disk cache by its own source file, but these functions take the
-    chain kernel's code into themselves: after an edit of that module they would load the old
-    code. A marker named by the hash of both sources says which code the cache holds (as
-    :mod:`solver.kernels.cache` does for the map kernels); where the directory cannot be
-    written, nothing is done.
-    """
-    here = Path(__file__)
-    sources = Path(str(chain_kernel.__file__)).read_bytes() + here.read_bytes()
-    cache = here.parent / "__pycache__"
-    marker = cache / f"{here.stem}.sources-{hashlib.sha256(sources).hexdigest()[:16]}"
-    try:
-        if marker.exists():
-            return
-        for pattern in ("*.nbi", "*.nbc", "sources-*"):
-            for stale in cache.glob(f"{here.stem}.{pattern}"):
-                stale.unlink(missing_ok=True)
-        cache.mkdir(exist_ok=True)
-        marker.touch()
-    except OSError:
-        return
-
-
-_drop_stale_cache()
+drop_stale_cache(Path(__file__))
 
 
 @njit(cache=True, nogil=True, error_model="numpy", inline="always")

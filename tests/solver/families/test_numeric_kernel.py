@@ -162,6 +162,8 @@ def test_compiled_joint_speeds_equal_numpy(name: str) -> None:
     compiled, reference = family(robot), family(arm(name, compiled=False))
     q = random_configurations(robot, 30, seed=8).T[:, :, None]  # (n, 30, 1)
     q[:, 3] = np.nan  # a branch without a solution
+    if robot.dof == 7:  # the xArm7 loses rank at q = 0: numpy (its SVD, the LP) decides there
+        q[:, 5] = np.clip(0.0, robot.q_lower, robot.q_upper)[:, None]
     rng = np.random.default_rng(9)
     twist = rng.normal(size=(6, 30, 1))
     point = rng.uniform(-0.5, 0.5, (3, 30, 1))
