@@ -26,15 +26,19 @@ from solver.families.numeric.chain import SerialChain
 # The Sobol sequence's seed: fixed, so that the same input gives the same branches.
 SOBOL_SEED = 20240611
 # Work of one placement in poses of a closed-form family (KinematicsFamily.path_cost), measured
-# on the 2-core development machine against the analytic UR5 map (3.8 us a pose on the ERK
-# path): seeding the first waypoint (K seeds, up to ik.SEED_ITERATIONS each) and following the
-# branches found to each next waypoint, for the worst catalogue arm of each size.
-# Seeding: the Panda took up to 24 ms a placement (64 seeds; placements of a differential
-# evolution, many seeds unconverged), UR5 as a URDF and the Jaco2 6-12 ms (32 seeds).
-SEED_COST = {6: 3_200.0, 7: 6_400.0}
-# Following: UR5 as a URDF 0.24 ms a waypoint, the Jaco2 0.08 ms; the Panda 0.59 ms, the xArm7
-# (whose +-2 pi joints give many distinct solutions) 1.44 ms.
-TRACK_COST = {6: 65.0, 7: 400.0}
+# with the compiled chain (ik_kernel) on the 2-core development machine against the analytic
+# UR5 map of the same run (ERK grid, 546 placements, 133 waypoints, 2026-12-02): seeding the
+# first waypoint (K seeds, up to ik.SEED_ITERATIONS each) and following each branch found to
+# each next waypoint, the whole map's time per placement and per waypoint. Each size has the
+# lines (seeding, following per waypoint) of its measured arms, and a path costs the highest.
+# Six joints: UR5 as a URDF 1,555 and 47.9 (59x the analytic map), the Jaco2 4,800 and 21.2
+# (its seeds converge slowly); a placement out of reach (every seed to the last iteration)
+# 3,616 for the UR5. Seven: the Panda 10,389 and 193 (an unreachable placement's seeding takes
+# 1.8 times a reachable one's: 5.0 against 2.8 ms CPU), the xArm7 5,784 and 144.
+COST_LINES: dict[int, tuple[tuple[float, float], ...]] = {
+    6: ((1_600.0, 50.0), (4_800.0, 22.0)),
+    7: ((18_500.0, 200.0),),
+}
 
 
 def seed_count(dof: int) -> int:
@@ -92,14 +96,15 @@ class NumericFamily(KinematicsFamily):
         return self.chain.dof
 
     def path_cost(self, n_waypoints: int) -> float:
-        """Seeding plus following, in closed-form poses (SEED_COST, TRACK_COST).
+        """Seeding plus following, in closed-form poses: the highest line of COST_LINES.
 
         Arms of more than seven joints scale the seven-joint figures by (dof / 7)^2 (the
         Jacobian products and solves grow about so).
         """
         size = min(max(self.dof, 6), 7)
         scale = max(self.dof / 7, 1.0) ** 2
-        return scale * (SEED_COST[size] + max(n_waypoints - 1, 0) * TRACK_COST[size])
+        following = max(n_waypoints - 1, 0)
+        return scale * max(seed + following * track for seed, track in COST_LINES[size])
 
     @property
     def branches(self) -> tuple[Branch, ...]:
