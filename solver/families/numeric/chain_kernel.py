@@ -56,47 +56,50 @@ def drop_stale_cache(module_file: Path) -> None:
 def frames(chain, q, work):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
     """Joint axes and origins, the flange's rotation and position, all in {B}, into ``work``.
 
-    ``SerialChain.frames`` for one q (n,): the same products, Rodrigues' formula
-    R exp([a] q) = c R + s R [a] + (1 - c) (R a) a^T for a revolute joint. ``work`` is
-    workspace's: axes (n, 3), origins (n, 3), rot (3, 3), pos (3,) are written.
+    ``SerialChain.frames`` for one q (n,), on the frames :meth:`SerialChain.packed` turns so
+    that every joint turns about its z: R_j = R_{j-1} M_j Rz(q_j), so the axis is the third
+    column of R_{j-1} M_j and the joint's rotation mixes two columns. ``work`` is workspace's:
+    axes (n, 3), origins (n, 3), rot (3, 3), pos (3,) are written.
     """
-    joint_rotation, joint_translation, axis, revolute, base_r, base_t, tool_r, tool_t = chain
-    axes, origins, rot, pos, r, tmp = work[0], work[1], work[2], work[3], work[4], work[5]
+    joint_rotation, joint_translation, _, revolute, base_r, base_t, tool_r, tool_t = chain
+    axes, origins, rot, pos, r = work[0], work[1], work[2], work[3], work[4]
     p0, p1, p2 = base_t[0], base_t[1], base_t[2]
     for i in range(3):
         for k in range(3):
             r[i, k] = base_r[i, k]
     for j in range(len(revolute)):
-        ax, ay, az = axis[j, 0], axis[j, 1], axis[j, 2]
         t0, t1, t2 = joint_translation[j, 0], joint_translation[j, 1], joint_translation[j, 2]
         p0 += r[0, 0] * t0 + r[0, 1] * t1 + r[0, 2] * t2
         p1 += r[1, 0] * t0 + r[1, 1] * t1 + r[1, 2] * t2
         p2 += r[2, 0] * t0 + r[2, 1] * t1 + r[2, 2] * t2
         origins[j, 0], origins[j, 1], origins[j, 2] = p0, p1, p2
+        turns = revolute[j]
+        c, s = (math.cos(q[j]), math.sin(q[j])) if turns else (1.0, 0.0)
         for i in range(3):
             r0, r1, r2 = r[i, 0], r[i, 1], r[i, 2]
-            for k in range(3):
-                tmp[i, k] = (
-                    r0 * joint_rotation[j, 0, k]
-                    + r1 * joint_rotation[j, 1, k]
-                    + r2 * joint_rotation[j, 2, k]
-                )
-            axes[j, i] = tmp[i, 0] * ax + tmp[i, 1] * ay + tmp[i, 2] * az
-        if revolute[j]:
-            c, s = math.cos(q[j]), math.sin(q[j])
-            for i in range(3):  # row i of R [a]: (r_i1 az - r_i2 ay, r_i2 ax - r_i0 az, ...)
-                t0, t1, t2 = tmp[i, 0], tmp[i, 1], tmp[i, 2]
-                u = (1.0 - c) * axes[j, i]
-                r[i, 0] = c * t0 + s * (t1 * az - t2 * ay) + u * ax
-                r[i, 1] = c * t1 + s * (t2 * ax - t0 * az) + u * ay
-                r[i, 2] = c * t2 + s * (t0 * ay - t1 * ax) + u * az
-        else:
+            m0 = (
+                r0 * joint_rotation[j, 0, 0]
+                + r1 * joint_rotation[j, 1, 0]
+                + r2 * joint_rotation[j, 2, 0]
+            )
+            m1 = (
+                r0 * joint_rotation[j, 0, 1]
+                + r1 * joint_rotation[j, 1, 1]
+                + r2 * joint_rotation[j, 2, 1]
+            )
+            m2 = (
+                r0 * joint_rotation[j, 0, 2]
+                + r1 * joint_rotation[j, 1, 2]
+                + r2 * joint_rotation[j, 2, 2]
+            )
+            axes[j, i] = m2
+            r[i, 0] = c * m0 + s * m1
+            r[i, 1] = c * m1 - s * m0
+            r[i, 2] = m2
+        if not turns:
             p0 += axes[j, 0] * q[j]
             p1 += axes[j, 1] * q[j]
             p2 += axes[j, 2] * q[j]
-            for i in range(3):
-                for k in range(3):
-                    r[i, k] = tmp[i, k]
     t0, t1, t2 = tool_t[0], tool_t[1], tool_t[2]
     pos[0] = p0 + r[0, 0] * t0 + r[0, 1] * t1 + r[0, 2] * t2
     pos[1] = p1 + r[1, 0] * t0 + r[1, 1] * t1 + r[1, 2] * t2
