@@ -34,9 +34,10 @@ class Settings(BaseSettings):
         "2-core development machine the default, 5 million, takes 1.5 to 5 s for a UR or OPW "
         "arm in fixed spin, depending on the day, by the compiled kernel, and about 2.3 times "
         "as long in free spin, by its own; /v1/map computes on DTF_THREADS threads). A pair "
-        "of a numeric-IK arm counts as the work of many (its family's path_cost: about 65 a "
-        "waypoint for 6 joints, 400 for 7, plus 3,200 or 6,400 a placement for the seeds), so "
-        "its limit is about the same time.",
+        "of a numeric-IK arm counts as the work of many (its family's path_cost: about 50 a "
+        "waypoint for 6 joints, 200 for 7, plus 1,600 to 4,800 or 18,500 a placement for the "
+        "seeds), so its limit is about the same time; /v1/evaluate weighs its one placement "
+        "the same way against this limit.",
     )
     max_search_poses: int = Field(
         default=6_100_000,

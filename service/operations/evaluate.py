@@ -31,6 +31,7 @@ def _evaluated(
     poses, placement = convert.spun_poses(path, body.spins), convert.placement_of(body.placement)
     spin_mode = convert.spin_mode_of(body.spin_mode, path)
     problem = convert.problem_of(robot, poses, path, ik=body.ik, spin_mode=spin_mode)
+    _check_work(problem, settings)
     if body.joint_path is not None:
         if spin_mode != "fixed":
             raise InvalidInputError("joint_path", "a joint path is evaluated in spin_mode fixed")
@@ -40,6 +41,26 @@ def _evaluated(
         evaluation = evaluate_path(problem, placement)
     feed = body.feed if body.feed is not None else path.feed
     return robot, path, evaluation, feed, problem
+
+
+def _check_work(problem: PathProblem, settings: Settings) -> None:
+    """Refuse an evaluation whose work, weighed as a map's, is over the map limit (before it).
+
+    One placement of the path costs its family's ``path_cost`` in closed-form poses (one a
+    waypoint for a closed-form family, far more for numeric IK), the unit of the map limit.
+
+    Raises:
+        InvalidInputError: on ``path``, saying the work and the limit.
+    """
+    n_waypoints = len(problem.waypoints)
+    work = problem.family.path_cost(n_waypoints)
+    limits = settings.map_limits()
+    if work > limits.poses:
+        raise InvalidInputError(
+            "path",
+            f"{n_waypoints} waypoints, as work {work:.4g} closed-form poses "
+            f"({problem.family.name} IK); the limit is {limits.poses} ({limits.poses_setting})",
+        )
 
 
 def joint_use_png(body: EvaluateRequest, settings: Settings) -> bytes:

@@ -18,7 +18,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from solver.core.codes import ACC_TIE_RTOL, FEASIBLE
+from solver.core.codes import ACC_TIE_RTOL, FEASIBLE, UNREACHABLE
 from solver.core.dtf import spin_rate_nearest_zero
 from solver.core.dtf_redundant import spin_rate_at_feed
 from solver.core.exceptions import InvalidInputError
@@ -155,6 +155,7 @@ def run_chunk(problem: PathProblem, placements: np.ndarray) -> ChunkResult:
     )
     solutions = family.solve_path(rotation, flange_position)
     q, status = solutions.q, solutions.status  # (n, B_all, C, W), (B_all, C, W)
+    branches = without_empty_slots(branches, status)
     # In free mode the position limits hold along the spin schedule, checked there, not here.
     free = problem.options.spin_mode == "free"
     tracked = track(
@@ -213,6 +214,28 @@ def run_chunk(problem: PathProblem, placements: np.ndarray) -> ChunkResult:
         final_binding=final[2],
         mu_acc=mu_acc,
     )
+
+
+def without_empty_slots(branches: np.ndarray, status: np.ndarray) -> np.ndarray:
+    """The branches to follow, less the trailing ones no placement of the chunk has solved.
+
+    A numeric family answers K slots and fills the first few (the distinct solutions it found);
+    the slots after the last one solved anywhere in the chunk would be tracked, bounded and
+    compared for nothing. Dropped, they change no answer: they are unreachable at the first
+    waypoint, so ``auto`` never takes them (a failure at waypoint 0 loses every tie to an
+    earlier branch). Only ``auto``'s branches 0..B-1 are trimmed, so the kept ones are a prefix
+    and the result's branch axis still indexes :attr:`PathProblem.branches`; one is always kept.
+
+    Args:
+        branches: the problem's branch indices (:attr:`PathProblem.branches`).
+        status: shape (B_all, C, W), the family's IK status of every slot.
+    """
+    if not np.array_equal(branches, np.arange(len(branches))):
+        return branches
+    solved = np.flatnonzero(
+        (status[: len(branches)] != UNREACHABLE).reshape(len(branches), -1).any(axis=1)
+    )
+    return branches[: solved[-1] + 1 if solved.size else 1]
 
 
 _NoBounds = tuple[None, None, None, None]

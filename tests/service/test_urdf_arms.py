@@ -9,6 +9,10 @@ from typing import Any
 import pytest
 from fastapi.testclient import TestClient
 
+from service.config import get_settings
+from solver.core.robots import example_robot_data_dir
+from solver.families import robot_from_urdf
+from solver.families.numeric.family import NumericFamily
 from tests.cases import EXAMPLES, OPTIMUM_EVALUATE_RTOL
 from tests.service.conftest import sent_back
 
@@ -198,3 +202,41 @@ def test_numeric_optimize_is_weighed_by_its_cost(
     [entry] = response.json()["detail"]
     assert entry["loc"] == ["body", "bounds"]
     assert "numeric IK" in entry["msg"] and "the limit is" in entry["msg"]
+
+
+def test_numeric_evaluate_is_weighed_by_its_cost(
+    client: TestClient,
+    panda: dict[str, Any],
+    waypoints: list[dict[str, Any]],
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """One placement of a numeric arm's path is its family's path_cost, against the map limit."""
+    limit = 1_000  # above ten closed-form poses, below one numeric seeding
+    monkeypatch.setenv("DTF_MAX_MAP_POSES", str(limit))
+    get_settings.cache_clear()
+    try:
+        body = {"robot": panda, "path": {"waypoints": waypoints}, "placement": PLACEMENT}
+        response = client.post("/v1/evaluate", json=body)
+        analytic = client.post("/v1/evaluate", json={**body, "robot": {"model": "ur5"}})
+    finally:
+        monkeypatch.undo()
+        get_settings.cache_clear()
+    assert response.status_code == 422, response.text
+    [entry] = response.json()["detail"]
+    assert entry["loc"] == ["body", "path"]
+    assert "10 waypoints, as work" in entry["msg"] and "(numeric IK)" in entry["msg"]
+    assert f"the limit is {limit} (DTF_MAX_MAP_POSES)" in entry["msg"]
+    assert analytic.status_code == 200, analytic.text
+
+
+def test_the_erk_size_map_of_a_six_joint_urdf_is_within_the_map_limit(
+    client: TestClient, erk_path: dict[str, Any]
+) -> None:
+    """Issue 27: the UR5 given as a URDF maps the ERK grid synchronously, as the analytic UR5."""
+    urdf = (example_robot_data_dir() / "ur_description" / "urdf" / "ur5_robot.urdf").read_text()
+    robot = {"urdf": urdf, "base_frame": "base", "tool_frame": "tool0"}
+    model = robot_from_urdf(urdf, base_frame="base", tool_frame="tool0").model
+    numeric = NumericFamily(model, base_frame="base", tool_frame="tool0")
+    assert 546 * numeric.path_cost(133) <= get_settings().max_map_poses
+    response = client.post("/v1/map", json={"robot": robot, "path": erk_path, "grid": ERK_GRID})
+    assert response.status_code == 200, response.text

@@ -87,6 +87,36 @@ class SerialChain:
             tool_translation=tool.translation.copy(),
         )
 
+    def packed(self) -> tuple[np.ndarray, ...]:
+        """The geometry as the compiled chain takes it (:mod:`~.chain_kernel`, :mod:`~.ik_kernel`).
+
+        Each joint frame is turned by A_j (A_j z = its axis), so that every joint turns about
+        its own z and a joint's rotation costs two columns, not a 3 x 3 product: joint
+        rotations M_j = A_{j-1}^T R_j A_j (n, 3, 3), translations A_{j-1}^T t_j (n, 3), the
+        axes (n, 3) as given, revolute (n,) bool, the base rotation (3, 3) and translation (3,),
+        the tool's A_n^T R_n_F (3, 3) and A_n^T t_n_F (3,). An axis along z gives A = I and
+        an axis along x or y a permutation, so most chains are taken exactly.
+        """
+        aligned = [_aligned_to_z(axis) for axis in self.axis]
+        before = [np.eye(3), *aligned[:-1]]
+        rotation = [
+            b.T @ r @ a for b, r, a in zip(before, self.joint_rotation, aligned, strict=True)
+        ]
+        translation = [b.T @ t for b, t in zip(before, self.joint_translation, strict=True)]
+        return tuple(
+            np.ascontiguousarray(a, dtype=bool if a is self.revolute else float)
+            for a in (
+                np.array(rotation),
+                np.array(translation),
+                self.axis,
+                self.revolute,
+                self.base_rotation,
+                self.base_translation,
+                aligned[-1].T @ self.tool_rotation,
+                aligned[-1].T @ self.tool_translation,
+            )
+        )
+
     def frames(self, q: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         """Every joint frame and the flange in {B}.
 
@@ -147,6 +177,21 @@ class SerialChain:
         jacobian[:, :3] = np.where(self.revolute[:, None], turning, axes).transpose(0, 2, 1)
         jacobian[:, 3:] = np.where(self.revolute[:, None], axes, 0.0).transpose(0, 2, 1)
         return jacobian, rotation, position
+
+
+def _aligned_to_z(axis: np.ndarray) -> np.ndarray:
+    """A rotation A (3, 3) with A z = ``axis``: the identity for z, a permutation for x or y."""
+    z = axis / np.linalg.norm(axis)
+    for candidate in np.eye(3):
+        if abs(candidate @ z) == 1.0:  # along a coordinate axis: a signed permutation
+            x = np.roll(candidate, 1) if candidate[2] == 0.0 else np.array([1.0, 0.0, 0.0])
+            x = x * np.sign(candidate @ z) if candidate[2] == 0.0 else x * np.sign(z[2])
+            break
+    else:
+        least = np.eye(3)[np.argmin(np.abs(z))]
+        x = np.cross(least, z)
+        x /= np.linalg.norm(x)
+    return np.column_stack([x, np.cross(z, x), z])
 
 
 def _skew(axis: np.ndarray) -> np.ndarray:

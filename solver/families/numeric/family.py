@@ -21,19 +21,23 @@ from solver.core.codes import OK, SINGULAR, UNREACHABLE
 from solver.core.dtf_redundant import redundant_speed
 from solver.core.family import Branch, KinematicsFamily, PathSolutions
 from solver.core.spatial import wrap_angle
-from solver.families.numeric import ik
+from solver.families.numeric import chain_kernel, ik, ik_kernel, redundant_kernel
 from solver.families.numeric.chain import SerialChain
 
 # Work of one placement in poses of a closed-form family (KinematicsFamily.path_cost), measured
-# on the 2-core development machine against the analytic UR5 map (3.8 us a pose on the ERK
-# path): seeding the first waypoint (K seeds, up to ik.SEED_ITERATIONS each) and following the
-# branches found to each next waypoint, for the worst catalogue arm of each size.
-# Seeding: the Panda took up to 24 ms a placement (64 seeds; placements of a differential
-# evolution, many seeds unconverged), UR5 as a URDF and the Jaco2 6-12 ms (32 seeds).
-SEED_COST = {6: 3_200.0, 7: 6_400.0}
-# Following: UR5 as a URDF 0.24 ms a waypoint, the Jaco2 0.08 ms; the Panda 0.59 ms, the xArm7
-# (whose +-2 pi joints give many distinct solutions) 1.44 ms.
-TRACK_COST = {6: 65.0, 7: 400.0}
+# with the compiled chain (ik_kernel) on the 2-core development machine against the analytic
+# UR5 map of the same run (ERK grid, 546 placements, 133 waypoints, 2026-12-02): seeding the
+# first waypoint (K seeds, up to ik.SEED_ITERATIONS each) and following each branch found to
+# each next waypoint, the whole map's time per placement and per waypoint. Each size has the
+# lines (seeding, following per waypoint) of its measured arms, and a path costs the highest.
+# Six joints: UR5 as a URDF 1,555 and 47.9 (59x the analytic map), the Jaco2 4,800 and 21.2
+# (its seeds converge slowly); a placement out of reach (every seed to the last iteration)
+# 3,616 for the UR5. Seven: the Panda 10,389 and 193 (an unreachable placement's seeding takes
+# 1.8 times a reachable one's: 5.0 against 2.8 ms CPU), the xArm7 5,784 and 144.
+COST_LINES: dict[int, tuple[tuple[float, float], ...]] = {
+    6: ((1_600.0, 50.0), (4_800.0, 22.0)),
+    7: ((18_500.0, 200.0),),
+}
 
 
 def seed_count(dof: int) -> int:
@@ -51,13 +55,23 @@ class NumericFamily(KinematicsFamily):
 
     name = "numeric"
 
-    def __init__(self, model: pin.Model, *, base_frame: str, tool_frame: str) -> None:
+    def __init__(
+        self,
+        model: pin.Model,
+        *,
+        base_frame: str,
+        tool_frame: str,
+        compiled: bool = True,
+    ) -> None:
         """Read the chain and fix the seeds.
 
         Args:
             model: pinocchio model whose joints (1-DOF, one serial chain) all move the tool.
             base_frame: {B}, fixed to the root.
             tool_frame: the flange {F}.
+            compiled: solve with the compiled chain (:mod:`solver.families.numeric.ik_kernel`);
+                False: with the numpy chain and :mod:`solver.families.numeric.ik`, the
+                reference it is tested against.
 
         Raises:
             RobotModelError: the model is not such a chain.
@@ -70,6 +84,8 @@ class NumericFamily(KinematicsFamily):
             count, lower=self.lower, upper=self.upper, revolute=self.chain.revolute
         )
         self._branches = tuple(Branch.named(solution=str(k)) for k in range(count))
+        self.compiled = compiled
+        self._packed = self.chain.packed()
 
     @property
     def dof(self) -> int:
@@ -77,14 +93,15 @@ class NumericFamily(KinematicsFamily):
         return self.chain.dof
 
     def path_cost(self, n_waypoints: int) -> float:
-        """Seeding plus following, in closed-form poses (SEED_COST, TRACK_COST).
+        """Seeding plus following, in closed-form poses: the highest line of COST_LINES.
 
         Arms of more than seven joints scale the seven-joint figures by (dof / 7)^2 (the
         Jacobian products and solves grow about so).
         """
         size = min(max(self.dof, 6), 7)
         scale = max(self.dof / 7, 1.0) ** 2
-        return scale * (SEED_COST[size] + max(n_waypoints - 1, 0) * TRACK_COST[size])
+        following = max(n_waypoints - 1, 0)
+        return scale * max(seed + following * track for seed, track in COST_LINES[size])
 
     @property
     def branches(self) -> tuple[Branch, ...]:
@@ -111,6 +128,30 @@ class NumericFamily(KinematicsFamily):
         q = q.reshape(n_poses, n_seeds, self.dof)
         return ik.distinct(q, converged.reshape(n_poses, n_seeds), self.chain.revolute)
 
+    def _compiled(
+        self, rotations: np.ndarray, positions: np.ndarray
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """:func:`ik_kernel.solve_paths` at rotations (P, W, 3, 3) and positions (P, W, 3).
+
+        Returns:
+            q (n, K, P, W), rad, wrapped, NaN in slots without a solution; status (K, P, W);
+            count (P,), the distinct solutions found at the first waypoints.
+        """
+        settings = np.array(
+            [ik.SEED_ITERATIONS, ik.TRACK_ITERATIONS, ik.DISTINCT, ik.SINGULAR_RCOND], dtype=float
+        )
+        constants = np.array([ik.TOLERANCE, ik.DAMPING_SCALE, ik.DAMPING_FLOOR])
+        result: tuple[np.ndarray, np.ndarray, np.ndarray] = ik_kernel.solve_paths(
+            self._packed,
+            self.seeds,
+            (self.lower, self.upper),
+            np.ascontiguousarray(rotations, dtype=float),
+            np.ascontiguousarray(positions, dtype=float),
+            settings,
+            constants,
+        )
+        return result
+
     def _wrapped_with_status(self, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Revolute joints wrapped to [-pi, pi) and the status of each solution, q (..., n)."""
         flat = q.reshape(-1, self.dof)
@@ -130,7 +171,12 @@ class NumericFamily(KinematicsFamily):
         batch = np.broadcast_shapes(rotation.shape[2:], position.shape[1:])
         rotation_flat = np.moveaxis(np.broadcast_to(rotation, (3, 3, *batch)), (0, 1), (-2, -1))
         position_flat = np.moveaxis(np.broadcast_to(position, (3, *batch)), 0, -1)
-        slots, _ = self._seeded(rotation_flat.reshape(-1, 3, 3), position_flat.reshape(-1, 3))
+        rotation_flat, position_flat = rotation_flat.reshape(-1, 3, 3), position_flat.reshape(-1, 3)
+        if self.compiled:  # a path of one waypoint: the seeding alone
+            q_k, status_k, _ = self._compiled(rotation_flat[:, None], position_flat[:, None])
+            q_shape = (self.dof, len(self.seeds), *batch)
+            return q_k.reshape(q_shape), status_k.reshape(q_shape[1:])
+        slots, _ = self._seeded(rotation_flat, position_flat)
         q, status = self._wrapped_with_status(slots)  # (P, K, n), (P, K)
         q = np.moveaxis(q.reshape(*batch, len(self.seeds), self.dof), (-1, -2), (0, 1))
         return q, np.moveaxis(status.reshape(*batch, len(self.seeds)), -1, 0)
@@ -154,6 +200,14 @@ class NumericFamily(KinematicsFamily):
         positions = np.moveaxis(np.broadcast_to(position, (3, *shape)), 0, -1)
         positions = positions.reshape(-1, n_waypoints, 3)
         n_paths, n_seeds = len(positions), len(self.seeds)
+        if self.compiled:
+            q_k, status_k, count_k = self._compiled(rotations, positions)
+            return PathSolutions(
+                q=q_k.reshape(self.dof, n_seeds, *batch, n_waypoints),
+                status=status_k.reshape(n_seeds, *batch, n_waypoints),
+                seeds=n_seeds,
+                branches_found=count_k.reshape(batch),
+            )
         slots, count = self._seeded(rotations[:, 0], positions[:, 0])
         q = np.full((n_paths, n_seeds, n_waypoints, self.dof), np.nan)
         q[:, :, 0] = slots
@@ -232,7 +286,26 @@ class NumericFamily(KinematicsFamily):
         point_flat = np.moveaxis(np.broadcast_to(tool_point, (3, *shape)), 0, -1).reshape(-1, 3)
         speeds = np.full(q_flat.shape, np.nan)
         rows = np.flatnonzero(np.isfinite(q_flat).all(axis=-1))
-        jacobian, _, _ = self.chain.jacobian(q_flat[rows], point_flat[rows])
+        if self.compiled and self.dof == 6:
+            speeds = chain_kernel.speeds_per_twist(
+                self._packed, *(np.ascontiguousarray(a) for a in (q_flat, twist_flat, point_flat))
+            )
+            return np.moveaxis(speeds.reshape(*shape, self.dof), -1, 0)
+        if self.compiled and self.dof == 7 and qdot_max is not None:
+            speeds, irregular = redundant_kernel.redundant_speeds(
+                self._packed,
+                *(np.ascontiguousarray(a) for a in (q_flat, twist_flat, point_flat)),
+                np.asarray(qdot_max, dtype=float),
+            )
+            rows = np.flatnonzero(irregular)  # J near rank loss: numpy's SVD or the LP decides
+        if self.compiled:
+            jacobian = chain_kernel.jacobians(
+                self._packed,
+                np.ascontiguousarray(q_flat[rows]),
+                np.ascontiguousarray(point_flat[rows]),
+            )
+        else:
+            jacobian, _, _ = self.chain.jacobian(q_flat[rows], point_flat[rows])
         if self.dof == 6:
             speeds[rows] = _solve_or_nan(jacobian, twist_flat[rows])
         elif self.dof > 6 and qdot_max is not None:

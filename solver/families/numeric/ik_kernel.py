@@ -1,0 +1,261 @@
+"""The numeric family's compiled IK: damped least squares, seeding and following, batched.
+
+The compiled twin of :mod:`solver.families.numeric.ik` (``solve``, ``distinct``,
+``is_singular``) and of :class:`~solver.families.numeric.family.NumericFamily`'s seeding and
+following (robots.md section 4), one problem at a time on the compiled chain
+(:mod:`solver.families.numeric.chain_kernel`): the same algorithm, constants and decisions; the
+numpy code is the reference the tests hold it to (the solutions and the maps, cell by cell).
+Every function releases the GIL (``nogil``).
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+from numba import njit
+
+from solver.core.codes import OK, SINGULAR, UNREACHABLE
+from solver.families.numeric.chain_kernel import (
+    drop_stale_cache,
+    frames,
+    jacobian_at,
+    lu_solve,
+    workspace,
+)
+
+_TWO_PI = 2.0 * math.pi
+
+
+drop_stale_cache(Path(__file__))
+
+
+@njit(cache=True, nogil=True, error_model="numpy", inline="always")
+def _pose_error(target_r, target_p, work):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
+    """``ik.pose_error`` at the flange in ``work``: e = [p* - p; log(R* R^T)] into work[8]."""
+    rot, pos, error, m = work[2], work[3], work[8], work[9]
+    for i in range(3):
+        error[i] = target_p[i] - pos[i]
+        for k in range(3):
+            m[i, k] = (
+                target_r[i, 0] * rot[k, 0] + target_r[i, 1] * rot[k, 1] + target_r[i, 2] * rot[k, 2]
+            )
+    s0 = 0.5 * (m[2, 1] - m[1, 2])
+    s1 = 0.5 * (m[0, 2] - m[2, 0])
+    s2 = 0.5 * (m[1, 0] - m[0, 1])
+    sin = math.sqrt(s0 * s0 + s1 * s1 + s2 * s2)
+    cos = 0.5 * (m[0, 0] + m[1, 1] + m[2, 2] - 1.0)
+    angle = math.atan2(sin, cos)
+    factor = angle / sin if sin > 1e-300 else 1.0
+    error[3], error[4], error[5] = factor * s0, factor * s1, factor * s2
+    if cos < -0.9:  # ik.rotation_log: the axis from the symmetric part near pi
+        c = 0
+        for k in range(1, 3):
+            if m[k, k] - cos > m[c, c] - cos:
+                c = k
+        v0 = 0.5 * (m[0, c] + m[c, 0]) - (cos if c == 0 else 0.0)
+        v1 = 0.5 * (m[1, c] + m[c, 1]) - (cos if c == 1 else 0.0)
+        v2 = 0.5 * (m[2, c] + m[c, 2]) - (cos if c == 2 else 0.0)
+        norm = math.sqrt(v0 * v0 + v1 * v1 + v2 * v2)
+        v0, v1, v2 = v0 / norm, v1 / norm, v2 / norm
+        turn = (-1.0 if v0 * s0 + v1 * s1 + v2 * s2 < 0.0 else 1.0) * angle
+        error[3], error[4], error[5] = turn * v0, turn * v1, turn * v2
+
+
+@njit(cache=True, nogil=True, error_model="numpy", inline="always")
+def _levenberg_marquardt(chain, q, target_r, target_p, iterations, box, constants, work):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
+    """``ik.solve`` for one problem: iterate q (n,) in place; True when converged.
+
+    ``box``: None, or (lower, upper) that every iterate is clipped into. ``constants``:
+    ik.TOLERANCE, ik.DAMPING_SCALE, ik.DAMPING_FLOOR. On return ``work`` holds the frames of
+    the last iterate (:func:`chain_kernel.frames`).
+    """
+    tolerance, scale, floor = constants[0], constants[1], constants[2]
+    n = len(q)
+    jac, normal, error = work[6], work[7], work[8]
+    for step in range(iterations + 1):
+        frames(chain, q, work)
+        _pose_error(target_r, target_p, work)
+        largest, finite, energy = 0.0, True, 0.0
+        for i in range(6):
+            largest = max(largest, abs(error[i]))
+            finite = finite and not math.isnan(error[i])
+            energy += error[i] * error[i]
+        if not finite or largest < tolerance:  # a NaN error stops a row in numpy too
+            return True
+        if step == iterations:
+            return False
+        jacobian_at(chain[3], work[0], work[1], work[3], jac)
+        damping = scale * 0.5 * energy + floor
+        for i in range(6):
+            for k in range(i + 1):
+                total = 0.0
+                for j in range(n):
+                    total += jac[i, j] * jac[k, j]
+                normal[i, k] = total
+                normal[k, i] = total
+            normal[i, i] += damping
+        if not lu_solve(normal, error):
+            return False
+        for j in range(n):
+            moved = q[j]
+            moved += (
+                jac[0, j] * error[0]
+                + jac[1, j] * error[1]
+                + jac[2, j] * error[2]
+                + jac[3, j] * error[3]
+                + jac[4, j] * error[4]
+                + jac[5, j] * error[5]
+            )
+            if box is not None:
+                moved = min(max(moved, box[0][j]), box[1][j])
+            q[j] = moved
+    return False
+
+
+@njit(cache=True, nogil=True, error_model="numpy")
+def solve_rows(chain, start, target_r, target_p, iterations, box, constants):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
+    """``ik.solve`` over M problems: q (M, n), the last iterates, and converged (M,), bool.
+
+    Args:
+        chain: :meth:`SerialChain.packed`.
+        start: shape (M, n), rad.
+        target_r: shape (M, 3, 3), R_B_F*.
+        target_p: shape (M, 3), m in {B}.
+        iterations: the most steps any problem takes.
+        box: None, or (lower, upper), each (n,), the box every iterate is clipped into.
+        constants: as for :func:`_levenberg_marquardt`.
+    """
+    q = start.copy()
+    converged = np.zeros(len(q), dtype=np.bool_)
+    work = workspace(q.shape[1])
+    for m in range(len(q)):
+        converged[m] = _levenberg_marquardt(
+            chain, q[m], target_r[m], target_p[m], iterations, box, constants, work
+        )
+    return q, converged
+
+
+@njit(cache=True, nogil=True, error_model="numpy", inline="always")
+def _wrapped_distance(a, b, revolute):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
+    """``ik.joint_distance`` of two configurations (n,): revolute differences wrapped."""
+    total = 0.0
+    for j in range(len(a)):
+        d = a[j] - b[j]
+        if revolute[j]:
+            d = (d + math.pi) % _TWO_PI - math.pi
+        total += d * d
+    return math.sqrt(total)
+
+
+@njit(cache=True, nogil=True, error_model="numpy", inline="always")
+def _singular(chain, rcond, work):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
+    """``ik.is_singular`` at the frames in ``work``: sigma_min / sigma_max of J below ``rcond``.
+
+    A Cholesky factor of J J^T - rcond^2 trace(J J^T) I proves sigma_min^2 above rcond^2
+    sigma_max^2 (trace >= sigma_max^2) without eigenvalues; only where it fails are the
+    eigenvalues computed, as numpy does.
+    """
+    n = len(chain[3])
+    jac, normal, factor = work[6], work[7], work[10]
+    jacobian_at(chain[3], work[0], work[1], work[3], jac)
+    trace = 0.0
+    for i in range(6):
+        for k in range(i + 1):
+            total = 0.0
+            for j in range(n):
+                total += jac[i, j] * jac[k, j]
+            normal[i, k] = total
+            normal[k, i] = total
+        trace += normal[i, i]
+    shift = rcond * rcond * trace
+    for j in range(6):  # Cholesky of normal - shift I, lower triangle
+        s = normal[j, j] - shift
+        for k in range(j):
+            s -= factor[j, k] * factor[j, k]
+        if not s > 0.0:
+            squares = np.linalg.eigvalsh(normal)
+            return squares[0] < rcond * rcond * squares[-1]
+        d = math.sqrt(s)
+        factor[j, j] = d
+        for i in range(j + 1, 6):
+            t = normal[i, j]
+            for k in range(j):
+                t -= factor[i, k] * factor[j, k]
+            factor[i, j] = t / d
+    return False
+
+
+@njit(cache=True, nogil=True, error_model="numpy")
+def solve_paths(chain, seeds, box, rotations, positions, settings, constants):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
+    """The family's ``solve_path`` for P paths: seeded at the first waypoint, then followed.
+
+    At the first waypoint every seed is solved within the joint box; the distinct solutions
+    (``ik.distinct``: wrapped joint distance above ``settings[2]`` from every earlier kept one)
+    fill the slots in seed order; each is followed to each next waypoint from its solution at
+    the previous one, without the box, until it does not converge (NaN from there).
+
+    Args:
+        chain: :meth:`SerialChain.packed`.
+        seeds: shape (K, n), the starts.
+        box: (lower, upper), each (n,), the joint box.
+        rotations: shape (P, W, 3, 3), R_B_F* of each path.
+        positions: shape (P, W, 3), m in {B}.
+        settings: ik.SEED_ITERATIONS, ik.TRACK_ITERATIONS, ik.DISTINCT, ik.SINGULAR_RCOND.
+        constants: as for :func:`_levenberg_marquardt`.
+
+    Returns:
+        q: shape (n, K, P, W), revolute joints wrapped to [-pi, pi), NaN where a slot has no
+        solution; status: shape (K, P, W), ``OK``, ``SINGULAR`` or ``UNREACHABLE``;
+        count: shape (P,), the distinct solutions found.
+    """
+    n_seeds, n = seeds.shape
+    n_paths, n_waypoints = positions.shape[0], positions.shape[1]
+    seed_iterations, track_iterations = int(settings[0]), int(settings[1])
+    apart, rcond = settings[2], settings[3]
+    revolute = chain[3]
+    q = np.full((n, n_seeds, n_paths, n_waypoints), np.nan)
+    status = np.full((n_seeds, n_paths, n_waypoints), UNREACHABLE)
+    count = np.zeros(n_paths, dtype=np.int64)
+    found = np.empty((n_seeds, n))
+    current = np.empty(n)
+    work = workspace(n)
+    for p in range(n_paths):
+        kept = 0
+        for k in range(n_seeds):
+            current[:] = seeds[k]
+            target_r, target_p = rotations[p, 0], positions[p, 0]
+            if not _levenberg_marquardt(
+                chain, current, target_r, target_p, seed_iterations, box, constants, work
+            ):
+                continue
+            new = True
+            for other in range(kept):
+                if _wrapped_distance(found[other], current, revolute) <= apart:
+                    new = False
+                    break
+            if new:
+                found[kept] = current
+                kept += 1
+        count[p] = kept
+        for b in range(kept):
+            current[:] = found[b]
+            frames(chain, current, work)
+            for w in range(n_waypoints):
+                if w > 0 and not _levenberg_marquardt(
+                    chain,
+                    current,
+                    rotations[p, w],
+                    positions[p, w],
+                    track_iterations,
+                    None,
+                    constants,
+                    work,
+                ):
+                    break
+                status[b, p, w] = SINGULAR if _singular(chain, rcond, work) else OK
+                for j in range(n):
+                    value = current[j]
+                    q[j, b, p, w] = (value + math.pi) % _TWO_PI - math.pi if revolute[j] else value
+    return q, status, count
