@@ -28,11 +28,13 @@ from service.api.routes import health
 from service.body import BODY_MODELS
 from service.config import get_settings
 from service.errors import (
+    SERVER_ERROR_RESPONSE,
     BodySizeLimitMiddleware,
     cancelled_handler,
     http_error_handler,
     job_store_unavailable_handler,
     request_validation_error_handler,
+    server_error_handler,
     solver_error_handler,
 )
 from service.jobs.runner import close_runners, get_runner
@@ -72,8 +74,9 @@ Every placement in an answer also comes as a controller frame (UR, KUKA, ABB, FA
 SI units throughout (m, rad, s). Paths are poses, tool points with tool axes, APT CL data or
 CSV (passes split at rapids; /v1/evaluate checks the programmed feed). Input errors
 are `422` with a `detail` list whose `loc` names the field (and waypoint index); oversized
-bodies are `413`; bodies not declared as JSON are `415`. These pages load nothing from the
-internet.
+bodies are `413`; bodies not declared as JSON (or sent without a Content-Type) are `415`; a body
+that stops short of its length is `408`. Every error answer (404, 429, 500 too) is a JSON object
+with the same `detail` list. These pages load nothing from the internet.
 """
 
 
@@ -151,7 +154,9 @@ def create_app() -> FastAPI:
             SolverError: solver_error_handler,
             Cancelled: cancelled_handler,
             JobStoreUnavailable: job_store_unavailable_handler,
+            Exception: server_error_handler,
         },
+        responses=SERVER_ERROR_RESPONSE,
         lifespan=lifespan,
     )
     app.include_router(health.router)

@@ -18,7 +18,7 @@ from pathlib import Path
 import numpy as np
 import pinocchio as pin
 
-from solver.core.exceptions import InvalidInputError, RobotModelError, quoted
+from solver.core.exceptions import InvalidInputError, RobotModelError, quoted, quoted_names
 from solver.core.family import KinematicsFamily
 from solver.core.urdf_structure import mimic_joints, root_links
 
@@ -128,7 +128,7 @@ def _checked_limits(
         count = limits.size if limits.ndim == 1 else f"an array of shape {limits.shape} of"
         raise InvalidInputError(
             field,
-            f"{count} values for the {len(joint_names)} joints ({', '.join(joint_names)}): "
+            f"{count} values for the {len(joint_names)} joints ({quoted_names(joint_names)}): "
             "give one per joint, in this order",
         )
     bad = np.flatnonzero(~np.isfinite(limits) | (limits < lower) | (limits > upper))
@@ -136,8 +136,8 @@ def _checked_limits(
         j = int(bad[0])
         raise InvalidInputError(
             field,
-            f"joint {j} ({joint_names[j]}) limit {float(limits[j]):.6g} {unit} must be > 0, "
-            f"within [{lower}, {upper}] {unit}",
+            f"joint {j} ({quoted(joint_names[j])}) limit {float(limits[j]):.6g} {unit} must be "
+            f"> 0, within [{lower}, {upper}] {unit}",
         )
     return limits
 
@@ -225,13 +225,13 @@ def robot_from_model(
     """
     for field, frame in (("robot.base_frame", base_frame), ("robot.tool_frame", tool_frame)):
         if not model.existFrame(frame):
-            names = ", ".join(f.name for f in model.frames if f.name != "universe")
+            names = quoted_names([f.name for f in model.frames if f.name != "universe"])
             raise RobotModelError(field, f"no frame {quoted(frame)} in the model; frames: {names}")
     base = model.frames[model.getFrameId(base_frame)]
     if base.parentJoint != 0:
         raise RobotModelError(
             "robot.base_frame",
-            f"frame {base_frame!r} moves with joint {model.names[base.parentJoint]!r}; "
+            f"frame {quoted(base_frame)} moves with joint {quoted(model.names[base.parentJoint])}; "
             "the base frame must be fixed to the root",
         )
     if any(model.joints[j].nq != 1 or model.joints[j].nv != 1 for j in range(1, model.njoints)):
@@ -288,13 +288,13 @@ def chain_from_urdf(urdf: str, *, tool_frame: str) -> pin.Model:
         if len(roots) > 1:  # pinocchio says why on stderr only
             raise RobotModelError(
                 "robot.urdf",
-                f"cannot parse the URDF: {len(roots)} root links ({', '.join(map(quoted, roots))})"
+                f"cannot parse the URDF: {len(roots)} root links ({quoted_names(roots)})"
                 ": every link but one must be a joint's child; remove the stray link or attach "
                 "it with a fixed joint",
             ) from exc
         raise RobotModelError("robot.urdf", f"cannot parse the URDF: {exc}") from exc
     if not full.existFrame(tool_frame):
-        names = ", ".join(f.name for f in full.frames if f.name != "universe")
+        names = quoted_names([f.name for f in full.frames if f.name != "universe"])
         raise RobotModelError(
             "robot.tool_frame", f"no frame {quoted(tool_frame)} in the model; frames: {names}"
         )
