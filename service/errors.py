@@ -51,6 +51,10 @@ RETRY_AFTER = {
     }
 }
 """The OpenAPI header entry of answers that say when to retry (429, 503)."""
+JSON_ERROR: dict[str, Any] = {
+    "content": {"application/json": {"schema": {"$ref": "#/components/schemas/ErrorResponse"}}}
+}
+"""An error answer's OpenAPI content, for routes whose own answers are not JSON (/metrics)."""
 SERVER_ERROR_RESPONSE: dict[int | str, dict[str, Any]] = {
     status.HTTP_500_INTERNAL_SERVER_ERROR: {
         "model": ErrorResponse,

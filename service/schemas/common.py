@@ -20,6 +20,7 @@ from pydantic import (
     field_validator,
 )
 from pydantic_core import PydanticCustomError
+from typing_extensions import TypeAliasType
 
 from solver.cam.frames import frames_of_placement
 from solver.core.spatial import MAX_COORDINATE, QUATERNION_NORM_TOLERANCE, pose_matrix
@@ -109,7 +110,17 @@ class ToolAxisWaypoint(RequestModel):
     )
 
 
-SpinMode = Literal["fixed", "free"]
+SpinMode = TypeAliasType(
+    "SpinMode",
+    Annotated[
+        Literal["fixed", "free"],
+        Field(
+            description="How the tool spin about its axis is taken: fixed, the orientations as "
+            "given; free, chosen per waypoint (a spindle, disc or grinder; cam.md section 2)."
+        ),
+    ],
+)
+"""One component for every spin_mode field, requests and answers alike."""
 
 
 class ControllerFrames(ResponseModel):
@@ -219,11 +230,12 @@ def _branch_kind(value: object) -> str:
 
 
 BranchChoice = Annotated[
-    Annotated[Literal["auto"], Tag("branch:auto")]
-    | Annotated[Branch, Tag("branch:named")]
-    | Annotated[NumericBranch, Tag("branch:numeric")],
+    Annotated[Branch, Tag("branch:named")]
+    | Annotated[NumericBranch, Tag("branch:numeric")]
+    | Annotated[Literal["auto"], Tag("branch:auto")],
     Discriminator(_branch_kind),
 ]
+"""The objects first: a generated client tries the variants in order, and the last untried."""
 
 
 def _blend_length() -> Any:
