@@ -41,6 +41,7 @@ from service.jobs.runner import close_runners, get_runner
 from service.jobs.store import JobStoreUnavailable
 from service.logs import log, log_to_stderr
 from service.metrics import instrument
+from service.spec import defaults_in_words
 from service.web import mount_page
 from service.work import STOPPING
 from solver.core.exceptions import SolverError
@@ -171,7 +172,10 @@ app = create_app()
 
 
 def _openapi() -> dict[str, Any]:
-    """FastAPI's description, with the schemas of the bodies validated in worker threads."""
+    """FastAPI's description, with the schemas of the bodies validated in worker threads.
+
+    Request defaults are stated in words (:mod:`service.spec`).
+    """
     if app.openapi_schema is None:
         spec = FastAPI.openapi(app)
         _, top = models_json_schema(
@@ -181,7 +185,8 @@ def _openapi() -> dict[str, Any]:
         components = spec.setdefault("components", {}).setdefault("schemas", {})
         for name, schema in top.get("$defs", {}).items():
             components.setdefault(name, schema)
-    return app.openapi_schema or spec
+        app.openapi_schema = defaults_in_words(spec)
+    return app.openapi_schema
 
 
 app.openapi = _openapi  # type: ignore[method-assign]
