@@ -11,6 +11,7 @@ import gc
 import signal
 import sys
 import threading
+import time
 from collections.abc import AsyncIterator
 from types import FrameType
 from typing import Any
@@ -39,7 +40,7 @@ from service.errors import (
 )
 from service.jobs.runner import close_runners, get_runner
 from service.jobs.store import JobStoreUnavailable
-from service.logs import log, log_to_stderr
+from service.logs import log, log_to_stderr, startup_log
 from service.metrics import instrument
 from service.spec import defaults_in_words
 from service.web import mount_page
@@ -97,7 +98,13 @@ async def lifespan(app: FastAPI) -> AsyncIterator[None]:
     _stop_work_on(signal.SIGTERM)
     _stop_work_on(signal.SIGINT)
     log_to_stderr()
+    started = time.monotonic()
+    startup_log.info(
+        "warming up: loading the compiled map kernels (the first start after an install "
+        "compiles them, about 30 s; later starts take a few seconds)"
+    )
     await anyio.to_thread.run_sync(_warm_up)
+    startup_log.info("ready after %.1f s of warm-up", time.monotonic() - started)
     gc.collect()
     gc.freeze()  # what startup made lives on: full collections no longer walk it
     try:
