@@ -127,9 +127,14 @@ class OptimizeRequest(RequestModel):
 
     @model_validator(mode="after")
     def _one_height(self) -> OptimizeRequest:
-        if (self.z is None) == (self.bounds.z is None):
+        if self.z is None and self.bounds.z is None:
             raise PydanticCustomError(
-                "height", "give z (a fixed height) or bounds.z (a range to search), not both"
+                "height", "no height: give z (a fixed height) or bounds.z (a range to search)"
+            )
+        if self.z is not None and self.bounds.z is not None:
+            raise PydanticCustomError(
+                "height",
+                "z (a fixed height) and bounds.z (a range to search) are both given: give one",
             )
         return self
 
