@@ -210,6 +210,11 @@ def test_input_errors_arrive_as_typed_error_responses(generated: ModuleType, cli
         )
         assert isinstance(answer, models.ErrorResponse)
         assert answer.detail[0].loc[:2] == ["body", "placement"]
+    too_many = {**GRID, "yaw": [0.01 * k for k in range(100)]}  # panels over DTF_MAX_PNG_PANELS
+    body = {"robot": EVALUATE["robot"], "path": EVALUATE["path"], "grid": too_many}
+    answer = _call(generated, "map_png", client=client, body=models.MapRequest.from_dict(body))
+    assert isinstance(answer, models.ErrorResponse)
+    assert answer.detail[0].loc[:2] == ["body", "grid"]
 
 
 def test_names_read_well(generated: ModuleType) -> None:
