@@ -94,9 +94,9 @@ class OptimizeRequest(RequestModel):
     bounds: Bounds = Field(description="Where the workpiece may go.")
     z: Coordinate | None = Field(
         default=None,
-        description="Height of the workpiece frame (m), the table height, within 1 km; required "
-        "unless "
-        "bounds.z gives a range to search.",
+        description="Height of the workpiece frame (m), the table height, within 1 km. Give "
+        "z or bounds.z (a range to search), exactly one: both or neither is a 422 on the "
+        "body (a rule between two fields, which JSON Schema here does not state).",
     )
     start: Placement | None = Field(
         default=None,
