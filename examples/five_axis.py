@@ -11,11 +11,10 @@ from __future__ import annotations
 
 import json
 import math
-import sys
 from pathlib import Path
 from typing import Any
 
-from http_post import Post, http_post
+from http_post import Post, run
 
 HERE = Path(__file__).resolve().parent
 
@@ -47,5 +46,4 @@ def lines(post: Post) -> list[str]:
 
 
 if __name__ == "__main__":
-    for line in lines(http_post(sys.argv[1] if len(sys.argv) > 1 else "http://127.0.0.1:8000")):
-        print(line)
+    run(lines)

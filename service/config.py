@@ -21,6 +21,12 @@ class Settings(BaseSettings):
         gt=0,
         description="Largest request body accepted (bytes); a larger one is answered 413.",
     )
+    body_read_seconds: float = Field(
+        default=10.0,
+        gt=0.0,
+        description="Longest wait (s) for a request body to arrive; a body that stops short of "
+        "its Content-Length is answered 408 then, and its connection closed.",
+    )
     max_map_cells: int = Field(
         default=50_000,
         gt=0,

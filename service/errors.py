@@ -7,8 +7,10 @@ Both use FastAPI's validation-error shape, ``{"detail": [{"loc": [...], "msg": .
 from __future__ import annotations
 
 import re
+from http import HTTPStatus
 from typing import Any
 
+import anyio
 from fastapi import Request, status
 from fastapi.exception_handlers import http_exception_handler
 from fastapi.exceptions import RequestValidationError
@@ -42,7 +44,29 @@ def solver_error_location(error: SolverError) -> list[str | int]:
     return ["body", *parts]
 
 
+RETRY_AFTER = {
+    "Retry-After": {
+        "description": "Seconds to wait before retrying.",
+        "schema": {"type": "integer"},
+    }
+}
+"""The OpenAPI header entry of answers that say when to retry (429, 503)."""
+JSON_ERROR: dict[str, Any] = {
+    "content": {"application/json": {"schema": {"$ref": "#/components/schemas/ErrorResponse"}}}
+}
+"""An error answer's OpenAPI content, for routes whose own answers are not JSON (/metrics)."""
+SERVER_ERROR_RESPONSE: dict[int | str, dict[str, Any]] = {
+    status.HTTP_500_INTERNAL_SERVER_ERROR: {
+        "model": ErrorResponse,
+        "description": "A fault of the service (a bug: no input should cause it), as JSON.",
+    }
+}
+"""The OpenAPI entry of the 500 answer, for every operation."""
 ERROR_RESPONSES: dict[int | str, dict[str, Any]] = {
+    status.HTTP_408_REQUEST_TIMEOUT: {
+        "model": ErrorResponse,
+        "description": "The body did not arrive in time (setting DTF_BODY_READ_SECONDS).",
+    },
     status.HTTP_413_CONTENT_TOO_LARGE: {
         "model": ErrorResponse,
         "description": "The body is over the size limit (setting DTF_MAX_BODY_BYTES).",
@@ -54,6 +78,7 @@ ERROR_RESPONSES: dict[int | str, dict[str, Any]] = {
     status.HTTP_503_SERVICE_UNAVAILABLE: {
         "model": ErrorResponse,
         "description": "The work was stopped because the service is shutting down; retry.",
+        "headers": RETRY_AFTER,
     },
     status.HTTP_422_UNPROCESSABLE_CONTENT: {
         "model": ErrorResponse,
@@ -92,11 +117,21 @@ async def request_validation_error_handler(
     return _error_response(status.HTTP_422_UNPROCESSABLE_CONTENT, details)
 
 
+def http_error_type(status_code: int) -> str:
+    """``404`` -> ``"not_found"``: the error type of an HTTP error without a field."""
+    try:
+        phrase = HTTPStatus(status_code).phrase
+    except ValueError:
+        return "http_error"
+    return re.sub(r"\W+", "_", phrase).strip("_").lower()
+
+
 async def http_error_handler(request: Request, error: StarletteHTTPException) -> Response:
-    """FastAPI's answer, except that a body it cannot decode is a ``422`` like any bad input.
+    """FastAPI's answer with a ``detail`` list, as 422s have; an undecodable body is a ``422``.
 
     FastAPI answers ``400`` when the JSON parser itself fails (bytes that are not UTF-8, arrays
-    nested deeper than the parser's recursion limit) rather than reporting a syntax error.
+    nested deeper than the parser's recursion limit) rather than reporting a syntax error. A
+    string ``detail`` (a 404 of an unknown route, a 405) becomes one error with no ``loc``.
     """
     cause = error.__cause__
     if error.status_code == 400 and isinstance(cause, UnicodeDecodeError | RecursionError):
@@ -113,7 +148,20 @@ async def http_error_handler(request: Request, error: StarletteHTTPException) ->
             if method != "HEAD"
         )
         error = StarletteHTTPException(405, error.detail, headers={"Allow": ", ".join(allowed)})
+    if isinstance(error.detail, str) and error.status_code not in (204, 304):
+        detail = ErrorDetail(loc=[], msg=error.detail, type=http_error_type(error.status_code))
+        response = _error_response(error.status_code, [detail])
+        response.headers.update(error.headers or {})
+        return response
     return await http_exception_handler(request, error)
+
+
+async def server_error_handler(request: Request, error: Exception) -> JSONResponse:
+    """Answer a fault of the service with ``500`` as a JSON error, not text (none is expected)."""
+    detail = ErrorDetail(
+        loc=[], msg=f"internal error ({type(error).__name__}); please report it", type="internal"
+    )
+    return _error_response(status.HTTP_500_INTERNAL_SERVER_ERROR, [detail])
 
 
 async def cancelled_handler(request: Request, error: Cancelled) -> JSONResponse:
@@ -173,6 +221,36 @@ def _not_json(content_type: str) -> JSONResponse:
     return _error_response(status.HTTP_415_UNSUPPORTED_MEDIA_TYPE, [detail])
 
 
+def _no_content_type() -> JSONResponse:
+    """The ``415`` answer to a body sent without a Content-Type."""
+    detail = ErrorDetail(
+        loc=["header", "content-type"],
+        msg="the body must be declared as JSON (content-type application/json); no content-type "
+        "was sent",
+        type="unsupported_media_type",
+    )
+    return _error_response(status.HTTP_415_UNSUPPORTED_MEDIA_TYPE, [detail])
+
+
+def _too_slow(seconds: float, size: int) -> JSONResponse:
+    """The ``408`` answer to a body that did not arrive within ``seconds``."""
+    detail = ErrorDetail(
+        loc=["body"],
+        msg=f"the body did not arrive within {seconds:g} s ({size} bytes came; "
+        "DTF_BODY_READ_SECONDS)",
+        type="body_timeout",
+    )
+    response = _error_response(status.HTTP_408_REQUEST_TIMEOUT, [detail])
+    response.headers["Connection"] = "close"
+    return response
+
+
+def _has_body(headers: Headers) -> bool:
+    """Whether a request announces a body (a Content-Length above 0, or chunks)."""
+    length = headers.get("content-length", "")
+    return (length.isdigit() and int(length) > 0) or "transfer-encoding" in headers
+
+
 def is_json(content_type: str) -> bool:
     """Whether a Content-Type names JSON (application/json or a +json type)."""
     media = content_type.split(";")[0].strip().lower()
@@ -184,10 +262,11 @@ def is_json(content_type: str) -> bool:
 class BodySizeLimitMiddleware:
     """Answer ``413`` to a body over ``Settings.max_body_bytes``, ``415`` to one not JSON.
 
-    Pure ASGI. A body declared as something other than JSON is refused unread. A declared
-    ``Content-Length`` over the limit is refused before reading; otherwise the body is read
-    (counting the bytes as they stream in, so a chunked body cannot slip through) and handed
-    on in one piece.
+    Pure ASGI. A body declared as something other than JSON, or sent without a Content-Type,
+    is refused unread. A declared ``Content-Length`` over the limit is refused before reading;
+    otherwise the body is read (counting the bytes as they stream in, so a chunked body cannot
+    slip through) and handed on in one piece. A body that stops short of its length is
+    answered ``408`` after ``Settings.body_read_seconds`` instead of holding the connection.
     """
 
     def __init__(self, app: ASGIApp) -> None:
@@ -199,16 +278,17 @@ class BodySizeLimitMiddleware:
         if scope["type"] != "http":
             await self.app(scope, receive, send)
             return
-        limit = get_settings().max_body_bytes
+        settings = get_settings()
+        limit = settings.max_body_bytes
         headers = Headers(scope=scope)
         content_type = headers.get("content-type")
-        if (
-            scope["method"] in ("POST", "PUT", "PATCH")
-            and content_type
-            and not is_json(content_type)
-        ):
-            await _not_json(content_type)(scope, receive, send)
-            return
+        if scope["method"] in ("POST", "PUT", "PATCH"):
+            if content_type and not is_json(content_type):
+                await _not_json(content_type)(scope, receive, send)
+                return
+            if not content_type and _has_body(headers):
+                await _no_content_type()(scope, receive, send)
+                return
         declared = headers.get("content-length", "")
         if declared.isdigit() and int(declared) > limit:
             await _too_large(int(declared), limit)(scope, receive, send)
@@ -216,17 +296,21 @@ class BodySizeLimitMiddleware:
         chunks: list[bytes] = []
         size = 0
         more_body = True
-        while more_body:
-            message = await receive()
-            if message["type"] != "http.request":  # the client went away
-                return
-            chunk: bytes = message.get("body", b"")
-            size += len(chunk)
-            if size > limit:
-                await _too_large(size, limit)(scope, receive, send)
-                return
-            chunks.append(chunk)
-            more_body = message.get("more_body", False)
+        with anyio.move_on_after(settings.body_read_seconds) as deadline:
+            while more_body:
+                message = await receive()
+                if message["type"] != "http.request":  # the client went away
+                    return
+                chunk: bytes = message.get("body", b"")
+                size += len(chunk)
+                if size > limit:
+                    await _too_large(size, limit)(scope, receive, send)
+                    return
+                chunks.append(chunk)
+                more_body = message.get("more_body", False)
+        if deadline.cancelled_caught:
+            await _too_slow(settings.body_read_seconds, size)(scope, receive, send)
+            return
         body: Message | None = {
             "type": "http.request",
             "body": b"".join(chunks),

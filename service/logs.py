@@ -1,10 +1,12 @@
-"""The service's own log lines (``dtf.*``): one logger for the jobs, sent to stderr once."""
+"""The service's own log lines (``dtf.*``): the jobs' and the start's, sent to stderr once."""
 
 from __future__ import annotations
 
 import logging
 
 log = logging.getLogger("dtf.jobs")
+startup_log = logging.getLogger("dtf.startup")
+"""The start's lines: the kernels' warm-up (its first time compiles them, about 30 s)."""
 
 
 def log_to_stderr() -> None:

@@ -11,6 +11,7 @@ import gc
 import signal
 import sys
 import threading
+import time
 from collections.abc import AsyncIterator
 from types import FrameType
 from typing import Any
@@ -28,17 +29,20 @@ from service.api.routes import health
 from service.body import BODY_MODELS
 from service.config import get_settings
 from service.errors import (
+    SERVER_ERROR_RESPONSE,
     BodySizeLimitMiddleware,
     cancelled_handler,
     http_error_handler,
     job_store_unavailable_handler,
     request_validation_error_handler,
+    server_error_handler,
     solver_error_handler,
 )
 from service.jobs.runner import close_runners, get_runner
 from service.jobs.store import JobStoreUnavailable
-from service.logs import log, log_to_stderr
+from service.logs import log, log_to_stderr, startup_log
 from service.metrics import instrument
+from service.spec import defaults_in_words
 from service.web import mount_page
 from service.work import STOPPING
 from solver.core.exceptions import SolverError
@@ -72,8 +76,9 @@ Every placement in an answer also comes as a controller frame (UR, KUKA, ABB, FA
 SI units throughout (m, rad, s). Paths are poses, tool points with tool axes, APT CL data or
 CSV (passes split at rapids; /v1/evaluate checks the programmed feed). Input errors
 are `422` with a `detail` list whose `loc` names the field (and waypoint index); oversized
-bodies are `413`; bodies not declared as JSON are `415`. These pages load nothing from the
-internet.
+bodies are `413`; bodies not declared as JSON (or sent without a Content-Type) are `415`; a body
+that stops short of its length is `408`. Every error answer (404, 429, 500 too) is a JSON object
+with the same `detail` list. These pages load nothing from the internet.
 """
 
 
@@ -93,7 +98,13 @@ async def lifespan(app: FastAPI) -> AsyncIterator[None]:
     _stop_work_on(signal.SIGTERM)
     _stop_work_on(signal.SIGINT)
     log_to_stderr()
+    started = time.monotonic()
+    startup_log.info(
+        "warming up: loading the compiled map kernels (the first start after an install "
+        "compiles them, about 30 s; later starts take a few seconds)"
+    )
     await anyio.to_thread.run_sync(_warm_up)
+    startup_log.info("ready after %.1f s of warm-up", time.monotonic() - started)
     gc.collect()
     gc.freeze()  # what startup made lives on: full collections no longer walk it
     try:
@@ -151,7 +162,9 @@ def create_app() -> FastAPI:
             SolverError: solver_error_handler,
             Cancelled: cancelled_handler,
             JobStoreUnavailable: job_store_unavailable_handler,
+            Exception: server_error_handler,
         },
+        responses=SERVER_ERROR_RESPONSE,
         lifespan=lifespan,
     )
     app.include_router(health.router)
@@ -166,7 +179,10 @@ app = create_app()
 
 
 def _openapi() -> dict[str, Any]:
-    """FastAPI's description, with the schemas of the bodies validated in worker threads."""
+    """FastAPI's description, with the schemas of the bodies validated in worker threads.
+
+    Request defaults are stated in words (:mod:`service.spec`).
+    """
     if app.openapi_schema is None:
         spec = FastAPI.openapi(app)
         _, top = models_json_schema(
@@ -176,7 +192,8 @@ def _openapi() -> dict[str, Any]:
         components = spec.setdefault("components", {}).setdefault("schemas", {})
         for name, schema in top.get("$defs", {}).items():
             components.setdefault(name, schema)
-    return app.openapi_schema or spec
+        app.openapi_schema = defaults_in_words(spec)
+    return app.openapi_schema
 
 
 app.openapi = _openapi  # type: ignore[method-assign]

@@ -17,7 +17,7 @@ from prometheus_client.core import GaugeMetricFamily, SummaryMetricFamily
 from prometheus_client.registry import Collector
 from prometheus_fastapi_instrumentator import Instrumentator
 
-from service.schemas import ErrorResponse
+from service.errors import JSON_ERROR, RETRY_AFTER, SERVER_ERROR_RESPONSE
 
 PLACEMENTS = Counter("dtf_placements", "Placements computed by /v1/map (synchronous maps).")
 
@@ -76,10 +76,12 @@ def instrument(app: FastAPI, *, job_store: Callable[[], JobStatistics]) -> None:
         response_class=PlainTextResponse,
         responses={
             200: {"content": {"text/plain": {"schema": {"type": "string"}}}},
+            500: {**SERVER_ERROR_RESPONSE[500], **JSON_ERROR},
             503: {
-                "model": ErrorResponse,
+                **JSON_ERROR,
                 "description": "The job store cannot be used (the detail says why); the job "
                 "metrics cannot be read, retry after Retry-After.",
+                "headers": RETRY_AFTER,
             },
         },
     )

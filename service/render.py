@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import io
 import math
+import textwrap
 
 import matplotlib
 
@@ -147,6 +148,16 @@ def _acceleration_panel(axes: Axes, use: np.ndarray, evaluation: PathEvaluation)
     axes.set_xlabel("waypoint")
     axes.set_ylabel("|qdd| / qddot_max")
     axes.set_ylim(bottom=0.0)
+
+
+def render_message(text: str) -> bytes:
+    """A PNG that says ``text`` where there is nothing to plot (a path that does not run)."""
+    figure = plt.figure(figsize=(8.0, 1.5), dpi=DPI)
+    figure.text(0.5, 0.5, textwrap.fill(text, 90), ha="center", va="center", fontsize=10)
+    buffer = io.BytesIO()
+    figure.savefig(buffer, format="png", dpi=DPI)
+    plt.close(figure)
+    return buffer.getvalue()
 
 
 def render_joint_use(

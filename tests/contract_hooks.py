@@ -1,10 +1,19 @@
-"""Schemathesis hooks: the service's rules that JSON Schema cannot state (issue 9).
+"""Schemathesis hooks: the service's rules that JSON Schema cannot state (issues 9 and 26).
 
 The committed spec states every rule on one field as JSON Schema (ranges, list lengths, the
-catalogue's names, which keys go together). The rules below relate several fields or need
-arithmetic; the spec states each in words, and these hooks apply them to the schema-valid
-("positive") cases schemathesis generates, so that ``positive_data_acceptance`` checks that the
-service accepts everything the spec and its words allow. Negative cases are left as generated.
+catalogue's names, which keys go together, non-zero vectors, whole numbers). The rules below
+relate several fields or need arithmetic; the spec states each in words (in the field's or the
+operation's description), and these hooks meet them in the schema-valid ("positive") cases
+schemathesis generates, so that ``positive_data_acceptance`` checks that the service accepts
+everything the spec and its words allow. Negative cases are left as generated.
+
+Two ways, both counted per rule in ``tests/artifacts/contract.txt``:
+
+- normalised (``NORMALISED``): the case is moved onto the rule (a vector scaled to unit length,
+  a pair put in order, a grid coarsened to the server's limits) and then must be accepted;
+- kept out (``KEPT_OUT``, the rules in ``KEEP_OUT``): the case is left as generated and runs
+  with every check but ``positive_data_acceptance``; the share of generated requests kept out
+  is printed and must stay under 2 % (tests/test_contract.py).
 
 Each rule is computed here independently of the service's code:
 
@@ -23,6 +32,7 @@ Each rule is computed here independently of the service's code:
 
 from __future__ import annotations
 
+import copy
 import math
 import re
 from collections import Counter
@@ -36,6 +46,19 @@ LIMITS: dict[str, float] = {}
 """The server's settings, as the test passed them (max_map_cells, max_map_poses, ...)."""
 STATUSES: Counter[tuple[str, str, int]] = Counter()
 """How many answers of each status each operation gave, with the generation mode."""
+NORMALISED: Counter[str] = Counter()
+"""Positive cases moved onto each rule stated in words (one count per case and rule)."""
+KEPT_OUT: Counter[tuple[str, int]] = Counter()
+"""Positive cases kept out of positive_data_acceptance, per rule and the status answered."""
+KEEP_OUT = {
+    "height": "POST /v1/optimize: z or bounds.z, exactly one (the operation's description)",
+}
+"""The cross-field rules whose breaking cases are kept out rather than normalised."""
+_MISSING = object()
+_KEPT: dict[int, tuple[str, schemathesis.Case]] = {}
+"""The rule each kept-out case breaks, by the case's id (the case kept, so the id stays its)."""
+_CHANGED: set[str] = set()
+"""The rules the case being mapped was moved onto."""
 
 AXIS_FORMS = ("tool_axis_waypoints", "cl_data", "csv")
 """Path forms given by tool axes: their default spin_mode is free (CSV_PATH below is one)."""
@@ -71,17 +94,26 @@ def _normalise(value: Any) -> Any:
         out = {}
         for key, item in value.items():
             if key in UNIT_KEYS and isinstance(item, list) and item:
-                norm = math.sqrt(sum(v * v for v in item))
-                item = [v / norm for v in item] if norm > 1e-150 else [0.0] * (len(item) - 1) + [1]
+                norm = math.hypot(*item)  # never 0: the spec refuses a zero vector
+                if norm != 1.0:
+                    _CHANGED.add("unit vector")
+                item = [v / norm for v in item]
             elif key in ("min", "max") and isinstance(value.get("min"), float | int):
+                if value["min"] > value["max"]:
+                    _CHANGED.add("min <= max")
                 low, high = sorted((value["min"], value["max"]))
                 item = low if key == "min" else high
             else:
                 item = _normalise(item)
             out[key] = item
         if isinstance(out.get("joint_position_limits"), list):
-            out["joint_position_limits"] = [sorted(pair) for pair in out["joint_position_limits"]]
+            pairs = out["joint_position_limits"]
+            if any(low > high for low, high in pairs):
+                _CHANGED.add("lower <= upper")
+            out["joint_position_limits"] = [sorted(pair) for pair in pairs]
         if isinstance(out.get("bounds"), dict):
+            if any(v and v[0] > v[1] for v in out["bounds"].values()):
+                _CHANGED.add("lower <= upper")
             out["bounds"] = {k: sorted(v) if v else v for k, v in out["bounds"].items()}
         return out
     if isinstance(value, list):
@@ -186,7 +218,7 @@ def _repair_dtf(body: dict[str, Any], lower: list[float], upper: list[float]) ->
         body["u_R"] = [0.0, 0.0, 1.0]
 
 
-def _repair_grid(grid: dict[str, Any], n: int, *, png: bool) -> None:
+def _repair_grid(grid: dict[str, Any], n: int, png: bool) -> None:
     """Steps coarse enough that the map is within the server's limits; PNG panels too."""
     spin = grid.get("spin")
     if png:  # panels: yaw values x spin values
@@ -207,12 +239,16 @@ def _repair_grid(grid: dict[str, Any], n: int, *, png: bool) -> None:
             )
 
 
-def _repair_optimize(body: dict[str, Any]) -> None:
-    """z or bounds.z; spin_path with casadi and fixed spin only; the start inside the bounds."""
+def _repair_optimize(body: dict[str, Any]) -> str | None:
+    """Spin_path with casadi and fixed spin only; the start inside the bounds.
+
+    Returns:
+        "height" where z and bounds.z are both given or both missing (kept out, as given).
+    """
     bounds = body["bounds"]
-    if body.get("z") is not None and bounds.get("z") is not None:
-        bounds["z"] = None
-    if body.get("z") is None and bounds.get("z") is None:
+    kept = "height" if (body.get("z") is None) == (bounds.get("z") is None) else None
+    given = body.get("z", _MISSING)
+    if kept is not None and body.get("z") is None:  # a z for the repairs below, undone after
         body["z"] = 0.1
     spin = bounds.get("spin")
     if spin is not None and spin[1] - spin[0] > 2 * math.pi:
@@ -238,48 +274,120 @@ def _repair_optimize(body: dict[str, Any]) -> None:
         for key in ("x", "y", "yaw", "spin", "z"):
             low, high = bounds.get(key) or ([body["z"]] * 2 if key == "z" else [0.0, 0.0])
             start[key] = min(max(start.get(key) or 0.0, low), high)
+    if kept is not None:  # sent as generated: z and bounds.z both given or both missing
+        if given is _MISSING:
+            body.pop("z")
+        else:
+            body["z"] = given
+    return kept
 
 
 def map_case(context: Any, case: schemathesis.Case) -> schemathesis.Case:
-    """Give positive cases unit vectors and ordered ranges, and meet the cross-field rules."""
+    """Move positive cases onto the rules stated in words; note those kept out, as generated."""
     if not _positive(case) or not isinstance(case.body, dict):
         return case
+    _CHANGED.clear()
     case.body = _normalise(case.body)
     route = case.operation.path
     if route == "/v1/jobs" and isinstance(case.body.get("request"), dict):
-        _repair(case.body["request"], f"/v1/{case.body.get('kind')}")  # a job: the route's body
+        # a job: the route's body
+        kept = _repair(case.body["request"], f"/v1/{case.body.get('kind')}")
     else:
-        _repair(case.body, route)
+        kept = _repair(case.body, route)
+    if kept is not None:
+        _KEPT[id(case)] = (kept, case)
+    NORMALISED.update(_CHANGED)
     return case
 
 
-def _repair(body: dict[str, Any], route: str) -> None:
-    """Meet the rules the spec states in words, for a body of ``route``."""
-    if isinstance(body.get("robot"), dict):
-        lower, upper = _repair_robot(body)
-        _repair_branch(body)
-        if route == "/v1/dtf":
-            _repair_dtf(body, lower, upper)
-    path = body.get("path")
-    if isinstance(path, dict) and path.get("cl_data") is not None:
-        path["cl_data"] = CL_PROGRAM  # a random string is no CL program: the CAM tests cover them
+def kept_out(case: schemathesis.Case) -> str | None:
+    """The KEEP_OUT rule ``case`` breaks (it then skips positive_data_acceptance), or None."""
+    rule, kept = _KEPT.get(id(case), (None, None))
+    return rule if kept is case else None
+
+
+def _noted(rule: str, body: dict[str, Any], action: Any, *args: Any) -> Any:
+    """``action(*args)``, noting ``rule`` when it changed ``body``."""
+    before = copy.deepcopy(body)
+    result = action(*args)
+    if body != before:
+        _CHANGED.add(rule)
+    return result
+
+
+def _stand_ins(path: dict[str, Any]) -> None:
+    """A small valid CL program or CSV for a random string (the CAM tests cover the parsers)."""
+    if path.get("cl_data") is not None:
+        path["cl_data"] = CL_PROGRAM
         if path.get("units") is not None:  # the request's units serve a program stating none
             path["cl_data"] = CL_PROGRAM.removeprefix("UNITS/MM\n")
-    if isinstance(path, dict) and path.get("csv") is not None:
+    if path.get("csv") is not None:
         path["csv"] = CSV_PATH
+
+
+def _repair(body: dict[str, Any], route: str) -> str | None:
+    """Meet the rules the spec states in words, for a body of ``route``; the kept-out rule."""
+    if isinstance(body.get("robot"), dict):
+        lower, upper = _noted(
+            "robot: a catalogue arm for a URDF or numeric one; a limit per joint; lower < upper",
+            body,
+            _repair_robot,
+            body,
+        )
+        _noted("ik.branch: the robot family's names", body, _repair_branch, body)
+        if route == "/v1/dtf":
+            _noted(
+                "q, u_T, u_R: one per joint within limits; as h asks",
+                body,
+                _repair_dtf,
+                body,
+                lower,
+                upper,
+            )
+    path = body.get("path")
+    if isinstance(path, dict):
+        _noted("path: a valid CL program or CSV", body, _stand_ins, path)
     n = 2 if isinstance(path, dict) and (path.get("cl_data") or path.get("csv")) else 0
     if isinstance(path, dict) and _waypoints(path):
         limit = "max_optimize_waypoints" if route == "/v1/optimize" else "max_path_waypoints"
-        _repair_path(path, int(LIMITS[limit]))
+        _noted(
+            "path: within the limit, consecutive waypoints distinct",
+            body,
+            _repair_path,
+            path,
+            int(LIMITS[limit]),
+        )
         n = len(_waypoints(path))
-    if route == "/v1/evaluate" and body.get("spins") is not None:
-        body["spins"] = _resized(body["spins"], n, 0.0)
-    if route == "/v1/evaluate":
-        body.pop("joint_path", None)  # a random joint path reaches no waypoint: its tests cover it
+    if route.startswith("/v1/evaluate") and body.get("spins") is not None:
+        _noted(
+            "spins: one per waypoint",
+            body,
+            body.__setitem__,
+            "spins",
+            _resized(body["spins"], n, 0.0),
+        )
+    if route.startswith("/v1/evaluate"):
+        # a random joint path reaches no waypoint: tests/service/test_urdf_arms.py covers it
+        if body.get("joint_path") is not None:
+            _noted("joint_path: reaches the waypoints", body, body.pop, "joint_path")
+        body.pop("joint_path", None)
     if route.startswith("/v1/map") and isinstance(body.get("grid"), dict) and n:
-        _repair_grid(body["grid"], n, png=route.endswith("/png"))
+        _noted(
+            "grid: within the server's limits",
+            body,
+            _repair_grid,
+            body["grid"],
+            n,
+            route.endswith("/png"),
+        )
     if route == "/v1/optimize" and isinstance(body.get("bounds"), dict):
-        _repair_optimize(body)
+        return _noted(
+            "bounds, start, spin_path: within the limits, as the method allows",
+            body,
+            _repair_optimize,
+            body,
+        )
+    return None
 
 
 def before_add_examples(context: Any, examples: list[schemathesis.Case]) -> None:

@@ -9,10 +9,14 @@ app's TestClient, so no server runs. The one option: PNG answers are read as byt
 from __future__ import annotations
 
 import importlib
+import importlib.util
 import json
 import math
+import re
 import subprocess
 import sys
+import time
+from collections.abc import Iterator
 from pathlib import Path
 from types import ModuleType
 from typing import Any
@@ -57,20 +61,47 @@ def _module(package: ModuleType, name: str) -> Any:
 
 
 @pytest.fixture(scope="module")
-def client(generated: ModuleType) -> Any:
-    return generated.Client(base_url="http://testserver").set_httpx_client(TestClient(app))
+def client(generated: ModuleType) -> Iterator[Any]:
+    """The generated client on the app (lifespan run: jobs are worked), raising on any status
+    the spec does not declare."""
+    with TestClient(app) as test_client:
+        yield generated.Client(
+            base_url="http://testserver", raise_on_unexpected_status=True
+        ).set_httpx_client(test_client)
+
+
+def _call(package: ModuleType, operation: str, **kwargs: Any) -> Any:
+    """Call ``api.<tag>.<operation>`` of the generated client (``sync``: the parsed answer)."""
+    tag = next(
+        name
+        for name in ("health", "robots", "dtf", "evaluate", "maps", "optimize", "paths", "jobs")
+        if importlib.util.find_spec(f"{package.__name__}.api.{name}.{operation}") is not None
+    )
+    return _module(package, f"api.{tag}.{operation}").sync(**kwargs)
+
+
+EVALUATE = json.loads((EXAMPLES / "evaluate_request.json").read_text())
+GRID = {
+    "x": {"min": 0.0, "max": 0.1, "step": 0.1},
+    "y": {"min": 0.45, "max": 0.45, "step": 0.1},
+    "z": 0.1,
+    "yaw": [0.0, 1.0],
+}
+PNG = b"\x89PNG\r\n\x1a\n"
 
 
 def test_every_route_through_typed_models(generated: ModuleType, client: Any) -> None:
     models = _module(generated, "models")
-    api = "api"
-    health = _module(generated, f"{api}.health.health").sync(client=client)
+    health = _call(generated, "health", client=client)
     assert isinstance(health, models.HealthResponse) and health.status == "ok"
-    robots = _module(generated, f"{api}.robots.list_robots").sync(client=client)
+    assert "dtf_jobs" in _call(generated, "metrics", client=client)
+    robots = _call(generated, "list_robots", client=client)
     assert isinstance(robots, models.RobotsResponse)
     assert {r.name for r in robots.robots} >= {"ur5", "kuka_kr6_r700_sixx"}
 
-    dtf = _module(generated, f"{api}.dtf.dtf").sync(
+    dtf = _call(
+        generated,
+        "dtf",
         client=client,
         body=models.DtfRequest.from_dict(
             {"robot": {"model": "ur5e"}, "q": [0.1, -1.2, 1.3, -1.5, -1.4, 0.2], "u_T": [1, 0, 0]}
@@ -78,34 +109,31 @@ def test_every_route_through_typed_models(generated: ModuleType, client: Any) ->
     )
     assert isinstance(dtf, models.DtfResponse) and dtf.v_max > 0 and dtf.omega_max == 0
 
-    request = json.loads((EXAMPLES / "evaluate_request.json").read_text())
-    evaluation = _module(generated, f"{api}.evaluate.evaluate").sync(
-        client=client, body=models.EvaluateRequest.from_dict(request)
-    )
+    body = models.EvaluateRequest.from_dict(EVALUATE)
+    evaluation = _call(generated, "evaluate", client=client, body=body)
     assert isinstance(evaluation, models.EvaluateResponse)
     assert evaluation.mu_path == pytest.approx(0.293729, abs=1e-6)
     assert evaluation.reason is None or isinstance(evaluation.reason, models.FailureReason)
+    assert evaluation.spin_mode == models.SpinMode.FIXED
+    picture = _call(generated, "evaluate_png", client=client, body=body)
+    assert picture.payload.read().startswith(PNG)
 
-    grid = {
-        "x": {"min": 0.0, "max": 0.1, "step": 0.1},
-        "y": {"min": 0.45, "max": 0.45, "step": 0.1},
-        "z": 0.1,
-        "yaw": [0.0, 1.0],
-    }
     map_body = models.MapRequest.from_dict(
-        {"robot": request["robot"], "path": request["path"], "grid": grid}
+        {"robot": EVALUATE["robot"], "path": EVALUATE["path"], "grid": GRID}
     )
-    cmap = _module(generated, f"{api}.maps.map_").sync(client=client, body=map_body)
+    cmap = _call(generated, "map_", client=client, body=map_body)
     assert isinstance(cmap, models.MapResponse) and len(cmap.cells) == 4
-    picture = _module(generated, f"{api}.maps.map_png").sync(client=client, body=map_body)
-    assert picture.payload.read().startswith(b"\x89PNG\r\n\x1a\n")
+    picture = _call(generated, "map_png", client=client, body=map_body)
+    assert picture.payload.read().startswith(PNG)
 
-    optimum = _module(generated, f"{api}.optimize.optimize").sync(
+    optimum = _call(
+        generated,
+        "optimize",
         client=client,
         body=models.OptimizeRequest.from_dict(
             {
-                "robot": request["robot"],
-                "path": request["path"],
+                "robot": EVALUATE["robot"],
+                "path": EVALUATE["path"],
                 "bounds": {"x": [-0.05, 0.05], "y": [0.4, 0.5], "yaw": [-0.3, 0.3]},
                 "z": 0.1,
             }
@@ -116,19 +144,82 @@ def test_every_route_through_typed_models(generated: ModuleType, client: Any) ->
     assert math.isfinite(optimum.solver.seconds)
 
     program = (EXAMPLES / "cam" / "sweep_mm.cl").read_text()
-    read = _module(generated, f"{api}.paths.import_path").sync(
-        client=client, body=models.PathImportRequest.from_dict({"path": {"cl_data": program}})
+    read = _call(
+        generated,
+        "import_path",
+        client=client,
+        body=models.PathImportRequest.from_dict({"path": {"cl_data": program}}),
     )
     assert isinstance(read, models.PathImportResponse)
     assert read.passes == [[0, 13], [13, 26], [26, 39]] and read.units == "mm"
+
+
+def test_jobs_through_typed_models(generated: ModuleType, client: Any) -> None:
+    """The 202 is a JobInfo, and a finished job's result the route's own typed answer."""
+    models = _module(generated, "models")
+    request = {"robot": EVALUATE["robot"], "path": EVALUATE["path"], "grid": GRID}
+    job = _call(
+        generated,
+        "submit_job",
+        client=client,
+        body=models.MapJob.from_dict({"kind": "map", "request": request}),
+    )
+    assert isinstance(job, models.JobInfo)
+    deadline = time.monotonic() + 120
+    while job.status not in (models.JobStatus.DONE, models.JobStatus.FAILED):
+        assert time.monotonic() < deadline, job
+        time.sleep(0.2)
+        job = _call(generated, "get_job", client=client, job_id=job.id)
+    assert job.status == models.JobStatus.DONE
+    assert isinstance(job.result, models.MapResponse) and len(job.result.cells) == 4
+    listed = _call(generated, "list_jobs", client=client, status=models.JobStatus.DONE)
+    assert isinstance(listed, models.JobList) and job.id in [j.id for j in listed.jobs]
+    kept = _call(generated, "cancel_job", client=client, job_id=job.id)
+    assert isinstance(kept, models.JobInfo) and kept.status == models.JobStatus.DONE
+    assert _call(generated, "delete_job", client=client, job_id=job.id) is None
+    gone = _call(generated, "get_job", client=client, job_id=job.id)
+    assert (
+        isinstance(gone, models.ErrorResponse) and gone.detail[0].to_dict()["type"] == "not_found"
+    )
+
+
+@pytest.mark.parametrize(
+    ("branch", "kind"),
+    [
+        ("auto", str),
+        ({"shoulder": "left", "elbow": "up", "wrist": "noflip"}, "Branch"),
+        ({"solution": 3}, "NumericBranch"),
+    ],
+)
+def test_every_branch_form_is_read_back(generated: ModuleType, branch: Any, kind: Any) -> None:
+    """A named branch was read as the const "auto" (listed first in the oneOf) and refused."""
+    models = _module(generated, "models")
+    policy = models.IkPolicy.from_dict({"branch": branch})
+    expected = kind if kind is str else getattr(models, kind)
+    assert isinstance(policy.branch, expected)
+    assert policy.to_dict()["branch"] == branch
 
 
 def test_input_errors_arrive_as_typed_error_responses(generated: ModuleType, client: Any) -> None:
     models = _module(generated, "models")
     request = json.loads((EXAMPLES / "evaluate_request.json").read_text())
     request["placement"]["y"] = 4500.0  # millimetres by mistake
-    answer = _module(generated, "api.evaluate.evaluate").sync(
-        client=client, body=models.EvaluateRequest.from_dict(request)
-    )
+    for operation in ("evaluate", "evaluate_png"):
+        answer = _call(
+            generated, operation, client=client, body=models.EvaluateRequest.from_dict(request)
+        )
+        assert isinstance(answer, models.ErrorResponse)
+        assert answer.detail[0].loc[:2] == ["body", "placement"]
+    too_many = {**GRID, "yaw": [0.01 * k for k in range(100)]}  # panels over DTF_MAX_PNG_PANELS
+    body = {"robot": EVALUATE["robot"], "path": EVALUATE["path"], "grid": too_many}
+    answer = _call(generated, "map_png", client=client, body=models.MapRequest.from_dict(body))
     assert isinstance(answer, models.ErrorResponse)
-    assert answer.detail[0].loc[:2] == ["body", "placement"]
+    assert answer.detail[0].loc[:2] == ["body", "grid"]
+
+
+def test_names_read_well(generated: ModuleType) -> None:
+    """One class per concept, none named after its position in a union (``...Type0``)."""
+    folder = Path(generated.__file__).parent / "models"
+    names = sorted(path.stem for path in folder.glob("*.py"))
+    assert [name for name in names if re.search(r"type_\d", name)] == []
+    assert [name for name in names if "spin_mode" in name] == ["spin_mode"]

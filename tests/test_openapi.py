@@ -36,6 +36,7 @@ def test_operation_ids_are_short_and_the_png_is_binary() -> None:
         "list_robots",
         "dtf",
         "evaluate",
+        "evaluate_png",
         "map",
         "map_png",
         "import_path",
@@ -47,8 +48,13 @@ def test_operation_ids_are_short_and_the_png_is_binary() -> None:
         "delete_job",
         "metrics",
     }
-    png = spec["paths"]["/v1/map/png"]["post"]["responses"]["200"]["content"]["image/png"]
-    assert png["schema"] == {"type": "string", "format": "binary"}
+    for route in ("/v1/map/png", "/v1/evaluate/png"):
+        answer = spec["paths"][route]["post"]["responses"]["200"]["content"]
+        assert answer == {"image/png": {"schema": {"type": "string", "format": "binary"}}}
+    for route in ("/v1/map", "/v1/evaluate"):  # one content type an operation (Accept unsaid)
+        assert list(spec["paths"][route]["post"]["responses"]["200"]["content"]) == [
+            "application/json"
+        ]
 
 
 def test_docs_are_served_offline() -> None:

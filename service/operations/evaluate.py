@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from service import convert
 from service.config import Settings
-from service.render import render_joint_use
+from service.render import render_joint_use, render_message
 from service.schemas import EvaluateRequest, EvaluateResponse, PathInput
 from solver.core.exceptions import InvalidInputError
 from solver.core.progress import Progress
@@ -68,16 +68,21 @@ def joint_use_png(body: EvaluateRequest, settings: Settings) -> bytes:
 
     The feed defaults to mu_path, or mu_acc with acceleration limits.
 
-    Raises:
-        InvalidInputError: on ``placement``, the path does not run there.
+    Where the path does not run (an unreachable placement is not an input error, api.md) the
+    picture says so: why, and at which waypoint.
     """
     robot, _, evaluation, feed, _ = _evaluated(body, settings)
     index = evaluation.feed_index  # mu_acc with acceleration limits
     if index is None or index <= 0.0:
-        raise InvalidInputError(
-            "placement",
-            f"the path does not run here ({evaluation.reason or 'mu_path is 0'}): no joint "
-            "speeds to draw; ask for JSON to see why",
+        where = (
+            ""
+            if evaluation.failed_waypoint is None
+            else f" at waypoint {evaluation.failed_waypoint}"
+        )
+        why = f"{evaluation.reason}{where}" if evaluation.reason else "mu_path is 0"
+        return render_message(
+            f"{robot.name}: the path does not run at this placement ({why}); no joint speeds to "
+            "draw (POST /v1/evaluate says more)"
         )
     check = check_feed(
         evaluation, index if feed is None else feed, robot.qdot_max, qddot_max=robot.qddot_max

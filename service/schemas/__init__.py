@@ -15,12 +15,14 @@ from service.schemas.common import (
     Pose,
     RequestModel,
     ResponseModel,
+    SpinMode,
     ToolAxisWaypoint,
 )
 from service.schemas.dtf import DtfRequest, DtfResponse
 from service.schemas.errors import ErrorDetail, ErrorResponse
 from service.schemas.evaluate import (
     Bottleneck,
+    DetailLevel,
     EvaluateRequest,
     EvaluateResponse,
     FailureReason,
@@ -33,11 +35,12 @@ from service.schemas.jobs import (
     JobInfo,
     JobList,
     JobProgress,
+    JobStatus,
     MapJob,
     OptimizeJob,
 )
 from service.schemas.map import Grid, GridAxis, MapCell, MapExtreme, MapRequest, MapResponse
-from service.schemas.motion import AccelerationResult, CycleTimeResult, PassCycleTime
+from service.schemas.motion import AccelerationResult, CycleTimeResult, LimitedBy, PassCycleTime
 from service.schemas.optimize import (
     Bounds,
     OptimizeRequest,
@@ -46,7 +49,15 @@ from service.schemas.optimize import (
     SpinPath,
     StartInfo,
 )
-from service.schemas.path import ClDataPath, CsvPath, Path, PathInput, PosePath, ToolAxisPath
+from service.schemas.path import (
+    ClDataPath,
+    CsvPath,
+    Path,
+    PathInput,
+    PosePath,
+    ProgramUnits,
+    ToolAxisPath,
+)
 from service.schemas.paths_import import (
     ImportedPose,
     PassOut,
@@ -58,6 +69,11 @@ from service.schemas.robot import CatalogueRobot, OpwGeometry, OpwRobot, Robot, 
 from service.schemas.robots import BranchLevel, HealthResponse, RobotInfo, RobotsResponse
 
 __all__ = [
+    "DetailLevel",
+    "JobStatus",
+    "LimitedBy",
+    "ProgramUnits",
+    "SpinMode",
     "AccelerationResult",
     "CycleTimeResult",
     "PassCycleTime",

@@ -13,6 +13,7 @@ from typing import Annotated, Any, Literal
 import numpy as np
 from pydantic import (
     BaseModel,
+    BeforeValidator,
     ConfigDict,
     Discriminator,
     Field,
@@ -20,6 +21,7 @@ from pydantic import (
     field_validator,
 )
 from pydantic_core import PydanticCustomError
+from typing_extensions import TypeAliasType
 
 from solver.cam.frames import frames_of_placement
 from solver.core.spatial import MAX_COORDINATE, QUATERNION_NORM_TOLERANCE, pose_matrix
@@ -35,9 +37,15 @@ MAX_ANGLE = 1e3  # rad: about 160 turns, beyond any joint or placement
 Angle = Annotated[float, Field(ge=-MAX_ANGLE, le=MAX_ANGLE)]
 """An angle (rad) within 1000 rad of zero."""
 UnitComponent = Annotated[float, Field(ge=-UNIT_BOUND, le=UNIT_BOUND)]
-UnitVector = Annotated[list[UnitComponent], Field(min_length=3, max_length=3)]
-"""A unit direction (dimensionless): a norm of 1, so each component within [-1, 1]."""
-Quaternion = Annotated[list[UnitComponent], Field(min_length=4, max_length=4)]
+NOT_ZERO: dict[str, Any] = {"not": {"items": {"const": 0}}}
+"""JSON Schema of a vector with a component other than 0 (a zero vector has no direction)."""
+UnitVector = Annotated[
+    list[UnitComponent], Field(min_length=3, max_length=3, json_schema_extra=NOT_ZERO)
+]
+"""A unit direction (dimensionless): a norm of 1, so each component within [-1, 1], not 0."""
+Quaternion = Annotated[
+    list[UnitComponent], Field(min_length=4, max_length=4, json_schema_extra=NOT_ZERO)
+]
 SHOWN_CHARACTERS = 100
 
 
@@ -109,7 +117,17 @@ class ToolAxisWaypoint(RequestModel):
     )
 
 
-SpinMode = Literal["fixed", "free"]
+SpinMode = TypeAliasType(
+    "SpinMode",
+    Annotated[
+        Literal["fixed", "free"],
+        Field(
+            description="How the tool spin about its axis is taken: fixed, the orientations as "
+            "given; free, chosen per waypoint (a spindle, disc or grinder; cam.md section 2)."
+        ),
+    ],
+)
+"""One component for every spin_mode field, requests and answers alike."""
 
 
 class ControllerFrames(ResponseModel):
@@ -192,6 +210,13 @@ class Branch(RequestModel):
 MAX_NUMERIC_BRANCHES = 64  # the seeds of the numeric family for seven joints or more
 
 
+def _integral(value: object) -> object:
+    """A whole number written as a float (``24.0``, an integer in JSON Schema) as an int."""
+    if isinstance(value, float) and value.is_integer():
+        return int(value)
+    return value
+
+
 class NumericBranch(RequestModel):
     """A branch of the numeric IK family: the k-th distinct solution found from the seeds.
 
@@ -201,7 +226,7 @@ class NumericBranch(RequestModel):
 
     model_config = ConfigDict(json_schema_extra={"examples": [{"solution": 0}]})
 
-    solution: int = Field(
+    solution: Annotated[int, BeforeValidator(_integral)] = Field(
         ge=0,
         le=MAX_NUMERIC_BRANCHES - 1,
         description="Index of the solution (from 0) among the distinct ones found at the first "
@@ -219,11 +244,12 @@ def _branch_kind(value: object) -> str:
 
 
 BranchChoice = Annotated[
-    Annotated[Literal["auto"], Tag("branch:auto")]
-    | Annotated[Branch, Tag("branch:named")]
-    | Annotated[NumericBranch, Tag("branch:numeric")],
+    Annotated[Branch, Tag("branch:named")]
+    | Annotated[NumericBranch, Tag("branch:numeric")]
+    | Annotated[Literal["auto"], Tag("branch:auto")],
     Discriminator(_branch_kind),
 ]
+"""The objects first: a generated client tries the variants in order, and the last untried."""
 
 
 def _blend_length() -> Any:

@@ -52,8 +52,12 @@ class DtfRequest(RequestModel):
         "null or left out for pure translation, 0 for pure reorientation.",
         json_schema_extra={
             "anyOf": [
-                {"type": "number", "enum": [0]},
-                {"type": "number", "minimum": MIN_H, "maximum": MAX_H},
+                {
+                    "type": "number",
+                    "minimum": 0,
+                    "maximum": MAX_H,
+                    "not": {"exclusiveMinimum": 0, "exclusiveMaximum": MIN_H},
+                },
                 {"type": "null"},
             ]
         },

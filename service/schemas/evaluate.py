@@ -8,6 +8,7 @@ from typing import Annotated, Literal
 from pydantic import ConfigDict, Field, model_validator
 from pydantic.config import JsonDict
 from pydantic_core import PydanticCustomError
+from typing_extensions import TypeAliasType
 
 from service.schemas.common import (
     Angle,
@@ -22,6 +23,18 @@ from service.schemas.common import (
 from service.schemas.motion import AccelerationResult, CycleTimeResult
 from service.schemas.path import MAX_PATH_WAYPOINTS, Path
 from service.schemas.robot import MAX_JOINTS, Robot
+
+DetailLevel = TypeAliasType(
+    "DetailLevel",
+    Annotated[
+        Literal["summary", "waypoints"],
+        Field(
+            description="summary: mu_path, bottleneck and branch only; waypoints: also every "
+            "waypoint's detail."
+        ),
+    ],
+)
+"""One component for the detail asked and the detail answered."""
 
 JointValues = Annotated[list[Angle], Field(min_length=1, max_length=MAX_JOINTS)]
 """One configuration: a value per joint (rad, m for prismatic joints), each within 1000."""
@@ -114,7 +127,7 @@ class EvaluateRequest(RequestModel):
         "axis is free (a spindle, disc or grinder; cam.md section 2). Default: free for "
         "tool_axis_waypoints, fixed for waypoints.",
     )
-    detail: Literal["summary", "waypoints"] | None = Field(
+    detail: DetailLevel | None = Field(
         default=None,
         description="summary: mu_path, bottleneck and branch only; waypoints: also every "
         "waypoint's q, task direction and speeds. Default: waypoints up to "
@@ -333,7 +346,7 @@ class EvaluateResponse(ResponseModel):
         description="With a feed (the request's, or the CL program's FEDRAT): whether the path "
         "runs at it; null without one.",
     )
-    detail: Literal["summary", "waypoints"] = Field(
+    detail: DetailLevel = Field(
         default="waypoints", description="Whether waypoints holds the per-waypoint detail."
     )
     waypoints: list[WaypointResult] = Field(

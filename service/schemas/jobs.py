@@ -4,8 +4,9 @@ from __future__ import annotations
 
 from typing import Annotated, Any, Literal
 
-from pydantic import ConfigDict, Discriminator, Field, Tag
+from pydantic import ConfigDict, Discriminator, Field, Tag, WithJsonSchema
 from pydantic.config import JsonDict
+from typing_extensions import TypeAliasType
 
 from service.schemas.common import RequestModel, ResponseModel
 from service.schemas.errors import ErrorDetail
@@ -14,7 +15,28 @@ from service.schemas.map import _MAP_REQUEST_EXAMPLE, MapRequest
 from service.schemas.optimize import _REQUEST as _OPTIMIZE_EXAMPLE
 from service.schemas.optimize import OptimizeRequest
 
-JobStatus = Literal["queued", "running", "done", "failed", "cancelled"]
+JobStatus = TypeAliasType(
+    "JobStatus",
+    Annotated[
+        Literal["queued", "running", "done", "failed", "cancelled"],
+        Field(description="Where a job is: queued, running, done, failed or cancelled."),
+    ],
+)
+"""One component for a job's status and the status filter of GET /v1/jobs."""
+JobResult = Annotated[
+    dict[str, Any] | None,
+    WithJsonSchema(
+        {
+            "anyOf": [
+                {"$ref": "#/components/schemas/MapResponse"},
+                {"$ref": "#/components/schemas/OptimizeResponse"},
+                {"$ref": "#/components/schemas/EvaluateResponse"},
+                {"type": "null"},
+            ]
+        }
+    ),
+]
+"""A finished job's answer, as its route gives it (kept as stored; typed for clients)."""
 
 
 class MapJob(RequestModel):
@@ -107,8 +129,10 @@ class JobInfo(ResponseModel):
     created: float = Field(description="When it was submitted (Unix time, s).")
     started: float | None = Field(description="When it last started (Unix time, s).")
     finished: float | None = Field(description="When it ended (Unix time, s).")
-    result: dict[str, Any] | None = Field(
-        default=None, description="When done: the route's own answer (MapResponse, ...)."
+    result: JobResult = Field(
+        default=None,
+        description="When done: the route's own answer (MapResponse, OptimizeResponse or "
+        "EvaluateResponse, as kind says).",
     )
     error: list[ErrorDetail] | None = Field(
         default=None, description="When failed: what was wrong, as a 422's detail."

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from typing import Annotated, Literal
+from typing import Annotated
 
 from pydantic import ConfigDict, Field
 from pydantic.config import JsonDict
@@ -20,6 +20,7 @@ from service.schemas.common import (
     placement_example,
 )
 from service.schemas.evaluate import _REQUEST_EXAMPLE, FailureReason
+from service.schemas.motion import LimitedBy
 from service.schemas.path import Path
 from service.schemas.robot import Robot
 from solver.core.spatial import MAX_COORDINATE
@@ -182,7 +183,7 @@ class MapCell(ResponseModel):
         "and acceleration limits allow (m/s, as /v1/evaluate's acceleration.mu_acc); the "
         "map's colour and what best and worst rank. null without them or when infeasible.",
     )
-    limited_by: Literal["speed", "acceleration"] | None = Field(
+    limited_by: LimitedBy | None = Field(
         default=None,
         description="With joint acceleration limits: what binds mu_acc there; null without them "
         "or when infeasible.",

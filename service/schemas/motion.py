@@ -2,12 +2,25 @@
 
 from __future__ import annotations
 
-from typing import Literal
+from typing import Annotated, Literal
 
 from pydantic import ConfigDict, Field
 from pydantic.config import JsonDict
+from typing_extensions import TypeAliasType
 
 from service.schemas.common import ResponseModel
+
+LimitedBy = TypeAliasType(
+    "LimitedBy",
+    Annotated[
+        Literal["speed", "acceleration"],
+        Field(
+            description="What binds mu_acc: speed, a joint speed limit (mu_acc = mu_path); "
+            "acceleration, a joint acceleration limit."
+        ),
+    ],
+)
+"""One component for what binds, in evaluate answers and map cells."""
 
 _PASS_EXAMPLE: JsonDict = {  # the README example at 10 rad/s^2
     "start": 0,
@@ -47,7 +60,7 @@ class AccelerationResult(ResponseModel):
         "2 q_i + q(s_i - b)) / b^2 in the tool point's arc length s; waypoints within b of a "
         "pass end are not constrained (the feed ramps there)."
     )
-    limited_by: Literal["speed", "acceleration"] = Field(
+    limited_by: LimitedBy = Field(
         description="speed: mu_acc = mu_path (a joint speed limit binds at the bottleneck); "
         "acceleration: a joint acceleration limit binds."
     )

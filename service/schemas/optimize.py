@@ -94,9 +94,9 @@ class OptimizeRequest(RequestModel):
     bounds: Bounds = Field(description="Where the workpiece may go.")
     z: Coordinate | None = Field(
         default=None,
-        description="Height of the workpiece frame (m), the table height, within 1 km; required "
-        "unless "
-        "bounds.z gives a range to search.",
+        description="Height of the workpiece frame (m), the table height, within 1 km. Give "
+        "z or bounds.z (a range to search), exactly one: both or neither is a 422 on the "
+        "body (a rule between two fields, which JSON Schema here does not state).",
     )
     start: Placement | None = Field(
         default=None,
@@ -127,9 +127,14 @@ class OptimizeRequest(RequestModel):
 
     @model_validator(mode="after")
     def _one_height(self) -> OptimizeRequest:
-        if (self.z is None) == (self.bounds.z is None):
+        if self.z is None and self.bounds.z is None:
             raise PydanticCustomError(
-                "height", "give z (a fixed height) or bounds.z (a range to search), not both"
+                "height", "no height: give z (a fixed height) or bounds.z (a range to search)"
+            )
+        if self.z is not None and self.bounds.z is not None:
+            raise PydanticCustomError(
+                "height",
+                "z (a fixed height) and bounds.z (a range to search) are both given: give one",
             )
         return self
 

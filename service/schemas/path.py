@@ -12,6 +12,7 @@ from typing import Annotated, Literal
 
 import numpy as np
 from pydantic import ConfigDict, Discriminator, Field, PrivateAttr, Tag
+from typing_extensions import TypeAliasType
 
 from service.schemas.common import Pose, RequestModel, SpinMode, ToolAxisWaypoint
 from solver.cam.cam_path import CamPath, Units
@@ -25,6 +26,16 @@ from solver.core.tool_axis import poses_from_tool_axes
 
 MAX_PATH_WAYPOINTS = 20_000
 """The most waypoints any route takes (DTF_MAX_PATH_WAYPOINTS may lower it, never raise it)."""
+
+
+ProgramUnits = TypeAliasType(
+    "ProgramUnits",
+    Annotated[
+        Literal["mm", "inch"],
+        Field(description="The length unit of a CL program that states none: mm or inch."),
+    ],
+)
+"""The units a request gives a CL program (a named component for generated clients)."""
 
 
 @dataclass(frozen=True)
@@ -211,7 +222,7 @@ class ClDataPath(RequestModel):
         "correction reported. The default spin_mode is free; the default feed of /v1/evaluate "
         "is the program's highest FEDRAT.",
     )
-    units: Literal["mm", "inch"] | None = Field(
+    units: ProgramUnits | None = Field(
         default=None,
         description="The length unit, for a program that states none (no UNITS or UNIT record "
         "and no FEDRAT/IPM, from which inches are inferred). A program that states none and "

@@ -15,7 +15,7 @@ from solver.cam.cl_systems import PART, CoordinateSystem, csys, msys
 from solver.cam.cl_units import feed_of, stated_units
 from solver.cam.read_report import SkippedRecord
 from solver.cam.reading import checked_position, is_number, near_unit_vector, parse_numbers
-from solver.core.exceptions import InvalidInputError, InvalidLineError
+from solver.core.exceptions import InvalidInputError, InvalidLineError, cut
 from solver.core.spatial import MAX_COORDINATE
 from solver.core.task import ANGULAR_TOLERANCE, LINEAR_TOLERANCE
 
@@ -99,7 +99,7 @@ class ClReader:
         """Count a record that carries no geometry or feed."""
         seen = self.skipped.get(record.word)
         self.skipped[record.word] = (
-            SkippedRecord(record.word, 1, record.line, recognised)
+            SkippedRecord(cut(record.word), 1, record.line, recognised)
             if seen is None
             else dataclasses.replace(seen, count=seen.count + 1)
         )

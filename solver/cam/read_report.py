@@ -14,7 +14,7 @@ class SkippedRecord:
     """Records of one word that carry no geometry or feed, skipped.
 
     Attributes:
-        word: the major word (``PAINT``, ``$$`` for comments).
+        word: the major word (``PAINT``, ``$$`` for comments), cut to 100 characters.
         count: how many records of it the file has.
         first_line: the line of the first, from 1.
         recognised: ``False`` for a word the reader does not know (check that it moves

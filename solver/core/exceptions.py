@@ -8,11 +8,28 @@ back as data in the result.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+
+
+def cut(text: str, *, limit: int = 100) -> str:
+    """``text`` as an answer echoes it: cut to ``limit`` characters (a request may send 2 MB)."""
+    return text if len(text) <= limit else text[:limit] + "..."
+
 
 def quoted(text: str, *, limit: int = 100) -> str:
     """``text`` in quotes for a message, cut to ``limit`` characters (a request may send 2 MB)."""
-    shown = text if len(text) <= limit else text[:limit] + "..."
-    return repr(shown)
+    return repr(cut(text, limit=limit))
+
+
+MAX_LISTED_NAMES = 20
+"""Names listed in one message at most (a URDF may hold thousands of links)."""
+
+
+def quoted_names(names: Sequence[str]) -> str:
+    """Names for a message: each quoted and cut to 100 characters, at most 20 of them."""
+    listed = ", ".join(quoted(name) for name in names[:MAX_LISTED_NAMES])
+    more = len(names) - MAX_LISTED_NAMES
+    return listed + (f" and {more} more" if more > 0 else "")
 
 
 class SolverError(Exception):

@@ -18,7 +18,7 @@ from pathlib import Path
 import numpy as np
 import pinocchio as pin
 
-from solver.core.exceptions import InvalidInputError, RobotModelError, quoted
+from solver.core.exceptions import InvalidInputError, RobotModelError, quoted, quoted_names
 from solver.core.family import KinematicsFamily
 from solver.core.urdf_chain import chain_from_urdf, frame_names
 
@@ -138,7 +138,7 @@ def _checked_limits(
         count = limits.size if limits.ndim == 1 else f"an array of shape {limits.shape} of"
         raise InvalidInputError(
             field,
-            f"{count} values for the {len(joint_names)} joints ({', '.join(joint_names)}): "
+            f"{count} values for the {len(joint_names)} joints ({quoted_names(joint_names)}): "
             "give one per joint, in this order",
         )
     bad = np.flatnonzero(~np.isfinite(limits) | (limits < lower) | (limits > upper))
@@ -146,8 +146,8 @@ def _checked_limits(
         j = int(bad[0])
         raise InvalidInputError(
             field,
-            f"joint {j} ({joint_names[j]}) limit {float(limits[j]):.6g} {unit} must be > 0, "
-            f"within [{lower}, {upper}] {unit}",
+            f"joint {j} ({quoted(joint_names[j])}) limit {float(limits[j]):.6g} {unit} must be "
+            f"> 0, within [{lower}, {upper}] {unit}",
         )
     return limits
 
@@ -241,7 +241,7 @@ def robot_from_model(
     if base.parentJoint != 0:
         raise RobotModelError(
             "robot.base_frame",
-            f"frame {base_frame!r} moves with joint {model.names[base.parentJoint]!r}; "
+            f"frame {quoted(base_frame)} moves with joint {quoted(model.names[base.parentJoint])}; "
             "the base frame must be fixed to the root",
         )
     if any(model.joints[j].nq != 1 or model.joints[j].nv != 1 for j in range(1, model.njoints)):

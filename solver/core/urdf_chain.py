@@ -10,22 +10,14 @@ from __future__ import annotations
 
 import pinocchio as pin
 
-from solver.core.exceptions import RobotModelError, quoted
+from solver.core.exceptions import RobotModelError, quoted, quoted_names
 from solver.core.native_stderr import first_error, native_stderr
 from solver.core.urdf_structure import mimic_joints, root_links
 
-# A refused URDF's message names at most this many of its root links.
-ROOTS_NAMED = 5
 
-
-def frame_names(model: pin.Model, *, limit: int = 100) -> str:
-    """The model's frame names for a message: at most ``limit``, each cut to ``limit`` characters.
-
-    A URDF in a request may name a link with megabytes.
-    """
-    names = [f.name for f in model.frames if f.name != "universe"]
-    shown = [name if len(name) <= limit else name[:limit] + "..." for name in names[:limit]]
-    return ", ".join(shown) + (f", ... ({len(names)} frames)" if len(names) > limit else "")
+def frame_names(model: pin.Model) -> str:
+    """The model's frame names for a message, each cut and at most 20 (:func:`quoted_names`)."""
+    return quoted_names([f.name for f in model.frames if f.name != "universe"])
 
 
 def chain_from_urdf(urdf: str, *, tool_frame: str) -> pin.Model:
@@ -50,9 +42,7 @@ def chain_from_urdf(urdf: str, *, tool_frame: str) -> pin.Model:
     if error is not None:
         roots = root_links(urdf)
         if len(roots) > 1:  # pinocchio says why on stderr only
-            named_roots = ", ".join(map(quoted, roots[:ROOTS_NAMED])) + (
-                ", ..." if len(roots) > ROOTS_NAMED else ""
-            )
+            named_roots = quoted_names(roots)
             raise RobotModelError(
                 "robot.urdf",
                 f"cannot parse the URDF: {len(roots)} root links ({named_roots})"

@@ -9,6 +9,7 @@ from typing import Any
 
 import pytest
 from pydantic import BaseModel
+from typing_extensions import TypeAliasType
 
 from service import schemas
 from service.main import app
@@ -51,7 +52,10 @@ def test_every_component_is_exported() -> None:
         for name in schemas.__all__
         if isinstance(value := getattr(schemas, name), type) and issubclass(value, enum.Enum)
     }
-    assert set(COMPONENTS) == {model.__name__ for model in MODELS} | enums
+    aliases = {  # named Literal types: one component each (SpinMode, JobStatus, ...)
+        name for name in schemas.__all__ if isinstance(getattr(schemas, name), TypeAliasType)
+    }
+    assert set(COMPONENTS) == {model.__name__ for model in MODELS} | enums | aliases
 
 
 def test_failure_reasons_are_one_enum() -> None:

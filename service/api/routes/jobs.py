@@ -18,7 +18,7 @@ from fastapi import APIRouter, HTTPException, Path, Query, Response, status
 from fastapi.responses import JSONResponse
 
 from service.deps import SettingsDep
-from service.errors import ERROR_RESPONSES
+from service.errors import ERROR_RESPONSES, RETRY_AFTER
 from service.jobs.checks import check_job
 from service.jobs.runner import get_runner
 from service.jobs.store import Job, QueueFull
@@ -33,9 +33,7 @@ JOB_RESPONSES: dict[int | str, dict[str, Any]] = {
         "description": "The job store cannot be used (corrupt, replaced or deleted file: the "
         "detail says which), or the service is shutting down; retry after Retry-After. The "
         "compute routes are not affected.",
-        "headers": {
-            "Retry-After": {"description": "Seconds to wait.", "schema": {"type": "integer"}}
-        },
+        "headers": RETRY_AFTER,
     },
 }
 
@@ -44,8 +42,14 @@ router = APIRouter(prefix="/jobs", tags=["jobs"], responses=JOB_RESPONSES)
 JobId = Annotated[UUID, Path(description="The job's id, as POST /v1/jobs answered it.")]
 
 NOT_FOUND: dict[int | str, dict[str, Any]] = {
-    404: {"description": "No job has this id (or it expired)."}
+    404: {"model": ErrorResponse, "description": "No job has this id (or it expired)."}
 }
+
+
+def _not_found(job_id: UUID) -> HTTPException:
+    """The 404 of an unknown job id, naming the path parameter."""
+    detail = ErrorDetail(loc=["path", "job_id"], msg=f"no job {str(job_id)!r}", type="not_found")
+    return HTTPException(status.HTTP_404_NOT_FOUND, [detail.model_dump()])
 
 
 def _units(job: Job) -> int:
@@ -83,7 +87,24 @@ def job_info(job: Job, *, with_result: bool = True) -> JobInfo:
     operation_id="submit_job",
     summary="Run a map, optimisation or evaluation as a job",
     status_code=status.HTTP_202_ACCEPTED,
-    responses={429: {"description": "Too many jobs queued or running; retry later."}},
+    response_model=JobInfo,
+    responses={
+        202: {
+            "description": "Queued: the job as GET /v1/jobs/{id} answers it.",
+            "headers": {
+                "Location": {
+                    "description": "The job's URL, /v1/jobs/{id}.",
+                    "schema": {"type": "string"},
+                }
+            },
+        },
+        429: {
+            "model": ErrorResponse,
+            "description": "Too many jobs queued or running (DTF_MAX_QUEUED_JOBS); retry after "
+            "Retry-After.",
+            "headers": RETRY_AFTER,
+        },
+    },
 )
 async def post_job(body: JobRequest, settings: SettingsDep) -> JSONResponse:
     """Queue the work; answer 202 with its id and Location.
@@ -103,9 +124,14 @@ async def post_job(body: JobRequest, settings: SettingsDep) -> JSONResponse:
             )
         )
     except QueueFull:
+        detail = ErrorDetail(
+            loc=[],
+            msg=f"{settings.max_queued_jobs} jobs are queued or running (DTF_MAX_QUEUED_JOBS)",
+            type="queue_full",
+        )
         raise HTTPException(
             status.HTTP_429_TOO_MANY_REQUESTS,
-            f"{settings.max_queued_jobs} jobs are queued or running (DTF_MAX_QUEUED_JOBS)",
+            [detail.model_dump()],
             headers={"Retry-After": "10"},
         ) from None
     runner.wake()  # an idle worker takes the job now
@@ -136,7 +162,7 @@ def get_job(job_id: JobId, settings: SettingsDep) -> JobInfo:
     """Status, progress with ETA, times, and the route's answer once done (or the error)."""
     job = get_runner(settings).store.get(str(job_id))
     if job is None:
-        raise HTTPException(status.HTTP_404_NOT_FOUND, f"no job {str(job_id)!r}")
+        raise _not_found(job_id)
     return job_info(job)
 
 
@@ -154,13 +180,13 @@ def cancel_job(job_id: JobId, settings: SettingsDep) -> JobInfo:
     """
     runner = get_runner(settings)
     if runner.store.get(str(job_id)) is None:
-        raise HTTPException(status.HTTP_404_NOT_FOUND, f"no job {str(job_id)!r}")
+        raise _not_found(job_id)
     runner.store.cancel(str(job_id))
     runner.wake()  # the supervisor sees the cancel now
     log.info("job %s cancel asked", job_id)
     job = runner.store.get(str(job_id))
     if job is None:  # deleted meanwhile
-        raise HTTPException(status.HTTP_404_NOT_FOUND, f"no job {str(job_id)!r}")
+        raise _not_found(job_id)
     return job_info(job)
 
 
@@ -179,7 +205,7 @@ def delete_job(job_id: JobId, settings: SettingsDep) -> Response:
     runner = get_runner(settings)
     runner.store.cancel(str(job_id))
     if not runner.store.delete(str(job_id)):
-        raise HTTPException(status.HTTP_404_NOT_FOUND, f"no job {str(job_id)!r}")
+        raise _not_found(job_id)
     runner.wake()  # the supervisor stops a running job's worker now
     log.info("job %s deleted", job_id)
     return Response(status_code=status.HTTP_204_NO_CONTENT)

@@ -38,12 +38,13 @@ async def post_map(
     request: Request,
     body: Annotated[MapRequest, body_in_thread(MapRequest)],
     settings: SettingsDep,
-    accept: Annotated[str, Header()] = "application/json",
+    accept: Annotated[str, Header(include_in_schema=False)] = "application/json",
 ) -> MapResponse | Response:
     """Every placement of the grid with its mu_path (or why it is infeasible), best and worst.
 
-    With ``Accept: image/png`` the answer is the colour map (as ``POST /v1/map/png`` gives it,
-    the operation generated clients should use for the picture).
+    The colour map is ``POST /v1/map/png`` (a browser may also ask this operation for it with
+    ``Accept: image/png``; one content type an operation keeps generated clients able to read
+    every answer).
     """
     png = convert.wants_png(accept)
 

@@ -33,7 +33,8 @@ async def post_optimize(
     No feasible placement inside the bounds is not an error: ``found`` is false. A box whose
     coarse map (20 mm, 15 degrees) would exceed DTF_MAX_MAP_CELLS cells, or DTF_MAX_MAP_POSES
     placement-waypoint pairs weighed by the IK family's cost, or whose scipy search would
-    exceed DTF_MAX_SEARCH_POSES, is a 422 on ``bounds``.
+    exceed DTF_MAX_SEARCH_POSES, is a 422 on ``bounds``. The height is ``z`` or
+    ``bounds.z``, exactly one of them (both or neither is a 422).
     """
     return await run_stoppable(
         request, lambda progress: json_response(optimum_of(body, settings, progress))

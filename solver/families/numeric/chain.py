@@ -17,7 +17,7 @@ from dataclasses import dataclass
 import numpy as np
 import pinocchio as pin
 
-from solver.core.exceptions import RobotModelError
+from solver.core.exceptions import RobotModelError, quoted
 
 
 @dataclass(frozen=True)
@@ -61,7 +61,7 @@ class SerialChain:
         if not serial or last != model.njoints - 1 or model.nq != model.njoints - 1:
             raise RobotModelError(
                 "robot.tool_frame",
-                f"numeric IK needs one serial chain of 1-DOF joints ending at {tool_frame!r}",
+                f"numeric IK needs one serial chain of 1-DOF joints ending at {quoted(tool_frame)}",
             )
         data = model.createData()
         q0 = pin.neutral(model)
