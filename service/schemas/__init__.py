@@ -33,8 +33,10 @@ from service.schemas.jobs import (
     JobInfo,
     JobList,
     JobProgress,
+    JobResultPage,
     MapJob,
     OptimizeJob,
+    ResultCells,
 )
 from service.schemas.map import Grid, GridAxis, MapCell, MapExtreme, MapRequest, MapResponse
 from service.schemas.motion import AccelerationResult, CycleTimeResult, PassCycleTime
@@ -66,6 +68,8 @@ __all__ = [
     "JobProgress",
     "JobList",
     "JobInfo",
+    "JobResultPage",
+    "ResultCells",
     "EvaluateJob",
     "AutoIkPolicy",
     "Bottleneck",

@@ -9,7 +9,6 @@ While the job store cannot be used, every route here answers 503 saying why.
 from __future__ import annotations
 
 import functools
-import time
 from typing import Annotated, Any
 from uuid import UUID
 
@@ -21,10 +20,17 @@ from service.deps import SettingsDep
 from service.errors import ERROR_RESPONSES
 from service.jobs.checks import check_job
 from service.jobs.runner import get_runner
-from service.jobs.store import Job, QueueFull
+from service.jobs.store import QueueFull
+from service.jobs.views import job_info, units_of
 from service.logs import log
-from service.schemas import ErrorDetail, ErrorResponse, MapRequest
-from service.schemas.jobs import JobInfo, JobList, JobProgress, JobRequest, JobStatus
+from service.schemas import ErrorResponse
+from service.schemas.jobs import (
+    JobInfo,
+    JobList,
+    JobRequest,
+    JobStatus,
+)
+from service.work import json_response
 
 JOB_RESPONSES: dict[int | str, dict[str, Any]] = {
     **ERROR_RESPONSES,
@@ -48,36 +54,6 @@ NOT_FOUND: dict[int | str, dict[str, Any]] = {
 }
 
 
-def _units(job: Job) -> int:
-    """Units of work of a job: a map's placements, else 100 (percent)."""
-    if job.kind == "map":
-        request = MapRequest.model_validate(job.request)
-        return max(1, request.grid.n_placements())
-    return 100
-
-
-def job_info(job: Job, *, with_result: bool = True) -> JobInfo:
-    """The API's view of a stored job."""
-    total = _units(job)
-    eta = None
-    if job.status == "running" and job.started is not None and job.fraction > 0.0:
-        elapsed = time.time() - job.started
-        eta = elapsed * (1.0 - job.fraction) / job.fraction
-    return JobInfo(
-        id=job.id,
-        kind=job.kind,
-        status=job.status,
-        progress=JobProgress(
-            done=round(job.fraction * total), total=total, fraction=job.fraction, eta_seconds=eta
-        ),
-        created=job.created,
-        started=job.started,
-        finished=job.finished,
-        result=job.result if with_result else None,
-        error=None if job.error is None else [ErrorDetail(**e) for e in job.error],
-    )
-
-
 @router.post(
     "",
     operation_id="submit_job",
@@ -99,7 +75,11 @@ async def post_job(body: JobRequest, settings: SettingsDep) -> JSONResponse:
     try:
         job = await anyio.to_thread.run_sync(
             functools.partial(
-                runner.store.create, body.kind, request, limit=settings.max_queued_jobs
+                runner.store.create,
+                body.kind,
+                request,
+                total=units_of(body),
+                limit=settings.max_queued_jobs,
             )
         )
     except QueueFull:
@@ -110,7 +90,7 @@ async def post_job(body: JobRequest, settings: SettingsDep) -> JSONResponse:
         ) from None
     runner.wake()  # an idle worker takes the job now
     log.info("job %s queued (%s)", job.id, body.kind)
-    info = job_info(job)
+    info = job_info(job, runner.store)
     return JSONResponse(
         info.model_dump(mode="json"),
         status_code=status.HTTP_202_ACCEPTED,
@@ -124,20 +104,38 @@ def get_jobs(
     job_status: Annotated[JobStatus | None, Query(alias="status")] = None,
     limit: Annotated[int, Query(ge=1, le=1000)] = 100,
 ) -> JobList:
-    """Every job the store holds (finished ones until DTF_JOB_TTL), newest first."""
-    jobs = get_runner(settings).store.jobs(status=job_status, limit=limit)
-    return JobList(jobs=[job_info(job, with_result=False) for job in jobs])
+    """Every job the store holds (finished ones until DTF_JOB_TTL), newest first.
+
+    Results are not read: ``result`` is null here; ``GET /v1/jobs/{id}`` gives it.
+    """
+    store = get_runner(settings).store
+    return JobList(
+        jobs=[job_info(state, store) for state in store.jobs(status=job_status, limit=limit)]
+    )
 
 
 @router.get(
-    "/{job_id}", operation_id="get_job", summary="A job's status and result", responses=NOT_FOUND
+    "/{job_id}",
+    operation_id="get_job",
+    summary="A job's status and result",
+    response_model=JobInfo,
+    responses=NOT_FOUND,
 )
-def get_job(job_id: JobId, settings: SettingsDep) -> JobInfo:
-    """Status, progress with ETA, times, and the route's answer once done (or the error)."""
-    job = get_runner(settings).store.get(str(job_id))
+def get_job(job_id: JobId, settings: SettingsDep) -> Response:
+    """Status, progress with ETA, times, and the route's answer once done (or the error).
+
+    A map's answer holds its cells up to DTF_JOB_PAGE_CELLS (default 10,000) of them; a larger
+    one comes without ``cells``, and ``result_cells`` says how many there are and where the
+    first page is: ``GET /v1/jobs/{id}/result?offset=0&limit=10000``, then each page's
+    ``next``.
+    """
+    store = get_runner(settings).store
+    job = store.get(str(job_id), inline_cells=settings.job_page_cells)
     if job is None:
         raise HTTPException(status.HTTP_404_NOT_FOUND, f"no job {str(job_id)!r}")
-    return job_info(job)
+    return json_response(
+        job_info(job, store, result=job.result, page_limit=settings.job_page_cells)
+    )
 
 
 @router.post(
@@ -153,15 +151,15 @@ def cancel_job(job_id: JobId, settings: SettingsDep) -> JobInfo:
     left as it is. The answer is the job after the cancel was asked.
     """
     runner = get_runner(settings)
-    if runner.store.get(str(job_id)) is None:
+    if runner.store.state(str(job_id)) is None:
         raise HTTPException(status.HTTP_404_NOT_FOUND, f"no job {str(job_id)!r}")
     runner.store.cancel(str(job_id))
     runner.wake()  # the supervisor sees the cancel now
     log.info("job %s cancel asked", job_id)
-    job = runner.store.get(str(job_id))
-    if job is None:  # deleted meanwhile
+    state = runner.store.state(str(job_id))
+    if state is None:  # deleted meanwhile
         raise HTTPException(status.HTTP_404_NOT_FOUND, f"no job {str(job_id)!r}")
-    return job_info(job)
+    return job_info(state, runner.store)
 
 
 @router.delete(
