@@ -40,7 +40,9 @@ async def post_evaluate(
 ) -> Response:
     """An unreachable placement is not an error: it answers ``feasible: false`` with a reason."""
     if convert.wants_png(accept):
-        picture = await run_stoppable(request, lambda _: joint_use_png(body, settings))
+        picture = await run_stoppable(
+            request, lambda progress: joint_use_png(body, settings, progress)
+        )
         return Response(picture, media_type="image/png")
     return await run_stoppable(
         request, lambda progress: json_response(evaluation_of(body, settings, progress))

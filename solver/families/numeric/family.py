@@ -13,12 +13,15 @@ J^-1 t: a batched 6 x 6 solve for six joints; for more, the joint speeds of the 
 
 from __future__ import annotations
 
+from collections.abc import Iterator
+
 import numpy as np
 import pinocchio as pin
 
 from solver.core.codes import OK, SINGULAR, UNREACHABLE
 from solver.core.dtf_redundant import redundant_speed
 from solver.core.family import Branch, KinematicsFamily, PathSolutions
+from solver.core.progress import Progress, span
 from solver.core.spatial import wrap_angle
 from solver.families.numeric import ik
 from solver.families.numeric.chain import SerialChain
@@ -35,6 +38,12 @@ SEED_COST = {6: 3_200.0, 7: 6_400.0}
 # Following: UR5 as a URDF 0.24 ms a waypoint, the Jaco2 0.08 ms; the Panda 0.59 ms, the xArm7
 # (whose +-2 pi joints give many distinct solutions) 1.44 ms.
 TRACK_COST = {6: 65.0, 7: 400.0}
+CHUNK_ROWS = 2048
+"""Configurations checked (singularity, joint speeds) between two progress reports: about
+0.2 s for seven joints under load, so that a cancelled evaluation stops within a second."""
+SEED_SHARE, FOLLOW_SHARE = 0.05, 0.9
+"""Where seeding the first waypoint ends, and following the branches, in a path's solve's
+progress (the rest: the singularity checks)."""
 
 
 def seed_count(dof: int) -> int:
@@ -95,8 +104,12 @@ class NumericFamily(KinematicsFamily):
         """``solution=0`` ... ``solution=K-1``: slots for the distinct solutions, in seed order."""
         return self._branches
 
-    def _seeded(self, rotation: np.ndarray, position: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    def _seeded(
+        self, rotation: np.ndarray, position: np.ndarray, progress: Progress | None = None
+    ) -> tuple[np.ndarray, np.ndarray]:
         """Distinct solutions within the limits from every seed: (P, 3, 3), (P, 3) -> slots.
+
+        ``progress`` is called after each iteration of the seeds' solve.
 
         Returns:
             slots (P, K, n), rad, NaN after the solutions found; count (P,).
@@ -111,16 +124,20 @@ class NumericFamily(KinematicsFamily):
             iterations=ik.SEED_ITERATIONS,
             lower=self.lower,
             upper=self.upper,
+            progress=progress,
         )
         q = q.reshape(n_poses, n_seeds, self.dof)
         return ik.distinct(q, converged.reshape(n_poses, n_seeds), self.chain.revolute)
 
-    def _wrapped_with_status(self, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    def _wrapped_with_status(
+        self, q: np.ndarray, progress: Progress | None = None
+    ) -> tuple[np.ndarray, np.ndarray]:
         """Revolute joints wrapped to [-pi, pi) and the status of each solution, q (..., n)."""
         flat = q.reshape(-1, self.dof)
         status = np.full(len(flat), UNREACHABLE)
         solved = np.flatnonzero(np.isfinite(flat).all(axis=-1))
-        status[solved] = np.where(ik.is_singular(self.chain, flat[solved]), SINGULAR, OK)
+        for rows in _in_chunks(solved, progress):
+            status[rows] = np.where(ik.is_singular(self.chain, flat[rows]), SINGULAR, OK)
         wrapped = np.where(self.chain.revolute, wrap_angle(q), q)
         return wrapped, status.reshape(q.shape[:-1])
 
@@ -139,7 +156,9 @@ class NumericFamily(KinematicsFamily):
         q = np.moveaxis(q.reshape(*batch, len(self.seeds), self.dof), (-1, -2), (0, 1))
         return q, np.moveaxis(status.reshape(*batch, len(self.seeds)), -1, 0)
 
-    def solve_path(self, rotation: np.ndarray, position: np.ndarray) -> PathSolutions:
+    def solve_path(
+        self, rotation: np.ndarray, position: np.ndarray, *, progress: Progress | None = None
+    ) -> PathSolutions:
         """Seeded solutions at the first waypoint, each followed along its path.
 
         Each step starts from the branch's solution at the previous waypoint (so for dof > 6 it
@@ -150,6 +169,9 @@ class NumericFamily(KinematicsFamily):
         Args:
             rotation: shape (3, 3, *batch, W), R_B_F, broadcasting with ``position``.
             position: shape (3, *batch, W), m in {B}.
+            progress: called after each waypoint followed, and after each chunk of
+                CHUNK_ROWS solutions checked for singularity; it may raise
+                :class:`solver.core.progress.Cancelled` to stop the work.
         """
         shape = np.broadcast_shapes(rotation.shape[2:], position.shape[1:])
         *batch, n_waypoints = shape
@@ -158,14 +180,19 @@ class NumericFamily(KinematicsFamily):
         positions = np.moveaxis(np.broadcast_to(position, (3, *shape)), 0, -1)
         positions = positions.reshape(-1, n_waypoints, 3)
         n_paths, n_seeds = len(positions), len(self.seeds)
-        slots, count = self._seeded(rotations[:, 0], positions[:, 0])
+        slots, count = self._seeded(
+            rotations[:, 0], positions[:, 0], span(progress, 0.0, SEED_SHARE)
+        )
         q = np.full((n_paths, n_seeds, n_waypoints, self.dof), np.nan)
         q[:, :, 0] = slots
         paths, branches = np.nonzero(np.isfinite(slots[..., 0]))
         q[paths, branches] = self._followed(
-            slots[paths, branches], rotations[paths], positions[paths]
+            slots[paths, branches],
+            rotations[paths],
+            positions[paths],
+            progress=span(progress, SEED_SHARE, FOLLOW_SHARE),
         )
-        wrapped, status = self._wrapped_with_status(q)
+        wrapped, status = self._wrapped_with_status(q, span(progress, FOLLOW_SHARE, 1.0))
         return PathSolutions(
             q=wrapped.transpose(3, 1, 0, 2).reshape(self.dof, n_seeds, *batch, n_waypoints),
             status=np.moveaxis(status, 1, 0).reshape(n_seeds, *batch, n_waypoints),
@@ -174,7 +201,12 @@ class NumericFamily(KinematicsFamily):
         )
 
     def _followed(
-        self, start: np.ndarray, rotations: np.ndarray, positions: np.ndarray
+        self,
+        start: np.ndarray,
+        rotations: np.ndarray,
+        positions: np.ndarray,
+        *,
+        progress: Progress | None = None,
     ) -> np.ndarray:
         """Each branch followed from its first solution, NaN from the waypoint where it is lost.
 
@@ -182,6 +214,7 @@ class NumericFamily(KinematicsFamily):
             start: shape (M, n), the branches' solutions at the first waypoint.
             rotations: shape (M, W, 3, 3), R_B_F* of each branch's path.
             positions: shape (M, W, 3), m in {B}.
+            progress: called after each waypoint with the fraction of waypoints followed.
 
         Returns:
             shape (M, W, n). A lost branch stays in the batch, frozen, until at least half of
@@ -196,6 +229,8 @@ class NumericFamily(KinematicsFamily):
         for waypoint in range(1, n_waypoints):
             if lost.all():
                 break
+            if progress is not None:
+                progress(waypoint / n_waypoints)
             solved, converged = ik.solve(
                 self.chain,
                 current,
@@ -222,11 +257,13 @@ class NumericFamily(KinematicsFamily):
         tool_point: np.ndarray,
         *,
         qdot_max: np.ndarray | None = None,
+        progress: Progress | None = None,
     ) -> np.ndarray:
         """J^-1 t (six joints) or the exact DTF LP's joint speeds per unit speed (more).
 
         See :meth:`KinematicsFamily.joint_speeds_per_unit_twist`. Only configurations with
-        finite joints are computed; the others come back NaN.
+        finite joints are computed, CHUNK_ROWS at a time with ``progress`` called after each;
+        the others come back NaN.
 
         Raises:
             ValueError: dof > 6 and no ``qdot_max``.
@@ -238,17 +275,38 @@ class NumericFamily(KinematicsFamily):
         twist_flat = np.moveaxis(np.broadcast_to(twist, (6, *shape)), 0, -1).reshape(-1, 6)
         point_flat = np.moveaxis(np.broadcast_to(tool_point, (3, *shape)), 0, -1).reshape(-1, 3)
         speeds = np.full(q_flat.shape, np.nan)
-        rows = np.flatnonzero(np.isfinite(q_flat).all(axis=-1))
-        jacobian, _, _ = self.chain.jacobian(q_flat[rows], point_flat[rows])
-        if self.dof == 6:
-            speeds[rows] = _solve_or_nan(jacobian, twist_flat[rows])
-        elif self.dof > 6 and qdot_max is not None:
-            speed, qdot = redundant_speed(jacobian, twist_flat[rows], qdot_max)
-            with np.errstate(divide="ignore", invalid="ignore"):
-                speeds[rows] = qdot / speed[:, None]
-        else:  # fewer than six joints: the least-squares speeds (the twist may be out of reach)
-            speeds[rows] = (np.linalg.pinv(jacobian) @ twist_flat[rows, :, None])[..., 0]
+        finite = np.flatnonzero(np.isfinite(q_flat).all(axis=-1))
+        for rows in _in_chunks(finite, progress):
+            speeds[rows] = self._speeds(q_flat[rows], twist_flat[rows], point_flat[rows], qdot_max)
         return np.moveaxis(speeds.reshape(*shape, self.dof), -1, 0)
+
+    def _speeds(
+        self,
+        q: np.ndarray,
+        twist: np.ndarray,
+        tool_point: np.ndarray,
+        qdot_max: np.ndarray | None,
+    ) -> np.ndarray:
+        """Joint speeds per unit twist at M finite configurations: (M, n), (M, 6), (M, 3)."""
+        jacobian, _, _ = self.chain.jacobian(q, tool_point)
+        if self.dof == 6:
+            return _solve_or_nan(jacobian, twist)
+        if self.dof > 6 and qdot_max is not None:
+            speed, qdot = redundant_speed(jacobian, twist, qdot_max)
+            with np.errstate(divide="ignore", invalid="ignore"):
+                out: np.ndarray = qdot / speed[:, None]
+            return out
+        # fewer than six joints: the least-squares speeds (the twist may be out of reach)
+        least: np.ndarray = (np.linalg.pinv(jacobian) @ twist[..., None])[..., 0]
+        return least
+
+
+def _in_chunks(rows: np.ndarray, progress: Progress | None) -> Iterator[np.ndarray]:
+    """``rows`` in pieces of CHUNK_ROWS, ``progress`` called after each piece is done."""
+    for start in range(0, len(rows), CHUNK_ROWS):
+        yield rows[start : start + CHUNK_ROWS]
+        if progress is not None:
+            progress(min(start + CHUNK_ROWS, len(rows)) / len(rows))
 
 
 def _solve_or_nan(jacobian: np.ndarray, twist: np.ndarray) -> np.ndarray:
