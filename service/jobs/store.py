@@ -28,7 +28,7 @@ from service.jobs.job import (
     job_of_row,
     state_of_row,
 )
-from service.jobs.results import read_cells, with_cells, write_result
+from service.jobs.results import cells_text, read_cells, with_cells, write_result
 from service.jobs.store_file import StoreFile
 
 __all__ = [
@@ -142,6 +142,18 @@ class JobStore(StoreFile):
                 return read_cells(db, job_id, offset=offset, limit=limit)
         cells = json.loads(row["result"]).get("cells", [])
         return list(cells[offset : offset + limit])
+
+    def cells_json(self, job_id: str, *, offset: int, limit: int) -> tuple[str, int]:
+        """:meth:`cells` as a JSON array's text, and how many cells it holds.
+
+        Whole stored pages are copied unparsed (:func:`service.jobs.results.cells_text`).
+        """
+        state = self.state(job_id)
+        if state is None or state.cells is None:
+            cells = self.cells(job_id, offset=offset, limit=limit)
+            return json.dumps(cells), len(cells)
+        with self._connection() as db:
+            return cells_text(db, job_id, offset=offset, limit=limit, total=state.cells)
 
     def cell_count(self, job_id: str) -> int:
         """How many cells a done job's result has (0 without cells or result)."""

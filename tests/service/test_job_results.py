@@ -51,7 +51,8 @@ def test_a_listing_reads_no_request_and_no_result(tmp_path: Path) -> None:
 
 
 @pytest.mark.parametrize(
-    ("offset", "limit"), [(0, 1000), (999, 2), (1500, 1000), (0, 2500), (2400, 500), (2500, 10)]
+    ("offset", "limit"),
+    [(0, 1000), (999, 2), (1500, 1000), (0, 2500), (1000, 1500), (2400, 500), (2500, 10)],
 )
 def test_a_page_is_the_same_cells_of_the_result(tmp_path: Path, offset: int, limit: int) -> None:
     store = JobStore(tmp_path / "jobs.sqlite3")
@@ -59,6 +60,8 @@ def test_a_page_is_the_same_cells_of_the_result(tmp_path: Path, offset: int, lim
     store.start(job.id)
     store.finish(job.id, "done", result={"cells": CELLS, "feasible_cells": 2500})
     assert store.cells(job.id, offset=offset, limit=limit) == CELLS[offset : offset + limit]
+    text, count = store.cells_json(job.id, offset=offset, limit=limit)
+    assert json.loads(text) == CELLS[offset : offset + limit] and count == len(json.loads(text))
     small, whole = store.get(job.id, inline_cells=2499), store.get(job.id)
     assert small is not None and small.result == {"feasible_cells": 2500}
     assert whole is not None and whole.result == {"cells": CELLS, "feasible_cells": 2500}
