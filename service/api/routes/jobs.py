@@ -16,6 +16,7 @@ import anyio
 from fastapi import APIRouter, HTTPException, Path, Query, Response, status
 from fastapi.responses import JSONResponse
 
+from service.body import union_body_in_thread, union_body_openapi
 from service.deps import SettingsDep
 from service.errors import ERROR_RESPONSES
 from service.jobs.checks import check_job
@@ -25,10 +26,13 @@ from service.jobs.views import job_info, units_of
 from service.logs import log
 from service.schemas import ErrorResponse
 from service.schemas.jobs import (
+    EvaluateJob,
     JobInfo,
     JobList,
     JobRequest,
     JobStatus,
+    MapJob,
+    OptimizeJob,
 )
 from service.work import json_response
 
@@ -49,6 +53,9 @@ router = APIRouter(prefix="/jobs", tags=["jobs"], responses=JOB_RESPONSES)
 
 JobId = Annotated[UUID, Path(description="The job's id, as POST /v1/jobs answered it.")]
 
+JOB_MODELS = (MapJob, OptimizeJob, EvaluateJob)
+"""The kinds of job a body may be (JobRequest's members, in its order)."""
+
 NOT_FOUND: dict[int | str, dict[str, Any]] = {
     404: {"description": "No job has this id (or it expired)."}
 }
@@ -60,9 +67,15 @@ NOT_FOUND: dict[int | str, dict[str, Any]] = {
     summary="Run a map, optimisation or evaluation as a job",
     status_code=status.HTTP_202_ACCEPTED,
     responses={429: {"description": "Too many jobs queued or running; retry later."}},
+    openapi_extra=union_body_openapi(JOB_MODELS),
 )
-async def post_job(body: JobRequest, settings: SettingsDep) -> JSONResponse:
+async def post_job(
+    body: Annotated[JobRequest, union_body_in_thread(JobRequest, JOB_MODELS)],
+    settings: SettingsDep,
+) -> JSONResponse:
     """Queue the work; answer 202 with its id and Location.
+
+    A large body (a 20,000-waypoint path) is validated off the event loop, in pieces.
 
     The request is checked as its route checks it before it is queued (the robot, the path as
     read, the options, the grid, the bounds), with the route's error types, a field inside the
