@@ -139,6 +139,13 @@ class Settings(BaseSettings):
         gt=0,
         description="Most placements one map job may ask for (its max_map_cells).",
     )
+    job_page_cells: int = Field(
+        default=10_000,
+        gt=0,
+        description="Most cells of a map job's result that GET /v1/jobs/{id} answers in it (a "
+        "larger result is answered without its cells, which GET /v1/jobs/{id}/result gives in "
+        "pages), and most cells one such page may hold (about 2.2 MB of JSON).",
+    )
     max_job_poses: int = Field(
         default=500_000_000,
         gt=0,

@@ -88,6 +88,12 @@ ERROR_RESPONSES: dict[int | str, dict[str, Any]] = {
 """OpenAPI entries of the error answers, for routers that take a body."""
 
 
+def job_not_found(job_id: object) -> StarletteHTTPException:
+    """The 404 of an unknown job id, naming the path parameter ``job_id``."""
+    detail = ErrorDetail(loc=["path", "job_id"], msg=f"no job {str(job_id)!r}", type="not_found")
+    return StarletteHTTPException(status.HTTP_404_NOT_FOUND, [detail.model_dump()])  # type: ignore[arg-type]
+
+
 def _error_response(status_code: int, details: list[ErrorDetail]) -> JSONResponse:
     """An error answer with its ``detail`` list."""
     return JSONResponse(status_code=status_code, content=ErrorResponse(detail=details).model_dump())

@@ -163,6 +163,60 @@ def test_a_client_that_leaves_stops_its_work() -> None:
         process.wait()
 
 
+def _busy(pid: int, seconds: float) -> float:
+    """The fraction of ``seconds`` in which a thread of the process is running or runnable.
+
+    A thread waiting for a core on a busy machine is still counted (state R), so this tells
+    computing from idle whatever the load, which CPU time does not.
+    """
+    samples, busy = 0, 0
+    end = time.monotonic() + seconds
+    while time.monotonic() < end:
+        states = []
+        for task in (Path("/proc") / str(pid) / "task").iterdir():
+            try:
+                states.append((task / "stat").read_text().rsplit(")", 1)[1].split()[0])
+            except OSError:
+                continue  # the thread ended meanwhile
+        samples, busy = samples + 1, busy + ("R" in states)
+        time.sleep(0.02)
+    return busy / max(samples, 1)
+
+
+@pytest.mark.parametrize("model", ["kinova_jaco2", "panda"])
+def test_an_evaluate_whose_client_leaves_stops_within_a_second(model: str) -> None:
+    # Numeric IK (six joints: J^-1 t; seven: the DTF LP) along 20,000 waypoints: tens of
+    # seconds of work, still running when the client leaves at 3 s (it gets no answer). The
+    # idle server is not quite still (the job supervisor looks at its store every 50 ms).
+    process, url = start_server({})
+    body = {
+        "robot": {"model": model},
+        "path": line_path(20_000, 2.5e-6),
+        "placement": EXAMPLE["placement"],
+    }
+    errors: list[Exception] = []
+
+    def leaves() -> None:
+        try:
+            httpx.post(url + "/v1/evaluate", json=body, timeout=3.0)
+        except httpx.ReadTimeout as error:
+            errors.append(error)
+
+    try:
+        client = threading.Thread(target=leaves)
+        client.start()
+        time.sleep(2.0)
+        working = _busy(process.pid, 0.8)
+        client.join()
+        assert len(errors) == 1  # the client left before an answer
+        time.sleep(1.0)
+        assert working > 0.8  # the evaluation ran before the client left
+        assert _busy(process.pid, 1.0) < 0.5  # and stopped within a second after
+    finally:
+        process.kill()
+        process.wait()
+
+
 def test_sigterm_stops_the_service_within_seconds() -> None:
     process, url = start_server(
         {"DTF_MAX_MAP_POSES": "40000000"}, "--timeout-graceful-shutdown", "2"

@@ -44,6 +44,7 @@ def test_operation_ids_are_short_and_the_png_is_binary() -> None:
         "submit_job",
         "list_jobs",
         "get_job",
+        "get_job_result",
         "cancel_job",
         "delete_job",
         "metrics",

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from fastapi import APIRouter
 
-from service.api.routes import dtf, evaluate, jobs, map, optimize, paths, robots
+from service.api.routes import dtf, evaluate, job_results, jobs, map, optimize, paths, robots
 
 api_router = APIRouter(prefix="/v1")
 api_router.include_router(robots.router)
@@ -14,3 +14,4 @@ api_router.include_router(map.router)
 api_router.include_router(optimize.router)
 api_router.include_router(paths.router)
 api_router.include_router(jobs.router)
+api_router.include_router(job_results.router)

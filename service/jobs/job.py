@@ -11,6 +11,11 @@ Status = Literal["queued", "running", "done", "failed", "cancelled"]
 Kind = Literal["map", "optimize", "evaluate"]
 FINISHED = ("done", "failed", "cancelled")
 
+STATE_COLUMNS = (
+    "id, kind, status, error, done, total, cells, created, started, finished, attempts, cancel"
+)
+"""The columns of a job's state: everything but its request and its result (the large ones)."""
+
 
 class JobStoreUnavailable(Exception):
     """The job store's file cannot be used: corrupt, replaced or deleted, or unreadable.
@@ -35,22 +40,26 @@ class QueueFull(Exception):
 
 
 @dataclass(frozen=True)
-class Job:
-    """One job as stored.
+class JobState:
+    """One job as stored, without its request and its result (what a job listing shows).
 
     Attributes:
+        error: a 422-style detail list when failed.
         fraction: the fraction of its work done, 0..1.
+        total: its units of work (a map's placements, else 100); None for a job stored by a
+            release that did not keep it.
+        cells: how many cells its result holds in pages (``JobStore.cells``); None when the
+            result has no cells (not a map, not done, or stored whole by an older release).
         created, started, finished: Unix times (s); None until they happen.
-        result: the route's JSON answer when done; error: a 422-style detail list when failed.
     """
 
     id: str
     kind: Kind
     status: Status
-    request: dict[str, Any]
-    result: dict[str, Any] | None
     error: list[dict[str, Any]] | None
     fraction: float
+    total: int | None
+    cells: int | None
     created: float
     started: float | None
     finished: float | None
@@ -58,19 +67,42 @@ class Job:
     cancel: bool
 
 
-def job_of_row(row: sqlite3.Row) -> Job:
-    """The job a row of the ``jobs`` table holds."""
-    return Job(
-        id=row["id"],
-        kind=row["kind"],
-        status=row["status"],
-        request=json.loads(row["request"]),
-        result=None if row["result"] is None else json.loads(row["result"]),
-        error=None if row["error"] is None else json.loads(row["error"]),
-        fraction=float(row["done"]),
-        created=row["created"],
-        started=row["started"],
-        finished=row["finished"],
-        attempts=row["attempts"],
-        cancel=bool(row["cancel"]),
-    )
+@dataclass(frozen=True)
+class Job(JobState):
+    """One job as stored, with its request and its result.
+
+    Attributes:
+        request: the route's body, as JSON.
+        result: the route's JSON answer when done; a map's ``cells`` are in it only when the
+            store was asked for them (``JobStore.get``'s ``inline_cells``).
+    """
+
+    request: dict[str, Any]
+    result: dict[str, Any] | None
+
+
+def _state_fields(row: sqlite3.Row) -> dict[str, Any]:
+    return {
+        "id": row["id"],
+        "kind": row["kind"],
+        "status": row["status"],
+        "error": None if row["error"] is None else json.loads(row["error"]),
+        "fraction": float(row["done"]),
+        "total": row["total"],
+        "cells": row["cells"],
+        "created": row["created"],
+        "started": row["started"],
+        "finished": row["finished"],
+        "attempts": row["attempts"],
+        "cancel": bool(row["cancel"]),
+    }
+
+
+def state_of_row(row: sqlite3.Row) -> JobState:
+    """The state a row of the ``jobs`` table holds (its STATE_COLUMNS)."""
+    return JobState(**_state_fields(row))
+
+
+def job_of_row(row: sqlite3.Row, result: dict[str, Any] | None) -> Job:
+    """The job a whole row of the ``jobs`` table holds, with its result as read."""
+    return Job(**_state_fields(row), request=json.loads(row["request"]), result=result)

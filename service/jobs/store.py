@@ -3,137 +3,63 @@
 The store is the one place job state lives, shared by the web process and the worker
 processes: a worker reports progress by writing it here, and finds a cancel request here.
 
-The file is opened on first use, not when the store is made: importing the service creates
-nothing. Whatever goes wrong with the file (corrupt, replaced or deleted while the service runs,
-unreadable) is one exception, :class:`JobStoreUnavailable`, which the service answers with 503:
-the job routes are down, the compute routes are not.
+Its file (:mod:`service.jobs.store_file`) is opened on first use; whatever goes wrong with it
+is :class:`JobStoreUnavailable` (503). A map's cells are kept in pages of their own
+(:mod:`service.jobs.results`), so that a job listing reads no result and a page of cells
+reads only that page.
 """
 
 from __future__ import annotations
 
 import json
-import os
-import sqlite3
-import threading
 import time
 import uuid
-from collections.abc import Iterator
-from contextlib import contextmanager
-from pathlib import Path
 from typing import Any
 
 from service.jobs.job import (
     FINISHED,
+    STATE_COLUMNS,
     Job,
+    JobState,
     JobStoreUnavailable,
     Kind,
     QueueFull,
     Status,
     job_of_row,
+    state_of_row,
 )
+from service.jobs.results import cells_text, read_cells, with_cells, write_result
+from service.jobs.store_file import StoreFile
 
-__all__ = ["FINISHED", "Job", "JobStore", "JobStoreUnavailable", "Kind", "QueueFull", "Status"]
-
-_SCHEMA = """
-CREATE TABLE IF NOT EXISTS jobs (
-    id TEXT PRIMARY KEY,
-    kind TEXT NOT NULL,
-    status TEXT NOT NULL,
-    request TEXT NOT NULL,
-    result TEXT,
-    error TEXT,
-    done REAL NOT NULL DEFAULT 0,
-    created REAL NOT NULL,
-    started REAL,
-    finished REAL,
-    attempts INTEGER NOT NULL DEFAULT 0,
-    cancel INTEGER NOT NULL DEFAULT 0
-);
-CREATE INDEX IF NOT EXISTS jobs_created ON jobs (created);
-"""
+__all__ = [
+    "FINISHED",
+    "Job",
+    "JobState",
+    "JobStore",
+    "JobStoreUnavailable",
+    "Kind",
+    "QueueFull",
+    "Status",
+]
 
 
-class JobStore:
-    """Jobs in an SQLite file; each call opens its own connection (safe across processes).
+class JobStore(StoreFile):
+    """Jobs in an SQLite file (:class:`StoreFile`): what the routes, runner and workers ask."""
 
-    The file is made by the web process's store (``create=True``) on its first use; the worker
-    processes' stores never make one, so a file deleted under a running service is found out
-    (503) rather than silently replaced by an empty one. Which file it is (device and inode) is
-    kept at the first use, so a file replaced under the running service is found out too.
-    """
-
-    def __init__(self, path: Path, *, create: bool = True) -> None:
-        """A store at ``path``, opened on first use (``create``: make the file if missing)."""
-        self.path = path
-        self._create = create
-        self._identity: tuple[int, int] | None = None
-        self._lock = threading.Lock()
-
-    def _unavailable(self, what: str) -> JobStoreUnavailable:
-        return JobStoreUnavailable(f"the job store {str(self.path)!r} {what}")
-
-    def _open(self) -> None:
-        """First use: make the directory, the file and the table; note which file it is."""
-        with self._lock:
-            if self._identity is not None:
-                return
-            try:
-                if self._create:
-                    self.path.parent.mkdir(parents=True, exist_ok=True)
-                with self._connect(create=self._create) as db:
-                    db.executescript(_SCHEMA)
-                status = os.stat(self.path)
-            except (sqlite3.Error, OSError) as error:
-                raise self._unavailable(f"cannot be used: {error}") from error
-            self._identity = (status.st_dev, status.st_ino)
-
-    def _check_identity(self) -> None:
-        """The file is the one first opened: not deleted, not replaced."""
-        try:
-            status = os.stat(self.path)
-        except FileNotFoundError:
-            raise self._unavailable(
-                "was deleted while the service ran, and its jobs with it; restart the service "
-                "to start a new, empty store"
-            ) from None
-        except OSError as error:
-            raise self._unavailable(f"cannot be used: {error}") from error
-        if (status.st_dev, status.st_ino) != self._identity:
-            raise self._unavailable(
-                "was replaced by another file while the service ran; restart the service to "
-                "use the new file"
-            )
-
-    @contextmanager
-    def _connect(self, *, create: bool) -> Iterator[sqlite3.Connection]:
-        mode = "rwc" if create else "rw"
-        uri = f"{self.path.absolute().as_uri()}?mode={mode}"
-        db = sqlite3.connect(uri, uri=True, timeout=30, isolation_level=None)
-        db.row_factory = sqlite3.Row
-        try:
-            db.execute("PRAGMA journal_mode=WAL")
-            yield db
-        finally:
-            db.close()
-
-    @contextmanager
-    def _connection(self) -> Iterator[sqlite3.Connection]:
-        """A connection to the store's file; any SQLite or OS error is JobStoreUnavailable."""
-        if self._identity is None:
-            self._open()
-        self._check_identity()
-        try:
-            with self._connect(create=False) as db:
-                yield db
-        except (sqlite3.Error, OSError) as error:
-            raise self._unavailable(f"cannot be used: {error}") from error
-
-    def create(self, kind: Kind, request: dict[str, Any], *, limit: int | None = None) -> Job:
+    def create(
+        self,
+        kind: Kind,
+        request: dict[str, Any],
+        *,
+        total: int | None = None,
+        limit: int | None = None,
+    ) -> Job:
         """A new queued job with a random id.
 
         Args:
             kind: what the job computes.
             request: the route's body, as JSON.
+            total: its units of work (a map's placements, else 100), kept for its progress.
             limit: at most this many jobs queued or running, counted in the insert's own
                 transaction (so that concurrent submissions cannot pass it together).
 
@@ -151,8 +77,9 @@ class JobStore:
                     if int(row[0]) >= limit:
                         raise QueueFull(limit)
                 db.execute(
-                    "INSERT INTO jobs (id, kind, status, request, created) VALUES (?, ?, ?, ?, ?)",
-                    (job_id, kind, "queued", json.dumps(request), time.time()),
+                    "INSERT INTO jobs (id, kind, status, request, created, total) "
+                    "VALUES (?, ?, ?, ?, ?, ?)",
+                    (job_id, kind, "queued", json.dumps(request), time.time(), total),
                 )
                 row = db.execute("SELECT * FROM jobs WHERE id = ?", (job_id,)).fetchone()
                 db.execute("COMMIT")
@@ -160,22 +87,80 @@ class JobStore:
                 if db.in_transaction:
                     db.execute("ROLLBACK")
                 raise
-        return job_of_row(row)
+        return job_of_row(row, None)
 
-    def get(self, job_id: str) -> Job | None:
-        """The job, or None for an unknown id."""
+    def get(self, job_id: str, *, inline_cells: int | None = None) -> Job | None:
+        """The job with its request and result, or None for an unknown id.
+
+        Args:
+            job_id: the job's id.
+            inline_cells: a result's cells are put in it when there are at most this many
+                (``Job.cells`` says how many there are); None: always.
+        """
         with self._connection() as db:
             row = db.execute("SELECT * FROM jobs WHERE id = ?", (job_id,)).fetchone()
-        return None if row is None else job_of_row(row)
+            if row is None:
+                return None
+            result = None if row["result"] is None else json.loads(row["result"])
+            count = row["cells"]
+            if result is not None and count is not None:
+                if inline_cells is None or count <= inline_cells:
+                    result = with_cells(result, read_cells(db, job_id, offset=0, limit=count))
+        return job_of_row(row, result)
 
-    def jobs(self, *, status: str | None, limit: int) -> list[Job]:
-        """The newest jobs first, optionally of one status."""
-        query, args = "SELECT * FROM jobs", []
+    def state(self, job_id: str) -> JobState | None:
+        """The job without its request and result, or None for an unknown id."""
+        with self._connection() as db:
+            row = db.execute(f"SELECT {STATE_COLUMNS} FROM jobs WHERE id = ?", (job_id,)).fetchone()
+        return None if row is None else state_of_row(row)
+
+    def jobs(self, *, status: str | None, limit: int) -> list[JobState]:
+        """The newest jobs first, optionally of one status, without requests and results."""
+        query, args = f"SELECT {STATE_COLUMNS} FROM jobs", []
         if status is not None:
             query, args = query + " WHERE status = ?", [status]
         with self._connection() as db:
             rows = db.execute(query + " ORDER BY created DESC LIMIT ?", [*args, limit]).fetchall()
-        return [job_of_row(row) for row in rows]
+        return [state_of_row(row) for row in rows]
+
+    def request(self, job_id: str) -> dict[str, Any] | None:
+        """The job's request (the route's body), or None for an unknown id."""
+        with self._connection() as db:
+            row = db.execute("SELECT request FROM jobs WHERE id = ?", (job_id,)).fetchone()
+        return None if row is None else dict(json.loads(row[0]))
+
+    def cells(self, job_id: str, *, offset: int, limit: int) -> list[dict[str, Any]]:
+        """Cells ``offset`` to ``offset + limit`` of a done job's result (fewer at its end).
+
+        A result stored whole by an older release (``Job.cells`` None) is read whole.
+        """
+        with self._connection() as db:
+            row = db.execute("SELECT result, cells FROM jobs WHERE id = ?", (job_id,)).fetchone()
+            if row is None or row["result"] is None:
+                return []
+            if row["cells"] is not None:
+                return read_cells(db, job_id, offset=offset, limit=limit)
+        cells = json.loads(row["result"]).get("cells", [])
+        return list(cells[offset : offset + limit])
+
+    def cells_json(self, job_id: str, *, offset: int, limit: int) -> tuple[str, int]:
+        """:meth:`cells` as a JSON array's text, and how many cells it holds.
+
+        Whole stored pages are copied unparsed (:func:`service.jobs.results.cells_text`).
+        """
+        state = self.state(job_id)
+        if state is None or state.cells is None:
+            cells = self.cells(job_id, offset=offset, limit=limit)
+            return json.dumps(cells), len(cells)
+        with self._connection() as db:
+            return cells_text(db, job_id, offset=offset, limit=limit, total=state.cells)
+
+    def cell_count(self, job_id: str) -> int:
+        """How many cells a done job's result has (0 without cells or result)."""
+        state = self.state(job_id)
+        if state is not None and state.cells is not None:
+            return state.cells
+        return len(self.cells(job_id, offset=0, limit=2**62))  # stored whole by an older release
 
     def start(self, job_id: str) -> bool:
         """Mark a queued job running (one more attempt); False if it is not queued."""
@@ -206,18 +191,27 @@ class JobStore:
         """Record how a job ended (with ``if_running``, only if it is still running)."""
         condition = " AND status = 'running'" if if_running else ""
         with self._connection() as db:
-            db.execute(
-                "UPDATE jobs SET status = ?, result = ?, error = ?, finished = ?, "
-                "done = CASE WHEN ? = 'done' THEN 1 ELSE done END WHERE id = ?" + condition,
-                (
-                    status,
-                    None if result is None else json.dumps(result),
-                    None if error is None else json.dumps(error),
-                    time.time(),
-                    status,
-                    job_id,
-                ),
-            )
+            db.execute("BEGIN IMMEDIATE")
+            try:
+                text, cells = (None, None) if result is None else write_result(db, job_id, result)
+                db.execute(
+                    "UPDATE jobs SET status = ?, result = ?, cells = ?, error = ?, finished = ?, "
+                    "done = CASE WHEN ? = 'done' THEN 1 ELSE done END WHERE id = ?" + condition,
+                    (
+                        status,
+                        text,
+                        cells,
+                        None if error is None else json.dumps(error),
+                        time.time(),
+                        status,
+                        job_id,
+                    ),
+                )
+                db.execute("COMMIT")
+            except BaseException:
+                if db.in_transaction:
+                    db.execute("ROLLBACK")
+                raise
 
     def queued(self, *, exclude: set[str], limit: int) -> list[str]:
         """The ids of the oldest queued jobs not in ``exclude``, at most ``limit``."""
@@ -263,6 +257,7 @@ class JobStore:
         cancel (the supervisor stops a worker that does not).
         """
         with self._connection() as db:
+            db.execute("DELETE FROM job_cells WHERE job_id = ?", (job_id,))
             return bool(db.execute("DELETE FROM jobs WHERE id = ?", (job_id,)).rowcount)
 
     def recover(self, *, attempts: int) -> list[str]:
@@ -297,13 +292,12 @@ class JobStore:
     def expire(self, *, ttl: float) -> int:
         """Forget finished jobs older than ``ttl`` seconds; how many."""
         with self._connection() as db:
-            return int(
-                db.execute(
-                    "DELETE FROM jobs WHERE status IN ('done', 'failed', 'cancelled') AND "
-                    "finished < ?",
-                    (time.time() - ttl,),
-                ).rowcount
-            )
+            expired = db.execute(
+                "DELETE FROM jobs WHERE status IN ('done', 'failed', 'cancelled') AND finished < ?",
+                (time.time() - ttl,),
+            ).rowcount
+            db.execute("DELETE FROM job_cells WHERE job_id NOT IN (SELECT id FROM jobs)")
+        return int(expired)
 
 
 def _interrupted(attempts: int) -> dict[str, Any]:

@@ -17,11 +17,12 @@ from solver.path.problem import PathProblem
 
 
 def _evaluated(
-    body: EvaluateRequest, settings: Settings
+    body: EvaluateRequest, settings: Settings, progress: Progress | None
 ) -> tuple[SolverRobot, PathInput, PathEvaluation, float | None, PathProblem]:
     """The robot, the path, its evaluation, the feed to check and the problem.
 
-    The path's size is checked first.
+    The path's size is checked first; ``progress`` is handed to the evaluation (a numeric
+    family reports as it goes, so a client that leaves stops it).
     """
     convert.check_path_size(
         body.path, limit=settings.max_path_waypoints, setting="DTF_MAX_PATH_WAYPOINTS"
@@ -36,9 +37,9 @@ def _evaluated(
         if spin_mode != "fixed":
             raise InvalidInputError("joint_path", "a joint path is evaluated in spin_mode fixed")
         joint_path = convert.joint_path_of(body.joint_path, robot)
-        evaluation = evaluate_joint_path(problem, placement, joint_path)
+        evaluation = evaluate_joint_path(problem, placement, joint_path, progress=progress)
     else:
-        evaluation = evaluate_path(problem, placement)
+        evaluation = evaluate_path(problem, placement, progress=progress)
     feed = body.feed if body.feed is not None else path.feed
     return robot, path, evaluation, feed, problem
 
@@ -63,7 +64,9 @@ def _check_work(problem: PathProblem, settings: Settings) -> None:
         )
 
 
-def joint_use_png(body: EvaluateRequest, settings: Settings) -> bytes:
+def joint_use_png(
+    body: EvaluateRequest, settings: Settings, progress: Progress | None = None
+) -> bytes:
     """The PNG of each joint's use of its speed (and acceleration) limit at the feed.
 
     The feed defaults to mu_path, or mu_acc with acceleration limits.
@@ -71,7 +74,7 @@ def joint_use_png(body: EvaluateRequest, settings: Settings) -> bytes:
     Where the path does not run (an unreachable placement is not an input error, api.md) the
     picture says so: why, and at which waypoint.
     """
-    robot, _, evaluation, feed, _ = _evaluated(body, settings)
+    robot, _, evaluation, feed, _ = _evaluated(body, settings, progress)
     index = evaluation.feed_index  # mu_acc with acceleration limits
     if index is None or index <= 0.0:
         where = (
@@ -94,7 +97,7 @@ def evaluation_of(
     body: EvaluateRequest, settings: Settings, progress: Progress
 ) -> EvaluateResponse:
     """The JSON answer of ``POST /v1/evaluate`` (an evaluate job's result too)."""
-    robot, path, evaluation, feed, problem = _evaluated(body, settings)
+    robot, path, evaluation, feed, problem = _evaluated(body, settings, progress)
     detail = body.detail or (
         "waypoints" if body.path.n_waypoints() <= settings.max_detail_waypoints else "summary"
     )

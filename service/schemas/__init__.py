@@ -35,9 +35,11 @@ from service.schemas.jobs import (
     JobInfo,
     JobList,
     JobProgress,
+    JobResultPage,
     JobStatus,
     MapJob,
     OptimizeJob,
+    ResultCells,
 )
 from service.schemas.map import Grid, GridAxis, MapCell, MapExtreme, MapRequest, MapResponse
 from service.schemas.motion import AccelerationResult, CycleTimeResult, LimitedBy, PassCycleTime
@@ -82,6 +84,8 @@ __all__ = [
     "JobProgress",
     "JobList",
     "JobInfo",
+    "JobResultPage",
+    "ResultCells",
     "EvaluateJob",
     "AutoIkPolicy",
     "Bottleneck",

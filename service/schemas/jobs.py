@@ -11,7 +11,7 @@ from typing_extensions import TypeAliasType
 from service.schemas.common import RequestModel, ResponseModel
 from service.schemas.errors import ErrorDetail
 from service.schemas.evaluate import _REQUEST_EXAMPLE, EvaluateRequest
-from service.schemas.map import _MAP_REQUEST_EXAMPLE, MapRequest
+from service.schemas.map import _CELL, _MAP_REQUEST_EXAMPLE, MapCell, MapRequest
 from service.schemas.optimize import _REQUEST as _OPTIMIZE_EXAMPLE
 from service.schemas.optimize import OptimizeRequest
 
@@ -117,6 +117,32 @@ _JOB_EXAMPLE: JsonDict = {
 }
 
 
+class ResultCells(ResponseModel):
+    """Where a map job's cells are: in its result, or in pages of GET /v1/jobs/{id}/result."""
+
+    model_config = ConfigDict(
+        json_schema_extra={
+            "examples": [
+                {
+                    "total": 500000,
+                    "in_result": False,
+                    "page_limit": 10000,
+                    "first_page": "/v1/jobs/0b6f3c1e-7f1e-4d0a-9d55-3c5d8b1f2a10/result"
+                    "?offset=0&limit=10000",
+                }
+            ]
+        }
+    )
+
+    total: int = Field(description="Cells in the map's answer.")
+    in_result: bool = Field(
+        description="Whether ``result.cells`` holds them all (at most DTF_JOB_PAGE_CELLS); when "
+        "false the result has no ``cells``: read them in pages from ``first_page`` on."
+    )
+    page_limit: int = Field(description="Most cells one page may hold (DTF_JOB_PAGE_CELLS).")
+    first_page: str = Field(description="The URL of the first page of cells.")
+
+
 class JobInfo(ResponseModel):
     """A job: its status, progress, times and, once finished, its result or error."""
 
@@ -137,6 +163,12 @@ class JobInfo(ResponseModel):
     error: list[ErrorDetail] | None = Field(
         default=None, description="When failed: what was wrong, as a 422's detail."
     )
+    result_cells: ResultCells | None = Field(
+        default=None,
+        description="When a map job is done: how many cells its answer has and where they are "
+        "(a result over DTF_JOB_PAGE_CELLS cells comes without them; page through "
+        "GET /v1/jobs/{id}/result?offset=&limit=).",
+    )
 
 
 class JobList(ResponseModel):
@@ -145,3 +177,30 @@ class JobList(ResponseModel):
     model_config = ConfigDict(json_schema_extra={"examples": [{"jobs": [_JOB_EXAMPLE]}]})
 
     jobs: list[JobInfo] = Field(description="The jobs.")
+
+
+class JobResultPage(ResponseModel):
+    """Cells ``offset`` to ``offset + limit`` of a done map job's answer, as ``POST /v1/map``."""
+
+    model_config = ConfigDict(
+        json_schema_extra={
+            "examples": [
+                {
+                    "offset": 0,
+                    "limit": 1,
+                    "total": 500000,
+                    "cells": [_CELL],
+                    "next": "/v1/jobs/0b6f3c1e-7f1e-4d0a-9d55-3c5d8b1f2a10/result?offset=1&limit=1",
+                }
+            ]
+        }
+    )
+
+    offset: int = Field(description="The index of the page's first cell in the map's cells.")
+    limit: int = Field(description="Most cells asked for.")
+    total: int = Field(description="Cells in the map's answer.")
+    cells: list[MapCell] = Field(
+        description="The cells, in the order of the map's ``cells`` (yaw-major, then y, then x); "
+        "fewer than ``limit`` at the end."
+    )
+    next: str | None = Field(description="The URL of the next page; null on the last one.")

@@ -18,6 +18,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from solver.core.exceptions import InvalidInputError
+from solver.core.progress import Progress
 
 
 @dataclass(frozen=True)
@@ -138,7 +139,9 @@ class KinematicsFamily(abc.ABC):
         """
         return None
 
-    def solve_path(self, rotation: np.ndarray, position: np.ndarray) -> PathSolutions:
+    def solve_path(
+        self, rotation: np.ndarray, position: np.ndarray, *, progress: Progress | None = None
+    ) -> PathSolutions:
         """IK solutions along paths: waypoints on the last batch axis, branches followed.
 
         An analytic family solves every waypoint on its own (its branch labels mean the same
@@ -149,6 +152,9 @@ class KinematicsFamily(abc.ABC):
             rotation: shape (3, 3, *batch, W), R_B_F of the flange, broadcasting with
                 ``position``.
             position: shape (3, *batch, W), m in {B}.
+            progress: called with the fraction done as the work goes (it may raise
+                :class:`solver.core.progress.Cancelled` to stop it); a family whose solve
+                takes milliseconds, as this default, need not call it.
         """
         q, status = self.solve(rotation, position)
         return PathSolutions(q=q, status=status)
@@ -179,6 +185,7 @@ class KinematicsFamily(abc.ABC):
         tool_point: np.ndarray,
         *,
         qdot_max: np.ndarray | None = None,
+        progress: Progress | None = None,
     ) -> np.ndarray:
         """J(q)^-1 t, batched, with J the Jacobian at ``tool_point`` in {B} axes.
 
@@ -192,6 +199,8 @@ class KinematicsFamily(abc.ABC):
                 point, {B} axes.
             tool_point: shape (3, ...) broadcastable to q, the tool point in {B} (m).
             qdot_max: shape (dof,), rad/s, the joint speed limits; needed for dof > 6 only.
+            progress: called with the fraction done as the work goes (it may raise
+                :class:`solver.core.progress.Cancelled`); a closed form need not call it.
 
         Returns:
             shape (dof, ...), joint speeds (rad/s); inf or NaN at an exactly singular q.

@@ -11,6 +11,7 @@ from collections.abc import Callable
 import numpy as np
 
 from solver.core.family import Branch, KinematicsFamily
+from solver.core.progress import Progress
 
 
 class ClosedFormFamily(KinematicsFamily):
@@ -61,6 +62,10 @@ class ClosedFormFamily(KinematicsFamily):
         tool_point: np.ndarray,
         *,
         qdot_max: np.ndarray | None = None,
+        progress: Progress | None = None,
     ) -> np.ndarray:
-        """J^-1 t in closed form (see :meth:`KinematicsFamily.joint_speeds_per_unit_twist`)."""
+        """J^-1 t in closed form (see :meth:`KinematicsFamily.joint_speeds_per_unit_twist`).
+
+        It takes milliseconds for a whole path: ``progress`` is not called.
+        """
         return type(self).speeds_function(self.parameters, q, twist, tool_point)

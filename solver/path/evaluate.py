@@ -20,6 +20,7 @@ from solver.core.codes import FEASIBLE, REASONS, Reason
 from solver.core.dtf import spin_rate_nearest_zero
 from solver.core.dtf_redundant import spin_rate_at_feed
 from solver.core.family import Branch
+from solver.core.progress import Progress
 from solver.core.spatial import Placement, rotation_about_z
 from solver.path.limits import JointAccelerationLimit, JointMotion, bound_by_limits
 from solver.path.pipeline import check_placements, run_chunk
@@ -148,13 +149,18 @@ def _turned(vectors: np.ndarray, yaw: float) -> np.ndarray:
     return out
 
 
-def evaluate_path(problem: PathProblem, placement: Placement) -> PathEvaluation:
+def evaluate_path(
+    problem: PathProblem, placement: Placement, *, progress: Progress | None = None
+) -> PathEvaluation:
     """mu_path of a path at a placement (spec sections 1-4).
 
     Args:
         problem: the robot (with a kinematics family, its speed limits and TCP), the tool
             path in {O} with its passes, and the options (branch, step bound, spin mode).
         placement: where {O} sits in {B}, and the tool spin (cam.md section 3).
+        progress: called with the fraction done while a numeric family solves the path (a
+            closed-form family's evaluation takes milliseconds); it may raise
+            :class:`solver.core.progress.Cancelled` to stop the work.
 
     Raises:
         NoAnalyticIkError: the robot has no kinematics family.
@@ -165,7 +171,7 @@ def evaluate_path(problem: PathProblem, placement: Placement) -> PathEvaluation:
     family = problem.family
     cell = check_placements(placement.as_row()[None])
     path = problem.prepared
-    run = run_chunk(problem, cell)
+    run = run_chunk(problem, cell, progress=progress)
     robot, spin_mode = problem.robot, problem.options.spin_mode
     pick = int(run.pick[0])
     reason = int(run.tracked.reason[pick, 0])

@@ -19,6 +19,7 @@ import numpy as np
 
 from solver.core.exceptions import InvalidInputError
 from solver.core.kinematics import tool_pose_in_base
+from solver.core.progress import Progress
 from solver.core.spatial import Placement, rotation_about_z
 from solver.path.evaluate import PathEvaluation, acceleration_index
 from solver.path.limits import JointMotion, bound_by_limits
@@ -108,6 +109,7 @@ def evaluate_joint_path(
     joint_path: np.ndarray,
     *,
     tolerance: float = POSE_TOLERANCE,
+    progress: Progress | None = None,
 ) -> PathEvaluation:
     """mu_path of a path at a placement along the given joint path (fixed spin mode).
 
@@ -117,6 +119,8 @@ def evaluate_joint_path(
         placement: where {O} sits in {B}, and the tool spin.
         joint_path: shape (N, n), rad, the configuration at every waypoint.
         tolerance: m and rad, as :func:`check_joint_path`.
+        progress: handed to the family's joint speeds (a numeric family reports as it goes;
+            it may raise :class:`solver.core.progress.Cancelled`).
 
     Returns:
         The evaluation along that joint path (``branch`` None: no IK branch was followed;
@@ -138,7 +142,7 @@ def evaluate_joint_path(
         [turn_by_yaw(path.twist[:, :3].T, yaw), turn_by_yaw(path.twist[:, 3:].T, yaw)]
     )
     qd_unit = family.joint_speeds_per_unit_twist(
-        q.T, twist[:, 0], poses[:, :3, 3].T, qdot_max=robot.qdot_max
+        q.T, twist[:, 0], poses[:, :3, 3].T, qdot_max=robot.qdot_max, progress=progress
     )  # (n, N), the same computation as the pipeline's at the tracked joints
     speed, limiting, _ = bound_by_limits(
         problem.waypoint_limits, JointMotion(q=q.T, qd_unit=qd_unit)

@@ -22,6 +22,7 @@ from solver.core.codes import ACC_TIE_RTOL, FEASIBLE, UNREACHABLE
 from solver.core.dtf import spin_rate_nearest_zero
 from solver.core.dtf_redundant import spin_rate_at_feed
 from solver.core.exceptions import InvalidInputError
+from solver.core.progress import Progress, span
 from solver.core.spatial import MAX_COORDINATE, rotation_about_z
 from solver.path.limits import JointMotion, bound_by_limits
 from solver.path.prepare import PreparedPath
@@ -129,7 +130,9 @@ def flange_at_spin(path: PreparedPath, spin: float) -> tuple[np.ndarray, np.ndar
     return rotation, position
 
 
-def run_chunk(problem: PathProblem, placements: np.ndarray) -> ChunkResult:
+def run_chunk(
+    problem: PathProblem, placements: np.ndarray, *, progress: Progress | None = None
+) -> ChunkResult:
     """The pipeline at C placements on the problem's branches.
 
     Args:
@@ -137,6 +140,8 @@ def run_chunk(problem: PathProblem, placements: np.ndarray) -> ChunkResult:
             (:attr:`PathProblem.branches` made).
         placements: shape (C, 5), [x (m), y (m), z (m), yaw (rad), spin (rad)], checked; one
             spin for the whole chunk.
+        progress: handed to the family's IK and joint speeds (a numeric family reports as
+            it goes; it may raise :class:`solver.core.progress.Cancelled`).
     """
     robot, path, branches = problem.robot, problem.prepared, problem.branches
     family = problem.family
@@ -153,7 +158,7 @@ def run_chunk(problem: PathProblem, placements: np.ndarray) -> ChunkResult:
     twist = np.concatenate(
         [turn_by_yaw(path.twist[:, :3].T, yaws), turn_by_yaw(path.twist[:, 3:].T, yaws)]
     )
-    solutions = family.solve_path(rotation, flange_position)
+    solutions = family.solve_path(rotation, flange_position, progress=span(progress, 0.0, 0.85))
     q, status = solutions.q, solutions.status  # (n, B_all, C, W), (B_all, C, W)
     branches = without_empty_slots(branches, status)
     # In free mode the position limits hold along the spin schedule, checked there, not here.
@@ -169,14 +174,18 @@ def run_chunk(problem: PathProblem, placements: np.ndarray) -> ChunkResult:
     # For dof > 6 these are the exact DTF LP's joint speeds per unit speed (robots.md section 5),
     # so the ratio below gives the LP's V_max for every dof.
     qd_unit = family.joint_speeds_per_unit_twist(
-        tracked.q, twist[:, None], tool_position[:, None], qdot_max=robot.qdot_max
+        tracked.q,
+        twist[:, None],
+        tool_position[:, None],
+        qdot_max=robot.qdot_max,
+        progress=span(progress, 0.85, 0.95),
     )
     qd_spin = qd_null = None
     if free:
         tool_z = turn_by_yaw(path.tool_rotation[:, :, 2].T, yaws)
         spin = np.concatenate([np.zeros_like(tool_z), np.broadcast_to(tool_z, twist[3:].shape)])
         qd_spin = family.joint_speeds_per_unit_twist(
-            tracked.q, spin[:, None], tool_position[:, None]
+            tracked.q, spin[:, None], tool_position[:, None], progress=span(progress, 0.95, 1.0)
         )  # the least-norm solution for more than six joints
         if robot.dof > 6:
             qd_null = family.null_space(tracked.q, tool_position[:, None])
@@ -190,6 +199,8 @@ def run_chunk(problem: PathProblem, placements: np.ndarray) -> ChunkResult:
         spins, tracked = _spin_schedule(problem, tracked, motion, qd_spin, mu_path)
         feasible = tracked.reason == FEASIBLE
         mu_path = np.where(feasible, mu_path, -np.inf)
+    if progress is not None:
+        progress(1.0)
     final = _final_path_bounds(problem, tracked, qd_unit, qd_spin, mu_path, feasible)
     mu_acc = final[3]
     if mu_acc is None:

@@ -9,7 +9,6 @@ While the job store cannot be used, every route here answers 503 saying why.
 from __future__ import annotations
 
 import functools
-import time
 from typing import Annotated, Any
 from uuid import UUID
 
@@ -17,14 +16,25 @@ import anyio
 from fastapi import APIRouter, HTTPException, Path, Query, Response, status
 from fastapi.responses import JSONResponse
 
+from service.body import union_body_in_thread, union_body_openapi
 from service.deps import SettingsDep
-from service.errors import ERROR_RESPONSES, RETRY_AFTER
+from service.errors import ERROR_RESPONSES, RETRY_AFTER, job_not_found
 from service.jobs.checks import check_job
 from service.jobs.runner import get_runner
-from service.jobs.store import Job, QueueFull
+from service.jobs.store import QueueFull
+from service.jobs.views import job_info, units_of
 from service.logs import log
-from service.schemas import ErrorDetail, ErrorResponse, MapRequest
-from service.schemas.jobs import JobInfo, JobList, JobProgress, JobRequest, JobStatus
+from service.schemas import ErrorDetail, ErrorResponse
+from service.schemas.jobs import (
+    EvaluateJob,
+    JobInfo,
+    JobList,
+    JobRequest,
+    JobStatus,
+    MapJob,
+    OptimizeJob,
+)
+from service.work import json_response
 
 JOB_RESPONSES: dict[int | str, dict[str, Any]] = {
     **ERROR_RESPONSES,
@@ -41,45 +51,12 @@ router = APIRouter(prefix="/jobs", tags=["jobs"], responses=JOB_RESPONSES)
 
 JobId = Annotated[UUID, Path(description="The job's id, as POST /v1/jobs answered it.")]
 
+JOB_MODELS = (MapJob, OptimizeJob, EvaluateJob)
+"""The kinds of job a body may be (JobRequest's members, in its order)."""
+
 NOT_FOUND: dict[int | str, dict[str, Any]] = {
     404: {"model": ErrorResponse, "description": "No job has this id (or it expired)."}
 }
-
-
-def _not_found(job_id: UUID) -> HTTPException:
-    """The 404 of an unknown job id, naming the path parameter."""
-    detail = ErrorDetail(loc=["path", "job_id"], msg=f"no job {str(job_id)!r}", type="not_found")
-    return HTTPException(status.HTTP_404_NOT_FOUND, [detail.model_dump()])
-
-
-def _units(job: Job) -> int:
-    """Units of work of a job: a map's placements, else 100 (percent)."""
-    if job.kind == "map":
-        request = MapRequest.model_validate(job.request)
-        return max(1, request.grid.n_placements())
-    return 100
-
-
-def job_info(job: Job, *, with_result: bool = True) -> JobInfo:
-    """The API's view of a stored job."""
-    total = _units(job)
-    eta = None
-    if job.status == "running" and job.started is not None and job.fraction > 0.0:
-        elapsed = time.time() - job.started
-        eta = elapsed * (1.0 - job.fraction) / job.fraction
-    return JobInfo(
-        id=job.id,
-        kind=job.kind,
-        status=job.status,
-        progress=JobProgress(
-            done=round(job.fraction * total), total=total, fraction=job.fraction, eta_seconds=eta
-        ),
-        created=job.created,
-        started=job.started,
-        finished=job.finished,
-        result=job.result if with_result else None,
-        error=None if job.error is None else [ErrorDetail(**e) for e in job.error],
-    )
 
 
 @router.post(
@@ -105,9 +82,15 @@ def job_info(job: Job, *, with_result: bool = True) -> JobInfo:
             "headers": RETRY_AFTER,
         },
     },
+    openapi_extra=union_body_openapi(JOB_MODELS),
 )
-async def post_job(body: JobRequest, settings: SettingsDep) -> JSONResponse:
+async def post_job(
+    body: Annotated[JobRequest, union_body_in_thread(JobRequest, JOB_MODELS)],
+    settings: SettingsDep,
+) -> JSONResponse:
     """Queue the work; answer 202 with its id and Location.
+
+    A large body (a 20,000-waypoint path) is validated off the event loop, in pieces.
 
     The request is checked as its route checks it before it is queued (the robot, the path as
     read, the options, the grid, the bounds), with the route's error types, a field inside the
@@ -120,7 +103,11 @@ async def post_job(body: JobRequest, settings: SettingsDep) -> JSONResponse:
     try:
         job = await anyio.to_thread.run_sync(
             functools.partial(
-                runner.store.create, body.kind, request, limit=settings.max_queued_jobs
+                runner.store.create,
+                body.kind,
+                request,
+                total=units_of(body),
+                limit=settings.max_queued_jobs,
             )
         )
     except QueueFull:
@@ -136,7 +123,7 @@ async def post_job(body: JobRequest, settings: SettingsDep) -> JSONResponse:
         ) from None
     runner.wake()  # an idle worker takes the job now
     log.info("job %s queued (%s)", job.id, body.kind)
-    info = job_info(job)
+    info = job_info(job, runner.store)
     return JSONResponse(
         info.model_dump(mode="json"),
         status_code=status.HTTP_202_ACCEPTED,
@@ -150,20 +137,38 @@ def get_jobs(
     job_status: Annotated[JobStatus | None, Query(alias="status")] = None,
     limit: Annotated[int, Query(ge=1, le=1000)] = 100,
 ) -> JobList:
-    """Every job the store holds (finished ones until DTF_JOB_TTL), newest first."""
-    jobs = get_runner(settings).store.jobs(status=job_status, limit=limit)
-    return JobList(jobs=[job_info(job, with_result=False) for job in jobs])
+    """Every job the store holds (finished ones until DTF_JOB_TTL), newest first.
+
+    Results are not read: ``result`` is null here; ``GET /v1/jobs/{id}`` gives it.
+    """
+    store = get_runner(settings).store
+    return JobList(
+        jobs=[job_info(state, store) for state in store.jobs(status=job_status, limit=limit)]
+    )
 
 
 @router.get(
-    "/{job_id}", operation_id="get_job", summary="A job's status and result", responses=NOT_FOUND
+    "/{job_id}",
+    operation_id="get_job",
+    summary="A job's status and result",
+    response_model=JobInfo,
+    responses=NOT_FOUND,
 )
-def get_job(job_id: JobId, settings: SettingsDep) -> JobInfo:
-    """Status, progress with ETA, times, and the route's answer once done (or the error)."""
-    job = get_runner(settings).store.get(str(job_id))
+def get_job(job_id: JobId, settings: SettingsDep) -> Response:
+    """Status, progress with ETA, times, and the route's answer once done (or the error).
+
+    A map's answer holds its cells up to DTF_JOB_PAGE_CELLS (default 10,000) of them; a larger
+    one comes without ``cells``, and ``result_cells`` says how many there are and where the
+    first page is: ``GET /v1/jobs/{id}/result?offset=0&limit=10000``, then each page's
+    ``next``.
+    """
+    store = get_runner(settings).store
+    job = store.get(str(job_id), inline_cells=settings.job_page_cells)
     if job is None:
-        raise _not_found(job_id)
-    return job_info(job)
+        raise job_not_found(job_id)
+    return json_response(
+        job_info(job, store, result=job.result, page_limit=settings.job_page_cells)
+    )
 
 
 @router.post(
@@ -179,15 +184,15 @@ def cancel_job(job_id: JobId, settings: SettingsDep) -> JobInfo:
     left as it is. The answer is the job after the cancel was asked.
     """
     runner = get_runner(settings)
-    if runner.store.get(str(job_id)) is None:
-        raise _not_found(job_id)
+    if runner.store.state(str(job_id)) is None:
+        raise job_not_found(job_id)
     runner.store.cancel(str(job_id))
     runner.wake()  # the supervisor sees the cancel now
     log.info("job %s cancel asked", job_id)
-    job = runner.store.get(str(job_id))
-    if job is None:  # deleted meanwhile
-        raise _not_found(job_id)
-    return job_info(job)
+    state = runner.store.state(str(job_id))
+    if state is None:  # deleted meanwhile
+        raise job_not_found(job_id)
+    return job_info(state, runner.store)
 
 
 @router.delete(
@@ -205,7 +210,7 @@ def delete_job(job_id: JobId, settings: SettingsDep) -> Response:
     runner = get_runner(settings)
     runner.store.cancel(str(job_id))
     if not runner.store.delete(str(job_id)):
-        raise _not_found(job_id)
+        raise job_not_found(job_id)
     runner.wake()  # the supervisor stops a running job's worker now
     log.info("job %s deleted", job_id)
     return Response(status_code=status.HTTP_204_NO_CONTENT)

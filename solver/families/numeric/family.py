@@ -14,12 +14,15 @@ J^-1 t: a batched 6 x 6 solve for six joints; for more, the joint speeds of the 
 
 from __future__ import annotations
 
+from collections.abc import Iterator
+
 import numpy as np
 import pinocchio as pin
 
 from solver.core.codes import OK, SINGULAR, UNREACHABLE
 from solver.core.dtf_redundant import redundant_speed
 from solver.core.family import Branch, KinematicsFamily, PathSolutions
+from solver.core.progress import Progress, span
 from solver.core.spatial import wrap_angle
 from solver.families.numeric import chain_kernel, ik, ik_kernel, redundant_kernel
 from solver.families.numeric.chain import SerialChain
@@ -38,6 +41,15 @@ COST_LINES: dict[int, tuple[tuple[float, float], ...]] = {
     6: ((1_600.0, 50.0), (4_800.0, 22.0)),
     7: ((18_500.0, 200.0),),
 }
+CHUNK_ROWS = 2048
+"""Configurations checked (singularity, joint speeds) between two progress reports: about
+0.2 s for seven joints under load, so that a cancelled evaluation stops within a second."""
+FOLLOW_WAYPOINTS = 256
+"""Waypoints of each path followed by the compiled chain between two progress reports (a
+seven-joint arm's slots: about 0.2 s)."""
+SEED_SHARE, FOLLOW_SHARE = 0.05, 0.9
+"""Where seeding the first waypoint ends, and following the branches, in a path's solve's
+progress (the rest: the singularity checks)."""
 
 
 def seed_count(dof: int) -> int:
@@ -108,8 +120,12 @@ class NumericFamily(KinematicsFamily):
         """``solution=0`` ... ``solution=K-1``: slots for the distinct solutions, in seed order."""
         return self._branches
 
-    def _seeded(self, rotation: np.ndarray, position: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    def _seeded(
+        self, rotation: np.ndarray, position: np.ndarray, progress: Progress | None = None
+    ) -> tuple[np.ndarray, np.ndarray]:
         """Distinct solutions within the limits from every seed: (P, 3, 3), (P, 3) -> slots.
+
+        ``progress`` is called after each iteration of the seeds' solve.
 
         Returns:
             slots (P, K, n), rad, NaN after the solutions found; count (P,).
@@ -124,14 +140,19 @@ class NumericFamily(KinematicsFamily):
             iterations=ik.SEED_ITERATIONS,
             lower=self.lower,
             upper=self.upper,
+            progress=progress,
         )
         q = q.reshape(n_poses, n_seeds, self.dof)
         return ik.distinct(q, converged.reshape(n_poses, n_seeds), self.chain.revolute)
 
     def _compiled(
-        self, rotations: np.ndarray, positions: np.ndarray
+        self, rotations: np.ndarray, positions: np.ndarray, progress: Progress | None = None
     ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """:func:`ik_kernel.solve_paths` at rotations (P, W, 3, 3) and positions (P, W, 3).
+        """The compiled seeding and following at rotations (P, W, 3, 3) and positions (P, W, 3).
+
+        :func:`ik_kernel.seed_paths` at the first waypoints, then :func:`ik_kernel.follow_paths`
+        in pieces of :data:`FOLLOW_WAYPOINTS` waypoints, ``progress`` called after each (the
+        pieces give the same bits as one).
 
         Returns:
             q (n, K, P, W), rad, wrapped, NaN in slots without a solution; status (K, P, W);
@@ -141,23 +162,46 @@ class NumericFamily(KinematicsFamily):
             [ik.SEED_ITERATIONS, ik.TRACK_ITERATIONS, ik.DISTINCT, ik.SINGULAR_RCOND], dtype=float
         )
         constants = np.array([ik.TOLERANCE, ik.DAMPING_SCALE, ik.DAMPING_FLOOR])
-        result: tuple[np.ndarray, np.ndarray, np.ndarray] = ik_kernel.solve_paths(
+        rotations = np.asarray(rotations, dtype=float)
+        positions = np.asarray(positions, dtype=float)
+        current, count = ik_kernel.seed_paths(
             self._packed,
             self.seeds,
             (self.lower, self.upper),
-            np.ascontiguousarray(rotations, dtype=float),
-            np.ascontiguousarray(positions, dtype=float),
+            np.ascontiguousarray(rotations[:, 0]),
+            np.ascontiguousarray(positions[:, 0]),
             settings,
             constants,
         )
-        return result
+        if progress is not None:
+            progress(SEED_SHARE)
+        (n_paths, n_waypoints), n_seeds = positions.shape[:2], len(self.seeds)
+        q = np.empty((self.dof, n_seeds, n_paths, n_waypoints))
+        status = np.empty((n_seeds, n_paths, n_waypoints), dtype=np.int64)
+        for first in range(0, n_waypoints, FOLLOW_WAYPOINTS):
+            piece = slice(first, min(first + FOLLOW_WAYPOINTS, n_waypoints))
+            q[..., piece], status[..., piece] = ik_kernel.follow_paths(
+                self._packed,
+                current,
+                np.ascontiguousarray(rotations[:, piece]),
+                np.ascontiguousarray(positions[:, piece]),
+                first > 0,
+                settings,
+                constants,
+            )
+            if progress is not None:
+                progress(SEED_SHARE + (1.0 - SEED_SHARE) * piece.stop / n_waypoints)
+        return q, status, count
 
-    def _wrapped_with_status(self, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    def _wrapped_with_status(
+        self, q: np.ndarray, progress: Progress | None = None
+    ) -> tuple[np.ndarray, np.ndarray]:
         """Revolute joints wrapped to [-pi, pi) and the status of each solution, q (..., n)."""
         flat = q.reshape(-1, self.dof)
         status = np.full(len(flat), UNREACHABLE)
         solved = np.flatnonzero(np.isfinite(flat).all(axis=-1))
-        status[solved] = np.where(ik.is_singular(self.chain, flat[solved]), SINGULAR, OK)
+        for rows in _in_chunks(solved, progress):
+            status[rows] = np.where(ik.is_singular(self.chain, flat[rows]), SINGULAR, OK)
         wrapped = np.where(self.chain.revolute, wrap_angle(q), q)
         return wrapped, status.reshape(q.shape[:-1])
 
@@ -181,7 +225,9 @@ class NumericFamily(KinematicsFamily):
         q = np.moveaxis(q.reshape(*batch, len(self.seeds), self.dof), (-1, -2), (0, 1))
         return q, np.moveaxis(status.reshape(*batch, len(self.seeds)), -1, 0)
 
-    def solve_path(self, rotation: np.ndarray, position: np.ndarray) -> PathSolutions:
+    def solve_path(
+        self, rotation: np.ndarray, position: np.ndarray, *, progress: Progress | None = None
+    ) -> PathSolutions:
         """Seeded solutions at the first waypoint, each followed along its path.
 
         Each step starts from the branch's solution at the previous waypoint (so for dof > 6 it
@@ -192,6 +238,10 @@ class NumericFamily(KinematicsFamily):
         Args:
             rotation: shape (3, 3, *batch, W), R_B_F, broadcasting with ``position``.
             position: shape (3, *batch, W), m in {B}.
+            progress: called after the seeding, after each piece of waypoints followed (each
+                waypoint without the compiled chain), and after each chunk of CHUNK_ROWS
+                solutions checked for singularity; it may raise
+                :class:`solver.core.progress.Cancelled` to stop the work.
         """
         shape = np.broadcast_shapes(rotation.shape[2:], position.shape[1:])
         *batch, n_waypoints = shape
@@ -201,21 +251,26 @@ class NumericFamily(KinematicsFamily):
         positions = positions.reshape(-1, n_waypoints, 3)
         n_paths, n_seeds = len(positions), len(self.seeds)
         if self.compiled:
-            q_k, status_k, count_k = self._compiled(rotations, positions)
+            q_k, status_k, count_k = self._compiled(rotations, positions, progress)
             return PathSolutions(
                 q=q_k.reshape(self.dof, n_seeds, *batch, n_waypoints),
                 status=status_k.reshape(n_seeds, *batch, n_waypoints),
                 seeds=n_seeds,
                 branches_found=count_k.reshape(batch),
             )
-        slots, count = self._seeded(rotations[:, 0], positions[:, 0])
+        slots, count = self._seeded(
+            rotations[:, 0], positions[:, 0], span(progress, 0.0, SEED_SHARE)
+        )
         q = np.full((n_paths, n_seeds, n_waypoints, self.dof), np.nan)
         q[:, :, 0] = slots
         paths, branches = np.nonzero(np.isfinite(slots[..., 0]))
         q[paths, branches] = self._followed(
-            slots[paths, branches], rotations[paths], positions[paths]
+            slots[paths, branches],
+            rotations[paths],
+            positions[paths],
+            progress=span(progress, SEED_SHARE, FOLLOW_SHARE),
         )
-        wrapped, status = self._wrapped_with_status(q)
+        wrapped, status = self._wrapped_with_status(q, span(progress, FOLLOW_SHARE, 1.0))
         return PathSolutions(
             q=wrapped.transpose(3, 1, 0, 2).reshape(self.dof, n_seeds, *batch, n_waypoints),
             status=np.moveaxis(status, 1, 0).reshape(n_seeds, *batch, n_waypoints),
@@ -224,7 +279,12 @@ class NumericFamily(KinematicsFamily):
         )
 
     def _followed(
-        self, start: np.ndarray, rotations: np.ndarray, positions: np.ndarray
+        self,
+        start: np.ndarray,
+        rotations: np.ndarray,
+        positions: np.ndarray,
+        *,
+        progress: Progress | None = None,
     ) -> np.ndarray:
         """Each branch followed from its first solution, NaN from the waypoint where it is lost.
 
@@ -232,6 +292,7 @@ class NumericFamily(KinematicsFamily):
             start: shape (M, n), the branches' solutions at the first waypoint.
             rotations: shape (M, W, 3, 3), R_B_F* of each branch's path.
             positions: shape (M, W, 3), m in {B}.
+            progress: called after each waypoint with the fraction of waypoints followed.
 
         Returns:
             shape (M, W, n). A lost branch stays in the batch, frozen, until at least half of
@@ -246,6 +307,8 @@ class NumericFamily(KinematicsFamily):
         for waypoint in range(1, n_waypoints):
             if lost.all():
                 break
+            if progress is not None:
+                progress(waypoint / n_waypoints)
             solved, converged = ik.solve(
                 self.chain,
                 current,
@@ -272,11 +335,13 @@ class NumericFamily(KinematicsFamily):
         tool_point: np.ndarray,
         *,
         qdot_max: np.ndarray | None = None,
+        progress: Progress | None = None,
     ) -> np.ndarray:
         """J^-1 t (six joints) or the exact DTF LP's joint speeds per unit speed (more).
 
         See :meth:`KinematicsFamily.joint_speeds_per_unit_twist`. Only configurations with
-        finite joints are computed; the others come back NaN.
+        finite joints are computed; the others come back NaN. With ``progress``, CHUNK_ROWS
+        configurations at a time, ``progress`` called after each (the same numbers).
 
         For dof > 6 without ``qdot_max``, the least-norm J^+ t (the free spin's direction).
         """
@@ -284,13 +349,32 @@ class NumericFamily(KinematicsFamily):
         q_flat = np.moveaxis(np.broadcast_to(q, (self.dof, *shape)), 0, -1).reshape(-1, self.dof)
         twist_flat = np.moveaxis(np.broadcast_to(twist, (6, *shape)), 0, -1).reshape(-1, 6)
         point_flat = np.moveaxis(np.broadcast_to(tool_point, (3, *shape)), 0, -1).reshape(-1, 3)
+        if progress is None:
+            speeds = self._speeds(q_flat, twist_flat, point_flat, qdot_max)
+        else:
+            speeds = np.empty(q_flat.shape)
+            for rows in _in_chunks(np.arange(len(q_flat)), progress):
+                piece = slice(rows[0], rows[-1] + 1)
+                speeds[piece] = self._speeds(
+                    q_flat[piece], twist_flat[piece], point_flat[piece], qdot_max
+                )
+        return np.moveaxis(speeds.reshape(*shape, self.dof), -1, 0)
+
+    def _speeds(
+        self,
+        q_flat: np.ndarray,
+        twist_flat: np.ndarray,
+        point_flat: np.ndarray,
+        qdot_max: np.ndarray | None,
+    ) -> np.ndarray:
+        """Joint speeds per unit twist at M configurations: (M, n), (M, 6), (M, 3) -> (M, n)."""
         speeds = np.full(q_flat.shape, np.nan)
         rows = np.flatnonzero(np.isfinite(q_flat).all(axis=-1))
         if self.compiled and self.dof == 6:
-            speeds = chain_kernel.speeds_per_twist(
+            six: np.ndarray = chain_kernel.speeds_per_twist(
                 self._packed, *(np.ascontiguousarray(a) for a in (q_flat, twist_flat, point_flat))
             )
-            return np.moveaxis(speeds.reshape(*shape, self.dof), -1, 0)
+            return six
         if self.compiled and self.dof == 7 and qdot_max is not None:
             speeds, irregular = redundant_kernel.redundant_speeds(
                 self._packed,
@@ -314,7 +398,7 @@ class NumericFamily(KinematicsFamily):
                 speeds[rows] = qdot / speed[:, None]
         else:  # fewer than six joints: least squares; more, without limits: the least norm
             speeds[rows] = (np.linalg.pinv(jacobian) @ twist_flat[rows, :, None])[..., 0]
-        return np.moveaxis(speeds.reshape(*shape, self.dof), -1, 0)
+        return speeds
 
     def null_space(self, q: np.ndarray, tool_point: np.ndarray) -> np.ndarray:
         """The last right singular vector of J at the tool point (see the base), batched."""
@@ -326,6 +410,14 @@ class NumericFamily(KinematicsFamily):
         jacobian, _, _ = self.chain.jacobian(q_flat[rows], point_flat[rows])
         null[rows] = np.linalg.svd(jacobian)[2][:, -1]
         return np.moveaxis(null.reshape(*shape, self.dof), -1, 0)
+
+
+def _in_chunks(rows: np.ndarray, progress: Progress | None) -> Iterator[np.ndarray]:
+    """``rows`` in pieces of CHUNK_ROWS, ``progress`` called after each piece is done."""
+    for start in range(0, len(rows), CHUNK_ROWS):
+        yield rows[start : start + CHUNK_ROWS]
+        if progress is not None:
+            progress(min(start + CHUNK_ROWS, len(rows)) / len(rows))
 
 
 def _solve_or_nan(jacobian: np.ndarray, twist: np.ndarray) -> np.ndarray:

@@ -21,6 +21,7 @@ import math
 
 import numpy as np
 
+from solver.core.progress import Progress
 from solver.core.spatial import wrap_angle
 from solver.families.numeric.chain import SerialChain
 
@@ -99,6 +100,7 @@ def solve(
     lower: np.ndarray | None = None,
     upper: np.ndarray | None = None,
     frozen: np.ndarray | None = None,
+    progress: Progress | None = None,
 ) -> tuple[np.ndarray, np.ndarray]:
     """Levenberg-Marquardt from each start to its target, batched.
 
@@ -117,6 +119,8 @@ def solve(
         upper: shape (n,), rad.
         frozen: shape (M,), bool: rows left at their start and reported not converged (a
             tracked branch already lost); ``None`` solves every row.
+        progress: called with the fraction of ``iterations`` done after each step (it may
+            raise :class:`solver.core.progress.Cancelled`).
 
     Returns:
         q: shape (M, n), the last iterate; converged: shape (M,), bool, |e|_inf < TOLERANCE.
@@ -141,6 +145,8 @@ def solve(
         if lower is not None and upper is not None:
             moved = np.clip(moved, lower, upper)
         batch_q = np.where(iterating[:, None], moved, batch_q)
+        if progress is not None:
+            progress((step + 1) / iterations)
         if len(batch_q) >= COMPACT_MIN_ROWS and 2 * np.count_nonzero(iterating) <= len(batch_q):
             q, converged = _settle(rows, q, converged, batch_q, iterating, frozen)
             rows = (np.arange(len(q)) if rows is None else rows)[iterating]

@@ -188,64 +188,96 @@ def _singular(chain, rcond, work):  # type: ignore[no-untyped-def]  # pragma: no
 
 
 @njit(cache=True, nogil=True, error_model="numpy")
-def solve_paths(chain, seeds, box, rotations, positions, settings, constants):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
-    """The family's ``solve_path`` for P paths: seeded at the first waypoint, then followed.
+def seed_paths(chain, seeds, box, rotations, positions, settings, constants):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
+    """The distinct solutions at each path's first pose, from every seed, within the joint box.
 
-    At the first waypoint every seed is solved within the joint box; the distinct solutions
-    (``ik.distinct``: wrapped joint distance above ``settings[2]`` from every earlier kept one)
-    fill the slots in seed order; each is followed to each next waypoint from its solution at
-    the previous one, without the box, until it does not converge (NaN from there).
+    The distinct solutions (``ik.distinct``: wrapped joint distance above ``settings[2]`` from
+    every earlier kept one) fill the slots in seed order.
 
     Args:
         chain: :meth:`SerialChain.packed`.
         seeds: shape (K, n), the starts.
         box: (lower, upper), each (n,), the joint box.
-        rotations: shape (P, W, 3, 3), R_B_F* of each path.
-        positions: shape (P, W, 3), m in {B}.
+        rotations: shape (P, 3, 3), R_B_F* of each path's first waypoint.
+        positions: shape (P, 3), m in {B}.
         settings: ik.SEED_ITERATIONS, ik.TRACK_ITERATIONS, ik.DISTINCT, ik.SINGULAR_RCOND.
         constants: as for :func:`_levenberg_marquardt`.
 
     Returns:
-        q: shape (n, K, P, W), revolute joints wrapped to [-pi, pi), NaN where a slot has no
-        solution; status: shape (K, P, W), ``OK``, ``SINGULAR`` or ``UNREACHABLE``;
+        found: shape (P, K, n), rad, unwrapped, NaN in the slots after the solutions found;
         count: shape (P,), the distinct solutions found.
     """
     n_seeds, n = seeds.shape
-    n_paths, n_waypoints = positions.shape[0], positions.shape[1]
-    seed_iterations, track_iterations = int(settings[0]), int(settings[1])
-    apart, rcond = settings[2], settings[3]
+    n_paths = positions.shape[0]
+    seed_iterations, apart = int(settings[0]), settings[2]
     revolute = chain[3]
-    q = np.full((n, n_seeds, n_paths, n_waypoints), np.nan)
-    status = np.full((n_seeds, n_paths, n_waypoints), UNREACHABLE)
+    found = np.full((n_paths, n_seeds, n), np.nan)
     count = np.zeros(n_paths, dtype=np.int64)
-    found = np.empty((n_seeds, n))
     current = np.empty(n)
     work = workspace(n)
     for p in range(n_paths):
         kept = 0
         for k in range(n_seeds):
             current[:] = seeds[k]
-            target_r, target_p = rotations[p, 0], positions[p, 0]
             if not _levenberg_marquardt(
-                chain, current, target_r, target_p, seed_iterations, box, constants, work
+                chain, current, rotations[p], positions[p], seed_iterations, box, constants, work
             ):
                 continue
             new = True
             for other in range(kept):
-                if _wrapped_distance(found[other], current, revolute) <= apart:
+                if _wrapped_distance(found[p, other], current, revolute) <= apart:
                     new = False
                     break
             if new:
-                found[kept] = current
+                found[p, kept] = current
                 kept += 1
         count[p] = kept
-        for b in range(kept):
-            current[:] = found[b]
-            frames(chain, current, work)
+    return found, count
+
+
+@njit(cache=True, nogil=True, error_model="numpy")
+def follow_paths(chain, current, rotations, positions, solve_first, settings, constants):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
+    """Each slot followed along one piece of its path, from its solution before the piece.
+
+    A slot is followed to each next waypoint from its solution at the previous one, without the
+    joint box, until it does not converge; it is then lost (NaN from there, and in every later
+    piece). A path cut in pieces gives the same bits as the whole path in one piece.
+
+    Args:
+        chain: :meth:`SerialChain.packed`.
+        current: shape (P, K, n), rad, unwrapped, in and out: each slot's solution at the
+            waypoint before the piece (``solve_first``) or at the piece's first waypoint (the
+            path's first piece, from :func:`seed_paths`); NaN for a slot without one. On return,
+            its solution at the piece's last waypoint, NaN where it was lost.
+        rotations: shape (P, W, 3, 3), R_B_F* of the piece's waypoints.
+        positions: shape (P, W, 3), m in {B}.
+        solve_first: whether the piece's first waypoint is solved (every piece but the first).
+        settings: ik.SEED_ITERATIONS, ik.TRACK_ITERATIONS, ik.DISTINCT, ik.SINGULAR_RCOND.
+        constants: as for :func:`_levenberg_marquardt`.
+
+    Returns:
+        q: shape (n, K, P, W), revolute joints wrapped to [-pi, pi), NaN where a slot has no
+        solution; status: shape (K, P, W), ``OK``, ``SINGULAR`` or ``UNREACHABLE``.
+    """
+    n_paths, n_seeds, n = current.shape
+    n_waypoints = positions.shape[1]
+    track_iterations, rcond = int(settings[1]), settings[3]
+    revolute = chain[3]
+    q = np.full((n, n_seeds, n_paths, n_waypoints), np.nan)
+    status = np.full((n_seeds, n_paths, n_waypoints), UNREACHABLE)
+    slot = np.empty(n)
+    work = workspace(n)
+    for p in range(n_paths):
+        for b in range(n_seeds):
+            if math.isnan(current[p, b, 0]):
+                continue
+            slot[:] = current[p, b]
+            if not solve_first:
+                frames(chain, slot, work)
             for w in range(n_waypoints):
-                if w > 0 and not _levenberg_marquardt(
+                if (w > 0 or solve_first) and not _levenberg_marquardt(
                     chain,
-                    current,
+                    slot,
                     rotations[p, w],
                     positions[p, w],
                     track_iterations,
@@ -253,9 +285,11 @@ def solve_paths(chain, seeds, box, rotations, positions, settings, constants):  
                     constants,
                     work,
                 ):
+                    slot[:] = np.nan
                     break
                 status[b, p, w] = SINGULAR if _singular(chain, rcond, work) else OK
                 for j in range(n):
-                    value = current[j]
+                    value = slot[j]
                     q[j, b, p, w] = (value + math.pi) % _TWO_PI - math.pi if revolute[j] else value
-    return q, status, count
+            current[p, b] = slot
+    return q, status

@@ -1,0 +1,235 @@
+"""Benchmark of the service at real size: prints figures, asserts nothing (issue 23).
+
+Run from the repository root::
+
+    python bench/service.py           # about two minutes
+    python bench/service.py --smoke   # small sizes, to check that the script runs
+
+Each figure is taken against a live uvicorn (``tests/live.py``), with its baseline in the same
+run:
+
+- the ERK-size map (UR5, 546 placements, 133 waypoints) through ``POST /v1/map`` on all cores
+  (DTF_THREADS, default the cores) and on one, against the scalar loop of ``bench/run.py``
+  (timed on a subset and extrapolated);
+- ``GET /v1/jobs?limit=1000`` with 50 large map jobs stored, against reading and parsing their
+  results as the listing did before (``SELECT *`` and ``json.loads`` of every result), and
+  ``GET /v1/jobs/{id}`` and one page of cells of one of them;
+- ``/healthz`` every 20 ms while the largest body (20,000 waypoints, DTF_MAX_PATH_WAYPOINTS)
+  is read, validated and computed: a UR5 evaluation to its end, and a Panda evaluation (numeric
+  IK, a minute of work) for its first seconds, after which the client leaves.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import sqlite3
+import statistics
+import sys
+import tempfile
+import threading
+import time
+from pathlib import Path
+from typing import Any
+
+import httpx
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))
+
+from run import load_path, scalar_cell  # noqa: E402 - bench/run.py, beside this script
+from timing import best_time  # noqa: E402
+
+from service.jobs.store import JobStore  # noqa: E402
+from solver.core.spatial import Placement  # noqa: E402
+from solver.families import get_robot  # noqa: E402
+from solver.path.capability_map import grid_axis  # noqa: E402
+from tests.live import start_server  # noqa: E402
+
+EXAMPLE = json.loads((ROOT / "examples" / "evaluate_request.json").read_text())
+ERK_GRID = {
+    "x": {"min": -0.25, "max": 0.25, "step": 0.02},
+    "y": {"min": 0.25, "max": 0.65, "step": 0.02},
+    "z": 0.1,
+    "yaw": 0.0,
+}
+
+
+def _map_seconds(body: dict[str, Any], threads: int | None, repeats: int) -> float:
+    """POST /v1/map of ``body``, best of ``repeats``, on a server with DTF_THREADS ``threads``."""
+    process, url = start_server({} if threads is None else {"DTF_THREADS": str(threads)})
+    try:
+        with httpx.Client(base_url=url, timeout=120) as client:
+
+            def one() -> None:
+                client.post("/v1/map", json=body).raise_for_status()
+
+            one()  # warm up
+            return best_time(one, repeats)
+    finally:
+        process.terminate()
+        process.wait()
+
+
+def erk_map_over_http(*, repeats: int, subset: int) -> None:
+    """The ERK-size map through POST /v1/map (1 thread, all cores) against the scalar loop."""
+    body = {"robot": {"model": "ur5"}, "path": EXAMPLE["path"], "grid": ERK_GRID}
+    t_one = _map_seconds(body, 1, repeats)
+    t_http = _map_seconds(body, None, repeats)
+    robot, path = get_robot("ur5"), load_path("curved_line")
+    xs = grid_axis(-0.25, 0.25, 0.02, field="x")
+    ys = grid_axis(0.25, 0.65, 0.02, field="y")
+    cells = len(xs) * len(ys)
+    picks = np.random.default_rng(0).choice(cells, size=subset, replace=False)
+    began = time.perf_counter()
+    for p in picks:
+        placement = Placement(float(xs[p % len(xs)]), float(ys[p // len(xs)]), 0.1, 0.0)
+        scalar_cell(robot, path, placement)
+    t_scalar = (time.perf_counter() - began) / subset * cells
+    print(
+        f"ERK-size map through POST /v1/map ({cells} placements, best of {repeats}): "
+        f"{t_http * 1e3:.1f} ms on DTF_THREADS={os.cpu_count()} (the default), "
+        f"{t_one * 1e3:.1f} ms on 1 ({t_one / t_http:.2f}x); scalar loop {t_scalar:.1f} s "
+        f"(extrapolated from {subset} cells): {t_scalar / t_http:,.0f}x (goal >= 5,000x)"
+    )
+
+
+def _cells(n: int) -> list[dict[str, Any]]:
+    """``n`` map cells as POST /v1/map answers them (about 220 bytes each)."""
+    return [
+        {
+            "x": -0.5 + 0.001 * (i % 1000),
+            "y": 0.001 * (i // 1000),
+            "yaw": 0.0,
+            "spin": 0.0,
+            "mu_path": 0.2 + 1e-7 * i,
+            "reason": None,
+            "failed_waypoint": None,
+            "bottleneck_waypoint": i % 133,
+            "bottleneck_joint": i % 6,
+            "branch": {"shoulder": "left", "elbow": "up", "wrist": "noflip"},
+            "mu_acc": None,
+            "limited_by": None,
+        }
+        for i in range(n)
+    ]
+
+
+def job_listing(*, jobs: int, cells: int) -> None:
+    """GET /v1/jobs with ``jobs`` done map jobs of ``cells`` cells each stored."""
+    with tempfile.TemporaryDirectory() as data:
+        store = JobStore(Path(data) / "jobs.sqlite3")
+        result = {"cells": _cells(cells), "best": None, "worst": None, "feasible_cells": cells}
+        ids = []
+        for _ in range(jobs):
+            job = store.create("map", {"grid": "not read"}, total=cells)
+            store.start(job.id)
+            store.finish(job.id, "done", result=result)
+            ids.append(job.id)
+
+        def as_before() -> None:  # the listing before: every row read, every result parsed
+            with sqlite3.connect(store.path) as db:
+                for row in db.execute("SELECT * FROM jobs ORDER BY created DESC LIMIT 1000"):
+                    json.loads(row[4])
+                for row in db.execute("SELECT cells FROM job_cells"):
+                    json.loads(row[0])
+
+        t_before = best_time(as_before, 3)
+        process, url = start_server({"DTF_DATA_DIR": data, "DTF_WORKERS": "1"})
+        try:
+            with httpx.Client(base_url=url, timeout=120) as client:
+                client.get("/v1/jobs")  # warm up
+                listing = [client.get("/v1/jobs", params={"limit": 1000}) for _ in range(20)]
+                took = [a.elapsed.total_seconds() for a in listing]
+                one = client.get(f"/v1/jobs/{ids[0]}")
+                page = client.get(f"/v1/jobs/{ids[0]}/result", params={"offset": cells // 2})
+        finally:
+            process.terminate()
+            process.wait()
+    print(
+        f"GET /v1/jobs?limit=1000 with {jobs} map jobs of {cells:,} cells stored: "
+        f"p50 {statistics.median(took) * 1e3:.1f} ms, max {max(took) * 1e3:.1f} ms, "
+        f"{len(listing[0].content):,} bytes; reading and parsing their results as before: "
+        f"{t_before:.2f} s ({t_before / statistics.median(took):,.0f}x)"
+    )
+    print(
+        f"  GET /v1/jobs/{{id}} of one: {one.elapsed.total_seconds() * 1e3:.1f} ms, "
+        f"{len(one.content):,} bytes "
+        f"({'with' if one.json()['result_cells']['in_result'] else 'without'} its cells); "
+        "a page of "
+        f"{len(page.json()['cells']):,} cells: {page.elapsed.total_seconds() * 1e3:.1f} ms, "
+        f"{len(page.content):,} bytes"
+    )
+
+
+def line_path(n: int, spacing: float) -> dict[str, Any]:
+    """A straight cut of ``n`` waypoints, ``spacing`` apart (m), the tool pointing down."""
+    down = [1.0, 0.0, 0.0, 0.0]
+    return {
+        "waypoints": [{"position": [spacing * i, 0.0, 0.0], "orientation": down} for i in range(n)]
+    }
+
+
+def _healthz_during(url: str, body: dict[str, Any], *, leave_after: float) -> list[float]:
+    """/healthz latencies (s), one every 20 ms, while POST /v1/evaluate of ``body`` runs."""
+    finished = threading.Event()
+
+    def post() -> None:
+        try:
+            httpx.post(url + "/v1/evaluate", json=body, timeout=leave_after)
+        except httpx.ReadTimeout:
+            pass  # the client left; the service stops the work
+        finished.set()
+
+    work = threading.Thread(target=post)
+    work.start()
+    latencies = []
+    with httpx.Client(base_url=url) as client:
+        while not finished.is_set():
+            began = time.perf_counter()
+            client.get("/healthz")
+            latencies.append(time.perf_counter() - began)
+            time.sleep(0.02)
+    work.join()
+    return latencies
+
+
+def healthz_during_the_largest_body(*, waypoints: int) -> None:
+    """/healthz p50, p90 and max while a body of ``waypoints`` waypoints is evaluated."""
+    process, url = start_server({})
+    try:
+        for model, leave_after in (("ur5", 120.0), ("panda", 8.0)):
+            body = {
+                "robot": {"model": model},
+                "path": line_path(waypoints, 2.5e-6),
+                "placement": EXAMPLE["placement"],
+            }
+            size = len(json.dumps(body))
+            leaves = f", client leaves at {leave_after:g} s" if model == "panda" else ""
+            latencies = sorted(_healthz_during(url, body, leave_after=leave_after))
+            p90 = latencies[int(0.9 * len(latencies))]
+            print(
+                f"/healthz during POST /v1/evaluate of {waypoints:,} waypoints ({model}, "
+                f"{size / 1e6:.2f} MB body{leaves}): "
+                f"p50 {statistics.median(latencies) * 1e3:.1f} ms, p90 {p90 * 1e3:.1f} ms "
+                f"(goal < 50 ms), max {latencies[-1] * 1e3:.1f} ms, {len(latencies)} probes"
+            )
+    finally:
+        process.terminate()
+        process.wait()
+
+
+def main() -> None:
+    """Print the figures."""
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--smoke", action="store_true", help="small sizes: check the script runs")
+    args = parser.parse_args()
+    erk_map_over_http(repeats=2 if args.smoke else 10, subset=2 if args.smoke else 12)
+    job_listing(jobs=5 if args.smoke else 50, cells=2_000 if args.smoke else 20_000)
+    healthz_during_the_largest_body(waypoints=2_000 if args.smoke else 20_000)
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,127 @@
+"""A job's result in the store: a map's cells in pages of their own, the rest as one text.
+
+A 500,000-placement map's result is about 108 MiB of JSON. Kept as one text, every read of the
+job parsed all of it: a job listing read and dropped every result, and ``GET /v1/jobs/{id}``
+answered all of it at once. Here the cells are kept in rows of PAGE_CELLS, so that the job
+without its cells, its number of cells and any page of them are read without the rest.
+"""
+
+from __future__ import annotations
+
+import json
+import sqlite3
+from typing import Any
+
+PAGE_CELLS = 1000
+"""Cells in one stored row (about 220 KB of JSON)."""
+
+SCHEMA = """
+CREATE TABLE IF NOT EXISTS jobs (
+    id TEXT PRIMARY KEY,
+    kind TEXT NOT NULL,
+    status TEXT NOT NULL,
+    request TEXT NOT NULL,
+    result TEXT,
+    error TEXT,
+    done REAL NOT NULL DEFAULT 0,
+    created REAL NOT NULL,
+    started REAL,
+    finished REAL,
+    attempts INTEGER NOT NULL DEFAULT 0,
+    cancel INTEGER NOT NULL DEFAULT 0,
+    total INTEGER,
+    cells INTEGER
+);
+CREATE INDEX IF NOT EXISTS jobs_created ON jobs (created);
+CREATE TABLE IF NOT EXISTS job_cells (
+    job_id TEXT NOT NULL,
+    page INTEGER NOT NULL,
+    cells TEXT NOT NULL,
+    PRIMARY KEY (job_id, page)
+);
+"""
+
+_ADDED_COLUMNS = {"total": "INTEGER", "cells": "INTEGER"}
+"""Columns a store made by an older release lacks (added on open; NULL in its rows)."""
+
+
+def make_tables(db: sqlite3.Connection) -> None:
+    """The tables, and the columns an older store lacks."""
+    db.executescript(SCHEMA)
+    present = {row[1] for row in db.execute("PRAGMA table_info(jobs)")}
+    for name, kind in _ADDED_COLUMNS.items():
+        if name not in present:
+            db.execute(f"ALTER TABLE jobs ADD COLUMN {name} {kind}")
+
+
+def write_result(
+    db: sqlite3.Connection, job_id: str, result: dict[str, Any]
+) -> tuple[str, int | None]:
+    """Keep a result's ``cells`` in pages (replacing any of an earlier run).
+
+    Returns:
+        The rest of the result as JSON text, and the number of cells (None without cells).
+    """
+    db.execute("DELETE FROM job_cells WHERE job_id = ?", (job_id,))
+    cells = result.get("cells")
+    if not isinstance(cells, list):
+        return json.dumps(result), None
+    db.executemany(
+        "INSERT INTO job_cells (job_id, page, cells) VALUES (?, ?, ?)",
+        (
+            (job_id, start // PAGE_CELLS, json.dumps(cells[start : start + PAGE_CELLS]))
+            for start in range(0, len(cells), PAGE_CELLS)
+        ),
+    )
+    return json.dumps({k: v for k, v in result.items() if k != "cells"}), len(cells)
+
+
+def read_cells(
+    db: sqlite3.Connection, job_id: str, *, offset: int, limit: int
+) -> list[dict[str, Any]]:
+    """Cells ``offset`` to ``offset + limit`` (end exclusive) of a job's result, in order."""
+    if limit <= 0:
+        return []
+    first, last = offset // PAGE_CELLS, (offset + limit - 1) // PAGE_CELLS
+    rows = db.execute(
+        "SELECT cells FROM job_cells WHERE job_id = ? AND page BETWEEN ? AND ? ORDER BY page",
+        (job_id, first, last),
+    ).fetchall()
+    cells = [cell for row in rows for cell in json.loads(row[0])]
+    start = offset - first * PAGE_CELLS
+    return cells[start : start + limit]
+
+
+def cells_text(
+    db: sqlite3.Connection, job_id: str, *, offset: int, limit: int, total: int
+) -> tuple[str, int]:
+    """Cells ``offset`` to ``offset + limit`` of a result of ``total`` cells, as a JSON array.
+
+    Stored rows the page takes whole are copied as text, unparsed; only a row the page cuts
+    is parsed (at most two). A page of 10,000 cells is then about 2 MB copied, not parsed
+    and written again.
+
+    Returns:
+        The JSON array's text and how many cells it holds.
+    """
+    end = min(offset + limit, total)
+    if end <= offset:
+        return "[]", 0
+    rows = db.execute(
+        "SELECT page, cells FROM job_cells WHERE job_id = ? AND page BETWEEN ? AND ? ORDER BY page",
+        (job_id, offset // PAGE_CELLS, (end - 1) // PAGE_CELLS),
+    ).fetchall()
+    parts = []
+    for page, text in rows:
+        first = page * PAGE_CELLS
+        low, high = max(offset - first, 0), min(end - first, PAGE_CELLS)
+        if low == 0 and high == min(PAGE_CELLS, total - first):
+            parts.append(text[1:-1])  # the whole row: its items, without the brackets
+        else:
+            parts.append(json.dumps(json.loads(text)[low:high])[1:-1])
+    return "[" + ", ".join(parts) + "]", end - offset
+
+
+def with_cells(result: dict[str, Any], cells: list[dict[str, Any]]) -> dict[str, Any]:
+    """The result with its cells put back first, where the map route answers them."""
+    return {"cells": cells, **result}

@@ -1,0 +1,119 @@
+"""Large bodies validated in pieces: the same model or the same 422 as one whole validation."""
+
+from __future__ import annotations
+
+import json
+from typing import Any
+
+import pytest
+from fastapi.testclient import TestClient
+from pydantic import TypeAdapter, ValidationError
+
+from service import body
+from service.body import PIECE_WAYPOINTS, validated_in_pieces
+from service.schemas import EvaluateRequest, MapRequest, OptimizeRequest, PathImportRequest
+from service.schemas.jobs import JobRequest
+from tests.cases import ROOT
+
+EXAMPLE = json.loads((ROOT / "examples" / "evaluate_request.json").read_text())
+N = 2 * PIECE_WAYPOINTS + 345  # three pieces, the last one short
+DOWN = [1.0, 0.0, 0.0, 0.0]
+POSES = {"waypoints": [{"position": [1e-5 * i, 0.0, 0.0], "orientation": DOWN} for i in range(N)]}
+AXES = {
+    "tool_axis_waypoints": [{"position": [1e-5 * i, 0.0, 0.0], "axis": [0, 0, 1]} for i in range(N)]
+}
+ROBOT, PLACEMENT = EXAMPLE["robot"], EXAMPLE["placement"]
+AXIS = {"min": -0.1, "max": 0.1, "step": 0.1}
+GRID = {"x": AXIS, "y": AXIS, "z": 0.1, "yaw": [0.0, 0.5]}
+BOUNDS = {"x": [-0.1, 0.1], "y": [0.4, 0.5], "yaw": [-1.0, 1.0]}
+BODIES: list[tuple[Any, dict[str, Any]]] = [
+    (EvaluateRequest, {"robot": ROBOT, "placement": PLACEMENT}),
+    (EvaluateRequest, {"robot": ROBOT, "placement": PLACEMENT, "spins": [0.0] * N}),
+    (MapRequest, {"robot": ROBOT, "grid": GRID}),
+    (OptimizeRequest, {"robot": ROBOT, "bounds": BOUNDS, "z": 0.1}),
+    (PathImportRequest, {}),
+    (JobRequest, {"kind": "evaluate", "request": {"robot": ROBOT, "placement": PLACEMENT}}),
+    (JobRequest, {"kind": "map", "request": {"robot": ROBOT, "grid": GRID}}),
+]
+
+
+class Counted:
+    """A piece validator that keeps the size of every piece it is given."""
+
+    def __init__(self, adapter: TypeAdapter[Any]) -> None:
+        self.adapter, self.sizes = adapter, []
+
+    def validate_python(self, items: list[Any]) -> Any:
+        self.sizes.append(len(items))
+        return self.adapter.validate_python(items)
+
+
+class Watched(TypeAdapter[Any]):
+    """A TypeAdapter that counts its whole validations of JSON (the fall-back)."""
+
+    whole = 0
+
+    def validate_json(self, *args: Any, **kwargs: Any) -> Any:
+        self.whole += 1
+        return super().validate_json(*args, **kwargs)
+
+
+def with_path(body: dict[str, Any], path: dict[str, Any]) -> dict[str, Any]:
+    """The body with its path (a job's inside its request)."""
+    if "request" in body:
+        return {**body, "request": {**body["request"], "path": path}}
+    return {**body, "path": path}
+
+
+@pytest.mark.parametrize("path", [POSES, AXES], ids=["poses", "tool_axes"])
+@pytest.mark.parametrize(("model", "rest"), BODIES, ids=[f"{i}" for i in range(len(BODIES))])
+def test_a_body_in_pieces_is_the_whole_validations_model(
+    model: Any, rest: dict[str, Any], path: dict[str, Any], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    raw = json.dumps(with_path(rest, path)).encode()
+    counted = {name: Counted(adapter) for name, adapter in body.PIECES.items()}
+    monkeypatch.setattr(body, "PIECES", counted)
+    adapter = Watched(model)
+    assert validated_in_pieces(adapter, raw) == TypeAdapter(model).validate_json(raw)
+    assert adapter.whole == 0  # no fall-back to the whole validation
+    (name,) = path
+    assert counted[name].sizes == [PIECE_WAYPOINTS, PIECE_WAYPOINTS, N - 2 * PIECE_WAYPOINTS]
+
+
+@pytest.mark.parametrize(
+    ("where", "value", "loc"),
+    [
+        (1700, {"position": [0.0, 0.0], "orientation": DOWN}, [1700, "position"]),
+        (2300, {"position": [0.0, 0.0, 0.0], "orientation": DOWN, "extra": 1}, [2300, "extra"]),
+        (999, {"position": [0.0, 0.0, "a"], "orientation": DOWN}, [999, "position", 2]),
+    ],
+)
+def test_a_bad_waypoint_in_a_piece_is_the_same_422(
+    client: TestClient, where: int, value: dict[str, Any], loc: list[Any]
+) -> None:
+    waypoints = [*POSES["waypoints"]]
+    waypoints[where] = value
+    sent = {
+        "robot": EXAMPLE["robot"],
+        "placement": EXAMPLE["placement"],
+        "path": {"waypoints": waypoints},
+    }
+    raw = json.dumps(sent).encode()
+    with pytest.raises(ValidationError) as pieces:
+        validated_in_pieces(EvaluateRequest, raw)
+    with pytest.raises(ValidationError) as whole:
+        EvaluateRequest.model_validate_json(raw)
+    assert pieces.value.errors() == whole.value.errors()
+    answer = client.post("/v1/evaluate", content=raw, headers={"content-type": "application/json"})
+    assert answer.status_code == 422, answer.text
+    assert answer.json()["detail"][0]["loc"][-len(loc) :] == loc
+    assert answer.json()["detail"][0]["loc"][:3] == ["body", "path", "waypoints"]
+
+
+def test_bad_json_is_the_same_error() -> None:
+    raw = json.dumps({"path": POSES}).encode()[:-7]
+    with pytest.raises(ValidationError) as pieces:
+        validated_in_pieces(PathImportRequest, raw)
+    with pytest.raises(ValidationError) as whole:
+        PathImportRequest.model_validate_json(raw)
+    assert pieces.value.errors() == whole.value.errors()

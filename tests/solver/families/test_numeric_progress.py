@@ -1,0 +1,90 @@
+"""A numeric family's path solve reports its progress and stops when the report raises.
+
+An evaluation along a long path with numeric IK takes tens of seconds (20,000 waypoints), so
+the family reports after every waypoint it follows and after every CHUNK_ROWS configurations
+it checks, and a caller stops it by raising Cancelled from the report (the service does when
+the client leaves). The reports must not change the answer: chunks of rows are computed as
+the rows alone are.
+"""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+from solver.core.progress import Cancelled
+from solver.core.spatial import Placement
+from solver.families import get_robot
+from solver.families.numeric.family import CHUNK_ROWS, NumericFamily
+from solver.path.evaluate import evaluate_path
+from tests.cases import ROOT
+from tests.problems import problem
+
+EXAMPLE = json.loads((ROOT / "examples" / "evaluate_request.json").read_text())
+PLACEMENT = Placement(**EXAMPLE["placement"])
+MODELS = ["kinova_jaco2", "panda"]  # six joints (J^-1 t), seven (the DTF LP)
+
+
+def line(n: int, spacing: float = 1e-4) -> np.ndarray:
+    """``n`` waypoints along x, ``spacing`` apart (m), the tool pointing down."""
+    poses = np.tile(np.diag([1.0, -1.0, -1.0, 1.0]), (n, 1, 1))
+    poses[:, 0, 3] = spacing * np.arange(n)
+    return poses
+
+
+@pytest.mark.parametrize("model", MODELS)
+def test_the_reports_rise_to_one_and_do_not_change_the_answer(model: str) -> None:
+    robot = get_robot(model)
+    path = line(40)
+    reports: list[float] = []
+    reported = evaluate_path(problem(robot, path), PLACEMENT, progress=reports.append)
+    quiet = evaluate_path(problem(robot, path), PLACEMENT)
+    assert reported.feasible and reported.mu_path == quiet.mu_path
+    np.testing.assert_array_equal(reported.q, quiet.q)
+    np.testing.assert_array_equal(reported.v_max, quiet.v_max)
+    assert len(reports) >= len(path) - 1  # one a waypoint followed at least
+    assert all(0.0 < f <= 1.0 for f in reports)
+    assert reports == sorted(reports) and reports[-1] == pytest.approx(1.0)
+
+
+@pytest.mark.parametrize("model", MODELS)
+def test_a_report_that_raises_stops_the_solve_at_once(model: str) -> None:
+    calls: list[float] = []
+
+    def leave(fraction: float) -> None:
+        calls.append(fraction)
+        if len(calls) == 5:
+            raise Cancelled
+
+    with pytest.raises(Cancelled):
+        evaluate_path(problem(get_robot(model), line(40)), PLACEMENT, progress=leave)
+    assert len(calls) == 5  # no work, hence no report, after the one that raised
+    assert calls[-1] < 0.5  # five of forty waypoints followed, not the whole path
+
+
+@pytest.mark.parametrize("model", MODELS)
+def test_joint_speeds_in_chunks_equal_each_row_alone(model: str) -> None:
+    robot = get_robot(model)
+    family = robot.family
+    assert isinstance(family, NumericFamily)
+    rng = np.random.default_rng(23)
+    count = 2 * CHUNK_ROWS + 17
+    q = rng.uniform(
+        np.maximum(robot.q_lower, -np.pi), np.minimum(robot.q_upper, np.pi), (count, robot.dof)
+    ).T
+    q[:, 5] = np.nan  # an unsolved configuration: NaN speeds, wherever its chunk
+    twist = rng.normal(size=(6, count))
+    point = rng.normal(scale=0.1, size=(3, count)) + 0.4
+    reports: list[float] = []
+    speeds = family.joint_speeds_per_unit_twist(
+        q, twist, point, qdot_max=robot.qdot_max, progress=reports.append
+    )
+    assert reports == [CHUNK_ROWS / (count - 1), 2 * CHUNK_ROWS / (count - 1), 1.0]
+    assert np.isnan(speeds[:, 5]).all()
+    for i in [0, 4, 6, CHUNK_ROWS - 1, CHUNK_ROWS, count - 1]:
+        alone = family.joint_speeds_per_unit_twist(
+            q[:, i : i + 1], twist[:, i : i + 1], point[:, i : i + 1], qdot_max=robot.qdot_max
+        )
+        np.testing.assert_array_equal(speeds[:, i], alone[:, 0])
