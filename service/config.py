@@ -63,6 +63,16 @@ class Settings(BaseSettings):
         description="Most waypoints a path of /v1/optimize may have: the NLP has 12 variables and "
         "12 equations a waypoint (1,000 waypoints take about 30 s).",
     )
+    max_cell_objects: int = Field(
+        default=100,
+        gt=0,
+        description="Most objects (fixed and workpiece) a request's cell may hold.",
+    )
+    max_mesh_triangles: int = Field(
+        default=50_000,
+        gt=0,
+        description="Most triangles one STL mesh of a cell may have.",
+    )
     max_detail_waypoints: int = Field(
         default=2_000,
         gt=0,

@@ -276,10 +276,47 @@ def _repair(body: dict[str, Any], route: str) -> None:
         body["spins"] = _resized(body["spins"], n, 0.0)
     if route == "/v1/evaluate":
         body.pop("joint_path", None)  # a random joint path reaches no waypoint: its tests cover it
+    if isinstance(body.get("cell"), dict):
+        _repair_cell(body, route)
     if route.startswith("/v1/map") and isinstance(body.get("grid"), dict) and n:
         _repair_grid(body["grid"], n, png=route.endswith("/png"))
     if route == "/v1/optimize" and isinstance(body.get("bounds"), dict):
         _repair_optimize(body)
+
+
+CUBE_STL = (
+    "solid cube\n"
+    + "".join(
+        "facet normal 0 0 0\nouter loop\n"
+        + "".join(f"vertex {x} {y} {z}\n" for x, y, z in triangle)
+        + "endloop\nendfacet\n"
+        for triangle in (((0, 0, 0), (1, 0, 0), (0, 1, 0)), ((0, 0, 0), (0, 1, 0), (0, 0, 1)))
+    )
+    + "endsolid cube\n"
+)
+
+
+def _repair_cell(body: dict[str, Any], route: str) -> None:
+    """A cell the robot can be checked in: radii for every arm (7: all are 6-joint arms here),
+    an STL for a random string, a cutting length within the tool, a normal that is not 0, at
+    most three objects a group. Maps and optimisations drop it: their work with a cell is
+    tested in tests/service/test_cell.py (a generated grid sized to the limits without a cell
+    would be refused for its collision work)."""
+    if route != "/v1/evaluate":
+        body.pop("cell")
+        return
+    cell = body["cell"]
+    cell["link_radii"] = [0.05] * 7
+    tool = cell.get("tool")
+    if isinstance(tool, dict) and tool.get("cutting_length") is not None:
+        tool["cutting_length"] = min(tool["cutting_length"], tool["length"])
+    for group in ("fixed", "workpiece"):
+        objects = cell[group] = (cell.get(group) or [])[:3]
+        for item in objects:
+            if item.get("shape") == "mesh":
+                item["stl"] = CUBE_STL
+            if item.get("shape") == "halfspace" and not any(item.get("normal") or []):
+                item["normal"] = [0.0, 0.0, 1.0]
 
 
 def before_add_examples(context: Any, examples: list[schemathesis.Case]) -> None:

@@ -30,7 +30,8 @@ def _evaluated(
     path = convert.path_of(body.path)
     poses, placement = convert.spun_poses(path, body.spins), convert.placement_of(body.placement)
     spin_mode = convert.spin_mode_of(body.spin_mode, path)
-    problem = convert.problem_of(robot, poses, path, ik=body.ik, spin_mode=spin_mode)
+    cell = convert.cell_of(body.cell, settings)
+    problem = convert.problem_of(robot, poses, path, ik=body.ik, spin_mode=spin_mode, cell=cell)
     if body.joint_path is not None:
         if spin_mode != "fixed":
             raise InvalidInputError("joint_path", "a joint path is evaluated in spin_mode fixed")

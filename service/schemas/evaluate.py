@@ -9,6 +9,7 @@ from pydantic import ConfigDict, Field, model_validator
 from pydantic.config import JsonDict
 from pydantic_core import PydanticCustomError
 
+from service.schemas.cell import CellSpec, Contact
 from service.schemas.common import (
     Angle,
     Branch,
@@ -92,6 +93,7 @@ class FailureReason(StrEnum):
     JOINT_LIMITS = "joint_limits"
     SINGULAR = "singular"
     DISCONTINUOUS = "discontinuous"
+    COLLISION = "collision"
 
 
 class EvaluateRequest(RequestModel):
@@ -107,6 +109,12 @@ class EvaluateRequest(RequestModel):
     placement: Placement = Field(description="Where {O} sits in the base frame {B}.")
     ik: IkPolicy = Field(
         default_factory=IkPolicy, description="IK branch and continuity bound; default auto."
+    )
+    cell: CellSpec | None = Field(
+        default=None,
+        description="The robot's surroundings and tool (cell.md): fixed objects in {B}, "
+        "workpiece objects in {O}; the path is checked against them and the robot itself at "
+        "every waypoint and sub-step. Default: no collision check.",
     )
     spin_mode: SpinMode | None = Field(
         default=None,
@@ -320,6 +328,16 @@ class EvaluateResponse(ResponseModel):
         description="With robot.joint_acceleration_limits: the cycle time at mu_acc, with the "
         "ramps at the pass ends, and the time-optimal one (s, motion.md section 4); null "
         "without them, when infeasible, or when mu_acc is 0.",
+    )
+    collision: Contact | None = Field(
+        default=None,
+        description="With a cell, when reason is collision: the first configuration closer than "
+        "the clearance, its robot part, obstacle and distance (m); else null.",
+    )
+    min_clearance: Contact | None = Field(
+        default=None,
+        description="With a cell, on a feasible path: the closest pair over every checked "
+        "configuration and its distance (m); else null.",
     )
     feed_check: FeedCheckResult | None = Field(
         default=None,

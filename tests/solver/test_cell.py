@@ -19,7 +19,9 @@ from solver.core.exceptions import InvalidInputError
 from solver.core.robots import example_robot_data_dir
 from solver.core.spatial import Placement
 from solver.families import get_robot
-from solver.path.capability_map import CapabilityMap, capability_map
+from solver.optimise.optimize import optimize_placement
+from solver.optimise.search_space import PlacementBounds
+from solver.path.capability_map import CapabilityMap, capability_map, grid_axis
 from solver.path.cell.shapes import Box, Cell, Halfspace, Mesh, Tool
 from solver.path.cell.stl import read_stl
 from solver.path.evaluate import evaluate_path
@@ -319,14 +321,14 @@ def test_an_stl_cube_is_the_box_for_coal(writer: object) -> None:
 )
 def test_a_bad_stl_is_an_input_error(data: bytes, message: str) -> None:
     with pytest.raises(InvalidInputError, match=message) as caught:
-        read_stl(data, max_triangles=11, field="cell.fixed[0].stl")
-    assert caught.value.field == "cell.fixed[0].stl"
+        read_stl(data, max_triangles=11, field="cell.fixed.0.stl")
+    assert caught.value.field == "cell.fixed.0.stl"
 
 
 @pytest.mark.parametrize(
     ("cell", "field"),
     [
-        (Cell(fixed=(Box((0.1, -1.0, 0.1)),)), "cell.fixed[0].size[1]"),
+        (Cell(fixed=(Box((0.1, -1.0, 0.1)),)), "cell.fixed.0.size.1"),
         (Cell(tool=Tool(0.02, 0.01, 0.02)), "cell.tool.cutting_length"),
         (Cell(clearance=-0.001), "cell.clearance"),
         (Cell(collision_step=0.0), "cell.collision_step"),
@@ -356,3 +358,41 @@ def test_a_flat_mesh_is_a_sheet_not_a_crash() -> None:
         coal.DistanceResult(),
     )
     assert distance == pytest.approx(0.2, abs=1e-6)
+
+
+OPT_BOUNDS = PlacementBounds(x=(-0.1, 0.1), y=(0.35, 0.55), yaw=(-0.3, 0.3), z=0.1)
+
+
+@pytest.fixture(scope="module")
+def blocked() -> dict:
+    """The velocity-best placement of a small box, and a cell whose fixture blocks its elbow."""
+    plain = optimize_placement(problem(None), bounds=OPT_BOUNDS, method="casadi")
+    assert plain.evaluation is not None and plain.evaluation.q is not None
+    robot = get_robot("ur5")
+    data = robot.model.createData()
+    pin.forwardKinematics(robot.model, data, plain.evaluation.q[66])
+    elbow = np.linalg.solve(robot.transform_world_to_base, np.append(data.oMi[3].translation, 1))
+    fixture = Box((0.06, 0.06, 0.06), pose(*elbow[:3]), name="fixture")
+    return {"plain": plain, "shapes": (TABLE, fixture)}
+
+
+@pytest.mark.parametrize("method", ["casadi", "scipy"])
+def test_the_optimisers_answer_collision_free_placements(blocked: dict, method: str) -> None:
+    shapes = blocked["shapes"]
+    cell = Cell(fixed=shapes)
+    before = evaluate_path(problem(cell), blocked["plain"].placement)
+    assert before.reason == "collision"  # the velocity-best placement hits the fixture
+    optimum = optimize_placement(problem(cell), bounds=OPT_BOUNDS, method=method)
+    assert optimum.found and optimum.evaluation is not None and optimum.mu_path is not None
+    q = optimum.evaluation.q
+    reference = coal_distances(q, [(s.geometry(), s.pose) for s in shapes], optimum.placement)
+    assert min(reference)[0] >= cell.clearance  # coal: no configuration closer than clearance
+    grid = capability_map(
+        problem(cell),
+        xs=grid_axis(*OPT_BOUNDS.x, 0.02, field="x"),
+        ys=grid_axis(*OPT_BOUNDS.y, 0.02, field="y"),
+        z=0.1,
+        yaws=grid_axis(*OPT_BOUNDS.yaw, math.radians(15), field="yaw"),
+    )
+    assert optimum.mu_path >= float(np.nanmax(grid.mu_path)) * (1 - 1e-9)
+    assert optimum.mu_path <= blocked["plain"].mu_path * (1 + 1e-9)

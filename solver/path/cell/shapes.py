@@ -54,7 +54,7 @@ class Box(Shape):
     def check(self, where: str) -> None:
         """Each side finite and > 0."""
         for k, side in enumerate(self.size):
-            _positive(side, f"{where}.size[{k}]")
+            _positive(side, f"{where}.size.{k}")
 
     def geometry(self) -> coal.CollisionGeometry:
         """A coal box."""
@@ -212,14 +212,14 @@ class Cell:
         """Raise InvalidInputError on the first bad field, named as the request names it."""
         for group, shapes in (("fixed", self.fixed), ("workpiece", self.workpiece)):
             for k, shape in enumerate(shapes):
-                shape.check(f"cell.{group}[{k}]")
+                shape.check(f"cell.{group}.{k}")
         if self.tool is not None:
             self.tool.check()
         if not (math.isfinite(self.clearance) and 0.0 <= self.clearance <= 1.0):
             raise InvalidInputError("cell.clearance", f"{self.clearance:.6g} m must be in [0, 1]")
         _positive(self.collision_step, "cell.collision_step", upper=math.pi)
         for k, radius in enumerate(self.link_radii or ()):
-            _positive(radius, f"cell.link_radii[{k}]", upper=1.0)
+            _positive(radius, f"cell.link_radii.{k}", upper=1.0)
 
     def obstacle_name(self, index: int) -> str:
         """The name of obstacle ``index`` (fixed first, then workpiece), or its place."""

@@ -20,7 +20,12 @@ _VERTEX = re.compile(rb"vertex\s+(\S+)\s+(\S+)\s+(\S+)")
 
 
 def read_stl(
-    data: bytes, *, max_triangles: int, units: str = "m", field: str = "stl"
+    data: bytes,
+    *,
+    max_triangles: int,
+    units: str = "m",
+    field: str = "stl",
+    setting: str = "max_mesh_triangles",
 ) -> np.ndarray:
     """The triangles of an STL file, in m.
 
@@ -29,6 +34,7 @@ def read_stl(
         max_triangles: the most triangles taken (a setting); more is an error.
         units: ``m``, ``mm``, ``cm`` or ``in``, the file's length unit.
         field: the request's field, named in errors.
+        setting: the name of the triangle limit, named in its error.
 
     Returns:
         shape (T, 3, 3), m, the corners of each triangle.
@@ -39,9 +45,9 @@ def read_stl(
     if units not in UNITS:
         raise InvalidInputError(f"{field}.units", f"unknown unit {units!r}; use {', '.join(UNITS)}")
     if data.lstrip()[:5].lower() == b"solid" and b"facet" in data[:4096]:
-        triangles = _ascii(data, max_triangles, field)
+        triangles = _ascii(data, (max_triangles, setting), field)
     else:
-        triangles = _binary(data, max_triangles, field)
+        triangles = _binary(data, (max_triangles, setting), field)
     if not len(triangles):
         raise InvalidInputError(field, "the STL has no triangles")
     if not np.all(np.isfinite(triangles)):
@@ -50,11 +56,11 @@ def read_stl(
     return scaled
 
 
-def _ascii(data: bytes, max_triangles: int, field: str) -> np.ndarray:
+def _ascii(data: bytes, limit: tuple[int, str], field: str) -> np.ndarray:
     """Triangles of an ASCII STL: every three ``vertex`` lines."""
     count = data.count(b"facet normal")
-    if count > max_triangles:
-        raise _too_many(count, max_triangles, field)
+    if count > limit[0]:
+        raise _too_many(count, limit, field)
     try:
         corners = np.array([[float(v) for v in m] for m in _VERTEX.findall(data)], dtype=float)
     except ValueError as exc:
@@ -67,7 +73,7 @@ def _ascii(data: bytes, max_triangles: int, field: str) -> np.ndarray:
     return corners.reshape(-1, 3, 3)
 
 
-def _binary(data: bytes, max_triangles: int, field: str) -> np.ndarray:
+def _binary(data: bytes, limit: tuple[int, str], field: str) -> np.ndarray:
     """Triangles of a binary STL: an 80-byte header, a count, 50 bytes a triangle."""
     if len(data) < _HEADER + 4:
         raise InvalidInputError(field, "not an STL: neither ASCII facets nor a binary header")
@@ -78,15 +84,13 @@ def _binary(data: bytes, max_triangles: int, field: str) -> np.ndarray:
             f"not an STL: a binary STL of {count} triangles is {_HEADER + 4 + _RECORD * count} "
             f"bytes, this is {len(data)}",
         )
-    if count > max_triangles:
-        raise _too_many(count, max_triangles, field)
+    if count > limit[0]:
+        raise _too_many(count, limit, field)
     record = np.dtype([("normal", "<f4", 3), ("corners", "<f4", (3, 3)), ("attribute", "<u2")])
     rows = np.frombuffer(data, dtype=record, count=count, offset=_HEADER + 4)
     return rows["corners"].astype(float)
 
 
-def _too_many(count: int, max_triangles: int, field: str) -> InvalidInputError:
-    """The error of a mesh over the triangle limit."""
-    return InvalidInputError(
-        field, f"{count} triangles; at most {max_triangles} (setting max_mesh_triangles)"
-    )
+def _too_many(count: int, limit: tuple[int, str], field: str) -> InvalidInputError:
+    """The error of a mesh over the triangle limit (its value and name)."""
+    return InvalidInputError(field, f"{count} triangles; at most {limit[0]} ({limit[1]})")
