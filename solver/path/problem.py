@@ -24,7 +24,7 @@ import numpy as np
 from solver.core.exceptions import InvalidInputError, NoAnalyticIkError, quoted
 from solver.core.family import Branch, KinematicsFamily
 from solver.core.robots import Robot
-from solver.path.cell.checker import CellChecker
+from solver.path.cell.checker import CELL_POSE_COST, CellChecker
 from solver.path.cell.limit import CellLimit
 from solver.path.cell.shapes import Cell
 from solver.path.limits import (
@@ -178,6 +178,16 @@ class PathProblem:
             return ()
         checker = CellChecker(self.robot, cell)
         return (CellLimit(checker, self.prepared.segment_in_pass),)
+
+    def path_cost(self, n_waypoints: int) -> float:
+        """The work of one placement of ``n_waypoints``, in poses of a closed-form family's map.
+
+        The family's cost (:meth:`KinematicsFamily.path_cost`), times the collision check's
+        (:data:`solver.path.cell.checker.CELL_POSE_COST`) with a cell: what the size limits of
+        the maps and searches weigh.
+        """
+        cost = self.family.path_cost(n_waypoints)
+        return cost * CELL_POSE_COST if self.options.cell is not None else cost
 
     @property
     def waypoint_limits(self) -> tuple[Limit, ...]:

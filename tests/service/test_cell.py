@@ -167,3 +167,18 @@ def test_a_map_in_a_cell_weighs_its_collision_work(
     assert "in a cell" in response.json()["detail"][0]["msg"]
     del request["cell"]
     assert client.post("/v1/map", json=request).status_code == 200
+
+
+def test_an_optimisation_in_a_cell_weighs_its_collision_work(
+    client: TestClient, body: dict
+) -> None:
+    box = {
+        "robot": body["robot"],
+        "path": body["path"],
+        "bounds": {"x": [-0.25, 0.25], "y": [0.25, 0.65], "yaw": [-3.14159, 3.14159]},
+        "z": 0.1,
+        "cell": {"fixed": [TABLE]},
+    }
+    response = client.post("/v1/optimize", json=box)  # 13,104 cells x 133 x 100: over 5 M
+    assert_names(response, 422, ["body", "bounds"])
+    assert "coarse map" in response.json()["detail"][0]["msg"]
