@@ -3,8 +3,9 @@
 Run by ``bench/run.py``, or alone from the repository root: ``python bench/cell.py``.
 The ERK-size map (546 placements, 133 waypoints) with a table top, a fixture box and the
 workpiece box, against the same map without a cell in the same run (the goal: at most 3x), for
-the UR5 (its URDF's meshes, as convex hulls) and the UR5e (capsules); then an optimisation with
-the cell: its time, its answer's clearance, and the best collision-free cell of its coarse map.
+the UR5 (its URDF's meshes, as convex hulls) and the UR5e (capsules), the tool point at the end
+of a 12 cm tool; then an optimisation with the cell: its time, its answer's clearance, and the
+best collision-free cell of a map of its box.
 """
 
 from __future__ import annotations
@@ -33,14 +34,15 @@ def _pose(x: float, y: float, z: float) -> np.ndarray:
 
 
 # The robot stands on the table (its top z = 0 in {B}); a fixture box beside the work; the part
-# (a block under the path, in {O}); a 12 cm spindle of 3 cm radius.
+# (a block under the path, in {O}); a 12 cm spindle of 3 cm radius, the tool point at its end.
+TOOL_LENGTH = 0.12
 CELL = Cell(
     fixed=(
         Halfspace((0.0, 0.0, 1.0), 0.0, name="table"),
         Box((0.1, 0.1, 0.3), _pose(-0.3, 0.2, 0.15), name="fixture"),
     ),
     workpiece=(Box((0.3, 0.12, 0.09), _pose(0.0, 0.06, -0.045), name="part"),),
-    tool=Tool(radius=0.03, length=0.12),
+    tool=Tool(radius=0.03, length=TOOL_LENGTH),
 )
 
 
@@ -57,7 +59,8 @@ def cell_lines(
     """Print the map with the cell against the map without, and an optimisation with it."""
     cells = len(xs) * len(ys)
     print(f"ERK-size map with a cell (table, fixture box, part box, tool; {cells} placements):")
-    for arm in (robot, get_robot("ur5e")):
+    for bare in (robot, get_robot("ur5e")):
+        arm = bare.with_options(transform_tool_to_tcp=_pose(0.0, 0.0, TOOL_LENGTH))
 
         def run_map(cell: Cell | None, arm: Robot = arm) -> object:
             problem = PathProblem.of(arm, path, PathOptions(cell=cell))
@@ -79,7 +82,8 @@ def cell_lines(
         if smoke
         else PlacementBounds(x=(-0.25, 0.25), y=(0.25, 0.65), yaw=(-0.3, 0.3), z=z)
     )
-    problem = PathProblem.of(robot, path, PathOptions(cell=CELL))
+    tooled = robot.with_options(transform_tool_to_tcp=_pose(0.0, 0.0, TOOL_LENGTH))
+    problem = PathProblem.of(tooled, path, PathOptions(cell=CELL))
     start = time.perf_counter()
     optimum = optimize_placement(problem, bounds=bounds, method="casadi")
     seconds = time.perf_counter() - start

@@ -151,6 +151,7 @@ def evaluate_response(
         cycle_time=cycle_time_to_api(cycle_time),
         collision=schemas.Contact.from_solver(ev.collision),
         min_clearance=schemas.Contact.from_solver(ev.min_clearance),
+        cell_approximated=None if ev.cell_approximated is None else list(ev.cell_approximated),
         feed_check=None
         if feed is None
         else schemas.FeedCheckResult(feed=feed.feed, feasible=feed.feasible, margin=feed.margin),

@@ -339,6 +339,13 @@ class EvaluateResponse(ResponseModel):
         description="With a cell, on a feasible path: the closest pair over every checked "
         "configuration and its distance (m); else null.",
     )
+    cell_approximated: list[str] | None = Field(
+        default=None,
+        description="With a cell: the robot's links given capsules along their kinematic "
+        "segments, having no collision geometry the service can read (an arm built from DH or "
+        "OPW parameters, a URDF whose meshes are elsewhere); null without a cell or when the "
+        "path was not checked.",
+    )
     feed_check: FeedCheckResult | None = Field(
         default=None,
         description="With a feed (the request's, or the CL program's FEDRAT): whether the path "

@@ -79,6 +79,7 @@ class PathEvaluation:
         collision: with a cell, where an infeasible path (reason ``collision``) first comes
             closer than the clearance (cell.md section 3); else ``None``.
         min_clearance: with a cell, the closest pair of a feasible path; else ``None``.
+        cell_approximated: with a cell, the robot's links given capsules; else ``None``.
     """
 
     feasible: bool
@@ -103,6 +104,7 @@ class PathEvaluation:
     acceleration: AccelerationIndex | None = None
     collision: Contact | None = None
     min_clearance: Contact | None = None
+    cell_approximated: tuple[str, ...] | None = None
 
     @property
     def feed_index(self) -> float | None:
@@ -177,14 +179,16 @@ def evaluate_path(problem: PathProblem, placement: Placement) -> PathEvaluation:
     pick = int(run.pick[0])
     reason = int(run.tracked.reason[pick, 0])
     verdict: PathVerdict | None = None
-    collision = None
+    collision, approximated = None, None
     if reason == FEASIBLE and problem.path_checks:
         chosen, verdict, refusal = clear_pick(problem, run, cell, 0, thorough=True)
         if chosen is None and refusal is not None:
             reason = problem.path_checks[0].reason
             collision = cell_detail(refusal).collision
+            approximated = cell_detail(refusal).approximated
         else:
             pick = int(chosen) if chosen is not None else pick
+            approximated = None if verdict is None else cell_detail(verdict).approximated
     infeasible = PathEvaluation(
         feasible=False,
         mu_path=None,
@@ -202,6 +206,7 @@ def evaluate_path(problem: PathProblem, placement: Placement) -> PathEvaluation:
         ik_seeds=run.ik_seeds,
         ik_branches_found=None if run.branches_found is None else int(run.branches_found[0]),
         collision=collision,
+        cell_approximated=approximated,
     )
     if reason != FEASIBLE:
         return infeasible

@@ -167,6 +167,7 @@ def evaluate_joint_path(
             reason="collision",
             failed_waypoint=verdict.failed_waypoint,
             collision=cell_detail(verdict).collision,
+            cell_approximated=cell_detail(verdict).approximated,
         )
     v_max = np.where(path.pure_rotation, 0.0, speed)
     with np.errstate(divide="ignore", invalid="ignore"):
@@ -190,6 +191,7 @@ def evaluate_joint_path(
         qdot=(qd_unit * speed).T,
         limiting_joint=limiting,
         min_clearance=None if verdict is None else cell_detail(verdict).closest,
+        cell_approximated=None if verdict is None else cell_detail(verdict).approximated,
     )
 
 

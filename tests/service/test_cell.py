@@ -182,3 +182,13 @@ def test_an_optimisation_in_a_cell_weighs_its_collision_work(
     response = client.post("/v1/optimize", json=box)  # 13,104 cells x 133 x 100: over 5 M
     assert_names(response, 422, ["body", "bounds"])
     assert "coarse map" in response.json()["detail"][0]["msg"]
+
+
+@pytest.mark.parametrize(("model", "count"), [("ur5", 0), ("ur5e", 7)])
+def test_the_answer_names_the_links_given_capsules(
+    client: TestClient, body: dict, model: str, count: int
+) -> None:
+    body["robot"] = {"model": model}
+    body["cell"] = {"fixed": [TABLE], "link_radii": [0.05] * 7}
+    answer = client.post("/v1/evaluate", json=body).json()
+    assert len(answer["cell_approximated"]) == count

@@ -18,10 +18,11 @@ import pytest
 from solver.core.exceptions import InvalidInputError
 from solver.core.robots import example_robot_data_dir
 from solver.core.spatial import Placement
-from solver.families import get_robot
+from solver.families import get_robot, robot_from_urdf
 from solver.optimise.optimize import optimize_placement
 from solver.optimise.search_space import PlacementBounds
 from solver.path.capability_map import CapabilityMap, capability_map, grid_axis
+from solver.path.cell.checker import CellChecker
 from solver.path.cell.shapes import Box, Cell, Halfspace, Mesh, Tool
 from solver.path.cell.stl import read_stl
 from solver.path.evaluate import evaluate_path
@@ -396,3 +397,22 @@ def test_the_optimisers_answer_collision_free_placements(blocked: dict, method: 
     )
     assert optimum.mu_path >= float(np.nanmax(grid.mu_path)) * (1 - 1e-9)
     assert optimum.mu_path <= blocked["plain"].mu_path * (1 + 1e-9)
+
+
+def test_a_urdf_whose_meshes_cannot_be_read_gets_capsules_where_it_has_no_primitive() -> None:
+    robots = example_robot_data_dir()
+    urdf = (robots / "ur_description" / "urdf" / "ur5_robot.urdf").read_text()
+    elsewhere = urdf.replace("package://example-robot-data/", "package://not-installed/")
+    arm = robot_from_urdf(elsewhere, base_frame="base", tool_frame="tool0", name="ur5-elsewhere")
+    checker = CellChecker(arm, Cell())
+    # every link's collision element is a mesh but the ee_link's box, on the last joint
+    assert checker.approximated == (
+        "base",
+        "shoulder_pan_joint",
+        "shoulder_lift_joint",
+        "elbow_joint",
+        "wrist_1_joint",
+        "wrist_2_joint",
+    )
+    assert CellChecker(get_robot("ur5"), Cell()).approximated == ()
+    assert len(CellChecker(get_robot("ur5e"), Cell()).approximated) == 7

@@ -29,9 +29,7 @@ DESCRIPTION = "differential_evolution + SLSQP (scipy)"
 def _size(problem: PathProblem, bounds: PlacementBounds) -> SearchSize:
     """The search's size for the problem's family (smaller for a costlier placement)."""
     n_waypoints = len(problem.waypoints)
-    return search_size(
-        bounds, path_cost=problem.path_cost(n_waypoints), n_waypoints=n_waypoints
-    )
+    return search_size(bounds, path_cost=problem.path_cost(n_waypoints), n_waypoints=n_waypoints)
 
 
 def check(problem: PathProblem, bounds: PlacementBounds, settings: Search) -> None:

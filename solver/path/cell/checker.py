@@ -60,11 +60,13 @@ class CellVerdict:
         closest: the closest pair over every checked configuration (None when the check
             stopped at the first collision).
         checks: how many configurations were checked.
+        approximated: the robot's links given capsules (no readable collision geometry).
     """
 
     collision: Contact | None
     closest: Contact | None
     checks: int
+    approximated: tuple[str, ...] = ()
 
 
 class CellChecker:
@@ -180,7 +182,7 @@ class CellChecker:
         for gid, pose in self._workpiece_ids:
             geometry.geometryObjects[gid].placement = placed * pose
         if not self._pairs:
-            return CellVerdict(collision=None, closest=None, checks=0)
+            return CellVerdict(None, None, 0, self.approximated)
         if not closest:
             return self._first_collision(configurations, owners)
         model = self.robot.model
@@ -195,11 +197,11 @@ class CellChecker:
             low = float(distances[pair])
             if low < self.cell.clearance:
                 hit = self._contact(int(owners[index]), pair, low)
-                return CellVerdict(collision=hit, closest=None, checks=index + 1)
+                return CellVerdict(hit, None, index + 1, self.approximated)
             if best is None or low < best[0]:
                 best = (low, index, pair)
         near = None if best is None else self._contact(int(owners[best[1]]), best[2], best[0])
-        return CellVerdict(collision=None, closest=near, checks=len(configurations))
+        return CellVerdict(None, near, len(configurations), self.approximated)
 
     def _first_collision(self, configurations: np.ndarray, owners: np.ndarray) -> CellVerdict:
         """The first collision along the configurations, each pair computed only when due.
@@ -221,7 +223,7 @@ class CellChecker:
             low = int(np.argmin(distances))
             if distances[low] < clearance:
                 hit = self._contact(int(owners[index]), int(due[low]), float(distances[low]))
-                return CellVerdict(collision=hit, closest=None, checks=checks)
+                return CellVerdict(hit, None, checks, self.approximated)
             window = configurations[index + 1 : index + 1 + _WINDOW]
             moved = np.abs(window - configurations[index]) @ self._weights[due].T  # (m, due)
             exceeded = moved >= distances - clearance
@@ -230,7 +232,7 @@ class CellChecker:
             first = np.where(exceeded.any(axis=0), exceeded.argmax(axis=0), len(window))
             clear_until[due] = index + first
             index = int(clear_until.min()) + 1
-        return CellVerdict(collision=None, closest=None, checks=checks)
+        return CellVerdict(None, None, checks, self.approximated)
 
     def _contact(self, waypoint: int, pair: int, distance: float) -> Contact:
         """The contact of pair ``pair`` (an index into the checked pairs)."""
