@@ -16,6 +16,7 @@ import pinocchio as pin
 import pytest
 
 from solver.core.exceptions import InvalidInputError
+from solver.core.parallel import SERIAL, ThreadRunner
 from solver.core.robots import example_robot_data_dir
 from solver.core.spatial import Placement
 from solver.families import get_robot, robot_from_urdf
@@ -416,3 +417,18 @@ def test_a_urdf_whose_meshes_cannot_be_read_gets_capsules_where_it_has_no_primit
     )
     assert CellChecker(get_robot("ur5"), Cell()).approximated == ()
     assert len(CellChecker(get_robot("ur5e"), Cell()).approximated) == 7
+
+
+def test_threads_give_the_serial_map() -> None:
+    """Each check poses the workpiece objects in its own copy of the geometry."""
+    part = Box((0.3, 0.12, 0.2), pose(0.0, 0.06, -0.09), name="part")
+    cell = Cell(fixed=(TABLE, FIXTURE), workpiece=(part,), tool=TOOL)
+    xs, ys = np.linspace(-0.2, 0.2, 5), np.linspace(0.3, 0.6, 4)
+    maps = [
+        capability_map(
+            problem(cell, tcp=TCP), xs=xs, ys=ys, z=0.1, yaws=np.zeros(1), runner=runner, chunk=2
+        )
+        for runner in (SERIAL, ThreadRunner(2))
+    ]
+    np.testing.assert_array_equal(maps[0].reason, maps[1].reason)
+    np.testing.assert_array_equal(maps[0].mu_path, maps[1].mu_path)

@@ -177,14 +177,14 @@ class CellChecker:
                 within the clearance (a map; :meth:`_first_collision`).
         """
         configurations, owners = self.configurations(np.asarray(q, float), segment_in_pass)
-        geometry = self.geometry
+        geometry = self.geometry.copy()  # its own workpiece poses: threads share the checker
         placed = self._world_to_base * pin.SE3(np.asarray(transform_workpiece_to_base, float))
         for gid, pose in self._workpiece_ids:
             geometry.geometryObjects[gid].placement = placed * pose
         if not self._pairs:
             return CellVerdict(None, None, 0, self.approximated)
         if not closest:
-            return self._first_collision(configurations, owners)
+            return self._first_collision(geometry, configurations, owners)
         model = self.robot.model
         data, gdata = model.createData(), geometry.createData()
         best: tuple[float, int, int] | None = None
@@ -203,13 +203,15 @@ class CellChecker:
         near = None if best is None else self._contact(int(owners[best[1]]), best[2], best[0])
         return CellVerdict(None, near, len(configurations), self.approximated)
 
-    def _first_collision(self, configurations: np.ndarray, owners: np.ndarray) -> CellVerdict:
+    def _first_collision(
+        self, geometry: pin.GeometryModel, configurations: np.ndarray, owners: np.ndarray
+    ) -> CellVerdict:
         """The first collision along the configurations, each pair computed only when due.
 
         A pair is due at a configuration its last distance does not prove clear
         (:mod:`solver.path.cell.bounds`); a configuration where no pair is due is skipped.
         """
-        model, geometry = self.robot.model, self.geometry
+        model = self.robot.model
         data, gdata = model.createData(), geometry.createData()
         clear_until = np.full(len(self._pairs), -1)  # the last configuration proven clear
         index, checks, clearance = 0, 0, self.cell.clearance
