@@ -19,6 +19,7 @@ from solver.path.evaluate import evaluate_path
 from solver.path.problem import PathOptions, PathProblem
 from tests.cases import EXAMPLES
 from tests.service.test_errors import assert_names
+from tests.service.test_job_routes import EXAMPLE, route_body
 from tests.solver.test_cell import binary_stl, cube_triangles
 from tests.solver.test_evaluate import load_path
 
@@ -192,3 +193,17 @@ def test_the_answer_names_the_links_given_capsules(
     body["cell"] = {"fixed": [TABLE], "link_radii": [0.05] * 7}
     answer = client.post("/v1/evaluate", json=body).json()
     assert len(answer["cell_approximated"]) == count
+
+
+@pytest.mark.parametrize("kind", ["evaluate", "map", "optimize"])
+def test_a_job_with_a_bad_cell_is_refused_at_submit_as_its_route_refuses_it(
+    client: TestClient, kind: str
+) -> None:
+    body = route_body(kind, EXAMPLE["path"])
+    body["cell"] = {"workpiece": [mesh("hello, not a mesh")]}
+    direct = client.post(f"/v1/{kind}", json=body)
+    assert_names(direct, 422, ["body", "cell", "workpiece", 0, "stl"])
+    submitted = client.post("/v1/jobs", json={"kind": kind, "request": body})
+    assert submitted.status_code == 422, submitted.text
+    (expected,), (detail,) = direct.json()["detail"], submitted.json()["detail"]
+    assert detail == {**expected, "loc": ["body", "request", *expected["loc"][1:]]}
