@@ -30,12 +30,13 @@ import time
 from pathlib import Path
 
 import httpx
-import memory  # bench/memory.py, parallel.py, acceleration.py, active_set.py, beside this script
+import memory  # bench/memory.py, parallel.py, acceleration.py, active_set.py, cell.py, beside it
 import numpy as np
 import parallel
 import ur_analytic_ik
 from acceleration import acceleration_lines
 from active_set import active_set_lines
+from cell import cell_lines
 from timing import best_time
 
 from solver.core.kinematics import jacobian_in_base
@@ -188,6 +189,7 @@ def main() -> None:
         f"{t_opw_numpy / t_opw:.2f}x the kernel"
     )
     acceleration_lines(robot, path, xs, ys, z, repeats=repeats, smoke=args.smoke)
+    cell_lines(robot, path, xs, ys, z, repeats=repeats, smoke=args.smoke)
     numeric_maps(path, xs, ys, z, t_map)
     optimisation(robot, path, smoke=args.smoke)
     active_set_lines(smoke=args.smoke)

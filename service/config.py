@@ -74,6 +74,16 @@ class Settings(BaseSettings):
         "a 10,487-move program on a UR5e takes seconds. The scipy method's search still "
         "evaluates the whole path (DTF_MAX_SEARCH_POSES bounds it).",
     )
+    max_cell_objects: int = Field(
+        default=100,
+        gt=0,
+        description="Most objects (fixed and workpiece) a request's cell may hold.",
+    )
+    max_mesh_triangles: int = Field(
+        default=50_000,
+        gt=0,
+        description="Most triangles one STL mesh of a cell may have.",
+    )
     max_detail_waypoints: int = Field(
         default=2_000,
         gt=0,

@@ -371,6 +371,14 @@ def _repair(body: dict[str, Any], route: str) -> str | None:
         if body.get("joint_path") is not None:
             _noted("joint_path: reaches the waypoints", body, body.pop, "joint_path")
         body.pop("joint_path", None)
+    if isinstance(body.get("cell"), dict):
+        _noted(
+            "cell: checkable (radii, an STL, a tool, a normal, evaluate only)",
+            body,
+            _repair_cell,
+            body,
+            route,
+        )
     if route.startswith("/v1/map") and isinstance(body.get("grid"), dict) and n:
         _noted(
             "grid: within the server's limits",
@@ -388,6 +396,41 @@ def _repair(body: dict[str, Any], route: str) -> str | None:
             body,
         )
     return None
+
+
+CUBE_STL = (
+    "solid cube\n"
+    + "".join(
+        "facet normal 0 0 0\nouter loop\n"
+        + "".join(f"vertex {x} {y} {z}\n" for x, y, z in triangle)
+        + "endloop\nendfacet\n"
+        for triangle in (((0, 0, 0), (1, 0, 0), (0, 1, 0)), ((0, 0, 0), (0, 1, 0), (0, 0, 1)))
+    )
+    + "endsolid cube\n"
+)
+
+
+def _repair_cell(body: dict[str, Any], route: str) -> None:
+    """A cell the robot can be checked in: radii for every arm (7: all are 6-joint arms here),
+    an STL for a random string, a cutting length within the tool, a normal that is not 0, at
+    most three objects a group. Maps and optimisations drop it: their work with a cell is
+    tested in tests/service/test_cell.py (a generated grid sized to the limits without a cell
+    would be refused for its collision work)."""
+    if not route.startswith("/v1/evaluate"):
+        body.pop("cell")
+        return
+    cell = body["cell"]
+    cell["link_radii"] = [0.05] * 7
+    tool = cell.get("tool")
+    if isinstance(tool, dict) and tool.get("cutting_length") is not None:
+        tool["cutting_length"] = min(tool["cutting_length"], tool["length"])
+    for group in ("fixed", "workpiece"):
+        objects = cell[group] = (cell.get(group) or [])[:3]
+        for item in objects:
+            if item.get("shape") == "mesh":
+                item["stl"] = CUBE_STL
+            if item.get("shape") == "halfspace" and not any(item.get("normal") or []):
+                item["normal"] = [0.0, 0.0, 1.0]
 
 
 def before_add_examples(context: Any, examples: list[schemathesis.Case]) -> None:

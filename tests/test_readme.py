@@ -92,3 +92,8 @@ def test_acceleration_example_output() -> None:
         "## Joint accelerations: the feed the arm can really run", "accelerations"
     )
     assert printed == lines
+
+
+def test_cell_example_output() -> None:
+    printed, lines = _example_lines("## The cell: placements that hit nothing", "cell")
+    assert printed == lines

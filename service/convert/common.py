@@ -7,7 +7,7 @@ import math
 import numpy as np
 
 from service import schemas
-from service.config import get_settings
+from service.config import Settings, get_settings
 from service.schemas.path import PathInput
 from solver.cam.frames import frames_of_placement
 from solver.core.exceptions import InvalidInputError
@@ -18,6 +18,7 @@ from solver.core.spatial import (
     spun_waypoints,
 )
 from solver.core.urdf_structure import joint_count
+from solver.path.cell.shapes import Cell
 from solver.path.problem import PathOptions, PathProblem, SpinMode
 
 
@@ -108,6 +109,7 @@ def problem_of(
     *,
     ik: schemas.IkPolicy | schemas.AutoIkPolicy,
     spin_mode: SpinMode,
+    cell: Cell | None = None,
 ) -> PathProblem:
     """The solver's problem: the robot along ``poses``, with the request's IK and spin mode.
 
@@ -117,14 +119,30 @@ def problem_of(
         path: the path as read (its passes).
         ik: the request's IK policy (branch, max_joint_step, blend_length).
         spin_mode: the spin mode (:func:`spin_mode_of`).
+        cell: the request's cell (:func:`cell_of`), or None.
     """
     options = PathOptions(
         branch=branch_of(ik.branch),
         max_joint_step=ik.max_joint_step,
         spin_mode=spin_mode,
         blend_length=ik.blend_length,
+        cell=cell,
     )
     return PathProblem.of(robot, poses, options, passes=path.passes)
+
+
+def cell_of(cell: schemas.CellSpec | None, settings: Settings) -> Cell | None:
+    """The solver's cell of a request, bounded by the settings; None without one.
+
+    Raises:
+        InvalidInputError: too many objects (DTF_MAX_CELL_OBJECTS), a mesh over
+            DTF_MAX_MESH_TRIANGLES or not an STL, naming the field.
+    """
+    if cell is None:
+        return None
+    return cell.to_solver(
+        max_objects=settings.max_cell_objects, max_triangles=settings.max_mesh_triangles
+    )
 
 
 def placement_of(placement: schemas.Placement) -> Placement:

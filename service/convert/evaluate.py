@@ -150,6 +150,9 @@ def evaluate_response(
         axis_correction=axis_correction,
         acceleration=acceleration_to_api(ev.acceleration, robot),
         cycle_time=cycle_time_to_api(cycle_time),
+        collision=schemas.Contact.from_solver(ev.collision),
+        min_clearance=schemas.Contact.from_solver(ev.min_clearance),
+        cell_approximated=None if ev.cell_approximated is None else list(ev.cell_approximated),
         feed_check=None
         if feed is None
         else schemas.FeedCheckResult(feed=feed.feed, feasible=feed.feasible, margin=feed.margin),

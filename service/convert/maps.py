@@ -15,6 +15,7 @@ from solver.core.exceptions import InvalidInputError
 from solver.core.robots import Robot
 from solver.core.spatial import MAX_COORDINATE
 from solver.path.capability_map import CapabilityMap, axis_length, grid_axis
+from solver.path.cell.checker import CELL_POSE_COST
 from solver.path.problem import SpinMode, require_family
 
 
@@ -28,11 +29,19 @@ class MapGrid:
     spins: np.ndarray
 
 
-def map_grid(grid: schemas.Grid, *, settings: Settings, n_waypoints: int, robot: Robot) -> MapGrid:
+def map_grid(
+    grid: schemas.Grid,
+    *,
+    settings: Settings,
+    n_waypoints: int,
+    robot: Robot,
+    with_cell: bool = False,
+) -> MapGrid:
     """The grid's values, after checking its size against the settings.
 
     The poses are weighed by the robot family's cost (``path_cost``: 1 a pose for a closed-form
-    family, far more for numeric IK), so that DTF_MAX_MAP_POSES bounds the time of every map.
+    family, far more for numeric IK), so that DTF_MAX_MAP_POSES bounds the time of every map;
+    with a cell, each pose also by the collision check's (``CELL_POSE_COST``).
 
     Raises:
         InvalidInputError: an axis is malformed, or the grid is over a size limit; the message
@@ -59,10 +68,10 @@ def map_grid(grid: schemas.Grid, *, settings: Settings, n_waypoints: int, robot:
         )
     poses = cells * n_waypoints
     family = require_family(robot)
-    work = cells * family.path_cost(n_waypoints)
+    work = cells * family.path_cost(n_waypoints) * (CELL_POSE_COST if with_cell else 1.0)
     if work > limits.poses:
         weighed = "" if work == poses else f", as work {work:.4g} closed-form poses"
-        weighed += "" if work == poses else f" ({family.name} IK)"
+        weighed += "" if work == poses else f" ({family.name} IK{' in a cell' * with_cell})"
         raise InvalidInputError(
             "grid",
             f"{size} * {n_waypoints} waypoints = {poses} poses{weighed}; the limit is "

@@ -39,22 +39,30 @@ def check_job(body: JobRequest, settings: Settings) -> None:
         raise
 
 
-def _problem(robot: Robot, body: MapRequest | EvaluateRequest | OptimizeRequest) -> PathProblem:
-    """The path read and checked, the options checked against the robot."""
+def _problem(
+    robot: Robot, body: MapRequest | EvaluateRequest | OptimizeRequest, settings: Settings
+) -> PathProblem:
+    """The path read and checked, the options (the cell too) checked against the robot."""
     path = convert.path_of(body.path)
     poses = convert.spun_poses(path, body.spins) if isinstance(body, EvaluateRequest) else None
     spin_mode = convert.spin_mode_of(body.spin_mode, path)
     problem = convert.problem_of(
-        robot, path.poses if poses is None else poses, path, ik=body.ik, spin_mode=spin_mode
+        robot,
+        path.poses if poses is None else poses,
+        path,
+        ik=body.ik,
+        spin_mode=spin_mode,
+        cell=convert.cell_of(body.cell, settings),
     )
     problem.prepared  # noqa: B018 - the path checked (repeated waypoints, passes)
     problem.branches  # noqa: B018 - the options checked against the robot
+    problem.path_checks  # noqa: B018 - the cell checked against the robot
     return problem
 
 
 def _check_map(body: MapRequest, settings: Settings) -> None:
     robot, _ = checked_grid(body, settings)
-    _problem(robot, body)
+    _problem(robot, body, settings)
 
 
 def _check_evaluate(body: EvaluateRequest, settings: Settings) -> None:
@@ -62,7 +70,7 @@ def _check_evaluate(body: EvaluateRequest, settings: Settings) -> None:
         body.path, limit=settings.max_path_waypoints, setting="DTF_MAX_PATH_WAYPOINTS"
     )
     robot = convert.robot_from_schema(body.robot)
-    problem = _problem(robot, body)
+    problem = _problem(robot, body, settings)
     if body.joint_path is not None:
         if problem.options.spin_mode != "fixed":
             raise InvalidInputError("joint_path", "a joint path is evaluated in spin_mode fixed")
@@ -74,7 +82,7 @@ def _check_optimize(body: OptimizeRequest, settings: Settings) -> None:
         body.path, limit=settings.max_optimize_waypoints, setting="DTF_MAX_OPTIMIZE_WAYPOINTS"
     )
     robot = convert.robot_from_schema(body.robot)
-    problem = _problem(robot, body)
+    problem = _problem(robot, body, settings)
     bounds = convert.bounds_of(body.bounds, z=body.z)
     bounds.check()
     method_named(body.method)

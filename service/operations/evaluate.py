@@ -31,7 +31,8 @@ def _evaluated(
     path = convert.path_of(body.path)
     poses, placement = convert.spun_poses(path, body.spins), convert.placement_of(body.placement)
     spin_mode = convert.spin_mode_of(body.spin_mode, path)
-    problem = convert.problem_of(robot, poses, path, ik=body.ik, spin_mode=spin_mode)
+    cell = convert.cell_of(body.cell, settings)
+    problem = convert.problem_of(robot, poses, path, ik=body.ik, spin_mode=spin_mode, cell=cell)
     _check_work(problem, settings)
     if body.joint_path is not None:
         if spin_mode != "fixed":
@@ -47,20 +48,23 @@ def _evaluated(
 def _check_work(problem: PathProblem, settings: Settings) -> None:
     """Refuse an evaluation whose work, weighed as a map's, is over the map limit (before it).
 
-    One placement of the path costs its family's ``path_cost`` in closed-form poses (one a
-    waypoint for a closed-form family, far more for numeric IK), the unit of the map limit.
+    One placement of the path costs the problem's ``path_cost`` in closed-form poses (one a
+    waypoint for a closed-form family, far more for numeric IK, times the collision check's
+    weight with a cell), the unit of the map limit.
 
     Raises:
         InvalidInputError: on ``path``, saying the work and the limit.
     """
     n_waypoints = len(problem.waypoints)
-    work = problem.family.path_cost(n_waypoints)
+    work = problem.path_cost(n_waypoints)
+    cell = ", with a cell" if problem.options.cell is not None else ""
     limits = settings.map_limits()
     if work > limits.poses:
         raise InvalidInputError(
             "path",
             f"{n_waypoints} waypoints, as work {work:.4g} closed-form poses "
-            f"({problem.family.name} IK); the limit is {limits.poses} ({limits.poses_setting})",
+            f"({problem.family.name} IK{cell}); the limit is {limits.poses} "
+            f"({limits.poses_setting})",
         )
 
 

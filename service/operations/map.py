@@ -24,7 +24,11 @@ def checked_grid(body: MapRequest, settings: Settings) -> tuple[Robot, convert.M
     )
     robot = convert.robot_from_schema(body.robot)
     grid = convert.map_grid(
-        body.grid, settings=settings, n_waypoints=body.path.n_waypoints(), robot=robot
+        body.grid,
+        settings=settings,
+        n_waypoints=body.path.n_waypoints(),
+        robot=robot,
+        with_cell=body.cell is not None,
     )
     return robot, grid
 
@@ -46,7 +50,10 @@ def computed_map(
         convert.check_png_size(grid, settings=settings)
     path = convert.path_of(body.path)
     spin_mode = convert.spin_mode_of(body.spin_mode, path)
-    problem = convert.problem_of(robot, path.poses, path, ik=body.ik, spin_mode=spin_mode)
+    cell = convert.cell_of(body.cell, settings)
+    problem = convert.problem_of(
+        robot, path.poses, path, ik=body.ik, spin_mode=spin_mode, cell=cell
+    )
     result = capability_map(
         problem,
         xs=grid.xs,

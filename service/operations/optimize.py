@@ -25,7 +25,10 @@ def optimum_of(
     bounds = convert.bounds_of(body.bounds, z=body.z)
     start = None if body.start is None else convert.placement_of(body.start)
     spin_mode = convert.spin_mode_of(body.spin_mode, path)
-    problem = convert.problem_of(robot, path.poses, path, ik=body.ik, spin_mode=spin_mode)
+    cell = convert.cell_of(body.cell, settings)
+    problem = convert.problem_of(
+        robot, path.poses, path, ik=body.ik, spin_mode=spin_mode, cell=cell
+    )
     optimum = optimize_placement(
         problem,
         bounds=bounds,

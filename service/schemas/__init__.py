@@ -4,6 +4,16 @@ Request models are strict, refuse unknown fields and refuse NaN and infinities; 
 its unit, and every model carries an example, so ``/docs`` reads as a manual.
 """
 
+from service.schemas.cell import (
+    BoxObject,
+    CellSpec,
+    Contact,
+    CylinderObject,
+    HalfspaceObject,
+    MeshObject,
+    SphereObject,
+    ToolSpec,
+)
 from service.schemas.common import (
     AutoIkPolicy,
     Branch,
@@ -77,6 +87,14 @@ __all__ = [
     "ProgramUnits",
     "SpinMode",
     "AccelerationResult",
+    "BoxObject",
+    "CellSpec",
+    "Contact",
+    "CylinderObject",
+    "HalfspaceObject",
+    "MeshObject",
+    "SphereObject",
+    "ToolSpec",
     "CycleTimeResult",
     "PassCycleTime",
     "OptimizeJob",

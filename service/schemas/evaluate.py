@@ -10,6 +10,7 @@ from pydantic.config import JsonDict
 from pydantic_core import PydanticCustomError
 from typing_extensions import TypeAliasType
 
+from service.schemas.cell import CellSpec, Contact
 from service.schemas.common import (
     Angle,
     Branch,
@@ -105,6 +106,7 @@ class FailureReason(StrEnum):
     JOINT_LIMITS = "joint_limits"
     SINGULAR = "singular"
     DISCONTINUOUS = "discontinuous"
+    COLLISION = "collision"
 
 
 class EvaluateRequest(RequestModel):
@@ -120,6 +122,12 @@ class EvaluateRequest(RequestModel):
     placement: Placement = Field(description="Where {O} sits in the base frame {B}.")
     ik: IkPolicy = Field(
         default_factory=IkPolicy, description="IK branch and continuity bound; default auto."
+    )
+    cell: CellSpec | None = Field(
+        default=None,
+        description="The robot's surroundings and tool (cell.md): fixed objects in {B}, "
+        "workpiece objects in {O}; the path is checked against them and the robot itself at "
+        "every waypoint and sub-step. Default: no collision check.",
     )
     spin_mode: SpinMode | None = Field(
         default=None,
@@ -340,6 +348,23 @@ class EvaluateResponse(ResponseModel):
         description="With robot.joint_acceleration_limits: the cycle time at mu_acc, with the "
         "ramps at the pass ends, and the time-optimal one (s, motion.md section 4); null "
         "without them, when infeasible, or when mu_acc is 0.",
+    )
+    collision: Contact | None = Field(
+        default=None,
+        description="With a cell, when reason is collision: the first configuration closer than "
+        "the clearance, its robot part, obstacle and distance (m); else null.",
+    )
+    min_clearance: Contact | None = Field(
+        default=None,
+        description="With a cell, on a feasible path: the closest pair over every checked "
+        "configuration and its distance (m); else null.",
+    )
+    cell_approximated: list[str] | None = Field(
+        default=None,
+        description="With a cell: the robot's links given capsules along their kinematic "
+        "segments, having no collision geometry the service can read (an arm built from DH or "
+        "OPW parameters, a URDF whose meshes are elsewhere); null without a cell or when the "
+        "path was not checked.",
     )
     feed_check: FeedCheckResult | None = Field(
         default=None,

@@ -7,6 +7,7 @@ from typing import Annotated
 from pydantic import ConfigDict, Field
 from pydantic.config import JsonDict
 
+from service.schemas.cell import CellSpec
 from service.schemas.common import (
     Angle,
     Branch,
@@ -115,6 +116,12 @@ class MapRequest(RequestModel):
     path: Path = Field(description="The tool path in the workpiece frame {O}.")
     grid: Grid = Field(description="The placements to evaluate.")
     ik: IkPolicy = Field(default_factory=IkPolicy, description="IK branch policy.")
+    cell: CellSpec | None = Field(
+        default=None,
+        description="The robot's surroundings and tool (cell.md): fixed objects in {B}, "
+        "workpiece objects in {O}; the path is checked against them and the robot itself at "
+        "every waypoint and sub-step. Default: no collision check.",
+    )
     spin_mode: SpinMode | None = Field(
         default=None,
         description="fixed: the orientations as given; free: the tool spin rate about the tool "

@@ -9,6 +9,7 @@ from pydantic import ConfigDict, Field, field_validator, model_validator
 from pydantic.config import JsonDict
 from pydantic_core import PydanticCustomError
 
+from service.schemas.cell import CellSpec
 from service.schemas.common import (
     Angle,
     AutoIkPolicy,
@@ -112,6 +113,12 @@ class OptimizeRequest(RequestModel):
         default_factory=AutoIkPolicy,
         description="IK policy: max_joint_step as for /v1/evaluate; the branch is auto (each "
         "start of the search follows its own branch, the answer uses the best).",
+    )
+    cell: CellSpec | None = Field(
+        default=None,
+        description="The robot's surroundings and tool (cell.md): fixed objects in {B}, "
+        "workpiece objects in {O}; the path is checked against them and the robot itself at "
+        "every waypoint and sub-step. Default: no collision check.",
     )
     spin_mode: SpinMode | None = Field(
         default=None,

@@ -15,11 +15,19 @@ OK = 0
 UNREACHABLE = 1
 SINGULAR = 2
 
-Reason = Literal["unreachable", "joint_limits", "singular", "discontinuous"]
-REASONS: tuple[Reason, ...] = ("unreachable", "joint_limits", "singular", "discontinuous")
+Reason = Literal["unreachable", "joint_limits", "singular", "discontinuous", "collision"]
+REASONS: tuple[Reason, ...] = (
+    "unreachable",
+    "joint_limits",
+    "singular",
+    "discontinuous",
+    "collision",
+)
 FEASIBLE = -1  # reason code of a feasible branch
-# The index of each reason in REASONS.
+# The index of each reason in REASONS. The kernels give the first four; ``collision`` (cell.md
+# section 3) is given after them, by the path checks of :mod:`solver.path.limits`.
 REASON_UNREACHABLE, REASON_JOINT_LIMITS, REASON_SINGULAR, REASON_DISCONTINUOUS = range(4)
+REASON_COLLISION = 4
 # Branches whose mu_path is within this relative tolerance of the best tie; the first in the
 # family's order is chosen (dtf.md section 4).
 TIE_RTOL = 1e-12

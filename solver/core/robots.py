@@ -61,6 +61,9 @@ class Robot:
             more; ``None`` for a shorter chain (``/v1/dtf`` only).
         qddot_max: shape (n,), rad/s^2, joint acceleration limits (all > 0), or ``None``: no
             acceleration limits, the path index is mu_path alone (motion.md section 1).
+        urdf: the URDF text the model was read from (its ``<collision>`` elements are the
+            robot's geometry in a cell, cell.md section 2); ``None`` for a model built from
+            kinematic parameters.
     """
 
     name: str
@@ -75,6 +78,7 @@ class Robot:
     transform_world_to_base: np.ndarray
     family: KinematicsFamily | None = None
     qddot_max: np.ndarray | None = None
+    urdf: str | None = None
 
     @property
     def dof(self) -> int:

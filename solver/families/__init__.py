@@ -7,6 +7,7 @@ other solver module imports a family (the qpsolvers pattern of a backend registr
 
 from __future__ import annotations
 
+import dataclasses
 import functools
 import importlib
 
@@ -104,6 +105,7 @@ def robot_from_urdf(
     model = chain_from_urdf(urdf, tool_frame=tool_frame)
     if family is None and model.existFrame(base_frame) and model.existFrame(tool_frame):
         family = default_family(model, base_frame=base_frame, tool_frame=tool_frame)
-    return robot_from_model(
+    robot = robot_from_model(
         name, model, base_frame=base_frame, tool_frame=tool_frame, qdot_max=qdot_max, family=family
     )
+    return dataclasses.replace(robot, urdf=urdf)

@@ -115,7 +115,7 @@ def _check_map_size(
     n_waypoints = mapped_waypoints(problem.prepared.n_waypoints)
     poses = math.prod(sizes) * n_waypoints
     family = problem.family
-    work = math.prod(sizes) * family.path_cost(n_waypoints)
+    work = math.prod(sizes) * problem.path_cost(n_waypoints)
     if max_poses is not None and work > max_poses:
         size = f"the search box's coarse map of {math.prod(sizes)} cells * {n_waypoints} "
         size += f"waypoints = {poses} poses"

@@ -73,7 +73,7 @@ def refine_cells(
     """
     free = np.flatnonzero(bounds.free)
     n_waypoints = problem.prepared.n_waypoints
-    per_cell = 2 * len(free) * rounds * problem.family.path_cost(n_waypoints)
+    per_cell = 2 * len(free) * rounds * problem.path_cost(n_waypoints)
     count = min(count, int(REFINE_WORK // max(per_cell, 1.0)))
     rest, cells = cells[count:], cells[:count]
     if not cells:
@@ -138,7 +138,7 @@ def climb(problem: PathProblem, bounds: PlacementBounds, start: Cell) -> Cell | 
         leaves fewer than CLIMB_MIN_EVALUATIONS or nothing is free.
     """
     free = np.flatnonzero(bounds.free)
-    cost = problem.family.path_cost(problem.prepared.n_waypoints)
+    cost = problem.path_cost(problem.prepared.n_waypoints)
     budget = min(CLIMB_EVALUATIONS, int(CLIMB_WORK // max(cost, 1.0)))
     if budget < CLIMB_MIN_EVALUATIONS or not len(free):
         return None

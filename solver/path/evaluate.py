@@ -22,7 +22,9 @@ from solver.core.dtf_redundant import spin_rate_at_feed
 from solver.core.family import Branch
 from solver.core.progress import Progress
 from solver.core.spatial import Placement, rotation_about_z
-from solver.path.limits import JointAccelerationLimit, JointMotion, bound_by_limits
+from solver.path.cell.checker import CellVerdict, Contact
+from solver.path.limits import JointAccelerationLimit, JointMotion, PathVerdict, bound_by_limits
+from solver.path.path_checks import clear_pick
 from solver.path.pipeline import check_placements, run_chunk
 from solver.path.problem import PathProblem, SpinMode
 
@@ -75,6 +77,11 @@ class PathEvaluation:
         ik_seeds: how many seeds a numeric IK family started from at the first waypoint;
             ``None`` for an analytic family (which finds every branch).
         ik_branches_found: how many distinct IK solutions it found there (``None`` likewise).
+        acceleration: mu_acc and where it binds, with acceleration limits (else ``None``).
+        collision: with a cell, where an infeasible path (reason ``collision``) first comes
+            closer than the clearance (cell.md section 3); else ``None``.
+        min_clearance: with a cell, the closest pair of a feasible path; else ``None``.
+        cell_approximated: with a cell, the robot's links given capsules; else ``None``.
     """
 
     feasible: bool
@@ -97,6 +104,9 @@ class PathEvaluation:
     ik_seeds: int | None = None
     ik_branches_found: int | None = None
     acceleration: AccelerationIndex | None = None
+    collision: Contact | None = None
+    min_clearance: Contact | None = None
+    cell_approximated: tuple[str, ...] | None = None
 
     @property
     def feed_index(self) -> float | None:
@@ -175,13 +185,26 @@ def evaluate_path(
     robot, spin_mode = problem.robot, problem.options.spin_mode
     pick = int(run.pick[0])
     reason = int(run.tracked.reason[pick, 0])
+    verdict: PathVerdict | None = None
+    collision, approximated = None, None
+    if reason == FEASIBLE and problem.path_checks:
+        chosen, verdict, refusal = clear_pick(problem, run, cell, 0, thorough=True)
+        if chosen is None and refusal is not None:
+            reason = problem.path_checks[0].reason
+            collision = cell_detail(refusal).collision
+            approximated = cell_detail(refusal).approximated
+        else:
+            pick = int(chosen) if chosen is not None else pick
+            approximated = None if verdict is None else cell_detail(verdict).approximated
     infeasible = PathEvaluation(
         feasible=False,
         mu_path=None,
         bottleneck_waypoint=None,
         bottleneck_joint=None,
         reason=REASONS[reason] if reason != FEASIBLE else None,
-        failed_waypoint=int(run.tracked.failed_waypoint[pick, 0]),
+        failed_waypoint=(
+            int(run.tracked.failed_waypoint[pick, 0]) if collision is None else collision.waypoint
+        ),
         branch=family.branches[int(indices[pick])],
         u_T=_turned(path.u_T, placement.yaw),
         u_R=_turned(path.u_R, placement.yaw),
@@ -189,6 +212,8 @@ def evaluate_path(
         spin_mode=spin_mode,
         ik_seeds=run.ik_seeds,
         ik_branches_found=None if run.branches_found is None else int(run.branches_found[0]),
+        collision=collision,
+        cell_approximated=approximated,
     )
     if reason != FEASIBLE:
         return infeasible
@@ -229,4 +254,13 @@ def evaluate_path(
         qdot=qdot.T,
         limiting_joint=limiting,
         spins=spins,
+        min_clearance=None if verdict is None else cell_detail(verdict).closest,
     )
+
+
+def cell_detail(verdict: PathVerdict) -> CellVerdict:
+    """The cell's report in a path check's verdict."""
+    detail = verdict.detail
+    if not isinstance(detail, CellVerdict):
+        raise TypeError(f"a path check gave {type(detail).__name__}, not a CellVerdict")
+    return detail

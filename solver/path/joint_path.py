@@ -21,8 +21,9 @@ from solver.core.exceptions import InvalidInputError
 from solver.core.kinematics import tool_pose_in_base
 from solver.core.progress import Progress
 from solver.core.spatial import Placement, rotation_about_z
-from solver.path.evaluate import PathEvaluation, acceleration_index
+from solver.path.evaluate import PathEvaluation, acceleration_index, cell_detail
 from solver.path.limits import JointMotion, bound_by_limits
+from solver.path.path_checks import check_path
 from solver.path.pipeline import turn_by_yaw
 from solver.path.problem import PathProblem
 
@@ -163,6 +164,15 @@ def evaluate_joint_path(
     singular = np.flatnonzero(~np.isfinite(speed))
     if singular.size:
         return dataclasses.replace(infeasible, reason="singular", failed_waypoint=int(singular[0]))
+    verdict = check_path(problem, q, placement.as_row(), thorough=True)
+    if verdict is not None and verdict.failed_waypoint is not None:
+        return dataclasses.replace(
+            infeasible,
+            reason="collision",
+            failed_waypoint=verdict.failed_waypoint,
+            collision=cell_detail(verdict).collision,
+            cell_approximated=cell_detail(verdict).approximated,
+        )
     v_max = np.where(path.pure_rotation, 0.0, speed)
     with np.errstate(divide="ignore", invalid="ignore"):
         omega_max = np.where(
@@ -184,6 +194,8 @@ def evaluate_joint_path(
         omega_max=omega_max,
         qdot=(qd_unit * speed).T,
         limiting_joint=limiting,
+        min_clearance=None if verdict is None else cell_detail(verdict).closest,
+        cell_approximated=None if verdict is None else cell_detail(verdict).approximated,
     )
 
 

@@ -13,6 +13,10 @@ the feed at each waypoint by its joint speeds per unit feed, whose minimum is mu
 path along the spin schedule that realises mu_path), and min(mu_path, its bounds) is the index
 the arm can run at: joint accelerations (:class:`JointAccelerationLimit`, motion.md section 2)
 give mu_acc.
+
+A limit that bounds no speed but admits or refuses a whole joint path (the cell, cell.md) is a
+:class:`PathCheck`: it runs after the speed limits, on the branches they leave feasible, best
+first (:mod:`solver.path.path_checks`).
 """
 
 from __future__ import annotations
@@ -99,6 +103,39 @@ class JointSpeedLimit(Limit):
         with np.errstate(divide="ignore", invalid="ignore"):  # infeasible branches
             speed = 1.0 / ratio.max(axis=0)
         return speed, limiting
+
+
+@dataclass(frozen=True)
+class PathVerdict:
+    """What a path check says of one joint path.
+
+    Attributes:
+        failed_waypoint: where the path is refused; None: admitted.
+        detail: the check's report (the cell: :class:`solver.path.cell.checker.CellVerdict`).
+    """
+
+    failed_waypoint: int | None
+    detail: object
+
+
+class PathCheck(abc.ABC):
+    """A limit that admits or refuses a tracked joint path at a placement (cell.md section 3)."""
+
+    #: Short name (``"collision"``).
+    name: str
+    #: The reason code (:data:`solver.core.codes.REASONS`) of a refused path.
+    reason: int
+
+    @abc.abstractmethod
+    def check(self, q: np.ndarray, placement: np.ndarray, *, thorough: bool) -> PathVerdict:
+        """Admit or refuse a joint path.
+
+        Args:
+            q: shape (W, n), rad, the tracked joint path.
+            placement: shape (5,), [x, y, z, yaw, spin] of {O} in {B}.
+            thorough: report everything (an evaluation); False: only whether it is refused,
+                as fast as can be (a map, an optimiser).
+        """
 
 
 @dataclass(frozen=True)

@@ -23,7 +23,8 @@ from solver.path.kernel_cells import (
     no_acc_columns,
     run_kernel,
 )
-from solver.path.pipeline import check_placements, run_chunk
+from solver.path.path_checks import refuse_colliding
+from solver.path.pipeline import ChunkResult, check_placements, run_chunk
 from solver.path.problem import PathProblem
 
 __all__ = ["PlacementEvaluator", "PlacementResults", "evaluate_placements"]
@@ -93,9 +94,13 @@ def _chunk(
     V_max along the path is (C, W) when ``with_speeds``, else (C, 0): a map of millions of
     placements keeps nothing per waypoint. Then the acceleration columns of :func:`_acc_columns`.
     """
-    run = run_chunk(problem, placements)
+    return _columns(problem, run_chunk(problem, placements), with_speeds)
+
+
+def _columns(problem: PathProblem, run: ChunkResult, with_speeds: bool) -> tuple[np.ndarray, ...]:
+    """The columns of :func:`_chunk` from a pipeline run, each placement at its ``pick``."""
     branches = problem.branches
-    pick, columns = run.pick, np.arange(len(placements))
+    pick, columns = run.pick, np.arange(len(run.pick))
     any_feasible = (run.tracked.reason == FEASIBLE).any(axis=0)
     chosen_v = np.where(any_feasible[:, None], run.v_max[pick, columns], np.nan)  # (C, W)
     worst = np.nan_to_num(chosen_v, nan=np.inf).argmin(axis=-1)
@@ -110,7 +115,7 @@ def _chunk(
     )
     bound, joint, binding = run.v_final, run.final_limiting, run.final_binding
     if run.mu_acc is None or bound is None or joint is None or binding is None:
-        return speed_columns + no_acc_columns(len(placements), with_speeds * chosen_v.shape[1])
+        return speed_columns + no_acc_columns(len(pick), with_speeds * chosen_v.shape[1])
     final_v = np.where(any_feasible[:, None], bound[pick, columns], np.nan)  # (C, W)
     low = np.nan_to_num(final_v, nan=np.inf).argmin(axis=-1)
     accelerated = any_feasible & (final_v[columns, low] < speed_columns[0])
@@ -150,6 +155,13 @@ def _task(
             parts.append(run_kernel(inputs[spin], rows, with_speeds))
     else:
         parts = [_chunk(problem, rows, with_speeds) for rows in _pieces(placements, chunk)]
+    if problem.path_checks:
+        columns_of = partial(_columns, problem, with_speeds=with_speeds)
+        pieces = _pieces(placements, chunk)
+        parts = [
+            refuse_colliding(problem, rows, part, columns_of)
+            for rows, part in zip(pieces, parts, strict=True)
+        ]
     return tuple(np.concatenate(c) for c in zip(*parts, strict=True))
 
 
@@ -198,6 +210,7 @@ def evaluate_placements(
         NoAnalyticIkError, InvalidInputError: as :func:`solver.path.evaluate.evaluate_path`.
     """
     _ = problem.branches  # the options checked before any work
+    _ = problem.path_checks  # and the cell
     cells = check_placements(placements)
     raise_malloc_thresholds()
     tasks = _pieces(cells, runner.task_size(len(cells), chunk))
@@ -258,6 +271,7 @@ class PlacementEvaluator:
         """
         self._problem = problem.with_options(branch=None)
         _ = self._problem.branches  # the options checked first
+        _ = self._problem.path_checks
         self._kernel = kernel_of(self._problem)
         self._last: tuple[float, KernelInputs] | None = None  # the spin asked for last
 
@@ -269,5 +283,8 @@ class PlacementEvaluator:
         spin = float(cells[0, 4])
         if self._last is None or self._last[0] != spin:
             self._last = (spin, kernel_inputs(self._problem, spin, self._kernel))
-        columns = list(run_kernel(self._last[1], cells, False))
-        return _results(self._problem, columns, False)
+        columns = run_kernel(self._last[1], cells, False)
+        if self._problem.path_checks:
+            columns_of = partial(_columns, self._problem, with_speeds=False)
+            columns = refuse_colliding(self._problem, cells, columns, columns_of)
+        return _results(self._problem, list(columns), False)

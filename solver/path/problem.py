@@ -24,7 +24,16 @@ import numpy as np
 from solver.core.exceptions import InvalidInputError, NoAnalyticIkError, quoted
 from solver.core.family import Branch, KinematicsFamily
 from solver.core.robots import Robot
-from solver.path.limits import BlendStencil, JointAccelerationLimit, JointSpeedLimit, Limit
+from solver.path.cell.checker import CELL_POSE_COST, CellChecker
+from solver.path.cell.limit import CellLimit
+from solver.path.cell.shapes import Cell
+from solver.path.limits import (
+    BlendStencil,
+    JointAccelerationLimit,
+    JointSpeedLimit,
+    Limit,
+    PathCheck,
+)
 from solver.path.prepare import PreparedPath, prepare_path
 
 DEFAULT_MAX_JOINT_STEP = 0.35
@@ -47,12 +56,14 @@ class PathOptions:
             variable of the DTF).
         blend_length: m, > 0 and finite, the length b over which a controller rounds a corner
             (motion.md section 1); used only with joint acceleration limits.
+        cell: the robot's surroundings and tool (cell.md); None checks no collisions.
     """
 
     branch: Branch | None = None
     max_joint_step: float = DEFAULT_MAX_JOINT_STEP
     spin_mode: SpinMode = "fixed"
     blend_length: float = DEFAULT_BLEND_LENGTH
+    cell: Cell | None = None
 
     def check(self, robot: Robot) -> np.ndarray:
         """Check the options against ``robot``; the branches to follow (all for ``auto``).
@@ -155,6 +166,29 @@ class PathProblem:
             limits.append(JointAccelerationLimit(self.robot.qddot_max, stencil))
         return tuple(limits)
 
+    @functools.cached_property
+    def path_checks(self) -> tuple[PathCheck, ...]:
+        """The limits that admit or refuse whole joint paths: the cell's, where one is given.
+
+        Raises:
+            InvalidInputError: a bad cell field (checked here, once per problem).
+        """
+        cell = self.options.cell
+        if cell is None:
+            return ()
+        checker = CellChecker(self.robot, cell)
+        return (CellLimit(checker, self.prepared.segment_in_pass),)
+
+    def path_cost(self, n_waypoints: int) -> float:
+        """The work of one placement of ``n_waypoints``, in poses of a closed-form family's map.
+
+        The family's cost (:meth:`KinematicsFamily.path_cost`), times the collision check's
+        (:data:`solver.path.cell.checker.CELL_POSE_COST`) with a cell: what the size limits of
+        the maps and searches weigh.
+        """
+        cost = self.family.path_cost(n_waypoints)
+        return cost * CELL_POSE_COST if self.options.cell is not None else cost
+
     @property
     def waypoint_limits(self) -> tuple[Limit, ...]:
         """The limits that bound V_max at each waypoint (their least bound's minimum: mu_path)."""
@@ -175,6 +209,8 @@ class PathProblem:
         shared = ["prepared"]
         if options.blend_length == self.options.blend_length:
             shared.append("limits")
+        if options.cell is self.options.cell:
+            shared.append("path_checks")
         for name in shared:
             if name in self.__dict__:
                 other.__dict__[name] = self.__dict__[name]

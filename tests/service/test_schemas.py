@@ -65,6 +65,7 @@ def test_failure_reasons_are_one_enum() -> None:
         "joint_limits",
         "singular",
         "discontinuous",
+        "collision",
     ]
     text = json.dumps(COMPONENTS)
     assert text.count('"discontinuous"') == 1

@@ -38,9 +38,7 @@ DESCRIPTION = "differential_evolution + SLSQP (scipy)"
 def _size(problem: PathProblem, bounds: PlacementBounds) -> SearchSize:
     """The search's size for the problem's family (smaller for a costlier placement)."""
     n_waypoints = len(problem.waypoints)
-    return search_size(
-        bounds, path_cost=problem.family.path_cost(n_waypoints), n_waypoints=n_waypoints
-    )
+    return search_size(bounds, path_cost=problem.path_cost(n_waypoints), n_waypoints=n_waypoints)
 
 
 def check(problem: PathProblem, bounds: PlacementBounds, settings: Search) -> None:
@@ -57,7 +55,7 @@ def check(problem: PathProblem, bounds: PlacementBounds, settings: Search) -> No
     if max_poses is None:
         return
     placements = search_placements(bounds, size)
-    work = placements * family.path_cost(n_waypoints)
+    work = placements * problem.path_cost(n_waypoints)
     if work > max_poses:
         raise InvalidInputError(
             "bounds",

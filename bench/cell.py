@@ -1,0 +1,123 @@
+"""Benchmark lines of the cell (issue 22): the map and an optimisation with collisions checked.
+
+Run by ``bench/run.py``, or alone from the repository root: ``python bench/cell.py``.
+The ERK-size map (546 placements, 133 waypoints) with a table top, a fixture box and the
+workpiece box, against the same map without a cell in the same run (the goal: at most 3x), for
+the UR5 (its URDF's meshes, as convex hulls) and the UR5e (capsules), the tool point at the end
+of a 12 cm tool; then an optimisation with the cell: its time, its answer's clearance, and the
+best collision-free cell of a map of its box.
+"""
+
+from __future__ import annotations
+
+import math
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+from timing import best_time
+
+from solver.core.robots import Robot
+from solver.families import get_robot
+from solver.optimise.optimize import optimize_placement
+from solver.optimise.search_space import PlacementBounds
+from solver.path.capability_map import capability_map, grid_axis
+from solver.path.cell.shapes import Box, Cell, Halfspace, Tool
+from solver.path.problem import PathOptions, PathProblem
+
+
+def _pose(x: float, y: float, z: float) -> np.ndarray:
+    matrix = np.eye(4)
+    matrix[:3, 3] = [x, y, z]
+    return matrix
+
+
+# The robot stands on the table (its top z = 0 in {B}); a fixture box beside the work; the part
+# (a block under the path, in {O}); a 12 cm spindle of 3 cm radius, the tool point at its end.
+TOOL_LENGTH = 0.12
+CELL = Cell(
+    fixed=(
+        Halfspace((0.0, 0.0, 1.0), 0.0, name="table"),
+        Box((0.1, 0.1, 0.3), _pose(-0.3, 0.2, 0.15), name="fixture"),
+    ),
+    workpiece=(Box((0.3, 0.12, 0.09), _pose(0.0, 0.06, -0.045), name="part"),),
+    tool=Tool(radius=0.03, length=TOOL_LENGTH),
+)
+
+
+def cell_lines(
+    robot: Robot,
+    path: np.ndarray,
+    xs: np.ndarray,
+    ys: np.ndarray,
+    z: float,
+    *,
+    repeats: int,
+    smoke: bool = False,
+) -> None:
+    """Print the map with the cell against the map without, and an optimisation with it."""
+    cells = len(xs) * len(ys)
+    print(f"ERK-size map with a cell (table, fixture box, part box, tool; {cells} placements):")
+    for bare in (robot, get_robot("ur5e")):
+        arm = bare.with_options(transform_tool_to_tcp=_pose(0.0, 0.0, TOOL_LENGTH))
+
+        def run_map(cell: Cell | None, arm: Robot = arm) -> object:
+            problem = PathProblem.of(arm, path, PathOptions(cell=cell))
+            return capability_map(problem, xs=xs, ys=ys, z=z, yaws=np.zeros(1))
+
+        run_map(None)
+        t_without = best_time(lambda: run_map(None), repeats)
+        start = time.perf_counter()
+        cmap = run_map(CELL)
+        t_with = time.perf_counter() - start
+        reason = getattr(cmap, "reason")  # noqa: B009 - an object typed loosely above
+        print(
+            f"  {arm.name}: with the cell {t_with:7.3f} s (one run), without {t_without:7.3f} s "
+            f"(best of {repeats}): {t_with / t_without:.1f}x (goal <= 3x); "
+            f"{int((reason == -1).sum())} feasible, {int((reason == 4).sum())} collision cells"
+        )
+    bounds = (
+        PlacementBounds(x=(-0.05, 0.05), y=(0.4, 0.5), yaw=(-0.2, 0.2), z=z)
+        if smoke
+        else PlacementBounds(x=(-0.25, 0.25), y=(0.25, 0.65), yaw=(-0.3, 0.3), z=z)
+    )
+    tooled = robot.with_options(transform_tool_to_tcp=_pose(0.0, 0.0, TOOL_LENGTH))
+    problem = PathProblem.of(tooled, path, PathOptions(cell=CELL))
+    start = time.perf_counter()
+    optimum = optimize_placement(problem, bounds=bounds, method="casadi")
+    seconds = time.perf_counter() - start
+    grid = capability_map(
+        problem,
+        xs=grid_axis(*bounds.x, 0.02, field="x"),
+        ys=grid_axis(*bounds.y, 0.02, field="y"),
+        z=z,
+        yaws=grid_axis(*bounds.yaw, math.radians(15), field="yaw"),
+    )
+    best = float(np.nanmax(grid.mu_path)) if np.isfinite(grid.mu_path).any() else math.nan
+    clearance = None if optimum.evaluation is None else optimum.evaluation.min_clearance
+    print(
+        f"ERK optimisation with the cell (UR5, casadi, x {bounds.x}, y {bounds.y}, yaw "
+        f"{bounds.yaw}): {seconds:.1f} s; mu_path {optimum.mu_path} m/s, min clearance "
+        f"{None if clearance is None else round(clearance.distance, 4)} m "
+        f"({None if clearance is None else clearance.robot_part} to "
+        f"{None if clearance is None else clearance.obstacle_name}); the best collision-free "
+        f"cell of a 20 mm / 15 deg map: {best:.6f} m/s"
+    )
+
+
+if __name__ == "__main__":
+    sys.path.insert(0, str(Path(__file__).parent))
+    from run import load_path
+
+    smoke = "--smoke" in sys.argv
+    step = 0.1 if smoke else 0.02
+    cell_lines(
+        get_robot("ur5"),
+        load_path("curved_line"),
+        grid_axis(-0.25, 0.25, step, field="x"),
+        grid_axis(0.25, 0.65, step, field="y"),
+        0.1,
+        repeats=1 if smoke else 3,
+        smoke=smoke,
+    )

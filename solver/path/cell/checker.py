@@ -1,0 +1,246 @@
+"""Distances between the robot, its tool and the cell's objects along a joint path (cell.md s. 3).
+
+One pinocchio ``GeometryModel`` holds the robot's geometry (:mod:`robot_geometry`) and the
+obstacles, on the base joint: ``fixed`` ones at their pose in {B}, ``workpiece`` ones at the
+placement's T_B_O times their pose. coal gives every checked pair's distance
+(``pin.computeDistances``). The pairs: every robot part (the tool included) against every
+obstacle, except the base against ``fixed`` objects (it stands on them, whatever the placement)
+and the tool's cutting part against ``workpiece`` objects (that is machining); and the robot's
+parts against each other where they are on joints that are neither the same nor adjacent and do
+not come within the clearance at the zero configuration.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import pinocchio as pin
+
+from solver.core.robots import Robot
+from solver.path.cell.bounds import pair_weights
+from solver.path.cell.robot_geometry import robot_geometry
+from solver.path.cell.shapes import Cell
+
+# What checking one pose of a path against a cell costs, in poses of a closed-form family's map
+# (KinematicsFamily.path_cost): the ERK map (UR5, 546 placements x 133 waypoints) with a table,
+# a fixture and the part took 50 to 60 times the map without (bench/cell.py), the sub-steps and
+# the first collision's early stop included; 100 leaves a margin for more objects and meshes.
+CELL_POSE_COST = 100.0
+_WINDOW = 32  # configurations looked ahead at once when skipping
+
+
+@dataclass(frozen=True)
+class Contact:
+    """The closest pair at one configuration of a path.
+
+    Attributes:
+        waypoint: the waypoint, or the one a sub-step after it follows.
+        robot_part: the robot's geometry object (a link's name with ``_0``, a capsule, ``tool``).
+        obstacle: the obstacle's index (``fixed`` first, then ``workpiece``), None for a robot
+            part (self-collision).
+        obstacle_name: its name, its place (``fixed[0]``), or the other robot part's name.
+        distance: m, the coal distance (negative: penetration depth as coal gives it).
+    """
+
+    waypoint: int
+    robot_part: str
+    obstacle: int | None
+    obstacle_name: str
+    distance: float
+
+
+@dataclass(frozen=True)
+class CellVerdict:
+    """A joint path against the cell: the first contact closer than the clearance, or the closest.
+
+    Attributes:
+        collision: the first configuration (in path order) closer than the clearance; None if
+            there is none.
+        closest: the closest pair over every checked configuration (None when the check
+            stopped at the first collision).
+        checks: how many configurations were checked.
+        approximated: the robot's links given capsules (no readable collision geometry).
+    """
+
+    collision: Contact | None
+    closest: Contact | None
+    checks: int
+    approximated: tuple[str, ...] = ()
+
+
+class CellChecker:
+    """The cell's pairs for one robot, checked along joint paths."""
+
+    def __init__(self, robot: Robot, cell: Cell) -> None:
+        """Build the geometry and choose the pairs.
+
+        Raises:
+            InvalidInputError: a bad cell field (:meth:`Cell.check`) or link radii.
+        """
+        cell.check()
+        self.robot, self.cell = robot, cell
+        made = robot_geometry(robot, tool=cell.tool, link_radii=cell.link_radii)
+        self.approximated = made.approximated
+        geometry = made.geometry
+        self._n_robot = geometry.ngeoms
+        world_to_base = pin.SE3(robot.transform_world_to_base)
+        self._world_to_base = world_to_base
+        shapes = cell.fixed + cell.workpiece
+        self._workpiece_ids = []
+        for k, shape in enumerate(shapes):
+            place = world_to_base * pin.SE3(np.asarray(shape.pose, dtype=float))
+            obj = pin.GeometryObject(f"obstacle_{k}", 0, place, shape.geometry())
+            gid = geometry.addGeometryObject(obj)
+            if k >= len(cell.fixed):
+                self._workpiece_ids.append((gid, pin.SE3(np.asarray(shape.pose, dtype=float))))
+        self.geometry = geometry
+        self._pairs: list[tuple[int, int]] = []
+        robot_ids = range(self._n_robot)
+        for part in robot_ids:
+            joint = int(geometry.geometryObjects[part].parentJoint)
+            for k in range(len(shapes)):
+                workpiece = k >= len(cell.fixed)
+                if (joint == 0 and not workpiece) or (part == made.cutting and workpiece):
+                    continue
+                self._pairs.append((part, self._n_robot + k))
+        self._pairs += self._self_pairs(made.cutting)
+        for a, b in self._pairs:
+            geometry.addCollisionPair(pin.CollisionPair(a, b))
+        self._weights = pair_weights(robot.model, geometry, self._pairs, self._n_robot)
+
+    def _self_pairs(self, cutting: int) -> list[tuple[int, int]]:
+        """Robot parts on joints neither the same nor adjacent, apart at the zero configuration."""
+        model, geometry = self.robot.model, self.geometry
+        pairs = []
+        for a in range(self._n_robot):
+            for b in range(a + 1, self._n_robot):
+                ja = int(geometry.geometryObjects[a].parentJoint)
+                jb = int(geometry.geometryObjects[b].parentJoint)
+                if ja == jb or model.parents[ja] == jb or model.parents[jb] == ja:
+                    continue
+                pairs.append((a, b))
+        probe = pin.GeometryModel()
+        for obj in geometry.geometryObjects[: self._n_robot]:
+            probe.addGeometryObject(obj)
+        for a, b in pairs:
+            probe.addCollisionPair(pin.CollisionPair(a, b))
+        data = probe.createData()
+        pin.computeDistances(model, model.createData(), probe, data, pin.neutral(model))
+        distances = [r.min_distance for r in data.distanceResults]
+        return [p for p, d in zip(pairs, distances, strict=True) if d > self.cell.clearance]
+
+    def configurations(
+        self, q: np.ndarray, segment_in_pass: np.ndarray
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """The waypoints and the sub-steps between them: configurations and their waypoint.
+
+        Within a pass, ceil(max_j |dq_j| / collision_step) - 1 evenly spaced sub-steps between
+        neighbours, so no joint moves more than ``collision_step`` between two checks.
+
+        Args:
+            q: shape (W, n), rad, the joint path.
+            segment_in_pass: shape (W - 1,), False where a rapid joins two passes (not checked
+                between).
+
+        Returns:
+            shape (M, n), rad; shape (M,), the waypoint each follows.
+        """
+        steps = np.abs(np.diff(q, axis=0)).max(axis=1) if len(q) > 1 else np.zeros(0)
+        counts = np.where(
+            segment_in_pass, np.ceil(steps / self.cell.collision_step - 1e-12), 1
+        ).astype(int)
+        counts = np.append(np.maximum(counts, 1), 1)  # the last waypoint: itself
+        owners = np.repeat(np.arange(len(q)), counts)
+        starts = np.cumsum(counts) - counts
+        fractions = (np.arange(len(owners)) - starts[owners]) / counts[owners]
+        following = np.minimum(owners + 1, len(q) - 1)
+        rows = q[owners] + fractions[:, None] * (q[following] - q[owners])
+        return rows, owners
+
+    def check(
+        self,
+        q: np.ndarray,
+        segment_in_pass: np.ndarray,
+        transform_workpiece_to_base: np.ndarray,
+        *,
+        closest: bool,
+    ) -> CellVerdict:
+        """Check a joint path at one placement.
+
+        Args:
+            q: shape (W, n), rad, the tracked joint path.
+            segment_in_pass: shape (W - 1,), False between passes.
+            transform_workpiece_to_base: shape (4, 4), T_B_O of the placement.
+            closest: check every configuration and give the closest pair (an evaluation);
+                False stops at the first collision and skips configurations that cannot come
+                within the clearance (a map; :meth:`_first_collision`).
+        """
+        configurations, owners = self.configurations(np.asarray(q, float), segment_in_pass)
+        geometry = self.geometry.copy()  # its own workpiece poses: threads share the checker
+        placed = self._world_to_base * pin.SE3(np.asarray(transform_workpiece_to_base, float))
+        for gid, pose in self._workpiece_ids:
+            geometry.geometryObjects[gid].placement = placed * pose
+        if not self._pairs:
+            return CellVerdict(None, None, 0, self.approximated)
+        if not closest:
+            return self._first_collision(geometry, configurations, owners)
+        model = self.robot.model
+        data, gdata = model.createData(), geometry.createData()
+        best: tuple[float, int, int] | None = None
+        for index, configuration in enumerate(configurations):
+            pin.computeDistances(model, data, geometry, gdata, configuration)
+            distances = np.array([r.min_distance for r in gdata.distanceResults])
+            if not len(distances):
+                break
+            pair = int(np.argmin(distances))
+            low = float(distances[pair])
+            if low < self.cell.clearance:
+                hit = self._contact(int(owners[index]), pair, low)
+                return CellVerdict(hit, None, index + 1, self.approximated)
+            if best is None or low < best[0]:
+                best = (low, index, pair)
+        near = None if best is None else self._contact(int(owners[best[1]]), best[2], best[0])
+        return CellVerdict(None, near, len(configurations), self.approximated)
+
+    def _first_collision(
+        self, geometry: pin.GeometryModel, configurations: np.ndarray, owners: np.ndarray
+    ) -> CellVerdict:
+        """The first collision along the configurations, each pair computed only when due.
+
+        A pair is due at a configuration its last distance does not prove clear
+        (:mod:`solver.path.cell.bounds`); a configuration where no pair is due is skipped.
+        """
+        model = self.robot.model
+        data, gdata = model.createData(), geometry.createData()
+        clear_until = np.full(len(self._pairs), -1)  # the last configuration proven clear
+        index, checks, clearance = 0, 0, self.cell.clearance
+        while index < len(configurations):
+            due = np.flatnonzero(clear_until < index)
+            pin.updateGeometryPlacements(model, data, geometry, gdata, configurations[index])
+            checks += 1
+            distances = np.array(
+                [pin.computeDistance(geometry, gdata, int(p)).min_distance for p in due]
+            )
+            low = int(np.argmin(distances))
+            if distances[low] < clearance:
+                hit = self._contact(int(owners[index]), int(due[low]), float(distances[low]))
+                return CellVerdict(hit, None, checks, self.approximated)
+            window = configurations[index + 1 : index + 1 + _WINDOW]
+            moved = np.abs(window - configurations[index]) @ self._weights[due].T  # (m, due)
+            exceeded = moved >= distances - clearance
+            if not len(window):
+                break
+            first = np.where(exceeded.any(axis=0), exceeded.argmax(axis=0), len(window))
+            clear_until[due] = index + first
+            index = int(clear_until.min()) + 1
+        return CellVerdict(None, None, checks, self.approximated)
+
+    def _contact(self, waypoint: int, pair: int, distance: float) -> Contact:
+        """The contact of pair ``pair`` (an index into the checked pairs)."""
+        a, b = self._pairs[pair]
+        objects = self.geometry.geometryObjects
+        if b >= self._n_robot:
+            k = b - self._n_robot
+            return Contact(waypoint, objects[a].name, k, self.cell.obstacle_name(k), distance)
+        return Contact(waypoint, objects[a].name, None, objects[b].name, distance)

@@ -1,0 +1,174 @@
+"""The robot's own geometry in a cell (cell.md section 2), as a pinocchio ``GeometryModel``.
+
+- An arm read from a URDF: its ``<collision>`` elements (pinocchio's URDF reader, coal shapes).
+  ``package://`` meshes resolve inside example-robot-data's share folder; every mesh is taken as
+  its convex hull (coal's ``buildConvexRepresentation``), which contains it. A URDF whose meshes
+  cannot be read keeps its primitive elements.
+- Any link left without geometry (an arm built from DH or OPW parameters, a URDF link with
+  none): a capsule along the link's kinematic segment, from its joint to the next joint (the
+  flange for the last link; the base to the first joint for the base), with the request's
+  ``link_radii`` or the arm's published radii (:data:`PUBLISHED_RADII`).
+- The tool (:class:`solver.path.cell.shapes.Tool`): two cylinders on the last joint along the
+  tool point's z, the holder and the cutting part that ends at the tool point.
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass
+
+import coal
+import numpy as np
+import pinocchio as pin
+
+from solver.core.exceptions import InvalidInputError
+from solver.core.robots import Robot, example_robot_data_dir
+from solver.path.cell.shapes import Tool
+
+# Capsule radii (m): the base, then one per joint's link. UR5e and UR10e: the collision capsules
+# of MuJoCo Menagerie (google-deepmind/mujoco_menagerie, universal_robots_ur5e/ur5e.xml and
+# universal_robots_ur10e/ur10e.xml, `class="collision"` geoms: shoulder, upper arm, forearm,
+# wrist 1, wrist 2, wrist 3), the base taken as the shoulder's. Other arms without a URDF (ur3e,
+# ur16e, the OPW arms) have no published radii here: a cell needs ``link_radii`` for them.
+PUBLISHED_RADII: dict[str, tuple[float, ...]] = {
+    "ur5e": (0.06, 0.06, 0.05, 0.038, 0.04, 0.04, 0.04),
+    "ur10e": (0.078, 0.078, 0.06, 0.043, 0.05, 0.046, 0.046),
+}
+# Radius of the capsule of a URDF link that has no readable collision element (m), unless the
+# request gives link_radii.
+DEFAULT_URDF_LINK_RADIUS = 0.05
+TOOL_HOLDER, TOOL_CUTTING = "tool", "tool_cutting"
+
+
+@dataclass(frozen=True)
+class RobotGeometry:
+    """The robot's geometry objects on its model, and how they were made.
+
+    Attributes:
+        geometry: the objects, each on the joint that carries it (0: the base).
+        approximated: the links (joint names, ``base``) given capsules.
+        cutting: index of the tool's cutting part, or -1 without a tool.
+    """
+
+    geometry: pin.GeometryModel
+    approximated: tuple[str, ...]
+    cutting: int
+
+
+def robot_geometry(
+    robot: Robot, *, tool: Tool | None, link_radii: tuple[float, ...] | None
+) -> RobotGeometry:
+    """The geometry of ``robot`` (and its tool) on ``robot.model``.
+
+    Raises:
+        InvalidInputError: on ``cell.link_radii``: the wrong count, or none given for an arm
+            without collision elements or published radii.
+    """
+    model = robot.model
+    geometry = _urdf_geometry(robot) if robot.urdf is not None else pin.GeometryModel()
+    carried = {int(g.parentJoint) for g in geometry.geometryObjects}
+    bare = [j for j in range(model.njoints) if j not in carried]
+    radii = _radii(robot, link_radii, needed=bool(bare) and robot.urdf is None)
+    approximated = []
+    for joint in bare:
+        start, end = _segment(robot, joint)
+        radius = radii[joint] if radii is not None else DEFAULT_URDF_LINK_RADIUS
+        name = "base" if joint == 0 else model.names[joint]
+        geometry.addGeometryObject(_capsule(f"{name}_capsule", joint, start, end, radius))
+        approximated.append(name)
+    cutting = -1
+    if tool is not None:
+        cutting = _add_tool(robot, geometry, tool)
+    return RobotGeometry(geometry, tuple(approximated), cutting)
+
+
+def _urdf_geometry(robot: Robot) -> pin.GeometryModel:
+    """The URDF's collision elements with meshes as convex hulls; primitives only if unreadable."""
+    urdf = robot.urdf or ""
+    share = str(example_robot_data_dir().parent.parent)  # package://example-robot-data/...
+    try:
+        geometry = pin.buildGeomFromUrdfString(
+            robot.model, urdf, pin.COLLISION, package_dirs=[share]
+        )
+    except (ValueError, RuntimeError):
+        primitives = re.sub(r"<collision\b.*?</collision>", _keep_primitive, urdf, flags=re.S)
+        geometry = pin.buildGeomFromUrdfString(
+            robot.model, primitives, pin.COLLISION, package_dirs=[share]
+        )
+    for obj in geometry.geometryObjects:
+        if isinstance(obj.geometry, coal.BVHModelBase):
+            obj.geometry.buildConvexRepresentation(False)
+            obj.geometry = obj.geometry.convex
+    return geometry
+
+
+def _keep_primitive(match: re.Match[str]) -> str:
+    """A ``<collision>`` element unless it holds a mesh."""
+    return "" if "<mesh" in match.group(0) else match.group(0)
+
+
+def _radii(
+    robot: Robot, link_radii: tuple[float, ...] | None, *, needed: bool
+) -> tuple[float, ...] | None:
+    """One radius per joint of the model (index 0 the base), from the request or published."""
+    count = robot.model.njoints
+    if link_radii is not None:
+        if len(link_radii) != count:
+            raise InvalidInputError(
+                "cell.link_radii",
+                f"{len(link_radii)} radii for {robot.name!r}: give {count}, the base's and one "
+                f"per joint ({', '.join(robot.joint_names)})",
+            )
+        return tuple(link_radii)
+    if robot.name in PUBLISHED_RADII:
+        return PUBLISHED_RADII[robot.name]
+    if needed:
+        raise InvalidInputError(
+            "cell.link_radii",
+            f"{robot.name!r} has no collision geometry and no published link radii: give "
+            f"link_radii, {count} values in m (the base's, then one per joint)",
+        )
+    return None
+
+
+def _segment(robot: Robot, joint: int) -> tuple[np.ndarray, np.ndarray]:
+    """The kinematic segment of ``joint``'s link in its frame: to the next joint or the flange."""
+    model = robot.model
+    children = [j for j in range(1, model.njoints) if model.parents[j] == joint]
+    if children:
+        end = model.jointPlacements[children[0]].translation
+    else:
+        flange = model.frames[model.getFrameId(robot.tool_frame)]
+        end = flange.placement.translation if flange.parentJoint == joint else np.zeros(3)
+    return np.zeros(3), np.array(end, dtype=float)
+
+
+def _capsule(
+    name: str, joint: int, start: np.ndarray, end: np.ndarray, radius: float
+) -> pin.GeometryObject:
+    """A capsule (a sphere where the segment has no length) from ``start`` to ``end``."""
+    axis = end - start
+    length = float(np.linalg.norm(axis))
+    if length < 1e-9:
+        placement = pin.SE3(np.eye(3), start)
+        return pin.GeometryObject(name, joint, placement, coal.Sphere(radius))
+    rotation = pin.Quaternion.FromTwoVectors(np.array([0.0, 0.0, 1.0]), axis / length)
+    placement = pin.SE3(rotation.matrix(), (start + end) / 2.0)
+    return pin.GeometryObject(name, joint, placement, coal.Capsule(radius, length))
+
+
+def _add_tool(robot: Robot, geometry: pin.GeometryModel, tool: Tool) -> int:
+    """Add the tool's holder (if longer than the cutting part) and cutting part; the latter's id."""
+    frame = robot.model.frames[robot.tool_point_frame]
+    joint, tcp = int(frame.parentJoint), frame.placement
+    holder = tool.length - tool.cutting_length
+    if holder > 1e-9:
+        centre = pin.SE3(np.eye(3), np.array([0.0, 0.0, -tool.cutting_length - holder / 2.0]))
+        geometry.addGeometryObject(
+            pin.GeometryObject(TOOL_HOLDER, joint, tcp * centre, coal.Cylinder(tool.radius, holder))
+        )
+    centre = pin.SE3(np.eye(3), np.array([0.0, 0.0, -tool.cutting_length / 2.0]))
+    cutting = coal.Cylinder(tool.radius, tool.cutting_length)
+    return int(
+        geometry.addGeometryObject(pin.GeometryObject(TOOL_CUTTING, joint, tcp * centre, cutting))
+    )

@@ -1,0 +1,229 @@
+"""What a cell holds (cell.md section 1): obstacles, the tool, the clearance and the step.
+
+Obstacles are frozen dataclasses that make their coal shape (:meth:`Shape.geometry`) and their
+pose (4 x 4, in {B} for ``fixed`` objects, in {O} for ``workpiece`` objects). Sizes are in m.
+"""
+
+from __future__ import annotations
+
+import abc
+import math
+from dataclasses import dataclass, field
+
+import coal
+import numpy as np
+
+from solver.core.exceptions import InvalidInputError
+
+DEFAULT_CLEARANCE = 0.005  # m, cell.md section 1
+DEFAULT_COLLISION_STEP = 0.05  # rad, cell.md section 3
+DEFAULT_CUTTING_LENGTH = 0.02  # m, cell.md section 1
+MAX_SIZE = 100.0  # m: no cell object is larger (a halfspace's offset likewise)
+
+
+def _positive(value: float, where: str, *, upper: float = MAX_SIZE) -> float:
+    """``value`` as a float, finite, > 0 and <= ``upper``; InvalidInputError on ``where``."""
+    number = float(value)
+    if not (math.isfinite(number) and 0.0 < number <= upper):
+        raise InvalidInputError(where, f"{number:.6g} must be > 0 and <= {upper:g}")
+    return number
+
+
+class Shape(abc.ABC):
+    """An obstacle: a coal shape at a pose."""
+
+    name: str | None
+    pose: np.ndarray
+
+    @abc.abstractmethod
+    def geometry(self) -> coal.CollisionGeometry:
+        """The coal shape, in its own frame."""
+
+    def check(self, where: str) -> None:  # noqa: B027  (shapes without sizes check nothing)
+        """Raise InvalidInputError on ``where`` when a size is not finite and > 0."""
+
+
+@dataclass(frozen=True)
+class Box(Shape):
+    """A box centred on its pose; size: (lx, ly, lz), m."""
+
+    size: tuple[float, float, float]
+    pose: np.ndarray = field(default_factory=lambda: np.eye(4))
+    name: str | None = None
+
+    def check(self, where: str) -> None:
+        """Each side finite and > 0."""
+        for k, side in enumerate(self.size):
+            _positive(side, f"{where}.size.{k}")
+
+    def geometry(self) -> coal.CollisionGeometry:
+        """A coal box."""
+        return coal.Box(*(float(s) for s in self.size))
+
+
+@dataclass(frozen=True)
+class Cylinder(Shape):
+    """A cylinder along its pose's z, centred; radius and length in m."""
+
+    radius: float
+    length: float
+    pose: np.ndarray = field(default_factory=lambda: np.eye(4))
+    name: str | None = None
+
+    def check(self, where: str) -> None:
+        """Radius and length finite and > 0."""
+        _positive(self.radius, f"{where}.radius")
+        _positive(self.length, f"{where}.length")
+
+    def geometry(self) -> coal.CollisionGeometry:
+        """A coal cylinder."""
+        return coal.Cylinder(float(self.radius), float(self.length))
+
+
+@dataclass(frozen=True)
+class Sphere(Shape):
+    """A sphere at its pose's origin; radius in m."""
+
+    radius: float
+    pose: np.ndarray = field(default_factory=lambda: np.eye(4))
+    name: str | None = None
+
+    def check(self, where: str) -> None:
+        """Radius finite and > 0."""
+        _positive(self.radius, f"{where}.radius")
+
+    def geometry(self) -> coal.CollisionGeometry:
+        """A coal sphere."""
+        return coal.Sphere(float(self.radius))
+
+
+@dataclass(frozen=True)
+class Halfspace(Shape):
+    """The points p with n . p <= d (a floor, a table top), n a unit normal; d in m."""
+
+    normal: tuple[float, float, float]
+    offset: float
+    name: str | None = None
+    pose: np.ndarray = field(default_factory=lambda: np.eye(4))
+
+    def check(self, where: str) -> None:
+        """A finite, non-zero normal and a finite offset within MAX_SIZE."""
+        n = np.asarray(self.normal, dtype=float)
+        if n.shape != (3,) or not np.all(np.isfinite(n)) or np.linalg.norm(n) < 1e-9:
+            raise InvalidInputError(f"{where}.normal", "needs three finite values, not all 0")
+        if not (math.isfinite(self.offset) and abs(self.offset) <= MAX_SIZE):
+            raise InvalidInputError(f"{where}.offset", f"{self.offset:.6g} m must be finite")
+
+    def geometry(self) -> coal.CollisionGeometry:
+        """A coal halfspace with its normal made unit (the offset scaled alike)."""
+        n = np.asarray(self.normal, dtype=float)
+        norm = float(np.linalg.norm(n))
+        return coal.Halfspace(n / norm, float(self.offset) / norm)
+
+
+@dataclass(frozen=True)
+class Mesh(Shape):
+    """A triangle mesh (read from an STL, :mod:`solver.path.cell.stl`) at its pose.
+
+    Attributes:
+        triangles: shape (T, 3, 3), m, the corners of each triangle in the mesh's frame.
+    """
+
+    triangles: np.ndarray
+    pose: np.ndarray = field(default_factory=lambda: np.eye(4))
+    name: str | None = None
+
+    def geometry(self) -> coal.CollisionGeometry:
+        """The mesh as its convex hull (as the robot's meshes, :mod:`robot_geometry`)."""
+        points = np.unique(np.asarray(self.triangles, dtype=float).reshape(-1, 3), axis=0)
+        points = _solid(points)
+        model = coal.BVHModelOBBRSS()
+        model.beginModel(0, len(points))
+        model.addVertices(np.ascontiguousarray(points))
+        model.endModel()
+        model.buildConvexHull(False, "Qt")  # qhull: triangulated facets
+        return model.convex
+
+
+FLAT = 1e-6  # m: a mesh thinner than this in a direction is given that thickness (a sheet)
+
+
+def _solid(points: np.ndarray) -> np.ndarray:
+    """The points, with copies moved by +-FLAT / 2 along each direction in which they are flat.
+
+    qhull cannot make the hull of a flat set (and coal's binding then crashes): a sheet, or a
+    line, becomes a slab FLAT thick.
+    """
+    centred = points - points.mean(axis=0)
+    _, _, directions = np.linalg.svd(centred, full_matrices=True)
+    for direction in directions:
+        extent = centred @ direction
+        if extent.max() - extent.min() < FLAT:
+            points = np.concatenate([points + FLAT / 2 * direction, points - FLAT / 2 * direction])
+    return points
+
+
+@dataclass(frozen=True)
+class Tool:
+    """The spindle and holder: a cylinder along tool z ending at the tool point (cell.md s. 1).
+
+    Attributes:
+        radius: m. length: m, from where it starts to the tool point. cutting_length: m, the
+            last part, ending at the tool point, that may touch ``workpiece`` objects.
+    """
+
+    radius: float
+    length: float
+    cutting_length: float = DEFAULT_CUTTING_LENGTH
+
+    def check(self) -> None:
+        """Sizes finite and > 0, the cutting length no longer than the tool."""
+        _positive(self.radius, "cell.tool.radius")
+        _positive(self.length, "cell.tool.length")
+        _positive(self.cutting_length, "cell.tool.cutting_length")
+        if self.cutting_length > self.length:
+            raise InvalidInputError(
+                "cell.tool.cutting_length",
+                f"{self.cutting_length:.6g} m is longer than the tool ({self.length:.6g} m)",
+            )
+
+
+@dataclass(frozen=True, eq=False)
+class Cell:
+    """The robot's surroundings (cell.md section 1).
+
+    Attributes:
+        fixed: objects in {B}. workpiece: objects in {O}, moving with the placement.
+        tool: the tool cylinder, or None (no tool geometry).
+        clearance: m, >= 0, the least distance any checked pair may come to.
+        collision_step: rad, > 0, the largest joint move between two checks.
+        link_radii: m, capsule radii per link of an arm that has no collision geometry
+            (base, then one per joint); None takes the robot's published ones.
+    """
+
+    fixed: tuple[Shape, ...] = ()
+    workpiece: tuple[Shape, ...] = ()
+    tool: Tool | None = None
+    clearance: float = DEFAULT_CLEARANCE
+    collision_step: float = DEFAULT_COLLISION_STEP
+    link_radii: tuple[float, ...] | None = None
+
+    def check(self) -> None:
+        """Raise InvalidInputError on the first bad field, named as the request names it."""
+        for group, shapes in (("fixed", self.fixed), ("workpiece", self.workpiece)):
+            for k, shape in enumerate(shapes):
+                shape.check(f"cell.{group}.{k}")
+        if self.tool is not None:
+            self.tool.check()
+        if not (math.isfinite(self.clearance) and 0.0 <= self.clearance <= 1.0):
+            raise InvalidInputError("cell.clearance", f"{self.clearance:.6g} m must be in [0, 1]")
+        _positive(self.collision_step, "cell.collision_step", upper=math.pi)
+        for k, radius in enumerate(self.link_radii or ()):
+            _positive(radius, f"cell.link_radii.{k}", upper=1.0)
+
+    def obstacle_name(self, index: int) -> str:
+        """The name of obstacle ``index`` (fixed first, then workpiece), or its place."""
+        shapes = self.fixed + self.workpiece
+        group = "fixed" if index < len(self.fixed) else "workpiece"
+        local = index if index < len(self.fixed) else index - len(self.fixed)
+        return shapes[index].name or f"{group}[{local}]"

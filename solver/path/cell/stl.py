@@ -1,0 +1,96 @@
+"""STL files, ASCII or binary, read into triangles (cell.md section 1), bounded in size.
+
+Only the facets' corners are read (normals are recomputed by whoever needs them). A file that
+is neither a well-formed ASCII STL nor a binary STL whose length matches its triangle count is
+an error naming the field, never a guess.
+"""
+
+from __future__ import annotations
+
+import re
+
+import numpy as np
+
+from solver.core.exceptions import InvalidInputError
+
+UNITS = {"m": 1.0, "mm": 0.001, "cm": 0.01, "in": 0.0254}
+_HEADER = 80
+_RECORD = 50  # bytes per binary triangle: normal, three corners (float32), attribute
+_VERTEX = re.compile(rb"vertex\s+(\S+)\s+(\S+)\s+(\S+)")
+
+
+def read_stl(
+    data: bytes,
+    *,
+    max_triangles: int,
+    units: str = "m",
+    field: str = "stl",
+    setting: str = "max_mesh_triangles",
+) -> np.ndarray:
+    """The triangles of an STL file, in m.
+
+    Args:
+        data: the file's bytes (ASCII text or binary).
+        max_triangles: the most triangles taken (a setting); more is an error.
+        units: ``m``, ``mm``, ``cm`` or ``in``, the file's length unit.
+        field: the request's field, named in errors.
+        setting: the name of the triangle limit, named in its error.
+
+    Returns:
+        shape (T, 3, 3), m, the corners of each triangle.
+
+    Raises:
+        InvalidInputError: not an STL, no triangles, too many, or a corner not finite.
+    """
+    if units not in UNITS:
+        raise InvalidInputError(f"{field}.units", f"unknown unit {units!r}; use {', '.join(UNITS)}")
+    if data.lstrip()[:5].lower() == b"solid" and b"facet" in data[:4096]:
+        triangles = _ascii(data, (max_triangles, setting), field)
+    else:
+        triangles = _binary(data, (max_triangles, setting), field)
+    if not len(triangles):
+        raise InvalidInputError(field, "the STL has no triangles")
+    if not np.all(np.isfinite(triangles)):
+        raise InvalidInputError(field, "the STL has a corner that is not a finite number")
+    scaled: np.ndarray = triangles * UNITS[units]
+    return scaled
+
+
+def _ascii(data: bytes, limit: tuple[int, str], field: str) -> np.ndarray:
+    """Triangles of an ASCII STL: every three ``vertex`` lines."""
+    count = data.count(b"facet normal")
+    if count > limit[0]:
+        raise _too_many(count, limit, field)
+    try:
+        corners = np.array([[float(v) for v in m] for m in _VERTEX.findall(data)], dtype=float)
+    except ValueError as exc:
+        message = f"not an STL: a vertex is not three numbers ({exc})"
+        raise InvalidInputError(field, message) from exc
+    if len(corners) != 3 * count:
+        raise InvalidInputError(
+            field, f"not an STL: {count} facets but {len(corners)} vertices (three a facet)"
+        )
+    return corners.reshape(-1, 3, 3)
+
+
+def _binary(data: bytes, limit: tuple[int, str], field: str) -> np.ndarray:
+    """Triangles of a binary STL: an 80-byte header, a count, 50 bytes a triangle."""
+    if len(data) < _HEADER + 4:
+        raise InvalidInputError(field, "not an STL: neither ASCII facets nor a binary header")
+    count = int(np.frombuffer(data, dtype="<u4", count=1, offset=_HEADER)[0])
+    if len(data) != _HEADER + 4 + _RECORD * count:
+        raise InvalidInputError(
+            field,
+            f"not an STL: a binary STL of {count} triangles is {_HEADER + 4 + _RECORD * count} "
+            f"bytes, this is {len(data)}",
+        )
+    if count > limit[0]:
+        raise _too_many(count, limit, field)
+    record = np.dtype([("normal", "<f4", 3), ("corners", "<f4", (3, 3)), ("attribute", "<u2")])
+    rows = np.frombuffer(data, dtype=record, count=count, offset=_HEADER + 4)
+    return rows["corners"].astype(float)
+
+
+def _too_many(count: int, limit: tuple[int, str], field: str) -> InvalidInputError:
+    """The error of a mesh over the triangle limit (its value and name)."""
+    return InvalidInputError(field, f"{count} triangles; at most {limit[0]} ({limit[1]})")

@@ -1,0 +1,209 @@
+"""The cell on the routes (cell.md): collisions reported, inputs bounded, errors named."""
+
+from __future__ import annotations
+
+import base64
+import json
+from collections.abc import Iterator
+from typing import Any
+
+import numpy as np
+import pytest
+from fastapi.testclient import TestClient
+
+from service.config import get_settings
+from solver.core.spatial import Placement
+from solver.families import get_robot
+from solver.path.cell.shapes import Box, Cell, Halfspace
+from solver.path.evaluate import evaluate_path
+from solver.path.problem import PathOptions, PathProblem
+from tests.cases import EXAMPLES
+from tests.service.test_errors import assert_names
+from tests.service.test_job_routes import EXAMPLE, route_body
+from tests.solver.test_cell import binary_stl, cube_triangles
+from tests.solver.test_evaluate import load_path
+
+TABLE = {"shape": "halfspace", "name": "table", "normal": [0, 0, 1], "offset": 0.0}
+FIXTURE = {
+    "shape": "box",
+    "name": "fixture",
+    "size": [0.1, 0.1, 0.6],
+    "pose": {"position": [-0.2, 0.55, 0.3], "orientation": [0, 0, 0, 1]},
+}
+
+
+@pytest.fixture
+def body() -> dict[str, Any]:
+    """The example evaluate request: ur5 on the curved line at (0, 0.45, 0.1)."""
+    return json.loads((EXAMPLES / "evaluate_request.json").read_text())
+
+
+@pytest.fixture
+def setting(monkeypatch: pytest.MonkeyPatch) -> Iterator[Any]:
+    """Set DTF_<NAME> settings for one test."""
+
+    def set_(**values: Any) -> None:
+        for name, value in values.items():
+            monkeypatch.setenv(f"DTF_{name.upper()}", str(value))
+        get_settings.cache_clear()
+
+    yield set_
+    get_settings.cache_clear()
+
+
+def solver_answer(fixed: tuple) -> Any:
+    """evaluate_path at the example's placement with a cell of ``fixed`` objects."""
+    problem = PathProblem.of(
+        get_robot("ur5"), load_path("curved_line"), PathOptions(cell=Cell(fixed=fixed))
+    )
+    return evaluate_path(problem, Placement(0.0, 0.45, 0.1, 0.0))
+
+
+def test_evaluate_reports_the_collision(client: TestClient, body: dict) -> None:
+    body["cell"] = {"fixed": [TABLE, FIXTURE]}
+    answer = client.post("/v1/evaluate", json=body).json()
+    fixture = Box(
+        (0.1, 0.1, 0.6),
+        np.array([[1, 0, 0, -0.2], [0, 1, 0, 0.55], [0, 0, 1, 0.3], [0, 0, 0, 1.0]]),
+        "fixture",
+    )
+    expected = solver_answer((Halfspace((0, 0, 1), 0.0, "table"), fixture))
+    assert answer["feasible"] is False and answer["reason"] == "collision"
+    contact = answer["collision"]
+    assert contact["obstacle"] == 1 and contact["obstacle_name"] == "fixture"
+    assert contact["waypoint"] == answer["failed_waypoint"] == expected.collision.waypoint
+    assert contact["distance"] == pytest.approx(expected.collision.distance, abs=1e-9)
+    assert answer["min_clearance"] is None
+
+
+def test_evaluate_reports_the_min_clearance(client: TestClient, body: dict) -> None:
+    body["cell"] = {"fixed": [TABLE]}
+    answer = client.post("/v1/evaluate", json=body).json()
+    expected = solver_answer((Halfspace((0, 0, 1), 0.0, "table"),))
+    assert answer["feasible"] is True and answer["collision"] is None
+    assert answer["min_clearance"]["distance"] == pytest.approx(
+        expected.min_clearance.distance, abs=1e-9
+    )
+    plain = client.post("/v1/evaluate", json={k: v for k, v in body.items() if k != "cell"})
+    assert answer["mu_path"] == plain.json()["mu_path"]
+
+
+def map_request(body: dict) -> dict[str, Any]:
+    """Three placements of the example path with a halfspace over the base."""
+    return {
+        "robot": body["robot"],
+        "path": body["path"],
+        "grid": {
+            "x": {"min": -0.1, "max": 0.1, "step": 0.1},
+            "y": {"min": 0.45, "max": 0.45, "step": 0.1},
+            "z": 0.1,
+            "yaw": 0.0,
+        },
+        "cell": {"fixed": [{"shape": "halfspace", "normal": [0, 0, 1], "offset": 0.1}]},
+    }
+
+
+def test_the_map_marks_collision_cells(client: TestClient, body: dict) -> None:
+    response = client.post("/v1/map", json=map_request(body))
+    assert response.status_code == 200, response.text
+    reasons = {cell["reason"] for cell in response.json()["cells"]}
+    assert reasons == {"collision"}
+
+
+def mesh(stl: str, units: str = "m") -> dict[str, Any]:
+    """A mesh object of an STL."""
+    return {"shape": "mesh", "stl": stl, "units": units}
+
+
+CUBE = base64.b64encode(binary_stl(cube_triangles(0.1))).decode()
+
+
+@pytest.mark.parametrize(
+    ("cell", "settings", "loc", "words"),
+    [
+        ({"fixed": [TABLE, FIXTURE]}, {"max_cell_objects": 1}, ["cell"], "DTF_MAX_CELL_OBJECTS"),
+        (
+            {"fixed": [mesh(CUBE)]},
+            {"max_mesh_triangles": 11},
+            ["cell", "fixed", 0, "stl"],
+            "DTF_MAX_MESH_TRIANGLES",
+        ),
+        (
+            {"workpiece": [mesh("hello, not a mesh")]},
+            {},
+            ["cell", "workpiece", 0, "stl"],
+            "not an STL",
+        ),
+        ({"fixed": [mesh("c29saWQ=")]}, {}, ["cell", "fixed", 0, "stl"], "not an STL"),
+        ({"fixed": [{"shape": "box", "size": [0.1, -0.1, 0.1]}]}, {}, ["cell", "fixed", 0], ""),
+        ({"fixed": [{"shape": "cone", "radius": 0.1}]}, {}, ["cell", "fixed", 0], ""),
+        ({"tool": {"radius": 0.02, "length": 0.01}}, {}, ["cell", "tool", "cutting_length"], ""),
+        ({"link_radii": [0.05, 0.05]}, {}, ["cell", "link_radii"], "give 7"),
+    ],
+    ids=["objects", "triangles", "text", "base64-not-stl", "size", "shape", "tool", "radii"],
+)
+def test_a_bad_cell_is_a_422_naming_its_field(
+    client: TestClient,
+    body: dict,
+    setting: Any,
+    cell: dict,
+    settings: dict,
+    loc: list,
+    words: str,
+) -> None:
+    setting(**settings)
+    body["cell"] = cell
+    response = client.post("/v1/evaluate", json=body)
+    assert_names(response, 422, ["body", *loc])
+    assert words in json.dumps(response.json())
+
+
+def test_a_map_in_a_cell_weighs_its_collision_work(
+    client: TestClient, body: dict, setting: Any
+) -> None:
+    setting(max_map_poses=1000)  # 3 placements x 133 waypoints = 399 poses: fine without a cell
+    request = map_request(body)
+    response = client.post("/v1/map", json=request)
+    assert_names(response, 422, ["body", "grid"])
+    assert "in a cell" in response.json()["detail"][0]["msg"]
+    del request["cell"]
+    assert client.post("/v1/map", json=request).status_code == 200
+
+
+def test_an_optimisation_in_a_cell_weighs_its_collision_work(
+    client: TestClient, body: dict
+) -> None:
+    box = {
+        "robot": body["robot"],
+        "path": body["path"],
+        "bounds": {"x": [-0.25, 0.25], "y": [0.25, 0.65], "yaw": [-3.14159, 3.14159]},
+        "z": 0.1,
+        "cell": {"fixed": [TABLE]},
+    }
+    response = client.post("/v1/optimize", json=box)  # 13,104 cells x 133 x 100: over 5 M
+    assert_names(response, 422, ["body", "bounds"])
+    assert "coarse map" in response.json()["detail"][0]["msg"]
+
+
+@pytest.mark.parametrize(("model", "count"), [("ur5", 0), ("ur5e", 7)])
+def test_the_answer_names_the_links_given_capsules(
+    client: TestClient, body: dict, model: str, count: int
+) -> None:
+    body["robot"] = {"model": model}
+    body["cell"] = {"fixed": [TABLE], "link_radii": [0.05] * 7}
+    answer = client.post("/v1/evaluate", json=body).json()
+    assert len(answer["cell_approximated"]) == count
+
+
+@pytest.mark.parametrize("kind", ["evaluate", "map", "optimize"])
+def test_a_job_with_a_bad_cell_is_refused_at_submit_as_its_route_refuses_it(
+    client: TestClient, kind: str
+) -> None:
+    body = route_body(kind, EXAMPLE["path"])
+    body["cell"] = {"workpiece": [mesh("hello, not a mesh")]}
+    direct = client.post(f"/v1/{kind}", json=body)
+    assert_names(direct, 422, ["body", "cell", "workpiece", 0, "stl"])
+    submitted = client.post("/v1/jobs", json={"kind": kind, "request": body})
+    assert submitted.status_code == 422, submitted.text
+    (expected,), (detail,) = direct.json()["detail"], submitted.json()["detail"]
+    assert detail == {**expected, "loc": ["body", "request", *expected["loc"][1:]]}

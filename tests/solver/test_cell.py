@@ -1,0 +1,434 @@
+"""The cell (cell.md): collisions and clearances against coal, geometry and the map.
+
+Known answers come from a pinocchio ``GeometryModel`` built here from the same URDF, with coal
+distances at the answer's joint angles (cell.md section 5), and from geometry: a halfspace above
+the base, a far box, a box around the tool point.
+"""
+
+from __future__ import annotations
+
+import math
+import struct
+
+import coal
+import numpy as np
+import pinocchio as pin
+import pytest
+
+from solver.core.exceptions import InvalidInputError
+from solver.core.parallel import SERIAL, ThreadRunner
+from solver.core.robots import example_robot_data_dir
+from solver.core.spatial import Placement
+from solver.families import get_robot, robot_from_urdf
+from solver.optimise.optimize import optimize_placement
+from solver.optimise.search_space import PlacementBounds
+from solver.path.capability_map import CapabilityMap, capability_map, grid_axis
+from solver.path.cell.checker import CellChecker
+from solver.path.cell.shapes import Box, Cell, Halfspace, Mesh, Tool
+from solver.path.cell.stl import read_stl
+from solver.path.evaluate import evaluate_path
+from solver.path.problem import PathOptions, PathProblem
+from tests.solver.test_evaluate import load_path
+
+PLACEMENT = Placement(0.0, 0.45, 0.1, 0.0)
+XS, YS = np.array([-0.1, 0.0, 0.1]), np.array([0.35, 0.45, 0.55])
+DISTANCE_ATOL = 1e-6  # m, cell.md section 5: both use the same shapes
+
+
+def pose(x: float, y: float, z: float) -> np.ndarray:
+    """A translation as a 4 x 4 pose."""
+    matrix = np.eye(4)
+    matrix[:3, 3] = [x, y, z]
+    return matrix
+
+
+def problem(cell: Cell | None, robot: str = "ur5", tcp: float = 0.0) -> PathProblem:
+    """The curved line on ``robot`` (its tool point ``tcp`` m along the flange's z), ``cell``."""
+    arm = get_robot(robot)
+    if tcp:
+        arm = arm.with_options(transform_tool_to_tcp=pose(0.0, 0.0, tcp))
+    return PathProblem.of(arm, load_path("curved_line"), PathOptions(cell=cell))
+
+
+def ur5_geometry() -> tuple[pin.Model, pin.GeometryModel]:
+    """UR5's collision elements read here from its URDF, meshes as their convex hulls."""
+    robot = get_robot("ur5")
+    robots = example_robot_data_dir()
+    urdf = (robots / "ur_description" / "urdf" / "ur5_robot.urdf").read_text()
+    geometry = pin.buildGeomFromUrdfString(
+        robot.model, urdf, pin.COLLISION, package_dirs=[str(robots.parent.parent)]
+    )
+    for obj in geometry.geometryObjects:
+        if isinstance(obj.geometry, coal.BVHModelBase):
+            obj.geometry.buildConvexRepresentation(False)
+            obj.geometry = obj.geometry.convex
+    return robot.model, geometry
+
+
+def substeps(q: np.ndarray, step: float) -> tuple[np.ndarray, np.ndarray]:
+    """Waypoints and the evenly spaced configurations between them, no joint moving > step."""
+    rows, owners = [], []
+    for i in range(len(q) - 1):
+        count = max(1, math.ceil(np.abs(q[i + 1] - q[i]).max() / step - 1e-12))
+        for k in range(count):
+            rows.append(q[i] + k / count * (q[i + 1] - q[i]))
+            owners.append(i)
+    return np.array([*rows, q[-1]]), np.array([*owners, len(q) - 1])
+
+
+def coal_distances(
+    q: np.ndarray, fixed: list[tuple[coal.CollisionGeometry, np.ndarray]], placement: Placement
+) -> list[tuple[float, int, str, str]]:
+    """Per configuration, the least distance, its waypoint, robot part and other object.
+
+    Pairs of cell.md: every robot link but the base against the fixed objects; links on joints
+    neither the same nor adjacent, apart (> clearance) at the zero configuration.
+    """
+    model, geometry = ur5_geometry()
+    data = model.createData()
+    pin.framesForwardKinematics(model, data, pin.neutral(model))
+    world_to_base = data.oMf[model.getFrameId("base")]
+    n_robot = geometry.ngeoms
+    for k, (shape, where) in enumerate(fixed):
+        geometry.addGeometryObject(
+            pin.GeometryObject(f"o{k}", 0, world_to_base * pin.SE3(where), shape)
+        )
+    objects = geometry.geometryObjects
+    pairs = [(a, n_robot + k) for a in range(n_robot) for k in range(len(fixed))]
+    pairs = [(a, b) for a, b in pairs if objects[a].parentJoint != 0]
+    candidates = []
+    for a in range(n_robot):
+        for b in range(a + 1, n_robot):
+            ja, jb = objects[a].parentJoint, objects[b].parentJoint
+            if abs(ja - jb) > 1:  # a serial chain: adjacent joints differ by one
+                candidates.append((a, b))
+    gdata = geometry.createData()
+    pin.updateGeometryPlacements(model, data, geometry, gdata, pin.neutral(model))
+    pairs += [(a, b) for a, b in candidates if _distance(geometry, gdata, a, b) > Cell().clearance]
+    configurations, owners = substeps(q, Cell().collision_step)
+    out = []
+    for configuration, owner in zip(configurations, owners, strict=True):
+        pin.updateGeometryPlacements(model, data, geometry, gdata, configuration)
+        best = min((_distance(geometry, gdata, a, b), a, b) for a, b in pairs)
+        other = objects[best[2]].name
+        out.append((best[0], int(owner), objects[best[1]].name, other))
+    return out
+
+
+def _distance(geometry: pin.GeometryModel, gdata: pin.GeometryData, a: int, b: int) -> float:
+    """coal's distance between objects a and b at their current placements."""
+    request, result = coal.DistanceRequest(), coal.DistanceResult()
+    objects = geometry.geometryObjects
+    return float(
+        coal.distance(
+            objects[a].geometry,
+            coal.Transform3s(gdata.oMg[a].rotation, gdata.oMg[a].translation),
+            objects[b].geometry,
+            coal.Transform3s(gdata.oMg[b].rotation, gdata.oMg[b].translation),
+            request,
+            result,
+        )
+    )
+
+
+FIXTURE = Box((0.1, 0.1, 0.6), pose(-0.2, 0.55, 0.3), name="fixture")
+TABLE = Halfspace((0.0, 0.0, 1.0), 0.0, name="table")
+
+
+@pytest.mark.parametrize(
+    ("shapes", "collides"),
+    [((TABLE,), False), ((TABLE, FIXTURE), True)],
+    ids=["feasible", "fixture"],
+)
+def test_collision_and_min_clearance_agree_with_coal(shapes: tuple, collides: bool) -> None:
+    evaluation = evaluate_path(problem(Cell(fixed=shapes)), PLACEMENT)
+    plain = evaluate_path(problem(None), PLACEMENT)
+    assert plain.feasible and plain.q is not None
+    reference = coal_distances(plain.q, [(s.geometry(), s.pose) for s in shapes], PLACEMENT)
+    if collides:
+        assert evaluation.reason == "collision"
+        first = next(r for r in reference if r[0] < Cell().clearance)
+        contact = evaluation.collision
+        assert contact is not None
+        assert contact.distance == pytest.approx(first[0], abs=DISTANCE_ATOL)
+        assert (contact.waypoint, contact.robot_part) == (first[1], first[2])
+        assert evaluation.failed_waypoint == first[1]
+        assert contact.obstacle_name == "fixture" and contact.obstacle == 1
+    else:
+        closest = min(reference)
+        assert evaluation.feasible and evaluation.min_clearance is not None
+        assert evaluation.mu_path == plain.mu_path
+        assert evaluation.min_clearance.distance == pytest.approx(closest[0], abs=DISTANCE_ATOL)
+        assert evaluation.min_clearance.waypoint == closest[1]
+        assert evaluation.min_clearance.robot_part == closest[2]
+
+
+def small_map(cell: Cell | None, robot: str = "ur5", tcp: float = 0.0) -> CapabilityMap:
+    """A 3 x 3 map of the curved line at yaw 0."""
+    return capability_map(problem(cell, robot, tcp), xs=XS, ys=YS, z=0.1, yaws=np.zeros(1))
+
+
+@pytest.mark.parametrize("robot", ["ur5", "ur5e"])
+def test_a_halfspace_just_above_the_base_collides_everywhere(robot: str) -> None:
+    plain = small_map(None, robot)
+    above_base = Halfspace((0.0, 0.0, 1.0), 0.1, name="above the base")
+    cells = small_map(Cell(fixed=(above_base,)), robot)
+    feasible = plain.reason == -1
+    assert feasible.any()
+    assert np.all(cells.reason[feasible] == 4)  # REASONS.index("collision")
+    assert np.all(cells.reason[~feasible] == plain.reason[~feasible])
+    assert np.all(np.isnan(cells.mu_path))
+
+
+def test_a_far_box_changes_no_cell() -> None:
+    plain = small_map(None)
+    far = small_map(Cell(fixed=(Box((1.0, 1.0, 1.0), pose(20.0, 20.0, 20.0)),)))
+    for name in ("mu_path", "reason", "failed_waypoint", "branch", "bottleneck_waypoint"):
+        np.testing.assert_array_equal(getattr(far, name), getattr(plain, name))
+
+
+def tool_point_box(side: float) -> Box:
+    """A cube of ``side`` around the tool point of the path's middle waypoint, in {O}."""
+    middle = load_path("curved_line")[66]
+    return Box((side, side, side), middle.copy())
+
+
+TOOL = Tool(radius=0.02, length=0.1, cutting_length=0.02)
+TCP = 0.12  # m, the tool point along the flange's z: the tool ends there, 2 cm clear of it
+
+
+@pytest.mark.parametrize(
+    ("group", "side", "collides"),
+    [("workpiece", 0.01, False), ("workpiece", 0.08, True), ("fixed", 0.01, True)],
+    ids=["workpiece-within-the-cutting-length", "workpiece-past-it", "fixed"],
+)
+def test_a_box_around_the_tool_point(group: str, side: float, collides: bool) -> None:
+    box = tool_point_box(side)
+    if group == "fixed":  # the same box, put in {B} at the placement
+        box = Box(box.size, PLACEMENT.transform_workpiece_to_base() @ box.pose)
+    cell = Cell(tool=TOOL, **{group: (box,)})
+    evaluation = evaluate_path(problem(cell, tcp=TCP), PLACEMENT)
+    if not collides:
+        assert evaluation.feasible and evaluation.min_clearance is not None
+        return
+    assert evaluation.reason == "collision" and evaluation.collision is not None
+    assert evaluation.collision.robot_part in ("tool", "tool_cutting", "wrist_3_link_0")
+    if group == "workpiece":  # in {O}: every placement of the map collides
+        plain, cells = small_map(None, tcp=TCP), small_map(cell, tcp=TCP)
+        assert (plain.reason == -1).any()
+        assert np.all(cells.reason[plain.reason == -1] == 4)
+
+
+def test_auto_takes_the_next_branch_when_the_best_collides() -> None:
+    plain = evaluate_path(problem(None), PLACEMENT)
+    assert plain.q is not None
+    model = get_robot("ur5").model
+    data = model.createData()
+    pin.forwardKinematics(model, data, plain.q[66])
+    elbow = data.oMi[3].translation  # the forearm's joint, in the model's root frame
+    base = get_robot("ur5").transform_world_to_base
+    where = np.linalg.solve(base, np.append(elbow, 1.0))[:3]
+    cell = Cell(fixed=(Box((0.05, 0.05, 0.05), pose(*where), name="at the elbow"),))
+    evaluation = evaluate_path(problem(cell), PLACEMENT)
+    assert evaluation.branch != plain.branch
+    if evaluation.feasible:
+        assert evaluation.mu_path is not None and plain.mu_path is not None
+        assert evaluation.mu_path <= plain.mu_path
+    else:
+        assert evaluation.reason == "collision"
+    cells = capability_map(
+        problem(cell),
+        xs=np.array([PLACEMENT.x]),
+        ys=np.array([PLACEMENT.y]),
+        z=0.1,
+        yaws=np.zeros(1),
+    )
+    assert cells.mu_path[0, 0, 0, 0] == pytest.approx(
+        evaluation.mu_path or math.nan, nan_ok=True, rel=1e-12
+    )
+
+
+def cube_triangles(side: float) -> np.ndarray:
+    """The 12 triangles of a cube of ``side`` centred on the origin."""
+    h = side / 2.0
+    corners = np.array([[x, y, z] for x in (-h, h) for y in (-h, h) for z in (-h, h)])
+    faces = [
+        (0, 1, 3),
+        (0, 3, 2),
+        (4, 6, 7),
+        (4, 7, 5),
+        (0, 4, 5),
+        (0, 5, 1),
+        (2, 3, 7),
+        (2, 7, 6),
+        (0, 2, 6),
+        (0, 6, 4),
+        (1, 5, 7),
+        (1, 7, 3),
+    ]
+    return corners[np.array(faces)]
+
+
+def ascii_stl(triangles: np.ndarray) -> bytes:
+    """An ASCII STL of the triangles."""
+    lines = ["solid cube"]
+    for triangle in triangles:
+        lines += ["facet normal 0 0 0", "outer loop"]
+        lines += [f"vertex {x:.9g} {y:.9g} {z:.9g}" for x, y, z in triangle]
+        lines += ["endloop", "endfacet"]
+    return ("\n".join([*lines, "endsolid cube"]) + "\n").encode()
+
+
+def binary_stl(triangles: np.ndarray) -> bytes:
+    """A binary STL of the triangles."""
+    body = b"".join(
+        struct.pack("<12fH", 0.0, 0.0, 0.0, *triangle.ravel(), 0) for triangle in triangles
+    )
+    return b"\0" * 80 + struct.pack("<I", len(triangles)) + body
+
+
+@pytest.mark.parametrize("writer", [ascii_stl, binary_stl])
+def test_an_stl_cube_is_the_box_for_coal(writer: object) -> None:
+    triangles = read_stl(writer(cube_triangles(100.0)), max_triangles=12, units="mm")  # type: ignore[operator]
+    np.testing.assert_allclose(triangles, cube_triangles(0.1), atol=1e-7)
+    mesh, box = Mesh(triangles).geometry(), coal.Box(0.1, 0.1, 0.1)
+    sphere = coal.Sphere(0.05)
+    for offset in ([0.3, 0.0, 0.0], [0.2, 0.2, 0.1]):
+        where = coal.Transform3s(np.eye(3), np.array(offset))
+        distances = [
+            coal.distance(
+                shape,
+                coal.Transform3s(),
+                sphere,
+                where,
+                coal.DistanceRequest(),
+                coal.DistanceResult(),
+            )
+            for shape in (mesh, box)
+        ]
+        assert distances[0] == pytest.approx(distances[1], abs=1e-6)
+
+
+@pytest.mark.parametrize(
+    ("data", "message"),
+    [
+        (b"not a mesh at all, just words" * 10, "not an STL"),
+        (
+            b"solid x\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nendloop\nendfacet\n",
+            "not an STL",
+        ),
+        (binary_stl(cube_triangles(1.0)), "max_mesh_triangles"),
+    ],
+    ids=["text", "two-vertices-missing", "too-many"],
+)
+def test_a_bad_stl_is_an_input_error(data: bytes, message: str) -> None:
+    with pytest.raises(InvalidInputError, match=message) as caught:
+        read_stl(data, max_triangles=11, field="cell.fixed.0.stl")
+    assert caught.value.field == "cell.fixed.0.stl"
+
+
+@pytest.mark.parametrize(
+    ("cell", "field"),
+    [
+        (Cell(fixed=(Box((0.1, -1.0, 0.1)),)), "cell.fixed.0.size.1"),
+        (Cell(tool=Tool(0.02, 0.01, 0.02)), "cell.tool.cutting_length"),
+        (Cell(clearance=-0.001), "cell.clearance"),
+        (Cell(collision_step=0.0), "cell.collision_step"),
+    ],
+)
+def test_a_bad_cell_names_its_field(cell: Cell, field: str) -> None:
+    with pytest.raises(InvalidInputError) as caught:
+        evaluate_path(problem(cell), PLACEMENT)
+    assert caught.value.field == field
+
+
+def test_an_arm_without_collision_geometry_or_radii_needs_link_radii() -> None:
+    with pytest.raises(InvalidInputError) as caught:
+        evaluate_path(problem(Cell(), "ur3e"), PLACEMENT)
+    assert caught.value.field == "cell.link_radii"
+
+
+def test_a_flat_mesh_is_a_sheet_not_a_crash() -> None:
+    sheet = np.array([[[0, 0, 0], [1, 0, 0], [0, 1, 0]], [[1, 0, 0], [1, 1, 0], [0, 1, 0]]], float)
+    above = coal.Transform3s(np.eye(3), np.array([0.5, 0.5, 0.3]))
+    distance = coal.distance(
+        Mesh(sheet).geometry(),
+        coal.Transform3s(),
+        coal.Sphere(0.1),
+        above,
+        coal.DistanceRequest(),
+        coal.DistanceResult(),
+    )
+    assert distance == pytest.approx(0.2, abs=1e-6)
+
+
+OPT_BOUNDS = PlacementBounds(x=(-0.1, 0.1), y=(0.35, 0.55), yaw=(-0.3, 0.3), z=0.1)
+
+
+@pytest.fixture(scope="module")
+def blocked() -> dict:
+    """The velocity-best placement of a small box, and a cell whose fixture blocks its elbow."""
+    plain = optimize_placement(problem(None), bounds=OPT_BOUNDS, method="casadi")
+    assert plain.evaluation is not None and plain.evaluation.q is not None
+    robot = get_robot("ur5")
+    data = robot.model.createData()
+    pin.forwardKinematics(robot.model, data, plain.evaluation.q[66])
+    elbow = np.linalg.solve(robot.transform_world_to_base, np.append(data.oMi[3].translation, 1))
+    fixture = Box((0.06, 0.06, 0.06), pose(*elbow[:3]), name="fixture")
+    return {"plain": plain, "shapes": (TABLE, fixture)}
+
+
+@pytest.mark.parametrize("method", ["casadi", "scipy"])
+def test_the_optimisers_answer_collision_free_placements(blocked: dict, method: str) -> None:
+    shapes = blocked["shapes"]
+    cell = Cell(fixed=shapes)
+    before = evaluate_path(problem(cell), blocked["plain"].placement)
+    assert before.reason == "collision"  # the velocity-best placement hits the fixture
+    optimum = optimize_placement(problem(cell), bounds=OPT_BOUNDS, method=method)
+    assert optimum.found and optimum.evaluation is not None and optimum.mu_path is not None
+    q = optimum.evaluation.q
+    reference = coal_distances(q, [(s.geometry(), s.pose) for s in shapes], optimum.placement)
+    assert min(reference)[0] >= cell.clearance  # coal: no configuration closer than clearance
+    grid = capability_map(
+        problem(cell),
+        xs=grid_axis(*OPT_BOUNDS.x, 0.02, field="x"),
+        ys=grid_axis(*OPT_BOUNDS.y, 0.02, field="y"),
+        z=0.1,
+        yaws=grid_axis(*OPT_BOUNDS.yaw, math.radians(15), field="yaw"),
+    )
+    assert optimum.mu_path >= float(np.nanmax(grid.mu_path)) * (1 - 1e-9)
+    assert optimum.mu_path <= blocked["plain"].mu_path * (1 + 1e-9)
+
+
+def test_a_urdf_whose_meshes_cannot_be_read_gets_capsules_where_it_has_no_primitive() -> None:
+    robots = example_robot_data_dir()
+    urdf = (robots / "ur_description" / "urdf" / "ur5_robot.urdf").read_text()
+    elsewhere = urdf.replace("package://example-robot-data/", "package://not-installed/")
+    arm = robot_from_urdf(elsewhere, base_frame="base", tool_frame="tool0", name="ur5-elsewhere")
+    checker = CellChecker(arm, Cell())
+    # every link's collision element is a mesh but the ee_link's box, on the last joint
+    assert checker.approximated == (
+        "base",
+        "shoulder_pan_joint",
+        "shoulder_lift_joint",
+        "elbow_joint",
+        "wrist_1_joint",
+        "wrist_2_joint",
+    )
+    assert CellChecker(get_robot("ur5"), Cell()).approximated == ()
+    assert len(CellChecker(get_robot("ur5e"), Cell()).approximated) == 7
+
+
+def test_threads_give_the_serial_map() -> None:
+    """Each check poses the workpiece objects in its own copy of the geometry."""
+    part = Box((0.3, 0.12, 0.2), pose(0.0, 0.06, -0.09), name="part")
+    cell = Cell(fixed=(TABLE, FIXTURE), workpiece=(part,), tool=TOOL)
+    xs, ys = np.linspace(-0.2, 0.2, 5), np.linspace(0.3, 0.6, 4)
+    maps = [
+        capability_map(
+            problem(cell, tcp=TCP), xs=xs, ys=ys, z=0.1, yaws=np.zeros(1), runner=runner, chunk=2
+        )
+        for runner in (SERIAL, ThreadRunner(2))
+    ]
+    np.testing.assert_array_equal(maps[0].reason, maps[1].reason)
+    np.testing.assert_array_equal(maps[0].mu_path, maps[1].mu_path)
