@@ -351,12 +351,12 @@ class NumericFamily(KinematicsFamily):
         point_flat = np.moveaxis(np.broadcast_to(tool_point, (3, *shape)), 0, -1).reshape(-1, 3)
         if progress is None:
             speeds = self._speeds(q_flat, twist_flat, point_flat, qdot_max)
-        else:
-            speeds = np.empty(q_flat.shape)
-            for rows in _in_chunks(np.arange(len(q_flat)), progress):
-                piece = slice(rows[0], rows[-1] + 1)
-                speeds[piece] = self._speeds(
-                    q_flat[piece], twist_flat[piece], point_flat[piece], qdot_max
+        else:  # the finite rows in chunks: each row's speeds as alone
+            speeds = np.full(q_flat.shape, np.nan)
+            finite = np.flatnonzero(np.isfinite(q_flat).all(axis=-1))
+            for rows in _in_chunks(finite, progress):
+                speeds[rows] = self._speeds(
+                    q_flat[rows], twist_flat[rows], point_flat[rows], qdot_max
                 )
         return np.moveaxis(speeds.reshape(*shape, self.dof), -1, 0)
 

@@ -1,9 +1,10 @@
 """A numeric family's path solve reports its progress and stops when the report raises.
 
 An evaluation along a long path with numeric IK takes tens of seconds (20,000 waypoints), so
-the family reports after every waypoint it follows and after every CHUNK_ROWS configurations
-it checks, and a caller stops it by raising Cancelled from the report (the service does when
-the client leaves). The reports must not change the answer: chunks of rows are computed as
+the family reports after the seeding, after every FOLLOW_WAYPOINTS waypoints it follows (every
+waypoint without the compiled chain) and after every CHUNK_ROWS configurations it checks,
+and a caller stops it by raising Cancelled from the report (the service does when the client
+leaves). The reports must not change the answer: chunks of rows are computed as
 the rows alone are.
 """
 
@@ -17,7 +18,8 @@ import pytest
 from solver.core.progress import Cancelled
 from solver.core.spatial import Placement
 from solver.families import get_robot
-from solver.families.numeric.family import CHUNK_ROWS, NumericFamily
+from solver.families.numeric import family as family_module
+from solver.families.numeric.family import CHUNK_ROWS, FOLLOW_WAYPOINTS, NumericFamily
 from solver.path.evaluate import evaluate_path
 from tests.cases import ROOT
 from tests.problems import problem
@@ -25,6 +27,8 @@ from tests.problems import problem
 EXAMPLE = json.loads((ROOT / "examples" / "evaluate_request.json").read_text())
 PLACEMENT = Placement(**EXAMPLE["placement"])
 MODELS = ["kinova_jaco2", "panda"]  # six joints (J^-1 t), seven (the DTF LP)
+PIECES = 3
+"""A path of this many pieces of FOLLOW_WAYPOINTS: the compiled chain reports after each."""
 
 
 def line(n: int, spacing: float = 1e-4) -> np.ndarray:
@@ -37,14 +41,14 @@ def line(n: int, spacing: float = 1e-4) -> np.ndarray:
 @pytest.mark.parametrize("model", MODELS)
 def test_the_reports_rise_to_one_and_do_not_change_the_answer(model: str) -> None:
     robot = get_robot(model)
-    path = line(40)
+    path = line(PIECES * FOLLOW_WAYPOINTS, spacing=2e-5)
     reports: list[float] = []
     reported = evaluate_path(problem(robot, path), PLACEMENT, progress=reports.append)
     quiet = evaluate_path(problem(robot, path), PLACEMENT)
     assert reported.feasible and reported.mu_path == quiet.mu_path
     np.testing.assert_array_equal(reported.q, quiet.q)
     np.testing.assert_array_equal(reported.v_max, quiet.v_max)
-    assert len(reports) >= len(path) - 1  # one a waypoint followed at least
+    assert len(reports) >= PIECES + 1  # the seeding, then one a piece followed at least
     assert all(0.0 < f <= 1.0 for f in reports)
     assert reports == sorted(reports) and reports[-1] == pytest.approx(1.0)
 
@@ -58,10 +62,11 @@ def test_a_report_that_raises_stops_the_solve_at_once(model: str) -> None:
         if len(calls) == 5:
             raise Cancelled
 
+    path = line(8 * FOLLOW_WAYPOINTS, spacing=1e-5)
     with pytest.raises(Cancelled):
-        evaluate_path(problem(get_robot(model), line(40)), PLACEMENT, progress=leave)
+        evaluate_path(problem(get_robot(model), path), PLACEMENT, progress=leave)
     assert len(calls) == 5  # no work, hence no report, after the one that raised
-    assert calls[-1] < 0.5  # five of forty waypoints followed, not the whole path
+    assert calls[-1] < 0.5  # the seeding and four of eight pieces followed, not the whole path
 
 
 @pytest.mark.parametrize("model", MODELS)
@@ -88,3 +93,19 @@ def test_joint_speeds_in_chunks_equal_each_row_alone(model: str) -> None:
             q[:, i : i + 1], twist[:, i : i + 1], point[:, i : i + 1], qdot_max=robot.qdot_max
         )
         np.testing.assert_array_equal(speeds[:, i], alone[:, 0])
+
+
+@pytest.mark.parametrize("model", MODELS)
+def test_a_path_followed_in_pieces_gives_the_bits_of_one_piece(
+    model: str, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    robot = get_robot(model)
+    placed = problem(robot, line(PIECES * FOLLOW_WAYPOINTS + 7, spacing=2e-5))
+    in_pieces = evaluate_path(placed, PLACEMENT)
+    monkeypatch.setattr(family_module, "FOLLOW_WAYPOINTS", 10**9)
+    whole = evaluate_path(
+        problem(robot, line(PIECES * FOLLOW_WAYPOINTS + 7, spacing=2e-5)), PLACEMENT
+    )
+    assert in_pieces.feasible and whole.feasible
+    np.testing.assert_array_equal(in_pieces.q, whole.q)
+    np.testing.assert_array_equal(in_pieces.v_max, whole.v_max)
