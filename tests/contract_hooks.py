@@ -42,6 +42,8 @@ from typing import Any
 import schemathesis
 from schemathesis import GenerationMode
 
+from service.config import Settings
+
 LIMITS: dict[str, float] = {}
 """The server's settings, as the test passed them (max_map_cells, max_map_poses, ...)."""
 STATUSES: Counter[tuple[str, str, int]] = Counter()
@@ -284,6 +286,8 @@ def _repair_optimize(body: dict[str, Any]) -> str | None:
 
 def map_case(context: Any, case: schemathesis.Case) -> schemathesis.Case:
     """Move positive cases onto the rules stated in words; note those kept out, as generated."""
+    if _positive(case) and case.operation.path == "/v1/jobs/{job_id}/result":
+        return _page_within_the_setting(case)
     if not _positive(case) or not isinstance(case.body, dict):
         return case
     _CHANGED.clear()
@@ -297,6 +301,16 @@ def map_case(context: Any, case: schemathesis.Case) -> schemathesis.Case:
     if kept is not None:
         _KEPT[id(case)] = (kept, case)
     NORMALISED.update(_CHANGED)
+    return case
+
+
+def _page_within_the_setting(case: schemathesis.Case) -> schemathesis.Case:
+    """A page's ``limit`` at most DTF_JOB_PAGE_CELLS, as the operation's description says."""
+    largest = Settings.model_fields["job_page_cells"].default
+    query = case.query or {}
+    if isinstance(query.get("limit"), int) and query["limit"] > largest:
+        query["limit"] = largest
+        NORMALISED.update({"limit: at most DTF_JOB_PAGE_CELLS (the server's setting)"})
     return case
 
 
