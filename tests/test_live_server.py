@@ -76,11 +76,12 @@ def at_the_limit() -> dict[str, tuple[str, dict[str, Any]]]:
         "evaluate": (
             "/v1/evaluate",
             {
-                # Numeric IK, the costliest evaluation of a path of this length (about 3 s):
-                # the body's validation, which holds the GIL, is then one /healthz probe of
-                # hundreds. A UR arm's evaluation took 0.6 s, 15 probes: the p90 was the second
-                # worst, and the validation, cut in two by a garbage collection, was two.
-                "robot": {"model": "kinova_jaco2"},
+                # Numeric IK on seven joints, the costliest evaluation of a path of this length
+                # (the Jaco2's, about 3 s before the compiled chain, now 0.2 s: 5 probes): the
+                # body's validation, which holds the GIL, is then one /healthz probe of dozens.
+                # A UR arm's evaluation took 0.6 s, 15 probes: the p90 was the second worst, and
+                # the validation, cut in two by a garbage collection, was two.
+                "robot": {"model": "panda"},
                 "path": long_path,
                 "placement": EXAMPLE["placement"],
             },
@@ -183,14 +184,17 @@ def _busy(pid: int, seconds: float) -> float:
     return busy / max(samples, 1)
 
 
-@pytest.mark.parametrize("model", ["kinova_jaco2", "panda"])
-def test_an_evaluate_whose_client_leaves_stops_within_a_second(model: str) -> None:
-    # Numeric IK (six joints: J^-1 t; seven: the DTF LP) along 20,000 waypoints: tens of
-    # seconds of work, still running when the client leaves at 3 s (it gets no answer). The
-    # idle server is not quite still (the job supervisor looks at its store every 50 ms).
+def test_an_evaluate_whose_client_leaves_stops_within_a_second() -> None:
+    # Numeric IK on seven joints (the DTF LP) along 20,000 waypoints, the schema's most: with
+    # the compiled chain about 2.5 s of work here (the Jaco2's six joints: under 1 s, too
+    # short to leave), still running when the client leaves at 1.2 s (it gets no answer). The
+    # work may end by itself within the second after (it did on the development machine idle,
+    # 2026-12-02): this test then cannot tell a stop from an end, and the mechanism is held by
+    # tests/solver/families/test_numeric_progress.py. The idle server is not quite still (the
+    # job supervisor looks at its store every 50 ms).
     process, url = start_server({})
     body = {
-        "robot": {"model": model},
+        "robot": {"model": "panda"},
         "path": line_path(20_000, 2.5e-6),
         "placement": EXAMPLE["placement"],
     }
@@ -198,18 +202,18 @@ def test_an_evaluate_whose_client_leaves_stops_within_a_second(model: str) -> No
 
     def leaves() -> None:
         try:
-            httpx.post(url + "/v1/evaluate", json=body, timeout=3.0)
+            httpx.post(url + "/v1/evaluate", json=body, timeout=1.2)
         except httpx.ReadTimeout as error:
             errors.append(error)
 
     try:
         client = threading.Thread(target=leaves)
         client.start()
-        time.sleep(2.0)
-        working = _busy(process.pid, 0.8)
+        time.sleep(0.5)
+        working = _busy(process.pid, 0.5)
         client.join()
         assert len(errors) == 1  # the client left before an answer
-        time.sleep(1.0)
+        time.sleep(0.5)
         assert working > 0.8  # the evaluation ran before the client left
         assert _busy(process.pid, 1.0) < 0.5  # and stopped within a second after
     finally:
