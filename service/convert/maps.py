@@ -36,12 +36,14 @@ def map_grid(
     n_waypoints: int,
     robot: Robot,
     with_cell: bool = False,
+    free_spin: bool = False,
 ) -> MapGrid:
     """The grid's values, after checking its size against the settings.
 
     The poses are weighed by the robot family's cost (``path_cost``: 1 a pose for a closed-form
     family, far more for numeric IK), so that DTF_MAX_MAP_POSES bounds the time of every map;
-    with a cell, each pose also by the collision check's (``CELL_POSE_COST``).
+    with a cell, each pose also by the collision check's (``CELL_POSE_COST``); in free spin as
+    the family weighs it (``free_spin``).
 
     Raises:
         InvalidInputError: an axis is malformed, or the grid is over a size limit; the message
@@ -68,7 +70,8 @@ def map_grid(
         )
     poses = cells * n_waypoints
     family = require_family(robot)
-    work = cells * family.path_cost(n_waypoints) * (CELL_POSE_COST if with_cell else 1.0)
+    cost = family.path_cost(n_waypoints, free_spin=free_spin)
+    work = cells * cost * (CELL_POSE_COST if with_cell else 1.0)
     if work > limits.poses:
         weighed = "" if work == poses else f", as work {work:.4g} closed-form poses"
         weighed += "" if work == poses else f" ({family.name} IK{' in a cell' * with_cell})"

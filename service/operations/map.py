@@ -23,12 +23,18 @@ def checked_grid(body: MapRequest, settings: Settings) -> tuple[Robot, convert.M
         body.path, limit=settings.max_path_waypoints, setting="DTF_MAX_PATH_WAYPOINTS"
     )
     robot = convert.robot_from_schema(body.robot)
+    # Free spin costs more on a redundant arm: its spin mode (the path's default unless given)
+    # weighs the grid; the path is read for that on such an arm only.
+    free_spin = (
+        robot.dof > 6 and convert.spin_mode_of(body.spin_mode, convert.path_of(body.path)) == "free"
+    )
     grid = convert.map_grid(
         body.grid,
         settings=settings,
         n_waypoints=body.path.n_waypoints(),
         robot=robot,
         with_cell=body.cell is not None,
+        free_spin=free_spin,
     )
     return robot, grid
 

@@ -119,8 +119,10 @@ class KinematicsFamily(abc.ABC):
             still filled where singular).
         """
 
-    def path_cost(self, n_waypoints: int) -> float:
+    def path_cost(self, n_waypoints: int, *, free_spin: bool = False) -> float:
         """Estimated work of one placement of a path of ``n_waypoints`` (IK, tracking, DTF).
+
+        ``free_spin``: with the tool spin free (a family whose free spin costs more says so).
 
         In poses of a closed-form family (all its branches and their DTF): the unit of the
         service's size limits (``DTF_MAX_MAP_POSES``), so that a request's cost is bounded

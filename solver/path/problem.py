@@ -186,7 +186,7 @@ class PathProblem:
         (:data:`solver.path.cell.checker.CELL_POSE_COST`) with a cell: what the size limits of
         the maps and searches weigh.
         """
-        cost = self.family.path_cost(n_waypoints)
+        cost = self.family.path_cost(n_waypoints, free_spin=self.options.spin_mode == "free")
         return cost * CELL_POSE_COST if self.options.cell is not None else cost
 
     @property

@@ -240,3 +240,26 @@ def test_the_erk_size_map_of_a_six_joint_urdf_is_within_the_map_limit(
     assert 546 * numeric.path_cost(133) <= get_settings().max_map_poses
     response = client.post("/v1/map", json={"robot": robot, "path": erk_path, "grid": ERK_GRID})
     assert response.status_code == 200, response.text
+
+
+@pytest.mark.parametrize("route", ["/v1/evaluate", "/v1/map"])
+def test_free_spin_on_a_redundant_arm_is_weighed_by_its_lp(
+    client: TestClient, waypoints: list[dict[str, Any]], route: str
+) -> None:
+    """Free spin on seven joints solves the vertex LP at every configuration: 35-41 times the
+    fixed spin's work (measured), so a request the fixed spin's limit admits may be refused."""
+    n = 2_000  # fixed spin: 18,500 + 200 * 1,999 = 418,300 poses, within 5 million; free: 50x
+    line = [
+        {"position": [1e-5 * i, 0.0, 0.0], "orientation": [1.0, 0.0, 0.0, 0.0]} for i in range(n)
+    ]
+    body: dict[str, Any] = {"robot": {"model": "panda"}, "path": {"waypoints": line}}
+    if route == "/v1/map":
+        axis = {"min": -0.1, "max": 0.1, "step": 0.1}
+        body["grid"] = {"x": axis, "y": {**axis, "min": 0.3, "max": 0.5}, "z": 0.1, "yaw": 0.0}
+    else:
+        body["placement"] = PLACEMENT
+    free = client.post(route, json={**body, "spin_mode": "free"})
+    assert free.status_code == 422, free.text
+    [entry] = free.json()["detail"]
+    assert entry["loc"] in (["body", "path"], ["body", "grid"])
+    assert "DTF_MAX_MAP_POSES" in entry["msg"]

@@ -41,6 +41,9 @@ COST_LINES: dict[int, tuple[tuple[float, float], ...]] = {
     6: ((1_600.0, 50.0), (4_800.0, 22.0)),
     7: ((18_500.0, 200.0),),
 }
+FREE_SPIN_REDUNDANT_COST = 50.0
+"""A seven-joint path's work in free spin against fixed: the Panda along 2,000 and 20,000
+waypoints took 35 and 41 times as long (2026-12-02, compiled chain; the vertex LP dominates)."""
 CHUNK_ROWS = 2048
 """Configurations checked (singularity, joint speeds) between two progress reports: about
 0.2 s for seven joints under load, so that a cancelled evaluation stops within a second."""
@@ -104,8 +107,12 @@ class NumericFamily(KinematicsFamily):
         """Number of joints."""
         return self.chain.dof
 
-    def path_cost(self, n_waypoints: int) -> float:
+    def path_cost(self, n_waypoints: int, *, free_spin: bool = False) -> float:
         """Seeding plus following, in closed-form poses: the highest line of COST_LINES.
+
+        In free spin an arm of more than six joints also solves the three-variable LP at every
+        configuration (:func:`solver.core.dtf_redundant.vertex_lp`): times
+        :data:`FREE_SPIN_REDUNDANT_COST`.
 
         Arms of more than seven joints scale the seven-joint figures by (dof / 7)^2 (the
         Jacobian products and solves grow about so).
@@ -113,7 +120,8 @@ class NumericFamily(KinematicsFamily):
         size = min(max(self.dof, 6), 7)
         scale = max(self.dof / 7, 1.0) ** 2
         following = max(n_waypoints - 1, 0)
-        return scale * max(seed + following * track for seed, track in COST_LINES[size])
+        cost = scale * max(seed + following * track for seed, track in COST_LINES[size])
+        return cost * FREE_SPIN_REDUNDANT_COST if free_spin and self.dof > 6 else cost
 
     @property
     def branches(self) -> tuple[Branch, ...]:
