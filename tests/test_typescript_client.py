@@ -18,10 +18,10 @@ import os
 import shutil
 import subprocess
 from pathlib import Path
-from typing import Any
 
 import pytest
 
+from service.spec import request_components
 from tests.cases import EXAMPLES, ROOT
 
 TOOLS = {"openapi-typescript": "7.13.0", "typescript": "5.9.3"}
@@ -45,33 +45,6 @@ def _npm_tools() -> Path:
     return folder / "node_modules" / ".bin"
 
 
-def _refs(value: Any) -> set[str]:
-    """The component names ``value`` refers to directly."""
-    if isinstance(value, dict):
-        own = {value["$ref"].rsplit("/", 1)[-1]} if "$ref" in value else set()
-        return own.union(*(_refs(item) for item in value.values()))
-    if isinstance(value, list):
-        return set().union(*(_refs(item) for item in value))
-    return set()
-
-
-def request_components(spec: dict[str, Any]) -> list[str]:
-    """Every component a request body reaches, directly or through other components."""
-    schemas = spec["components"]["schemas"]
-    todo = {
-        name
-        for path in spec["paths"].values()
-        for operation in path.values()
-        for name in _refs(operation.get("requestBody", {}))
-    }
-    seen: set[str] = set()
-    while todo:
-        name = todo.pop()
-        seen.add(name)
-        todo |= _refs(schemas[name]) - seen
-    return sorted(seen)
-
-
 def test_request_examples_compile_with_tsc_strict(tmp_path: Path) -> None:
     tools = _npm_tools()
     spec = json.loads((ROOT / "openapi" / "openapi.json").read_text())
@@ -86,7 +59,7 @@ def test_request_examples_compile_with_tsc_strict(tmp_path: Path) -> None:
     assert generated.returncode == 0, generated.stdout + generated.stderr
     lines = ['import type { components } from "./api";', ""]
     typed = 0
-    for name in request_components(spec):
+    for name in sorted(request_components(spec)):
         for k, example in enumerate(spec["components"]["schemas"][name].get("examples", [])):
             lines.append(
                 f'export const {name}_{k}: components["schemas"]["{name}"] = {json.dumps(example)};'
