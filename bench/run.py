@@ -277,9 +277,9 @@ def numeric_maps(path: np.ndarray, xs: np.ndarray, ys: np.ndarray, z: float, t_m
     frames = {"base_frame": "base", "tool_frame": "tool0"}
     numeric = NumericFamily(chain_from_urdf(urdf, tool_frame="tool0"), **frames)
     arms = {
-        "UR5 as a URDF": (robot_from_urdf(urdf, **frames, family=numeric), "30x"),
-        "UR5 recognised": (robot_from_urdf(urdf, **frames), "1x"),
-        "Panda": (get_robot("panda"), "60x"),
+        "UR5 as a URDF": (robot_from_urdf(urdf, **frames, family=numeric), "goal <= 30x"),
+        "UR5 recognised": (robot_from_urdf(urdf, **frames), "the UR closed form"),
+        "Panda": (get_robot("panda"), "goal <= 60x"),
     }
     reference = capability_map(
         PathProblem.of(analytic, path), xs=xs, ys=ys, z=z, yaws=np.zeros(1)
@@ -292,7 +292,7 @@ def numeric_maps(path: np.ndarray, xs: np.ndarray, ys: np.ndarray, z: float, t_m
         seconds = time.perf_counter() - start
         line = (
             f"  {label:14s} {seconds:8.3f} s   {seconds / t_map:6.1f}x the analytic UR5 map "
-            f"(goal <= {goal})"
+            f"({goal})"
         )
         if arm.dof == 6:
             same = np.isclose(cmap.mu_path, reference, rtol=1e-10, atol=0) | (

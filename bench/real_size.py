@@ -2,8 +2,8 @@
 
 Run from the repository root::
 
-    python bench/service.py           # about two minutes
-    python bench/service.py --smoke   # small sizes, to check that the script runs
+    python bench/real_size.py           # about two minutes
+    python bench/real_size.py --smoke   # small sizes, to check that the script runs
 
 Each figure is taken against a live uvicorn (``tests/live.py``), with its baseline in the same
 run:
