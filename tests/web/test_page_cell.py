@@ -318,3 +318,21 @@ def test_an_invalid_size_shows_the_apis_error_beside_its_field(
     assert page.text_content("#form-error") == ""
     row = page.locator(".cell-box").last
     assert row.locator(".field[data-tail='box.size'] .error").text_content() == detail[0]["msg"]
+
+
+@pytest.mark.parametrize("width", [1280, 800])
+def test_the_open_editor_reads_at_1280_and_800_px(page: Page, width: int) -> None:
+    page.set_viewport_size({"width": width, "height": 1200})
+    add_box(
+        page,
+        frame="workpiece",
+        name="part",
+        size=["0.3", "0.12", "0.09"],
+        at=["0", "0.06", "-0.045"],
+        rpy=["0", "0", "0"],
+    )
+    page.fill("#tool-radius", "0.03")
+    assert page.is_visible(".cell-box .remove-box")
+    overflow = page.evaluate("document.documentElement.scrollWidth - window.innerWidth")
+    assert overflow <= 0
+    snapshot(page, f"cell-editor-{width}")
