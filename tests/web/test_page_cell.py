@@ -336,3 +336,29 @@ def test_the_open_editor_reads_at_1280_and_800_px(page: Page, width: int) -> Non
     overflow = page.evaluate("document.documentElement.scrollWidth - window.innerWidth")
     assert overflow <= 0
     snapshot(page, f"cell-editor-{width}")
+
+
+@pytest.mark.parametrize(
+    ("fields", "loc", "api_loc"),
+    [
+        ({"table-height": "200"}, "cell.fixed.0", "cell.fixed.0.halfspace.offset"),
+        ({"tool-radius": "-0.03", "tool-length": "0.12"}, "cell.tool.radius", "cell.tool.radius"),
+        ({"tool-radius": "0.03"}, "cell.tool.length", "cell.tool.length"),
+        ({"table-height": "0", "clearance": "2"}, "cell.clearance", "cell.clearance"),
+    ],
+)
+def test_the_table_tool_and_clearance_errors_show_beside_their_fields(
+    page: Page, url: str, fields: dict[str, str], loc: str, api_loc: str
+) -> None:
+    open_editor(page)
+    fill(page, {**SMALL, **fields})
+    with page.expect_request(lambda r: r.method == "POST" and r.url.endswith("/v1/jobs")) as sent:
+        page.click("#run")
+    selector = f".field[data-loc='{loc}'] .error"
+    page.wait_for_function(f'document.querySelector("{selector}").textContent', timeout=60_000)
+    answer = httpx.post(f"{url}/v1/jobs", json=sent.value.post_data_json, timeout=60)
+    assert answer.status_code == 422
+    detail = answer.json()["detail"]
+    assert [".".join(map(str, d["loc"][2:])) for d in detail] == [api_loc]
+    assert page.text_content(selector) == detail[0]["msg"]
+    assert page.text_content("#form-error") == ""
