@@ -2,12 +2,13 @@
 // with joint acceleration limits), a cell's joint speeds and accelerations, the cycle time, the
 // optimum. Plain JavaScript; it calls only this service's API. Its other scripts, loaded before
 // it: format.js (rounding, controller frames), axes.js (the panels' axes), plot.js (the clicked
-// placement's plot), optimum.js (the optimiser).
+// placement's plot), cell.js (the cell editor and its words), optimum.js (the optimiser).
 "use strict";
 
 const $ = (id) => document.getElementById(id);
 const REASON_COLOURS = {
   unreachable: "#e0e0e0", joint_limits: "#f4a6c0", singular: "#555555", discontinuous: "#ffb74d",
+  collision: "#c62828",
 };
 const state = {
   robots: [], path: null, pathProblem: "no path loaded yet", source: null, map: null, grid: null,
@@ -95,7 +96,10 @@ function gridBody() {
 }
 
 function mapBody() {
-  return { robot: robotBody(), path: state.path, grid: gridBody(), ik: ikBody(), spin_mode: spinMode() };
+  return {
+    robot: robotBody(), path: state.path, grid: gridBody(), ik: ikBody(), spin_mode: spinMode(),
+    cell: cellBody(),
+  };
 }
 
 function showLimits() {
@@ -272,15 +276,16 @@ function clearMap() {
 
 function clearCell() {
   $("cell-summary").textContent = "Click (or press Enter on) a cell to see V_max along the path and each joint's use of its limit at the feed.";
-  for (const id of ["bottleneck", "acceleration", "cycle-time"]) $(id).textContent = "";
+  for (const id of ["bottleneck", "acceleration", "cycle-time", "cell-verdict"]) $(id).textContent = "";
   const canvas = $("plot");
   canvas.getContext("2d").clearRect(0, 0, canvas.width, canvas.height);
   delete canvas.dataset.drawn;
 }
 
 function clearOptimum() {
-  for (const id of ["opt-mu", "opt-acc", "opt-acc-binds", "opt-improvement", "opt-where"]) $(id).textContent = "";
+  for (const id of ["opt-mu", "opt-acc", "opt-acc-binds", "opt-improvement", "opt-where", "opt-clearance"]) $(id).textContent = "";
   $("opt-acc-line").hidden = true;
+  $("opt-clearance").hidden = true;
   $("opt-mu-line").hidden = true;
   $("frames").tBodies[0].textContent = "";
   $("frames").hidden = true;
@@ -363,8 +368,11 @@ function drawMap(answer) {
   const size = Math.min(48, Math.max(2, Math.floor(480 / Math.max(xs.length, ys.length))));
   state.scale = { low, high, xs, ys, size, key };
   const byAcc = cells.filter((c) => c.limited_by === "acceleration").length;
+  const collisions = cells.filter((c) => c.reason === "collision").length;
   $("summary").textContent = `${cells.length} cells, ${answer.feasible_cells} feasible`
-    + (key === "mu_acc" ? `; colour: mu_acc, limited by acceleration in ${byAcc} cells, by speed in ${answer.feasible_cells - byAcc}` : "");
+    + (key === "mu_acc" ? `; colour: mu_acc, limited by acceleration in ${byAcc} cells, by speed in ${answer.feasible_cells - byAcc}` : "")
+    + (state.mapBody && state.mapBody.cell ? `; ${collisions} in collision with the cell` : "");
+  $("summary").dataset.collisions = String(collisions);
   $("summary").dataset.cells = String(cells.length);
   $("summary").dataset.key = key;
   $("cb-label").textContent = `${key} (m/s)`;
@@ -439,6 +447,10 @@ function describe(c) {
   const lines = [`x ${c.x.toFixed(4)} m, y ${c.y.toFixed(4)} m, yaw ${c.yaw.toFixed(4)} rad`];
   if (c.mu_path === null) {
     lines.push(`infeasible: ${c.reason} at waypoint ${c.failed_waypoint}`);
+    if (c.reason === "collision") {  // the map's cell says where, the evaluation what hits what
+      const contact = state.whereAcc.get(cellKey(c));
+      lines.push(contact ? collisionText(contact, state.mapBody.cell) : "what hits what: asking the API…");
+    }
   } else {
     lines.push(`mu_path ${c.mu_path.toFixed(6)} m/s`);
     lines.push(`bottleneck: joint ${c.bottleneck_joint + 1}, waypoint ${c.bottleneck_waypoint}`);
@@ -459,15 +471,18 @@ function describe(c) {
 
 function cellKey(c) { return `${c.x} ${c.y} ${c.yaw} ${c.spin}`; }
 
-// A map cell says whether acceleration binds, not where: the summary evaluation of the cell
-// hovered (or under the keyboard cursor) gives it, asked once per cell and kept.
+// A map cell says whether acceleration binds, not where, and that it collides, not with what:
+// the summary evaluation of the cell hovered (or under the keyboard cursor) gives them, asked
+// once per cell and kept.
 function askWhere(c) {
-  if (c.mu_acc == null || c.limited_by !== "acceleration" || state.whereAcc.has(cellKey(c))) return;
+  const collides = c.reason === "collision";
+  if (!collides && (c.mu_acc == null || c.limited_by !== "acceleration")) return;
+  if (state.whereAcc.has(cellKey(c))) return;
   state.whereAcc.set(cellKey(c), null);
   const body = { ...state.mapBody, placement: placementOf(c), detail: "summary" };
   delete body.grid;
   api("POST", "/v1/evaluate", body).then((answer) => {
-    state.whereAcc.set(cellKey(c), answer.acceleration);
+    state.whereAcc.set(cellKey(c), collides ? answer.collision : answer.acceleration);
     if (state.tipCell === c) { $("tooltip").textContent = describe(c); $("tooltip").dataset.where = "1"; }
   }).catch(() => state.whereAcc.delete(cellKey(c)));
 }
@@ -525,6 +540,7 @@ async function evaluateCell(c) {
     feed: value("feed"),
     ik: ikBody(),
     spin_mode: state.mapBody ? state.mapBody.spin_mode : spinMode(),
+    cell: cellBody(),
   };
   $("cell-summary").textContent = "evaluating…";
   const answer = await api("POST", "/v1/evaluate", body).catch(() => null);
@@ -537,6 +553,7 @@ async function evaluateCell(c) {
   $("cell-summary").textContent = answer.feasible
     ? `${where}: mu_path ${answer.mu_path.toFixed(6)} m/s${use}`
     : `${where}: infeasible (${answer.reason} at waypoint ${answer.failed_waypoint})`;
+  $("cell-verdict").textContent = cellVerdict(answer, body.cell);
   if (answer.feasible && answer.spin_mode === "free") await compareFixedSpin(body, answer);
   const b = answer.bottleneck;
   $("bottleneck").textContent = b ? `bottleneck: waypoint ${b.waypoint}, joint ${b.joint + 1} (${b.joint_name})` : "";
@@ -616,6 +633,7 @@ async function start() {
   $("inputs").addEventListener("submit", runMap);
   $("cancel").addEventListener("click", cancelMap);
   $("optimize").addEventListener("click", optimize);
+  startCellEditor();
   await loadExample();
   document.body.dataset.ready = "1";
 }

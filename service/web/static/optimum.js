@@ -47,13 +47,20 @@ async function optimize() {
   const body = {
     robot: robotBody(), path: state.path, method: $("method").value, z: grid.z, ik: ikBody(),
     bounds: { x: [grid.x.min, grid.x.max], y: [grid.y.min, grid.y.max], yaw: yawRange(grid) },
-    spin_mode: spinMode(),
+    spin_mode: spinMode(), cell: cellBody(),
   };
   $("opt-mu").textContent = "optimising…";
   $("opt-mu-line").hidden = false;
   const answer = await api("POST", "/v1/optimize", body, BOUND_FIELDS).catch(() => null);
   if (!answer) { $("opt-mu").textContent = "no optimum: see the errors above"; return; }
-  if (!answer.found) { $("opt-mu").textContent = "no feasible placement"; return; }
+  if (!answer.found) {
+    $("opt-mu").textContent = body.cell ? "no feasible placement free of collisions" : "no feasible placement";
+    return;
+  }
+  if (body.cell && answer.evaluation) {
+    $("opt-clearance").textContent = cellVerdict(answer.evaluation, body.cell);
+    $("opt-clearance").hidden = false;
+  }
   const p = answer.placement;
   $("opt-mu").textContent = `${answer.mu_path.toFixed(6)} m/s`;
   const start = answer.start.mu_path === null ? "infeasible" : answer.start.mu_path.toFixed(6) + " m/s";

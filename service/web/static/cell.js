@@ -1,0 +1,200 @@
+// The cell editor (spec/cell.md): a table top, boxes fixed in the base frame {B} or moving with
+// the workpiece in {O}, the tool and the clearance; the `cell` of a request built from them, and
+// the words for what an answer says of it (a collision, the least clearance). With no table, no
+// box and no tool the page sends no cell, so the answers are those of a request without one.
+"use strict";
+
+const DEGREE = Math.PI / 180;
+const cellEditor = { boxes: 0 };
+
+// The unit quaternion [x, y, z, w] of R = Rz(yaw) Ry(pitch) Rx(roll), angles in rad.
+function quaternionOf(roll, pitch, yaw) {
+  const cr = Math.cos(roll / 2), sr = Math.sin(roll / 2);
+  const cp = Math.cos(pitch / 2), sp = Math.sin(pitch / 2);
+  const cy = Math.cos(yaw / 2), sy = Math.sin(yaw / 2);
+  return [
+    sr * cp * cy - cr * sp * sy,
+    cr * sp * cy + sr * cp * sy,
+    cr * cp * sy - sr * sp * cy,
+    cr * cp * cy + sr * sp * sy,
+  ];
+}
+
+// A number input's value as typed: empty or a word is NaN, which JSON sends as null, so that the
+// API says beside the field what is wrong (nothing is read as 0 or dropped here).
+function typed(input) {
+  const text = input.value.trim();
+  return text === "" ? NaN : Number(text);
+}
+
+// One labelled group of number inputs with its error line; `tail` is its place in an object's
+// loc (`box.size`), completed with the object's group and index when a body is built.
+function numberGroup(tail, label, names, values, owner) {
+  const field = document.createElement("div");
+  field.className = "field";
+  field.dataset.tail = tail;
+  const title = document.createElement("span");
+  title.className = "label";
+  title.textContent = label;
+  field.appendChild(title);
+  names.forEach((name, k) => {
+    const input = document.createElement("input");
+    input.type = "number"; input.step = "any"; input.className = "short";
+    input.value = values[k];
+    input.dataset.part = name;
+    input.setAttribute("aria-label", `${owner} ${name}`);
+    field.appendChild(input);
+  });
+  const error = document.createElement("span");
+  error.className = "error"; error.setAttribute("role", "alert");
+  field.appendChild(error);
+  return field;
+}
+
+// A new box row: its frame (fixed or workpiece), name, sizes, position and angles.
+function addBox() {
+  cellEditor.boxes += 1;
+  const n = cellEditor.boxes;
+  const owner = `box ${n}`;
+  const row = document.createElement("fieldset");
+  row.className = "cell-box";
+  row.dataset.box = String(n);
+  const legend = document.createElement("legend");
+  legend.textContent = `Box ${n}`;
+  row.appendChild(legend);
+  const head = document.createElement("div");
+  head.className = "field";
+  head.dataset.tail = "";
+  head.innerHTML = `<label>Frame and name</label>
+    <select class="box-frame" aria-label="${owner} frame">
+      <option value="fixed">fixed: in the base frame {B}, stays put</option>
+      <option value="workpiece">workpiece: in {O}, moves with the placement</option>
+    </select>
+    <input class="box-name" type="text" value="${owner}" aria-label="${owner} name">
+    <span class="error" role="alert"></span>`;
+  row.appendChild(head);
+  row.appendChild(numberGroup("box.size", "Size lx, ly, lz (m)", ["lx (m)", "ly (m)", "lz (m)"], [0.1, 0.1, 0.1], owner));
+  row.appendChild(numberGroup("box.pose.position", "Centre x, y, z (m)", ["x (m)", "y (m)", "z (m)"], [0, 0, 0], owner));
+  row.appendChild(numberGroup("box.pose.orientation", "Roll, pitch, yaw (deg; R = Rz(yaw) Ry(pitch) Rx(roll))",
+    ["roll (deg)", "pitch (deg)", "yaw (deg)"], [0, 0, 0], owner));
+  const remove = document.createElement("button");
+  remove.type = "button"; remove.className = "remove-box"; remove.textContent = "Remove";
+  remove.setAttribute("aria-label", `Remove ${owner}`);
+  remove.addEventListener("click", () => { row.remove(); showCellStatus(); });
+  row.appendChild(remove);
+  $("cell-boxes").appendChild(row);
+  showCellStatus();
+  return row;
+}
+
+function parts(row, tail) {
+  return [...row.querySelector(`.field[data-tail="${tail}"]`).querySelectorAll("input")].map(typed);
+}
+
+// The box of a row as the API takes it.
+function boxObject(row) {
+  const [roll, pitch, yaw] = parts(row, "box.pose.orientation").map((a) => a * DEGREE);
+  const name = row.querySelector(".box-name").value.trim();
+  const box = {
+    shape: "box",
+    size: parts(row, "box.size"),
+    pose: { position: parts(row, "box.pose.position"), orientation: quaternionOf(roll, pitch, yaw) },
+  };
+  if (name) box.name = name;
+  return box;
+}
+
+// The tool, when any of its fields is filled: each as typed (an empty radius or length is the
+// API's "Field required" beside it); an empty cutting length is the API's default.
+function toolBody() {
+  const ids = ["tool-radius", "tool-length", "tool-cutting-length"];
+  if (ids.every((id) => $(id).value.trim() === "")) return undefined;
+  const tool = { radius: value("tool-radius"), length: value("tool-length") };
+  if ($("tool-cutting-length").value.trim() !== "") tool.cutting_length = value("tool-cutting-length");
+  return tool;
+}
+
+// The request's `cell`, or undefined (left out of the body) when there is nothing in it. Every
+// field's loc is numbered as the body is, so that the API's errors go beside their fields.
+function cellBody() {
+  const fixed = [], workpiece = [];
+  const table = $("table-height");
+  if (table.value.trim() !== "") {
+    table.closest(".field").dataset.loc = "cell.fixed.0";
+    fixed.push({ shape: "halfspace", name: "table", normal: [0, 0, 1], offset: value("table-height") });
+  } else {
+    table.closest(".field").dataset.loc = "cell.table";
+  }
+  for (const row of $("cell-boxes").querySelectorAll(".cell-box")) {
+    const group = row.querySelector(".box-frame").value === "workpiece" ? workpiece : fixed;
+    const place = `cell.${group === fixed ? "fixed" : "workpiece"}.${group.length}`;
+    for (const field of row.querySelectorAll(".field")) {
+      field.dataset.loc = field.dataset.tail ? `${place}.${field.dataset.tail}` : place;
+    }
+    group.push(boxObject(row));
+  }
+  const tool = toolBody();
+  if (!fixed.length && !workpiece.length && !tool) return undefined;
+  const cell = { fixed, workpiece };
+  if (tool) cell.tool = tool;
+  if ($("clearance").value.trim() !== "") cell.clearance = value("clearance");
+  return cell;
+}
+
+// What the editor holds, in a line under it.
+function showCellStatus() {
+  const boxes = $("cell-boxes").querySelectorAll(".cell-box").length;
+  const table = $("table-height").value.trim() !== "";
+  const tool = ["tool-radius", "tool-length", "tool-cutting-length"].some((id) => $(id).value.trim() !== "");
+  const things = [table ? "a table top" : "", boxes ? `${boxes} box${boxes === 1 ? "" : "es"}` : "", tool ? "the tool" : ""]
+    .filter(Boolean);
+  $("cell-status").textContent = things.length
+    ? `Checked along the path against ${things.join(", ")}, and the robot against itself.`
+    : "Empty: nothing is checked (no cell is sent).";
+}
+
+function millimetres(metresValue) { return `${fixed(1000 * metresValue, 1)} mm`; }
+
+// An obstacle of a contact by its name and its place in the request's lists (fixed first, then
+// workpiece, as the API counts them); null is another part of the robot.
+function obstacleOf(contact, cell) {
+  if (contact.obstacle === null) return `${contact.obstacle_name} (the robot itself)`;
+  const fixedCount = cell ? cell.fixed.length : 0;
+  const place = contact.obstacle < fixedCount ? `fixed[${contact.obstacle}]`
+    : `workpiece[${contact.obstacle - fixedCount}]`;
+  return contact.obstacle_name === place ? place : `${contact.obstacle_name} (${place})`;
+}
+
+function clearanceOf(cell) { return cell && cell.clearance !== undefined ? cell.clearance : 0.005; }
+
+// A collision as a sentence: robot part, obstacle, waypoint, distance against the clearance.
+function collisionText(contact, cell) {
+  const overlap = contact.distance < 0 ? ", overlapping" : "";
+  return `${contact.robot_part} hits ${obstacleOf(contact, cell)} at waypoint ${contact.waypoint}: `
+    + `distance ${millimetres(contact.distance)}${overlap} (clearance ${millimetres(clearanceOf(cell))})`;
+}
+
+// The least clearance of a feasible path as a sentence.
+function clearanceText(contact, cell) {
+  return `min clearance ${millimetres(contact.distance)}: ${contact.robot_part} to ${obstacleOf(contact, cell)}`
+    + ` at waypoint ${contact.waypoint} (clearance asked ${millimetres(clearanceOf(cell))})`;
+}
+
+// What an evaluation says of the cell: the collision, or the least clearance, and the links
+// given capsules for want of collision geometry; empty without a cell.
+function cellVerdict(answer, cell) {
+  if (!cell) return "";
+  const text = answer.collision ? `collision: ${collisionText(answer.collision, cell)}`
+    : answer.min_clearance ? clearanceText(answer.min_clearance, cell) : "";
+  const approximated = answer.cell_approximated && answer.cell_approximated.length
+    ? `; links approximated by capsules: ${answer.cell_approximated.join(", ")}` : "";
+  return text + approximated;
+}
+
+function startCellEditor() {
+  $("add-box").addEventListener("click", addBox);
+  for (const id of ["table-height", "tool-radius", "tool-length", "tool-cutting-length"]) {
+    $(id).addEventListener("input", showCellStatus);
+  }
+  showCellStatus();
+}

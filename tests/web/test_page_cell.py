@@ -1,0 +1,371 @@
+"""The page's cell editor (issue 22) in headless Chromium: table, boxes, tool, clearance.
+
+Every figure the page shows is compared with the API's own answer to the body the page sent
+(caught here as the browser sends it), and with geometry or the README where those fix it: a
+table top above the base collides everywhere, a box 5 m away changes no cell, the README's
+fixture box makes the velocity-best placement collide. Screenshots go to ``tests/artifacts/``.
+"""
+
+from __future__ import annotations
+
+import re
+from typing import Any
+
+import httpx
+import pytest
+from playwright.sync_api import Page, Request
+from scipy.spatial.transform import Rotation
+
+from tests.cases import ROOT
+from tests.web.conftest import snapshot
+from tests.web.test_page import EXAMPLE_PATH, SMALL, fill, grid_of, pixel
+from tests.web.test_page import cell_point as panel_point
+
+README = (ROOT / "README.md").read_text()
+COLLISION_RGB = (0xC6, 0x28, 0x28)  # the page's collision colour, written again
+README_GRID = {
+    "x-min": "-0.1",
+    "x-max": "0.1",
+    "x-step": "0.1",
+    "y-min": "0.35",
+    "y-max": "0.55",
+    "y-step": "0.1",
+    "z": "0.1",
+    "yaws": "-0.3, 0.3",
+    "spins": "0",
+}
+
+
+def run_map(page: Page) -> dict[str, Any]:
+    """Run the map from the page; the job's request as the browser sent it."""
+    with page.expect_request(lambda r: r.method == "POST" and r.url.endswith("/v1/jobs")) as sent:
+        page.click("#run")
+    page.wait_for_function("document.getElementById('summary').dataset.cells", timeout=120_000)
+    request = sent_json(sent.value)
+    assert request["kind"] == "map"
+    return dict(request["request"])
+
+
+def sent_json(request: Request) -> dict[str, Any]:
+    """The JSON body the browser sent."""
+    body = request.post_data_json
+    assert isinstance(body, dict), body
+    return body
+
+
+def api_map(url: str, body: dict[str, Any]) -> dict[str, Any]:
+    answer = httpx.post(f"{url}/v1/map", json=body, timeout=120)
+    assert answer.status_code == 200, answer.text
+    return dict(answer.json())
+
+
+def add_box(
+    page: Page, *, frame: str, name: str, size: list[str], at: list[str], rpy: list[str]
+) -> None:
+    """Add a box row and fill it (the last row of the editor)."""
+    open_editor(page)
+    page.click("#add-box")
+    row = page.locator(".cell-box").last
+    row.locator(".box-frame").select_option(frame)
+    row.locator(".box-name").fill(name)
+    for tail, values in (
+        ("box.size", size),
+        ("box.pose.position", at),
+        ("box.pose.orientation", rpy),
+    ):
+        inputs = row.locator(f".field[data-tail='{tail}'] input")
+        for k, value in enumerate(values):
+            inputs.nth(k).fill(value)
+
+
+def open_editor(page: Page) -> None:
+    """Unfold the cell editor (folded while empty)."""
+    page.evaluate("document.getElementById('cell-details').open = true")
+
+
+def cell_point(
+    page: Page, panel: int, cell: dict[str, Any], api: dict[str, Any]
+) -> dict[str, float]:
+    """Where a cell of a panel is on the screen, the panel scrolled into view first."""
+    page.locator(".panel canvas").nth(panel).scroll_into_view_if_needed()
+    return panel_point(page, panel, cell, api)
+
+
+def hover_text(page: Page, point: dict[str, float]) -> str:
+    """The tooltip of the cell under ``point``, once the API has said what hits what."""
+    page.mouse.move(point["x"], point["y"])
+    page.wait_for_function("document.getElementById('tooltip').dataset.where", timeout=60_000)
+    return page.text_content("#tooltip") or ""
+
+
+def mm(value: float) -> str:
+    return f"{1000 * value:.1f} mm"
+
+
+def test_an_empty_editor_sends_no_cell(page: Page, url: str) -> None:
+    assert page.text_content("#cell-status") == "Empty: nothing is checked (no cell is sent)."
+    assert page.get_attribute("#cell-details", "open") is None  # folded while empty
+    fill(page, SMALL)
+    request = run_map(page)
+    assert "cell" not in request
+    with page.expect_request(lambda r: r.url.endswith("/v1/optimize")) as sent:
+        page.click("#optimize")
+    assert "cell" not in sent_json(sent.value)
+    page.wait_for_function("document.getElementById('opt-where').textContent", timeout=120_000)
+    assert page.is_hidden("#opt-clearance")
+
+
+def test_a_table_above_the_base_makes_every_cell_collide_and_the_hover_names_the_parts(
+    page: Page, url: str
+) -> None:
+    open_editor(page)
+    fill(page, {**SMALL, "table-height": "0.2"})
+    request = run_map(page)
+    table = {"shape": "halfspace", "name": "table", "normal": [0, 0, 1], "offset": 0.2}
+    assert request["cell"] == {"fixed": [table], "workpiece": []}
+    api = api_map(url, request)
+    # geometry: a table top 0.2 m above the base plane cuts the upper arm at every placement
+    assert {c["reason"] for c in api["cells"]} == {"collision"}
+    assert page.get_attribute("#summary", "data-collisions") == str(len(api["cells"]))
+    per_panel = len(api["cells"]) // 2
+    for k, cell in enumerate(api["cells"]):
+        assert pixel(page, k // per_panel, cell, api) == COLLISION_RGB
+    cell = api["cells"][per_panel + 7]
+    text = hover_text(page, cell_point(page, 1, cell, api))
+    placement = {"x": cell["x"], "y": cell["y"], "z": 0.1, "yaw": cell["yaw"], "spin": 0.0}
+    evaluation = httpx.post(
+        f"{url}/v1/evaluate",
+        json={
+            "robot": {"model": "ur5"},
+            "path": EXAMPLE_PATH,
+            "placement": placement,
+            "cell": {"fixed": [table]},
+        },
+        timeout=60,
+    ).json()
+    hit = evaluation["collision"]
+    assert hit["obstacle_name"] == "table"
+    assert f"infeasible: collision at waypoint {cell['failed_waypoint']}" in text
+    assert (
+        f"{hit['robot_part']} hits table (fixed[0]) at waypoint {hit['waypoint']}: "
+        f"distance {mm(hit['distance'])}, overlapping (clearance 5.0 mm)"
+    ) in text
+    snapshot(page, "cell-table-hover")
+
+
+def test_a_far_box_changes_no_cell(page: Page, url: str) -> None:
+    fill(page, SMALL)
+    plain = run_map(page)
+    before = page.evaluate(
+        "[...document.querySelectorAll('.panel canvas')].map(c => c.toDataURL())"
+    )
+    add_box(
+        page,
+        frame="fixed",
+        name="far",
+        size=["0.2", "0.2", "0.2"],
+        at=["5", "5", "0"],
+        rpy=["0", "0", "0"],
+    )
+    request = run_map(page)
+    box = request["cell"]["fixed"][0]
+    assert box["size"] == [0.2, 0.2, 0.2]
+    assert box["pose"]["position"] == [5, 5, 0]
+    after = page.evaluate("[...document.querySelectorAll('.panel canvas')].map(c => c.toDataURL())")
+    assert after == before  # every cell painted as without the box
+    assert page.get_attribute("#summary", "data-collisions") == "0"
+    with_box, without = api_map(url, request), api_map(url, plain)
+    assert [c["mu_path"] for c in with_box["cells"]] == [c["mu_path"] for c in without["cells"]]
+
+
+def test_a_boxs_frame_and_angles_reach_the_request(page: Page, url: str) -> None:
+    """The angles as scipy turns Rz(yaw) Ry(pitch) Rx(roll) into [x, y, z, w]; groups in order."""
+    fill(page, {**SMALL, "x-step": "0.1", "y-step": "0.1", "yaws": "0"})
+    add_box(
+        page,
+        frame="workpiece",
+        name="part",
+        size=["0.1", "0.05", "0.02"],
+        at=["0", "0.06", "-0.03"],
+        rpy=["10", "-20", "30"],
+    )
+    add_box(
+        page,
+        frame="fixed",
+        name="wall",
+        size=["0.1", "2", "2"],
+        at=["-3", "0", "1"],
+        rpy=["0", "0", "90"],
+    )
+    page.fill("#tool-radius", "0.03")
+    page.fill("#tool-length", "0.12")
+    page.fill("#clearance", "0.002")
+    request = run_map(page)
+    cell = request["cell"]
+    assert [o["name"] for o in cell["fixed"]] == ["wall"]
+    assert [o["name"] for o in cell["workpiece"]] == ["part"]
+    assert cell["tool"] == {"radius": 0.03, "length": 0.12}
+    assert cell["clearance"] == 0.002
+    for obj, rpy in ((cell["workpiece"][0], (10, -20, 30)), (cell["fixed"][0], (0, 0, 90))):
+        expected = Rotation.from_euler("ZYX", rpy[::-1], degrees=True).as_quat()
+        assert obj["pose"]["orientation"] == pytest.approx(list(expected), abs=1e-12)
+    assert page.get_attribute("#summary", "data-cells") == str(len(api_map(url, request)["cells"]))
+
+
+def readme_figures() -> dict[str, str]:
+    """The README's cell example output, read with a regex."""
+    found = re.search(
+        r"velocity-best: mu_path = (?P<fast>[\d.]+) m/s at x (?P<fx>[-\d.]+) m, "
+        r"y (?P<fy>[-\d.]+) m, yaw (?P<fyaw>[-\d.]+) rad\n"
+        r"in the cell: collision of (?P<part>\w+) with (?P<obstacle>\w+) "
+        r"at waypoint (?P<waypoint>\d+) \((?P<distance>[\d.]+) mm < 5 mm clearance\)\n"
+        r"collision-free optimum: mu_path = (?P<free>[\d.]+) m/s at x (?P<x>[-\d.]+) m, "
+        r"y (?P<y>[-\d.]+) m, yaw (?P<yaw>[-\d.]+) rad; min clearance (?P<clear>[\d.]+) mm "
+        r"\((?P<near>\w+) to (?P<near_obstacle>\w+)\)",
+        README,
+    )
+    assert found, "the README's cell example output"
+    return found.groupdict()
+
+
+def optimise(page: Page) -> dict[str, Any]:
+    """Optimise from the page; the request it sent."""
+    with page.expect_request(lambda r: r.url.endswith("/v1/optimize")) as sent:
+        page.click("#optimize")
+    page.wait_for_function("document.getElementById('opt-where').textContent", timeout=300_000)
+    return sent_json(sent.value)
+
+
+def test_the_readme_fixture_makes_the_velocity_best_placement_collide(page: Page, url: str) -> None:
+    readme = readme_figures()
+    fill(page, README_GRID)
+    assert optimise(page)["bounds"]["yaw"] == [-0.3, 0.3]
+    assert page.text_content("#opt-mu") == f"{readme['fast']} m/s"
+    assert (page.text_content("#opt-where") or "").startswith(
+        f"x {readme['fx']} m, y {readme['fy']} m, z 0.1000 m, yaw {readme['fyaw']} rad"
+    )
+    open_editor(page)
+    page.fill("#table-height", "0")
+    add_box(
+        page,
+        frame="fixed",
+        name="fixture",
+        size=["0.08"] * 3,
+        at=["0.085", "0.32", "0.35"],
+        rpy=["0", "0", "0"],
+    )
+    request = run_map(page)
+    api = api_map(url, request)
+    fast = next(
+        c
+        for c in api["cells"]
+        if (c["x"], c["y"], c["yaw"])
+        == pytest.approx((float(readme["fx"]), float(readme["fy"]), float(readme["fyaw"])))
+    )
+    assert fast["reason"] == "collision"
+    assert pixel(page, 1, fast, api) == COLLISION_RGB
+    text = hover_text(page, cell_point(page, 1, fast, api))
+    assert (
+        f"{readme['part']} hits {readme['obstacle']} (fixed[1]) at waypoint {readme['waypoint']}: "
+        f"distance {readme['distance']} mm (clearance 5.0 mm)"
+    ) in text
+    page.mouse.click(*cell_point(page, 1, fast, api).values())
+    page.wait_for_function("document.getElementById('cell-verdict').textContent", timeout=60_000)
+    assert (page.text_content("#cell-verdict") or "").startswith(
+        f"collision: {readme['part']} hits {readme['obstacle']} (fixed[1])"
+    )
+    sent = optimise(page)
+    assert sent["cell"] == request["cell"]
+    answer = httpx.post(f"{url}/v1/optimize", json=sent, timeout=300).json()
+    near = answer["evaluation"]["min_clearance"]
+    assert page.text_content("#opt-mu") == f"{answer['mu_path']:.6f} m/s" == f"{readme['free']} m/s"
+    assert page.text_content("#opt-clearance") == (
+        f"min clearance {mm(near['distance'])}: {near['robot_part']} to "
+        f"{readme['near_obstacle']} (fixed[0]) at waypoint {near['waypoint']} "
+        "(clearance asked 5.0 mm)"
+    )
+    assert mm(near["distance"]) == f"{readme['clear']} mm"
+    assert near["robot_part"] == readme["near"]
+    snapshot(page, "cell-readme-optimum")
+
+
+@pytest.mark.parametrize(
+    ("frame", "loc"),
+    [("fixed", "cell.fixed.1.box.size"), ("workpiece", "cell.workpiece.0.box.size")],
+)
+@pytest.mark.parametrize("button", ["#run", "#optimize"])
+def test_an_invalid_size_shows_the_apis_error_beside_its_field(
+    page: Page, url: str, frame: str, loc: str, button: str
+) -> None:
+    open_editor(page)
+    fill(page, {**SMALL, "table-height": "0"})
+    add_box(
+        page,
+        frame=frame,
+        name="bad",
+        size=["0.1", "-0.05", "0.1"],
+        at=["0", "0.5", "0"],
+        rpy=["0", "0", "0"],
+    )
+    page.click(button)
+    selector = f".field[data-loc='{loc}'] .error"
+    page.wait_for_function(
+        f'document.querySelector("{selector}") && document.querySelector("{selector}").textContent',
+        timeout=60_000,
+    )
+    cell: dict[str, list[dict[str, Any]]] = {
+        "fixed": [{"shape": "halfspace", "normal": [0, 0, 1], "offset": 0}],
+        "workpiece": [],
+    }
+    cell[frame].append({"shape": "box", "size": [0.1, -0.05, 0.1]})
+    body = {"robot": {"model": "ur5"}, "path": EXAMPLE_PATH, "grid": grid_of(SMALL), "cell": cell}
+    detail = httpx.post(f"{url}/v1/map", json=body, timeout=60).json()["detail"]
+    assert [".".join(map(str, d["loc"][1:])) for d in detail] == [f"{loc}.1"]
+    assert page.text_content(selector) == detail[0]["msg"]
+    assert page.text_content("#form-error") == ""
+    row = page.locator(".cell-box").last
+    assert row.locator(".field[data-tail='box.size'] .error").text_content() == detail[0]["msg"]
+
+
+@pytest.mark.parametrize("width", [1280, 800])
+def test_the_open_editor_reads_at_1280_and_800_px(page: Page, width: int) -> None:
+    page.set_viewport_size({"width": width, "height": 1200})
+    add_box(
+        page,
+        frame="workpiece",
+        name="part",
+        size=["0.3", "0.12", "0.09"],
+        at=["0", "0.06", "-0.045"],
+        rpy=["0", "0", "0"],
+    )
+    page.fill("#tool-radius", "0.03")
+    assert page.is_visible(".cell-box .remove-box")
+    overflow = page.evaluate("document.documentElement.scrollWidth - window.innerWidth")
+    assert overflow <= 0
+    snapshot(page, f"cell-editor-{width}")
+
+
+@pytest.mark.parametrize(
+    ("fields", "loc", "api_loc"),
+    [
+        ({"table-height": "200"}, "cell.fixed.0", "cell.fixed.0.halfspace.offset"),
+        ({"tool-radius": "-0.03", "tool-length": "0.12"}, "cell.tool.radius", "cell.tool.radius"),
+        ({"tool-radius": "0.03"}, "cell.tool.length", "cell.tool.length"),
+        ({"table-height": "0", "clearance": "2"}, "cell.clearance", "cell.clearance"),
+    ],
+)
+def test_the_table_tool_and_clearance_errors_show_beside_their_fields(
+    page: Page, url: str, fields: dict[str, str], loc: str, api_loc: str
+) -> None:
+    open_editor(page)
+    fill(page, {**SMALL, **fields})
+    with page.expect_request(lambda r: r.method == "POST" and r.url.endswith("/v1/jobs")) as sent:
+        page.click("#run")
+    selector = f".field[data-loc='{loc}'] .error"
+    page.wait_for_function(f'document.querySelector("{selector}").textContent', timeout=60_000)
+    answer = httpx.post(f"{url}/v1/jobs", json=sent_json(sent.value), timeout=60)
+    assert answer.status_code == 422
+    detail = answer.json()["detail"]
+    assert [".".join(map(str, d["loc"][2:])) for d in detail] == [api_loc]
+    assert page.text_content(selector) == detail[0]["msg"]
+    assert page.text_content("#form-error") == ""
