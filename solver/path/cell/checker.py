@@ -18,6 +18,7 @@ import numpy as np
 import pinocchio as pin
 
 from solver.core.robots import Robot
+from solver.path.cell import fast
 from solver.path.cell.bounds import pair_weights
 from solver.path.cell.robot_geometry import robot_geometry
 from solver.path.cell.shapes import Cell
@@ -59,7 +60,7 @@ class CellVerdict:
             there is none.
         closest: the closest pair over every checked configuration (None when the check
             stopped at the first collision).
-        checks: how many configurations were checked.
+        checks: how many configurations were checked (by coal, in a fast map check).
         approximated: the robot's links given capsules (no readable collision geometry).
     """
 
@@ -108,6 +109,13 @@ class CellChecker:
         for a, b in self._pairs:
             geometry.addCollisionPair(pin.CollisionPair(a, b))
         self._weights = pair_weights(robot.model, geometry, self._pairs, self._n_robot)
+        self._fixed_places = [obj.placement for obj in geometry.geometryObjects[self._n_robot :]]
+        try:
+            self._fast: fast.FastCell | None = fast.FastCell(
+                robot.model, geometry, self._n_robot, self._pairs
+            )
+        except NotImplementedError:
+            self._fast = None  # a joint or shape the compiled sweep lacks: coal alone
 
     def _self_pairs(self, cutting: int) -> list[tuple[int, int]]:
         """Robot parts on joints neither the same nor adjacent, apart at the zero configuration."""
@@ -165,6 +173,7 @@ class CellChecker:
         transform_workpiece_to_base: np.ndarray,
         *,
         closest: bool,
+        reference: bool = False,
     ) -> CellVerdict:
         """Check a joint path at one placement.
 
@@ -175,14 +184,17 @@ class CellChecker:
             closest: check every configuration and give the closest pair (an evaluation);
                 False stops at the first collision and skips configurations that cannot come
                 within the clearance (a map; :meth:`_first_collision`).
+            reference: coal at every checked configuration, as the compiled sweep
+                (:mod:`solver.path.cell.fast`) must agree with; also where the sweep lacks a
+                joint or shape.
         """
         configurations, owners = self.configurations(np.asarray(q, float), segment_in_pass)
-        geometry = self.geometry.copy()  # its own workpiece poses: threads share the checker
         placed = self._world_to_base * pin.SE3(np.asarray(transform_workpiece_to_base, float))
-        for gid, pose in self._workpiece_ids:
-            geometry.geometryObjects[gid].placement = placed * pose
         if not self._pairs:
             return CellVerdict(None, None, 0, self.approximated)
+        if self._fast is not None and not reference:
+            return self._fast_check(configurations, owners, placed, closest=closest)
+        geometry = self._placed_geometry(placed)
         if not closest:
             return self._first_collision(geometry, configurations, owners)
         model = self.robot.model
@@ -202,6 +214,50 @@ class CellChecker:
                 best = (low, index, pair)
         near = None if best is None else self._contact(int(owners[best[1]]), best[2], best[0])
         return CellVerdict(None, near, len(configurations), self.approximated)
+
+    def _placed_geometry(self, placed: pin.SE3) -> pin.GeometryModel:
+        """A copy of the geometry with the workpiece objects at ``placed`` (threads share self)."""
+        geometry = self.geometry.copy()
+        for gid, pose in self._workpiece_ids:
+            geometry.geometryObjects[gid].placement = placed * pose
+        return geometry
+
+    def _fast_check(
+        self, configurations: np.ndarray, owners: np.ndarray, placed: pin.SE3, *, closest: bool
+    ) -> CellVerdict:
+        """:meth:`check` by the compiled sweep, coal only where it cannot decide."""
+        assert self._fast is not None
+        places = list(self._fixed_places)
+        for gid, pose in self._workpiece_ids:
+            places[gid - self._n_robot] = placed * pose
+        obstacles = self._fast.obstacle_pack(places)
+        made: list[tuple[pin.GeometryModel, pin.GeometryData, pin.Data]] = []
+
+        def coal_distances(index: int, due: np.ndarray) -> np.ndarray:
+            if not made:
+                geometry = self._placed_geometry(placed)
+                made.append((geometry, geometry.createData(), self.robot.model.createData()))
+            geometry, gdata, data = made[0]
+            model = self.robot.model
+            pin.updateGeometryPlacements(model, data, geometry, gdata, configurations[index])
+            return np.array(
+                [pin.computeDistance(geometry, gdata, int(p)).min_distance for p in due]
+            )
+
+        clearance = self.cell.clearance
+        if closest:
+            hit, near = fast.closest_contact(
+                self._fast, configurations, obstacles, clearance, coal_distances
+            )
+            checks = len(configurations) if hit is None else hit[0] + 1
+        else:
+            hit, checks = fast.first_collision(
+                self._fast, configurations, obstacles, self._weights, clearance, coal_distances
+            )
+            near = None
+        collision = None if hit is None else self._contact(int(owners[hit[0]]), hit[1], hit[2])
+        nearest = None if near is None else self._contact(int(owners[near[0]]), near[1], near[2])
+        return CellVerdict(collision, nearest, checks, self.approximated)
 
     def _first_collision(
         self, geometry: pin.GeometryModel, configurations: np.ndarray, owners: np.ndarray

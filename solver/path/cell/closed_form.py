@@ -1,0 +1,121 @@
+"""Closed-form distances from a capsule (a segment swept by a ball) to the cell's primitives.
+
+Compiled scalar code (numba, ``nogil``) for the fast cell check (:mod:`solver.path.cell.sweep`):
+the distance from a segment [a, b] of radius r to a halfspace, a sphere (or another capsule:
+segment to segment) and a box, each exact where the shapes are apart (coal agrees, tested in
+tests/solver/test_cell_closed_form.py). Where they overlap the values are only <= 0 (not coal's
+penetration depth): the check takes such pairs to coal.
+
+Segment to box: in the box's frame the squared distance from a(t) = a + t (b - a) is
+sum_i max(|a_i(t)| - h_i, 0)^2, convex and quadratic between the parameters where a coordinate
+crosses +-h_i; each piece's minimum, clamped to the piece, gives the exact minimum.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+
+@njit(cache=True, nogil=True, error_model="numpy", inline="always")
+def _clamp01(x):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
+    """The value clamped to [0, 1]."""
+    return 0.0 if x < 0.0 else (1.0 if x > 1.0 else x)
+
+
+@njit(cache=True, nogil=True, error_model="numpy")
+def segment_halfspace(a, b, radius, normal, offset):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
+    """Distance from the capsule [a, b] (radius) to the points p with normal . p <= offset."""
+    da = normal[0] * a[0] + normal[1] * a[1] + normal[2] * a[2] - offset
+    db = normal[0] * b[0] + normal[1] * b[1] + normal[2] * b[2] - offset
+    return min(da, db) - radius
+
+
+@njit(cache=True, nogil=True, error_model="numpy")
+def segment_segment(p1, q1, p2, q2):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
+    """Distance between the segments [p1, q1] and [p2, q2] (either may be a point).
+
+    The closest parameters of Ericson's "Real-Time Collision Detection" 5.1.9: the unclamped
+    line parameters, clamped, the other one recomputed and clamped again.
+    """
+    d1 = q1 - p1
+    d2 = q2 - p2
+    r = p1 - p2
+    a = d1[0] * d1[0] + d1[1] * d1[1] + d1[2] * d1[2]
+    e = d2[0] * d2[0] + d2[1] * d2[1] + d2[2] * d2[2]
+    f = d2[0] * r[0] + d2[1] * r[1] + d2[2] * r[2]
+    tiny = 1e-30
+    if a <= tiny and e <= tiny:
+        s, t = 0.0, 0.0
+    elif a <= tiny:
+        s, t = 0.0, _clamp01(f / e)
+    else:
+        c = d1[0] * r[0] + d1[1] * r[1] + d1[2] * r[2]
+        if e <= tiny:
+            s, t = _clamp01(-c / a), 0.0
+        else:
+            bb = d1[0] * d2[0] + d1[1] * d2[1] + d1[2] * d2[2]
+            denom = a * e - bb * bb
+            s = _clamp01((bb * f - c * e) / denom) if denom > 1e-14 * a * e else 0.0
+            t = (bb * s + f) / e
+            if t < 0.0:
+                t, s = 0.0, _clamp01(-c / a)
+            elif t > 1.0:
+                t, s = 1.0, _clamp01((bb - c) / a)
+    total = 0.0
+    for i in range(3):
+        gap = p1[i] + d1[i] * s - p2[i] - d2[i] * t
+        total += gap * gap
+    return math.sqrt(total)
+
+
+@njit(cache=True, nogil=True, error_model="numpy", inline="always")
+def _side(x, half):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
+    """The face a coordinate x is beyond (+-half), or 0 within [-half, half]."""
+    return half if x > half else (-half if x < -half else 0.0)
+
+
+@njit(cache=True, nogil=True, error_model="numpy")
+def _box_piece(a, d, half, lo, hi):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
+    """Smallest squared distance to the box over t in [lo, hi], where no coordinate crosses."""
+    mid = 0.5 * (lo + hi)
+    qa, qb = 0.0, 0.0  # the piece's quadratic: qa t^2 + qb t + ...
+    for i in range(3):
+        side = _side(a[i] + mid * d[i], half[i])
+        if side != 0.0:
+            qa += d[i] * d[i]
+            qb += 2.0 * (a[i] - side) * d[i]
+    t = lo if qa <= 0.0 else min(max(-qb / (2.0 * qa), lo), hi)
+    total = 0.0
+    for i in range(3):
+        side = _side(a[i] + mid * d[i], half[i])
+        if side != 0.0:
+            gap = a[i] - side + t * d[i]
+            total += gap * gap
+    return total
+
+
+@njit(cache=True, nogil=True, error_model="numpy")
+def segment_box(a, b, half):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
+    """Distance from the segment [a, b] to the box [-half, half], both in the box's frame."""
+    d = b - a
+    cuts = np.empty(8)
+    cuts[0], cuts[1] = 0.0, 1.0
+    count = 2
+    for i in range(3):
+        if d[i] != 0.0:
+            for sign in (-1.0, 1.0):
+                t = (sign * half[i] - a[i]) / d[i]
+                if 0.0 < t < 1.0:
+                    cuts[count] = t
+                    count += 1
+    cuts = np.sort(cuts[:count])
+    best = np.inf
+    for k in range(count - 1):
+        if cuts[k + 1] > cuts[k]:
+            best = min(best, _box_piece(a, d, half, cuts[k], cuts[k + 1]))
+    if best == np.inf:  # a point
+        best = _box_piece(a, d, half, 0.0, 0.0)
+    return math.sqrt(best)

@@ -1,0 +1,184 @@
+"""The fast cell check: compiled bounds decide, coal only where a bound cannot (cell.md s. 4).
+
+The compiled sweep (:mod:`solver.path.cell.sweep`) gives every checked pair a lower bound on
+its distance at a configuration: the exact distance for capsules, spheres, boxes and
+halfspaces (:mod:`closed_form`), the distance between bounding capsules for meshes and
+cylinders (:mod:`capsules`). A pair goes to coal (the reference's own call, the same numbers)
+only where its bound is within the clearance plus :data:`MARGIN`, or where it could be the
+closest pair of an evaluation. So the answers are the reference's
+(:meth:`solver.path.cell.checker.CellChecker.check` with ``reference=True``): the first
+configuration closer than the clearance, the pair and coal's distance there, and the closest
+pair of a clear path, ties broken alike (the first configuration, then the first pair).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+import numpy as np
+import pinocchio as pin
+
+from solver.path.cell import sweep
+from solver.path.cell.capsules import Primitive, primitive
+
+# m: a bound within this of the clearance (or of an evaluation's closest distance) goes to
+# coal, whose GJK distances for boxes and meshes may differ from the exact ones by its
+# tolerance (well under 1e-6 m in tests/solver/test_cell_closed_form.py).
+MARGIN = 1e-5
+
+_AXES = {"X": (1.0, 0.0, 0.0), "Y": (0.0, 1.0, 0.0), "Z": (0.0, 0.0, 1.0)}
+
+# coal's distance of pair p at configuration m: (m, pair indices) -> distances
+CoalDistances = Callable[[int, np.ndarray], np.ndarray]
+
+
+def _joint_pack(model: pin.Model) -> tuple[np.ndarray, ...] | None:
+    """The model's joints for the sweep's forward kinematics; None for a joint it lacks."""
+    count = model.njoints
+    kind, axis = np.zeros(count, dtype=np.int64), np.zeros((count, 3))
+    q_index = np.zeros(count, dtype=np.int64)
+    for j in range(1, count):
+        joint = model.joints[j]
+        name = joint.shortname().removeprefix("JointModel")
+        if joint.nq != 1 or joint.nv != 1 or joint.idx_q != joint.idx_v:
+            return None
+        if name in ("RX", "RY", "RZ", "PX", "PY", "PZ"):
+            axis[j] = _AXES[name[1]]
+        elif name in ("RevoluteUnaligned", "PrismaticUnaligned"):
+            axis[j] = np.asarray(joint.extract().axis, dtype=float)
+        else:
+            return None
+        kind[j] = 1 if name.startswith("R") else 2
+        q_index[j] = joint.idx_q
+    rotations = np.array([np.asarray(p.rotation) for p in model.jointPlacements])
+    translations = np.array([np.asarray(p.translation) for p in model.jointPlacements])
+    parents = np.array(list(model.parents), dtype=np.int64)
+    return parents, rotations, translations, kind, axis, q_index
+
+
+class FastCell:
+    """The compiled side of a :class:`CellChecker`: its robot parts and obstacles as primitives.
+
+    Attributes:
+        robot: the sweep's robot pack.
+        pairs: shape (P, 2), the checked pairs (robot parts; obstacles after them).
+    """
+
+    def __init__(
+        self,
+        model: pin.Model,
+        geometry: pin.GeometryModel,
+        n_robot: int,
+        pairs: list[tuple[int, int]],
+    ) -> None:
+        """Build the packs; raise NotImplementedError for a joint or shape the sweep lacks."""
+        joints = _joint_pack(model)
+        if joints is None:
+            raise NotImplementedError("a joint the sweep has no kinematics for")
+        objects = geometry.geometryObjects
+        parts = [
+            primitive(objects[g].geometry, robot_part=True).placed(objects[g].placement)
+            for g in range(n_robot)
+        ]
+        self.robot = (
+            *joints,
+            np.array([int(objects[g].parentJoint) for g in range(n_robot)], dtype=np.int64),
+            np.array([p.ends for p in parts]),
+            np.array([p.radius for p in parts]),
+        )
+        self.obstacles = [
+            primitive(objects[g].geometry, robot_part=False) for g in range(n_robot, len(objects))
+        ]
+        self.pairs = np.array(pairs, dtype=np.int64).reshape(-1, 2)
+
+    def obstacle_pack(self, placements: list[pin.SE3]) -> tuple[np.ndarray, ...]:
+        """The sweep's obstacle pack with each obstacle at its world placement."""
+        placed: list[Primitive] = [
+            shape.placed(at) for shape, at in zip(self.obstacles, placements, strict=True)
+        ]
+        rotations = np.array([np.asarray(at.rotation) for at in placements]).reshape(-1, 3, 3)
+        centres = np.array([np.asarray(at.translation) for at in placements]).reshape(-1, 3)
+        return (
+            np.array([p.kind for p in placed], dtype=np.int64),
+            np.array([p.ends for p in placed]).reshape(-1, 2, 3),
+            np.array([p.radius for p in placed], dtype=float),
+            rotations,
+            centres,
+            np.array([p.half for p in placed]).reshape(-1, 3),
+        )
+
+
+def first_collision(
+    fast: FastCell,
+    configurations: np.ndarray,
+    obstacles: tuple[np.ndarray, ...],
+    weights: np.ndarray,
+    clearance: float,
+    coal_distances: CoalDistances,
+) -> tuple[tuple[int, int, float] | None, int]:
+    """The first configuration closer than the clearance: (index, pair, coal's distance).
+
+    Returns:
+        That contact (None on a clear path) and how many configurations went to coal.
+    """
+    count = len(fast.pairs)
+    clear_until = np.full(count, -1, dtype=np.int64)
+    known, need = np.full(count, np.nan), np.zeros(count, dtype=np.bool_)
+    start, coal_checks = 0, 0
+    while True:
+        index = int(
+            sweep.first_due(
+                configurations, fast.robot, obstacles, fast.pairs, weights,
+                clearance + MARGIN, clearance, clear_until, start, known, need,
+            )
+        )  # fmt: skip
+        if index >= len(configurations):
+            return None, coal_checks
+        due = np.flatnonzero(need)
+        distances = coal_distances(index, due)
+        coal_checks += 1
+        low = int(np.argmin(distances))
+        if distances[low] < clearance:
+            return (index, int(due[low]), float(distances[low])), coal_checks
+        known[:] = np.nan
+        known[due] = distances
+        start = index
+
+
+def closest_contact(
+    fast: FastCell,
+    configurations: np.ndarray,
+    obstacles: tuple[np.ndarray, ...],
+    clearance: float,
+    coal_distances: CoalDistances,
+) -> tuple[tuple[int, int, float] | None, tuple[int, int, float] | None]:
+    """The first configuration closer than the clearance, else the closest pair of the path.
+
+    Every bound at every configuration (:func:`sweep.bounds`); coal on the pairs whose bound is
+    within the clearance (in path order, up to the first collision), else on the pairs whose
+    bound is within the smallest coal distance found (plus the margin), the lowest bound's
+    first: no other pair can be closer.
+
+    Returns:
+        (index, pair, distance) of the collision and None, or None and the closest pair.
+    """
+    low = sweep.bounds(configurations, fast.robot, obstacles, fast.pairs)
+    near = low <= clearance + MARGIN
+    for index in np.flatnonzero(near.any(axis=1)):
+        due = np.flatnonzero(near[index])
+        distances = coal_distances(int(index), due)
+        first = int(np.argmin(distances))
+        if distances[first] < clearance:
+            return (int(index), int(due[first]), float(distances[first])), None
+    lowest = np.unravel_index(int(np.argmin(low)), low.shape)
+    ceiling = float(coal_distances(int(lowest[0]), np.array([lowest[1]]))[0])
+    best: tuple[float, int, int] = (ceiling, int(lowest[0]), int(lowest[1]))
+    rows = np.flatnonzero((low <= ceiling + MARGIN).any(axis=1))
+    for index in rows:
+        due = np.flatnonzero(low[index] <= best[0] + MARGIN)
+        if not len(due):
+            continue
+        distances = coal_distances(int(index), due)
+        first = int(np.argmin(distances))
+        best = min(best, (float(distances[first]), int(index), int(due[first])))
+    return None, (best[1], best[2], best[0])
