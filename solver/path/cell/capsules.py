@@ -28,6 +28,9 @@ class Primitive:
         radius: a capsule's radius; a halfspace's offset.
         half: shape (3,), a box's half sizes.
         exact: the shape is the coal shape itself (not a capsule around it).
+        vertices: shape (V, 3): with ``ball``, a convex set that contains the shape (the shape
+            itself but for a cylinder, a prism around it); none for a halfspace.
+        ball: m, the radius swept around the vertices' hull.
     """
 
     kind: int
@@ -35,6 +38,8 @@ class Primitive:
     radius: float
     half: np.ndarray
     exact: bool
+    vertices: np.ndarray
+    ball: float
 
     def placed(self, placement: pin.SE3) -> Primitive:
         """The primitive moved by ``placement``."""
@@ -43,15 +48,36 @@ class Primitive:
             normal = rotation @ self.ends[0]
             ends = np.array([normal, np.zeros(3)])
             offset = self.radius + float(normal @ translation)
-            return Primitive(HALFSPACE, ends, offset, self.half, self.exact)
+            return Primitive(HALFSPACE, ends, offset, self.half, self.exact, self.vertices, 0.0)
         ends = self.ends @ rotation.T + translation
-        return Primitive(self.kind, ends, self.radius, self.half, self.exact)
+        vertices = self.vertices @ rotation.T + translation
+        return Primitive(self.kind, ends, self.radius, self.half, self.exact, vertices, self.ball)
 
 
-def _segment(half_length: float, radius: float, *, exact: bool) -> Primitive:
-    """A capsule along z from -half_length to half_length."""
+_SIDES = 16  # a cylinder's prism: a regular polygon around its circle
+
+
+def _corners(half: np.ndarray) -> np.ndarray:
+    """The 8 corners of the box [-half, half]."""
+    signs = np.array([[sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)])
+    corners: np.ndarray = signs * half
+    return corners
+
+
+def _capsule(half_length: float, radius: float) -> Primitive:
+    """A capsule along z from -half_length to half_length (exact)."""
     ends = np.array([[0.0, 0.0, -half_length], [0.0, 0.0, half_length]])
-    return Primitive(CAPSULE, ends, radius, np.zeros(3), exact)
+    return Primitive(CAPSULE, ends, radius, np.zeros(3), True, ends, radius)
+
+
+def _cylinder(half_length: float, radius: float) -> Primitive:
+    """A capsule around the cylinder along z; a 16-sided prism around it as its vertices."""
+    ends = np.array([[0.0, 0.0, -half_length], [0.0, 0.0, half_length]])
+    angles = 2.0 * np.pi * np.arange(_SIDES) / _SIDES
+    outer = radius / np.cos(np.pi / _SIDES) * (1.0 + 1e-9)
+    ring = np.column_stack([outer * np.cos(angles), outer * np.sin(angles), np.zeros(_SIDES)])
+    prism = np.vstack([ring + ends[0], ring + ends[1]])
+    return Primitive(CAPSULE, ends, radius, np.zeros(3), False, prism, 0.0)
 
 
 def _around_points(points: np.ndarray) -> Primitive:
@@ -63,7 +89,7 @@ def _around_points(points: np.ndarray) -> Primitive:
     off_axis = np.linalg.norm(spread - np.outer(along, axis), axis=1)
     radius = float(off_axis.max()) * (1.0 + 1e-9) + 1e-12
     ends = np.array([centre + along.min() * axis, centre + along.max() * axis])
-    return Primitive(CAPSULE, ends, radius, np.zeros(3), False)
+    return Primitive(CAPSULE, ends, radius, np.zeros(3), False, points, 0.0)
 
 
 def primitive(shape: coal.CollisionGeometry, *, robot_part: bool) -> Primitive:
@@ -71,25 +97,28 @@ def primitive(shape: coal.CollisionGeometry, *, robot_part: bool) -> Primitive:
     if shape.getSweptSphereRadius() != 0.0:
         raise NotImplementedError("swept-sphere shapes are left to coal")
     if isinstance(shape, coal.Sphere):
-        return Primitive(CAPSULE, np.zeros((2, 3)), float(shape.radius), np.zeros(3), True)
+        centre = np.zeros((2, 3))
+        return Primitive(
+            CAPSULE, centre, float(shape.radius), np.zeros(3), True, centre, shape.radius
+        )
     if isinstance(shape, coal.Capsule):
-        return _segment(float(shape.halfLength), float(shape.radius), exact=True)
+        return _capsule(float(shape.halfLength), float(shape.radius))
     if isinstance(shape, coal.Cylinder):
-        return _segment(float(shape.halfLength), float(shape.radius), exact=False)
+        return _cylinder(float(shape.halfLength), float(shape.radius))
     if isinstance(shape, coal.Halfspace) and not robot_part:
         ends = np.array([np.asarray(shape.n, dtype=float), np.zeros(3)])
-        return Primitive(HALFSPACE, ends, float(shape.d), np.zeros(3), True)
+        return Primitive(HALFSPACE, ends, float(shape.d), np.zeros(3), True, np.zeros((0, 3)), 0.0)
     if isinstance(shape, coal.Box):
         half = np.asarray(shape.halfSide, dtype=float)
         if not robot_part:
-            return Primitive(BOX, np.zeros((2, 3)), 0.0, half, True)
-        corners = np.array([[sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)])
-        return _around_points(corners * half)
+            corners = _corners(half)
+            return Primitive(BOX, np.zeros((2, 3)), 0.0, half, True, corners, 0.0)
+        return _around_points(_corners(half))
     if isinstance(shape, coal.ConvexBase):
         return _around_points(np.asarray(shape.points(), dtype=float))
     if isinstance(shape, coal.Halfspace):
         raise NotImplementedError("a robot part that is a halfspace is left to coal")
     shape.computeLocalAABB()
-    centre = np.asarray(shape.aabb_center, dtype=float)
-    radius = float(shape.aabb_radius) * (1.0 + 1e-9) + 1e-12
-    return Primitive(CAPSULE, np.array([centre, centre]), radius, np.zeros(3), False)
+    box = shape.aabb_local
+    low, high = np.asarray(box.min_, dtype=float), np.asarray(box.max_, dtype=float)
+    return _around_points(_corners((high - low) / 2.0) + (high + low) / 2.0)

@@ -34,11 +34,11 @@ def segment_halfspace(a, b, radius, normal, offset):  # type: ignore[no-untyped-
 
 
 @njit(cache=True, nogil=True, error_model="numpy")
-def segment_segment(p1, q1, p2, q2):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
-    """Distance between the segments [p1, q1] and [p2, q2] (either may be a point).
+def segment_params(p1, q1, p2, q2):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
+    """The parameters (s, t) of the closest points of the segments [p1, q1] and [p2, q2].
 
-    The closest parameters of Ericson's "Real-Time Collision Detection" 5.1.9: the unclamped
-    line parameters, clamped, the other one recomputed and clamped again.
+    Ericson's "Real-Time Collision Detection" 5.1.9: the unclamped line parameters, clamped,
+    the other one recomputed and clamped again; either segment may be a point.
     """
     d1 = q1 - p1
     d2 = q2 - p2
@@ -48,25 +48,30 @@ def segment_segment(p1, q1, p2, q2):  # type: ignore[no-untyped-def]  # pragma: 
     f = d2[0] * r[0] + d2[1] * r[1] + d2[2] * r[2]
     tiny = 1e-30
     if a <= tiny and e <= tiny:
-        s, t = 0.0, 0.0
-    elif a <= tiny:
-        s, t = 0.0, _clamp01(f / e)
-    else:
-        c = d1[0] * r[0] + d1[1] * r[1] + d1[2] * r[2]
-        if e <= tiny:
-            s, t = _clamp01(-c / a), 0.0
-        else:
-            bb = d1[0] * d2[0] + d1[1] * d2[1] + d1[2] * d2[2]
-            denom = a * e - bb * bb
-            s = _clamp01((bb * f - c * e) / denom) if denom > 1e-14 * a * e else 0.0
-            t = (bb * s + f) / e
-            if t < 0.0:
-                t, s = 0.0, _clamp01(-c / a)
-            elif t > 1.0:
-                t, s = 1.0, _clamp01((bb - c) / a)
+        return 0.0, 0.0
+    if a <= tiny:
+        return 0.0, _clamp01(f / e)
+    c = d1[0] * r[0] + d1[1] * r[1] + d1[2] * r[2]
+    if e <= tiny:
+        return _clamp01(-c / a), 0.0
+    bb = d1[0] * d2[0] + d1[1] * d2[1] + d1[2] * d2[2]
+    denom = a * e - bb * bb
+    s = _clamp01((bb * f - c * e) / denom) if denom > 1e-14 * a * e else 0.0
+    t = (bb * s + f) / e
+    if t < 0.0:
+        return _clamp01(-c / a), 0.0
+    if t > 1.0:
+        return _clamp01((bb - c) / a), 1.0
+    return s, t
+
+
+@njit(cache=True, nogil=True, error_model="numpy")
+def segment_segment(p1, q1, p2, q2):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
+    """Distance between the segments [p1, q1] and [p2, q2] (either may be a point)."""
+    s, t = segment_params(p1, q1, p2, q2)
     total = 0.0
     for i in range(3):
-        gap = p1[i] + d1[i] * s - p2[i] - d2[i] * t
+        gap = p1[i] + (q1[i] - p1[i]) * s - p2[i] - (q2[i] - p2[i]) * t
         total += gap * gap
     return math.sqrt(total)
 
@@ -94,12 +99,15 @@ def _box_piece(a, d, half, lo, hi):  # type: ignore[no-untyped-def]  # pragma: n
         if side != 0.0:
             gap = a[i] - side + t * d[i]
             total += gap * gap
-    return total
+    return total, t
 
 
 @njit(cache=True, nogil=True, error_model="numpy")
-def segment_box(a, b, half):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
-    """Distance from the segment [a, b] to the box [-half, half], both in the box's frame."""
+def segment_box_param(a, b, half):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
+    """The squared distance from the segment [a, b] to the box [-half, half], and where.
+
+    Both in the box's frame; the second value is the segment's parameter of its closest point.
+    """
     d = b - a
     cuts = np.empty(8)
     cuts[0], cuts[1] = 0.0, 1.0
@@ -112,10 +120,18 @@ def segment_box(a, b, half):  # type: ignore[no-untyped-def]  # pragma: no cover
                     cuts[count] = t
                     count += 1
     cuts = np.sort(cuts[:count])
-    best = np.inf
+    best, where = np.inf, 0.0
     for k in range(count - 1):
         if cuts[k + 1] > cuts[k]:
-            best = min(best, _box_piece(a, d, half, cuts[k], cuts[k + 1]))
+            value, t = _box_piece(a, d, half, cuts[k], cuts[k + 1])
+            if value < best:
+                best, where = value, t
     if best == np.inf:  # a point
-        best = _box_piece(a, d, half, 0.0, 0.0)
-    return math.sqrt(best)
+        best, where = _box_piece(a, d, half, 0.0, 0.0)
+    return best, where
+
+
+@njit(cache=True, nogil=True, error_model="numpy")
+def segment_box(a, b, half):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
+    """Distance from the segment [a, b] to the box [-half, half], both in the box's frame."""
+    return math.sqrt(segment_box_param(a, b, half)[0])

@@ -56,6 +56,15 @@ def _joint_pack(model: pin.Model) -> tuple[np.ndarray, ...] | None:
     return parents, rotations, translations, kind, axis, q_index
 
 
+def _vertex_pack(shapes: list[Primitive]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Offsets (S + 1,) into the stacked vertices (V, 3), and each shape's ball radius (S,)."""
+    counts = [len(p.vertices) for p in shapes]
+    offsets = np.concatenate([[0], np.cumsum(counts)]).astype(np.int64)
+    stacked = [p.vertices for p in shapes if len(p.vertices)]
+    vertices = np.vstack(stacked) if stacked else np.zeros((0, 3))
+    return offsets, vertices.astype(float), np.array([p.ball for p in shapes], dtype=float)
+
+
 class FastCell:
     """The compiled side of a :class:`CellChecker`: its robot parts and obstacles as primitives.
 
@@ -85,6 +94,8 @@ class FastCell:
             np.array([int(objects[g].parentJoint) for g in range(n_robot)], dtype=np.int64),
             np.array([p.ends for p in parts]),
             np.array([p.radius for p in parts]),
+            np.array([p.exact for p in parts], dtype=np.bool_),
+            *_vertex_pack(parts),
         )
         self.obstacles = [
             primitive(objects[g].geometry, robot_part=False) for g in range(n_robot, len(objects))
@@ -105,6 +116,8 @@ class FastCell:
             rotations,
             centres,
             np.array([p.half for p in placed]).reshape(-1, 3),
+            np.array([p.exact for p in placed], dtype=np.bool_),
+            *_vertex_pack(placed),
         )
 
 
@@ -162,7 +175,7 @@ def closest_contact(
     Returns:
         (index, pair, distance) of the collision and None, or None and the closest pair.
     """
-    low = sweep.bounds(configurations, fast.robot, obstacles, fast.pairs)
+    low = sweep.bounds(configurations, fast.robot, obstacles, fast.pairs, np.inf)
     near = low <= clearance + MARGIN
     for index in np.flatnonzero(near.any(axis=1)):
         due = np.flatnonzero(near[index])

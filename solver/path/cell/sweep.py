@@ -27,9 +27,9 @@ import numpy as np
 from numba import njit
 
 from solver.path.cell.closed_form import (
-    segment_box,
+    segment_box_param,
     segment_halfspace,
-    segment_segment,
+    segment_params,
 )
 
 
@@ -98,31 +98,130 @@ def _parts(q, robot, rot, pos, ends):  # type: ignore[no-untyped-def]  # pragma:
 
 
 @njit(cache=True, nogil=True, error_model="numpy")
-def _bound(p, pairs, ends, robot, obstacles, local):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
-    """A lower bound on pair p's distance (exact for closed-form pairs), m."""
-    radius = robot[8]
-    a, b = pairs[p, 0], pairs[p, 1]
-    n_robot = len(radius)
-    if b < n_robot:
-        gap = segment_segment(ends[a, 0], ends[a, 1], ends[b, 0], ends[b, 1])
-        return gap - radius[a] - radius[b]
-    k = b - n_robot
-    kind, o_ends, o_radius, o_rot, o_centre, o_half = obstacles
-    if kind[k] == 0:
-        return segment_halfspace(ends[a, 0], ends[a, 1], radius[a], o_ends[k, 0], o_radius[k])
-    if kind[k] == 1:
-        gap = segment_segment(ends[a, 0], ends[a, 1], o_ends[k, 0], o_ends[k, 1])
-        return gap - radius[a] - o_radius[k]
-    for e in range(2):  # into the box's frame
-        for i in range(3):
-            local[e, i] = 0.0
-            for m in range(3):
-                local[e, i] += o_rot[k, m, i] * (ends[a, e, m] - o_centre[k, m])
-    return segment_box(local[0], local[1], o_half[k]) - radius[a]
+def _reach(r, u, robot, rot, pos, point):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
+    """The largest u . x over robot part r's points of u . x (its vertices' plus its ball's radius).
+
+    The vertex reaching farthest goes into ``point`` (world).
+    """
+    j, offsets, vertices = robot[6][r], robot[10], robot[11]
+    u0 = rot[j, 0, 0] * u[0] + rot[j, 1, 0] * u[1] + rot[j, 2, 0] * u[2]
+    u1 = rot[j, 0, 1] * u[0] + rot[j, 1, 1] * u[1] + rot[j, 2, 1] * u[2]
+    u2 = rot[j, 0, 2] * u[0] + rot[j, 1, 2] * u[1] + rot[j, 2, 2] * u[2]
+    best, at = -np.inf, offsets[r]
+    for v in range(offsets[r], offsets[r + 1]):
+        value = u0 * vertices[v, 0] + u1 * vertices[v, 1] + u2 * vertices[v, 2]
+        if value > best:
+            best, at = value, v
+    for i in range(3):
+        point[i] = pos[j, i]
+        for k in range(3):
+            point[i] += rot[j, i, k] * vertices[at, k]
+    return best + u[0] * pos[j, 0] + u[1] * pos[j, 1] + u[2] * pos[j, 2] + robot[12][r]
 
 
 @njit(cache=True, nogil=True, error_model="numpy")
-def bounds(configurations, robot, obstacles, pairs):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
+def _gap(a, b, u, robot, obstacles, rot, pos):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
+    """How far part a and object b are apart along the unit u (from a to b): a lower bound.
+
+    Also along the direction between the farthest-reaching vertices (up to three times): any
+    direction's separation is a lower bound, the largest is kept.
+    """
+    n_robot = len(robot[8])
+    near, far, direction = np.empty(3), np.empty(3), u.copy()
+    best = -np.inf
+    for _ in range(4):
+        if b < n_robot:
+            low = -_reach(b, -direction, robot, rot, pos, far)
+        else:
+            k = b - n_robot
+            offsets, vertices = obstacles[7], obstacles[8]
+            low, at = np.inf, offsets[k]
+            for v in range(offsets[k], offsets[k + 1]):
+                value = direction[0] * vertices[v, 0] + direction[1] * vertices[v, 1]
+                value += direction[2] * vertices[v, 2]
+                if value < low:
+                    low, at = value, v
+            low -= obstacles[9][k]
+            for i in range(3):
+                far[i] = vertices[at, i]
+        gap = low - _reach(a, direction, robot, rot, pos, near)
+        best = max(best, gap)
+        length = 0.0
+        for i in range(3):
+            direction[i] = far[i] - near[i]
+            length += direction[i] * direction[i]
+        if length < 1e-24:
+            break
+        direction /= math.sqrt(length)
+    return best
+
+
+@njit(cache=True, nogil=True, error_model="numpy")
+def _bound(p, pairs, ends, robot, obstacles, local, near, rot, pos):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
+    """A lower bound on pair p's distance (exact for closed-form pairs), m.
+
+    The distance between the capsules (exact where both are the shapes themselves); where that
+    is ``near`` or less and a shape is only bounded by its capsule, the larger of it and the
+    shapes' separation along the direction between the capsules' closest points (and a box's
+    face normals; a halfspace's normal: exact for a convex mesh).
+    """
+    radius, exact = robot[8], robot[9]
+    a, b = pairs[p, 0], pairs[p, 1]
+    n_robot = len(radius)
+    u = np.empty(3)
+    if b < n_robot:
+        s, t = segment_params(ends[a, 0], ends[a, 1], ends[b, 0], ends[b, 1])
+        for i in range(3):
+            u[i] = ends[b, 0, i] + t * (ends[b, 1, i] - ends[b, 0, i])
+            u[i] -= ends[a, 0, i] + s * (ends[a, 1, i] - ends[a, 0, i])
+        both = exact[a] and exact[b]
+        value = math.sqrt(u[0] * u[0] + u[1] * u[1] + u[2] * u[2]) - radius[a] - radius[b]
+    else:
+        k = b - n_robot
+        kind, o_ends, o_radius, o_rot, o_centre, o_half = obstacles[:6]
+        both = exact[a] and obstacles[6][k]
+        if kind[k] == 0:
+            value = segment_halfspace(ends[a, 0], ends[a, 1], radius[a], o_ends[k, 0], o_radius[k])
+            if value <= near and not both:  # the part's lowest point along the normal
+                u[0], u[1], u[2] = -o_ends[k, 0, 0], -o_ends[k, 0, 1], -o_ends[k, 0, 2]
+                value = max(value, -_reach(a, u, robot, rot, pos, local[0]) - o_radius[k])
+            return value
+        if kind[k] == 1:
+            s, t = segment_params(ends[a, 0], ends[a, 1], o_ends[k, 0], o_ends[k, 1])
+            for i in range(3):
+                u[i] = o_ends[k, 0, i] + t * (o_ends[k, 1, i] - o_ends[k, 0, i])
+                u[i] -= ends[a, 0, i] + s * (ends[a, 1, i] - ends[a, 0, i])
+            value = math.sqrt(u[0] * u[0] + u[1] * u[1] + u[2] * u[2]) - radius[a] - o_radius[k]
+        else:
+            for e in range(2):  # into the box's frame
+                for i in range(3):
+                    local[e, i] = 0.0
+                    for m in range(3):
+                        local[e, i] += o_rot[k, m, i] * (ends[a, e, m] - o_centre[k, m])
+            squared, t = segment_box_param(local[0], local[1], o_half[k])
+            value = math.sqrt(squared) - radius[a]
+            if value <= near and not both:
+                for i in range(3):  # the box's closest point less the segment's, in the world
+                    x = local[0, i] + t * (local[1, i] - local[0, i])
+                    local[0, i] = min(max(x, -o_half[k, i]), o_half[k, i]) - x
+                for i in range(3):
+                    u[i] = o_rot[k, i, 0] * local[0, 0] + o_rot[k, i, 1] * local[0, 1]
+                    u[i] += o_rot[k, i, 2] * local[0, 2]
+                for i in range(3):  # the face normals, towards the part
+                    for sign in (-1.0, 1.0):
+                        normal = np.empty(3)
+                        for m in range(3):
+                            normal[m] = -sign * o_rot[k, m, i]
+                        value = max(value, _gap(a, b, normal, robot, obstacles, rot, pos))
+    if value <= near and not both:
+        length = math.sqrt(u[0] * u[0] + u[1] * u[1] + u[2] * u[2])
+        if length > 1e-12:
+            value = max(value, _gap(a, b, u / length, robot, obstacles, rot, pos))
+    return value
+
+
+@njit(cache=True, nogil=True, error_model="numpy")
+def bounds(configurations, robot, obstacles, pairs, near):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
     """Every pair's distance bound at every configuration: shape (M, P), m."""
     n_joints, n_parts = len(robot[0]), len(robot[8])
     rot, pos = np.empty((n_joints, 3, 3)), np.empty((n_joints, 3))
@@ -131,7 +230,7 @@ def bounds(configurations, robot, obstacles, pairs):  # type: ignore[no-untyped-
     for m in range(len(configurations)):
         _parts(configurations[m], robot, rot, pos, ends)
         for p in range(len(pairs)):
-            out[m, p] = _bound(p, pairs, ends, robot, obstacles, local)
+            out[m, p] = _bound(p, pairs, ends, robot, obstacles, local, near, rot, pos)
     return out
 
 
@@ -190,7 +289,7 @@ def first_due(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
                 if not placed:
                     _parts(configurations[index], robot, rot, pos, ends)
                     placed = True
-                distance = _bound(p, pairs, ends, robot, obstacles, local)
+                distance = _bound(p, pairs, ends, robot, obstacles, local, near, rot, pos)
                 if distance <= near:
                     need[p] = needed = True
                     continue
