@@ -20,6 +20,7 @@ from solver.families import get_robot
 from solver.path.capability_map import capability_map, grid_axis
 from solver.path.cell.checker import CellChecker, CellVerdict
 from solver.path.cell.shapes import Box, Cell, Cylinder, Halfspace, Sphere, Tool
+from solver.path.cell.sweep import substeps
 from solver.path.problem import PathOptions, PathProblem
 from tests.solver.test_evaluate import load_path
 
@@ -109,3 +110,16 @@ def test_fast_map_equals_coal_only(name: str, monkeypatch: pytest.MonkeyPatch) -
     np.testing.assert_array_equal(fast.reason, reference.reason)
     np.testing.assert_array_equal(fast.mu_path, reference.mu_path)
     assert (fast.reason == 4).any() or name == "ur5"
+
+
+def test_compiled_substeps_equal_the_checkers() -> None:
+    """The compiled sub-steps are CellChecker.configurations', float for float."""
+    checker = CellChecker(_arm("ur5e"), CELL)
+    rng = np.random.default_rng(3)
+    q = np.cumsum(rng.uniform(-0.2, 0.2, (30, 6)), axis=0)
+    in_pass = rng.uniform(size=29) > 0.2
+    rows, owners = checker.configurations(q, in_pass)
+    compiled_rows, compiled_owners = substeps(q, in_pass, CELL.collision_step)
+    assert len(rows) > 60  # sub-steps were made
+    np.testing.assert_array_equal(compiled_rows, rows)
+    np.testing.assert_array_equal(compiled_owners, owners)

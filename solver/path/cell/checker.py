@@ -18,7 +18,7 @@ import numpy as np
 import pinocchio as pin
 
 from solver.core.robots import Robot
-from solver.path.cell import fast
+from solver.path.cell import fast, sweep
 from solver.path.cell.bounds import pair_weights
 from solver.path.cell.robot_geometry import robot_geometry
 from solver.path.cell.shapes import Cell
@@ -109,7 +109,6 @@ class CellChecker:
         for a, b in self._pairs:
             geometry.addCollisionPair(pin.CollisionPair(a, b))
         self._weights = pair_weights(robot.model, geometry, self._pairs, self._n_robot)
-        self._fixed_places = [obj.placement for obj in geometry.geometryObjects[self._n_robot :]]
         try:
             self._fast: fast.FastCell | None = fast.FastCell(
                 robot.model, geometry, self._n_robot, self._pairs
@@ -188,12 +187,17 @@ class CellChecker:
                 (:mod:`solver.path.cell.fast`) must agree with; also where the sweep lacks a
                 joint or shape.
         """
-        configurations, owners = self.configurations(np.asarray(q, float), segment_in_pass)
         placed = self._world_to_base * pin.SE3(np.asarray(transform_workpiece_to_base, float))
         if not self._pairs:
             return CellVerdict(None, None, 0, self.approximated)
         if self._fast is not None and not reference:
+            configurations, owners = sweep.substeps(
+                np.ascontiguousarray(q, dtype=float),
+                np.asarray(segment_in_pass, dtype=np.bool_),
+                float(self.cell.collision_step),
+            )
             return self._fast_check(configurations, owners, placed, closest=closest)
+        configurations, owners = self.configurations(np.asarray(q, float), segment_in_pass)
         geometry = self._placed_geometry(placed)
         if not closest:
             return self._first_collision(geometry, configurations, owners)
@@ -227,10 +231,8 @@ class CellChecker:
     ) -> CellVerdict:
         """:meth:`check` by the compiled sweep, coal only where it cannot decide."""
         assert self._fast is not None
-        places = list(self._fixed_places)
-        for gid, pose in self._workpiece_ids:
-            places[gid - self._n_robot] = placed * pose
-        obstacles = self._fast.obstacle_pack(places)
+        moved = {gid - self._n_robot: placed * pose for gid, pose in self._workpiece_ids}
+        obstacles = self._fast.obstacle_pack(moved)
         made: list[tuple[pin.GeometryModel, pin.GeometryData, pin.Data]] = []
 
         def coal_distances(index: int, due: np.ndarray) -> np.ndarray:

@@ -38,23 +38,24 @@ def segment_params(p1, q1, p2, q2):  # type: ignore[no-untyped-def]  # pragma: n
     """The parameters (s, t) of the closest points of the segments [p1, q1] and [p2, q2].
 
     Ericson's "Real-Time Collision Detection" 5.1.9: the unclamped line parameters, clamped,
-    the other one recomputed and clamped again; either segment may be a point.
+    the other one recomputed and clamped again; either segment may be a point. Scalar code:
+    no array is made.
     """
-    d1 = q1 - p1
-    d2 = q2 - p2
-    r = p1 - p2
-    a = d1[0] * d1[0] + d1[1] * d1[1] + d1[2] * d1[2]
-    e = d2[0] * d2[0] + d2[1] * d2[1] + d2[2] * d2[2]
-    f = d2[0] * r[0] + d2[1] * r[1] + d2[2] * r[2]
+    a = e = f = c = bb = 0.0
+    for i in range(3):
+        d1, d2, r = q1[i] - p1[i], q2[i] - p2[i], p1[i] - p2[i]
+        a += d1 * d1
+        e += d2 * d2
+        f += d2 * r
+        c += d1 * r
+        bb += d1 * d2
     tiny = 1e-30
     if a <= tiny and e <= tiny:
         return 0.0, 0.0
     if a <= tiny:
         return 0.0, _clamp01(f / e)
-    c = d1[0] * r[0] + d1[1] * r[1] + d1[2] * r[2]
     if e <= tiny:
         return _clamp01(-c / a), 0.0
-    bb = d1[0] * d2[0] + d1[1] * d2[1] + d1[2] * d2[2]
     denom = a * e - bb * bb
     s = _clamp01((bb * f - c * e) / denom) if denom > 1e-14 * a * e else 0.0
     t = (bb * s + f) / e
@@ -83,55 +84,59 @@ def _side(x, half):  # type: ignore[no-untyped-def]  # pragma: no cover - compil
 
 
 @njit(cache=True, nogil=True, error_model="numpy")
-def _box_piece(a, d, half, lo, hi):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
+def _box_piece(a, b, half, lo, hi):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
     """Smallest squared distance to the box over t in [lo, hi], where no coordinate crosses."""
     mid = 0.5 * (lo + hi)
     qa, qb = 0.0, 0.0  # the piece's quadratic: qa t^2 + qb t + ...
     for i in range(3):
-        side = _side(a[i] + mid * d[i], half[i])
+        d = b[i] - a[i]
+        side = _side(a[i] + mid * d, half[i])
         if side != 0.0:
-            qa += d[i] * d[i]
-            qb += 2.0 * (a[i] - side) * d[i]
+            qa += d * d
+            qb += 2.0 * (a[i] - side) * d
     t = lo if qa <= 0.0 else min(max(-qb / (2.0 * qa), lo), hi)
     total = 0.0
     for i in range(3):
-        side = _side(a[i] + mid * d[i], half[i])
+        d = b[i] - a[i]
+        side = _side(a[i] + mid * d, half[i])
         if side != 0.0:
-            gap = a[i] - side + t * d[i]
+            gap = a[i] - side + t * d
             total += gap * gap
     return total, t
 
 
 @njit(cache=True, nogil=True, error_model="numpy")
-def segment_box_param(a, b, half):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
+def segment_box_param(a, b, half, cuts):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
     """The squared distance from the segment [a, b] to the box [-half, half], and where.
 
     Both in the box's frame; the second value is the segment's parameter of its closest point.
+    ``cuts`` (8,) is work space for the pieces' ends, sorted in place.
     """
-    d = b - a
-    cuts = np.empty(8)
-    cuts[0], cuts[1] = 0.0, 1.0
-    count = 2
+    cuts[0] = 0.0
+    count = 1
     for i in range(3):
-        if d[i] != 0.0:
+        d = b[i] - a[i]
+        if d != 0.0:
             for sign in (-1.0, 1.0):
-                t = (sign * half[i] - a[i]) / d[i]
+                t = (sign * half[i] - a[i]) / d
                 if 0.0 < t < 1.0:
-                    cuts[count] = t
+                    k = count  # insertion into the sorted cuts
+                    while k > 0 and cuts[k - 1] > t:
+                        cuts[k] = cuts[k - 1]
+                        k -= 1
+                    cuts[k] = t
                     count += 1
-    cuts = np.sort(cuts[:count])
-    best, where = np.inf, 0.0
-    for k in range(count - 1):
+    cuts[count] = 1.0
+    best, where = _box_piece(a, b, half, 0.0, 0.0)  # a point, or the start
+    for k in range(count):
         if cuts[k + 1] > cuts[k]:
-            value, t = _box_piece(a, d, half, cuts[k], cuts[k + 1])
+            value, t = _box_piece(a, b, half, cuts[k], cuts[k + 1])
             if value < best:
                 best, where = value, t
-    if best == np.inf:  # a point
-        best, where = _box_piece(a, d, half, 0.0, 0.0)
     return best, where
 
 
 @njit(cache=True, nogil=True, error_model="numpy")
 def segment_box(a, b, half):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
     """Distance from the segment [a, b] to the box [-half, half], both in the box's frame."""
-    return math.sqrt(segment_box_param(a, b, half)[0])
+    return math.sqrt(segment_box_param(a, b, half, np.empty(8))[0])

@@ -100,13 +100,18 @@ class FastCell:
         self.obstacles = [
             primitive(objects[g].geometry, robot_part=False) for g in range(n_robot, len(objects))
         ]
+        self._placements = [objects[g].placement for g in range(n_robot, len(objects))]
+        self._placed = [
+            s.placed(at) for s, at in zip(self.obstacles, self._placements, strict=True)
+        ]
         self.pairs = np.array(pairs, dtype=np.int64).reshape(-1, 2)
 
-    def obstacle_pack(self, placements: list[pin.SE3]) -> tuple[np.ndarray, ...]:
-        """The sweep's obstacle pack with each obstacle at its world placement."""
-        placed: list[Primitive] = [
-            shape.placed(at) for shape, at in zip(self.obstacles, placements, strict=True)
-        ]
+    def obstacle_pack(self, moved: dict[int, pin.SE3]) -> tuple[np.ndarray, ...]:
+        """The sweep's obstacle pack, obstacle k at ``moved[k]`` if given, else as built."""
+        placed = list(self._placed)
+        placements = list(self._placements)
+        for k, at in moved.items():
+            placed[k], placements[k] = self.obstacles[k].placed(at), at
         rotations = np.array([np.asarray(at.rotation) for at in placements]).reshape(-1, 3, 3)
         centres = np.array([np.asarray(at.translation) for at in placements]).reshape(-1, 3)
         return (

@@ -34,14 +34,16 @@ from solver.path.cell.closed_form import (
 
 
 @njit(cache=True, nogil=True, error_model="numpy")
-def _frames(q, robot, rot, pos):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
-    """The joints' world rotations (J, 3, 3) and origins (J, 3) at q, into rot and pos."""
+def _frames(q, robot, rot, pos, turn):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
+    """The joints' world rotations (J, 3, 3) and origins (J, 3) at q, into rot and pos.
+
+    ``turn`` (3, 3) is work space.
+    """
     parent, jrot, jpos, kind, axis, qi = robot[0], robot[1], robot[2], robot[3], robot[4], robot[5]
     for i in range(3):
         pos[0, i] = 0.0
         for k in range(3):
             rot[0, i, k] = 1.0 if i == k else 0.0
-    turn = np.empty((3, 3))
     for j in range(1, len(parent)):
         p = parent[j]
         for i in range(3):
@@ -81,9 +83,9 @@ def _frames(q, robot, rot, pos):  # type: ignore[no-untyped-def]  # pragma: no c
 
 
 @njit(cache=True, nogil=True, error_model="numpy")
-def _parts(q, robot, rot, pos, ends):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
+def _parts(q, robot, rot, pos, ends, turn):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
     """Every robot part's capsule ends in the world at q, into ends (R, 2, 3)."""
-    _frames(q, robot, rot, pos)
+    _frames(q, robot, rot, pos, turn)
     joint, local = robot[6], robot[7]
     for r in range(len(joint)):
         j = joint[r]
@@ -99,7 +101,7 @@ def _parts(q, robot, rot, pos, ends):  # type: ignore[no-untyped-def]  # pragma:
 
 @njit(cache=True, nogil=True, error_model="numpy")
 def _reach(r, u, robot, rot, pos, point):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
-    """The largest u . x over robot part r's points of u . x (its vertices' plus its ball's radius).
+    """The largest u . x over robot part r's points (its vertices' plus its ball's radius).
 
     The vertex reaching farthest goes into ``point`` (world).
     """
@@ -120,16 +122,18 @@ def _reach(r, u, robot, rot, pos, point):  # type: ignore[no-untyped-def]  # pra
 
 
 @njit(cache=True, nogil=True, error_model="numpy")
-def _gap(a, b, u, robot, obstacles, rot, pos):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
+def _gap(a, b, u, robot, obstacles, rot, pos, work, tries):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
     """How far part a and object b are apart along the unit u (from a to b): a lower bound.
 
-    Also along the direction between the farthest-reaching vertices (up to three times): any
-    direction's separation is a lower bound, the largest is kept.
+    Then along the direction between the farthest-reaching vertices (``tries`` directions in
+    all): any direction's separation is a lower bound, the largest is kept.
     """
     n_robot = len(robot[8])
-    near, far, direction = np.empty(3), np.empty(3), u.copy()
+    near, far, direction = work[4], work[5], work[6]
+    for i in range(3):
+        direction[i] = u[i]
     best = -np.inf
-    for _ in range(4):
+    for _ in range(tries):
         if b < n_robot:
             low = -_reach(b, -direction, robot, rot, pos, far)
         else:
@@ -152,12 +156,14 @@ def _gap(a, b, u, robot, obstacles, rot, pos):  # type: ignore[no-untyped-def]  
             length += direction[i] * direction[i]
         if length < 1e-24:
             break
-        direction /= math.sqrt(length)
+        length = math.sqrt(length)
+        for i in range(3):
+            direction[i] /= length
     return best
 
 
 @njit(cache=True, nogil=True, error_model="numpy")
-def _bound(p, pairs, ends, robot, obstacles, local, near, rot, pos):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
+def _bound(p, pairs, ends, robot, obstacles, work, near, rot, pos, cuts):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
     """A lower bound on pair p's distance (exact for closed-form pairs), m.
 
     The distance between the capsules (exact where both are the shapes themselves); where that
@@ -168,7 +174,7 @@ def _bound(p, pairs, ends, robot, obstacles, local, near, rot, pos):  # type: ig
     radius, exact = robot[8], robot[9]
     a, b = pairs[p, 0], pairs[p, 1]
     n_robot = len(radius)
-    u = np.empty(3)
+    local, u, normal = work[0:2], work[2], work[3]
     if b < n_robot:
         s, t = segment_params(ends[a, 0], ends[a, 1], ends[b, 0], ends[b, 1])
         for i in range(3):
@@ -198,7 +204,7 @@ def _bound(p, pairs, ends, robot, obstacles, local, near, rot, pos):  # type: ig
                     local[e, i] = 0.0
                     for m in range(3):
                         local[e, i] += o_rot[k, m, i] * (ends[a, e, m] - o_centre[k, m])
-            squared, t = segment_box_param(local[0], local[1], o_half[k])
+            squared, t = segment_box_param(local[0], local[1], o_half[k], cuts)
             value = math.sqrt(squared) - radius[a]
             if value <= near and not both:
                 for i in range(3):  # the box's closest point less the segment's, in the world
@@ -209,14 +215,16 @@ def _bound(p, pairs, ends, robot, obstacles, local, near, rot, pos):  # type: ig
                     u[i] += o_rot[k, i, 2] * local[0, 2]
                 for i in range(3):  # the face normals, towards the part
                     for sign in (-1.0, 1.0):
-                        normal = np.empty(3)
                         for m in range(3):
                             normal[m] = -sign * o_rot[k, m, i]
-                        value = max(value, _gap(a, b, normal, robot, obstacles, rot, pos))
+                        gap = _gap(a, b, normal, robot, obstacles, rot, pos, work, 1)
+                        value = max(value, gap)
     if value <= near and not both:
         length = math.sqrt(u[0] * u[0] + u[1] * u[1] + u[2] * u[2])
         if length > 1e-12:
-            value = max(value, _gap(a, b, u / length, robot, obstacles, rot, pos))
+            for i in range(3):
+                u[i] /= length
+            value = max(value, _gap(a, b, u, robot, obstacles, rot, pos, work, 4))
     return value
 
 
@@ -225,12 +233,17 @@ def bounds(configurations, robot, obstacles, pairs, near):  # type: ignore[no-un
     """Every pair's distance bound at every configuration: shape (M, P), m."""
     n_joints, n_parts = len(robot[0]), len(robot[8])
     rot, pos = np.empty((n_joints, 3, 3)), np.empty((n_joints, 3))
-    ends, local = np.empty((n_parts, 2, 3)), np.empty((2, 3))
+    ends, work, cuts, turn = (
+        np.empty((n_parts, 2, 3)),
+        np.empty((8, 3)),
+        np.empty(8),
+        np.empty((3, 3)),
+    )
     out = np.empty((len(configurations), len(pairs)))
     for m in range(len(configurations)):
-        _parts(configurations[m], robot, rot, pos, ends)
+        _parts(configurations[m], robot, rot, pos, ends, turn)
         for p in range(len(pairs)):
-            out[m, p] = _bound(p, pairs, ends, robot, obstacles, local, near, rot, pos)
+            out[m, p] = _bound(p, pairs, ends, robot, obstacles, work, near, rot, pos, cuts)
     return out
 
 
@@ -274,7 +287,12 @@ def first_due(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
     """
     n_joints, n_parts = len(robot[0]), len(robot[8])
     rot, pos = np.empty((n_joints, 3, 3)), np.empty((n_joints, 3))
-    ends, local = np.empty((n_parts, 2, 3)), np.empty((2, 3))
+    ends, work, cuts, turn = (
+        np.empty((n_parts, 2, 3)),
+        np.empty((8, 3)),
+        np.empty(8),
+        np.empty((3, 3)),
+    )
     count, n_pairs = len(configurations), len(pairs)
     index = start
     while index < count:
@@ -287,9 +305,9 @@ def first_due(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
                 distance = known[p]
             else:
                 if not placed:
-                    _parts(configurations[index], robot, rot, pos, ends)
+                    _parts(configurations[index], robot, rot, pos, ends, turn)
                     placed = True
-                distance = _bound(p, pairs, ends, robot, obstacles, local, near, rot, pos)
+                distance = _bound(p, pairs, ends, robot, obstacles, work, near, rot, pos, cuts)
                 if distance <= near:
                     need[p] = needed = True
                     continue
@@ -307,3 +325,31 @@ def first_due(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
             return index
         index = clear_until.min() + 1
     return count
+
+
+@njit(cache=True, nogil=True, error_model="numpy")
+def substeps(q, segment_in_pass, step):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
+    """:meth:`solver.path.cell.checker.CellChecker.configurations`, compiled (the same floats).
+
+    Returns:
+        shape (M, n), rad, the configurations; shape (M,), the waypoint each follows.
+    """
+    count, n = q.shape
+    counts = np.ones(count, dtype=np.int64)
+    for w in range(count - 1):
+        if segment_in_pass[w]:
+            largest = 0.0
+            for j in range(n):
+                largest = max(largest, abs(q[w + 1, j] - q[w, j]))
+            counts[w] = max(int(np.ceil(largest / step - 1e-12)), 1)
+    rows, owners = np.empty((counts.sum(), n)), np.empty(counts.sum(), dtype=np.int64)
+    m = 0
+    for w in range(count):
+        following = min(w + 1, count - 1)
+        for k in range(counts[w]):
+            fraction = k / counts[w]
+            for j in range(n):
+                rows[m, j] = q[w, j] + fraction * (q[following, j] - q[w, j])
+            owners[m] = w
+            m += 1
+    return rows, owners
