@@ -100,18 +100,15 @@ class FastCell:
         self.obstacles = [
             primitive(objects[g].geometry, robot_part=False) for g in range(n_robot, len(objects))
         ]
-        self._placements = [objects[g].placement for g in range(n_robot, len(objects))]
-        self._placed = [
-            s.placed(at) for s, at in zip(self.obstacles, self._placements, strict=True)
-        ]
+        placements = [objects[g].placement for g in range(n_robot, len(objects))]
+        self._pack = self._packed(
+            [s.placed(at) for s, at in zip(self.obstacles, placements, strict=True)], placements
+        )
         self.pairs = np.array(pairs, dtype=np.int64).reshape(-1, 2)
 
-    def obstacle_pack(self, moved: dict[int, pin.SE3]) -> tuple[np.ndarray, ...]:
-        """The sweep's obstacle pack, obstacle k at ``moved[k]`` if given, else as built."""
-        placed = list(self._placed)
-        placements = list(self._placements)
-        for k, at in moved.items():
-            placed[k], placements[k] = self.obstacles[k].placed(at), at
+    @staticmethod
+    def _packed(placed: list[Primitive], placements: list[pin.SE3]) -> tuple[np.ndarray, ...]:
+        """The sweep's obstacle pack of placed primitives."""
         rotations = np.array([np.asarray(at.rotation) for at in placements]).reshape(-1, 3, 3)
         centres = np.array([np.asarray(at.translation) for at in placements]).reshape(-1, 3)
         return (
@@ -124,6 +121,22 @@ class FastCell:
             np.array([p.exact for p in placed], dtype=np.bool_),
             *_vertex_pack(placed),
         )
+
+    def obstacle_pack(self, moved: dict[int, pin.SE3]) -> tuple[np.ndarray, ...]:
+        """The sweep's obstacle pack, obstacle k at ``moved[k]`` if given, else as built.
+
+        The arrays a placement changes are copied (threads share the built ones).
+        """
+        kind, ends, radius, rotations, centres, half, exact, offsets, vertices, ball = self._pack
+        if moved:
+            ends, radius, rotations = ends.copy(), radius.copy(), rotations.copy()
+            centres, vertices = centres.copy(), vertices.copy()
+        for k, at in moved.items():
+            shape = self.obstacles[k].placed(at)
+            ends[k], radius[k] = shape.ends, shape.radius
+            rotations[k], centres[k] = at.rotation, at.translation
+            vertices[offsets[k] : offsets[k + 1]] = shape.vertices
+        return kind, ends, radius, rotations, centres, half, exact, offsets, vertices, ball
 
 
 def first_collision(

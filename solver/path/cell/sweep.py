@@ -122,11 +122,12 @@ def _reach(r, u, robot, rot, pos, point):  # type: ignore[no-untyped-def]  # pra
 
 
 @njit(cache=True, nogil=True, error_model="numpy")
-def _gap(a, b, u, robot, obstacles, rot, pos, work, tries):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
+def _gap(a, b, u, robot, obstacles, rot, pos, work, tries, enough):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
     """How far part a and object b are apart along the unit u (from a to b): a lower bound.
 
     Then along the direction between the farthest-reaching vertices (``tries`` directions in
-    all): any direction's separation is a lower bound, the largest is kept.
+    all, stopping once one exceeds ``enough``): any direction's separation is a lower bound,
+    the largest is kept.
     """
     n_robot = len(robot[8])
     near, far, direction = work[4], work[5], work[6]
@@ -150,6 +151,8 @@ def _gap(a, b, u, robot, obstacles, rot, pos, work, tries):  # type: ignore[no-u
                 far[i] = vertices[at, i]
         gap = low - _reach(a, direction, robot, rot, pos, near)
         best = max(best, gap)
+        if best > enough:
+            break
         length = 0.0
         for i in range(3):
             direction[i] = far[i] - near[i]
@@ -213,18 +216,19 @@ def _bound(p, pairs, ends, robot, obstacles, work, near, rot, pos, cuts):  # typ
                 for i in range(3):
                     u[i] = o_rot[k, i, 0] * local[0, 0] + o_rot[k, i, 1] * local[0, 1]
                     u[i] += o_rot[k, i, 2] * local[0, 2]
-                for i in range(3):  # the face normals, towards the part
-                    for sign in (-1.0, 1.0):
-                        for m in range(3):
-                            normal[m] = -sign * o_rot[k, m, i]
-                        gap = _gap(a, b, normal, robot, obstacles, rot, pos, work, 1)
-                        value = max(value, gap)
     if value <= near and not both:
         length = math.sqrt(u[0] * u[0] + u[1] * u[1] + u[2] * u[2])
         if length > 1e-12:
             for i in range(3):
                 u[i] /= length
-            value = max(value, _gap(a, b, u, robot, obstacles, rot, pos, work, 4))
+            value = max(value, _gap(a, b, u, robot, obstacles, rot, pos, work, 4, near))
+    if value <= near and not both and b >= n_robot and obstacles[0][b - n_robot] == 2:
+        for i in range(3):  # a box's face normals, towards the part
+            for sign in (-1.0, 1.0):
+                for m in range(3):
+                    normal[m] = -sign * obstacles[3][b - n_robot, m, i]
+                gap = _gap(a, b, normal, robot, obstacles, rot, pos, work, 1, near)
+                value = max(value, gap)
     return value
 
 
