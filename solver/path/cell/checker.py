@@ -24,10 +24,12 @@ from solver.path.cell.robot_geometry import robot_geometry
 from solver.path.cell.shapes import Cell
 
 # What checking one pose of a path against a cell costs, in poses of a closed-form family's map
-# (KinematicsFamily.path_cost): the ERK map (UR5, 546 placements x 133 waypoints) with a table,
-# a fixture and the part took 50 to 60 times the map without (bench/cell.py), the sub-steps and
-# the first collision's early stop included; 100 leaves a margin for more objects and meshes.
-CELL_POSE_COST = 100.0
+# (KinematicsFamily.path_cost): the ERK map (546 placements x 133 waypoints) with a table, a
+# fixture and the part took 22 to 36 times the map without with the compiled sweep (bench/cell.py,
+# UR5 meshes and UR5e capsules, on a loaded machine; coal alone: 50 to 60 times), of which 4 to 7
+# times is the map re-solving the joint paths it checks; 50 leaves a margin for more objects,
+# meshes and coal calls.
+CELL_POSE_COST = 50.0
 _WINDOW = 32  # configurations looked ahead at once when skipping
 
 
