@@ -8,6 +8,10 @@ obstacle, except the base against ``fixed`` objects (it stands on them, whatever
 and the tool's cutting part against ``workpiece`` objects (that is machining); and the robot's
 parts against each other where they are on joints that are neither the same nor adjacent and do
 not come within the clearance at the zero configuration.
+
+A check runs the compiled sweep (:mod:`solver.path.cell.fast`): closed-form distances and
+bounds decide most pairs, coal the rest, with the answers of coal alone (``reference=True``,
+also used where the sweep lacks a joint or shape).
 """
 
 from __future__ import annotations
@@ -18,7 +22,7 @@ import numpy as np
 import pinocchio as pin
 
 from solver.core.robots import Robot
-from solver.path.cell import fast, sweep
+from solver.path.cell import fast, kinematics
 from solver.path.cell.bounds import pair_weights
 from solver.path.cell.robot_geometry import robot_geometry
 from solver.path.cell.shapes import Cell
@@ -193,7 +197,7 @@ class CellChecker:
         if not self._pairs:
             return CellVerdict(None, None, 0, self.approximated)
         if self._fast is not None and not reference:
-            configurations, owners = sweep.substeps(
+            configurations, owners = kinematics.substeps(
                 np.ascontiguousarray(q, dtype=float),
                 np.asarray(segment_in_pass, dtype=np.bool_),
                 float(self.cell.collision_step),
