@@ -1,8 +1,8 @@
 """The compiled cell check gives the coal-only check's answers (issue 22).
 
 The reference is :meth:`CellChecker.check` with ``reference=True`` (coal at every checked
-configuration); the compiled sweep must give the same first collision (configuration, robot
-part, obstacle, coal's distance) and the same closest pair of a clear path, for the UR5 (its
+configuration); the compiled sweep (a map's check) must give the same first collision
+(configuration, robot part, obstacle, coal's distance), for the UR5 (its
 URDF's meshes as convex hulls, bounded by capsules) and the UR5e (capsules, closed form), on
 seeded random joint paths and placements in a cell with every primitive kind; and the same map
 cell for cell.
@@ -80,10 +80,10 @@ def test_fast_check_equals_coal_only(name: str) -> None:
         in_pass[5] = False  # a rapid: no sub-steps across it
         placement = Placement(*rng.uniform(-0.3, 0.3, 2), 0.1, float(rng.uniform(-1, 1)))
         transform = placement.transform_workpiece_to_base()
-        for closest in (True, False):
-            fast = checker.check(q, in_pass, transform, closest=closest)
-            reference = checker.check(q, in_pass, transform, closest=closest, reference=True)
-            _same(fast, reference)
+        fast = checker.check(q, in_pass, transform, closest=False)
+        _same(fast, checker.check(q, in_pass, transform, closest=False, reference=True))
+        if fast.collision is not None:  # an evaluation (coal alone) finds the same collision
+            _same(fast, checker.check(q, in_pass, transform, closest=True))
         collisions += fast.collision is not None
         clear += fast.collision is None
     assert collisions >= 4 and clear >= 4  # both kinds of answer are compared

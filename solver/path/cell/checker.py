@@ -9,9 +9,9 @@ and the tool's cutting part against ``workpiece`` objects (that is machining); a
 parts against each other where they are on joints that are neither the same nor adjacent and do
 not come within the clearance at the zero configuration.
 
-A check runs the compiled sweep (:mod:`solver.path.cell.fast`): closed-form distances and
-bounds decide most pairs, coal the rest, with the answers of coal alone (``reference=True``,
-also used where the sweep lacks a joint or shape).
+A map's check runs the compiled sweep (:mod:`solver.path.cell.fast`): closed-form distances
+and bounds decide most pairs, coal the rest, with the answers of coal alone (``reference=True``;
+an evaluation, and a robot or cell the sweep lacks a joint or shape for, use coal alone).
 """
 
 from __future__ import annotations
@@ -191,18 +191,18 @@ class CellChecker:
                 within the clearance (a map; :meth:`_first_collision`).
             reference: coal at every checked configuration, as the compiled sweep
                 (:mod:`solver.path.cell.fast`) must agree with; also where the sweep lacks a
-                joint or shape.
+                joint or shape, and for ``closest`` (an evaluation: coal is faster there).
         """
         placed = self._world_to_base * pin.SE3(np.asarray(transform_workpiece_to_base, float))
         if not self._pairs:
             return CellVerdict(None, None, 0, self.approximated)
-        if self._fast is not None and not reference:
+        if self._fast is not None and not reference and not closest:
             configurations, owners = kinematics.substeps(
                 np.ascontiguousarray(q, dtype=float),
                 np.asarray(segment_in_pass, dtype=np.bool_),
                 float(self.cell.collision_step),
             )
-            return self._fast_check(configurations, owners, placed, closest=closest)
+            return self._fast_check(configurations, owners, placed)
         configurations, owners = self.configurations(np.asarray(q, float), segment_in_pass)
         geometry = self._placed_geometry(placed)
         if not closest:
@@ -233,9 +233,9 @@ class CellChecker:
         return geometry
 
     def _fast_check(
-        self, configurations: np.ndarray, owners: np.ndarray, placed: pin.SE3, *, closest: bool
+        self, configurations: np.ndarray, owners: np.ndarray, placed: pin.SE3
     ) -> CellVerdict:
-        """:meth:`check` by the compiled sweep, coal only where it cannot decide."""
+        """:meth:`check` of a map by the compiled sweep, coal only where it cannot decide."""
         assert self._fast is not None
         moved = {gid - self._n_robot: placed * pose for gid, pose in self._workpiece_ids}
         obstacles = self._fast.obstacle_pack(moved)
@@ -252,20 +252,16 @@ class CellChecker:
                 [pin.computeDistance(geometry, gdata, int(p)).min_distance for p in due]
             )
 
-        clearance = self.cell.clearance
-        if closest:
-            hit, near = fast.closest_contact(
-                self._fast, configurations, obstacles, clearance, coal_distances
-            )
-            checks = len(configurations) if hit is None else hit[0] + 1
-        else:
-            hit, checks = fast.first_collision(
-                self._fast, configurations, obstacles, self._weights, clearance, coal_distances
-            )
-            near = None
+        hit, checks = fast.first_collision(
+            self._fast,
+            configurations,
+            obstacles,
+            self._weights,
+            self.cell.clearance,
+            coal_distances,
+        )
         collision = None if hit is None else self._contact(int(owners[hit[0]]), hit[1], hit[2])
-        nearest = None if near is None else self._contact(int(owners[near[0]]), near[1], near[2])
-        return CellVerdict(collision, nearest, checks, self.approximated)
+        return CellVerdict(collision, None, checks, self.approximated)
 
     def _first_collision(
         self, geometry: pin.GeometryModel, configurations: np.ndarray, owners: np.ndarray

@@ -8,8 +8,7 @@ between bounding capsules, raised where that is near the clearance to the shapes
 along a few directions (support functions of their vertices: convex meshes, boxes, a prism
 around a cylinder; exact against a halfspace). :func:`first_due` walks a path as
 :meth:`solver.path.cell.checker.CellChecker.check` does for a map (conservative advancement,
-:mod:`solver.path.cell.bounds`), returning where coal must decide a pair; :func:`bounds` gives
-every configuration's bounds at once (an evaluation).
+:mod:`solver.path.cell.bounds`), returning where coal must decide a pair.
 
 The packs (:class:`solver.path.cell.fast.FastCell` builds them):
 - robot: parent (J,), joint rotation (J, 3, 3) and translation (J, 3) in the parent, kind (J,)
@@ -169,25 +168,6 @@ def _bound(p, pairs, ends, robot, obstacles, work, near, rot, pos, cuts):  # typ
                 gap = _gap(a, b, normal, robot, obstacles, rot, pos, work, 1, near)
                 value = max(value, gap)
     return value
-
-
-@njit(cache=True, nogil=True, error_model="numpy")
-def bounds(configurations, robot, obstacles, pairs, near):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
-    """Every pair's distance bound at every configuration: shape (M, P), m."""
-    n_joints, n_parts = len(robot[0]), len(robot[8])
-    rot, pos = np.empty((n_joints, 3, 3)), np.empty((n_joints, 3))
-    ends, work, cuts, turn = (
-        np.empty((n_parts, 2, 3)),
-        np.empty((8, 3)),
-        np.empty(8),
-        np.empty((3, 3)),
-    )
-    out = np.empty((len(configurations), len(pairs)))
-    for m in range(len(configurations)):
-        _parts(configurations[m], robot, rot, pos, ends, turn)
-        for p in range(len(pairs)):
-            out[m, p] = _bound(p, pairs, ends, robot, obstacles, work, near, rot, pos, cuts)
-    return out
 
 
 @njit(cache=True, nogil=True, error_model="numpy")
