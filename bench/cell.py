@@ -4,8 +4,10 @@ Run by ``bench/run.py``, or alone from the repository root: ``python bench/cell.
 The ERK-size map (546 placements, 133 waypoints) with a table top, a fixture box and the
 workpiece box, against the same map without a cell in the same run (the goal: at most 3x), for
 the UR5 (its URDF's meshes, as convex hulls) and the UR5e (capsules), the tool point at the end
-of a 12 cm tool; then an optimisation with the cell: its time, its answer's clearance, and the
-best collision-free cell of a map of its box.
+of a 12 cm tool; the compiled check (:mod:`solver.path.cell.fast`) and the coal-only reference
+it must agree with (``CellChecker.check(reference=True)``: here by taking the compiled sweep
+away, as tests/solver/test_cell_fast.py does); then an optimisation with the cell: its time,
+its answer's clearance, and the best collision-free cell of a map of its box.
 """
 
 from __future__ import annotations
@@ -13,11 +15,14 @@ from __future__ import annotations
 import math
 import sys
 import time
+from collections.abc import Iterator
+from contextlib import contextmanager
 from pathlib import Path
 
 import numpy as np
 from timing import best_time
 
+import solver.path.cell.checker as checker_module
 from solver.core.robots import Robot
 from solver.families import get_robot
 from solver.optimise.optimize import optimize_placement
@@ -46,6 +51,21 @@ CELL = Cell(
 )
 
 
+@contextmanager
+def _coal_only() -> Iterator[None]:
+    """Checkers made inside check with coal alone (the reference), as before the sweep."""
+    compiled = checker_module.fast.FastCell
+
+    def refuse(*args: object) -> None:
+        raise NotImplementedError
+
+    checker_module.fast.FastCell = refuse  # type: ignore[assignment,misc]
+    try:
+        yield
+    finally:
+        checker_module.fast.FastCell = compiled  # type: ignore[misc]
+
+
 def cell_lines(
     robot: Robot,
     path: np.ndarray,
@@ -67,14 +87,20 @@ def cell_lines(
             return capability_map(problem, xs=xs, ys=ys, z=z, yaws=np.zeros(1))
 
         run_map(None)
+        run_map(CELL)  # the compiled sweep's first call compiles nothing more, loads its cache
         t_without = best_time(lambda: run_map(None), repeats)
         start = time.perf_counter()
         cmap = run_map(CELL)
         t_with = time.perf_counter() - start
+        with _coal_only():
+            start = time.perf_counter()
+            run_map(CELL)
+            t_coal = time.perf_counter() - start
         reason = getattr(cmap, "reason")  # noqa: B009 - an object typed loosely above
         print(
             f"  {arm.name}: with the cell {t_with:7.3f} s (one run), without {t_without:7.3f} s "
-            f"(best of {repeats}): {t_with / t_without:.1f}x (goal <= 3x); "
+            f"(best of {repeats}): {t_with / t_without:.1f}x (goal <= 3x); coal only "
+            f"{t_coal:7.3f} s: {t_coal / t_without:.1f}x; "
             f"{int((reason == -1).sum())} feasible, {int((reason == 4).sum())} collision cells"
         )
     bounds = (

@@ -176,11 +176,11 @@ def test_an_optimisation_in_a_cell_weighs_its_collision_work(
     box = {
         "robot": body["robot"],
         "path": body["path"],
-        "bounds": {"x": [-0.25, 0.25], "y": [0.25, 0.65], "yaw": [-3.14159, 3.14159]},
+        "bounds": {"x": [-0.35, 0.35], "y": [0.15, 0.75], "yaw": [-3.14159, 3.14159]},
         "z": 0.1,
         "cell": {"fixed": [TABLE]},
     }
-    response = client.post("/v1/optimize", json=box)  # 13,104 cells x 133 x 100: over 5 M
+    response = client.post("/v1/optimize", json=box)  # 816 coarse cells x 133 x 50: over 5 M
     assert_names(response, 422, ["body", "bounds"])
     assert "coarse map" in response.json()["detail"][0]["msg"]
 

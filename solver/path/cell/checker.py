@@ -8,6 +8,10 @@ obstacle, except the base against ``fixed`` objects (it stands on them, whatever
 and the tool's cutting part against ``workpiece`` objects (that is machining); and the robot's
 parts against each other where they are on joints that are neither the same nor adjacent and do
 not come within the clearance at the zero configuration.
+
+A map's check runs the compiled sweep (:mod:`solver.path.cell.fast`): closed-form distances
+and bounds decide most pairs, coal the rest, with the answers of coal alone (``reference=True``;
+an evaluation, and a robot or cell the sweep lacks a joint or shape for, use coal alone).
 """
 
 from __future__ import annotations
@@ -18,15 +22,18 @@ import numpy as np
 import pinocchio as pin
 
 from solver.core.robots import Robot
+from solver.path.cell import fast, kinematics
 from solver.path.cell.bounds import pair_weights
 from solver.path.cell.robot_geometry import robot_geometry
 from solver.path.cell.shapes import Cell
 
 # What checking one pose of a path against a cell costs, in poses of a closed-form family's map
-# (KinematicsFamily.path_cost): the ERK map (UR5, 546 placements x 133 waypoints) with a table,
-# a fixture and the part took 50 to 60 times the map without (bench/cell.py), the sub-steps and
-# the first collision's early stop included; 100 leaves a margin for more objects and meshes.
-CELL_POSE_COST = 100.0
+# (KinematicsFamily.path_cost): the ERK map (546 placements x 133 waypoints) with a table, a
+# fixture and the part took 22 to 36 times the map without with the compiled sweep (bench/cell.py,
+# UR5 meshes and UR5e capsules, on a loaded machine; coal alone: 50 to 60 times), of which 4 to 7
+# times is the map re-solving the joint paths it checks; 50 leaves a margin for more objects,
+# meshes and coal calls.
+CELL_POSE_COST = 50.0
 _WINDOW = 32  # configurations looked ahead at once when skipping
 
 
@@ -59,7 +66,7 @@ class CellVerdict:
             there is none.
         closest: the closest pair over every checked configuration (None when the check
             stopped at the first collision).
-        checks: how many configurations were checked.
+        checks: how many configurations were checked (by coal, in a fast map check).
         approximated: the robot's links given capsules (no readable collision geometry).
     """
 
@@ -108,6 +115,12 @@ class CellChecker:
         for a, b in self._pairs:
             geometry.addCollisionPair(pin.CollisionPair(a, b))
         self._weights = pair_weights(robot.model, geometry, self._pairs, self._n_robot)
+        try:
+            self._fast: fast.FastCell | None = fast.FastCell(
+                robot.model, geometry, self._n_robot, self._pairs
+            )
+        except NotImplementedError:
+            self._fast = None  # a joint or shape the compiled sweep lacks: coal alone
 
     def _self_pairs(self, cutting: int) -> list[tuple[int, int]]:
         """Robot parts on joints neither the same nor adjacent, apart at the zero configuration."""
@@ -165,6 +178,7 @@ class CellChecker:
         transform_workpiece_to_base: np.ndarray,
         *,
         closest: bool,
+        reference: bool = False,
     ) -> CellVerdict:
         """Check a joint path at one placement.
 
@@ -175,14 +189,22 @@ class CellChecker:
             closest: check every configuration and give the closest pair (an evaluation);
                 False stops at the first collision and skips configurations that cannot come
                 within the clearance (a map; :meth:`_first_collision`).
+            reference: coal at every checked configuration, as the compiled sweep
+                (:mod:`solver.path.cell.fast`) must agree with; also where the sweep lacks a
+                joint or shape, and for ``closest`` (an evaluation: coal is faster there).
         """
-        configurations, owners = self.configurations(np.asarray(q, float), segment_in_pass)
-        geometry = self.geometry.copy()  # its own workpiece poses: threads share the checker
         placed = self._world_to_base * pin.SE3(np.asarray(transform_workpiece_to_base, float))
-        for gid, pose in self._workpiece_ids:
-            geometry.geometryObjects[gid].placement = placed * pose
         if not self._pairs:
             return CellVerdict(None, None, 0, self.approximated)
+        if self._fast is not None and not reference and not closest:
+            configurations, owners = kinematics.substeps(
+                np.ascontiguousarray(q, dtype=float),
+                np.asarray(segment_in_pass, dtype=np.bool_),
+                float(self.cell.collision_step),
+            )
+            return self._fast_check(configurations, owners, placed)
+        configurations, owners = self.configurations(np.asarray(q, float), segment_in_pass)
+        geometry = self._placed_geometry(placed)
         if not closest:
             return self._first_collision(geometry, configurations, owners)
         model = self.robot.model
@@ -202,6 +224,44 @@ class CellChecker:
                 best = (low, index, pair)
         near = None if best is None else self._contact(int(owners[best[1]]), best[2], best[0])
         return CellVerdict(None, near, len(configurations), self.approximated)
+
+    def _placed_geometry(self, placed: pin.SE3) -> pin.GeometryModel:
+        """A copy of the geometry with the workpiece objects at ``placed`` (threads share self)."""
+        geometry = self.geometry.copy()
+        for gid, pose in self._workpiece_ids:
+            geometry.geometryObjects[gid].placement = placed * pose
+        return geometry
+
+    def _fast_check(
+        self, configurations: np.ndarray, owners: np.ndarray, placed: pin.SE3
+    ) -> CellVerdict:
+        """:meth:`check` of a map by the compiled sweep, coal only where it cannot decide."""
+        assert self._fast is not None
+        moved = {gid - self._n_robot: placed * pose for gid, pose in self._workpiece_ids}
+        obstacles = self._fast.obstacle_pack(moved)
+        made: list[tuple[pin.GeometryModel, pin.GeometryData, pin.Data]] = []
+
+        def coal_distances(index: int, due: np.ndarray) -> np.ndarray:
+            if not made:
+                geometry = self._placed_geometry(placed)
+                made.append((geometry, geometry.createData(), self.robot.model.createData()))
+            geometry, gdata, data = made[0]
+            model = self.robot.model
+            pin.updateGeometryPlacements(model, data, geometry, gdata, configurations[index])
+            return np.array(
+                [pin.computeDistance(geometry, gdata, int(p)).min_distance for p in due]
+            )
+
+        hit, checks = fast.first_collision(
+            self._fast,
+            configurations,
+            obstacles,
+            self._weights,
+            self.cell.clearance,
+            coal_distances,
+        )
+        collision = None if hit is None else self._contact(int(owners[hit[0]]), hit[1], hit[2])
+        return CellVerdict(collision, None, checks, self.approximated)
 
     def _first_collision(
         self, geometry: pin.GeometryModel, configurations: np.ndarray, owners: np.ndarray
