@@ -24,7 +24,7 @@ CELL = {
         {
             "shape": "box",
             "name": "fixture",
-            "size": [0.08, 0.08, 0.08],
+            "size": [0.04, 0.04, 0.04],
             "pose": {"position": [0.085, 0.32, 0.35], "orientation": [0, 0, 0, 1]},
         },
     ]

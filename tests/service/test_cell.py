@@ -85,7 +85,9 @@ def test_evaluate_reports_the_min_clearance(client: TestClient, body: dict) -> N
         expected.min_clearance.distance, abs=1e-9
     )
     plain = client.post("/v1/evaluate", json={k: v for k, v in body.items() if k != "cell"})
-    assert answer["mu_path"] == plain.json()["mu_path"]
+    # the velocity-best branch (wrist noflip) brings the wrist within the clearance of the
+    # forearm: the answer is its tie, the wrist flipped, equal to the last bits
+    assert answer["mu_path"] == pytest.approx(plain.json()["mu_path"], rel=1e-12)
 
 
 def map_request(body: dict) -> dict[str, Any]:

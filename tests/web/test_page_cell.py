@@ -250,7 +250,7 @@ def test_the_readme_fixture_makes_the_velocity_best_placement_collide(page: Page
         page,
         frame="fixed",
         name="fixture",
-        size=["0.08"] * 3,
+        size=["0.04"] * 3,
         at=["0.085", "0.32", "0.35"],
         rpy=["0", "0", "0"],
     )

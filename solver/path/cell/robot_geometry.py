@@ -1,9 +1,9 @@
 """The robot's own geometry in a cell (cell.md section 2), as a pinocchio ``GeometryModel``.
 
 - An arm read from a URDF: its ``<collision>`` elements (pinocchio's URDF reader, coal shapes).
-  ``package://`` meshes resolve inside example-robot-data's share folder; every mesh is taken as
-  its convex hull (coal's ``buildConvexRepresentation``), which contains it. A URDF whose meshes
-  cannot be read keeps its primitive elements.
+  ``package://`` meshes resolve inside example-robot-data's share folder; every mesh is taken
+  as its convex hull (:func:`solver.path.cell.shapes.convex_hull`), which contains it. A URDF
+  whose meshes cannot be read keeps its primitive elements.
 - Any link left without geometry (an arm built from DH or OPW parameters, a URDF link with
   none): a capsule along the link's kinematic segment, from its joint to the next joint (the
   flange for the last link; the base to the first joint for the base), with the request's
@@ -23,7 +23,7 @@ import pinocchio as pin
 
 from solver.core.exceptions import InvalidInputError
 from solver.core.robots import Robot, example_robot_data_dir
-from solver.path.cell.shapes import Tool
+from solver.path.cell.shapes import Tool, convex_hull
 
 # Capsule radii (m): the base, then one per joint's link. UR5e and UR10e: the collision capsules
 # of MuJoCo Menagerie (google-deepmind/mujoco_menagerie, universal_robots_ur5e/ur5e.xml and
@@ -97,8 +97,8 @@ def _urdf_geometry(robot: Robot) -> pin.GeometryModel:
         )
     for obj in geometry.geometryObjects:
         if isinstance(obj.geometry, coal.BVHModelBase):
-            obj.geometry.buildConvexRepresentation(False)
-            obj.geometry = obj.geometry.convex
+            mesh = obj.geometry
+            obj.geometry = convex_hull(np.array([mesh.vertex(k) for k in range(mesh.num_vertices)]))
     return geometry
 
 
