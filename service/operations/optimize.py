@@ -10,7 +10,7 @@ from solver.core.parallel import TaskRunner, ThreadRunner
 from solver.core.progress import Progress
 from solver.optimise.optimize import optimize_placement
 from solver.optimise.search_space import PlacementBounds
-from solver.optimise.work import work_of
+from solver.optimise.work import COARSE_MAP, work_of
 from solver.path.problem import PathProblem
 
 
@@ -59,7 +59,7 @@ def check_work(
     coarse map or differential evolution, the refinement, the Nelder-Mead climbs, the local
     solves' whole-path checks, the candidates), each weighed by the problem's ``path_cost``:
     against DTF_MAX_MAP_POSES for casadi (DTF_MAX_JOB_POSES in a job), DTF_MAX_SEARCH_POSES
-    for scipy.
+    for scipy; a coarse map of more cells than DTF_MAX_MAP_CELLS (DTF_MAX_JOB_CELLS) first.
 
     Raises:
         InvalidInputError: on ``bounds``, saying the phases, the work and the limit.
@@ -74,6 +74,13 @@ def check_work(
     else:
         limits = settings.map_limits()
         limit, setting, hint = limits.poses, limits.poses_setting, "; narrow the bounds"
+        cells = work.placements(COARSE_MAP)
+        if cells > limits.cells:
+            raise InvalidInputError(
+                "bounds",
+                f"the search box needs a coarse map of {cells} cells (20 mm, 15 deg); the "
+                f"limit is {limits.cells} ({limits.cells_setting}){hint}",
+            )
     if weighed > limit:
         cell = ", with a cell" if problem.options.cell is not None else ""
         raise InvalidInputError(

@@ -34,6 +34,8 @@ from solver.optimise.search_space import PlacementBounds
 from solver.optimise.symmetry import turns_about_base_z
 from solver.path.problem import PathProblem
 
+COARSE_MAP = "coarse map"
+"""The name of the casadi method's coarse map among the phases."""
 SINGLE_PLACEMENT_COST = 2.0
 """The weight of a placement evaluated on its own, against one evaluated in a batch."""
 
@@ -129,7 +131,7 @@ def work_of(
     return OptimisationWork(
         (
             Phase("start", 1, n, one_at_a_time=True),
-            Phase("coarse map", cells, mapped_waypoints(n)),
+            Phase(COARSE_MAP, cells, mapped_waypoints(n)),
             Phase("refinement", refined_count(problem, bounds) * 2 * free * REFINE_ROUNDS, n),
             Phase("IPOPT starts and whole-path checks", solves, n, one_at_a_time=True),
             Phase("Nelder-Mead climbs", climbs, n, one_at_a_time=True),

@@ -150,3 +150,20 @@ def test_the_issue_jaco2_search_is_within_the_default_limits(
     response = client.post("/v1/optimize", json=body)
     assert response.status_code == 200, response.text
     assert response.json()["found"] and response.json()["mu_path"] > 0.4
+
+
+def test_a_coarse_map_over_the_cell_limit_names_the_setting(
+    client: TestClient, request_body: dict, setting: Any
+) -> None:
+    """x and y at 20 mm (11 * 6), yaw at 15 deg (3): 198 cells, over a limit of 100."""
+    body = {
+        "robot": {"model": "kuka_kr6_r700_sixx"},  # no symmetry: the map is over (x, y, yaw)
+        "path": request_body["path"],
+        "bounds": {"x": [0.4, 0.6], "y": [-0.05, 0.05], "yaw": [-0.3, 0.3]},
+        "z": 0.1,
+    }
+    setting(max_map_cells=100)
+    response = client.post("/v1/optimize", json=body)
+    assert_names(response, 422, ["body", "bounds"])
+    message = response.json()["detail"][0]["msg"]
+    assert "a coarse map of 198 cells" in message and "100 (DTF_MAX_MAP_CELLS)" in message
