@@ -11,10 +11,10 @@ service's size limits, so that a search whose work is over a limit is refused be
 A placement evaluated on its own costs more than its share of a batch (the numeric family
 seeds and follows a whole chunk in one compiled call; the map kernel's inputs are per call):
 measured with ``bench/numeric_optimisation.py`` (2026-12-02, loaded machine), one at a time took
-1.3 to 1.9 times a batch's share for numeric IK (UR5 as a URDF, the Jaco2; 2 and 133 waypoints)
-and for the analytic UR5 on 133 waypoints, so such phases weigh SINGLE_PLACEMENT_COST a
-placement. The analytic UR5 on 2 waypoints took 3 to 4 times (22 us a placement: its climbs'
-1,208 placements take about 30 ms, far below any limit).
+1.3 to 2.1 times a batch's share for numeric IK (UR5 as a URDF, the Jaco2; 2 and 133 waypoints)
+and 1.8 for the analytic UR5 on 133 waypoints, so such phases weigh SINGLE_PLACEMENT_COST a
+placement. The analytic UR5 on 2 waypoints took 3 to 5 times (22-44 us a placement: its
+climbs' 1,208 placements take about 50 ms, far below any limit).
 
 Not counted: the local solvers' own iterations (IPOPT works on the NLP, bounded by its time
 limit; SLSQP's finite differences by its iterations), and, for a program longer than
@@ -38,7 +38,7 @@ from solver.path.problem import PathProblem
 
 COARSE_MAP = "coarse map"
 """The name of the casadi method's coarse map among the phases."""
-SINGLE_PLACEMENT_COST = 2.0
+SINGLE_PLACEMENT_COST = 2.5
 """The weight of a placement evaluated on its own, against one evaluated in a batch."""
 
 
