@@ -10,8 +10,10 @@ y = 0.25..0.65 m, step 0.02 m, z = 0.1 m, 133 waypoints, all IK branches), the s
 scalar loop (ur-analytic-ik IK, pinocchio Jacobian and numpy solve per pose and branch) timed
 on a subset in the same run and extrapolated, their ratio, the time per pose and branch, and
 the 8-yaw map against the 1-yaw map; the numeric IK family's map on the same grid (UR5 read as a
-plain URDF, checked equal to the analytic map, and the Panda) against the analytic one; the map
-and the optimisers with joint acceleration limits (``bench/acceleration.py``); the optimisation of
+plain URDF, checked equal to the analytic map, and the Panda) against the analytic one; the
+2-waypoint optimisation of the Jaco2 (numeric IK) against the UR5's
+(``bench/numeric_optimisation.py``); the map and the optimisers with joint acceleration limits
+(``bench/acceleration.py``); the optimisation of
 published-size programs on active sets (``bench/active_set.py``). Then the
 placement optimisation of the same problem
 (yaw free): each method's time and optimum, against the best cell of a fine grid (10 mm,
@@ -37,6 +39,7 @@ import ur_analytic_ik
 from acceleration import acceleration_lines
 from active_set import active_set_lines
 from cell import cell_lines
+from numeric_optimisation import numeric_optimisation_lines
 from timing import best_time
 
 from solver.core.kinematics import jacobian_in_base
@@ -191,6 +194,7 @@ def main() -> None:
     acceleration_lines(robot, path, xs, ys, z, repeats=repeats, smoke=args.smoke)
     cell_lines(robot, path, xs, ys, z, repeats=repeats, smoke=args.smoke)
     numeric_maps(path, xs, ys, z, t_map)
+    numeric_optimisation_lines(path, smoke=args.smoke)
     optimisation(robot, path, smoke=args.smoke)
     active_set_lines(smoke=args.smoke)
     evaluate_over_http(requests=20 if args.smoke else 200)

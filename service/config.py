@@ -49,10 +49,13 @@ class Settings(BaseSettings):
         default=6_100_000,
         gt=0,
         description="Most placement-waypoint pairs, weighed as for DTF_MAX_MAP_POSES, that the "
-        "scipy method's differential evolution of one /v1/optimize request may evaluate (61 "
-        "generations of 20 placements per free variable for a closed-form arm; a costlier IK "
-        "family gets a smaller search, down to 11 generations of 5). The default admits every "
-        "search of a closed-form arm on a path of 1,000 waypoints (61 * 20 * 5 * 1000); a "
+        "scipy method's search of one /v1/optimize request may evaluate: its differential "
+        "evolution (61 populations of 20 placements per free variable, rounded up to a power "
+        "of two, for a closed-form arm; a costlier IK family gets a smaller search, down to 11 "
+        "of 5 per free variable), its refinement, Nelder-Mead climbs and whole-path checks. "
+        "The default admits every search of a closed-form arm over x, y and yaw on a path of "
+        "1,000 waypoints (about 5 million: 61 * 64 * 1000 of them the differential "
+        "evolution's), and with the spin or z free too up to about 600 waypoints; a "
         "longer program is refused with a message that points to the casadi method; "
         "with numeric IK it admits a short path (the Panda on 10 waypoints: about 20 s) and "
         "refuses a search that would take much longer.",

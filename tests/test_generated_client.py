@@ -223,3 +223,22 @@ def test_names_read_well(generated: ModuleType) -> None:
     names = sorted(path.stem for path in folder.glob("*.py"))
     assert [name for name in names if re.search(r"type_\d", name)] == []
     assert [name for name in names if "spin_mode" in name] == ["spin_mode"]
+
+
+def test_fixed_field_names_keep_their_wire_names(generated: ModuleType) -> None:
+    """api.md fixes ``min``, ``u_T`` and ``type``; the client spells them ``min_``, ``u_t``,
+    ``type_`` and sends the API's names.
+
+    openapi-python-client (0.29) snake-cases every property and suffixes ``_`` to a Python
+    keyword or builtin; it has no way to rename one: its config's ``class_overrides`` renames
+    classes and modules, ``field_prefix`` applies only to names that are no identifier, and its
+    one ``x-`` extension, ``x-enum-varnames``, names enum members. Only a contract change would.
+    """
+    models = _module(generated, "models")
+    axis = models.GridAxis(min_=0.1, max_=0.2, step=0.05)
+    assert axis.to_dict() == {"min": 0.1, "max": 0.2, "step": 0.05}
+    assert models.GridAxis.from_dict({"min": 0.1, "max": 0.2, "step": 0.05}).min_ == 0.1
+    error = models.ErrorDetail.from_dict({"loc": ["body"], "msg": "m", "type": "missing"})
+    assert error.type_ == "missing" and error.to_dict()["type"] == "missing"
+    request = models.DtfRequest.from_dict({"robot": {"model": "ur5"}, "q": [0.0] * 6})
+    assert hasattr(request, "u_t") and not hasattr(request, "u_T")

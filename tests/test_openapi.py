@@ -6,6 +6,7 @@ import json
 import re
 from pathlib import Path
 
+import pytest
 from fastapi.testclient import TestClient
 
 from service.main import app
@@ -70,3 +71,41 @@ def test_docs_are_served_offline() -> None:
     description = app.openapi()["info"]["description"]
     for route in ("/healthz", "/v1/robots", "/v1/dtf", "/v1/evaluate", "/v1/map", "/v1/optimize"):
         assert f" {route}`" in description, route
+
+
+WORD_RULES = {
+    # Issue 26: rules the JSON Schema cannot state (one field against another, a length or a
+    # name that depends on the robot), stated where a client's author reads the field; the
+    # contract test's hooks (tests/contract_hooks.py) meet them in the generated requests.
+    "lower == upper joint limits": ("OpwRobot", "joint_position_limits", "lower < upper"),
+    "a catalogue arm's lists of another length": (
+        "CatalogueRobot",
+        "joint_velocity_limits",
+        "one per joint",
+    ),
+    "a URDF arm's lists of another length": ("UrdfRobot", "joint_velocity_limits", "one per joint"),
+    "spins of another length": ("EvaluateRequest", "spins", "one per waypoint"),
+    "repeated poses": ("PosePath", "waypoints", "consecutive ones distinct"),
+    "repeated tool points": ("ToolAxisPath", "tool_axis_waypoints", "consecutive ones distinct"),
+    "a string that is no URDF": ("UrdfRobot", "urdf", "URDF document"),
+    "a UR branch on an OPW arm": (
+        "IkPolicy",
+        "branch",
+        "GET /v1/robots lists each robot's branches",
+    ),
+    "a start outside the bounds": ("OptimizeRequest", "start", "inside the bounds"),
+}
+
+
+@pytest.mark.parametrize("rule", list(WORD_RULES))
+def test_each_rule_in_words_is_in_the_committed_spec(rule: str) -> None:
+    component, field, words = WORD_RULES[rule]
+    spec = json.loads(SPEC_PATH.read_text())
+    description = spec["components"]["schemas"][component]["properties"][field]["description"]
+    assert words in re.sub(r"\s+", " ", description), (rule, description)
+
+
+def test_the_height_rule_is_in_the_optimize_description() -> None:
+    """z and bounds.z both given or both missing: the one rule kept out of the contract test."""
+    description = json.loads(SPEC_PATH.read_text())["paths"]["/v1/optimize"]["post"]["description"]
+    assert "exactly one of them (both or neither is a 422)" in re.sub(r"\s+", " ", description)

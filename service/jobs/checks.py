@@ -12,6 +12,7 @@ from __future__ import annotations
 from service import convert
 from service.config import Settings
 from service.operations import checked_grid
+from service.operations.optimize import check_work
 from service.schemas import EvaluateRequest, MapRequest, OptimizeRequest
 from service.schemas.jobs import EvaluateJob, JobRequest, MapJob
 from solver.core.exceptions import InvalidInputError, SolverError
@@ -96,3 +97,4 @@ def _check_optimize(body: OptimizeRequest, settings: Settings) -> None:
                 f"x {start.x:g} m, y {start.y:g} m, z {start.z:g} m, yaw {start.yaw:g} rad, "
                 f"spin {start.spin:g} rad is outside the bounds",
             )
+    check_work(problem, bounds, body, settings)

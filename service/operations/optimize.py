@@ -5,9 +5,13 @@ from __future__ import annotations
 from service import convert
 from service.config import Settings
 from service.schemas import OptimizeRequest, OptimizeResponse
+from solver.core.exceptions import InvalidInputError
 from solver.core.parallel import TaskRunner, ThreadRunner
 from solver.core.progress import Progress
 from solver.optimise.optimize import optimize_placement
+from solver.optimise.search_space import PlacementBounds
+from solver.optimise.work import COARSE_MAP, work_of
+from solver.path.problem import PathProblem
 
 
 def optimum_of(
@@ -29,6 +33,7 @@ def optimum_of(
     problem = convert.problem_of(
         robot, path.poses, path, ik=body.ik, spin_mode=spin_mode, cell=cell
     )
+    check_work(problem, bounds, body, settings)
     optimum = optimize_placement(
         problem,
         bounds=bounds,
@@ -43,3 +48,44 @@ def optimum_of(
         runner=ThreadRunner(settings.threads) if runner is None else runner,
     )
     return convert.optimize_response(optimum, robot, axis_correction=path.axis_correction)
+
+
+def check_work(
+    problem: PathProblem, bounds: PlacementBounds, body: OptimizeRequest, settings: Settings
+) -> None:
+    """Refuse a search whose whole work is over its limit, before any of it.
+
+    Every phase's placements at most (:func:`solver.optimise.work.work_of`: the start, the
+    coarse map or differential evolution, the refinement, the Nelder-Mead climbs, the local
+    solves' whole-path checks, the candidates), each weighed by the problem's ``path_cost``:
+    against DTF_MAX_MAP_POSES for casadi (DTF_MAX_JOB_POSES in a job), DTF_MAX_SEARCH_POSES
+    for scipy; a coarse map of more cells than DTF_MAX_MAP_CELLS (DTF_MAX_JOB_CELLS) first.
+
+    Raises:
+        InvalidInputError: on ``bounds``, saying the phases, the work and the limit.
+    """
+    bounds.check()
+    spin_step = None if body.spin_path is None else body.spin_path.max_spin_step
+    work = work_of(problem, bounds, method=body.method, max_spin_step=spin_step)
+    weighed = work.weighed(problem)
+    if body.method == "scipy":
+        limit, setting = settings.max_search_poses, "DTF_MAX_SEARCH_POSES"
+        hint = "; fix a variable, shorten the path, or use method casadi"
+    else:
+        limits = settings.map_limits()
+        limit, setting, hint = limits.poses, limits.poses_setting, "; narrow the bounds"
+        cells = work.placements(COARSE_MAP)
+        if cells > limits.cells:
+            raise InvalidInputError(
+                "bounds",
+                f"the search box needs a coarse map of {cells} cells (20 mm, 15 deg); the "
+                f"limit is {limits.cells} ({limits.cells_setting}){hint}",
+            )
+    if weighed > limit:
+        cell = ", with a cell" if problem.options.cell is not None else ""
+        raise InvalidInputError(
+            "bounds",
+            f"the {body.method} search evaluates placements of {problem.prepared.n_waypoints} "
+            f"waypoints: {work.describe()}, as work {weighed:.4g} closed-form poses "
+            f"({problem.family.name} IK{cell}); the limit is {limit} ({setting}){hint}",
+        )

@@ -127,6 +127,20 @@ def _check_map_size(
         raise InvalidInputError("bounds", f"{size}; the limit is {max_poses}")
 
 
+def coarse_map_cells(bounds: PlacementBounds, *, symmetric: bool) -> int:
+    """How many cells the coarse map of ``bounds`` has (what :func:`coarse_cells` evaluates).
+
+    Cells outside the box are not evaluated, so this is an upper bound of its placements.
+    """
+    sizes, _ = _map_sizes(
+        bounds,
+        symmetric=symmetric,
+        n_spins=len(_spin_values(bounds)[0]),
+        n_heights=len(_heights(bounds)),
+    )
+    return math.prod(sizes)
+
+
 _Point = tuple[float, float, float] | None  # (x, y, yaw) of a cell, None outside the box
 
 

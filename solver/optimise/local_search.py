@@ -47,6 +47,23 @@ REFINE_ROUNDS = 12
 REFINE_WORK = 3e5
 
 
+def refined_count(
+    problem: PathProblem,
+    bounds: PlacementBounds,
+    *,
+    count: int = REFINED_CELLS,
+    rounds: int = REFINE_ROUNDS,
+) -> int:
+    """How many cells :func:`refine_cells` climbs at most: ``count``, fewer within REFINE_WORK.
+
+    Each climbed cell evaluates 2 placements a free variable a round, each weighed by the
+    problem's ``path_cost``.
+    """
+    cost = problem.path_cost(problem.prepared.n_waypoints)
+    per_cell = 2 * int(bounds.free.sum()) * rounds * cost
+    return min(count, int(REFINE_WORK // max(per_cell, 1.0)))
+
+
 def refine_cells(
     problem: PathProblem,
     bounds: PlacementBounds,
@@ -72,9 +89,7 @@ def refine_cells(
     after each round (and may stop the work there).
     """
     free = np.flatnonzero(bounds.free)
-    n_waypoints = problem.prepared.n_waypoints
-    per_cell = 2 * len(free) * rounds * problem.path_cost(n_waypoints)
-    count = min(count, int(REFINE_WORK // max(per_cell, 1.0)))
+    count = refined_count(problem, bounds, count=count, rounds=rounds)
     rest, cells = cells[count:], cells[:count]
     if not cells:
         return rest
@@ -128,6 +143,29 @@ CLIMB_MIN_EVALUATIONS = 50
 _TOLERANCE = 1e-7  # m and rad, of Nelder-Mead's simplex
 
 
+def climb_budget(problem: PathProblem, bounds: PlacementBounds) -> int:
+    """The evaluations one :func:`climb` asks Nelder-Mead for: 0 where it does not climb.
+
+    CLIMB_EVALUATIONS, fewer within CLIMB_WORK (each placement weighed by the problem's
+    ``path_cost``); 0 below CLIMB_MIN_EVALUATIONS or with nothing free.
+    """
+    cost = problem.path_cost(problem.prepared.n_waypoints)
+    budget = min(CLIMB_EVALUATIONS, int(CLIMB_WORK // max(cost, 1.0)))
+    return budget if budget >= CLIMB_MIN_EVALUATIONS and bounds.free.any() else 0
+
+
+def climb_evaluations(problem: PathProblem, bounds: PlacementBounds) -> int:
+    """The placements one :func:`climb` evaluates at most, one at a time.
+
+    scipy 1.17 stops Nelder-Mead at its budget exactly; releases before it checked the budget
+    between iterations, and one iteration evaluates up to F + 2 points (a reflection, a
+    contraction, then a shrink of F vertices) for F free variables: at most budget + F + 1
+    (0 where it does not climb).
+    """
+    budget = climb_budget(problem, bounds)
+    return budget + int(bounds.free.sum()) + 1 if budget else 0
+
+
 def climb(problem: PathProblem, bounds: PlacementBounds, start: Cell) -> Cell | None:
     """Nelder-Mead on mu_path over the free variables, from ``start``, inside the bounds.
 
@@ -138,9 +176,8 @@ def climb(problem: PathProblem, bounds: PlacementBounds, start: Cell) -> Cell | 
         leaves fewer than CLIMB_MIN_EVALUATIONS or nothing is free.
     """
     free = np.flatnonzero(bounds.free)
-    cost = problem.path_cost(problem.prepared.n_waypoints)
-    budget = min(CLIMB_EVALUATIONS, int(CLIMB_WORK // max(cost, 1.0)))
-    if budget < CLIMB_MIN_EVALUATIONS or not len(free):
+    budget = climb_budget(problem, bounds)
+    if not budget:
         return None
     best = [start]
     evaluate = PlacementEvaluator(problem)

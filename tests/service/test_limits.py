@@ -10,6 +10,7 @@ import pytest
 from fastapi.testclient import TestClient
 
 from service.config import get_settings
+from solver.families import get_robot
 from tests.cases import EXAMPLES
 from tests.service.test_errors import assert_names
 
@@ -100,3 +101,69 @@ def test_evaluate_detail_summary(client: TestClient, request_body: dict, setting
     assert client.post("/v1/evaluate", json=request_body).json()["detail"] == "summary"
     asked = client.post("/v1/evaluate", json={**request_body, "detail": "waypoints"}).json()
     assert len(asked["waypoints"]) == 133
+
+
+JACO2_BODY = {  # issue 26: 32.8 s before the compiled chain
+    "robot": {"model": "kinova_jaco2"},
+    "bounds": {"x": [-0.25, 0.25], "y": [0.25, 0.65], "yaw": [-3.14159, 3.14159]},
+    "z": 0.1,
+}
+
+
+@pytest.mark.parametrize(
+    ("method", "global_placements", "limit_name"),
+    [
+        # (r, psi): r from 0.25 to hypot(0.25, 0.65) m at 20 mm is 23, psi at 15 deg 24.
+        ("casadi", 23 * 24, "max_map_poses"),
+        # 21 populations of 7 a free variable, 3 free: 21 members, 32 from scipy's Sobol start.
+        ("scipy", 21 * 32, "max_search_poses"),
+    ],
+)
+def test_a_search_over_its_limit_beyond_its_global_phase_is_refused(
+    client: TestClient,
+    request_body: dict,
+    setting: Any,
+    method: str,
+    global_placements: int,
+    limit_name: str,
+) -> None:
+    """The limit admits the coarse map (or the differential evolution) alone, not the rest of
+    the search: refused before it starts, naming the setting."""
+    waypoints = request_body["path"]["waypoints"][:2]
+    body = {**JACO2_BODY, "path": {"waypoints": waypoints}, "method": method}
+    per_placement = get_robot("kinova_jaco2").family.path_cost(2)
+    setting(**{limit_name: int(global_placements * per_placement) + 1})
+    response = client.post("/v1/optimize", json=body)
+    assert_names(response, 422, ["body", "bounds"])
+    message = response.json()["detail"][0]["msg"]
+    assert f"the limit is {int(global_placements * per_placement) + 1}" in message
+    assert f"(DTF_{limit_name.upper()})" in message and "(numeric IK)" in message
+    assert f"{global_placements} " in message  # the global phase, among the phases
+
+
+@pytest.mark.parametrize("method", ["casadi", "scipy"])
+def test_the_issue_jaco2_search_is_within_the_default_limits(
+    client: TestClient, request_body: dict, method: str
+) -> None:
+    waypoints = request_body["path"]["waypoints"][:2]
+    body = {**JACO2_BODY, "path": {"waypoints": waypoints}, "method": method}
+    response = client.post("/v1/optimize", json=body)
+    assert response.status_code == 200, response.text
+    assert response.json()["found"] and response.json()["mu_path"] > 0.4
+
+
+def test_a_coarse_map_over_the_cell_limit_names_the_setting(
+    client: TestClient, request_body: dict, setting: Any
+) -> None:
+    """x and y at 20 mm (11 * 6), yaw at 15 deg (3): 198 cells, over a limit of 100."""
+    body = {
+        "robot": {"model": "kuka_kr6_r700_sixx"},  # no symmetry: the map is over (x, y, yaw)
+        "path": request_body["path"],
+        "bounds": {"x": [0.4, 0.6], "y": [-0.05, 0.05], "yaw": [-0.3, 0.3]},
+        "z": 0.1,
+    }
+    setting(max_map_cells=100)
+    response = client.post("/v1/optimize", json=body)
+    assert_names(response, 422, ["body", "bounds"])
+    message = response.json()["detail"][0]["msg"]
+    assert "a coarse map of 198 cells" in message and "100 (DTF_MAX_MAP_CELLS)" in message

@@ -31,10 +31,12 @@ async def post_optimize(
     """Maximise mu_path over (x, y, yaw) inside the bounds; every answer checked by the evaluator.
 
     No feasible placement inside the bounds is not an error: ``found`` is false. A box whose
-    coarse map (20 mm, 15 degrees) would exceed DTF_MAX_MAP_CELLS cells, or DTF_MAX_MAP_POSES
-    placement-waypoint pairs weighed by the IK family's cost, or whose scipy search would
-    exceed DTF_MAX_SEARCH_POSES, is a 422 on ``bounds``. The height is ``z`` or
-    ``bounds.z``, exactly one of them (both or neither is a 422).
+    coarse map (20 mm, 15 degrees) would exceed DTF_MAX_MAP_CELLS cells, or whose whole search
+    (the coarse map or the scipy method's differential evolution, the refinement, the
+    Nelder-Mead climbs, the whole-path checks of the local solves), in placement-waypoint
+    pairs weighed by the IK family's cost, would exceed DTF_MAX_MAP_POSES (casadi) or
+    DTF_MAX_SEARCH_POSES (scipy), is a 422 on ``bounds``, before any work. The height is ``z``
+    or ``bounds.z``, exactly one of them (both or neither is a 422).
     """
     return await run_stoppable(
         request, lambda progress: json_response(optimum_of(body, settings, progress))

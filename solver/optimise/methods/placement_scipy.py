@@ -85,7 +85,8 @@ def search_size(bounds: PlacementBounds, *, path_cost: float, n_waypoints: int) 
     """
     if path_cost <= n_waypoints:
         return FULL_SEARCH
-    full = search_placements(bounds, FULL_SEARCH)
+    # The full search's nominal placements (Sobol's rounding aside): the sizes as calibrated.
+    full = (GENERATIONS + 1) * POPULATION * max(int(bounds.free.sum()), 1)
     fraction = min(1.0, SEARCH_WORK / (full * path_cost))
     return SearchSize(
         population=max(MIN_POPULATION, round(POPULATION * math.sqrt(fraction))),
@@ -96,9 +97,18 @@ def search_size(bounds: PlacementBounds, *, path_cost: float, n_waypoints: int) 
 
 
 def search_placements(bounds: PlacementBounds, size: SearchSize = FULL_SEARCH) -> int:
-    """How many placements differential evolution evaluates in ``bounds`` (at most)."""
+    """How many placements differential evolution evaluates in ``bounds`` (at most).
+
+    The first population and one a generation. scipy makes a population of
+    max(5, population * free variables) members, and a Sobol start (``init="sobol"``, as
+    :func:`global_search` asks) rounds that up to a power of two: 3 free variables at 20 each
+    are 64 members, not 60 (the Jaco2's smallest search, 7 each: 32, not 21).
+    """
     n_free = int(bounds.free.sum())
-    return (size.generations + 1) * size.population * n_free if n_free else 1
+    if not n_free:
+        return 1
+    members = max(5, size.population * n_free)
+    return (size.generations + 1) * (1 << (members - 1).bit_length())
 
 
 def _full(bounds: PlacementBounds, free_values: np.ndarray) -> np.ndarray:

@@ -35,7 +35,7 @@ from solver.path.problem import PathProblem
 DESCRIPTION = "differential_evolution + SLSQP (scipy)"
 
 
-def _size(problem: PathProblem, bounds: PlacementBounds) -> SearchSize:
+def size_of(problem: PathProblem, bounds: PlacementBounds) -> SearchSize:
     """The search's size for the problem's family (smaller for a costlier placement)."""
     n_waypoints = len(problem.waypoints)
     return search_size(bounds, path_cost=problem.path_cost(n_waypoints), n_waypoints=n_waypoints)
@@ -50,7 +50,7 @@ def check(problem: PathProblem, bounds: PlacementBounds, settings: Search) -> No
         InvalidInputError: on ``bounds``, saying the size asked for and the limit.
     """
     family, n_waypoints = problem.family, len(problem.waypoints)
-    size = _size(problem, bounds)
+    size = size_of(problem, bounds)
     max_poses = settings.max_search_poses
     if max_poses is None:
         return
@@ -72,10 +72,10 @@ def search(
     """Candidates: DE's best placement, SLSQP's polishes, Nelder-Mead climbs; DE's generations.
 
     Each basin DE saw is climbed first by the compass search, then polished by SLSQP on the
-    branch it ends on. The search is sized by :func:`_size` (smaller for a family whose
+    branch it ends on. The search is sized by :func:`size_of` (smaller for a family whose
     placement costs more).
     """
-    progress, size = settings.progress, _size(problem, bounds)
+    progress, size = settings.progress, size_of(problem, bounds)
     basins, iterations = global_search(
         problem,
         bounds,

@@ -1,0 +1,142 @@
+"""An optimisation's placement evaluations, counted before it starts (what the limits weigh).
+
+:func:`solver.optimise.optimize.optimize_placement` evaluates mu_path in phases whose size the
+code fixes: the start; the coarse map (casadi) or the differential evolution (scipy); the compass
+refinement; the Nelder-Mead climbs, one placement a call; the checks of each local solve's
+answer on the whole path (the active set); the judging of every candidate. :func:`work_of` gives
+each phase's placements at most, and :meth:`OptimisationWork.weighed` their work in poses of a
+closed-form family (:meth:`solver.path.problem.PathProblem.path_cost`), the unit of the
+service's size limits, so that a search whose work is over a limit is refused before it starts.
+
+A placement evaluated on its own costs more than its share of a batch (the numeric family
+seeds and follows a whole chunk in one compiled call; the map kernel's inputs are per call):
+measured with ``bench/numeric_optimisation.py`` (2026-12-02, loaded machine), one at a time took
+1.3 to 2.1 times a batch's share for numeric IK (UR5 as a URDF, the Jaco2; 2 and 133 waypoints)
+and 1.8 for the analytic UR5 on 133 waypoints, so such phases weigh SINGLE_PLACEMENT_COST a
+placement. The analytic UR5 on 2 waypoints took 3 to 5 times (22-44 us a placement: its
+climbs' 1,208 placements take about 50 ms, far below any limit).
+
+Not counted: the local solvers' own iterations (IPOPT works on the NLP, bounded by its time
+limit; SLSQP's finite differences by its iterations), and, for a program longer than
+:data:`solver.optimise.coarse_rows.MAX_MAP_ROWS`, the coarse map's check of its best cells on
+the whole path.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from solver.optimise.active_set import MAX_ROUNDS
+from solver.optimise.coarse_rows import mapped_waypoints
+from solver.optimise.coarse_search import coarse_map_cells
+from solver.optimise.local_search import N_CLIMBS, REFINE_ROUNDS, climb_evaluations, refined_count
+from solver.optimise.methods import casadi_method, method_named, scipy_method
+from solver.optimise.methods.placement_scipy import search_placements
+from solver.optimise.search_space import PlacementBounds
+from solver.optimise.symmetry import turns_about_base_z
+from solver.path.problem import PathProblem
+
+COARSE_MAP = "coarse map"
+"""The name of the casadi method's coarse map among the phases."""
+SINGLE_PLACEMENT_COST = 2.5
+"""The weight of a placement evaluated on its own, against one evaluated in a batch."""
+
+
+@dataclass(frozen=True)
+class Phase:
+    """One phase of an optimisation.
+
+    Attributes:
+        name: what it is, as a message names it.
+        placements: the placements it evaluates at most.
+        n_waypoints: the waypoints of each (the coarse map of a long program maps fewer).
+        one_at_a_time: whether each placement is a call of its own.
+    """
+
+    name: str
+    placements: int
+    n_waypoints: int
+    one_at_a_time: bool = False
+
+
+@dataclass(frozen=True)
+class OptimisationWork:
+    """The phases of one optimisation, each with its placements at most."""
+
+    phases: tuple[Phase, ...]
+
+    def placements(self, name: str) -> int:
+        """The placements of the phase called ``name`` (0 where there is none)."""
+        return sum(phase.placements for phase in self.phases if phase.name == name)
+
+    def weighed(self, problem: PathProblem) -> float:
+        """The whole work in closed-form poses: each placement weighed by its path's cost."""
+        return sum(
+            phase.placements
+            * problem.path_cost(phase.n_waypoints)
+            * (SINGLE_PLACEMENT_COST if phase.one_at_a_time else 1.0)
+            for phase in self.phases
+        )
+
+    def describe(self) -> str:
+        """The phases that evaluate anything, as a message says them."""
+        return ", ".join(
+            f"{phase.placements} {phase.name}" for phase in self.phases if phase.placements
+        )
+
+
+def work_of(
+    problem: PathProblem,
+    bounds: PlacementBounds,
+    *,
+    method: str = "casadi",
+    max_spin_step: float | None = None,
+    active_set: bool = True,
+) -> OptimisationWork:
+    """The placements :func:`solver.optimise.optimize.optimize_placement` evaluates at most.
+
+    Args:
+        problem: the problem as the optimiser takes it (its path is prepared here).
+        bounds: the box.
+        method: ``casadi`` or ``scipy``.
+        max_spin_step: as the optimiser takes it (a spin path solves the whole path).
+        active_set: as the optimiser takes it.
+
+    Raises:
+        InvalidInputError: an unknown method (on ``method``), a bad path.
+    """
+    method_named(method)
+    n = problem.prepared.n_waypoints
+    free = int(bounds.free.sum())
+    climbs = N_CLIMBS * climb_evaluations(problem, bounds)
+    on_active_set = active_set and max_spin_step is None and problem.robot.dof <= 6
+    if method == "scipy":
+        size = scipy_method.size_of(problem, bounds)
+        refined = refined_count(problem, bounds, count=size.basins)
+        # Each basin polished: its whole-path check before each SLSQP round and after it.
+        solves = size.basins * (1 + MAX_ROUNDS) if on_active_set else 0
+        return OptimisationWork(
+            (
+                Phase("start", 1, n, one_at_a_time=True),
+                Phase("differential evolution", search_placements(bounds, size), n),
+                Phase("refinement", refined * 2 * free * REFINE_ROUNDS, n),
+                Phase("whole-path checks", solves, n, one_at_a_time=True),
+                Phase("Nelder-Mead climbs", climbs, n, one_at_a_time=True),
+                Phase("candidates", 2 + size.basins + N_CLIMBS, n, one_at_a_time=True),
+            )
+        )
+    cells = coarse_map_cells(bounds, symmetric=turns_about_base_z(problem.robot))
+    starts = casadi_method.N_STARTS
+    # Each IPOPT start: its cell evaluated on its branch, then (on active sets) the first
+    # set's whole-path bounds and one whole-path check after each of its solves.
+    solves = starts * (1 + (1 + MAX_ROUNDS if on_active_set else 0))
+    return OptimisationWork(
+        (
+            Phase("start", 1, n, one_at_a_time=True),
+            Phase(COARSE_MAP, cells, mapped_waypoints(n)),
+            Phase("refinement", refined_count(problem, bounds) * 2 * free * REFINE_ROUNDS, n),
+            Phase("IPOPT starts and whole-path checks", solves, n, one_at_a_time=True),
+            Phase("Nelder-Mead climbs", climbs, n, one_at_a_time=True),
+            Phase("candidates", 2 + starts + N_CLIMBS, n, one_at_a_time=True),
+        )
+    )

@@ -1,0 +1,161 @@
+"""An optimisation's placements, counted while it runs, against the estimate made before it.
+
+Each module that evaluates placements for the optimiser is wrapped with a counter (the call's
+placements, and whether it asked for one at a time); the counts per phase must be within
+:func:`solver.optimise.work.work_of`'s, and a phase the estimate weighs as batched must not go
+one placement a call. Issue 26: the Jaco2 on the README path's first two waypoints (32.8 s
+before the compiled chain); the Nelder-Mead climbs, one placement at a time, with the numeric
+family too (its climbs are skipped at the shipped budget, so one case raises it).
+"""
+
+from __future__ import annotations
+
+import math
+from collections import Counter
+from collections.abc import Callable
+from typing import Any
+
+import numpy as np
+import pytest
+
+from solver.families import get_robot
+from solver.optimise import active_set, coarse_rows, local_search
+from solver.optimise import optimize as front_door
+from solver.optimise.coarse_search import coarse_cells
+from solver.optimise.methods import casadi_method, placement_scipy
+from solver.optimise.search_space import PlacementBounds
+from solver.optimise.work import work_of
+from solver.path.placements import PlacementEvaluator
+from solver.path.problem import PathProblem
+from tests.solver.test_evaluate import load_path
+
+ISSUE_BOX = PlacementBounds(x=(-0.25, 0.25), y=(0.25, 0.65), yaw=(-math.pi, math.pi), z=0.1)
+SMALL_BOX = PlacementBounds(x=(-0.1, 0.1), y=(0.4, 0.5), yaw=(-0.3, 0.3), z=0.1)
+
+# The estimate's phases that each counted place contributes to.
+PHASES = {
+    "casadi": {
+        "front door": ("start", "candidates"),
+        "global": ("coarse map",),
+        "refinement": ("refinement",),
+        "climbs": ("Nelder-Mead climbs",),
+        "solves": ("IPOPT starts and whole-path checks",),
+    },
+    "scipy": {
+        "front door": ("start", "candidates"),
+        "global": ("differential evolution",),
+        "refinement": ("refinement",),
+        "climbs": ("Nelder-Mead climbs",),
+        "solves": ("whole-path checks",),
+    },
+}
+ONE_AT_A_TIME = {"front door", "climbs", "solves"}
+
+
+class Counted:
+    """Placements evaluated per counted place, and the largest batch of each."""
+
+    def __init__(self) -> None:
+        self.placements: Counter[str] = Counter()
+        self.largest: Counter[str] = Counter()
+
+    def add(self, where: str, placements: int) -> None:
+        self.placements[where] += placements
+        self.largest[where] = max(self.largest[where], placements)
+
+    def wrap(self, where: str, function: Callable[..., Any]) -> Callable[..., Any]:
+        def counted(problem: PathProblem, rows: Any, *args: Any, **keywords: Any) -> Any:
+            self.add(where, 1 if not isinstance(rows, np.ndarray) else len(rows))
+            return function(problem, rows, *args, **keywords)
+
+        return counted
+
+    def polish_apart(self, function: Callable[..., Any]) -> Callable[..., Any]:
+        """Differential evolution counted as the global phase; SLSQP's polish left out."""
+
+        def counted(problem: PathProblem, rows: np.ndarray, **keywords: Any) -> Any:
+            self.add("polish" if keywords.get("with_speeds") else "global", len(rows))
+            return function(problem, rows, **keywords)
+
+        return counted
+
+
+@pytest.fixture
+def counted(monkeypatch: pytest.MonkeyPatch) -> Counted:
+    counts = Counted()
+    monkeypatch.setattr(
+        front_door, "evaluate_path", counts.wrap("front door", front_door.evaluate_path)
+    )
+    monkeypatch.setattr(
+        casadi_method, "evaluate_path", counts.wrap("solves", casadi_method.evaluate_path)
+    )
+    monkeypatch.setattr(
+        active_set, "evaluate_placements", counts.wrap("solves", active_set.evaluate_placements)
+    )
+    monkeypatch.setattr(
+        coarse_rows, "evaluate_placements", counts.wrap("global", coarse_rows.evaluate_placements)
+    )
+    monkeypatch.setattr(
+        placement_scipy,
+        "evaluate_placements",
+        counts.polish_apart(placement_scipy.evaluate_placements),
+    )
+    monkeypatch.setattr(
+        local_search,
+        "evaluate_placements",
+        counts.wrap("refinement", local_search.evaluate_placements),
+    )
+
+    class CountedEvaluator(PlacementEvaluator):
+        def __call__(self, placements: np.ndarray) -> Any:
+            counts.add("climbs", len(placements))
+            return super().__call__(placements)
+
+    monkeypatch.setattr(local_search, "PlacementEvaluator", CountedEvaluator)
+    return counts
+
+
+CASES = {
+    "jaco2 issue 26": ("kinova_jaco2", 2, ISSUE_BOX, None),
+    "jaco2 climbing": ("kinova_jaco2", 2, SMALL_BOX, 1e6),
+    "ur5 climbing": ("ur5", 10, SMALL_BOX, None),
+}
+
+
+@pytest.mark.parametrize("method", ["casadi", "scipy"])
+@pytest.mark.parametrize("case", list(CASES))
+def test_the_estimate_covers_every_evaluation(
+    counted: Counted, monkeypatch: pytest.MonkeyPatch, case: str, method: str
+) -> None:
+    name, n_waypoints, bounds, climb_work = CASES[case]
+    if climb_work is not None:
+        monkeypatch.setattr(local_search, "CLIMB_WORK", climb_work)
+    problem = PathProblem.of(get_robot(name), load_path("curved_line")[:n_waypoints])
+    estimate = work_of(problem, bounds, method=method)
+    optimum = front_door.optimize_placement(problem, bounds=bounds, method=method)
+    assert optimum.found
+    for where, phases in PHASES[method].items():
+        allowed = sum(estimate.placements(phase) for phase in phases)
+        assert counted.placements[where] <= allowed, (where, counted.placements, estimate)
+        if where in ONE_AT_A_TIME:
+            assert counted.largest[where] <= 1, (where, counted.largest)
+    if climb_work is not None or name == "ur5":  # the climbs ran: the case shows something
+        assert counted.placements["climbs"] > 0
+    else:  # numeric IK at the shipped budget: no climbs, as the estimate says
+        assert counted.placements["climbs"] == 0 == estimate.placements("Nelder-Mead climbs")
+
+
+def test_a_climb_runs_to_its_budget_one_placement_a_call(
+    counted: Counted, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """From the ERK box's best coarse cell Nelder-Mead is still climbing at 60 evaluations."""
+    monkeypatch.setattr(local_search, "CLIMB_EVALUATIONS", 60)
+    problem = PathProblem.of(get_robot("ur5"), load_path("curved_line"))
+    [best, *_] = coarse_cells(problem, ISSUE_BOX, symmetric=False, near=1.5)
+    assert local_search.climb(problem, ISSUE_BOX, best) is not None
+    budget = local_search.climb_budget(problem, ISSUE_BOX)
+    assert budget == 60  # 60 * 133 waypoints within CLIMB_WORK
+    assert counted.largest["climbs"] == 1
+    assert (
+        budget <= counted.placements["climbs"] <= local_search.climb_evaluations(problem, ISSUE_BOX)
+    )
