@@ -148,6 +148,7 @@ class NumericFamily(KinematicsFamily):
             iterations=ik.SEED_ITERATIONS,
             lower=self.lower,
             upper=self.upper,
+            stall=(ik.STALL_STEPS, ik.STALL_RATIO),
             progress=progress,
         )
         q = q.reshape(n_poses, n_seeds, self.dof)
@@ -167,7 +168,15 @@ class NumericFamily(KinematicsFamily):
             count (P,), the distinct solutions found at the first waypoints.
         """
         settings = np.array(
-            [ik.SEED_ITERATIONS, ik.TRACK_ITERATIONS, ik.DISTINCT, ik.SINGULAR_RCOND], dtype=float
+            [
+                ik.SEED_ITERATIONS,
+                ik.TRACK_ITERATIONS,
+                ik.DISTINCT,
+                ik.SINGULAR_RCOND,
+                ik.STALL_STEPS,
+                ik.STALL_RATIO,
+            ],
+            dtype=float,
         )
         constants = np.array([ik.TOLERANCE, ik.DAMPING_SCALE, ik.DAMPING_FLOOR])
         rotations = np.asarray(rotations, dtype=float)
