@@ -29,17 +29,18 @@ from solver.families.numeric.chain import SerialChain
 
 # Work of one placement in poses of a closed-form family (KinematicsFamily.path_cost), measured
 # with the compiled chain (ik_kernel) on the 2-core development machine against the analytic
-# UR5 map of the same run (ERK grid, 546 placements, 133 waypoints, 2026-12-02): seeding the
-# first waypoint (K seeds, up to ik.SEED_ITERATIONS each) and following each branch found to
-# each next waypoint, the whole map's time per placement and per waypoint. Each size has the
-# lines (seeding, following per waypoint) of its measured arms, and a path costs the highest.
-# Six joints: UR5 as a URDF 1,555 and 47.9 (59x the analytic map), the Jaco2 4,800 and 21.2
-# (its seeds converge slowly); a placement out of reach (every seed to the last iteration)
-# 3,616 for the UR5. Seven: the Panda 10,389 and 193 (an unreachable placement's seeding takes
-# 1.8 times a reachable one's: 5.0 against 2.8 ms CPU), the xArm7 5,784 and 144.
+# UR5 map of the same run (ERK grid, 546 placements, 133 waypoints; CPU time, the machine
+# loaded, 2026-12-02, after seeds were given up on a stall, ik.STALL_STEPS): seeding the first
+# waypoint (K seeds) and following each branch found to each next waypoint, the whole map's
+# time per placement and per waypoint, from maps of 2 and 133 waypoints. Each size has the
+# lines (seeding, following per waypoint) of its measured arms, about 25 % above the
+# measurement, and a path costs the highest. Six joints: UR5 as a URDF 618 and 38.7, the Jaco2
+# 742 and 13.0; placements out of reach (z 5 m) seed for less now (596 and 504: their seeds
+# stall early). Seven: the Panda 2,021 and 125, the xArm7 1,388 and 177 (the following line
+# kept at the 200 measured before, which the free spin's weight was measured against).
 COST_LINES: dict[int, tuple[tuple[float, float], ...]] = {
-    6: ((1_600.0, 50.0), (4_800.0, 22.0)),
-    7: ((18_500.0, 200.0),),
+    6: ((800.0, 48.0), (1_000.0, 17.0)),
+    7: ((2_600.0, 200.0),),
 }
 FREE_SPIN_REDUNDANT_COST = 50.0
 """A seven-joint path's work in free spin against fixed: the Panda along 2,000 and 20,000
