@@ -41,7 +41,7 @@ class Settings(BaseSettings):
         "arm in fixed spin, depending on the day, by the compiled kernel, and about 2.3 times "
         "as long in free spin, by its own; /v1/map computes on DTF_THREADS threads). A pair "
         "of a numeric-IK arm counts as the work of many (its family's path_cost: about 50 a "
-        "waypoint for 6 joints, 200 for 7, plus 1,600 to 4,800 or 18,500 a placement for the "
+        "waypoint for 6 joints, 200 for 7, plus 800 to 1,000 or 2,600 a placement for the "
         "seeds), so its limit is about the same time; /v1/evaluate weighs its one placement "
         "the same way against this limit.",
     )

@@ -2,8 +2,9 @@
 
 robots.md section 4. At the first waypoint of a path the IK starts from a fixed set of seeds
 covering the joint box (a fractional factorial design at each joint's quartiles,
-:func:`solver.families.numeric.ik.seeds`; K = 32 for six joints, 64 for seven or more), keeps every
-distinct solution within the joint limits as a branch, labelled by its index in seed order, and
+:func:`solver.families.numeric.ik.seeds`; K = 32 for six joints, 64 for seven or more; a seed
+whose error stops shrinking is given up, ``ik.STALL_STEPS``), keeps every distinct solution
+within the joint limits as a branch, labelled by its index in seed order, and
 follows each branch to the next waypoint from its solution at the previous one. The same input
 gives the same branches. A numeric family cannot promise that it found every branch: it reports
 how many it found.
@@ -29,21 +30,25 @@ from solver.families.numeric.chain import SerialChain
 
 # Work of one placement in poses of a closed-form family (KinematicsFamily.path_cost), measured
 # with the compiled chain (ik_kernel) on the 2-core development machine against the analytic
-# UR5 map of the same run (ERK grid, 546 placements, 133 waypoints, 2026-12-02): seeding the
-# first waypoint (K seeds, up to ik.SEED_ITERATIONS each) and following each branch found to
-# each next waypoint, the whole map's time per placement and per waypoint. Each size has the
-# lines (seeding, following per waypoint) of its measured arms, and a path costs the highest.
-# Six joints: UR5 as a URDF 1,555 and 47.9 (59x the analytic map), the Jaco2 4,800 and 21.2
-# (its seeds converge slowly); a placement out of reach (every seed to the last iteration)
-# 3,616 for the UR5. Seven: the Panda 10,389 and 193 (an unreachable placement's seeding takes
-# 1.8 times a reachable one's: 5.0 against 2.8 ms CPU), the xArm7 5,784 and 144.
+# UR5 map of the same run (ERK grid, 546 placements, 133 waypoints; CPU time, the machine
+# loaded, 2026-12-02, after seeds were given up on a stall, ik.STALL_STEPS): seeding the first
+# waypoint (K seeds) and following each branch found to each next waypoint, the whole map's
+# time per placement and per waypoint, from maps of 2 and 133 waypoints. Each size has the
+# lines (seeding, following per waypoint) of its measured arms, about 25 % above the
+# measurement, and a path costs the highest. Six joints: UR5 as a URDF 618 and 38.7, the Jaco2
+# 742 and 13.0; placements out of reach (z 5 m) seed for less now (596 and 504: their seeds
+# stall early). Seven: the Panda 2,021 and 125, the xArm7 1,388 and 177 (the following line
+# kept at the 200 measured before, which the free spin's weight was measured against).
 COST_LINES: dict[int, tuple[tuple[float, float], ...]] = {
-    6: ((1_600.0, 50.0), (4_800.0, 22.0)),
-    7: ((18_500.0, 200.0),),
+    6: ((800.0, 48.0), (1_000.0, 17.0)),
+    7: ((2_600.0, 200.0),),
 }
 FREE_SPIN_REDUNDANT_COST = 50.0
-"""A seven-joint path's work in free spin against fixed: the Panda along 2,000 and 20,000
-waypoints took 35 and 41 times as long (2026-12-02, compiled chain; the vertex LP dominates)."""
+"""A seven-joint path's work in free spin against the fixed spin's cost line: the Panda along
+2,000 and 20,000 waypoints took 35 and 41 times the fixed spin's time (2026-12-02, compiled
+chain; the vertex LP dominates). Measured again after the stall rule (CPU time, loaded machine,
+the same day): 2,000 waypoints free 6.45 s, 57 times the fixed spin's 0.113 s, or 13.7 million
+poses of the analytic UR5 map's; 50 times the fixed line weighs it 20.1 million."""
 CHUNK_ROWS = 2048
 """Configurations checked (singularity, joint speeds) between two progress reports: about
 0.2 s for seven joints under load, so that a cancelled evaluation stops within a second."""
@@ -148,6 +153,7 @@ class NumericFamily(KinematicsFamily):
             iterations=ik.SEED_ITERATIONS,
             lower=self.lower,
             upper=self.upper,
+            stall=(ik.STALL_STEPS, ik.STALL_RATIO),
             progress=progress,
         )
         q = q.reshape(n_poses, n_seeds, self.dof)
@@ -167,7 +173,15 @@ class NumericFamily(KinematicsFamily):
             count (P,), the distinct solutions found at the first waypoints.
         """
         settings = np.array(
-            [ik.SEED_ITERATIONS, ik.TRACK_ITERATIONS, ik.DISTINCT, ik.SINGULAR_RCOND], dtype=float
+            [
+                ik.SEED_ITERATIONS,
+                ik.TRACK_ITERATIONS,
+                ik.DISTINCT,
+                ik.SINGULAR_RCOND,
+                ik.STALL_STEPS,
+                ik.STALL_RATIO,
+            ],
+            dtype=float,
         )
         constants = np.array([ik.TOLERANCE, ik.DAMPING_SCALE, ik.DAMPING_FLOOR])
         rotations = np.asarray(rotations, dtype=float)

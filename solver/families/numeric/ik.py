@@ -36,6 +36,12 @@ DAMPING_SCALE = 0.1
 # Iterations from a seed of the joint box (the first waypoint), and from the previous waypoint.
 SEED_ITERATIONS = 150
 TRACK_ITERATIONS = 12
+# A seed is given up at every STALL_STEPS-th step where |e|_inf is above STALL_RATIO times what
+# it was STALL_STEPS steps before: most seeds that do not converge sit at a joint limit, where
+# the clipped steps no longer shrink e, and took all SEED_ITERATIONS steps (83 % of the UR5's
+# seeding steps on the ERK grid, 91 % of the Panda's).
+STALL_STEPS = 10
+STALL_RATIO = 0.8
 # Two solutions are distinct when their wrapped joint distance exceeds this (rad, m).
 DISTINCT = 1e-3
 # A solution whose Jacobian has sigma_min / sigma_max below this is singular (the analytic
@@ -100,6 +106,7 @@ def solve(
     lower: np.ndarray | None = None,
     upper: np.ndarray | None = None,
     frozen: np.ndarray | None = None,
+    stall: tuple[int, float] = (0, 0.0),
     progress: Progress | None = None,
 ) -> tuple[np.ndarray, np.ndarray]:
     """Levenberg-Marquardt from each start to its target, batched.
@@ -119,6 +126,9 @@ def solve(
         upper: shape (n,), rad.
         frozen: shape (M,), bool: rows left at their start and reported not converged (a
             tracked branch already lost); ``None`` solves every row.
+        stall: (steps, ratio): a problem is given up (not converged) at every ``steps``-th step
+            where its |e|_inf is above ``ratio`` times what it was ``steps`` steps before;
+            steps 0: never (``STALL_STEPS``, ``STALL_RATIO`` for the seeds).
         progress: called with the fraction of ``iterations`` done after each step (it may
             raise :class:`solver.core.progress.Cancelled`).
 
@@ -128,16 +138,27 @@ def solve(
     q = np.array(start, dtype=float)
     converged = np.zeros(len(q), dtype=bool)
     iterating = np.ones(len(q), dtype=bool) if frozen is None else ~frozen
+    given_up = np.zeros(len(q), dtype=bool) if frozen is None else frozen.copy()
+    checkpoint = np.full(len(q), np.inf)  # |e|_inf at the last stall check
     rows: np.ndarray | None = None  # after a compaction: the problem of each batch row
     batch_q, batch_rotation, batch_position = q, target_rotation, target_position
+    stall_steps, stall_ratio = stall
     for step in range(iterations + 1):
         if not iterating.any():
             break
         jacobian, rotation, position = chain.jacobian(batch_q)
         error = pose_error(rotation, position, batch_rotation, batch_position)
-        iterating &= np.abs(error).max(axis=-1) >= TOLERANCE
+        largest = np.abs(error).max(axis=-1)
+        iterating &= largest >= TOLERANCE
         if not iterating.any() or step == iterations:
             break
+        if stall_steps > 0 and step % stall_steps == 0:
+            stalled = iterating & (largest > stall_ratio * checkpoint)
+            given_up |= stalled
+            iterating &= ~stalled
+            checkpoint = largest
+            if not iterating.any():
+                break
         damping = DAMPING_SCALE * 0.5 * np.einsum("mi,mi->m", error, error) + DAMPING_FLOOR
         normal = jacobian @ jacobian.transpose(0, 2, 1) + damping[:, None, None] * np.eye(6)
         dq = (jacobian.transpose(0, 2, 1) @ np.linalg.solve(normal, error[..., None]))[..., 0]
@@ -148,11 +169,12 @@ def solve(
         if progress is not None:
             progress((step + 1) / iterations)
         if len(batch_q) >= COMPACT_MIN_ROWS and 2 * np.count_nonzero(iterating) <= len(batch_q):
-            q, converged = _settle(rows, q, converged, batch_q, iterating, frozen)
+            q, converged = _settle(rows, q, converged, batch_q, iterating | given_up)
             rows = (np.arange(len(q)) if rows is None else rows)[iterating]
             batch_q, batch_rotation = batch_q[iterating], batch_rotation[iterating]
-            batch_position, iterating = batch_position[iterating], iterating[iterating]
-    return _settle(rows, q, converged, batch_q, iterating, frozen)
+            batch_position, checkpoint = batch_position[iterating], checkpoint[iterating]
+            given_up, iterating = given_up[iterating], iterating[iterating]
+    return _settle(rows, q, converged, batch_q, iterating | given_up)
 
 
 def _settle(
@@ -160,27 +182,25 @@ def _settle(
     q: np.ndarray,
     converged: np.ndarray,
     batch_q: np.ndarray,
-    iterating: np.ndarray,
-    frozen: np.ndarray | None,
+    unsolved: np.ndarray,
 ) -> tuple[np.ndarray, np.ndarray]:
-    """Write the batch's iterates back to their problems: those no longer iterating converged.
+    """Write the batch's iterates back to their problems and which of them converged.
 
     Args:
         rows: the problem of each batch row; ``None`` while the batch is every problem.
         q: shape (M, n), the problems' iterates.
         converged: shape (M,), bool.
         batch_q: shape (len(batch), n), the batch's iterates.
-        iterating: shape (len(batch),), bool, the batch rows not yet converged.
-        frozen: the rows frozen from the start (never converged); only in the first batch.
+        unsolved: shape (len(batch),), bool, the batch rows still iterating, given up or
+            frozen: the others converged.
 
     Returns:
         q (M, n) and converged (M,), updated.
     """
     if rows is None:
-        done = ~iterating if frozen is None else ~iterating & ~frozen
-        return batch_q.copy(), done
+        return batch_q.copy(), ~unsolved
     q[rows] = batch_q
-    converged[rows] = ~iterating
+    converged[rows] = ~unsolved
     return q, converged
 
 

@@ -64,18 +64,41 @@ def _pose_error(target_r, target_p, work):  # type: ignore[no-untyped-def]  # pr
 
 
 @njit(cache=True, nogil=True, error_model="numpy", inline="always")
-def _levenberg_marquardt(chain, q, target_r, target_p, iterations, box, constants, work):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
+def _normal(jac, normal):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
+    """J J^T of jac (6, n) into normal (6, 6), the lower triangle summed and mirrored."""
+    n = jac.shape[1]
+    for i in range(6):
+        for k in range(i + 1):
+            total = 0.0
+            for j in range(n):
+                total += jac[i, j] * jac[k, j]
+            normal[i, k] = total
+            normal[k, i] = total
+
+
+@njit(cache=True, nogil=True, error_model="numpy", inline="always")
+def _levenberg_marquardt(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
+    chain, q, target_r, target_p, iterations, box, constants, work, cached, stall
+):
     """``ik.solve`` for one problem: iterate q (n,) in place; True when converged.
 
     ``box``: None, or (lower, upper) that every iterate is clipped into. ``constants``:
-    ik.TOLERANCE, ik.DAMPING_SCALE, ik.DAMPING_FLOOR. On return ``work`` holds the frames of
-    the last iterate (:func:`chain_kernel.frames`).
+    ik.TOLERANCE, ik.DAMPING_SCALE, ik.DAMPING_FLOOR. ``cached``: ``work`` already holds the
+    frames of q, its Jacobian at the flange and J J^T (as :func:`_singular` leaves them), so the
+    first step takes them from there: the same numbers, one chain evaluation fewer. ``stall``:
+    (steps, ratio), give up (False) at every ``steps``-th step where |e|_inf is above ``ratio``
+    times what it was ``steps`` steps before (``ik.solve``'s ``stall``); steps 0: never. On
+    return ``work`` holds the frames of the last iterate (:func:`chain_kernel.frames`).
     """
     tolerance, scale, floor = constants[0], constants[1], constants[2]
+    stall_steps, stall_ratio = stall
+    checkpoint = math.inf
     n = len(q)
     jac, normal, error = work[6], work[7], work[8]
     for step in range(iterations + 1):
-        frames(chain, q, work)
+        reuse = cached and step == 0
+        if not reuse:
+            frames(chain, q, work)
         _pose_error(target_r, target_p, work)
         largest, finite, energy = 0.0, True, 0.0
         for i in range(6):
@@ -86,15 +109,15 @@ def _levenberg_marquardt(chain, q, target_r, target_p, iterations, box, constant
             return True
         if step == iterations:
             return False
-        jacobian_at(chain[3], work[0], work[1], work[3], jac)
+        if stall_steps > 0 and step % stall_steps == 0:
+            if largest > stall_ratio * checkpoint:
+                return False
+            checkpoint = largest
         damping = scale * 0.5 * energy + floor
+        if not reuse:
+            jacobian_at(chain[3], work[0], work[1], work[3], jac)
+            _normal(jac, normal)
         for i in range(6):
-            for k in range(i + 1):
-                total = 0.0
-                for j in range(n):
-                    total += jac[i, j] * jac[k, j]
-                normal[i, k] = total
-                normal[k, i] = total
             normal[i, i] += damping
         if not lu_solve(normal, error):
             return False
@@ -115,7 +138,7 @@ def _levenberg_marquardt(chain, q, target_r, target_p, iterations, box, constant
 
 
 @njit(cache=True, nogil=True, error_model="numpy")
-def solve_rows(chain, start, target_r, target_p, iterations, box, constants):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
+def solve_rows(chain, start, target_r, target_p, iterations, box, constants, stall=(0, 0.0)):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
     """``ik.solve`` over M problems: q (M, n), the last iterates, and converged (M,), bool.
 
     Args:
@@ -126,13 +149,14 @@ def solve_rows(chain, start, target_r, target_p, iterations, box, constants):  #
         iterations: the most steps any problem takes.
         box: None, or (lower, upper), each (n,), the box every iterate is clipped into.
         constants: as for :func:`_levenberg_marquardt`.
+        stall: (steps, ratio), as ``ik.solve``'s ``stall``; steps 0: never given up early.
     """
     q = start.copy()
     converged = np.zeros(len(q), dtype=np.bool_)
     work = workspace(q.shape[1])
     for m in range(len(q)):
         converged[m] = _levenberg_marquardt(
-            chain, q[m], target_r[m], target_p[m], iterations, box, constants, work
+            chain, q[m], target_r[m], target_p[m], iterations, box, constants, work, False, stall
         )
     return q, converged
 
@@ -157,17 +181,11 @@ def _singular(chain, rcond, work):  # type: ignore[no-untyped-def]  # pragma: no
     sigma_max^2 (trace >= sigma_max^2) without eigenvalues; only where it fails are the
     eigenvalues computed, as numpy does.
     """
-    n = len(chain[3])
     jac, normal, factor = work[6], work[7], work[10]
     jacobian_at(chain[3], work[0], work[1], work[3], jac)
+    _normal(jac, normal)
     trace = 0.0
     for i in range(6):
-        for k in range(i + 1):
-            total = 0.0
-            for j in range(n):
-                total += jac[i, j] * jac[k, j]
-            normal[i, k] = total
-            normal[k, i] = total
         trace += normal[i, i]
     shift = rcond * rcond * trace
     for j in range(6):  # Cholesky of normal - shift I, lower triangle
@@ -200,7 +218,8 @@ def seed_paths(chain, seeds, box, rotations, positions, settings, constants):  #
         box: (lower, upper), each (n,), the joint box.
         rotations: shape (P, 3, 3), R_B_F* of each path's first waypoint.
         positions: shape (P, 3), m in {B}.
-        settings: ik.SEED_ITERATIONS, ik.TRACK_ITERATIONS, ik.DISTINCT, ik.SINGULAR_RCOND.
+        settings: ik.SEED_ITERATIONS, ik.TRACK_ITERATIONS, ik.DISTINCT, ik.SINGULAR_RCOND,
+            ik.STALL_STEPS, ik.STALL_RATIO.
         constants: as for :func:`_levenberg_marquardt`.
 
     Returns:
@@ -210,6 +229,7 @@ def seed_paths(chain, seeds, box, rotations, positions, settings, constants):  #
     n_seeds, n = seeds.shape
     n_paths = positions.shape[0]
     seed_iterations, apart = int(settings[0]), settings[2]
+    stall = (int(settings[4]), settings[5])
     revolute = chain[3]
     found = np.full((n_paths, n_seeds, n), np.nan)
     count = np.zeros(n_paths, dtype=np.int64)
@@ -220,7 +240,16 @@ def seed_paths(chain, seeds, box, rotations, positions, settings, constants):  #
         for k in range(n_seeds):
             current[:] = seeds[k]
             if not _levenberg_marquardt(
-                chain, current, rotations[p], positions[p], seed_iterations, box, constants, work
+                chain,
+                current,
+                rotations[p],
+                positions[p],
+                seed_iterations,
+                box,
+                constants,
+                work,
+                False,
+                stall,
             ):
                 continue
             new = True
@@ -252,7 +281,7 @@ def follow_paths(chain, current, rotations, positions, solve_first, settings, co
         rotations: shape (P, W, 3, 3), R_B_F* of the piece's waypoints.
         positions: shape (P, W, 3), m in {B}.
         solve_first: whether the piece's first waypoint is solved (every piece but the first).
-        settings: ik.SEED_ITERATIONS, ik.TRACK_ITERATIONS, ik.DISTINCT, ik.SINGULAR_RCOND.
+        settings: as for :func:`seed_paths`.
         constants: as for :func:`_levenberg_marquardt`.
 
     Returns:
@@ -284,6 +313,8 @@ def follow_paths(chain, current, rotations, positions, solve_first, settings, co
                     None,
                     constants,
                     work,
+                    w > 0,  # the frames, J and J J^T of the waypoint before, from _singular
+                    (0, 0.0),
                 ):
                     slot[:] = np.nan
                     break

@@ -126,6 +126,45 @@ def test_compiled_solve_equals_numpy_solve(name: str, clip: bool) -> None:
     np.testing.assert_allclose(solved[converged], reference[converged], rtol=0, atol=Q_ATOL)
 
 
+@pytest.mark.parametrize("name", ROBOTS)
+def test_seeds_given_up_on_a_stall_alike_and_only_those(name: str) -> None:
+    """Seeds' solves with the stall rule: compiled = numpy, and a subset of the full solves.
+
+    Until a problem is given up its iterates are those without the rule, so the problems that
+    converge with it converge without it too, to the same q; and some rows stop early (their
+    last iterate is not the one without the rule).
+    """
+    robot = arm(name)
+    numeric = family(robot)
+    targets = random_configurations(robot, 12, seed=8)
+    rotation, position = numeric.chain.forward(targets)
+    start = np.tile(numeric.seeds, (len(targets), 1))
+    rotation = np.repeat(rotation, len(numeric.seeds), axis=0)
+    position = np.repeat(position, len(numeric.seeds), axis=0)
+    box = (numeric.lower, numeric.upper)
+    constants = np.array([ik.TOLERANCE, ik.DAMPING_SCALE, ik.DAMPING_FLOOR])
+    stall = (ik.STALL_STEPS, ik.STALL_RATIO)
+    args = (numeric.chain.packed(), start, rotation, position, ik.SEED_ITERATIONS, box, constants)
+    solved, converged = ik_kernel.solve_rows(*args, stall)
+    whole, whole_converged = ik_kernel.solve_rows(*args)
+    reference, reference_converged = ik.solve(
+        numeric.chain,
+        start,
+        rotation,
+        position,
+        iterations=ik.SEED_ITERATIONS,
+        lower=numeric.lower,
+        upper=numeric.upper,
+        stall=stall,
+    )
+    np.testing.assert_array_equal(converged, reference_converged)
+    np.testing.assert_allclose(solved[converged], reference[converged], rtol=0, atol=Q_ATOL)
+    assert not np.any(converged & ~whole_converged)
+    np.testing.assert_array_equal(solved[converged], whole[converged])
+    assert converged.any()
+    assert np.any(solved[~converged] != whole[~converged])
+
+
 def path_poses(robot: Robot, placements: np.ndarray, waypoints: int) -> tuple[np.ndarray, ...]:
     """The flange poses of the README path at placements (P, 5): (3, 3, P, W), (3, P, W)."""
     problem = PathProblem.of(robot, load_path("curved_line")[:waypoints])
