@@ -154,26 +154,30 @@ def test_a_table_above_the_base_makes_every_cell_collide_and_the_hover_names_the
 
 
 def test_a_far_box_changes_no_cell(page: Page, url: str) -> None:
+    # The baseline has a cell too (one far box): with a cell the robot is checked against
+    # itself, which changes ties and cells of its own; a second far box must change nothing.
     fill(page, SMALL)
+    add_box(page, frame="fixed", name="far", size=["0.2"] * 3, at=["-5", "-5", "0"], rpy=["0"] * 3)
     plain = run_map(page)
     before = page.evaluate(
         "[...document.querySelectorAll('.panel canvas')].map(c => c.toDataURL())"
     )
+    collisions = page.get_attribute("#summary", "data-collisions")
     add_box(
         page,
         frame="fixed",
-        name="far",
+        name="farther",
         size=["0.2", "0.2", "0.2"],
         at=["5", "5", "0"],
         rpy=["0", "0", "0"],
     )
     request = run_map(page)
-    box = request["cell"]["fixed"][0]
+    box = request["cell"]["fixed"][1]
     assert box["size"] == [0.2, 0.2, 0.2]
     assert box["pose"]["position"] == [5, 5, 0]
     after = page.evaluate("[...document.querySelectorAll('.panel canvas')].map(c => c.toDataURL())")
     assert after == before  # every cell painted as without the box
-    assert page.get_attribute("#summary", "data-collisions") == "0"
+    assert page.get_attribute("#summary", "data-collisions") == collisions
     with_box, without = api_map(url, request), api_map(url, plain)
     assert [c["mu_path"] for c in with_box["cells"]] == [c["mu_path"] for c in without["cells"]]
 
@@ -210,6 +214,11 @@ def test_a_boxs_frame_and_angles_reach_the_request(page: Page, url: str) -> None
         expected = Rotation.from_euler("ZYX", rpy[::-1], degrees=True).as_quat()
         assert obj["pose"]["orientation"] == pytest.approx(list(expected), abs=1e-12)
     assert page.get_attribute("#summary", "data-cells") == str(len(api_map(url, request)["cells"]))
+
+
+def placed(name: str) -> str:
+    """Where the page says an object of the README's cell is: its list place, or the robot."""
+    return {"table": "fixed[0]", "fixture": "fixed[1]"}.get(name, "the robot itself")
 
 
 def readme_figures() -> dict[str, str]:
@@ -266,13 +275,14 @@ def test_the_readme_fixture_makes_the_velocity_best_placement_collide(page: Page
     assert pixel(page, 1, fast, api) == COLLISION_RGB
     text = hover_text(page, cell_point(page, 1, fast, api))
     assert (
-        f"{readme['part']} hits {readme['obstacle']} (fixed[1]) at waypoint {readme['waypoint']}: "
+        f"{readme['part']} hits {readme['obstacle']} ({placed(readme['obstacle'])}) "
+        f"at waypoint {readme['waypoint']}: "
         f"distance {readme['distance']} mm (clearance 5.0 mm)"
     ) in text
     page.mouse.click(*cell_point(page, 1, fast, api).values())
     page.wait_for_function("document.getElementById('cell-verdict').textContent", timeout=60_000)
     assert (page.text_content("#cell-verdict") or "").startswith(
-        f"collision: {readme['part']} hits {readme['obstacle']} (fixed[1])"
+        f"collision: {readme['part']} hits {readme['obstacle']} ({placed(readme['obstacle'])})"
     )
     sent = optimise(page)
     assert sent["cell"] == request["cell"]
@@ -281,7 +291,8 @@ def test_the_readme_fixture_makes_the_velocity_best_placement_collide(page: Page
     assert page.text_content("#opt-mu") == f"{answer['mu_path']:.6f} m/s" == f"{readme['free']} m/s"
     assert page.text_content("#opt-clearance") == (
         f"min clearance {mm(near['distance'])}: {near['robot_part']} to "
-        f"{readme['near_obstacle']} (fixed[0]) at waypoint {near['waypoint']} "
+        f"{readme['near_obstacle']} ({placed(readme['near_obstacle'])}) "
+        f"at waypoint {near['waypoint']} "
         "(clearance asked 5.0 mm)"
     )
     assert mm(near["distance"]) == f"{readme['clear']} mm"
