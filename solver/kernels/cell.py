@@ -130,6 +130,24 @@ def set_limits(limit, g, best, tie):  # type: ignore[no-untyped-def]  # pragma: 
 
 
 @njit(cache=True, error_model="numpy", nogil=True)
+def next_row(remaining, alive, bound):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
+    """The row to follow next, or -1: the first remaining alive row whose bound is about the top.
+
+    ``bound`` is the least speed bound a row's probes saw. The first of a near tie, as the
+    choice prefers it: rows after it then go at their probes.
+    """
+    top = -np.inf
+    for i in range(remaining.shape[0]):
+        if remaining[i] and alive[i]:
+            top = max(top, bound[i])
+    near = top - 1e-9 * abs(top) if np.isfinite(top) else top
+    for i in range(remaining.shape[0]):
+        if remaining[i] and alive[i] and bound[i] >= near:
+            return i
+    return -1
+
+
+@njit(cache=True, error_model="numpy", nogil=True)
 def choice_holds(alive, why, slowest, feed, tie, pick):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
     """Whether row ``pick`` is the cell's answer whatever the pruned rows' mu_path.
 

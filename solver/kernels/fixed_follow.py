@@ -131,12 +131,13 @@ def follow_rows(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
 @njit(cache=True, error_model="numpy", nogil=True)
 def probe_rows(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
     todo, limit, w, family, par, poses, branches, pure_rotation, inverse_qdot, scratch, cq, sq,
-    qd, status, need, alive, why, where, slowest, hint,
+    qd, status, need, alive, why, where, slowest, hint, bound,
 ):  # fmt: skip
     """Prune the rows marked in ``todo`` whose speed bound at waypoint w is below their ``limit``.
 
     A row that is not OK at w fails there or before (its bound -inf); one whose bound there is
-    below its limit (:func:`solver.kernels.cell.set_limits`) has its mu_path below it.
+    below its limit (:func:`solver.kernels.cell.set_limits`) has its mu_path below it. The
+    others keep in ``bound`` the least bound seen (:func:`solver.kernels.cell.next_row`).
     """
     need[:] = False
     for i in range(branches.shape[0]):
@@ -153,3 +154,5 @@ def probe_rows(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
         v = 0.0 if pure_rotation[w] else speed
         if v < limit[i]:
             prune(i, w, v, alive, why, where, slowest, hint)
+        else:
+            bound[i] = min(bound[i], v)

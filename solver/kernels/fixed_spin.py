@@ -52,6 +52,7 @@ from solver.kernels.cell import (
     PRUNED,
     branch_work,
     choice_holds,
+    next_row,
     pose_work,
     set_limits,
     start_again,
@@ -162,6 +163,9 @@ def map_cells(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
     todo = np.empty(n_branches, dtype=np.bool_)
     hint = np.full(n_branches, -1)
     limit = np.empty(n_branches)
+    bound = np.empty(n_branches)
+    remaining = np.empty(n_branches, dtype=np.bool_)
+    probed = (slowest, hint, bound)
     accelerations = qddot_max.shape[0] > 0
     feed, acc_at, acc_by, _, acc_speeds, probes, steps = acc_work(
         n_branches, n_waypoints, v_acc.shape[1] > 0
@@ -181,23 +185,29 @@ def map_cells(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
         kept = (slowest, slowest_at, slowest_joint, speeds, chords2, largest2, inside, crossed)
         limit[:] = -np.inf
         todo[:] = False
-        if not accelerations:  # pruning: the previous placement's branch first
-            todo[guess] = True
-            follow_rows(todo, limit, *posed, *path_tests, *found, *kept, hint)
-            todo[:] = ~todo
-            if alive[guess]:
-                set_limits(limit, guess, slowest[guess], TIE_RTOL)
-                probe_rows(
-                    todo, limit, slowest_at[guess], *posed, inverse_qdot, *found, slowest, hint
-                )
-                for i in range(n_branches):
-                    if todo[i] and alive[i] and hint[i] >= 0:
-                        probe_rows(
-                            todo, limit, hint[i], *posed, inverse_qdot, *found, slowest, hint
-                        )
-        else:
+        if accelerations:
             todo[:] = True
-        follow_rows(todo, limit, *posed, *path_tests, *found, *kept, hint)
+            follow_rows(todo, limit, *posed, *path_tests, *found, *kept, hint)
+        else:  # pruning: the previous placement's branch first, then the most promising
+            bound[:] = np.inf
+            remaining[:] = True
+            best = -1
+            row = guess
+            while row >= 0:
+                remaining[row] = False
+                todo[:] = False
+                todo[row] = True
+                follow_rows(todo, limit, *posed, *path_tests, *found, *kept, hint)
+                if alive[row] and (best < 0 or slowest[row] > slowest[best]):
+                    best = row
+                    set_limits(limit, row, slowest[row], TIE_RTOL)
+                    w = slowest_at[row]
+                    probe_rows(remaining, limit, w, *posed, inverse_qdot, *found, *probed)
+                    for i in range(n_branches):
+                        if remaining[i] and alive[i] and hint[i] >= 0:
+                            w = hint[i]
+                            probe_rows(remaining, limit, w, *posed, inverse_qdot, *found, *probed)
+                row = next_row(remaining, alive, bound)
         if accelerations:
             cell_mu_acc(
                 alive, why, where, slowest, branches, cq, sq, qd, qd, False, inverse_qdot,
