@@ -5,7 +5,10 @@ placement, a cell of the map, as the numpy pipeline does (dtf.md section 9): the
 the placement's yaw and moved (:func:`turned_poses`); the family's pose kernel over blocks of
 :data:`BLOCK` waypoints; per branch the IK and step tests and the running minimum of the speed
 bound; then the branch, by :func:`solver.path.tracking.choose_branch`'s rule, written to the
-answer arrays (:func:`write_cell`). What differs between the kernels (the speed bound, the
+answer arrays (:func:`write_cell`). Pruning: with a feasible branch at ``best``, a branch whose
+mu_path bound (a probe's or its running minimum) cannot be chosen is left (:func:`set_limits`,
+:func:`prune`, :func:`next_row`), and :func:`choice_holds` says whether the answer stands
+whatever the pruned branches' mu_path. What differs between the kernels (the speed bound, the
 position limits' tests, the spin schedule) stays in each.
 """
 

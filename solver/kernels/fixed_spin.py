@@ -28,6 +28,13 @@ waypoints:
 6. the branch: :func:`solver.path.tracking.choose_branch`'s rule, by mu_acc where it is
    computed (:func:`solver.kernels.cell.write_cell`).
 
+Without acceleration limits the branches are pruned (:mod:`solver.kernels.cell`): the branch the
+previous placement chose is followed first; once a branch is feasible, every other is probed at
+its bottleneck (and where each was least before) and followed, most promising first, only while
+its running minimum can still be chosen; a final check follows the pruned branches to the end
+where one might change the answer, so every reported field is the full loop's (ERK grid:
+about a quarter of the pose-branches computed).
+
 A branch stops at its first failure and a placement at its last live branch. Why compiled:
 the fused loops keep a waypoint's values in registers, where numpy makes and reads back an
 array per formula, and no atan2 is taken (it was a third of the kernel's time while the
