@@ -193,31 +193,34 @@ def _busy(pid: int, seconds: float) -> float:
 def _guarded_cut(n: int) -> dict[str, Any]:
     """A Panda evaluation of a 5 cm cut of ``n`` waypoints in a cell that it never touches.
 
-    Numeric IK on seven joints, then the cell's check at every waypoint: both report as they
-    go, so a client that leaves stops the work (run_stoppable). The far box is there to be
-    checked; the evaluation runs to the path's end.
+    Numeric IK on seven joints, then the cell's check at every waypoint against 24 boxes far
+    away (there to be checked: the evaluation runs to the path's end): both report as they go,
+    so a client that leaves stops the work (run_stoppable).
     """
-    box = {
-        "shape": "box",
-        "name": "far",
-        "size": [0.1, 0.1, 0.1],
-        "pose": {"position": [3.0, 3.0, 3.0], "orientation": [0, 0, 0, 1]},
-    }
+    boxes = [
+        {
+            "shape": "box",
+            "name": f"far {k}",
+            "size": [0.1, 0.1, 0.1],
+            "pose": {"position": [3.0 + 0.2 * k, 3.0, 3.0], "orientation": [0, 0, 0, 1]},
+        }
+        for k in range(24)
+    ]
     return {
         "robot": {"model": "panda"},
         "path": line_path(n, 0.05 / n),
         "placement": EXAMPLE["placement"],
-        "cell": {"fixed": [box]},
+        "cell": {"fixed": boxes},
     }
 
 
 def test_an_evaluate_whose_client_leaves_stops_within_a_second() -> None:
     # The work is known to outlast the window: half the path, to its end on the same server,
-    # takes LONG_ENOUGH or more (3.8 s at 5,000 waypoints on the development machine under
-    # load, 2026-12-02), so the whole path would keep the server busy past the window (1.5 s
-    # to 3.5 s after the request) had the client's leaving not stopped it; a test that cannot
-    # tell a stop from an end says so instead of passing. The idle server is not quite still
-    # (the job supervisor looks at its store every 50 ms).
+    # takes LONG_ENOUGH or more (10,000 waypoints, 24 boxes: 4.7 s in process on the
+    # development machine, 2026-12-02; 2.7 s with one box), so the whole path would keep the
+    # server busy past the window (1.5 s to 3.5 s after the request) had the client's leaving
+    # not stopped it; a test that cannot tell a stop from an end says so instead of passing.
+    # The idle server is not quite still (the job supervisor looks at its store every 50 ms).
     process, url = start_server({"DTF_MAX_MAP_POSES": "1000000000"})
     full = _guarded_cut(20_000)
     errors: list[Exception] = []
