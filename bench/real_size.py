@@ -10,7 +10,8 @@ run:
 
 - the ERK-size map (UR5, 546 placements, 133 waypoints) through ``POST /v1/map`` on all cores
   (DTF_THREADS, default the cores) and on one, against the scalar loop of ``bench/run.py``
-  (timed on a subset and extrapolated);
+  (timed on a subset and extrapolated), and where its time goes in the route (in process:
+  validation, the map, the response's cells, its JSON);
 - ``GET /v1/jobs?limit=1000`` with 50 large map jobs stored, against reading and parsing their
   results as the listing did before (``SELECT *`` and ``json.loads`` of every result), and
   ``GET /v1/jobs/{id}`` and one page of cells of one of them;
@@ -42,7 +43,12 @@ sys.path.insert(0, str(ROOT))
 from run import load_path, scalar_cell  # noqa: E402 - bench/run.py, beside this script
 from timing import best_time  # noqa: E402
 
+from service.config import Settings  # noqa: E402
+from service.convert import map_response  # noqa: E402
 from service.jobs.store import JobStore  # noqa: E402
+from service.operations.map import computed_map  # noqa: E402
+from service.schemas import MapRequest  # noqa: E402
+from solver.core.parallel import ThreadRunner  # noqa: E402
 from solver.core.spatial import Placement  # noqa: E402
 from solver.families import get_robot  # noqa: E402
 from solver.path.capability_map import grid_axis  # noqa: E402
@@ -93,6 +99,36 @@ def erk_map_over_http(*, repeats: int, subset: int) -> None:
         f"{t_http * 1e3:.1f} ms on DTF_THREADS={os.cpu_count()} (the default), "
         f"{t_one * 1e3:.1f} ms on 1 ({t_one / t_http:.2f}x); scalar loop {t_scalar:.1f} s "
         f"(extrapolated from {subset} cells): {t_scalar / t_http:,.0f}x (goal >= 5,000x)"
+    )
+
+
+def erk_route_parts(*, repeats: int) -> None:
+    """Where the ERK-size map's time goes in the route, in this process (no HTTP).
+
+    The body's validation, the map on one thread and on DTF_THREADS, the response's cells, its
+    JSON.
+    """
+    body = {"robot": {"model": "ur5"}, "path": EXAMPLE["path"], "grid": ERK_GRID}
+    raw = json.dumps(body).encode()
+    request = MapRequest.model_validate_json(raw)
+    settings = Settings()
+
+    def computed(threads: int) -> tuple[Any, ...]:
+        runner = ThreadRunner(threads)
+        return computed_map(request, settings, png=False, progress=lambda _: None, runner=runner)
+
+    result, robot, spin_mode = computed(settings.threads)
+    response = map_response(result, robot, spin_mode=spin_mode)
+    parts = {
+        "validation": best_time(lambda: MapRequest.model_validate_json(raw), repeats),
+        "map on 1 thread": best_time(lambda: computed(1), repeats),
+        f"map on {settings.threads}": best_time(lambda: computed(settings.threads), repeats),
+        "response cells": best_time(lambda: map_response(result, robot, spin_mode=spin_mode), 10),
+        "JSON": best_time(response.model_dump_json, repeats),
+    }
+    print(
+        "  in the route (in process, best of "
+        f"{repeats}): " + ", ".join(f"{name} {t * 1e3:.2f} ms" for name, t in parts.items())
     )
 
 
@@ -227,6 +263,7 @@ def main() -> None:
     parser.add_argument("--smoke", action="store_true", help="small sizes: check the script runs")
     args = parser.parse_args()
     erk_map_over_http(repeats=2 if args.smoke else 10, subset=2 if args.smoke else 12)
+    erk_route_parts(repeats=2 if args.smoke else 10)
     job_listing(jobs=5 if args.smoke else 50, cells=2_000 if args.smoke else 20_000)
     healthz_during_the_largest_body(waypoints=2_000 if args.smoke else 20_000)
 

@@ -164,6 +164,12 @@ def test_a_client_that_leaves_stops_its_work() -> None:
         process.wait()
 
 
+# The evaluate that the client leaves: it leaves LEAVES_AT s after sending, the server must be
+# idle STOPS_WITHIN s later, and the work must be known to last LONG_ENOUGH s uncancelled.
+LEAVES_AT, STOPS_WITHIN = 1.5, 1.0
+LONG_ENOUGH = LEAVES_AT + STOPS_WITHIN + 1.0 + 0.5
+
+
 def _busy(pid: int, seconds: float) -> float:
     """The fraction of ``seconds`` in which a thread of the process is running or runnable.
 
@@ -184,38 +190,62 @@ def _busy(pid: int, seconds: float) -> float:
     return busy / max(samples, 1)
 
 
-def test_an_evaluate_whose_client_leaves_stops_within_a_second() -> None:
-    # Numeric IK on seven joints (the DTF LP) along 20,000 waypoints, the schema's most: with
-    # the compiled chain about 2.5 s of work here (the Jaco2's six joints: under 1 s, too
-    # short to leave), still running when the client leaves at 1.2 s (it gets no answer). The
-    # work may end by itself within the second after (it did on the development machine idle,
-    # 2026-12-02): this test then cannot tell a stop from an end, and the mechanism is held by
-    # tests/solver/families/test_numeric_progress.py. The idle server is not quite still (the
-    # job supervisor looks at its store every 50 ms).
-    process, url = start_server({})
-    body = {
+def _guarded_cut(n: int) -> dict[str, Any]:
+    """A Panda evaluation of a 5 cm cut of ``n`` waypoints in a cell that it never touches.
+
+    Numeric IK on seven joints, then the cell's check at every waypoint against 24 boxes far
+    away (there to be checked: the evaluation runs to the path's end): both report as they go,
+    so a client that leaves stops the work (run_stoppable).
+    """
+    boxes = [
+        {
+            "shape": "box",
+            "name": f"far {k}",
+            "size": [0.1, 0.1, 0.1],
+            "pose": {"position": [3.0 + 0.2 * k, 3.0, 3.0], "orientation": [0, 0, 0, 1]},
+        }
+        for k in range(24)
+    ]
+    return {
         "robot": {"model": "panda"},
-        "path": line_path(20_000, 2.5e-6),
+        "path": line_path(n, 0.05 / n),
         "placement": EXAMPLE["placement"],
+        "cell": {"fixed": boxes},
     }
+
+
+def test_an_evaluate_whose_client_leaves_stops_within_a_second() -> None:
+    # The work is known to outlast the window: half the path, to its end on the same server,
+    # takes LONG_ENOUGH or more (10,000 waypoints, 24 boxes: 4.7 s in process on the
+    # development machine, 2026-12-02; 2.7 s with one box), so the whole path would keep the
+    # server busy past the window (1.5 s to 3.5 s after the request) had the client's leaving
+    # not stopped it; a test that cannot tell a stop from an end says so instead of passing.
+    # The idle server is not quite still (the job supervisor looks at its store every 50 ms).
+    process, url = start_server({"DTF_MAX_MAP_POSES": "1000000000"})
+    full = _guarded_cut(20_000)
     errors: list[Exception] = []
 
     def leaves() -> None:
         try:
-            httpx.post(url + "/v1/evaluate", json=body, timeout=1.2)
+            httpx.post(url + "/v1/evaluate", json=full, timeout=LEAVES_AT)
         except httpx.ReadTimeout as error:
             errors.append(error)
 
     try:
+        began = time.monotonic()
+        half = httpx.post(url + "/v1/evaluate", json=_guarded_cut(10_000), timeout=300)
+        half_seconds = time.monotonic() - began
+        assert half.status_code == 200 and half.json()["feasible"]
+        assert half_seconds >= LONG_ENOUGH, "the work may end by itself within the window"
         client = threading.Thread(target=leaves)
         client.start()
-        time.sleep(0.5)
+        time.sleep(LEAVES_AT - 0.6)
         working = _busy(process.pid, 0.5)
         client.join()
         assert len(errors) == 1  # the client left before an answer
-        time.sleep(0.5)
+        time.sleep(STOPS_WITHIN - 0.1)
         assert working > 0.8  # the evaluation ran before the client left
-        assert _busy(process.pid, 1.0) < 0.5  # and stopped within a second after
+        assert _busy(process.pid, 1.0) < 0.5  # and had stopped a second after
     finally:
         process.kill()
         process.wait()

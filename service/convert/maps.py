@@ -117,39 +117,47 @@ def _extreme(cmap: CapabilityMap, *, best: bool) -> schemas.MapExtreme | None:
 _LIMITED_BY: tuple[Literal["speed", "acceleration"], ...] = ("speed", "acceleration")
 
 
-def _acceleration_columns(
-    cmap: CapabilityMap, index: tuple[int, ...], feasible: bool
-) -> dict[str, Any]:
-    """A cell's mu_acc and what binds it (empty without acceleration limits or when infeasible)."""
-    if cmap.mu_acc is None or cmap.limited_by is None or not feasible:
-        return {}
-    return {
-        "mu_acc": float(cmap.mu_acc[index]),
-        "limited_by": _LIMITED_BY[min(int(cmap.limited_by[index]), 1)],
-    }
+def _acceleration_columns(cmap: CapabilityMap) -> tuple[list[Any], list[Any]]:
+    """Per cell (in C order) its mu_acc and what binds it: None without acceleration limits.
+
+    Infeasible cells' values are never read.
+    """
+    if cmap.mu_acc is None or cmap.limited_by is None:
+        return [None] * cmap.mu_path.size, [None] * cmap.mu_path.size
+    bound = [_LIMITED_BY[min(k, 1)] for k in cmap.limited_by.ravel().tolist()]
+    return cmap.mu_acc.ravel().tolist(), bound
 
 
 def map_response(cmap: CapabilityMap, robot: Robot, *, spin_mode: SpinMode) -> schemas.MapResponse:
-    """The JSON answer of ``POST /v1/map``: cells yaw-major, then y, then x."""
+    """The JSON answer of ``POST /v1/map``: cells yaw-major, then y, then x.
+
+    The columns are read as Python lists once (indexing numpy arrays cell by cell took longer
+    than validating the cells; ``model_construct``, unvalidated, was slower still).
+    """
     branches = [branch_to_api(b) for b in require_family(robot).branches]
+    feasible = (cmap.reason == FEASIBLE).ravel().tolist()
+    mu, reason = cmap.mu_path.ravel().tolist(), cmap.reason.ravel().tolist()
+    failed, branch = cmap.failed_waypoint.ravel().tolist(), cmap.branch.ravel().tolist()
+    at, joint = cmap.bottleneck_waypoint.ravel().tolist(), cmap.bottleneck_joint.ravel().tolist()
+    mu_acc, limited_by = _acceleration_columns(cmap)
+    xs, ys, yaws, spins = (a.tolist() for a in (cmap.xs, cmap.ys, cmap.yaws, cmap.spins))
     cells = []
-    for s, k, j, i in np.ndindex(cmap.mu_path.shape):
-        feasible = cmap.reason[s, k, j, i] == FEASIBLE
+    for c, (s, k, j, i) in enumerate(np.ndindex(cmap.mu_path.shape)):
+        ok = feasible[c]
         cells.append(
             schemas.MapCell(
-                x=float(cmap.xs[i]),
-                y=float(cmap.ys[j]),
-                yaw=float(cmap.yaws[k]),
-                spin=float(cmap.spins[s]),
-                mu_path=float(cmap.mu_path[s, k, j, i]) if feasible else None,
-                reason=None
-                if feasible
-                else schemas.FailureReason(REASONS[int(cmap.reason[s, k, j, i])]),
-                failed_waypoint=None if feasible else int(cmap.failed_waypoint[s, k, j, i]),
-                bottleneck_waypoint=int(cmap.bottleneck_waypoint[s, k, j, i]) if feasible else None,
-                bottleneck_joint=int(cmap.bottleneck_joint[s, k, j, i]) if feasible else None,
-                branch=branches[int(cmap.branch[s, k, j, i])] if feasible else None,
-                **_acceleration_columns(cmap, (s, k, j, i), bool(feasible)),
+                x=xs[i],
+                y=ys[j],
+                yaw=yaws[k],
+                spin=spins[s],
+                mu_path=mu[c] if ok else None,
+                reason=None if ok else schemas.FailureReason(REASONS[reason[c]]),
+                failed_waypoint=None if ok else failed[c],
+                bottleneck_waypoint=at[c] if ok else None,
+                bottleneck_joint=joint[c] if ok else None,
+                branch=branches[branch[c]] if ok else None,
+                mu_acc=mu_acc[c] if ok else None,
+                limited_by=limited_by[c] if ok else None,
             )
         )
     return schemas.MapResponse(

@@ -8,6 +8,8 @@ from pathlib import Path
 
 import solver.kernels.accelerations
 import solver.kernels.cell
+import solver.kernels.fixed_follow
+import solver.kernels.free_follow
 import solver.kernels.limits
 import solver.kernels.positions
 import solver.kernels.spin_schedule
@@ -32,6 +34,8 @@ def drop_stale_compiled_code(name: str) -> None:
         solver.kernels.positions,
         solver.kernels.limits,
         solver.kernels.cell,
+        solver.kernels.fixed_follow,
+        solver.kernels.free_follow,
         solver.kernels.accelerations,
         solver.kernels.spin_schedule,
         sys.modules[name],

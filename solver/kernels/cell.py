@@ -5,7 +5,10 @@ placement, a cell of the map, as the numpy pipeline does (dtf.md section 9): the
 the placement's yaw and moved (:func:`turned_poses`); the family's pose kernel over blocks of
 :data:`BLOCK` waypoints; per branch the IK and step tests and the running minimum of the speed
 bound; then the branch, by :func:`solver.path.tracking.choose_branch`'s rule, written to the
-answer arrays (:func:`write_cell`). What differs between the kernels (the speed bound, the
+answer arrays (:func:`write_cell`). Pruning: with a feasible branch at ``best``, a branch whose
+mu_path bound (a probe's or its running minimum) cannot be chosen is left (:func:`set_limits`,
+:func:`prune`, :func:`next_row`), and :func:`choice_holds` says whether the answer stands
+whatever the pruned branches' mu_path. What differs between the kernels (the speed bound, the
 position limits' tests, the spin schedule) stays in each.
 """
 
@@ -17,6 +20,8 @@ from numba import njit
 from solver.core.codes import FEASIBLE
 from solver.families.kernels import N_BRANCHES, N_JOINTS, SCRATCH_ROWS, warm_up_arm
 
+# A pruned branch's ``why``: never reported (see :func:`prune`).
+PRUNED = -2
 # Waypoints solved together: the pose kernels run level by level over a block, and a block is
 # the unit of the early stop when every branch has failed.
 BLOCK = 32
@@ -68,6 +73,16 @@ def start_cell(alive, why, where):  # type: ignore[no-untyped-def]  # pragma: no
 
 
 @njit(cache=True, error_model="numpy", nogil=True, inline="always")
+def start_again(rows, alive, why, where):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
+    """The rows marked in ``rows`` alive again, none failed, to be followed from the start."""
+    for i in range(rows.shape[0]):
+        if rows[i]:
+            alive[i] = True
+            why[i] = FEASIBLE
+            where[i] = -1
+
+
+@njit(cache=True, error_model="numpy", nogil=True, inline="always")
 def wanted_branches(branches, alive, need):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
     """Mark in ``need`` (8,) the branch indices of ``branches`` that are still ``alive``."""
     need[:] = False
@@ -81,6 +96,82 @@ def fail(i, code, w, alive, why, where):  # type: ignore[no-untyped-def]  # prag
     alive[i] = False
     why[i] = code
     where[i] = w
+
+
+@njit(cache=True, error_model="numpy", nogil=True, inline="always")
+def prune(i, w, bound, alive, why, where, slowest, hint):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
+    """Branch row i is left at waypoint w, its mu_path known to be at most ``bound``.
+
+    The row keeps ``bound`` in ``slowest`` (-inf where it fails) for :func:`choice_holds`;
+    its ``why`` and ``where`` are never reported (the cell is feasible: see
+    :func:`set_limits`).
+    """
+    alive[i] = False
+    why[i] = PRUNED
+    where[i] = -1
+    slowest[i] = bound
+    hint[i] = w
+
+
+@njit(cache=True, error_model="numpy", nogil=True)
+def set_limits(limit, g, best, tie):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
+    """Per row, the mu_path bound under which it is pruned, once row g is feasible at ``best``.
+
+    :func:`write_cell` takes the first row within the relative ``tie`` of the highest, which is
+    at least ``best``: a row before g below best - tie |best| is never chosen (twice the tie
+    leaves the rounding aside); a row after g at most ``best`` is not chosen before g, and
+    one a hair above (half the tie) moves the highest by less than the tie. Whether the cell's
+    answer holds with every pruned row at its bound is checked after (:func:`choice_holds`).
+    """
+    for i in range(limit.shape[0]):
+        if i < g:
+            limit[i] = best - 2.0 * tie * abs(best)
+        elif i > g:
+            limit[i] = best + 0.5 * tie * abs(best)
+        else:
+            limit[i] = -np.inf
+
+
+@njit(cache=True, error_model="numpy", nogil=True)
+def next_row(remaining, alive, bound):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
+    """The row to follow next, or -1: the first remaining alive row whose bound is about the top.
+
+    ``bound`` is the least speed bound a row's probes saw. The first of a near tie, as the
+    choice prefers it: rows after it then go at their probes.
+    """
+    top = -np.inf
+    for i in range(remaining.shape[0]):
+        if remaining[i] and alive[i]:
+            top = max(top, bound[i])
+    near = top - 1e-9 * abs(top) if np.isfinite(top) else top
+    for i in range(remaining.shape[0]):
+        if remaining[i] and alive[i] and bound[i] >= near:
+            return i
+    return -1
+
+
+@njit(cache=True, error_model="numpy", nogil=True)
+def choice_holds(alive, why, slowest, feed, tie, pick):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
+    """Whether row ``pick`` is the cell's answer whatever the pruned rows' mu_path.
+
+    ``pick`` is chosen among the rows followed to the end; each pruned row's mu_path is at most
+    its bound in ``slowest``, or it is infeasible. The highest index may rise from T (the rows
+    followed) up to U (the largest bound): the pick must stay within the tie of U, and no
+    pruned row before it may reach the tie of T (the rows followed before it do not: it is
+    the first that does). Margins of half and
+    twice the tie leave the rounding of the tie test aside.
+    """
+    top = -np.inf
+    for i in range(alive.shape[0]):
+        if alive[i]:
+            top = max(top, feed[i])
+    upper = top
+    for i in range(alive.shape[0]):
+        if why[i] == PRUNED:
+            upper = max(upper, slowest[i])
+            if i < pick and not slowest[i] < top - 2.0 * tie * abs(top):
+                return False
+    return feed[pick] >= upper - 0.5 * tie * abs(upper)
 
 
 @njit(cache=True, error_model="numpy", nogil=True)

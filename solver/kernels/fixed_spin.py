@@ -28,6 +28,13 @@ waypoints:
 6. the branch: :func:`solver.path.tracking.choose_branch`'s rule, by mu_acc where it is
    computed (:func:`solver.kernels.cell.write_cell`).
 
+Without acceleration limits the branches are pruned (:mod:`solver.kernels.cell`): the branch the
+previous placement chose is followed first; once a branch is feasible, every other is probed at
+its bottleneck (and where each was least before) and followed, most promising first, only while
+its running minimum can still be chosen; a final check follows the pruned branches to the end
+where one might change the answer, so every reported field is the full loop's (the ERK-size
+map: about a third of the CPU time of the loop over every branch, 2026-12-02).
+
 A branch stops at its first failure and a placement at its last live branch. Why compiled:
 the fused loops keep a waypoint's values in registers, where numpy makes and reads back an
 array per formula, and no atan2 is taken (it was a third of the kernel's time while the
@@ -44,39 +51,28 @@ import math
 import numpy as np
 from numba import njit
 
-from solver.core.codes import (
-    ACC_TIE_RTOL,
-    REASON_DISCONTINUOUS,
-    REASON_JOINT_LIMITS,
-    REASON_SINGULAR,
-    REASON_UNREACHABLE,
-    SINGULAR,
-    TIE_RTOL,
-    UNREACHABLE,
-)
-from solver.families.kernels import N_JOINTS, pose_block
+from solver.core.codes import ACC_TIE_RTOL, FEASIBLE, TIE_RTOL
+from solver.families.kernels import N_JOINTS
 from solver.kernels.accelerations import acc_work, cell_mu_acc, write_acc
 from solver.kernels.cache import drop_stale_compiled_code
 from solver.kernels.cell import (
-    BLOCK,
+    PRUNED,
     branch_work,
-    fail,
+    choice_holds,
+    next_row,
     pose_work,
+    set_limits,
+    start_again,
     start_cell,
     turned_poses,
-    wanted_branches,
     warm_up_accelerations,
     warm_up_answers,
     warm_up_placement,
     write_cell,
 )
-from solver.kernels.limits import joint_speed_bound, step_stencil
-from solver.kernels.positions import (
-    NARROW,
-    WIDE,
-    first_outside_pairs,
-    limit_modes,
-)
+from solver.kernels.fixed_follow import follow_rows, probe_rows
+from solver.kernels.limits import step_stencil
+from solver.kernels.positions import limit_modes
 
 _TWO_PI = 2 * math.pi
 
@@ -171,90 +167,54 @@ def map_cells(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
     largest2 = np.empty((n_branches, N_JOINTS))
     inside = np.empty((n_branches, N_JOINTS))
     crossed = np.empty((n_branches, N_JOINTS), dtype=np.bool_)
+    todo = np.empty(n_branches, dtype=np.bool_)
+    hint = np.full(n_branches, -1)
+    limit = np.empty(n_branches)
+    bound = np.empty(n_branches)
+    remaining = np.empty(n_branches, dtype=np.bool_)
+    probed = (slowest, hint, bound)
     accelerations = qddot_max.shape[0] > 0
     feed, acc_at, acc_by, _, acc_speeds, probes, steps = acc_work(
         n_branches, n_waypoints, v_acc.shape[1] > 0
     )
     steps_c = step_stencil(stencil_index, stencil_weight)
     inverse_qdot = 1.0 / qdot_max
-    check_steps = max_joint_step < math.pi
-    cos_step = math.cos(max_joint_step)
+    guess = 0
     for c in range(n_cells):
         start_cell(alive, why, where)
-        chords2[:] = 0.0
-        largest2[:] = 0.0
-        inside[:] = np.inf
-        crossed[:] = False
-        n_alive = n_branches
         turned_poses(
             c, cos_yaw[c], sin_yaw[c], offset, flange_rotation, flange_position, tool_position,
             twist, poses,
         )  # fmt: skip
-        for w0 in range(0, n_waypoints, BLOCK):
-            w1 = min(w0 + BLOCK, n_waypoints)
-            wanted_branches(branches, alive, need)
-            pose_block(family, par, poses, w0, w1, need, scratch, cq, sq, status, qd)
-            for i in range(n_branches):
-                if not alive[i]:
-                    continue
-                b = branches[i]
-                for w in range(w0, w1):
-                    code = -1
-                    if status[b, w] == UNREACHABLE:
-                        code = REASON_UNREACHABLE
-                    elif status[b, w] == SINGULAR:
-                        code = REASON_SINGULAR
-                    elif w > 0:
-                        checked = check_steps and segment_checked[w - 1]
-                        for j in range(N_JOINTS):
-                            c0, s0 = cq[b, j, w - 1], sq[b, j, w - 1]
-                            c1, s1 = cq[b, j, w], sq[b, j, w]
-                            if checked and c0 * c1 + s0 * s1 < cos_step:
-                                code = REASON_DISCONTINUOUS
-                                break
-                            if modes[j] == WIDE:
-                                chord2 = (c1 - c0) * (c1 - c0) + (s1 - s0) * (s1 - s0)
-                                chords2[i, j] += chord2
-                                largest2[i, j] = max(largest2[i, j], chord2)
-                            elif modes[j] == NARROW and not crossed[i, j]:
-                                # Does the step's short arc pass the middle of the gap, the
-                                # angle opposite the range's middle? Where both ends lie on
-                                # the middle's side (u > 0) and the sign of v changes, it
-                                # passes the middle instead; otherwise it may (so: the exact
-                                # test).
-                                u0 = c0 * arc[j, 0] + s0 * arc[j, 1]
-                                v0 = s0 * arc[j, 0] - c0 * arc[j, 1]
-                                u1 = c1 * arc[j, 0] + s1 * arc[j, 1]
-                                v1 = s1 * arc[j, 0] - c1 * arc[j, 1]
-                                crossed[i, j] = v0 * v1 <= 0.0 and (u0 <= 0.0 or u1 <= 0.0)
-                    if code >= 0:
-                        alive[i] = False
-                        why[i] = code
-                        where[i] = w
-                        n_alive -= 1
-                        break
-                    for j in range(N_JOINTS):
-                        if modes[j] == NARROW:
-                            margin = cq[b, j, w] * arc[j, 0] + sq[b, j, w] * arc[j, 1] - arc[j, 2]
-                            inside[i, j] = min(inside[i, j], margin)
-                    speed, limiting = joint_speed_bound(qd, b, w, inverse_qdot)
-                    v = 0.0 if pure_rotation[w] else speed
-                    if w == 0 or v < slowest[i]:
-                        slowest[i] = v
-                        slowest_at[i] = w
-                        slowest_joint[i] = limiting
-                    if speeds.shape[0]:
-                        speeds[i, w] = v
-            if n_alive == 0:
-                break
-        for i in range(n_branches):
-            if not alive[i]:
-                continue
-            first = first_outside_pairs(
-                cq, sq, branches[i], i, lower, upper, modes, chords2, largest2, inside, crossed
-            )
-            if first < n_waypoints:
-                fail(i, REASON_JOINT_LIMITS, first, alive, why, where)
+        posed = (family, par, poses, branches, pure_rotation)
+        found = (scratch, cq, sq, qd, status, need, alive, why, where)
+        path_tests = (segment_checked, lower, upper, modes, arc, inverse_qdot, max_joint_step)
+        kept = (slowest, slowest_at, slowest_joint, speeds, chords2, largest2, inside, crossed)
+        limit[:] = -np.inf
+        todo[:] = False
+        if accelerations:
+            todo[:] = True
+            follow_rows(todo, limit, *posed, *path_tests, *found, *kept, hint)
+        else:  # pruning: the previous placement's branch first, then the most promising
+            bound[:] = np.inf
+            remaining[:] = True
+            best = -1
+            row = guess
+            while row >= 0:
+                remaining[row] = False
+                todo[:] = False
+                todo[row] = True
+                follow_rows(todo, limit, *posed, *path_tests, *found, *kept, hint)
+                if alive[row] and (best < 0 or slowest[row] > slowest[best]):
+                    best = row
+                    set_limits(limit, row, slowest[row], TIE_RTOL)
+                    w = slowest_at[row]
+                    probe_rows(remaining, limit, w, *posed, inverse_qdot, *found, *probed)
+                    for i in range(n_branches):
+                        if remaining[i] and alive[i] and hint[i] >= 0:
+                            w = hint[i]
+                            probe_rows(remaining, limit, w, *posed, inverse_qdot, *found, *probed)
+                row = next_row(remaining, alive, bound)
         if accelerations:
             cell_mu_acc(
                 alive, why, where, slowest, branches, cq, sq, qd, qd, False, inverse_qdot,
@@ -262,11 +222,22 @@ def map_cells(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
                 steps_c, stencil_waypoints, qddot_max, feed, acc_at, acc_by, acc_speeds, probes,
                 steps,
             )  # fmt: skip
-        pick = write_cell(
-            c, branches, alive, why, where, feed if accelerations else slowest,
-            ACC_TIE_RTOL if accelerations else TIE_RTOL, slowest, slowest_at, slowest_joint, speeds,
-            mu, reason, failed, branch, bottleneck_waypoint, bottleneck_joint, v_out,
-        )  # fmt: skip
+        answer = (slowest, slowest_at, slowest_joint, speeds, mu, reason, failed, branch,
+                  bottleneck_waypoint, bottleneck_joint, v_out)  # fmt: skip
+        if accelerations:
+            pick = write_cell(c, branches, alive, why, where, feed, ACC_TIE_RTOL, *answer)
+        else:
+            pick = write_cell(c, branches, alive, why, where, slowest, TIE_RTOL, *answer)
+            if not choice_holds(alive, why, slowest, slowest, TIE_RTOL, pick):
+                # a pruned row might change the answer: follow the pruned rows to the end
+                for i in range(n_branches):
+                    todo[i] = why[i] == PRUNED
+                start_again(todo, alive, why, where)
+                limit[:] = -np.inf
+                follow_rows(todo, limit, *posed, *path_tests, *found, *kept, hint)
+                pick = write_cell(c, branches, alive, why, where, slowest, TIE_RTOL, *answer)
+        if reason[c] == FEASIBLE:
+            guess = pick
         if accelerations:
             write_acc(
                 c, pick, reason, slowest, slowest_at, slowest_joint, feed, acc_at, acc_by,

@@ -12,12 +12,14 @@ tested against (tests/solver/test_free_spin_kernel.py). Per placement:
    position limits (they hold along the spin schedule); V_max by the exact two-variable LP
    (:func:`solver.kernels.limits.two_variable_speed`, as
    :func:`solver.core.dtf.two_variable_speed`) and its running minimum, mu_path;
-3. without acceleration limits, each branch still feasible, fastest first, until one holds
-   (and those tied with it): the spin rate nearest zero at the feed mu_path
-   (:func:`solver.core.dtf.spin_rate_nearest_zero`), the joints moved by the spin
-   (:func:`solver.path.pipeline._spin_schedule`), and that joint path tracked again with the
-   position limits and the step test (:func:`solver.path.tracking.track`), in
-   :mod:`solver.kernels.spin_schedule`;
+3. without acceleration limits, the branches pruned (:mod:`solver.kernels.cell`,
+   :mod:`solver.kernels.free_follow`): the branch the previous placement chose first, then the
+   most promising, each followed to the end tracked again along its spin schedule (the spin
+   rate nearest zero at the feed mu_path, :func:`solver.core.dtf.spin_rate_nearest_zero`; the
+   joints moved by the spin, :func:`solver.path.pipeline._spin_schedule`; that joint path
+   tracked with the position limits and the step test, :func:`solver.path.tracking.track`,
+   in :mod:`solver.kernels.spin_schedule`); the others probed and left once they cannot be
+   chosen, and followed to the end after all where the answer might depend on them;
 4. with joint acceleration limits, the branches in their order, each tracked along its spin
    schedule and its mu_acc formed from the spun path's steps, unless a waypoint shows that
    it cannot be chosen (:func:`solver.kernels.accelerations.cell_mu_acc`);
@@ -31,35 +33,27 @@ import math
 import numpy as np
 from numba import njit
 
-from solver.core.codes import (
-    ACC_TIE_RTOL,
-    FEASIBLE,
-    REASON_DISCONTINUOUS,
-    REASON_SINGULAR,
-    REASON_UNREACHABLE,
-    SINGULAR,
-    TIE_RTOL,
-    UNREACHABLE,
-)
-from solver.families.kernels import N_JOINTS, pose_block
-from solver.kernels.accelerations import acc_work, cell_mu_acc, next_fastest, write_acc
+from solver.core.codes import ACC_TIE_RTOL, FEASIBLE, TIE_RTOL
+from solver.families.kernels import N_JOINTS
+from solver.kernels.accelerations import acc_work, cell_mu_acc, write_acc
 from solver.kernels.cache import drop_stale_compiled_code
 from solver.kernels.cell import (
-    BLOCK,
+    PRUNED,
     branch_work,
-    fail,
+    choice_holds,
+    next_row,
     pose_work,
+    set_limits,
+    start_again,
     start_cell,
     turned_poses,
-    wanted_branches,
     warm_up_accelerations,
     warm_up_answers,
     warm_up_placement,
     write_cell,
 )
-from solver.kernels.limits import step_stencil, two_variable_speed
-from solver.kernels.positions import relative_path
-from solver.kernels.spin_schedule import spun_failure
+from solver.kernels.free_follow import follow_free_rows, probe_free_rows, spun_check
+from solver.kernels.limits import step_stencil
 
 _TWO_PI = 2 * math.pi
 drop_stale_compiled_code(__name__)
@@ -153,12 +147,14 @@ def free_cells(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
     spun = np.empty((n_waypoints, N_JOINTS))
     accelerations = qddot_max.shape[0] > 0
     keep_acc = v_acc.shape[1] > 0
-    feed, acc_at, acc_by, checked, acc_speeds, probes, steps = acc_work(
-        n_branches, n_waypoints, keep_acc
-    )
+    feed, acc_at, acc_by, _, acc_speeds, probes, steps = acc_work(n_branches, n_waypoints, keep_acc)
     steps_c = step_stencil(stencil_index, stencil_weight)
-    check_steps = max_joint_step < math.pi
-    cos_step = math.cos(max_joint_step)
+    todo = np.empty(n_branches, dtype=np.bool_)
+    remaining = np.empty(n_branches, dtype=np.bool_)
+    hint = np.full(n_branches, -1)
+    limit = np.empty(n_branches)
+    bound = np.empty(n_branches)
+    guess = 0
     for c in range(n_cells):
         ca, sa = cos_yaw[c], sin_yaw[c]
         turned_poses(
@@ -174,46 +170,16 @@ def free_cells(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
             spin_poses[16, w] = sa * x + ca * y
             spin_poses[17, w] = tool_axis[w, 2]
         start_cell(alive, why, where)
-        n_alive = n_branches
-        for w0 in range(0, n_waypoints, BLOCK):
-            w1 = min(w0 + BLOCK, n_waypoints)
-            wanted_branches(branches, alive, need)
-            pose_block(family, par, spin_poses, w0, w1, need, scratch, cq, sq, status, qs)
-            pose_block(family, par, poses, w0, w1, need, scratch, cq, sq, status, qd)
-            for i in range(n_branches):
-                if not alive[i]:
-                    continue
-                b = branches[i]
-                for w in range(w0, w1):
-                    code = -1
-                    if status[b, w] == UNREACHABLE:
-                        code = REASON_UNREACHABLE
-                    elif status[b, w] == SINGULAR:
-                        code = REASON_SINGULAR
-                    elif w > 0 and check_steps and segment_checked[w - 1]:
-                        for j in range(N_JOINTS):
-                            c0, s0 = cq[b, j, w - 1], sq[b, j, w - 1]
-                            c1, s1 = cq[b, j, w], sq[b, j, w]
-                            if c0 * c1 + s0 * s1 < cos_step:
-                                code = REASON_DISCONTINUOUS
-                                break
-                    if code >= 0:
-                        alive[i] = False
-                        why[i] = code
-                        where[i] = w
-                        n_alive -= 1
-                        break
-                    speed, limiting = two_variable_speed(qd, qs, b, w, qdot_max)
-                    v = 0.0 if pure_rotation[w] else speed
-                    if w == 0 or v < slowest[i]:
-                        slowest[i] = v
-                        slowest_at[i] = w
-                        slowest_joint[i] = limiting
-                    if speeds.shape[0]:
-                        speeds[i, w] = v
-            if n_alive == 0:
-                break
+        posed = (family, par, poses, spin_poses, branches, pure_rotation)
+        found = (scratch, cq, sq, qd, qs, status, need, alive, why, where, slowest)
+        kept = (slowest_at, slowest_joint, speeds, hint)
+        steps_tests = (segment_checked, qdot_max, max_joint_step)
+        spun_args = (cq, sq, qd, qs, branches, slowest, length, segment_checked, lower, upper,
+                     qdot_max, max_joint_step, spun, alive, why, where)  # fmt: skip
+        limit[:] = -np.inf
         if accelerations:
+            todo[:] = True
+            follow_free_rows(todo, limit, *posed, *steps_tests, *found, *kept)
             tie = ACC_TIE_RTOL
             cell_mu_acc(
                 alive, why, where, slowest, branches, cq, sq, qd, qs, True, length,
@@ -222,29 +188,53 @@ def free_cells(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
                 steps,
             )  # fmt: skip
         else:
-            # The spin schedule's tracking, from the fastest branch down: once one holds, a
-            # slower branch can be chosen only if tied with it, so the rest need not be
-            # tracked again.
+            # Pruning (solver.kernels.cell): the previous placement's branch first, then the
+            # most promising; each followed to the end is tracked along its spin schedule
+            # (the joints moved by the spin at the spin rate nearest zero at the feed
+            # mu_path, with the position limits and the step test), which decides whether
+            # it is feasible.
             tie = TIE_RTOL
-            checked[:] = False
+            bound[:] = np.inf
+            remaining[:] = True
+            best = -1
+            row = guess
+            while row >= 0:
+                remaining[row] = False
+                todo[:] = False
+                todo[row] = True
+                follow_free_rows(todo, limit, *posed, *steps_tests, *found, *kept)
+                if alive[row]:
+                    spun_check(row, *spun_args)
+                if alive[row] and (best < 0 or slowest[row] > slowest[best]):
+                    best = row
+                    set_limits(limit, row, slowest[row], tie)
+                    w = slowest_at[row]
+                    probe_free_rows(remaining, limit, w, *posed, qdot_max, *found, hint, bound)
+                    for i in range(n_branches):
+                        if remaining[i] and alive[i] and hint[i] >= 0:
+                            w = hint[i]
+                            probe_free_rows(
+                                remaining, limit, w, *posed, qdot_max, *found, hint, bound
+                            )
+                row = next_row(remaining, alive, bound)
             feed[:] = slowest
-            top = -np.inf
-            i = next_fastest(alive, checked, slowest, top, tie)
-            while i >= 0:
-                rate = slowest[i] if slowest[i] > 0.0 and math.isfinite(slowest[i]) else 0.0
-                code, at = spun_failure(
-                    relative_path(cq, sq, branches[i], True), qd, qs, branches[i], rate, length,
-                    segment_checked, lower, upper, qdot_max, max_joint_step, spun,
-                )  # fmt: skip
-                if code != FEASIBLE:
-                    fail(i, code, at, alive, why, where)
-                else:
-                    top = max(top, slowest[i])
-                i = next_fastest(alive, checked, slowest, top, tie)
-        pick = write_cell(
-            c, branches, alive, why, where, feed, tie, slowest, slowest_at, slowest_joint, speeds,
-            mu, reason, failed, branch, bottleneck_waypoint, bottleneck_joint, v_out,
-        )  # fmt: skip
+        answer = (slowest, slowest_at, slowest_joint, speeds, mu, reason, failed, branch,
+                  bottleneck_waypoint, bottleneck_joint, v_out)  # fmt: skip
+        pick = write_cell(c, branches, alive, why, where, feed, tie, *answer)
+        if not accelerations and not choice_holds(alive, why, slowest, feed, tie, pick):
+            # a pruned row might change the answer: follow the pruned rows to the end
+            for i in range(n_branches):
+                todo[i] = why[i] == PRUNED
+            start_again(todo, alive, why, where)
+            limit[:] = -np.inf
+            follow_free_rows(todo, limit, *posed, *steps_tests, *found, *kept)
+            for i in range(n_branches):
+                if todo[i] and alive[i]:
+                    spun_check(i, *spun_args)
+            feed[:] = slowest
+            pick = write_cell(c, branches, alive, why, where, feed, tie, *answer)
+        if reason[c] == FEASIBLE:
+            guess = pick
         if accelerations:
             write_acc(
                 c, pick, reason, slowest, slowest_at, slowest_joint, feed, acc_at, acc_by,

@@ -133,26 +133,23 @@ def _task(
     problem: PathProblem,
     with_speeds: bool,
     chunk: int,
-    compiled: bool,
+    inputs: dict[float, KernelInputs] | None,
     placements: np.ndarray,
 ) -> tuple[np.ndarray, ...]:
     """Evaluate a task's placements in chunks: the columns of :func:`_chunk`, concatenated.
 
     The compiled kernel (:mod:`solver.kernels.fixed_spin`, in free spin
-    :mod:`solver.kernels.free_spin`), where the family has one, or else the numpy pipeline,
-    both taking placements of any yaws together. A task may run in another process
-    (a Dask worker), so it sets the malloc thresholds itself.
+    :mod:`solver.kernels.free_spin`) where ``inputs`` holds its inputs (one per spin of the
+    placements, made once for all the tasks), or else the numpy pipeline, both taking
+    placements of any yaws together. A task may run in another process (a Dask worker), so it
+    sets the malloc thresholds itself.
     """
     raise_malloc_thresholds()
-    kernel = kernel_of(problem) if compiled else None
-    if kernel is not None:
-        inputs: dict[float, KernelInputs] = {}  # made once per spin, not once per chunk
-        parts = []
-        for rows in _pieces(placements, chunk):
-            spin = float(rows[0, 4])
-            if spin not in inputs:
-                inputs[spin] = kernel_inputs(problem, spin, kernel)
-            parts.append(run_kernel(inputs[spin], rows, with_speeds))
+    if inputs is not None:
+        parts = [
+            run_kernel(inputs[float(rows[0, 4])], rows, with_speeds)
+            for rows in _pieces(placements, chunk)
+        ]
     else:
         parts = [_chunk(problem, rows, with_speeds) for rows in _pieces(placements, chunk)]
     if problem.path_checks:
@@ -221,7 +218,11 @@ def evaluate_placements(
         if progress is not None:
             progress(completed[0] / len(cells))
 
-    work = partial(_task, problem, with_speeds, chunk, compiled)
+    kernel = kernel_of(problem) if compiled else None
+    inputs = None  # the kernel's, made once per spin, not once per task (a map's 5 tasks: 6 ms)
+    if kernel is not None:
+        inputs = {spin: kernel_inputs(problem, spin, kernel) for spin in set(cells[:, 4].tolist())}
+    work = partial(_task, problem, with_speeds, chunk, inputs)
     parts = runner.run(work, tasks, done)
     n_waypoints = problem.prepared.n_waypoints
     empty = (np.zeros(0), *(np.zeros(0, dtype=int),) * 5, np.zeros((0, n_waypoints)))
