@@ -53,12 +53,15 @@ class Phase:
         placements: the placements it evaluates at most.
         n_waypoints: the waypoints of each (the coarse map of a long program maps fewer).
         one_at_a_time: whether each placement is a call of its own.
+        without_cell: whether its placements are evaluated without the cell (the kinematics
+            alone: weighed by the family's cost, not the cell's).
     """
 
     name: str
     placements: int
     n_waypoints: int
     one_at_a_time: bool = False
+    without_cell: bool = False
 
 
 @dataclass(frozen=True)
@@ -73,9 +76,10 @@ class OptimisationWork:
 
     def weighed(self, problem: PathProblem) -> float:
         """The whole work in closed-form poses: each placement weighed by its path's cost."""
+        clear = problem.with_options(cell=None)
         return sum(
             phase.placements
-            * problem.path_cost(phase.n_waypoints)
+            * (clear if phase.without_cell else problem).path_cost(phase.n_waypoints)
             * (SINGLE_PLACEMENT_COST if phase.one_at_a_time else 1.0)
             for phase in self.phases
         )
@@ -124,6 +128,12 @@ def work_of(
             (
                 Phase("start", 1, n, one_at_a_time=True),
                 Phase("differential evolution", search_placements(bounds, size), n),
+                Phase(
+                    "differential evolution's collisions, without the cell",
+                    backed * search_placements(bounds, size),
+                    n,
+                    without_cell=True,
+                ),
                 Phase("refinement", refined * 2 * free * REFINE_ROUNDS, n),
                 Phase("whole-path checks", solves, n, one_at_a_time=True),
                 Phase("Nelder-Mead climbs", climbs, n, one_at_a_time=True),
