@@ -31,7 +31,7 @@ from solver.optimise.candidate import Candidate, Search
 from solver.optimise.coarse_search import MAX_COARSE_CELLS
 from solver.optimise.methods import Method, method_named
 from solver.optimise.search_space import PlacementBounds, variables_of, vector_of
-from solver.optimise.symmetry import arc_coordinates, arc_point, turns_about_base_z
+from solver.optimise.symmetry import arc_coordinates, arc_point, symmetric_search
 from solver.path.evaluate import PathEvaluation, evaluate_path
 from solver.path.joint_path import EXACT_POSE_TOLERANCE, evaluate_joint_path
 from solver.path.problem import PathProblem
@@ -202,7 +202,7 @@ def optimize_placement(
             f"{start.spin:g} rad is outside the bounds",
         )
     settings = Search(
-        symmetric=turns_about_base_z(problem.robot),
+        symmetric=symmetric_search(problem),
         near=math.atan2(start.y, start.x),
         max_spin_step=max_spin_step,
         max_coarse_cells=max_coarse_cells,

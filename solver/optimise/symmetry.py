@@ -4,6 +4,11 @@ When joint 1 turns about the base z axis, turning a placement about that axis by
 (position rotated, yaw + alpha) only shifts q1 by alpha, so mu_path depends on
 (r, psi) = (sqrt(x^2 + y^2), yaw - atan2(y, x)) alone. The placements of one (r, psi) form an
 arc; :func:`arc_point` picks one of them inside the bounds, deterministically.
+
+A cell keeps the symmetry only where its ``fixed`` objects turn into themselves about that axis
+(a floor or table top: a halfspace whose normal is the base z axis): a fixture beside the robot
+does not turn with the placement, so the map and the local searches then work over (x, y, yaw)
+(:func:`symmetric_search`). The workpiece objects, the tool and the robot itself turn with it.
 """
 
 from __future__ import annotations
@@ -15,6 +20,8 @@ import numpy as np
 from solver.core.kinematics import jacobian_in_base, tool_pose_in_base
 from solver.core.robots import Robot
 from solver.optimise.search_space import PlacementBounds
+from solver.path.cell.shapes import Cell, Halfspace
+from solver.path.problem import PathProblem
 
 _TWO_PI = 2 * math.pi
 
@@ -35,6 +42,27 @@ def turns_about_base_z(robot: Robot) -> bool:
     about_z = np.allclose(np.abs(axis), [0.0, 0.0, 1.0], atol=1e-12)
     through_origin = np.allclose(jacobian[:3, 0], np.cross(axis, point), atol=1e-12)
     return bool(about_z and through_origin)
+
+
+def symmetric_search(problem: PathProblem) -> bool:
+    """Whether the optimisers search over (r, psi).
+
+    Joint 1 turns about the base z axis (:func:`turns_about_base_z`) and the problem's cell, if
+    any, turns into itself about it.
+    """
+    cell = problem.options.cell
+    return turns_about_base_z(problem.robot) and (cell is None or _turns_into_itself(cell))
+
+
+def _turns_into_itself(cell: Cell) -> bool:
+    """Whether every fixed object is a halfspace whose normal (posed) is the base z axis."""
+    for shape in cell.fixed:
+        if not isinstance(shape, Halfspace):
+            return False
+        normal = np.asarray(shape.pose, dtype=float)[:3, :3] @ np.asarray(shape.normal, float)
+        if np.linalg.norm(np.cross(normal, [0.0, 0.0, 1.0])) > 1e-12 * np.linalg.norm(normal):
+            return False
+    return True
 
 
 def arc_coordinates(x: float, y: float, yaw: float) -> tuple[float, float]:

@@ -3,7 +3,8 @@
 :func:`solver.optimise.optimize.optimize_placement` evaluates mu_path in phases whose size the
 code fixes: the start; the coarse map (casadi) or the differential evolution (scipy); the compass
 refinement; the Nelder-Mead climbs, one placement a call; the checks of each local solve's
-answer on the whole path (the active set); the judging of every candidate. :func:`work_of` gives
+answer on the whole path (the active set); with a cell, the back-off of each local solve's
+answer (:mod:`solver.optimise.back_off`); the judging of every candidate. :func:`work_of` gives
 each phase's placements at most, and :meth:`OptimisationWork.weighed` their work in poses of a
 closed-form family (:meth:`solver.path.problem.PathProblem.path_cost`), the unit of the
 service's size limits, so that a search whose work is over a limit is refused before it starts.
@@ -27,13 +28,14 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from solver.optimise.active_set import MAX_ROUNDS
+from solver.optimise.back_off import BACK_OFF_PLACEMENTS, backs_off
 from solver.optimise.coarse_rows import mapped_waypoints
 from solver.optimise.coarse_search import coarse_map_cells
 from solver.optimise.local_search import N_CLIMBS, REFINE_ROUNDS, climb_evaluations, refined_count
 from solver.optimise.methods import casadi_method, method_named, scipy_method
 from solver.optimise.methods.placement_scipy import search_placements
 from solver.optimise.search_space import PlacementBounds
-from solver.optimise.symmetry import turns_about_base_z
+from solver.optimise.symmetry import symmetric_search
 from solver.path.problem import PathProblem
 
 COARSE_MAP = "coarse map"
@@ -51,12 +53,15 @@ class Phase:
         placements: the placements it evaluates at most.
         n_waypoints: the waypoints of each (the coarse map of a long program maps fewer).
         one_at_a_time: whether each placement is a call of its own.
+        without_cell: whether its placements are evaluated without the cell (the kinematics
+            alone: weighed by the family's cost, not the cell's).
     """
 
     name: str
     placements: int
     n_waypoints: int
     one_at_a_time: bool = False
+    without_cell: bool = False
 
 
 @dataclass(frozen=True)
@@ -71,9 +76,10 @@ class OptimisationWork:
 
     def weighed(self, problem: PathProblem) -> float:
         """The whole work in closed-form poses: each placement weighed by its path's cost."""
+        clear = problem.with_options(cell=None)
         return sum(
             phase.placements
-            * problem.path_cost(phase.n_waypoints)
+            * (clear if phase.without_cell else problem).path_cost(phase.n_waypoints)
             * (SINGLE_PLACEMENT_COST if phase.one_at_a_time else 1.0)
             for phase in self.phases
         )
@@ -110,6 +116,9 @@ def work_of(
     free = int(bounds.free.sum())
     climbs = N_CLIMBS * climb_evaluations(problem, bounds)
     on_active_set = active_set and max_spin_step is None and problem.robot.dof <= 6
+    # With a cell each local solve's answer may be backed off towards its start: one more
+    # candidate, found by bisection (solver.optimise.back_off).
+    backed = backs_off(problem)
     if method == "scipy":
         size = scipy_method.size_of(problem, bounds)
         refined = refined_count(problem, bounds, count=size.basins)
@@ -119,13 +128,20 @@ def work_of(
             (
                 Phase("start", 1, n, one_at_a_time=True),
                 Phase("differential evolution", search_placements(bounds, size), n),
+                Phase(
+                    "differential evolution's collisions, without the cell",
+                    backed * search_placements(bounds, size),
+                    n,
+                    without_cell=True,
+                ),
                 Phase("refinement", refined * 2 * free * REFINE_ROUNDS, n),
                 Phase("whole-path checks", solves, n, one_at_a_time=True),
                 Phase("Nelder-Mead climbs", climbs, n, one_at_a_time=True),
-                Phase("candidates", 2 + size.basins + N_CLIMBS, n, one_at_a_time=True),
+                Phase("back-offs", backed * size.basins * BACK_OFF_PLACEMENTS, n, True),
+                Phase("candidates", 2 + (1 + backed) * size.basins + N_CLIMBS, n, True),
             )
         )
-    cells = coarse_map_cells(bounds, symmetric=turns_about_base_z(problem.robot))
+    cells = coarse_map_cells(bounds, symmetric=symmetric_search(problem))
     starts = casadi_method.N_STARTS
     # Each IPOPT start: its cell evaluated on its branch, then (on active sets) the first
     # set's whole-path bounds and one whole-path check after each of its solves.
@@ -137,6 +153,7 @@ def work_of(
             Phase("refinement", refined_count(problem, bounds) * 2 * free * REFINE_ROUNDS, n),
             Phase("IPOPT starts and whole-path checks", solves, n, one_at_a_time=True),
             Phase("Nelder-Mead climbs", climbs, n, one_at_a_time=True),
-            Phase("candidates", 2 + starts + N_CLIMBS, n, one_at_a_time=True),
+            Phase("back-offs", backed * starts * BACK_OFF_PLACEMENTS, n, one_at_a_time=True),
+            Phase("candidates", 2 + (1 + backed) * starts + N_CLIMBS, n, one_at_a_time=True),
         )
     )

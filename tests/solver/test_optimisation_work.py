@@ -5,7 +5,9 @@ placements, and whether it asked for one at a time); the counts per phase must b
 :func:`solver.optimise.work.work_of`'s, and a phase the estimate weighs as batched must not go
 one placement a call. Issue 26: the Jaco2 on the README path's first two waypoints (32.8 s
 before the compiled chain); the Nelder-Mead climbs, one placement at a time, with the numeric
-family too (its climbs are skipped at the shipped budget, so one case raises it).
+family too (its climbs are skipped at the shipped budget, so one case raises it); and the UR5
+in a cell whose fixture blocks the velocity-best placement (test_cell's), where local solves'
+answers are backed off and differential evolution scores collisions without the cell.
 """
 
 from __future__ import annotations
@@ -19,14 +21,16 @@ import numpy as np
 import pytest
 
 from solver.families import get_robot
-from solver.optimise import active_set, coarse_rows, local_search
+from solver.optimise import active_set, back_off, coarse_rows, local_search
 from solver.optimise import optimize as front_door
 from solver.optimise.coarse_search import coarse_cells
 from solver.optimise.methods import casadi_method, placement_scipy
 from solver.optimise.search_space import PlacementBounds
 from solver.optimise.work import work_of
+from solver.path.cell.shapes import Cell
 from solver.path.placements import PlacementEvaluator
-from solver.path.problem import PathProblem
+from solver.path.problem import PathOptions, PathProblem
+from tests.solver.test_cell import OPT_BOUNDS, blocking_cell
 from tests.solver.test_evaluate import load_path
 
 ISSUE_BOX = PlacementBounds(x=(-0.25, 0.25), y=(0.25, 0.65), yaw=(-math.pi, math.pi), z=0.1)
@@ -40,6 +44,7 @@ PHASES = {
         "refinement": ("refinement",),
         "climbs": ("Nelder-Mead climbs",),
         "solves": ("IPOPT starts and whole-path checks",),
+        "back-offs": ("back-offs",),
     },
     "scipy": {
         "front door": ("start", "candidates"),
@@ -47,9 +52,11 @@ PHASES = {
         "refinement": ("refinement",),
         "climbs": ("Nelder-Mead climbs",),
         "solves": ("whole-path checks",),
+        "back-offs": ("back-offs",),
+        "collisions": ("differential evolution's collisions, without the cell",),
     },
 }
-ONE_AT_A_TIME = {"front door", "climbs", "solves"}
+ONE_AT_A_TIME = {"front door", "climbs", "solves", "back-offs"}
 
 
 class Counted:
@@ -58,6 +65,7 @@ class Counted:
     def __init__(self) -> None:
         self.placements: Counter[str] = Counter()
         self.largest: Counter[str] = Counter()
+        self.in_a_cell = False  # the optimisation's problem has a cell
 
     def add(self, where: str, placements: int) -> None:
         self.placements[where] += placements
@@ -74,7 +82,10 @@ class Counted:
         """Differential evolution counted as the global phase; SLSQP's polish left out."""
 
         def counted(problem: PathProblem, rows: np.ndarray, **keywords: Any) -> Any:
-            self.add("polish" if keywords.get("with_speeds") else "global", len(rows))
+            where = "polish" if keywords.get("with_speeds") else "global"
+            if where == "global" and problem.options.cell is None and self.in_a_cell:
+                where = "collisions"  # the kinematics alone at placements in collision
+            self.add(where, len(rows))
             return function(problem, rows, **keywords)
 
         return counted
@@ -112,6 +123,13 @@ def counted(monkeypatch: pytest.MonkeyPatch) -> Counted:
             return super().__call__(placements)
 
     monkeypatch.setattr(local_search, "PlacementEvaluator", CountedEvaluator)
+
+    class CountedBackOff(PlacementEvaluator):
+        def __call__(self, placements: np.ndarray) -> Any:
+            counts.add("back-offs", len(placements))
+            return super().__call__(placements)
+
+    monkeypatch.setattr(back_off, "PlacementEvaluator", CountedBackOff)
     return counts
 
 
@@ -119,18 +137,28 @@ CASES = {
     "jaco2 issue 26": ("kinova_jaco2", 2, ISSUE_BOX, None),
     "jaco2 climbing": ("kinova_jaco2", 2, SMALL_BOX, 1e6),
     "ur5 climbing": ("ur5", 10, SMALL_BOX, None),
+    "ur5 in a cell": ("ur5", None, OPT_BOUNDS, None),
 }
+
+
+@pytest.fixture(scope="module")
+def blocking() -> Cell:
+    """test_cell's fixture at the velocity-best placement's elbow, found before any counting."""
+    return Cell(fixed=blocking_cell()["shapes"])
 
 
 @pytest.mark.parametrize("method", ["casadi", "scipy"])
 @pytest.mark.parametrize("case", list(CASES))
 def test_the_estimate_covers_every_evaluation(
-    counted: Counted, monkeypatch: pytest.MonkeyPatch, case: str, method: str
+    blocking: Cell, counted: Counted, monkeypatch: pytest.MonkeyPatch, case: str, method: str
 ) -> None:
     name, n_waypoints, bounds, climb_work = CASES[case]
     if climb_work is not None:
         monkeypatch.setattr(local_search, "CLIMB_WORK", climb_work)
-    problem = PathProblem.of(get_robot(name), load_path("curved_line")[:n_waypoints])
+    cell = blocking if case == "ur5 in a cell" else None
+    counted.in_a_cell = cell is not None
+    path = load_path("curved_line")[:n_waypoints]
+    problem = PathProblem.of(get_robot(name), path, PathOptions(cell=cell))
     estimate = work_of(problem, bounds, method=method)
     optimum = front_door.optimize_placement(problem, bounds=bounds, method=method)
     assert optimum.found
@@ -139,7 +167,10 @@ def test_the_estimate_covers_every_evaluation(
         assert counted.placements[where] <= allowed, (where, counted.placements, estimate)
         if where in ONE_AT_A_TIME:
             assert counted.largest[where] <= 1, (where, counted.largest)
-    if climb_work is not None or name == "ur5":  # the climbs ran: the case shows something
+    if cell is not None:  # a local solve climbed into the fixture and was backed off
+        assert counted.placements["back-offs"] > 0
+        assert (counted.placements["collisions"] > 0) == (method == "scipy")
+    elif climb_work is not None or name == "ur5":  # the climbs ran: the case shows something
         assert counted.placements["climbs"] > 0
     else:  # numeric IK at the shipped budget: no climbs, as the estimate says
         assert counted.placements["climbs"] == 0 == estimate.placements("Nelder-Mead climbs")

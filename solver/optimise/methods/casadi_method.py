@@ -5,7 +5,9 @@ z axis, over (x, y, yaw) otherwise; :mod:`solver.optimise.coarse_search`); the c
 ranks their basins (:func:`solver.optimise.local_search.refine_cells`); from the best few, each
 on its own IK branch, IPOPT solves the epigraph NLP of
 :mod:`solver.optimise.methods.placement_nlp`, and Nelder-Mead climbs mu_path itself from the
-best refined cells (which may cross to another branch, where IPOPT cannot).
+best refined cells (which may cross to another branch, where IPOPT cannot). With a cell, an
+optimum that is not clear of it is also backed off towards its start
+(:mod:`solver.optimise.back_off`).
 """
 
 from __future__ import annotations
@@ -23,6 +25,7 @@ from solver.optimise.active_set import (
     solve_on_active_set,
     whole_path_bounds,
 )
+from solver.optimise.back_off import back_off
 from solver.optimise.candidate import ZERO_SPEED, Candidate, Search
 from solver.optimise.coarse_search import Cell, coarse_cells
 from solver.optimise.local_search import climbs, refine_cells
@@ -99,6 +102,9 @@ def search(
             if solved is not None:
                 candidates.append(solved[0])
                 iterations += solved[1]
+                backed = back_off(problem, bounds, cell.vector, solved[0])
+                if backed is not None:  # IPOPT, blind to the cell, climbed into it
+                    candidates.append(backed)
         candidates += climbed()
     return candidates, iterations
 

@@ -143,6 +143,10 @@ def global_search(
 ) -> tuple[list[Basin], int]:
     """Differential evolution over the free variables; the best point of each distinct basin.
 
+    With a cell, a placement in collision scores worse than any feasible one but by its
+    mu_path without the cell (``collisions_scored``), not as flat as the kinematics'
+    refusals.
+
     Every placement DE evaluates is kept; the best ones that lie apart (by BASIN_GAP, in
     (r, psi) when ``symmetric``, else in (x, y, yaw); spins as angles) are returned, up to
     ``size.basins``: DE settles in one basin, and the landscape has near-equal mirror-image optima.
@@ -151,6 +155,7 @@ def global_search(
         ([(decision vector, mu_path, branch index), ...] best first, generations).
     """
     seen: list[tuple[np.ndarray, np.ndarray, np.ndarray]] = []
+    clear = problem.with_options(cell=None)  # the kinematics alone, for placements in collision
 
     def objective(points: np.ndarray) -> np.ndarray:  # points: (F, S)
         vectors = _full(bounds, points.T)
@@ -159,6 +164,24 @@ def global_search(
         if progress is not None:
             progress(len(seen) / (size.generations + 1))
         values: np.ndarray = np.where(np.isnan(result.feed_index), INFEASIBLE, -result.feed_index)
+        if problem.path_checks:
+            values = collisions_scored(values, vectors, result.reason)
+        return values
+
+    def collisions_scored(
+        values: np.ndarray, vectors: np.ndarray, reasons: np.ndarray
+    ) -> np.ndarray:
+        """Each placement the cell refuses scored by its mu_path without the cell.
+
+        1 / (2 + mu_path): worse than any feasible placement (<= 0), better than one the
+        kinematics refuse (INFEASIBLE), and better the faster the arm would be there: the
+        population keeps moving towards the fast placements, whose edge against the obstacles
+        is where the cell's optimum lies, instead of settling in the first clear basin.
+        """
+        refused = np.flatnonzero(reasons == problem.path_checks[0].reason)
+        if len(refused):
+            kinematic = evaluate_placements(clear, bounds.rows(vectors[refused]), runner=runner)
+            values[refused] = 1.0 / (2.0 + np.nan_to_num(kinematic.feed_index))
         return values
 
     free = bounds.free

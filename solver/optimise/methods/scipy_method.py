@@ -4,6 +4,8 @@ Differential evolution over the free variables, every generation one batch throu
 :mod:`solver.path.placements`; each basin it saw is climbed by the compass search, then
 polished by SLSQP on the epigraph form with finite-difference gradients on the branch it ends
 on (:mod:`solver.optimise.methods.placement_scipy`); Nelder-Mead climbs mu_path from the best.
+With a cell, a polish that is not clear of it is also backed off towards its start
+(:mod:`solver.optimise.back_off`).
 """
 
 from __future__ import annotations
@@ -19,6 +21,7 @@ from solver.optimise.active_set import (
     solve_on_active_set,
     whole_path_bounds,
 )
+from solver.optimise.back_off import back_off
 from solver.optimise.candidate import ZERO_SPEED, Candidate, Search
 from solver.optimise.coarse_search import Cell
 from solver.optimise.local_search import climbs, refine_cells
@@ -107,6 +110,9 @@ def search(
         )
         candidates.append(candidate)
         iterations += steps
+        backed = back_off(problem, bounds, placement, candidate)
+        if backed is not None:  # SLSQP, blind to the cell, went into it
+            candidates.append(backed)
     candidates += climbs(problem, bounds, refined)
     return candidates, iterations
 
