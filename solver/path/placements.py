@@ -87,14 +87,14 @@ class PlacementResults:
 
 
 def _chunk(
-    problem: PathProblem, placements: np.ndarray, with_speeds: bool
+    problem: PathProblem, placements: np.ndarray, with_speeds: bool, prune: bool = True
 ) -> tuple[np.ndarray, ...]:
     """Evaluate C placements: per placement mu, reason, failed, branch, bottleneck, V_max.
 
     V_max along the path is (C, W) when ``with_speeds``, else (C, 0): a map of millions of
     placements keeps nothing per waypoint. Then the acceleration columns of :func:`_acc_columns`.
     """
-    return _columns(problem, run_chunk(problem, placements), with_speeds)
+    return _columns(problem, run_chunk(problem, placements, prune=prune), with_speeds)
 
 
 def _columns(problem: PathProblem, run: ChunkResult, with_speeds: bool) -> tuple[np.ndarray, ...]:
@@ -134,6 +134,7 @@ def _task(
     with_speeds: bool,
     chunk: int,
     compiled: bool,
+    prune: bool,
     placements: np.ndarray,
 ) -> tuple[np.ndarray, ...]:
     """Evaluate a task's placements in chunks: the columns of :func:`_chunk`, concatenated.
@@ -154,7 +155,7 @@ def _task(
                 inputs[spin] = kernel_inputs(problem, spin, kernel)
             parts.append(run_kernel(inputs[spin], rows, with_speeds))
     else:
-        parts = [_chunk(problem, rows, with_speeds) for rows in _pieces(placements, chunk)]
+        parts = [_chunk(problem, rows, with_speeds, prune) for rows in _pieces(placements, chunk)]
     if problem.path_checks:
         columns_of = partial(_columns, problem, with_speeds=with_speeds)
         pieces = _pieces(placements, chunk)
@@ -190,6 +191,7 @@ def evaluate_placements(
     progress: Callable[[float], None] | None = None,
     runner: TaskRunner = SERIAL,
     compiled: bool = True,
+    prune: bool = True,
 ) -> PlacementResults:
     """mu_path of a path at each of P placements.
 
@@ -205,6 +207,9 @@ def evaluate_placements(
         runner: runs the tasks (:mod:`solver.core.parallel`); every runner gives the same answer.
         compiled: use the compiled kernel where the family has one
             (:mod:`solver.kernels.fixed_spin`); False runs the numpy pipeline, the reference.
+        prune: in the numpy pipeline, stop following branches that cannot be a placement's
+            chosen one (:mod:`solver.path.pruning`: the same results, less work); False:
+            follow every branch, the reference.
 
     Raises:
         NoAnalyticIkError, InvalidInputError: as :func:`solver.path.evaluate.evaluate_path`.
@@ -221,7 +226,7 @@ def evaluate_placements(
         if progress is not None:
             progress(completed[0] / len(cells))
 
-    work = partial(_task, problem, with_speeds, chunk, compiled)
+    work = partial(_task, problem, with_speeds, chunk, compiled, prune)
     parts = runner.run(work, tasks, done)
     n_waypoints = problem.prepared.n_waypoints
     empty = (np.zeros(0), *(np.zeros(0, dtype=int),) * 5, np.zeros((0, n_waypoints)))
