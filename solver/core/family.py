@@ -32,12 +32,16 @@ class PathSolutions:
             for an analytic family (it returns every branch).
         branches_found: shape batch, the distinct solutions found at the first waypoint of each
             path (numeric families); ``None`` for an analytic family.
+        slots: shape (n_branches, *batch), the family's branch each row of ``q`` holds at each
+            path, in the family's order (a pruned map's rows, :mod:`solver.path.pruning`);
+            ``None``: row b is branch b everywhere.
     """
 
     q: np.ndarray
     status: np.ndarray
     seeds: int | None = None
     branches_found: np.ndarray | None = None
+    slots: np.ndarray | None = None
 
 
 class FollowsInSteps(abc.ABC):

@@ -88,6 +88,9 @@ class ChunkResult:
         final_binding: shape (B, C, W), which of the final-path limits binds (None likewise).
         mu_acc: shape (B, C), m/s, min(mu_path, min_i v_final), -inf on infeasible branches;
             None without final-path limits. With it, ``pick`` takes the highest mu_acc.
+        branch_of: shape (B, C), the index on :attr:`PathProblem.branches` of each row at each
+            placement, where the rows are a pruned map's (``PathSolutions.slots``); None:
+            row b is branch b.
     """
 
     tracked: Tracked
@@ -106,6 +109,7 @@ class ChunkResult:
     final_limiting: np.ndarray | None = None
     final_binding: np.ndarray | None = None
     mu_acc: np.ndarray | None = None
+    branch_of: np.ndarray | None = None
 
 
 def turn_by_yaw(vectors: np.ndarray, yaws: np.ndarray) -> np.ndarray:
@@ -236,6 +240,7 @@ def run_chunk(
         final_limiting=final[1],
         final_binding=final[2],
         mu_acc=mu_acc,
+        branch_of=None if solutions.slots is None else solutions.slots[branches],
     )
 
 

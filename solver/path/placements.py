@@ -108,7 +108,7 @@ def _columns(problem: PathProblem, run: ChunkResult, with_speeds: bool) -> tuple
         np.where(any_feasible, run.mu_path[pick, columns], np.nan),
         run.tracked.reason[pick, columns],
         run.tracked.failed_waypoint[pick, columns],
-        branches[pick],
+        branches[pick if run.branch_of is None else run.branch_of[pick, columns]],
         np.where(any_feasible, worst, -1),
         np.where(any_feasible, run.limiting[pick, columns, worst], -1),
         chosen_v if with_speeds else chosen_v[:, :0],

@@ -191,12 +191,12 @@ def pruned_solutions(
         tool_position: shape (3, C, W), m in {B}.
 
     Returns:
-        As :meth:`KinematicsFamily.solve_path`, where a dropped branch is unreachable (NaN)
-        at every waypoint, and only the slots up to the last one solved at any placement
-        (the others are empty; :func:`solver.path.pipeline.without_empty_slots`).
+        As :meth:`KinematicsFamily.solve_path`, but each placement's rows are only its kept
+        slots, in order (``PathSolutions.slots`` names them), then unreachable rows; a row
+        after the kept ones at a placement is unreachable (NaN) at every waypoint.
     """
     chunk = _Chunk(problem, rotation, flange_position, twist, tool_position)
-    n_waypoints = flange_position.shape[-1]
+    n_cells, n_waypoints = flange_position.shape[1:]
     current, count = chunk.family.seed_first(chunk.rotations[:, 0], chunk.positions[:, 0])
     n_seeds = current.shape[1]
     current = np.ascontiguousarray(current[:, : max(int(count.max()), 1)])  # the slots found
@@ -215,9 +215,16 @@ def pruned_solutions(
     threshold = _threshold(state.best)
     complete = state.position >= n_waypoints
     hopeless = found & (~complete | (state.bound < threshold))
-    state.q[:, hopeless] = np.nan
-    state.status[hopeless] = UNREACHABLE
-    return PathSolutions(q=state.q, status=state.status, seeds=n_seeds, branches_found=count)
+    # Each placement's kept slots first, in the family's order (so ties go as before); the
+    # dropped ones and those without a solution after them, as many rows as the most kept.
+    kept = ~hopeless & (state.status[..., 0] != UNREACHABLE)
+    slots = np.argsort(~kept, axis=0, kind="stable")[: max(int(kept.sum(axis=0).max()), 1)]
+    cells = np.arange(n_cells)
+    q, status = state.q[:, slots, cells], state.status[slots, cells]
+    dropped = hopeless[slots, cells]
+    q[:, dropped] = np.nan
+    status[dropped] = UNREACHABLE
+    return PathSolutions(q=q, status=status, seeds=n_seeds, branches_found=count, slots=slots)
 
 
 def _threshold(best: np.ndarray) -> np.ndarray:
