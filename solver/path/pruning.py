@@ -141,6 +141,8 @@ class _State:
         position: shape (K, C), the next waypoint to follow.
         q: shape (n, K, C, W), rad, wrapped; status: shape (K, C, W).
         bound: shape (K, C), the least V_max followed so far (inf before any).
+        settled: shape (K, C), a singular waypoint or a step over the bound was followed: the
+            branch's reason and failing waypoint are known (nothing later comes first).
         broken: shape (K, C), tracking refuses the waypoints followed so far (singular, a step
             over the bound, or no joint copy within the limits): the branch is infeasible.
         last, unwrapped, low, high: shape (n, K, C): the last solution followed, the unwrapped
@@ -157,6 +159,7 @@ class _State:
         self.status = np.full((n_slots, n_cells, n_waypoints), UNREACHABLE, dtype=np.int64)
         self.bound = np.full((n_slots, n_cells), np.inf)
         self.broken = np.zeros((n_slots, n_cells), dtype=bool)
+        self.settled = np.zeros((n_slots, n_cells), dtype=bool)
         self.last = np.full((dof, n_slots, n_cells), np.nan)
         self.unwrapped, self.low, self.high = self.last.copy(), self.last.copy(), self.last.copy()
         self.best = np.full(n_cells, -np.inf)
@@ -211,7 +214,9 @@ def pruned_solutions(
             break
         _advance(chunk, state, chosen)
     found = state.best > -np.inf
-    _advance(chunk, state, state.live & ~found, to_end=True)  # the furthest failure counts
+    # Where none is feasible, the furthest failure is the cell's: every branch to the end,
+    # except those whose failure is settled (they come back unreachable after it).
+    _advance(chunk, state, state.live & ~found & ~state.settled, to_end=True)
     threshold = _threshold(state.best)
     complete = state.position >= n_waypoints
     hopeless = found & (~complete | (state.bound < threshold))
@@ -266,8 +271,9 @@ def _advance(chunk: _Chunk, state: _State, chosen: np.ndarray, to_end: bool = Fa
     v_max = chunk.v_max(q[..., probed], cells, waypoints[:, probed])
     state.bound[slots, cells] = np.fmin(state.bound[slots, cells], np.fmin.reduce(v_max, axis=-1))
     singular = inside & (state.status[slots[:, None], cells[:, None], waypoints] == SINGULAR)
-    state.broken[slots, cells] |= singular.any(axis=-1)
-    state.broken[slots, cells] |= _tracked_so_far(chunk.problem, state, slots, cells, q, begin)
+    jump, limits = _tracked_so_far(chunk.problem, state, slots, cells, q, begin)
+    state.settled[slots, cells] |= singular.any(axis=-1) | jump
+    state.broken[slots, cells] |= state.settled[slots, cells] | limits
     complete = (end >= n_waypoints) & np.isfinite(state.current[cells, slots, 0])
     done, at = slots[complete], cells[complete]
     if done.size:
@@ -282,13 +288,17 @@ def _tracked_so_far(
     cells: np.ndarray,
     q: np.ndarray,
     begin: np.ndarray,
-) -> np.ndarray:
+) -> tuple[np.ndarray, np.ndarray]:
     """Whether tracking refuses the slots' paths up to their pieces' ends: a step, the limits.
 
     :func:`solver.path.tracking.track`'s unwrapping, carried from piece to piece (q: (n, M, w),
-    the pieces from waypoints ``begin``, NaN past the path's end); the limits are judged with
-    a margin (the running sums round otherwise than tracking's), so a path refused here is
-    refused there.
+    the pieces from waypoints ``begin``, NaN past the path's end); the steps are tracking's to
+    the bit, the limits are judged with a margin (the running sums round otherwise than
+    tracking's), so a path refused here is refused there.
+
+    Returns:
+        jump: shape (M,), a step over ``max_joint_step``; limits: shape (M,), no joint copy
+        holds the path so far within the limits.
     """
     first = begin == 0
     before = np.where(first, q[..., 0], state.last[:, slots, cells])
@@ -311,5 +321,5 @@ def _tracked_so_far(
     robot = problem.robot
     k_low = np.ceil((robot.q_lower[:, None] - low) / _TWO_PI - LIMIT_MARGIN)
     k_high = np.floor((robot.q_upper[:, None] - high) / _TWO_PI + LIMIT_MARGIN)
-    refused: np.ndarray = jump | np.any(k_low > k_high, axis=0)
-    return refused
+    limits: np.ndarray = np.any(k_low > k_high, axis=0)
+    return jump, limits

@@ -37,6 +37,7 @@ FIELDS = (
 )
 CASES = {  # the arm, and its grid's x and y ranges
     "panda": ("panda", (-0.25, 0.25), (0.25, 0.65)),
+    "xarm7": ("xarm7", (-0.25, 0.25), (0.25, 0.65)),
     "ur5_urdf": ("ur5_urdf", (-0.25, 0.25), (0.25, 0.65)),
     "irb2400_urdf": ("irb2400_urdf", (0.6, 1.0), (-0.25, 0.25)),
 }
@@ -87,6 +88,8 @@ def test_pruned_map_equals_following_every_branch(name: str) -> None:
         np.testing.assert_array_equal(getattr(pruned, field), getattr(every, field), err_msg=field)
     feasible = np.isfinite(every.mu_path)
     assert 10 <= feasible.sum() < len(placements)  # both kinds of cell are compared
+    if robot.dof == 7:  # and cells whose branches all fail, some after the first waypoint
+        assert np.any(~feasible & (every.failed_waypoint > 0))
     # Pruning happened: branches were dropped (unreachable from their first waypoint).
     cells = check_placements(placements)
     kept, followed = (followed_branches(run_chunk(problem, cells, prune=p)) for p in (True, False))
