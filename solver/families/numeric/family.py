@@ -182,7 +182,8 @@ class NumericFamily(KinematicsFamily, FollowsInSteps):
         unpruned one, of an IRB 2400 URDF 1.8 times (143 placements of the ERK path, same run,
         loaded machine, 2026-12-02): their few branches are cheap to follow (a UR's four
         shoulder branches tie and are all followed anyway), and the bounds cost more than the
-        following they save. The Panda's map: 1.9 times faster pruned.
+        following they save. Seven joints, pruned against unpruned (CPU time, best of 3, same
+        run): the Panda's ERK map 1.76 times faster, the xArm7 1.69, the LBR iiwa 14 1.25.
         """
         return self.compiled and self.dof > 6
 
