@@ -52,6 +52,7 @@ from solver.families.numeric.family import NumericFamily
 from solver.optimise.optimize import optimize_placement
 from solver.optimise.search_space import PlacementBounds
 from solver.path.capability_map import capability_map, grid_axis
+from solver.path.placements import evaluate_placements
 from solver.path.problem import PathOptions, PathProblem
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -304,6 +305,16 @@ def numeric_maps(path: np.ndarray, xs: np.ndarray, ys: np.ndarray, z: float, t_m
             )
             line += f"; equal to it on {same.mean():.1%} of the cells"
         print(line)
+    # The Panda's map prunes branches that cannot be a cell's best (solver/path/pruning.py):
+    # the same map following every branch, for the ratio.
+    panda = PathProblem.of(get_robot("panda"), path)
+    grid_y, grid_x = np.meshgrid(ys, xs, indexing="ij")
+    cells = np.column_stack([grid_x.ravel(), grid_y.ravel(), np.full(grid_x.size, z)])
+    start = time.perf_counter()
+    evaluate_placements(panda, np.column_stack([cells, np.zeros((len(cells), 2))]), prune=False)
+    seconds = time.perf_counter() - start
+    label = "Panda unpruned"
+    print(f"  {label:14s} {seconds:8.3f} s   {seconds / t_map:6.1f}x (every branch followed)")
 
 
 def optimisation(robot: Robot, path: np.ndarray, *, smoke: bool) -> None:

@@ -27,6 +27,7 @@ from solver.core.spatial import MAX_COORDINATE, rotation_about_z
 from solver.path.limits import JointMotion, bound_by_limits
 from solver.path.prepare import PreparedPath
 from solver.path.problem import PathProblem
+from solver.path.pruning import can_prune, pruned_solutions
 from solver.path.tracking import Tracked, choose_branch, track
 
 
@@ -87,6 +88,9 @@ class ChunkResult:
         final_binding: shape (B, C, W), which of the final-path limits binds (None likewise).
         mu_acc: shape (B, C), m/s, min(mu_path, min_i v_final), -inf on infeasible branches;
             None without final-path limits. With it, ``pick`` takes the highest mu_acc.
+        branch_of: shape (B, C), the index on :attr:`PathProblem.branches` of each row at each
+            placement, where the rows are a pruned map's (``PathSolutions.slots``); None:
+            row b is branch b.
     """
 
     tracked: Tracked
@@ -105,6 +109,7 @@ class ChunkResult:
     final_limiting: np.ndarray | None = None
     final_binding: np.ndarray | None = None
     mu_acc: np.ndarray | None = None
+    branch_of: np.ndarray | None = None
 
 
 def turn_by_yaw(vectors: np.ndarray, yaws: np.ndarray) -> np.ndarray:
@@ -131,7 +136,11 @@ def flange_at_spin(path: PreparedPath, spin: float) -> tuple[np.ndarray, np.ndar
 
 
 def run_chunk(
-    problem: PathProblem, placements: np.ndarray, *, progress: Progress | None = None
+    problem: PathProblem,
+    placements: np.ndarray,
+    *,
+    progress: Progress | None = None,
+    prune: bool = False,
 ) -> ChunkResult:
     """The pipeline at C placements on the problem's branches.
 
@@ -142,6 +151,10 @@ def run_chunk(
             spin for the whole chunk.
         progress: handed to the family's IK and joint speeds (a numeric family reports as
             it goes; it may raise :class:`solver.core.progress.Cancelled`).
+        prune: a map's run: where :func:`solver.path.pruning.can_prune` admits it, branches
+            that cannot be the chosen one are not followed to the end, and come back
+            unreachable; the chosen branch's answer is the same (``progress`` then unused by
+            the IK). False: every branch followed (an evaluation reports them).
     """
     robot, path, branches = problem.robot, problem.prepared, problem.branches
     family = problem.family
@@ -158,7 +171,10 @@ def run_chunk(
     twist = np.concatenate(
         [turn_by_yaw(path.twist[:, :3].T, yaws), turn_by_yaw(path.twist[:, 3:].T, yaws)]
     )
-    solutions = family.solve_path(rotation, flange_position, progress=span(progress, 0.0, 0.85))
+    if prune and can_prune(problem):
+        solutions = pruned_solutions(problem, rotation, flange_position, twist, tool_position)
+    else:
+        solutions = family.solve_path(rotation, flange_position, progress=span(progress, 0.0, 0.85))
     q, status = solutions.q, solutions.status  # (n, B_all, C, W), (B_all, C, W)
     branches = without_empty_slots(branches, status)
     # In free mode the position limits hold along the spin schedule, checked there, not here.
@@ -224,6 +240,7 @@ def run_chunk(
         final_limiting=final[1],
         final_binding=final[2],
         mu_acc=mu_acc,
+        branch_of=None if solutions.slots is None else solutions.slots[branches],
     )
 
 
@@ -243,9 +260,8 @@ def without_empty_slots(branches: np.ndarray, status: np.ndarray) -> np.ndarray:
     """
     if not np.array_equal(branches, np.arange(len(branches))):
         return branches
-    solved = np.flatnonzero(
-        (status[: len(branches)] != UNREACHABLE).reshape(len(branches), -1).any(axis=1)
-    )
+    given = status[: len(branches)]  # a pruned map's IK answers only the slots it solved
+    solved = np.flatnonzero((given != UNREACHABLE).reshape(len(given), -1).any(axis=1))
     return branches[: solved[-1] + 1 if solved.size else 1]
 
 

@@ -87,14 +87,14 @@ class PlacementResults:
 
 
 def _chunk(
-    problem: PathProblem, placements: np.ndarray, with_speeds: bool
+    problem: PathProblem, placements: np.ndarray, with_speeds: bool, prune: bool = True
 ) -> tuple[np.ndarray, ...]:
     """Evaluate C placements: per placement mu, reason, failed, branch, bottleneck, V_max.
 
     V_max along the path is (C, W) when ``with_speeds``, else (C, 0): a map of millions of
     placements keeps nothing per waypoint. Then the acceleration columns of :func:`_acc_columns`.
     """
-    return _columns(problem, run_chunk(problem, placements), with_speeds)
+    return _columns(problem, run_chunk(problem, placements, prune=prune), with_speeds)
 
 
 def _columns(problem: PathProblem, run: ChunkResult, with_speeds: bool) -> tuple[np.ndarray, ...]:
@@ -108,7 +108,7 @@ def _columns(problem: PathProblem, run: ChunkResult, with_speeds: bool) -> tuple
         np.where(any_feasible, run.mu_path[pick, columns], np.nan),
         run.tracked.reason[pick, columns],
         run.tracked.failed_waypoint[pick, columns],
-        branches[pick],
+        branches[pick if run.branch_of is None else run.branch_of[pick, columns]],
         np.where(any_feasible, worst, -1),
         np.where(any_feasible, run.limiting[pick, columns, worst], -1),
         chosen_v if with_speeds else chosen_v[:, :0],
@@ -134,6 +134,7 @@ def _task(
     with_speeds: bool,
     chunk: int,
     inputs: dict[float, KernelInputs] | None,
+    prune: bool,
     placements: np.ndarray,
 ) -> tuple[np.ndarray, ...]:
     """Evaluate a task's placements in chunks: the columns of :func:`_chunk`, concatenated.
@@ -151,7 +152,7 @@ def _task(
             for rows in _pieces(placements, chunk)
         ]
     else:
-        parts = [_chunk(problem, rows, with_speeds) for rows in _pieces(placements, chunk)]
+        parts = [_chunk(problem, rows, with_speeds, prune) for rows in _pieces(placements, chunk)]
     if problem.path_checks:
         columns_of = partial(_columns, problem, with_speeds=with_speeds)
         pieces = _pieces(placements, chunk)
@@ -187,6 +188,7 @@ def evaluate_placements(
     progress: Callable[[float], None] | None = None,
     runner: TaskRunner = SERIAL,
     compiled: bool = True,
+    prune: bool = True,
 ) -> PlacementResults:
     """mu_path of a path at each of P placements.
 
@@ -202,6 +204,9 @@ def evaluate_placements(
         runner: runs the tasks (:mod:`solver.core.parallel`); every runner gives the same answer.
         compiled: use the compiled kernel where the family has one
             (:mod:`solver.kernels.fixed_spin`); False runs the numpy pipeline, the reference.
+        prune: in the numpy pipeline, stop following branches that cannot be a placement's
+            chosen one (:mod:`solver.path.pruning`: the same results, less work); False:
+            follow every branch, the reference.
 
     Raises:
         NoAnalyticIkError, InvalidInputError: as :func:`solver.path.evaluate.evaluate_path`.
@@ -222,7 +227,7 @@ def evaluate_placements(
     inputs = None  # the kernel's, made once per spin, not once per task (a map's 5 tasks: 6 ms)
     if kernel is not None:
         inputs = {spin: kernel_inputs(problem, spin, kernel) for spin in set(cells[:, 4].tolist())}
-    work = partial(_task, problem, with_speeds, chunk, inputs)
+    work = partial(_task, problem, with_speeds, chunk, inputs, prune)
     parts = runner.run(work, tasks, done)
     n_waypoints = problem.prepared.n_waypoints
     empty = (np.zeros(0), *(np.zeros(0, dtype=int),) * 5, np.zeros((0, n_waypoints)))

@@ -324,3 +324,65 @@ def follow_paths(chain, current, rotations, positions, solve_first, settings, co
                     q[j, b, p, w] = (value + math.pi) % _TWO_PI - math.pi if revolute[j] else value
             current[p, b] = slot
     return q, status
+
+
+@njit(cache=True, nogil=True, error_model="numpy")
+def follow_ranges(chain, current, rotations, positions, start, stop, out, settings, constants):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
+    """Each slot followed from its own waypoint ``start`` to before ``stop``, into q and status.
+
+    :func:`follow_paths` with a piece per slot: the same decisions and numbers, a slot's
+    waypoints solved as they would be in any pieces (the first piece's first waypoint is the
+    seed's solution, not solved again).
+
+    Args:
+        chain: :meth:`SerialChain.packed`.
+        current: shape (P, K, n), in and out: each slot's solution at waypoint ``start - 1``
+            (at waypoint 0 where ``start`` is 0); on return at ``stop - 1``, NaN where lost.
+        rotations: shape (P, W, 3, 3), R_B_F* of every waypoint of the paths.
+        positions: shape (P, W, 3), m in {B}.
+        start: shape (K, P), the first waypoint of each slot's piece.
+        stop: shape (K, P), the waypoint after its last; a slot with ``stop <= start``, or a
+            NaN solution, is not followed.
+        out: q (n, K, P, W), written with the pieces' solutions, wrapped (left alone
+            elsewhere), and status (K, P, W), their statuses (``UNREACHABLE`` once lost).
+        settings: as for :func:`seed_paths`.
+        constants: as for :func:`_levenberg_marquardt`.
+    """
+    n_paths, n_seeds, n = current.shape
+    q, status = out
+    track_iterations, rcond = int(settings[1]), settings[3]
+    revolute = chain[3]
+    slot = np.empty(n)
+    work = workspace(n)
+    for p in range(n_paths):
+        for b in range(n_seeds):
+            first, last = start[b, p], stop[b, p]
+            if last <= first or math.isnan(current[p, b, 0]):
+                continue
+            slot[:] = current[p, b]
+            if first == 0:
+                frames(chain, slot, work)
+            for w in range(first, last):
+                if w > 0 and not _levenberg_marquardt(
+                    chain,
+                    slot,
+                    rotations[p, w],
+                    positions[p, w],
+                    track_iterations,
+                    None,
+                    constants,
+                    work,
+                    w > first,  # the frames, J and J J^T of the waypoint before, from _singular
+                    (0, 0.0),
+                ):
+                    slot[:] = np.nan
+                    for rest in range(w, last):
+                        status[b, p, rest] = UNREACHABLE
+                        for j in range(n):
+                            q[j, b, p, rest] = np.nan
+                    break
+                status[b, p, w] = SINGULAR if _singular(chain, rcond, work) else OK
+                for j in range(n):
+                    value = slot[j]
+                    q[j, b, p, w] = (value + math.pi) % _TWO_PI - math.pi if revolute[j] else value
+            current[p, b] = slot
