@@ -116,7 +116,7 @@ def _gap(a, b, u, robot, obstacles, rot, pos, work, tries, enough):  # type: ign
     return best
 
 
-@njit(cache=True, nogil=True, error_model="numpy")
+@njit(cache=True, nogil=True, error_model="numpy", inline="always")
 def _bound(p, pairs, ends, robot, obstacles, work, near, rot, pos, cuts):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
     """A lower bound on pair p's distance (exact for closed-form pairs), m.
 
