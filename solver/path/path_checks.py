@@ -19,7 +19,7 @@ from solver.path.limits import PathVerdict
 from solver.path.pipeline import ChunkResult, run_chunk
 from solver.path.problem import PathProblem
 
-# The columns of one placement from a pipeline run whose ``pick`` is the branch to report.
+# The columns of a pipeline run's placements, each at its ``pick`` (the branch to report).
 Columns = Callable[[ChunkResult], tuple[np.ndarray, ...]]
 
 
@@ -51,11 +51,18 @@ def branch_order(run: ChunkResult, cell: int) -> list[int]:
 
 
 def clear_pick(
-    problem: PathProblem, run: ChunkResult, placements: np.ndarray, cell: int, *, thorough: bool
+    problem: PathProblem,
+    run: ChunkResult,
+    placements: np.ndarray,
+    cell: int,
+    *,
+    thorough: bool,
+    known: tuple[np.ndarray, PathVerdict] | None = None,
 ) -> tuple[int | None, PathVerdict | None, PathVerdict | None]:
     """The branch placement ``cell`` takes with the path checks: the best that passes them.
 
-    With a fixed branch only the pipeline's pick is checked.
+    With a fixed branch only the pipeline's pick is checked. ``known``: a joint path already
+    checked, and its verdict, taken for a branch whose joint path equals it to the bit.
 
     Returns:
         the branch (axis B) or None when every feasible branch is refused; the verdict of the
@@ -65,7 +72,10 @@ def clear_pick(
     first_refusal = None
     for b in order if problem.options.branch is None else order[:1]:
         q = run.tracked.q[:, b, cell].T
-        verdict = check_path(problem, q, placements[cell], thorough=thorough)
+        if known is not None and np.array_equal(q, known[0]):
+            verdict: PathVerdict | None = known[1]
+        else:
+            verdict = check_path(problem, q, placements[cell], thorough=thorough)
         if verdict is None or verdict.failed_waypoint is None:
             return b, verdict, first_refusal
         first_refusal = first_refusal or verdict
@@ -85,7 +95,7 @@ def refuse_colliding(
         placements: shape (C, 5), one spin, as the columns were computed.
         columns: mu, reason, failed waypoint, branch (family index), ... as
             :func:`solver.path.placements._chunk` gives them.
-        columns_of: the columns of a one-placement pipeline run at its ``pick``.
+        columns_of: the columns of a pipeline run, each placement at its ``pick``.
     """
     if not problem.path_checks:
         return columns
@@ -93,6 +103,7 @@ def refuse_colliding(
     reason, branch = out[1], out[3]
     family = problem.family
     feasible = np.flatnonzero(reason == FEASIBLE)
+    refused: dict[int, tuple[np.ndarray, PathVerdict]] = {}
     for b in np.unique(branch[feasible]):
         cells = feasible[branch[feasible] == b]
         taken = problem.with_options(branch=family.branches[int(b)])
@@ -101,28 +112,41 @@ def refuse_colliding(
             q = single.tracked.q[:, 0, k].T
             verdict = check_path(problem, q, placements[c], thorough=False)
             if verdict is not None and verdict.failed_waypoint is not None:
-                _next_branch(problem, placements[c : c + 1], out, int(c), verdict, columns_of)
+                refused[int(c)] = (q, verdict)
+    if refused:
+        _next_branches(problem, placements, out, refused, columns_of)
     return tuple(out)
 
 
-def _next_branch(
+def _next_branches(
     problem: PathProblem,
-    row: np.ndarray,
+    placements: np.ndarray,
     out: list[np.ndarray],
-    c: int,
-    refusal: PathVerdict,
+    refused: dict[int, tuple[np.ndarray, PathVerdict]],
     columns_of: Columns,
 ) -> None:
-    """Placement ``c``'s columns from its best branch that passes (auto), else refused."""
+    """The refused placements' columns from their best branches that pass (auto), else refused.
+
+    One pipeline run for all of them (a chunk's placements share a spin); the refused joint
+    path is not checked again.
+    """
+    cells = np.array(sorted(refused))
+    taken = np.zeros(len(cells), dtype=bool)
     if problem.options.branch is None:
-        run = run_chunk(problem, row)
-        chosen, _, _ = clear_pick(problem, run, row, 0, thorough=False)
-        if chosen is not None:
-            picked = columns_of(dataclasses.replace(run, pick=np.array([chosen])))
+        rows = placements[cells]
+        run = run_chunk(problem, rows)
+        chosen = np.array(run.pick, copy=True)
+        for k, c in enumerate(cells):
+            branch, _, _ = clear_pick(problem, run, rows, k, thorough=False, known=refused[int(c)])
+            if branch is not None:
+                chosen[k], taken[k] = branch, True
+        if taken.any():
+            picked = columns_of(dataclasses.replace(run, pick=chosen))
             for column, value in zip(out, picked, strict=True):
-                column[c] = value[0]
-            return
-    _refuse(out, c, problem.path_checks[0].reason, int(refusal.failed_waypoint or 0))
+                column[cells[taken]] = value[taken]
+    for c in cells[~taken]:
+        verdict = refused[int(c)][1]
+        _refuse(out, int(c), problem.path_checks[0].reason, int(verdict.failed_waypoint or 0))
 
 
 def _refuse(columns: list[np.ndarray], c: int, reason: int, waypoint: int) -> None:

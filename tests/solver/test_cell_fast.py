@@ -21,6 +21,7 @@ from solver.path.capability_map import capability_map, grid_axis
 from solver.path.cell.checker import CellChecker, CellVerdict
 from solver.path.cell.kinematics import substeps
 from solver.path.cell.shapes import Box, Cell, Cylinder, Halfspace, Sphere, Tool
+from solver.path.evaluate import evaluate_path
 from solver.path.problem import PathOptions, PathProblem
 from tests.solver.test_evaluate import load_path
 
@@ -123,3 +124,39 @@ def test_compiled_substeps_equal_the_checkers() -> None:
     assert len(rows) > 60  # sub-steps were made
     np.testing.assert_array_equal(compiled_rows, rows)
     np.testing.assert_array_equal(compiled_owners, owners)
+
+
+@pytest.mark.parametrize("name", ["ur5", "ur5e"])
+def test_map_cells_taking_the_next_branch_equal_evaluate(name: str) -> None:
+    """A map's cells whose best branch collides: the branch taken, as /v1/evaluate takes it.
+
+    The map checks the refused cells of a chunk together (one pipeline run); evaluate checks
+    one placement on its own, with coal alone (its own code path): same reason, branch,
+    failed waypoint and mu_path.
+    """
+    problem = PathProblem.of(_arm(name), load_path("curved_line"), PathOptions(cell=CELL))
+    plain = PathProblem.of(_arm(name), load_path("curved_line"), PathOptions(cell=Cell()))
+    axes = {
+        "xs": grid_axis(-0.25, 0.25, 0.1, field="x"),
+        "ys": grid_axis(0.25, 0.65, 0.1, field="y"),
+        "z": 0.1,
+        "yaws": np.array([0.0, 0.6]),
+    }
+    cells = capability_map(problem, **axes)  # type: ignore[arg-type]
+    free = capability_map(plain, **axes)  # type: ignore[arg-type]
+    moved = (cells.reason == -1) & (free.reason == -1) & (cells.branch != free.branch)
+    assert moved.any()  # some cell's best branch collides and another is taken
+    refused = (cells.reason == 4) & (free.reason == -1)
+    for index in zip(*np.nonzero(moved | refused), strict=True):
+        _, yaw, iy, ix = index
+        placement = Placement(float(axes["xs"][ix]), float(axes["ys"][iy]), 0.1, 0.6 * yaw)
+        evaluation = evaluate_path(problem, placement)
+        if cells.reason[index] == -1:
+            assert evaluation.feasible
+            assert evaluation.branch == problem.family.branches[cells.branch[index]]
+            assert evaluation.mu_path == pytest.approx(cells.mu_path[index], rel=1e-12)
+        else:
+            assert (evaluation.reason, evaluation.failed_waypoint) == (
+                "collision",
+                cells.failed_waypoint[index],
+            )

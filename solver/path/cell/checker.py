@@ -29,11 +29,12 @@ from solver.path.cell.shapes import Cell
 
 # What checking one pose of a path against a cell costs, in poses of a closed-form family's map
 # (KinematicsFamily.path_cost): the ERK map (546 placements x 133 waypoints) with a table, a
-# fixture and the part took 22 to 36 times the map without with the compiled sweep (bench/cell.py,
-# UR5 meshes and UR5e capsules, on a loaded machine; coal alone: 50 to 60 times), of which 4 to 7
-# times is the map re-solving the joint paths it checks; 50 leaves a margin for more objects,
-# meshes and coal calls.
-CELL_POSE_COST = 50.0
+# fixture and the part took 48 to 71 times the map without (bench/cell.py, UR5 meshes and UR5e
+# capsules, best of 3 each, on a loaded machine; coal alone: 250 to 450 times). The ratio rose
+# from 22-36x although the check got 1.2-2.6x faster: the map without a cell got about 3 times
+# faster (its kernels prune branches). 80 leaves a margin (100 would refuse the README's cell
+# optimisation, 5.4 million weighted poses; 80 weighs it 4.3 million of the 5 million allowed).
+CELL_POSE_COST = 80.0
 _WINDOW = 32  # configurations looked ahead at once when skipping
 
 

@@ -15,7 +15,7 @@ import numpy as np
 from numba import njit
 
 
-@njit(cache=True, nogil=True, error_model="numpy")
+@njit(cache=True, nogil=True, error_model="numpy", inline="always")
 def frames(q, robot, rot, pos, turn):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
     """The joints' world rotations (J, 3, 3) and origins (J, 3) at q, into rot and pos.
 
@@ -64,7 +64,7 @@ def frames(q, robot, rot, pos, turn):  # type: ignore[no-untyped-def]  # pragma:
                     rot[j, i, k] = r0 * turn[0, k] + r1 * turn[1, k] + r2 * turn[2, k]
 
 
-@njit(cache=True, nogil=True, error_model="numpy")
+@njit(cache=True, nogil=True, error_model="numpy", inline="always")
 def parts(q, robot, rot, pos, ends, turn):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
     """Every robot part's capsule ends in the world at q, into ends (R, 2, 3)."""
     frames(q, robot, rot, pos, turn)

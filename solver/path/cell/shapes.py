@@ -148,7 +148,9 @@ def _solid(points: np.ndarray) -> np.ndarray:
     line, becomes a slab FLAT thick.
     """
     centred = points - points.mean(axis=0)
-    _, _, directions = np.linalg.svd(centred, full_matrices=True)
+    # Only the right singular vectors are used: U stays thin (full, it is P x P: 0.2 s for a
+    # robot's meshes); below three points the full set of three directions is needed.
+    _, _, directions = np.linalg.svd(centred, full_matrices=len(centred) < 3)
     for direction in directions:
         extent = centred @ direction
         if extent.max() - extent.min() < FLAT:

@@ -63,16 +63,19 @@ def _reach(r, u, robot, rot, pos, point):  # type: ignore[no-untyped-def]  # pra
 def _gap(a, b, u, robot, obstacles, rot, pos, work, tries, enough):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
     """How far part a and object b are apart along the unit u (from a to b): a lower bound.
 
-    Then along the direction between the farthest-reaching vertices (``tries`` directions in
-    all, stopping once one exceeds ``enough``): any direction's separation is a lower bound,
-    the largest is kept.
+    Then along the directions of a Frank-Wolfe descent on the least vector of the vertex sets'
+    Minkowski difference (b's points less a's): each step takes the support point s (b's lowest
+    vertex less a's farthest along the current direction) and moves the vector z towards it,
+    with an exact line search; the next direction is z's. ``tries`` directions in all,
+    stopping once one exceeds ``enough`` or z stops moving: any direction's separation is a
+    lower bound, the largest is kept (for convex shapes it tends to their distance).
     """
     n_robot = len(robot[8])
-    near, far, direction = work[4], work[5], work[6]
+    near, far, direction, z = work[4], work[5], work[6], work[7]
     for i in range(3):
         direction[i] = u[i]
     best = -np.inf
-    for _ in range(tries):
+    for attempt in range(tries):
         if b < n_robot:
             low = -_reach(b, -direction, robot, rot, pos, far)
         else:
@@ -91,19 +94,29 @@ def _gap(a, b, u, robot, obstacles, rot, pos, work, tries, enough):  # type: ign
         best = max(best, gap)
         if best > enough:
             break
-        length = 0.0
-        for i in range(3):
-            direction[i] = far[i] - near[i]
-            length += direction[i] * direction[i]
-        if length < 1e-24:
+        if attempt == 0:
+            for i in range(3):
+                z[i] = far[i] - near[i]
+        else:  # z + gamma (s - z), gamma in [0, 1] minimising the length
+            step_z, step_step = 0.0, 0.0
+            for i in range(3):
+                step = far[i] - near[i] - z[i]
+                step_z += step * z[i]
+                step_step += step * step
+            if step_step < 1e-24 or step_z >= 0.0:
+                break
+            gamma = min(-step_z / step_step, 1.0)
+            for i in range(3):
+                z[i] += gamma * (far[i] - near[i] - z[i])
+        length = math.sqrt(z[0] * z[0] + z[1] * z[1] + z[2] * z[2])
+        if length < 1e-12:
             break
-        length = math.sqrt(length)
         for i in range(3):
-            direction[i] /= length
+            direction[i] = z[i] / length
     return best
 
 
-@njit(cache=True, nogil=True, error_model="numpy")
+@njit(cache=True, nogil=True, error_model="numpy", inline="always")
 def _bound(p, pairs, ends, robot, obstacles, work, near, rot, pos, cuts):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
     """A lower bound on pair p's distance (exact for closed-form pairs), m.
 
@@ -159,7 +172,7 @@ def _bound(p, pairs, ends, robot, obstacles, work, near, rot, pos, cuts):  # typ
         if length > 1e-12:
             for i in range(3):
                 u[i] /= length
-            value = max(value, _gap(a, b, u, robot, obstacles, rot, pos, work, 4, near))
+            value = max(value, _gap(a, b, u, robot, obstacles, rot, pos, work, 24, near))
     if value <= near and not both and b >= n_robot and obstacles[0][b - n_robot] == 2:
         for i in range(3):  # a box's face normals, towards the part
             for sign in (-1.0, 1.0):
