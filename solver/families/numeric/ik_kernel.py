@@ -265,6 +265,60 @@ def seed_paths(chain, seeds, box, rotations, positions, settings, constants):  #
 
 
 @njit(cache=True, nogil=True, error_model="numpy")
+def _follow(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
+    chain,
+    slot,
+    rotations,
+    positions,
+    first,
+    last,
+    skip_first,
+    track_iterations,
+    rcond,
+    revolute,
+    constants,
+    work,
+    q,
+    status,
+    b,
+    p,
+):
+    """One slot followed over waypoints ``first`` to ``last - 1`` of its path, into q and status.
+
+    ``slot`` holds its solution at the waypoint before ``first``, or at ``first`` itself with
+    ``skip_first`` (the path's first waypoint: the seed's solution, not solved again). Lost
+    where a waypoint does not converge: ``slot`` NaN, and NaN / ``UNREACHABLE`` from there to
+    ``last``. The serving loops of :func:`follow_paths` and :func:`follow_ranges`.
+    """
+    n = slot.shape[0]
+    if skip_first:
+        frames(chain, slot, work)
+    for w in range(first, last):
+        if not (skip_first and w == first) and not _levenberg_marquardt(
+            chain,
+            slot,
+            rotations[w],
+            positions[w],
+            track_iterations,
+            None,
+            constants,
+            work,
+            w > first,  # the frames, J and J J^T of the waypoint before, from _singular
+            (0, 0.0),
+        ):
+            slot[:] = np.nan
+            for rest in range(w, last):
+                status[b, p, rest] = UNREACHABLE
+                for j in range(n):
+                    q[j, b, p, rest] = np.nan
+            return
+        status[b, p, w] = SINGULAR if _singular(chain, rcond, work) else OK
+        for j in range(n):
+            value = slot[j]
+            q[j, b, p, w] = (value + math.pi) % _TWO_PI - math.pi if revolute[j] else value
+
+
+@njit(cache=True, nogil=True, error_model="numpy")
 def follow_paths(chain, current, rotations, positions, solve_first, settings, constants):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
     """Each slot followed along one piece of its path, from its solution before the piece.
 
@@ -301,27 +355,24 @@ def follow_paths(chain, current, rotations, positions, solve_first, settings, co
             if math.isnan(current[p, b, 0]):
                 continue
             slot[:] = current[p, b]
-            if not solve_first:
-                frames(chain, slot, work)
-            for w in range(n_waypoints):
-                if (w > 0 or solve_first) and not _levenberg_marquardt(
-                    chain,
-                    slot,
-                    rotations[p, w],
-                    positions[p, w],
-                    track_iterations,
-                    None,
-                    constants,
-                    work,
-                    w > 0,  # the frames, J and J J^T of the waypoint before, from _singular
-                    (0, 0.0),
-                ):
-                    slot[:] = np.nan
-                    break
-                status[b, p, w] = SINGULAR if _singular(chain, rcond, work) else OK
-                for j in range(n):
-                    value = slot[j]
-                    q[j, b, p, w] = (value + math.pi) % _TWO_PI - math.pi if revolute[j] else value
+            _follow(
+                chain,
+                slot,
+                rotations[p],
+                positions[p],
+                0,
+                n_waypoints,
+                not solve_first,
+                track_iterations,
+                rcond,
+                revolute,
+                constants,
+                work,
+                q,
+                status,
+                b,
+                p,
+            )
             current[p, b] = slot
     return q, status
 
@@ -360,29 +411,22 @@ def follow_ranges(chain, current, rotations, positions, start, stop, out, settin
             if last <= first or math.isnan(current[p, b, 0]):
                 continue
             slot[:] = current[p, b]
-            if first == 0:
-                frames(chain, slot, work)
-            for w in range(first, last):
-                if w > 0 and not _levenberg_marquardt(
-                    chain,
-                    slot,
-                    rotations[p, w],
-                    positions[p, w],
-                    track_iterations,
-                    None,
-                    constants,
-                    work,
-                    w > first,  # the frames, J and J J^T of the waypoint before, from _singular
-                    (0, 0.0),
-                ):
-                    slot[:] = np.nan
-                    for rest in range(w, last):
-                        status[b, p, rest] = UNREACHABLE
-                        for j in range(n):
-                            q[j, b, p, rest] = np.nan
-                    break
-                status[b, p, w] = SINGULAR if _singular(chain, rcond, work) else OK
-                for j in range(n):
-                    value = slot[j]
-                    q[j, b, p, w] = (value + math.pi) % _TWO_PI - math.pi if revolute[j] else value
+            _follow(
+                chain,
+                slot,
+                rotations[p],
+                positions[p],
+                first,
+                last,
+                first == 0,
+                track_iterations,
+                rcond,
+                revolute,
+                constants,
+                work,
+                q,
+                status,
+                b,
+                p,
+            )
             current[p, b] = slot
