@@ -5,7 +5,9 @@ The suite took 10 to 11 minutes on one process of the 2-core development machine
 but the tests that bound a live server's latency (``/healthz`` under load, a cancel within a
 second, SIGTERM within seconds: marked ``latency``) fail beside a second worker's CPU-bound
 tests, which take the server's time slices. So they run after, alone, with the coverage of the
-first run appended. Arguments are passed to both runs; either failing fails the whole.
+first run appended. Modules are handed out in collection order, the longest first (FIRST in
+tests/conftest.py), not by their number of tests. Arguments are passed to both runs; either
+failing fails the whole.
 """
 
 from __future__ import annotations
@@ -21,7 +23,17 @@ def main(arguments: list[str]) -> int:
     """Both runs; the first failing status, else 0."""
     pytest = [sys.executable, "-m", "pytest"]
     runs = [
-        [*pytest, "-n", "2", "--dist", "loadscope", "-m", "not latency", *arguments],
+        [
+            *pytest,
+            "-n",
+            "2",
+            "--dist",
+            "loadscope",
+            "--no-loadscope-reorder",
+            "-m",
+            "not latency",
+            *arguments,
+        ],
         [*pytest, "-m", "latency", "--cov-append", *arguments],
     ]
     status = 0

@@ -21,8 +21,8 @@ from service.jobs.store import JobStore
 from tests.cases import ROOT
 from tests.live import start_server
 
-# Response times are bounded here: scripts/run_tests.py runs these alone, after the rest.
-pytestmark = pytest.mark.latency
+# The tests that bound response times are marked latency: scripts/run_tests.py runs them alone,
+# after the rest; the others run beside the suite's other worker.
 
 EXAMPLE = json.loads((ROOT / "examples" / "evaluate_request.json").read_text())
 SMALL_GRID = {
@@ -104,6 +104,7 @@ def test_a_map_job_answers_what_the_route_answers(tmp_path: Path) -> None:
         process.wait()
 
 
+@pytest.mark.latency
 def test_a_running_50000_placement_map_is_cancelled_within_a_second(tmp_path: Path) -> None:
     process, url = server(tmp_path)
     try:
@@ -161,6 +162,7 @@ def test_a_restart_finishes_an_interrupted_job_with_the_same_result(tmp_path: Pa
         process.wait()
 
 
+@pytest.mark.latency
 def test_health_stays_fast_while_four_map_jobs_run(tmp_path: Path) -> None:
     process, url = server(tmp_path, DTF_WORKERS="4")
     try:
