@@ -244,7 +244,9 @@ class KinematicsFamily(abc.ABC):
         q, status = self.solve(rotation, position)
         return PathSolutions(q=q, status=status)
 
-    def null_space(self, q: np.ndarray, tool_point: np.ndarray) -> np.ndarray:
+    def null_space(
+        self, q: np.ndarray, tool_point: np.ndarray, *, progress: Progress | None = None
+    ) -> np.ndarray:
         """A unit vector spanning the null space of J(q), batched (seven-joint arms).
 
         The free spin of a seven-joint arm is a three-variable LP whose third variable moves
@@ -253,6 +255,8 @@ class KinematicsFamily(abc.ABC):
         Args:
             q: shape (dof, ...), rad.
             tool_point: shape (3, ...) broadcastable to q, m in {B}.
+            progress: called with the fraction done as the work goes (it may raise
+                :class:`solver.core.progress.Cancelled` to stop it).
 
         Returns:
             shape (dof, ...), NaN where q is not finite.

@@ -20,10 +20,10 @@ import numpy as np
 
 from solver.core.codes import ACC_TIE_RTOL, FEASIBLE, UNREACHABLE
 from solver.core.dtf import spin_rate_nearest_zero
-from solver.core.dtf_redundant import spin_rate_at_feed
 from solver.core.exceptions import InvalidInputError
 from solver.core.progress import Progress, span
 from solver.core.spatial import MAX_COORDINATE, rotation_about_z
+from solver.path.in_pieces import bound_in_pieces, spin_rates_in_pieces
 from solver.path.limits import JointMotion, bound_by_limits
 from solver.path.prepare import PreparedPath
 from solver.path.problem import PathProblem
@@ -171,14 +171,17 @@ def run_chunk(
     twist = np.concatenate(
         [turn_by_yaw(path.twist[:, :3].T, yaws), turn_by_yaw(path.twist[:, 3:].T, yaws)]
     )
+    free = problem.options.spin_mode == "free"
+    shares = REDUNDANT_FREE_SHARES if free and robot.dof > 6 else SHARES
     if prune and can_prune(problem):
         solutions = pruned_solutions(problem, rotation, flange_position, twist, tool_position)
     else:
-        solutions = family.solve_path(rotation, flange_position, progress=span(progress, 0.0, 0.85))
+        solutions = family.solve_path(
+            rotation, flange_position, progress=_part(progress, shares, 0)
+        )
     q, status = solutions.q, solutions.status  # (n, B_all, C, W), (B_all, C, W)
     branches = without_empty_slots(branches, status)
     # In free mode the position limits hold along the spin schedule, checked there, not here.
-    free = problem.options.spin_mode == "free"
     tracked = track(
         q[:, branches],
         status[branches],
@@ -194,25 +197,29 @@ def run_chunk(
         twist[:, None],
         tool_position[:, None],
         qdot_max=robot.qdot_max,
-        progress=span(progress, 0.85, 0.95),
+        progress=_part(progress, shares, 1),
     )
     qd_spin = qd_null = None
     if free:
         tool_z = turn_by_yaw(path.tool_rotation[:, :, 2].T, yaws)
         spin = np.concatenate([np.zeros_like(tool_z), np.broadcast_to(tool_z, twist[3:].shape)])
         qd_spin = family.joint_speeds_per_unit_twist(
-            tracked.q, spin[:, None], tool_position[:, None], progress=span(progress, 0.95, 1.0)
+            tracked.q, spin[:, None], tool_position[:, None], progress=_part(progress, shares, 2)
         )  # the least-norm solution for more than six joints
         if robot.dof > 6:
-            qd_null = family.null_space(tracked.q, tool_position[:, None])
+            qd_null = family.null_space(
+                tracked.q, tool_position[:, None], progress=_part(progress, shares, 3)
+            )
     motion = JointMotion(q=tracked.q, qd_unit=qd_unit, qd_spin=qd_spin, qd_null=qd_null)
-    speed, limiting, _ = bound_by_limits(problem.waypoint_limits, motion)  # (B, C, W)
+    speed, limiting = bound_in_pieces(problem.waypoint_limits, motion, _part(progress, shares, 4))
     v_max = np.where(path.pure_rotation, 0.0, speed)
     feasible = tracked.reason == FEASIBLE  # (B, C)
     mu_path = np.where(feasible, v_max.min(axis=-1), -np.inf)
     spins = None
     if qd_spin is not None:
-        spins, tracked = _spin_schedule(problem, tracked, motion, qd_spin, mu_path)
+        spins, tracked = _spin_schedule(
+            problem, tracked, motion, qd_spin, mu_path, _part(progress, shares, 5)
+        )
         feasible = tracked.reason == FEASIBLE
         mu_path = np.where(feasible, mu_path, -np.inf)
     if progress is not None:
@@ -242,6 +249,18 @@ def run_chunk(
         mu_acc=mu_acc,
         branch_of=None if solutions.slots is None else solutions.slots[branches],
     )
+
+
+SHARES = (0.85, 0.95, 1.0, 1.0, 1.0, 1.0)
+"""Where each part of a chunk's work ends in its progress: the IK, the joint speeds per unit
+feed, those per unit spin (free spin), the null space, the limits, the spin schedule."""
+REDUNDANT_FREE_SHARES = (0.6, 0.7, 0.75, 0.8, 0.95, 1.0)
+"""The same for an arm of more than six joints in free spin, where the spin LP is work too."""
+
+
+def _part(progress: Progress | None, shares: tuple[float, ...], k: int) -> Progress | None:
+    """The progress callback of part ``k`` of a chunk's work (:data:`SHARES`)."""
+    return span(progress, shares[k - 1] if k else 0.0, shares[k])
 
 
 def without_empty_slots(branches: np.ndarray, status: np.ndarray) -> np.ndarray:
@@ -297,6 +316,7 @@ def _spin_schedule(
     motion: JointMotion,
     qd_spin: np.ndarray,
     mu_path: np.ndarray,
+    progress: Progress | None = None,
 ) -> tuple[np.ndarray, Tracked]:
     """The spins that realise mu_path in free mode, and the joint paths along them.
 
@@ -315,6 +335,8 @@ def _spin_schedule(
             its joints follow the spin by the least-norm qd_spin.
         qd_spin: shape (n, B, C, W), J^-1 [0; z_tool] (the least-norm one for seven joints).
         mu_path: shape (B, C), m/s, -inf where infeasible.
+        progress: called after each piece of waypoints whose spin rates are found (seven
+            joints: the LP, :func:`solver.path.in_pieces.spin_rates_in_pieces`).
 
     Returns:
         spins (B, C, W), rad (0 where infeasible or mu_path = 0), and the tracking of the spun
@@ -326,7 +348,9 @@ def _spin_schedule(
     if motion.qd_null is None:
         rate = spin_rate_nearest_zero(qd_unit, qd_spin, robot.qdot_max, feed)
     else:
-        rate, _ = spin_rate_at_feed(qd_unit, qd_spin, motion.qd_null, robot.qdot_max, feed)
+        rate = spin_rates_in_pieces(
+            qd_unit, qd_spin, motion.qd_null, robot.qdot_max, feed, progress
+        )
     length = np.linalg.norm(np.diff(path.tool_position, axis=0), axis=1)  # (W - 1,)
     with np.errstate(divide="ignore", invalid="ignore"):
         step = np.where(feed > 0.0, rate[..., :-1] * length / feed, 0.0)  # (B, C, W - 1)

@@ -465,6 +465,12 @@ class NumericFamily(KinematicsFamily, FollowsInSteps):
                 np.asarray(qdot_max, dtype=float),
             )
             rows = np.flatnonzero(irregular)  # J near rank loss: numpy's SVD or the LP decides
+        elif self.compiled and self.dof == 7:  # the free spin's least-norm direction
+            speeds, _, irregular = redundant_kernel.least_norm_and_null(
+                self._packed,
+                *(np.ascontiguousarray(a) for a in (q_flat, twist_flat, point_flat)),
+            )
+            rows = np.flatnonzero(irregular)
         if self.compiled:
             jacobian = chain_kernel.jacobians(
                 self._packed,
@@ -483,15 +489,30 @@ class NumericFamily(KinematicsFamily, FollowsInSteps):
             speeds[rows] = (np.linalg.pinv(jacobian) @ twist_flat[rows, :, None])[..., 0]
         return speeds
 
-    def null_space(self, q: np.ndarray, tool_point: np.ndarray) -> np.ndarray:
-        """The last right singular vector of J at the tool point (see the base), batched."""
+    def null_space(
+        self, q: np.ndarray, tool_point: np.ndarray, *, progress: Progress | None = None
+    ) -> np.ndarray:
+        """The last right singular vector of J at the tool point (see the base), batched.
+
+        Seven joints on the compiled chain: the QR's (:mod:`redundant_kernel`; its sign may
+        differ from the SVD's, which no LP answer depends on), the SVD's where J nears rank
+        loss. CHUNK_ROWS configurations at a time, ``progress`` called after each.
+        """
         shape = np.broadcast_shapes(q.shape[1:], tool_point.shape[1:])
         q_flat = np.moveaxis(np.broadcast_to(q, (self.dof, *shape)), 0, -1).reshape(-1, self.dof)
         point_flat = np.moveaxis(np.broadcast_to(tool_point, (3, *shape)), 0, -1).reshape(-1, 3)
         null = np.full(q_flat.shape, np.nan)
-        rows = np.flatnonzero(np.isfinite(q_flat).all(axis=-1))
-        jacobian, _, _ = self.chain.jacobian(q_flat[rows], point_flat[rows])
-        null[rows] = np.linalg.svd(jacobian)[2][:, -1]
+        for rows in _in_chunks(np.flatnonzero(np.isfinite(q_flat).all(axis=-1)), progress):
+            if self.compiled and self.dof == 7:
+                _, null[rows], irregular = redundant_kernel.least_norm_and_null(
+                    self._packed,
+                    np.ascontiguousarray(q_flat[rows]),
+                    np.zeros((len(rows), 6)),
+                    np.ascontiguousarray(point_flat[rows]),
+                )
+                rows = rows[irregular]
+            jacobian, _, _ = self.chain.jacobian(q_flat[rows], point_flat[rows])
+            null[rows] = np.linalg.svd(jacobian)[2][:, -1]
         return np.moveaxis(null.reshape(*shape, self.dof), -1, 0)
 
 
