@@ -43,12 +43,14 @@ COST_LINES: dict[int, tuple[tuple[float, float], ...]] = {
     6: ((800.0, 48.0), (1_000.0, 17.0)),
     7: ((2_600.0, 200.0),),
 }
-FREE_SPIN_REDUNDANT_COST = 50.0
-"""A seven-joint path's work in free spin against the fixed spin's cost line: the Panda along
-2,000 and 20,000 waypoints took 35 and 41 times the fixed spin's time (2026-12-02, compiled
-chain; the vertex LP dominates). Measured again after the stall rule (CPU time, loaded machine,
-the same day): 2,000 waypoints free 6.45 s, 57 times the fixed spin's 0.113 s, or 13.7 million
-poses of the analytic UR5 map's; 50 times the fixed line weighs it 20.1 million."""
+FREE_SPIN_REDUNDANT_COST = 3.0
+"""A seven-joint path's work in free spin against the fixed spin's cost line (the vertex LPs of
+:mod:`solver.kernels.spin_lp`, the QR's null space). Evaluations, CPU time, best of 2, loaded
+machine, 2026-12-02, same run: the Panda along 2,000 waypoints free 0.246 s against fixed
+0.120 s (2.05 times), 20,000: 2.75 s against 1.28 s (2.15); the xArm7 2.29 and 1.87 times.
+Maps (ERK path, 99 placements; a free-spin map is not pruned): the Panda's free map 3.0 times
+its pruned fixed map, the xArm7's 2.5 times, about 2 times the unpruned line this weighs.
+(Before the LPs were compiled: 50, measured 35-57 times.)"""
 CHUNK_ROWS = 2048
 """Configurations checked (singularity, joint speeds) between two progress reports: about
 0.2 s for seven joints under load, so that a cancelled evaluation stops within a second."""
@@ -116,7 +118,7 @@ class NumericFamily(KinematicsFamily, FollowsInSteps):
         """Seeding plus following, in closed-form poses: the highest line of COST_LINES.
 
         In free spin an arm of more than six joints also solves the three-variable LP at every
-        configuration (:func:`solver.core.dtf_redundant.vertex_lp`): times
+        configuration (:func:`solver.kernels.spin_lp.spin_speeds`): times
         :data:`FREE_SPIN_REDUNDANT_COST`.
 
         Arms of more than seven joints scale the seven-joint figures by (dof / 7)^2 (the
