@@ -214,6 +214,15 @@ class KinematicsFamily(abc.ABC):
         """
         return float(n_waypoints)
 
+    def map_cost(self, n_waypoints: int, *, free_spin: bool = False, pruned: bool = False) -> float:
+        """The work of one placement of a map, in the unit of :meth:`path_cost`.
+
+        ``pruned``: the map may drop branches that cannot be a cell's best
+        (:func:`solver.path.pruning.can_prune`). The default is :meth:`path_cost`; a family
+        whose map costs otherwise than an evaluation overrides it with measured figures.
+        """
+        return self.path_cost(n_waypoints, free_spin=free_spin)
+
     def map_kernel(self) -> tuple[int, np.ndarray] | None:
         """The compiled pose kernel's family code and parameters, or None where there is none.
 

@@ -55,6 +55,19 @@ NUMPY_CHAIN_COST = 35.0
 """The numpy chain's work against the compiled one's (a chain with mimic joints runs on numpy):
 the UR5 as a URDF, ERK path (133 waypoints), CPU time, loaded machine, 2026-12-02, same run:
 an evaluation 0.164 s against 0.005 s (33 times), a 30-placement map 0.93 s against 0.10 s."""
+NUMPY_MAP_COST = 12.0
+"""The numpy chain's map against the compiled chain's line: measured 9.3 times (the UR5 as a
+URDF, 30 placements of the ERK path, the run of NUMPY_CHAIN_COST)."""
+FIRST_PIECE = 32
+"""Waypoints every branch of a pruned map is followed before any is dropped (the pruning's
+``solver.path.pruning.PIECE``, held equal by a test)."""
+MAP_TAIL_SHARE = 0.5
+"""A pruned map's work after the first piece against following every branch (the seven-joint
+line). Measured: the CPU time of the following and the bounds past the first piece, pruned
+against unpruned, 99 placements, ERK path (133 waypoints) and 600 (the ERK path there and back),
+loaded machine, 2026-12-02, same run: Panda 0.19 and 0.11, xArm7 0.38 and 0.29 (the whole map
+0.46 / 0.18 and 0.60 / 0.34 of the unpruned one). In counts (tests/solver/families/
+test_numeric_map_work.py), the branch-waypoints followed past the first piece: 0.09 to 0.16."""
 CHUNK_ROWS = 2048
 """Configurations checked (singularity, joint speeds) between two progress reports: about
 0.2 s for seven joints under load, so that a cancelled evaluation stops within a second."""
@@ -136,6 +149,24 @@ class NumericFamily(KinematicsFamily, FollowsInSteps):
         cost = scale * max(seed + following * track for seed, track in COST_LINES[size])
         cost = cost if self.compiled else cost * NUMPY_CHAIN_COST
         return cost * FREE_SPIN_REDUNDANT_COST if free_spin and self.dof > 6 else cost
+
+    def map_cost(self, n_waypoints: int, *, free_spin: bool = False, pruned: bool = False) -> float:
+        """A map's placement (see the base), in the unit of :meth:`path_cost`.
+
+        A pruned map (compiled, seven joints, fixed spin) follows every branch for FIRST_PIECE
+        waypoints, then about MAP_TAIL_SHARE of them; the numpy chain weighs NUMPY_MAP_COST.
+        """
+        if not self.compiled:
+            return self.path_cost(n_waypoints, free_spin=free_spin) * (
+                NUMPY_MAP_COST / NUMPY_CHAIN_COST
+            )
+        if free_spin or not (pruned and self.follows_in_steps):
+            return self.path_cost(n_waypoints, free_spin=free_spin)
+        following = max(n_waypoints - 1, 0)
+        tail = max(following - FIRST_PIECE, 0)
+        followed = following - tail + MAP_TAIL_SHARE * tail
+        scale = max(self.dof / 7, 1.0) ** 2
+        return scale * max(seed + followed * track for seed, track in COST_LINES[7])
 
     @property
     def branches(self) -> tuple[Branch, ...]:
