@@ -1,6 +1,7 @@
-"""Per-waypoint work done in pieces of waypoints, with a progress report after each piece.
+"""Work along a path done in pieces, with a progress report after each piece.
 
-The limits on each waypoint (:class:`solver.path.limits.Limit`, the waypoint kind) and a
+Tracking follows each branch alone, so pieces of branches give the bits of the whole. The
+limits on each waypoint (:class:`solver.path.limits.Limit`, the waypoint kind) and a
 seven-joint arm's spin rates at a feed look at one waypoint's motion at a time, so pieces of
 waypoints give the bits of the whole. In free spin their LPs are seconds of work along a long
 path (:mod:`solver.kernels.spin_lp`): the pieces let a caller see the work go on and stop it
@@ -9,11 +10,15 @@ path (:mod:`solver.kernels.spin_lp`): the pieces let a caller see the work go on
 
 from __future__ import annotations
 
+from collections.abc import Callable
+from typing import Any
+
 import numpy as np
 
 from solver.core.progress import Progress
 from solver.kernels.spin_lp import spin_rate_at_feed
 from solver.path.limits import JointMotion, Limit, bound_by_limits
+from solver.path.tracking import Tracked, track
 
 LIMIT_ROWS = 16_384
 """Configurations (branches x placements x waypoints) in one piece: the seven-joint spin LP
@@ -87,3 +92,45 @@ def spin_rates_in_pieces(
         if progress is not None:
             progress(piece.stop / shape[-1])
     return rate
+
+
+def track_in_pieces(
+    q: np.ndarray,
+    status: np.ndarray,
+    progress: Progress | None,
+    *,
+    joints_of: Callable[[slice], np.ndarray] | None = None,
+    **options: Any,
+) -> Tracked:
+    """:func:`solver.path.tracking.track` of branches in pieces of the branch axis.
+
+    Each branch (and placement) is tracked alone, so pieces of branches give the bits of the
+    whole; a piece holds about LIMIT_ROWS configurations (one branch at least).
+
+    Args:
+        q: shape (n, B, ..., W), rad, as :func:`track` takes it.
+        status: shape (B, ..., W).
+        progress: called after each piece with the fraction of branches done.
+        joints_of: the joint paths to track of a slice of branches (n, b, ..., W), made piece
+            by piece (the free spin's moved paths); None: ``q[:, rows]``.
+        options: :func:`track`'s keywords (the limits, the step, the checked segments).
+    """
+    joints = joints_of if joints_of is not None else (lambda rows: q[:, rows])
+    if progress is None or q.shape[1] <= 1:
+        return track(joints(slice(None)), status, **options)
+    per_branch = max(int(np.prod(q.shape[2:])), 1)
+    size = max(LIMIT_ROWS // per_branch, 1)
+    n_branches = q.shape[1]
+    reason = np.empty(q.shape[1:-1], dtype=np.int64)
+    failed = np.empty(q.shape[1:-1], dtype=np.int64)
+    tracked_q = np.empty(q.shape)
+    for start in range(0, n_branches, size):
+        rows = slice(start, min(start + size, n_branches))
+        piece = track(joints(rows), status[rows], **options)
+        reason[rows], failed[rows], tracked_q[:, rows] = (
+            piece.reason,
+            piece.failed_waypoint,
+            piece.q,
+        )
+        progress(rows.stop / n_branches)
+    return Tracked(reason=reason, failed_waypoint=failed, q=tracked_q)

@@ -131,11 +131,11 @@ def test_a_seven_joint_free_spin_reports_through_its_lps_and_stops_there(
         np.testing.assert_array_equal(getattr(reported, field), getattr(quiet, field))
     assert reports == sorted(reports) and reports[-1] == pytest.approx(1.0)
     shares = REDUNDANT_FREE_SHARES
-    for low, high in [(shares[2], shares[3]), (shares[3], shares[4]), (shares[4], shares[5])]:
-        assert sum(low < f <= high for f in reports) >= (2 if low == shares[2] else 10)
+    for low, high in [(shares[3], shares[4]), (shares[4], shares[5]), (shares[5], shares[6])]:
+        assert sum(low < f <= high for f in reports) >= (2 if low == shares[3] else 10)
 
 
-@pytest.mark.parametrize("part", [3, 4, 5])  # the null space, the spin LP, the spin rates
+@pytest.mark.parametrize("part", [1, 4, 5, 6])  # tracking, null space, spin LP, spin schedule
 def test_a_seven_joint_free_spin_stops_in_each_part(part: int) -> None:
     shares = REDUNDANT_FREE_SHARES
     calls: list[float] = []
