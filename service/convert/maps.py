@@ -15,7 +15,6 @@ from solver.core.exceptions import InvalidInputError
 from solver.core.robots import Robot
 from solver.core.spatial import MAX_COORDINATE
 from solver.path.capability_map import CapabilityMap, axis_length, grid_axis
-from solver.path.cell.checker import CELL_POSE_COST
 from solver.path.problem import SpinMode, require_family
 
 
@@ -35,15 +34,15 @@ def map_grid(
     settings: Settings,
     n_waypoints: int,
     robot: Robot,
+    cost: float,
     with_cell: bool = False,
-    free_spin: bool = False,
 ) -> MapGrid:
     """The grid's values, after checking its size against the settings.
 
-    The poses are weighed by the robot family's cost (``path_cost``: 1 a pose for a closed-form
-    family, far more for numeric IK), so that DTF_MAX_MAP_POSES bounds the time of every map;
-    with a cell, each pose also by the collision check's (``CELL_POSE_COST``); in free spin as
-    the family weighs it (``free_spin``).
+    Each placement weighs ``cost`` closed-form poses (the problem's map figure,
+    :func:`solver.path.capability_map.map_cost`: 1 a pose for a closed-form family, far more
+    for numeric IK, a cell's check, the free spin), so that DTF_MAX_MAP_POSES bounds the time
+    of every map.
 
     Raises:
         InvalidInputError: an axis is malformed, or the grid is over a size limit; the message
@@ -70,8 +69,7 @@ def map_grid(
         )
     poses = cells * n_waypoints
     family = require_family(robot)
-    cost = family.path_cost(n_waypoints, free_spin=free_spin)
-    work = cells * cost * (CELL_POSE_COST if with_cell else 1.0)
+    work = cells * cost
     if work > limits.poses:
         weighed = "" if work == poses else f", as work {work:.4g} closed-form poses"
         weighed += "" if work == poses else f" ({family.name} IK{' in a cell' * with_cell})"

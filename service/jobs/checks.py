@@ -62,7 +62,7 @@ def _problem(
 
 
 def _check_map(body: MapRequest, settings: Settings) -> None:
-    robot, _ = checked_grid(body, settings)
+    robot, _, _ = checked_grid(body, settings)
     _problem(robot, body, settings)
 
 

@@ -9,12 +9,17 @@ from service.schemas import MapRequest, MapResponse
 from solver.core.parallel import TaskRunner, ThreadRunner
 from solver.core.progress import Progress
 from solver.core.robots import Robot
-from solver.path.capability_map import CapabilityMap, capability_map
-from solver.path.problem import SpinMode
+from solver.path.capability_map import CapabilityMap, capability_map, map_cost
+from solver.path.problem import PathProblem, SpinMode
 
 
-def checked_grid(body: MapRequest, settings: Settings) -> tuple[Robot, convert.MapGrid]:
-    """The robot and the grid of a map request, its size checked against ``settings``.
+def checked_grid(
+    body: MapRequest, settings: Settings
+) -> tuple[Robot, convert.MapGrid, PathProblem]:
+    """The robot, the grid and the problem of a map request, its size checked against ``settings``.
+
+    The grid's work is the problem's (:func:`solver.path.capability_map.map_cost`: the family's
+    map figure, whether the map may drop branches, a cell's check).
 
     Raises:
         InvalidInputError: the path or the grid over a limit (the message names the setting).
@@ -23,20 +28,21 @@ def checked_grid(body: MapRequest, settings: Settings) -> tuple[Robot, convert.M
         body.path, limit=settings.max_path_waypoints, setting="DTF_MAX_PATH_WAYPOINTS"
     )
     robot = convert.robot_from_schema(body.robot)
-    # Free spin costs more on a redundant arm: its spin mode (the path's default unless given)
-    # weighs the grid; the path is read for that on such an arm only.
-    free_spin = (
-        robot.dof > 6 and convert.spin_mode_of(body.spin_mode, convert.path_of(body.path)) == "free"
+    path = convert.path_of(body.path)
+    spin_mode = convert.spin_mode_of(body.spin_mode, path)
+    cell = convert.cell_of(body.cell, settings)
+    problem = convert.problem_of(
+        robot, path.poses, path, ik=body.ik, spin_mode=spin_mode, cell=cell
     )
     grid = convert.map_grid(
         body.grid,
         settings=settings,
         n_waypoints=body.path.n_waypoints(),
         robot=robot,
+        cost=map_cost(problem),
         with_cell=body.cell is not None,
-        free_spin=free_spin,
     )
-    return robot, grid
+    return robot, grid, problem
 
 
 def computed_map(
@@ -51,15 +57,9 @@ def computed_map(
 
     The placements run on ``runner``, by default on DTF_THREADS threads.
     """
-    robot, grid = checked_grid(body, settings)
+    robot, grid, problem = checked_grid(body, settings)
     if png:
         convert.check_png_size(grid, settings=settings)
-    path = convert.path_of(body.path)
-    spin_mode = convert.spin_mode_of(body.spin_mode, path)
-    cell = convert.cell_of(body.cell, settings)
-    problem = convert.problem_of(
-        robot, path.poses, path, ik=body.ik, spin_mode=spin_mode, cell=cell
-    )
     result = capability_map(
         problem,
         xs=grid.xs,
@@ -70,7 +70,7 @@ def computed_map(
         progress=progress,
         runner=ThreadRunner(settings.threads) if runner is None else runner,
     )
-    return result, robot, spin_mode
+    return result, robot, problem.options.spin_mode
 
 
 def map_of(

@@ -214,6 +214,15 @@ class KinematicsFamily(abc.ABC):
         """
         return float(n_waypoints)
 
+    def map_cost(self, n_waypoints: int, *, free_spin: bool = False, pruned: bool = False) -> float:
+        """The work of one placement of a map, in the unit of :meth:`path_cost`.
+
+        ``pruned``: the map may drop branches that cannot be a cell's best
+        (:func:`solver.path.pruning.can_prune`). The default is :meth:`path_cost`; a family
+        whose map costs otherwise than an evaluation overrides it with measured figures.
+        """
+        return self.path_cost(n_waypoints, free_spin=free_spin)
+
     def map_kernel(self) -> tuple[int, np.ndarray] | None:
         """The compiled pose kernel's family code and parameters, or None where there is none.
 
@@ -244,7 +253,9 @@ class KinematicsFamily(abc.ABC):
         q, status = self.solve(rotation, position)
         return PathSolutions(q=q, status=status)
 
-    def null_space(self, q: np.ndarray, tool_point: np.ndarray) -> np.ndarray:
+    def null_space(
+        self, q: np.ndarray, tool_point: np.ndarray, *, progress: Progress | None = None
+    ) -> np.ndarray:
         """A unit vector spanning the null space of J(q), batched (seven-joint arms).
 
         The free spin of a seven-joint arm is a three-variable LP whose third variable moves
@@ -253,6 +264,8 @@ class KinematicsFamily(abc.ABC):
         Args:
             q: shape (dof, ...), rad.
             tool_point: shape (3, ...) broadcastable to q, m in {B}.
+            progress: called with the fraction done as the work goes (it may raise
+                :class:`solver.core.progress.Cancelled` to stop it).
 
         Returns:
             shape (dof, ...), NaN where q is not finite.

@@ -248,14 +248,19 @@ def robot_from_model(
             f"frame {quoted(base_frame)} moves with joint {quoted(model.names[base.parentJoint])}; "
             "the base frame must be fixed to the root",
         )
-    if any(model.joints[j].nq != 1 or model.joints[j].nv != 1 for j in range(1, model.njoints)):
+    coordinates = [
+        j
+        for j in range(1, model.njoints)
+        if model.joints[j].shortname() != "JointModelMimic"  # a mimic joint follows another
+    ]
+    if any(model.joints[j].nq != 1 or model.joints[j].nv != 1 for j in coordinates):
         raise RobotModelError(
             "robot.urdf", "only revolute and prismatic joints are supported between base and tool"
         )
     data = model.createData()
     pin.framesForwardKinematics(model, data, pin.neutral(model))
     transform_world_to_base = data.oMf[model.getFrameId(base_frame)].homogeneous.copy()
-    joint_names = tuple(model.names[1:])
+    joint_names = tuple(model.names[j] for j in coordinates)
     if qdot_max is not None:
         limits = check_speed_limits(qdot_max, joint_names)
     else:

@@ -12,7 +12,7 @@ import pinocchio as pin
 
 from solver.core.exceptions import RobotModelError, quoted, quoted_names
 from solver.core.native_stderr import first_error, native_stderr
-from solver.core.urdf_structure import mimic_joints, root_links
+from solver.core.urdf_structure import Mimic, mimic_joints, root_links
 
 
 def frame_names(model: pin.Model) -> str:
@@ -57,20 +57,43 @@ def chain_from_urdf(urdf: str, *, tool_frame: str) -> pin.Model:
             "robot.tool_frame", f"no frame {quoted(tool_frame)} in the model; frames: {names}"
         )
     tool_joint = full.frames[full.getFrameId(tool_frame)].parentJoint
-    chain = set(full.supports[tool_joint])
-    locked = [j for j in range(1, full.njoints) if j not in chain]
+    chain = {full.names[j] for j in full.supports[tool_joint]}
     mimics = mimic_joints(urdf)
-    coupled = [full.names[j] for j in sorted(chain) if full.names[j] in mimics]
-    if coupled:
-        mimic = mimics[coupled[0]]
-        raise RobotModelError(
-            "robot.urdf",
-            f"joint {quoted(mimic.joint)} mimics {quoted(mimic.leader)} (q = "
-            f"{mimic.multiplier:g} q_leader + {mimic.offset:g}) between the base and the tool: "
-            "coupled joints are not modelled yet, and reading it as a free joint would give "
-            "joint paths the arm cannot run",
-        )
+    coupled = [mimics[name] for name in sorted(chain) if name in mimics]
+    for mimic in coupled:
+        if mimic.leader not in chain or mimic.leader in mimics or mimic.multiplier == 0.0:
+            raise RobotModelError(
+                "robot.urdf",
+                f"joint {quoted(mimic.joint)} mimics {quoted(mimic.leader)} (q = "
+                f"{mimic.multiplier:g} q_leader + {mimic.offset:g}) between the base and the "
+                "tool, but its leader is not a joint of its own between them (or the "
+                "multiplier is 0): that coupling is not modelled",
+            )
+    if coupled:  # pinocchio couples them: one coordinate per leader
+        full = pin.buildModelFromXML(urdf, mimic=True)
+    locked = [j for j in range(1, full.njoints) if full.names[j] not in chain]
     model = pin.buildReducedModel(full, locked, pin.neutral(full)) if locked else full
     if model.nv == 0:
         raise RobotModelError("robot.tool_frame", f"no joint moves frame {quoted(tool_frame)}")
+    for mimic in coupled:
+        _limit_leader(model, mimic)
     return model
+
+
+def _limit_leader(model: pin.Model, mimic: Mimic) -> None:
+    """Narrow the leader's limits in ``model`` by the mimic joint's own, through the coupling.
+
+    q_mimic = m q + o within [lower, upper] holds q within [(lower - o) / m, (upper - o) / m]
+    (ends swapped for m < 0), and |qdot_mimic| = |m| |qdot| <= velocity holds |qdot| <=
+    velocity / |m|: the leader's limits are the tighter of its own and these, so every limit
+    (the DTF's, the position checks) counts the mimic joint.
+    """
+    index = model.joints[model.getJointId(mimic.leader)].idx_q
+    m, o = mimic.multiplier, mimic.offset
+    if mimic.lower is not None and mimic.upper is not None:
+        ends = sorted(((mimic.lower - o) / m, (mimic.upper - o) / m))
+        model.lowerPositionLimit[index] = max(model.lowerPositionLimit[index], ends[0])
+        model.upperPositionLimit[index] = min(model.upperPositionLimit[index], ends[1])
+    if mimic.velocity is not None and mimic.velocity > 0.0:
+        speed = min(model.velocityLimit[index], mimic.velocity / abs(m))
+        model.velocityLimit[index] = speed

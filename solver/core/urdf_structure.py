@@ -15,12 +15,19 @@ from dataclasses import dataclass
 
 @dataclass(frozen=True)
 class Mimic:
-    """A joint that follows another: q = multiplier * q_leader + offset (URDF ``<mimic>``)."""
+    """A joint that follows another: q = multiplier * q_leader + offset (URDF ``<mimic>``).
+
+    ``lower``, ``upper`` (rad or m) and ``velocity`` (rad/s or m/s) are the mimic joint's own
+    limits (its ``<limit>``), None where not given.
+    """
 
     joint: str
     leader: str
     multiplier: float
     offset: float
+    lower: float | None = None
+    upper: float | None = None
+    velocity: float | None = None
 
 
 def _tree(urdf: str) -> ElementTree.Element | None:
@@ -58,10 +65,26 @@ def mimic_joints(urdf: str) -> dict[str, Mimic]:
     for joint in root.iter("joint"):
         for mimic in joint.iter("mimic"):
             name = joint.get("name", "")
+            limit = joint.find("limit")
+            bounds = {
+                key: _number(limit.get(key)) if limit is not None else None
+                for key in ("lower", "upper", "velocity")
+            }
+            if joint.get("type") == "continuous":
+                bounds["lower"] = bounds["upper"] = None
             mimics[name] = Mimic(
                 joint=name,
                 leader=mimic.get("joint", ""),
                 multiplier=float(mimic.get("multiplier", "1") or 1.0),
                 offset=float(mimic.get("offset", "0") or 0.0),
+                **bounds,
             )
     return mimics
+
+
+def _number(text: str | None) -> float | None:
+    """A limit's value, None where absent or not a number."""
+    try:
+        return None if text is None else float(text)
+    except ValueError:
+        return None

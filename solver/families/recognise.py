@@ -102,5 +102,10 @@ def recognised_ur(chain: SerialChain) -> UrFamily | None:
 
 
 def recognised_family(chain: SerialChain) -> KinematicsFamily | None:
-    """The analytic family of a URDF chain, where its structure is one we solve in closed form."""
+    """The analytic family of a URDF chain, where its structure is one we solve in closed form.
+
+    A chain with mimic joints is not one (its joints are coupled).
+    """
+    if chain.coupling is not None:
+        return None
     return recognised_opw(chain) or recognised_ur(chain)

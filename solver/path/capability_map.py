@@ -16,10 +16,19 @@ from solver.core.codes import REASONS
 from solver.core.exceptions import InvalidInputError
 from solver.core.parallel import SERIAL, TaskRunner
 from solver.core.spatial import Placement
+from solver.path.cell.checker import CELL_POSE_COST
 from solver.path.placements import DEFAULT_CHUNK, evaluate_placements
 from solver.path.problem import PathProblem
+from solver.path.pruning import can_prune
 
-__all__ = ["REASONS", "CapabilityMap", "axis_length", "capability_map", "grid_axis"]
+__all__ = [
+    "REASONS",
+    "CapabilityMap",
+    "axis_length",
+    "capability_map",
+    "grid_axis",
+    "map_cost",
+]
 
 
 @dataclass(frozen=True)
@@ -198,3 +207,18 @@ def capability_map(
             )
         },
     )
+
+
+def map_cost(problem: PathProblem) -> float:
+    """The work of one placement of ``problem``'s map, in closed-form poses (the size limits').
+
+    The family's map figure (:meth:`solver.core.family.KinematicsFamily.map_cost`), told
+    whether the map may drop branches (:func:`solver.path.pruning.can_prune`), times the
+    collision check's with a cell (such a map never drops branches).
+    """
+    n_waypoints = problem.prepared.n_waypoints
+    free_spin = problem.options.spin_mode == "free"
+    if problem.options.cell is not None:
+        return problem.family.map_cost(n_waypoints, free_spin=free_spin) * CELL_POSE_COST
+    pruned = can_prune(problem)
+    return problem.family.map_cost(n_waypoints, free_spin=free_spin, pruned=pruned)

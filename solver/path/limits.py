@@ -27,7 +27,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from solver.core.dtf import two_variable_speed
-from solver.core.dtf_redundant import spin_speed
+from solver.kernels.spin_lp import spin_speed
 
 
 @dataclass(frozen=True)
@@ -78,7 +78,8 @@ class JointSpeedLimit(Limit):
     """Joint speed limits: the DTF, 1 / max_j |qd_j| / qdot_max_j (Sensors 2022 eq. (30)).
 
     With the spin rate free, the exact two-variable LP (:func:`solver.core.dtf.two_variable_speed`),
-    and for seven joints the three-variable one (:func:`solver.core.dtf_redundant.spin_speed`).
+    and for seven joints the three-variable one (:func:`solver.core.dtf_redundant.spin_speed`,
+    compiled: :func:`solver.kernels.spin_lp.spin_speed`).
     """
 
     name = "speed"

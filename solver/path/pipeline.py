@@ -20,15 +20,15 @@ import numpy as np
 
 from solver.core.codes import ACC_TIE_RTOL, FEASIBLE, UNREACHABLE
 from solver.core.dtf import spin_rate_nearest_zero
-from solver.core.dtf_redundant import spin_rate_at_feed
 from solver.core.exceptions import InvalidInputError
 from solver.core.progress import Progress, span
 from solver.core.spatial import MAX_COORDINATE, rotation_about_z
+from solver.path.in_pieces import bound_in_pieces, spin_rates_in_pieces, track_in_pieces
 from solver.path.limits import JointMotion, bound_by_limits
 from solver.path.prepare import PreparedPath
 from solver.path.problem import PathProblem
 from solver.path.pruning import can_prune, pruned_solutions
-from solver.path.tracking import Tracked, choose_branch, track
+from solver.path.tracking import Tracked, choose_branch
 
 
 def check_placements(placements: np.ndarray) -> np.ndarray:
@@ -171,17 +171,21 @@ def run_chunk(
     twist = np.concatenate(
         [turn_by_yaw(path.twist[:, :3].T, yaws), turn_by_yaw(path.twist[:, 3:].T, yaws)]
     )
+    free = problem.options.spin_mode == "free"
+    shares = REDUNDANT_FREE_SHARES if free and robot.dof > 6 else SHARES
     if prune and can_prune(problem):
         solutions = pruned_solutions(problem, rotation, flange_position, twist, tool_position)
     else:
-        solutions = family.solve_path(rotation, flange_position, progress=span(progress, 0.0, 0.85))
+        solutions = family.solve_path(
+            rotation, flange_position, progress=_part(progress, shares, 0)
+        )
     q, status = solutions.q, solutions.status  # (n, B_all, C, W), (B_all, C, W)
     branches = without_empty_slots(branches, status)
     # In free mode the position limits hold along the spin schedule, checked there, not here.
-    free = problem.options.spin_mode == "free"
-    tracked = track(
+    tracked = track_in_pieces(
         q[:, branches],
         status[branches],
+        _part(progress, shares, 1),
         lower=np.full(robot.dof, -np.inf) if free else robot.q_lower,
         upper=np.full(robot.dof, np.inf) if free else robot.q_upper,
         max_joint_step=problem.options.max_joint_step,
@@ -194,25 +198,29 @@ def run_chunk(
         twist[:, None],
         tool_position[:, None],
         qdot_max=robot.qdot_max,
-        progress=span(progress, 0.85, 0.95),
+        progress=_part(progress, shares, 2),
     )
     qd_spin = qd_null = None
     if free:
         tool_z = turn_by_yaw(path.tool_rotation[:, :, 2].T, yaws)
         spin = np.concatenate([np.zeros_like(tool_z), np.broadcast_to(tool_z, twist[3:].shape)])
         qd_spin = family.joint_speeds_per_unit_twist(
-            tracked.q, spin[:, None], tool_position[:, None], progress=span(progress, 0.95, 1.0)
+            tracked.q, spin[:, None], tool_position[:, None], progress=_part(progress, shares, 3)
         )  # the least-norm solution for more than six joints
         if robot.dof > 6:
-            qd_null = family.null_space(tracked.q, tool_position[:, None])
+            qd_null = family.null_space(
+                tracked.q, tool_position[:, None], progress=_part(progress, shares, 4)
+            )
     motion = JointMotion(q=tracked.q, qd_unit=qd_unit, qd_spin=qd_spin, qd_null=qd_null)
-    speed, limiting, _ = bound_by_limits(problem.waypoint_limits, motion)  # (B, C, W)
+    speed, limiting = bound_in_pieces(problem.waypoint_limits, motion, _part(progress, shares, 5))
     v_max = np.where(path.pure_rotation, 0.0, speed)
     feasible = tracked.reason == FEASIBLE  # (B, C)
     mu_path = np.where(feasible, v_max.min(axis=-1), -np.inf)
     spins = None
     if qd_spin is not None:
-        spins, tracked = _spin_schedule(problem, tracked, motion, qd_spin, mu_path)
+        spins, tracked = _spin_schedule(
+            problem, tracked, motion, qd_spin, mu_path, _part(progress, shares, 6)
+        )
         feasible = tracked.reason == FEASIBLE
         mu_path = np.where(feasible, mu_path, -np.inf)
     if progress is not None:
@@ -242,6 +250,19 @@ def run_chunk(
         mu_acc=mu_acc,
         branch_of=None if solutions.slots is None else solutions.slots[branches],
     )
+
+
+SHARES = (0.8, 0.85, 0.95, 1.0, 1.0, 1.0, 1.0)
+"""Where each part of a chunk's work ends in its progress: the IK, the tracking, the joint
+speeds per unit feed, those per unit spin (free spin), the null space, the limits, the spin
+schedule."""
+REDUNDANT_FREE_SHARES = (0.55, 0.6, 0.7, 0.75, 0.8, 0.9, 1.0)
+"""The same for an arm of more than six joints in free spin, where the spin LP is work too."""
+
+
+def _part(progress: Progress | None, shares: tuple[float, ...], k: int) -> Progress | None:
+    """The progress callback of part ``k`` of a chunk's work (:data:`SHARES`)."""
+    return span(progress, shares[k - 1] if k else 0.0, shares[k])
 
 
 def without_empty_slots(branches: np.ndarray, status: np.ndarray) -> np.ndarray:
@@ -297,6 +318,7 @@ def _spin_schedule(
     motion: JointMotion,
     qd_spin: np.ndarray,
     mu_path: np.ndarray,
+    progress: Progress | None = None,
 ) -> tuple[np.ndarray, Tracked]:
     """The spins that realise mu_path in free mode, and the joint paths along them.
 
@@ -315,6 +337,9 @@ def _spin_schedule(
             its joints follow the spin by the least-norm qd_spin.
         qd_spin: shape (n, B, C, W), J^-1 [0; z_tool] (the least-norm one for seven joints).
         mu_path: shape (B, C), m/s, -inf where infeasible.
+        progress: called after each piece of waypoints whose spin rates are found (seven
+            joints: the LP, :func:`solver.path.in_pieces.spin_rates_in_pieces`), then after each
+            piece of branches tracked along the spins.
 
     Returns:
         spins (B, C, W), rad (0 where infeasible or mu_path = 0), and the tracking of the spun
@@ -326,16 +351,26 @@ def _spin_schedule(
     if motion.qd_null is None:
         rate = spin_rate_nearest_zero(qd_unit, qd_spin, robot.qdot_max, feed)
     else:
-        rate, _ = spin_rate_at_feed(qd_unit, qd_spin, motion.qd_null, robot.qdot_max, feed)
+        rate = spin_rates_in_pieces(
+            qd_unit, qd_spin, motion.qd_null, robot.qdot_max, feed, span(progress, 0.0, 0.5)
+        )
     length = np.linalg.norm(np.diff(path.tool_position, axis=0), axis=1)  # (W - 1,)
     with np.errstate(divide="ignore", invalid="ignore"):
         step = np.where(feed > 0.0, rate[..., :-1] * length / feed, 0.0)  # (B, C, W - 1)
     step = np.where(path.segment_in_pass, step, 0.0)  # each pass starts at the placement's spin
     spins = cumsum_within_passes(step, path.segment_in_pass)
-    moved = cumsum_within_passes(step * qd_spin[..., :-1], path.segment_in_pass)
-    spun = track(
-        tracked.q + np.nan_to_num(moved),
+
+    def spun_joints(rows: slice) -> np.ndarray:
+        """The joint paths of some branches moved by the spins, (n, b, C, W)."""
+        moved = cumsum_within_passes(step[rows] * qd_spin[:, rows, ..., :-1], path.segment_in_pass)
+        joints: np.ndarray = tracked.q[:, rows] + np.nan_to_num(moved)
+        return joints
+
+    spun = track_in_pieces(
+        tracked.q,
         np.zeros(tracked.q.shape[1:], dtype=int),  # every pose was solved: only limits, steps
+        span(progress, 0.5, 1.0),
+        joints_of=spun_joints,
         lower=robot.q_lower,
         upper=robot.q_upper,
         max_joint_step=problem.options.max_joint_step,

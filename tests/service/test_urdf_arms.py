@@ -6,15 +6,18 @@ from __future__ import annotations
 import json
 from typing import Any
 
+import pinocchio as pin
 import pytest
 from fastapi.testclient import TestClient
 
 from service.config import get_settings
 from solver.core.robots import example_robot_data_dir
-from solver.families import robot_from_urdf
+from solver.families import get_robot, robot_from_urdf
 from solver.families.numeric.family import NumericFamily
 from tests.cases import EXAMPLES, OPTIMUM_EVALUATE_RTOL
 from tests.service.conftest import sent_back
+from tests.solver.families.test_mimic import arm as mimic_arm
+from tests.solver.families.test_mimic import arm_urdf
 
 PLACEMENT = {"x": 0.0, "y": 0.45, "z": 0.1, "yaw": 0.0}
 
@@ -248,9 +251,12 @@ def test_the_erk_size_map_of_a_six_joint_urdf_is_within_the_map_limit(
 def test_free_spin_on_a_redundant_arm_is_weighed_by_its_lp(
     client: TestClient, waypoints: list[dict[str, Any]], route: str
 ) -> None:
-    """Free spin on seven joints solves the vertex LP at every configuration: 35-41 times the
+    """Free spin on seven joints solves the vertex LP at every configuration: about twice the
     fixed spin's work (measured), so a request the fixed spin's limit admits may be refused."""
-    n = 2_000  # fixed spin: 2,600 + 200 * 1,999 = 402,400 poses, within 5 million; free: 50x
+    n = 10_000  # fixed spin: 2,600 + 200 * 9,999 = 2.0 million poses, within 5 million; free: 3x
+    family = get_robot("panda").family
+    assert family is not None
+    assert family.path_cost(n) <= get_settings().max_map_poses < family.path_cost(n, free_spin=True)
     line = [
         {"position": [1e-5 * i, 0.0, 0.0], "orientation": [1.0, 0.0, 0.0, 0.0]} for i in range(n)
     ]
@@ -265,3 +271,43 @@ def test_free_spin_on_a_redundant_arm_is_weighed_by_its_lp(
     [entry] = free.json()["detail"]
     assert entry["loc"] in (["body", "path"], ["body", "grid"])
     assert "DTF_MAX_MAP_POSES" in entry["msg"]
+
+
+@pytest.mark.parametrize("route", ["/v1/evaluate", "/v1/map", "/v1/optimize"])
+def test_an_arm_with_a_mimic_joint_is_answered_on_its_coordinates(
+    client: TestClient, route: str
+) -> None:
+    """Issue 27: a mimic joint between base and tool is honoured (the solver's tests hold the
+    coupling and its limits: tests/solver/families/test_mimic.py); the answer names the six
+    coordinates. Its numpy IK makes the optimiser's search too much work: a 422 naming the limit."""
+    robot, path = mimic_arm(0.5)
+    waypoints = [
+        {"position": list(pose[:3, 3]), "orientation": list(pin.Quaternion(pose[:3, :3]).coeffs())}
+        for pose in (path[:3] if route == "/v1/optimize" else path)
+    ]
+    body: dict[str, Any] = {
+        "robot": {"urdf": arm_urdf(0.5), "base_frame": "l0", "tool_frame": "tool0"},
+        "path": {"waypoints": waypoints},
+    }
+    if route == "/v1/evaluate":
+        body["placement"] = {"x": 0.0, "y": 0.0, "z": 0.0, "yaw": 0.0}
+    else:
+        axis = {"min": -0.01, "max": 0.01, "step": 0.01}
+        body["grid" if route == "/v1/map" else "bounds"] = (
+            {"x": axis, "y": axis, "z": 0.0, "yaw": 0.0}
+            if route == "/v1/map"
+            else {"x": [-0.01, 0.01], "y": [-0.01, 0.01], "yaw": [-0.01, 0.01]}
+        )
+        if route == "/v1/optimize":
+            body["method"], body["z"] = "casadi", 0.0
+    response = client.post(route, json=body)
+    if route == "/v1/optimize":  # numpy IK (35x) over a search: over the work limit
+        assert response.status_code == 422, response.text
+        assert "DTF_MAX_MAP_POSES" in response.json()["detail"][0]["msg"]
+        return
+    assert response.status_code == 200, response.text
+    answer = response.json()
+    if route == "/v1/evaluate":
+        assert answer["feasible"], answer
+        assert answer["bottleneck"]["joint_name"] in robot.joint_names
+        assert {len(w["q"]) for w in answer["waypoints"]} == {6}

@@ -3,7 +3,8 @@
 For seven joints the DTF with the tool spin free is max s s.t. J qdot = s t_hat + sigma [0; z],
 |qdot| <= qdot_max, with sigma free (cam.md section 2, dtf.md section 3): three variables
 (s, sigma, and the null-space rate). The known answers are that LP written here for HiGHS
-(scipy.optimize.linprog) on pinocchio's Jacobian of the Panda.
+(scipy.optimize.linprog) on pinocchio's Jacobian of the Panda; the pipeline solves it compiled
+(:mod:`solver.kernels.spin_lp`), and both it and the numpy reference are held to HiGHS.
 """
 
 from __future__ import annotations
@@ -15,10 +16,11 @@ import pytest
 import scipy.linalg
 import scipy.optimize
 
-from solver.core.dtf_redundant import spin_rate_at_feed, spin_speed
+from solver.core import dtf_redundant
 from solver.core.kinematics import jacobian_in_base, tool_pose_in_base
 from solver.core.spatial import Placement, pose_matrix
 from solver.families import get_robot
+from solver.kernels import spin_lp as compiled_lp
 from tests.cases import EXAMPLES, FREE_SPIN_LP_RTOL, MAP_EVALUATE_RTOL
 from tests.problems import capability_map, evaluate_path
 
@@ -43,7 +45,15 @@ def spin_lp(jacobian: np.ndarray, twist: np.ndarray, axis: np.ndarray, limits: n
     return float(result.x[n])
 
 
-def test_the_three_variable_lp_equals_highs_and_its_joint_speeds_are_within_limits() -> None:
+IMPLEMENTATIONS = {"numpy": dtf_redundant, "compiled": compiled_lp}
+
+
+@pytest.mark.parametrize("implementation", IMPLEMENTATIONS)
+def test_the_three_variable_lp_equals_highs_and_its_joint_speeds_are_within_limits(
+    implementation: str,
+) -> None:
+    spin_speed = IMPLEMENTATIONS[implementation].spin_speed
+    spin_rate_at_feed = IMPLEMENTATIONS[implementation].spin_rate_at_feed
     robot = get_robot("panda")
     rng = np.random.default_rng(27)
     a, c, b, lp, jacobians, twists, axes = [], [], [], [], [], [], []
@@ -84,6 +94,32 @@ def test_the_three_variable_lp_equals_highs_and_its_joint_speeds_are_within_limi
         for m in range(0, 300, 30)
     ])  # fmt: skip
     assert np.all(speed[::30] >= fixed * (1 - 1e-9))
+
+
+def test_the_compiled_lps_equal_the_numpy_reference_on_degenerate_rows_too() -> None:
+    """Random directions with rows that are not finite, zero, repeated or at feed 0."""
+    rng = np.random.default_rng(2027)
+    count = 2_000
+    a, c, b = (rng.normal(size=(7, count)) for _ in range(3))
+    limits = rng.uniform(0.5, 3.0, 7)
+    a[:, 3], b[2, 8] = np.nan, np.inf  # not finite: NaN speed, spin rates 0
+    a[4, 10] = c[4, 10] = b[4, 10] = 0.0  # a joint that nothing moves
+    a[:, 12], c[:, 12], b[:, 12] = a[:, 11], c[:, 11], b[:, 11]
+    c[:, 13] = 0.0  # rank 2: no vertex (vertex_lp needs rank 3), NaN in both
+    reference = dtf_redundant.spin_speed(a, c, b, limits)
+    compiled = compiled_lp.spin_speed(a, c, b, limits)
+    np.testing.assert_allclose(compiled[0], reference[0], rtol=1e-12)
+    np.testing.assert_array_equal(compiled[1], reference[1])
+    assert np.isnan(compiled[0][[3, 8, 13]]).all() and np.isfinite(compiled[0][[10, 12]]).all()
+    feed = np.where(np.isfinite(reference[0]), reference[0], 0.0)
+    feed = feed * rng.choice([0.0, 0.5, 0.99, 1.0], count)
+    rates = dtf_redundant.spin_rate_at_feed(a, c, b, limits, feed)
+    compiled_rates = compiled_lp.spin_rate_at_feed(a, c, b, limits, feed)
+    inside = feed < reference[0] * 0.999  # at the optimum the interval is ~1e-12 wide
+    for ours, theirs in zip(compiled_rates, rates, strict=True):
+        np.testing.assert_allclose(ours[inside], theirs[inside], rtol=1e-9, atol=1e-12)
+        np.testing.assert_allclose(ours, theirs, atol=1e-9)
+    assert compiled_rates[0][3] == compiled_rates[1][3] == 0.0
 
 
 @pytest.fixture(scope="module")

@@ -32,6 +32,10 @@ class SerialChain:
         base_rotation: shape (3, 3), R_B_root. base_translation: shape (3,), m.
         tool_rotation: shape (3, 3), R_n_F, the flange in the last joint's frame.
         tool_translation: shape (3,), m.
+        coupling: shape (n_joints, dof), the joints' angles per unit of each coordinate, for a
+            chain with mimic joints (URDF ``<mimic>``: q_j = multiplier q_leader + offset);
+            None: every joint is a coordinate of its own.
+        coupling_offset: shape (n_joints,), the joints' angles at q = 0 (None likewise).
     """
 
     joint_rotation: np.ndarray
@@ -42,11 +46,27 @@ class SerialChain:
     base_translation: np.ndarray
     tool_rotation: np.ndarray
     tool_translation: np.ndarray
+    coupling: np.ndarray | None = None
+    coupling_offset: np.ndarray | None = None
 
     @property
     def dof(self) -> int:
-        """Number of joints n."""
-        return len(self.revolute)
+        """Number of coordinates n (the joints less the mimic joints)."""
+        return len(self.revolute) if self.coupling is None else self.coupling.shape[1]
+
+    @property
+    def q_revolute(self) -> np.ndarray:
+        """Which coordinates turn a revolute joint, shape (n,)."""
+        if self.coupling is None:
+            return self.revolute
+        return np.array([self.revolute[np.argmax(column != 0)] for column in self.coupling.T])
+
+    def joint_angles(self, q: np.ndarray) -> np.ndarray:
+        """Every joint's angle, (M, n) -> (M, n_joints): the mimic joints' from their leaders."""
+        if self.coupling is None or self.coupling_offset is None:
+            return q
+        angles: np.ndarray = q @ self.coupling.T + self.coupling_offset
+        return angles
 
     @classmethod
     def from_model(cls, model: pin.Model, *, base_frame: str, tool_frame: str) -> SerialChain:
@@ -58,7 +78,9 @@ class SerialChain:
         """
         last = model.frames[model.getFrameId(tool_frame)].parentJoint
         serial = all(model.parents[j] == j - 1 for j in range(1, model.njoints))
-        if not serial or last != model.njoints - 1 or model.nq != model.njoints - 1:
+        mimics = [j for j in range(1, model.njoints) if _is_mimic(model.joints[j])]
+        coordinates = model.njoints - 1 - len(mimics)
+        if not serial or last != model.njoints - 1 or model.nq != coordinates:
             raise RobotModelError(
                 "robot.tool_frame",
                 f"numeric IK needs one serial chain of 1-DOF joints ending at {quoted(tool_frame)}",
@@ -66,9 +88,21 @@ class SerialChain:
         data = model.createData()
         q0 = pin.neutral(model)
         axes, revolute = [], []
+        coupling = np.zeros((model.njoints - 1, model.nq))
+        offset = np.zeros(model.njoints - 1)
         for j in range(1, model.njoints):
+            joint = model.joints[j]
+            if j in mimics:
+                mimic = joint.extract()
+                coupling[j - 1, mimic.idx_q] = mimic.scaling
+                offset[j - 1] = mimic.offset
+                axis, turns = _mimic_motion(model, j, mimic.idx_q, mimic.scaling)
+                axes.append(axis)
+                revolute.append(turns)
+                continue
+            coupling[j - 1, joint.idx_q] = 1.0
             # The joint's motion subspace in its own frame: [v; w] per unit joint speed.
-            motion = pin.computeJointJacobian(model, data, q0, j)[:, model.joints[j].idx_v]
+            motion = pin.computeJointJacobian(model, data, q0, j)[:, joint.idx_v]
             turns = bool(np.linalg.norm(motion[3:]) > 0.5)
             axes.append(motion[3:] if turns else motion[:3])
             revolute.append(turns)
@@ -85,6 +119,8 @@ class SerialChain:
             base_translation=base.translation.copy(),
             tool_rotation=tool.rotation.copy(),
             tool_translation=tool.translation.copy(),
+            coupling=coupling if mimics else None,
+            coupling_offset=offset if mimics else None,
         )
 
     def packed(self) -> tuple[np.ndarray, ...]:
@@ -96,7 +132,12 @@ class SerialChain:
         axes (n, 3) as given, revolute (n,) bool, the base rotation (3, 3) and translation (3,),
         the tool's A_n^T R_n_F (3, 3) and A_n^T t_n_F (3,). An axis along z gives A = I and
         an axis along x or y a permutation, so most chains are taken exactly.
+
+        Raises:
+            RobotModelError: the chain has mimic joints (the compiled chain has no coupling).
         """
+        if self.coupling is not None:
+            raise RobotModelError("robot.urdf", "the compiled chain has no mimic joints")
         aligned = [_aligned_to_z(axis) for axis in self.axis]
         before = [np.eye(3), *aligned[:-1]]
         rotation = [
@@ -124,16 +165,18 @@ class SerialChain:
             q: shape (M, n), rad (m for prismatic joints).
 
         Returns:
-            joint axes (M, n, 3) and origins (M, n, 3, m) in {B}; the flange's rotation
+            joint axes (M, n_joints, 3) and origins (M, n_joints, 3, m) in {B} (every joint,
+            the mimic joints too); the flange's rotation
             (M, 3, 3) and position (M, 3, m) in {B}.
         """
-        m = len(q)
+        m, n_joints = len(q), len(self.revolute)
+        q = self.joint_angles(q)
         rotation = np.broadcast_to(self.base_rotation, (m, 3, 3))
         position = np.broadcast_to(self.base_translation, (m, 3))
-        axes = np.empty((m, self.dof, 3))
-        origins = np.empty((m, self.dof, 3))
+        axes = np.empty((m, n_joints, 3))
+        origins = np.empty((m, n_joints, 3))
         cos, sin = np.cos(q), np.sin(q)
-        for j in range(self.dof):
+        for j in range(n_joints):
             position = position + _times(rotation, self.joint_translation[j])
             rotation = _times(rotation, self.joint_rotation[j])
             axis = self.axis[j]
@@ -172,11 +215,43 @@ class SerialChain:
         axes, origins, rotation, position = self.frames(q)
         at = position if point is None else np.broadcast_to(point, position.shape)
         # Both halves are set below; np.zeros would release the GIL (see ik.COMPACT_MIN_ROWS).
-        jacobian = np.empty((len(q), 6, self.dof))
+        jacobian = np.empty((len(q), 6, len(self.revolute)))
         turning = np.cross(axes, at[:, None, :] - origins)  # (M, n, 3)
         jacobian[:, :3] = np.where(self.revolute[:, None], turning, axes).transpose(0, 2, 1)
         jacobian[:, 3:] = np.where(self.revolute[:, None], axes, 0.0).transpose(0, 2, 1)
+        if self.coupling is not None:  # d(pose)/dq = sum over joints of J_j dq_j/dq
+            jacobian = jacobian @ self.coupling
         return jacobian, rotation, position
+
+
+def _is_mimic(joint: pin.JointModel) -> bool:
+    """Whether a pinocchio joint is a mimic joint (read with ``mimic=True``)."""
+    return bool(joint.shortname() == "JointModelMimic")
+
+
+def _mimic_motion(
+    model: pin.Model, j: int, leader_q: int, scaling: float
+) -> tuple[np.ndarray, bool]:
+    """The axis of mimic joint ``j`` in its own frame, and whether it turns.
+
+    pinocchio keeps the mimicked joint's type out of reach; its motion is read from the frames
+    instead: turning the leader by delta moves joint j's frame, relative to its placement in
+    its parent, by scaling * delta about (or along) its axis.
+    """
+    data = model.createData()
+    relative = []
+    for delta in (0.0, 0.25):
+        q = pin.neutral(model)
+        q[leader_q] += delta
+        pin.forwardKinematics(model, data, q)
+        fixed = data.oMi[model.parents[j]] * model.jointPlacements[j]
+        relative.append(fixed.inverse() * data.oMi[j])
+    step = relative[1] * relative[0].inverse()
+    turn = pin.log3(step.rotation)
+    if np.linalg.norm(turn) > 1e-9:
+        return turn / np.linalg.norm(turn) * np.sign(scaling), True
+    slide = relative[1].translation - relative[0].translation
+    return slide / np.linalg.norm(slide) * np.sign(scaling), False
 
 
 def _aligned_to_z(axis: np.ndarray) -> np.ndarray:

@@ -43,12 +43,31 @@ COST_LINES: dict[int, tuple[tuple[float, float], ...]] = {
     6: ((800.0, 48.0), (1_000.0, 17.0)),
     7: ((2_600.0, 200.0),),
 }
-FREE_SPIN_REDUNDANT_COST = 50.0
-"""A seven-joint path's work in free spin against the fixed spin's cost line: the Panda along
-2,000 and 20,000 waypoints took 35 and 41 times the fixed spin's time (2026-12-02, compiled
-chain; the vertex LP dominates). Measured again after the stall rule (CPU time, loaded machine,
-the same day): 2,000 waypoints free 6.45 s, 57 times the fixed spin's 0.113 s, or 13.7 million
-poses of the analytic UR5 map's; 50 times the fixed line weighs it 20.1 million."""
+FREE_SPIN_REDUNDANT_COST = 3.0
+"""A seven-joint path's work in free spin against the fixed spin's cost line (the vertex LPs of
+:mod:`solver.kernels.spin_lp`, the QR's null space). Evaluations, CPU time, best of 2, loaded
+machine, 2026-12-02, same run: the Panda along 2,000 waypoints free 0.246 s against fixed
+0.120 s (2.05 times), 20,000: 2.75 s against 1.28 s (2.15); the xArm7 2.29 and 1.87 times.
+Maps (ERK path, 99 placements; a free-spin map is not pruned): the Panda's free map 3.0 times
+its pruned fixed map, the xArm7's 2.5 times, about 2 times the unpruned line this weighs.
+(Before the LPs were compiled: 50, measured 35-57 times.)"""
+NUMPY_CHAIN_COST = 35.0
+"""The numpy chain's work against the compiled one's (a chain with mimic joints runs on numpy):
+the UR5 as a URDF, ERK path (133 waypoints), CPU time, loaded machine, 2026-12-02, same run:
+an evaluation 0.164 s against 0.005 s (33 times), a 30-placement map 0.93 s against 0.10 s."""
+NUMPY_MAP_COST = 12.0
+"""The numpy chain's map against the compiled chain's line: measured 9.3 times (the UR5 as a
+URDF, 30 placements of the ERK path, the run of NUMPY_CHAIN_COST)."""
+FIRST_PIECE = 32
+"""Waypoints every branch of a pruned map is followed before any is dropped (the pruning's
+``solver.path.pruning.PIECE``, held equal by a test)."""
+MAP_TAIL_SHARE = 0.5
+"""A pruned map's work after the first piece against following every branch (the seven-joint
+line). Measured: the CPU time of the following and the bounds past the first piece, pruned
+against unpruned, 99 placements, ERK path (133 waypoints) and 600 (the ERK path there and back),
+loaded machine, 2026-12-02, same run: Panda 0.19 and 0.11, xArm7 0.38 and 0.29 (the whole map
+0.46 / 0.18 and 0.60 / 0.34 of the unpruned one). In counts (tests/solver/families/
+test_numeric_map_work.py), the branch-waypoints followed past the first piece: 0.09 to 0.16."""
 CHUNK_ROWS = 2048
 """Configurations checked (singularity, joint speeds) between two progress reports: about
 0.2 s for seven joints under load, so that a cancelled evaluation stops within a second."""
@@ -101,11 +120,12 @@ class NumericFamily(KinematicsFamily, FollowsInSteps):
         self.upper = model.upperPositionLimit.copy()
         count = seed_count(self.chain.dof)
         self.seeds = ik.seeds(
-            count, lower=self.lower, upper=self.upper, revolute=self.chain.revolute
+            count, lower=self.lower, upper=self.upper, revolute=self.chain.q_revolute
         )
         self._branches = tuple(Branch.named(solution=str(k)) for k in range(count))
-        self.compiled = compiled
-        self._packed = self.chain.packed()
+        # The compiled chain has no mimic joints: a coupled chain runs on numpy.
+        self.compiled = compiled and self.chain.coupling is None
+        self._packed = self.chain.packed() if self.compiled else ()
 
     @property
     def dof(self) -> int:
@@ -116,17 +136,37 @@ class NumericFamily(KinematicsFamily, FollowsInSteps):
         """Seeding plus following, in closed-form poses: the highest line of COST_LINES.
 
         In free spin an arm of more than six joints also solves the three-variable LP at every
-        configuration (:func:`solver.core.dtf_redundant.vertex_lp`): times
+        configuration (:func:`solver.kernels.spin_lp.spin_speeds`): times
         :data:`FREE_SPIN_REDUNDANT_COST`.
 
         Arms of more than seven joints scale the seven-joint figures by (dof / 7)^2 (the
-        Jacobian products and solves grow about so).
+        Jacobian products and solves grow about so); the numpy chain (mimic joints) costs
+        :data:`NUMPY_CHAIN_COST` times the compiled one.
         """
         size = min(max(self.dof, 6), 7)
         scale = max(self.dof / 7, 1.0) ** 2
         following = max(n_waypoints - 1, 0)
         cost = scale * max(seed + following * track for seed, track in COST_LINES[size])
+        cost = cost if self.compiled else cost * NUMPY_CHAIN_COST
         return cost * FREE_SPIN_REDUNDANT_COST if free_spin and self.dof > 6 else cost
+
+    def map_cost(self, n_waypoints: int, *, free_spin: bool = False, pruned: bool = False) -> float:
+        """A map's placement (see the base), in the unit of :meth:`path_cost`.
+
+        A pruned map (compiled, seven joints, fixed spin) follows every branch for FIRST_PIECE
+        waypoints, then about MAP_TAIL_SHARE of them; the numpy chain weighs NUMPY_MAP_COST.
+        """
+        if not self.compiled:
+            return self.path_cost(n_waypoints, free_spin=free_spin) * (
+                NUMPY_MAP_COST / NUMPY_CHAIN_COST
+            )
+        if free_spin or not (pruned and self.follows_in_steps):
+            return self.path_cost(n_waypoints, free_spin=free_spin)
+        following = max(n_waypoints - 1, 0)
+        tail = max(following - FIRST_PIECE, 0)
+        followed = following - tail + MAP_TAIL_SHARE * tail
+        scale = max(self.dof / 7, 1.0) ** 2
+        return scale * max(seed + followed * track for seed, track in COST_LINES[7])
 
     @property
     def branches(self) -> tuple[Branch, ...]:
@@ -157,7 +197,7 @@ class NumericFamily(KinematicsFamily, FollowsInSteps):
             progress=progress,
         )
         q = q.reshape(n_poses, n_seeds, self.dof)
-        return ik.distinct(q, converged.reshape(n_poses, n_seeds), self.chain.revolute)
+        return ik.distinct(q, converged.reshape(n_poses, n_seeds), self.chain.q_revolute)
 
     def _settings(self) -> tuple[np.ndarray, np.ndarray]:
         """The compiled IK's settings and constants (:func:`ik_kernel.seed_paths`)."""
@@ -285,7 +325,7 @@ class NumericFamily(KinematicsFamily, FollowsInSteps):
         solved = np.flatnonzero(np.isfinite(flat).all(axis=-1))
         for rows in _in_chunks(solved, progress):
             status[rows] = np.where(ik.is_singular(self.chain, flat[rows]), SINGULAR, OK)
-        wrapped = np.where(self.chain.revolute, wrap_angle(q), q)
+        wrapped = np.where(self.chain.q_revolute, wrap_angle(q), q)
         return wrapped, status.reshape(q.shape[:-1])
 
     def solve(self, rotation: np.ndarray, position: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -465,6 +505,12 @@ class NumericFamily(KinematicsFamily, FollowsInSteps):
                 np.asarray(qdot_max, dtype=float),
             )
             rows = np.flatnonzero(irregular)  # J near rank loss: numpy's SVD or the LP decides
+        elif self.compiled and self.dof == 7:  # the free spin's least-norm direction
+            speeds, _, irregular = redundant_kernel.least_norm_and_null(
+                self._packed,
+                *(np.ascontiguousarray(a) for a in (q_flat, twist_flat, point_flat)),
+            )
+            rows = np.flatnonzero(irregular)
         if self.compiled:
             jacobian = chain_kernel.jacobians(
                 self._packed,
@@ -483,15 +529,30 @@ class NumericFamily(KinematicsFamily, FollowsInSteps):
             speeds[rows] = (np.linalg.pinv(jacobian) @ twist_flat[rows, :, None])[..., 0]
         return speeds
 
-    def null_space(self, q: np.ndarray, tool_point: np.ndarray) -> np.ndarray:
-        """The last right singular vector of J at the tool point (see the base), batched."""
+    def null_space(
+        self, q: np.ndarray, tool_point: np.ndarray, *, progress: Progress | None = None
+    ) -> np.ndarray:
+        """The last right singular vector of J at the tool point (see the base), batched.
+
+        Seven joints on the compiled chain: the QR's (:mod:`redundant_kernel`; its sign may
+        differ from the SVD's, which no LP answer depends on), the SVD's where J nears rank
+        loss. CHUNK_ROWS configurations at a time, ``progress`` called after each.
+        """
         shape = np.broadcast_shapes(q.shape[1:], tool_point.shape[1:])
         q_flat = np.moveaxis(np.broadcast_to(q, (self.dof, *shape)), 0, -1).reshape(-1, self.dof)
         point_flat = np.moveaxis(np.broadcast_to(tool_point, (3, *shape)), 0, -1).reshape(-1, 3)
         null = np.full(q_flat.shape, np.nan)
-        rows = np.flatnonzero(np.isfinite(q_flat).all(axis=-1))
-        jacobian, _, _ = self.chain.jacobian(q_flat[rows], point_flat[rows])
-        null[rows] = np.linalg.svd(jacobian)[2][:, -1]
+        for rows in _in_chunks(np.flatnonzero(np.isfinite(q_flat).all(axis=-1)), progress):
+            if self.compiled and self.dof == 7:
+                _, null[rows], irregular = redundant_kernel.least_norm_and_null(
+                    self._packed,
+                    np.ascontiguousarray(q_flat[rows]),
+                    np.zeros((len(rows), 6)),
+                    np.ascontiguousarray(point_flat[rows]),
+                )
+                rows = rows[irregular]
+            jacobian, _, _ = self.chain.jacobian(q_flat[rows], point_flat[rows])
+            null[rows] = np.linalg.svd(jacobian)[2][:, -1]
         return np.moveaxis(null.reshape(*shape, self.dof), -1, 0)
 
 

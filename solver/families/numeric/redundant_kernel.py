@@ -139,3 +139,43 @@ def redundant_speeds(chain, q, twist, point, qdot_max):  # type: ignore[no-untyp
         for j in range(n):
             speeds[m, j] = (best * a[j] + lam * b[j]) / best
     return speeds, irregular
+
+
+@njit(cache=True, nogil=True, error_model="numpy")
+def least_norm_and_null(chain, q, twist, point):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
+    """J^+ t and a unit null-space vector of J at M configurations of a seven-joint chain.
+
+    The free spin's directions (robots.md section 5): the least-norm joint speeds of the twist
+    (``[0; z_tool]``) and the null space, from the QR of :func:`redundant_speeds`.
+
+    Args:
+        chain: :meth:`SerialChain.packed`, seven joints.
+        q: shape (M, 7), rad; rows not finite give NaN.
+        twist: shape (M, 6), at the points.
+        point: shape (M, 3), m in {B}, where the twist is.
+
+    Returns:
+        least: shape (M, 7), J^+ twist; null: shape (M, 7), unit, its sign arbitrary;
+        irregular: shape (M,), bool, rows left to numpy (J near rank loss), NaN in both.
+    """
+    n_rows, n = q.shape
+    least = np.full((n_rows, n), np.nan)
+    null = np.full((n_rows, n), np.nan)
+    irregular = np.zeros(n_rows, dtype=np.bool_)
+    work = workspace(n)
+    jac = work[6]
+    house, a, b = np.empty((7, 7)), np.empty(7), np.empty(7)
+    for m in range(n_rows):
+        finite = True
+        for j in range(n):
+            finite = finite and math.isfinite(q[m, j])
+        if not finite:
+            continue
+        frames(chain, q[m], work)
+        jacobian_at(chain[3], work[0], work[1], point[m], jac)
+        if not _null_and_pseudo_inverse(jac, twist[m], house, a, b):
+            irregular[m] = True
+            continue
+        least[m] = a
+        null[m] = b
+    return least, null, irregular

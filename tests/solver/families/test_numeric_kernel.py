@@ -15,8 +15,9 @@ import pytest
 from solver.core.kinematics import jacobian_in_base
 from solver.core.robots import Robot
 from solver.families import get_robot
-from solver.families.numeric import chain_kernel, ik, ik_kernel
+from solver.families.numeric import chain_kernel, ik, ik_kernel, redundant_kernel
 from solver.families.numeric.family import NumericFamily
+from solver.kernels import spin_lp
 from solver.path.pipeline import flange_at_spin, turn_by_yaw
 from solver.path.problem import PathProblem
 from tests.cases import NUMERIC_MODELS
@@ -212,6 +213,31 @@ def test_compiled_joint_speeds_equal_numpy(name: str) -> None:
     np.testing.assert_allclose(ours, theirs, rtol=1e-9, atol=1e-12)
 
 
+@pytest.mark.parametrize("name", ["panda", "xarm7"])
+def test_compiled_free_spin_directions_equal_numpy(name: str) -> None:
+    """A seven-joint free spin's least-norm J^+ t and null space (the QR's, numpy's SVD's)."""
+    robot = arm(name)
+    compiled, reference = family(robot), family(arm(name, compiled=False))
+    q = random_configurations(robot, 40, seed=12).T[:, :, None]  # (n, 40, 1)
+    q[:, 3] = np.nan
+    q[:, 5] = np.clip(0.0, robot.q_lower, robot.q_upper)[:, None]  # the xArm7 loses rank here
+    rng = np.random.default_rng(13)
+    twist = rng.normal(size=(6, 40, 1))
+    point = rng.uniform(-0.5, 0.5, (3, 40, 1))
+    ours = compiled.joint_speeds_per_unit_twist(q, twist, point)
+    theirs = reference.joint_speeds_per_unit_twist(q, twist, point)
+    np.testing.assert_allclose(ours, theirs, rtol=1e-9, atol=1e-12)
+    null, null_reference = compiled.null_space(q, point), reference.null_space(q, point)
+    assert np.isnan(null[:, 3]).all()
+    sign = np.sign(np.sum(null * null_reference, axis=0))  # a null vector's sign is arbitrary
+    np.testing.assert_allclose(null * sign, null_reference, rtol=0, atol=1e-9)
+    jacobians = [jacobian_in_base(robot, q[:, m, 0]) for m in range(40) if m != 3]
+    products = [
+        j @ v for j, v in zip(jacobians, np.delete(null[:, :, 0], 3, axis=1).T, strict=True)
+    ]
+    assert np.abs(products).max() < 1e-9  # J b = 0, pinocchio's J
+
+
 @pytest.mark.parametrize("name", ROBOTS)
 def test_compiled_map_equals_numpy_map_cell_by_cell(name: str) -> None:
     """Reasons, failing waypoints, mu_path and the chosen joint path on every cell."""
@@ -233,7 +259,7 @@ def test_every_compiled_function_releases_the_gil() -> None:
     """numba's nogil: a map on a worker thread leaves the GIL to the event loop (stop 19)."""
     functions = [
         getattr(module, name)
-        for module in (chain_kernel, ik_kernel)
+        for module in (chain_kernel, ik_kernel, redundant_kernel, spin_lp)
         for name in dir(module)
         if hasattr(getattr(module, name), "targetoptions")
     ]

@@ -20,7 +20,9 @@ from solver.core.spatial import Placement
 from solver.families import get_robot
 from solver.families.numeric import family as family_module
 from solver.families.numeric.family import CHUNK_ROWS, FOLLOW_WAYPOINTS, NumericFamily
+from solver.path import in_pieces
 from solver.path.evaluate import evaluate_path
+from solver.path.pipeline import REDUNDANT_FREE_SHARES
 from tests.cases import ROOT
 from tests.problems import problem
 
@@ -109,3 +111,41 @@ def test_a_path_followed_in_pieces_gives_the_bits_of_one_piece(
     assert in_pieces.feasible and whole.feasible
     np.testing.assert_array_equal(in_pieces.q, whole.q)
     np.testing.assert_array_equal(in_pieces.v_max, whole.v_max)
+
+
+def test_a_seven_joint_free_spin_reports_through_its_lps_and_stops_there(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """Issue 27: the Panda's free spin solves an LP at every configuration (the spin LP, then
+    the spin rates at the feed): both report after every piece of LIMIT_ROWS configurations
+    (pieces give the bits of the whole) and a report that raises there stops the work."""
+    monkeypatch.setattr(in_pieces, "LIMIT_ROWS", 64)
+    robot = get_robot("panda")
+    path = line(PIECES * FOLLOW_WAYPOINTS, spacing=2e-5)
+    placed = problem(robot, path, spin_mode="free")
+    reports: list[float] = []
+    reported = evaluate_path(placed, PLACEMENT, progress=reports.append)
+    quiet = evaluate_path(placed, PLACEMENT)
+    assert reported.feasible and reported.mu_path == quiet.mu_path
+    for field in ("q", "v_max", "qdot", "spins"):
+        np.testing.assert_array_equal(getattr(reported, field), getattr(quiet, field))
+    assert reports == sorted(reports) and reports[-1] == pytest.approx(1.0)
+    shares = REDUNDANT_FREE_SHARES
+    for low, high in [(shares[3], shares[4]), (shares[4], shares[5]), (shares[5], shares[6])]:
+        assert sum(low < f <= high for f in reports) >= (2 if low == shares[3] else 10)
+
+
+@pytest.mark.parametrize("part", [1, 4, 5, 6])  # tracking, null space, spin LP, spin schedule
+def test_a_seven_joint_free_spin_stops_in_each_part(part: int) -> None:
+    shares = REDUNDANT_FREE_SHARES
+    calls: list[float] = []
+
+    def leave(fraction: float) -> None:
+        calls.append(fraction)
+        if fraction > shares[part - 1]:
+            raise Cancelled
+
+    placed = problem(get_robot("panda"), line(2 * FOLLOW_WAYPOINTS, 2e-5), spin_mode="free")
+    with pytest.raises(Cancelled):
+        evaluate_path(placed, PLACEMENT, progress=leave)
+    assert shares[part - 1] < calls[-1] <= shares[part]  # and nothing after
