@@ -143,16 +143,51 @@ def global_search(
 ) -> tuple[list[Basin], int]:
     """Differential evolution over the free variables; the best point of each distinct basin.
 
+    Every placement DE evaluates is kept; the best ones that lie apart (:func:`distinct_best`)
+    are returned, up to ``size.basins``: DE settles in one basin, and the landscape has
+    near-equal mirror-image optima.
+
+    Returns:
+        ([(decision vector, mu_path, branch index), ...] best first, generations).
+    """
+    seen, generations = evolve(problem, bounds, size=size, progress=progress, runner=runner)
+    chosen = distinct_best(seen, symmetric, size.basins)
+    return [(seen.vectors[i].copy(), float(seen.mu[i]), int(seen.branch[i])) for i in chosen], (
+        generations
+    )
+
+
+@dataclass(frozen=True)
+class Seen:
+    """Every placement a differential evolution evaluated, in order.
+
+    Attributes:
+        vectors: shape (P, N_VARIABLES), the decision vectors.
+        mu: shape (P,), m/s, the index DE maximised (mu_path, or mu_acc), NaN where infeasible.
+        branch: shape (P,), the branch index at each.
+    """
+
+    vectors: np.ndarray
+    mu: np.ndarray
+    branch: np.ndarray
+
+
+def evolve(
+    problem: PathProblem,
+    bounds: PlacementBounds,
+    *,
+    size: SearchSize = FULL_SEARCH,
+    progress: Progress | None = None,
+    runner: TaskRunner = SERIAL,
+) -> tuple[Seen, int]:
+    """Differential evolution over the free variables of ``bounds``, on ``problem``'s path.
+
     With a cell, a placement in collision scores worse than any feasible one but by its
     mu_path without the cell (``collisions_scored``), not as flat as the kinematics'
     refusals.
 
-    Every placement DE evaluates is kept; the best ones that lie apart (by BASIN_GAP, in
-    (r, psi) when ``symmetric``, else in (x, y, yaw); spins as angles) are returned, up to
-    ``size.basins``: DE settles in one basin, and the landscape has near-equal mirror-image optima.
-
     Returns:
-        ([(decision vector, mu_path, branch index), ...] best first, generations).
+        every placement evaluated, and DE's generations.
     """
     seen: list[tuple[np.ndarray, np.ndarray, np.ndarray]] = []
     clear = problem.with_options(cell=None)  # the kinematics alone, for placements in collision
@@ -203,19 +238,28 @@ def global_search(
             vectorized=True,
         )
         generations = int(found.nit)
-    vectors = np.concatenate([s[0] for s in seen])
-    mu = np.concatenate([s[1] for s in seen])
-    branch = np.concatenate([s[2] for s in seen])
-    feasible = np.flatnonzero(~np.isnan(mu))
-    order = feasible[np.argsort(-mu[feasible], kind="stable")]
-    coordinates, scale = _basin_coordinates(vectors, symmetric)
+    return Seen(
+        np.concatenate([s[0] for s in seen]),
+        np.concatenate([s[1] for s in seen]),
+        np.concatenate([s[2] for s in seen]),
+    ), generations
+
+
+def distinct_best(seen: Seen, symmetric: bool, count: int) -> list[int]:
+    """The indices of the best feasible placements that lie apart, best first, ``count`` at most.
+
+    Apart: by BASIN_GAP, in (r, psi) when ``symmetric``, else in (x, y, yaw); spins as angles.
+    """
+    feasible = np.flatnonzero(~np.isnan(seen.mu))
+    order = feasible[np.argsort(-seen.mu[feasible], kind="stable")]
+    coordinates, scale = _basin_coordinates(seen.vectors, symmetric)
     chosen: list[int] = []
     for i in order:
         if all(np.max(np.abs(coordinates[i] - coordinates[j]) * scale) > 1.0 for j in chosen):
             chosen.append(int(i))
-            if len(chosen) == size.basins:
+            if len(chosen) == count:
                 break
-    return [(vectors[i].copy(), float(mu[i]), int(branch[i])) for i in chosen], generations
+    return chosen
 
 
 def polish(
