@@ -48,6 +48,7 @@ from timing import best_time  # noqa: E402
 
 from service.config import Settings  # noqa: E402
 from service.convert import map_response  # noqa: E402
+from service.convert.map_json import map_json  # noqa: E402
 from service.jobs.store import JobStore  # noqa: E402
 from service.operations.map import computed_map  # noqa: E402
 from service.schemas import MapRequest  # noqa: E402
@@ -109,7 +110,7 @@ def erk_route_parts(*, repeats: int) -> None:
     """Where the ERK-size map's time goes in the route, in this process (no HTTP).
 
     The body's validation, the map on one thread and on DTF_THREADS, the response's cells, its
-    JSON.
+    JSON (the model's way), and the same body written from the columns (the route's way).
     """
     body = {"robot": {"model": "ur5"}, "path": EXAMPLE["path"], "grid": ERK_GRID}
     raw = json.dumps(body).encode()
@@ -128,6 +129,9 @@ def erk_route_parts(*, repeats: int) -> None:
         f"map on {settings.threads}": best_time(lambda: computed(settings.threads), repeats),
         "response cells": best_time(lambda: map_response(result, robot, spin_mode=spin_mode), 10),
         "JSON": best_time(response.model_dump_json, repeats),
+        "written body (cells and JSON, what the route does)": best_time(
+            lambda: map_json(result, robot, spin_mode=spin_mode), repeats
+        ),
     }
     print(
         "  in the route (in process, best of "
