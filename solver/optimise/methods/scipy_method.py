@@ -29,7 +29,6 @@ from solver.optimise.methods.placement_scipy import (
     Basin,
     SearchSize,
     global_search,
-    polish,
     search_placements,
     search_size,
 )
@@ -39,6 +38,7 @@ from solver.optimise.methods.search_rows import (
     search_on_rows,
     searched_waypoints,
 )
+from solver.optimise.methods.slsqp_polish import polish
 from solver.optimise.search_space import PlacementBounds
 from solver.path.problem import PathProblem
 
