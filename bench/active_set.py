@@ -27,11 +27,17 @@ from solver.path.problem import PathOptions, PathProblem
 
 BOUNDS = PlacementBounds(x=(-0.4, 0.2), y=(0.2, 0.6), yaw=(-math.pi, math.pi), z=0.0)
 MAX_MAP_POSES = 5_000_000  # the service's default DTF_MAX_MAP_POSES
+MAX_SEARCH_POSES = 6_100_000  # the service's default DTF_MAX_SEARCH_POSES
 MAX_SOLVER_SECONDS = 20.0  # the service's default DTF_MAX_SOLVER_SECONDS
 
 
-def _optimised(moves: int, *, active_set: bool = True) -> tuple[float, float, PlacementOptimum]:
-    """Read a program of ``moves`` moves and optimise it: read time, optimise time, answer."""
+def _optimised(
+    moves: int, *, active_set: bool = True, method: str = "casadi"
+) -> tuple[float, float, PlacementOptimum]:
+    """Read a program of ``moves`` moves and optimise it: read time, optimise time, answer.
+
+    With the service's default limits (``active_set=False`` lifts the scipy search's).
+    """
     began = time.perf_counter()
     program = read_cl_data(pocket_program(moves))
     waypoints = program.waypoints_in_workpiece()
@@ -44,8 +50,9 @@ def _optimised(moves: int, *, active_set: bool = True) -> tuple[float, float, Pl
     optimum = optimize_placement(
         problem,
         bounds=BOUNDS,
-        method="casadi",
+        method=method,
         max_coarse_poses=MAX_MAP_POSES,
+        max_search_poses=MAX_SEARCH_POSES if active_set else None,
         max_solver_seconds=MAX_SOLVER_SECONDS,
         runner=ThreadRunner(2),
         active_set=active_set,
@@ -64,7 +71,7 @@ def _line(
     read_in = "" if read is None else f" read in {read:.2f} s,"
     return (
         f"  {label}: {moves} moves{read_in} optimised in {seconds:.2f} s "
-        f"({optimum.solver.iterations} IPOPT iterations), {mu}, {rows}"
+        f"({optimum.solver.iterations} iterations), {mu}, {rows}"
     )
 
 

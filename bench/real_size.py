@@ -15,6 +15,8 @@ run:
 - ``GET /v1/jobs?limit=1000`` with 50 large map jobs stored, against reading and parsing their
   results as the listing did before (``SELECT *`` and ``json.loads`` of every result), and
   ``GET /v1/jobs/{id}`` and one page of cells of one of them;
+- the scipy method on 5,000- and 10,487-move programs (its differential evolution on sets of
+  the waypoints), and on a 2,000-move one against the whole-path evolution;
 - ``/healthz`` every 20 ms while the largest body (20,000 waypoints, DTF_MAX_PATH_WAYPOINTS)
   is read, validated and computed: a UR5 evaluation to its end, and a Panda evaluation (numeric
   IK, a minute of work) for its first seconds, after which the client leaves.
@@ -40,11 +42,13 @@ import numpy as np
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
+from active_set import _line, _optimised  # noqa: E402 - bench/active_set.py, beside this
 from run import load_path, scalar_cell  # noqa: E402 - bench/run.py, beside this script
 from timing import best_time  # noqa: E402
 
 from service.config import Settings  # noqa: E402
 from service.convert import map_response  # noqa: E402
+from service.convert.map_json import map_json  # noqa: E402
 from service.jobs.store import JobStore  # noqa: E402
 from service.operations.map import computed_map  # noqa: E402
 from service.schemas import MapRequest  # noqa: E402
@@ -106,7 +110,7 @@ def erk_route_parts(*, repeats: int) -> None:
     """Where the ERK-size map's time goes in the route, in this process (no HTTP).
 
     The body's validation, the map on one thread and on DTF_THREADS, the response's cells, its
-    JSON.
+    JSON (the model's way), and the same body written from the columns (the route's way).
     """
     body = {"robot": {"model": "ur5"}, "path": EXAMPLE["path"], "grid": ERK_GRID}
     raw = json.dumps(body).encode()
@@ -125,6 +129,9 @@ def erk_route_parts(*, repeats: int) -> None:
         f"map on {settings.threads}": best_time(lambda: computed(settings.threads), repeats),
         "response cells": best_time(lambda: map_response(result, robot, spin_mode=spin_mode), 10),
         "JSON": best_time(response.model_dump_json, repeats),
+        "written body (cells and JSON, what the route does)": best_time(
+            lambda: map_json(result, robot, spin_mode=spin_mode), repeats
+        ),
     }
     print(
         "  in the route (in process, best of "
@@ -257,6 +264,31 @@ def healthz_during_the_largest_body(*, waypoints: int) -> None:
         process.wait()
 
 
+def scipy_on_sets(*, smoke: bool) -> None:
+    """The scipy method on long programs (its evolutions on sets), and against the whole path.
+
+    As ``bench/active_set.py`` optimises (UR5e, x -0.4..0.2 m, y 0.2..0.6 m, any yaw, free
+    spin, two threads), with the service's DTF_MAX_SEARCH_POSES; the baseline, same run: the
+    whole-path differential evolution (``active_set=False``, its limit lifted) on a program
+    just over MAX_SEARCH_ROWS.
+    """
+    _optimised(200, method="scipy")  # the kernels and the catalogue load outside the figures
+    print("scipy on long programs (evolutions on sets of the waypoints):")
+    for moves in (1_500,) if smoke else (5_000, 10_487):
+        read, seconds, optimum = _optimised(moves, method="scipy")
+        print(_line("synthetic NX-like program", moves, read, seconds, optimum))
+    moves = 1_100 if smoke else 2_000
+    _, whole_seconds, whole = _optimised(moves, method="scipy", active_set=False)
+    _, seconds, optimum = _optimised(moves, method="scipy")
+    print(_line("whole-path DE", moves, None, whole_seconds, whole))
+    print(_line("DE on sets   ", moves, None, seconds, optimum))
+    if whole.mu_path is not None and optimum.mu_path is not None:
+        print(
+            f"  on sets / whole path: {seconds / whole_seconds:.2f}x the time, mu_path "
+            f"relative difference {abs(optimum.mu_path / whole.mu_path - 1):.1e}"
+        )
+
+
 def main() -> None:
     """Print the figures."""
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
@@ -266,6 +298,7 @@ def main() -> None:
     erk_route_parts(repeats=2 if args.smoke else 10)
     job_listing(jobs=5 if args.smoke else 50, cells=2_000 if args.smoke else 20_000)
     healthz_during_the_largest_body(waypoints=2_000 if args.smoke else 20_000)
+    scipy_on_sets(smoke=args.smoke)
 
 
 if __name__ == "__main__":

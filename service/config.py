@@ -56,7 +56,9 @@ class Settings(BaseSettings):
         "The default admits every search of a closed-form arm over x, y and yaw on a path of "
         "1,000 waypoints (about 5 million: 61 * 64 * 1000 of them the differential "
         "evolution's), and with the spin or z free too up to about 600 waypoints; a "
-        "longer program is refused with a message that points to the casadi method; "
+        "program over 1,000 waypoints is searched on a set of the waypoints that bind (three "
+        "evolutions on at most 300, their best placements checked on the whole path), which "
+        "admits a closed-form arm over x, y and yaw up to about 18,000 waypoints; "
         "with numeric IK it admits a short path (the Panda on 10 waypoints: about 20 s) and "
         "refuses a search that would take much longer.",
     )
@@ -74,8 +76,9 @@ class Settings(BaseSettings):
         description="Most waypoints a path of /v1/optimize may have. The local solves work on the "
         "waypoints that bind (an active set, checked on the whole path), and a program over "
         "2,000 waypoints is mapped on such a set too, so the work grows slowly with the path: "
-        "a 10,487-move program on a UR5e takes seconds. The scipy method's search still "
-        "evaluates the whole path (DTF_MAX_SEARCH_POSES bounds it).",
+        "a 10,487-move program on a UR5e takes seconds. The scipy method's differential "
+        "evolution of a program over 1,000 waypoints runs on such a set too "
+        "(DTF_MAX_SEARCH_POSES bounds it).",
     )
     max_cell_objects: int = Field(
         default=100,

@@ -101,7 +101,8 @@ def check_png_size(grid: MapGrid, *, settings: Settings) -> None:
         )
 
 
-def _extreme(cmap: CapabilityMap, *, best: bool) -> schemas.MapExtreme | None:
+def extreme(cmap: CapabilityMap, *, best: bool) -> schemas.MapExtreme | None:
+    """The best (or worst) feasible cell as the answer gives it; None where none is."""
     index = cmap.extreme(best=best)
     if index is None:
         return None
@@ -115,7 +116,7 @@ def _extreme(cmap: CapabilityMap, *, best: bool) -> schemas.MapExtreme | None:
 _LIMITED_BY: tuple[Literal["speed", "acceleration"], ...] = ("speed", "acceleration")
 
 
-def _acceleration_columns(cmap: CapabilityMap) -> tuple[list[Any], list[Any]]:
+def acceleration_columns(cmap: CapabilityMap) -> tuple[list[Any], list[Any]]:
     """Per cell (in C order) its mu_acc and what binds it: None without acceleration limits.
 
     Infeasible cells' values are never read.
@@ -137,7 +138,7 @@ def map_response(cmap: CapabilityMap, robot: Robot, *, spin_mode: SpinMode) -> s
     mu, reason = cmap.mu_path.ravel().tolist(), cmap.reason.ravel().tolist()
     failed, branch = cmap.failed_waypoint.ravel().tolist(), cmap.branch.ravel().tolist()
     at, joint = cmap.bottleneck_waypoint.ravel().tolist(), cmap.bottleneck_joint.ravel().tolist()
-    mu_acc, limited_by = _acceleration_columns(cmap)
+    mu_acc, limited_by = acceleration_columns(cmap)
     xs, ys, yaws, spins = (a.tolist() for a in (cmap.xs, cmap.ys, cmap.yaws, cmap.spins))
     cells = []
     for c, (s, k, j, i) in enumerate(np.ndindex(cmap.mu_path.shape)):
@@ -160,8 +161,8 @@ def map_response(cmap: CapabilityMap, robot: Robot, *, spin_mode: SpinMode) -> s
         )
     return schemas.MapResponse(
         cells=cells,
-        best=_extreme(cmap, best=True),
-        worst=_extreme(cmap, best=False),
+        best=extreme(cmap, best=True),
+        worst=extreme(cmap, best=False),
         feasible_cells=int(np.sum(cmap.reason == FEASIBLE)),
         spin_mode=spin_mode,
         recognised=require_family(robot).recognised,

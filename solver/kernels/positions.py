@@ -151,6 +151,8 @@ def shift_to_copy(path, lower, upper):  # type: ignore[no-untyped-def]  # pragma
 _SERIES = 0.125
 _ASIN = (1.0, 1.0 / 6.0, 3.0 / 40.0, 5.0 / 112.0, 35.0 / 1152.0, 63.0 / 2816.0, 231.0 / 13312.0,
          143.0 / 10240.0)  # fmt: skip
+# rad: a step this near pi or nearer is formed from the two angles (see :func:`pair_step`).
+_HALF_TURN = 1e-9
 
 
 @njit(cache=True, error_model="numpy", nogil=True, inline="always")
@@ -158,7 +160,14 @@ def pair_step(c0, s0, c1, s1):  # type: ignore[no-untyped-def]  # pragma: no cov
     """The angle from the (cos, sin) pair (c0, s0) to (c1, s1), in [-pi, pi].
 
     As :func:`wrapped_step` gives it: asin of their cross product by its series where the step
-    is small (no atan2), atan2 of cross and dot products otherwise.
+    is small (no atan2), atan2 of cross and dot products otherwise. A step of about half a turn
+    (within _HALF_TURN of pi) is :func:`wrapped_step` of the two angles' difference, as
+    :func:`solver.path.tracking.track` forms it: its sign is then the difference's, not that of
+    a cross product rounded to a signed zero (the pairs (1, 0) and (-1, -0.0) are a step of
+    -pi there and +pi by atan2(+0.0, -1)). Such steps happen only where the step bound does not
+    apply (a rapid between passes), and the sign decides which way a joint has turned: a path
+    that flips a joint by half a turn at several rapids would otherwise drift by whole turns
+    and fail its position limits where the numpy pipeline's holds them.
     """
     cross = c0 * s1 - s0 * c1
     dot = c0 * c1 + s0 * s1
@@ -168,7 +177,10 @@ def pair_step(c0, s0, c1, s1):  # type: ignore[no-untyped-def]  # pragma: no cov
         for term in range(6, -1, -1):
             series = series * x2 + _ASIN[term]
         return cross * series
-    return math.atan2(cross, dot)
+    step = math.atan2(cross, dot)
+    if abs(step) > math.pi - _HALF_TURN:
+        return wrapped_step(math.atan2(s1, c1) - math.atan2(s0, c0))
+    return step
 
 
 @njit(cache=True, error_model="numpy", nogil=True)

@@ -84,7 +84,7 @@ def map_values(
         whole = evaluate_placements(problem, placements, progress=progress, runner=runner)
         return MapValues(whole.feed_index, whole.branch)
     sample = np.unique(np.linspace(0, len(placements) - 1, SAMPLE_CELLS).round().astype(int))
-    first = _binding(problem, placements[sample], None, runner)[0]
+    first = binding_rows(problem, placements[sample], None, runner)[0]
     rows = closure(problem, first, neighbours=False)
     feed_index = np.full(len(placements), np.nan)
     branch = np.zeros(len(placements), dtype=int)
@@ -94,7 +94,9 @@ def map_values(
             on_waypoints(problem, rows), placements, progress=part, runner=runner
         )
         best = np.array(maxima(on_set.feed_index)[:VERIFIED_CELLS], dtype=int)
-        added, whole = _binding(problem, placements[best], on_set.feed_index[best], runner, rows)
+        added, whole = binding_rows(
+            problem, placements[best], on_set.feed_index[best], runner, rows
+        )
         feed_index[:] = np.nan
         feed_index[best], branch[best] = whole.feed_index, whole.branch
         grown = closure(problem, np.union1d(rows, added), neighbours=False)
@@ -107,7 +109,7 @@ def map_values(
     return MapValues(feed_index, branch, rows)
 
 
-def _binding(
+def binding_rows(
     problem: PathProblem,
     placements: np.ndarray,
     on_set: np.ndarray | None,

@@ -34,6 +34,12 @@ from solver.optimise.coarse_search import coarse_map_cells
 from solver.optimise.local_search import N_CLIMBS, REFINE_ROUNDS, climb_evaluations, refined_count
 from solver.optimise.methods import casadi_method, method_named, scipy_method
 from solver.optimise.methods.placement_scipy import search_placements
+from solver.optimise.methods.search_rows import (
+    SAMPLE_CELLS,
+    SEARCH_ROUNDS,
+    VERIFIED,
+    searched_waypoints,
+)
 from solver.optimise.search_space import PlacementBounds
 from solver.optimise.symmetry import symmetric_search
 from solver.path.problem import PathProblem
@@ -124,16 +130,25 @@ def work_of(
         refined = refined_count(problem, bounds, count=size.basins)
         # Each basin polished: its whole-path check before each SLSQP round and after it.
         solves = size.basins * (1 + MAX_ROUNDS) if on_active_set else 0
+        # A long program's evolutions run on a set of its waypoints, each round's best placements
+        # checked on the whole path (solver.optimise.methods.search_rows).
+        on_rows = scipy_method.rows_searched(problem, active_set)
+        evolutions = SEARCH_ROUNDS if on_rows else 1
+        searched = searched_waypoints(n) if on_rows else n
+        verified = SAMPLE_CELLS + SEARCH_ROUNDS * max(VERIFIED, size.basins) if on_rows else 0
         return OptimisationWork(
             (
                 Phase("start", 1, n, one_at_a_time=True),
-                Phase("differential evolution", search_placements(bounds, size), n),
+                Phase(
+                    "differential evolution", evolutions * search_placements(bounds, size), searched
+                ),
                 Phase(
                     "differential evolution's collisions, without the cell",
-                    backed * search_placements(bounds, size),
-                    n,
+                    backed * evolutions * search_placements(bounds, size),
+                    searched,
                     without_cell=True,
                 ),
+                Phase("differential evolution's whole-path checks", verified, n),
                 Phase("refinement", refined * 2 * free * REFINE_ROUNDS, n),
                 Phase("whole-path checks", solves, n, one_at_a_time=True),
                 Phase("Nelder-Mead climbs", climbs, n, one_at_a_time=True),

@@ -2,10 +2,10 @@
 
 Differential evolution needs no gradients and looks at the whole box; every generation is one
 batch through :func:`solver.path.placements.evaluate_placements`. The best points of the few best
-distinct basins it saw are then polished by SLSQP on  maximise s  s.t.  V_i(v) >= s  for every
-waypoint i, with V_i on the IK branch of that point and its gradient by central differences (one
-batch of placements). Both work on the free variables of the decision vector
-(:mod:`solver.optimise.search_space`: x, y, yaw and the tool spin when its range is not one value).
+distinct basins it saw are then polished by SLSQP on the epigraph form
+(:mod:`solver.optimise.methods.slsqp_polish`). Both work on the free variables of the decision
+vector (:mod:`solver.optimise.search_space`: x, y, yaw and the tool spin when its range is not
+one value).
 
 The search's size (population, generations, polish iterations) is the full one for a
 closed-form family, whose placement costs one unit of work a waypoint. A family whose placement
@@ -21,7 +21,6 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.optimize
 
-from solver.core.family import Branch
 from solver.core.parallel import SERIAL, TaskRunner
 from solver.core.progress import Progress
 from solver.optimise.search_space import PlacementBounds, variables_of
@@ -32,7 +31,6 @@ SEED = 0  # differential evolution is seeded: same input, same output
 POLISH_ITERATIONS = 200  # SLSQP iterations at most from one start
 POPULATION = 20  # per dimension
 GENERATIONS = 60
-DIFFERENCE_STEP = 1e-6  # m and rad, for the polish's gradients
 INFEASIBLE = 1.0  # objective of an infeasible placement (feasible ones are -mu_path <= 0)
 N_BASINS = 3  # distinct basins polished
 BASIN_GAP = (0.05, 0.35)  # m and rad (about 20 degrees): placements closer are one basin
@@ -111,7 +109,7 @@ def search_placements(bounds: PlacementBounds, size: SearchSize = FULL_SEARCH) -
     return (size.generations + 1) * (1 << (members - 1).bit_length())
 
 
-def _full(bounds: PlacementBounds, free_values: np.ndarray) -> np.ndarray:
+def full_vectors(bounds: PlacementBounds, free_values: np.ndarray) -> np.ndarray:
     """Decision vectors (P, N_VARIABLES) from the free variables' values (P, F); the rest fixed."""
     vectors = np.tile(bounds.lower, (len(free_values), 1))
     vectors[:, bounds.free] = free_values
@@ -143,22 +141,57 @@ def global_search(
 ) -> tuple[list[Basin], int]:
     """Differential evolution over the free variables; the best point of each distinct basin.
 
+    Every placement DE evaluates is kept; the best ones that lie apart (:func:`distinct_best`)
+    are returned, up to ``size.basins``: DE settles in one basin, and the landscape has
+    near-equal mirror-image optima.
+
+    Returns:
+        ([(decision vector, mu_path, branch index), ...] best first, generations).
+    """
+    seen, generations = evolve(problem, bounds, size=size, progress=progress, runner=runner)
+    chosen = distinct_best(seen, symmetric, size.basins)
+    return [(seen.vectors[i].copy(), float(seen.mu[i]), int(seen.branch[i])) for i in chosen], (
+        generations
+    )
+
+
+@dataclass(frozen=True)
+class Seen:
+    """Every placement a differential evolution evaluated, in order.
+
+    Attributes:
+        vectors: shape (P, N_VARIABLES), the decision vectors.
+        mu: shape (P,), m/s, the index DE maximised (mu_path, or mu_acc), NaN where infeasible.
+        branch: shape (P,), the branch index at each.
+    """
+
+    vectors: np.ndarray
+    mu: np.ndarray
+    branch: np.ndarray
+
+
+def evolve(
+    problem: PathProblem,
+    bounds: PlacementBounds,
+    *,
+    size: SearchSize = FULL_SEARCH,
+    progress: Progress | None = None,
+    runner: TaskRunner = SERIAL,
+) -> tuple[Seen, int]:
+    """Differential evolution over the free variables of ``bounds``, on ``problem``'s path.
+
     With a cell, a placement in collision scores worse than any feasible one but by its
     mu_path without the cell (``collisions_scored``), not as flat as the kinematics'
     refusals.
 
-    Every placement DE evaluates is kept; the best ones that lie apart (by BASIN_GAP, in
-    (r, psi) when ``symmetric``, else in (x, y, yaw); spins as angles) are returned, up to
-    ``size.basins``: DE settles in one basin, and the landscape has near-equal mirror-image optima.
-
     Returns:
-        ([(decision vector, mu_path, branch index), ...] best first, generations).
+        every placement evaluated, and DE's generations.
     """
     seen: list[tuple[np.ndarray, np.ndarray, np.ndarray]] = []
     clear = problem.with_options(cell=None)  # the kinematics alone, for placements in collision
 
     def objective(points: np.ndarray) -> np.ndarray:  # points: (F, S)
-        vectors = _full(bounds, points.T)
+        vectors = full_vectors(bounds, points.T)
         result = evaluate_placements(problem, bounds.rows(vectors), runner=runner)
         seen.append((vectors, result.feed_index, result.branch))
         if progress is not None:
@@ -203,87 +236,25 @@ def global_search(
             vectorized=True,
         )
         generations = int(found.nit)
-    vectors = np.concatenate([s[0] for s in seen])
-    mu = np.concatenate([s[1] for s in seen])
-    branch = np.concatenate([s[2] for s in seen])
-    feasible = np.flatnonzero(~np.isnan(mu))
-    order = feasible[np.argsort(-mu[feasible], kind="stable")]
-    coordinates, scale = _basin_coordinates(vectors, symmetric)
+    return Seen(
+        np.concatenate([s[0] for s in seen]),
+        np.concatenate([s[1] for s in seen]),
+        np.concatenate([s[2] for s in seen]),
+    ), generations
+
+
+def distinct_best(seen: Seen, symmetric: bool, count: int) -> list[int]:
+    """The indices of the best feasible placements that lie apart, best first, ``count`` at most.
+
+    Apart: by BASIN_GAP, in (r, psi) when ``symmetric``, else in (x, y, yaw); spins as angles.
+    """
+    feasible = np.flatnonzero(~np.isnan(seen.mu))
+    order = feasible[np.argsort(-seen.mu[feasible], kind="stable")]
+    coordinates, scale = _basin_coordinates(seen.vectors, symmetric)
     chosen: list[int] = []
     for i in order:
         if all(np.max(np.abs(coordinates[i] - coordinates[j]) * scale) > 1.0 for j in chosen):
             chosen.append(int(i))
-            if len(chosen) == size.basins:
+            if len(chosen) == count:
                 break
-    return [(vectors[i].copy(), float(mu[i]), int(branch[i])) for i in chosen], generations
-
-
-def polish(
-    problem: PathProblem,
-    bounds: PlacementBounds,
-    start: np.ndarray,
-    start_speed: float,
-    branch: Branch,
-    *,
-    size: SearchSize = FULL_SEARCH,
-    progress: Progress | None = None,
-) -> tuple[np.ndarray, str, int]:
-    """SLSQP on the epigraph form over the free variables, from a feasible start, on one branch.
-
-    Returns:
-        the decision vector, SLSQP's message, its iterations.
-    """
-    free = bounds.free
-    n_free = int(free.sum())
-    steps = np.eye(n_free) * DIFFERENCE_STEP
-    offsets = np.vstack([np.zeros(n_free), steps, -steps])
-    cache: dict[tuple[float, ...], np.ndarray] = {}
-    on_branch = problem.with_options(branch=branch)
-
-    def speeds(v: np.ndarray) -> np.ndarray:
-        """V_max per waypoint at v and at v +- steps: (1 + 2F, N), NaN where infeasible."""
-        key = tuple(v[:n_free])
-        if key not in cache:
-            result = evaluate_placements(
-                on_branch, bounds.rows(_full(bounds, v[:n_free] + offsets)), with_speeds=True
-            )
-            bounds_per_waypoint = result.feed_bounds  # V_max, or with V_acc the least of both
-            if bounds_per_waypoint is None:  # not reached: asked for with_speeds
-                raise RuntimeError("evaluate_placements returned no speeds")
-            cache[key] = bounds_per_waypoint
-            if progress is not None:
-                progress(len(cache) / (size.polish_iterations + 1))
-        return cache[key]
-
-    def margin(v: np.ndarray) -> np.ndarray:
-        here = speeds(v)[0]
-        values: np.ndarray = np.where(np.isnan(here), -1.0, here) - v[n_free]
-        return values
-
-    def margin_gradient(v: np.ndarray) -> np.ndarray:
-        table = speeds(v)
-        here, plus, minus = table[0], table[1 : 1 + n_free], table[1 + n_free :]
-        central = (plus - minus) / (2 * DIFFERENCE_STEP)
-        forward = (plus - here) / DIFFERENCE_STEP
-        backward = (here - minus) / DIFFERENCE_STEP
-        gradient = np.where(
-            np.isnan(central), np.where(np.isnan(forward), backward, forward), central
-        )
-        jacobian: np.ndarray = np.column_stack([np.nan_to_num(gradient.T), -np.ones(len(here))])
-        return jacobian
-
-    if n_free == 0:
-        return np.asarray(start, dtype=float), "nothing to polish: every variable is fixed", 0
-    objective_gradient = np.zeros(n_free + 1)
-    objective_gradient[-1] = -1.0
-    result = scipy.optimize.minimize(
-        lambda v: -v[n_free],
-        x0=np.array([*np.asarray(start)[free], start_speed]),
-        jac=lambda v: objective_gradient,
-        bounds=[*zip(bounds.lower[free], bounds.upper[free], strict=True), (0.0, None)],
-        constraints=[{"type": "ineq", "fun": margin, "jac": margin_gradient}],
-        method="SLSQP",
-        options={"ftol": 1e-14, "maxiter": size.polish_iterations},
-    )
-    vector = _full(bounds, result.x[None, :n_free])[0]
-    return vector, str(result.message), int(result.nit)
+    return chosen

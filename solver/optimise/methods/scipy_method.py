@@ -26,12 +26,19 @@ from solver.optimise.candidate import ZERO_SPEED, Candidate, Search
 from solver.optimise.coarse_search import Cell
 from solver.optimise.local_search import climbs, refine_cells
 from solver.optimise.methods.placement_scipy import (
+    Basin,
     SearchSize,
     global_search,
-    polish,
     search_placements,
     search_size,
 )
+from solver.optimise.methods.search_rows import (
+    SEARCH_ROUNDS,
+    on_rows,
+    search_on_rows,
+    searched_waypoints,
+)
+from solver.optimise.methods.slsqp_polish import polish
 from solver.optimise.search_space import PlacementBounds
 from solver.path.problem import PathProblem
 
@@ -58,15 +65,27 @@ def check(problem: PathProblem, bounds: PlacementBounds, settings: Search) -> No
     if max_poses is None:
         return
     placements = search_placements(bounds, size)
-    work = placements * problem.path_cost(n_waypoints)
+    searched = n_waypoints
+    if rows_searched(problem, settings.active_set):
+        placements *= SEARCH_ROUNDS
+        searched = searched_waypoints(n_waypoints)
+    work = placements * problem.path_cost(searched)
     if work > max_poses:
         raise InvalidInputError(
             "bounds",
             f"the scipy search of {int(bounds.free.sum())} free variables evaluates "
-            f"{placements} placements * {n_waypoints} waypoints = {placements * n_waypoints} "
+            f"{placements} placements * {searched} waypoints = {placements * searched} "
             f"poses, as work {work:.4g} closed-form poses ({family.name} IK); the limit is "
             f"{max_poses}; fix a variable, shorten the path, or use method casadi",
         )
+
+
+def rows_searched(problem: PathProblem, active_set: bool) -> bool:
+    """Whether differential evolution runs on a set of the waypoints (a long program's).
+
+    :mod:`solver.optimise.methods.search_rows`, unless ``active_set`` is off (the reference).
+    """
+    return active_set and on_rows(len(problem.waypoints))
 
 
 def search(
@@ -79,14 +98,7 @@ def search(
     placement costs more).
     """
     progress, size = settings.progress, size_of(problem, bounds)
-    basins, iterations = global_search(
-        problem,
-        bounds,
-        symmetric=settings.symmetric,
-        size=size,
-        progress=span(progress, 0.0, 0.6),
-        runner=settings.runner,
-    )
+    basins, iterations = _global(problem, bounds, size, span(progress, 0.0, 0.6), settings)
     if not basins:
         return [], iterations
     if problem.prepared.pure_rotation.any() or basins[0][1] <= 0.0:
@@ -115,6 +127,38 @@ def search(
             candidates.append(backed)
     candidates += climbs(problem, bounds, refined)
     return candidates, iterations
+
+
+def _global(
+    problem: PathProblem,
+    bounds: PlacementBounds,
+    size: SearchSize,
+    progress: Progress | None,
+    settings: Search,
+) -> tuple[list[Basin], int]:
+    """Differential evolution's basins (their whole-path mu_path) and its generations.
+
+    On the whole path, or for a long program on a set of its waypoints
+    (:mod:`solver.optimise.methods.search_rows`).
+    """
+    if not rows_searched(problem, settings.active_set):
+        return global_search(
+            problem,
+            bounds,
+            symmetric=settings.symmetric,
+            size=size,
+            progress=progress,
+            runner=settings.runner,
+        )
+    found = search_on_rows(
+        problem,
+        bounds,
+        symmetric=settings.symmetric,
+        size=size,
+        progress=progress,
+        runner=settings.runner,
+    )
+    return found.basins, found.generations
 
 
 def _polished(
