@@ -5,21 +5,14 @@ bounds a constant feed along each feasible branch's final tracked joint path (in
 the path along the spin schedule): mu_acc = min(mu_path, min_i V_acc,i), and the ``auto``
 branch is the one with the highest mu_acc (:func:`solver.path.tracking.choose_branch`, ties
 within ``ACC_TIE_RTOL`` to the first). The kernels do the same here, with the limit's hooks
-(:mod:`solver.kernels.limits`).
-
-The branches (:func:`cell_mu_acc`) are taken in their order, and a branch is
-left as soon as a bound of its mu_acc (its mu_path, or one waypoint's V_acc) is at most
-``top``, the highest index of the branches before it: an earlier branch then has an index at
-least as high, so whatever the tie, the choice takes that one (or one before it) and never this
-one. Each branch is first probed at the waypoints where the branches before it bound, then
-scanned along its path until such a waypoint. Branches of one shoulder share joints (a UR's
+(:mod:`solver.kernels.limits`), and prune the branches as without the limits
+(:mod:`solver.kernels.acc_cells`): a branch is known either whole (its mu_acc, where it binds,
+V_acc per waypoint: :func:`scan_row`) or by a bound of its mu_acc, its running minimum of
+V_max (mu_acc <= mu_path) or one stencil row's V_acc (:func:`probe_acc_rows`,
+:func:`probe_free_acc_rows`), and is left once the bound is below its limit
+(:func:`solver.kernels.cell.set_limits`). Branches of one shoulder share joints (a UR's
 wrist_3 differs between them by pi, which no second difference sees): their V_acc there is
-equal to the bit, as D is formed from the steps (:func:`solver.kernels.limits.step_stencil`),
-and most branches are left at their first probe. In free spin a branch is tracked along its
-spin schedule only when no probe leaves it.
-
-Without acceleration limits the free-spin kernel tracks the spin schedule fastest first
-(:func:`next_fastest`) and stops at the first branch that holds, ties apart.
+equal to the bit, as D is formed from the steps (:func:`solver.kernels.limits.step_stencil`).
 
 Without acceleration limits the kernels get ``qddot_max`` of shape (0,) and skip all of this.
 """
@@ -31,52 +24,33 @@ import math
 import numpy as np
 from numba import njit
 
-from solver.core.codes import FEASIBLE
-from solver.families.kernels import N_JOINTS
-from solver.kernels.cell import fail
+from solver.core.codes import FEASIBLE, OK
+from solver.families.kernels import N_JOINTS, pose_block
+from solver.kernels.cell import prune
 from solver.kernels.limits import acceleration_at
-from solver.kernels.positions import pair_step, relative_path, wrapped_step
-from solver.kernels.spin_schedule import spin_rate, spun_failure
+from solver.kernels.positions import pair_step, wrapped_step
+from solver.kernels.spin_schedule import no_spin_below, spin_rate
 
 
 @njit(cache=True, error_model="numpy", nogil=True, inline="always")
 def acc_work(n_branches, n_waypoints, keep_speeds):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
-    """Per branch: its index for the choice, where mu_acc binds, and V_acc per waypoint.
-
-    The index is mu_acc, or mu_path where it was not computed; ``taken`` marks the branches
-    whose mu_acc was.
+    """Per branch: its mu_acc, where it binds, V_acc per waypoint, and where to probe it.
 
     Returns:
-        feed, acc_at, acc_joint, taken: shape (B,); acc_speeds: shape (B, W), or (B, 0) when
-        not ``keep_speeds``; probes: shape (B + 1,), the stencil rows where branches bound,
-        their count last (:func:`cell_mu_acc`); steps: shape (W, 6), one branch's joint steps.
+        feed, acc_at, acc_joint: shape (B,), mu_acc and its waypoint and joint (-1: none);
+        acc_speeds: shape (B, W), or (B, 0) when not ``keep_speeds``; acc_hint: shape (B,),
+        the stencil row where each branch's V_acc was least or left it (-1: none; kept from
+        placement to placement); steps: shape (W, 6), one branch's joint steps; moves:
+        shape (W,), its spin's moves (:func:`spin_moves`; zeros, none, in fixed spin).
     """
     feed = np.empty(n_branches)
     acc_at = np.empty(n_branches, dtype=np.int64)
     acc_joint = np.empty(n_branches, dtype=np.int64)
-    taken = np.empty(n_branches, dtype=np.bool_)
     acc_speeds = np.empty((n_branches, n_waypoints if keep_speeds else 0))
-    probes = np.zeros(n_branches + 1, dtype=np.int64)
+    acc_hint = np.full(n_branches, -1)
     steps = np.empty((n_waypoints, N_JOINTS))
-    return feed, acc_at, acc_joint, taken, acc_speeds, probes, steps
-
-
-@njit(cache=True, error_model="numpy", nogil=True)
-def next_fastest(alive, taken, slowest, top, tie):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
-    """The alive branch not yet taken with the highest mu_path (the first at a tie), or -1.
-
-    -1 too where that mu_path is below ``top`` (the highest index found so far) and not tied
-    with it (relative ``tie``): no branch left can then be chosen. The branch returned is
-    marked taken.
-    """
-    i = -1
-    for k in range(alive.shape[0]):
-        if alive[k] and not taken[k] and (i < 0 or slowest[k] > slowest[i]):
-            i = k
-    if i < 0 or slowest[i] < top - tie * abs(top):
-        return -1
-    taken[i] = True
-    return i
+    moves = np.zeros(n_waypoints)
+    return feed, acc_at, acc_joint, acc_speeds, acc_hint, steps, moves
 
 
 @njit(cache=True, error_model="numpy", nogil=True)
@@ -137,106 +111,174 @@ def spun_steps(cq, sq, qd, qs, b, lo, hi, rate, length, qdot_max, steps):  # typ
             steps[w, j] = wrapped_step(steps[w, j] + spin * qs[b, j, w - 1])
 
 
+@njit(cache=True, error_model="numpy", nogil=True, inline="always")
+def spin_rate_of(slowest, free):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
+    """The feed a branch's spin schedule is taken at: its mu_path in free spin, else 0 (none)."""
+    return slowest if free and slowest > 0.0 and math.isfinite(slowest) else 0.0
+
+
 @njit(cache=True, error_model="numpy", nogil=True)
-def cell_mu_acc(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
-    alive, why, where, slowest, branches, cq, sq, qd, qs, free, length, segment_checked, lower,
-    upper, qdot_max, max_joint_step, spun, index, c, waypoints, qddot_max, feed, acc_at,
-    acc_joint, acc_speeds, probes, steps,
+def left_at_probes(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
+    i, limit, probes, b, rate, cq, sq, qd, qs, length, qdot_max, index, c, qddot_max, steps,
+    alive, why, where, slowest, acc_hint,
 ):  # fmt: skip
-    """mu_acc in ``feed`` of the branches the choice can take; below the best, the others.
+    """Whether row i, followed to the end, is left at one of the stencil rows ``probes``.
 
-    Branch by branch in their order (see the module): skipped where its mu_path is at most
-    ``top``, left at the first probe (a waypoint where a branch before it bound) whose V_acc
-    is; in free spin then tracked along its spin schedule
-    (:func:`solver.kernels.spin_schedule.spun_failure`, which may fail it); then scanned along
-    its steps (:func:`solver.kernels.limits.acceleration_at`) until a waypoint whose V_acc is
-    at most ``top``. A branch scanned to the end has its mu_acc, the least V_acc (the first
-    waypoint and joint at a tie; where it binds goes to ``acc_at``, ``acc_joint``, and V_acc
-    per waypoint to ``acc_speeds``); a branch left has such a bound in ``feed``.
-
-    Args:
-        alive: shape (B,), the branches that hold (a branch the spin schedule fails: out).
-        why: shape (B,), out, why a branch failed.
-        where: shape (B,), out, where.
-        slowest: shape (B,), m/s, their mu_path.
-        branches: shape (B,), their indices in the pairs.
-        cq: shape (8, 6, W), the joints' cos per branch.
-        sq: shape (8, 6, W), their sin.
-        qd: shape (8, 6, W), J^-1 t_hat (free spin).
-        qs: shape (8, 6, W), J^-1 [0; z_tool] (free spin).
-        free: free spin: the joint paths along the spin schedule.
-        length: shape (W - 1,), m, the segments' lengths (free spin).
-        segment_checked: shape (W - 1,), bool, where the step bound applies (free spin).
-        lower: shape (6,), rad, lower position limits (free spin).
-        upper: shape (6,), rad, upper position limits (free spin).
-        qdot_max: shape (6,), rad/s (free spin).
-        max_joint_step: rad (free spin).
-        spun: shape (W, 6), work (free spin).
-        index: shape (K, 5), the blend stencil's waypoints.
-        c: shape (K, S), its step form (:func:`solver.kernels.limits.step_stencil`).
-        waypoints: shape (K,), the constrained waypoints.
-        qddot_max: shape (6,), rad/s^2.
-        feed: shape (B,), out, m/s.
-        acc_at: shape (B,), out.
-        acc_joint: shape (B,), out.
-        acc_speeds: shape (B, W) or (B, 0), out.
-        probes: shape (B + 1,), work.
-        steps: shape (W, 6), work.
+    Its V_acc there (:func:`spun_steps` at ``rate``, 0 in fixed spin) below ``limit`` leaves
+    it (:func:`solver.kernels.cell.prune`, its bound the least of that V_acc and its mu_path).
+    ``probes``: stencil rows, -1 for none (the best row's and the row's own ``acc_hint``).
     """
-    feed[:] = slowest
-    probes[-1] = 0
-    top = -np.inf
-    for i in range(branches.shape[0]):
-        if not alive[i] or slowest[i] <= top:
+    for p in probes:
+        if p < 0:
             continue
-        b = branches[i]
-        rate = slowest[i] if free and slowest[i] > 0.0 and math.isfinite(slowest[i]) else 0.0
-        left = False
-        for p in range(probes[-1]):
-            k = probes[p]
-            start, span = index[k, 0], index[k, -1] - index[k, 0]
-            spun_steps(cq, sq, qd, qs, b, start, start + span, rate, length, qdot_max, steps)
-            worst, joint = acceleration_at(steps, start, span, c, k, qddot_max)
-            if 1.0 / math.sqrt(worst) <= top:
-                feed[i] = 1.0 / math.sqrt(worst)
-                acc_at[i] = waypoints[k]
-                acc_joint[i] = joint
+        start, span = index[p, 0], index[p, -1] - index[p, 0]
+        spun_steps(cq, sq, qd, qs, b, start, start + span, rate, length, qdot_max, steps)
+        worst, _ = acceleration_at(steps, start, span, c, p, qddot_max)
+        speed = 1.0 / math.sqrt(worst)
+        if speed < limit:
+            prune(i, p, min(slowest[i], speed), alive, why, where, slowest, acc_hint)
+            return True
+    return False
+
+
+@njit(cache=True, error_model="numpy", nogil=True)
+def spin_moves(qd, qs, b, rate, length, qdot_max, moves):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
+    """Branch b's spin over each segment at the feed ``rate``: moves[w] for the step to w.
+
+    sigma dt, as :func:`spun_steps` forms it (``moves``: shape (W,), out; none without a
+    feed). Made once per branch, so that :func:`scan_row`'s loop calls nothing.
+    """
+    moves[:] = 0.0
+    if rate <= 0.0:
+        return
+    for w in range(1, moves.shape[0]):
+        moves[w] = spin_rate(qd, qs, b, w - 1, qdot_max, rate) * length[w - 1] / rate
+
+
+@njit(cache=True, error_model="numpy", nogil=True, inline="always")
+def moved_steps(cq, sq, qs, b, lo, hi, moves, steps):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
+    """:func:`spun_steps` with the spin's moves made (:func:`spin_moves`), lo < w <= hi.
+
+    The same bits: the pair's step plus the move times J^-1 [0; z_tool], brought into
+    [-pi, pi]; with no move (fixed spin, or no feed) the pair's step itself.
+    """
+    for w in range(lo + 1, hi + 1):
+        move = moves[w]
+        for j in range(N_JOINTS):
+            step = pair_step(cq[b, j, w - 1], sq[b, j, w - 1], cq[b, j, w], sq[b, j, w])
+            steps[w, j] = wrapped_step(step + move * qs[b, j, w - 1])
+
+
+@njit(cache=True, error_model="numpy", nogil=True)
+def scan_row(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
+    i, limit, b, cq, sq, qs, moves, index, c, waypoints, qddot_max, feed, acc_at, acc_joint,
+    acc_speeds, acc_hint, steps, alive, why, where, slowest,
+):  # fmt: skip
+    """Row i's mu_acc, the branch followed to the end; or the row left below ``limit``.
+
+    Scanned along its steps (:func:`moved_steps`; ``moves`` from :func:`spin_moves` in free
+    spin, zeros in fixed spin): as soon as the least V_acc so far is below ``limit`` the row
+    is left (:func:`solver.kernels.cell.prune`, its bound the least of that V_acc and its
+    mu_path). A row scanned to the end has its mu_acc in ``feed``, min(mu_path, least V_acc)
+    (the first waypoint and joint at a tie; where it binds in ``acc_at``, ``acc_joint`` and
+    ``acc_hint``, V_acc per waypoint in ``acc_speeds``). Arrays as :func:`acc_work` makes
+    them; ``index``, ``c``, ``waypoints``: the blend stencil
+    (:func:`solver.kernels.limits.step_stencil`).
+    """
+    keep = acc_speeds.shape[1] > 0
+    if keep:
+        acc_speeds[i, :] = np.inf
+    largest, at, joint, built, left = -1.0, -1, -1, 0, False
+    for k in range(waypoints.shape[0]):
+        start, span = index[k, 0], index[k, -1] - index[k, 0]
+        moved_steps(cq, sq, qs, b, built, start + span, moves, steps)
+        built = max(built, start + span)
+        worst, limiting = acceleration_at(steps, start, span, c, k, qddot_max)
+        if keep:
+            acc_speeds[i, waypoints[k]] = 1.0 / math.sqrt(worst)
+        if worst > largest:  # V_acc = 1 / sqrt(worst) below the least so far
+            largest, at, joint = worst, k, limiting
+            if 1.0 / math.sqrt(worst) < limit:
                 left = True
                 break
-        if left:
+    least = 1.0 / math.sqrt(largest) if at >= 0 else np.inf
+    if left:
+        prune(i, at, min(slowest[i], least), alive, why, where, slowest, acc_hint)
+        return
+    feed[i] = min(slowest[i], least)
+    acc_at[i] = waypoints[at] if at >= 0 else -1
+    acc_joint[i] = joint
+    acc_hint[i] = at
+
+
+@njit(cache=True, error_model="numpy", nogil=True, inline="always")
+def probed_speed(i, k, b, cq, sq, status, index, c, qddot_max, steps):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
+    """Row i's V_acc at stencil row k from its pairs (no spin), -inf where it fails there.
+
+    A branch not OK at a waypoint of the stencil fails there or before: no mu_acc.
+    """
+    start, span = index[k, 0], index[k, -1] - index[k, 0]
+    for w in range(start, start + span + 1):
+        if status[b, w] != OK:
+            return -np.inf
+    pair_steps(cq, sq, b, start, start + span, steps)
+    worst, _ = acceleration_at(steps, start, span, c, k, qddot_max)
+    return 1.0 / math.sqrt(worst)
+
+
+@njit(cache=True, error_model="numpy", nogil=True)
+def probe_acc_rows(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
+    todo, limit, k, family, par, poses, branches, scratch, cq, sq, qd, status, need, alive,
+    why, where, slowest, acc_hint, bound, index, c, qddot_max, steps,
+):  # fmt: skip
+    """Fixed spin: leave the rows in ``todo`` whose V_acc at stencil row k is below ``limit``.
+
+    The stencil's waypoints solved for those rows (the family's pose kernel); V_acc from the
+    steps of their pairs, the bits :func:`scan_row` forms there. The others keep in ``bound``
+    the least bound seen (:func:`solver.kernels.cell.next_row`).
+    """
+    need[:] = False
+    for i in range(branches.shape[0]):
+        need[branches[i]] = need[branches[i]] or (todo[i] and alive[i])
+    start, span = index[k, 0], index[k, -1] - index[k, 0]
+    pose_block(family, par, poses, start, start + span + 1, need, scratch, cq, sq, status, qd)
+    for i in range(branches.shape[0]):
+        if not (todo[i] and alive[i]):
             continue
-        if free:
-            code, at = spun_failure(
-                relative_path(cq, sq, b, True), qd, qs, b, rate, length, segment_checked,
-                lower, upper, qdot_max, max_joint_step, spun,
-            )  # fmt: skip
-            if code != FEASIBLE:
-                fail(i, code, at, alive, why, where)
-                continue
-        row = acc_speeds[i] if acc_speeds.shape[1] else acc_speeds[0, :0]
-        if row.shape[0]:
-            row[:] = np.inf
-        largest, at, joint, built = -1.0, -1, -1, 0
-        for k in range(waypoints.shape[0]):
-            start, span = index[k, 0], index[k, -1] - index[k, 0]
-            spun_steps(cq, sq, qd, qs, b, built, start + span, rate, length, qdot_max, steps)
-            built = max(built, start + span)
-            worst, limiting = acceleration_at(steps, start, span, c, k, qddot_max)
-            if row.shape[0]:
-                row[waypoints[k]] = 1.0 / math.sqrt(worst)
-            if worst > largest:  # V_acc = 1 / sqrt(worst) below the least so far
-                largest, at, joint = worst, k, limiting
-                if 1.0 / math.sqrt(worst) <= top:
-                    break
-        least = 1.0 / math.sqrt(largest) if at >= 0 else np.inf
-        feed[i] = min(slowest[i], least)
-        acc_at[i] = waypoints[at] if at >= 0 else -1
-        acc_joint[i] = joint
-        top = max(top, feed[i])
-        if at >= 0:
-            new = True
-            for p in range(probes[-1]):
-                new = new and probes[p] != at
-            if new:
-                probes[probes[-1]] = at
-                probes[-1] += 1
+        speed = probed_speed(i, k, branches[i], cq, sq, status, index, c, qddot_max, steps)
+        if speed < limit[i]:
+            prune(i, k, speed, alive, why, where, slowest, acc_hint)
+        else:
+            bound[i] = min(bound[i], speed)
+
+
+@njit(cache=True, error_model="numpy", nogil=True)
+def probe_free_acc_rows(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
+    todo, limit, k, family, par, poses, branches, qdot_max, scratch, cq, sq, qd, status, need,
+    alive, why, where, slowest, acc_hint, bound, reach, index, c, qddot_max, steps,
+):  # fmt: skip
+    """Free spin: as :func:`probe_acc_rows`, for the rows whose spin is none at stencil row k.
+
+    A row's spin schedule is taken at its mu_path, unknown until it is followed; ``reach``
+    (the least V_max its probes saw) is at least that. Where even at ``reach`` the spin rate
+    nearest zero is zero on every segment of the stencil
+    (:func:`solver.kernels.spin_schedule.no_spin_below`), it is zero at the row's mu_path too,
+    and V_acc there is that of its pairs, the bits :func:`scan_row` forms; other rows are not
+    probed here.
+    """
+    need[:] = False
+    for i in range(branches.shape[0]):
+        need[branches[i]] = need[branches[i]] or (todo[i] and alive[i] and reach[i] < np.inf)
+    start, span = index[k, 0], index[k, -1] - index[k, 0]
+    pose_block(family, par, poses, start, start + span + 1, need, scratch, cq, sq, status, qd)
+    for i in range(branches.shape[0]):
+        if not (todo[i] and alive[i] and need[branches[i]]):
+            continue
+        b = branches[i]
+        speed = probed_speed(i, k, b, cq, sq, status, index, c, qddot_max, steps)
+        if speed > -np.inf and not no_spin_below(qd, b, start, start + span, reach[i], qdot_max):
+            continue
+        if speed < limit[i]:
+            prune(i, k, speed, alive, why, where, slowest, acc_hint)
+        else:
+            bound[i] = min(bound[i], speed)

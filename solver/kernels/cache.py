@@ -6,6 +6,7 @@ import hashlib
 import sys
 from pathlib import Path
 
+import solver.kernels.acc_cells
 import solver.kernels.accelerations
 import solver.kernels.cell
 import solver.kernels.fixed_follow
@@ -37,6 +38,7 @@ def drop_stale_compiled_code(name: str) -> None:
         solver.kernels.fixed_follow,
         solver.kernels.free_follow,
         solver.kernels.accelerations,
+        solver.kernels.acc_cells,
         solver.kernels.spin_schedule,
         sys.modules[name],
     )

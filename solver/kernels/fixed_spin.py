@@ -23,12 +23,13 @@ waypoints:
    and runs the exact test of :func:`solver.path.tracking.track`;
 5. with joint acceleration limits, mu_acc of the branches the choice can take, from their
    joint paths' steps (:func:`solver.kernels.positions.pair_step`: the angle between
-   neighbouring pairs, by a series where small), each branch left as soon as a waypoint
-   shows it cannot be chosen (:func:`solver.kernels.accelerations.cell_mu_acc`);
+   neighbouring pairs, by a series where small), the branches pruned by mu_acc as below
+   (:mod:`solver.kernels.acc_cells`);
 6. the branch: :func:`solver.path.tracking.choose_branch`'s rule, by mu_acc where it is
    computed (:func:`solver.kernels.cell.write_cell`).
 
-Without acceleration limits the branches are pruned (:mod:`solver.kernels.cell`): the branch the
+The branches are pruned (:mod:`solver.kernels.cell`; with acceleration limits by mu_acc,
+:mod:`solver.kernels.acc_cells`): the branch the
 previous placement chose is followed first; once a branch is feasible, every other is probed at
 its bottleneck (and where each was least before) and followed, most promising first, only while
 its running minimum can still be chosen; a final check follows the pruned branches to the end
@@ -51,9 +52,10 @@ import math
 import numpy as np
 from numba import njit
 
-from solver.core.codes import ACC_TIE_RTOL, FEASIBLE, TIE_RTOL
+from solver.core.codes import FEASIBLE, TIE_RTOL
 from solver.families.kernels import N_JOINTS
-from solver.kernels.accelerations import acc_work, cell_mu_acc, write_acc
+from solver.kernels.acc_cells import fixed_cell
+from solver.kernels.accelerations import acc_work, write_acc
 from solver.kernels.cache import drop_stale_compiled_code
 from solver.kernels.cell import (
     PRUNED,
@@ -174,10 +176,10 @@ def map_cells(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
     remaining = np.empty(n_branches, dtype=np.bool_)
     probed = (slowest, hint, bound)
     accelerations = qddot_max.shape[0] > 0
-    feed, acc_at, acc_by, _, acc_speeds, probes, steps = acc_work(
-        n_branches, n_waypoints, v_acc.shape[1] > 0
-    )
-    steps_c = step_stencil(stencil_index, stencil_weight)
+    acc = acc_work(n_branches, n_waypoints, v_acc.shape[1] > 0)
+    feed, acc_at, acc_by, acc_speeds = acc[0], acc[1], acc[2], acc[3]
+    stencil = (stencil_index, step_stencil(stencil_index, stencil_weight), stencil_waypoints)
+    work = (todo, limit, remaining, bound)
     inverse_qdot = 1.0 / qdot_max
     guess = 0
     for c in range(n_cells):
@@ -190,12 +192,15 @@ def map_cells(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
         found = (scratch, cq, sq, qd, status, need, alive, why, where)
         path_tests = (segment_checked, lower, upper, modes, arc, inverse_qdot, max_joint_step)
         kept = (slowest, slowest_at, slowest_joint, speeds, chords2, largest2, inside, crossed)
-        limit[:] = -np.inf
-        todo[:] = False
-        if accelerations:
-            todo[:] = True
-            follow_rows(todo, limit, *posed, *path_tests, *found, *kept, hint)
+        answer = (slowest, slowest_at, slowest_joint, speeds, mu, reason, failed, branch,
+                  bottleneck_waypoint, bottleneck_joint, v_out)  # fmt: skip
+        if accelerations:  # pruned by mu_acc (solver.kernels.acc_cells)
+            pick = fixed_cell(
+                c, guess, work, posed, path_tests, found, kept, hint, qddot_max, stencil, acc,
+                answer,
+            )  # fmt: skip
         else:  # pruning: the previous placement's branch first, then the most promising
+            limit[:] = -np.inf
             bound[:] = np.inf
             remaining[:] = True
             best = -1
@@ -215,18 +220,6 @@ def map_cells(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
                             w = hint[i]
                             probe_rows(remaining, limit, w, *posed, inverse_qdot, *found, *probed)
                 row = next_row(remaining, alive, bound)
-        if accelerations:
-            cell_mu_acc(
-                alive, why, where, slowest, branches, cq, sq, qd, qd, False, inverse_qdot,
-                segment_checked, lower, upper, qdot_max, max_joint_step, steps, stencil_index,
-                steps_c, stencil_waypoints, qddot_max, feed, acc_at, acc_by, acc_speeds, probes,
-                steps,
-            )  # fmt: skip
-        answer = (slowest, slowest_at, slowest_joint, speeds, mu, reason, failed, branch,
-                  bottleneck_waypoint, bottleneck_joint, v_out)  # fmt: skip
-        if accelerations:
-            pick = write_cell(c, branches, alive, why, where, feed, ACC_TIE_RTOL, *answer)
-        else:
             pick = write_cell(c, branches, alive, why, where, slowest, TIE_RTOL, *answer)
             if not choice_holds(alive, why, slowest, slowest, TIE_RTOL, pick):
                 # a pruned row might change the answer: follow the pruned rows to the end

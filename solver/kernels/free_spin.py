@@ -20,9 +20,9 @@ tested against (tests/solver/test_free_spin_kernel.py). Per placement:
    tracked with the position limits and the step test, :func:`solver.path.tracking.track`,
    in :mod:`solver.kernels.spin_schedule`); the others probed and left once they cannot be
    chosen, and followed to the end after all where the answer might depend on them;
-4. with joint acceleration limits, the branches in their order, each tracked along its spin
-   schedule and its mu_acc formed from the spun path's steps, unless a waypoint shows that
-   it cannot be chosen (:func:`solver.kernels.accelerations.cell_mu_acc`);
+4. with joint acceleration limits, the branches pruned likewise by mu_acc
+   (:mod:`solver.kernels.acc_cells`): each followed to the end is tracked along its spin
+   schedule and its mu_acc formed from the spun path's steps;
 5. the branch: :func:`solver.path.tracking.choose_branch`'s rule, by mu_acc where computed.
 """
 
@@ -33,9 +33,10 @@ import math
 import numpy as np
 from numba import njit
 
-from solver.core.codes import ACC_TIE_RTOL, FEASIBLE, TIE_RTOL
+from solver.core.codes import FEASIBLE, TIE_RTOL
 from solver.families.kernels import N_JOINTS
-from solver.kernels.accelerations import acc_work, cell_mu_acc, write_acc
+from solver.kernels.acc_cells import free_cell
+from solver.kernels.accelerations import acc_work, write_acc
 from solver.kernels.cache import drop_stale_compiled_code
 from solver.kernels.cell import (
     PRUNED,
@@ -147,13 +148,15 @@ def free_cells(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
     spun = np.empty((n_waypoints, N_JOINTS))
     accelerations = qddot_max.shape[0] > 0
     keep_acc = v_acc.shape[1] > 0
-    feed, acc_at, acc_by, _, acc_speeds, probes, steps = acc_work(n_branches, n_waypoints, keep_acc)
-    steps_c = step_stencil(stencil_index, stencil_weight)
+    acc = acc_work(n_branches, n_waypoints, keep_acc)
+    feed, acc_at, acc_by, acc_speeds = acc[0], acc[1], acc[2], acc[3]
+    stencil = (stencil_index, step_stencil(stencil_index, stencil_weight), stencil_waypoints)
     todo = np.empty(n_branches, dtype=np.bool_)
     remaining = np.empty(n_branches, dtype=np.bool_)
     hint = np.full(n_branches, -1)
     limit = np.empty(n_branches)
     bound = np.empty(n_branches)
+    work = (todo, limit, remaining, bound, np.empty(n_branches))
     guess = 0
     for c in range(n_cells):
         ca, sa = cos_yaw[c], sin_yaw[c]
@@ -176,16 +179,12 @@ def free_cells(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
         steps_tests = (segment_checked, qdot_max, max_joint_step)
         spun_args = (cq, sq, qd, qs, branches, slowest, length, segment_checked, lower, upper,
                      qdot_max, max_joint_step, spun, alive, why, where)  # fmt: skip
-        limit[:] = -np.inf
-        if accelerations:
-            todo[:] = True
-            follow_free_rows(todo, limit, *posed, *steps_tests, *found, *kept)
-            tie = ACC_TIE_RTOL
-            cell_mu_acc(
-                alive, why, where, slowest, branches, cq, sq, qd, qs, True, length,
-                segment_checked, lower, upper, qdot_max, max_joint_step, spun, stencil_index,
-                steps_c, stencil_waypoints, qddot_max, feed, acc_at, acc_by, acc_speeds, probes,
-                steps,
+        answer = (slowest, slowest_at, slowest_joint, speeds, mu, reason, failed, branch,
+                  bottleneck_waypoint, bottleneck_joint, v_out)  # fmt: skip
+        if accelerations:  # pruned by mu_acc (solver.kernels.acc_cells)
+            pick = free_cell(
+                c, guess, work, posed, steps_tests, found, kept, spun_args, qddot_max, stencil,
+                acc, answer,
             )  # fmt: skip
         else:
             # Pruning (solver.kernels.cell): the previous placement's branch first, then the
@@ -193,7 +192,7 @@ def free_cells(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
             # (the joints moved by the spin at the spin rate nearest zero at the feed
             # mu_path, with the position limits and the step test), which decides whether
             # it is feasible.
-            tie = TIE_RTOL
+            limit[:] = -np.inf
             bound[:] = np.inf
             remaining[:] = True
             best = -1
@@ -207,7 +206,7 @@ def free_cells(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
                     spun_check(row, *spun_args)
                 if alive[row] and (best < 0 or slowest[row] > slowest[best]):
                     best = row
-                    set_limits(limit, row, slowest[row], tie)
+                    set_limits(limit, row, slowest[row], TIE_RTOL)
                     w = slowest_at[row]
                     probe_free_rows(remaining, limit, w, *posed, qdot_max, *found, hint, bound)
                     for i in range(n_branches):
@@ -217,22 +216,18 @@ def free_cells(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
                                 remaining, limit, w, *posed, qdot_max, *found, hint, bound
                             )
                 row = next_row(remaining, alive, bound)
-            feed[:] = slowest
-        answer = (slowest, slowest_at, slowest_joint, speeds, mu, reason, failed, branch,
-                  bottleneck_waypoint, bottleneck_joint, v_out)  # fmt: skip
-        pick = write_cell(c, branches, alive, why, where, feed, tie, *answer)
-        if not accelerations and not choice_holds(alive, why, slowest, feed, tie, pick):
-            # a pruned row might change the answer: follow the pruned rows to the end
-            for i in range(n_branches):
-                todo[i] = why[i] == PRUNED
-            start_again(todo, alive, why, where)
-            limit[:] = -np.inf
-            follow_free_rows(todo, limit, *posed, *steps_tests, *found, *kept)
-            for i in range(n_branches):
-                if todo[i] and alive[i]:
-                    spun_check(i, *spun_args)
-            feed[:] = slowest
-            pick = write_cell(c, branches, alive, why, where, feed, tie, *answer)
+            pick = write_cell(c, branches, alive, why, where, slowest, TIE_RTOL, *answer)
+            if not choice_holds(alive, why, slowest, slowest, TIE_RTOL, pick):
+                # a pruned row might change the answer: follow the pruned rows to the end
+                for i in range(n_branches):
+                    todo[i] = why[i] == PRUNED
+                start_again(todo, alive, why, where)
+                limit[:] = -np.inf
+                follow_free_rows(todo, limit, *posed, *steps_tests, *found, *kept)
+                for i in range(n_branches):
+                    if todo[i] and alive[i]:
+                        spun_check(i, *spun_args)
+                pick = write_cell(c, branches, alive, why, where, slowest, TIE_RTOL, *answer)
         if reason[c] == FEASIBLE:
             guess = pick
         if accelerations:

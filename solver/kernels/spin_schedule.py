@@ -84,3 +84,19 @@ def spun_failure(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
     if at < n_waypoints:
         return REASON_JOINT_LIMITS, at
     return FEASIBLE, -1
+
+
+@njit(cache=True, error_model="numpy", nogil=True)
+def no_spin_below(qd, b, lo, hi, feed, qdot_max):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
+    """Whether :func:`spin_rate` is zero at every feed up to ``feed`` on waypoints lo..hi-1.
+
+    Where the fixed-spin joint speeds (``qd``, J^-1 t_hat) stay within the limits at the feed,
+    zero spin is inside every joint's interval and the rate nearest zero is zero; the test
+    rounds as :func:`spin_rate` does, and a lower feed rounds to speeds no larger.
+    """
+    inside = feed * _INSIDE
+    for w in range(lo, hi):
+        for j in range(N_JOINTS):
+            if not abs(inside * qd[b, j, w]) <= qdot_max[j]:
+                return False
+    return True

@@ -148,6 +148,34 @@ def test_erk_grid(accelerations: Accelerations) -> None:
         assert set(result.limited_by) == {0 if np.min(accelerations) > 100.0 else 1}
 
 
+@pytest.mark.parametrize("spin_mode", ["fixed", "free"])
+@pytest.mark.parametrize("seed", range(4))
+def test_seeded_placements_with_acceleration_limits(spin_mode: str, seed: int) -> None:
+    """Pruning by mu_acc (solver.kernels.acc_cells) keeps the unpruned choice: seeded
+    placements in a random order (so the branch followed first is often not the best, and
+    near neighbours share their bottlenecks less), random per-joint limits, each cell against
+    the numpy pipeline, which forms mu_acc on every branch."""
+    rng = np.random.default_rng(seed)
+    placements = np.column_stack(
+        [
+            rng.uniform(-0.35, 0.35, 60),
+            rng.uniform(0.2, 0.75, 60),
+            np.full(60, 0.1),
+            rng.uniform(-math.pi, math.pi, 60),
+        ]
+    )
+    limits = tuple(rng.uniform(2.0, 40.0, 6))
+    result, reasons = same_cells(
+        get_robot("ur5"),
+        load_path("curved_line"),
+        placements,
+        accelerations=limits,
+        spin_mode=spin_mode,
+    )
+    assert "feasible" in reasons and result.limited_by is not None
+    assert 1 in set(result.limited_by)
+
+
 @pytest.mark.parametrize("accelerations", [None, 10.0])
 def test_eight_yaw_grid(accelerations: float | None) -> None:
     """8 yaws in one call: the kernel takes mixed yaws, the numpy pipeline one at a time."""

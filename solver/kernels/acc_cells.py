@@ -1,0 +1,213 @@
+"""One placement of a map kernel with joint acceleration limits: branches pruned by mu_acc.
+
+motion.md section 3: a cell's branch is the one with the highest mu_acc
+(:func:`solver.path.tracking.choose_branch` with ``ACC_TIE_RTOL``). As without the limits
+(:mod:`solver.kernels.cell`), the branch the previous placement chose is followed first, and
+once a branch is feasible every other is known by a bound of its mu_acc until the bound is below
+its limit (:func:`solver.kernels.cell.set_limits`): its running minimum of V_max (mu_acc <=
+mu_path), V_max at the best branch's bottleneck, V_acc at the stencil row where the best
+branch's mu_acc binds, and both where each branch was least at the placement before
+(:mod:`solver.kernels.accelerations`). A branch still in the running is followed to the end
+(in free spin tracked along its spin schedule), probed there, and scanned
+(:func:`solver.kernels.accelerations.scan_row`), most promising first. Where a left branch
+might change the answer (:func:`solver.kernels.cell.choice_holds`) the left branches are
+followed and scanned to the end after all, so every reported field is the full loop's.
+
+:func:`fixed_cell` serves :func:`solver.kernels.fixed_spin.map_cells`, :func:`free_cell`
+:func:`solver.kernels.free_spin.free_cells`; the tuples are theirs.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+from solver.core.codes import ACC_TIE_RTOL
+from solver.kernels.accelerations import (
+    left_at_probes,
+    probe_acc_rows,
+    probe_free_acc_rows,
+    scan_row,
+    spin_moves,
+    spin_rate_of,
+)
+from solver.kernels.cell import PRUNED, choice_holds, next_row, set_limits, start_again, write_cell
+from solver.kernels.fixed_follow import follow_rows, probe_rows
+from solver.kernels.free_follow import follow_free_rows, probe_free_rows, spun_check
+
+
+@njit(cache=True, error_model="numpy", nogil=True)
+def fixed_cell(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
+    c, guess, work, posed, path_tests, found, kept, hint, qddot_max, stencil, acc, answer
+):
+    """Placement c in fixed spin with acceleration limits; returns the chosen branch's row.
+
+    Args:
+        c: the placement.
+        guess: the row to follow first (the previous placement's choice).
+        work: (todo, limit, remaining, bound), per row.
+        posed: (family, par, poses, branches, pure_rotation), as
+            :func:`solver.kernels.fixed_follow.follow_rows` takes them.
+        path_tests: (segment_checked, lower, upper, modes, arc, inverse_qdot, max_joint_step).
+        found: (scratch, cq, sq, qd, status, need, alive, why, where).
+        kept: (slowest, slowest_at, slowest_joint, speeds, chords2, largest2, inside, crossed).
+        hint: shape (B,), where each row's V_max was least.
+        qddot_max: shape (6,), rad/s^2.
+        stencil: (index, c, waypoints), the blend stencil in step form.
+        acc: from :func:`solver.kernels.accelerations.acc_work`.
+        answer: the answer arrays :func:`solver.kernels.cell.write_cell` fills.
+    """
+    todo, limit, remaining, bound = work
+    family, par, poses, branches, _ = posed
+    scratch, cq, sq, qd, status, need, alive, why, where = found
+    slowest, slowest_at = kept[0], kept[1]
+    inverse_qdot = path_tests[5]
+    index, steps_c, waypoints = stencil
+    feed, acc_at, acc_joint, acc_speeds, acc_hint, steps, moves = acc
+    scan = (index, steps_c, waypoints, qddot_max, feed, acc_at, acc_joint, acc_speeds, acc_hint,
+            steps, alive, why, where, slowest)  # fmt: skip
+    grid = (family, par, poses, branches, scratch, cq, sq, qd, status, need, alive, why, where,
+            slowest, acc_hint, bound, index, steps_c, qddot_max, steps)  # fmt: skip
+    limit[:] = -np.inf
+    bound[:] = np.inf
+    remaining[:] = True
+    best, row = -1, guess
+    while row >= 0:
+        remaining[row] = False
+        todo[:] = False
+        todo[row] = True
+        follow_rows(todo, limit, *posed, *path_tests, *found, *kept, hint)
+        if alive[row]:
+            probes = (acc_hint[best] if best >= 0 else -1, acc_hint[row])
+            b = branches[row]
+            if not left_at_probes(
+                row, limit[row], probes, b, 0.0, cq, sq, qd, qd, inverse_qdot, inverse_qdot,
+                index, steps_c, qddot_max, steps, alive, why, where, slowest, acc_hint,
+            ):  # fmt: skip
+                scan_row(row, limit[row], b, cq, sq, qd, moves, *scan)
+        if alive[row] and (best < 0 or feed[row] > feed[best]):
+            best = row
+            set_limits(limit, row, feed[row], ACC_TIE_RTOL)
+            k = acc_hint[row]
+            if k >= 0:
+                probe_acc_rows(remaining, limit, k, *grid)
+            probe_rows(remaining, limit, slowest_at[row], *posed, inverse_qdot, *found, slowest,
+                       hint, bound)  # fmt: skip
+            for i in range(branches.shape[0]):  # each row where it was least before
+                todo[:] = False
+                todo[i] = remaining[i] and alive[i]
+                if todo[i] and acc_hint[i] >= 0 and acc_hint[i] != k:
+                    probe_acc_rows(todo, limit, acc_hint[i], *grid)
+                if todo[i] and alive[i] and hint[i] >= 0 and hint[i] != slowest_at[row]:
+                    probe_rows(todo, limit, hint[i], *posed, inverse_qdot, *found, slowest, hint,
+                               bound)  # fmt: skip
+        row = next_row(remaining, alive, bound)
+    pick = write_cell(c, branches, alive, why, where, feed, ACC_TIE_RTOL, *answer)
+    if choice_holds(alive, why, slowest, feed, ACC_TIE_RTOL, pick):
+        return pick
+    # a left row might change the answer: follow the left rows to the end
+    for i in range(branches.shape[0]):
+        todo[i] = why[i] == PRUNED
+    start_again(todo, alive, why, where)
+    limit[:] = -np.inf
+    follow_rows(todo, limit, *posed, *path_tests, *found, *kept, hint)
+    for i in range(branches.shape[0]):
+        if todo[i] and alive[i]:
+            scan_row(i, -np.inf, branches[i], cq, sq, qd, moves, *scan)
+    return write_cell(c, branches, alive, why, where, feed, ACC_TIE_RTOL, *answer)
+
+
+@njit(cache=True, error_model="numpy", nogil=True)
+def free_cell(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
+    c, guess, work, posed, steps_tests, found, kept, spun_args, qddot_max, stencil, acc, answer
+):
+    """Placement c in free spin with acceleration limits; returns the chosen branch's row.
+
+    As :func:`fixed_cell`; a row followed to the end is probed, then tracked along its spin
+    schedule at its mu_path (:func:`solver.kernels.free_follow.spun_check`), then scanned.
+    Before a row is followed its V_acc is known only where its spin is none
+    (:func:`solver.kernels.accelerations.probe_free_acc_rows`).
+
+    Args:
+        c: the placement.
+        guess: the row to follow first.
+        work: (todo, limit, remaining, bound, reach), per row; ``reach`` the least V_max
+            probed, a bound of mu_path (``bound`` that of mu_acc).
+        posed: (family, par, poses, spin_poses, branches, pure_rotation).
+        steps_tests: (segment_checked, qdot_max, max_joint_step).
+        found: (scratch, cq, sq, qd, qs, status, need, alive, why, where, slowest).
+        kept: (slowest_at, slowest_joint, speeds, hint).
+        spun_args: the arguments of :func:`solver.kernels.free_follow.spun_check` after i.
+        qddot_max: shape (6,), rad/s^2.
+        stencil: (index, c, waypoints), the blend stencil in step form.
+        acc: from :func:`solver.kernels.accelerations.acc_work`.
+        answer: the answer arrays :func:`solver.kernels.cell.write_cell` fills.
+    """
+    todo, limit, remaining, bound, reach = work
+    family, par, poses, _, branches, _ = posed
+    scratch, cq, sq, qd, qs, status, need, alive, why, where, slowest = found
+    slowest_at, hint = kept[0], kept[3]
+    qdot_max = steps_tests[1]
+    length = spun_args[6]
+    index, steps_c, waypoints = stencil
+    feed, acc_at, acc_joint, acc_speeds, acc_hint, steps, moves = acc
+    scan = (index, steps_c, waypoints, qddot_max, feed, acc_at, acc_joint, acc_speeds, acc_hint,
+            steps, alive, why, where, slowest)  # fmt: skip
+    grid = (family, par, poses, branches, qdot_max, scratch, cq, sq, qd, status, need, alive,
+            why, where, slowest, acc_hint, bound, reach, index, steps_c, qddot_max,
+            steps)  # fmt: skip
+    limit[:] = -np.inf
+    bound[:] = np.inf
+    reach[:] = np.inf
+    remaining[:] = True
+    best, row = -1, guess
+    while row >= 0:
+        remaining[row] = False
+        todo[:] = False
+        todo[row] = True
+        follow_free_rows(todo, limit, *posed, *steps_tests, *found, *kept)
+        if alive[row]:
+            probes = (acc_hint[best] if best >= 0 else -1, acc_hint[row])
+            b, rate = branches[row], spin_rate_of(slowest[row], True)
+            if not left_at_probes(
+                row, limit[row], probes, b, rate, cq, sq, qd, qs, length, qdot_max, index,
+                steps_c, qddot_max, steps, alive, why, where, slowest, acc_hint,
+            ):  # fmt: skip
+                spun_check(row, *spun_args)
+                if alive[row]:
+                    spin_moves(qd, qs, b, rate, length, qdot_max, moves)
+                    scan_row(row, limit[row], b, cq, sq, qs, moves, *scan)
+        if alive[row] and (best < 0 or feed[row] > feed[best]):
+            best = row
+            set_limits(limit, row, feed[row], ACC_TIE_RTOL)
+            probe_free_rows(remaining, limit, slowest_at[row], *posed, qdot_max, *found, hint,
+                            reach)  # fmt: skip
+            for i in range(branches.shape[0]):
+                if remaining[i] and alive[i] and hint[i] >= 0:
+                    probe_free_rows(remaining, limit, hint[i], *posed, qdot_max, *found, hint,
+                                    reach)  # fmt: skip
+            for i in range(branches.shape[0]):
+                bound[i] = min(bound[i], reach[i])
+            if acc_hint[row] >= 0:
+                probe_free_acc_rows(remaining, limit, acc_hint[row], *grid)
+            for i in range(branches.shape[0]):
+                if remaining[i] and alive[i] and acc_hint[i] >= 0:
+                    probe_free_acc_rows(remaining, limit, acc_hint[i], *grid)
+        row = next_row(remaining, alive, bound)
+    pick = write_cell(c, branches, alive, why, where, feed, ACC_TIE_RTOL, *answer)
+    if choice_holds(alive, why, slowest, feed, ACC_TIE_RTOL, pick):
+        return pick
+    # a left row might change the answer: follow the left rows to the end
+    for i in range(branches.shape[0]):
+        todo[i] = why[i] == PRUNED
+    start_again(todo, alive, why, where)
+    limit[:] = -np.inf
+    follow_free_rows(todo, limit, *posed, *steps_tests, *found, *kept)
+    for i in range(branches.shape[0]):
+        if todo[i] and alive[i]:
+            spun_check(i, *spun_args)
+            if alive[i]:
+                rate = spin_rate_of(slowest[i], True)
+                spin_moves(qd, qs, branches[i], rate, length, qdot_max, moves)
+                scan_row(i, -np.inf, branches[i], cq, sq, qs, moves, *scan)
+    return write_cell(c, branches, alive, why, where, feed, ACC_TIE_RTOL, *answer)
