@@ -100,6 +100,33 @@ class FollowsInSteps(abc.ABC):
             q (n, K, P, W), rad, wrapped, NaN where not followed or lost; status (K, P, W).
         """
 
+    @property
+    def follows_bounded(self) -> bool:
+        """Whether :meth:`follow_bounded` can be used (:mod:`solver.path.bounded`)."""
+        return False
+
+    def follow_bounded(
+        self,
+        current: np.ndarray,
+        poses: tuple[np.ndarray, np.ndarray],
+        speeds: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray],
+        rules: tuple[float, float],
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """Every slot followed from the first waypoints, those that cannot be a map's pick dropped.
+
+        Args:
+            current: shape (P, K, n), the slots' solutions at the first waypoints (read only).
+            poses: rotations (P, W, 3, 3) and positions (P, W, 3) of the flange.
+            speeds: twists (P, W, 6), tool points (P, W, 3), qdot_max (n,) and the waypoints
+                of pure rotation (W,), for V_max along each slot.
+            rules: (tie, margin): the pick's tie tolerance and a margin for rounding.
+
+        Returns:
+            q (n, K, P, W), wrapped; status (K, P, W); bound (K, P), the least V_max
+            followed; dropped (K, P), the slots whose following was stopped.
+        """
+        raise NotImplementedError
+
     @abc.abstractmethod
     def follow_ranges(
         self,

@@ -22,8 +22,10 @@ from solver.core.codes import ACC_TIE_RTOL, FEASIBLE, UNREACHABLE
 from solver.core.dtf import spin_rate_nearest_zero
 from solver.core.dtf_redundant import spin_rate_at_feed
 from solver.core.exceptions import InvalidInputError
+from solver.core.family import FollowsInSteps
 from solver.core.progress import Progress, span
 from solver.core.spatial import MAX_COORDINATE, rotation_about_z
+from solver.path.bounded import bounded_solutions
 from solver.path.limits import JointMotion, bound_by_limits
 from solver.path.prepare import PreparedPath
 from solver.path.problem import PathProblem
@@ -172,7 +174,9 @@ def run_chunk(
         [turn_by_yaw(path.twist[:, :3].T, yaws), turn_by_yaw(path.twist[:, 3:].T, yaws)]
     )
     if prune and can_prune(problem):
-        solutions = pruned_solutions(problem, rotation, flange_position, twist, tool_position)
+        bounded = isinstance(family, FollowsInSteps) and family.follows_bounded
+        prune_with = bounded_solutions if bounded else pruned_solutions
+        solutions = prune_with(problem, rotation, flange_position, twist, tool_position)
     else:
         solutions = family.solve_path(rotation, flange_position, progress=span(progress, 0.0, 0.85))
     q, status = solutions.q, solutions.status  # (n, B_all, C, W), (B_all, C, W)
