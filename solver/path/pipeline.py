@@ -25,7 +25,7 @@ from solver.core.exceptions import InvalidInputError
 from solver.core.family import FollowsInSteps
 from solver.core.progress import Progress, span
 from solver.core.spatial import MAX_COORDINATE, rotation_about_z
-from solver.path.bounded import bounded_solutions
+from solver.path.bounded import bounded_solutions, pick_stands
 from solver.path.limits import JointMotion, bound_by_limits
 from solver.path.prepare import PreparedPath
 from solver.path.problem import PathProblem
@@ -214,6 +214,8 @@ def run_chunk(
     v_max = np.where(path.pure_rotation, 0.0, speed)
     feasible = tracked.reason == FEASIBLE  # (B, C)
     mu_path = np.where(feasible, v_max.min(axis=-1), -np.inf)
+    if solutions.bound is not None and not pick_stands(solutions, branches, mu_path):
+        return run_chunk(problem, placements, progress=progress)  # every branch followed
     spins = None
     if qd_spin is not None:
         spins, tracked = _spin_schedule(problem, tracked, motion, qd_spin, mu_path)

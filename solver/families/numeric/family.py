@@ -239,8 +239,8 @@ class NumericFamily(KinematicsFamily, FollowsInSteps):
         self,
         current: np.ndarray,
         poses: tuple[np.ndarray, np.ndarray],
-        speeds: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray],
-        rules: tuple[float, float],
+        speeds: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, float],
+        rules: tuple[float, ...],
     ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         """:func:`bounded_kernel.follow_bounded` (see :meth:`FollowsInSteps.follow_bounded`)."""
         settings, constants = self._settings()
@@ -250,6 +250,7 @@ class NumericFamily(KinematicsFamily, FollowsInSteps):
                 current,
                 *(np.ascontiguousarray(a, dtype=float) for a in (*poses, *speeds[:3])),
                 np.asarray(speeds[3], dtype=np.bool_),
+                (self.lower, self.upper, np.array([speeds[4]], dtype=float)),
                 settings,
                 constants,
                 np.array(rules, dtype=float),

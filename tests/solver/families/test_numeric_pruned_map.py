@@ -160,3 +160,21 @@ def test_drops_the_check_refuses_are_followed_after_all(
     assert sum(refused) > 0
     for field in FIELDS:
         np.testing.assert_array_equal(getattr(pruned, field), getattr(every, field), err_msg=field)
+
+
+@pytest.mark.parametrize(
+    "setting",
+    [("ROUGH", 0), ("RESIDUAL", 0.0), ("MOTION", 0.0), ("STRIDE", 1)],
+    ids=["every_slot_exact", "no_stride_trusted", "no_motion_trusted", "stride_1"],
+)
+def test_scouting_settings_change_no_field(
+    setting: tuple[str, float], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Without scouting, with every stride untrusted (followed exactly), or waypoint by waypoint."""
+    problem = PathProblem.of(numeric("ur5_urdf"), load_path("curved_line")[:60])
+    placements = placements_of("ur5_urdf")
+    ours = evaluate_placements(problem, placements, with_speeds=True)
+    monkeypatch.setattr(bounded, *setting)
+    theirs = evaluate_placements(problem, placements, with_speeds=True)
+    for field in FIELDS:
+        np.testing.assert_array_equal(getattr(ours, field), getattr(theirs, field), err_msg=field)
