@@ -24,7 +24,9 @@ field of the cell changes (tested cell by cell against following every branch).
 Only where that argument holds: the map's ``auto`` branch, fixed spin, limits that bound each
 waypoint by its own configuration (the joint speeds), no final-path limit (mu_acc ranks the
 branches) and no path check (the cell takes the next branch when the best collides).
-Evaluations follow every branch: their answer reports the whole joint paths.
+Evaluations follow every branch: their answer reports the whole joint paths. A family that
+follows bounded (six joints, :attr:`FollowsInSteps.follows_bounded`) is pruned under the same
+conditions in one compiled pass instead (:mod:`solver.path.bounded`).
 """
 
 from __future__ import annotations
