@@ -307,6 +307,7 @@ def follow_bounded(  # type: ignore[no-untyped-def]  # pragma: no cover - compil
     slot = np.empty(n)
     limits = (qdot_max, pure_rotation, joint_limits[0], joint_limits[1], joint_limits[2][0])
     order = np.empty(2 * n_seeds, dtype=np.int64)
+    clean, slowest_of = np.empty(n_seeds), np.zeros(n_seeds, dtype=np.int64)
     lead = 0
     for p in range(n_paths):
         path = (rotations[p], positions[p], twists[p], tools[p])
@@ -318,6 +319,7 @@ def follow_bounded(  # type: ignore[no-untyped-def]  # pragma: no cover - compil
                 order[size] = b
                 size += 1
         candidate, best, slowest = -1, -math.inf, 0
+        clean[:] = -math.inf  # the least V_max of each slot followed exactly and clean
         k = 0
         while k < size:
             b = order[k]
@@ -365,8 +367,14 @@ def follow_bounded(  # type: ignore[no-untyped-def]  # pragma: no cover - compil
             dropped[b, p] = drop
             if failed or drop:
                 continue
-            if candidate < 0 or least > best or (b < candidate and least >= best):
-                candidate, best, slowest = b, least, at
+            clean[b], slowest_of[b] = least, at
+            top = -math.inf  # the candidate as the pick is taken: the first of the top's tie
+            for other in range(n_seeds):
+                top = max(top, clean[other])
+            for other in range(n_seeds):
+                if clean[other] >= top - tie * abs(top):
+                    candidate, best, slowest = other, clean[other], slowest_of[other]
+                    break
         if candidate >= 0:
             lead = candidate
     return q, status, bound, dropped
