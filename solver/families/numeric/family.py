@@ -45,6 +45,9 @@ from solver.families.numeric.chain import SerialChain
 # 742 and 13.0; placements out of reach (z 5 m) seed for less now (596 and 504: their seeds
 # stall early). Seven: the Panda 2,021 and 125, the xArm7 1,388 and 177 (the following line
 # kept at the 200 measured before, which the free spin's weight was measured against).
+# Maps share these lines with evaluations, which follow every branch: a six-joint map pruned
+# in one pass (solver/path/bounded.py) costs about a quarter of its line (UR5 as a URDF, ERK
+# map, 2026-12-02), so its estimate is an upper bound; the lines are not lowered for it.
 COST_LINES: dict[int, tuple[tuple[float, float], ...]] = {
     6: ((800.0, 48.0), (1_000.0, 17.0)),
     7: ((2_600.0, 200.0),),
