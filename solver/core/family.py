@@ -35,6 +35,10 @@ class PathSolutions:
         slots: shape (n_branches, *batch), the family's branch each row of ``q`` holds at each
             path, in the family's order (a pruned map's rows, :mod:`solver.path.pruning`);
             ``None``: row b is branch b everywhere.
+        bound: shape (K, *batch), a six-joint pruned map's (:mod:`solver.path.bounded`): the
+            least V_max followed of each of the family's branches; ``None`` otherwise.
+        dropped: shape (K, *batch), bool, with ``bound``: the branches whose following was
+            stopped (their rows unreachable); the caller checks that the pick stands.
     """
 
     q: np.ndarray
@@ -42,6 +46,8 @@ class PathSolutions:
     seeds: int | None = None
     branches_found: np.ndarray | None = None
     slots: np.ndarray | None = None
+    bound: np.ndarray | None = None
+    dropped: np.ndarray | None = None
 
 
 class FollowsInSteps(abc.ABC):
@@ -99,6 +105,35 @@ class FollowsInSteps(abc.ABC):
         Returns:
             q (n, K, P, W), rad, wrapped, NaN where not followed or lost; status (K, P, W).
         """
+
+    @property
+    def follows_bounded(self) -> bool:
+        """Whether :meth:`follow_bounded` can be used (:mod:`solver.path.bounded`)."""
+        return False
+
+    def follow_bounded(
+        self,
+        current: np.ndarray,
+        poses: tuple[np.ndarray, np.ndarray],
+        speeds: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, float],
+        rules: tuple[float, ...],
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """Every slot followed from the first waypoints, those that cannot be a map's pick dropped.
+
+        Args:
+            current: shape (P, K, n), the slots' solutions at the first waypoints (read only).
+            poses: rotations (P, W, 3, 3) and positions (P, W, 3) of the flange.
+            speeds: twists (P, W, 6), tool points (P, W, 3), qdot_max (n,), the waypoints of
+                pure rotation (W,), for V_max along each slot, and the joint step tracking
+                calls a jump.
+            rules: (tie, margin, rough steps, slack): the pick's tie tolerance, a margin for
+                rounding, and how slots are scouted (:mod:`solver.path.bounded`).
+
+        Returns:
+            q (n, K, P, W), wrapped; status (K, P, W); bound (K, P), the least V_max
+            followed; dropped (K, P), the slots whose following was stopped.
+        """
+        raise NotImplementedError
 
     @abc.abstractmethod
     def follow_ranges(

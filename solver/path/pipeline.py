@@ -21,8 +21,10 @@ import numpy as np
 from solver.core.codes import ACC_TIE_RTOL, FEASIBLE, UNREACHABLE
 from solver.core.dtf import spin_rate_nearest_zero
 from solver.core.exceptions import InvalidInputError
+from solver.core.family import FollowsInSteps
 from solver.core.progress import Progress, span
 from solver.core.spatial import MAX_COORDINATE, rotation_about_z
+from solver.path.bounded import bounded_solutions, pick_stands
 from solver.path.in_pieces import bound_in_pieces, spin_rates_in_pieces, track_in_pieces
 from solver.path.limits import JointMotion, bound_by_limits
 from solver.path.prepare import PreparedPath
@@ -174,7 +176,9 @@ def run_chunk(
     free = problem.options.spin_mode == "free"
     shares = REDUNDANT_FREE_SHARES if free and robot.dof > 6 else SHARES
     if prune and can_prune(problem):
-        solutions = pruned_solutions(problem, rotation, flange_position, twist, tool_position)
+        bounded = isinstance(family, FollowsInSteps) and family.follows_bounded
+        prune_with = bounded_solutions if bounded else pruned_solutions
+        solutions = prune_with(problem, rotation, flange_position, twist, tool_position)
     else:
         solutions = family.solve_path(
             rotation, flange_position, progress=_part(progress, shares, 0)
@@ -216,6 +220,8 @@ def run_chunk(
     v_max = np.where(path.pure_rotation, 0.0, speed)
     feasible = tracked.reason == FEASIBLE  # (B, C)
     mu_path = np.where(feasible, v_max.min(axis=-1), -np.inf)
+    if solutions.bound is not None and not pick_stands(solutions, branches, mu_path):
+        return run_chunk(problem, placements, progress=progress)  # every branch followed
     spins = None
     if qd_spin is not None:
         spins, tracked = _spin_schedule(

@@ -24,7 +24,9 @@ field of the cell changes (tested cell by cell against following every branch).
 Only where that argument holds: the map's ``auto`` branch, fixed spin, limits that bound each
 waypoint by its own configuration (the joint speeds), no final-path limit (mu_acc ranks the
 branches) and no path check (the cell takes the next branch when the best collides).
-Evaluations follow every branch: their answer reports the whole joint paths.
+Evaluations follow every branch: their answer reports the whole joint paths. A family that
+follows bounded (six joints, :attr:`FollowsInSteps.follows_bounded`) is pruned under the same
+conditions in one compiled pass instead (:mod:`solver.path.bounded`).
 """
 
 from __future__ import annotations
@@ -64,7 +66,7 @@ def can_prune(problem: PathProblem) -> bool:
     n_branches = len(family.branches)
     return (
         isinstance(family, FollowsInSteps)
-        and family.follows_in_steps
+        and (family.follows_in_steps or family.follows_bounded)
         and problem.options.spin_mode == "fixed"
         and not problem.final_path_limits
         and not problem.path_checks
@@ -75,7 +77,7 @@ def can_prune(problem: PathProblem) -> bool:
     )
 
 
-class _Chunk:
+class Chunk:
     """One chunk's paths, the family and limits, and the bounds of V_max along them."""
 
     def __init__(
@@ -198,7 +200,7 @@ def pruned_solutions(
         slots, in order (``PathSolutions.slots`` names them), then unreachable rows; a row
         after the kept ones at a placement is unreachable (NaN) at every waypoint.
     """
-    chunk = _Chunk(problem, rotation, flange_position, twist, tool_position)
+    chunk = Chunk(problem, rotation, flange_position, twist, tool_position)
     n_cells, n_waypoints = flange_position.shape[1:]
     current, count = chunk.family.seed_first(chunk.rotations[:, 0], chunk.positions[:, 0])
     n_seeds = current.shape[1]
@@ -243,7 +245,7 @@ def _threshold(best: np.ndarray) -> np.ndarray:
     return threshold
 
 
-def _advance(chunk: _Chunk, state: _State, chosen: np.ndarray, to_end: bool = False) -> None:
+def _advance(chunk: Chunk, state: _State, chosen: np.ndarray, to_end: bool = False) -> None:
     """Follow the ``chosen`` slots (K, C) a piece (or to the end) further, and what it shows.
 
     Their solutions and statuses, bounds and tracking so far; a slot that reaches the end

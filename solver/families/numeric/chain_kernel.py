@@ -25,7 +25,7 @@ import numpy as np
 from numba import njit
 
 
-def drop_stale_cache(module_file: Path) -> None:
+def drop_stale_cache(module_file: Path, *also: Path) -> None:
     """Drop the cached machine code of a module whose compiled code takes this module's in.
 
     numba keys a function's disk cache by its own source file, but the IK and redundant-speed
@@ -36,8 +36,9 @@ def drop_stale_cache(module_file: Path) -> None:
 
     Args:
         module_file: the source file of the module whose cache to check.
+        also: the source files of other modules whose compiled code it takes in.
     """
-    sources = Path(__file__).read_bytes() + module_file.read_bytes()
+    sources = b"".join(f.read_bytes() for f in (Path(__file__), module_file, *also))
     cache = module_file.parent / "__pycache__"
     marker = cache / f"{module_file.stem}.sources-{hashlib.sha256(sources).hexdigest()[:16]}"
     try:

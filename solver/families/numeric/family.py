@@ -25,7 +25,13 @@ from solver.core.dtf_redundant import redundant_speed
 from solver.core.family import Branch, FollowsInSteps, KinematicsFamily, PathSolutions
 from solver.core.progress import Progress, span
 from solver.core.spatial import wrap_angle
-from solver.families.numeric import chain_kernel, ik, ik_kernel, redundant_kernel
+from solver.families.numeric import (
+    bounded_kernel,
+    chain_kernel,
+    ik,
+    ik_kernel,
+    redundant_kernel,
+)
 from solver.families.numeric.chain import SerialChain
 
 # Work of one placement in poses of a closed-form family (KinematicsFamily.path_cost), measured
@@ -39,6 +45,9 @@ from solver.families.numeric.chain import SerialChain
 # 742 and 13.0; placements out of reach (z 5 m) seed for less now (596 and 504: their seeds
 # stall early). Seven: the Panda 2,021 and 125, the xArm7 1,388 and 177 (the following line
 # kept at the 200 measured before, which the free spin's weight was measured against).
+# Maps share these lines with evaluations, which follow every branch: a six-joint map pruned
+# in one pass (solver/path/bounded.py) costs about a quarter of its line (UR5 as a URDF, ERK
+# map, 2026-12-02), so its estimate is an upper bound; the lines are not lowered for it.
 COST_LINES: dict[int, tuple[tuple[float, float], ...]] = {
     6: ((800.0, 48.0), (1_000.0, 17.0)),
     7: ((2_600.0, 200.0),),
@@ -218,7 +227,8 @@ class NumericFamily(KinematicsFamily, FollowsInSteps):
     def follows_in_steps(self) -> bool:
         """The compiled chain of more than six joints; the numpy reference only whole paths.
 
-        Six joints are followed whole: a pruned map of the UR5 URDF took 1.05 times the
+        Six joints are pruned in one compiled pass instead (:attr:`follows_bounded`); in
+        steps, a pruned map of the UR5 URDF took 1.05 times the
         unpruned one, of an IRB 2400 URDF 1.8 times (143 placements of the ERK path, same run,
         loaded machine, 2026-12-02): their few branches are cheap to follow (a UR's four
         shoulder branches tie and are all followed anyway), and the bounds cost more than the
@@ -262,6 +272,34 @@ class NumericFamily(KinematicsFamily, FollowsInSteps):
             constants,
         )
         return q, status
+
+    @property
+    def follows_bounded(self) -> bool:
+        """The compiled chain of six joints (:mod:`solver.path.bounded`)."""
+        return self.compiled and self.dof == 6
+
+    def follow_bounded(
+        self,
+        current: np.ndarray,
+        poses: tuple[np.ndarray, np.ndarray],
+        speeds: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, float],
+        rules: tuple[float, ...],
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """:func:`bounded_kernel.follow_bounded` (see :meth:`FollowsInSteps.follow_bounded`)."""
+        settings, constants = self._settings()
+        result: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray] = (
+            bounded_kernel.follow_bounded(
+                self._packed,
+                current,
+                *(np.ascontiguousarray(a, dtype=float) for a in (*poses, *speeds[:3])),
+                np.asarray(speeds[3], dtype=np.bool_),
+                (self.lower, self.upper, np.array([speeds[4]], dtype=float)),
+                settings,
+                constants,
+                np.array(rules, dtype=float),
+            )
+        )
+        return result
 
     def follow_ranges(
         self,

@@ -3,8 +3,9 @@
 :mod:`solver.path.pruning`: a cell's reported fields (mu_path, reason, failing waypoint, branch,
 binding waypoint and joint, V_max along the chosen branch) are those of following every branch
 (``prune=False``), bit for bit, and those of the numpy chain (the reference, never pruned) to
-its tolerance. Six-joint arms are not pruned in maps (their following is cheap); here their
-family is made to follow in steps, so the argument is checked on a UR and an OPW arm too.
+its tolerance. Seven-joint arms are pruned in steps (:mod:`solver.path.pruning`), six-joint
+arms in one compiled pass (:mod:`solver.path.bounded`): both are checked, the latter on a UR and
+an OPW arm (whose family, made to follow in steps here, still takes the compiled pass).
 """
 
 from __future__ import annotations
@@ -18,6 +19,7 @@ from solver.core.codes import REASON_UNREACHABLE
 from solver.core.family import Branch
 from solver.core.robots import Robot
 from solver.families.numeric.family import NumericFamily
+from solver.path import bounded
 from solver.path.pipeline import ChunkResult, check_placements, run_chunk
 from solver.path.placements import PlacementResults, evaluate_placements
 from solver.path.problem import PathOptions, PathProblem
@@ -129,6 +131,50 @@ def test_maps_that_need_every_branch_are_not_pruned(options: PathOptions) -> Non
     assert not can_prune(problem)
 
 
-def test_six_joint_maps_follow_every_branch() -> None:
-    assert not can_prune(PathProblem.of(numeric("ur5_urdf"), load_path("curved_line")[:10]))
+def test_six_joint_maps_prune_in_one_compiled_pass() -> None:
+    ur5 = PathProblem.of(numeric("ur5_urdf"), load_path("curved_line")[:10])
+    family = ur5.family
+    assert can_prune(ur5) and isinstance(family, NumericFamily) and family.follows_bounded
+    assert not can_prune(PathProblem.of(numeric("ur5_urdf", compiled=False), ur5.waypoints))
     assert can_prune(PathProblem.of(numeric("panda"), load_path("curved_line")[:10]))
+
+
+@pytest.mark.parametrize("name", ["ur5_urdf", "irb2400_urdf"])
+def test_drops_the_check_refuses_are_followed_after_all(
+    name: str, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The check made stricter (bounds raised 0.1 %) refuses drops: the same answer."""
+    problem = PathProblem.of(numeric(name), load_path("curved_line")[:60])
+    placements = placements_of(name)
+    every = evaluate_placements(problem, placements, with_speeds=True, prune=False)
+    refused = []
+    checked = bounded.choice_holds
+
+    def counted(mu: np.ndarray, bound: np.ndarray, dropped: np.ndarray) -> np.ndarray:
+        holds = checked(mu, bound * 1.001, dropped)
+        refused.append(int(np.count_nonzero(~holds)))
+        return holds
+
+    monkeypatch.setattr(bounded, "choice_holds", counted)
+    pruned = evaluate_placements(problem, placements, with_speeds=True)
+    assert sum(refused) > 0
+    for field in FIELDS:
+        np.testing.assert_array_equal(getattr(pruned, field), getattr(every, field), err_msg=field)
+
+
+@pytest.mark.parametrize(
+    "setting",
+    [("ROUGH", 0), ("RESIDUAL", 0.0), ("MOTION", 0.0), ("STRIDE", 1)],
+    ids=["every_slot_exact", "no_stride_trusted", "no_motion_trusted", "stride_1"],
+)
+def test_scouting_settings_change_no_field(
+    setting: tuple[str, float], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Without scouting, with every stride untrusted (followed exactly), or waypoint by waypoint."""
+    problem = PathProblem.of(numeric("ur5_urdf"), load_path("curved_line")[:60])
+    placements = placements_of("ur5_urdf")
+    ours = evaluate_placements(problem, placements, with_speeds=True)
+    monkeypatch.setattr(bounded, *setting)
+    theirs = evaluate_placements(problem, placements, with_speeds=True)
+    for field in FIELDS:
+        np.testing.assert_array_equal(getattr(ours, field), getattr(theirs, field), err_msg=field)

@@ -1,0 +1,149 @@
+"""A six-joint numeric map cell's IK: the candidate first, the others dropped once hopeless.
+
+:mod:`solver.path.pruning` follows a seven-joint arm's branches in pieces, best bound first,
+from Python; a six-joint arm's following is too cheap for that (the bounds cost more than they
+save). Here the whole choice runs compiled, one placement after the other
+(:meth:`solver.core.family.FollowsInSteps.follow_bounded`): the slot the previous placement
+ended with is followed first to the end (the candidate), then each other slot in order, with
+V_max at every waypoint; a slot is dropped once its least V_max so far shows that it can
+neither tie with the candidate nor beat it. The other slots are scouted: followed with a few
+rough steps a stride of waypoints, solved exactly (and their V_max taken) at the candidate's
+slowest waypoint and wherever the rough V_max comes near dropping them; only exact V_max
+bound a slot, and a slot that is not dropped (or whose stride is not trusted to stay on its
+branch) is followed exactly from its first waypoint, so every row handed on is
+``follow_paths``' to the bit. That is the argument of the analytic map kernels'
+pruning (:mod:`solver.kernels.fixed_spin`): mu_path is the least V_max along the branch, and
+:func:`solver.path.tracking.choose_branch` takes the highest, the first in order of a tie.
+
+The kernel only guesses the candidate's feasibility (tracking's joint limits and steps are
+judged by the pipeline), and its V_max round otherwise than the pipeline's. So the pipeline
+checks every placement afterwards (:func:`pick_stands`) with its own mu_path of the slots
+followed to the end: where a dropped slot could change a placement's choice, the chunk is run
+again following every slot (none of 546 placements of the UR5's ERK map). A dropped slot
+comes back unreachable from its first waypoint, as in :mod:`solver.path.pruning`, so no
+reported field of the cell changes (tested cell by cell against following every slot).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from solver.core.codes import TIE_RTOL, UNREACHABLE
+from solver.core.family import PathSolutions
+from solver.path.problem import PathProblem
+from solver.path.pruning import Chunk
+
+MARGIN = 1e-13
+"""Relative slack on a dropped slot's bound: the kernel's V_max come from the unwrapped
+solutions, the pipeline's from the tracked ones (2 pi apart), equal to rounding (about 1e-15
+on the UR5 and OPW arms); it must stay well under TIE_RTOL, or slots that tie to rounding (a
+UR's shoulder branches) could never be dropped."""
+
+ROUGH = 3
+"""Damped least-squares steps a stride when a slot other than the candidate is scouted
+(without a convergence test). From one waypoint to the next (UR5 on the ERK path), one step
+leaves |e|_inf about 1e-4, two about 1e-9 (90th percentile); over a stride of 8 two leave
+about 1e-5, so three."""
+STRIDE = 8
+"""Waypoints a scouted slot goes at a time (stopping at the candidate's slowest waypoint).
+The UR5-as-URDF ERK map's compiled following took 0.56 times as long as following every slot
+other than the candidate exactly (with drops), with the lead alone 0.35 (the same slots
+dropped; loaded machine, best of 5, same run); strides of 4 and 12 about the same as 8."""
+RESIDUAL = 1e-6
+"""A stride whose rough steps leave |e|_inf (m, rad) above this is not trusted to have stayed
+on the slot's branch: the slot is followed exactly instead."""
+MOTION = 0.35
+"""Nor one that moves a joint more than this (rad, m): the joint step tracking calls a jump
+between two waypoints (``PathOptions.max_joint_step``'s default)."""
+SLACK = 1e-5
+"""Where a scouted slot's rough V_max is within this (relative) of dropping it, it is solved
+exactly there and its exact V_max enters its bound (the rough ones only say where to look)."""
+
+
+def bounded_solutions(
+    problem: PathProblem,
+    rotation: np.ndarray,
+    flange_position: np.ndarray,
+    twist: np.ndarray,
+    tool_position: np.ndarray,
+) -> PathSolutions:
+    """The family's solutions along a chunk's paths, slots that cannot be the pick dropped.
+
+    Args and returns as :func:`solver.path.pruning.pruned_solutions`.
+    """
+    chunk = Chunk(problem, rotation, flange_position, twist, tool_position)
+    family = chunk.family
+    current, count = family.seed_first(chunk.rotations[:, 0], chunk.positions[:, 0])
+    n_seeds = current.shape[1]
+    current = np.ascontiguousarray(current[:, : max(int(count.max()), 1)])
+    speeds = (
+        np.moveaxis(chunk.twist, 0, -1),
+        np.moveaxis(chunk.tool, 0, -1),
+        problem.robot.qdot_max,
+        problem.prepared.pure_rotation,
+        problem.options.max_joint_step,
+    )
+    q, status, bound, dropped = family.follow_bounded(
+        current,
+        (chunk.rotations, chunk.positions),
+        speeds,
+        (TIE_RTOL, MARGIN, ROUGH, SLACK, STRIDE, RESIDUAL, MOTION),
+    )
+    kept = ~dropped & (status[..., 0] != UNREACHABLE)
+    order = np.argsort(~kept, axis=0, kind="stable")[: max(int(kept.sum(axis=0).max()), 1)]
+    every = np.arange(len(count))
+    q, status = q[:, order, every], status[order, every]
+    gone = dropped[order, every]
+    q[:, gone] = np.nan
+    status[gone] = UNREACHABLE
+    return PathSolutions(
+        q=q,
+        status=status,
+        seeds=n_seeds,
+        branches_found=count,
+        slots=order,
+        bound=bound,
+        dropped=dropped,
+    )
+
+
+def pick_stands(solutions: PathSolutions, rows: np.ndarray, mu_path: np.ndarray) -> bool:
+    """Whether every placement's pick stands whatever its dropped slots (:func:`choice_holds`).
+
+    Args:
+        solutions: :func:`bounded_solutions`' answer.
+        rows: the rows of ``solutions.q`` the pipeline followed (a prefix).
+        mu_path: shape (len(rows), C), the pipeline's mu_path of those rows, -inf infeasible.
+    """
+    assert solutions.slots is not None and solutions.bound is not None
+    assert solutions.dropped is not None
+    mu = np.full(solutions.bound.shape, -np.inf)
+    cells = np.arange(solutions.bound.shape[1])
+    mu[solutions.slots[rows], cells] = mu_path  # a dropped slot's row is unreachable: -inf
+    return bool(choice_holds(mu, solutions.bound, solutions.dropped).all())
+
+
+def choice_holds(mu: np.ndarray, bound: np.ndarray, dropped: np.ndarray) -> np.ndarray:
+    """Whether each placement's pick stands whatever its dropped slots' mu_path (K, C) -> (C,).
+
+    The pick is :func:`solver.path.tracking.choose_branch`'s among the slots followed to the
+    end (``mu``: their mu_path, -inf where infeasible or dropped). A dropped slot's mu_path is
+    at most its ``bound`` (1 + MARGIN), or it is infeasible: one after the pick cannot change it
+    while that bound less its tie tolerance is at most the pick's mu_path (it could raise the
+    highest only so far that the pick still ties with it); one before it while the bound is
+    below the highest less the tie tolerance (it cannot tie). A placement without a feasible
+    slot followed holds only if nothing was dropped (its answer is the furthest failure).
+    """
+    feasible = mu > -np.inf
+    top = mu.max(axis=0)
+    tied = feasible & (mu >= top - TIE_RTOL * np.abs(top))
+    pick = tied.argmax(axis=0)
+    chosen = np.take_along_axis(mu, pick[None], axis=0)[0]
+    high = bound * (1.0 + MARGIN)
+    with np.errstate(invalid="ignore"):
+        after = high - TIE_RTOL * np.abs(high) <= chosen
+        before = high < top - TIE_RTOL * np.abs(top)
+    later = np.arange(len(mu))[:, None] > pick
+    harmless = ~dropped | np.where(later, after, before)
+    holds: np.ndarray = ~dropped.any(axis=0) | (feasible.any(axis=0) & harmless.all(axis=0))
+    return holds
