@@ -22,7 +22,7 @@ import numpy as np
 import pinocchio as pin
 
 from solver.core.robots import Robot
-from solver.path.cell import fast, kinematics
+from solver.path.cell import batch, fast, kinematics
 from solver.path.cell.bounds import pair_weights
 from solver.path.cell.robot_geometry import robot_geometry
 from solver.path.cell.shapes import Cell
@@ -235,6 +235,43 @@ class CellChecker:
             geometry.geometryObjects[gid].placement = placed * pose
         return geometry
 
+    def check_many(
+        self,
+        joint_paths: np.ndarray,
+        segment_in_pass: np.ndarray,
+        transforms_workpiece_to_base: np.ndarray,
+    ) -> list[CellVerdict]:
+        """:meth:`check` of a map (``closest=False``) for N joint paths, the same verdicts.
+
+        The compiled sweep runs over every path in one call (:mod:`solver.path.cell.batch`);
+        coal then decides, path by path, where a bound cannot.
+
+        Args:
+            joint_paths: shape (N, W, n), rad, tracked joint paths.
+            segment_in_pass: shape (W - 1,), False between passes.
+            transforms_workpiece_to_base: shape (N, 4, 4), T_B_O of each path's placement.
+        """
+        if not self._pairs or self._fast is None:
+            return [
+                self.check(q, segment_in_pass, transform, closest=False)
+                for q, transform in zip(joint_paths, transforms_workpiece_to_base, strict=True)
+            ]
+        placed = [
+            self._world_to_base * pin.SE3(transform) for transform in transforms_workpiece_to_base
+        ]
+        return batch.check_paths(
+            self._fast,
+            np.ascontiguousarray(joint_paths, dtype=float),
+            np.asarray(segment_in_pass, dtype=np.bool_),
+            {
+                gid - self._n_robot: [at * pose for at in placed]
+                for gid, pose in self._workpiece_ids
+            },
+            (self._weights, self.cell.clearance, self.cell.collision_step),
+            lambda c, configurations: self._coal_distances(configurations, placed[c]),
+            self._finish,
+        )
+
     def _fast_check(
         self, configurations: np.ndarray, owners: np.ndarray, placed: pin.SE3
     ) -> CellVerdict:
@@ -242,6 +279,25 @@ class CellChecker:
         assert self._fast is not None
         moved = {gid - self._n_robot: placed * pose for gid, pose in self._workpiece_ids}
         obstacles = self._fast.obstacle_pack(moved)
+        hit, checks = fast.first_collision(
+            self._fast,
+            configurations,
+            obstacles,
+            self._weights,
+            self.cell.clearance,
+            self._coal_distances(configurations, placed),
+        )
+        return self._finish(hit, checks, owners)
+
+    def _finish(
+        self, hit: tuple[int, int, float] | None, checks: int, owners: np.ndarray
+    ) -> CellVerdict:
+        """The verdict of the compiled sweep's answer (configuration, pair, coal's distance)."""
+        collision = None if hit is None else self._contact(int(owners[hit[0]]), hit[1], hit[2])
+        return CellVerdict(collision, None, checks, self.approximated)
+
+    def _coal_distances(self, configurations: np.ndarray, placed: pin.SE3) -> fast.CoalDistances:
+        """The coal distances of some pairs at a configuration, the workpiece at ``placed``."""
         made: list[tuple[pin.GeometryModel, pin.GeometryData, pin.Data]] = []
 
         def coal_distances(index: int, due: np.ndarray) -> np.ndarray:
@@ -255,16 +311,7 @@ class CellChecker:
                 [pin.computeDistance(geometry, gdata, int(p)).min_distance for p in due]
             )
 
-        hit, checks = fast.first_collision(
-            self._fast,
-            configurations,
-            obstacles,
-            self._weights,
-            self.cell.clearance,
-            coal_distances,
-        )
-        collision = None if hit is None else self._contact(int(owners[hit[0]]), hit[1], hit[2])
-        return CellVerdict(collision, None, checks, self.approximated)
+        return coal_distances
 
     def _first_collision(
         self, geometry: pin.GeometryModel, configurations: np.ndarray, owners: np.ndarray

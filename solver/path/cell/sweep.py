@@ -30,6 +30,8 @@ import numpy as np
 from numba import njit
 
 from solver.path.cell.closed_form import (
+    box_param,
+    params,
     segment_box_param,
     segment_halfspace,
     segment_params,
@@ -37,7 +39,7 @@ from solver.path.cell.closed_form import (
 from solver.path.cell.kinematics import parts as _parts
 
 
-@njit(cache=True, nogil=True, error_model="numpy")
+@njit(cache=True, nogil=True, error_model="numpy", inline="always")
 def _reach(r, u, robot, rot, pos, point):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
     """The largest u . x over robot part r's points (its vertices' plus its ball's radius).
 
@@ -183,6 +185,51 @@ def _bound(p, pairs, ends, robot, obstacles, work, near, rot, pos, cuts):  # typ
     return value
 
 
+@njit(cache=True, nogil=True, error_model="numpy", inline="always")
+def _capsule_bound(a, b, ends, radius, kind, o_ends, o_radius, o_rot, o_centre, o_half, cuts):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
+    """The first value of :func:`_bound`: the distance between part a's capsule and object b.
+
+    Exact where both are the shapes themselves; scalar code on the unpacked packs (a view or
+    a pack's tuple made per pair cost 0.3 to 0.6 microseconds, a hundred times the sums).
+    """
+    n_robot = radius.shape[0]
+    a0x, a0y, a0z = ends[a, 0, 0], ends[a, 0, 1], ends[a, 0, 2]
+    a1x, a1y, a1z = ends[a, 1, 0], ends[a, 1, 1], ends[a, 1, 2]
+    if b < n_robot:
+        b0x, b0y, b0z = ends[b, 0, 0], ends[b, 0, 1], ends[b, 0, 2]
+        b1x, b1y, b1z = ends[b, 1, 0], ends[b, 1, 1], ends[b, 1, 2]
+        other = radius[b]
+    else:
+        k = b - n_robot
+        if kind[k] == 0:
+            nx, ny, nz = o_ends[k, 0, 0], o_ends[k, 0, 1], o_ends[k, 0, 2]
+            da = nx * a0x + ny * a0y + nz * a0z - o_radius[k]
+            db = nx * a1x + ny * a1y + nz * a1z - o_radius[k]
+            return min(da, db) - radius[a]
+        if kind[k] == 2:  # into the box's frame
+            cx, cy, cz = a0x - o_centre[k, 0], a0y - o_centre[k, 1], a0z - o_centre[k, 2]
+            ex, ey, ez = a1x - o_centre[k, 0], a1y - o_centre[k, 1], a1z - o_centre[k, 2]
+            r = o_rot[k]
+            squared, _ = box_param(
+                r[0, 0] * cx + r[1, 0] * cy + r[2, 0] * cz,
+                r[0, 1] * cx + r[1, 1] * cy + r[2, 1] * cz,
+                r[0, 2] * cx + r[1, 2] * cy + r[2, 2] * cz,
+                r[0, 0] * ex + r[1, 0] * ey + r[2, 0] * ez,
+                r[0, 1] * ex + r[1, 1] * ey + r[2, 1] * ez,
+                r[0, 2] * ex + r[1, 2] * ey + r[2, 2] * ez,
+                o_half[k, 0], o_half[k, 1], o_half[k, 2], cuts,
+            )  # fmt: skip
+            return math.sqrt(squared) - radius[a]
+        b0x, b0y, b0z = o_ends[k, 0, 0], o_ends[k, 0, 1], o_ends[k, 0, 2]
+        b1x, b1y, b1z = o_ends[k, 1, 0], o_ends[k, 1, 1], o_ends[k, 1, 2]
+        other = o_radius[k]
+    s, t = params(a0x, a0y, a0z, a1x, a1y, a1z, b0x, b0y, b0z, b1x, b1y, b1z)
+    ux = b0x + t * (b1x - b0x) - (a0x + s * (a1x - a0x))
+    uy = b0y + t * (b1y - b0y) - (a0y + s * (a1y - a0y))
+    uz = b0z + t * (b1z - b0z) - (a0z + s * (a1z - a0z))
+    return math.sqrt(ux * ux + uy * uy + uz * uz) - radius[a] - other
+
+
 @njit(cache=True, nogil=True, error_model="numpy")
 def first_due(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
     configurations,
@@ -230,6 +277,9 @@ def first_due(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
         np.empty((3, 3)),
     )
     count, n_pairs = len(configurations), len(pairs)
+    radius, exact = robot[8], robot[9]
+    kind, o_ends, o_radius, o_rot, o_centre, o_half, o_exact = obstacles[:7]
+    n_robot = radius.shape[0]
     index = start
     while index < count:
         placed, needed = False, False
@@ -243,7 +293,13 @@ def first_due(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
                 if not placed:
                     _parts(configurations[index], robot, rot, pos, ends, turn)
                     placed = True
-                distance = _bound(p, pairs, ends, robot, obstacles, work, near, rot, pos, cuts)
+                a, b = pairs[p, 0], pairs[p, 1]
+                distance = _capsule_bound(
+                    a, b, ends, radius, kind, o_ends, o_radius, o_rot, o_centre, o_half, cuts
+                )
+                both = exact[a] and (exact[b] if b < n_robot else o_exact[b - n_robot])
+                if distance <= near and not both:  # a mesh or a cylinder: its own bounds
+                    distance = _bound(p, pairs, ends, robot, obstacles, work, near, rot, pos, cuts)
                 if distance <= near:
                     need[p] = needed = True
                     continue
