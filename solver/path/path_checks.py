@@ -16,7 +16,7 @@ import numpy as np
 
 from solver.core.codes import FEASIBLE
 from solver.path.limits import PathVerdict
-from solver.path.pipeline import ChunkResult, run_chunk
+from solver.path.pipeline import ChunkResult, run_chunk, tracked_joint_paths
 from solver.path.problem import PathProblem
 
 # The columns of a pipeline run's placements, each at its ``pick`` (the branch to report).
@@ -129,18 +129,15 @@ def refuse_colliding(
     out = [np.array(c, copy=True) for c in columns]
     reason, branch = out[1], out[3]
     family = problem.family
-    feasible = np.flatnonzero(reason == FEASIBLE)
-    n_joints, n_waypoints = problem.robot.dof, problem.prepared.n_waypoints
-    joint_paths = np.empty((len(feasible), n_waypoints, n_joints))
-    order = np.empty(len(feasible), dtype=int)
-    done = 0
-    for b in np.unique(branch[feasible]):
-        cells = feasible[branch[feasible] == b]
-        taken = problem.with_options(branch=family.branches[int(b)])
-        single = run_chunk(taken, placements[cells])
-        joint_paths[done : done + len(cells)] = single.tracked.q[:, 0].transpose(1, 2, 0)
-        order[done : done + len(cells)] = cells
-        done += len(cells)
+    order = np.flatnonzero(reason == FEASIBLE)
+    joint_paths = _chosen_joint_paths(problem, placements[order], branch[order])
+    if joint_paths is None:  # one run per branch taken
+        joint_paths = np.empty((len(order), problem.prepared.n_waypoints, problem.robot.dof))
+        for b in np.unique(branch[order]):
+            taken = branch[order] == b
+            single = run_chunk(problem.with_options(branch=family.branches[int(b)]),
+                               placements[order[taken]])  # fmt: skip
+            joint_paths[taken] = single.tracked.q[:, 0].transpose(1, 2, 0)
     verdicts = check_paths(problem, joint_paths, placements[order])
     refused = {
         int(c): (q, verdict)
@@ -150,6 +147,15 @@ def refuse_colliding(
     if refused:
         _next_branches(problem, placements, out, refused, columns_of)
     return tuple(out)
+
+
+def _chosen_joint_paths(
+    problem: PathProblem, placements: np.ndarray, branch: np.ndarray
+) -> np.ndarray | None:
+    """The joint paths (C, W, n) of each placement's branch (family indices); None: run each."""
+    if not len(placements):
+        return np.zeros((0, problem.prepared.n_waypoints, problem.robot.dof))
+    return tracked_joint_paths(problem, placements, branch)
 
 
 def _next_branches(
