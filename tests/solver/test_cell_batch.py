@@ -12,11 +12,13 @@ import numpy as np
 import pytest
 
 from solver.core.spatial import Placement
+from solver.path.capability_map import capability_map, grid_axis
 from solver.path.cell.batch import placed_obstacles
 from solver.path.cell.cache import checker_for
 from solver.path.cell.checker import CellChecker
 from solver.path.cell.limit import workpiece_to_base
 from solver.path.cell.shapes import Box, Cell, Cylinder, Halfspace, Mesh, Sphere, Tool
+from solver.path.evaluate import evaluate_path
 from solver.path.pipeline import run_chunk, tracked_joint_paths
 from solver.path.problem import PathOptions, PathProblem
 from tests.solver.test_cell_fast import CELL, _arm, _pose, _same
@@ -158,3 +160,26 @@ def test_chosen_joint_paths_equal_a_run_on_each_branch(name: str) -> None:
     assert checked >= 6  # feasible paths of several branches compared
     free = problem.with_options(spin_mode="free")
     assert tracked_joint_paths(free, placements, rows) is None  # the spin schedule's path
+
+
+def test_free_spin_map_cells_equal_evaluate() -> None:
+    """Free spin (each branch's run: its spin schedule's path): map cells = evaluate's answers."""
+    problem = PathProblem.of(
+        _arm("ur5e"), load_path("curved_line"), PathOptions(cell=CELL, spin_mode="free")
+    )
+    xs, ys = grid_axis(-0.2, 0.2, 0.1, field="x"), grid_axis(0.3, 0.6, 0.1, field="y")
+    cells = capability_map(problem, xs=xs, ys=ys, z=0.1, yaws=np.array([0.0]))
+    for index in zip(*np.nonzero(np.ones_like(cells.reason, dtype=bool)), strict=True):
+        _, _, iy, ix = index
+        evaluation = evaluate_path(problem, Placement(float(xs[ix]), float(ys[iy]), 0.1, 0.0))
+        assert evaluation.feasible == (cells.reason[index] == -1)
+        if evaluation.feasible:
+            assert evaluation.branch == problem.family.branches[cells.branch[index]]
+            assert evaluation.mu_path == pytest.approx(cells.mu_path[index], rel=1e-12)
+        else:
+            assert evaluation.failed_waypoint == cells.failed_waypoint[index]
+    assert (cells.reason == -1).sum() >= 4
+    plain = capability_map(
+        problem.with_options(cell=Cell()), xs=xs, ys=ys, z=0.1, yaws=np.array([0.0])
+    )
+    assert (cells.branch != plain.branch).any()  # a best branch collides: the next one taken

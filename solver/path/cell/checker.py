@@ -29,13 +29,12 @@ from solver.path.cell.shapes import Cell
 
 # What checking one pose of a path against a cell costs, in poses of a closed-form family's map
 # (KinematicsFamily.path_cost): the ERK map (546 placements x 133 waypoints) with a table, a
-# fixture and the part took 48 to 71 times the map without (bench/cell.py, UR5 meshes and UR5e
-# capsules, best of 3 each, on a loaded machine; coal alone: 250 to 450 times). The ratio rose
-# from 22-36x although the check got 1.2-2.6x faster: the map without a cell got about 3 times
-# faster (its kernels prune branches), so a closed-form pose now costs less than the limits were
-# set for (5 million of them take 1 to 1.4 s, not 10). 50, at the low end of the measurement:
-# the optimisers in a cell search (x, y, yaw) past a fixture (no arc symmetry), and 80 refused
-# the README's cell optimisation (7.0 million weighted poses; 50 weighs it 4.4 million).
+# fixture and the part took 46 to 59 times the map without for the UR5 (its meshes) and 20 to
+# 30 times for the UR5e (capsules) (bench/cell.py and the same maps' CPU time, best of 3 to 5,
+# loaded machine, 2026-12-02, after the chunk's paths were checked in one compiled call; 72 to
+# 96 and 35 to 44 times before, in the same runs). 50, within the UR5's range and above the
+# UR5e's: the optimisers in a cell search (x, y, yaw) past a fixture (no arc symmetry), and 80
+# refused the README's cell optimisation (7.0 million weighted poses; 50 weighs it 4.4 million).
 CELL_POSE_COST = 50.0
 _WINDOW = 32  # configurations looked ahead at once when skipping
 
