@@ -183,3 +183,16 @@ def test_free_spin_map_cells_equal_evaluate() -> None:
         problem.with_options(cell=Cell()), xs=xs, ys=ys, z=0.1, yaws=np.array([0.0])
     )
     assert (cells.branch != plain.branch).any()  # a best branch collides: the next one taken
+
+
+def test_a_chunk_without_feasible_placements() -> None:
+    """No path to check (nothing feasible in a chunk): no verdict, the map's cells unchanged."""
+    checker = CellChecker(_arm("ur5e"), MOVING)
+    assert (
+        checker.check_many(np.zeros((0, 12, 6)), np.ones(11, dtype=bool), np.zeros((0, 4, 4))) == []
+    )
+    problem = PathProblem.of(_arm("ur5e"), load_path("curved_line"), PathOptions(cell=CELL))
+    far = capability_map(
+        problem, xs=np.array([3.0, 3.1]), ys=np.array([3.0]), z=0.1, yaws=np.array([0.0])
+    )
+    assert (far.reason == 0).all()  # unreachable, as without a cell

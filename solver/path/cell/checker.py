@@ -250,6 +250,8 @@ class CellChecker:
             segment_in_pass: shape (W - 1,), False between passes.
             transforms_workpiece_to_base: shape (N, 4, 4), T_B_O of each path's placement.
         """
+        if not len(joint_paths):
+            return []
         if not self._pairs or self._fast is None:
             return [
                 self.check(q, segment_in_pass, transform, closest=False)
