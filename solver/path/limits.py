@@ -138,6 +138,18 @@ class PathCheck(abc.ABC):
                 as fast as can be (a map, an optimiser).
         """
 
+    def check_many(self, joint_paths: np.ndarray, placements: np.ndarray) -> list[PathVerdict]:
+        """:meth:`check` of N joint paths, not thorough (a map's chunk): the same verdicts.
+
+        Args:
+            joint_paths: shape (N, W, n), rad, tracked joint paths.
+            placements: shape (N, 5), each path's placement.
+        """
+        return [
+            self.check(q, placement, thorough=False)
+            for q, placement in zip(joint_paths, placements, strict=True)
+        ]
+
 
 @dataclass(frozen=True)
 class BlendStencil:

@@ -16,7 +16,7 @@ import numpy as np
 
 from solver.core.codes import FEASIBLE
 from solver.path.limits import PathVerdict
-from solver.path.pipeline import ChunkResult, run_chunk
+from solver.path.pipeline import ChunkResult, run_chunk, tracked_joint_paths
 from solver.path.problem import PathProblem
 
 # The columns of a pipeline run's placements, each at its ``pick`` (the branch to report).
@@ -82,6 +82,30 @@ def clear_pick(
     return None, None, first_refusal
 
 
+def check_paths(
+    problem: PathProblem, joint_paths: np.ndarray, placements: np.ndarray
+) -> list[PathVerdict | None]:
+    """:func:`check_path` (not thorough) of N joint paths (N, W, n) at placements (N, 5).
+
+    Each check takes every path not yet refused at once (:meth:`PathCheck.check_many`).
+    """
+    verdicts: list[PathVerdict | None] = [None] * len(joint_paths)
+    open_ = np.arange(len(joint_paths))
+    for check in problem.path_checks:
+        if not len(open_):
+            break
+        answers = check.check_many(joint_paths[open_], placements[open_])
+        for k, verdict in zip(open_, answers, strict=True):
+            verdicts[k] = verdict
+        open_ = np.array([k for k in open_ if not _refused(verdicts[k])], dtype=int)
+    return verdicts
+
+
+def _refused(verdict: PathVerdict | None) -> bool:
+    """Whether a verdict refuses its path."""
+    return verdict is not None and verdict.failed_waypoint is not None
+
+
 def refuse_colliding(
     problem: PathProblem,
     placements: np.ndarray,
@@ -89,6 +113,9 @@ def refuse_colliding(
     columns_of: Columns,
 ) -> tuple[np.ndarray, ...]:
     """The placements' columns with the path checks applied (cell.md section 3).
+
+    The chosen branches' joint paths of every feasible placement are checked together
+    (:func:`check_paths`), then the refused placements' next branches (:func:`_next_branches`).
 
     Args:
         problem: the robot, the path, the options (with the cell).
@@ -102,20 +129,33 @@ def refuse_colliding(
     out = [np.array(c, copy=True) for c in columns]
     reason, branch = out[1], out[3]
     family = problem.family
-    feasible = np.flatnonzero(reason == FEASIBLE)
-    refused: dict[int, tuple[np.ndarray, PathVerdict]] = {}
-    for b in np.unique(branch[feasible]):
-        cells = feasible[branch[feasible] == b]
-        taken = problem.with_options(branch=family.branches[int(b)])
-        single = run_chunk(taken, placements[cells])
-        for k, c in enumerate(cells):
-            q = single.tracked.q[:, 0, k].T
-            verdict = check_path(problem, q, placements[c], thorough=False)
-            if verdict is not None and verdict.failed_waypoint is not None:
-                refused[int(c)] = (q, verdict)
+    order = np.flatnonzero(reason == FEASIBLE)
+    joint_paths = _chosen_joint_paths(problem, placements[order], branch[order])
+    if joint_paths is None:  # one run per branch taken
+        joint_paths = np.empty((len(order), problem.prepared.n_waypoints, problem.robot.dof))
+        for b in np.unique(branch[order]):
+            taken = branch[order] == b
+            single = run_chunk(problem.with_options(branch=family.branches[int(b)]),
+                               placements[order[taken]])  # fmt: skip
+            joint_paths[taken] = single.tracked.q[:, 0].transpose(1, 2, 0)
+    verdicts = check_paths(problem, joint_paths, placements[order])
+    refused = {
+        int(c): (q, verdict)
+        for c, q, verdict in zip(order, joint_paths, verdicts, strict=True)
+        if verdict is not None and verdict.failed_waypoint is not None
+    }
     if refused:
         _next_branches(problem, placements, out, refused, columns_of)
     return tuple(out)
+
+
+def _chosen_joint_paths(
+    problem: PathProblem, placements: np.ndarray, branch: np.ndarray
+) -> np.ndarray | None:
+    """The joint paths (C, W, n) of each placement's branch (family indices); None: run each."""
+    if not len(placements):
+        return np.zeros((0, problem.prepared.n_waypoints, problem.robot.dof))
+    return tracked_joint_paths(problem, placements, branch)
 
 
 def _next_branches(
@@ -127,7 +167,9 @@ def _next_branches(
 ) -> None:
     """The refused placements' columns from their best branches that pass (auto), else refused.
 
-    One pipeline run for all of them (a chunk's placements share a spin); the refused joint
+    One pipeline run for all of them (a chunk's placements share a spin); then, round by
+    round, each placement's next branch in :func:`branch_order` is checked, all of a round
+    together (:func:`check_paths`): the branch :func:`clear_pick` takes. The refused joint
     path is not checked again.
     """
     cells = np.array(sorted(refused))
@@ -136,10 +178,25 @@ def _next_branches(
         rows = placements[cells]
         run = run_chunk(problem, rows)
         chosen = np.array(run.pick, copy=True)
-        for k, c in enumerate(cells):
-            branch, _, _ = clear_pick(problem, run, rows, k, thorough=False, known=refused[int(c)])
-            if branch is not None:
-                chosen[k], taken[k] = branch, True
+        orders = [branch_order(run, k) for k in range(len(cells))]
+        step = [0] * len(cells)
+        while True:
+            due: list[tuple[int, int]] = []  # (placement k, branch) checked this round
+            for k, c in enumerate(cells):
+                while not taken[k] and step[k] < len(orders[k]):
+                    b = orders[k][step[k]]
+                    if not np.array_equal(run.tracked.q[:, b, k].T, refused[int(c)][0]):
+                        due.append((k, b))
+                        break
+                    step[k] += 1  # the refused joint path itself
+            if not due:
+                break
+            joint_paths = np.array([run.tracked.q[:, b, k].T for k, b in due])
+            verdicts = check_paths(problem, joint_paths, rows[[k for k, _ in due]])
+            for (k, b), verdict in zip(due, verdicts, strict=True):
+                step[k] += 1
+                if not _refused(verdict):
+                    chosen[k], taken[k] = b, True
         if taken.any():
             picked = columns_of(dataclasses.replace(run, pick=chosen))
             for column, value in zip(out, picked, strict=True):

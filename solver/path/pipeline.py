@@ -137,6 +137,65 @@ def flange_at_spin(path: PreparedPath, spin: float) -> tuple[np.ndarray, np.ndar
     return rotation, position
 
 
+def placed_flange(
+    problem: PathProblem, placements: np.ndarray
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The yaws and the flange poses in {B} of a chunk's placements (one spin).
+
+    Returns:
+        yaws: shape (C,), rad, or (1,) where they are all one (broadcast: less to read);
+        R_B_F: shape (3, 3, C, W); p_B_F: shape (3, C, W), m.
+    """
+    yaws = placements[:, 3]
+    if np.all(yaws == yaws[0]):
+        yaws = yaws[:1]
+    if np.any(placements[:, 4] != placements[0, 4]):
+        raise InvalidInputError("placements", "a chunk must have one spin")
+    offset = placements[:, :3].T[:, :, None]  # (3, C, 1)
+    flange_rotation, flange_position_o = flange_at_spin(problem.prepared, float(placements[0, 4]))
+    rotation = turn_by_yaw(flange_rotation.transpose(1, 2, 0), yaws)  # (3, 3, C, W)
+    flange_position = turn_by_yaw(flange_position_o.T, yaws) + offset
+    return yaws, rotation, flange_position
+
+
+def tracked_joint_paths(
+    problem: PathProblem, placements: np.ndarray, rows: np.ndarray
+) -> np.ndarray | None:
+    """The joint paths a run on one branch gives, each placement on its own branch.
+
+    What :func:`run_chunk` tracks at placement c with the problem's branch set to the family's
+    branch ``rows[c]``, without the joint speeds (a path check needs the angles alone); one IK
+    solve for every placement.
+
+    Args:
+        problem: the problem (fixed spin: free spin tracks its spin schedule's path).
+        placements: shape (C, 5), one spin, checked.
+        rows: shape (C,), an index into the family's branches per placement.
+
+    Returns:
+        shape (C, W, n), rad; None where the family answers in slots (numeric IK) or the
+        spin is free: there :func:`run_chunk` on each branch is the way.
+    """
+    if problem.options.spin_mode == "free":
+        return None
+    _, rotation, flange_position = placed_flange(problem, placements)
+    solutions = problem.family.solve_path(rotation, flange_position)
+    if solutions.slots is not None:
+        return None
+    cells = np.arange(len(placements))
+    robot = problem.robot
+    tracked = track(
+        solutions.q[:, rows, cells][:, None],  # (n, 1, C, W): one branch, as run_chunk's
+        solutions.status[rows, cells][None],
+        lower=robot.q_lower,
+        upper=robot.q_upper,
+        max_joint_step=problem.options.max_joint_step,
+        segment_checked=problem.prepared.segment_in_pass,
+    )
+    joint_paths: np.ndarray = tracked.q[:, 0].transpose(1, 2, 0)
+    return joint_paths
+
+
 def run_chunk(
     problem: PathProblem,
     placements: np.ndarray,
@@ -160,15 +219,8 @@ def run_chunk(
     """
     robot, path, branches = problem.robot, problem.prepared, problem.branches
     family = problem.family
-    yaws = placements[:, 3]
-    if np.all(yaws == yaws[0]):  # one turn for the chunk: broadcast it (less memory to read)
-        yaws = yaws[:1]
-    if np.any(placements[:, 4] != placements[0, 4]):
-        raise InvalidInputError("placements", "a chunk must have one spin")
+    yaws, rotation, flange_position = placed_flange(problem, placements)
     offset = placements[:, :3].T[:, :, None]  # (3, C, 1)
-    flange_rotation, flange_position_o = flange_at_spin(path, float(placements[0, 4]))
-    rotation = turn_by_yaw(flange_rotation.transpose(1, 2, 0), yaws)  # (3, 3, C, W)
-    flange_position = turn_by_yaw(flange_position_o.T, yaws) + offset
     tool_position = turn_by_yaw(path.tool_position.T, yaws) + offset
     twist = np.concatenate(
         [turn_by_yaw(path.twist[:, :3].T, yaws), turn_by_yaw(path.twist[:, 3:].T, yaws)]

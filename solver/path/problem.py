@@ -24,7 +24,8 @@ import numpy as np
 from solver.core.exceptions import InvalidInputError, NoAnalyticIkError, quoted
 from solver.core.family import Branch, KinematicsFamily
 from solver.core.robots import Robot
-from solver.path.cell.checker import CELL_POSE_COST, CellChecker
+from solver.path.cell.cache import checker_for
+from solver.path.cell.checker import CELL_POSE_COST
 from solver.path.cell.limit import CellLimit
 from solver.path.cell.shapes import Cell
 from solver.path.limits import (
@@ -176,7 +177,7 @@ class PathProblem:
         cell = self.options.cell
         if cell is None:
             return ()
-        checker = CellChecker(self.robot, cell)
+        checker = checker_for(self.robot, cell)
         return (CellLimit(checker, self.prepared.segment_in_pass),)
 
     def path_cost(self, n_waypoints: int) -> float:

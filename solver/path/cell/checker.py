@@ -22,20 +22,19 @@ import numpy as np
 import pinocchio as pin
 
 from solver.core.robots import Robot
-from solver.path.cell import fast, kinematics
+from solver.path.cell import batch, fast, kinematics
 from solver.path.cell.bounds import pair_weights
 from solver.path.cell.robot_geometry import robot_geometry
 from solver.path.cell.shapes import Cell
 
 # What checking one pose of a path against a cell costs, in poses of a closed-form family's map
 # (KinematicsFamily.path_cost): the ERK map (546 placements x 133 waypoints) with a table, a
-# fixture and the part took 48 to 71 times the map without (bench/cell.py, UR5 meshes and UR5e
-# capsules, best of 3 each, on a loaded machine; coal alone: 250 to 450 times). The ratio rose
-# from 22-36x although the check got 1.2-2.6x faster: the map without a cell got about 3 times
-# faster (its kernels prune branches), so a closed-form pose now costs less than the limits were
-# set for (5 million of them take 1 to 1.4 s, not 10). 50, at the low end of the measurement:
-# the optimisers in a cell search (x, y, yaw) past a fixture (no arc symmetry), and 80 refused
-# the README's cell optimisation (7.0 million weighted poses; 50 weighs it 4.4 million).
+# fixture and the part took 46 to 59 times the map without for the UR5 (its meshes) and 20 to
+# 30 times for the UR5e (capsules) (bench/cell.py and the same maps' CPU time, best of 3 to 5,
+# loaded machine, 2026-12-02, after the chunk's paths were checked in one compiled call; 72 to
+# 96 and 35 to 44 times before, in the same runs). 50, within the UR5's range and above the
+# UR5e's: the optimisers in a cell search (x, y, yaw) past a fixture (no arc symmetry), and 80
+# refused the README's cell optimisation (7.0 million weighted poses; 50 weighs it 4.4 million).
 CELL_POSE_COST = 50.0
 _WINDOW = 32  # configurations looked ahead at once when skipping
 
@@ -235,6 +234,45 @@ class CellChecker:
             geometry.geometryObjects[gid].placement = placed * pose
         return geometry
 
+    def check_many(
+        self,
+        joint_paths: np.ndarray,
+        segment_in_pass: np.ndarray,
+        transforms_workpiece_to_base: np.ndarray,
+    ) -> list[CellVerdict]:
+        """:meth:`check` of a map (``closest=False``) for N joint paths, the same verdicts.
+
+        The compiled sweep runs over every path in one call (:mod:`solver.path.cell.batch`);
+        coal then decides, path by path, where a bound cannot.
+
+        Args:
+            joint_paths: shape (N, W, n), rad, tracked joint paths.
+            segment_in_pass: shape (W - 1,), False between passes.
+            transforms_workpiece_to_base: shape (N, 4, 4), T_B_O of each path's placement.
+        """
+        if not len(joint_paths):
+            return []
+        if not self._pairs or self._fast is None:
+            return [
+                self.check(q, segment_in_pass, transform, closest=False)
+                for q, transform in zip(joint_paths, transforms_workpiece_to_base, strict=True)
+            ]
+        placed = [
+            self._world_to_base * pin.SE3(transform) for transform in transforms_workpiece_to_base
+        ]
+        return batch.check_paths(
+            self._fast,
+            np.ascontiguousarray(joint_paths, dtype=float),
+            np.asarray(segment_in_pass, dtype=np.bool_),
+            {
+                gid - self._n_robot: [at * pose for at in placed]
+                for gid, pose in self._workpiece_ids
+            },
+            (self._weights, self.cell.clearance, self.cell.collision_step),
+            lambda c, configurations: self._coal_distances(configurations, placed[c]),
+            self._finish,
+        )
+
     def _fast_check(
         self, configurations: np.ndarray, owners: np.ndarray, placed: pin.SE3
     ) -> CellVerdict:
@@ -242,6 +280,25 @@ class CellChecker:
         assert self._fast is not None
         moved = {gid - self._n_robot: placed * pose for gid, pose in self._workpiece_ids}
         obstacles = self._fast.obstacle_pack(moved)
+        hit, checks = fast.first_collision(
+            self._fast,
+            configurations,
+            obstacles,
+            self._weights,
+            self.cell.clearance,
+            self._coal_distances(configurations, placed),
+        )
+        return self._finish(hit, checks, owners)
+
+    def _finish(
+        self, hit: tuple[int, int, float] | None, checks: int, owners: np.ndarray
+    ) -> CellVerdict:
+        """The verdict of the compiled sweep's answer (configuration, pair, coal's distance)."""
+        collision = None if hit is None else self._contact(int(owners[hit[0]]), hit[1], hit[2])
+        return CellVerdict(collision, None, checks, self.approximated)
+
+    def _coal_distances(self, configurations: np.ndarray, placed: pin.SE3) -> fast.CoalDistances:
+        """The coal distances of some pairs at a configuration, the workpiece at ``placed``."""
         made: list[tuple[pin.GeometryModel, pin.GeometryData, pin.Data]] = []
 
         def coal_distances(index: int, due: np.ndarray) -> np.ndarray:
@@ -255,16 +312,7 @@ class CellChecker:
                 [pin.computeDistance(geometry, gdata, int(p)).min_distance for p in due]
             )
 
-        hit, checks = fast.first_collision(
-            self._fast,
-            configurations,
-            obstacles,
-            self._weights,
-            self.cell.clearance,
-            coal_distances,
-        )
-        collision = None if hit is None else self._contact(int(owners[hit[0]]), hit[1], hit[2])
-        return CellVerdict(collision, None, checks, self.approximated)
+        return coal_distances
 
     def _first_collision(
         self, geometry: pin.GeometryModel, configurations: np.ndarray, owners: np.ndarray

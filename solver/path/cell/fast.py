@@ -156,17 +156,45 @@ def first_collision(
     """
     count = len(fast.pairs)
     clear_until = np.full(count, -1, dtype=np.int64)
-    known, need = np.full(count, np.nan), np.zeros(count, dtype=np.bool_)
-    start, coal_checks = 0, 0
-    while True:
-        index = int(
-            sweep.first_due(
-                configurations, fast.robot, obstacles, fast.pairs, weights,
-                clearance + MARGIN, clearance, clear_until, start, known, need,
-            )
-        )  # fmt: skip
-        if index >= len(configurations):
-            return None, coal_checks
+    need = np.zeros(count, dtype=np.bool_)
+    index = int(
+        sweep.first_due(
+            configurations, fast.robot, obstacles, fast.pairs, weights,
+            clearance + MARGIN, clearance, clear_until, 0, np.full(count, np.nan), need,
+        )
+    )  # fmt: skip
+    return resume(
+        fast, configurations, obstacles, weights, clearance, coal_distances,
+        (index, clear_until, need),
+    )  # fmt: skip
+
+
+def resume(
+    fast: FastCell,
+    configurations: np.ndarray,
+    obstacles: tuple[np.ndarray, ...],
+    weights: np.ndarray,
+    clearance: float,
+    coal_distances: CoalDistances,
+    state: tuple[int, np.ndarray, np.ndarray],
+) -> tuple[tuple[int, int, float] | None, int]:
+    """:func:`first_collision` from where :func:`sweep.first_due` stopped.
+
+    Args:
+        fast: the compiled side of the checker.
+        configurations: shape (M, n), the path's configurations.
+        obstacles: the obstacle pack at the path's placement.
+        weights: shape (P, n), :func:`sweep.first_due`'s.
+        clearance: m.
+        coal_distances: coal's distances at the path's placement.
+        state: that configuration (the configuration count: the path is clear), the pairs'
+            last configurations proven clear (P,) and the pairs coal must decide there (P,),
+            both updated in place.
+    """
+    index, clear_until, need = state
+    known = np.full(len(fast.pairs), np.nan)
+    coal_checks = 0
+    while index < len(configurations):
         due = np.flatnonzero(need)
         distances = coal_distances(index, due)
         coal_checks += 1
@@ -175,4 +203,10 @@ def first_collision(
             return (index, int(due[low]), float(distances[low])), coal_checks
         known[:] = np.nan
         known[due] = distances
-        start = index
+        index = int(
+            sweep.first_due(
+                configurations, fast.robot, obstacles, fast.pairs, weights,
+                clearance + MARGIN, clearance, clear_until, index, known, need,
+            )
+        )  # fmt: skip
+    return None, coal_checks

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from solver.core.codes import REASON_COLLISION
@@ -33,3 +35,27 @@ class CellLimit(PathCheck):
         verdict = self.checker.check(q, self.segment_in_pass, transform, closest=thorough)
         failed = None if verdict.collision is None else verdict.collision.waypoint
         return PathVerdict(failed, verdict)
+
+    def check_many(self, joint_paths: np.ndarray, placements: np.ndarray) -> list[PathVerdict]:
+        """Check N joint paths at their placements in one compiled sweep (a map's chunk)."""
+        verdicts = self.checker.check_many(
+            joint_paths, self.segment_in_pass, workpiece_to_base(placements)
+        )
+        return [
+            PathVerdict(None if v.collision is None else v.collision.waypoint, v) for v in verdicts
+        ]
+
+
+def workpiece_to_base(placements: np.ndarray) -> np.ndarray:
+    """T_B_O of N placements (N, 5), shape (N, 4, 4): :meth:`Placement.transform_workpiece_to_base`.
+
+    The same floats (``math``'s cosine and sine), without making a :class:`Placement` each
+    (its checks cost 0.1 ms; a map's placements were checked once).
+    """
+    transforms = np.zeros((len(placements), 4, 4))
+    for transform, (x, y, z, yaw) in zip(transforms, placements[:, :4].tolist(), strict=True):
+        c, s = math.cos(yaw), math.sin(yaw)
+        transform[0] = c, -s, 0.0, x
+        transform[1] = s, c, 0.0, y
+        transform[2, 2], transform[2, 3], transform[3, 3] = 1.0, z, 1.0
+    return transforms
