@@ -30,7 +30,7 @@ from solver.path.limits import JointMotion, bound_by_limits
 from solver.path.prepare import PreparedPath
 from solver.path.problem import PathProblem
 from solver.path.pruning import can_prune, pruned_solutions
-from solver.path.tracking import Tracked, choose_branch
+from solver.path.tracking import Tracked, choose_branch, track
 
 
 def check_placements(placements: np.ndarray) -> np.ndarray:
