@@ -18,11 +18,9 @@ from __future__ import annotations
 import numpy as np
 import pinocchio as pin
 
-from solver.core.codes import OK, SINGULAR, UNREACHABLE
 from solver.core.family import Branch, FollowsInSteps, KinematicsFamily, PathSolutions
 from solver.core.progress import Progress, span
-from solver.core.spatial import wrap_angle
-from solver.families.numeric import bounded_kernel, costs, ik, ik_kernel, velocity
+from solver.families.numeric import bounded_kernel, costs, ik, ik_kernel, reference, velocity
 from solver.families.numeric.chain import SerialChain
 
 FOLLOW_WAYPOINTS = 256
@@ -104,32 +102,6 @@ class NumericFamily(KinematicsFamily, FollowsInSteps):
     def branches(self) -> tuple[Branch, ...]:
         """``solution=0`` ... ``solution=K-1``: slots for the distinct solutions, in seed order."""
         return self._branches
-
-    def _seeded(
-        self, rotation: np.ndarray, position: np.ndarray, progress: Progress | None = None
-    ) -> tuple[np.ndarray, np.ndarray]:
-        """Distinct solutions within the limits from every seed: (P, 3, 3), (P, 3) -> slots.
-
-        ``progress`` is called after each iteration of the seeds' solve.
-
-        Returns:
-            slots (P, K, n), rad, NaN after the solutions found; count (P,).
-        """
-        n_poses, n_seeds = len(position), len(self.seeds)
-        start = np.broadcast_to(self.seeds, (n_poses, n_seeds, self.dof)).reshape(-1, self.dof)
-        q, converged = ik.solve(
-            self.chain,
-            start,
-            np.repeat(rotation, n_seeds, axis=0),
-            np.repeat(position, n_seeds, axis=0),
-            iterations=ik.SEED_ITERATIONS,
-            lower=self.lower,
-            upper=self.upper,
-            stall=(ik.STALL_STEPS, ik.STALL_RATIO),
-            progress=progress,
-        )
-        q = q.reshape(n_poses, n_seeds, self.dof)
-        return ik.distinct(q, converged.reshape(n_poses, n_seeds), self.chain.q_revolute)
 
     def _settings(self) -> tuple[np.ndarray, np.ndarray]:
         """The compiled IK's settings and constants (:func:`ik_kernel.seed_paths`)."""
@@ -277,18 +249,6 @@ class NumericFamily(KinematicsFamily, FollowsInSteps):
                 progress(SEED_SHARE + (1.0 - SEED_SHARE) * piece.stop / n_waypoints)
         return q, status, count
 
-    def _wrapped_with_status(
-        self, q: np.ndarray, progress: Progress | None = None
-    ) -> tuple[np.ndarray, np.ndarray]:
-        """Revolute joints wrapped to [-pi, pi) and the status of each solution, q (..., n)."""
-        flat = q.reshape(-1, self.dof)
-        status = np.full(len(flat), UNREACHABLE)
-        solved = np.flatnonzero(np.isfinite(flat).all(axis=-1))
-        for rows in velocity.in_chunks(solved, progress):
-            status[rows] = np.where(ik.is_singular(self.chain, flat[rows]), SINGULAR, OK)
-        wrapped = np.where(self.chain.q_revolute, wrap_angle(q), q)
-        return wrapped, status.reshape(q.shape[:-1])
-
     def solve(self, rotation: np.ndarray, position: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """The distinct solutions found from the seeds at each pose (see KinematicsFamily.solve).
 
@@ -304,8 +264,10 @@ class NumericFamily(KinematicsFamily, FollowsInSteps):
             q_k, status_k, _ = self._compiled(rotation_flat[:, None], position_flat[:, None])
             q_shape = (self.dof, len(self.seeds), *batch)
             return q_k.reshape(q_shape), status_k.reshape(q_shape[1:])
-        slots, _ = self._seeded(rotation_flat, position_flat)
-        q, status = self._wrapped_with_status(slots)  # (P, K, n), (P, K)
+        slots, _ = reference.seeded(
+            self.chain, self.seeds, (self.lower, self.upper), rotation_flat, position_flat
+        )
+        q, status = reference.wrapped_with_status(self.chain, slots)  # (P, K, n), (P, K)
         q = np.moveaxis(q.reshape(*batch, len(self.seeds), self.dof), (-1, -2), (0, 1))
         return q, np.moveaxis(status.reshape(*batch, len(self.seeds)), -1, 0)
 
@@ -342,75 +304,33 @@ class NumericFamily(KinematicsFamily, FollowsInSteps):
                 seeds=n_seeds,
                 branches_found=count_k.reshape(batch),
             )
-        slots, count = self._seeded(
-            rotations[:, 0], positions[:, 0], span(progress, 0.0, SEED_SHARE)
+        slots, count = reference.seeded(
+            self.chain,
+            self.seeds,
+            (self.lower, self.upper),
+            rotations[:, 0],
+            positions[:, 0],
+            span(progress, 0.0, SEED_SHARE),
         )
         q = np.full((n_paths, n_seeds, n_waypoints, self.dof), np.nan)
         q[:, :, 0] = slots
         paths, branches = np.nonzero(np.isfinite(slots[..., 0]))
-        q[paths, branches] = self._followed(
+        q[paths, branches] = reference.followed(
+            self.chain,
             slots[paths, branches],
             rotations[paths],
             positions[paths],
             progress=span(progress, SEED_SHARE, FOLLOW_SHARE),
         )
-        wrapped, status = self._wrapped_with_status(q, span(progress, FOLLOW_SHARE, 1.0))
+        wrapped, status = reference.wrapped_with_status(
+            self.chain, q, span(progress, FOLLOW_SHARE, 1.0)
+        )
         return PathSolutions(
             q=wrapped.transpose(3, 1, 0, 2).reshape(self.dof, n_seeds, *batch, n_waypoints),
             status=np.moveaxis(status, 1, 0).reshape(n_seeds, *batch, n_waypoints),
             seeds=n_seeds,
             branches_found=count.reshape(batch),
         )
-
-    def _followed(
-        self,
-        start: np.ndarray,
-        rotations: np.ndarray,
-        positions: np.ndarray,
-        *,
-        progress: Progress | None = None,
-    ) -> np.ndarray:
-        """Each branch followed from its first solution, NaN from the waypoint where it is lost.
-
-        Args:
-            start: shape (M, n), the branches' solutions at the first waypoint.
-            rotations: shape (M, W, 3, 3), R_B_F* of each branch's path.
-            positions: shape (M, W, 3), m in {B}.
-            progress: called after each waypoint with the fraction of waypoints followed.
-
-        Returns:
-            shape (M, W, n). A lost branch stays in the batch, frozen, until at least half of
-            it is lost and it holds ``ik.COMPACT_MIN_ROWS`` rows, for the reason given there.
-        """
-        n_waypoints = positions.shape[1]
-        track = np.full((len(start), n_waypoints, self.dof), np.nan)
-        rows = np.arange(len(start))  # the branch of each batch row
-        local = track.copy()  # the batch's rows of track
-        local[:, 0] = current = start
-        lost = np.zeros(len(start), dtype=bool)
-        for waypoint in range(1, n_waypoints):
-            if lost.all():
-                break
-            if progress is not None:
-                progress(waypoint / n_waypoints)
-            solved, converged = ik.solve(
-                self.chain,
-                current,
-                rotations[:, waypoint],
-                positions[:, waypoint],
-                iterations=ik.TRACK_ITERATIONS,
-                frozen=lost,
-            )
-            lost |= ~converged
-            current = np.where(lost[:, None], current, solved)  # a lost row keeps a finite q
-            local[:, waypoint] = np.where(lost[:, None], np.nan, solved)
-            if len(rows) >= ik.COMPACT_MIN_ROWS and 2 * np.count_nonzero(lost) >= len(rows):
-                track[rows] = local
-                keep = ~lost
-                rows, local, current, lost = rows[keep], local[keep], current[keep], lost[keep]
-                rotations, positions = rotations[keep], positions[keep]
-        track[rows] = local
-        return track
 
     def joint_speeds_per_unit_twist(
         self,
