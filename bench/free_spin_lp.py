@@ -22,7 +22,7 @@ import numpy as np
 from solver.core import dtf_redundant
 from solver.core.spatial import Placement
 from solver.families import get_robot
-from solver.families.numeric.family import FREE_SPIN_REDUNDANT_COST
+from solver.families.numeric.costs import FREE_SPIN_REDUNDANT_COST
 from solver.kernels import spin_lp
 from solver.path.evaluate import evaluate_path
 from solver.path.problem import PathOptions, PathProblem

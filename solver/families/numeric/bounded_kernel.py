@@ -5,10 +5,11 @@ the previous path ended with as its candidate is followed first to the end, then
 slot, in order; along each, V_max = 1 / max_j |(J^-1 t)_j| / qdot_max_j is computed at every
 waypoint (J at the tool point), and its least value so far bounds the branch's mu_path. A slot
 is dropped (its following stopped) once that bound shows it can neither tie with the
-candidate nor beat it (the rules of :func:`_hopeless`). A slot's solutions, status and loss
-are those of :func:`solver.families.numeric.ik_kernel.follow_paths`, bit for bit: the same
-steps from the same starts. Whether a drop was right is decided by the caller, from the
-pipeline's own mu_path of the slots followed to the end. Every function releases the GIL.
+candidate nor beat it (the rules of :func:`solver.families.numeric.scout_kernel.hopeless`,
+where the V_max and the scouting live too). A slot's solutions, status and loss are those of
+:func:`solver.families.numeric.ik_kernel.follow_paths`, bit for bit: the same steps from the
+same starts. Whether a drop was right is decided by the caller, from the pipeline's own
+mu_path of the slots followed to the end. Every function releases the GIL.
 """
 
 from __future__ import annotations
@@ -20,109 +21,14 @@ import numpy as np
 from numba import njit
 
 from solver.core.codes import OK, SINGULAR, UNREACHABLE
-from solver.families.numeric import ik_kernel
-from solver.families.numeric.chain_kernel import (
-    drop_stale_cache,
-    frames,
-    jacobian_at,
-    lu_solve,
-    workspace,
-)
-from solver.families.numeric.ik_kernel import _levenberg_marquardt, _pose_error, _singular
+from solver.families.numeric import ik_kernel, scout_kernel
+from solver.families.numeric.chain_kernel import drop_stale_cache, frames, workspace
+from solver.families.numeric.ik_kernel import _levenberg_marquardt, _singular
+from solver.families.numeric.scout_kernel import hopeless, scouted, v_max
 
 _TWO_PI = 2.0 * math.pi
 
-drop_stale_cache(Path(__file__), Path(ik_kernel.__file__))
-
-
-@njit(cache=True, nogil=True, error_model="numpy", inline="always")
-def _v_max(chain, twist, tool, qdot_max, work, jac, rhs):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
-    """V_max at the frames in ``work``: 1 / max_j |(J^-1 t)_j| / qdot_max_j; inf if J singular.
-
-    J at the tool point (6, 6) into ``jac``, J^-1 t into ``rhs``; ``work``'s own J and J J^T
-    (which the next waypoint's first step reuses) are left alone.
-    """
-    jacobian_at(chain[3], work[0], work[1], tool, jac)
-    for i in range(6):
-        rhs[i] = twist[i]
-    if not lu_solve(jac, rhs):
-        return math.inf
-    ratio = 0.0
-    for j in range(6):
-        ratio = max(ratio, abs(rhs[j]) / qdot_max[j])
-    return 1.0 / ratio if ratio > 0.0 else math.inf
-
-
-@njit(cache=True, nogil=True, error_model="numpy", inline="always")
-def _hopeless(slot, bound, candidate, best, tie, margin):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
-    """Whether a slot whose mu_path is at most ``bound`` can be dropped against the candidate.
-
-    ``best``: the candidate's mu_path as followed here. A slot after the candidate in order
-    cannot take its place once bound (1 + margin) (1 - tie) <= best (1 - margin) (it could
-    at most tie, and the first of a tie is taken); one before it once
-    bound (1 + margin) < best (1 - margin) (1 - tie) (it cannot tie). ``margin`` covers the
-    rounding between these V_max and the pipeline's.
-    """
-    if candidate < 0 or not best > 0.0 or math.isinf(best):
-        return False
-    high = bound * (1.0 + margin)
-    low = best * (1.0 - margin)
-    if slot > candidate:
-        return high * (1.0 - tie) <= low
-    return high < low * (1.0 - tie)
-
-
-@njit(cache=True, nogil=True, error_model="numpy", inline="always")
-def _fresh_jacobian(chain, work):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
-    """J at the flange and J J^T of the frames in ``work``, as the next step takes them."""
-    jacobian_at(chain[3], work[0], work[1], work[3], work[6])
-    jac, normal = work[6], work[7]
-    for i in range(6):
-        for k in range(i + 1):
-            total = 0.0
-            for j in range(jac.shape[1]):
-                total += jac[i, j] * jac[k, j]
-            normal[i, k] = total
-            normal[k, i] = total
-
-
-@njit(cache=True, nogil=True, error_model="numpy", inline="always")
-def _rough_steps(chain, q, target_r, target_p, steps, residual, constants, work):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
-    """``steps`` damped least-squares steps of q towards the pose; whether |e|_inf < residual.
-
-    ``work`` holds the frames, J and J J^T of q on entry and of the last iterate on return.
-    False too where a step meets a singular system or a NaN.
-    """
-    scale, floor = constants[1], constants[2]
-    n = len(q)
-    jac, normal, error = work[6], work[7], work[8]
-    for _ in range(steps):
-        _pose_error(target_r, target_p, work)
-        energy = 0.0
-        for i in range(6):
-            energy += error[i] * error[i]
-        if math.isnan(energy):
-            return False
-        for i in range(6):
-            normal[i, i] += scale * 0.5 * energy + floor
-        if not lu_solve(normal, error):
-            return False
-        for j in range(n):
-            q[j] += (
-                jac[0, j] * error[0]
-                + jac[1, j] * error[1]
-                + jac[2, j] * error[2]
-                + jac[3, j] * error[3]
-                + jac[4, j] * error[4]
-                + jac[5, j] * error[5]
-            )
-        frames(chain, q, work)
-        _fresh_jacobian(chain, work)
-    _pose_error(target_r, target_p, work)
-    largest = 0.0
-    for i in range(6):
-        largest = max(largest, abs(error[i]))
-    return largest < residual  # False for a NaN too
+drop_stale_cache(Path(__file__), Path(ik_kernel.__file__), Path(scout_kernel.__file__))
 
 
 @njit(cache=True, nogil=True, error_model="numpy", inline="always")
@@ -173,74 +79,16 @@ def _exact(chain, slot, path, limits, settings, constants, rules, work, spare, o
             low[j], high[j], before[j] = min(low[j], value), max(high[j], value), value
         speed = 0.0
         if not pure_rotation[w]:
-            speed = _v_max(chain, twists[w], tools[w], qdot_max, work, spare[0], spare[1])
+            speed = v_max(chain, twists[w], tools[w], qdot_max, work, spare[0], spare[1])
         if speed < least:
             least, slowest = speed, w
-        if _hopeless(b, least, candidate, best, tie, margin):
+        if hopeless(b, least, candidate, best, tie, margin):
             return least, slowest, failed, True
     for j in range(len(slot)):  # tracking's copies 2 pi k within the limits, with a margin
         k_low = math.ceil((lower[j] - low[j]) / _TWO_PI + 1e-9)
         k_high = math.floor((upper[j] - high[j]) / _TWO_PI - 1e-9)
         failed = failed or k_low > k_high
     return least, slowest, failed, False
-
-
-@njit(cache=True, nogil=True, error_model="numpy", inline="always")
-def _scouted(chain, slot, path, limits, settings, constants, rules, work, spare):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
-    """One slot scouted with rough strides from ``slot``; its exact bound, and if it is dropped.
-
-    ``rules``: (tie, margin, slot index, candidate, best, rough steps, slack, stride, the
-    candidate's slowest waypoint). The slot goes ``stride`` waypoints at a time, stopping at
-    the candidate's slowest waypoint on its way, ``rough`` steps each; it is solved exactly
-    at that waypoint, and wherever its rough V_max is within ``slack`` of what would drop it.
-    A stride that leaves |e|_inf above ``residual`` or moves a joint more than ``motion`` is
-    not trusted to stay on the branch: the scouting stops there. Returns (the least exact
-    V_max, dropped); not dropped: to be followed exactly.
-    """
-    rotations, positions, twists, tools = path
-    qdot_max, pure_rotation = limits[0], limits[1]
-    track_iterations = int(settings[1])
-    tie, margin, b, candidate, best, rough, slack, stride, slowest, residual, motion = rules
-    before = spare[2]
-    frames(chain, slot, work)
-    _fresh_jacobian(chain, work)
-    least, w, last = math.inf, 0, len(positions) - 1
-    while True:
-        if pure_rotation[w]:
-            least = 0.0
-        else:
-            speed = _v_max(chain, twists[w], tools[w], qdot_max, work, spare[0], spare[1])
-            near = _hopeless(b, speed * (1.0 - slack), candidate, best, tie, margin)
-            if near or w == slowest:
-                if w > 0 and not _levenberg_marquardt(
-                    chain,
-                    slot,
-                    rotations[w],
-                    positions[w],
-                    track_iterations,
-                    None,
-                    constants,
-                    work,
-                    True,
-                    (0, 0.0),
-                ):
-                    return least, False
-                exact = _v_max(chain, twists[w], tools[w], qdot_max, work, spare[0], spare[1])
-                least = min(least, exact)
-                _fresh_jacobian(chain, work)
-        if _hopeless(b, least, candidate, best, tie, margin):
-            return least, True
-        if w == last:
-            return least, False
-        step = min(w + stride, last)
-        w = slowest if w < slowest < step else step
-        before[:] = slot
-        target_r, target_p = rotations[w], positions[w]
-        if not _rough_steps(chain, slot, target_r, target_p, rough, residual, constants, work):
-            return least, False  # a stride too far to trust: followed exactly
-        for j in range(len(slot)):
-            if not abs(slot[j] - before[j]) <= motion:
-                return least, False
 
 
 @njit(cache=True, nogil=True, error_model="numpy")
@@ -262,7 +110,7 @@ def follow_bounded(  # type: ignore[no-untyped-def]  # pragma: no cover - compil
 
     The candidate (the previous path's, else the first slot) is followed exactly
     (``follow_paths``' steps). Once a path has a candidate, every other slot is first
-    scouted (:func:`_scouted`): ``rules[2]`` rough steps a stride of ``rules[4]`` waypoints,
+    scouted (:func:`scouted`): ``rules[2]`` rough steps a stride of ``rules[4]`` waypoints,
     stopping at the candidate's slowest waypoint, its rough V_max only a sign of where to
     look; there, and wherever that is within ``rules[3]`` (relative) of what would drop it,
     the slot is solved exactly (the full steps from the rough iterate) and its exact V_max
@@ -285,7 +133,7 @@ def follow_bounded(  # type: ignore[no-untyped-def]  # pragma: no cover - compil
             tracking judges, with a margin) is not taken as the candidate.
         settings: as for :func:`~solver.families.numeric.ik_kernel.seed_paths`.
         constants: as for :func:`~solver.families.numeric.ik_kernel.follow_paths`.
-        rules: (tie, margin) for :func:`_hopeless`; rough steps a stride (0: every slot
+        rules: (tie, margin) for :func:`hopeless`; rough steps a stride (0: every slot
             followed exactly); the slack of the rough V_max; the stride (waypoints); the
             residual and joint motion (rad or m) a trusted stride stays within.
 
@@ -341,7 +189,7 @@ def follow_bounded(  # type: ignore[no-untyped-def]  # pragma: no cover - compil
                     residual,
                     motion,
                 )
-                least, drop = _scouted(
+                least, drop = scouted(
                     chain, slot, path, limits, settings, constants, scout, work, spare
                 )
                 bound[b, p] = least

@@ -5,7 +5,7 @@ from __future__ import annotations
 import pytest
 
 from solver.families import get_robot
-from solver.families.numeric.family import COST_LINES
+from solver.families.numeric.costs import COST_LINES
 from tests.cases import NUMERIC_MODELS, OPW_MODELS, UR_MODELS
 
 

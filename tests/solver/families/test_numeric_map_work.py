@@ -16,12 +16,8 @@ import numpy as np
 import pytest
 
 from solver.families import get_robot
-from solver.families.numeric.family import (
-    COST_LINES,
-    FIRST_PIECE,
-    MAP_TAIL_SHARE,
-    NumericFamily,
-)
+from solver.families.numeric.costs import COST_LINES, FIRST_PIECE, MAP_TAIL_SHARE
+from solver.families.numeric.family import NumericFamily
 from solver.path import pruning
 from solver.path.capability_map import map_cost
 from solver.path.cell.checker import CELL_POSE_COST

@@ -19,7 +19,8 @@ from solver.core.progress import Cancelled
 from solver.core.spatial import Placement
 from solver.families import get_robot
 from solver.families.numeric import family as family_module
-from solver.families.numeric.family import CHUNK_ROWS, FOLLOW_WAYPOINTS, NumericFamily
+from solver.families.numeric.family import FOLLOW_WAYPOINTS, NumericFamily
+from solver.families.numeric.velocity import CHUNK_ROWS
 from solver.path import in_pieces
 from solver.path.evaluate import evaluate_path
 from solver.path.pipeline import REDUNDANT_FREE_SHARES

@@ -1,0 +1,173 @@
+"""Bounds for :mod:`solver.families.numeric.bounded_kernel`: V_max, the drop rule, scouting.
+
+robots.md section 4, :mod:`solver.path.bounded`: V_max = 1 / max_j |(J^-1 t)_j| / qdot_max_j at
+a waypoint (J at the tool point); the rule that drops a slot against the candidate; and the
+scouting of a slot other than the candidate, rough damped least-squares steps a stride of
+waypoints, solved exactly where its bound is decided. Every function releases the GIL.
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+from numba import njit
+
+from solver.families.numeric import ik_kernel
+from solver.families.numeric.chain_kernel import (
+    drop_stale_cache,
+    frames,
+    jacobian_at,
+    lu_solve,
+)
+from solver.families.numeric.ik_kernel import _levenberg_marquardt, _pose_error
+
+drop_stale_cache(Path(__file__), Path(ik_kernel.__file__))
+
+
+@njit(cache=True, nogil=True, error_model="numpy", inline="always")
+def v_max(chain, twist, tool, qdot_max, work, jac, rhs):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
+    """V_max at the frames in ``work``: 1 / max_j |(J^-1 t)_j| / qdot_max_j; inf if J singular.
+
+    J at the tool point (6, 6) into ``jac``, J^-1 t into ``rhs``; ``work``'s own J and J J^T
+    (which the next waypoint's first step reuses) are left alone.
+    """
+    jacobian_at(chain[3], work[0], work[1], tool, jac)
+    for i in range(6):
+        rhs[i] = twist[i]
+    if not lu_solve(jac, rhs):
+        return math.inf
+    ratio = 0.0
+    for j in range(6):
+        ratio = max(ratio, abs(rhs[j]) / qdot_max[j])
+    return 1.0 / ratio if ratio > 0.0 else math.inf
+
+
+@njit(cache=True, nogil=True, error_model="numpy", inline="always")
+def hopeless(slot, bound, candidate, best, tie, margin):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
+    """Whether a slot whose mu_path is at most ``bound`` can be dropped against the candidate.
+
+    ``best``: the candidate's mu_path as followed here. A slot after the candidate in order
+    cannot take its place once bound (1 + margin) (1 - tie) <= best (1 - margin) (it could
+    at most tie, and the first of a tie is taken); one before it once
+    bound (1 + margin) < best (1 - margin) (1 - tie) (it cannot tie). ``margin`` covers the
+    rounding between these V_max and the pipeline's.
+    """
+    if candidate < 0 or not best > 0.0 or math.isinf(best):
+        return False
+    high = bound * (1.0 + margin)
+    low = best * (1.0 - margin)
+    if slot > candidate:
+        return high * (1.0 - tie) <= low
+    return high < low * (1.0 - tie)
+
+
+@njit(cache=True, nogil=True, error_model="numpy", inline="always")
+def fresh_jacobian(chain, work):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
+    """J at the flange and J J^T of the frames in ``work``, as the next step takes them."""
+    jacobian_at(chain[3], work[0], work[1], work[3], work[6])
+    jac, normal = work[6], work[7]
+    for i in range(6):
+        for k in range(i + 1):
+            total = 0.0
+            for j in range(jac.shape[1]):
+                total += jac[i, j] * jac[k, j]
+            normal[i, k] = total
+            normal[k, i] = total
+
+
+@njit(cache=True, nogil=True, error_model="numpy", inline="always")
+def rough_steps(chain, q, target_r, target_p, steps, residual, constants, work):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
+    """``steps`` damped least-squares steps of q towards the pose; whether |e|_inf < residual.
+
+    ``work`` holds the frames, J and J J^T of q on entry and of the last iterate on return.
+    False too where a step meets a singular system or a NaN.
+    """
+    scale, floor = constants[1], constants[2]
+    n = len(q)
+    jac, normal, error = work[6], work[7], work[8]
+    for _ in range(steps):
+        _pose_error(target_r, target_p, work)
+        energy = 0.0
+        for i in range(6):
+            energy += error[i] * error[i]
+        if math.isnan(energy):
+            return False
+        for i in range(6):
+            normal[i, i] += scale * 0.5 * energy + floor
+        if not lu_solve(normal, error):
+            return False
+        for j in range(n):
+            q[j] += (
+                jac[0, j] * error[0]
+                + jac[1, j] * error[1]
+                + jac[2, j] * error[2]
+                + jac[3, j] * error[3]
+                + jac[4, j] * error[4]
+                + jac[5, j] * error[5]
+            )
+        frames(chain, q, work)
+        fresh_jacobian(chain, work)
+    _pose_error(target_r, target_p, work)
+    largest = 0.0
+    for i in range(6):
+        largest = max(largest, abs(error[i]))
+    return largest < residual  # False for a NaN too
+
+
+@njit(cache=True, nogil=True, error_model="numpy", inline="always")
+def scouted(chain, slot, path, limits, settings, constants, rules, work, spare):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
+    """One slot scouted with rough strides from ``slot``; its exact bound, and if it is dropped.
+
+    ``rules``: (tie, margin, slot index, candidate, best, rough steps, slack, stride, the
+    candidate's slowest waypoint). The slot goes ``stride`` waypoints at a time, stopping at
+    the candidate's slowest waypoint on its way, ``rough`` steps each; it is solved exactly
+    at that waypoint, and wherever its rough V_max is within ``slack`` of what would drop it.
+    A stride that leaves |e|_inf above ``residual`` or moves a joint more than ``motion`` is
+    not trusted to stay on the branch: the scouting stops there. Returns (the least exact
+    V_max, dropped); not dropped: to be followed exactly.
+    """
+    rotations, positions, twists, tools = path
+    qdot_max, pure_rotation = limits[0], limits[1]
+    track_iterations = int(settings[1])
+    tie, margin, b, candidate, best, rough, slack, stride, slowest, residual, motion = rules
+    before = spare[2]
+    frames(chain, slot, work)
+    fresh_jacobian(chain, work)
+    least, w, last = math.inf, 0, len(positions) - 1
+    while True:
+        if pure_rotation[w]:
+            least = 0.0
+        else:
+            speed = v_max(chain, twists[w], tools[w], qdot_max, work, spare[0], spare[1])
+            near = hopeless(b, speed * (1.0 - slack), candidate, best, tie, margin)
+            if near or w == slowest:
+                if w > 0 and not _levenberg_marquardt(
+                    chain,
+                    slot,
+                    rotations[w],
+                    positions[w],
+                    track_iterations,
+                    None,
+                    constants,
+                    work,
+                    True,
+                    (0, 0.0),
+                ):
+                    return least, False
+                exact = v_max(chain, twists[w], tools[w], qdot_max, work, spare[0], spare[1])
+                least = min(least, exact)
+                fresh_jacobian(chain, work)
+        if hopeless(b, least, candidate, best, tie, margin):
+            return least, True
+        if w == last:
+            return least, False
+        step = min(w + stride, last)
+        w = slowest if w < slowest < step else step
+        before[:] = slot
+        target_r, target_p = rotations[w], positions[w]
+        if not rough_steps(chain, slot, target_r, target_p, rough, residual, constants, work):
+            return least, False  # a stride too far to trust: followed exactly
+        for j in range(len(slot)):
+            if not abs(slot[j] - before[j]) <= motion:
+                return least, False
