@@ -21,7 +21,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from solver.core.codes import ACC_TIE_RTOL, FEASIBLE, UNREACHABLE
-from solver.core.family import FollowsInSteps
+from solver.core.follows_in_steps import FollowsInSteps
 from solver.core.progress import Progress, span
 from solver.path.bounded import bounded_solutions, pick_stands
 from solver.path.in_pieces import bound_in_pieces, track_in_pieces

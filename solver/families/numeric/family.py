@@ -22,7 +22,8 @@ import pinocchio as pin
 
 from solver.core.codes import OK, SINGULAR, UNREACHABLE
 from solver.core.dtf_redundant import redundant_speed
-from solver.core.family import Branch, FollowsInSteps, KinematicsFamily, PathSolutions
+from solver.core.family import Branch, KinematicsFamily, PathSolutions
+from solver.core.follows_in_steps import FollowsInSteps
 from solver.core.progress import Progress, span
 from solver.core.spatial import wrap_angle
 from solver.families.numeric import (
