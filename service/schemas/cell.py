@@ -22,7 +22,6 @@ from service.schemas.common import (
     pose_matrix_of,
 )
 from solver.core.exceptions import InvalidInputError
-from solver.path.cell.checker import Contact as SolverContact
 from solver.path.cell.shapes import (
     DEFAULT_CLEARANCE,
     DEFAULT_COLLISION_STEP,
@@ -38,6 +37,7 @@ from solver.path.cell.shapes import (
     Tool,
 )
 from solver.path.cell.stl import read_stl
+from solver.path.cell.verdict import Contact as SolverContact
 
 MAX_CELL_OBJECTS = 1_000  # the schema's bound; the setting DTF_MAX_CELL_OBJECTS is lower
 MAX_LINK_RADII = 64

@@ -179,7 +179,7 @@ def turned_poses(c, ca, sa, offset, flange_rotation, flange_position, tool_posit
     """Fill ``poses`` (21, W) for placement c: the path turned by its yaw and moved.
 
     Rows: R_B_F row by row (0-8), p_B_F (9-11), t_hat in {B} (12-17), the tool point (18-20);
-    the same arithmetic as :func:`solver.path.pipeline.turn_by_yaw`.
+    the same arithmetic as :func:`solver.path.placed.turn_by_yaw`.
     """
     for w in range(flange_rotation.shape[0]):
         for k in range(3):  # R_B_F = Rz(yaw) R_O_F, row by row

@@ -8,7 +8,7 @@ waypoints:
 
 1. turn the prepared path by the placement's yaw and move it
    (:func:`solver.kernels.cell.turned_poses`, the arithmetic of
-   :func:`solver.path.pipeline.turn_by_yaw`);
+   :func:`solver.path.placed.turn_by_yaw`);
 2. IK of the flange poses on the branches still alive and J^-1 t on each (the family's pose
    kernel, :mod:`solver.families.kernels`, level by level), every angle a (cos, sin) pair;
 3. each branch still alive, waypoint by waypoint: unreachable, then singular, then the step test

@@ -16,7 +16,7 @@ tested against (tests/solver/test_free_spin_kernel.py). Per placement:
    :mod:`solver.kernels.free_follow`): the branch the previous placement chose first, then the
    most promising, each followed to the end tracked again along its spin schedule (the spin
    rate nearest zero at the feed mu_path, :func:`solver.core.dtf.spin_rate_nearest_zero`; the
-   joints moved by the spin, :func:`solver.path.pipeline._spin_schedule`; that joint path
+   joints moved by the spin, :func:`solver.path.spin_schedule.spin_schedule`; that joint path
    tracked with the position limits and the step test, :func:`solver.path.tracking.track`,
    in :mod:`solver.kernels.spin_schedule`); the others probed and left once they cannot be
    chosen, and followed to the end after all where the answer might depend on them;

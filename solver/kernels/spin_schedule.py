@@ -1,6 +1,6 @@
 """The free-spin kernel's spin schedule: the spin rates at the feed, and the spun path's tracking.
 
-cam.md section 2, as :func:`solver.path.pipeline._spin_schedule`: at the feed mu_path the spin
+cam.md section 2, as :func:`solver.path.spin_schedule.spin_schedule`: at the feed mu_path the spin
 rate nearest zero at each waypoint (:func:`spin_rate`), the joints moved by the spin, and that
 joint path tracked again with the step test and the position limits (:func:`spun_failure`).
 Called by :func:`solver.kernels.free_spin.free_cells`.
@@ -45,9 +45,10 @@ def spun_failure(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
 
     ``path`` (W, 6) is the branch's tracked joint path; it is overwritten by the spun one,
     q_i + sum_k<i sigma_k dt_k J^-1 [0; z_tool]_k, each pass restarting the sum
-    (:func:`solver.path.pipeline.cumsum_within_passes`; a rapid moves no spin). That path is then
-    tracked as :func:`solver.path.tracking.track` does: the step test, then the position limits;
-    ``spun`` (W, 6), out, gets the tracked path (before its 2 pi copy is chosen).
+    (:func:`solver.path.spin_schedule.cumsum_within_passes`; a rapid moves no spin). That path
+    is then tracked as :func:`solver.path.tracking.track` does: the step test, then the
+    position limits; ``spun`` (W, 6), out, gets the tracked path (before its 2 pi copy is
+    chosen).
 
     Returns:
         (FEASIBLE, -1) where it holds.

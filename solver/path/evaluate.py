@@ -22,10 +22,11 @@ from solver.core.family import Branch
 from solver.core.progress import Progress
 from solver.core.spatial import Placement, rotation_about_z
 from solver.kernels.spin_lp import spin_rate_at_feed
-from solver.path.cell.checker import CellVerdict, Contact
+from solver.path.cell.verdict import CellVerdict, Contact
 from solver.path.limits import JointAccelerationLimit, JointMotion, PathVerdict, bound_by_limits
 from solver.path.path_checks import clear_pick
-from solver.path.pipeline import check_placements, run_chunk
+from solver.path.pipeline import run_chunk
+from solver.path.placed import check_placements
 from solver.path.problem import PathProblem, SpinMode
 
 __all__ = ["AccelerationIndex", "Branch", "PathEvaluation", "acceleration_index", "evaluate_path"]

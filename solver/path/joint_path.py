@@ -24,7 +24,7 @@ from solver.core.spatial import Placement, rotation_about_z
 from solver.path.evaluate import PathEvaluation, acceleration_index, cell_detail
 from solver.path.limits import JointMotion, bound_by_limits
 from solver.path.path_checks import check_path
-from solver.path.pipeline import turn_by_yaw
+from solver.path.placed import turn_by_yaw
 from solver.path.problem import PathProblem
 
 # m and rad: how far forward kinematics of a joint path sent to /v1/evaluate may be from the

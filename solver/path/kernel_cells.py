@@ -17,7 +17,7 @@ from solver.kernels.fixed_spin import map_cells
 from solver.kernels.free_spin import free_cells
 from solver.kernels.positions import limit_modes
 from solver.path.limits import JointAccelerationLimit
-from solver.path.pipeline import flange_at_spin
+from solver.path.placed import flange_at_spin
 from solver.path.problem import PathProblem
 
 

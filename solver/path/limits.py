@@ -112,7 +112,7 @@ class PathVerdict:
 
     Attributes:
         failed_waypoint: where the path is refused; None: admitted.
-        detail: the check's report (the cell: :class:`solver.path.cell.checker.CellVerdict`).
+        detail: the check's report (the cell: :class:`solver.path.cell.verdict.CellVerdict`).
     """
 
     failed_waypoint: int | None

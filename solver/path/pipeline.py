@@ -8,8 +8,10 @@ optimisers) both run :func:`run_chunk`; only the robot's kinematics family
 (:mod:`solver.path.limits`, the DTF first) how fast each waypoint may run.
 
 What makes it fast (dtf.md section 9): t_hat is computed once in {O} and only turned by each
-placement's yaw; all placements of a chunk, all waypoints and all IK branches are one set of
-component-first arrays with waypoints last.
+placement's yaw (:mod:`solver.path.placed`); all placements of a chunk, all waypoints and all IK
+branches are one set of component-first arrays with waypoints last. Free spin's schedule is
+:mod:`solver.path.spin_schedule`; the path checks (the cell) run after, in
+:mod:`solver.path.path_checks`.
 """
 
 from __future__ import annotations
@@ -19,39 +21,16 @@ from dataclasses import dataclass
 import numpy as np
 
 from solver.core.codes import ACC_TIE_RTOL, FEASIBLE, UNREACHABLE
-from solver.core.dtf import spin_rate_nearest_zero
-from solver.core.exceptions import InvalidInputError
-from solver.core.family import FollowsInSteps
+from solver.core.follows_in_steps import FollowsInSteps
 from solver.core.progress import Progress, span
-from solver.core.spatial import MAX_COORDINATE, rotation_about_z
 from solver.path.bounded import bounded_solutions, pick_stands
-from solver.path.in_pieces import bound_in_pieces, spin_rates_in_pieces, track_in_pieces
+from solver.path.in_pieces import bound_in_pieces, track_in_pieces
 from solver.path.limits import JointMotion, bound_by_limits
-from solver.path.prepare import PreparedPath
+from solver.path.placed import placed_flange, turn_by_yaw
 from solver.path.problem import PathProblem
 from solver.path.pruning import can_prune, pruned_solutions
-from solver.path.tracking import Tracked, choose_branch, track
-
-
-def check_placements(placements: np.ndarray) -> np.ndarray:
-    """Placements as a float array (P, 5) of finite [x, y, z, yaw, spin] within MAX_COORDINATE.
-
-    The one batched layout of placements (:meth:`solver.core.spatial.Placement.as_row`); (P, 4)
-    arrays without the spin are taken with spin 0.
-
-    Raises:
-        InvalidInputError: wrong shape, not finite, or too far.
-    """
-    arr = np.asarray(placements, dtype=float)
-    if arr.ndim == 2 and arr.shape[1] == 4:
-        arr = np.column_stack([arr, np.zeros(len(arr))])
-    if arr.ndim != 2 or arr.shape[1] != 5:
-        raise InvalidInputError("placements", f"{arr.shape=}, needs (P, 5): x, y, z, yaw, spin")
-    if not np.all(np.isfinite(arr)) or np.any(np.abs(arr[:, :3]) > MAX_COORDINATE):
-        raise InvalidInputError(
-            "placements", f"need finite values, positions within {MAX_COORDINATE} m"
-        )
-    return arr
+from solver.path.spin_schedule import spin_schedule
+from solver.path.tracking import Tracked, choose_branch
 
 
 @dataclass(frozen=True)
@@ -112,88 +91,6 @@ class ChunkResult:
     final_binding: np.ndarray | None = None
     mu_acc: np.ndarray | None = None
     branch_of: np.ndarray | None = None
-
-
-def turn_by_yaw(vectors: np.ndarray, yaws: np.ndarray) -> np.ndarray:
-    """Rz(yaw) v for every yaw: vectors (3, ..., W) in {O} -> (3, ..., C, W), C-contiguous.
-
-    Args:
-        vectors: shape (3, ..., W), in {O}.
-        yaws: shape (C,), rad (C = 1 broadcasts one turn over a chunk).
-    """
-    cos, sin = np.cos(yaws)[:, None], np.sin(yaws)[:, None]
-    x, y = vectors[0][..., None, :], vectors[1][..., None, :]
-    z = np.broadcast_to(vectors[2][..., None, :], np.broadcast_shapes(x.shape, cos.shape))
-    return np.stack([cos * x - sin * y, sin * x + cos * y, z])
-
-
-def flange_at_spin(path: PreparedPath, spin: float) -> tuple[np.ndarray, np.ndarray]:
-    """R_O_F (N, 3, 3) and p_O_F (N, 3) with every tool pose turned by ``spin`` about its z."""
-    if spin == 0.0:
-        return path.flange_rotation, path.flange_position
-    turned = path.tool_rotation @ rotation_about_z(spin)
-    rotation = turned @ path.tool_to_flange[:3, :3]
-    position = path.tool_position + turned @ path.tool_to_flange[:3, 3]
-    return rotation, position
-
-
-def placed_flange(
-    problem: PathProblem, placements: np.ndarray
-) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """The yaws and the flange poses in {B} of a chunk's placements (one spin).
-
-    Returns:
-        yaws: shape (C,), rad, or (1,) where they are all one (broadcast: less to read);
-        R_B_F: shape (3, 3, C, W); p_B_F: shape (3, C, W), m.
-    """
-    yaws = placements[:, 3]
-    if np.all(yaws == yaws[0]):
-        yaws = yaws[:1]
-    if np.any(placements[:, 4] != placements[0, 4]):
-        raise InvalidInputError("placements", "a chunk must have one spin")
-    offset = placements[:, :3].T[:, :, None]  # (3, C, 1)
-    flange_rotation, flange_position_o = flange_at_spin(problem.prepared, float(placements[0, 4]))
-    rotation = turn_by_yaw(flange_rotation.transpose(1, 2, 0), yaws)  # (3, 3, C, W)
-    flange_position = turn_by_yaw(flange_position_o.T, yaws) + offset
-    return yaws, rotation, flange_position
-
-
-def tracked_joint_paths(
-    problem: PathProblem, placements: np.ndarray, rows: np.ndarray
-) -> np.ndarray | None:
-    """The joint paths a run on one branch gives, each placement on its own branch.
-
-    What :func:`run_chunk` tracks at placement c with the problem's branch set to the family's
-    branch ``rows[c]``, without the joint speeds (a path check needs the angles alone); one IK
-    solve for every placement.
-
-    Args:
-        problem: the problem (fixed spin: free spin tracks its spin schedule's path).
-        placements: shape (C, 5), one spin, checked.
-        rows: shape (C,), an index into the family's branches per placement.
-
-    Returns:
-        shape (C, W, n), rad; None where the family answers in slots (numeric IK) or the
-        spin is free: there :func:`run_chunk` on each branch is the way.
-    """
-    if problem.options.spin_mode == "free":
-        return None
-    _, rotation, flange_position = placed_flange(problem, placements)
-    solutions = problem.family.solve_path(rotation, flange_position)
-    if solutions.slots is not None:
-        return None
-    cells = np.arange(len(placements))
-    robot = problem.robot
-    tracked = track(
-        solutions.q[:, rows, cells][:, None],  # (n, 1, C, W): one branch, as run_chunk's
-        solutions.status[rows, cells][None],
-        lower=robot.q_lower,
-        upper=robot.q_upper,
-        max_joint_step=problem.options.max_joint_step,
-        segment_checked=problem.prepared.segment_in_pass,
-    )
-    joint_paths: np.ndarray = tracked.q[:, 0].transpose(1, 2, 0)
-    return joint_paths
 
 
 def run_chunk(
@@ -276,7 +173,7 @@ def run_chunk(
         return run_chunk(problem, placements, progress=progress)  # every branch followed
     spins = None
     if qd_spin is not None:
-        spins, tracked = _spin_schedule(
+        spins, tracked = spin_schedule(
             problem, tracked, motion, qd_spin, mu_path, _part(progress, shares, 6)
         )
         feasible = tracked.reason == FEASIBLE
@@ -368,92 +265,3 @@ def _final_path_bounds(
     lowest = bound.min(axis=-1) if bound.shape[-1] else np.full(mu_path.shape, np.inf)
     mu_acc = np.where(feasible, np.minimum(mu_path, lowest), -np.inf)
     return bound, joint, binding, mu_acc
-
-
-def _spin_schedule(
-    problem: PathProblem,
-    tracked: Tracked,
-    motion: JointMotion,
-    qd_spin: np.ndarray,
-    mu_path: np.ndarray,
-    progress: Progress | None = None,
-) -> tuple[np.ndarray, Tracked]:
-    """The spins that realise mu_path in free mode, and the joint paths along them.
-
-    At the feed F = mu_path each waypoint admits an interval of spin rates; the one nearest zero
-    is held over the segment (its duration |dp_i| / F), which gives the spins phi_i. The joints
-    follow q_i + sum_k<i sigma_k dt_k J^-1 [0; z_tool]_k: exact for a straight spindle (only the
-    last joint moves), first order otherwise (cam.md section 2). Those joint paths are tracked
-    again, so the last joint's limits and steps are checked along the schedule.
-
-    Args:
-        problem: the robot, the prepared path and the options.
-        tracked: the branches followed at the given spin; q (n, B, C, W).
-        motion: their joint speeds per unit feed (qd_unit) and, for seven joints, the null
-            space of J (qd_null), each (n, B, C, W). A seven-joint arm's spin rate is that of
-            the three-variable LP (:func:`solver.core.dtf_redundant.spin_rate_at_feed`), and
-            its joints follow the spin by the least-norm qd_spin.
-        qd_spin: shape (n, B, C, W), J^-1 [0; z_tool] (the least-norm one for seven joints).
-        mu_path: shape (B, C), m/s, -inf where infeasible.
-        progress: called after each piece of waypoints whose spin rates are found (seven
-            joints: the LP, :func:`solver.path.in_pieces.spin_rates_in_pieces`), then after each
-            piece of branches tracked along the spins.
-
-    Returns:
-        spins (B, C, W), rad (0 where infeasible or mu_path = 0), and the tracking of the spun
-        joint paths (where the branch was feasible).
-    """
-    robot, path = problem.robot, problem.prepared
-    feed = np.where(np.isfinite(mu_path) & (mu_path > 0.0), mu_path, 0.0)[..., None]
-    qd_unit = motion.qd_unit
-    if motion.qd_null is None:
-        rate = spin_rate_nearest_zero(qd_unit, qd_spin, robot.qdot_max, feed)
-    else:
-        rate = spin_rates_in_pieces(
-            qd_unit, qd_spin, motion.qd_null, robot.qdot_max, feed, span(progress, 0.0, 0.5)
-        )
-    length = np.linalg.norm(np.diff(path.tool_position, axis=0), axis=1)  # (W - 1,)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        step = np.where(feed > 0.0, rate[..., :-1] * length / feed, 0.0)  # (B, C, W - 1)
-    step = np.where(path.segment_in_pass, step, 0.0)  # each pass starts at the placement's spin
-    spins = cumsum_within_passes(step, path.segment_in_pass)
-
-    def spun_joints(rows: slice) -> np.ndarray:
-        """The joint paths of some branches moved by the spins, (n, b, C, W)."""
-        moved = cumsum_within_passes(step[rows] * qd_spin[:, rows, ..., :-1], path.segment_in_pass)
-        joints: np.ndarray = tracked.q[:, rows] + np.nan_to_num(moved)
-        return joints
-
-    spun = track_in_pieces(
-        tracked.q,
-        np.zeros(tracked.q.shape[1:], dtype=int),  # every pose was solved: only limits, steps
-        span(progress, 0.5, 1.0),
-        joints_of=spun_joints,
-        lower=robot.q_lower,
-        upper=robot.q_upper,
-        max_joint_step=problem.options.max_joint_step,
-        segment_checked=path.segment_in_pass,
-    )
-    keep = np.isfinite(mu_path)
-    return spins, Tracked(
-        reason=np.where(keep, spun.reason, tracked.reason),
-        failed_waypoint=np.where(keep, spun.failed_waypoint, tracked.failed_waypoint),
-        q=np.where(keep[None, ..., None], spun.q, tracked.q),
-    )
-
-
-def cumsum_within_passes(steps: np.ndarray, segment_in_pass: np.ndarray) -> np.ndarray:
-    """Running sums of per-segment steps along the last axis, restarting at 0 at each pass.
-
-    Args:
-        steps: shape (..., W - 1), one value per segment.
-        segment_in_pass: shape (W - 1,), False where a segment joins two passes.
-
-    Returns:
-        shape (..., W): 0 at the first waypoint of every pass.
-    """
-    total = np.concatenate([np.zeros(steps.shape[:-1] + (1,)), np.cumsum(steps, axis=-1)], axis=-1)
-    starts = np.concatenate([[True], ~segment_in_pass])  # (W,), the first waypoint of each pass
-    first = np.maximum.accumulate(np.where(starts, np.arange(len(starts)), 0))
-    result: np.ndarray = total - total[..., first]
-    return result

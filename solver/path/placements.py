@@ -24,7 +24,8 @@ from solver.path.kernel_cells import (
     run_kernel,
 )
 from solver.path.path_checks import refuse_colliding
-from solver.path.pipeline import ChunkResult, check_placements, run_chunk
+from solver.path.pipeline import ChunkResult, run_chunk
+from solver.path.placed import check_placements
 from solver.path.problem import PathProblem
 
 __all__ = ["PlacementEvaluator", "PlacementResults", "evaluate_placements"]

@@ -5,9 +5,9 @@ highest mu_path, the first in order among those within ``TIE_RTOL`` of it. mu_pa
 V_max along the branch, so the least V_max over the waypoints followed so far bounds it from
 above: once that bound is below the best complete, feasible branch's mu_path less its tie
 tolerance, the branch can neither be the best nor tie with it, and following it further is
-wasted. A numeric family's work is that following (:class:`solver.core.family.FollowsInSteps`);
-the analytic acceleration kernel drops branches by the same argument
-(:mod:`solver.kernels.accelerations`).
+wasted. A numeric family's work is that following
+(:class:`solver.core.follows_in_steps.FollowsInSteps`); the analytic acceleration kernel drops
+branches by the same argument (:mod:`solver.kernels.accelerations`).
 
 So, for a chunk of placements, best first: every branch is followed along the first
 :data:`PIECE` waypoints; then, at each placement, the branch with the highest bound (with those
@@ -36,7 +36,8 @@ import math
 import numpy as np
 
 from solver.core.codes import FEASIBLE, SINGULAR, TIE_RTOL, UNREACHABLE
-from solver.core.family import FollowsInSteps, PathSolutions
+from solver.core.family import PathSolutions
+from solver.core.follows_in_steps import FollowsInSteps
 from solver.path.limits import JointMotion, JointSpeedLimit, bound_by_limits
 from solver.path.problem import PathProblem
 from solver.path.tracking import track

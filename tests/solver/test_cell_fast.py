@@ -18,9 +18,10 @@ from solver.core.robots import Robot
 from solver.core.spatial import Placement
 from solver.families import get_robot
 from solver.path.capability_map import capability_map, grid_axis
-from solver.path.cell.checker import CellChecker, CellVerdict
+from solver.path.cell.checker import CellChecker
 from solver.path.cell.kinematics import substeps
 from solver.path.cell.shapes import Box, Cell, Cylinder, Halfspace, Sphere, Tool
+from solver.path.cell.verdict import CellVerdict
 from solver.path.evaluate import evaluate_path
 from solver.path.problem import PathOptions, PathProblem
 from tests.solver.test_evaluate import load_path

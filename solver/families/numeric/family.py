@@ -18,7 +18,8 @@ from __future__ import annotations
 import numpy as np
 import pinocchio as pin
 
-from solver.core.family import Branch, FollowsInSteps, KinematicsFamily, PathSolutions
+from solver.core.family import Branch, KinematicsFamily, PathSolutions
+from solver.core.follows_in_steps import FollowsInSteps
 from solver.core.progress import Progress, span
 from solver.families.numeric import bounded_kernel, costs, ik, ik_kernel, reference, velocity
 from solver.families.numeric.chain import SerialChain

@@ -1,13 +1,8 @@
 """Distances between the robot, its tool and the cell's objects along a joint path (cell.md s. 3).
 
-One pinocchio ``GeometryModel`` holds the robot's geometry (:mod:`robot_geometry`) and the
-obstacles, on the base joint: ``fixed`` ones at their pose in {B}, ``workpiece`` ones at the
-placement's T_B_O times their pose. coal gives every checked pair's distance
-(``pin.computeDistances``). The pairs: every robot part (the tool included) against every
-obstacle, except the base against ``fixed`` objects (it stands on them, whatever the placement)
-and the tool's cutting part against ``workpiece`` objects (that is machining); and the robot's
-parts against each other where they are on joints that are neither the same nor adjacent and do
-not come within the clearance at the zero configuration.
+The robot's geometry, the obstacles and the pairs to check are built once per robot and cell
+(:mod:`solver.path.cell.scene`); the checker places the ``workpiece`` objects at each
+placement's T_B_O and gives every checked pair's distance by coal (``pin.computeDistances``).
 
 A map's check runs the compiled sweep (:mod:`solver.path.cell.fast`): closed-form distances
 and bounds decide most pairs, coal the rest, with the answers of coal alone (``reference=True``;
@@ -16,16 +11,14 @@ an evaluation, and a robot or cell the sweep lacks a joint or shape for, use coa
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import numpy as np
 import pinocchio as pin
 
 from solver.core.robots import Robot
 from solver.path.cell import batch, fast, kinematics
-from solver.path.cell.bounds import pair_weights
-from solver.path.cell.robot_geometry import robot_geometry
+from solver.path.cell.scene import build_scene
 from solver.path.cell.shapes import Cell
+from solver.path.cell.verdict import CellVerdict, Contact
 
 # What checking one pose of a path against a cell costs, in poses of a closed-form family's map
 # (KinematicsFamily.path_cost): the ERK map (546 placements x 133 waypoints) with a table, a
@@ -39,111 +32,26 @@ CELL_POSE_COST = 50.0
 _WINDOW = 32  # configurations looked ahead at once when skipping
 
 
-@dataclass(frozen=True)
-class Contact:
-    """The closest pair at one configuration of a path.
-
-    Attributes:
-        waypoint: the waypoint, or the one a sub-step after it follows.
-        robot_part: the robot's geometry object (a link's name with ``_0``, a capsule, ``tool``).
-        obstacle: the obstacle's index (``fixed`` first, then ``workpiece``), None for a robot
-            part (self-collision).
-        obstacle_name: its name, its place (``fixed[0]``), or the other robot part's name.
-        distance: m, the coal distance (negative: penetration depth as coal gives it).
-    """
-
-    waypoint: int
-    robot_part: str
-    obstacle: int | None
-    obstacle_name: str
-    distance: float
-
-
-@dataclass(frozen=True)
-class CellVerdict:
-    """A joint path against the cell: the first contact closer than the clearance, or the closest.
-
-    Attributes:
-        collision: the first configuration (in path order) closer than the clearance; None if
-            there is none.
-        closest: the closest pair over every checked configuration (None when the check
-            stopped at the first collision).
-        checks: how many configurations were checked (by coal, in a fast map check).
-        approximated: the robot's links given capsules (no readable collision geometry).
-    """
-
-    collision: Contact | None
-    closest: Contact | None
-    checks: int
-    approximated: tuple[str, ...] = ()
-
-
 class CellChecker:
     """The cell's pairs for one robot, checked along joint paths."""
 
     def __init__(self, robot: Robot, cell: Cell) -> None:
-        """Build the geometry and choose the pairs.
+        """Build the geometry and choose the pairs (:func:`solver.path.cell.scene.build_scene`).
 
         Raises:
             InvalidInputError: a bad cell field (:meth:`Cell.check`) or link radii.
         """
         cell.check()
         self.robot, self.cell = robot, cell
-        made = robot_geometry(robot, tool=cell.tool, link_radii=cell.link_radii)
-        self.approximated = made.approximated
-        geometry = made.geometry
-        self._n_robot = geometry.ngeoms
-        world_to_base = pin.SE3(robot.transform_world_to_base)
-        self._world_to_base = world_to_base
-        shapes = cell.fixed + cell.workpiece
-        self._workpiece_ids = []
-        for k, shape in enumerate(shapes):
-            place = world_to_base * pin.SE3(np.asarray(shape.pose, dtype=float))
-            obj = pin.GeometryObject(f"obstacle_{k}", 0, place, shape.geometry())
-            gid = geometry.addGeometryObject(obj)
-            if k >= len(cell.fixed):
-                self._workpiece_ids.append((gid, pin.SE3(np.asarray(shape.pose, dtype=float))))
-        self.geometry = geometry
-        self._pairs: list[tuple[int, int]] = []
-        robot_ids = range(self._n_robot)
-        for part in robot_ids:
-            joint = int(geometry.geometryObjects[part].parentJoint)
-            for k in range(len(shapes)):
-                workpiece = k >= len(cell.fixed)
-                if (joint == 0 and not workpiece) or (part == made.cutting and workpiece):
-                    continue
-                self._pairs.append((part, self._n_robot + k))
-        self._pairs += self._self_pairs(made.cutting)
-        for a, b in self._pairs:
-            geometry.addCollisionPair(pin.CollisionPair(a, b))
-        self._weights = pair_weights(robot.model, geometry, self._pairs, self._n_robot)
-        try:
-            self._fast: fast.FastCell | None = fast.FastCell(
-                robot.model, geometry, self._n_robot, self._pairs
-            )
-        except NotImplementedError:
-            self._fast = None  # a joint or shape the compiled sweep lacks: coal alone
-
-    def _self_pairs(self, cutting: int) -> list[tuple[int, int]]:
-        """Robot parts on joints neither the same nor adjacent, apart at the zero configuration."""
-        model, geometry = self.robot.model, self.geometry
-        pairs = []
-        for a in range(self._n_robot):
-            for b in range(a + 1, self._n_robot):
-                ja = int(geometry.geometryObjects[a].parentJoint)
-                jb = int(geometry.geometryObjects[b].parentJoint)
-                if ja == jb or model.parents[ja] == jb or model.parents[jb] == ja:
-                    continue
-                pairs.append((a, b))
-        probe = pin.GeometryModel()
-        for obj in geometry.geometryObjects[: self._n_robot]:
-            probe.addGeometryObject(obj)
-        for a, b in pairs:
-            probe.addCollisionPair(pin.CollisionPair(a, b))
-        data = probe.createData()
-        pin.computeDistances(model, model.createData(), probe, data, pin.neutral(model))
-        distances = [r.min_distance for r in data.distanceResults]
-        return [p for p, d in zip(pairs, distances, strict=True) if d > self.cell.clearance]
+        scene = build_scene(robot, cell)
+        self.approximated = scene.approximated
+        self.geometry = scene.geometry
+        self._n_robot = scene.n_robot
+        self._world_to_base = scene.world_to_base
+        self._workpiece_ids = scene.workpiece_ids
+        self._pairs = scene.pairs
+        self._weights = scene.weights
+        self._fast = scene.compiled
 
     def configurations(
         self, q: np.ndarray, segment_in_pass: np.ndarray

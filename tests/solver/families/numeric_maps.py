@@ -17,7 +17,8 @@ from solver.families import get_robot, robot_from_urdf
 from solver.families.numeric.family import NumericFamily
 from solver.families.opw.family import OpwFamily
 from solver.families.ur.catalogue import _exact_right_angles
-from solver.path.pipeline import check_placements, run_chunk
+from solver.path.pipeline import run_chunk
+from solver.path.placed import check_placements
 from solver.path.problem import PathProblem
 
 

@@ -18,7 +18,7 @@ from solver.families import get_robot
 from solver.families.numeric import chain_kernel, ik, ik_kernel, redundant_kernel
 from solver.families.numeric.family import NumericFamily
 from solver.kernels import spin_lp
-from solver.path.pipeline import flange_at_spin, turn_by_yaw
+from solver.path.placed import flange_at_spin, turn_by_yaw
 from solver.path.problem import PathProblem
 from tests.cases import NUMERIC_MODELS
 from tests.solver.families.numeric_maps import (

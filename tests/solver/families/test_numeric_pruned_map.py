@@ -20,7 +20,8 @@ from solver.core.family import Branch
 from solver.core.robots import Robot
 from solver.families.numeric.family import NumericFamily
 from solver.path import bounded
-from solver.path.pipeline import ChunkResult, check_placements, run_chunk
+from solver.path.pipeline import ChunkResult, run_chunk
+from solver.path.placed import check_placements
 from solver.path.placements import PlacementResults, evaluate_placements
 from solver.path.problem import PathOptions, PathProblem
 from solver.path.pruning import can_prune

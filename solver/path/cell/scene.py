@@ -1,0 +1,119 @@
+"""The cell's geometry for one robot: its parts, the obstacles, the pairs to check (cell.md s. 3).
+
+One pinocchio ``GeometryModel`` holds the robot's geometry (:mod:`robot_geometry`) and the
+obstacles, on the base joint: ``fixed`` ones at their pose in {B}, ``workpiece`` ones at the
+placement's T_B_O times their pose (placed by the checker, :mod:`solver.path.cell.checker`).
+The pairs: every robot part (the tool included) against every obstacle, except the base against
+``fixed`` objects (it stands on them, whatever the placement) and the tool's cutting part
+against ``workpiece`` objects (that is machining); and the robot's parts against each other
+where they are on joints that are neither the same nor adjacent and do not come within the
+clearance at the zero configuration.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import pinocchio as pin
+
+from solver.core.robots import Robot
+from solver.path.cell import fast
+from solver.path.cell.bounds import pair_weights
+from solver.path.cell.robot_geometry import robot_geometry
+from solver.path.cell.shapes import Cell
+
+
+@dataclass(frozen=True)
+class CellScene:
+    """A robot and a cell's objects in one geometry model, with the pairs to check.
+
+    Attributes:
+        geometry: the robot's parts (indices below ``n_robot``), then the obstacles (``fixed``
+            first, then ``workpiece``), the checked pairs registered as collision pairs.
+        n_robot: how many geometry objects are the robot's.
+        world_to_base: {B} in the model's root frame.
+        workpiece_ids: each ``workpiece`` object's geometry index and its pose in {O}.
+        pairs: the checked pairs (geometry indices, the robot's part first).
+        weights: :func:`solver.path.cell.bounds.pair_weights` of the pairs.
+        compiled: the compiled sweep's model; None where it lacks a joint or shape (coal alone).
+        approximated: the robot's links given capsules (no readable collision geometry).
+    """
+
+    geometry: pin.GeometryModel
+    n_robot: int
+    world_to_base: pin.SE3
+    workpiece_ids: list[tuple[int, pin.SE3]]
+    pairs: list[tuple[int, int]]
+    weights: np.ndarray
+    compiled: fast.FastCell | None
+    approximated: tuple[str, ...]
+
+
+def build_scene(robot: Robot, cell: Cell) -> CellScene:
+    """Build the geometry and choose the pairs of a checked cell (:meth:`Cell.check`).
+
+    Raises:
+        InvalidInputError: bad link radii.
+    """
+    made = robot_geometry(robot, tool=cell.tool, link_radii=cell.link_radii)
+    geometry = made.geometry
+    n_robot = geometry.ngeoms
+    world_to_base = pin.SE3(robot.transform_world_to_base)
+    shapes = cell.fixed + cell.workpiece
+    workpiece_ids = []
+    for k, shape in enumerate(shapes):
+        place = world_to_base * pin.SE3(np.asarray(shape.pose, dtype=float))
+        obj = pin.GeometryObject(f"obstacle_{k}", 0, place, shape.geometry())
+        gid = geometry.addGeometryObject(obj)
+        if k >= len(cell.fixed):
+            workpiece_ids.append((gid, pin.SE3(np.asarray(shape.pose, dtype=float))))
+    pairs: list[tuple[int, int]] = []
+    for part in range(n_robot):
+        joint = int(geometry.geometryObjects[part].parentJoint)
+        for k in range(len(shapes)):
+            workpiece = k >= len(cell.fixed)
+            if (joint == 0 and not workpiece) or (part == made.cutting and workpiece):
+                continue
+            pairs.append((part, n_robot + k))
+    pairs += _self_pairs(robot.model, geometry, n_robot, cell.clearance)
+    for a, b in pairs:
+        geometry.addCollisionPair(pin.CollisionPair(a, b))
+    weights = pair_weights(robot.model, geometry, pairs, n_robot)
+    try:
+        compiled: fast.FastCell | None = fast.FastCell(robot.model, geometry, n_robot, pairs)
+    except NotImplementedError:
+        compiled = None  # a joint or shape the compiled sweep lacks: coal alone
+    return CellScene(
+        geometry=geometry,
+        n_robot=n_robot,
+        world_to_base=world_to_base,
+        workpiece_ids=workpiece_ids,
+        pairs=pairs,
+        weights=weights,
+        compiled=compiled,
+        approximated=made.approximated,
+    )
+
+
+def _self_pairs(
+    model: pin.Model, geometry: pin.GeometryModel, n_robot: int, clearance: float
+) -> list[tuple[int, int]]:
+    """Robot parts on joints neither the same nor adjacent, apart at the zero configuration."""
+    pairs = []
+    for a in range(n_robot):
+        for b in range(a + 1, n_robot):
+            ja = int(geometry.geometryObjects[a].parentJoint)
+            jb = int(geometry.geometryObjects[b].parentJoint)
+            if ja == jb or model.parents[ja] == jb or model.parents[jb] == ja:
+                continue
+            pairs.append((a, b))
+    probe = pin.GeometryModel()
+    for obj in geometry.geometryObjects[:n_robot]:
+        probe.addGeometryObject(obj)
+    for a, b in pairs:
+        probe.addCollisionPair(pin.CollisionPair(a, b))
+    data = probe.createData()
+    pin.computeDistances(model, model.createData(), probe, data, pin.neutral(model))
+    distances = [r.min_distance for r in data.distanceResults]
+    return [p for p, d in zip(pairs, distances, strict=True) if d > clearance]

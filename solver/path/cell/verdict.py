@@ -1,0 +1,48 @@
+"""What a cell check answers: the first contact closer than the clearance, or the closest.
+
+The records :class:`solver.path.cell.checker.CellChecker` gives for a joint path at a placement;
+an evaluation reports them (:mod:`solver.path.evaluate`, the service's ``Contact``).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+
+@dataclass(frozen=True)
+class Contact:
+    """The closest pair at one configuration of a path.
+
+    Attributes:
+        waypoint: the waypoint, or the one a sub-step after it follows.
+        robot_part: the robot's geometry object (a link's name with ``_0``, a capsule, ``tool``).
+        obstacle: the obstacle's index (``fixed`` first, then ``workpiece``), None for a robot
+            part (self-collision).
+        obstacle_name: its name, its place (``fixed[0]``), or the other robot part's name.
+        distance: m, the coal distance (negative: penetration depth as coal gives it).
+    """
+
+    waypoint: int
+    robot_part: str
+    obstacle: int | None
+    obstacle_name: str
+    distance: float
+
+
+@dataclass(frozen=True)
+class CellVerdict:
+    """A joint path against the cell: the first contact closer than the clearance, or the closest.
+
+    Attributes:
+        collision: the first configuration (in path order) closer than the clearance; None if
+            there is none.
+        closest: the closest pair over every checked configuration (None when the check
+            stopped at the first collision).
+        checks: how many configurations were checked (by coal, in a fast map check).
+        approximated: the robot's links given capsules (no readable collision geometry).
+    """
+
+    collision: Contact | None
+    closest: Contact | None
+    checks: int
+    approximated: tuple[str, ...] = ()
