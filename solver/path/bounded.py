@@ -3,9 +3,9 @@
 :mod:`solver.path.pruning` follows a seven-joint arm's branches in pieces, best bound first,
 from Python; a six-joint arm's following is too cheap for that (the bounds cost more than they
 save). Here the whole choice runs compiled, one placement after the other
-(:meth:`solver.core.follows_in_steps.FollowsInSteps.follow_bounded`): the slot the previous placement
-ended with is followed first to the end (the candidate), then each other slot in order, with
-V_max at every waypoint; a slot is dropped once its least V_max so far shows that it can
+(:meth:`solver.core.follows_in_steps.FollowsInSteps.follow_bounded`): the slot the previous
+placement ended with is followed first to the end (the candidate), then each other slot in
+order, with V_max at every waypoint; a slot is dropped once its least V_max so far shows that it can
 neither tie with the candidate nor beat it. The other slots are scouted: followed with a few
 rough steps a stride of waypoints, solved exactly (and their V_max taken) at the candidate's
 slowest waypoint and wherever the rough V_max comes near dropping them; only exact V_max
