@@ -24,6 +24,7 @@ import pinocchio as pin
 from solver.core.robots import Robot
 from solver.path.cell import batch, fast, kinematics
 from solver.path.cell.bounds import pair_weights
+from solver.path.cell.coal_data import CoalData
 from solver.path.cell.robot_geometry import robot_geometry
 from solver.path.cell.shapes import Cell
 
@@ -117,6 +118,7 @@ class CellChecker:
         for a, b in self._pairs:
             geometry.addCollisionPair(pin.CollisionPair(a, b))
         self._weights = pair_weights(robot.model, geometry, self._pairs, self._n_robot)
+        self._coal_data = CoalData(robot.model, self.geometry, self._workpiece_ids)
         try:
             self._fast: fast.FastCell | None = fast.FastCell(
                 robot.model, geometry, self._n_robot, self._pairs
@@ -303,8 +305,7 @@ class CellChecker:
 
         def coal_distances(index: int, due: np.ndarray) -> np.ndarray:
             if not made:
-                geometry = self._placed_geometry(placed)
-                made.append((geometry, geometry.createData(), self.robot.model.createData()))
+                made.append(self._coal_data.at(placed))
             geometry, gdata, data = made[0]
             model = self.robot.model
             pin.updateGeometryPlacements(model, data, geometry, gdata, configurations[index])
