@@ -16,6 +16,7 @@ import pinocchio as pin
 
 from solver.core.robots import Robot
 from solver.path.cell import batch, fast, kinematics
+from solver.path.cell.coal_data import CoalData
 from solver.path.cell.scene import build_scene
 from solver.path.cell.shapes import Cell
 from solver.path.cell.verdict import CellVerdict, Contact
@@ -52,6 +53,7 @@ class CellChecker:
         self._pairs = scene.pairs
         self._weights = scene.weights
         self._fast = scene.compiled
+        self._coal_data = CoalData(robot.model, self.geometry, self._workpiece_ids)
 
     def configurations(
         self, q: np.ndarray, segment_in_pass: np.ndarray
@@ -211,8 +213,7 @@ class CellChecker:
 
         def coal_distances(index: int, due: np.ndarray) -> np.ndarray:
             if not made:
-                geometry = self._placed_geometry(placed)
-                made.append((geometry, geometry.createData(), self.robot.model.createData()))
+                made.append(self._coal_data.at(placed))
             geometry, gdata, data = made[0]
             model = self.robot.model
             pin.updateGeometryPlacements(model, data, geometry, gdata, configurations[index])

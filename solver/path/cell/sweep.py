@@ -128,8 +128,11 @@ def _bound(p, pairs, ends, robot, obstacles, work, near, rot, pos, cuts, last): 
     face normals; a halfspace's normal: exact for a convex mesh). ``last`` (P, 3): per pair,
     the direction whose separation last proved it farther than ``near`` (NaN: none), tried
     first (the path moves little between checks: one direction instead of up to 24 steps of
-    the descent, the UR5's meshes' sweep 1.15x faster); any direction's separation is a
-    lower bound, so the answer is the same.
+    the descent, the UR5's meshes' sweep 1.15x faster); kept in the world for an obstacle
+    pair, in part a's frame for a self pair (the joints before part a turn both parts alike,
+    so the wrist pairs' direction still separates them after the arm has moved: the UR5's
+    ERK cell map's sweep about 1.1x faster again); any direction's separation is a lower
+    bound, so the answer is the same.
     """
     radius, exact = robot[8], robot[9]
     a, b = pairs[p, 0], pairs[p, 1]
@@ -173,8 +176,14 @@ def _bound(p, pairs, ends, robot, obstacles, work, near, rot, pos, cuts, last): 
                 for i in range(3):
                     u[i] = o_rot[k, i, 0] * local[0, 0] + o_rot[k, i, 1] * local[0, 1]
                     u[i] += o_rot[k, i, 2] * local[0, 2]
+    ja = robot[6][a]  # a self pair's last direction is kept in part a's frame
     if value <= near and not both and last[p, 0] == last[p, 0]:  # what separated them before
-        value = max(value, _gap(a, b, last[p], robot, obstacles, rot, pos, work, 1, near))
+        for i in range(3):
+            normal[i] = last[p, i]
+            if b < n_robot:
+                normal[i] = rot[ja, i, 0] * last[p, 0] + rot[ja, i, 1] * last[p, 1]
+                normal[i] += rot[ja, i, 2] * last[p, 2]
+        value = max(value, _gap(a, b, normal, robot, obstacles, rot, pos, work, 1, near))
         if value > near:
             return value
     if value <= near and not both:
@@ -193,6 +202,9 @@ def _bound(p, pairs, ends, robot, obstacles, work, near, rot, pos, cuts, last): 
     if value > near and not both:  # the direction that proved it: tried first next time
         for i in range(3):
             last[p, i] = work[6, i]
+            if b < n_robot:  # the joints before part a turn both parts: a's frame keeps it
+                last[p, i] = rot[ja, 0, i] * work[6, 0] + rot[ja, 1, i] * work[6, 1]
+                last[p, i] += rot[ja, 2, i] * work[6, 2]
     return value
 
 
