@@ -86,6 +86,28 @@ def _null_and_pseudo_inverse(jac, twist, house, a, b):  # type: ignore[no-untype
     return True
 
 
+_SKIPPED, _IRREGULAR, _SOLVED = 0, 1, 2
+"""What :func:`_directions_at` did with a configuration: not finite, J near rank loss, solved."""
+
+
+@njit(cache=True, nogil=True, error_model="numpy", inline="always")
+def _directions_at(chain, q, twist, point, work, house, a, b):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
+    """J^+ twist into ``a`` and the null space into ``b`` at one configuration ``q`` (7,).
+
+    Returns:
+        _SKIPPED where ``q`` is not finite, _IRREGULAR where J nears rank loss (numpy
+        decides), else _SOLVED.
+    """
+    for j in range(q.shape[0]):
+        if not math.isfinite(q[j]):
+            return _SKIPPED
+    frames(chain, q, work)
+    jacobian_at(chain[3], work[0], work[1], point, work[6])
+    if not _null_and_pseudo_inverse(work[6], twist, house, a, b):
+        return _IRREGULAR
+    return _SOLVED
+
+
 @njit(cache=True, nogil=True, error_model="numpy")
 def redundant_speeds(chain, q, twist, point, qdot_max):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
     """The joint speeds qdot / s at the LP optimum, at M configurations of a seven-joint chain.
@@ -106,18 +128,11 @@ def redundant_speeds(chain, q, twist, point, qdot_max):  # type: ignore[no-untyp
     speeds = np.full((n_rows, n), np.nan)
     irregular = np.zeros(n_rows, dtype=np.bool_)
     work = workspace(n)
-    jac = work[6]
     house, a, b = np.empty((7, 7)), np.empty(7), np.empty(7)
     for m in range(n_rows):
-        finite = True
-        for j in range(n):
-            finite = finite and math.isfinite(q[m, j])
-        if not finite:
-            continue
-        frames(chain, q[m], work)
-        jacobian_at(chain[3], work[0], work[1], point[m], jac)
-        if not _null_and_pseudo_inverse(jac, twist[m], house, a, b):
-            irregular[m] = True
+        solved = _directions_at(chain, q[m], twist[m], point[m], work, house, a, b)
+        if solved != _SOLVED:
+            irregular[m] = solved == _IRREGULAR
             continue
         best = np.inf  # two_variable_speed: the least pair bound, NaN pairs ignored
         for j in range(n):
@@ -163,18 +178,11 @@ def least_norm_and_null(chain, q, twist, point):  # type: ignore[no-untyped-def]
     null = np.full((n_rows, n), np.nan)
     irregular = np.zeros(n_rows, dtype=np.bool_)
     work = workspace(n)
-    jac = work[6]
     house, a, b = np.empty((7, 7)), np.empty(7), np.empty(7)
     for m in range(n_rows):
-        finite = True
-        for j in range(n):
-            finite = finite and math.isfinite(q[m, j])
-        if not finite:
-            continue
-        frames(chain, q[m], work)
-        jacobian_at(chain[3], work[0], work[1], point[m], jac)
-        if not _null_and_pseudo_inverse(jac, twist[m], house, a, b):
-            irregular[m] = True
+        solved = _directions_at(chain, q[m], twist[m], point[m], work, house, a, b)
+        if solved != _SOLVED:
+            irregular[m] = solved == _IRREGULAR
             continue
         least[m] = a
         null[m] = b
