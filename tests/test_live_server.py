@@ -31,12 +31,13 @@ pytestmark = pytest.mark.latency
 
 EXAMPLE = json.loads((ROOT / "examples" / "evaluate_request.json").read_text())
 N = len(EXAMPLE["path"]["waypoints"])
-MAP_POSES = 2_000_000
+MAP_POSES = 8_000_000  # 2 M: the map at the limit ended in 8 probes once the kernels pruned
 OPTIMIZE_WAYPOINTS = 100
 PATH_WAYPOINTS = 5_000  # validating a body holds the GIL about 5-13 us a waypoint (pydantic-core)
 LIMITS = {
     "DTF_MAX_PATH_WAYPOINTS": str(PATH_WAYPOINTS),
     "DTF_MAX_MAP_POSES": str(MAP_POSES),
+    "DTF_MAX_MAP_CELLS": "100000",  # MAP_POSES of the README path: 60,150 cells
     "DTF_MAX_OPTIMIZE_WAYPOINTS": str(OPTIMIZE_WAYPOINTS),
     "DTF_MAX_SOLVER_SECONDS": "3",
 }
