@@ -13,6 +13,7 @@ import pytest
 
 from solver.core.spatial import Placement
 from solver.path.capability_map import capability_map, grid_axis
+from solver.path.cell import sweep
 from solver.path.cell.batch import placed_obstacles
 from solver.path.cell.cache import checker_for
 from solver.path.cell.checker import CellChecker
@@ -184,6 +185,9 @@ def test_free_spin_map_cells_equal_evaluate() -> None:
         problem.with_options(cell=Cell()), xs=xs, ys=ys, z=0.1, yaws=np.array([0.0])
     )
     assert (cells.branch != plain.branch).any()  # a best branch collides: the next one taken
+    # The map's batch and evaluate's walk share the sweep's one compiled signature (a second one
+    # doubled its compile time, 20 s of CPU, in every process that ran both).
+    assert len(sweep.first_due.signatures) == 1
 
 
 def test_a_chunk_without_feasible_placements() -> None:

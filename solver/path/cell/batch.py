@@ -113,6 +113,7 @@ def first_due_paths(  # type: ignore[no-untyped-def]  # pragma: no cover - compi
         need: shape (N, P), bool, out, the pairs coal must decide there.
     """
     known = np.full(pairs.shape[0], np.nan)
+    start = np.int64(0)  # not the literal 0: first_due's one compiled signature, fast.py's too
     for c in range(joint_paths.shape[0]):
         configurations, _ = substeps(joint_paths[c], segment_in_pass, collision_step)
         obstacles = (kind, ends[c], radius[c], rotation[c], centre[c], half, exact, offsets,
@@ -120,7 +121,7 @@ def first_due_paths(  # type: ignore[no-untyped-def]  # pragma: no cover - compi
         clear_until[c, :] = -1
         at = first_due(
             configurations, robot, obstacles, pairs, weights, near, clearance, clear_until[c],
-            0, known, need[c],
+            start, known, need[c],
         )  # fmt: skip
         index[c] = -1 if at >= configurations.shape[0] else at
 

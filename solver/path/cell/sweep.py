@@ -118,7 +118,7 @@ def _gap(a, b, u, robot, obstacles, rot, pos, work, tries, enough):  # type: ign
     return best
 
 
-@njit(cache=True, nogil=True, error_model="numpy", inline="always")
+@njit(cache=True, nogil=True, error_model="numpy")
 def _bound(p, pairs, ends, robot, obstacles, work, near, rot, pos, cuts, last):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
     """A lower bound on pair p's distance (exact for closed-form pairs), m.
 
@@ -208,7 +208,7 @@ def _bound(p, pairs, ends, robot, obstacles, work, near, rot, pos, cuts, last): 
     return value
 
 
-@njit(cache=True, nogil=True, error_model="numpy", inline="always")
+@njit(cache=True, nogil=True, error_model="numpy")
 def _capsule_bound(a, b, ends, radius, kind, o_ends, o_radius, o_rot, o_centre, o_half, cuts):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
     """The first value of :func:`_bound`: the distance between part a's capsule and object b.
 
