@@ -181,7 +181,7 @@ def map_cells(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
     stencil = (stencil_index, step_stencil(stencil_index, stencil_weight), stencil_waypoints)
     work = (todo, limit, remaining, bound)
     inverse_qdot = 1.0 / qdot_max
-    guess = 0
+    guess = np.int64(0)  # not the literal 0: the callees get one compiled signature, not two
     for c in range(n_cells):
         start_cell(alive, why, where)
         turned_poses(
@@ -203,7 +203,7 @@ def map_cells(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
             limit[:] = -np.inf
             bound[:] = np.inf
             remaining[:] = True
-            best = -1
+            best = np.int64(-1)
             row = guess
             while row >= 0:
                 remaining[row] = False

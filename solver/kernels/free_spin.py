@@ -157,7 +157,7 @@ def free_cells(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
     limit = np.empty(n_branches)
     bound = np.empty(n_branches)
     work = (todo, limit, remaining, bound, np.empty(n_branches))
-    guess = 0
+    guess = np.int64(0)  # not the literal 0: the callees get one compiled signature, not two
     for c in range(n_cells):
         ca, sa = cos_yaw[c], sin_yaw[c]
         turned_poses(
@@ -195,7 +195,7 @@ def free_cells(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
             limit[:] = -np.inf
             bound[:] = np.inf
             remaining[:] = True
-            best = -1
+            best = np.int64(-1)
             row = guess
             while row >= 0:
                 remaining[row] = False
