@@ -1,42 +1,58 @@
-"""Run the test suite: most of it on two worker processes, the latency tests alone after it.
+"""Run the tests: the kernels compiled first, most tests on two workers, the latency tests alone.
 
-The suite took 10 to 11 minutes on one process of the 2-core development machine, over the
-10-minute goal. On two workers (pytest-xdist, each module on one worker) it takes about half,
-but the tests that bound a live server's latency (``/healthz`` under load, a cancel within a
-second, SIGTERM within seconds: marked ``latency``) fail beside a second worker's CPU-bound
-tests, which take the server's time slices. So they run after, alone, with the coverage of the
-first run appended. Modules are handed out in collection order, the longest first (FIRST in
-tests/conftest.py), not by their number of tests. Arguments are passed to both runs; either
-failing fails the whole.
+1. The numba kernels are compiled into their disk cache (``scripts/compile_kernels.py``, its
+   groups in two processes, the cores): on a fresh clone about 140 s of CPU, which the two
+   workers and the live servers they start would otherwise each spend on the kernels they meet
+   together (the map kernels in a server's warm-up and in the other worker's tests at once).
+2. The tests on two worker processes (pytest-xdist, each module on one worker, handed out in
+   collection order, the longest first: FIRST in tests/conftest.py). One process took 10 to 11
+   minutes on the 2-core development machine, over the 10-minute goal.
+3. The tests that bound a live server's latency (``/healthz`` under load, a cancel within a
+   second, SIGTERM within seconds: marked ``latency``), alone: beside a second worker's
+   CPU-bound tests they fail, since those take the server's time slices.
+
+``--coverage`` adds a coverage report of ``solver`` and ``service`` (both runs, combined): it
+makes the suite about half as long again, so it is asked for, not the default. Other arguments
+are passed to both pytest runs. Any step failing fails the whole.
 """
 
 from __future__ import annotations
 
 import subprocess
 import sys
+import time
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
+COMPILE_GROUPS = (("numeric6",), ("analytic", "cell", "numeric7"))
+"""scripts/compile_kernels.py's groups in two processes: about 70 and 85 s of CPU, cold."""
+COVERAGE = ["--cov=solver", "--cov=service", "--cov-report=term:skip-covered"]
+
+
+def compile_kernels() -> int:
+    """Every group of scripts/compile_kernels.py at once; the first failing status, else 0."""
+    start = time.perf_counter()
+    script = str(ROOT / "scripts" / "compile_kernels.py")
+    processes = [
+        subprocess.Popen([sys.executable, script, *groups], cwd=ROOT) for groups in COMPILE_GROUPS
+    ]
+    codes = [process.wait() for process in processes]
+    print(f"kernels ready in {time.perf_counter() - start:.1f} s", flush=True)
+    return next((code for code in codes if code), 0)
 
 
 def main(arguments: list[str]) -> int:
-    """Both runs; the first failing status, else 0."""
+    """Compile, then both runs; the first failing status, else 0."""
+    coverage = "--coverage" in arguments
+    arguments = [a for a in arguments if a != "--coverage"]
     pytest = [sys.executable, "-m", "pytest"]
+    workers = ["-n", "2", "--dist", "loadscope", "--no-loadscope-reorder", "-m", "not latency"]
     runs = [
-        [
-            *pytest,
-            "-n",
-            "2",
-            "--dist",
-            "loadscope",
-            "--no-loadscope-reorder",
-            "-m",
-            "not latency",
-            *arguments,
-        ],
-        [*pytest, "-m", "latency", "--cov-append", *arguments],
+        [*pytest, *workers, *(COVERAGE if coverage else []), *arguments],
+        [*pytest, "-m", "latency", *([*COVERAGE, "--cov-append"] if coverage else []), *arguments],
     ]
-    status = 0
+    print("$ scripts/compile_kernels.py", flush=True)
+    status = compile_kernels()
     for command in runs:
         print("$", " ".join(command[1:]), flush=True)
         code = subprocess.call(command, cwd=ROOT)
