@@ -56,7 +56,7 @@ def _coal_only() -> Iterator[None]:
     """Checkers made inside check with coal alone (the reference), as before the sweep."""
     compiled = checker_module.fast.FastCell
 
-    def refuse(*args: object) -> None:
+    def refuse(*args: object, **kwargs: object) -> None:
         raise NotImplementedError
 
     checker_module.fast.FastCell = refuse  # type: ignore[assignment,misc]
