@@ -43,6 +43,7 @@ def test_table_bounds_are_below_coal() -> None:
         ("base_link_0", "upper_arm_link_0"),
         ("forearm_link_0", "wrist_2_link_0"),
         ("wrist_1_link_0", "wrist_3_link_0"),
+        ("forearm_link_0", "wrist_3_link_0"),  # three joints: wrist 3 as its swept cylinder
     } <= names
     model = checker.robot.model
     geometry, gdata, data = checker._coal_data.at(pin.SE3.Identity())

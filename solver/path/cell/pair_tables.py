@@ -6,7 +6,9 @@ before j_a turn both parts alike, the others neither. Where the parts' capsules 
 configurations (the UR5's base and upper arm, its forearm and second wrist, its first and third
 wrist), the sweep (:mod:`solver.path.cell.sweep`) needed their meshes' support functions at
 every configuration it checked. For such a pair with one or two chain joints, all revolute, coal's
-distance is tabulated once on a grid of those joints over a turn (2 pi periodic), and
+distance is tabulated once on a grid of those joints over a turn (2 pi periodic); with three
+(the UR5's forearm and third wrist), part b is replaced by the cylinder about j_b's axis that
+holds it at every angle (no nearer to part a than b is), on j_b's parent: two joints. Then
 
     d(q) >= T[g] - MARGIN - sum_k w_k |q_k - g_k|
 
@@ -16,7 +18,8 @@ and coal's distance is the exact one within :data:`solver.path.cell.fast.MARGIN`
 pair's weight (:func:`solver.path.cell.bounds.pair_weights`), or smaller where k's axis is fixed
 to a part: the first chain joint's axis is fixed in part a's frame (then turning it moves part a
 relative to b by at most a's largest distance from that axis), the last one's (j_b) in b's frame;
-a part's largest distance from a line is bounded by its bounding box's corners.
+a part's largest distance from a line is its convex mesh's vertices' (else its bounding box's
+corners'), plus coal's swept sphere radius.
 
 The pack (:func:`table_bound`): per pair its table or -1 (P,); per table the q indices (T, 2),
 the grid counts (T, 2), the weights (T, 2) (a second dimension unused: index 0, count 1,
@@ -27,17 +30,21 @@ from __future__ import annotations
 
 import math
 
+import coal
 import numpy as np
 import pinocchio as pin
 from numba import njit
 
+from solver.path.cell.bounds import pair_weights
 from solver.path.cell.closed_form import segment_segment
 
-# Grid points of a table (coal distances made once per checker: about 5 microseconds each).
+# Grid points of a table (coal distances made once per checker: about 6 microseconds each, the
+# UR5's five tables 0.45 s on a loaded machine).
 BUDGET = 1 << 14
 # A pair is tabulated when its capsules come within the clearance at this fraction or more of
-# random configurations (seeded): where the sweep would need its meshes at most checks.
-OVERLAP = 0.5
+# random configurations (seeded): where the sweep would need its meshes at most checks (the
+# UR5: 1.0, 1.0, 1.0, 0.72 and 0.48 for the pairs tabulated, 0.3 or less for the others).
+OVERLAP = 0.4
 _SAMPLES = 64
 _TURN = 2.0 * math.pi
 TablePack = tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]
@@ -70,27 +77,66 @@ def empty_tables(n_pairs: int) -> TablePack:
     )
 
 
+def _points(obj: pin.GeometryObject) -> tuple[np.ndarray, float]:
+    """Points (k, 3) in the object's joint frame whose convex hull holds it, and its inflation.
+
+    A convex mesh's vertices; else its bounding box's corners. The inflation (m): coal's swept
+    sphere radius, every point of the object within it of the hull.
+    """
+    shape = obj.geometry
+    if isinstance(shape, coal.ConvexBase):
+        local = np.asarray(shape.points(), dtype=float).reshape(-1, 3)
+    else:
+        shape.computeLocalAABB()
+        low = np.asarray(shape.aabb_local.min_, dtype=float)
+        high = np.asarray(shape.aabb_local.max_, dtype=float)
+        local = np.array([[(low, high)[(i >> k) & 1][k] for k in range(3)] for i in range(8)])
+    at = local @ np.asarray(obj.placement.rotation).T + np.asarray(obj.placement.translation)
+    return at, float(shape.getSweptSphereRadius())
+
+
 def _largest_from_axis(obj: pin.GeometryObject, origin: np.ndarray, axis: np.ndarray) -> float:
-    """Bound (m) on any point of the object's distance from a line (its bounding box's corners).
+    """Bound (m) on any point of the object's distance from a line.
 
     The line: through ``origin`` along the unit ``axis``, in the object's joint frame.
     """
-    obj.geometry.computeLocalAABB()
-    box = obj.geometry.aabb_local
-    low, high = np.asarray(box.min_, dtype=float), np.asarray(box.max_, dtype=float)
-    corners = np.array([[(low, high)[(i >> k) & 1][k] for k in range(3)] for i in range(8)])
-    at = corners @ np.asarray(obj.placement.rotation).T + np.asarray(obj.placement.translation)
+    at, inflation = _points(obj)
     along = (at - origin) @ axis
-    return float(np.sqrt(np.max(np.sum((at - origin) ** 2, axis=1) - along**2).clip(0.0)))
+    squared = np.sum((at - origin) ** 2, axis=1) - along**2
+    return float(np.sqrt(np.max(squared).clip(0.0))) + inflation
+
+
+def _revolved(
+    model: pin.Model, obj: pin.GeometryObject, joint: int, axis: np.ndarray
+) -> pin.GeometryObject:
+    """A cylinder about ``joint``'s axis holding ``obj`` at every angle, on the joint's parent.
+
+    ``obj`` is on ``joint``; the cylinder is what it sweeps turning about the axis (``axis``
+    in the joint's frame, through its origin) and more: a part's distance to another is at
+    least the cylinder's, whatever the joint's angle.
+    """
+    at, inflation = _points(obj)
+    along = at @ axis
+    radius = float(np.sqrt(np.max(np.sum(at**2, axis=1) - along**2).clip(0.0))) + inflation
+    low, high = float(along.min()) - inflation, float(along.max()) + inflation
+    z = axis / np.linalg.norm(axis)
+    x = np.cross(z, [1.0, 0.0, 0.0] if abs(z[0]) < 0.9 else [0.0, 1.0, 0.0])
+    x /= np.linalg.norm(x)
+    frame = pin.SE3(np.column_stack([x, np.cross(z, x), z]), z * (low + high) / 2.0)
+    cylinder = coal.Cylinder(radius, max(high - low, 1e-9))
+    placement = model.jointPlacements[joint] * frame
+    return pin.GeometryObject(
+        f"{obj.name}_revolved", int(model.parents[joint]), placement, cylinder
+    )
 
 
 def _chain(model: pin.Model, ja: int, jb: int, kind: np.ndarray) -> list[int] | None:
-    """The joints after ja up to jb (ja an ancestor of jb), if one or two and all revolute."""
+    """The joints after ja up to jb (ja an ancestor of jb), if one to three and all revolute."""
     supports = list(model.supports[jb])
     if ja == jb or ja not in supports:
         return None
     chain = supports[supports.index(ja) + 1 :]
-    return chain if 1 <= len(chain) <= 2 and all(kind[k] == 1 for k in chain) else None
+    return chain if 1 <= len(chain) <= 3 and all(kind[k] == 1 for k in chain) else None
 
 
 def _overlap(robot: tuple[np.ndarray, ...], model: pin.Model, a: int, b: int, near: float) -> float:
@@ -140,16 +186,22 @@ def build_tables(
         chain = _chain(model, ja, jb, kind)
         if chain is None or _overlap(robot, model, first, second, near) < OVERLAP:
             continue
-        w = [float(weights[p, model.joints[k].idx_v]) for k in chain]
+        a_obj, b_obj, row = objects[first], objects[second], weights[p]
+        if len(chain) == 3:  # the last joint's part as the cylinder it sweeps
+            b_obj, chain = _revolved(model, b_obj, chain[2], axes[chain[2]]), chain[:2]
+            probe = pin.GeometryModel()
+            probe.addGeometryObject(a_obj)
+            probe.addGeometryObject(b_obj)
+            row = pair_weights(model, probe, [(0, 1)], 2)[0]
+        w = [float(row[model.joints[k].idx_v]) for k in chain]
         placement = model.jointPlacements[chain[0]]
         axis = np.asarray(placement.rotation) @ axes[chain[0]]
-        w[0] = min(w[0], _largest_from_axis(objects[first], placement.translation, axis))
-        w[-1] = min(w[-1], _largest_from_axis(objects[second], np.zeros(3), axes[chain[-1]]))
+        w[0] = min(w[0], _largest_from_axis(a_obj, placement.translation, axis))
+        w[-1] = min(w[-1], _largest_from_axis(b_obj, np.zeros(3), axes[chain[-1]]))
         scale = (BUDGET / math.prod(w)) ** (1.0 / len(chain))
         counts = [max(4, int(scale * wk)) for wk in w]
         q_index = [model.joints[k].idx_q for k in chain]
-        rows.append((q_index, counts, w, _tabulate(model, objects[first], objects[second],
-                                                   q_index, counts)))  # fmt: skip
+        rows.append((q_index, counts, w, _tabulate(model, a_obj, b_obj, q_index, counts)))
         table_of[p] = len(rows) - 1
     if not rows:
         return empty_tables(len(pairs))
@@ -177,12 +229,16 @@ def _tabulate(
     probe.addGeometryObject(second)
     probe.addCollisionPair(pin.CollisionPair(0, 1))
     data, gdata = model.createData(), probe.createData()
-    values = np.empty(counts)
+    values = np.empty(math.prod(counts))
     q = pin.neutral(model)
-    for flat in range(values.size):
-        at = np.unravel_index(flat, counts)
-        for d, k in enumerate(q_index):
-            q[k] = at[d] * (_TURN / counts[d])
-        pin.updateGeometryPlacements(model, data, probe, gdata, q)
-        values[at] = pin.computeDistance(probe, gdata, 0).min_distance
-    return values
+    grids = [np.arange(n) * (_TURN / n) for n in counts]
+    flat = 0
+    for x in grids[0]:
+        q[q_index[0]] = x
+        for y in grids[1] if len(grids) > 1 else [0.0]:
+            if len(grids) > 1:
+                q[q_index[1]] = y
+            pin.updateGeometryPlacements(model, data, probe, gdata, q)
+            values[flat] = pin.computeDistance(probe, gdata, 0).min_distance
+            flat += 1
+    return values.reshape(counts)
