@@ -6,8 +6,10 @@ workpiece box, against the same map without a cell in the same run (the goal: at
 the UR5 (its URDF's meshes, as convex hulls) and the UR5e (capsules), the tool point at the end
 of a 12 cm tool; the compiled check (:mod:`solver.path.cell.fast`) and the coal-only reference
 it must agree with (``CellChecker.check(reference=True)``: here by taking the compiled sweep
-away, as tests/solver/test_cell_fast.py does); then an optimisation with the cell: its time,
-its answer's clearance, and the best collision-free cell of a map of its box.
+away, as tests/solver/test_cell_fast.py does), and the checker's build time (its self pairs'
+tables, :mod:`solver.path.cell.pair_tables`, made once per robot and cell); then an
+optimisation with the cell: its time, its answer's clearance, and the best collision-free cell
+of a map of its box.
 """
 
 from __future__ import annotations
@@ -56,7 +58,7 @@ def _coal_only() -> Iterator[None]:
     """Checkers made inside check with coal alone (the reference), as before the sweep."""
     compiled = checker_module.fast.FastCell
 
-    def refuse(*args: object) -> None:
+    def refuse(*args: object, **kwargs: object) -> None:
         raise NotImplementedError
 
     checker_module.fast.FastCell = refuse  # type: ignore[assignment,misc]
@@ -96,11 +98,15 @@ def cell_lines(
             run_map(CELL)
             t_coal = time.perf_counter() - start
         reason = getattr(cmap, "reason")  # noqa: B009 - an object typed loosely above
+        start = time.perf_counter()
+        checker_module.CellChecker(arm, CELL)  # what the first map with the cell pays once
+        t_build = time.perf_counter() - start
         print(
             f"  {arm.name}: with the cell {t_with:7.3f} s, without {t_without:7.3f} s (best of "
             f"{repeats} each): {t_with / t_without:.1f}x (goal <= 3x); coal only (one run) "
             f"{t_coal:7.3f} s: {t_coal / t_without:.1f}x; "
-            f"{int((reason == -1).sum())} feasible, {int((reason == 4).sum())} collision cells"
+            f"{int((reason == -1).sum())} feasible, {int((reason == 4).sum())} collision cells; "
+            f"the checker's build (pair tables included, once per robot and cell) {t_build:.2f} s"
         )
     bounds = (
         PlacementBounds(x=(-0.05, 0.05), y=(0.4, 0.5), yaw=(-0.2, 0.2), z=z)

@@ -15,6 +15,7 @@ from collections.abc import Callable
 import numpy as np
 
 from solver.core.codes import FEASIBLE
+from solver.core.family import PathSolutions
 from solver.path.limits import PathVerdict
 from solver.path.pipeline import ChunkResult, run_chunk
 from solver.path.placed import placed_flange
@@ -25,8 +26,28 @@ from solver.path.tracking import track
 Columns = Callable[[ChunkResult], tuple[np.ndarray, ...]]
 
 
+def chunk_solutions(problem: PathProblem, placements: np.ndarray) -> PathSolutions | None:
+    """The family's IK at placements (C, 5) of one spin; None in free spin (its own path)."""
+    if problem.options.spin_mode == "free" or not len(placements):
+        return None
+    _, rotation, flange_position = placed_flange(problem, placements)
+    return problem.family.solve_path(rotation, flange_position)
+
+
+def _per_placement(solutions: PathSolutions | None) -> bool:
+    """An analytic family's solutions: each placement solved on its own, every branch a row.
+
+    A subset's solutions are then these arrays' columns, the same floats (a numeric family
+    seeds a chunk together).
+    """
+    return solutions is not None and solutions.seeds is None and solutions.slots is None
+
+
 def tracked_joint_paths(
-    problem: PathProblem, placements: np.ndarray, rows: np.ndarray
+    problem: PathProblem,
+    placements: np.ndarray,
+    rows: np.ndarray,
+    solutions: PathSolutions | None = None,
 ) -> np.ndarray | None:
     """The joint paths a run on one branch gives, each placement on its own branch.
 
@@ -38,6 +59,7 @@ def tracked_joint_paths(
         problem: the problem (fixed spin: free spin tracks its spin schedule's path).
         placements: shape (C, 5), one spin, checked.
         rows: shape (C,), an index into the family's branches per placement.
+        solutions: :func:`chunk_solutions` at the placements, if already made.
 
     Returns:
         shape (C, W, n), rad; None where the family answers in slots (numeric IK) or the
@@ -45,8 +67,9 @@ def tracked_joint_paths(
     """
     if problem.options.spin_mode == "free":
         return None
-    _, rotation, flange_position = placed_flange(problem, placements)
-    solutions = problem.family.solve_path(rotation, flange_position)
+    if solutions is None:
+        _, rotation, flange_position = placed_flange(problem, placements)
+        solutions = problem.family.solve_path(rotation, flange_position)
     if solutions.slots is not None:
         return None
     cells = np.arange(len(placements))
@@ -170,7 +193,8 @@ def refuse_colliding(
     reason, branch = out[1], out[3]
     family = problem.family
     order = np.flatnonzero(reason == FEASIBLE)
-    joint_paths = _chosen_joint_paths(problem, placements[order], branch[order])
+    solutions = chunk_solutions(problem, placements[order])
+    joint_paths = _chosen_joint_paths(problem, placements[order], branch[order], solutions)
     if joint_paths is None:  # one run per branch taken
         joint_paths = np.empty((len(order), problem.prepared.n_waypoints, problem.robot.dof))
         for b in np.unique(branch[order]):
@@ -185,17 +209,21 @@ def refuse_colliding(
         if verdict is not None and verdict.failed_waypoint is not None
     }
     if refused:
-        _next_branches(problem, placements, out, refused, columns_of)
+        known = (order, solutions) if solutions is not None and _per_placement(solutions) else None
+        _next_branches(problem, placements, out, refused, columns_of, known)
     return tuple(out)
 
 
 def _chosen_joint_paths(
-    problem: PathProblem, placements: np.ndarray, branch: np.ndarray
+    problem: PathProblem,
+    placements: np.ndarray,
+    branch: np.ndarray,
+    solutions: PathSolutions | None,
 ) -> np.ndarray | None:
     """The joint paths (C, W, n) of each placement's branch (family indices); None: run each."""
     if not len(placements):
         return np.zeros((0, problem.prepared.n_waypoints, problem.robot.dof))
-    return tracked_joint_paths(problem, placements, branch)
+    return tracked_joint_paths(problem, placements, branch, solutions)
 
 
 def _next_branches(
@@ -204,19 +232,25 @@ def _next_branches(
     out: list[np.ndarray],
     refused: dict[int, tuple[np.ndarray, PathVerdict]],
     columns_of: Columns,
+    known: tuple[np.ndarray, PathSolutions] | None = None,
 ) -> None:
     """The refused placements' columns from their best branches that pass (auto), else refused.
 
-    One pipeline run for all of them (a chunk's placements share a spin); then, round by
-    round, each placement's next branch in :func:`branch_order` is checked, all of a round
-    together (:func:`check_paths`): the branch :func:`clear_pick` takes. The refused joint
-    path is not checked again.
+    One pipeline run for all of them (a chunk's placements share a spin; its IK taken from
+    ``known``, the checked placements' indices and an analytic family's solutions there, where
+    given); then, round by round, each placement's next branch in :func:`branch_order` is
+    checked, all of a round together (:func:`check_paths`): the branch :func:`clear_pick`
+    takes. The refused joint path is not checked again.
     """
     cells = np.array(sorted(refused))
     taken = np.zeros(len(cells), dtype=bool)
     if problem.options.branch is None:
         rows = placements[cells]
-        run = run_chunk(problem, rows)
+        solutions = None
+        if known is not None:
+            at = np.searchsorted(known[0], cells)  # the refused are among the checked
+            solutions = PathSolutions(known[1].q[:, :, at], known[1].status[:, at])
+        run = run_chunk(problem, rows, solutions=solutions)
         chosen = np.array(run.pick, copy=True)
         orders = [branch_order(run, k) for k in range(len(cells))]
         step = [0] * len(cells)

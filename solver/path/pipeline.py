@@ -21,6 +21,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from solver.core.codes import ACC_TIE_RTOL, FEASIBLE, UNREACHABLE
+from solver.core.family import PathSolutions
 from solver.core.follows_in_steps import FollowsInSteps
 from solver.core.progress import Progress, span
 from solver.path.bounded import bounded_solutions, pick_stands
@@ -99,6 +100,7 @@ def run_chunk(
     *,
     progress: Progress | None = None,
     prune: bool = False,
+    solutions: PathSolutions | None = None,
 ) -> ChunkResult:
     """The pipeline at C placements on the problem's branches.
 
@@ -113,6 +115,8 @@ def run_chunk(
             that cannot be the chosen one are not followed to the end, and come back
             unreachable; the chosen branch's answer is the same (``progress`` then unused by
             the IK). False: every branch followed (an evaluation reports them).
+        solutions: the family's IK at these placements, already solved (an analytic family's,
+            the same arrays; not with ``prune``).
     """
     robot, path, branches = problem.robot, problem.prepared, problem.branches
     family = problem.family
@@ -128,7 +132,7 @@ def run_chunk(
         bounded = isinstance(family, FollowsInSteps) and family.follows_bounded
         prune_with = bounded_solutions if bounded else pruned_solutions
         solutions = prune_with(problem, rotation, flange_position, twist, tool_position)
-    else:
+    elif solutions is None:
         solutions = family.solve_path(
             rotation, flange_position, progress=_part(progress, shares, 0)
         )

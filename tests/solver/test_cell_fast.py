@@ -103,7 +103,7 @@ def test_fast_map_equals_coal_only(name: str, monkeypatch: pytest.MonkeyPatch) -
     }
     fast = capability_map(problem, **axes)  # type: ignore[arg-type]
 
-    def coal_only(*args: object) -> None:
+    def coal_only(*args: object, **kwargs: object) -> None:
         raise NotImplementedError
 
     monkeypatch.setattr(checker_module.fast, "FastCell", coal_only)

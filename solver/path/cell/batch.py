@@ -80,6 +80,7 @@ def first_due_paths(  # type: ignore[no-untyped-def]  # pragma: no cover - compi
     ball,
     pairs,
     weights,
+    tables,
     near,
     clearance,
     clear_until,
@@ -105,6 +106,7 @@ def first_due_paths(  # type: ignore[no-untyped-def]  # pragma: no cover - compi
         ball: shape (K,).
         pairs: shape (P, 2).
         weights: shape (P, n), :func:`first_due`'s.
+        tables: :func:`first_due`'s.
         near: m, :func:`first_due`'s.
         clearance: m.
         clear_until: shape (N, P), out, as :func:`first_due` leaves it for each path.
@@ -120,8 +122,8 @@ def first_due_paths(  # type: ignore[no-untyped-def]  # pragma: no cover - compi
                      vertices[c], ball)  # fmt: skip
         clear_until[c, :] = -1
         at = first_due(
-            configurations, robot, obstacles, pairs, weights, near, clearance, clear_until[c],
-            start, known, need[c],
+            configurations, robot, obstacles, pairs, weights, tables, near, clearance,
+            clear_until[c], start, known, need[c],
         )  # fmt: skip
         index[c] = -1 if at >= configurations.shape[0] else at
 
@@ -157,7 +159,7 @@ def check_paths(
     need = np.zeros((count, n_pairs), dtype=np.bool_)
     first_due_paths(
         joint_paths, segment_in_pass, step, fast.robot, kind, ends, radius, rotation, centre,
-        half, exact, offsets, vertices, ball, fast.pairs, weights, clearance + MARGIN,
+        half, exact, offsets, vertices, ball, fast.pairs, weights, fast.tables, clearance + MARGIN,
         clearance, clear_until, index, need,
     )  # fmt: skip
     verdicts = []

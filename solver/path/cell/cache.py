@@ -2,7 +2,8 @@
 
 Building a checker (the URDF's meshes read and made convex hulls, the compiled side's packs,
 the pair weights, the self-collision probe at the zero configuration) took 0.07 to 0.1 s for
-the UR5, ten times the ERK map without a cell: every request, map and optimisation builds its
+the UR5, ten times the ERK map without a cell (and about 0.4 s more since its self pairs'
+tables, :mod:`solver.path.cell.pair_tables`): every request, map and optimisation builds its
 own :class:`solver.path.problem.PathProblem`, and each asked for a new checker. A checker is
 read-only once built (a placement's geometry is a copy, :meth:`CellChecker.check`), so
 problems with the same robot and cell share one, across threads.
@@ -26,7 +27,8 @@ from solver.path.cell import fast
 from solver.path.cell.checker import CellChecker
 from solver.path.cell.shapes import Cell
 
-# Checkers kept, the least recently used dropped first (a UR5's holds its link hulls: ~1 MB).
+# Checkers kept, the least recently used dropped first (a UR5's holds its link hulls, ~1 MB, and
+# its self pairs' tables, 0.65 MB).
 MAX_CHECKERS = 8
 
 _checkers: OrderedDict[tuple[object, str], CellChecker] = OrderedDict()

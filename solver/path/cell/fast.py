@@ -22,6 +22,7 @@ import pinocchio as pin
 
 from solver.path.cell import sweep
 from solver.path.cell.capsules import Primitive, primitive
+from solver.path.cell.pair_tables import build_tables
 
 # m: a bound within this of the clearance (or of an evaluation's closest distance) goes to
 # coal, whose GJK distances for boxes and meshes may differ from the exact ones by its
@@ -73,6 +74,7 @@ class FastCell:
     Attributes:
         robot: the sweep's robot pack.
         pairs: shape (P, 2), the checked pairs (robot parts; obstacles after them).
+        tables: the self pairs' tables (:mod:`solver.path.cell.pair_tables`).
     """
 
     def __init__(
@@ -81,8 +83,20 @@ class FastCell:
         geometry: pin.GeometryModel,
         n_robot: int,
         pairs: list[tuple[int, int]],
+        *,
+        weights: np.ndarray,
+        clearance: float,
     ) -> None:
-        """Build the packs; raise NotImplementedError for a joint or shape the sweep lacks."""
+        """Build the packs; raise NotImplementedError for a joint or shape the sweep lacks.
+
+        Args:
+            model: the robot's model.
+            geometry: the robot's parts (``n_robot``), then the obstacles.
+            n_robot: how many geometry objects are the robot's.
+            pairs: the checked pairs (geometry indices).
+            weights: shape (P, nv), :func:`solver.path.cell.bounds.pair_weights` of the pairs.
+            clearance: m, the cell's.
+        """
         joints = _joint_pack(model)
         if joints is None:
             raise NotImplementedError("a joint the sweep has no kinematics for")
@@ -107,6 +121,9 @@ class FastCell:
             [s.placed(at) for s, at in zip(self.obstacles, placements, strict=True)], placements
         )
         self.pairs = np.array(pairs, dtype=np.int64).reshape(-1, 2)
+        self.tables = build_tables(
+            model, geometry, self.robot, self.pairs, weights, clearance + MARGIN
+        )
 
     @staticmethod
     def _packed(placed: list[Primitive], placements: list[pin.SE3]) -> tuple[np.ndarray, ...]:
@@ -159,7 +176,7 @@ def first_collision(
     need = np.zeros(count, dtype=np.bool_)
     index = int(
         sweep.first_due(
-            configurations, fast.robot, obstacles, fast.pairs, weights,
+            configurations, fast.robot, obstacles, fast.pairs, weights, fast.tables,
             clearance + MARGIN, clearance, clear_until, 0, np.full(count, np.nan), need,
         )
     )  # fmt: skip
@@ -205,7 +222,7 @@ def resume(
         known[due] = distances
         index = int(
             sweep.first_due(
-                configurations, fast.robot, obstacles, fast.pairs, weights,
+                configurations, fast.robot, obstacles, fast.pairs, weights, fast.tables,
                 clearance + MARGIN, clearance, clear_until, index, known, need,
             )
         )  # fmt: skip

@@ -81,7 +81,9 @@ def build_scene(robot: Robot, cell: Cell) -> CellScene:
         geometry.addCollisionPair(pin.CollisionPair(a, b))
     weights = pair_weights(robot.model, geometry, pairs, n_robot)
     try:
-        compiled: fast.FastCell | None = fast.FastCell(robot.model, geometry, n_robot, pairs)
+        compiled: fast.FastCell | None = fast.FastCell(
+            robot.model, geometry, n_robot, pairs, weights=weights, clearance=cell.clearance
+        )
     except NotImplementedError:
         compiled = None  # a joint or shape the compiled sweep lacks: coal alone
     return CellScene(

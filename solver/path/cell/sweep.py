@@ -6,7 +6,9 @@ in the world, and for each checked pair a lower bound on its distance (:mod:`clo
 exact where both shapes are capsules, spheres, boxes or halfspaces; otherwise the distance
 between bounding capsules, raised where that is near the clearance to the shapes' separation
 along a few directions (support functions of their vertices: convex meshes, boxes, a prism
-around a cylinder; exact against a halfspace). :func:`first_due` walks a path as
+around a cylinder; exact against a halfspace), after a tabulated bound for the self pairs
+whose capsules overlap at most configurations (:mod:`solver.path.cell.pair_tables`).
+:func:`first_due` walks a path as
 :meth:`solver.path.cell.checker.CellChecker.check` does for a map (conservative advancement,
 :mod:`solver.path.cell.bounds`), returning where coal must decide a pair.
 
@@ -37,6 +39,7 @@ from solver.path.cell.closed_form import (
     segment_params,
 )
 from solver.path.cell.kinematics import parts as _parts
+from solver.path.cell.pair_tables import table_bound
 
 
 @njit(cache=True, nogil=True, error_model="numpy", inline="always")
@@ -260,6 +263,7 @@ def first_due(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
     obstacles,
     pairs,
     weights,
+    tables,
     near,
     clearance,
     clear_until,
@@ -281,6 +285,8 @@ def first_due(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
         obstacles: the obstacle pack.
         pairs: shape (P, 2).
         weights: shape (P, n), how fast each pair can close in (:mod:`bounds`).
+        tables: the self pairs' tables (:mod:`solver.path.cell.pair_tables`), tried before
+            their meshes.
         near: m, a bound at or below this goes to coal.
         clearance: m, the cell's clearance.
         clear_until: shape (P,), in and out: the last configuration each pair is proven clear.
@@ -322,6 +328,11 @@ def first_due(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
                     a, b, ends, radius, kind, o_ends, o_radius, o_rot, o_centre, o_half, cuts
                 )
                 both = exact[a] and (exact[b] if b < n_robot else o_exact[b - n_robot])
+                if distance <= near and not both and tables[0][p] >= 0:  # a tabulated pair
+                    bound = table_bound(
+                        tables[0][p], configurations[index], tables, near - clearance
+                    )
+                    distance = max(distance, bound)
                 if distance <= near and not both:  # a mesh or a cylinder: its own bounds
                     distance = _bound(
                         p, pairs, ends, robot, obstacles, work, near, rot, pos, cuts, last

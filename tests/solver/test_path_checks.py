@@ -1,0 +1,90 @@
+"""The path checks' reuse of a chunk's IK for its refused placements (issue 22).
+
+A map with a cell checks each feasible placement's chosen joint path; the refused ones run the
+pipeline again for their next branches, taking the IK already solved for the chunk
+(:func:`solver.path.path_checks.chunk_solutions`). That rests on an analytic family solving
+each placement on its own: a subset's solutions equal to the bit the full set's columns
+(checked here against the family solving the subset alone); and the map is the map without the
+reuse, every field to the bit.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import solver.path.path_checks as path_checks
+from solver.core.robots import Robot
+from solver.families import get_robot, robot_from_urdf
+from solver.path.capability_map import capability_map, grid_axis
+from solver.path.placed import placed_flange
+from solver.path.problem import PathOptions, PathProblem
+from tests.solver.families.numeric_maps import opw_urdf
+from tests.solver.test_cell_fast import _arm
+from tests.solver.test_cell_pair_tables import ON_TABLE
+from tests.solver.test_evaluate import load_path
+
+
+def _robot(name: str) -> Robot:
+    if name == "kr6":  # an OPW arm's closed form, recognised in its URDF
+        urdf = opw_urdf("kuka_kr6_r700_sixx")
+        return robot_from_urdf(urdf, base_frame="base_link", tool_frame="tool0")
+    return get_robot(name)
+
+
+@pytest.mark.parametrize("name", ["ur5", "ur5e", "kr6"])
+def test_subset_solutions_are_the_full_sets_columns(name: str) -> None:
+    """Seeded random placements and subsets: the same floats and statuses."""
+    problem = PathProblem.of(_robot(name), load_path("curved_line"), PathOptions())
+    rng = np.random.default_rng(5)
+    for _ in range(10):
+        count = int(rng.integers(5, 40))
+        placements = np.column_stack(
+            [
+                rng.uniform(-0.3, 0.3, count),
+                rng.uniform(0.2, 0.7, count),
+                np.full(count, 0.1),
+                rng.uniform(-1.0, 1.0, count),
+                np.zeros(count),
+            ]
+        )
+        solutions = path_checks.chunk_solutions(problem, placements)
+        assert solutions is not None and path_checks._per_placement(solutions)
+        subset = np.sort(rng.choice(count, int(rng.integers(1, count + 1)), replace=False))
+        _, rotation, position = placed_flange(problem, placements[subset])
+        alone = problem.family.solve_path(rotation, position)
+        np.testing.assert_array_equal(solutions.q[:, :, subset], alone.q)
+        np.testing.assert_array_equal(solutions.status[:, subset], alone.status)
+
+
+@pytest.mark.parametrize("name", ["ur5", "ur5e"])
+def test_map_reusing_the_ik_equals_without(name: str, monkeypatch: pytest.MonkeyPatch) -> None:
+    """The ERK path's map with a cell, every field to the bit, next branches taken."""
+    axes = {
+        "xs": grid_axis(-0.25, 0.25, 0.05, field="x"),
+        "ys": grid_axis(0.25, 0.65, 0.05, field="y"),
+        "z": 0.1,
+        "yaws": np.array([0.0, 0.6]),
+    }
+    given: list[bool] = []  # per pipeline run of refused placements: was the IK handed over?
+    run_chunk = path_checks.run_chunk
+
+    def spy(*args: object, **kwargs: object) -> object:
+        given.append(kwargs.get("solutions") is not None)
+        return run_chunk(*args, **kwargs)  # type: ignore[arg-type]
+
+    monkeypatch.setattr(path_checks, "run_chunk", spy)
+    problem = PathProblem.of(_arm(name), load_path("curved_line"), PathOptions(cell=ON_TABLE))
+    plain = PathProblem.of(_arm(name), load_path("curved_line"), PathOptions())
+    reused = capability_map(problem, **axes)  # type: ignore[arg-type]
+    assert given and all(given)
+    given.clear()
+    free = capability_map(plain, **axes)  # type: ignore[arg-type]
+    assert ((reused.branch != free.branch) & (reused.reason == -1)).any()  # next branches
+    monkeypatch.setattr(path_checks, "_per_placement", lambda solutions: False)
+    again = capability_map(problem, **axes)  # type: ignore[arg-type]
+    assert given and not any(given)
+    fields = [k for k, v in vars(reused).items() if isinstance(v, np.ndarray)]
+    assert "mu_path" in fields and "branch" in fields
+    for field in fields:
+        np.testing.assert_array_equal(getattr(reused, field), getattr(again, field), field)
