@@ -187,7 +187,12 @@ class NumericFamily(KinematicsFamily, FollowsInSteps):
 
     @property
     def follows_bounded(self) -> bool:
-        """The compiled chain of six or seven joints (:mod:`solver.path.bounded`)."""
+        """The compiled chain of six or seven joints (:mod:`solver.path.bounded`).
+
+        Seven joints (:mod:`bounded_redundant_kernel`): the Panda's ERK map (546 placements,
+        two threads) took 0.66 to 0.70 times the CPU time of its pruning in steps (best of 3,
+        alternating, machine loaded to 5-6 on 2 cores, 2026-12-02), the same answers.
+        """
         return self.compiled and self.dof in (6, 7)
 
     def follow_bounded(
