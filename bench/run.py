@@ -305,8 +305,9 @@ def numeric_maps(path: np.ndarray, xs: np.ndarray, ys: np.ndarray, z: float, t_m
             )
             line += f"; equal to it on {same.mean():.1%} of the cells"
         print(line)
-    # The Panda's map prunes branches that cannot be a cell's best (solver/path/pruning.py):
-    # the same map following every branch, for the ratio.
+    # The Panda's map prunes branches that cannot be a cell's best in one compiled pass
+    # (solver/families/numeric/bounded_redundant_kernel.py): the same map following every
+    # branch, for the ratio.
     panda = PathProblem.of(get_robot("panda"), path)
     grid_y, grid_x = np.meshgrid(ys, xs, indexing="ij")
     cells = np.column_stack([grid_x.ravel(), grid_y.ravel(), np.full(grid_x.size, z)])

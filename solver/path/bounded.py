@@ -22,6 +22,10 @@ followed to the end: where a dropped slot could change a placement's choice, the
 again following every slot (none of 546 placements of the UR5's ERK map). A dropped slot
 comes back unreachable from its first waypoint, as in :mod:`solver.path.pruning`, so no
 reported field of the cell changes (tested cell by cell against following every slot).
+
+Seven-joint (redundant) chains take the same seam with their own pass
+(:mod:`solver.families.numeric.bounded_redundant_kernel`): no scouting (a redundant branch's
+solutions depend on every waypoint before), the slots followed best bound first.
 """
 
 from __future__ import annotations

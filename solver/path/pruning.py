@@ -25,8 +25,9 @@ Only where that argument holds: the map's ``auto`` branch, fixed spin, limits th
 waypoint by its own configuration (the joint speeds), no final-path limit (mu_acc ranks the
 branches) and no path check (the cell takes the next branch when the best collides).
 Evaluations follow every branch: their answer reports the whole joint paths. A family that
-follows bounded (six joints, :attr:`FollowsInSteps.follows_bounded`) is pruned under the same
-conditions in one compiled pass instead (:mod:`solver.path.bounded`).
+follows bounded (six and seven joints, :attr:`FollowsInSteps.follows_bounded`) is pruned under
+the same conditions in one compiled pass instead (:mod:`solver.path.bounded`); this serves arms
+of more joints.
 """
 
 from __future__ import annotations

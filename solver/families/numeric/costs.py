@@ -52,6 +52,23 @@ loaded machine, 2026-12-02, same run: Panda 0.19 and 0.11, xArm7 0.38 and 0.29 (
 test_numeric_map_work.py), the branch-waypoints followed past the first piece: 0.09 to 0.16."""
 
 
+BOUNDED_MAP_SHARE = 0.55
+"""A seven-joint map pruned in one pass (:mod:`solver.families.numeric.bounded_redundant_kernel`):
+its work past the seeding against the line's following (every branch), about 25 % above the
+pass's measured share. CPU time, best of 3, loaded machine, 2026-12-02, same run, 20 x 11
+placements of the ERK grid: the pass against following every slot, the ERK path (133
+waypoints) and 400 (there and back), Panda 0.43 and 0.21, xArm7 0.41 and 0.20; the whole map
+past the seeding against the unpruned one's (133 waypoints, serial) Panda 0.29, xArm7 0.35 (the
+pipeline tracks and bounds only the slots kept), so the figure is an upper bound. In counts
+(tests/solver/families/test_numeric_map_work.py): the pass follows 0.10 to 0.25 of every
+branch's waypoints, each FOLLOW_WITH_V_MAX times a plain one's work (V_max, the exact LP, at
+every waypoint followed)."""
+FOLLOW_WITH_V_MAX = 2.0
+"""A waypoint followed by the one-pass pruning (V_max at it) against one followed plainly:
+the pass's time share over its counted share (BOUNDED_MAP_SHARE's runs): Panda 1.8 and 1.8, xArm7
+1.8 and 2.0."""
+
+
 def _scale(dof: int) -> float:
     """Arms of more than seven joints: the seven-joint figures times (dof / 7)^2."""
     return max(dof / 7, 1.0) ** 2
@@ -82,12 +99,19 @@ def path_cost(dof: int, compiled: bool, n_waypoints: int, *, free_spin: bool = F
 
 
 def map_cost(
-    dof: int, compiled: bool, n_waypoints: int, *, free_spin: bool = False, pruned: bool = False
+    dof: int,
+    compiled: bool,
+    n_waypoints: int,
+    *,
+    free_spin: bool = False,
+    pruned: bool = False,
+    bounded: bool = False,
 ) -> float:
     """A map's placement, in the unit of :func:`path_cost`.
 
     A pruned map (``pruned``: the compiled chain followed in steps, fixed spin) follows every
-    branch for FIRST_PIECE waypoints, then about MAP_TAIL_SHARE of them; the numpy chain
+    branch for FIRST_PIECE waypoints, then about MAP_TAIL_SHARE of them; a seven-joint map
+    pruned in one pass (``bounded``) BOUNDED_MAP_SHARE of the following; the numpy chain
     weighs NUMPY_MAP_COST.
 
     Args:
@@ -96,14 +120,19 @@ def map_cost(
         n_waypoints: the path's waypoints.
         free_spin: the seven-joint free spin.
         pruned: the map prunes branches in steps (``FollowsInSteps.follows_in_steps``).
+        bounded: the map prunes a seven-joint arm's branches in one pass
+            (``FollowsInSteps.follows_bounded``).
     """
     if not compiled:
         return path_cost(dof, compiled, n_waypoints, free_spin=free_spin) * (
             NUMPY_MAP_COST / NUMPY_CHAIN_COST
         )
-    if free_spin or not pruned:
+    if free_spin or not (pruned or bounded):
         return path_cost(dof, compiled, n_waypoints, free_spin=free_spin)
     following = max(n_waypoints - 1, 0)
+    if bounded:
+        share = BOUNDED_MAP_SHARE * following
+        return _scale(dof) * max(seed + share * track for seed, track in COST_LINES[7])
     tail = max(following - FIRST_PIECE, 0)
     followed = following - tail + MAP_TAIL_SHARE * tail
     return _scale(dof) * max(seed + followed * track for seed, track in COST_LINES[7])

@@ -21,7 +21,15 @@ import pinocchio as pin
 from solver.core.family import Branch, KinematicsFamily, PathSolutions
 from solver.core.follows_in_steps import FollowsInSteps
 from solver.core.progress import Progress, span
-from solver.families.numeric import bounded_kernel, costs, ik, ik_kernel, reference, velocity
+from solver.families.numeric import (
+    bounded_kernel,
+    bounded_redundant_kernel,
+    costs,
+    ik,
+    ik_kernel,
+    reference,
+    velocity,
+)
 from solver.families.numeric.chain import SerialChain
 
 FOLLOW_WAYPOINTS = 256
@@ -30,6 +38,11 @@ seven-joint arm's slots: about 0.2 s)."""
 SEED_SHARE, FOLLOW_SHARE = 0.05, 0.9
 """Where seeding the first waypoint ends, and following the branches, in a path's solve's
 progress (the rest: the singularity checks)."""
+REDUNDANT_MARGIN = 1e-10
+"""Relative slack on a seven-joint slot's bound (:mod:`bounded_redundant_kernel`): its V_max come
+from the unwrapped solutions, the pipeline's from the tracked path (2 pi k and the steps' running
+sums apart): measured at most 6e-15 apart on the Panda, 1e-13 on the xArm7 (every slot of a
+40 mm ERK grid followed to the end, 2026-12-02)."""
 
 
 def seed_count(dof: int) -> int:
@@ -96,7 +109,8 @@ class NumericFamily(KinematicsFamily, FollowsInSteps):
             self.compiled,
             n_waypoints,
             free_spin=free_spin,
-            pruned=pruned and self.follows_in_steps,
+            pruned=pruned and self.follows_in_steps and not self.follows_bounded,
+            bounded=pruned and self.follows_bounded and self.dof == 7,
         )
 
     @property
@@ -123,13 +137,15 @@ class NumericFamily(KinematicsFamily, FollowsInSteps):
     def follows_in_steps(self) -> bool:
         """The compiled chain of more than six joints; the numpy reference only whole paths.
 
-        Six joints are pruned in one compiled pass instead (:attr:`follows_bounded`); in
-        steps, a pruned map of the UR5 URDF took 1.05 times the
+        Six and seven joints are pruned in one compiled pass instead (:attr:`follows_bounded`),
+        more joints in steps (:mod:`solver.path.pruning`). Six joints in
+        steps: a pruned map of the UR5 URDF took 1.05 times the
         unpruned one, of an IRB 2400 URDF 1.8 times (143 placements of the ERK path, same run,
         loaded machine, 2026-12-02): their few branches are cheap to follow (a UR's four
         shoulder branches tie and are all followed anyway), and the bounds cost more than the
         following they save. Seven joints, pruned against unpruned (CPU time, best of 3, same
-        run): the Panda's ERK map 1.76 times faster, the xArm7 1.69, the LBR iiwa 14 1.25.
+        run): the Panda's ERK map 1.76 times faster, the xArm7 1.69, the LBR iiwa 14 1.25 (in
+        one pass now, :attr:`follows_bounded`).
         """
         return self.compiled and self.dof > 6
 
@@ -171,8 +187,13 @@ class NumericFamily(KinematicsFamily, FollowsInSteps):
 
     @property
     def follows_bounded(self) -> bool:
-        """The compiled chain of six joints (:mod:`solver.path.bounded`)."""
-        return self.compiled and self.dof == 6
+        """The compiled chain of six or seven joints (:mod:`solver.path.bounded`).
+
+        Seven joints (:mod:`bounded_redundant_kernel`): the Panda's ERK map (546 placements,
+        two threads) took 0.66 to 0.70 times the CPU time of its pruning in steps (best of 3,
+        alternating, machine loaded to 5-6 on 2 cores, 2026-12-02), the same answers.
+        """
+        return self.compiled and self.dof in (6, 7)
 
     def follow_bounded(
         self,
@@ -181,19 +202,24 @@ class NumericFamily(KinematicsFamily, FollowsInSteps):
         speeds: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, float],
         rules: tuple[float, ...],
     ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-        """:func:`bounded_kernel.follow_bounded` (see :meth:`FollowsInSteps.follow_bounded`)."""
+        """:func:`bounded_kernel.follow_bounded` (see :meth:`FollowsInSteps.follow_bounded`).
+
+        Seven joints: :func:`bounded_redundant_kernel.follow_bounded`, its margin
+        :data:`REDUNDANT_MARGIN` at least.
+        """
         settings, constants = self._settings()
-        result: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray] = (
-            bounded_kernel.follow_bounded(
-                self._packed,
-                current,
-                *(np.ascontiguousarray(a, dtype=float) for a in (*poses, *speeds[:3])),
-                np.asarray(speeds[3], dtype=np.bool_),
-                (self.lower, self.upper, np.array([speeds[4]], dtype=float)),
-                settings,
-                constants,
-                np.array(rules, dtype=float),
-            )
+        kernel = bounded_kernel if self.dof == 6 else bounded_redundant_kernel
+        if self.dof > 6:
+            rules = (rules[0], max(rules[1], REDUNDANT_MARGIN), *rules[2:])
+        result: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray] = kernel.follow_bounded(
+            self._packed,
+            current,
+            *(np.ascontiguousarray(a, dtype=float) for a in (*poses, *speeds[:3])),
+            np.asarray(speeds[3], dtype=np.bool_),
+            (self.lower, self.upper, np.array([speeds[4]], dtype=float)),
+            settings,
+            constants,
+            np.array(rules, dtype=float),
         )
         return result
 

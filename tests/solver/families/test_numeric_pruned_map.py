@@ -3,9 +3,11 @@
 :mod:`solver.path.pruning`: a cell's reported fields (mu_path, reason, failing waypoint, branch,
 binding waypoint and joint, V_max along the chosen branch) are those of following every branch
 (``prune=False``), bit for bit, and those of the numpy chain (the reference, never pruned) to
-its tolerance. Seven-joint arms are pruned in steps (:mod:`solver.path.pruning`), six-joint
-arms in one compiled pass (:mod:`solver.path.bounded`): both are checked, the latter on a UR and
-an OPW arm (whose family, made to follow in steps here, still takes the compiled pass).
+its tolerance. Six- and seven-joint arms are pruned in one compiled pass
+(:mod:`solver.path.bounded`; seven joints: :mod:`solver.families.numeric.bounded_redundant_kernel`),
+checked on the Panda, the xArm7, a UR and an OPW arm (whose family, made to follow in steps
+here, still takes the compiled pass); arms of more joints in steps (:mod:`solver.path.pruning`),
+checked on the Panda made to (``panda_in_steps``).
 """
 
 from __future__ import annotations
@@ -41,6 +43,7 @@ FIELDS = (
 CASES = {  # the arm, and its grid's x and y ranges
     "panda": ("panda", (-0.25, 0.25), (0.25, 0.65)),
     "xarm7": ("xarm7", (-0.25, 0.25), (0.25, 0.65)),
+    "panda_in_steps": ("panda", (-0.25, 0.25), (0.25, 0.65)),
     "ur5_urdf": ("ur5_urdf", (-0.25, 0.25), (0.25, 0.65)),
     "irb2400_urdf": ("irb2400_urdf", (0.6, 1.0), (-0.25, 0.25)),
 }
@@ -55,11 +58,20 @@ class _InSteps(NumericFamily):
         return True
 
 
-def stepped(robot: Robot) -> Robot:
-    """``robot`` whose numeric family follows in steps (six joints are otherwise not pruned)."""
+class _OnlyInSteps(_InSteps):
+    """The numeric family pruned in steps, never in one pass (as arms of eight joints are)."""
+
+    @property
+    def follows_bounded(self) -> bool:
+        """Never."""
+        return False
+
+
+def stepped(robot: Robot, *, only: bool = False) -> Robot:
+    """``robot`` whose numeric family follows in steps (``only``: and not in one pass)."""
     family = robot.family
     assert isinstance(family, NumericFamily)
-    stepping = _InSteps.__new__(_InSteps)
+    stepping = (_OnlyInSteps if only else _InSteps).__new__(_OnlyInSteps if only else _InSteps)
     stepping.__dict__.update(family.__dict__)
     return dataclasses.replace(robot, family=stepping)
 
@@ -81,7 +93,7 @@ def placements_of(name: str) -> np.ndarray:
 
 @pytest.mark.parametrize("name", CASES)
 def test_pruned_map_equals_following_every_branch(name: str) -> None:
-    robot = stepped(numeric(CASES[name][0]))
+    robot = stepped(numeric(CASES[name][0]), only=name.endswith("_in_steps"))
     problem = PathProblem.of(robot, load_path("curved_line"))
     assert can_prune(problem)
     placements = placements_of(name)
@@ -110,8 +122,9 @@ def test_pruned_map_equals_numpy_reference(name: str) -> None:
     """The numpy chain follows every branch (it does not follow in steps): the reference."""
     path = load_path("curved_line")[:60]
     placements = placements_of(name)
-    ours = evaluate_placements(PathProblem.of(stepped(numeric(name)), path), placements)
-    reference_problem = PathProblem.of(numeric(name, compiled=False), path)
+    robot = stepped(numeric(CASES[name][0]), only=name.endswith("_in_steps"))
+    ours = evaluate_placements(PathProblem.of(robot, path), placements)
+    reference_problem = PathProblem.of(numeric(CASES[name][0], compiled=False), path)
     assert not can_prune(reference_problem)
     theirs: PlacementResults = evaluate_placements(reference_problem, placements)
     for field in ("reason", "failed_waypoint", "branch", "bottleneck_waypoint"):
@@ -137,7 +150,9 @@ def test_six_joint_maps_prune_in_one_compiled_pass() -> None:
     family = ur5.family
     assert can_prune(ur5) and isinstance(family, NumericFamily) and family.follows_bounded
     assert not can_prune(PathProblem.of(numeric("ur5_urdf", compiled=False), ur5.waypoints))
-    assert can_prune(PathProblem.of(numeric("panda"), load_path("curved_line")[:10]))
+    panda = PathProblem.of(numeric("panda"), load_path("curved_line")[:10])
+    family = panda.family
+    assert can_prune(panda) and isinstance(family, NumericFamily) and family.follows_bounded
 
 
 @pytest.mark.parametrize("name", ["ur5_urdf", "irb2400_urdf"])
