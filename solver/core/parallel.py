@@ -82,14 +82,14 @@ SERIAL = SerialRunner()
 
 
 class ThreadRunner:
-    """Tasks on a pool of threads (numpy releases the GIL in its array loops).
+    """Tasks on the calling thread and a few more (numpy and the compiled kernels release the GIL).
 
     Args:
         threads: threads at most, >= 1.
     """
 
     def __init__(self, threads: int) -> None:
-        """A runner on ``threads`` threads (made per run, so a runner holds no threads)."""
+        """A runner on ``threads`` threads, the caller's included (helpers made per run)."""
         if threads < 1:
             raise ValueError(f"{threads=} must be >= 1")
         self.threads = threads
