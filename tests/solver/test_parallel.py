@@ -81,6 +81,47 @@ def test_a_threaded_run_uses_several_threads() -> None:
     assert len(seen) == 2
 
 
+def test_the_calling_thread_computes_and_reports_every_task() -> None:
+    caller = threading.get_ident()
+    ran_on: dict[int, int] = {}
+    reported_on: set[int] = set()
+    barrier = threading.Barrier(2, timeout=5)
+
+    def work(task: int) -> int:
+        ran_on[task] = threading.get_ident()
+        if task < 2:
+            barrier.wait()  # the caller and the helper each hold one of the first two
+        return -task
+
+    def done(i: int) -> None:
+        reported_on.add(threading.get_ident())
+
+    assert ThreadRunner(2).run(work, list(range(8)), done) == [-t for t in range(8)]
+    assert caller in ran_on.values() and len(set(ran_on.values())) == 2
+    assert reported_on == {caller}
+
+
+def test_a_task_that_raises_in_a_helper_is_raised_and_stops_the_work() -> None:
+    caller = threading.get_ident()
+    started: list[int] = []
+    release = threading.Event()
+
+    def work(task: int) -> int:
+        started.append(task)
+        if threading.get_ident() != caller:
+            raise ValueError(f"task {task}")
+        release.wait(5)  # the caller's first task ends once the helper has failed
+        return task
+
+    def done(i: int) -> None:
+        pass
+
+    threading.Timer(0.2, release.set).start()
+    with pytest.raises(ValueError, match="task [01]"):
+        ThreadRunner(2).run(work, list(range(50)), done)
+    assert sorted(started) == [0, 1]  # one task each; none started after the failure
+
+
 def test_task_sizes_are_whole_chunks_within_the_cap() -> None:
     assert tasks_of(1000, 32, per_worker=4, workers=2, cap=512) == 128
     assert tasks_of(10, 32, per_worker=4, workers=2, cap=512) == 32
