@@ -226,6 +226,23 @@ def probed_speed(i, k, b, cq, sq, status, index, c, qddot_max, steps):  # type: 
     return 1.0 / math.sqrt(worst)
 
 
+@njit(cache=True, error_model="numpy", nogil=True, inline="always")
+def probed_before(i, acc_hint, probed, k):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
+    """Whether row i's stencil row ``acc_hint[i]`` needs no probe of the rows left to follow.
+
+    None (-1), the best row's ``k`` (probed already), or a row before i marked in ``probed``
+    was probed there (a row's acc_hint changes only where it is left, to the stencil row that
+    left it, itself probed). ``acc_hint``: shape (B,); ``probed``: shape (B,), bool.
+    """
+    ki = acc_hint[i]
+    if ki < 0 or ki == k:
+        return True
+    for m in range(i):
+        if probed[m] and acc_hint[m] == ki:
+            return True
+    return False
+
+
 @njit(cache=True, error_model="numpy", nogil=True)
 def probe_acc_rows(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
     todo, limit, k, family, par, poses, branches, scratch, cq, sq, qd, status, need, alive,
