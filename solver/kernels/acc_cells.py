@@ -32,12 +32,12 @@ from solver.kernels.accelerations import (
     probe_free_acc_rows,
     probed_before,
     scan_row,
-    spin_moves,
     spin_rate_of,
 )
 from solver.kernels.cell import PRUNED, choice_holds, next_row, set_limits, start_again, write_cell
 from solver.kernels.fixed_follow import follow_rows, probe_rows
-from solver.kernels.free_follow import follow_free_rows, probe_free_rows, spun_check
+from solver.kernels.free_follow import follow_free_rows, moved_check, probe_free_rows
+from solver.kernels.spin_schedule import spin_moves
 
 
 @njit(cache=True, error_model="numpy", nogil=True)
@@ -132,7 +132,8 @@ def free_cell(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
     """Placement c in free spin with acceleration limits; returns the chosen branch's row.
 
     As :func:`fixed_cell`; a row followed to the end is probed, then tracked along its spin
-    schedule at its mu_path (:func:`solver.kernels.free_follow.spun_check`), then scanned.
+    schedule at its mu_path (:func:`solver.kernels.free_follow.moved_check`, the spin's moves
+    made once for it and the scan), then scanned.
     Before a row is followed its V_acc is known only where its spin is none
     (:func:`solver.kernels.accelerations.probe_free_acc_rows`).
 
@@ -182,9 +183,9 @@ def free_cell(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
                 row, limit[row], probes, b, rate, cq, sq, qd, qs, length, qdot_max, index,
                 steps_c, qddot_max, steps, alive, why, where, slowest, acc_hint,
             ):  # fmt: skip
-                spun_check(row, *spun_args)
+                spin_moves(qd, qs, b, rate, length, qdot_max, moves)
+                moved_check(row, moves, *spun_args)
                 if alive[row]:
-                    spin_moves(qd, qs, b, rate, length, qdot_max, moves)
                     scan_row(row, limit[row], b, cq, sq, qs, moves, *scan)
         if followed and why[row] == PRUNED:  # left by its V_acc: the others probed there
             probe_free_acc_rows(remaining, limit, acc_hint[row], *grid)
@@ -199,11 +200,14 @@ def free_cell(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
                                     reach)  # fmt: skip
             for i in range(branches.shape[0]):
                 bound[i] = min(bound[i], reach[i])
-            if acc_hint[row] >= 0:
-                probe_free_acc_rows(remaining, limit, acc_hint[row], *grid)
+            k = acc_hint[row]
+            if k >= 0:
+                probe_free_acc_rows(remaining, limit, k, *grid)
+            todo[:] = False  # the rows whose acc_hint was probed
             for i in range(branches.shape[0]):
-                if remaining[i] and alive[i] and acc_hint[i] >= 0:
+                if remaining[i] and alive[i] and not probed_before(i, acc_hint, todo, k):
                     probe_free_acc_rows(remaining, limit, acc_hint[i], *grid)
+                    todo[i] = True
         row = next_row(remaining, alive, bound)
     pick = write_cell(c, branches, alive, why, where, feed, ACC_TIE_RTOL, *answer)
     if choice_holds(alive, why, slowest, feed, ACC_TIE_RTOL, pick):
@@ -216,9 +220,9 @@ def free_cell(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
     follow_free_rows(todo, limit, *posed, *steps_tests, *found, *kept)
     for i in range(branches.shape[0]):
         if todo[i] and alive[i]:
-            spun_check(i, *spun_args)
+            rate = spin_rate_of(slowest[i], True)
+            spin_moves(qd, qs, branches[i], rate, length, qdot_max, moves)
+            moved_check(i, moves, *spun_args)
             if alive[i]:
-                rate = spin_rate_of(slowest[i], True)
-                spin_moves(qd, qs, branches[i], rate, length, qdot_max, moves)
                 scan_row(i, -np.inf, branches[i], cq, sq, qs, moves, *scan)
     return write_cell(c, branches, alive, why, where, feed, ACC_TIE_RTOL, *answer)

@@ -14,8 +14,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from solver.core.dtf import spin_rate_nearest_zero
 from solver.families import get_robot
 from solver.kernels.accelerations import probed_before
+from solver.kernels.spin_schedule import spin_moves
 from tests.solver.test_evaluate import load_path
 from tests.solver.test_map_kernel import grid, same_cells
 
@@ -64,3 +66,23 @@ def test_probed_before_once_per_stencil_row() -> None:
     probed[3] = True
     assert probed_before(5, acc_hint, probed, 9)
     assert not probed_before(0, acc_hint, probed, 9)
+
+
+@pytest.mark.parametrize("seed", range(3))
+def test_spin_moves_are_the_numpy_schedules(seed: int) -> None:
+    """The spin's moves the free-spin check and scan share (made once per branch) against the
+    numpy schedule's sigma dt: the spin rate nearest zero at the feed times the segment's length
+    over the feed; none without a feed."""
+    rng = np.random.default_rng(seed)
+    n, b, feed = 40, 3, 0.2
+    qd = rng.normal(0.0, 10.0, (8, 6, n))  # the feed alone would break the speed limits
+    qs = rng.uniform(0.5, 1.0, (8, 6, n)) * rng.choice([-1.0, 1.0], (8, 6, n))
+    length = rng.uniform(0.001, 0.003, n - 1)
+    qdot_max = np.full(6, 3.0)
+    moves = np.full(n, np.nan)
+    spin_moves(qd, qs, b, feed, length, qdot_max, moves)
+    sigma = spin_rate_nearest_zero(qd[b, :, :-1], qs[b, :, :-1], qdot_max, np.full(n - 1, feed))
+    assert moves[0] == 0.0 and np.count_nonzero(sigma) > n // 4
+    np.testing.assert_allclose(moves[1:], sigma * length / feed, rtol=1e-12, atol=0.0)
+    spin_moves(qd, qs, b, 0.0, length, qdot_max, moves)
+    assert not moves.any()
