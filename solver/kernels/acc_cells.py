@@ -105,10 +105,12 @@ def fixed_cell(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
                 if remaining[i] and alive[i] and not probed_before(i, acc_hint, todo, k):
                     probe_acc_rows(remaining, limit, acc_hint[i], *grid)
                     todo[i] = True
+            todo[:] = False  # the rows whose hint was probed
             for i in range(branches.shape[0]):
-                if remaining[i] and alive[i] and hint[i] >= 0 and hint[i] != slowest_at[row]:
+                if remaining[i] and alive[i] and not probed_before(i, hint, todo, slowest_at[row]):
                     probe_rows(remaining, limit, hint[i], *posed, inverse_qdot, *found, slowest,
                                hint, bound)  # fmt: skip
+                    todo[i] = True
         row = next_row(remaining, alive, bound)
     pick = write_cell(c, branches, alive, why, where, feed, ACC_TIE_RTOL, *answer)
     if choice_holds(alive, why, slowest, feed, ACC_TIE_RTOL, pick):
@@ -194,10 +196,12 @@ def free_cell(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
             set_limits(limit, row, feed[row], ACC_TIE_RTOL)
             probe_free_rows(remaining, limit, slowest_at[row], *posed, qdot_max, *found, hint,
                             reach)  # fmt: skip
+            todo[:] = False  # the rows whose hint was probed
             for i in range(branches.shape[0]):
-                if remaining[i] and alive[i] and hint[i] >= 0:
+                if remaining[i] and alive[i] and not probed_before(i, hint, todo, slowest_at[row]):
                     probe_free_rows(remaining, limit, hint[i], *posed, qdot_max, *found, hint,
                                     reach)  # fmt: skip
+                    todo[i] = True
             for i in range(branches.shape[0]):
                 bound[i] = min(bound[i], reach[i])
             k = acc_hint[row]

@@ -215,18 +215,20 @@ def probed_speed(i, k, b, cq, sq, status, index, c, qddot_max, steps):  # type: 
 
 
 @njit(cache=True, error_model="numpy", nogil=True, inline="always")
-def probed_before(i, acc_hint, probed, k):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
-    """Whether row i's stencil row ``acc_hint[i]`` needs no probe of the rows left to follow.
+def probed_before(i, hints, probed, k):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
+    """Whether row i's hint ``hints[i]`` needs no probe of the rows left to follow.
 
-    None (-1), the best row's ``k`` (probed already), or a row before i marked in ``probed``
-    was probed there (a row's acc_hint changes only where it is left, to the stencil row that
-    left it, itself probed). ``acc_hint``: shape (B,); ``probed``: shape (B,), bool.
+    ``hints``: shape (B,), where each row was least or left (a stencil row, ``acc_hint``, or
+    a waypoint, ``hint``). None (-1), the best row's ``k`` (probed already), or a row before i
+    marked in ``probed`` (shape (B,), bool) was probed there: a second probe at the same place
+    finds what the first did. (A row's hint changes only where it is left, to the place that
+    left it, itself probed.)
     """
-    ki = acc_hint[i]
-    if ki < 0 or ki == k:
+    here = hints[i]
+    if here < 0 or here == k:
         return True
     for m in range(i):
-        if probed[m] and acc_hint[m] == ki:
+        if probed[m] and hints[m] == here:
             return True
     return False
 
