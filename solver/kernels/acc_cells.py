@@ -6,7 +6,10 @@ motion.md section 3: a cell's branch is the one with the highest mu_acc
 once a branch is feasible every other is known by a bound of its mu_acc until the bound is below
 its limit (:func:`solver.kernels.cell.set_limits`): its running minimum of V_max (mu_acc <=
 mu_path), V_max at the best branch's bottleneck, V_acc at the stencil row where the best
-branch's mu_acc binds, and both where each branch was least at the placement before
+branch's mu_acc binds, both where each branch was least at the placement before (each such
+row probed once for all the branches left to follow), and V_acc at the stencil row where a
+branch followed to the end was left by its V_acc (the branches of one shoulder share joints,
+so they are often left there too: the ERK-size map then follows a sixth fewer branches)
 (:mod:`solver.kernels.accelerations`). A branch still in the running is followed to the end
 (in free spin tracked along its spin schedule), probed there, and scanned
 (:func:`solver.kernels.accelerations.scan_row`), most promising first. Where a left branch
@@ -27,13 +30,14 @@ from solver.kernels.accelerations import (
     left_at_probes,
     probe_acc_rows,
     probe_free_acc_rows,
+    probed_before,
     scan_row,
-    spin_moves,
     spin_rate_of,
 )
 from solver.kernels.cell import PRUNED, choice_holds, next_row, set_limits, start_again, write_cell
 from solver.kernels.fixed_follow import follow_rows, probe_rows
-from solver.kernels.free_follow import follow_free_rows, probe_free_rows, spun_check
+from solver.kernels.free_follow import follow_free_rows, moved_check, probe_free_rows
+from solver.kernels.spin_schedule import spin_moves
 
 
 @njit(cache=True, error_model="numpy", nogil=True)
@@ -77,7 +81,8 @@ def fixed_cell(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
         todo[:] = False
         todo[row] = True
         follow_rows(todo, limit, *posed, *path_tests, *found, *kept, hint)
-        if alive[row]:
+        followed = alive[row]
+        if followed:
             probes = (acc_hint[best] if best >= 0 else -1, acc_hint[row])
             b = branches[row]
             if not left_at_probes(
@@ -85,6 +90,8 @@ def fixed_cell(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
                 index, steps_c, qddot_max, steps, alive, why, where, slowest, acc_hint,
             ):  # fmt: skip
                 scan_row(row, limit[row], b, cq, sq, qd, moves, *scan)
+        if followed and why[row] == PRUNED:  # left by its V_acc: the others probed there
+            probe_acc_rows(remaining, limit, acc_hint[row], *grid)
         if alive[row] and (best < 0 or feed[row] > feed[best]):
             best = row
             set_limits(limit, row, feed[row], ACC_TIE_RTOL)
@@ -93,14 +100,17 @@ def fixed_cell(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
                 probe_acc_rows(remaining, limit, k, *grid)
             probe_rows(remaining, limit, slowest_at[row], *posed, inverse_qdot, *found, slowest,
                        hint, bound)  # fmt: skip
-            for i in range(branches.shape[0]):  # each row where it was least before
-                todo[:] = False
-                todo[i] = remaining[i] and alive[i]
-                if todo[i] and acc_hint[i] >= 0 and acc_hint[i] != k:
-                    probe_acc_rows(todo, limit, acc_hint[i], *grid)
-                if todo[i] and alive[i] and hint[i] >= 0 and hint[i] != slowest_at[row]:
-                    probe_rows(todo, limit, hint[i], *posed, inverse_qdot, *found, slowest, hint,
-                               bound)  # fmt: skip
+            todo[:] = False  # the rows whose acc_hint was probed
+            for i in range(branches.shape[0]):  # where each row was least before, once each
+                if remaining[i] and alive[i] and not probed_before(i, acc_hint, todo, k):
+                    probe_acc_rows(remaining, limit, acc_hint[i], *grid)
+                    todo[i] = True
+            todo[:] = False  # the rows whose hint was probed
+            for i in range(branches.shape[0]):
+                if remaining[i] and alive[i] and not probed_before(i, hint, todo, slowest_at[row]):
+                    probe_rows(remaining, limit, hint[i], *posed, inverse_qdot, *found, slowest,
+                               hint, bound)  # fmt: skip
+                    todo[i] = True
         row = next_row(remaining, alive, bound)
     pick = write_cell(c, branches, alive, why, where, feed, ACC_TIE_RTOL, *answer)
     if choice_holds(alive, why, slowest, feed, ACC_TIE_RTOL, pick):
@@ -124,7 +134,8 @@ def free_cell(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
     """Placement c in free spin with acceleration limits; returns the chosen branch's row.
 
     As :func:`fixed_cell`; a row followed to the end is probed, then tracked along its spin
-    schedule at its mu_path (:func:`solver.kernels.free_follow.spun_check`), then scanned.
+    schedule at its mu_path (:func:`solver.kernels.free_follow.moved_check`, the spin's moves
+    made once for it and the scan), then scanned.
     Before a row is followed its V_acc is known only where its spin is none
     (:func:`solver.kernels.accelerations.probe_free_acc_rows`).
 
@@ -166,33 +177,41 @@ def free_cell(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
         todo[:] = False
         todo[row] = True
         follow_free_rows(todo, limit, *posed, *steps_tests, *found, *kept)
-        if alive[row]:
+        followed = alive[row]
+        if followed:
             probes = (acc_hint[best] if best >= 0 else -1, acc_hint[row])
             b, rate = branches[row], spin_rate_of(slowest[row], True)
             if not left_at_probes(
                 row, limit[row], probes, b, rate, cq, sq, qd, qs, length, qdot_max, index,
                 steps_c, qddot_max, steps, alive, why, where, slowest, acc_hint,
             ):  # fmt: skip
-                spun_check(row, *spun_args)
+                spin_moves(qd, qs, b, rate, length, qdot_max, moves)
+                moved_check(row, moves, *spun_args)
                 if alive[row]:
-                    spin_moves(qd, qs, b, rate, length, qdot_max, moves)
                     scan_row(row, limit[row], b, cq, sq, qs, moves, *scan)
+        if followed and why[row] == PRUNED:  # left by its V_acc: the others probed there
+            probe_free_acc_rows(remaining, limit, acc_hint[row], *grid)
         if alive[row] and (best < 0 or feed[row] > feed[best]):
             best = row
             set_limits(limit, row, feed[row], ACC_TIE_RTOL)
             probe_free_rows(remaining, limit, slowest_at[row], *posed, qdot_max, *found, hint,
                             reach)  # fmt: skip
+            todo[:] = False  # the rows whose hint was probed
             for i in range(branches.shape[0]):
-                if remaining[i] and alive[i] and hint[i] >= 0:
+                if remaining[i] and alive[i] and not probed_before(i, hint, todo, slowest_at[row]):
                     probe_free_rows(remaining, limit, hint[i], *posed, qdot_max, *found, hint,
                                     reach)  # fmt: skip
+                    todo[i] = True
             for i in range(branches.shape[0]):
                 bound[i] = min(bound[i], reach[i])
-            if acc_hint[row] >= 0:
-                probe_free_acc_rows(remaining, limit, acc_hint[row], *grid)
+            k = acc_hint[row]
+            if k >= 0:
+                probe_free_acc_rows(remaining, limit, k, *grid)
+            todo[:] = False  # the rows whose acc_hint was probed
             for i in range(branches.shape[0]):
-                if remaining[i] and alive[i] and acc_hint[i] >= 0:
+                if remaining[i] and alive[i] and not probed_before(i, acc_hint, todo, k):
                     probe_free_acc_rows(remaining, limit, acc_hint[i], *grid)
+                    todo[i] = True
         row = next_row(remaining, alive, bound)
     pick = write_cell(c, branches, alive, why, where, feed, ACC_TIE_RTOL, *answer)
     if choice_holds(alive, why, slowest, feed, ACC_TIE_RTOL, pick):
@@ -205,9 +224,9 @@ def free_cell(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
     follow_free_rows(todo, limit, *posed, *steps_tests, *found, *kept)
     for i in range(branches.shape[0]):
         if todo[i] and alive[i]:
-            spun_check(i, *spun_args)
+            rate = spin_rate_of(slowest[i], True)
+            spin_moves(qd, qs, branches[i], rate, length, qdot_max, moves)
+            moved_check(i, moves, *spun_args)
             if alive[i]:
-                rate = spin_rate_of(slowest[i], True)
-                spin_moves(qd, qs, branches[i], rate, length, qdot_max, moves)
                 scan_row(i, -np.inf, branches[i], cq, sq, qs, moves, *scan)
     return write_cell(c, branches, alive, why, where, feed, ACC_TIE_RTOL, *answer)

@@ -41,7 +41,8 @@ def acc_work(n_branches, n_waypoints, keep_speeds):  # type: ignore[no-untyped-d
         acc_speeds: shape (B, W), or (B, 0) when not ``keep_speeds``; acc_hint: shape (B,),
         the stencil row where each branch's V_acc was least or left it (-1: none; kept from
         placement to placement); steps: shape (W, 6), one branch's joint steps; moves:
-        shape (W,), its spin's moves (:func:`spin_moves`; zeros, none, in fixed spin).
+        shape (W,), its spin's moves (:func:`solver.kernels.spin_schedule.spin_moves`; zeros,
+        none, in fixed spin).
     """
     feed = np.empty(n_branches)
     acc_at = np.empty(n_branches, dtype=np.int64)
@@ -141,23 +142,9 @@ def left_at_probes(  # type: ignore[no-untyped-def]  # pragma: no cover - compil
     return False
 
 
-@njit(cache=True, error_model="numpy", nogil=True)
-def spin_moves(qd, qs, b, rate, length, qdot_max, moves):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
-    """Branch b's spin over each segment at the feed ``rate``: moves[w] for the step to w.
-
-    sigma dt, as :func:`spun_steps` forms it (``moves``: shape (W,), out; none without a
-    feed). Made once per branch, so that :func:`scan_row`'s loop calls nothing.
-    """
-    moves[:] = 0.0
-    if rate <= 0.0:
-        return
-    for w in range(1, moves.shape[0]):
-        moves[w] = spin_rate(qd, qs, b, w - 1, qdot_max, rate) * length[w - 1] / rate
-
-
 @njit(cache=True, error_model="numpy", nogil=True, inline="always")
 def moved_steps(cq, sq, qs, b, lo, hi, moves, steps):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
-    """:func:`spun_steps` with the spin's moves made (:func:`spin_moves`), lo < w <= hi.
+    """:func:`spun_steps` with the spin's moves made (``moves``), lo < w <= hi.
 
     The same bits: the pair's step plus the move times J^-1 [0; z_tool], brought into
     [-pi, pi]; with no move (fixed spin, or no feed) the pair's step itself.
@@ -176,7 +163,8 @@ def scan_row(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
 ):  # fmt: skip
     """Row i's mu_acc, the branch followed to the end; or the row left below ``limit``.
 
-    Scanned along its steps (:func:`moved_steps`; ``moves`` from :func:`spin_moves` in free
+    Scanned along its steps (:func:`moved_steps`; ``moves`` from
+    :func:`solver.kernels.spin_schedule.spin_moves` in free
     spin, zeros in fixed spin): as soon as the least V_acc so far is below ``limit`` the row
     is left (:func:`solver.kernels.cell.prune`, its bound the least of that V_acc and its
     mu_path). A row scanned to the end has its mu_acc in ``feed``, min(mu_path, least V_acc)
@@ -224,6 +212,25 @@ def probed_speed(i, k, b, cq, sq, status, index, c, qddot_max, steps):  # type: 
     pair_steps(cq, sq, b, start, start + span, steps)
     worst, _ = acceleration_at(steps, start, span, c, k, qddot_max)
     return 1.0 / math.sqrt(worst)
+
+
+@njit(cache=True, error_model="numpy", nogil=True, inline="always")
+def probed_before(i, hints, probed, k):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
+    """Whether row i's hint ``hints[i]`` needs no probe of the rows left to follow.
+
+    ``hints``: shape (B,), where each row was least or left (a stencil row, ``acc_hint``, or
+    a waypoint, ``hint``). None (-1), the best row's ``k`` (probed already), or a row before i
+    marked in ``probed`` (shape (B,), bool) was probed there: a second probe at the same place
+    finds what the first did. (A row's hint changes only where it is left, to the place that
+    left it, itself probed.)
+    """
+    here = hints[i]
+    if here < 0 or here == k:
+        return True
+    for m in range(i):
+        if probed[m] and hints[m] == here:
+            return True
+    return False
 
 
 @njit(cache=True, error_model="numpy", nogil=True)

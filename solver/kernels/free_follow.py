@@ -26,7 +26,7 @@ from solver.families.kernels import N_JOINTS, pose_block
 from solver.kernels.cell import BLOCK, fail, prune
 from solver.kernels.limits import two_variable_speed
 from solver.kernels.positions import relative_path
-from solver.kernels.spin_schedule import spun_failure
+from solver.kernels.spin_schedule import moved_failure, spun_failure
 
 
 @njit(cache=True, error_model="numpy", nogil=True, inline="always")
@@ -146,6 +146,24 @@ def spun_check(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
     code, at = spun_failure(
         relative_path(cq, sq, branches[i], True), qd, qs, branches[i], rate, length,
         segment_checked, lower, upper, qdot_max, max_joint_step, spun,
+    )  # fmt: skip
+    if code != FEASIBLE:
+        fail(i, code, at, alive, why, where)
+
+
+@njit(cache=True, error_model="numpy", nogil=True)
+def moved_check(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
+    i, moves, cq, sq, qd, qs, branches, slowest, length, segment_checked, lower, upper, qdot_max,
+    max_joint_step, spun, alive, why, where,
+):  # fmt: skip
+    """:func:`spun_check` with the spin's moves at the row's mu_path already made.
+
+    ``moves``: shape (W,), from :func:`solver.kernels.spin_schedule.spin_moves`, made once for
+    this check and the acceleration scan (:mod:`solver.kernels.acc_cells`).
+    """
+    code, at = moved_failure(
+        relative_path(cq, sq, branches[i], True), moves, qs, branches[i], segment_checked, lower,
+        upper, max_joint_step, spun,
     )  # fmt: skip
     if code != FEASIBLE:
         fail(i, code, at, alive, why, where)

@@ -38,6 +38,21 @@ def spin_rate(qd, qs, b, w, qdot_max, feed):  # type: ignore[no-untyped-def]  # 
 
 
 @njit(cache=True, error_model="numpy", nogil=True)
+def spin_moves(qd, qs, b, feed, length, qdot_max, moves):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
+    """Branch b's spin over each segment at the feed (m/s): moves[w] = sigma dt for the step to w.
+
+    The spin rate nearest zero at the segment's first waypoint (:func:`spin_rate`) times its
+    length (``length``: shape (W - 1,), m) over the feed; none (zeros) without a feed.
+    ``moves``: shape (W,), out (moves[0] = 0).
+    """
+    moves[:] = 0.0
+    if not feed > 0.0:
+        return
+    for w in range(1, moves.shape[0]):
+        moves[w] = spin_rate(qd, qs, b, w - 1, qdot_max, feed) * length[w - 1] / feed
+
+
+@njit(cache=True, error_model="numpy", nogil=True)
 def spun_failure(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
     path, qd, qs, b, feed, length, segment_checked, lower, upper, qdot_max, max_joint_step, spun
 ):
@@ -48,22 +63,30 @@ def spun_failure(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
     (:func:`solver.path.spin_schedule.cumsum_within_passes`; a rapid moves no spin). That path
     is then tracked as :func:`solver.path.tracking.track` does: the step test, then the
     position limits; ``spun`` (W, 6), out, gets the tracked path (before its 2 pi copy is
-    chosen).
+    chosen). The spin's moves at the feed (:func:`spin_moves`), then :func:`moved_failure`.
 
     Returns:
         (FEASIBLE, -1) where it holds.
     """
+    moves = np.empty(path.shape[0])
+    spin_moves(qd, qs, b, feed, length, qdot_max, moves)
+    return moved_failure(path, moves, qs, b, segment_checked, lower, upper, max_joint_step, spun)
+
+
+@njit(cache=True, error_model="numpy", nogil=True)
+def moved_failure(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
+    path, moves, qs, b, segment_checked, lower, upper, max_joint_step, spun
+):
+    """:func:`spun_failure` with the spin's moves made (:func:`spin_moves`, shape (W,)).
+
+    A caller that needs the moves too (the acceleration scan) makes them once.
+    """
     n_waypoints, dof = path.shape
-    steps = np.empty(max(n_waypoints - 1, 0))
-    for w in range(n_waypoints - 1):
-        step = 0.0
-        if feed > 0.0:
-            step = spin_rate(qd, qs, b, w, qdot_max, feed) * length[w] / feed
-        steps[w] = step if segment_checked[w] else 0.0
     for j in range(dof):
         total, start = 0.0, 0.0
         for w in range(1, n_waypoints):
-            total += steps[w - 1] * qs[b, j, w - 1]
+            step = moves[w] if segment_checked[w - 1] else 0.0
+            total += step * qs[b, j, w - 1]
             if not segment_checked[w - 1]:
                 start = total  # w starts a pass
             moved = total - start
