@@ -163,7 +163,11 @@ class UrdfRobot(_RobotOptions):
         min_length=1, description="The tool flange frame; a link or frame of the URDF."
     )
     joint_velocity_limits: list[SpeedLimit] | None = _speed_limits(
-        None, required=False, extra=" Default: the URDF's velocity limits."
+        None,
+        required=False,
+        extra=" Default: the URDF's velocity limits. With <mimic> joints, one per coordinate (a "
+        "mimic joint has none): a leader's limit above its mimic joint's own over |multiplier| "
+        "is refused (422).",
     )
 
     def to_solver(self) -> SolverRobot:

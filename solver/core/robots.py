@@ -20,7 +20,8 @@ import pinocchio as pin
 
 from solver.core.exceptions import InvalidInputError, RobotModelError, quoted, quoted_names
 from solver.core.family import KinematicsFamily
-from solver.core.urdf_chain import chain_from_urdf, frame_names
+from solver.core.urdf_chain import chain_from_urdf, check_mimic_speed_limits, frame_names
+from solver.core.urdf_structure import Mimic
 
 __all__ = [
     "Robot",
@@ -64,6 +65,8 @@ class Robot:
         urdf: the URDF text the model was read from (its ``<collision>`` elements are the
             robot's geometry in a cell, cell.md section 2); ``None`` for a model built from
             kinematic parameters.
+        mimics: the chain's mimic joints (URDF ``<mimic>``), whose own speed limits bound
+            any speed limits given for their leaders (:func:`check_mimic_speed_limits`).
     """
 
     name: str
@@ -79,6 +82,7 @@ class Robot:
     family: KinematicsFamily | None = None
     qddot_max: np.ndarray | None = None
     urdf: str | None = None
+    mimics: tuple[Mimic, ...] = ()
 
     @property
     def dof(self) -> int:
@@ -106,11 +110,13 @@ class Robot:
                 ones (none for a model that has none).
 
         Raises:
-            InvalidInputError: a limit has the wrong shape, is not finite or is <= 0.
+            InvalidInputError: a limit has the wrong shape, is not finite or is <= 0, or a
+                speed limit would let a mimic joint pass its own.
         """
         robot = self
         if qdot_max is not None:
             limits = check_speed_limits(qdot_max, self.joint_names)
+            check_mimic_speed_limits(limits, self.joint_names, self.mimics)
             robot = dataclasses.replace(robot, qdot_max=limits)
         if qddot_max is not None:
             accelerations = check_acceleration_limits(qddot_max, self.joint_names)
@@ -220,6 +226,7 @@ def robot_from_model(
     tool_frame: str,
     qdot_max: np.ndarray | list[float] | None = None,
     family: KinematicsFamily | None,
+    mimics: tuple[Mimic, ...] = (),
 ) -> Robot:
     """Check the frames of ``model`` and wrap it as a :class:`Robot`.
 
@@ -232,10 +239,13 @@ def robot_from_model(
         family: the kinematics family; ``None`` for none (``/v1/dtf`` only). The registry's
             :func:`solver.families.default_family` gives the numeric one to a serial chain of
             six joints or more.
+        mimics: the model's mimic joints with their own limits (its leaders' limits in the
+            model are already narrowed by them); ``qdot_max`` is checked against them.
 
     Raises:
         RobotModelError: a frame is missing or moves, a joint is not 1-DOF, or the model's
             speed limits are unusable and none are given.
+        InvalidInputError: ``qdot_max`` is unusable or would let a mimic joint pass its own.
     """
     for field, frame in (("robot.base_frame", base_frame), ("robot.tool_frame", tool_frame)):
         if not model.existFrame(frame):
@@ -263,6 +273,7 @@ def robot_from_model(
     joint_names = tuple(model.names[j] for j in coordinates)
     if qdot_max is not None:
         limits = check_speed_limits(qdot_max, joint_names)
+        check_mimic_speed_limits(limits, joint_names, mimics)
     else:
         try:
             limits = check_speed_limits(model.velocityLimit, joint_names)
@@ -283,6 +294,7 @@ def robot_from_model(
         transform_tool_to_tcp=np.eye(4),
         transform_world_to_base=transform_world_to_base,
         family=family,
+        mimics=mimics,
     )
     return robot
 

@@ -3,14 +3,19 @@
 pinocchio's parser (urdfdom) is run with its stderr captured (:mod:`solver.core.native_stderr`)
 so that a refusal carries its reason; what pinocchio leaves unsaid (two root links, mimic joints
 between base and tool) is read from the document itself (:mod:`solver.core.urdf_structure`).
-Names in messages are cut (a request may send a name of megabytes).
+A request's speed limits, one per coordinate, cannot name a mimic joint: they are checked
+against the mimic joints' own (:func:`check_mimic_speed_limits`). Names in messages are cut (a
+request may send a name of megabytes).
 """
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+
+import numpy as np
 import pinocchio as pin
 
-from solver.core.exceptions import RobotModelError, quoted, quoted_names
+from solver.core.exceptions import InvalidInputError, RobotModelError, quoted, quoted_names
 from solver.core.native_stderr import first_error, native_stderr
 from solver.core.urdf_structure import Mimic, mimic_joints, root_links
 
@@ -97,3 +102,51 @@ def _limit_leader(model: pin.Model, mimic: Mimic) -> None:
     if mimic.velocity is not None and mimic.velocity > 0.0:
         speed = min(model.velocityLimit[index], mimic.velocity / abs(m))
         model.velocityLimit[index] = speed
+
+
+def chain_mimics(urdf: str, model: pin.Model) -> tuple[Mimic, ...]:
+    """The mimic joints of ``model`` (read by :func:`chain_from_urdf` from ``urdf``), in order."""
+    mimics = mimic_joints(urdf)
+    return tuple(
+        mimics[model.names[j]]
+        for j in range(1, model.njoints)
+        if model.joints[j].shortname() == "JointModelMimic" and model.names[j] in mimics
+    )
+
+
+def check_mimic_speed_limits(
+    qdot_max: np.ndarray, joint_names: Sequence[str], mimics: Sequence[Mimic]
+) -> None:
+    """Refuse speed limits that would let a mimic joint pass its own (a request's limits).
+
+    A request gives one speed limit per coordinate: a mimic joint has no entry, its speed is
+    |m| times its leader's. A leader's limit above velocity / |m| would drive the mimic joint
+    past its own URDF limit; neither clipping it silently nor dropping the mimic's limit is
+    right, so it is refused, naming both joints and the largest value accepted (exact: that
+    value itself passes).
+
+    Args:
+        qdot_max: shape (n,), rad/s (m/s), the checked limits, one per coordinate.
+        joint_names: the n coordinates' joint names (the leaders among them).
+        mimics: the chain's mimic joints, each with its own limits (:func:`chain_mimics`).
+
+    Raises:
+        InvalidInputError: on ``robot.joint_velocity_limits``, naming the leader, the mimic
+            joint, the coupling and the bound.
+    """
+    for mimic in mimics:
+        if mimic.velocity is None or mimic.velocity <= 0.0 or mimic.leader not in joint_names:
+            continue  # no usable limit of its own: the leader's bounds it
+        k = list(joint_names).index(mimic.leader)
+        bound = mimic.velocity / abs(mimic.multiplier)
+        if qdot_max[k] > bound:
+            raise InvalidInputError(
+                "robot.joint_velocity_limits",
+                f"joint {k} ({quoted(mimic.leader)}) limit {float(qdot_max[k]):.6g} would let "
+                f"joint {quoted(mimic.joint)}, which mimics it (q = {mimic.multiplier:g} "
+                f"q_leader + {mimic.offset:g}), move at {abs(mimic.multiplier) * qdot_max[k]:.6g}"
+                f", past its own URDF velocity limit {mimic.velocity:g}; the limits are one per "
+                f"coordinate and a mimic joint has none: give {quoted(mimic.leader)} at most "
+                f"{bound!r} (its limit over |multiplier|), or raise the mimic joint's limit in "
+                "the URDF",
+            )

@@ -17,6 +17,7 @@ import pinocchio as pin
 from solver.core.exceptions import RobotModelError, UnknownRobotError
 from solver.core.family import KinematicsFamily
 from solver.core.robots import Robot, chain_from_urdf, robot_from_model
+from solver.core.urdf_chain import chain_mimics
 from solver.families.numeric.chain import SerialChain
 from solver.families.numeric.family import NumericFamily
 from solver.families.recognise import recognised_family
@@ -101,11 +102,19 @@ def robot_from_urdf(
     Raises:
         RobotModelError: the URDF cannot be parsed, a frame is missing, or the chain has
             joints other than 1-DOF revolute or prismatic ones.
+        InvalidInputError: ``qdot_max`` is unusable, or a leader's would let its mimic joint
+            pass the mimic's own limit (:func:`solver.core.urdf_chain.check_mimic_speed_limits`).
     """
     model = chain_from_urdf(urdf, tool_frame=tool_frame)
     if family is None and model.existFrame(base_frame) and model.existFrame(tool_frame):
         family = default_family(model, base_frame=base_frame, tool_frame=tool_frame)
     robot = robot_from_model(
-        name, model, base_frame=base_frame, tool_frame=tool_frame, qdot_max=qdot_max, family=family
+        name,
+        model,
+        base_frame=base_frame,
+        tool_frame=tool_frame,
+        qdot_max=qdot_max,
+        family=family,
+        mimics=chain_mimics(urdf, model),
     )
     return dataclasses.replace(robot, urdf=urdf)

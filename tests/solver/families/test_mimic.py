@@ -14,7 +14,7 @@ import pinocchio as pin
 import pytest
 import scipy.optimize
 
-from solver.core.exceptions import RobotModelError
+from solver.core.exceptions import InvalidInputError, RobotModelError
 from solver.core.kinematics import tool_pose_in_base
 from solver.core.robots import Robot
 from solver.core.spatial import Placement
@@ -131,6 +131,29 @@ def test_the_path_keeps_the_coupling_and_runs_at_the_coupled_lp(mimic_speed: flo
     assert bottleneck is not None
     binding = int(np.argmax(load[bottleneck]))
     assert (binding == 5) == (mimic_speed == 0.5)  # the mimic binds where it is the tighter
+
+
+@pytest.mark.parametrize("through", ["urdf", "with_options"])
+def test_a_leaders_speed_limit_the_mimic_cannot_follow_is_refused(through: str) -> None:
+    """A request's limits, one per coordinate, cannot drop j5b's own: |m| qdot_j5 <= 0.5."""
+    bound = 0.5 / abs(MULTIPLIER)
+    robot, _ = arm(0.5)
+
+    def given(j5: float) -> Robot:
+        limits = [SPEED] * 4 + [j5, SPEED]
+        if through == "with_options":
+            return robot.with_options(qdot_max=limits)
+        return robot_from_urdf(arm_urdf(0.5), base_frame="l0", tool_frame="tool0", qdot_max=limits)
+
+    assert given(bound).qdot_max[4] == bound  # the bound itself, exactly as given
+    assert given(0.1).qdot_max[4] == 0.1
+    with pytest.raises(InvalidInputError) as error:
+        given(np.nextafter(bound, 1.0))
+    assert error.value.field == "robot.joint_velocity_limits"
+    assert "joint 4 ('j5')" in error.value.message and "'j5b'" in error.value.message
+    assert f"at most {bound!r}" in error.value.message
+    loose, _ = arm(100.0)  # j5b's limit looser than j5's: any limit for j5 is accepted
+    assert loose.with_options(qdot_max=[SPEED] * 6).qdot_max[4] == SPEED
 
 
 def test_a_mimic_whose_leader_is_off_the_chain_is_refused_naming_it() -> None:
