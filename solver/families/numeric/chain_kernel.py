@@ -214,9 +214,19 @@ def speeds_per_twist(chain, q, twist, point):  # type: ignore[no-untyped-def]  #
 
     NaN rows where q is not finite or J is exactly singular (as the family's numpy solve).
     """
+    result = np.full(q.shape, np.nan)
+    _speeds_into(chain, q, twist, point, workspace(q.shape[1]), result)
+    return result
+
+
+@njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
+def _speeds_into(chain, q, twist, point, work, result):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
+    """:func:`speeds_per_twist`' loop into its preallocated ``result`` (M, 6).
+
+    Compiled without numba's reference counting (``_nrt=False``: it allocates nothing), which
+    the inlined :func:`frames` otherwise costs at every row; the same arithmetic, the same bits.
+    """
     n_rows, n = q.shape
-    result = np.full((n_rows, n), np.nan)
-    work = workspace(n)
     jac, rhs = work[6], work[8]
     for m in range(n_rows):
         finite = True
@@ -231,4 +241,3 @@ def speeds_per_twist(chain, q, twist, point):  # type: ignore[no-untyped-def]  #
         if lu_solve(jac, rhs):
             for j in range(n):
                 result[m, j] = rhs[j]
-    return result

@@ -173,6 +173,18 @@ def _wrapped_distance(a, b, revolute):  # type: ignore[no-untyped-def]  # pragma
     return math.sqrt(total)
 
 
+@njit("boolean(float64[:, ::1], float64)", cache=True, nogil=True, error_model="numpy")
+def _eigen_singular(normal, rcond):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
+    """sigma_min / sigma_max below ``rcond`` from the eigenvalues of J J^T (``normal``), as numpy.
+
+    Not inlined, and compiled at import for its one signature (so with numba's runtime,
+    whatever calls it): kernels that take :func:`_singular` in may then be compiled without
+    reference counting (``_nrt=False``), which only this call's allocation needs.
+    """
+    squares = np.linalg.eigvalsh(normal)
+    return squares[0] < rcond * rcond * squares[-1]
+
+
 @njit(cache=True, nogil=True, error_model="numpy", inline="always")
 def _singular(chain, rcond, work):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
     """``ik.is_singular`` at the frames in ``work``: sigma_min / sigma_max of J below ``rcond``.
@@ -193,8 +205,7 @@ def _singular(chain, rcond, work):  # type: ignore[no-untyped-def]  # pragma: no
         for k in range(j):
             s -= factor[j, k] * factor[j, k]
         if not s > 0.0:
-            squares = np.linalg.eigvalsh(normal)
-            return squares[0] < rcond * rcond * squares[-1]
+            return _eigen_singular(normal, rcond)
         d = math.sqrt(s)
         factor[j, j] = d
         for i in range(j + 1, 6):
@@ -228,17 +239,41 @@ def seed_paths(chain, seeds, box, rotations, positions, settings, constants):  #
     """
     n_seeds, n = seeds.shape
     n_paths = positions.shape[0]
+    found = np.full((n_paths, n_seeds, n), np.nan)
+    count = np.zeros(n_paths, dtype=np.int64)
+    _seed_all(
+        chain,
+        seeds,
+        box,
+        (rotations, positions),
+        settings,
+        constants,
+        workspace(n),
+        np.empty(n),
+        (found, count),
+    )
+    return found, count
+
+
+@njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
+def _seed_all(chain, seeds, box, poses, settings, constants, work, current, out):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
+    """:func:`seed_paths`' loop into its preallocated ``out`` (found, count).
+
+    Compiled without numba's reference counting (``_nrt=False``: it allocates nothing), which
+    the inlined helpers' tuples of arrays otherwise cost at every step (atomic increments and
+    decrements); the same arithmetic, the same bits. ``poses``: rotations and positions.
+    """
+    rotations, positions = poses
+    found, count = out
+    n_seeds, n = seeds.shape
     seed_iterations, apart = int(settings[0]), settings[2]
     stall = (int(settings[4]), settings[5])
     revolute = chain[3]
-    found = np.full((n_paths, n_seeds, n), np.nan)
-    count = np.zeros(n_paths, dtype=np.int64)
-    current = np.empty(n)
-    work = workspace(n)
-    for p in range(n_paths):
+    for p in range(positions.shape[0]):
         kept = 0
         for k in range(n_seeds):
-            current[:] = seeds[k]
+            for j in range(n):
+                current[j] = seeds[k, j]
             if not _levenberg_marquardt(
                 chain,
                 current,
@@ -258,10 +293,10 @@ def seed_paths(chain, seeds, box, rotations, positions, settings, constants):  #
                     new = False
                     break
             if new:
-                found[p, kept] = current
+                for j in range(n):
+                    found[p, kept, j] = current[j]
                 kept += 1
         count[p] = kept
-    return found, count
 
 
 @njit(cache=True, nogil=True, error_model="numpy")

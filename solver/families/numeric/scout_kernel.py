@@ -164,7 +164,8 @@ def scouted(chain, slot, path, limits, settings, constants, rules, work, spare):
             return least, False
         step = min(w + stride, last)
         w = slowest if w < slowest < step else step
-        before[:] = slot
+        for j in range(len(slot)):
+            before[j] = slot[j]
         target_r, target_p = rotations[w], positions[w]
         if not rough_steps(chain, slot, target_r, target_p, rough, residual, constants, work):
             return least, False  # a stride too far to trust: followed exactly
