@@ -15,13 +15,6 @@ from service.schemas.cell import (
     ToolSpec,
 )
 from service.schemas.common import (
-    AutoIkPolicy,
-    Branch,
-    ControllerFrames,
-    IkPolicy,
-    NumericBranch,
-    Placement,
-    PlacementResult,
     Pose,
     RequestModel,
     ResponseModel,
@@ -40,6 +33,7 @@ from service.schemas.evaluate import (
     IkInfo,
     WaypointResult,
 )
+from service.schemas.ik import AutoIkPolicy, Branch, IkPolicy, NumericBranch
 from service.schemas.jobs import (
     EvaluateJob,
     JobInfo,
@@ -77,6 +71,7 @@ from service.schemas.paths_import import (
     PathImportResponse,
     SkippedRecordOut,
 )
+from service.schemas.placement import ControllerFrames, Placement, PlacementResult
 from service.schemas.robot import CatalogueRobot, OpwGeometry, OpwRobot, Robot, UrdfRobot
 from service.schemas.robots import BranchLevel, HealthResponse, RobotInfo, RobotsResponse
 

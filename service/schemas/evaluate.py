@@ -11,18 +11,11 @@ from pydantic_core import PydanticCustomError
 from typing_extensions import TypeAliasType
 
 from service.schemas.cell import CellSpec, Contact
-from service.schemas.common import (
-    Angle,
-    Branch,
-    IkPolicy,
-    NumericBranch,
-    Placement,
-    RequestModel,
-    ResponseModel,
-    SpinMode,
-)
+from service.schemas.common import Angle, RequestModel, ResponseModel, SpinMode
+from service.schemas.ik import Branch, IkPolicy, NumericBranch
 from service.schemas.motion import AccelerationResult, CycleTimeResult
 from service.schemas.path import MAX_PATH_WAYPOINTS, Path
+from service.schemas.placement import Placement
 from service.schemas.robot import MAX_JOINTS, Robot
 
 DetailLevel = TypeAliasType(
