@@ -55,6 +55,7 @@ from service.schemas.optimize import (
     SpinPath,
     StartInfo,
 )
+from service.schemas.opw_robot import OpwGeometry, OpwRobot
 from service.schemas.path import (
     ClDataPath,
     CsvPath,
@@ -72,7 +73,7 @@ from service.schemas.paths_import import (
     SkippedRecordOut,
 )
 from service.schemas.placement import ControllerFrames, Placement, PlacementResult
-from service.schemas.robot import CatalogueRobot, OpwGeometry, OpwRobot, Robot, UrdfRobot
+from service.schemas.robot import CatalogueRobot, Robot, UrdfRobot
 from service.schemas.robots import BranchLevel, HealthResponse, RobotInfo, RobotsResponse
 
 __all__ = [

@@ -16,7 +16,8 @@ from service.schemas.ik import Branch, IkPolicy, NumericBranch
 from service.schemas.motion import AccelerationResult, CycleTimeResult
 from service.schemas.path import MAX_PATH_WAYPOINTS, Path
 from service.schemas.placement import Placement
-from service.schemas.robot import MAX_JOINTS, Robot
+from service.schemas.robot import Robot
+from service.schemas.robot_options import MAX_JOINTS
 
 DetailLevel = TypeAliasType(
     "DetailLevel",
