@@ -56,15 +56,9 @@ from service.schemas.optimize import (
     StartInfo,
 )
 from service.schemas.opw_robot import OpwGeometry, OpwRobot
-from service.schemas.path import (
-    ClDataPath,
-    CsvPath,
-    Path,
-    PathInput,
-    PosePath,
-    ProgramUnits,
-    ToolAxisPath,
-)
+from service.schemas.path import Path, PosePath, ToolAxisPath
+from service.schemas.path_cam import ClDataPath, CsvPath, ProgramUnits
+from service.schemas.path_input import PathInput
 from service.schemas.paths_import import (
     ImportedPose,
     PassOut,

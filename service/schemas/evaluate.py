@@ -14,7 +14,8 @@ from service.schemas.cell import CellSpec, Contact
 from service.schemas.common import Angle, RequestModel, ResponseModel, SpinMode
 from service.schemas.ik import Branch, IkPolicy, NumericBranch
 from service.schemas.motion import AccelerationResult, CycleTimeResult
-from service.schemas.path import MAX_PATH_WAYPOINTS, Path
+from service.schemas.path import Path
+from service.schemas.path_input import MAX_PATH_WAYPOINTS
 from service.schemas.placement import Placement
 from service.schemas.robot import Robot
 from service.schemas.robot_options import MAX_JOINTS
