@@ -4,15 +4,13 @@ Request models are strict, refuse unknown fields and refuse NaN and infinities; 
 its unit, and every model carries an example, so ``/docs`` reads as a manual.
 """
 
-from service.schemas.cell import (
+from service.schemas.cell import CellSpec, Contact, ToolSpec
+from service.schemas.cell_objects import (
     BoxObject,
-    CellSpec,
-    Contact,
     CylinderObject,
     HalfspaceObject,
     MeshObject,
     SphereObject,
-    ToolSpec,
 )
 from service.schemas.common import (
     Pose,
