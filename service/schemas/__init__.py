@@ -21,10 +21,9 @@ from service.schemas.common import (
 )
 from service.schemas.dtf import DtfRequest, DtfResponse
 from service.schemas.errors import ErrorDetail, ErrorResponse
-from service.schemas.evaluate import (
+from service.schemas.evaluate_request import DetailLevel, EvaluateRequest
+from service.schemas.evaluate_response import (
     Bottleneck,
-    DetailLevel,
-    EvaluateRequest,
     EvaluateResponse,
     FailureReason,
     FeedCheckResult,

@@ -9,7 +9,8 @@ from pydantic.config import JsonDict
 
 from service.schemas.cell import CellSpec
 from service.schemas.common import Angle, Coordinate, RequestModel, ResponseModel, SpinMode
-from service.schemas.evaluate import _REQUEST_EXAMPLE, FailureReason
+from service.schemas.evaluate_request import _REQUEST_EXAMPLE
+from service.schemas.evaluate_response import FailureReason
 from service.schemas.ik import Branch, IkPolicy, NumericBranch
 from service.schemas.motion import LimitedBy
 from service.schemas.path import Path

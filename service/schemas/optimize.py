@@ -11,7 +11,8 @@ from pydantic_core import PydanticCustomError
 
 from service.schemas.cell import CellSpec
 from service.schemas.common import Angle, Coordinate, RequestModel, ResponseModel, SpinMode
-from service.schemas.evaluate import _REQUEST_EXAMPLE, EvaluateResponse
+from service.schemas.evaluate_request import _REQUEST_EXAMPLE
+from service.schemas.evaluate_response import EvaluateResponse
 from service.schemas.ik import AutoIkPolicy
 from service.schemas.path import Path
 from service.schemas.placement import Placement, PlacementResult, placement_example
