@@ -27,10 +27,10 @@ from starlette.exceptions import HTTPException as StarletteHTTPException
 from service.api import api_router
 from service.api.routes import health
 from service.body import BODY_MODELS
+from service.body_limits import BodySizeLimitMiddleware
 from service.config import get_settings
 from service.errors import (
     SERVER_ERROR_RESPONSE,
-    BodySizeLimitMiddleware,
     cancelled_handler,
     http_error_handler,
     job_store_unavailable_handler,

@@ -20,8 +20,8 @@ import pytest
 from fastapi.testclient import TestClient
 from starlette.types import Message, Receive, Scope, Send
 
+from service.body_limits import BodySizeLimitMiddleware
 from service.config import get_settings
-from service.errors import BodySizeLimitMiddleware
 from service.jobs.store import JobStore, QueueFull
 from service.main import app
 from tests.cases import ROOT
