@@ -38,8 +38,8 @@ from service.errors import (
     server_error_handler,
     solver_error_handler,
 )
+from service.jobs.job import JobStoreUnavailable
 from service.jobs.runner import close_runners, get_runner
-from service.jobs.store import JobStoreUnavailable
 from service.logs import log, log_to_stderr, startup_log
 from service.metrics import instrument
 from service.spec import defaults_in_words
