@@ -1,7 +1,8 @@
-"""Error answers: schema and solver input errors as ``422``, oversized bodies as ``413``.
+"""Error answers: schema and solver input errors as ``422``, and their OpenAPI entries.
 
-Both use FastAPI's validation-error shape, ``{"detail": [{"loc": [...], "msg": ..., "type":
-...}]}``, so a client reads every input error the same way.
+They use FastAPI's validation-error shape, ``{"detail": [{"loc": [...], "msg": ..., "type":
+...}]}``, as do HTTP errors, faults, stops and the body's own limits (``413``, ``415``, ``408``:
+:mod:`service.body_limits`), so a client reads every error the same way.
 """
 
 from __future__ import annotations
@@ -10,17 +11,13 @@ import re
 from http import HTTPStatus
 from typing import Any
 
-import anyio
 from fastapi import Request, status
 from fastapi.exception_handlers import http_exception_handler
 from fastapi.exceptions import RequestValidationError
 from fastapi.responses import JSONResponse, Response
-from starlette.datastructures import Headers
 from starlette.exceptions import HTTPException as StarletteHTTPException
 from starlette.routing import Route
-from starlette.types import ASGIApp, Message, Receive, Scope, Send
 
-from service.config import get_settings
 from service.jobs.job import JobStoreUnavailable
 from service.schemas import ErrorDetail, ErrorResponse
 from solver.core.exceptions import SolverError
@@ -94,7 +91,7 @@ def job_not_found(job_id: object) -> StarletteHTTPException:
     return StarletteHTTPException(status.HTTP_404_NOT_FOUND, [detail.model_dump()])  # type: ignore[arg-type]
 
 
-def _error_response(status_code: int, details: list[ErrorDetail]) -> JSONResponse:
+def error_response(status_code: int, details: list[ErrorDetail]) -> JSONResponse:
     """An error answer with its ``detail`` list."""
     return JSONResponse(status_code=status_code, content=ErrorResponse(detail=details).model_dump())
 
@@ -120,7 +117,7 @@ async def request_validation_error_handler(
         ErrorDetail(loc=request_location(e["loc"]), msg=e["msg"], type=e["type"])
         for e in error.errors()
     ]
-    return _error_response(status.HTTP_422_UNPROCESSABLE_CONTENT, details)
+    return error_response(status.HTTP_422_UNPROCESSABLE_CONTENT, details)
 
 
 def http_error_type(status_code: int) -> str:
@@ -144,7 +141,7 @@ async def http_error_handler(request: Request, error: StarletteHTTPException) ->
         detail = ErrorDetail(
             loc=["body"], msg=f"cannot decode the JSON: {cause}", type="json_invalid"
         )
-        return _error_response(status.HTTP_422_UNPROCESSABLE_CONTENT, [detail])
+        return error_response(status.HTTP_422_UNPROCESSABLE_CONTENT, [detail])
     if error.status_code == 405:  # Allow lists every method of the path, not one route's
         allowed = sorted(
             method
@@ -156,7 +153,7 @@ async def http_error_handler(request: Request, error: StarletteHTTPException) ->
         error = StarletteHTTPException(405, error.detail, headers={"Allow": ", ".join(allowed)})
     if isinstance(error.detail, str) and error.status_code not in (204, 304):
         detail = ErrorDetail(loc=[], msg=error.detail, type=http_error_type(error.status_code))
-        response = _error_response(error.status_code, [detail])
+        response = error_response(error.status_code, [detail])
         response.headers.update(error.headers or {})
         return response
     return await http_exception_handler(request, error)
@@ -167,7 +164,7 @@ async def server_error_handler(request: Request, error: Exception) -> JSONRespon
     detail = ErrorDetail(
         loc=[], msg=f"internal error ({type(error).__name__}); please report it", type="internal"
     )
-    return _error_response(status.HTTP_500_INTERNAL_SERVER_ERROR, [detail])
+    return error_response(status.HTTP_500_INTERNAL_SERVER_ERROR, [detail])
 
 
 async def cancelled_handler(request: Request, error: Cancelled) -> JSONResponse:
@@ -175,7 +172,7 @@ async def cancelled_handler(request: Request, error: Cancelled) -> JSONResponse:
     detail = ErrorDetail(
         loc=[], msg="the work was stopped: the service is shutting down", type="cancelled"
     )
-    response = _error_response(status.HTTP_503_SERVICE_UNAVAILABLE, [detail])
+    response = error_response(status.HTTP_503_SERVICE_UNAVAILABLE, [detail])
     response.headers["Retry-After"] = "5"
     return response
 
@@ -193,7 +190,7 @@ async def job_store_unavailable_handler(
     with the file, for the operator.
     """
     detail = ErrorDetail(loc=[], msg=error.reason, type="job_store_unavailable")
-    response = _error_response(status.HTTP_503_SERVICE_UNAVAILABLE, [detail])
+    response = error_response(status.HTTP_503_SERVICE_UNAVAILABLE, [detail])
     response.headers["Retry-After"] = str(STORE_RETRY_SECONDS)
     return response
 
@@ -203,131 +200,4 @@ async def solver_error_handler(request: Request, error: SolverError) -> JSONResp
     detail = ErrorDetail(
         loc=solver_error_location(error), msg=error.message, type=solver_error_type(error)
     )
-    return _error_response(status.HTTP_422_UNPROCESSABLE_CONTENT, [detail])
-
-
-def _too_large(size: int, limit: int) -> JSONResponse:
-    """The ``413`` answer, for a body of at least ``size`` bytes."""
-    detail = ErrorDetail(
-        loc=["body"],
-        msg=f"request body is over the limit of {limit} bytes (at least {size} bytes)",
-        type="body_too_large",
-    )
-    return _error_response(status.HTTP_413_CONTENT_TOO_LARGE, [detail])
-
-
-def _not_json(content_type: str) -> JSONResponse:
-    """The ``415`` answer to a body declared as something other than JSON."""
-    shown = content_type if len(content_type) <= 100 else content_type[:100] + "..."
-    detail = ErrorDetail(
-        loc=["header", "content-type"],
-        msg=f"the body must be JSON (content-type application/json), not {shown!r}",
-        type="unsupported_media_type",
-    )
-    return _error_response(status.HTTP_415_UNSUPPORTED_MEDIA_TYPE, [detail])
-
-
-def _no_content_type() -> JSONResponse:
-    """The ``415`` answer to a body sent without a Content-Type."""
-    detail = ErrorDetail(
-        loc=["header", "content-type"],
-        msg="the body must be declared as JSON (content-type application/json); no content-type "
-        "was sent",
-        type="unsupported_media_type",
-    )
-    return _error_response(status.HTTP_415_UNSUPPORTED_MEDIA_TYPE, [detail])
-
-
-def _too_slow(seconds: float, size: int) -> JSONResponse:
-    """The ``408`` answer to a body that did not arrive within ``seconds``."""
-    detail = ErrorDetail(
-        loc=["body"],
-        msg=f"the body did not arrive within {seconds:g} s ({size} bytes came; "
-        "DTF_BODY_READ_SECONDS)",
-        type="body_timeout",
-    )
-    response = _error_response(status.HTTP_408_REQUEST_TIMEOUT, [detail])
-    response.headers["Connection"] = "close"
-    return response
-
-
-def _has_body(headers: Headers) -> bool:
-    """Whether a request announces a body (a Content-Length above 0, or chunks)."""
-    length = headers.get("content-length", "")
-    return (length.isdigit() and int(length) > 0) or "transfer-encoding" in headers
-
-
-def is_json(content_type: str) -> bool:
-    """Whether a Content-Type names JSON (application/json or a +json type)."""
-    media = content_type.split(";")[0].strip().lower()
-    return media == "application/json" or (
-        media.startswith("application/") and media.endswith("+json")
-    )
-
-
-class BodySizeLimitMiddleware:
-    """Answer ``413`` to a body over ``Settings.max_body_bytes``, ``415`` to one not JSON.
-
-    Pure ASGI. A body declared as something other than JSON, or sent without a Content-Type,
-    is refused unread. A declared ``Content-Length`` over the limit is refused before reading;
-    otherwise the body is read (counting the bytes as they stream in, so a chunked body cannot
-    slip through) and handed on in one piece. A body that stops short of its length is
-    answered ``408`` after ``Settings.body_read_seconds`` instead of holding the connection.
-    """
-
-    def __init__(self, app: ASGIApp) -> None:
-        """Wrap ``app``."""
-        self.app = app
-
-    async def __call__(self, scope: Scope, receive: Receive, send: Send) -> None:
-        """Check the body size of an HTTP request, then pass it on."""
-        if scope["type"] != "http":
-            await self.app(scope, receive, send)
-            return
-        settings = get_settings()
-        limit = settings.max_body_bytes
-        headers = Headers(scope=scope)
-        content_type = headers.get("content-type")
-        if scope["method"] in ("POST", "PUT", "PATCH"):
-            if content_type and not is_json(content_type):
-                await _not_json(content_type)(scope, receive, send)
-                return
-            if not content_type and _has_body(headers):
-                await _no_content_type()(scope, receive, send)
-                return
-        declared = headers.get("content-length", "")
-        if declared.isdigit() and int(declared) > limit:
-            await _too_large(int(declared), limit)(scope, receive, send)
-            return
-        chunks: list[bytes] = []
-        size = 0
-        more_body = True
-        with anyio.move_on_after(settings.body_read_seconds) as deadline:
-            while more_body:
-                message = await receive()
-                if message["type"] != "http.request":  # the client went away
-                    return
-                chunk: bytes = message.get("body", b"")
-                size += len(chunk)
-                if size > limit:
-                    await _too_large(size, limit)(scope, receive, send)
-                    return
-                chunks.append(chunk)
-                more_body = message.get("more_body", False)
-        if deadline.cancelled_caught:
-            await _too_slow(settings.body_read_seconds, size)(scope, receive, send)
-            return
-        body: Message | None = {
-            "type": "http.request",
-            "body": b"".join(chunks),
-            "more_body": False,
-        }
-
-        async def replay() -> Message:
-            nonlocal body
-            if body is None:
-                return await receive()
-            message, body = body, None
-            return message
-
-        await self.app(scope, replay, send)
+    return error_response(status.HTTP_422_UNPROCESSABLE_CONTENT, [detail])

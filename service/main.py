@@ -27,10 +27,10 @@ from starlette.exceptions import HTTPException as StarletteHTTPException
 from service.api import api_router
 from service.api.routes import health
 from service.body import BODY_MODELS
+from service.body_limits import BodySizeLimitMiddleware
 from service.config import get_settings
 from service.errors import (
     SERVER_ERROR_RESPONSE,
-    BodySizeLimitMiddleware,
     cancelled_handler,
     http_error_handler,
     job_store_unavailable_handler,
@@ -38,8 +38,8 @@ from service.errors import (
     server_error_handler,
     solver_error_handler,
 )
+from service.jobs.job import JobStoreUnavailable
 from service.jobs.runner import close_runners, get_runner
-from service.jobs.store import JobStoreUnavailable
 from service.logs import log, log_to_stderr, startup_log
 from service.metrics import instrument
 from service.spec import defaults_in_words

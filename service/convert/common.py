@@ -8,7 +8,7 @@ import numpy as np
 
 from service import schemas
 from service.config import Settings, get_settings
-from service.schemas.path import PathInput
+from service.schemas.path_input import PathInput
 from solver.cam.frames import frames_of_placement
 from solver.core.exceptions import InvalidInputError
 from solver.core.family import Branch

@@ -23,7 +23,8 @@ from multiprocessing.process import BaseProcess
 from pathlib import Path
 
 from service.config import Settings
-from service.jobs.store import JobStore, JobStoreUnavailable
+from service.jobs.job import JobStoreUnavailable
+from service.jobs.store import JobStore
 from service.jobs.worker import serve
 from service.logs import log
 

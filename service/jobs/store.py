@@ -4,9 +4,9 @@ The store is the one place job state lives, shared by the web process and the wo
 processes: a worker reports progress by writing it here, and finds a cancel request here.
 
 Its file (:mod:`service.jobs.store_file`) is opened on first use; whatever goes wrong with it
-is :class:`JobStoreUnavailable` (503). A map's cells are kept in pages of their own
-(:mod:`service.jobs.results`), so that a job listing reads no result and a page of cells
-reads only that page.
+is :class:`~service.jobs.job.JobStoreUnavailable` (503). What it reads is
+:class:`~service.jobs.store_reads.JobReads`; this module holds what changes a job: submission,
+the runner's and the workers' updates, cancel, delete, recovery after a restart and expiry.
 """
 
 from __future__ import annotations
@@ -16,35 +16,17 @@ import time
 import uuid
 from typing import Any
 
-from service.jobs.job import (
-    FINISHED,
-    STATE_COLUMNS,
-    Job,
-    JobState,
-    JobStoreUnavailable,
-    Kind,
-    QueueFull,
-    Status,
-    job_of_row,
-    state_of_row,
-)
-from service.jobs.results import cells_text, read_cells, with_cells, write_result
-from service.jobs.store_file import StoreFile
-
-__all__ = [
-    "FINISHED",
-    "Job",
-    "JobState",
-    "JobStore",
-    "JobStoreUnavailable",
-    "Kind",
-    "QueueFull",
-    "Status",
-]
+from service.jobs.job import Job, Kind, QueueFull, Status, job_of_row
+from service.jobs.results import write_result
+from service.jobs.store_reads import JobReads
 
 
-class JobStore(StoreFile):
-    """Jobs in an SQLite file (:class:`StoreFile`): what the routes, runner and workers ask."""
+class JobStore(JobReads):
+    """Jobs in an SQLite file: its reads (:class:`JobReads`) and the changes made to jobs.
+
+    The routes submit, cancel and delete; the runner starts, recovers and expires; the workers
+    report progress and finish.
+    """
 
     def create(
         self,
@@ -88,79 +70,6 @@ class JobStore(StoreFile):
                     db.execute("ROLLBACK")
                 raise
         return job_of_row(row, None)
-
-    def get(self, job_id: str, *, inline_cells: int | None = None) -> Job | None:
-        """The job with its request and result, or None for an unknown id.
-
-        Args:
-            job_id: the job's id.
-            inline_cells: a result's cells are put in it when there are at most this many
-                (``Job.cells`` says how many there are); None: always.
-        """
-        with self._connection() as db:
-            row = db.execute("SELECT * FROM jobs WHERE id = ?", (job_id,)).fetchone()
-            if row is None:
-                return None
-            result = None if row["result"] is None else json.loads(row["result"])
-            count = row["cells"]
-            if result is not None and count is not None:
-                if inline_cells is None or count <= inline_cells:
-                    result = with_cells(result, read_cells(db, job_id, offset=0, limit=count))
-        return job_of_row(row, result)
-
-    def state(self, job_id: str) -> JobState | None:
-        """The job without its request and result, or None for an unknown id."""
-        with self._connection() as db:
-            row = db.execute(f"SELECT {STATE_COLUMNS} FROM jobs WHERE id = ?", (job_id,)).fetchone()
-        return None if row is None else state_of_row(row)
-
-    def jobs(self, *, status: str | None, limit: int) -> list[JobState]:
-        """The newest jobs first, optionally of one status, without requests and results."""
-        query, args = f"SELECT {STATE_COLUMNS} FROM jobs", []
-        if status is not None:
-            query, args = query + " WHERE status = ?", [status]
-        with self._connection() as db:
-            rows = db.execute(query + " ORDER BY created DESC LIMIT ?", [*args, limit]).fetchall()
-        return [state_of_row(row) for row in rows]
-
-    def request(self, job_id: str) -> dict[str, Any] | None:
-        """The job's request (the route's body), or None for an unknown id."""
-        with self._connection() as db:
-            row = db.execute("SELECT request FROM jobs WHERE id = ?", (job_id,)).fetchone()
-        return None if row is None else dict(json.loads(row[0]))
-
-    def cells(self, job_id: str, *, offset: int, limit: int) -> list[dict[str, Any]]:
-        """Cells ``offset`` to ``offset + limit`` of a done job's result (fewer at its end).
-
-        A result stored whole by an older release (``Job.cells`` None) is read whole.
-        """
-        with self._connection() as db:
-            row = db.execute("SELECT result, cells FROM jobs WHERE id = ?", (job_id,)).fetchone()
-            if row is None or row["result"] is None:
-                return []
-            if row["cells"] is not None:
-                return read_cells(db, job_id, offset=offset, limit=limit)
-        cells = json.loads(row["result"]).get("cells", [])
-        return list(cells[offset : offset + limit])
-
-    def cells_json(self, job_id: str, *, offset: int, limit: int) -> tuple[str, int]:
-        """:meth:`cells` as a JSON array's text, and how many cells it holds.
-
-        Whole stored pages are copied unparsed (:func:`service.jobs.results.cells_text`).
-        """
-        state = self.state(job_id)
-        if state is None or state.cells is None:
-            cells = self.cells(job_id, offset=offset, limit=limit)
-            return json.dumps(cells), len(cells)
-        with self._connection() as db:
-            return cells_text(db, job_id, offset=offset, limit=limit, total=state.cells)
-
-    def cell_count(self, job_id: str) -> int:
-        """How many cells a done job's result has (0 without cells or result)."""
-        state = self.state(job_id)
-        if state is not None and state.cells is not None:
-            return state.cells
-        return len(self.cells(job_id, offset=0, limit=2**62))  # stored whole by an older release
 
     def start(self, job_id: str) -> bool:
         """Mark a queued job running (one more attempt); False if it is not queued."""

@@ -5,7 +5,8 @@ from __future__ import annotations
 import time
 from typing import Any
 
-from service.jobs.store import JobState, JobStore
+from service.jobs.job import JobState
+from service.jobs.store import JobStore
 from service.schemas import ErrorDetail, MapRequest
 from service.schemas.jobs import JobInfo, JobProgress, JobRequest, MapJob, ResultCells
 

@@ -24,7 +24,8 @@ from pydantic import ValidationError
 
 from service.config import Settings
 from service.errors import request_location, solver_error_location, solver_error_type
-from service.jobs.store import JobStore, JobStoreUnavailable
+from service.jobs.job import JobStoreUnavailable
+from service.jobs.store import JobStore
 from service.logs import log, log_to_stderr
 from service.operations import evaluation_of, map_of, optimum_of
 from service.schemas import EvaluateRequest, MapRequest, OptimizeRequest

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from service import convert
 from service.config import Settings
-from service.schemas.path import PathInput
+from service.schemas.path_input import PathInput
 from service.schemas.paths_import import (
     ImportedPose,
     PassOut,

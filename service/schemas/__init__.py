@@ -4,24 +4,15 @@ Request models are strict, refuse unknown fields and refuse NaN and infinities; 
 its unit, and every model carries an example, so ``/docs`` reads as a manual.
 """
 
-from service.schemas.cell import (
+from service.schemas.cell import CellSpec, Contact, ToolSpec
+from service.schemas.cell_objects import (
     BoxObject,
-    CellSpec,
-    Contact,
     CylinderObject,
     HalfspaceObject,
     MeshObject,
     SphereObject,
-    ToolSpec,
 )
 from service.schemas.common import (
-    AutoIkPolicy,
-    Branch,
-    ControllerFrames,
-    IkPolicy,
-    NumericBranch,
-    Placement,
-    PlacementResult,
     Pose,
     RequestModel,
     ResponseModel,
@@ -30,16 +21,16 @@ from service.schemas.common import (
 )
 from service.schemas.dtf import DtfRequest, DtfResponse
 from service.schemas.errors import ErrorDetail, ErrorResponse
-from service.schemas.evaluate import (
+from service.schemas.evaluate_request import DetailLevel, EvaluateRequest
+from service.schemas.evaluate_response import (
     Bottleneck,
-    DetailLevel,
-    EvaluateRequest,
     EvaluateResponse,
     FailureReason,
     FeedCheckResult,
     IkInfo,
     WaypointResult,
 )
+from service.schemas.ik import AutoIkPolicy, Branch, IkPolicy, NumericBranch
 from service.schemas.jobs import (
     EvaluateJob,
     JobInfo,
@@ -61,15 +52,10 @@ from service.schemas.optimize import (
     SpinPath,
     StartInfo,
 )
-from service.schemas.path import (
-    ClDataPath,
-    CsvPath,
-    Path,
-    PathInput,
-    PosePath,
-    ProgramUnits,
-    ToolAxisPath,
-)
+from service.schemas.opw_robot import OpwGeometry, OpwRobot
+from service.schemas.path import Path, PosePath, ToolAxisPath
+from service.schemas.path_cam import ClDataPath, CsvPath, ProgramUnits
+from service.schemas.path_input import PathInput
 from service.schemas.paths_import import (
     ImportedPose,
     PassOut,
@@ -77,7 +63,8 @@ from service.schemas.paths_import import (
     PathImportResponse,
     SkippedRecordOut,
 )
-from service.schemas.robot import CatalogueRobot, OpwGeometry, OpwRobot, Robot, UrdfRobot
+from service.schemas.placement import ControllerFrames, Placement, PlacementResult
+from service.schemas.robot import CatalogueRobot, Robot, UrdfRobot
 from service.schemas.robots import BranchLevel, HealthResponse, RobotInfo, RobotsResponse
 
 __all__ = [

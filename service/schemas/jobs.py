@@ -10,7 +10,7 @@ from typing_extensions import TypeAliasType
 
 from service.schemas.common import RequestModel, ResponseModel
 from service.schemas.errors import ErrorDetail
-from service.schemas.evaluate import _REQUEST_EXAMPLE, EvaluateRequest
+from service.schemas.evaluate_request import _REQUEST_EXAMPLE, EvaluateRequest
 from service.schemas.map import _CELL, _MAP_REQUEST_EXAMPLE, MapCell, MapRequest
 from service.schemas.optimize import _REQUEST as _OPTIMIZE_EXAMPLE
 from service.schemas.optimize import OptimizeRequest

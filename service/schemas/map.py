@@ -8,21 +8,13 @@ from pydantic import ConfigDict, Field
 from pydantic.config import JsonDict
 
 from service.schemas.cell import CellSpec
-from service.schemas.common import (
-    Angle,
-    Branch,
-    Coordinate,
-    IkPolicy,
-    NumericBranch,
-    PlacementResult,
-    RequestModel,
-    ResponseModel,
-    SpinMode,
-    placement_example,
-)
-from service.schemas.evaluate import _REQUEST_EXAMPLE, FailureReason
+from service.schemas.common import Angle, Coordinate, RequestModel, ResponseModel, SpinMode
+from service.schemas.evaluate_request import _REQUEST_EXAMPLE
+from service.schemas.evaluate_response import FailureReason
+from service.schemas.ik import Branch, IkPolicy, NumericBranch
 from service.schemas.motion import LimitedBy
 from service.schemas.path import Path
+from service.schemas.placement import PlacementResult, placement_example
 from service.schemas.robot import Robot
 from solver.core.spatial import MAX_COORDINATE
 from solver.path.capability_map import axis_length

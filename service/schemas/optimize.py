@@ -10,19 +10,12 @@ from pydantic.config import JsonDict
 from pydantic_core import PydanticCustomError
 
 from service.schemas.cell import CellSpec
-from service.schemas.common import (
-    Angle,
-    AutoIkPolicy,
-    Coordinate,
-    Placement,
-    PlacementResult,
-    RequestModel,
-    ResponseModel,
-    SpinMode,
-    placement_example,
-)
-from service.schemas.evaluate import _REQUEST_EXAMPLE, EvaluateResponse
+from service.schemas.common import Angle, Coordinate, RequestModel, ResponseModel, SpinMode
+from service.schemas.evaluate_request import _REQUEST_EXAMPLE
+from service.schemas.evaluate_response import EvaluateResponse
+from service.schemas.ik import AutoIkPolicy
 from service.schemas.path import Path
+from service.schemas.placement import Placement, PlacementResult, placement_example
 from service.schemas.robot import Robot
 
 Range = Annotated[list[Coordinate], Field(min_length=2, max_length=2)]

@@ -1,96 +1,24 @@
 """The tool path of a request: one object per path form, told apart by its key (cam.md).
 
-``path`` is a ``oneOf``: full poses (``waypoints``) or tool points with tool axes
-(``tool_axis_waypoints``). Each form converts itself to the poses the solver takes
-(``to_solver``); a new path form (CL data, CSV) is a new variant here.
+``path`` is a ``oneOf``: full poses (``waypoints``), tool points with tool axes
+(``tool_axis_waypoints``), or a CAM program as CL data or CSV (:mod:`service.schemas.path_cam`).
+Each form converts itself to the poses the solver takes (``to_solver``, a
+:class:`~service.schemas.path_input.PathInput`); a new path form is a new variant here.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-from typing import Annotated, Literal
+from typing import Annotated
 
 import numpy as np
-from pydantic import ConfigDict, Discriminator, Field, PrivateAttr, Tag
-from typing_extensions import TypeAliasType
+from pydantic import ConfigDict, Discriminator, Field, Tag
 
-from service.schemas.common import Pose, RequestModel, SpinMode, ToolAxisWaypoint
-from solver.cam.cam_path import CamPath, Units
-from solver.cam.cl_data import DEFAULT_ARC_TOLERANCE, read_cl_data
-from solver.cam.csv_path import read_csv_path
-from solver.cam.read_report import ReadReport, UnitsSource
-from solver.cam.reading import is_number
+from service.schemas.common import Pose, RequestModel, ToolAxisWaypoint
+from service.schemas.path_cam import ClDataPath, CsvPath
+from service.schemas.path_input import MAX_PATH_WAYPOINTS, PathInput
 from solver.core.spatial import check_position, pose_matrices
 from solver.core.task import task_requirements
 from solver.core.tool_axis import poses_from_tool_axes
-
-MAX_PATH_WAYPOINTS = 20_000
-"""The most waypoints any route takes (DTF_MAX_PATH_WAYPOINTS may lower it, never raise it)."""
-
-
-ProgramUnits = TypeAliasType(
-    "ProgramUnits",
-    Annotated[
-        Literal["mm", "inch"],
-        Field(description="The length unit of a CL program that states none: mm or inch."),
-    ],
-)
-"""The units a request gives a CL program (a named component for generated clients)."""
-
-
-@dataclass(frozen=True)
-class PathInput:
-    """A request's path as the solver takes it.
-
-    Attributes:
-        poses: shape (N, 4, 4), T_O_i (m).
-        axis_correction: the largest correction made to a tool axis's length (0 for poses).
-        default_spin_mode: ``free`` for a path given by tool axes, ``fixed`` for poses.
-        passes: index ranges [start, stop) of the passes (cam.md section 5); None: one pass.
-        feed: the program's feed (m/s), its highest FEDRAT; None when it programs none.
-        units: the length unit the path was written in.
-        units_source: how the units were known: ``stated``, ``inferred`` (CL data, from an
-            inch feed) or ``request`` (the request's units, or metres by the API).
-        units_note: the evidence for the units.
-        pass_operations: each pass's operation name (CL data), ``None`` where none is named;
-            empty for other forms.
-        pass_feeds: each pass's highest feed (m/s) or ``None``; empty for poses and axes.
-        one_point_passes: passes of one point dropped (CL data).
-        report: what the CL reader skipped, dropped and inferred; ``None`` for other forms.
-    """
-
-    poses: np.ndarray
-    axis_correction: float
-    default_spin_mode: SpinMode
-    passes: tuple[tuple[int, int], ...] | None = None
-    feed: float | None = None
-    units: str = "m"
-    units_source: UnitsSource = "request"
-    units_note: str = "the API's unit (m)"
-    pass_operations: tuple[str | None, ...] = ()
-    pass_feeds: tuple[float | None, ...] = ()
-    one_point_passes: int = 0
-    report: ReadReport | None = None
-
-
-def _from_cam(cam: CamPath, *, field: str, units_note: str) -> PathInput:
-    """The solver's path of a CAM program: its poses, passes, feed, units and read report."""
-    report = cam.report
-    return PathInput(
-        poses=cam.waypoints_in_workpiece(field=field),
-        axis_correction=cam.axis_correction,
-        default_spin_mode=cam.default_spin_mode,
-        passes=cam.passes,
-        feed=cam.feed,
-        units=cam.units,
-        units_source="request" if report is None else report.units_source,
-        units_note=units_note if report is None else report.units_note,
-        pass_operations=cam.pass_operations,
-        pass_feeds=cam.pass_feeds,
-        one_point_passes=cam.one_point_passes,
-        report=report,
-    )
-
 
 _RULES = (
     "consecutive ones distinct (apart by 1e-9 m or 1e-9 rad at least), and no segment turning "
@@ -184,124 +112,6 @@ class ToolAxisPath(RequestModel):
         poses, correction = poses_from_tool_axes(positions, np.array([p.axis for p in points]))
         task_requirements(poses, field=field)  # names this field, not path.waypoints, on an error
         return PathInput(poses=poses, axis_correction=correction, default_spin_mode="free")
-
-
-MAX_CAM_TEXT = 2_000_000
-"""Characters of CL data or CSV at most (a request body is at most 2 MB anyway)."""
-
-
-CL_UNITS: dict[str, Units] = {"mm": "mm", "inch": "inches"}
-
-
-class ClDataPath(RequestModel):
-    """A CAM program as APT CL data (cam.md sections 5 and 9), as CAM systems write it.
-
-    NX, SolidWorks CAM, CATIA or Mastercam: passes split at rapids, tool changes and
-    operations; feed from FEDRAT.
-    """
-
-    model_config = ConfigDict(
-        json_schema_extra={
-            "examples": [
-                {
-                    "cl_data": "UNITS/MM\nMULTAX/ON\nFEDRAT/MMPM, 1500\n"
-                    "GOTO/0, 0, 0, 0, 0, 1\nGOTO/10, 0, 0, 0, 0, 1\nGOTO/20, 0, 1, 0, 0, 1\n"
-                }
-            ]
-        }
-    )
-
-    cl_data: str = Field(
-        min_length=1,
-        max_length=MAX_CAM_TEXT,
-        description="APT CL data as CAM writes it (cam.md sections 5 and 9): GOTO (3 numbers "
-        "keep the last tool axis), CIRCLE arcs, FEDRAT, RAPID, UNITS/UNIT, MSYS/CSYS, TOOL PATH "
-        "and tool changes. Records without geometry or feed are skipped and counted (see "
-        "/v1/paths/import); a record that would move the tool in a way not applied is a 422 "
-        "naming its line. Tool axes within 1e-3 of unit length are normalised and the "
-        "correction reported. The default spin_mode is free; the default feed of /v1/evaluate "
-        "is the program's highest FEDRAT.",
-    )
-    units: ProgramUnits | None = Field(
-        default=None,
-        description="The length unit, for a program that states none (no UNITS or UNIT record "
-        "and no FEDRAT/IPM, from which inches are inferred). A program that states none and "
-        "is sent without units is a 422 on path.units; units that contradict the program's "
-        "UNITS record are a 422 too.",
-    )
-    arc_tolerance: float = Field(
-        default=DEFAULT_ARC_TOLERANCE,
-        ge=1e-7,
-        le=1e-3,
-        description="m: CIRCLE arcs are interpolated by points whose chords stay this close to "
-        "the arc (default 1e-5 m = 0.01 mm).",
-    )
-    _read: CamPath | None = PrivateAttr(default=None)
-
-    def cam_path(self) -> CamPath:
-        """The program as read, once (the waypoint count and the poses come from one reading).
-
-        Raises:
-            InvalidLineError: a record that cannot be read, naming its line.
-            InvalidInputError: no units (on ``path.units``), or more waypoints than any route
-                takes (on ``path``).
-        """
-        if self._read is None:
-            self._read = read_cl_data(
-                self.cl_data,
-                units=None if self.units is None else CL_UNITS[self.units],
-                arc_tolerance=self.arc_tolerance,
-                max_waypoints=MAX_PATH_WAYPOINTS,
-                field="path.cl_data",
-                units_field="path.units",
-            )
-        return self._read
-
-    def n_waypoints(self) -> int:
-        """The number of waypoints as read: what /v1/paths/import shows (cam.md section 9)."""
-        return self.cam_path().n_waypoints
-
-    def to_solver(self) -> PathInput:
-        """The program's poses, passes, feed, units and what was skipped.
-
-        Raises:
-            InvalidLineError: a record that cannot be read, naming its line.
-        """
-        return _from_cam(self.cam_path(), field="path.cl_data", units_note="")
-
-
-class CsvPath(RequestModel):
-    """A path as CSV, one waypoint a line: x,y,z,i,j,k (tool axis) or x,y,z,qx,qy,qz,qw."""
-
-    model_config = ConfigDict(
-        json_schema_extra={
-            "examples": [{"csv": "x,y,z,i,j,k\n0,0,0,0,0,1\n10,0,0,0,0,1\n", "units": "mm"}]
-        }
-    )
-
-    csv: str = Field(
-        min_length=1,
-        max_length=MAX_CAM_TEXT,
-        description="One waypoint a line: x,y,z,i,j,k (a tool axis, tip towards holder) or "
-        "x,y,z,qx,qy,qz,qw (a pose); an optional header line naming those columns. Vectors "
-        "within 1e-3 of unit length are normalised and the correction reported.",
-    )
-    units: Literal["mm", "inch", "m"] = Field(description="The unit of x, y, z: mm, inch or m.")
-
-    def n_waypoints(self) -> int:
-        """The number of waypoints as read: the non-blank lines after any header (cam.md 9)."""
-        rows = [row for row in self.csv.splitlines() if row.strip()]
-        header = bool(rows) and not all(is_number(cell) for cell in rows[0].split(","))
-        return len(rows) - int(header)
-
-    def to_solver(self) -> PathInput:
-        """The path's poses (one pass, no feed).
-
-        Raises:
-            InvalidLineError: a line that cannot be read, naming it.
-        """
-        cam = read_csv_path(self.csv, units=self.units, field="path.csv")
-        return _from_cam(cam, field="path.csv", units_note=f"the request's units ({self.units})")
 
 
 _FORMS = ("waypoints", "tool_axis_waypoints", "cl_data", "csv")

@@ -20,9 +20,10 @@ import pytest
 from fastapi.testclient import TestClient
 from starlette.types import Message, Receive, Scope, Send
 
+from service.body_limits import BodySizeLimitMiddleware
 from service.config import get_settings
-from service.errors import BodySizeLimitMiddleware
-from service.jobs.store import JobStore, QueueFull
+from service.jobs.job import QueueFull
+from service.jobs.store import JobStore
 from service.main import app
 from tests.cases import ROOT
 

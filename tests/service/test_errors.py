@@ -13,8 +13,8 @@ import pytest
 from fastapi.testclient import TestClient
 from starlette.types import Message, Receive, Scope, Send
 
+from service.body_limits import BodySizeLimitMiddleware
 from service.convert import wants_png
-from service.errors import BodySizeLimitMiddleware
 from tests.cases import EXAMPLES
 
 DELETE = object()

@@ -13,8 +13,9 @@ import pytest
 
 from service.config import Settings
 from service.jobs import worker
+from service.jobs.job import Job, JobStoreUnavailable
 from service.jobs.runner import KILL_AFTER, JobRunner
-from service.jobs.store import Job, JobStore, JobStoreUnavailable
+from service.jobs.store import JobStore
 from service.logs import log
 from tests.cases import ROOT
 from tests.service.jobs_workers import stuck

@@ -11,7 +11,8 @@ from pathlib import Path
 
 import pytest
 
-from service.jobs.store import JobStore, JobStoreUnavailable, QueueFull
+from service.jobs.job import JobStoreUnavailable, QueueFull
+from service.jobs.store import JobStore
 from tests.cases import ROOT
 
 EXAMPLE = json.loads((ROOT / "examples" / "evaluate_request.json").read_text())

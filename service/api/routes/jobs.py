@@ -20,8 +20,8 @@ from service.body import union_body_in_thread, union_body_openapi
 from service.deps import SettingsDep
 from service.errors import ERROR_RESPONSES, RETRY_AFTER, job_not_found
 from service.jobs.checks import check_job
+from service.jobs.job import QueueFull
 from service.jobs.runner import get_runner
-from service.jobs.store import QueueFull
 from service.jobs.views import job_info, units_of
 from service.logs import log
 from service.schemas import ErrorDetail, ErrorResponse

@@ -1,0 +1,93 @@
+"""What the job store reads: a job, its state, a listing, its request and its result's cells.
+
+Reads never change the file. A map's cells are read a page at a time
+(:mod:`service.jobs.results`), so that a job listing reads no result and a page of cells reads
+only that page. The changes (submit, run, finish, cancel, expire) are
+:class:`service.jobs.store.JobStore`'s.
+"""
+
+from __future__ import annotations
+
+import json
+from typing import Any
+
+from service.jobs.job import STATE_COLUMNS, Job, JobState, job_of_row, state_of_row
+from service.jobs.results import cells_text, read_cells, with_cells
+from service.jobs.store_file import StoreFile
+
+
+class JobReads(StoreFile):
+    """The queries of the job store's SQLite file (:class:`StoreFile`): what the routes read."""
+
+    def get(self, job_id: str, *, inline_cells: int | None = None) -> Job | None:
+        """The job with its request and result, or None for an unknown id.
+
+        Args:
+            job_id: the job's id.
+            inline_cells: a result's cells are put in it when there are at most this many
+                (``Job.cells`` says how many there are); None: always.
+        """
+        with self._connection() as db:
+            row = db.execute("SELECT * FROM jobs WHERE id = ?", (job_id,)).fetchone()
+            if row is None:
+                return None
+            result = None if row["result"] is None else json.loads(row["result"])
+            count = row["cells"]
+            if result is not None and count is not None:
+                if inline_cells is None or count <= inline_cells:
+                    result = with_cells(result, read_cells(db, job_id, offset=0, limit=count))
+        return job_of_row(row, result)
+
+    def state(self, job_id: str) -> JobState | None:
+        """The job without its request and result, or None for an unknown id."""
+        with self._connection() as db:
+            row = db.execute(f"SELECT {STATE_COLUMNS} FROM jobs WHERE id = ?", (job_id,)).fetchone()
+        return None if row is None else state_of_row(row)
+
+    def jobs(self, *, status: str | None, limit: int) -> list[JobState]:
+        """The newest jobs first, optionally of one status, without requests and results."""
+        query, args = f"SELECT {STATE_COLUMNS} FROM jobs", []
+        if status is not None:
+            query, args = query + " WHERE status = ?", [status]
+        with self._connection() as db:
+            rows = db.execute(query + " ORDER BY created DESC LIMIT ?", [*args, limit]).fetchall()
+        return [state_of_row(row) for row in rows]
+
+    def request(self, job_id: str) -> dict[str, Any] | None:
+        """The job's request (the route's body), or None for an unknown id."""
+        with self._connection() as db:
+            row = db.execute("SELECT request FROM jobs WHERE id = ?", (job_id,)).fetchone()
+        return None if row is None else dict(json.loads(row[0]))
+
+    def cells(self, job_id: str, *, offset: int, limit: int) -> list[dict[str, Any]]:
+        """Cells ``offset`` to ``offset + limit`` of a done job's result (fewer at its end).
+
+        A result stored whole by an older release (``Job.cells`` None) is read whole.
+        """
+        with self._connection() as db:
+            row = db.execute("SELECT result, cells FROM jobs WHERE id = ?", (job_id,)).fetchone()
+            if row is None or row["result"] is None:
+                return []
+            if row["cells"] is not None:
+                return read_cells(db, job_id, offset=offset, limit=limit)
+        cells = json.loads(row["result"]).get("cells", [])
+        return list(cells[offset : offset + limit])
+
+    def cells_json(self, job_id: str, *, offset: int, limit: int) -> tuple[str, int]:
+        """:meth:`cells` as a JSON array's text, and how many cells it holds.
+
+        Whole stored pages are copied unparsed (:func:`service.jobs.results.cells_text`).
+        """
+        state = self.state(job_id)
+        if state is None or state.cells is None:
+            cells = self.cells(job_id, offset=offset, limit=limit)
+            return json.dumps(cells), len(cells)
+        with self._connection() as db:
+            return cells_text(db, job_id, offset=offset, limit=limit, total=state.cells)
+
+    def cell_count(self, job_id: str) -> int:
+        """How many cells a done job's result has (0 without cells or result)."""
+        state = self.state(job_id)
+        if state is not None and state.cells is not None:
+            return state.cells
+        return len(self.cells(job_id, offset=0, limit=2**62))  # stored whole by an older release

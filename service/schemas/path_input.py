@@ -1,0 +1,72 @@
+"""A request's path as the solver takes it: poses, passes, feed, units and what was read.
+
+Every path form of a request (:mod:`service.schemas.path`, :mod:`service.schemas.path_cam`)
+converts itself to one :class:`PathInput`.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from service.schemas.common import SpinMode
+from solver.cam.cam_path import CamPath
+from solver.cam.read_report import ReadReport, UnitsSource
+
+MAX_PATH_WAYPOINTS = 20_000
+"""The most waypoints any route takes (DTF_MAX_PATH_WAYPOINTS may lower it, never raise it)."""
+
+
+@dataclass(frozen=True)
+class PathInput:
+    """A request's path as the solver takes it.
+
+    Attributes:
+        poses: shape (N, 4, 4), T_O_i (m).
+        axis_correction: the largest correction made to a tool axis's length (0 for poses).
+        default_spin_mode: ``free`` for a path given by tool axes, ``fixed`` for poses.
+        passes: index ranges [start, stop) of the passes (cam.md section 5); None: one pass.
+        feed: the program's feed (m/s), its highest FEDRAT; None when it programs none.
+        units: the length unit the path was written in.
+        units_source: how the units were known: ``stated``, ``inferred`` (CL data, from an
+            inch feed) or ``request`` (the request's units, or metres by the API).
+        units_note: the evidence for the units.
+        pass_operations: each pass's operation name (CL data), ``None`` where none is named;
+            empty for other forms.
+        pass_feeds: each pass's highest feed (m/s) or ``None``; empty for poses and axes.
+        one_point_passes: passes of one point dropped (CL data).
+        report: what the CL reader skipped, dropped and inferred; ``None`` for other forms.
+    """
+
+    poses: np.ndarray
+    axis_correction: float
+    default_spin_mode: SpinMode
+    passes: tuple[tuple[int, int], ...] | None = None
+    feed: float | None = None
+    units: str = "m"
+    units_source: UnitsSource = "request"
+    units_note: str = "the API's unit (m)"
+    pass_operations: tuple[str | None, ...] = ()
+    pass_feeds: tuple[float | None, ...] = ()
+    one_point_passes: int = 0
+    report: ReadReport | None = None
+
+    @classmethod
+    def from_cam(cls, cam: CamPath, *, field: str, units_note: str) -> PathInput:
+        """The solver's path of a CAM program: its poses, passes, feed, units and read report."""
+        report = cam.report
+        return cls(
+            poses=cam.waypoints_in_workpiece(field=field),
+            axis_correction=cam.axis_correction,
+            default_spin_mode=cam.default_spin_mode,
+            passes=cam.passes,
+            feed=cam.feed,
+            units=cam.units,
+            units_source="request" if report is None else report.units_source,
+            units_note=units_note if report is None else report.units_note,
+            pass_operations=cam.pass_operations,
+            pass_feeds=cam.pass_feeds,
+            one_point_passes=cam.one_point_passes,
+            report=report,
+        )
