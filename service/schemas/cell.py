@@ -18,6 +18,7 @@ from solver.path.cell.shapes import (
     DEFAULT_CLEARANCE,
     DEFAULT_COLLISION_STEP,
     DEFAULT_CUTTING_LENGTH,
+    MIN_COLLISION_STEP,
     Cell,
     Tool,
 )
@@ -86,9 +87,10 @@ class CellSpec(RequestModel):
     )
     collision_step: float = Field(
         default=DEFAULT_COLLISION_STEP,
-        gt=0.0,
+        ge=MIN_COLLISION_STEP,
         le=math.pi,
-        description="rad, the largest joint move between two checks.",
+        description="rad, the largest joint move between two checks; a finer step weighs "
+        "proportionally more against the size limits (50 times the default's at the least).",
     )
     link_radii: list[Size] | None = Field(
         default=None,

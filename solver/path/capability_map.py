@@ -16,7 +16,7 @@ from solver.core.codes import REASONS
 from solver.core.exceptions import InvalidInputError
 from solver.core.parallel import SERIAL, TaskRunner
 from solver.core.spatial import Placement
-from solver.path.cell.checker import CELL_POSE_COST
+from solver.path.cell.checker import cell_pose_cost
 from solver.path.placements import DEFAULT_CHUNK, evaluate_placements
 from solver.path.problem import PathProblem
 from solver.path.pruning import can_prune
@@ -219,6 +219,7 @@ def map_cost(problem: PathProblem) -> float:
     n_waypoints = problem.prepared.n_waypoints
     free_spin = problem.options.spin_mode == "free"
     if problem.options.cell is not None:
-        return problem.family.map_cost(n_waypoints, free_spin=free_spin) * CELL_POSE_COST
+        cost = problem.family.map_cost(n_waypoints, free_spin=free_spin)
+        return cost * cell_pose_cost(problem.options.cell)
     pruned = can_prune(problem)
     return problem.family.map_cost(n_waypoints, free_spin=free_spin, pruned=pruned)

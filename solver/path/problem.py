@@ -25,7 +25,7 @@ from solver.core.exceptions import InvalidInputError, NoAnalyticIkError, quoted
 from solver.core.family import Branch, KinematicsFamily
 from solver.core.robots import Robot
 from solver.path.cell.cache import checker_for
-from solver.path.cell.checker import CELL_POSE_COST
+from solver.path.cell.checker import cell_pose_cost
 from solver.path.cell.limit import CellLimit
 from solver.path.cell.shapes import Cell
 from solver.path.limits import (
@@ -184,11 +184,12 @@ class PathProblem:
         """The work of one placement of ``n_waypoints``, in poses of a closed-form family's map.
 
         The family's cost (:meth:`KinematicsFamily.path_cost`), times the collision check's
-        (:data:`solver.path.cell.checker.CELL_POSE_COST`) with a cell: what the size limits of
+        (:func:`solver.path.cell.checker.cell_pose_cost`) with a cell: what the size limits of
         the maps and searches weigh.
         """
         cost = self.family.path_cost(n_waypoints, free_spin=self.options.spin_mode == "free")
-        return cost * CELL_POSE_COST if self.options.cell is not None else cost
+        cell = self.options.cell
+        return cost * cell_pose_cost(cell) if cell is not None else cost
 
     @property
     def waypoint_limits(self) -> tuple[Limit, ...]:

@@ -141,8 +141,19 @@ CUBE = base64.b64encode(binary_stl(cube_triangles(0.1))).decode()
         ({"fixed": [{"shape": "cone", "radius": 0.1}]}, {}, ["cell", "fixed", 0], ""),
         ({"tool": {"radius": 0.02, "length": 0.01}}, {}, ["cell", "tool", "cutting_length"], ""),
         ({"link_radii": [0.05, 0.05]}, {}, ["cell", "link_radii"], "give 7"),
+        ({"collision_step": 1e-4}, {}, ["cell", "collision_step"], "0.001"),
     ],
-    ids=["objects", "triangles", "text", "base64-not-stl", "size", "shape", "tool", "radii"],
+    ids=[
+        "objects",
+        "triangles",
+        "text",
+        "base64-not-stl",
+        "size",
+        "shape",
+        "tool",
+        "radii",
+        "step",
+    ],  # fmt: skip
 )
 def test_a_bad_cell_is_a_422_naming_its_field(
     client: TestClient,
@@ -170,6 +181,31 @@ def test_a_map_in_a_cell_weighs_its_collision_work(
     assert "in a cell" in response.json()["detail"][0]["msg"]
     del request["cell"]
     assert client.post("/v1/map", json=request).status_code == 200
+
+
+def test_a_finer_collision_step_weighs_its_sub_steps(
+    client: TestClient, body: dict, setting: Any
+) -> None:
+    """3 placements x 133 waypoints x 50: 19,950 poses; at a tenth of the step, ten times that."""
+    setting(max_map_poses=100_000)
+    request = map_request(body)
+    assert client.post("/v1/map", json=request).status_code == 200
+    request["cell"]["collision_step"] = 0.005
+    response = client.post("/v1/map", json=request)
+    assert_names(response, 422, ["body", "grid"])
+    assert "in a cell" in response.json()["detail"][0]["msg"]
+
+
+def test_a_tool_without_thickness_is_checked(client: TestClient, body: dict) -> None:
+    """A 5e-324 m tool (schemathesis found it: a table grid sized by 0 was a 500) answers."""
+    body["cell"] = {
+        "fixed": [TABLE],
+        "link_radii": [0.05] * 7,
+        "tool": {"radius": 5e-324, "length": 0.12, "cutting_length": 5e-324},
+        "collision_step": 0.001,
+    }
+    response = client.post("/v1/evaluate", json=body)
+    assert response.status_code == 200, response.text
 
 
 def test_an_optimisation_in_a_cell_weighs_its_collision_work(

@@ -198,6 +198,8 @@ def build_tables(
         axis = np.asarray(placement.rotation) @ axes[chain[0]]
         w[0] = min(w[0], _largest_from_axis(a_obj, placement.translation, axis))
         w[-1] = min(w[-1], _largest_from_axis(b_obj, np.zeros(3), axes[chain[-1]]))
+        if not all(math.isfinite(wk) and wk > 0.0 for wk in w):
+            continue  # a joint moving neither part: no grid to size; the sweep's bounds decide
         scale = (BUDGET / math.prod(w)) ** (1.0 / len(chain))
         counts = [max(4, int(scale * wk)) for wk in w]
         q_index = [model.joints[k].idx_q for k in chain]

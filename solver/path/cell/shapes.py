@@ -17,6 +17,7 @@ from solver.core.exceptions import InvalidInputError
 
 DEFAULT_CLEARANCE = 0.005  # m, cell.md section 1
 DEFAULT_COLLISION_STEP = 0.05  # rad, cell.md section 3
+MIN_COLLISION_STEP = 0.001  # rad: finer checks weigh 50x the default's sub-steps and more
 DEFAULT_CUTTING_LENGTH = 0.02  # m, cell.md section 1
 MAX_SIZE = 100.0  # m: no cell object is larger (a halfspace's offset likewise)
 
@@ -205,7 +206,8 @@ class Cell:
         fixed: objects in {B}. workpiece: objects in {O}, moving with the placement.
         tool: the tool cylinder, or None (no tool geometry).
         clearance: m, >= 0, the least distance any checked pair may come to.
-        collision_step: rad, > 0, the largest joint move between two checks.
+        collision_step: rad, in [MIN_COLLISION_STEP, pi], the largest joint move between two
+            checks.
         link_radii: m, capsule radii per link of an arm that has no collision geometry
             (base, then one per joint); None takes the robot's published ones.
     """
@@ -226,7 +228,11 @@ class Cell:
             self.tool.check()
         if not (math.isfinite(self.clearance) and 0.0 <= self.clearance <= 1.0):
             raise InvalidInputError("cell.clearance", f"{self.clearance:.6g} m must be in [0, 1]")
-        _positive(self.collision_step, "cell.collision_step", upper=math.pi)
+        step = float(self.collision_step)
+        if not (math.isfinite(step) and MIN_COLLISION_STEP <= step <= math.pi):
+            raise InvalidInputError(
+                "cell.collision_step", f"{step:.6g} rad must be in [{MIN_COLLISION_STEP:g}, pi]"
+            )
         for k, radius in enumerate(self.link_radii or ()):
             _positive(radius, f"cell.link_radii.{k}", upper=1.0)
 
