@@ -22,7 +22,7 @@ from solver.core.robots import Robot
 from solver.families import get_robot
 from solver.path.pipeline import run_chunk
 from solver.path.placed import check_placements, placed_flange
-from solver.path.placements import evaluate_placements
+from solver.path.placements import PlacementResults, evaluate_placements
 from solver.path.problem import PathProblem
 from tests.solver.families.numeric_maps import erk_placements, opw_from_urdf, ur5_from_urdf
 from tests.solver.families.test_numeric_kernel import MU_RTOL as COMPILED_RTOL
@@ -45,7 +45,9 @@ CASES = {
 PASSES = ((0, CROSSED), (CROSSED, 8))  # the crossing step is the rapid between two passes
 
 
-def crossing_path(robot: Robot, frames: tuple[str, str], ends: tuple[list[float], ...]):  # type: ignore[no-untyped-def]
+def crossing_path(
+    robot: Robot, frames: tuple[str, str], ends: tuple[list[float], list[float]]
+) -> np.ndarray:
     """Flange poses (8, 4, 4) in the base frame along the straight joint path between ``ends``."""
     model = robot.model
     data = model.createData()
@@ -63,7 +65,9 @@ def grid() -> np.ndarray:
     return erk_placements(np.array([-0.01, 0.0, 0.01]), np.array([-0.01, 0.0, 0.01]), 0.0)
 
 
-def maps(name: str, passes: tuple[tuple[int, int], ...] | None, **numeric: bool):  # type: ignore[no-untyped-def]
+def maps(
+    name: str, passes: tuple[tuple[int, int], ...] | None, **numeric: bool
+) -> list[PlacementResults]:
     """The analytic and the numeric map of the case (``evaluate_placements``' results)."""
     make, frames, ends = CASES[name]
     arm = make(**numeric)
@@ -144,7 +148,9 @@ def test_compiled_statuses_equal_numpy(name: str) -> None:
 
 @pytest.mark.parametrize("passes", [None, PASSES], ids=["one_pass", "two_passes"])
 @pytest.mark.parametrize("name", CASES)
-def test_pruned_equals_unpruned_and_numpy(name: str, passes: tuple | None) -> None:  # type: ignore[type-arg]
+def test_pruned_equals_unpruned_and_numpy(
+    name: str, passes: tuple[tuple[int, int], ...] | None
+) -> None:
     make, frames, ends = CASES[name]
     path = crossing_path(make(), frames, ends)
     compiled = PathProblem.of(make(), path, passes=passes)
