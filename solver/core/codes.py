@@ -14,6 +14,13 @@ from typing import Literal
 OK = 0
 UNREACHABLE = 1
 SINGULAR = 2
+# A regular solution on the other side of the singular set: det J < 0 (a six-joint numeric
+# family's solutions carry the sign of det J, J (6, 6) at the flange or any point, as OK and
+# OK_MIRRORED; an analytic family gives OK only, its branch labels fix that sign). Tracking
+# calls a change between OK and OK_MIRRORED from one waypoint of a pass to the next a
+# discontinuity: the branch crossed a singularity (q5 = 0, the elbow, the shoulder) between
+# the samples, where the analytic branch jumps (robots.md: a wrist never passes q5 = 0).
+OK_MIRRORED = 3
 
 Reason = Literal["unreachable", "joint_limits", "singular", "discontinuous", "collision"]
 REASONS: tuple[Reason, ...] = (

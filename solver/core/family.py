@@ -29,7 +29,9 @@ class PathSolutions:
 
     Attributes:
         q: shape (dof, n_branches, *batch, W), rad, NaN where a branch has no solution.
-        status: shape (n_branches, *batch, W), ``OK``, ``UNREACHABLE`` or ``SINGULAR``.
+        status: shape (n_branches, *batch, W), ``OK``, ``UNREACHABLE`` or ``SINGULAR``; a
+            six-joint numeric family's regular solutions are ``OK_MIRRORED`` where det J < 0
+            (tracking: a change of that sign within a pass is a discontinuity).
         seeds: how many seeds a numeric family started from at the first waypoint; ``None``
             for an analytic family (it returns every branch).
         branches_found: shape batch, the distinct solutions found at the first waypoint of each
@@ -128,7 +130,8 @@ class KinematicsFamily(abc.ABC):
             q: shape (dof, n_branches, *batch), rad in [-pi, pi] (copies 2 pi away are left to
             tracking), NaN where a branch has no solution;
             status: shape (n_branches, *batch), ``OK``, ``UNREACHABLE`` or ``SINGULAR`` (q is
-            still filled where singular).
+            still filled where singular); ``OK_MIRRORED`` for a regular solution with det J < 0
+            (six-joint numeric families only, see :data:`solver.core.codes.OK_MIRRORED`).
         """
 
     def path_cost(self, n_waypoints: int, *, free_spin: bool = False) -> float:

@@ -1,7 +1,9 @@
 """Following IK branches along a path, batched over branches and placements (spec section 4).
 
 A branch is feasible along a path when every waypoint has a regular solution on it, no joint
-moves more than ``max_joint_step`` between neighbouring waypoints, and each joint's whole path,
+moves more than ``max_joint_step`` between neighbouring waypoints nor does the sign of det J
+change between them (``OK`` to ``OK_MIRRORED``: a singularity crossed between the samples,
+which only a numeric family's statuses show), and each joint's whole path,
 unwrapped, fits inside its position limits with some 2 pi copy. The first failure names the
 waypoint; at one waypoint ``unreachable`` comes before ``singular`` before ``discontinuous``,
 and ``joint_limits`` is the first waypoint whose joint range no copy can hold.
@@ -19,6 +21,8 @@ import numpy as np
 from solver.core.codes import (
     EDGE,
     FEASIBLE,
+    OK,
+    OK_MIRRORED,
     REASON_DISCONTINUOUS,
     REASON_JOINT_LIMITS,
     REASON_SINGULAR,
@@ -54,6 +58,19 @@ def _first_true(mask: np.ndarray) -> np.ndarray:
     return first
 
 
+def crossed(status: np.ndarray) -> np.ndarray:
+    """Where det J changes sign between neighbouring waypoints: status (..., W) -> (..., W - 1).
+
+    True where one end is ``OK`` and the other ``OK_MIRRORED`` (both regular, det J of opposite
+    signs): the branch passed a singular configuration between the samples.
+    """
+    before, after = status[..., :-1], status[..., 1:]
+    result: np.ndarray = ((before == OK) & (after == OK_MIRRORED)) | (
+        (before == OK_MIRRORED) & (after == OK)
+    )
+    return result
+
+
 def track(
     q: np.ndarray,
     status: np.ndarray,
@@ -67,7 +84,8 @@ def track(
 
     Args:
         q: shape (n, *batch, W), rad in [-pi, pi], each branch's solution at every waypoint.
-        status: shape (*batch, W), the IK status of those solutions.
+        status: shape (*batch, W), the IK status of those solutions (``OK_MIRRORED`` next to
+            ``OK`` is a discontinuity, see :func:`crossed`).
         lower: shape (n,), rad, lower position limits.
         upper: shape (n,), rad, upper position limits.
         max_joint_step: rad, the largest move of any joint between neighbouring waypoints.
@@ -82,6 +100,7 @@ def track(
     step -= np.where(step > math.pi, _TWO_PI, np.where(step < -math.pi, -_TWO_PI, 0.0))
     with np.errstate(invalid="ignore"):
         jump = np.any(np.abs(step) > max_joint_step, axis=0)
+    jump |= crossed(status)
     if segment_checked is not None:
         jump &= segment_checked
     first = np.stack(

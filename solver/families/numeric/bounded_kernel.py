@@ -20,10 +20,10 @@ from pathlib import Path
 import numpy as np
 from numba import njit
 
-from solver.core.codes import OK, SINGULAR, UNREACHABLE
+from solver.core.codes import OK_MIRRORED, SINGULAR, UNREACHABLE
 from solver.families.numeric import ik_kernel, scout_kernel
 from solver.families.numeric.chain_kernel import drop_stale_cache, frames, workspace
-from solver.families.numeric.ik_kernel import _levenberg_marquardt, _singular
+from solver.families.numeric.ik_kernel import _levenberg_marquardt, regular_status
 from solver.families.numeric.scout_kernel import hopeless, scouted, v_max
 
 _TWO_PI = 2.0 * math.pi
@@ -54,8 +54,8 @@ def _exact(chain, slot, path, limits, settings, constants, rules, work, spare, o
     the pure rotations, the joint limits and the joint step tracking calls a jump; ``rules``:
     (tie, margin, slot index, candidate, best); ``out``: q and status of this slot (6, W)
     and (W,). Returns (least V_max, its first waypoint, whether it cannot be the candidate:
-    lost, singular, a step not below the jump or no copy 2 pi k within the limits (judged
-    with a margin: tracking decides), dropped).
+    lost, singular, a step not below the jump or across a change of det J's sign, or no copy
+    2 pi k within the limits (judged with a margin: tracking decides), dropped).
     """
     rotations, positions, twists, tools = path
     qdot_max, pure_rotation, lower, upper, max_step = limits
@@ -82,11 +82,10 @@ def _exact(chain, slot, path, limits, settings, constants, rules, work, spare, o
             (0, 0.0),
         ):
             return least, slowest, True, False
-        if _singular(chain, rcond, work):
-            status[w] = SINGULAR
-            failed = True
-        else:
-            status[w] = OK
+        status[w] = regular_status(chain, rcond, work)
+        failed = failed or status[w] == SINGULAR
+        # det J changed sign from the waypoint before: a singularity crossed (tracking's jump)
+        failed = failed or (w > 0 and (status[w] == OK_MIRRORED) != (status[w - 1] == OK_MIRRORED))
         for j in range(len(slot)):
             value = slot[j]
             q[j, w] = wrapped(value) if revolute[j] else value

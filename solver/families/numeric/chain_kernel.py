@@ -179,6 +179,35 @@ def lu_solve(a, b):  # type: ignore[no-untyped-def]  # pragma: no cover - compil
     return True
 
 
+@njit(cache=True, nogil=True, error_model="numpy", inline="always")
+def det_negative(jac, a):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
+    """Whether det J < 0, J (6, 6) in ``jac`` (left alone), by LU with partial pivoting in ``a``.
+
+    LAPACK's getrf (``np.linalg.det``) takes the same pivots; where J is regular (as the
+    singularity test asks first) the sign does not depend on the rounding.
+    """
+    for i in range(6):
+        for k in range(6):
+            a[i, k] = jac[i, k]
+    negative = False
+    for col in range(6):
+        pivot = col
+        for row in range(col + 1, 6):
+            if abs(a[row, col]) > abs(a[pivot, col]):
+                pivot = row
+        if pivot != col:
+            negative = not negative
+            for k in range(6):
+                a[col, k], a[pivot, k] = a[pivot, k], a[col, k]
+        if a[col, col] < 0.0:
+            negative = not negative
+        for row in range(col + 1, 6):
+            f = a[row, col] / a[col, col]
+            for k in range(col + 1, 6):
+                a[row, k] -= f * a[col, k]
+    return negative
+
+
 @njit(cache=True, nogil=True, error_model="numpy")
 def jacobians(chain, q, point):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
     """``SerialChain.jacobian`` at M configurations: (M, 6, n) at the points (M, 3), {B} axes.

@@ -6,8 +6,11 @@ covering the joint box (a fractional factorial design at each joint's quartiles,
 whose error stops shrinking is given up, ``ik.STALL_STEPS``), keeps every distinct solution
 within the joint limits as a branch, labelled by its index in seed order, and
 follows each branch to the next waypoint from its solution at the previous one. The same input
-gives the same branches. A numeric family cannot promise that it found every branch: it reports
-how many it found.
+gives the same branches. Six joints: each regular solution's status carries the sign of det J
+(``OK`` / ``OK_MIRRORED``), so tracking sees a branch that crosses a singularity between two
+waypoints (robots.md: a wrist never passes q5 = 0) where an analytic branch, whose label fixes
+that sign, jumps; seven joints have no det J (their statuses stay ``OK``). A numeric family
+cannot promise that it found every branch: it reports how many it found.
 
 J^-1 t and the null space: :mod:`solver.families.numeric.velocity`; the work model:
 :mod:`solver.families.numeric.costs`.

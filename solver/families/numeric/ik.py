@@ -21,6 +21,7 @@ import math
 
 import numpy as np
 
+from solver.core.codes import OK, OK_MIRRORED, SINGULAR
 from solver.core.progress import Progress
 from solver.core.spatial import wrap_angle
 from solver.families.numeric.chain import SerialChain
@@ -271,6 +272,27 @@ def distinct(
 def is_singular(chain: SerialChain, q: np.ndarray) -> np.ndarray:
     """Where the Jacobian of q (M, n) loses rank: sigma_min / sigma_max < SINGULAR_RCOND."""
     jacobian, _, _ = chain.jacobian(q)
+    return _singular(jacobian)
+
+
+def _singular(jacobian: np.ndarray) -> np.ndarray:
+    """:func:`is_singular` of Jacobians (M, 6, n)."""
     squares = np.linalg.eigvalsh(jacobian @ jacobian.transpose(0, 2, 1))  # sigma^2, ascending
     singular: np.ndarray = squares[:, 0] < SINGULAR_RCOND**2 * squares[:, -1]
     return singular
+
+
+def regular_status(chain: SerialChain, q: np.ndarray) -> np.ndarray:
+    """The status of solutions q (M, n), finite: ``SINGULAR``, else ``OK`` or ``OK_MIRRORED``.
+
+    ``OK_MIRRORED`` where a six-joint chain's det J < 0 (J (6, 6) at the flange, {B} axes; its
+    sign is the same at any point and in any axes); seven or more joints have no det J and are
+    ``OK``. The sign is well defined where J is regular (sigma_min / sigma_max at least
+    ``SINGULAR_RCOND``), so LU's rounding cannot flip it.
+    """
+    jacobian, _, _ = chain.jacobian(q)
+    mirrored = np.linalg.det(jacobian) < 0.0 if chain.dof == 6 else np.zeros(len(q), dtype=bool)
+    status: np.ndarray = np.where(
+        _singular(jacobian), SINGULAR, np.where(mirrored, OK_MIRRORED, OK)
+    )
+    return status

@@ -16,8 +16,9 @@ from pathlib import Path
 import numpy as np
 from numba import njit
 
-from solver.core.codes import OK, SINGULAR, UNREACHABLE
+from solver.core.codes import OK, OK_MIRRORED, SINGULAR, UNREACHABLE
 from solver.families.numeric.chain_kernel import (
+    det_negative,
     drop_stale_cache,
     frames,
     jacobian_at,
@@ -216,6 +217,20 @@ def _singular(chain, rcond, work):  # type: ignore[no-untyped-def]  # pragma: no
     return False
 
 
+@njit(cache=True, nogil=True, error_model="numpy", inline="always")
+def regular_status(chain, rcond, work):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
+    """``ik.regular_status`` at the frames in ``work``: SINGULAR, else OK or OK_MIRRORED.
+
+    After :func:`_singular` (which leaves J at the flange in ``work[6]``), a six-joint chain's
+    sign of det J by LU in ``work[10]`` (the Cholesky factor, free again).
+    """
+    if _singular(chain, rcond, work):
+        return SINGULAR
+    if len(chain[3]) == 6 and det_negative(work[6], work[10]):
+        return OK_MIRRORED
+    return OK
+
+
 @njit(cache=True, nogil=True, error_model="numpy")
 def seed_paths(chain, seeds, box, rotations, positions, settings, constants):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
     """The distinct solutions at each path's first pose, from every seed, within the joint box.
@@ -347,7 +362,7 @@ def _follow(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
                 for j in range(n):
                     q[j, b, p, rest] = np.nan
             return
-        status[b, p, w] = SINGULAR if _singular(chain, rcond, work) else OK
+        status[b, p, w] = regular_status(chain, rcond, work)
         for j in range(n):
             value = slot[j]
             q[j, b, p, w] = (value + math.pi) % _TWO_PI - math.pi if revolute[j] else value

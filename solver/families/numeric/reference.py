@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from solver.core.codes import OK, SINGULAR, UNREACHABLE
+from solver.core.codes import UNREACHABLE
 from solver.core.progress import Progress
 from solver.core.spatial import wrap_angle
 from solver.families.numeric import ik
@@ -115,6 +115,6 @@ def wrapped_with_status(
     status = np.full(len(flat), UNREACHABLE)
     solved = np.flatnonzero(np.isfinite(flat).all(axis=-1))
     for rows in in_chunks(solved, progress):
-        status[rows] = np.where(ik.is_singular(chain, flat[rows]), SINGULAR, OK)
+        status[rows] = ik.regular_status(chain, flat[rows])
     wrapped = np.where(chain.q_revolute, wrap_angle(q), q)
     return wrapped, status.reshape(q.shape[:-1])
