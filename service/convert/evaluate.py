@@ -118,8 +118,13 @@ def evaluate_response(
     with_waypoints: bool = True,
     feed: FeedCheck | None = None,
     cycle_time: CycleTime | None = None,
+    path_read: schemas.PathRead | None = None,
 ) -> schemas.EvaluateResponse:
-    """The response of ``POST /v1/evaluate`` (per-waypoint detail when ``with_waypoints``)."""
+    """The response of ``POST /v1/evaluate`` (per-waypoint detail when ``with_waypoints``).
+
+    ``path_read``: how the CAM program was read, None for poses and tool axes (and in
+    ``/v1/optimize``'s evaluation, whose answer has it).
+    """
     ev = evaluation
     bottleneck = None
     if ev.bottleneck_waypoint is not None and ev.bottleneck_joint is not None:
@@ -156,4 +161,5 @@ def evaluate_response(
         feed_check=None
         if feed is None
         else schemas.FeedCheckResult(feed=feed.feed, feasible=feed.feasible, margin=feed.margin),
+        path_read=path_read,
     )

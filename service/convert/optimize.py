@@ -22,9 +22,16 @@ def bounds_of(bounds: schemas.Bounds, *, z: float | None) -> PlacementBounds:
 
 
 def optimize_response(
-    optimum: PlacementOptimum, robot: Robot, *, axis_correction: float = 0.0
+    optimum: PlacementOptimum,
+    robot: Robot,
+    *,
+    axis_correction: float = 0.0,
+    path_read: schemas.PathRead | None = None,
 ) -> schemas.OptimizeResponse:
-    """The answer of ``POST /v1/optimize`` (``found: false`` when nothing was feasible)."""
+    """The answer of ``POST /v1/optimize`` (``found: false`` when nothing was feasible).
+
+    ``path_read``: how the CAM program was read, None for poses and tool axes.
+    """
     report = optimum.solver
     return schemas.OptimizeResponse(
         found=optimum.found,
@@ -48,4 +55,5 @@ def optimize_response(
             iterations=report.iterations,
             seconds=report.seconds,
         ),
+        path_read=path_read,
     )

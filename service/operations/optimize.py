@@ -47,7 +47,12 @@ def optimum_of(
         progress=progress,
         runner=ThreadRunner(settings.threads) if runner is None else runner,
     )
-    return convert.optimize_response(optimum, robot, axis_correction=path.axis_correction)
+    return convert.optimize_response(
+        optimum,
+        robot,
+        axis_correction=path.axis_correction,
+        path_read=convert.path_read_of(path),
+    )
 
 
 def check_work(

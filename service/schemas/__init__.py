@@ -56,12 +56,11 @@ from service.schemas.opw_robot import OpwGeometry, OpwRobot
 from service.schemas.path import Path, PosePath, ToolAxisPath
 from service.schemas.path_cam import ClDataPath, CsvPath, ProgramUnits
 from service.schemas.path_input import PathInput
+from service.schemas.path_read import PassOut, PathRead, SkippedRecordOut
 from service.schemas.paths_import import (
     ImportedPose,
-    PassOut,
     PathImportRequest,
     PathImportResponse,
-    SkippedRecordOut,
 )
 from service.schemas.placement import ControllerFrames, Placement, PlacementResult
 from service.schemas.robot import CatalogueRobot, Robot, UrdfRobot
@@ -115,6 +114,7 @@ __all__ = [
     "IkInfo",
     "ImportedPose",
     "PassOut",
+    "PathRead",
     "SkippedRecordOut",
     "IkPolicy",
     "MapCell",

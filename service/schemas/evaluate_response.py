@@ -13,6 +13,7 @@ from service.schemas.common import ResponseModel, SpinMode
 from service.schemas.evaluate_request import DetailLevel
 from service.schemas.ik import Branch, NumericBranch
 from service.schemas.motion import AccelerationResult, CycleTimeResult
+from service.schemas.path_read import PATH_READ, PathRead
 
 _RESPONSE_EXAMPLE_WAYPOINT: JsonDict = {
     "index": 0,
@@ -257,6 +258,10 @@ class EvaluateResponse(ResponseModel):
         default=None,
         description="With a feed (the request's, or the CL program's FEDRAT): whether the path "
         "runs at it; null without one.",
+    )
+    path_read: PathRead | None = Field(
+        default=None,
+        description=f"{PATH_READ} In /v1/optimize's evaluation, null: that answer has it.",
     )
     detail: DetailLevel = Field(
         default="waypoints", description="Whether waypoints holds the per-waypoint detail."

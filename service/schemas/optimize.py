@@ -15,6 +15,7 @@ from service.schemas.evaluate_request import _REQUEST_EXAMPLE
 from service.schemas.evaluate_response import EvaluateResponse
 from service.schemas.ik import AutoIkPolicy
 from service.schemas.path import Path
+from service.schemas.path_read import PATH_READ, PathRead
 from service.schemas.placement import Placement, PlacementResult, placement_example
 from service.schemas.robot import Robot
 
@@ -235,3 +236,4 @@ class OptimizeResponse(ResponseModel):
         "redundancy too, so it may differ from the tracked IK branch. /v1/evaluate with this "
         "joint_path gives this mu_path. null for six joints.",
     )
+    path_read: PathRead | None = Field(default=None, description=PATH_READ)
