@@ -79,6 +79,9 @@ def evaluation_text(answer: EvaluateResponse) -> str:
     lines = read_text(answer.path_read)
     if not answer.feasible:
         where = "" if answer.failed_waypoint is None else f" at waypoint {answer.failed_waypoint}"
+        if answer.failed_pass is not None:
+            named = "" if answer.failed_operation is None else f", {answer.failed_operation}"
+            where += f" (pass {answer.failed_pass}{named})"
         return "\n".join([*lines, f"infeasible: {answer.reason}{where}"])
     lines.append(f"mu_path: {answer.mu_path:.4f} m/s (spin {answer.spin_mode})")
     if answer.bottleneck is not None:
@@ -129,7 +132,8 @@ def optimum_text(answer: OptimizeResponse) -> str:
     """How the program was read; the optimum with its controller frames, or that none is."""
     lines = read_text(answer.path_read)
     if not answer.found or answer.placement is None or answer.mu_path is None:
-        return "\n".join([*lines, "no feasible placement inside the bounds"])
+        why = "" if answer.failure is None else f": {answer.failure.message}"
+        return "\n".join([*lines, f"no feasible placement inside the bounds{why}"])
     gain = answer.improvement_percent
     lines += [
         f"optimum: mu_path {answer.mu_path:.4f} m/s"

@@ -119,11 +119,13 @@ def evaluate_response(
     feed: FeedCheck | None = None,
     cycle_time: CycleTime | None = None,
     path_read: schemas.PathRead | None = None,
+    failed_in: tuple[int | None, str | None] = (None, None),
 ) -> schemas.EvaluateResponse:
     """The response of ``POST /v1/evaluate`` (per-waypoint detail when ``with_waypoints``).
 
     ``path_read``: how the CAM program was read, None for poses and tool axes (and in
-    ``/v1/optimize``'s evaluation, whose answer has it).
+    ``/v1/optimize``'s evaluation, whose answer has it); ``failed_in``: the pass and operation
+    of the failed waypoint, of CAM input (:func:`service.convert.path_read.pass_at`).
     """
     ev = evaluation
     bottleneck = None
@@ -139,6 +141,8 @@ def evaluate_response(
         bottleneck=bottleneck,
         reason=None if ev.reason is None else schemas.FailureReason(ev.reason),
         failed_waypoint=ev.failed_waypoint,
+        failed_pass=failed_in[0],
+        failed_operation=failed_in[1],
         branch=branch_to_api(ev.branch),
         ik=schemas.IkInfo.model_validate(
             {

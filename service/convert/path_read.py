@@ -51,3 +51,19 @@ def path_read_of(path: PathInput) -> schemas.PathRead | None:
     if path.cam_form is None:
         return None
     return schemas.PathRead(form=path.cam_form, **read_fields(path))
+
+
+def pass_at(path: PathInput, waypoint: int | None) -> tuple[int | None, str | None]:
+    """The pass (its index, from 0) holding ``waypoint`` and its operation's name, of CAM input.
+
+    ``(None, None)`` for poses and tool axes, without a waypoint, or for one in no pass; the
+    operation is None where the file names none.
+    """
+    if path.cam_form is None or waypoint is None:
+        return None, None
+    passes = path.passes or ((0, len(path.poses)),)
+    for k, (start, stop) in enumerate(passes):
+        if start <= waypoint < stop:
+            operations = path.pass_operations
+            return k, operations[k] if k < len(operations) else None
+    return None, None

@@ -50,8 +50,7 @@ def optimum_of(
     return convert.optimize_response(
         optimum,
         robot,
-        axis_correction=path.axis_correction,
-        path_read=convert.path_read_of(path),
+        path=path,
     )
 
 

@@ -78,9 +78,10 @@ class PathRead(ResponseModel):
                     "units_source": "inferred",
                     "units_note": "no UNITS record; a feed in inches per minute, FEDRAT/IPM at "
                     "line 21",
-                    "feed": 0.004233,
+                    "feed": 0.008467,
                     "pass_details": [
-                        {"start": 0, "stop": 61, "operation": "FLOOR_SLOT", "feed": 0.004233}
+                        {"start": 0, "stop": 83, "operation": "FLOOR_SLOT", "feed": 0.008467},
+                        {"start": 83, "stop": 89, "operation": "VARIABLE_CONTOUR", "feed": 0.00635},
                     ],
                     "skipped_records": [
                         {"word": "PAINT", "count": 11, "first_line": 11, "recognised": True}
@@ -119,3 +120,11 @@ PATH_READ = (
     "counted); null for poses and tool-axis waypoints."
 )
 """The description of every answer's ``path_read`` field."""
+FAILED_PASS = (
+    "When the path came as CL data or CSV and a waypoint fails: the pass holding it (index into "
+    "path_read.pass_details, from 0); null otherwise."
+)
+FAILED_OPERATION = (
+    "When the path came as CL data or CSV and a waypoint fails: the operation of its pass, as "
+    "the file names it (NX TOOL PATH, PARTNO, PPRINT); null otherwise or where none is named."
+)
