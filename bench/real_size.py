@@ -121,7 +121,7 @@ def erk_route_parts(*, repeats: int) -> None:
         runner = ThreadRunner(threads)
         return computed_map(request, settings, png=False, progress=lambda _: None, runner=runner)
 
-    result, robot, spin_mode = computed(settings.threads)
+    result, robot, spin_mode, _ = computed(settings.threads)
     response = map_response(result, robot, spin_mode=spin_mode)
     parts = {
         "validation": best_time(lambda: MapRequest.model_validate_json(raw), repeats),

@@ -107,7 +107,7 @@ def round_trips(*, repeats: int) -> None:
         def in_process() -> None:
             request = MapRequest.model_validate_json(raw)
             runner = ThreadRunner(settings.threads)
-            result, robot, spin_mode = computed_map(
+            result, robot, spin_mode, _ = computed_map(
                 request, settings, png=False, progress=lambda _: None, runner=runner
             )
             map_json(result, robot, spin_mode=spin_mode)

@@ -139,8 +139,10 @@ def _map(args: argparse.Namespace) -> int:
         body["spin_mode"] = args.spin_mode
     request = _validated(MapRequest, body)
     with ProgressBar(enabled=args.progress) as bar:
-        result, robot, spin_mode = computed_map(request, get_settings(), png=True, progress=bar)
-    answer = convert.map_response(result, robot, spin_mode=spin_mode)
+        result, robot, spin_mode, path_read = computed_map(
+            request, get_settings(), png=True, progress=bar
+        )
+    answer = convert.map_response(result, robot, spin_mode=spin_mode, path_read=path_read)
     Path(args.png).write_bytes(map_png(result, robot))
     _print(answer, args, lambda: map_text(answer, args.png))
     return OK if answer.feasible_cells else INFEASIBLE

@@ -6,7 +6,13 @@ import sys
 import time
 from types import TracebackType
 
-from service.schemas import EvaluateResponse, MapResponse, OptimizeResponse, PlacementResult
+from service.schemas import (
+    EvaluateResponse,
+    MapResponse,
+    OptimizeResponse,
+    PathRead,
+    PlacementResult,
+)
 from service.schemas.paths_import import PathImportResponse
 
 _MM_PER_MIN = 60e3
@@ -47,12 +53,37 @@ def import_text(answer: PathImportResponse, name: str) -> str:
     return "\n".join(lines)
 
 
+def read_text(read: PathRead | None) -> list[str]:
+    """How the program was read: its units and how known, passes, what was skipped or dropped.
+
+    No lines for a path of poses or tool axes (``read`` None).
+    """
+    if read is None:
+        return []
+    line = (
+        f"read: {len(read.pass_details)} passes ({read.arcs} arcs interpolated; dropped: "
+        f"{read.repeated_points} repeated point(s), {read.one_point_passes} one-point pass(es))"
+    )
+    if read.skipped_records:
+        line += "; skipped (no geometry, no feed): " + ", ".join(
+            f"{r.word} {r.count} (line {r.first_line}"
+            + (")" if r.recognised else ", not recognised: check it moves nothing)")
+            for r in read.skipped_records
+        )
+    lines = [f"units: {read.units} ({read.units_source}: {read.units_note})", line]
+    return lines
+
+
 def evaluation_text(answer: EvaluateResponse) -> str:
-    """mu_path, the bottleneck and the feed check, or why the path does not run."""
+    """How the program was read; mu_path, the bottleneck and the feed check, or why not."""
+    lines = read_text(answer.path_read)
     if not answer.feasible:
         where = "" if answer.failed_waypoint is None else f" at waypoint {answer.failed_waypoint}"
-        return f"infeasible: {answer.reason}{where}"
-    lines = [f"mu_path: {answer.mu_path:.4f} m/s (spin {answer.spin_mode})"]
+        if answer.failed_pass is not None:
+            named = "" if answer.failed_operation is None else f", {answer.failed_operation}"
+            where += f" (pass {answer.failed_pass}{named})"
+        return "\n".join([*lines, f"infeasible: {answer.reason}{where}"])
+    lines.append(f"mu_path: {answer.mu_path:.4f} m/s (spin {answer.spin_mode})")
     if answer.bottleneck is not None:
         lines.append(
             f"bottleneck: waypoint {answer.bottleneck.waypoint}, joint "
@@ -88,8 +119,9 @@ def _placement(placement: PlacementResult) -> list[str]:
 
 
 def map_text(answer: MapResponse, png: str) -> str:
-    """The map's size, its best placement, the picture's file."""
-    lines = [f"map: {answer.feasible_cells} of {len(answer.cells)} placements feasible; {png}"]
+    """How the program was read; the map's size, its best placement, the picture's file."""
+    lines = read_text(answer.path_read)
+    lines.append(f"map: {answer.feasible_cells} of {len(answer.cells)} placements feasible; {png}")
     if answer.best is not None:
         lines.append(f"best: mu_path {answer.best.mu_path:.4f} m/s")
         lines += _placement(answer.best.placement)
@@ -97,11 +129,13 @@ def map_text(answer: MapResponse, png: str) -> str:
 
 
 def optimum_text(answer: OptimizeResponse) -> str:
-    """The optimum with its controller frames, or that none is feasible."""
+    """How the program was read; the optimum with its controller frames, or that none is."""
+    lines = read_text(answer.path_read)
     if not answer.found or answer.placement is None or answer.mu_path is None:
-        return "no feasible placement inside the bounds"
+        why = "" if answer.failure is None else f": {answer.failure.message}"
+        return "\n".join([*lines, f"no feasible placement inside the bounds{why}"])
     gain = answer.improvement_percent
-    lines = [
+    lines += [
         f"optimum: mu_path {answer.mu_path:.4f} m/s"
         + ("" if gain is None else f" ({gain:+.1f} % over the start)"),
         *_placement(answer.placement),

@@ -28,6 +28,7 @@ from service.convert.dtf import dtf_response
 from service.convert.evaluate import evaluate_response
 from service.convert.maps import MapGrid, check_png_size, map_grid, map_response
 from service.convert.optimize import bounds_of, optimize_response
+from service.convert.path_read import pass_at, path_read_of
 from service.convert.robots import robot_info
 
 __all__ = [
@@ -46,7 +47,9 @@ __all__ = [
     "map_grid",
     "map_response",
     "optimize_response",
+    "pass_at",
     "path_of",
+    "path_read_of",
     "placement_of",
     "problem_of",
     "cell_of",

@@ -118,8 +118,15 @@ def evaluate_response(
     with_waypoints: bool = True,
     feed: FeedCheck | None = None,
     cycle_time: CycleTime | None = None,
+    path_read: schemas.PathRead | None = None,
+    failed_in: tuple[int | None, str | None] = (None, None),
 ) -> schemas.EvaluateResponse:
-    """The response of ``POST /v1/evaluate`` (per-waypoint detail when ``with_waypoints``)."""
+    """The response of ``POST /v1/evaluate`` (per-waypoint detail when ``with_waypoints``).
+
+    ``path_read``: how the CAM program was read, None for poses and tool axes (and in
+    ``/v1/optimize``'s evaluation, whose answer has it); ``failed_in``: the pass and operation
+    of the failed waypoint, of CAM input (:func:`service.convert.path_read.pass_at`).
+    """
     ev = evaluation
     bottleneck = None
     if ev.bottleneck_waypoint is not None and ev.bottleneck_joint is not None:
@@ -134,6 +141,8 @@ def evaluate_response(
         bottleneck=bottleneck,
         reason=None if ev.reason is None else schemas.FailureReason(ev.reason),
         failed_waypoint=ev.failed_waypoint,
+        failed_pass=failed_in[0],
+        failed_operation=failed_in[1],
         branch=branch_to_api(ev.branch),
         ik=schemas.IkInfo.model_validate(
             {
@@ -156,4 +165,5 @@ def evaluate_response(
         feed_check=None
         if feed is None
         else schemas.FeedCheckResult(feed=feed.feed, feasible=feed.feasible, margin=feed.margin),
+        path_read=path_read,
     )

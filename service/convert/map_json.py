@@ -29,8 +29,14 @@ from solver.path.problem import SpinMode, require_family
 _NO_CELLS = b'{"cells":[]'
 
 
-def map_json(cmap: CapabilityMap, robot: Robot, *, spin_mode: SpinMode) -> bytes:
-    """``map_response(cmap, robot, spin_mode=spin_mode).model_dump_json()``, as bytes."""
+def map_json(
+    cmap: CapabilityMap,
+    robot: Robot,
+    *,
+    spin_mode: SpinMode,
+    path_read: schemas.PathRead | None = None,
+) -> bytes:
+    """``map_response(cmap, robot, spin_mode=..., path_read=...).model_dump_json()``, as bytes."""
     family = require_family(robot)
     rest = schemas.MapResponse(
         cells=[],
@@ -39,6 +45,7 @@ def map_json(cmap: CapabilityMap, robot: Robot, *, spin_mode: SpinMode) -> bytes
         feasible_cells=int(np.sum(cmap.reason == FEASIBLE)),
         spin_mode=spin_mode,
         recognised=family.recognised,
+        path_read=path_read,
     ).model_dump_json()
     branches = [to_json(_dumped(branch_to_api(b))).decode() for b in family.branches]
     reasons = [to_json(r).decode() for r in REASONS]

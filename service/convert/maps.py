@@ -127,8 +127,16 @@ def acceleration_columns(cmap: CapabilityMap) -> tuple[list[Any], list[Any]]:
     return cmap.mu_acc.ravel().tolist(), bound
 
 
-def map_response(cmap: CapabilityMap, robot: Robot, *, spin_mode: SpinMode) -> schemas.MapResponse:
+def map_response(
+    cmap: CapabilityMap,
+    robot: Robot,
+    *,
+    spin_mode: SpinMode,
+    path_read: schemas.PathRead | None = None,
+) -> schemas.MapResponse:
     """The JSON answer of ``POST /v1/map``: cells yaw-major, then y, then x.
+
+    ``path_read``: how the CAM program was read, None for poses and tool axes.
 
     The columns are read as Python lists once (indexing numpy arrays cell by cell took longer
     than validating the cells; ``model_construct``, unvalidated, was slower still).
@@ -166,4 +174,5 @@ def map_response(cmap: CapabilityMap, robot: Robot, *, spin_mode: SpinMode) -> s
         feasible_cells=int(np.sum(cmap.reason == FEASIBLE)),
         spin_mode=spin_mode,
         recognised=require_family(robot).recognised,
+        path_read=path_read,
     )

@@ -5,7 +5,10 @@ from __future__ import annotations
 from service import schemas
 from service.convert.common import api_placement
 from service.convert.evaluate import evaluate_response
+from service.convert.path_read import pass_at, path_read_of
+from service.schemas.path_input import PathInput
 from solver.core.robots import Robot
+from solver.optimise.failures import SearchFailure
 from solver.optimise.optimize import PlacementOptimum
 from solver.optimise.search_space import PlacementBounds
 
@@ -21,11 +24,44 @@ def bounds_of(bounds: schemas.Bounds, *, z: float | None) -> PlacementBounds:
     )
 
 
+def failure_to_api(
+    failure: SearchFailure | None, path: PathInput | None
+) -> schemas.SearchFailure | None:
+    """The answer's ``failure``: the most common failure, its pass and operation, a sentence."""
+    if failure is None:
+        return None
+    k, operation = (None, None) if path is None else pass_at(path, failure.failed_waypoint)
+    where = ""
+    if failure.failed_waypoint is not None:
+        where = f", most often first at waypoint {failure.failed_waypoint}"
+        if k is not None:
+            where += f" (pass {k}" + ("" if operation is None else f", {operation}") + ")"
+    return schemas.SearchFailure(
+        reason=schemas.FailureReason(failure.reason),
+        failed_waypoint=failure.failed_waypoint,
+        failed_pass=k,
+        failed_operation=operation,
+        count=failure.count,
+        judged=failure.judged,
+        message=f"none of the {failure.judged} placement(s) judged on the whole path (the start "
+        f"included) runs it; {failure.count} of them {failure.reason}{where}",
+    )
+
+
 def optimize_response(
-    optimum: PlacementOptimum, robot: Robot, *, axis_correction: float = 0.0
+    optimum: PlacementOptimum,
+    robot: Robot,
+    *,
+    axis_correction: float = 0.0,
+    path: PathInput | None = None,
 ) -> schemas.OptimizeResponse:
-    """The answer of ``POST /v1/optimize`` (``found: false`` when nothing was feasible)."""
+    """The answer of ``POST /v1/optimize`` (``found: false`` when nothing was feasible).
+
+    ``path``: the request's path, for how a CAM program was read (``path_read``) and the pass
+    and operation of a failure; its ``axis_correction`` is the answer's.
+    """
     report = optimum.solver
+    start = optimum.start_evaluation
     return schemas.OptimizeResponse(
         found=optimum.found,
         placement=None if optimum.placement is None else api_placement(optimum.placement),
@@ -33,11 +69,19 @@ def optimize_response(
         mu_acc=optimum.mu_acc,
         evaluation=None
         if optimum.evaluation is None
-        else evaluate_response(optimum.evaluation, robot, axis_correction=axis_correction),
+        else evaluate_response(
+            optimum.evaluation,
+            robot,
+            axis_correction=axis_correction if path is None else path.axis_correction,
+        ),
         start=schemas.StartInfo(
             placement=api_placement(optimum.start),
             mu_path=optimum.start_mu_path,
             mu_acc=optimum.start_mu_acc,
+            reason=None
+            if start is None or start.reason is None
+            else schemas.FailureReason(start.reason),
+            failed_waypoint=None if start is None else start.failed_waypoint,
         ),
         improvement_percent=optimum.improvement_percent,
         spins=None if optimum.spins is None else optimum.spins.tolist(),
@@ -48,4 +92,6 @@ def optimize_response(
             iterations=report.iterations,
             seconds=report.seconds,
         ),
+        path_read=None if path is None else path_read_of(path),
+        failure=failure_to_api(optimum.failure, path),
     )

@@ -62,7 +62,7 @@ def _problem(
 
 
 def _check_map(body: MapRequest, settings: Settings) -> None:
-    robot, _, _ = checked_grid(body, settings)
+    robot = checked_grid(body, settings).robot
     _problem(robot, body, settings)
 
 

@@ -112,4 +112,6 @@ def evaluation_of(
         with_waypoints=detail == "waypoints",
         feed=None if feed is None else check_feed(evaluation, feed, robot.qdot_max),
         cycle_time=cycle_time(problem, evaluation),
+        path_read=convert.path_read_of(path),
+        failed_in=convert.pass_at(path, evaluation.failed_waypoint),
     )

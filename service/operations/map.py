@@ -2,10 +2,12 @@
 
 from __future__ import annotations
 
+from typing import NamedTuple
+
 from service import convert
 from service.config import Settings
 from service.render import render_png
-from service.schemas import MapRequest, MapResponse
+from service.schemas import MapRequest, MapResponse, PathRead
 from solver.core.parallel import TaskRunner, ThreadRunner
 from solver.core.progress import Progress
 from solver.core.robots import Robot
@@ -13,9 +15,32 @@ from solver.path.capability_map import CapabilityMap, capability_map, map_cost
 from solver.path.problem import PathProblem, SpinMode
 
 
-def checked_grid(
-    body: MapRequest, settings: Settings
-) -> tuple[Robot, convert.MapGrid, PathProblem]:
+class ComputedMap(NamedTuple):
+    """A map computed, with what its answer says besides the cells.
+
+    Attributes:
+        result: the map.
+        robot: the robot it is of.
+        spin_mode: the spin mode it was computed in.
+        path_read: how the CAM program was read (None for poses and tool axes).
+    """
+
+    result: CapabilityMap
+    robot: Robot
+    spin_mode: SpinMode
+    path_read: PathRead | None
+
+
+class CheckedGrid(NamedTuple):
+    """A map request checked: the robot, the grid, the problem, how the path was read."""
+
+    robot: Robot
+    grid: convert.MapGrid
+    problem: PathProblem
+    path_read: PathRead | None
+
+
+def checked_grid(body: MapRequest, settings: Settings) -> CheckedGrid:
     """The robot, the grid and the problem of a map request, its size checked against ``settings``.
 
     The grid's work is the problem's (:func:`solver.path.capability_map.map_cost`: the family's
@@ -42,7 +67,7 @@ def checked_grid(
         cost=map_cost(problem),
         with_cell=body.cell is not None,
     )
-    return robot, grid, problem
+    return CheckedGrid(robot, grid, problem, convert.path_read_of(path))
 
 
 def computed_map(
@@ -52,12 +77,12 @@ def computed_map(
     png: bool,
     progress: Progress,
     runner: TaskRunner | None = None,
-) -> tuple[CapabilityMap, Robot, SpinMode]:
-    """The map a request asks for, its size checked first; the robot; the spin mode.
+) -> ComputedMap:
+    """The map a request asks for, its size checked first; the robot; the spin mode; the reading.
 
     The placements run on ``runner``, by default on DTF_THREADS threads.
     """
-    robot, grid, problem = checked_grid(body, settings)
+    robot, grid, problem, path_read = checked_grid(body, settings)
     if png:
         convert.check_png_size(grid, settings=settings)
     result = capability_map(
@@ -70,17 +95,17 @@ def computed_map(
         progress=progress,
         runner=ThreadRunner(settings.threads) if runner is None else runner,
     )
-    return result, robot, problem.options.spin_mode
+    return ComputedMap(result, robot, problem.options.spin_mode, path_read)
 
 
 def map_of(
     body: MapRequest, settings: Settings, progress: Progress, runner: TaskRunner | None = None
 ) -> MapResponse:
     """The JSON answer of ``POST /v1/map`` (a map job's result too, its tasks on ``runner``)."""
-    result, robot, spin_mode = computed_map(
+    result, robot, spin_mode, path_read = computed_map(
         body, settings, png=False, progress=progress, runner=runner
     )
-    return convert.map_response(result, robot, spin_mode=spin_mode)
+    return convert.map_response(result, robot, spin_mode=spin_mode, path_read=path_read)
 
 
 def map_png(result: CapabilityMap, robot: Robot) -> bytes:

@@ -47,7 +47,11 @@ def optimum_of(
         progress=progress,
         runner=ThreadRunner(settings.threads) if runner is None else runner,
     )
-    return convert.optimize_response(optimum, robot, axis_correction=path.axis_correction)
+    return convert.optimize_response(
+        optimum,
+        robot,
+        path=path,
+    )
 
 
 def check_work(

@@ -48,6 +48,7 @@ from service.schemas.optimize import (
     Bounds,
     OptimizeRequest,
     OptimizeResponse,
+    SearchFailure,
     SolverInfo,
     SpinPath,
     StartInfo,
@@ -56,12 +57,11 @@ from service.schemas.opw_robot import OpwGeometry, OpwRobot
 from service.schemas.path import Path, PosePath, ToolAxisPath
 from service.schemas.path_cam import ClDataPath, CsvPath, ProgramUnits
 from service.schemas.path_input import PathInput
+from service.schemas.path_read import PassOut, PathRead, SkippedRecordOut
 from service.schemas.paths_import import (
     ImportedPose,
-    PassOut,
     PathImportRequest,
     PathImportResponse,
-    SkippedRecordOut,
 )
 from service.schemas.placement import ControllerFrames, Placement, PlacementResult
 from service.schemas.robot import CatalogueRobot, Robot, UrdfRobot
@@ -115,6 +115,7 @@ __all__ = [
     "IkInfo",
     "ImportedPose",
     "PassOut",
+    "PathRead",
     "SkippedRecordOut",
     "IkPolicy",
     "MapCell",
@@ -139,6 +140,7 @@ __all__ = [
     "Robot",
     "RobotInfo",
     "RobotsResponse",
+    "SearchFailure",
     "SolverInfo",
     "SpinPath",
     "StartInfo",

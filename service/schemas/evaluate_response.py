@@ -13,6 +13,7 @@ from service.schemas.common import ResponseModel, SpinMode
 from service.schemas.evaluate_request import DetailLevel
 from service.schemas.ik import Branch, NumericBranch
 from service.schemas.motion import AccelerationResult, CycleTimeResult
+from service.schemas.path_read import FAILED_OPERATION, FAILED_PASS, PATH_READ, PathRead
 
 _RESPONSE_EXAMPLE_WAYPOINT: JsonDict = {
     "index": 0,
@@ -207,6 +208,8 @@ class EvaluateResponse(ResponseModel):
     failed_waypoint: int | None = Field(
         description="Index of the first waypoint that fails; null when feasible."
     )
+    failed_pass: int | None = Field(default=None, description=FAILED_PASS)
+    failed_operation: str | None = Field(default=None, description=FAILED_OPERATION)
     branch: Branch | NumericBranch | None = Field(
         description="IK branch used (when infeasible with auto: the one that got furthest): "
         "named for a UR or OPW arm, a solution index for the numeric family; null when no "
@@ -257,6 +260,10 @@ class EvaluateResponse(ResponseModel):
         default=None,
         description="With a feed (the request's, or the CL program's FEDRAT): whether the path "
         "runs at it; null without one.",
+    )
+    path_read: PathRead | None = Field(
+        default=None,
+        description=f"{PATH_READ} In /v1/optimize's evaluation, null: that answer has it.",
     )
     detail: DetailLevel = Field(
         default="waypoints", description="Whether waypoints holds the per-waypoint detail."

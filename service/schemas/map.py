@@ -14,6 +14,7 @@ from service.schemas.evaluate_response import FailureReason
 from service.schemas.ik import Branch, IkPolicy, NumericBranch
 from service.schemas.motion import LimitedBy
 from service.schemas.path import Path
+from service.schemas.path_read import PATH_READ, PathRead
 from service.schemas.placement import PlacementResult, placement_example
 from service.schemas.robot import Robot
 from solver.core.spatial import MAX_COORDINATE
@@ -243,3 +244,4 @@ class MapResponse(ResponseModel):
         description="Set when the robot is a URDF whose chain was recognised as an OPW or UR arm "
         "and solved in closed form (as /v1/evaluate's ik.recognised); null otherwise.",
     )
+    path_read: PathRead | None = Field(default=None, description=PATH_READ)

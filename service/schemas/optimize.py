@@ -12,9 +12,10 @@ from pydantic_core import PydanticCustomError
 from service.schemas.cell import CellSpec
 from service.schemas.common import Angle, Coordinate, RequestModel, ResponseModel, SpinMode
 from service.schemas.evaluate_request import _REQUEST_EXAMPLE
-from service.schemas.evaluate_response import EvaluateResponse
+from service.schemas.evaluate_response import EvaluateResponse, FailureReason
 from service.schemas.ik import AutoIkPolicy
 from service.schemas.path import Path
+from service.schemas.path_read import FAILED_OPERATION, FAILED_PASS, PATH_READ, PathRead
 from service.schemas.placement import Placement, PlacementResult, placement_example
 from service.schemas.robot import Robot
 
@@ -150,11 +151,54 @@ class StartInfo(ResponseModel):
 
     placement: PlacementResult = Field(description="The start (m, rad).")
     mu_path: float | None = Field(description="Its mu_path (m/s); null when infeasible.")
+    reason: FailureReason | None = Field(
+        default=None, description="Why the path does not run there; null when it does."
+    )
+    failed_waypoint: int | None = Field(
+        default=None, description="The first waypoint that fails there; null when it runs."
+    )
     mu_acc: float | None = Field(
         default=None,
         description="With robot.joint_acceleration_limits: its mu_acc (m/s), what "
         "improvement_percent compares with; null without them or when infeasible.",
     )
+
+
+class SearchFailure(ResponseModel):
+    """Why no placement was found: the most common failure of the placements judged."""
+
+    model_config = ConfigDict(
+        json_schema_extra={
+            "examples": [
+                {
+                    "reason": "joint_limits",
+                    "failed_waypoint": 39,
+                    "failed_pass": 1,
+                    "failed_operation": "ROTARY_SPIN",
+                    "count": 1,
+                    "judged": 1,
+                    "message": "none of the 1 placement(s) judged on the whole path (the start "
+                    "included) runs it; 1 of them joint_limits, most often first at waypoint "
+                    "39 (pass 1, ROTARY_SPIN)",
+                }
+            ]
+        }
+    )
+
+    reason: FailureReason = Field(
+        description="The most common reason among the placements judged on the whole path."
+    )
+    failed_waypoint: int | None = Field(
+        description="The most common first failing waypoint of those (the lowest of equals)."
+    )
+    failed_pass: int | None = Field(description=FAILED_PASS)
+    failed_operation: str | None = Field(description=FAILED_OPERATION)
+    count: int = Field(description="How many of the placements judged failed for reason.")
+    judged: int = Field(
+        description="How many placements the search judged on the whole path (its candidates "
+        "and the start), none feasible."
+    )
+    message: str = Field(description="The same in a sentence.")
 
 
 class SolverInfo(ResponseModel):
@@ -234,4 +278,11 @@ class OptimizeResponse(ResponseModel):
         "waypoint (N rows of n values, rad) that mu_path is at; the casadi method chooses the "
         "redundancy too, so it may differ from the tracked IK branch. /v1/evaluate with this "
         "joint_path gives this mu_path. null for six joints.",
+    )
+    path_read: PathRead | None = Field(default=None, description=PATH_READ)
+    failure: SearchFailure | None = Field(
+        default=None,
+        description="When found is false: why, the most common failure of the placements the "
+        "search judged on the whole path (the start included), with its waypoint and, for CL "
+        "or CSV input, its pass and operation; null when found.",
     )

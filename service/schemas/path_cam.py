@@ -109,7 +109,7 @@ class ClDataPath(RequestModel):
         Raises:
             InvalidLineError: a record that cannot be read, naming its line.
         """
-        return PathInput.from_cam(self.cam_path(), field="path.cl_data", units_note="")
+        return PathInput.from_cam(self.cam_path(), form="cl_data", units_note="")
 
 
 class CsvPath(RequestModel):
@@ -143,6 +143,4 @@ class CsvPath(RequestModel):
             InvalidLineError: a line that cannot be read, naming it.
         """
         cam = read_csv_path(self.csv, units=self.units, field="path.csv")
-        return PathInput.from_cam(
-            cam, field="path.csv", units_note=f"the request's units ({self.units})"
-        )
+        return PathInput.from_cam(cam, form="csv", units_note=f"the request's units ({self.units})")

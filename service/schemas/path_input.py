@@ -7,6 +7,7 @@ converts itself to one :class:`PathInput`.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Literal
 
 import numpy as np
 
@@ -37,6 +38,8 @@ class PathInput:
         pass_feeds: each pass's highest feed (m/s) or ``None``; empty for poses and axes.
         one_point_passes: passes of one point dropped (CL data).
         report: what the CL reader skipped, dropped and inferred; ``None`` for other forms.
+        cam_form: the CAM form the path came in (``cl_data``, ``csv``); ``None`` for poses
+            and tool axes.
     """
 
     poses: np.ndarray
@@ -51,10 +54,20 @@ class PathInput:
     pass_feeds: tuple[float | None, ...] = ()
     one_point_passes: int = 0
     report: ReadReport | None = None
+    cam_form: Literal["cl_data", "csv"] | None = None
 
     @classmethod
-    def from_cam(cls, cam: CamPath, *, field: str, units_note: str) -> PathInput:
-        """The solver's path of a CAM program: its poses, passes, feed, units and read report."""
+    def from_cam(
+        cls, cam: CamPath, *, form: Literal["cl_data", "csv"], units_note: str
+    ) -> PathInput:
+        """The solver's path of a CAM program: its poses, passes, feed, units and read report.
+
+        Args:
+            cam: the program as read.
+            form: its form in the request; errors name the field ``path.<form>``.
+            units_note: the evidence for the units where the reader gives none (a CSV).
+        """
+        field = f"path.{form}"
         report = cam.report
         return cls(
             poses=cam.waypoints_in_workpiece(field=field),
@@ -69,4 +82,5 @@ class PathInput:
             pass_feeds=cam.pass_feeds,
             one_point_passes=cam.one_point_passes,
             report=report,
+            cam_form=form,
         )

@@ -8,6 +8,13 @@ from pydantic import ConfigDict, Field
 
 from service.schemas.common import RequestModel, ResponseModel, SpinMode
 from service.schemas.path import Path
+from service.schemas.path_read import (
+    SKIPPED,
+    UNITS_NOTE,
+    UNITS_SOURCE,
+    PassOut,
+    SkippedRecordOut,
+)
 
 
 class PathImportRequest(RequestModel):
@@ -37,41 +44,6 @@ class ImportedPose(ResponseModel):
     orientation: list[float] = Field(
         description="Unit quaternion [qx, qy, qz, qw] (ROS order); tool z = -(tool axis)."
     )
-
-
-class SkippedRecordOut(ResponseModel):
-    """Records of one word skipped: they carry no geometry and no feed (cam.md section 9)."""
-
-    model_config = ConfigDict(
-        json_schema_extra={
-            "examples": [{"word": "PAINT", "count": 31, "first_line": 5, "recognised": True}]
-        }
-    )
-
-    word: str = Field(description="The major word (PAINT, TLDATA; $$ for comments).")
-    count: int = Field(description="How many records of this word the file has.")
-    first_line: int = Field(description="The line of the first one, from 1.")
-    recognised: bool = Field(
-        description="false for a word the reader does not know: check that it moves nothing."
-    )
-
-
-class PassOut(ResponseModel):
-    """One pass: its range of waypoints and the operation it belongs to."""
-
-    model_config = ConfigDict(
-        json_schema_extra={
-            "examples": [{"start": 0, "stop": 108, "operation": "CAVITY_MILL", "feed": 0.004233}]
-        }
-    )
-
-    start: int = Field(description="Its first waypoint's index.")
-    stop: int = Field(description="One past its last waypoint's index.")
-    operation: str | None = Field(
-        description="The operation's name in the file (NX TOOL PATH, PARTNO, PPRINT); null "
-        "where the file names none."
-    )
-    feed: float | None = Field(description="Its highest programmed feed (m/s), or null.")
 
 
 class PathImportResponse(ResponseModel):
@@ -120,19 +92,12 @@ class PathImportResponse(ResponseModel):
         "(normalised within 1e-3); 0 when none was needed."
     )
     spin_mode: SpinMode = Field(description="The default spin_mode of this path form.")
-    units_source: Literal["stated", "inferred", "request"] = Field(
-        description="How the units were known: stated by the file (UNITS, UNIT), inferred "
-        "(no UNITS record, but FEDRAT/IPM: inches), or from the request (its units; metres for "
-        "poses and tool-axis waypoints)."
-    )
-    units_note: str = Field(description="The evidence for the units, e.g. 'UNITS/MM at line 3'.")
+    units_source: Literal["stated", "inferred", "request"] = Field(description=UNITS_SOURCE)
+    units_note: str = Field(description=UNITS_NOTE)
     pass_details: list[PassOut] = Field(
         description="Each pass, in the order of passes, with its operation and feed."
     )
-    skipped_records: list[SkippedRecordOut] = Field(
-        description="CL data: the records skipped (no geometry, no feed), one entry a word, in "
-        "the order first met; empty for other forms."
-    )
+    skipped_records: list[SkippedRecordOut] = Field(description=SKIPPED)
     repeated_points: int = Field(
         description="CL data: GOTOs to where the tool already was, dropped."
     )

@@ -29,6 +29,7 @@ from solver.core.robots import Robot
 from solver.core.spatial import Placement, spun_waypoints
 from solver.optimise.candidate import Candidate, Search
 from solver.optimise.coarse_search import MAX_COARSE_CELLS
+from solver.optimise.failures import SearchFailure, search_failure
 from solver.optimise.methods import Method, method_named
 from solver.optimise.search_space import PlacementBounds, variables_of, vector_of
 from solver.optimise.symmetry import arc_coordinates, arc_point, symmetric_search
@@ -73,6 +74,10 @@ class PlacementOptimum:
         active_waypoints: the waypoints in the final active set of the local solve that gave
             the answer (:mod:`solver.optimise.active_set`); None where the answer came from the
             whole path or from no local solve.
+        start_evaluation: the evaluator's answer at the start (its reason and failed
+            waypoint when it does not run).
+        failure: when nothing was found, the most common failure of the placements judged
+            (:mod:`solver.optimise.failures`); None when found.
     """
 
     found: bool
@@ -89,6 +94,8 @@ class PlacementOptimum:
     mu_acc: float | None = None
     start_mu_acc: float | None = None
     active_waypoints: int | None = None
+    start_evaluation: PathEvaluation | None = None
+    failure: SearchFailure | None = None
 
 
 def _place_on_arc(
@@ -224,7 +231,8 @@ def optimize_placement(
         *candidates,
         Candidate(vector_of(start), "no better placement found than the start"),
     ]
-    best = _best_candidate(problem, bounds, candidates, settings)
+    judged: list[PathEvaluation] = []
+    best = _best_candidate(problem, bounds, candidates, settings, judged)
     report = SolverReport(chosen_method.description, "", iterations, time.perf_counter() - began)
     if best is None:
         return PlacementOptimum(
@@ -237,6 +245,8 @@ def optimize_placement(
             improvement_percent=None,
             solver=dataclasses.replace(report, status="no feasible placement inside the bounds"),
             symmetric=settings.symmetric,
+            start_evaluation=start_evaluation,
+            failure=search_failure(judged),
         )
     index, placement, evaluation, chosen = best
     status = chosen.status
@@ -260,6 +270,7 @@ def optimize_placement(
         if start_evaluation.acceleration is None
         else start_evaluation.acceleration.mu_acc,
         active_waypoints=None if chosen.rows is None else len(chosen.rows),
+        start_evaluation=start_evaluation,
     )
 
 
@@ -281,11 +292,13 @@ def _best_candidate(
     bounds: PlacementBounds,
     candidates: list[Candidate],
     settings: Search,
+    judged_all: list[PathEvaluation],
 ) -> tuple[float, Placement, PathEvaluation, Candidate] | None:
     """The candidate the evaluator finds fastest (the first of equals), or None if none runs.
 
     Each is clamped into the bounds and moved along its arc (:func:`_place_on_arc`); one with
-    its own joint path (a redundant arm's NLP) is judged along that path too.
+    its own joint path (a redundant arm's NLP) is judged along that path too. Every
+    evaluation made is appended to ``judged_all``, in order.
     """
     best: tuple[float, Placement, PathEvaluation, Candidate] | None = None
     for candidate in candidates:
@@ -309,6 +322,7 @@ def _best_candidate(
             except InvalidInputError:  # off its poses, limits or steps: only tracking counts
                 pass
         judged.append(evaluate_path(judged_problem, placement))
+        judged_all.extend(judged)
         for evaluation in judged:
             index = evaluation.feed_index  # mu_acc with acceleration limits, else mu_path
             if index is not None and (best is None or index > best[0]):

@@ -73,7 +73,8 @@ def test_evaluate_json_is_the_api_answer(
 def test_an_unreachable_placement_is_exit_infeasible(capsys: pytest.CaptureFixture[str]) -> None:
     code, out, _ = run(capsys, "evaluate", str(PROGRAM), "--robot", "ur5e", "--at=3,0,0,0")
     assert code == INFEASIBLE
-    assert out.startswith("infeasible: ")
+    assert out.startswith("units: inches (inferred: ")  # how the program was read, first
+    assert out.splitlines()[-1].startswith("infeasible: ")
 
 
 def test_a_feed_the_path_cannot_run_is_exit_infeasible(capsys: pytest.CaptureFixture[str]) -> None:

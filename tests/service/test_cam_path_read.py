@@ -1,0 +1,151 @@
+"""How a CAM program was read, in every answer computed from it (``path_read``, cam.md 9).
+
+An inch NX listing with no UNITS record (examples/cam/nx_slot_plate.cls: the units inferred from
+its FEDRAT/IPM record) through /v1/evaluate, /v1/optimize, /v1/map and their jobs: each answer
+says inches, inferred, and the record's line, found here by reading the file's lines; and each
+gives what /v1/paths/import gives for the program. A path of poses or tool axes has none.
+"""
+
+from __future__ import annotations
+
+import json
+import time
+from collections.abc import Iterator
+from pathlib import Path
+from typing import Any
+
+import pytest
+from fastapi.testclient import TestClient
+
+from service.cli import OK, main
+from service.config import Settings
+from service.deps import _settings
+from service.main import app
+from tests.cases import ROOT
+
+PROGRAM = ROOT / "examples" / "cam" / "nx_slot_plate.cls"
+TEXT = PROGRAM.read_text()
+IPM_LINE = next(n for n, line in enumerate(TEXT.splitlines(), 1) if line.startswith("FEDRAT/IPM"))
+ROBOT = {"model": "ur5e"}
+AT = {"x": 0.0, "y": 0.3, "z": 0.0, "yaw": 0.0}
+AXIS = {"min": -0.1, "max": 0.1, "step": 0.1}
+GRID = {"x": AXIS, "y": {"min": 0.3, "max": 0.3, "step": 0.1}, "z": 0.0, "yaw": 0.0}
+BOUNDS = {"bounds": {"x": [-0.05, 0.05], "y": [0.25, 0.35], "yaw": [-0.2, 0.2]}, "z": 0.0}
+POSES = json.loads((ROOT / "examples" / "evaluate_request.json").read_text())["path"]
+AXES = json.loads((ROOT / "examples" / "cam" / "sweep_tool_axis_waypoints.json").read_text())
+READ_FIELDS = (
+    "units",
+    "units_source",
+    "units_note",
+    "feed",
+    "pass_details",
+    "skipped_records",
+    "repeated_points",
+    "one_point_passes",
+    "arcs",
+)
+
+
+def body_of(route: str, path: dict[str, Any]) -> dict[str, Any]:
+    """A request of ``route`` for ``path`` on the UR5e near (0, 0.3)."""
+    extra = {"evaluate": {"placement": AT}, "map": {"grid": GRID}, "optimize": BOUNDS}[route]
+    return {"robot": ROBOT, "path": path, **extra}
+
+
+def answer_of(client: TestClient, route: str, path: dict[str, Any]) -> dict[str, Any]:
+    answer = client.post(f"/v1/{route}", json=body_of(route, path))
+    assert answer.status_code == 200, answer.text
+    result: dict[str, Any] = answer.json()
+    return result
+
+
+def imported(client: TestClient, path: dict[str, Any]) -> dict[str, Any]:
+    """What /v1/paths/import reports of the path, its waypoints and poses-only fields left out."""
+    answer = client.post("/v1/paths/import", json={"path": path})
+    assert answer.status_code == 200, answer.text
+    return {key: answer.json()[key] for key in READ_FIELDS}
+
+
+@pytest.mark.parametrize("route", ["evaluate", "optimize", "map"])
+def test_an_inch_program_says_inches_inferred_and_the_line(client: TestClient, route: str) -> None:
+    read = answer_of(client, route, {"cl_data": TEXT})["path_read"]
+    assert read["form"] == "cl_data"
+    assert (read["units"], read["units_source"]) == ("inches", "inferred")
+    assert f"FEDRAT/IPM at line {IPM_LINE}" in read["units_note"]
+    assert read["feed"] == pytest.approx(20 * 0.0254 / 60, rel=1e-12)  # FEDRAT/IPM 20
+    assert {key: read[key] for key in READ_FIELDS} == imported(client, {"cl_data": TEXT})
+    words = {record["word"]: record["count"] for record in read["skipped_records"]}
+    assert words["PAINT"] == sum(line.startswith("PAINT/") for line in TEXT.splitlines())
+
+
+def test_optimize_says_it_once(client: TestClient) -> None:
+    answer = answer_of(client, "optimize", {"cl_data": TEXT})
+    assert answer["found"] and answer["evaluation"]["path_read"] is None
+    assert answer["path_read"]["units_source"] == "inferred"
+
+
+def test_a_csv_says_the_request_gave_its_units(client: TestClient) -> None:
+    csv = "x,y,z,i,j,k\n0,0,0,0,0,1\n10,0,0,0,0,1\n20,0,1,0,0,1\n"
+    read = answer_of(client, "evaluate", {"csv": csv, "units": "mm"})["path_read"]
+    assert (read["form"], read["units"], read["units_source"]) == ("csv", "mm", "request")
+    assert read["pass_details"] == [{"start": 0, "stop": 3, "operation": None, "feed": None}]
+
+
+@pytest.mark.parametrize("route", ["evaluate", "optimize", "map"])
+@pytest.mark.parametrize("form", ["waypoints", "tool_axis_waypoints"])
+def test_a_path_of_poses_or_axes_has_no_reading(client: TestClient, route: str, form: str) -> None:
+    path = POSES if form == "waypoints" else {"tool_axis_waypoints": AXES["passes"][0]}
+    answer = answer_of(client, route, path)
+    assert "path_read" in answer and answer["path_read"] is None
+
+
+@pytest.fixture
+def own_store(tmp_path: Path) -> Iterator[Path]:
+    """The app with its jobs in ``tmp_path`` (a queue no other test fills), room for the search."""
+    settings = Settings(data_dir=tmp_path, workers=1, max_job_poses=1_000_000)
+
+    async def own() -> Settings:
+        return settings
+
+    app.dependency_overrides[_settings] = own
+    yield tmp_path
+    app.dependency_overrides.pop(_settings)
+
+
+@pytest.mark.parametrize("kind", ["evaluate", "optimize", "map"])
+def test_a_job_says_it_as_its_route(client: TestClient, own_store: Path, kind: str) -> None:
+    body = body_of(kind, {"cl_data": TEXT})
+    submitted = client.post("/v1/jobs", json={"kind": kind, "request": body})
+    assert submitted.status_code in (200, 201, 202), submitted.text
+    job_id = submitted.json()["id"]
+    deadline = time.monotonic() + 120
+    job: dict[str, Any] = {}
+    while time.monotonic() < deadline:
+        job = client.get(f"/v1/jobs/{job_id}").json()
+        if job["status"] not in ("queued", "running"):
+            break
+        time.sleep(0.05)
+    assert job["status"] == "done", job
+    assert job["result"]["path_read"] == answer_of(client, kind, {"cl_data": TEXT})["path_read"]
+
+
+@pytest.mark.parametrize(
+    "argv",
+    [
+        ["evaluate", "--at=0,0.3,0,0"],
+        ["optimise", "--x=-0.05:0.05", "--y", "0.25:0.35", "--yaw=-0.2:0.2"],
+        ["map", "--x=-0.1:0.1:0.1", "--y", "0.3:0.3:0.1", "--png", "{tmp}/map.png"],
+    ],
+    ids=["evaluate", "optimise", "map"],
+)
+def test_the_cli_text_says_it(
+    argv: list[str], tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    args = [argv[0], str(PROGRAM), "--robot", "ur5e"] + [a.format(tmp=tmp_path) for a in argv[1:]]
+    code = main(args)
+    out = capsys.readouterr().out
+    assert code == OK
+    lines = out.splitlines()
+    assert lines[0].startswith("units: inches (inferred: no UNITS record")
+    assert lines[0].endswith(f"FEDRAT/IPM at line {IPM_LINE})")
+    assert "PAINT 11 (line 11)" in out
