@@ -24,7 +24,7 @@ from solver.core.codes import OK_MIRRORED, SINGULAR, UNREACHABLE
 from solver.families.numeric import ik_kernel, scout_kernel
 from solver.families.numeric.chain_kernel import drop_stale_cache, frames, workspace
 from solver.families.numeric.ik_kernel import _levenberg_marquardt, regular_status
-from solver.families.numeric.scout_kernel import hopeless, scouted, v_max
+from solver.families.numeric.scout_kernel import hopeless, scouted, v_max, within_limits
 
 _TWO_PI = 2.0 * math.pi
 
@@ -98,10 +98,7 @@ def _exact(chain, slot, path, limits, settings, constants, rules, work, spare, o
             least, slowest = speed, w
         if hopeless(b, least, candidate, best, tie, margin):
             return least, slowest, failed, True
-    for j in range(len(slot)):  # tracking's copies 2 pi k within the limits, with a margin
-        k_low = math.ceil((lower[j] - low[j]) / _TWO_PI + 1e-9)
-        k_high = math.floor((upper[j] - high[j]) / _TWO_PI - 1e-9)
-        failed = failed or k_low > k_high
+    failed = failed or not within_limits(lower, upper, low, high)
     return least, slowest, failed, False
 
 

@@ -32,14 +32,20 @@ import numpy as np
 from numba import njit
 
 from solver.core.codes import OK, SINGULAR, UNREACHABLE
-from solver.families.numeric import ik_kernel, redundant_kernel
+from solver.families.numeric import ik_kernel, redundant_kernel, scout_kernel
 from solver.families.numeric.chain_kernel import drop_stale_cache, frames, jacobian_at, workspace
 from solver.families.numeric.ik_kernel import _levenberg_marquardt, _singular
 from solver.families.numeric.redundant_kernel import _null_and_pseudo_inverse
+from solver.families.numeric.scout_kernel import hopeless, within_limits
 
 _TWO_PI = 2.0 * math.pi
 
-drop_stale_cache(Path(__file__), Path(ik_kernel.__file__), Path(redundant_kernel.__file__))
+drop_stale_cache(
+    Path(__file__),
+    Path(ik_kernel.__file__),
+    Path(redundant_kernel.__file__),
+    Path(scout_kernel.__file__),
+)
 
 
 @njit(cache=True, nogil=True, error_model="numpy", inline="always")
@@ -82,25 +88,6 @@ def redundant_v_max(chain, twist, tool, qdot_max, work, spare):  # type: ignore[
             return math.inf
         ratio = max(ratio, share)
     return 1.0 / ratio if ratio > 0.0 else math.inf
-
-
-@njit(cache=True, nogil=True, error_model="numpy", inline="always")
-def hopeless(slot, bound, candidate, best, tie, margin):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
-    """Whether a slot whose mu_path is at most ``bound`` cannot be picked over the candidate.
-
-    ``best``: the candidate's mu_path as followed here. A slot after the candidate in order
-    cannot take its place once bound (1 + margin) (1 - tie) <= best (1 - margin) (it could
-    at most tie, and the first of a tie is taken); one before it once
-    bound (1 + margin) < best (1 - margin) (1 - tie) (it cannot tie). ``margin`` covers the
-    rounding between these V_max and the pipeline's.
-    """
-    if candidate < 0 or not best > 0.0 or math.isinf(best):
-        return False
-    high = bound * (1.0 + margin)
-    low = best * (1.0 - margin)
-    if slot > candidate:
-        return high * (1.0 - tie) <= low
-    return high < low * (1.0 - tie)
 
 
 @njit(cache=True, nogil=True, error_model="numpy", inline="always")
@@ -171,17 +158,6 @@ def _one_waypoint(chain, b, w, cached, path, limits, settings, constants, slots,
     if pure_rotation[w]:
         return 0.0
     return redundant_v_max(chain, twists[w], tools[w], qdot_max, work, spare)
-
-
-@njit(cache=True, nogil=True, error_model="numpy", inline="always")
-def _within_limits(lower, upper, low, high):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
-    """Whether each joint's range [low, high] (n,) has a 2 pi copy within the limits (margin)."""
-    for j in range(len(low)):
-        k_low = math.ceil((lower[j] - low[j]) / _TWO_PI + 1e-9)
-        k_high = math.floor((upper[j] - high[j]) / _TWO_PI - 1e-9)
-        if k_low > k_high:
-            return False
-    return True
 
 
 @njit(cache=True, nogil=True, error_model="numpy")
@@ -266,7 +242,7 @@ def follow_bounded(  # type: ignore[no-untyped-def]  # pragma: no cover - compil
             if w + 1 < n_waypoints:
                 continue
             done[b] = True
-            failed[b] = failed[b] or not _within_limits(limits[2], limits[3], low[b], high[b])
+            failed[b] = failed[b] or not within_limits(limits[2], limits[3], low[b], high[b])
             if failed[b]:
                 continue
             clean[b] = least[b]

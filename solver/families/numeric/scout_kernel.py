@@ -24,6 +24,8 @@ from solver.families.numeric.ik_kernel import _levenberg_marquardt, _pose_error
 
 drop_stale_cache(Path(__file__), Path(ik_kernel.__file__))
 
+_TWO_PI = 2.0 * math.pi
+
 
 @njit(cache=True, nogil=True, error_model="numpy", inline="always")
 def v_max(chain, twist, tool, qdot_max, work, jac, rhs):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
@@ -60,6 +62,20 @@ def hopeless(slot, bound, candidate, best, tie, margin):  # type: ignore[no-unty
     if slot > candidate:
         return high * (1.0 - tie) <= low
     return high < low * (1.0 - tie)
+
+
+@njit(cache=True, nogil=True, error_model="numpy", inline="always")
+def within_limits(lower, upper, low, high):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
+    """Whether each joint's range [low, high] (n,) has a 2 pi copy within the limits (margin).
+
+    Tracking's 2 pi k copy test (:func:`solver.path.tracking.track`) on a followed slot's range.
+    """
+    for j in range(len(low)):
+        k_low = math.ceil((lower[j] - low[j]) / _TWO_PI + 1e-9)
+        k_high = math.floor((upper[j] - high[j]) / _TWO_PI - 1e-9)
+        if k_low > k_high:
+            return False
+    return True
 
 
 @njit(cache=True, nogil=True, error_model="numpy", inline="always")
