@@ -16,6 +16,7 @@ import numpy as np
 from solver.core.codes import FEASIBLE
 from solver.core.malloc import raise_malloc_thresholds
 from solver.core.parallel import SERIAL, TaskRunner
+from solver.path.bounded import one_pass_chunk
 from solver.path.kernel_cells import (
     KernelInputs,
     kernel_inputs,
@@ -220,6 +221,7 @@ def evaluate_placements(
     _ = problem.path_checks  # and the cell
     cells = check_placements(placements)
     raise_malloc_thresholds()
+    chunk = one_pass_chunk(problem, chunk) if prune else chunk
     tasks = _pieces(cells, runner.task_size(len(cells), chunk))
     completed = [0]
 

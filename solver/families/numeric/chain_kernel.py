@@ -53,6 +53,16 @@ def drop_stale_cache(module_file: Path, *also: Path) -> None:
         return
 
 
+def kernel_array(a: np.ndarray, dtype: type = float) -> np.ndarray:
+    """``a`` as the kernels take it: C-contiguous, writable, of ``dtype`` (a copy where not).
+
+    numba compiles a function once per argument type, and a read-only array (a broadcast or a
+    view of one) is another type than a writable one: arrays handed to the kernels are made
+    alike, so each kernel is compiled for one signature.
+    """
+    return np.require(a, dtype=dtype, requirements=("C", "W"))
+
+
 @njit(cache=True, nogil=True, error_model="numpy", inline="always")
 def frames(chain, q, work):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
     """Joint axes and origins, the flange's rotation and position, all in {B}, into ``work``.
@@ -177,6 +187,42 @@ def lu_solve(a, b):  # type: ignore[no-untyped-def]  # pragma: no cover - compil
             total -= a[row, k] * b[k]
         b[row] = total / a[row, row]
     return True
+
+
+@njit(cache=True, nogil=True, error_model="numpy", inline="always")
+def lu_solve_signed(a, b):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
+    """:func:`lu_solve` (the same operations, the same x), and whether det a < 0.
+
+    The sign of det a from the factors: a row swap and a negative pivot each flip it, as in
+    :func:`det_negative`. Returns (solved, negative); ``negative`` is meaningless unless solved.
+    """
+    size = len(b)
+    negative = False
+    for col in range(size):
+        pivot = col
+        for row in range(col + 1, size):
+            if abs(a[row, col]) > abs(a[pivot, col]):
+                pivot = row
+        if a[pivot, col] == 0.0:
+            return False, negative
+        if pivot != col:
+            negative = not negative
+            for k in range(size):
+                a[col, k], a[pivot, k] = a[pivot, k], a[col, k]
+            b[col], b[pivot] = b[pivot], b[col]
+        if a[col, col] < 0.0:
+            negative = not negative
+        for row in range(col + 1, size):
+            f = a[row, col] / a[col, col]
+            for k in range(col + 1, size):
+                a[row, k] -= f * a[col, k]
+            b[row] -= f * b[col]
+    for row in range(size - 1, -1, -1):
+        total = b[row]
+        for k in range(row + 1, size):
+            total -= a[row, k] * b[k]
+        b[row] = total / a[row, row]
+    return True, negative
 
 
 @njit(cache=True, nogil=True, error_model="numpy", inline="always")

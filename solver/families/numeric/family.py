@@ -34,6 +34,7 @@ from solver.families.numeric import (
     velocity,
 )
 from solver.families.numeric.chain import SerialChain
+from solver.families.numeric.chain_kernel import kernel_array
 
 FOLLOW_WAYPOINTS = 256
 """Waypoints of each path followed by the compiled chain between two progress reports (a
@@ -161,8 +162,8 @@ class NumericFamily(KinematicsFamily, FollowsInSteps):
             self._packed,
             self.seeds,
             (self.lower, self.upper),
-            np.ascontiguousarray(rotations, dtype=float),
-            np.ascontiguousarray(positions, dtype=float),
+            kernel_array(rotations),
+            kernel_array(positions),
             settings,
             constants,
         )
@@ -180,8 +181,8 @@ class NumericFamily(KinematicsFamily, FollowsInSteps):
         q, status = ik_kernel.follow_paths(
             self._packed,
             current,
-            np.ascontiguousarray(rotations, dtype=float),
-            np.ascontiguousarray(positions, dtype=float),
+            kernel_array(rotations),
+            kernel_array(positions),
             solve_first,
             settings,
             constants,
@@ -217,8 +218,8 @@ class NumericFamily(KinematicsFamily, FollowsInSteps):
         result: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray] = kernel.follow_bounded(
             self._packed,
             current,
-            *(np.ascontiguousarray(a, dtype=float) for a in (*poses, *speeds[:3])),
-            np.asarray(speeds[3], dtype=np.bool_),
+            *(kernel_array(a) for a in (*poses, *speeds[:3])),
+            kernel_array(speeds[3], np.bool_),
             (self.lower, self.upper, np.array([speeds[4]], dtype=float)),
             settings,
             constants,
@@ -240,10 +241,10 @@ class NumericFamily(KinematicsFamily, FollowsInSteps):
         ik_kernel.follow_ranges(
             self._packed,
             current,
-            rotations,
-            positions,
-            np.ascontiguousarray(start, dtype=np.int64),
-            np.ascontiguousarray(stop, dtype=np.int64),
+            kernel_array(rotations),
+            kernel_array(positions),
+            kernel_array(start, np.int64),
+            kernel_array(stop, np.int64),
             out,
             settings,
             constants,

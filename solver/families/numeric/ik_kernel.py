@@ -256,6 +256,14 @@ def seed_paths(chain, seeds, box, rotations, positions, settings, constants):  #
     n_paths = positions.shape[0]
     found = np.full((n_paths, n_seeds, n), np.nan)
     count = np.zeros(n_paths, dtype=np.int64)
+    first = (
+        np.empty((n_seeds, n, 3)),
+        np.empty((n_seeds, n, 3)),
+        np.empty((n_seeds, 3, 3)),
+        np.empty((n_seeds, 3)),
+        np.empty((n_seeds, 6, n)),
+        np.empty((n_seeds, 6, 6)),
+    )
     _seed_all(
         chain,
         seeds,
@@ -263,32 +271,43 @@ def seed_paths(chain, seeds, box, rotations, positions, settings, constants):  #
         (rotations, positions),
         settings,
         constants,
-        workspace(n),
-        np.empty(n),
+        (workspace(n), np.empty(n), first),
         (found, count),
     )
     return found, count
 
 
 @njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
-def _seed_all(chain, seeds, box, poses, settings, constants, work, current, out):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
+def _seed_all(chain, seeds, box, poses, settings, constants, buffers, out):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
     """:func:`seed_paths`' loop into its preallocated ``out`` (found, count).
 
     Compiled without numba's reference counting (``_nrt=False``: it allocates nothing), which
     the inlined helpers' tuples of arrays otherwise cost at every step (atomic increments and
-    decrements); the same arithmetic, the same bits. ``poses``: rotations and positions.
+    decrements); the same arithmetic, the same bits. ``poses``: rotations and positions;
+    ``buffers``: the chain's workspace, the iterate (n,), and ``first``: each seed's frames (axes
+    (K, n, 3), origins (K, n, 3), rotation (K, 3, 3), position (K, 3)), its Jacobian at the
+    flange (K, 6, n) and J J^T (K, 6, 6). A seed's frames do not depend on the pose sought, so
+    they are computed once for all the paths and copied into the workspace before each
+    solve's first step (``cached``): the numbers the step would compute, not computed again.
     """
     rotations, positions = poses
     found, count = out
+    work, current, first = buffers
     n_seeds, n = seeds.shape
     seed_iterations, apart = int(settings[0]), settings[2]
     stall = (int(settings[4]), settings[5])
     revolute = chain[3]
+    for k in range(n_seeds):
+        frames(chain, seeds[k], work)
+        jacobian_at(revolute, work[0], work[1], work[3], work[6])
+        _normal(work[6], work[7])
+        _copy_frames(work, first, k, True)
     for p in range(positions.shape[0]):
         kept = 0
         for k in range(n_seeds):
             for j in range(n):
                 current[j] = seeds[k, j]
+            _copy_frames(work, first, k, False)
             if not _levenberg_marquardt(
                 chain,
                 current,
@@ -298,7 +317,7 @@ def _seed_all(chain, seeds, box, poses, settings, constants, work, current, out)
                 box,
                 constants,
                 work,
-                False,
+                True,  # the seed's frames, J and J J^T, copied in
                 stall,
             ):
                 continue
@@ -312,6 +331,42 @@ def _seed_all(chain, seeds, box, poses, settings, constants, work, current, out)
                     found[p, kept, j] = current[j]
                 kept += 1
         count[p] = kept
+
+
+@njit(cache=True, nogil=True, error_model="numpy", inline="always")
+def _copy_frames(work, first, k, into_first):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
+    """Seed k's frames, J and J J^T between the workspace and ``first`` (:func:`_seed_all`).
+
+    ``into_first``: from the workspace into row k of ``first``; else from there into it.
+    """
+    axes, origins, rot, pos, jac, normal = first
+    for j in range(axes.shape[1]):
+        for i in range(3):
+            if into_first:
+                axes[k, j, i], origins[k, j, i] = work[0][j, i], work[1][j, i]
+            else:
+                work[0][j, i], work[1][j, i] = axes[k, j, i], origins[k, j, i]
+    for i in range(3):
+        if into_first:
+            pos[k, i] = work[3][i]
+        else:
+            work[3][i] = pos[k, i]
+        for c in range(3):
+            if into_first:
+                rot[k, i, c] = work[2][i, c]
+            else:
+                work[2][i, c] = rot[k, i, c]
+    for i in range(6):
+        for c in range(jac.shape[2]):
+            if into_first:
+                jac[k, i, c] = work[6][i, c]
+            else:
+                work[6][i, c] = jac[k, i, c]
+        for c in range(6):
+            if into_first:
+                normal[k, i, c] = work[7][i, c]
+            else:
+                work[7][i, c] = normal[k, i, c]
 
 
 @njit(cache=True, nogil=True, error_model="numpy")
@@ -410,7 +465,7 @@ def follow_paths(chain, current, rotations, positions, solve_first, settings, co
                 slot,
                 rotations[p],
                 positions[p],
-                0,
+                np.int64(0),  # not a literal 0: follow_ranges' signature, compiled once
                 n_waypoints,
                 not solve_first,
                 track_iterations,

@@ -16,6 +16,7 @@ from solver.core.dtf_redundant import redundant_speed
 from solver.core.progress import Progress
 from solver.families.numeric import chain_kernel, redundant_kernel
 from solver.families.numeric.chain import SerialChain
+from solver.families.numeric.chain_kernel import kernel_array
 
 CHUNK_ROWS = 2048
 """Configurations checked (singularity, joint speeds) between two progress reports: about
@@ -74,31 +75,31 @@ def _speeds(
     qdot_max: np.ndarray | None,
 ) -> np.ndarray:
     """Joint speeds per unit twist at M configurations: (M, n), (M, 6), (M, 3) -> (M, n)."""
-    speeds = np.full(q_flat.shape, np.nan)
-    rows = np.flatnonzero(np.isfinite(q_flat).all(axis=-1))
     if arm.compiled and arm.dof == 6:
         six: np.ndarray = chain_kernel.speeds_per_twist(
-            arm.packed, *(np.ascontiguousarray(a) for a in (q_flat, twist_flat, point_flat))
+            arm.packed, *(kernel_array(a) for a in (q_flat, twist_flat, point_flat))
         )
         return six
+    speeds = np.full(q_flat.shape, np.nan)
+    rows = np.flatnonzero(np.isfinite(q_flat).all(axis=-1))
     if arm.compiled and arm.dof == 7 and qdot_max is not None:
         speeds, irregular = redundant_kernel.redundant_speeds(
             arm.packed,
-            *(np.ascontiguousarray(a) for a in (q_flat, twist_flat, point_flat)),
-            np.asarray(qdot_max, dtype=float),
+            *(kernel_array(a) for a in (q_flat, twist_flat, point_flat)),
+            kernel_array(qdot_max),
         )
         rows = np.flatnonzero(irregular)  # J near rank loss: numpy's SVD or the LP decides
     elif arm.compiled and arm.dof == 7:  # the free spin's least-norm direction
         speeds, _, irregular = redundant_kernel.least_norm_and_null(
             arm.packed,
-            *(np.ascontiguousarray(a) for a in (q_flat, twist_flat, point_flat)),
+            *(kernel_array(a) for a in (q_flat, twist_flat, point_flat)),
         )
         rows = np.flatnonzero(irregular)
     if arm.compiled:
         jacobian = chain_kernel.jacobians(
             arm.packed,
-            np.ascontiguousarray(q_flat[rows]),
-            np.ascontiguousarray(point_flat[rows]),
+            kernel_array(q_flat[rows]),
+            kernel_array(point_flat[rows]),
         )
     else:
         jacobian, _, _ = arm.chain.jacobian(q_flat[rows], point_flat[rows])
@@ -130,9 +131,9 @@ def null_space(
         if arm.compiled and arm.dof == 7:
             _, null[rows], irregular = redundant_kernel.least_norm_and_null(
                 arm.packed,
-                np.ascontiguousarray(q_flat[rows]),
+                kernel_array(q_flat[rows]),
                 np.zeros((len(rows), 6)),
-                np.ascontiguousarray(point_flat[rows]),
+                kernel_array(point_flat[rows]),
             )
             rows = rows[irregular]
         jacobian, _, _ = arm.chain.jacobian(q_flat[rows], point_flat[rows])
