@@ -7,7 +7,7 @@ waypoint (J at the tool point), and its least value so far bounds the branch's m
 is dropped (its following stopped) once that bound shows it can neither tie with the
 candidate nor beat it (the rules of :func:`solver.families.numeric.scout_kernel.hopeless`,
 where the V_max and the scouting live too). A slot's solutions, status and loss are those of
-:func:`solver.families.numeric.ik_kernel.follow_paths`, bit for bit: the same steps from the
+:func:`solver.families.numeric.follow_kernel.follow_paths`, bit for bit: the same steps from the
 same starts. Whether a drop was right is decided by the caller, from the pipeline's own
 mu_path of the slots followed to the end. Every function releases the GIL.
 """
@@ -182,7 +182,7 @@ def follow_bounded(  # type: ignore[no-untyped-def]  # pragma: no cover - compil
     Args:
         chain: :meth:`SerialChain.packed`, six joints.
         current: shape (P, K, 6), the slots' solutions at each path's first waypoint
-            (:func:`~solver.families.numeric.ik_kernel.seed_paths`), NaN without one; read only.
+            (:func:`~solver.families.numeric.seed_kernel.seed_paths`), NaN without one; read only.
         rotations: shape (P, W, 3, 3), R_B_F* of every waypoint.
         positions: shape (P, W, 3), m in {B}.
         twists: shape (P, W, 6), t_hat in {B} at the tool point.
@@ -191,8 +191,8 @@ def follow_bounded(  # type: ignore[no-untyped-def]  # pragma: no cover - compil
         pure_rotation: shape (W,), bool: V_max is 0 there (the pipeline's rule).
         joint_limits: lower and upper (n,) and (max_joint_step,): a slot outside them (as
             tracking judges, with a margin) is not taken as the candidate.
-        settings: as for :func:`~solver.families.numeric.ik_kernel.seed_paths`.
-        constants: as for :func:`~solver.families.numeric.ik_kernel.follow_paths`.
+        settings: as for :func:`~solver.families.numeric.seed_kernel.seed_paths`.
+        constants: as for :func:`~solver.families.numeric.follow_kernel.follow_paths`.
         rules: (tie, margin) for :func:`hopeless`; rough steps a stride (0: every slot
             followed exactly); the slack of the rough V_max; the stride (waypoints); the
             residual and joint motion (rad or m) a trusted stride stays within.

@@ -180,7 +180,7 @@ def follow_bounded(  # type: ignore[no-untyped-def]  # pragma: no cover - compil
     Args:
         chain: :meth:`SerialChain.packed`, seven joints.
         current: shape (P, K, 7), the slots' solutions at each path's first waypoint
-            (:func:`~solver.families.numeric.ik_kernel.seed_paths`), NaN without one; read only.
+            (:func:`~solver.families.numeric.seed_kernel.seed_paths`), NaN without one; read only.
         rotations: shape (P, W, 3, 3), R_B_F* of every waypoint.
         positions: shape (P, W, 3), m in {B}.
         twists: shape (P, W, 6), t_hat in {B} at the tool point.
@@ -189,8 +189,8 @@ def follow_bounded(  # type: ignore[no-untyped-def]  # pragma: no cover - compil
         pure_rotation: shape (W,), bool: V_max is 0 there (the pipeline's rule).
         joint_limits: lower and upper (7,) and (max_joint_step,): a slot outside them (as
             tracking judges, with a margin) is not taken as the candidate.
-        settings: as for :func:`~solver.families.numeric.ik_kernel.seed_paths`.
-        constants: as for :func:`~solver.families.numeric.ik_kernel.follow_paths`.
+        settings: as for :func:`~solver.families.numeric.seed_kernel.seed_paths`.
+        constants: as for :func:`~solver.families.numeric.follow_kernel.follow_paths`.
         rules: (tie, margin) for :func:`hopeless` (the rest, the six-joint scouting's, unused).
 
     Returns:

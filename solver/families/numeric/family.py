@@ -28,9 +28,10 @@ from solver.families.numeric import (
     bounded_kernel,
     bounded_redundant_kernel,
     costs,
+    follow_kernel,
     ik,
-    ik_kernel,
     reference,
+    seed_kernel,
     velocity,
 )
 from solver.families.numeric.chain import SerialChain
@@ -78,7 +79,8 @@ class NumericFamily(KinematicsFamily, FollowsInSteps):
             model: pinocchio model whose joints (1-DOF, one serial chain) all move the tool.
             base_frame: {B}, fixed to the root.
             tool_frame: the flange {F}.
-            compiled: solve with the compiled chain (:mod:`solver.families.numeric.ik_kernel`);
+            compiled: solve with the compiled chain (:mod:`solver.families.numeric.seed_kernel`,
+                :mod:`~solver.families.numeric.follow_kernel`);
                 False: with the numpy chain and :mod:`solver.families.numeric.ik`, the
                 reference it is tested against.
 
@@ -123,7 +125,7 @@ class NumericFamily(KinematicsFamily, FollowsInSteps):
         return self._branches
 
     def _settings(self) -> tuple[np.ndarray, np.ndarray]:
-        """The compiled IK's settings and constants (:func:`ik_kernel.seed_paths`)."""
+        """The compiled IK's settings and constants (:func:`seed_kernel.seed_paths`)."""
         settings = np.array(
             [
                 ik.SEED_ITERATIONS,
@@ -156,9 +158,9 @@ class NumericFamily(KinematicsFamily, FollowsInSteps):
     def seed_first(
         self, rotations: np.ndarray, positions: np.ndarray
     ) -> tuple[np.ndarray, np.ndarray]:
-        """:func:`ik_kernel.seed_paths` (see :meth:`FollowsInSteps.seed_first`)."""
+        """:func:`seed_kernel.seed_paths` (see :meth:`FollowsInSteps.seed_first`)."""
         settings, constants = self._settings()
-        current, count = ik_kernel.seed_paths(
+        current, count = seed_kernel.seed_paths(
             self._packed,
             self.seeds,
             (self.lower, self.upper),
@@ -176,9 +178,9 @@ class NumericFamily(KinematicsFamily, FollowsInSteps):
         positions: np.ndarray,
         solve_first: bool,
     ) -> tuple[np.ndarray, np.ndarray]:
-        """:func:`ik_kernel.follow_paths` (see :meth:`FollowsInSteps.follow_piece`)."""
+        """:func:`follow_kernel.follow_paths` (see :meth:`FollowsInSteps.follow_piece`)."""
         settings, constants = self._settings()
-        q, status = ik_kernel.follow_paths(
+        q, status = follow_kernel.follow_paths(
             self._packed,
             current,
             kernel_array(rotations),
@@ -236,9 +238,9 @@ class NumericFamily(KinematicsFamily, FollowsInSteps):
         stop: np.ndarray,
         out: tuple[np.ndarray, np.ndarray],
     ) -> None:
-        """:func:`ik_kernel.follow_ranges` (see :meth:`FollowsInSteps.follow_ranges`)."""
+        """:func:`follow_kernel.follow_ranges` (see :meth:`FollowsInSteps.follow_ranges`)."""
         settings, constants = self._settings()
-        ik_kernel.follow_ranges(
+        follow_kernel.follow_ranges(
             self._packed,
             current,
             kernel_array(rotations),

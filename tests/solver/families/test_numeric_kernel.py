@@ -15,7 +15,14 @@ import pytest
 from solver.core.kinematics import jacobian_in_base
 from solver.core.robots import Robot
 from solver.families import get_robot
-from solver.families.numeric import chain_kernel, ik, ik_kernel, redundant_kernel
+from solver.families.numeric import (
+    chain_kernel,
+    follow_kernel,
+    ik,
+    ik_kernel,
+    redundant_kernel,
+    seed_kernel,
+)
 from solver.families.numeric.family import NumericFamily
 from solver.kernels import spin_lp
 from solver.path.placed import flange_at_spin, turn_by_yaw
@@ -259,7 +266,14 @@ def test_every_compiled_function_releases_the_gil() -> None:
     """numba's nogil: a map on a worker thread leaves the GIL to the event loop (stop 19)."""
     functions = [
         getattr(module, name)
-        for module in (chain_kernel, ik_kernel, redundant_kernel, spin_lp)
+        for module in (
+            chain_kernel,
+            ik_kernel,
+            seed_kernel,
+            follow_kernel,
+            redundant_kernel,
+            spin_lp,
+        )
         for name in dir(module)
         if hasattr(getattr(module, name), "targetoptions")
     ]

@@ -1,6 +1,6 @@
 """The six-joint map's kernels compiled without reference counting keep their answers.
 
-:func:`solver.families.numeric.bounded_kernel.follow_bounded`, ``ik_kernel.seed_paths`` and
+:func:`solver.families.numeric.bounded_kernel.follow_bounded`, ``seed_kernel.seed_paths`` and
 ``chain_kernel.speeds_per_twist`` run their loops compiled with ``_nrt=False``; the maps they
 give are held to the numpy reference and to following every slot elsewhere
 (test_numeric_kernel.py, test_numeric_pruned_map.py). Here: the branches of that code those

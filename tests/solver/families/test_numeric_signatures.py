@@ -13,7 +13,7 @@ from __future__ import annotations
 import numpy as np
 
 from solver.core.codes import TIE_RTOL
-from solver.families.numeric import bounded_kernel, chain_kernel, ik_kernel
+from solver.families.numeric import bounded_kernel, chain_kernel, follow_kernel, seed_kernel
 from solver.families.numeric.family import NumericFamily
 from solver.path import bounded
 from tests.solver.families.numeric_maps import ur5_from_urdf
@@ -63,8 +63,8 @@ def test_read_only_and_writable_inputs_share_one_signature() -> None:
     for read_only, writable in zip(*answers, strict=True):
         np.testing.assert_array_equal(read_only, writable)
     for kernel in (
-        ik_kernel.seed_paths,
-        ik_kernel.follow_paths,
+        seed_kernel.seed_paths,
+        follow_kernel.follow_paths,
         bounded_kernel.follow_bounded,
         chain_kernel.speeds_per_twist,
     ):
