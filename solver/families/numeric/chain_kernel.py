@@ -162,9 +162,18 @@ def jacobian_at(revolute, axes, origins, at, jac):  # type: ignore[no-untyped-de
 def lu_solve(a, b):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
     """Solve a x = b in place (x in ``b``) by LU with partial pivoting; False if a is singular.
 
-    What LAPACK's gesv (``np.linalg.solve``) does; ``a`` (k, k) is overwritten.
+    What LAPACK's gesv (``np.linalg.solve``) does; ``a`` (k, k) is overwritten. Six
+    unknowns (every J J^T and 6 x 6 J here) take a copy whose size is a constant, which the
+    compiler unrolls: the same operations in the same order.
     """
-    size = len(b)
+    if len(b) == 6:
+        return _lu_solve(a, b, 6)
+    return _lu_solve(a, b, len(b))
+
+
+@njit(cache=True, nogil=True, error_model="numpy", inline="always")
+def _lu_solve(a, b, size):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
+    """:func:`lu_solve` of ``size`` unknowns."""
     for col in range(size):
         pivot = col
         for row in range(col + 1, size):
@@ -195,8 +204,16 @@ def lu_solve_signed(a, b):  # type: ignore[no-untyped-def]  # pragma: no cover -
 
     The sign of det a from the factors: a row swap and a negative pivot each flip it, as in
     :func:`det_negative`. Returns (solved, negative); ``negative`` is meaningless unless solved.
+    Six unknowns take a copy whose size is a constant, as :func:`lu_solve`.
     """
-    size = len(b)
+    if len(b) == 6:
+        return _lu_solve_signed(a, b, 6)
+    return _lu_solve_signed(a, b, len(b))
+
+
+@njit(cache=True, nogil=True, error_model="numpy", inline="always")
+def _lu_solve_signed(a, b, size):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
+    """:func:`lu_solve_signed` of ``size`` unknowns."""
     negative = False
     for col in range(size):
         pivot = col

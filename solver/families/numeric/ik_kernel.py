@@ -64,8 +64,20 @@ def _pose_error(target_r, target_p, work):  # type: ignore[no-untyped-def]  # pr
 
 @njit(cache=True, nogil=True, error_model="numpy", inline="always")
 def _normal(jac, normal):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
-    """J J^T of jac (6, n) into normal (6, 6), the lower triangle summed and mirrored."""
-    n = jac.shape[1]
+    """J J^T of jac (6, n) into normal (6, 6), the lower triangle summed and mirrored.
+
+    Six joints take a copy whose n is a constant, which the compiler unrolls (the same sums
+    in the same order).
+    """
+    if jac.shape[1] == 6:
+        _normal_of(jac, normal, 6)
+    else:
+        _normal_of(jac, normal, jac.shape[1])
+
+
+@njit(cache=True, nogil=True, error_model="numpy", inline="always")
+def _normal_of(jac, normal, n):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
+    """:func:`_normal` over the first n columns."""
     for i in range(6):
         for k in range(i + 1):
             total = 0.0
