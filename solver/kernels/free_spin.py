@@ -11,15 +11,16 @@ tested against (tests/solver/test_free_spin_kernel.py). Per placement:
 2. each branch: unreachable, singular, then the step test against the previous waypoint, no
    position limits (they hold along the spin schedule); V_max by the exact two-variable LP
    (:func:`solver.kernels.limits.two_variable_speed`, as
-   :func:`solver.core.dtf.two_variable_speed`) and its running minimum, mu_path;
+   :func:`solver.core.two_variable_lp.two_variable_speed`) and its running minimum, mu_path;
 3. without acceleration limits, the branches pruned (:mod:`solver.kernels.cell`,
    :mod:`solver.kernels.free_follow`): the branch the previous placement chose first, then the
    most promising, each followed to the end tracked again along its spin schedule (the spin
-   rate nearest zero at the feed mu_path, :func:`solver.core.dtf.spin_rate_nearest_zero`; the
-   joints moved by the spin, :func:`solver.path.spin_schedule.spin_schedule`; that joint path
-   tracked with the position limits and the step test, :func:`solver.path.tracking.track`,
-   in :mod:`solver.kernels.spin_schedule`); the others probed and left once they cannot be
-   chosen, and followed to the end after all where the answer might depend on them;
+   rate nearest zero at the feed mu_path,
+   :func:`solver.core.two_variable_lp.spin_rate_nearest_zero`; the joints moved by the spin,
+   :func:`solver.path.spin_schedule.spin_schedule`; that joint path tracked with the position
+   limits and the step test, :func:`solver.path.tracking.track`, in
+   :mod:`solver.kernels.spin_schedule`); the others probed and left once they cannot be chosen,
+   and followed to the end after all where the answer might depend on them;
 4. with joint acceleration limits, the branches pruned likewise by mu_acc
    (:mod:`solver.kernels.acc_cells`): each followed to the end is tracked along its spin
    schedule and its mu_acc formed from the spun path's steps;

@@ -26,7 +26,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from solver.core.dtf import two_variable_speed
+from solver.core.two_variable_lp import two_variable_speed
 from solver.kernels.spin_lp import spin_speed
 
 
@@ -77,9 +77,10 @@ class Limit(abc.ABC):
 class JointSpeedLimit(Limit):
     """Joint speed limits: the DTF, 1 / max_j |qd_j| / qdot_max_j (Sensors 2022 eq. (30)).
 
-    With the spin rate free, the exact two-variable LP (:func:`solver.core.dtf.two_variable_speed`),
-    and for seven joints the three-variable one (:func:`solver.core.dtf_redundant.spin_speed`,
-    compiled: :func:`solver.kernels.spin_lp.spin_speed`).
+    With the spin rate free, the exact two-variable LP
+    (:func:`solver.core.two_variable_lp.two_variable_speed`), and for seven joints the
+    three-variable one (:func:`solver.core.dtf_redundant.spin_speed`, compiled:
+    :func:`solver.kernels.spin_lp.spin_speed`).
     """
 
     name = "speed"
