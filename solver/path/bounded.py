@@ -34,8 +34,8 @@ import numpy as np
 
 from solver.core.codes import TIE_RTOL, UNREACHABLE
 from solver.core.family import PathSolutions
+from solver.path.chunk import Chunk
 from solver.path.problem import PathProblem
-from solver.path.pruning import Chunk
 
 MARGIN = 1e-13
 """Relative slack on a dropped slot's bound: the kernel's V_max come from the unwrapped
