@@ -16,7 +16,8 @@ import numpy as np
 from timing import best_time
 
 from solver.families import get_robot
-from solver.optimise.optimize import PlacementOptimum, optimize_placement
+from solver.optimise.optimize import optimize_placement
+from solver.optimise.optimum import PlacementOptimum
 from solver.optimise.search_space import PlacementBounds
 from solver.optimise.work import SINGLE_PLACEMENT_COST, work_of
 from solver.path.placement_evaluator import PlacementEvaluator
