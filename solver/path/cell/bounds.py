@@ -22,9 +22,16 @@ def _lever(model: pin.Model, joint: int, carrier: int) -> float:
 
 
 def _extent(obj: pin.GeometryObject) -> float:
-    """Bound on the distance from an object's joint origin to any of its points (m)."""
+    """Bound on the distance from an object's joint origin to any of its points (m).
+
+    The ball about its local bounding box's centre (``aabb_center``, in the geometry's frame)
+    of radius ``aabb_radius``, placed on the joint: a mesh's box is not centred on its origin
+    (the UR5's upper arm: 0.213 m along z, so 0.50 m where the ball about the origin said 0.29).
+    """
     obj.geometry.computeLocalAABB()
-    return float(np.linalg.norm(obj.placement.translation)) + float(obj.geometry.aabb_radius)
+    placement = obj.placement
+    centre = placement.translation + placement.rotation @ np.asarray(obj.geometry.aabb_center)
+    return float(np.linalg.norm(centre)) + float(obj.geometry.aabb_radius)
 
 
 def pair_weights(
