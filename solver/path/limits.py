@@ -156,6 +156,14 @@ class PathCheck(abc.ABC):
             for q, placement in zip(joint_paths, placements, strict=True)
         ]
 
+    def refuses_at(self, q: np.ndarray, placement: np.ndarray, refusal: PathVerdict) -> bool:
+        """A quick test: True only where :meth:`check` refuses ``q`` too (none here).
+
+        A map tries a refused pick's next branches (``q`` (W, n) at ``placement`` (5,)) where
+        ``refusal`` refused the pick, before checking them whole; False says nothing.
+        """
+        return False
+
 
 @dataclass(frozen=True)
 class BlendStencil:

@@ -254,15 +254,19 @@ def _next_branches(
         chosen = np.array(run.pick, copy=True)
         orders = [branch_order(run, k) for k in range(len(cells))]
         step = [0] * len(cells)
+        hints = [refused[int(c)][1] for c in cells]  # each placement's last refusal
         while True:
             due: list[tuple[int, int]] = []  # (placement k, branch) checked this round
             for k, c in enumerate(cells):
                 while not taken[k] and step[k] < len(orders[k]):
                     b = orders[k][step[k]]
-                    if not np.array_equal(run.tracked.q[:, b, k].T, refused[int(c)][0]):
+                    q = run.tracked.q[:, b, k].T
+                    if not np.array_equal(q, refused[int(c)][0]) and not _refused_again(
+                        problem, q, rows[k], hints[k]
+                    ):
                         due.append((k, b))
                         break
-                    step[k] += 1  # the refused joint path itself
+                    step[k] += 1  # the refused joint path itself, or one refused where it was
             if not due:
                 break
             joint_paths = np.array([run.tracked.q[:, b, k].T for k, b in due])
@@ -271,6 +275,8 @@ def _next_branches(
                 step[k] += 1
                 if not _refused(verdict):
                     chosen[k], taken[k] = b, True
+                elif verdict is not None:
+                    hints[k] = verdict
         if taken.any():
             picked = columns_of(dataclasses.replace(run, pick=chosen))
             for column, value in zip(out, picked, strict=True):
@@ -278,6 +284,17 @@ def _next_branches(
     for c in cells[~taken]:
         verdict = refused[int(c)][1]
         _refuse(out, int(c), problem.path_checks[0].reason, int(verdict.failed_waypoint or 0))
+
+
+def _refused_again(
+    problem: PathProblem, q: np.ndarray, placement: np.ndarray, refusal: PathVerdict
+) -> bool:
+    """Whether a check refuses ``q`` (W, n) where it refused another path of the placement.
+
+    Of the next branches only whether they pass counts (the pick's refusal is reported): a
+    quick test never wrong when it refuses (:meth:`PathCheck.refuses_at`) spares a whole check.
+    """
+    return any(check.refuses_at(q, placement, refusal) for check in problem.path_checks)
 
 
 def _refuse(columns: list[np.ndarray], c: int, reason: int, waypoint: int) -> None:

@@ -65,6 +65,12 @@ class CellChecker:
         self._weights = scene.weights
         self._fast = scene.compiled
         self._coal_data = CoalData(robot.model, self.geometry, self._workpiece_ids)
+        # collides_at's own copies: the sweep's coal calls see the data they saw before.
+        self._hint_data = CoalData(robot.model, self.geometry, self._workpiece_ids)
+        objects = self.geometry.geometryObjects
+        self._pair_of = {
+            (objects[a].name, objects[b].name): p for p, (a, b) in enumerate(self._pairs)
+        }
 
     def configurations(
         self, q: np.ndarray, segment_in_pass: np.ndarray
@@ -266,6 +272,29 @@ class CellChecker:
             clear_until[due] = index + first
             index = int(clear_until.min()) + 1
         return CellVerdict(None, None, checks, self.approximated)
+
+    def collides_at(
+        self, configuration: np.ndarray, transform_workpiece_to_base: np.ndarray, contact: Contact
+    ) -> bool:
+        """Whether coal finds ``contact``'s pair under the clearance less ``fast.MARGIN`` there.
+
+        The quick test of :meth:`solver.path.cell.limit.CellLimit.refuses_at`: where a path's
+        waypoint is that close, no bound proves it clear, so the check reaches it (or stops
+        before) and coal's distance there (within its tolerance, well under the margin)
+        refuses the path too. ``configuration`` (n,), rad; T_B_O (4, 4).
+        """
+        objects = self.geometry.geometryObjects
+        other = contact.obstacle_name if contact.obstacle is None else None
+        if contact.obstacle is not None:
+            other = objects[self._n_robot + contact.obstacle].name
+        pair = self._pair_of.get((contact.robot_part, other))
+        if pair is None:
+            return False
+        placed = self._world_to_base * pin.SE3(np.asarray(transform_workpiece_to_base, float))
+        geometry, gdata, data = self._hint_data.at(placed)
+        pin.updateGeometryPlacements(self.robot.model, data, geometry, gdata, configuration)
+        distance = pin.computeDistance(geometry, gdata, pair).min_distance
+        return bool(distance < self.cell.clearance - fast.MARGIN)
 
     def _contact(self, waypoint: int, pair: int, distance: float) -> Contact:
         """The contact of pair ``pair`` (an index into the checked pairs)."""
