@@ -24,17 +24,12 @@ import numpy as np
 from solver.core.exceptions import InvalidInputError, NoAnalyticIkError, quoted
 from solver.core.family import Branch, KinematicsFamily
 from solver.core.robots import Robot
+from solver.path.blend_stencil import BlendStencil
 from solver.path.cell.cache import checker_for
 from solver.path.cell.checker import cell_pose_cost
 from solver.path.cell.limit import CellLimit
 from solver.path.cell.shapes import Cell
-from solver.path.limits import (
-    BlendStencil,
-    JointAccelerationLimit,
-    JointSpeedLimit,
-    Limit,
-    PathCheck,
-)
+from solver.path.limits import JointAccelerationLimit, JointSpeedLimit, Limit, PathCheck
 from solver.path.prepare import PreparedPath, prepare_path
 
 DEFAULT_MAX_JOINT_STEP = 0.35
