@@ -18,28 +18,8 @@ from solver.core.robots import Robot
 from solver.path.cell import batch, fast, kinematics
 from solver.path.cell.coal_data import CoalData
 from solver.path.cell.scene import build_scene
-from solver.path.cell.shapes import DEFAULT_COLLISION_STEP, Cell
+from solver.path.cell.shapes import Cell
 from solver.path.cell.verdict import CellVerdict, Contact
-
-# What checking one pose of a path against a cell costs, in poses of a closed-form family's map
-# (KinematicsFamily.path_cost): the ERK map (546 placements x 133 waypoints) with a table, a
-# fixture and the part took 46 to 59 times the map without for the UR5 (its meshes) and 20 to
-# 30 times for the UR5e (capsules) (bench/cell.py and the same maps' CPU time, best of 3 to 5,
-# loaded machine, 2026-12-02, after the chunk's paths were checked in one compiled call; 72 to
-# 96 and 35 to 44 times before, in the same runs). 50, within the UR5's range and above the
-# UR5e's: the optimisers in a cell search (x, y, yaw) past a fixture (no arc symmetry), and 80
-# refused the README's cell optimisation (7.0 million weighted poses; 50 weighs it 4.4 million).
-CELL_POSE_COST = 50.0
-
-
-def cell_pose_cost(cell: Cell) -> float:
-    """The collision check's weight per pose: CELL_POSE_COST at the default collision step.
-
-    A finer step checks proportionally more sub-steps between waypoints, so it weighs more
-    (at the least step, 0.001 rad, 50 times as much): the size limits see it before the work.
-    """
-    return CELL_POSE_COST * max(1.0, DEFAULT_COLLISION_STEP / cell.collision_step)
-
 
 _WINDOW = 32  # configurations looked ahead at once when skipping
 
