@@ -21,8 +21,8 @@ from solver.path.cell.cache import checker_for
 from solver.path.cell.checker import CellChecker
 from solver.path.cell.limit import workpiece_to_base
 from solver.path.cell.shapes import Box, Cell, Cylinder, Halfspace, Mesh, Sphere, Tool
+from solver.path.chosen_paths import tracked_joint_paths
 from solver.path.evaluate import evaluate_path
-from solver.path.path_checks import tracked_joint_paths
 from solver.path.pipeline import run_chunk
 from solver.path.problem import PathOptions, PathProblem
 from tests.solver.test_cell_fast import CELL, _arm, _pose, _same
