@@ -152,7 +152,9 @@ def free_cells(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
     acc = acc_work(n_branches, n_waypoints, keep_acc)
     feed, acc_at, acc_by, acc_speeds = acc[0], acc[1], acc[2], acc[3]
     steps_c = step_stencil(stencil_index, stencil_weight)
-    rows = scan_work(stencil_index, steps_c, n_waypoints)
+    rows = scan_work(
+        stencil_index, steps_c, n_waypoints, segment_checked, max_joint_step, qddot_max
+    )
     stencil = (stencil_index, steps_c, stencil_waypoints, rows)
     todo = np.empty(n_branches, dtype=np.bool_)
     remaining = np.empty(n_branches, dtype=np.bool_)
