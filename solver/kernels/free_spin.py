@@ -37,6 +37,7 @@ from numba import njit
 from solver.core.codes import FEASIBLE, TIE_RTOL
 from solver.families.kernels import N_JOINTS
 from solver.kernels.acc_cells import free_cell
+from solver.kernels.acc_scan import scan_work
 from solver.kernels.accelerations import acc_work, write_acc
 from solver.kernels.cache import drop_stale_compiled_code
 from solver.kernels.cell import (
@@ -151,7 +152,11 @@ def free_cells(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
     keep_acc = v_acc.shape[1] > 0
     acc = acc_work(n_branches, n_waypoints, keep_acc)
     feed, acc_at, acc_by, acc_speeds = acc[0], acc[1], acc[2], acc[3]
-    stencil = (stencil_index, step_stencil(stencil_index, stencil_weight), stencil_waypoints)
+    steps_c = step_stencil(stencil_index, stencil_weight)
+    rows = scan_work(
+        stencil_index, steps_c, n_waypoints, segment_checked, max_joint_step, qddot_max
+    )
+    stencil = (stencil_index, steps_c, stencil_waypoints, rows)
     todo = np.empty(n_branches, dtype=np.bool_)
     remaining = np.empty(n_branches, dtype=np.bool_)
     hint = np.full(n_branches, -1)
