@@ -142,7 +142,7 @@ def map_cells(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
         max_joint_step: rad.
         qddot_max: shape (6,), rad/s^2, or (0,) without acceleration limits (then the blend
             stencil and the acceleration answers are not read).
-        stencil_index: shape (K, 5), :class:`solver.path.limits.BlendStencil`'s ``index``.
+        stencil_index: shape (K, 5), :class:`solver.path.blend_stencil.BlendStencil`'s ``index``.
         stencil_weight: shape (K, 5), its ``weight``.
         stencil_waypoints: shape (K,), its ``waypoints``.
         mu: shape (C,), out, m/s, NaN where infeasible.
