@@ -21,7 +21,8 @@ from programs import pocket_program
 from solver.cam.cl_data import read_cl_data
 from solver.core.parallel import ThreadRunner
 from solver.families import get_robot
-from solver.optimise.optimize import PlacementOptimum, optimize_placement
+from solver.optimise.optimize import optimize_placement
+from solver.optimise.optimum import PlacementOptimum
 from solver.optimise.search_space import PlacementBounds
 from solver.path.problem import PathOptions, PathProblem
 

@@ -16,10 +16,12 @@ import numpy as np
 from timing import best_time
 
 from solver.families import get_robot
-from solver.optimise.optimize import PlacementOptimum, optimize_placement
+from solver.optimise.optimize import optimize_placement
+from solver.optimise.optimum import PlacementOptimum
 from solver.optimise.search_space import PlacementBounds
 from solver.optimise.work import SINGLE_PLACEMENT_COST, work_of
-from solver.path.placements import PlacementEvaluator, evaluate_placements
+from solver.path.placement_evaluator import PlacementEvaluator
+from solver.path.placements import evaluate_placements
 from solver.path.problem import PathProblem
 
 ARMS = ("ur5", "kinova_jaco2")  # the baseline first

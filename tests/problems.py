@@ -17,6 +17,7 @@ import numpy as np
 from solver.core.robots import Robot
 from solver.core.spatial import Placement
 from solver.optimise import optimize
+from solver.optimise.optimum import PlacementOptimum
 from solver.path import capability_map as capability
 from solver.path import evaluate, placements
 from solver.path.problem import PathOptions, PathProblem
@@ -58,9 +59,7 @@ def capability_map(
     return capability.capability_map(problem(robot, waypoints, passes=passes, **options), **rest)
 
 
-def optimize_placement(
-    robot: Robot, waypoints: np.ndarray, **keywords: Any
-) -> optimize.PlacementOptimum:
+def optimize_placement(robot: Robot, waypoints: np.ndarray, **keywords: Any) -> PlacementOptimum:
     """:func:`solver.optimise.optimize.optimize_placement` with keyword options."""
     passes = keywords.pop("passes", None)
     options, rest = _split(keywords)

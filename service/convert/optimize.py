@@ -9,7 +9,7 @@ from service.convert.path_read import pass_at, path_read_of
 from service.schemas.path_input import PathInput
 from solver.core.robots import Robot
 from solver.optimise.failures import SearchFailure
-from solver.optimise.optimize import PlacementOptimum
+from solver.optimise.optimum import PlacementOptimum
 from solver.optimise.search_space import PlacementBounds
 
 

@@ -11,7 +11,7 @@ from typing import Annotated, Any
 from pydantic import Field
 
 from service.schemas.common import Pose, RequestModel, pose_matrix_of
-from solver.core.robots import (
+from solver.core.joint_limits import (
     MAX_ACCELERATION_LIMIT,
     MAX_SPEED_LIMIT,
     MIN_ACCELERATION_LIMIT,

@@ -15,14 +15,19 @@ The sense of the turn:
   defined, and a full circle turn counter-clockwise about the axis (APT's right-hand rule).
 
 A full circle is an arc whose end equals its start (seen along the axis).
+
+The reader (:mod:`solver.cam.cl_reader`) holds a :class:`Circle` until its end ``GOTO``, and
+:func:`arc_cuts` turns it into cutting points, the tool axis blended along them.
 """
 
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 
 import numpy as np
 
+from solver.cam.cl_records import Record
 from solver.core.exceptions import InvalidLineError
 from solver.core.task import LINEAR_TOLERANCE
 
@@ -148,3 +153,81 @@ def _check_radii(
             line=line,
             text=text,
         )
+
+
+@dataclass(frozen=True)
+class Circle:
+    """A CIRCLE waiting for its end.
+
+    Attributes:
+        record: the CIRCLE record.
+        start: shape (3,), m, the tool position where the arc starts.
+        start_axis: shape (3,), the tool axis there.
+        centre: shape (3,), m.
+        axis: shape (3,), the arc's unit axis.
+        radius: m, as stated, or None.
+        turns: whole turns added (NX's TIMES, n).
+    """
+
+    record: Record
+    start: np.ndarray
+    start_axis: np.ndarray
+    centre: np.ndarray
+    axis: np.ndarray
+    radius: float | None
+    turns: int
+
+
+def arc_cuts(
+    circle: Circle,
+    end: np.ndarray,
+    axis: np.ndarray,
+    *,
+    tolerance: float,
+    clockwise: bool | None,
+    field: str,
+) -> tuple[np.ndarray, np.ndarray]:
+    """The cutting points of an arc before its end, and the tool axis blended along them.
+
+    Args:
+        circle: the CIRCLE, with where the arc starts.
+        end: shape (3,), m, the arc's end (the ``GOTO`` after ``CIRCLE``).
+        axis: shape (3,), the unit tool axis at the end.
+        tolerance: m, the largest distance of a chord from the arc.
+        clockwise: the sense of the turn about the arc's axis (NX), or None (the shorter way).
+        field: the request field the errors name.
+
+    Returns:
+        points: shape (k, 3), m, the arc's points after its start and before its end;
+        blends: shape (k, 3), the unit tool axis at each, blended linearly from the start's.
+
+    Raises:
+        InvalidLineError: an arc :func:`arc_points` refuses, or a tool axis that turns by a
+            right angle or more along it (naming the CIRCLE's line).
+    """
+    record = circle.record
+    points = arc_points(
+        circle.start,
+        end,
+        circle.centre,
+        circle.axis,
+        radius=circle.radius,
+        tolerance=tolerance,
+        clockwise_about_axis=clockwise,
+        extra_turns=circle.turns,
+        field=field,
+        line=record.line,
+        text=record.text,
+    )
+    if float(circle.start_axis @ axis) <= 0.0:
+        raise InvalidLineError(
+            field,
+            "the tool axis turns by a right angle or more along the arc; the reader "
+            "blends it only across smaller turns",
+            line=record.line,
+            text=record.text,
+        )
+    t = (np.arange(1, len(points)) / len(points))[:, None]
+    blends = (1.0 - t) * circle.start_axis + t * axis
+    blends /= np.linalg.norm(blends, axis=1)[:, None]
+    return points[:-1], blends

@@ -8,7 +8,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from solver.cam.arcs import arc_points
+from solver.cam.arcs import Circle, arc_cuts
 from solver.cam.cam_path import Units
 from solver.cam.cl_records import REFUSED, Record, kind_of
 from solver.cam.cl_systems import PART, CoordinateSystem, csys, msys
@@ -21,29 +21,6 @@ from solver.core.task import ANGULAR_TOLERANCE, LINEAR_TOLERANCE
 
 TOOL_CHANGE = frozenset({"LOADTL", "LOAD"})
 """Words of a tool change: a new pass."""
-
-
-@dataclass(frozen=True)
-class Circle:
-    """A CIRCLE waiting for its end.
-
-    Attributes:
-        record: the CIRCLE record.
-        start: shape (3,), m, the tool position where the arc starts.
-        start_axis: shape (3,), the tool axis there.
-        centre: shape (3,), m.
-        axis: shape (3,), the arc's unit axis.
-        radius: m, as stated, or None.
-        turns: whole turns added (NX's TIMES, n).
-    """
-
-    record: Record
-    start: np.ndarray
-    start_axis: np.ndarray
-    centre: np.ndarray
-    axis: np.ndarray
-    radius: float | None
-    turns: int
 
 
 @dataclass
@@ -280,29 +257,10 @@ class ClReader:
 
     def read_arc_end(self, circle: Circle, end: np.ndarray, axis: np.ndarray) -> None:
         """The points of an arc before its end, as cuts; the tool axis blended along it."""
-        points = arc_points(
-            circle.start,
-            end,
-            circle.centre,
-            circle.axis,
-            radius=circle.radius,
-            tolerance=self.tolerance,
-            clockwise_about_axis=self.clockwise,
-            extra_turns=circle.turns,
-            field=self.field,
-            line=circle.record.line,
-            text=circle.record.text,
+        points, blends = arc_cuts(
+            circle, end, axis, tolerance=self.tolerance, clockwise=self.clockwise, field=self.field
         )
-        if float(circle.start_axis @ axis) <= 0.0:
-            raise self.error(
-                "the tool axis turns by a right angle or more along the arc; the reader "
-                "blends it only across smaller turns",
-                circle.record,
-            )
-        t = (np.arange(1, len(points)) / len(points))[:, None]
-        blends = (1.0 - t) * circle.start_axis + t * axis
-        blends /= np.linalg.norm(blends, axis=1)[:, None]
-        for point, blend in zip(points[:-1], blends, strict=True):
+        for point, blend in zip(points, blends, strict=True):
             self.cut(point, blend, circle.record.line)
 
     def cut(self, position: np.ndarray, axis: np.ndarray, line: int) -> None:

@@ -4,8 +4,8 @@ dtf.md section 3 defines V_max for every arm as the LP  max s  s.t.  J qdot = s 
 |qdot| <= qdot_max. For seven joints and J of full rank (robots.md section 5) every solution is
 qdot = s a + lam b with a = J^+ t_hat and b a unit vector spanning the null space of J, so the
 LP has two variables, max s s.t. |s a_j + lam b_j| <= qdot_max_j, solved exactly and vectorised
-by :func:`solver.core.dtf.two_variable_speed`. Beyond seven joints, or where J loses rank, HiGHS
-solves the LP one configuration at a time (:func:`solver.core.dtf.lp_speed`).
+by :func:`solver.core.two_variable_lp.two_variable_speed`. Beyond seven joints, or where J loses
+rank, HiGHS solves the LP one configuration at a time (:func:`solver.core.dtf.lp_speed`).
 """
 
 from __future__ import annotations
@@ -14,7 +14,8 @@ import itertools
 
 import numpy as np
 
-from solver.core.dtf import lp_speed, spin_rate_nearest_zero, two_variable_speed
+from solver.core.dtf import lp_speed
+from solver.core.two_variable_lp import spin_rate_nearest_zero, two_variable_speed
 
 # Below this sigma_6 / sigma_1 the null space of a 6 x 7 Jacobian is not one-dimensional to
 # working precision, and the LP is solved by HiGHS instead.
@@ -164,9 +165,9 @@ def spin_rate_at_feed(
     """The spin rate nearest 0 at a feed, and the null-space rate then (seven joints).
 
     At s = feed (1 - 1e-12) (a short interval, as in
-    :func:`solver.core.dtf.spin_rate_nearest_zero`), sigma ranges over an interval: its ends
-    are two LPs in (sigma, lam) (:func:`vertex_lp`); sigma is the point of it nearest 0, and
-    lam then the point of its own interval nearest 0.
+    :func:`solver.core.two_variable_lp.spin_rate_nearest_zero`), sigma ranges over an interval:
+    its ends are two LPs in (sigma, lam) (:func:`vertex_lp`); sigma is the point of it nearest 0,
+    and lam then the point of its own interval nearest 0.
 
     Args:
         a: shape (n, ...), as for :func:`spin_speed`.

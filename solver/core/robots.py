@@ -4,8 +4,9 @@ A :class:`Robot` wraps a pinocchio model with the two frames the method needs: t
 {B} in which poses and twists are expressed, and the tool point {TCP} (the tool frame {F} times
 an optional offset T_F_TCP), plus the kinematics family that solves its IK (robots.md section 1).
 The catalogue, and the numeric family a URDF arm gets by default, are the families' registry's
-(:mod:`solver.families`, a layer above); this module builds robots and checks limits, and
-re-exports :func:`solver.core.urdf_chain.chain_from_urdf`, which reads URDFs.
+(:mod:`solver.families`, a layer above); this module builds robots (their limits checked by
+:mod:`solver.core.joint_limits`), and re-exports :func:`solver.core.urdf_chain.chain_from_urdf`,
+which reads URDFs.
 """
 
 from __future__ import annotations
@@ -18,28 +19,19 @@ from pathlib import Path
 import numpy as np
 import pinocchio as pin
 
-from solver.core.exceptions import InvalidInputError, RobotModelError, quoted, quoted_names
+from solver.core.exceptions import InvalidInputError, RobotModelError, quoted
 from solver.core.family import KinematicsFamily
+from solver.core.joint_limits import check_acceleration_limits, check_speed_limits
 from solver.core.urdf_chain import chain_from_urdf, check_mimic_speed_limits, frame_names
 from solver.core.urdf_structure import Mimic
 
 __all__ = [
     "Robot",
     "chain_from_urdf",
-    "check_acceleration_limits",
-    "check_speed_limits",
     "example_robot_data_dir",
     "frame_names",
     "robot_from_model",
 ]
-
-# Joint speed limits outside this range (rad/s) are input errors: no arm is that slow or fast,
-# and the LP solver treats bounds past 1e20 as infinite.
-MIN_SPEED_LIMIT = 1e-6
-MAX_SPEED_LIMIT = 1e4
-# Joint acceleration limits outside this range (rad/s^2) are input errors likewise (motion.md).
-MIN_ACCELERATION_LIMIT = 1e-6
-MAX_ACCELERATION_LIMIT = 1e8
 
 
 @dataclass(frozen=True, eq=False)
@@ -127,85 +119,6 @@ class Robot:
             _set_tool_point(model, robot.tool_frame, tcp)
             robot = dataclasses.replace(robot, model=model, transform_tool_to_tcp=tcp.copy())
         return robot
-
-
-def _checked_limits(
-    values: np.ndarray | list[float],
-    joint_names: tuple[str, ...],
-    *,
-    field: str,
-    unit: str,
-    lower: float,
-    upper: float,
-) -> np.ndarray:
-    """Per-joint limits as a float array: one per joint, finite, within [lower, upper].
-
-    Raises:
-        InvalidInputError: on ``field``, naming the count or the joint at fault.
-    """
-    limits = np.array(values, dtype=float)
-    if limits.shape != (len(joint_names),):
-        count = limits.size if limits.ndim == 1 else f"an array of shape {limits.shape} of"
-        raise InvalidInputError(
-            field,
-            f"{count} values for the {len(joint_names)} joints ({quoted_names(joint_names)}): "
-            "give one per joint, in this order",
-        )
-    bad = np.flatnonzero(~np.isfinite(limits) | (limits < lower) | (limits > upper))
-    if bad.size:
-        j = int(bad[0])
-        raise InvalidInputError(
-            field,
-            f"joint {j} ({quoted(joint_names[j])}) limit {float(limits[j]):.6g} {unit} must be "
-            f"> 0, within [{lower}, {upper}] {unit}",
-        )
-    return limits
-
-
-def check_speed_limits(
-    qdot_max: np.ndarray | list[float], joint_names: tuple[str, ...]
-) -> np.ndarray:
-    """Joint speed limits as a float array, after checking them.
-
-    Args:
-        qdot_max: shape (n,), rad/s, each in [MIN_SPEED_LIMIT, MAX_SPEED_LIMIT].
-        joint_names: the n joint names, for the message.
-
-    Raises:
-        InvalidInputError: on ``robot.joint_velocity_limits``: wrong length, not finite, or
-            out of range.
-    """
-    return _checked_limits(
-        qdot_max,
-        joint_names,
-        field="robot.joint_velocity_limits",
-        unit="rad/s",
-        lower=MIN_SPEED_LIMIT,
-        upper=MAX_SPEED_LIMIT,
-    )
-
-
-def check_acceleration_limits(
-    qddot_max: np.ndarray | list[float], joint_names: tuple[str, ...]
-) -> np.ndarray:
-    """Joint acceleration limits as a float array, after checking them (motion.md section 1).
-
-    Args:
-        qddot_max: shape (n,), rad/s^2, each in [MIN_ACCELERATION_LIMIT, MAX_ACCELERATION_LIMIT].
-        joint_names: the n joint names, for the message.
-
-    Raises:
-        InvalidInputError: on ``robot.joint_acceleration_limits``, naming the joint: wrong
-            length, not finite, or out of range.
-    """
-    return _checked_limits(
-        qddot_max,
-        joint_names,
-        field="robot.joint_acceleration_limits",
-        unit="rad/s^2",
-        lower=MIN_ACCELERATION_LIMIT,
-        upper=MAX_ACCELERATION_LIMIT,
-    )
 
 
 def _set_tool_point(model: pin.Model, tool_frame: str, transform_tool_to_tcp: np.ndarray) -> None:

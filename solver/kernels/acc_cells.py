@@ -12,7 +12,7 @@ branch followed to the end was left by its V_acc (the branches of one shoulder s
 so they are often left there too: the ERK-size map then follows a sixth fewer branches)
 (:mod:`solver.kernels.accelerations`). A branch still in the running is followed to the end
 (in free spin tracked along its spin schedule), probed there, and scanned
-(:func:`solver.kernels.accelerations.scan_row`), most promising first. Where a left branch
+(:func:`solver.kernels.acc_scan.scan_row`), most promising first. Where a left branch
 might change the answer (:func:`solver.kernels.cell.choice_holds`) the left branches are
 followed and scanned to the end after all, so every reported field is the full loop's.
 
@@ -26,12 +26,12 @@ import numpy as np
 from numba import njit
 
 from solver.core.codes import ACC_TIE_RTOL
+from solver.kernels.acc_scan import scan_row
 from solver.kernels.accelerations import (
     left_at_probes,
     probe_acc_rows,
     probe_free_acc_rows,
     probed_before,
-    scan_row,
     spin_rate_of,
 )
 from solver.kernels.cell import PRUNED, choice_holds, next_row, set_limits, start_again, write_cell
@@ -57,7 +57,8 @@ def fixed_cell(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
         kept: (slowest, slowest_at, slowest_joint, speeds, chords2, largest2, inside, crossed).
         hint: shape (B,), where each row's V_max was least.
         qddot_max: shape (6,), rad/s^2.
-        stencil: (index, c, waypoints), the blend stencil in step form.
+        stencil: (index, c, waypoints, rows), the blend stencil in step form and in row form
+            (:func:`solver.kernels.acc_scan.scan_work`).
         acc: from :func:`solver.kernels.accelerations.acc_work`.
         answer: the answer arrays :func:`solver.kernels.cell.write_cell` fills.
     """
@@ -66,10 +67,10 @@ def fixed_cell(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
     scratch, cq, sq, qd, status, need, alive, why, where = found
     slowest, slowest_at = kept[0], kept[1]
     inverse_qdot = path_tests[5]
-    index, steps_c, waypoints = stencil
+    index, steps_c, waypoints, rows = stencil
     feed, acc_at, acc_joint, acc_speeds, acc_hint, steps, moves = acc
-    scan = (index, steps_c, waypoints, qddot_max, feed, acc_at, acc_joint, acc_speeds, acc_hint,
-            steps, alive, why, where, slowest)  # fmt: skip
+    scan = (rows, waypoints, qddot_max, feed, acc_at, acc_joint, acc_speeds, acc_hint, alive, why,
+            where, slowest)  # fmt: skip
     grid = (family, par, poses, branches, scratch, cq, sq, qd, status, need, alive, why, where,
             slowest, acc_hint, bound, index, steps_c, qddot_max, steps)  # fmt: skip
     limit[:] = -np.inf
@@ -150,7 +151,8 @@ def free_cell(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
         kept: (slowest_at, slowest_joint, speeds, hint).
         spun_args: the arguments of :func:`solver.kernels.free_follow.spun_check` after i.
         qddot_max: shape (6,), rad/s^2.
-        stencil: (index, c, waypoints), the blend stencil in step form.
+        stencil: (index, c, waypoints, rows), the blend stencil in step form and in row form
+            (:func:`solver.kernels.acc_scan.scan_work`).
         acc: from :func:`solver.kernels.accelerations.acc_work`.
         answer: the answer arrays :func:`solver.kernels.cell.write_cell` fills.
     """
@@ -160,10 +162,10 @@ def free_cell(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
     slowest_at, hint = kept[0], kept[3]
     qdot_max = steps_tests[1]
     length = spun_args[6]
-    index, steps_c, waypoints = stencil
+    index, steps_c, waypoints, rows = stencil
     feed, acc_at, acc_joint, acc_speeds, acc_hint, steps, moves = acc
-    scan = (index, steps_c, waypoints, qddot_max, feed, acc_at, acc_joint, acc_speeds, acc_hint,
-            steps, alive, why, where, slowest)  # fmt: skip
+    scan = (rows, waypoints, qddot_max, feed, acc_at, acc_joint, acc_speeds, acc_hint, alive, why,
+            where, slowest)  # fmt: skip
     grid = (family, par, poses, branches, qdot_max, scratch, cq, sq, qd, status, need, alive,
             why, where, slowest, acc_hint, bound, reach, index, steps_c, qddot_max,
             steps)  # fmt: skip

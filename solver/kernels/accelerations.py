@@ -7,8 +7,8 @@ branch is the one with the highest mu_acc (:func:`solver.path.tracking.choose_br
 within ``ACC_TIE_RTOL`` to the first). The kernels do the same here, with the limit's hooks
 (:mod:`solver.kernels.limits`), and prune the branches as without the limits
 (:mod:`solver.kernels.acc_cells`): a branch is known either whole (its mu_acc, where it binds,
-V_acc per waypoint: :func:`scan_row`) or by a bound of its mu_acc, its running minimum of
-V_max (mu_acc <= mu_path) or one stencil row's V_acc (:func:`probe_acc_rows`,
+V_acc per waypoint: :func:`solver.kernels.acc_scan.scan_row`) or by a bound of its mu_acc, its
+running minimum of V_max (mu_acc <= mu_path) or one stencil row's V_acc (:func:`probe_acc_rows`,
 :func:`probe_free_acc_rows`), and is left once the bound is below its limit
 (:func:`solver.kernels.cell.set_limits`). Branches of one shoulder share joints (a UR's
 wrist_3 differs between them by pi, which no second difference sees): their V_acc there is
@@ -143,63 +143,6 @@ def left_at_probes(  # type: ignore[no-untyped-def]  # pragma: no cover - compil
 
 
 @njit(cache=True, error_model="numpy", nogil=True, inline="always")
-def moved_steps(cq, sq, qs, b, lo, hi, moves, steps):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
-    """:func:`spun_steps` with the spin's moves made (``moves``), lo < w <= hi.
-
-    The same bits: the pair's step plus the move times J^-1 [0; z_tool], brought into
-    [-pi, pi]; with no move (fixed spin, or no feed) the pair's step itself.
-    """
-    for w in range(lo + 1, hi + 1):
-        move = moves[w]
-        for j in range(N_JOINTS):
-            step = pair_step(cq[b, j, w - 1], sq[b, j, w - 1], cq[b, j, w], sq[b, j, w])
-            steps[w, j] = wrapped_step(step + move * qs[b, j, w - 1])
-
-
-@njit(cache=True, error_model="numpy", nogil=True)
-def scan_row(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
-    i, limit, b, cq, sq, qs, moves, index, c, waypoints, qddot_max, feed, acc_at, acc_joint,
-    acc_speeds, acc_hint, steps, alive, why, where, slowest,
-):  # fmt: skip
-    """Row i's mu_acc, the branch followed to the end; or the row left below ``limit``.
-
-    Scanned along its steps (:func:`moved_steps`; ``moves`` from
-    :func:`solver.kernels.spin_schedule.spin_moves` in free
-    spin, zeros in fixed spin): as soon as the least V_acc so far is below ``limit`` the row
-    is left (:func:`solver.kernels.cell.prune`, its bound the least of that V_acc and its
-    mu_path). A row scanned to the end has its mu_acc in ``feed``, min(mu_path, least V_acc)
-    (the first waypoint and joint at a tie; where it binds in ``acc_at``, ``acc_joint`` and
-    ``acc_hint``, V_acc per waypoint in ``acc_speeds``). Arrays as :func:`acc_work` makes
-    them; ``index``, ``c``, ``waypoints``: the blend stencil
-    (:func:`solver.kernels.limits.step_stencil`).
-    """
-    keep = acc_speeds.shape[1] > 0
-    if keep:
-        acc_speeds[i, :] = np.inf
-    largest, at, joint, built, left = -1.0, -1, -1, 0, False
-    for k in range(waypoints.shape[0]):
-        start, span = index[k, 0], index[k, -1] - index[k, 0]
-        moved_steps(cq, sq, qs, b, built, start + span, moves, steps)
-        built = max(built, start + span)
-        worst, limiting = acceleration_at(steps, start, span, c, k, qddot_max)
-        if keep:
-            acc_speeds[i, waypoints[k]] = 1.0 / math.sqrt(worst)
-        if worst > largest:  # V_acc = 1 / sqrt(worst) below the least so far
-            largest, at, joint = worst, k, limiting
-            if 1.0 / math.sqrt(worst) < limit:
-                left = True
-                break
-    least = 1.0 / math.sqrt(largest) if at >= 0 else np.inf
-    if left:
-        prune(i, at, min(slowest[i], least), alive, why, where, slowest, acc_hint)
-        return
-    feed[i] = min(slowest[i], least)
-    acc_at[i] = waypoints[at] if at >= 0 else -1
-    acc_joint[i] = joint
-    acc_hint[i] = at
-
-
-@njit(cache=True, error_model="numpy", nogil=True, inline="always")
 def probed_speed(i, k, b, cq, sq, status, index, c, qddot_max, steps):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
     """Row i's V_acc at stencil row k from its pairs (no spin), -inf where it fails there.
 
@@ -241,8 +184,8 @@ def probe_acc_rows(  # type: ignore[no-untyped-def]  # pragma: no cover - compil
     """Fixed spin: leave the rows in ``todo`` whose V_acc at stencil row k is below ``limit``.
 
     The stencil's waypoints solved for those rows (the family's pose kernel); V_acc from the
-    steps of their pairs, the bits :func:`scan_row` forms there. The others keep in ``bound``
-    the least bound seen (:func:`solver.kernels.cell.next_row`).
+    steps of their pairs, the bits :func:`solver.kernels.acc_scan.scan_row` forms there. The
+    others keep in ``bound`` the least bound seen (:func:`solver.kernels.cell.next_row`).
     """
     need[:] = False
     for i in range(branches.shape[0]):
@@ -270,7 +213,8 @@ def probe_free_acc_rows(  # type: ignore[no-untyped-def]  # pragma: no cover - c
     (the least V_max its probes saw) is at least that. Where even at ``reach`` the spin rate
     nearest zero is zero on every segment of the stencil
     (:func:`solver.kernels.spin_schedule.no_spin_below`), it is zero at the row's mu_path too,
-    and V_acc there is that of its pairs, the bits :func:`scan_row` forms; other rows are not
+    and V_acc there is that of its pairs, the bits :func:`solver.kernels.acc_scan.scan_row`
+    forms; other rows are not
     probed here.
     """
     need[:] = False

@@ -55,6 +55,7 @@ from numba import njit
 from solver.core.codes import FEASIBLE, TIE_RTOL
 from solver.families.kernels import N_JOINTS
 from solver.kernels.acc_cells import fixed_cell
+from solver.kernels.acc_scan import scan_work
 from solver.kernels.accelerations import acc_work, write_acc
 from solver.kernels.cache import drop_stale_compiled_code
 from solver.kernels.cell import (
@@ -141,7 +142,7 @@ def map_cells(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
         max_joint_step: rad.
         qddot_max: shape (6,), rad/s^2, or (0,) without acceleration limits (then the blend
             stencil and the acceleration answers are not read).
-        stencil_index: shape (K, 5), :class:`solver.path.limits.BlendStencil`'s ``index``.
+        stencil_index: shape (K, 5), :class:`solver.path.blend_stencil.BlendStencil`'s ``index``.
         stencil_weight: shape (K, 5), its ``weight``.
         stencil_waypoints: shape (K,), its ``waypoints``.
         mu: shape (C,), out, m/s, NaN where infeasible.
@@ -178,7 +179,11 @@ def map_cells(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
     accelerations = qddot_max.shape[0] > 0
     acc = acc_work(n_branches, n_waypoints, v_acc.shape[1] > 0)
     feed, acc_at, acc_by, acc_speeds = acc[0], acc[1], acc[2], acc[3]
-    stencil = (stencil_index, step_stencil(stencil_index, stencil_weight), stencil_waypoints)
+    steps_c = step_stencil(stencil_index, stencil_weight)
+    rows = scan_work(
+        stencil_index, steps_c, n_waypoints, segment_checked, max_joint_step, qddot_max
+    )
+    stencil = (stencil_index, steps_c, stencil_waypoints, rows)
     work = (todo, limit, remaining, bound)
     inverse_qdot = 1.0 / qdot_max
     guess = np.int64(0)  # not the literal 0: the callees get one compiled signature, not two

@@ -11,15 +11,16 @@ tested against (tests/solver/test_free_spin_kernel.py). Per placement:
 2. each branch: unreachable, singular, then the step test against the previous waypoint, no
    position limits (they hold along the spin schedule); V_max by the exact two-variable LP
    (:func:`solver.kernels.limits.two_variable_speed`, as
-   :func:`solver.core.dtf.two_variable_speed`) and its running minimum, mu_path;
+   :func:`solver.core.two_variable_lp.two_variable_speed`) and its running minimum, mu_path;
 3. without acceleration limits, the branches pruned (:mod:`solver.kernels.cell`,
    :mod:`solver.kernels.free_follow`): the branch the previous placement chose first, then the
    most promising, each followed to the end tracked again along its spin schedule (the spin
-   rate nearest zero at the feed mu_path, :func:`solver.core.dtf.spin_rate_nearest_zero`; the
-   joints moved by the spin, :func:`solver.path.spin_schedule.spin_schedule`; that joint path
-   tracked with the position limits and the step test, :func:`solver.path.tracking.track`,
-   in :mod:`solver.kernels.spin_schedule`); the others probed and left once they cannot be
-   chosen, and followed to the end after all where the answer might depend on them;
+   rate nearest zero at the feed mu_path,
+   :func:`solver.core.two_variable_lp.spin_rate_nearest_zero`; the joints moved by the spin,
+   :func:`solver.path.spin_schedule.spin_schedule`; that joint path tracked with the position
+   limits and the step test, :func:`solver.path.tracking.track`, in
+   :mod:`solver.kernels.spin_schedule`); the others probed and left once they cannot be chosen,
+   and followed to the end after all where the answer might depend on them;
 4. with joint acceleration limits, the branches pruned likewise by mu_acc
    (:mod:`solver.kernels.acc_cells`): each followed to the end is tracked along its spin
    schedule and its mu_acc formed from the spun path's steps;
@@ -36,6 +37,7 @@ from numba import njit
 from solver.core.codes import FEASIBLE, TIE_RTOL
 from solver.families.kernels import N_JOINTS
 from solver.kernels.acc_cells import free_cell
+from solver.kernels.acc_scan import scan_work
 from solver.kernels.accelerations import acc_work, write_acc
 from solver.kernels.cache import drop_stale_compiled_code
 from solver.kernels.cell import (
@@ -150,7 +152,11 @@ def free_cells(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
     keep_acc = v_acc.shape[1] > 0
     acc = acc_work(n_branches, n_waypoints, keep_acc)
     feed, acc_at, acc_by, acc_speeds = acc[0], acc[1], acc[2], acc[3]
-    stencil = (stencil_index, step_stencil(stencil_index, stencil_weight), stencil_waypoints)
+    steps_c = step_stencil(stencil_index, stencil_weight)
+    rows = scan_work(
+        stencil_index, steps_c, n_waypoints, segment_checked, max_joint_step, qddot_max
+    )
+    stencil = (stencil_index, steps_c, stencil_waypoints, rows)
     todo = np.empty(n_branches, dtype=np.bool_)
     remaining = np.empty(n_branches, dtype=np.bool_)
     hint = np.full(n_branches, -1)

@@ -40,10 +40,10 @@ def joint_speed_bound(qd, b, w, inverse_qdot):  # type: ignore[no-untyped-def]  
 def two_variable_speed(qd, qs, b, w, qdot_max):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
     """Joint speeds in free spin: the largest s with |s a_j + sigma b_j| <= qdot_max_j, and j.
 
-    :func:`solver.core.dtf.two_variable_speed` at waypoint w of branch b (a = qd[b, :, w],
-    J^-1 t_hat; b = qs[b, :, w], J^-1 [0; z_tool]; both shape (8, 6, W); ``qdot_max`` shape
-    (6,), rad/s): the least pair bound, the first pair at a tie, of the pair the joint sigma
-    helps less.
+    :func:`solver.core.two_variable_lp.two_variable_speed` at waypoint w of branch b
+    (a = qd[b, :, w], J^-1 t_hat; b = qs[b, :, w], J^-1 [0; z_tool]; both shape (8, 6, W);
+    ``qdot_max`` shape (6,), rad/s): the least pair bound, the first pair at a tie, of the pair
+    the joint sigma helps less.
     """
     best = np.inf
     first, second = 0, 1

@@ -156,6 +156,25 @@ _HALF_TURN = 1e-9
 
 
 @njit(cache=True, error_model="numpy", nogil=True, inline="always")
+def series_holds(cross, dot):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
+    """Whether :func:`small_step` gives the step of a pair's ``cross`` and ``dot`` products.
+
+    Without a branch (``&``), so that a loop of them vectorises; False where either is NaN.
+    """
+    return (dot > 0.0) & (abs(cross) <= _SERIES)
+
+
+@njit(cache=True, error_model="numpy", nogil=True, inline="always")
+def small_step(cross):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
+    """asin(cross) by its series (:data:`_ASIN`), for |cross| <= _SERIES and a positive dot."""
+    x2 = cross * cross
+    series = _ASIN[7]
+    for term in range(6, -1, -1):
+        series = series * x2 + _ASIN[term]
+    return cross * series
+
+
+@njit(cache=True, error_model="numpy", nogil=True, inline="always")
 def pair_step(c0, s0, c1, s1):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
     """The angle from the (cos, sin) pair (c0, s0) to (c1, s1), in [-pi, pi].
 
@@ -171,12 +190,8 @@ def pair_step(c0, s0, c1, s1):  # type: ignore[no-untyped-def]  # pragma: no cov
     """
     cross = c0 * s1 - s0 * c1
     dot = c0 * c1 + s0 * s1
-    if dot > 0.0 and abs(cross) <= _SERIES:
-        x2 = cross * cross
-        series = _ASIN[7]
-        for term in range(6, -1, -1):
-            series = series * x2 + _ASIN[term]
-        return cross * series
+    if series_holds(cross, dot):
+        return small_step(cross)
     step = math.atan2(cross, dot)
     if abs(step) > math.pi - _HALF_TURN:
         return wrapped_step(math.atan2(s1, c1) - math.atan2(s0, c0))

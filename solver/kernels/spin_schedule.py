@@ -17,13 +17,13 @@ from solver.core.codes import FEASIBLE, REASON_DISCONTINUOUS, REASON_JOINT_LIMIT
 from solver.families.kernels import N_JOINTS
 from solver.kernels.positions import first_outside, wrapped_step
 
-_INSIDE = 1.0 - 1e-12  # as solver.core.dtf.spin_rate_nearest_zero
+_INSIDE = 1.0 - 1e-12  # as solver.core.two_variable_lp.spin_rate_nearest_zero
 _HUGE = np.finfo(np.float64).max  # numpy.nan_to_num's value for inf
 
 
 @njit(cache=True, error_model="numpy", nogil=True)
 def spin_rate(qd, qs, b, w, qdot_max, feed):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
-    """:func:`solver.core.dtf.spin_rate_nearest_zero` at one waypoint, at the feed."""
+    """:func:`solver.core.two_variable_lp.spin_rate_nearest_zero` at one waypoint, at the feed."""
     inside = feed * _INSIDE
     low, high = -np.inf, np.inf
     for j in range(N_JOINTS):

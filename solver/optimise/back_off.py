@@ -13,7 +13,7 @@ import numpy as np
 
 from solver.optimise.candidate import Candidate
 from solver.optimise.search_space import PlacementBounds, placement_rows
-from solver.path.placements import PlacementEvaluator
+from solver.path.placement_evaluator import PlacementEvaluator
 from solver.path.problem import PathProblem
 
 BACK_OFF_STEPS = 12  # bisections: the point found is within 1/4096 of the segment of the edge

@@ -31,7 +31,8 @@ from solver.optimise.search_space import (
     decision_vector,
     placement_rows,
 )
-from solver.path.placements import PlacementEvaluator, evaluate_placements
+from solver.path.placement_evaluator import PlacementEvaluator
+from solver.path.placements import evaluate_placements
 from solver.path.problem import PathProblem
 
 # Half the coarse map's step of each variable: the first steps of both searches.

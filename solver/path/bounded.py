@@ -35,8 +35,9 @@ import numpy as np
 from solver.core.codes import TIE_RTOL, UNREACHABLE
 from solver.core.family import PathSolutions
 from solver.core.follows_in_steps import FollowsInSteps
+from solver.path.chunk import Chunk
 from solver.path.problem import PathProblem
-from solver.path.pruning import Chunk, can_prune
+from solver.path.pruning import can_prune
 
 MARGIN = 1e-13
 """Relative slack on a dropped slot's bound: the kernel's V_max come from the unwrapped

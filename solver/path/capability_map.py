@@ -16,7 +16,7 @@ from solver.core.codes import REASONS
 from solver.core.exceptions import InvalidInputError
 from solver.core.parallel import SERIAL, TaskRunner
 from solver.core.spatial import Placement
-from solver.path.cell.checker import cell_pose_cost
+from solver.path.cell.cost import cell_pose_cost
 from solver.path.placements import DEFAULT_CHUNK, evaluate_placements
 from solver.path.problem import PathProblem
 from solver.path.pruning import can_prune

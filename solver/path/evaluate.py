@@ -17,10 +17,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from solver.core.codes import FEASIBLE, REASONS, Reason
-from solver.core.dtf import spin_rate_nearest_zero
 from solver.core.family import Branch
 from solver.core.progress import Progress
 from solver.core.spatial import Placement, rotation_about_z
+from solver.core.two_variable_lp import spin_rate_nearest_zero
 from solver.kernels.spin_lp import spin_rate_at_feed
 from solver.path.cell.verdict import CellVerdict, Contact
 from solver.path.limits import JointAccelerationLimit, JointMotion, PathVerdict, bound_by_limits

@@ -16,74 +16,13 @@ import numpy as np
 
 from solver.core.codes import FEASIBLE
 from solver.core.family import PathSolutions
+from solver.path.chosen_paths import chosen_joint_paths, chunk_solutions, per_placement
 from solver.path.limits import PathVerdict
 from solver.path.pipeline import ChunkResult, run_chunk
-from solver.path.placed import placed_flange
 from solver.path.problem import PathProblem
-from solver.path.tracking import track
 
 # The columns of a pipeline run's placements, each at its ``pick`` (the branch to report).
 Columns = Callable[[ChunkResult], tuple[np.ndarray, ...]]
-
-
-def chunk_solutions(problem: PathProblem, placements: np.ndarray) -> PathSolutions | None:
-    """The family's IK at placements (C, 5) of one spin; None in free spin (its own path)."""
-    if problem.options.spin_mode == "free" or not len(placements):
-        return None
-    _, rotation, flange_position = placed_flange(problem, placements)
-    return problem.family.solve_path(rotation, flange_position)
-
-
-def _per_placement(solutions: PathSolutions | None) -> bool:
-    """An analytic family's solutions: each placement solved on its own, every branch a row.
-
-    A subset's solutions are then these arrays' columns, the same floats (a numeric family
-    seeds a chunk together).
-    """
-    return solutions is not None and solutions.seeds is None and solutions.slots is None
-
-
-def tracked_joint_paths(
-    problem: PathProblem,
-    placements: np.ndarray,
-    rows: np.ndarray,
-    solutions: PathSolutions | None = None,
-) -> np.ndarray | None:
-    """The joint paths a run on one branch gives, each placement on its own branch.
-
-    What :func:`solver.path.pipeline.run_chunk` tracks at placement c with the problem's
-    branch set to the family's branch ``rows[c]``, without the joint speeds (a path check
-    needs the angles alone); one IK solve for every placement.
-
-    Args:
-        problem: the problem (fixed spin: free spin tracks its spin schedule's path).
-        placements: shape (C, 5), one spin, checked.
-        rows: shape (C,), an index into the family's branches per placement.
-        solutions: :func:`chunk_solutions` at the placements, if already made.
-
-    Returns:
-        shape (C, W, n), rad; None where the family answers in slots (numeric IK) or the
-        spin is free: there :func:`solver.path.pipeline.run_chunk` on each branch is the way.
-    """
-    if problem.options.spin_mode == "free":
-        return None
-    if solutions is None:
-        _, rotation, flange_position = placed_flange(problem, placements)
-        solutions = problem.family.solve_path(rotation, flange_position)
-    if solutions.slots is not None:
-        return None
-    cells = np.arange(len(placements))
-    robot = problem.robot
-    tracked = track(
-        solutions.q[:, rows, cells][:, None],  # (n, 1, C, W): one branch, as run_chunk's
-        solutions.status[rows, cells][None],
-        lower=robot.q_lower,
-        upper=robot.q_upper,
-        max_joint_step=problem.options.max_joint_step,
-        segment_checked=problem.prepared.segment_in_pass,
-    )
-    joint_paths: np.ndarray = tracked.q[:, 0].transpose(1, 2, 0)
-    return joint_paths
 
 
 def check_path(
@@ -194,7 +133,7 @@ def refuse_colliding(
     family = problem.family
     order = np.flatnonzero(reason == FEASIBLE)
     solutions = chunk_solutions(problem, placements[order])
-    joint_paths = _chosen_joint_paths(problem, placements[order], branch[order], solutions)
+    joint_paths = chosen_joint_paths(problem, placements[order], branch[order], solutions)
     if joint_paths is None:  # one run per branch taken
         joint_paths = np.empty((len(order), problem.prepared.n_waypoints, problem.robot.dof))
         for b in np.unique(branch[order]):
@@ -209,21 +148,9 @@ def refuse_colliding(
         if verdict is not None and verdict.failed_waypoint is not None
     }
     if refused:
-        known = (order, solutions) if solutions is not None and _per_placement(solutions) else None
+        known = (order, solutions) if solutions is not None and per_placement(solutions) else None
         _next_branches(problem, placements, out, refused, columns_of, known)
     return tuple(out)
-
-
-def _chosen_joint_paths(
-    problem: PathProblem,
-    placements: np.ndarray,
-    branch: np.ndarray,
-    solutions: PathSolutions | None,
-) -> np.ndarray | None:
-    """The joint paths (C, W, n) of each placement's branch (family indices); None: run each."""
-    if not len(placements):
-        return np.zeros((0, problem.prepared.n_waypoints, problem.robot.dof))
-    return tracked_joint_paths(problem, placements, branch, solutions)
 
 
 def _next_branches(
@@ -254,15 +181,19 @@ def _next_branches(
         chosen = np.array(run.pick, copy=True)
         orders = [branch_order(run, k) for k in range(len(cells))]
         step = [0] * len(cells)
+        hints = [refused[int(c)][1] for c in cells]  # each placement's last refusal
         while True:
             due: list[tuple[int, int]] = []  # (placement k, branch) checked this round
             for k, c in enumerate(cells):
                 while not taken[k] and step[k] < len(orders[k]):
                     b = orders[k][step[k]]
-                    if not np.array_equal(run.tracked.q[:, b, k].T, refused[int(c)][0]):
+                    q = run.tracked.q[:, b, k].T
+                    if not np.array_equal(q, refused[int(c)][0]) and not _refused_again(
+                        problem, q, rows[k], hints[k]
+                    ):
                         due.append((k, b))
                         break
-                    step[k] += 1  # the refused joint path itself
+                    step[k] += 1  # the refused joint path itself, or one refused where it was
             if not due:
                 break
             joint_paths = np.array([run.tracked.q[:, b, k].T for k, b in due])
@@ -271,6 +202,8 @@ def _next_branches(
                 step[k] += 1
                 if not _refused(verdict):
                     chosen[k], taken[k] = b, True
+                elif verdict is not None:
+                    hints[k] = verdict
         if taken.any():
             picked = columns_of(dataclasses.replace(run, pick=chosen))
             for column, value in zip(out, picked, strict=True):
@@ -278,6 +211,17 @@ def _next_branches(
     for c in cells[~taken]:
         verdict = refused[int(c)][1]
         _refuse(out, int(c), problem.path_checks[0].reason, int(verdict.failed_waypoint or 0))
+
+
+def _refused_again(
+    problem: PathProblem, q: np.ndarray, placement: np.ndarray, refusal: PathVerdict
+) -> bool:
+    """Whether a check refuses ``q`` (W, n) where it refused another path of the placement.
+
+    Of the next branches only whether they pass counts (the pick's refusal is reported): a
+    quick test never wrong when it refuses (:meth:`PathCheck.refuses_at`) spares a whole check.
+    """
+    return any(check.refuses_at(q, placement, refusal) for check in problem.path_checks)
 
 
 def _refuse(columns: list[np.ndarray], c: int, reason: int, waypoint: int) -> None:

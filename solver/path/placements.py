@@ -29,7 +29,7 @@ from solver.path.pipeline import ChunkResult, run_chunk
 from solver.path.placed import check_placements
 from solver.path.problem import PathProblem
 
-__all__ = ["PlacementEvaluator", "PlacementResults", "evaluate_placements"]
+__all__ = ["PlacementResults", "columns_of_run", "evaluate_placements", "results_of_columns"]
 
 DEFAULT_CHUNK = 32
 
@@ -96,10 +96,12 @@ def _chunk(
     V_max along the path is (C, W) when ``with_speeds``, else (C, 0): a map of millions of
     placements keeps nothing per waypoint. Then the acceleration columns of :func:`_acc_columns`.
     """
-    return _columns(problem, run_chunk(problem, placements, prune=prune), with_speeds)
+    return columns_of_run(problem, run_chunk(problem, placements, prune=prune), with_speeds)
 
 
-def _columns(problem: PathProblem, run: ChunkResult, with_speeds: bool) -> tuple[np.ndarray, ...]:
+def columns_of_run(
+    problem: PathProblem, run: ChunkResult, with_speeds: bool
+) -> tuple[np.ndarray, ...]:
     """The columns of :func:`_chunk` from a pipeline run, each placement at its ``pick``."""
     branches = problem.branches
     pick, columns = run.pick, np.arange(len(run.pick))
@@ -160,7 +162,7 @@ def _task(
     else:
         parts = [_chunk(problem, rows, with_speeds, prune) for rows in _pieces(placements, chunk)]
     if problem.path_checks:
-        columns_of = partial(_columns, problem, with_speeds=with_speeds)
+        columns_of = partial(columns_of_run, problem, with_speeds=with_speeds)
         pieces = _pieces(placements, chunk)
         parts = [
             refuse_colliding(problem, rows, part, columns_of)
@@ -240,10 +242,10 @@ def evaluate_placements(
     empty = (np.zeros(0), *(np.zeros(0, dtype=int),) * 5, np.zeros((0, n_waypoints)))
     empty += no_acc_columns(0, n_waypoints)
     columns = [np.concatenate(c) for c in zip(*parts, strict=True)] if parts else list(empty)
-    return _results(problem, columns, with_speeds)
+    return results_of_columns(problem, columns, with_speeds)
 
 
-def _results(
+def results_of_columns(
     problem: PathProblem, columns: list[np.ndarray], with_speeds: bool
 ) -> PlacementResults:
     """The results of the columns of :func:`_chunk` (the acceleration ones where limits are)."""
@@ -264,40 +266,3 @@ def _results(
         acc_joint=acc_joint if accelerations else None,
         v_acc=v_acc if accelerations and with_speeds else None,
     )
-
-
-class PlacementEvaluator:
-    """mu_path of one path at placements asked for one or a few at a time (the local searches).
-
-    The same answers as :func:`evaluate_placements` with the same settings: the same compiled
-    kernel, or that function itself where the family has no kernel. The
-    kernel's inputs are made once per spin, not once per call, and no tasks are planned: the
-    optimisers' Nelder-Mead climbs ask for one placement at a time, 1,200 times an
-    optimisation, and that preparation cost twice the kernel's own time.
-    """
-
-    def __init__(self, problem: PathProblem) -> None:
-        """An evaluator of the problem's path on its robot, on the ``auto`` branch.
-
-        Raises:
-            NoAnalyticIkError, InvalidInputError: as :func:`evaluate_placements`.
-        """
-        self._problem = problem.with_options(branch=None)
-        _ = self._problem.branches  # the options checked first
-        _ = self._problem.path_checks
-        self._kernel = kernel_of(self._problem)
-        self._last: tuple[float, KernelInputs] | None = None  # the spin asked for last
-
-    def __call__(self, placements: np.ndarray) -> PlacementResults:
-        """mu_path at P placements, shape (P, 5) as :func:`evaluate_placements` takes them."""
-        cells = check_placements(placements)
-        if self._kernel is None or np.any(cells[:, 4] != cells[0, 4]):
-            return evaluate_placements(self._problem, cells)
-        spin = float(cells[0, 4])
-        if self._last is None or self._last[0] != spin:
-            self._last = (spin, kernel_inputs(self._problem, spin, self._kernel))
-        columns = run_kernel(self._last[1], cells, False)
-        if self._problem.path_checks:
-            columns_of = partial(_columns, self._problem, with_speeds=False)
-            columns = refuse_colliding(self._problem, cells, columns, columns_of)
-        return _results(self._problem, list(columns), False)

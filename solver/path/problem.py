@@ -24,17 +24,12 @@ import numpy as np
 from solver.core.exceptions import InvalidInputError, NoAnalyticIkError, quoted
 from solver.core.family import Branch, KinematicsFamily
 from solver.core.robots import Robot
+from solver.path.blend_stencil import BlendStencil
 from solver.path.cell.cache import checker_for
-from solver.path.cell.checker import cell_pose_cost
+from solver.path.cell.cost import cell_pose_cost
 from solver.path.cell.limit import CellLimit
 from solver.path.cell.shapes import Cell
-from solver.path.limits import (
-    BlendStencil,
-    JointAccelerationLimit,
-    JointSpeedLimit,
-    Limit,
-    PathCheck,
-)
+from solver.path.limits import JointAccelerationLimit, JointSpeedLimit, Limit, PathCheck
 from solver.path.prepare import PreparedPath, prepare_path
 
 DEFAULT_MAX_JOINT_STEP = 0.35
@@ -184,7 +179,7 @@ class PathProblem:
         """The work of one placement of ``n_waypoints``, in poses of a closed-form family's map.
 
         The family's cost (:meth:`KinematicsFamily.path_cost`), times the collision check's
-        (:func:`solver.path.cell.checker.cell_pose_cost`) with a cell: what the size limits of
+        (:func:`solver.path.cell.cost.cell_pose_cost`) with a cell: what the size limits of
         the maps and searches weigh.
         """
         cost = self.family.path_cost(n_waypoints, free_spin=self.options.spin_mode == "free")

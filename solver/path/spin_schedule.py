@@ -10,8 +10,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from solver.core.dtf import spin_rate_nearest_zero
 from solver.core.progress import Progress, span
+from solver.core.two_variable_lp import spin_rate_nearest_zero
 from solver.path.in_pieces import spin_rates_in_pieces, track_in_pieces
 from solver.path.limits import JointMotion
 from solver.path.problem import PathProblem

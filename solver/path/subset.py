@@ -18,7 +18,8 @@ import dataclasses
 
 import numpy as np
 
-from solver.path.limits import BlendStencil, JointAccelerationLimit, Limit
+from solver.path.blend_stencil import BlendStencil
+from solver.path.limits import JointAccelerationLimit, Limit
 from solver.path.prepare import PreparedPath
 from solver.path.problem import PathProblem
 

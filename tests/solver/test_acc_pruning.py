@@ -14,7 +14,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from solver.core.dtf import spin_rate_nearest_zero
+from solver.core.two_variable_lp import spin_rate_nearest_zero
 from solver.families import get_robot
 from solver.kernels.accelerations import probed_before
 from solver.kernels.spin_schedule import spin_moves

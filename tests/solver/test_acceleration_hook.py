@@ -20,7 +20,8 @@ from solver.kernels.accelerations import pair_steps, spun_steps
 from solver.kernels.limits import acceleration_at, step_stencil
 from solver.kernels.positions import relative_path
 from solver.kernels.spin_schedule import spun_failure
-from solver.path.limits import BlendStencil, JointAccelerationLimit, JointMotion
+from solver.path.blend_stencil import BlendStencil
+from solver.path.limits import JointAccelerationLimit, JointMotion
 
 
 def numpy_bound(path: np.ndarray, limit: JointAccelerationLimit) -> tuple[np.ndarray, int, int]:

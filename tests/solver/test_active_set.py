@@ -18,7 +18,8 @@ from solver.families import get_robot
 from solver.optimise import active_set, coarse_rows
 from solver.optimise.coarse_search import coarse_cells
 from solver.optimise.methods import casadi_method
-from solver.optimise.optimize import PlacementOptimum, optimize_placement
+from solver.optimise.optimize import optimize_placement
+from solver.optimise.optimum import PlacementOptimum
 from solver.optimise.search_space import PlacementBounds
 from solver.path.evaluate import evaluate_path
 from solver.path.placements import evaluate_placements

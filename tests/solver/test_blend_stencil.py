@@ -6,7 +6,7 @@ import numpy as np
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from solver.path.limits import BlendStencil
+from solver.path.blend_stencil import BlendStencil
 from tests.cases import SECOND_DIFFERENCE_RTOL
 from tests.solver.test_acceleration import independent_second_difference
 

@@ -9,10 +9,10 @@ import numpy as np
 import pytest
 import scipy.optimize
 
-from solver.core.dtf import spin_rate_nearest_zero, two_variable_speed
 from solver.core.exceptions import InvalidInputError
 from solver.core.kinematics import jacobian_in_base, tool_pose_in_base
 from solver.core.spatial import Placement
+from solver.core.two_variable_lp import spin_rate_nearest_zero, two_variable_speed
 from solver.families import get_robot, robot_from_urdf
 from solver.optimise.search_space import PlacementBounds
 from tests.cases import (

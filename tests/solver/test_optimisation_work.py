@@ -28,7 +28,7 @@ from solver.optimise.methods import casadi_method, placement_scipy
 from solver.optimise.search_space import PlacementBounds
 from solver.optimise.work import work_of
 from solver.path.cell.shapes import Cell
-from solver.path.placements import PlacementEvaluator
+from solver.path.placement_evaluator import PlacementEvaluator
 from solver.path.problem import PathOptions, PathProblem
 from tests.solver.test_cell import OPT_BOUNDS, blocking_cell
 from tests.solver.test_evaluate import load_path

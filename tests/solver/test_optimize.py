@@ -15,7 +15,7 @@ from solver.core.robots import Robot
 from solver.core.spatial import Placement
 from solver.families import get_robot
 from solver.optimise import local_search
-from solver.optimise.optimize import PlacementOptimum
+from solver.optimise.optimum import PlacementOptimum
 from solver.optimise.search_space import PlacementBounds, vector_of
 from solver.optimise.symmetry import arc_coordinates, arc_point, turns_about_base_z
 from solver.path.capability_map import grid_axis

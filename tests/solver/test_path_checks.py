@@ -2,7 +2,7 @@
 
 A map with a cell checks each feasible placement's chosen joint path; the refused ones run the
 pipeline again for their next branches, taking the IK already solved for the chunk
-(:func:`solver.path.path_checks.chunk_solutions`). That rests on an analytic family solving
+(:func:`solver.path.chosen_paths.chunk_solutions`). That rests on an analytic family solving
 each placement on its own: a subset's solutions equal to the bit the full set's columns
 (checked here against the family solving the subset alone); and the map is the map without the
 reuse, every field to the bit.
@@ -13,6 +13,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+import solver.path.chosen_paths as chosen_paths
 import solver.path.path_checks as path_checks
 from solver.core.robots import Robot
 from solver.families import get_robot, robot_from_urdf
@@ -48,8 +49,8 @@ def test_subset_solutions_are_the_full_sets_columns(name: str) -> None:
                 np.zeros(count),
             ]
         )
-        solutions = path_checks.chunk_solutions(problem, placements)
-        assert solutions is not None and path_checks._per_placement(solutions)
+        solutions = chosen_paths.chunk_solutions(problem, placements)
+        assert solutions is not None and chosen_paths.per_placement(solutions)
         subset = np.sort(rng.choice(count, int(rng.integers(1, count + 1)), replace=False))
         _, rotation, position = placed_flange(problem, placements[subset])
         alone = problem.family.solve_path(rotation, position)
@@ -81,7 +82,7 @@ def test_map_reusing_the_ik_equals_without(name: str, monkeypatch: pytest.Monkey
     given.clear()
     free = capability_map(plain, **axes)  # type: ignore[arg-type]
     assert ((reused.branch != free.branch) & (reused.reason == -1)).any()  # next branches
-    monkeypatch.setattr(path_checks, "_per_placement", lambda solutions: False)
+    monkeypatch.setattr(path_checks, "per_placement", lambda solutions: False)
     again = capability_map(problem, **axes)  # type: ignore[arg-type]
     assert given and not any(given)
     fields = [k for k, v in vars(reused).items() if isinstance(v, np.ndarray)]

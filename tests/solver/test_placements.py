@@ -14,7 +14,7 @@ from solver.core.malloc import raise_malloc_thresholds
 from solver.core.spatial import Placement
 from solver.families import get_robot
 from solver.families.ur.ik import BRANCHES
-from solver.path.placements import PlacementEvaluator
+from solver.path.placement_evaluator import PlacementEvaluator
 from tests.cases import MAP_EVALUATE_RTOL
 from tests.problems import evaluate_path, evaluate_placements, prepare_path
 from tests.solver.test_evaluate import load_path

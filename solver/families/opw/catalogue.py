@@ -7,7 +7,8 @@ import math
 import numpy as np
 
 from solver.core.exceptions import InvalidInputError
-from solver.core.robots import Robot, check_speed_limits, robot_from_model
+from solver.core.joint_limits import check_speed_limits
+from solver.core.robots import Robot, robot_from_model
 from solver.families.opw.arms import ARMS
 from solver.families.opw.family import OpwFamily
 from solver.families.opw.model import opw_model

@@ -66,7 +66,7 @@ def acceleration_rows(
     """The rows D_ij s^2 of joint acceleration limits, and their bounds a_j (motion.md s. 3).
 
     D_i is linear in the joint values: the blend stencil's weights of five waypoints' q
-    (:class:`solver.path.limits.BlendStencil`, path-only), so each row is |D_ij| s^2 <= a_j,
+    (:class:`solver.path.blend_stencil.BlendStencil`, path-only), so each row is |D_ij| s^2 <= a_j,
     as -a_j <= D_ij s^2 <= a_j. None (no rows) without acceleration limits.
 
     Returns:

@@ -36,8 +36,9 @@ from typing import Any
 import casadi
 import numpy as np
 
-from solver.core.progress import Cancelled, Progress
+from solver.core.progress import Progress
 from solver.optimise.methods.casadi_kinematics import symbolic_kinematics
+from solver.optimise.methods.ipopt_iterations import MAX_ITERATIONS, IterationHook
 from solver.optimise.methods.nlp_derivatives import NLP_THREADS, Layout
 from solver.optimise.methods.nlp_derivatives import derivatives as assembled_derivatives
 from solver.optimise.methods.nlp_terms import (
@@ -55,45 +56,6 @@ _MARGIN = 1e-9
 
 # casadi's bundled stubs reject valid SX/MX expressions (DM + SX, MX in nlpsol): untyped here.
 ca: Any = casadi
-MAX_ITERATIONS = 300
-
-
-class _IterationHook(ca.Callback):  # type: ignore[misc]
-    """IPOPT's call after each iteration: reports progress; a :class:`Cancelled` stops IPOPT."""
-
-    def __init__(self, n_variables: int, n_constraints: int) -> None:
-        ca.Callback.__init__(self)
-        self._sizes = {"x": n_variables, "lam_x": n_variables}
-        self._sizes |= {"g": n_constraints, "lam_g": n_constraints, "f": 1}
-        self.progress: Progress | None = None
-        self.cancelled: Cancelled | None = None
-        self.iteration = 0
-        self.construct("iteration_hook", {})
-
-    def get_n_in(self) -> int:
-        return int(ca.nlpsol_n_out())
-
-    def get_n_out(self) -> int:
-        return 1
-
-    def get_name_in(self, i: int) -> str:
-        return str(ca.nlpsol_out(i))
-
-    def get_name_out(self, i: int) -> str:
-        return "stop"
-
-    def get_sparsity_in(self, i: int) -> Any:
-        size = self._sizes.get(str(ca.nlpsol_out(i)), 0)
-        return ca.Sparsity.dense(size, 1) if size else ca.Sparsity(0, 0)
-
-    def eval(self, arguments: Any) -> list[int]:
-        self.iteration += 1
-        if self.progress is not None and self.cancelled is None:
-            try:
-                self.progress(min(self.iteration / MAX_ITERATIONS, 1.0))
-            except Cancelled as stop:
-                self.cancelled = stop
-        return [1 if self.cancelled is not None else 0]
 
 
 @dataclass(frozen=True)
@@ -210,7 +172,7 @@ class PlacementNlp:
             "ipopt.mu_init": 1e-5,
         }
         options.update({f"ipopt.{k}": v for k, v in (ipopt_options or {}).items()})
-        self._hook = _IterationHook(int(variables.numel()), int(constraints.numel()))
+        self._hook = IterationHook(int(variables.numel()), int(constraints.numel()))
         options["iteration_callback"] = self._hook
         if derivatives:
             options["jac_g"], options["hess_lag"] = assembled_derivatives(

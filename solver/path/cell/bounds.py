@@ -6,6 +6,13 @@ sum_j w_pj |dq_j|, with w_pj a bound on the distance from joint j's axis to the 
 j moves relative to the other object: the chain's length from joint j to the part's joint plus
 the part's extent from its joint (the triangle inequality). A pair at distance d is then clear
 at every configuration within sum_j w_pj |dq_j| < d - clearance (conservative advancement).
+
+Against a ``fixed`` halfspace (the table top) only the motion along its normal n counts: a turn
+dq about an axis k moves every point within the plane normal to k, whose component along n is
+at most |n x k| of the move. For a joint whose axis is fixed in the world (its parent is the
+root: a serial arm's first joint), |n x k| is a constant, and w_pj takes that factor: the first
+joint of an arm standing on its table (k = n) does not move any part towards the table at all,
+so the shoulder's distance to it is checked once a path, the upper arm's when q2 moves.
 """
 
 from __future__ import annotations
@@ -22,13 +29,50 @@ def _lever(model: pin.Model, joint: int, carrier: int) -> float:
 
 
 def _extent(obj: pin.GeometryObject) -> float:
-    """Bound on the distance from an object's joint origin to any of its points (m)."""
+    """Bound on the distance from an object's joint origin to any of its points (m).
+
+    The ball about its local bounding box's centre (``aabb_center``, in the geometry's frame)
+    of radius ``aabb_radius``, placed on the joint: a mesh's box is not centred on its origin
+    (the UR5's upper arm: 0.213 m along z, so 0.50 m where the ball about the origin said 0.29).
+    """
     obj.geometry.computeLocalAABB()
-    return float(np.linalg.norm(obj.placement.translation)) + float(obj.geometry.aabb_radius)
+    placement = obj.placement
+    centre = placement.translation + placement.rotation @ np.asarray(obj.geometry.aabb_center)
+    return float(np.linalg.norm(centre)) + float(obj.geometry.aabb_radius)
+
+
+def _world_axis(model: pin.Model, joint: int) -> np.ndarray | None:
+    """A revolute joint's axis in the world where it is fixed there (its parent the root)."""
+    if model.parents[joint] != 0:
+        return None
+    name = model.joints[joint].shortname().removeprefix("JointModel")
+    if name in ("RX", "RY", "RZ"):
+        local = np.eye(3)["XYZ".index(name[1])]
+    elif name == "RevoluteUnaligned":
+        local = np.asarray(model.joints[joint].extract().axis, dtype=float)
+    else:
+        return None
+    axis: np.ndarray = np.asarray(model.jointPlacements[joint].rotation) @ local
+    unit: np.ndarray = axis / np.linalg.norm(axis)
+    return unit
+
+
+def _halfspace_normal(obj: pin.GeometryObject) -> np.ndarray | None:
+    """A halfspace obstacle's unit normal in the world; None for any other shape."""
+    if type(obj.geometry).__name__ != "Halfspace":
+        return None
+    normal: np.ndarray = np.asarray(obj.placement.rotation) @ np.asarray(obj.geometry.n)
+    unit: np.ndarray = normal / np.linalg.norm(normal)
+    return unit
 
 
 def pair_weights(
-    model: pin.Model, geometry: pin.GeometryModel, pairs: list[tuple[int, int]], n_robot: int
+    model: pin.Model,
+    geometry: pin.GeometryModel,
+    pairs: list[tuple[int, int]],
+    n_robot: int,
+    *,
+    n_fixed: int = 0,
 ) -> np.ndarray:
     """W (P, nv), m/rad (m/m for a prismatic joint): see the module docstring.
 
@@ -38,17 +82,23 @@ def pair_weights(
         pairs: (robot part, other object) index pairs; the other is an obstacle (static within
             a path) when its index is ``n_robot`` or more.
         n_robot: how many of the objects are the robot's.
+        n_fixed: how many obstacles after the robot's objects are at their final pose (the
+            cell's ``fixed`` ones; a halfspace among them takes the factor |n x k| above).
     """
     objects = geometry.geometryObjects
     weights = np.zeros((len(pairs), model.nv))
     for p, (a, b) in enumerate(pairs):
         moving = [a] if b >= n_robot else [a, b]
         supports = [set(model.supports[int(objects[g].parentJoint)]) for g in moving]
+        normal = _halfspace_normal(objects[b]) if n_robot <= b < n_robot + n_fixed else None
         for k, g in enumerate(moving):
             carrier = int(objects[g].parentJoint)
             others = supports[1 - k] if len(moving) == 2 else {0}
             for joint in supports[k] - others - {0}:
                 reach = _lever(model, joint, carrier) + _extent(objects[g])
                 prismatic = model.joints[joint].shortname().startswith("JointModelP")
+                axis = None if normal is None else _world_axis(model, joint)
+                if normal is not None and axis is not None:  # only the move along the normal
+                    reach *= float(np.linalg.norm(np.cross(normal, axis)))
                 weights[p, model.joints[joint].idx_v] += max(reach, 1.0) if prismatic else reach
     return weights

@@ -18,28 +18,8 @@ from solver.core.robots import Robot
 from solver.path.cell import batch, fast, kinematics
 from solver.path.cell.coal_data import CoalData
 from solver.path.cell.scene import build_scene
-from solver.path.cell.shapes import DEFAULT_COLLISION_STEP, Cell
+from solver.path.cell.shapes import Cell
 from solver.path.cell.verdict import CellVerdict, Contact
-
-# What checking one pose of a path against a cell costs, in poses of a closed-form family's map
-# (KinematicsFamily.path_cost): the ERK map (546 placements x 133 waypoints) with a table, a
-# fixture and the part took 46 to 59 times the map without for the UR5 (its meshes) and 20 to
-# 30 times for the UR5e (capsules) (bench/cell.py and the same maps' CPU time, best of 3 to 5,
-# loaded machine, 2026-12-02, after the chunk's paths were checked in one compiled call; 72 to
-# 96 and 35 to 44 times before, in the same runs). 50, within the UR5's range and above the
-# UR5e's: the optimisers in a cell search (x, y, yaw) past a fixture (no arc symmetry), and 80
-# refused the README's cell optimisation (7.0 million weighted poses; 50 weighs it 4.4 million).
-CELL_POSE_COST = 50.0
-
-
-def cell_pose_cost(cell: Cell) -> float:
-    """The collision check's weight per pose: CELL_POSE_COST at the default collision step.
-
-    A finer step checks proportionally more sub-steps between waypoints, so it weighs more
-    (at the least step, 0.001 rad, 50 times as much): the size limits see it before the work.
-    """
-    return CELL_POSE_COST * max(1.0, DEFAULT_COLLISION_STEP / cell.collision_step)
-
 
 _WINDOW = 32  # configurations looked ahead at once when skipping
 
@@ -65,6 +45,12 @@ class CellChecker:
         self._weights = scene.weights
         self._fast = scene.compiled
         self._coal_data = CoalData(robot.model, self.geometry, self._workpiece_ids)
+        # collides_at's own copies: the sweep's coal calls see the data they saw before.
+        self._hint_data = CoalData(robot.model, self.geometry, self._workpiece_ids)
+        objects = self.geometry.geometryObjects
+        self._pair_of = {
+            (objects[a].name, objects[b].name): p for p, (a, b) in enumerate(self._pairs)
+        }
 
     def configurations(
         self, q: np.ndarray, segment_in_pass: np.ndarray
@@ -266,6 +252,29 @@ class CellChecker:
             clear_until[due] = index + first
             index = int(clear_until.min()) + 1
         return CellVerdict(None, None, checks, self.approximated)
+
+    def collides_at(
+        self, configuration: np.ndarray, transform_workpiece_to_base: np.ndarray, contact: Contact
+    ) -> bool:
+        """Whether coal finds ``contact``'s pair under the clearance less ``fast.MARGIN`` there.
+
+        The quick test of :meth:`solver.path.cell.limit.CellLimit.refuses_at`: where a path's
+        waypoint is that close, no bound proves it clear, so the check reaches it (or stops
+        before) and coal's distance there (within its tolerance, well under the margin)
+        refuses the path too. ``configuration`` (n,), rad; T_B_O (4, 4).
+        """
+        objects = self.geometry.geometryObjects
+        other = contact.obstacle_name if contact.obstacle is None else None
+        if contact.obstacle is not None:
+            other = objects[self._n_robot + contact.obstacle].name
+        pair = self._pair_of.get((contact.robot_part, other))
+        if pair is None:
+            return False
+        placed = self._world_to_base * pin.SE3(np.asarray(transform_workpiece_to_base, float))
+        geometry, gdata, data = self._hint_data.at(placed)
+        pin.updateGeometryPlacements(self.robot.model, data, geometry, gdata, configuration)
+        distance = pin.computeDistance(geometry, gdata, pair).min_distance
+        return bool(distance < self.cell.clearance - fast.MARGIN)
 
     def _contact(self, waypoint: int, pair: int, distance: float) -> Contact:
         """The contact of pair ``pair`` (an index into the checked pairs)."""

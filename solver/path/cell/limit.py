@@ -9,6 +9,7 @@ import numpy as np
 from solver.core.codes import REASON_COLLISION
 from solver.core.spatial import Placement
 from solver.path.cell.checker import CellChecker
+from solver.path.cell.verdict import CellVerdict
 from solver.path.limits import PathCheck, PathVerdict
 
 
@@ -35,6 +36,19 @@ class CellLimit(PathCheck):
         verdict = self.checker.check(q, self.segment_in_pass, transform, closest=thorough)
         failed = None if verdict.collision is None else verdict.collision.waypoint
         return PathVerdict(failed, verdict)
+
+    def refuses_at(self, q: np.ndarray, placement: np.ndarray, refusal: PathVerdict) -> bool:
+        """Whether ``q`` collides on the refusal's pair at its waypoint (``PathCheck.refuses_at``).
+
+        By :meth:`CellChecker.collides_at`: coal's distance of that pair below the clearance
+        less a margin at ``q``'s configuration at that waypoint, which the check reaches.
+        """
+        detail = refusal.detail
+        if not isinstance(detail, CellVerdict) or detail.collision is None:
+            return False
+        contact = detail.collision
+        transform = workpiece_to_base(placement[None])[0]
+        return self.checker.collides_at(q[contact.waypoint], transform, contact)
 
     def check_many(self, joint_paths: np.ndarray, placements: np.ndarray) -> list[PathVerdict]:
         """Check N joint paths at their placements in one compiled sweep (a map's chunk)."""

@@ -79,7 +79,7 @@ def build_scene(robot: Robot, cell: Cell) -> CellScene:
     pairs += _self_pairs(robot.model, geometry, n_robot, cell.clearance)
     for a, b in pairs:
         geometry.addCollisionPair(pin.CollisionPair(a, b))
-    weights = pair_weights(robot.model, geometry, pairs, n_robot)
+    weights = pair_weights(robot.model, geometry, pairs, n_robot, n_fixed=len(cell.fixed))
     try:
         compiled: fast.FastCell | None = fast.FastCell(
             robot.model, geometry, n_robot, pairs, weights=weights, clearance=cell.clearance

@@ -31,6 +31,7 @@ import math
 import numpy as np
 from numba import njit
 
+from solver.path.cell.advance import clear_until as advance
 from solver.path.cell.closed_form import (
     box_param,
     params,
@@ -340,16 +341,7 @@ def first_due(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
                 if distance <= near:
                     need[p] = needed = True
                     continue
-            slack = distance - clearance
-            m = index + 1
-            while m < count:
-                moved = 0.0
-                for j in range(configurations.shape[1]):
-                    moved += weights[p, j] * abs(configurations[m, j] - configurations[index, j])
-                if moved >= slack:
-                    break
-                m += 1
-            clear_until[p] = m - 1
+            clear_until[p] = advance(configurations, weights, p, index, distance - clearance)
         if needed:
             return index
         index = clear_until.min() + 1

@@ -30,7 +30,7 @@ from solver.families.numeric.costs import (
 from solver.families.numeric.family import NumericFamily
 from solver.path import pruning
 from solver.path.capability_map import map_cost
-from solver.path.cell.checker import CELL_POSE_COST
+from solver.path.cell.cost import CELL_POSE_COST
 from solver.path.cell.shapes import Cell, Halfspace
 from solver.path.placements import evaluate_placements
 from solver.path.problem import PathOptions, PathProblem

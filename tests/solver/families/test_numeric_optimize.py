@@ -19,7 +19,7 @@ from solver.optimise.methods.placement_scipy import (
     search_placements,
     search_size,
 )
-from solver.optimise.optimize import PlacementOptimum
+from solver.optimise.optimum import PlacementOptimum
 from solver.optimise.search_space import PlacementBounds
 from solver.path.joint_path import evaluate_joint_path
 from tests.cases import EXAMPLES, OPTIMUM_EVALUATE_RTOL
