@@ -20,24 +20,22 @@ from pathlib import Path
 import numpy as np
 from numba import njit
 
-from solver.core.codes import OK, OK_MIRRORED, SINGULAR, UNREACHABLE
+from solver.core.codes import OK_MIRRORED, SINGULAR, UNREACHABLE
 from solver.families.numeric import ik_kernel, scout_kernel
 from solver.families.numeric.chain_kernel import (
-    det_negative,
     drop_stale_cache,
     frames,
-    jacobian_at,
-    lu_solve_signed,
     workspace,
 )
-from solver.families.numeric.ik_kernel import _levenberg_marquardt, _singular
-from solver.families.numeric.scout_kernel import hopeless, scouted, within_limits
+from solver.families.numeric.ik_kernel import _levenberg_marquardt
+from solver.families.numeric.scout_kernel import (
+    hopeless,
+    scouted,
+    status_and_speed,
+    within_limits,
+)
 
 _TWO_PI = 2.0 * math.pi
-NEAR_TOOL = 99.0
-"""m: a tool point at most this far from the flange takes det J's sign from V_max's LU
-(:func:`_status_and_speed`); (1 + 99)^2 rcond leaves J_tool's sigma_min / sigma_max about 450 times
-above the LU's backward error."""
 
 drop_stale_cache(Path(__file__), Path(ik_kernel.__file__), Path(scout_kernel.__file__))
 
@@ -55,43 +53,6 @@ def wrapped(value):  # type: ignore[no-untyped-def]  # pragma: no cover - compil
     if 0.0 <= shifted < _TWO_PI:
         return shifted - math.pi
     return shifted % _TWO_PI - math.pi
-
-
-@njit(cache=True, nogil=True, error_model="numpy", inline="always")
-def _status_and_speed(chain, rcond, at, qdot_max, work, spare):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
-    """``regular_status`` and :func:`v_max` (the same numbers) at the frames in ``work``.
-
-    ``at``: the twist (6,) and the tool point (3,). The sign of det J comes from the LU of J
-    at the tool point that V_max solves with, not from a second LU of J at the flange
-    (``det_negative``): J_tool = [[I, -[d]x], [0, I]] J_flange (d from the flange to the tool
-    point), a factor of determinant 1, so both have the sign of det J_flange wherever the
-    status is not ``SINGULAR``. There sigma_min / sigma_max of J_flange is above ``rcond``
-    (1e-7), so J_tool's is above rcond / (1 + |d|)^2, at least 1e-11 for |d| <= NEAR_TOOL,
-    while the LU's backward error (about 6 * 2^5 * 1.1e-16 relative, the worst growth of
-    six columns) is below 2.2e-14: the factored matrix has J_tool's sign. Farther tool points,
-    or an exactly singular J_tool, take the flange's LU as before. ``spare[0]``, ``spare[1]``:
-    J at the tool point and J^-1 t (as :func:`v_max` leaves them). Returns (status, V_max).
-    """
-    twist, tool = at
-    singular = _singular(chain, rcond, work)  # J at the flange in work[6]
-    jac, rhs = spare[0], spare[1]
-    jacobian_at(chain[3], work[0], work[1], tool, jac)
-    for i in range(6):
-        rhs[i] = twist[i]
-    solved, negative = lu_solve_signed(jac, rhs)
-    speed = math.inf
-    if solved:
-        ratio = 0.0
-        for j in range(6):
-            ratio = max(ratio, abs(rhs[j]) / qdot_max[j])
-        speed = 1.0 / ratio if ratio > 0.0 else math.inf
-    if singular:
-        return SINGULAR, speed
-    pos = work[3]
-    d0, d1, d2 = tool[0] - pos[0], tool[1] - pos[1], tool[2] - pos[2]
-    if not solved or not d0 * d0 + d1 * d1 + d2 * d2 <= NEAR_TOOL * NEAR_TOOL:
-        negative = det_negative(work[6], work[10])
-    return (OK_MIRRORED if negative else OK), speed
 
 
 @njit(cache=True, nogil=True, error_model="numpy", inline="always")
@@ -130,7 +91,7 @@ def _exact(chain, slot, path, limits, settings, constants, rules, work, spare, o
             (0, 0.0),
         ):
             return least, slowest, True, False
-        status[w], speed = _status_and_speed(
+        status[w], speed = status_and_speed(
             chain, rcond, (twists[w], tools[w]), qdot_max, work, spare
         )
         failed = failed or status[w] == SINGULAR

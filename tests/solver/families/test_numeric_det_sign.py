@@ -1,6 +1,6 @@
 """The six-joint pass takes det J's sign from V_max's LU (J at the tool point): the same statuses.
 
-:func:`solver.families.numeric.bounded_kernel._status_and_speed` reads the sign of det J from
+:func:`solver.families.numeric.scout_kernel.status_and_speed` reads the sign of det J from
 the LU of J at the tool point (J_tool = S J_flange, det S = 1) instead of a second LU of J at
 the flange; a tool point farther than ``NEAR_TOOL`` from the flange takes the flange's LU. Held
 here: the LU's sign against numpy's determinant and its solution against :func:`lu_solve` bit
@@ -14,7 +14,7 @@ import numpy as np
 from numba import njit
 
 from solver.core.codes import OK, OK_MIRRORED, SINGULAR, TIE_RTOL
-from solver.families.numeric import bounded_kernel, chain_kernel
+from solver.families.numeric import chain_kernel, scout_kernel
 from solver.families.numeric.family import NumericFamily
 from solver.path import bounded
 from tests.solver.families.numeric_maps import ur5_from_urdf
@@ -69,7 +69,7 @@ def test_statuses_across_a_sign_change_as_follow_paths_with_near_and_far_tools()
     assert SINGULAR not in expected[0, 0]
     twists = np.random.default_rng(12).normal(size=(1, n, 6))
     rules = (TIE_RTOL, bounded.MARGIN, bounded.ROUGH, bounded.SLACK, bounded.STRIDE)
-    for offset in (0.05, 2 * bounded_kernel.NEAR_TOOL):  # V_max's LU; the flange's
+    for offset in (0.05, 2 * scout_kernel.NEAR_TOOL):  # V_max's LU; the flange's
         q, status, _, dropped = family.follow_bounded(
             path_q[None, :1].copy(),
             (rotations[None], positions[None]),
