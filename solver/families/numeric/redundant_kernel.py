@@ -3,7 +3,8 @@
 robots.md section 5 and :mod:`solver.core.dtf_redundant`: with J (6 x 7) of full rank every
 solution of J qdot = s t_hat is qdot = s a + lam b, a = J^+ t_hat and b a unit null-space
 vector, and the LP max s s.t. |s a_j + lam b_j| <= qdot_max_j has the closed form of
-:func:`solver.core.dtf.two_variable_speed`, lam then :func:`solver.core.dtf.spin_rate_nearest_zero`.
+:func:`solver.core.two_variable_lp.two_variable_speed`, lam then
+:func:`solver.core.two_variable_lp.spin_rate_nearest_zero`.
 numpy takes a and b from a batched SVD, which was most of a Panda map; here they come from a
 Householder QR of J^T = Q R (b the last column of Q, a = Q_1 R^-T t_hat), per configuration on
 the compiled chain. Where R's diagonal spans more than ``QR_RCOND`` the configuration is left
