@@ -16,8 +16,12 @@ so they are often left there too: the ERK-size map then follows a sixth fewer br
 might change the answer (:func:`solver.kernels.cell.choice_holds`) the left branches are
 followed and scanned to the end after all, so every reported field is the full loop's.
 
-:func:`fixed_cell` serves :func:`solver.kernels.fixed_spin.map_cells`, :func:`free_cell`
-:func:`solver.kernels.free_spin.free_cells`; the tuples are theirs.
+:func:`fixed_cell` serves :func:`solver.kernels.fixed_spin.map_cells`,
+:func:`solver.kernels.acc_free.free_cell` :func:`solver.kernels.free_spin.free_cells`; the tuples
+are theirs. Each call in them names its arrays: a call written with ``*tuple`` (or with more than
+30 arguments, which Python passes as one tuple) builds a tuple of its arguments, each array's
+reference count up and down once per call, and the calls made per branch were most of the
+limits' cost (the ERK-size map, 2026-12-02).
 """
 
 from __future__ import annotations
@@ -30,14 +34,10 @@ from solver.kernels.acc_scan import scan_row
 from solver.kernels.accelerations import (
     left_at_probes,
     probe_acc_rows,
-    probe_free_acc_rows,
     probed_before,
-    spin_rate_of,
 )
 from solver.kernels.cell import PRUNED, choice_holds, next_row, set_limits, start_again, write_cell
 from solver.kernels.fixed_follow import follow_rows, probe_rows
-from solver.kernels.free_follow import follow_free_rows, moved_check, probe_free_rows
-from solver.kernels.spin_schedule import spin_moves
 
 
 @njit(cache=True, error_model="numpy", nogil=True)
@@ -63,16 +63,13 @@ def fixed_cell(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
         answer: the answer arrays :func:`solver.kernels.cell.write_cell` fills.
     """
     todo, limit, remaining, bound = work
-    family, par, poses, branches, _ = posed
+    family, par, poses, branches, pure_rotation = posed
+    segment_checked, lower, upper, modes, arc, inverse_qdot, max_joint_step = path_tests
     scratch, cq, sq, qd, status, need, alive, why, where = found
-    slowest, slowest_at = kept[0], kept[1]
-    inverse_qdot = path_tests[5]
+    slowest, slowest_at, slowest_joint, speeds, chords2, largest2, inside, crossed = kept
     index, steps_c, waypoints, rows = stencil
     feed, acc_at, acc_joint, acc_speeds, acc_hint, steps, moves = acc
-    scan = (rows, waypoints, qddot_max, feed, acc_at, acc_joint, acc_speeds, acc_hint, alive, why,
-            where, slowest)  # fmt: skip
-    grid = (family, par, poses, branches, scratch, cq, sq, qd, status, need, alive, why, where,
-            slowest, acc_hint, bound, index, steps_c, qddot_max, steps)  # fmt: skip
+    _, _, _, _, mu, reason, failed, branch, bottleneck_waypoint, bottleneck_joint, v_out = answer
     limit[:] = -np.inf
     bound[:] = np.inf
     remaining[:] = True
@@ -81,7 +78,12 @@ def fixed_cell(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
         remaining[row] = False
         todo[:] = False
         todo[row] = True
-        follow_rows(todo, limit, *posed, *path_tests, *found, *kept, hint)
+        follow_rows(
+            todo, limit, family, par, poses, branches, pure_rotation, segment_checked, lower,
+            upper, modes, arc, inverse_qdot, max_joint_step, scratch, cq, sq, qd, status, need,
+            alive, why, where, slowest, slowest_at, slowest_joint, speeds, chords2, largest2,
+            inside, crossed, hint,
+        )  # fmt: skip
         followed = alive[row]
         if followed:
             probes = (acc_hint[best] if best >= 0 else -1, acc_hint[row])
@@ -90,30 +92,54 @@ def fixed_cell(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
                 row, limit[row], probes, b, 0.0, cq, sq, qd, qd, inverse_qdot, inverse_qdot,
                 index, steps_c, qddot_max, steps, alive, why, where, slowest, acc_hint,
             ):  # fmt: skip
-                scan_row(row, limit[row], b, cq, sq, qd, moves, *scan)
+                scan_row(
+                    row, limit[row], b, cq, sq, qd, moves, rows, waypoints, qddot_max, feed,
+                    acc_at, acc_joint, acc_speeds, acc_hint, alive, why, where, slowest,
+                )  # fmt: skip
         if followed and why[row] == PRUNED:  # left by its V_acc: the others probed there
-            probe_acc_rows(remaining, limit, acc_hint[row], *grid)
+            probe_acc_rows(
+                remaining, limit, acc_hint[row], family, par, poses, branches, scratch, cq, sq,
+                qd, status, need, alive, why, where, slowest, acc_hint, bound, index, steps_c,
+                qddot_max, steps,
+            )  # fmt: skip
         if alive[row] and (best < 0 or feed[row] > feed[best]):
             best = row
             set_limits(limit, row, feed[row], ACC_TIE_RTOL)
             k = acc_hint[row]
             if k >= 0:
-                probe_acc_rows(remaining, limit, k, *grid)
-            probe_rows(remaining, limit, slowest_at[row], *posed, inverse_qdot, *found, slowest,
-                       hint, bound)  # fmt: skip
+                probe_acc_rows(
+                    remaining, limit, k, family, par, poses, branches, scratch, cq, sq, qd,
+                    status, need, alive, why, where, slowest, acc_hint, bound, index, steps_c,
+                    qddot_max, steps,
+                )  # fmt: skip
+            probe_rows(
+                remaining, limit, slowest_at[row], family, par, poses, branches, pure_rotation,
+                inverse_qdot, scratch, cq, sq, qd, status, need, alive, why, where, slowest,
+                hint, bound,
+            )  # fmt: skip
             todo[:] = False  # the rows whose acc_hint was probed
             for i in range(branches.shape[0]):  # where each row was least before, once each
                 if remaining[i] and alive[i] and not probed_before(i, acc_hint, todo, k):
-                    probe_acc_rows(remaining, limit, acc_hint[i], *grid)
+                    probe_acc_rows(
+                        remaining, limit, acc_hint[i], family, par, poses, branches, scratch,
+                        cq, sq, qd, status, need, alive, why, where, slowest, acc_hint, bound,
+                        index, steps_c, qddot_max, steps,
+                    )  # fmt: skip
                     todo[i] = True
             todo[:] = False  # the rows whose hint was probed
             for i in range(branches.shape[0]):
                 if remaining[i] and alive[i] and not probed_before(i, hint, todo, slowest_at[row]):
-                    probe_rows(remaining, limit, hint[i], *posed, inverse_qdot, *found, slowest,
-                               hint, bound)  # fmt: skip
+                    probe_rows(
+                        remaining, limit, hint[i], family, par, poses, branches, pure_rotation,
+                        inverse_qdot, scratch, cq, sq, qd, status, need, alive, why, where,
+                        slowest, hint, bound,
+                    )  # fmt: skip
                     todo[i] = True
         row = next_row(remaining, alive, bound)
-    pick = write_cell(c, branches, alive, why, where, feed, ACC_TIE_RTOL, *answer)
+    pick = write_cell(
+        c, branches, alive, why, where, feed, ACC_TIE_RTOL, slowest, slowest_at, slowest_joint,
+        speeds, mu, reason, failed, branch, bottleneck_waypoint, bottleneck_joint, v_out,
+    )  # fmt: skip
     if choice_holds(alive, why, slowest, feed, ACC_TIE_RTOL, pick):
         return pick
     # a left row might change the answer: follow the left rows to the end
@@ -121,114 +147,19 @@ def fixed_cell(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
         todo[i] = why[i] == PRUNED
     start_again(todo, alive, why, where)
     limit[:] = -np.inf
-    follow_rows(todo, limit, *posed, *path_tests, *found, *kept, hint)
+    follow_rows(
+        todo, limit, family, par, poses, branches, pure_rotation, segment_checked, lower, upper,
+        modes, arc, inverse_qdot, max_joint_step, scratch, cq, sq, qd, status, need, alive, why,
+        where, slowest, slowest_at, slowest_joint, speeds, chords2, largest2, inside, crossed,
+        hint,
+    )  # fmt: skip
     for i in range(branches.shape[0]):
         if todo[i] and alive[i]:
-            scan_row(i, -np.inf, branches[i], cq, sq, qd, moves, *scan)
-    return write_cell(c, branches, alive, why, where, feed, ACC_TIE_RTOL, *answer)
-
-
-@njit(cache=True, error_model="numpy", nogil=True)
-def free_cell(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
-    c, guess, work, posed, steps_tests, found, kept, spun_args, qddot_max, stencil, acc, answer
-):
-    """Placement c in free spin with acceleration limits; returns the chosen branch's row.
-
-    As :func:`fixed_cell`; a row followed to the end is probed, then tracked along its spin
-    schedule at its mu_path (:func:`solver.kernels.free_follow.moved_check`, the spin's moves
-    made once for it and the scan), then scanned.
-    Before a row is followed its V_acc is known only where its spin is none
-    (:func:`solver.kernels.accelerations.probe_free_acc_rows`).
-
-    Args:
-        c: the placement.
-        guess: the row to follow first.
-        work: (todo, limit, remaining, bound, reach), per row; ``reach`` the least V_max
-            probed, a bound of mu_path (``bound`` that of mu_acc).
-        posed: (family, par, poses, spin_poses, branches, pure_rotation).
-        steps_tests: (segment_checked, qdot_max, max_joint_step).
-        found: (scratch, cq, sq, qd, qs, status, need, alive, why, where, slowest).
-        kept: (slowest_at, slowest_joint, speeds, hint).
-        spun_args: the arguments of :func:`solver.kernels.free_follow.spun_check` after i.
-        qddot_max: shape (6,), rad/s^2.
-        stencil: (index, c, waypoints, rows), the blend stencil in step form and in row form
-            (:func:`solver.kernels.acc_scan.scan_work`).
-        acc: from :func:`solver.kernels.accelerations.acc_work`.
-        answer: the answer arrays :func:`solver.kernels.cell.write_cell` fills.
-    """
-    todo, limit, remaining, bound, reach = work
-    family, par, poses, _, branches, _ = posed
-    scratch, cq, sq, qd, qs, status, need, alive, why, where, slowest = found
-    slowest_at, hint = kept[0], kept[3]
-    qdot_max = steps_tests[1]
-    length = spun_args[6]
-    index, steps_c, waypoints, rows = stencil
-    feed, acc_at, acc_joint, acc_speeds, acc_hint, steps, moves = acc
-    scan = (rows, waypoints, qddot_max, feed, acc_at, acc_joint, acc_speeds, acc_hint, alive, why,
-            where, slowest)  # fmt: skip
-    grid = (family, par, poses, branches, qdot_max, scratch, cq, sq, qd, status, need, alive,
-            why, where, slowest, acc_hint, bound, reach, index, steps_c, qddot_max,
-            steps)  # fmt: skip
-    limit[:] = -np.inf
-    bound[:] = np.inf
-    reach[:] = np.inf
-    remaining[:] = True
-    best, row = -1, guess
-    while row >= 0:
-        remaining[row] = False
-        todo[:] = False
-        todo[row] = True
-        follow_free_rows(todo, limit, *posed, *steps_tests, *found, *kept)
-        followed = alive[row]
-        if followed:
-            probes = (acc_hint[best] if best >= 0 else -1, acc_hint[row])
-            b, rate = branches[row], spin_rate_of(slowest[row], True)
-            if not left_at_probes(
-                row, limit[row], probes, b, rate, cq, sq, qd, qs, length, qdot_max, index,
-                steps_c, qddot_max, steps, alive, why, where, slowest, acc_hint,
-            ):  # fmt: skip
-                spin_moves(qd, qs, b, rate, length, qdot_max, moves)
-                moved_check(row, moves, *spun_args)
-                if alive[row]:
-                    scan_row(row, limit[row], b, cq, sq, qs, moves, *scan)
-        if followed and why[row] == PRUNED:  # left by its V_acc: the others probed there
-            probe_free_acc_rows(remaining, limit, acc_hint[row], *grid)
-        if alive[row] and (best < 0 or feed[row] > feed[best]):
-            best = row
-            set_limits(limit, row, feed[row], ACC_TIE_RTOL)
-            probe_free_rows(remaining, limit, slowest_at[row], *posed, qdot_max, *found, hint,
-                            reach)  # fmt: skip
-            todo[:] = False  # the rows whose hint was probed
-            for i in range(branches.shape[0]):
-                if remaining[i] and alive[i] and not probed_before(i, hint, todo, slowest_at[row]):
-                    probe_free_rows(remaining, limit, hint[i], *posed, qdot_max, *found, hint,
-                                    reach)  # fmt: skip
-                    todo[i] = True
-            for i in range(branches.shape[0]):
-                bound[i] = min(bound[i], reach[i])
-            k = acc_hint[row]
-            if k >= 0:
-                probe_free_acc_rows(remaining, limit, k, *grid)
-            todo[:] = False  # the rows whose acc_hint was probed
-            for i in range(branches.shape[0]):
-                if remaining[i] and alive[i] and not probed_before(i, acc_hint, todo, k):
-                    probe_free_acc_rows(remaining, limit, acc_hint[i], *grid)
-                    todo[i] = True
-        row = next_row(remaining, alive, bound)
-    pick = write_cell(c, branches, alive, why, where, feed, ACC_TIE_RTOL, *answer)
-    if choice_holds(alive, why, slowest, feed, ACC_TIE_RTOL, pick):
-        return pick
-    # a left row might change the answer: follow the left rows to the end
-    for i in range(branches.shape[0]):
-        todo[i] = why[i] == PRUNED
-    start_again(todo, alive, why, where)
-    limit[:] = -np.inf
-    follow_free_rows(todo, limit, *posed, *steps_tests, *found, *kept)
-    for i in range(branches.shape[0]):
-        if todo[i] and alive[i]:
-            rate = spin_rate_of(slowest[i], True)
-            spin_moves(qd, qs, branches[i], rate, length, qdot_max, moves)
-            moved_check(i, moves, *spun_args)
-            if alive[i]:
-                scan_row(i, -np.inf, branches[i], cq, sq, qs, moves, *scan)
-    return write_cell(c, branches, alive, why, where, feed, ACC_TIE_RTOL, *answer)
+            scan_row(
+                i, -np.inf, branches[i], cq, sq, qd, moves, rows, waypoints, qddot_max, feed,
+                acc_at, acc_joint, acc_speeds, acc_hint, alive, why, where, slowest,
+            )  # fmt: skip
+    return write_cell(
+        c, branches, alive, why, where, feed, ACC_TIE_RTOL, slowest, slowest_at, slowest_joint,
+        speeds, mu, reason, failed, branch, bottleneck_waypoint, bottleneck_joint, v_out,
+    )  # fmt: skip

@@ -147,7 +147,7 @@ def row_ratios(rows, qddot_max):  # type: ignore[no-untyped-def]  # pragma: no c
                 joint[k] = j
 
 
-@njit(cache=True, error_model="numpy", nogil=True)
+@njit(cache=True, error_model="numpy", nogil=True, _nrt=False)
 def scan_row(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
     i, limit, b, cq, sq, qs, moves, rows, waypoints, qddot_max, feed, acc_at, acc_joint,
     acc_speeds, acc_hint, alive, why, where, slowest,
@@ -164,7 +164,9 @@ def scan_row(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
     Arrays as :func:`solver.kernels.accelerations.acc_work` and :func:`scan_work` make them;
     ``waypoints``: the blend stencil's. A row whose mu_path is below the stencil's floor
     (:func:`scan_work`) is not read: its mu_acc is its mu_path (no V_acc kept, and none is
-    where it binds).
+    where it binds). Compiled without numba's reference counting (``_nrt=False``, as the
+    numeric families' kernels; it allocates nothing): its loops keep numba from pruning the
+    atomic increment and decrement of each array argument at every call.
     """
     keep = acc_speeds.shape[1] > 0
     if slowest[i] < rows[7] and not keep:  # below the floor: the speeds bind, as a scan finds

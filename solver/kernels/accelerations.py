@@ -15,6 +15,11 @@ wrist_3 differs between them by pi, which no second difference sees): their V_ac
 equal to the bit, as D is formed from the steps (:func:`solver.kernels.limits.step_stencil`).
 
 Without acceleration limits the kernels get ``qddot_max`` of shape (0,) and skip all of this.
+
+The functions called per branch (:func:`left_at_probes`, :func:`probe_acc_rows`,
+:func:`probe_free_acc_rows`) are compiled without numba's reference counting (``_nrt=False``, as
+the numeric families' kernels; they allocate nothing): it incremented and decremented each array
+argument atomically at every call, and their loops keep numba from pruning the pairs.
 """
 
 from __future__ import annotations
@@ -118,7 +123,7 @@ def spin_rate_of(slowest, free):  # type: ignore[no-untyped-def]  # pragma: no c
     return slowest if free and slowest > 0.0 and math.isfinite(slowest) else 0.0
 
 
-@njit(cache=True, error_model="numpy", nogil=True)
+@njit(cache=True, error_model="numpy", nogil=True, _nrt=False)
 def left_at_probes(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
     i, limit, probes, b, rate, cq, sq, qd, qs, length, qdot_max, index, c, qddot_max, steps,
     alive, why, where, slowest, acc_hint,
@@ -176,7 +181,7 @@ def probed_before(i, hints, probed, k):  # type: ignore[no-untyped-def]  # pragm
     return False
 
 
-@njit(cache=True, error_model="numpy", nogil=True)
+@njit(cache=True, error_model="numpy", nogil=True, _nrt=False)
 def probe_acc_rows(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
     todo, limit, k, family, par, poses, branches, scratch, cq, sq, qd, status, need, alive,
     why, where, slowest, acc_hint, bound, index, c, qddot_max, steps,
@@ -202,7 +207,7 @@ def probe_acc_rows(  # type: ignore[no-untyped-def]  # pragma: no cover - compil
             bound[i] = min(bound[i], speed)
 
 
-@njit(cache=True, error_model="numpy", nogil=True)
+@njit(cache=True, error_model="numpy", nogil=True, _nrt=False)
 def probe_free_acc_rows(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
     todo, limit, k, family, par, poses, branches, qdot_max, scratch, cq, sq, qd, status, need,
     alive, why, where, slowest, acc_hint, bound, reach, index, c, qddot_max, steps,

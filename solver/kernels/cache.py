@@ -7,6 +7,7 @@ import sys
 from pathlib import Path
 
 import solver.kernels.acc_cells
+import solver.kernels.acc_free
 import solver.kernels.acc_scan
 import solver.kernels.accelerations
 import solver.kernels.cell
@@ -40,6 +41,7 @@ def drop_stale_compiled_code(name: str) -> None:
         solver.kernels.free_follow,
         solver.kernels.accelerations,
         solver.kernels.acc_cells,
+        solver.kernels.acc_free,
         solver.kernels.acc_scan,
         solver.kernels.spin_schedule,
         sys.modules[name],

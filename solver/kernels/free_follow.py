@@ -159,7 +159,7 @@ def moved_check(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
     """:func:`spun_check` with the spin's moves at the row's mu_path already made.
 
     ``moves``: shape (W,), from :func:`solver.kernels.spin_schedule.spin_moves`, made once for
-    this check and the acceleration scan (:mod:`solver.kernels.acc_cells`).
+    this check and the acceleration scan (:mod:`solver.kernels.acc_free`).
     """
     code, at = moved_failure(
         relative_path(cq, sq, branches[i], True), moves, qs, branches[i], segment_checked, lower,

@@ -36,7 +36,7 @@ from numba import njit
 
 from solver.core.codes import FEASIBLE, TIE_RTOL
 from solver.families.kernels import N_JOINTS
-from solver.kernels.acc_cells import free_cell
+from solver.kernels.acc_free import free_cell
 from solver.kernels.acc_scan import scan_work
 from solver.kernels.accelerations import acc_work, write_acc
 from solver.kernels.cache import drop_stale_compiled_code
@@ -187,7 +187,7 @@ def free_cells(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
                      qdot_max, max_joint_step, spun, alive, why, where)  # fmt: skip
         answer = (slowest, slowest_at, slowest_joint, speeds, mu, reason, failed, branch,
                   bottleneck_waypoint, bottleneck_joint, v_out)  # fmt: skip
-        if accelerations:  # pruned by mu_acc (solver.kernels.acc_cells)
+        if accelerations:  # pruned by mu_acc (solver.kernels.acc_free)
             pick = free_cell(
                 c, guess, work, posed, steps_tests, found, kept, spun_args, qddot_max, stencil,
                 acc, answer,
