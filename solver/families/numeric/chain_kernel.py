@@ -10,7 +10,8 @@ arrays in a loop.
 
 The chain is the tuple :meth:`SerialChain.packed` gives: joint rotations (n, 3, 3), joint
 translations (n, 3), axes (n, 3), revolute (n,) bool, base rotation (3, 3) and translation (3,),
-tool rotation (3, 3) and translation (3,). The helpers :mod:`solver.families.numeric.ik_kernel`
+tool rotation (3, 3) and translation (3,). J^-1 t solves by the LU of
+:mod:`solver.families.numeric.lu_kernel`. The helpers :mod:`solver.families.numeric.ik_kernel`
 takes into itself are inlined (``inline="always"``), which lets numba drop the reference counting
 of the work arrays between them.
 """
@@ -24,21 +25,26 @@ from pathlib import Path
 import numpy as np
 from numba import njit
 
+from solver.families.numeric import lu_kernel
+from solver.families.numeric.lu_kernel import lu_solve
+
 
 def drop_stale_cache(module_file: Path, *also: Path) -> None:
     """Drop the cached machine code of a module whose compiled code takes this module's in.
 
     numba keys a function's disk cache by its own source file, but the IK and redundant-speed
-    kernels take this chain's code into themselves: after an edit of this module they would
-    load the old code. A marker named by the hash of both sources says which code the cache
-    holds (as :mod:`solver.kernels.cache` does for the map kernels); where the directory
-    cannot be written, nothing is done.
+    kernels take this chain's code and its LU's (:mod:`~solver.families.numeric.lu_kernel`)
+    into themselves: after an edit of either they would load the old code. A marker named by
+    the hash of these sources and the module's says which code the cache holds (as
+    :mod:`solver.kernels.cache` does for the map kernels); where the directory cannot be
+    written, nothing is done.
 
     Args:
         module_file: the source file of the module whose cache to check.
         also: the source files of other modules whose compiled code it takes in.
     """
-    sources = b"".join(f.read_bytes() for f in (Path(__file__), module_file, *also))
+    shared = (Path(__file__), Path(str(lu_kernel.__file__)))
+    sources = b"".join(f.read_bytes() for f in (*shared, module_file, *also))
     cache = module_file.parent / "__pycache__"
     marker = cache / f"{module_file.stem}.sources-{hashlib.sha256(sources).hexdigest()[:16]}"
     try:
@@ -51,6 +57,9 @@ def drop_stale_cache(module_file: Path, *also: Path) -> None:
         marker.touch()
     except OSError:
         return
+
+
+drop_stale_cache(Path(__file__))  # speeds_per_twist takes the LU in
 
 
 def kernel_array(a: np.ndarray, dtype: type = float) -> np.ndarray:
@@ -156,119 +165,6 @@ def jacobian_at(revolute, axes, origins, at, jac):  # type: ignore[no-untyped-de
         else:
             jac[0, j], jac[1, j], jac[2, j] = a0, a1, a2
             jac[3, j], jac[4, j], jac[5, j] = 0.0, 0.0, 0.0
-
-
-@njit(cache=True, nogil=True, error_model="numpy", inline="always")
-def lu_solve(a, b):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
-    """Solve a x = b in place (x in ``b``) by LU with partial pivoting; False if a is singular.
-
-    What LAPACK's gesv (``np.linalg.solve``) does; ``a`` (k, k) is overwritten. Six
-    unknowns (every J J^T and 6 x 6 J here) take a copy whose size is a constant, which the
-    compiler unrolls: the same operations in the same order.
-    """
-    if len(b) == 6:
-        return _lu_solve(a, b, 6)
-    return _lu_solve(a, b, len(b))
-
-
-@njit(cache=True, nogil=True, error_model="numpy", inline="always")
-def _lu_solve(a, b, size):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
-    """:func:`lu_solve` of ``size`` unknowns."""
-    for col in range(size):
-        pivot = col
-        for row in range(col + 1, size):
-            if abs(a[row, col]) > abs(a[pivot, col]):
-                pivot = row
-        if a[pivot, col] == 0.0:
-            return False
-        if pivot != col:
-            for k in range(size):
-                a[col, k], a[pivot, k] = a[pivot, k], a[col, k]
-            b[col], b[pivot] = b[pivot], b[col]
-        for row in range(col + 1, size):
-            f = a[row, col] / a[col, col]
-            for k in range(col + 1, size):
-                a[row, k] -= f * a[col, k]
-            b[row] -= f * b[col]
-    for row in range(size - 1, -1, -1):
-        total = b[row]
-        for k in range(row + 1, size):
-            total -= a[row, k] * b[k]
-        b[row] = total / a[row, row]
-    return True
-
-
-@njit(cache=True, nogil=True, error_model="numpy", inline="always")
-def lu_solve_signed(a, b):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
-    """:func:`lu_solve` (the same operations, the same x), and whether det a < 0.
-
-    The sign of det a from the factors: a row swap and a negative pivot each flip it, as in
-    :func:`det_negative`. Returns (solved, negative); ``negative`` is meaningless unless solved.
-    Six unknowns take a copy whose size is a constant, as :func:`lu_solve`.
-    """
-    if len(b) == 6:
-        return _lu_solve_signed(a, b, 6)
-    return _lu_solve_signed(a, b, len(b))
-
-
-@njit(cache=True, nogil=True, error_model="numpy", inline="always")
-def _lu_solve_signed(a, b, size):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
-    """:func:`lu_solve_signed` of ``size`` unknowns."""
-    negative = False
-    for col in range(size):
-        pivot = col
-        for row in range(col + 1, size):
-            if abs(a[row, col]) > abs(a[pivot, col]):
-                pivot = row
-        if a[pivot, col] == 0.0:
-            return False, negative
-        if pivot != col:
-            negative = not negative
-            for k in range(size):
-                a[col, k], a[pivot, k] = a[pivot, k], a[col, k]
-            b[col], b[pivot] = b[pivot], b[col]
-        if a[col, col] < 0.0:
-            negative = not negative
-        for row in range(col + 1, size):
-            f = a[row, col] / a[col, col]
-            for k in range(col + 1, size):
-                a[row, k] -= f * a[col, k]
-            b[row] -= f * b[col]
-    for row in range(size - 1, -1, -1):
-        total = b[row]
-        for k in range(row + 1, size):
-            total -= a[row, k] * b[k]
-        b[row] = total / a[row, row]
-    return True, negative
-
-
-@njit(cache=True, nogil=True, error_model="numpy", inline="always")
-def det_negative(jac, a):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
-    """Whether det J < 0, J (6, 6) in ``jac`` (left alone), by LU with partial pivoting in ``a``.
-
-    LAPACK's getrf (``np.linalg.det``) takes the same pivots; where J is regular (as the
-    singularity test asks first) the sign does not depend on the rounding.
-    """
-    for i in range(6):
-        for k in range(6):
-            a[i, k] = jac[i, k]
-    negative = False
-    for col in range(6):
-        pivot = col
-        for row in range(col + 1, 6):
-            if abs(a[row, col]) > abs(a[pivot, col]):
-                pivot = row
-        if pivot != col:
-            negative = not negative
-            for k in range(6):
-                a[col, k], a[pivot, k] = a[pivot, k], a[col, k]
-        if a[col, col] < 0.0:
-            negative = not negative
-        for row in range(col + 1, 6):
-            f = a[row, col] / a[col, col]
-            for k in range(col + 1, 6):
-                a[row, k] -= f * a[col, k]
-    return negative
 
 
 @njit(cache=True, nogil=True, error_model="numpy")

@@ -13,7 +13,8 @@ that sign, jumps; seven joints have no det J (their statuses stay ``OK``). A num
 cannot promise that it found every branch: it reports how many it found.
 
 J^-1 t and the null space: :mod:`solver.families.numeric.velocity`; the work model:
-:mod:`solver.families.numeric.costs`.
+:mod:`solver.families.numeric.costs`; the compiled seeding and following that the pruned map
+steers: :mod:`solver.families.numeric.following`.
 """
 
 from __future__ import annotations
@@ -22,20 +23,10 @@ import numpy as np
 import pinocchio as pin
 
 from solver.core.family import Branch, KinematicsFamily, PathSolutions
-from solver.core.follows_in_steps import FollowsInSteps
 from solver.core.progress import Progress, span
-from solver.families.numeric import (
-    bounded_kernel,
-    bounded_redundant_kernel,
-    costs,
-    follow_kernel,
-    ik,
-    reference,
-    seed_kernel,
-    velocity,
-)
+from solver.families.numeric import costs, ik, reference, velocity
 from solver.families.numeric.chain import SerialChain
-from solver.families.numeric.chain_kernel import kernel_array
+from solver.families.numeric.following import CompiledFollowing
 
 FOLLOW_WAYPOINTS = 256
 """Waypoints of each path followed by the compiled chain between two progress reports (a
@@ -43,11 +34,6 @@ seven-joint arm's slots: about 0.2 s)."""
 SEED_SHARE, FOLLOW_SHARE = 0.05, 0.9
 """Where seeding the first waypoint ends, and following the branches, in a path's solve's
 progress (the rest: the singularity checks)."""
-REDUNDANT_MARGIN = 1e-10
-"""Relative slack on a seven-joint slot's bound (:mod:`bounded_redundant_kernel`): its V_max come
-from the unwrapped solutions, the pipeline's from the tracked path (2 pi k and the steps' running
-sums apart): measured at most 6e-15 apart on the Panda, 1e-13 on the xArm7 (every slot of a
-40 mm ERK grid followed to the end, 2026-12-02)."""
 
 
 def seed_count(dof: int) -> int:
@@ -55,7 +41,7 @@ def seed_count(dof: int) -> int:
     return 32 if dof <= 6 else 64
 
 
-class NumericFamily(KinematicsFamily, FollowsInSteps):
+class NumericFamily(KinematicsFamily, CompiledFollowing):
     """A serial chain of a pinocchio model, from {B} to the flange {F}.
 
     Branch ``solution=k`` is the k-th distinct solution found at a path's first waypoint (at
@@ -123,134 +109,6 @@ class NumericFamily(KinematicsFamily, FollowsInSteps):
     def branches(self) -> tuple[Branch, ...]:
         """``solution=0`` ... ``solution=K-1``: slots for the distinct solutions, in seed order."""
         return self._branches
-
-    def _settings(self) -> tuple[np.ndarray, np.ndarray]:
-        """The compiled IK's settings and constants (:func:`seed_kernel.seed_paths`)."""
-        settings = np.array(
-            [
-                ik.SEED_ITERATIONS,
-                ik.TRACK_ITERATIONS,
-                ik.DISTINCT,
-                ik.SINGULAR_RCOND,
-                ik.STALL_STEPS,
-                ik.STALL_RATIO,
-            ],
-            dtype=float,
-        )
-        return settings, np.array([ik.TOLERANCE, ik.DAMPING_SCALE, ik.DAMPING_FLOOR])
-
-    @property
-    def follows_in_steps(self) -> bool:
-        """The compiled chain of more than six joints; the numpy reference only whole paths.
-
-        Six and seven joints are pruned in one compiled pass instead (:attr:`follows_bounded`),
-        more joints in steps (:mod:`solver.path.pruning`). Six joints in
-        steps: a pruned map of the UR5 URDF took 1.05 times the
-        unpruned one, of an IRB 2400 URDF 1.8 times (143 placements of the ERK path, same run,
-        loaded machine, 2026-12-02): their few branches are cheap to follow (a UR's four
-        shoulder branches tie and are all followed anyway), and the bounds cost more than the
-        following they save. Seven joints, pruned against unpruned (CPU time, best of 3, same
-        run): the Panda's ERK map 1.76 times faster, the xArm7 1.69, the LBR iiwa 14 1.25 (in
-        one pass now, :attr:`follows_bounded`).
-        """
-        return self.compiled and self.dof > 6
-
-    def seed_first(
-        self, rotations: np.ndarray, positions: np.ndarray
-    ) -> tuple[np.ndarray, np.ndarray]:
-        """:func:`seed_kernel.seed_paths` (see :meth:`FollowsInSteps.seed_first`)."""
-        settings, constants = self._settings()
-        current, count = seed_kernel.seed_paths(
-            self._packed,
-            self.seeds,
-            (self.lower, self.upper),
-            kernel_array(rotations),
-            kernel_array(positions),
-            settings,
-            constants,
-        )
-        return current, count
-
-    def follow_piece(
-        self,
-        current: np.ndarray,
-        rotations: np.ndarray,
-        positions: np.ndarray,
-        solve_first: bool,
-    ) -> tuple[np.ndarray, np.ndarray]:
-        """:func:`follow_kernel.follow_paths` (see :meth:`FollowsInSteps.follow_piece`)."""
-        settings, constants = self._settings()
-        q, status = follow_kernel.follow_paths(
-            self._packed,
-            current,
-            kernel_array(rotations),
-            kernel_array(positions),
-            solve_first,
-            settings,
-            constants,
-        )
-        return q, status
-
-    @property
-    def follows_bounded(self) -> bool:
-        """The compiled chain of six or seven joints (:mod:`solver.path.bounded`).
-
-        Seven joints (:mod:`bounded_redundant_kernel`): the Panda's ERK map (546 placements,
-        two threads) took 0.66 to 0.70 times the CPU time of its pruning in steps (best of 3,
-        alternating, machine loaded to 5-6 on 2 cores, 2026-12-02), the same answers.
-        """
-        return self.compiled and self.dof in (6, 7)
-
-    def follow_bounded(
-        self,
-        current: np.ndarray,
-        poses: tuple[np.ndarray, np.ndarray],
-        speeds: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, float],
-        rules: tuple[float, ...],
-    ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-        """:func:`bounded_kernel.follow_bounded` (see :meth:`FollowsInSteps.follow_bounded`).
-
-        Seven joints: :func:`bounded_redundant_kernel.follow_bounded`, its margin
-        :data:`REDUNDANT_MARGIN` at least.
-        """
-        settings, constants = self._settings()
-        kernel = bounded_kernel if self.dof == 6 else bounded_redundant_kernel
-        if self.dof > 6:
-            rules = (rules[0], max(rules[1], REDUNDANT_MARGIN), *rules[2:])
-        result: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray] = kernel.follow_bounded(
-            self._packed,
-            current,
-            *(kernel_array(a) for a in (*poses, *speeds[:3])),
-            kernel_array(speeds[3], np.bool_),
-            (self.lower, self.upper, np.array([speeds[4]], dtype=float)),
-            settings,
-            constants,
-            np.array(rules, dtype=float),
-        )
-        return result
-
-    def follow_ranges(
-        self,
-        current: np.ndarray,
-        rotations: np.ndarray,
-        positions: np.ndarray,
-        start: np.ndarray,
-        stop: np.ndarray,
-        out: tuple[np.ndarray, np.ndarray],
-    ) -> None:
-        """:func:`follow_kernel.follow_ranges` (see :meth:`FollowsInSteps.follow_ranges`)."""
-        settings, constants = self._settings()
-        follow_kernel.follow_ranges(
-            self._packed,
-            current,
-            kernel_array(rotations),
-            kernel_array(positions),
-            kernel_array(start, np.int64),
-            kernel_array(stop, np.int64),
-            out,
-            settings,
-            constants,
-        )
 
     def _compiled(
         self, rotations: np.ndarray, positions: np.ndarray, progress: Progress | None = None

@@ -18,14 +18,8 @@ import numpy as np
 from numba import njit
 
 from solver.core.codes import OK, OK_MIRRORED, SINGULAR
-from solver.families.numeric.chain_kernel import (
-    det_negative,
-    drop_stale_cache,
-    frames,
-    jacobian_at,
-    lu_solve,
-    workspace,
-)
+from solver.families.numeric.chain_kernel import drop_stale_cache, frames, jacobian_at, workspace
+from solver.families.numeric.lu_kernel import det_negative, lu_solve
 
 drop_stale_cache(Path(__file__))
 

@@ -16,15 +16,9 @@ from numba import njit
 
 from solver.core.codes import OK, OK_MIRRORED, SINGULAR
 from solver.families.numeric import ik_kernel
-from solver.families.numeric.chain_kernel import (
-    det_negative,
-    drop_stale_cache,
-    frames,
-    jacobian_at,
-    lu_solve,
-    lu_solve_signed,
-)
+from solver.families.numeric.chain_kernel import drop_stale_cache, frames, jacobian_at
 from solver.families.numeric.ik_kernel import _levenberg_marquardt, _pose_error, _singular
+from solver.families.numeric.lu_kernel import det_negative, lu_solve, lu_solve_signed
 
 drop_stale_cache(Path(__file__), Path(ik_kernel.__file__))
 

@@ -19,7 +19,8 @@ import pytest
 
 from solver.core.codes import TIE_RTOL
 from solver.families.numeric.bounded_redundant_kernel import hopeless
-from solver.families.numeric.family import REDUNDANT_MARGIN, NumericFamily
+from solver.families.numeric.family import NumericFamily
+from solver.families.numeric.following import REDUNDANT_MARGIN
 from solver.path.pipeline import run_chunk
 from solver.path.placed import check_placements
 from solver.path.problem import PathProblem

@@ -14,7 +14,7 @@ import numpy as np
 from numba import njit
 
 from solver.core.codes import OK, OK_MIRRORED, SINGULAR, TIE_RTOL
-from solver.families.numeric import chain_kernel, scout_kernel
+from solver.families.numeric import chain_kernel, lu_kernel, scout_kernel
 from solver.families.numeric.family import NumericFamily
 from solver.path import bounded
 from tests.solver.families.numeric_maps import ur5_from_urdf
@@ -25,8 +25,8 @@ _Both = tuple[bool, bool, np.ndarray, bool, np.ndarray]
 @njit(cache=False)
 def _both(a: np.ndarray, b: np.ndarray) -> _Both:  # pragma: no cover - compiled
     a_plain, b_plain = a.copy(), b.copy()
-    solved, negative = chain_kernel.lu_solve_signed(a, b)
-    plain = chain_kernel.lu_solve(a_plain, b_plain)
+    solved, negative = lu_kernel.lu_solve_signed(a, b)
+    plain = lu_kernel.lu_solve(a_plain, b_plain)
     return solved, negative, b, plain, b_plain
 
 

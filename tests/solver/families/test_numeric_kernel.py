@@ -20,6 +20,7 @@ from solver.families.numeric import (
     follow_kernel,
     ik,
     ik_kernel,
+    lu_kernel,
     redundant_kernel,
     seed_kernel,
 )
@@ -269,6 +270,7 @@ def test_every_compiled_function_releases_the_gil() -> None:
         for module in (
             chain_kernel,
             ik_kernel,
+            lu_kernel,
             seed_kernel,
             follow_kernel,
             redundant_kernel,
