@@ -14,6 +14,10 @@ from __future__ import annotations
 
 from numba import njit
 
+from solver.path.cell.kernel_cache import drop_stale_cell_kernels
+
+drop_stale_cell_kernels()  # the kernels here take callees and constants of other modules in
+
 
 @njit(cache=True, nogil=True, error_model="numpy")
 def clear_until(configurations, weights, p, index, slack):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled

@@ -24,8 +24,11 @@ from numba import njit
 
 from solver.path.cell.capsules import HALFSPACE
 from solver.path.cell.fast import MARGIN, CoalDistances, FastCell, resume
+from solver.path.cell.kernel_cache import drop_stale_cell_kernels
 from solver.path.cell.kinematics import substeps
 from solver.path.cell.sweep import first_due
+
+drop_stale_cell_kernels()  # the kernels here take callees and constants of other modules in
 
 V = TypeVar("V")  # a verdict
 

@@ -18,6 +18,10 @@ import math
 import numpy as np
 from numba import njit
 
+from solver.path.cell.kernel_cache import drop_stale_cell_kernels
+
+drop_stale_cell_kernels()  # the kernels here take callees and constants of other modules in
+
 
 @njit(cache=True, nogil=True, error_model="numpy", inline="always")
 def _clamp01(x):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled

@@ -37,6 +37,9 @@ from numba import njit
 
 from solver.path.cell.bounds import pair_weights
 from solver.path.cell.closed_form import segment_segment
+from solver.path.cell.kernel_cache import drop_stale_cell_kernels
+
+drop_stale_cell_kernels()  # the kernels here take callees and constants of other modules in
 
 # Grid points of a table (coal distances made once per checker: about 6 microseconds each, the
 # UR5's five tables 0.45 s on a loaded machine).

@@ -17,6 +17,9 @@ import numpy as np
 from numba import njit
 
 from solver.path.cell.closed_form import segment_box_param, segment_halfspace, segment_params
+from solver.path.cell.kernel_cache import drop_stale_cell_kernels
+
+drop_stale_cell_kernels()  # the kernels here take callees and constants of other modules in
 
 
 @njit(cache=True, nogil=True, error_model="numpy", inline="always")

@@ -33,9 +33,12 @@ from numba import njit
 
 from solver.path.cell.advance import clear_until as advance
 from solver.path.cell.closed_form import box_param, params
+from solver.path.cell.kernel_cache import drop_stale_cell_kernels
 from solver.path.cell.kinematics import parts as _parts
 from solver.path.cell.pair_tables import table_bound
 from solver.path.cell.separation import separation_bound
+
+drop_stale_cell_kernels()  # the kernels here take callees and constants of other modules in
 
 
 @njit(cache=True, nogil=True, error_model="numpy")

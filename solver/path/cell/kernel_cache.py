@@ -1,0 +1,53 @@
+"""numba's disk cache of the cell's compiled kernels, dropped when any of their sources changes.
+
+numba keys a compiled function's disk cache (``cache=True``, files in ``__pycache__``) by its
+own source file, but the cell's kernels take their callees into themselves across modules (the
+batch takes the sweep, the sweep the forward scan, the closed-form distances, the pair tables
+and the separation bounds) and freeze the constants they read (``capsules.HALFSPACE``,
+``fast.MARGIN``): after an edit of one of those, a caller would load its old machine code. A
+marker named by the hash of every source of this package says which code the caches hold; a
+new hash drops the cached code of every kernel module here (as :mod:`solver.kernels.cache` does
+for the map kernels). Where the directory cannot be written (an installed copy), numba caches
+elsewhere or not at all and nothing is done.
+"""
+
+from __future__ import annotations
+
+import hashlib
+from pathlib import Path
+
+_PACKAGE = Path(__file__).resolve().parent
+KERNEL_MODULES = (
+    "advance",
+    "batch",
+    "closed_form",
+    "kinematics",
+    "pair_tables",
+    "separation",
+    "sweep",
+)
+"""The modules of this package with compiled functions (``@njit(cache=True)``)."""
+
+
+def drop_stale_cell_kernels(package: Path = _PACKAGE) -> None:
+    """Delete the cell kernels' cached machine code unless it was compiled from these sources.
+
+    Args:
+        package: the folder of the sources and of their ``__pycache__`` (this package's).
+    """
+    sources = sorted(package.glob("*.py"))
+    stamp = hashlib.sha256(b"".join(path.read_bytes() for path in sources)).hexdigest()[:16]
+    cache = package / "__pycache__"
+    marker = cache / f"cell_kernels.sources-{stamp}"
+    try:
+        if marker.exists():
+            return
+        for stem in KERNEL_MODULES:
+            for stale in [*cache.glob(f"{stem}.*.nbi"), *cache.glob(f"{stem}.*.nbc")]:
+                stale.unlink(missing_ok=True)
+        for old in cache.glob("cell_kernels.sources-*"):
+            old.unlink(missing_ok=True)
+        cache.mkdir(exist_ok=True)
+        marker.touch()
+    except OSError:
+        return
