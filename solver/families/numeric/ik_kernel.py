@@ -69,7 +69,7 @@ def _normal(jac, normal):  # type: ignore[no-untyped-def]  # pragma: no cover - 
         _normal_of(jac, normal, jac.shape[1])
 
 
-@njit(cache=True, nogil=True, error_model="numpy", inline="always")
+@njit(cache=True, nogil=True, error_model="numpy")
 def _normal_of(jac, normal, n):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
     """:func:`_normal` over the first n columns."""
     for i in range(6):
