@@ -21,40 +21,12 @@ from numba import njit
 def lu_solve(a, b):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
     """Solve a x = b in place (x in ``b``) by LU with partial pivoting; False if a is singular.
 
-    What LAPACK's gesv (``np.linalg.solve``) does; ``a`` (k, k) is overwritten. Six
-    unknowns (every J J^T and 6 x 6 J here) take a copy whose size is a constant, which the
-    compiler unrolls: the same operations in the same order.
+    What LAPACK's gesv (``np.linalg.solve``) does; ``a`` (k, k) is overwritten: the body of
+    :func:`lu_solve_signed`, the sign of det a dropped (following it changes no operation on
+    ``a`` or ``b``).
     """
-    if len(b) == 6:
-        return _lu_solve(a, b, 6)
-    return _lu_solve(a, b, len(b))
-
-
-@njit(cache=True, nogil=True, error_model="numpy")
-def _lu_solve(a, b, size):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
-    """:func:`lu_solve` of ``size`` unknowns."""
-    for col in range(size):
-        pivot = col
-        for row in range(col + 1, size):
-            if abs(a[row, col]) > abs(a[pivot, col]):
-                pivot = row
-        if a[pivot, col] == 0.0:
-            return False
-        if pivot != col:
-            for k in range(size):
-                a[col, k], a[pivot, k] = a[pivot, k], a[col, k]
-            b[col], b[pivot] = b[pivot], b[col]
-        for row in range(col + 1, size):
-            f = a[row, col] / a[col, col]
-            for k in range(col + 1, size):
-                a[row, k] -= f * a[col, k]
-            b[row] -= f * b[col]
-    for row in range(size - 1, -1, -1):
-        total = b[row]
-        for k in range(row + 1, size):
-            total -= a[row, k] * b[k]
-        b[row] = total / a[row, row]
-    return True
+    solved, _ = lu_solve_signed(a, b)
+    return solved
 
 
 @njit(cache=True, nogil=True, error_model="numpy", inline="always")
@@ -63,7 +35,8 @@ def lu_solve_signed(a, b):  # type: ignore[no-untyped-def]  # pragma: no cover -
 
     The sign of det a from the factors: a row swap and a negative pivot each flip it, as in
     :func:`det_negative`. Returns (solved, negative); ``negative`` is meaningless unless solved.
-    Six unknowns take a copy whose size is a constant, as :func:`lu_solve`.
+    Six unknowns (every J J^T and 6 x 6 J here) take a copy whose size is a constant, which the
+    compiler unrolls: the same operations in the same order.
     """
     if len(b) == 6:
         return _lu_solve_signed(a, b, 6)
