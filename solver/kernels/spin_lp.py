@@ -20,6 +20,7 @@ import numpy as np
 from numba import njit
 
 from solver.core.dtf_redundant import VERTEX_DET_RTOL, VERTEX_RTOL
+from solver.core.kernel_arrays import kernel_array
 
 _INSIDE = 1.0 - 1e-12  # as solver.core.dtf_redundant.spin_rate_at_feed
 
@@ -180,18 +181,8 @@ def spin_rates_at_feed(a, c, b, qdot_max, feed):  # type: ignore[no-untyped-def]
 
 
 def _rows(v: np.ndarray) -> np.ndarray:
-    """Component-first (n, ...) -> contiguous rows (M, n), writable (see :func:`_writable`)."""
-    return _writable(np.moveaxis(v, 0, -1).reshape(-1, len(v)))
-
-
-def _writable(v: np.ndarray) -> np.ndarray:
-    """``v`` as a writable C-contiguous float array, copied only where it is not one.
-
-    numba compiles a kernel once per argument type, and a read-only array (a broadcast view,
-    a robot's frozen limits) is another type than a writable one: the kernels here had two to
-    four signatures each, compiled once per installation.
-    """
-    return np.require(v, dtype=float, requirements=["C", "W"])
+    """Component-first (n, ...) -> contiguous rows (M, n), as the kernels take them."""
+    return kernel_array(np.moveaxis(v, 0, -1).reshape(-1, len(v)))
 
 
 def spin_speed(
@@ -210,7 +201,7 @@ def spin_speed(
     """
     shape = np.broadcast_shapes(a.shape, c.shape, b.shape)
     a, c, b = (np.broadcast_to(v, shape) for v in (a, c, b))
-    speed, limiting = spin_speeds(_rows(a), _rows(c), _rows(b), _writable(qdot_max))
+    speed, limiting = spin_speeds(_rows(a), _rows(c), _rows(b), kernel_array(qdot_max))
     return speed.reshape(shape[1:]), limiting.reshape(shape[1:])
 
 
@@ -231,6 +222,6 @@ def spin_rate_at_feed(
     """
     shape = np.broadcast_shapes(a.shape, c.shape, b.shape)
     a, c, b = (np.broadcast_to(v, shape) for v in (a, c, b))
-    feeds = _writable(np.broadcast_to(feed, shape[1:]).reshape(-1))
-    sigma, lam = spin_rates_at_feed(_rows(a), _rows(c), _rows(b), _writable(qdot_max), feeds)
+    feeds = kernel_array(np.broadcast_to(feed, shape[1:]).reshape(-1))
+    sigma, lam = spin_rates_at_feed(_rows(a), _rows(c), _rows(b), kernel_array(qdot_max), feeds)
     return sigma.reshape(shape[1:]), lam.reshape(shape[1:])

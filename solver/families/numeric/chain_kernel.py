@@ -62,16 +62,6 @@ def drop_stale_cache(module_file: Path, *also: Path) -> None:
 drop_stale_cache(Path(__file__))  # speeds_per_twist takes the LU in
 
 
-def kernel_array(a: np.ndarray, dtype: type = float) -> np.ndarray:
-    """``a`` as the kernels take it: C-contiguous, writable, of ``dtype`` (a copy where not).
-
-    numba compiles a function once per argument type, and a read-only array (a broadcast or a
-    view of one) is another type than a writable one: arrays handed to the kernels are made
-    alike, so each kernel is compiled for one signature.
-    """
-    return np.require(a, dtype=dtype, requirements=("C", "W"))
-
-
 @njit(cache=True, nogil=True, error_model="numpy", inline="always")
 def frames(chain, q, work):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
     """Joint axes and origins, the flange's rotation and position, all in {B}, into ``work``.

@@ -16,6 +16,7 @@ import abc
 import numpy as np
 
 from solver.core.follows_in_steps import FollowsInSteps
+from solver.core.kernel_arrays import kernel_array
 from solver.families.numeric import (
     bounded_kernel,
     bounded_redundant_kernel,
@@ -23,7 +24,6 @@ from solver.families.numeric import (
     ik,
     seed_kernel,
 )
-from solver.families.numeric.chain_kernel import kernel_array
 
 REDUNDANT_MARGIN = 1e-10
 """Relative slack on a seven-joint slot's bound (:mod:`bounded_redundant_kernel`): its V_max come

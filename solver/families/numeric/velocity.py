@@ -13,10 +13,10 @@ from typing import NamedTuple
 import numpy as np
 
 from solver.core.dtf_redundant import redundant_speed
+from solver.core.kernel_arrays import kernel_array
 from solver.core.progress import Progress
 from solver.families.numeric import chain_kernel, redundant_kernel
 from solver.families.numeric.chain import SerialChain
-from solver.families.numeric.chain_kernel import kernel_array
 
 CHUNK_ROWS = 2048
 """Configurations checked (singularity, joint speeds) between two progress reports: about

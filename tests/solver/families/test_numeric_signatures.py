@@ -4,7 +4,7 @@ numba compiles a kernel once per argument type, and a read-only array (a broadca
 whose ``writeable`` flag is off, as a robot's limits may be) is another type than a writable
 one: each such caller compiled the six-joint seeding, following and J^-1 t a second time
 (seconds of CPU each on a fresh install). The family makes its arrays alike
-(:func:`solver.families.numeric.chain_kernel.kernel_array`); here read-only and writable
+(:func:`solver.core.kernel_arrays.kernel_array`); here read-only and writable
 inputs give the same answers and leave one signature per kernel.
 """
 
