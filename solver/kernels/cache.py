@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import hashlib
 import sys
 from pathlib import Path
 
@@ -16,6 +15,7 @@ import solver.kernels.free_follow
 import solver.kernels.limits
 import solver.kernels.positions
 import solver.kernels.spin_schedule
+from solver.core.compiled_cache import drop_stale_caches
 from solver.families.kernels import KERNEL_SOURCES
 
 
@@ -47,19 +47,4 @@ def drop_stale_compiled_code(name: str) -> None:
         sys.modules[name],
     )
     files = [Path(str(module.__file__)) for module in modules]
-    stamp = hashlib.sha256(b"".join(path.read_bytes() for path in files)).hexdigest()[:16]
-    stem = files[-1].stem
-    marker = files[-1].parent / "__pycache__" / f"{stem}.sources-{stamp}"
-    try:
-        if marker.exists():
-            return
-        for path in files:
-            cache = path.parent / "__pycache__"
-            for stale in [*cache.glob(f"{path.stem}.*.nbi"), *cache.glob(f"{path.stem}.*.nbc")]:
-                stale.unlink(missing_ok=True)
-        for old in marker.parent.glob(f"{stem}.sources-*"):
-            old.unlink(missing_ok=True)
-        marker.parent.mkdir(exist_ok=True)
-        marker.touch()
-    except OSError:
-        return
+    drop_stale_caches(files[-1].parent / "__pycache__" / files[-1].stem, files, files)

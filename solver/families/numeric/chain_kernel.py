@@ -18,13 +18,13 @@ of the work arrays between them.
 
 from __future__ import annotations
 
-import hashlib
 import math
 from pathlib import Path
 
 import numpy as np
 from numba import njit
 
+from solver.core.compiled_cache import drop_stale_caches
 from solver.families.numeric import lu_kernel
 from solver.families.numeric.lu_kernel import lu_solve
 
@@ -44,19 +44,8 @@ def drop_stale_cache(module_file: Path, *also: Path) -> None:
         also: the source files of other modules whose compiled code it takes in.
     """
     shared = (Path(__file__), Path(str(lu_kernel.__file__)))
-    sources = b"".join(f.read_bytes() for f in (*shared, module_file, *also))
-    cache = module_file.parent / "__pycache__"
-    marker = cache / f"{module_file.stem}.sources-{hashlib.sha256(sources).hexdigest()[:16]}"
-    try:
-        if marker.exists():
-            return
-        for pattern in ("*.nbi", "*.nbc", "sources-*"):
-            for stale in cache.glob(f"{module_file.stem}.{pattern}"):
-                stale.unlink(missing_ok=True)
-        cache.mkdir(exist_ok=True)
-        marker.touch()
-    except OSError:
-        return
+    marker = module_file.parent / "__pycache__" / module_file.stem
+    drop_stale_caches(marker, (*shared, module_file, *also), (module_file,))
 
 
 drop_stale_cache(Path(__file__))  # speeds_per_twist takes the LU in

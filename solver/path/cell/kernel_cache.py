@@ -13,8 +13,9 @@ elsewhere or not at all and nothing is done.
 
 from __future__ import annotations
 
-import hashlib
 from pathlib import Path
+
+from solver.core.compiled_cache import drop_stale_caches
 
 _PACKAGE = Path(__file__).resolve().parent
 KERNEL_MODULES = (
@@ -35,19 +36,7 @@ def drop_stale_cell_kernels(package: Path = _PACKAGE) -> None:
     Args:
         package: the folder of the sources and of their ``__pycache__`` (this package's).
     """
-    sources = sorted(package.glob("*.py"))
-    stamp = hashlib.sha256(b"".join(path.read_bytes() for path in sources)).hexdigest()[:16]
-    cache = package / "__pycache__"
-    marker = cache / f"cell_kernels.sources-{stamp}"
-    try:
-        if marker.exists():
-            return
-        for stem in KERNEL_MODULES:
-            for stale in [*cache.glob(f"{stem}.*.nbi"), *cache.glob(f"{stem}.*.nbc")]:
-                stale.unlink(missing_ok=True)
-        for old in cache.glob("cell_kernels.sources-*"):
-            old.unlink(missing_ok=True)
-        cache.mkdir(exist_ok=True)
-        marker.touch()
-    except OSError:
-        return
+    cached = [package / f"{stem}.py" for stem in KERNEL_MODULES]
+    drop_stale_caches(
+        package / "__pycache__" / "cell_kernels", sorted(package.glob("*.py")), cached
+    )
