@@ -22,15 +22,14 @@ from solver.families.kernels import KERNEL_SOURCES
 def drop_stale_compiled_code(name: str) -> None:
     """Delete the cached machine code of module ``name``'s kernels when a callee has changed.
 
-    numba's disk cache (``cache=True``, files in ``__pycache__``) is keyed by the source file
+    numba's disk cache (``cache=True``) is keyed by the source file
     of the cached function only, but the compiled functions take their callees into themselves
     (the dispatcher :func:`solver.families.kernels.pose_block` the families' pose kernels,
     whose modules it lists in :data:`~solver.families.kernels.KERNEL_SOURCES`, and the map
     kernels the dispatcher and the helpers of :mod:`solver.kernels`): after an edit of a
     callee they would load the old code. A marker named by the hash of all those sources says
-    which code the caches hold; a new hash drops the cached code of every one of them. Where
-    the directories cannot be written (an installed copy), numba caches elsewhere or not at all
-    and nothing is done here.
+    which code the caches hold; a new hash drops the cached code of every one of them, wherever
+    numba keeps it (:func:`solver.core.compiled_cache.numba_cache_folder`).
     """
     modules = (
         *KERNEL_SOURCES,
@@ -47,4 +46,4 @@ def drop_stale_compiled_code(name: str) -> None:
         sys.modules[name],
     )
     files = [Path(str(module.__file__)) for module in modules]
-    drop_stale_caches(files[-1].parent / "__pycache__" / files[-1].stem, files, files)
+    drop_stale_caches(files[-1].stem, files, files)

@@ -2,13 +2,18 @@
 
 numba keys a kernel's cache by its own file; the cell's kernels take callees and constants of
 other modules in, so an edit there must drop every cell kernel's cached code (a caller would
-otherwise run its old machine code). Checked on a copy of the package's sources.
+otherwise run its old machine code). Checked on a copy of the package's sources, with numba's
+cache beside them and in the folder NUMBA_CACHE_DIR names.
 """
 
 from __future__ import annotations
 
+import hashlib
 import shutil
 from pathlib import Path
+
+import numba
+import pytest
 
 from solver.path.cell import kernel_cache
 
@@ -20,7 +25,10 @@ def _cached(cache: Path) -> Path:
     return cached
 
 
-def test_an_edit_of_any_source_drops_every_kernels_cache(tmp_path: Path) -> None:
+def test_an_edit_of_any_source_drops_every_kernels_cache(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    monkeypatch.setattr(numba.config, "CACHE_DIR", "")  # numba caches beside the sources
     for source in Path(kernel_cache.__file__).parent.glob("*.py"):
         shutil.copy(source, tmp_path / source.name)
     cache = tmp_path / "__pycache__"
@@ -39,3 +47,28 @@ def test_an_edit_of_any_source_drops_every_kernels_cache(tmp_path: Path) -> None
     kernel_cache.drop_stale_cell_kernels(tmp_path)
     assert not kept.exists()
     assert len(list(cache.glob("cell_kernels.sources-*"))) == 1
+
+
+def test_the_caches_in_the_folder_numba_cache_dir_names_are_dropped(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    package = tmp_path / "cell"
+    package.mkdir()
+    for source in Path(kernel_cache.__file__).parent.glob("*.py"):
+        shutil.copy(source, package / source.name)
+    monkeypatch.setattr(numba.config, "CACHE_DIR", str(tmp_path / "numba"))
+    # numba's documented layout under NUMBA_CACHE_DIR: <folder name>_<sha1 of the folder's path>
+    cache = tmp_path / "numba" / f"cell_{hashlib.sha1(str(package).encode()).hexdigest()}"
+    cache.mkdir(parents=True)
+    first = _cached(cache)
+    kernel_cache.drop_stale_cell_kernels(package)
+    assert not first.exists()
+    assert len(list(cache.glob("cell_kernels.sources-*"))) == 1
+    assert not (package / "__pycache__").exists()  # nothing written beside the sources
+    kept = _cached(cache)
+    kernel_cache.drop_stale_cell_kernels(package)
+    assert kept.exists()
+    with (package / "sweep.py").open("a") as edited:
+        edited.write("\n# edited\n")
+    kernel_cache.drop_stale_cell_kernels(package)
+    assert not kept.exists()

@@ -36,16 +36,14 @@ def drop_stale_cache(module_file: Path, *also: Path) -> None:
     kernels take this chain's code and its LU's (:mod:`~solver.families.numeric.lu_kernel`)
     into themselves: after an edit of either they would load the old code. A marker named by
     the hash of these sources and the module's says which code the cache holds (as
-    :mod:`solver.kernels.cache` does for the map kernels); where the directory cannot be
-    written, nothing is done.
+    :mod:`solver.kernels.cache` does for the map kernels), wherever numba keeps it.
 
     Args:
         module_file: the source file of the module whose cache to check.
         also: the source files of other modules whose compiled code it takes in.
     """
     shared = (Path(__file__), Path(str(lu_kernel.__file__)))
-    marker = module_file.parent / "__pycache__" / module_file.stem
-    drop_stale_caches(marker, (*shared, module_file, *also), (module_file,))
+    drop_stale_caches(module_file.stem, (*shared, module_file, *also), (module_file,))
 
 
 drop_stale_cache(Path(__file__))  # speeds_per_twist takes the LU in

@@ -1,14 +1,12 @@
 """numba's disk cache of the cell's compiled kernels, dropped when any of their sources changes.
 
-numba keys a compiled function's disk cache (``cache=True``, files in ``__pycache__``) by its
-own source file, but the cell's kernels take their callees into themselves across modules (the
-batch takes the sweep, the sweep the forward scan, the closed-form distances, the pair tables
-and the separation bounds) and freeze the constants they read (``capsules.HALFSPACE``,
-``fast.MARGIN``): after an edit of one of those, a caller would load its old machine code. A
-marker named by the hash of every source of this package says which code the caches hold; a
-new hash drops the cached code of every kernel module here (as :mod:`solver.kernels.cache` does
-for the map kernels). Where the directory cannot be written (an installed copy), numba caches
-elsewhere or not at all and nothing is done.
+numba keys a compiled function's disk cache (``cache=True``) by its own source file, but the cell's
+kernels take their callees into themselves across modules (the batch takes the sweep, the sweep the
+forward scan, the closed-form distances, the pair tables and the separation bounds) and freeze the
+constants they read (``capsules.HALFSPACE``, ``fast.MARGIN``): after an edit of one of those, a
+caller would load its old machine code. A marker named by the hash of every source of this package
+says which code the caches hold; a new hash drops the cached code of every kernel module here (as
+:mod:`solver.kernels.cache` does for the map kernels), wherever numba keeps them.
 """
 
 from __future__ import annotations
@@ -34,9 +32,7 @@ def drop_stale_cell_kernels(package: Path = _PACKAGE) -> None:
     """Delete the cell kernels' cached machine code unless it was compiled from these sources.
 
     Args:
-        package: the folder of the sources and of their ``__pycache__`` (this package's).
+        package: the folder of the sources (this package's).
     """
     cached = [package / f"{stem}.py" for stem in KERNEL_MODULES]
-    drop_stale_caches(
-        package / "__pycache__" / "cell_kernels", sorted(package.glob("*.py")), cached
-    )
+    drop_stale_caches("cell_kernels", sorted(package.glob("*.py")), cached)
