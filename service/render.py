@@ -171,27 +171,78 @@ def render_joint_use(
     (motion.md section 2), the waypoint where mu_acc binds marked.
     """
     use = np.abs(check.use) if check.use is not None else np.zeros((0, len(joint_names)))
+    labels = [_legend_label(name) for name in joint_names]
+    w, b = evaluation.bottleneck_waypoint, evaluation.bottleneck_joint
+    if w is not None and b is not None:
+        labels.append(_legend_label(f"bottleneck: {joint_names[b]}"))
+    height = 7.0 if check.acceleration_use is not None else 4.0
+    figure = plt.figure(figsize=(JOINT_USE_WIDTH_INCHES, height), dpi=DPI)
+    panels = _joint_use_layout(2 if check.acceleration_use is not None else 1, height, labels)
+    axes = figure.add_axes(panels[0])
     if check.acceleration_use is not None:
-        figure, (axes, below) = plt.subplots(
-            2, 1, figsize=(8.0, 7.0), dpi=DPI, layout="constrained", sharex=True
-        )
+        below = figure.add_axes(panels[1], sharex=axes)
         _acceleration_panel(below, check.acceleration_use, evaluation)
+        axes.tick_params(labelbottom=False)
     else:
-        figure, axes = plt.subplots(figsize=(8.0, 4.0), dpi=DPI, layout="constrained")
+        axes.set_xlabel("waypoint")
     waypoints = np.arange(len(use))
-    for j, name in enumerate(joint_names):
-        axes.plot(waypoints, use[:, j], label=name, lw=1.2)
+    for j, label in enumerate(labels[: len(joint_names)]):
+        axes.plot(waypoints, use[:, j], label=label, lw=1.2)
     axes.axhline(1.0, color="red", ls="--", lw=1.0, label="limit")
-    if evaluation.bottleneck_waypoint is not None and evaluation.bottleneck_joint is not None:
-        w, j = evaluation.bottleneck_waypoint, evaluation.bottleneck_joint
-        axes.plot(w, use[w, j], "o", color="black", ms=8, label=f"bottleneck: {joint_names[j]}")
+    if w is not None and b is not None:
+        axes.plot(w, use[w, b], "o", color="black", ms=8, label=labels[-1])
     state = "runs" if check.feasible else "does NOT run"
-    axes.set_title(f"{title}: feed {check.feed:.4g} m/s {state} (margin {check.margin:.3g})")
-    axes.set_xlabel("waypoint")
+    axes.set_title(
+        f"{title}: feed {check.feed:.4g} m/s {state} (margin {check.margin:.3g})", fontsize=10
+    )
     axes.set_ylabel("|qdot| / qdot_max")
     axes.set_ylim(bottom=0.0)
-    figure.legend(loc="outside right upper", fontsize=8)
+    figure.legend(
+        loc="upper right",
+        bbox_to_anchor=(1.0, 1.0 - JOINT_USE_MARGINS_INCHES[2] / height),
+        fontsize=LEGEND_POINTS,
+        frameon=False,
+    )
     buffer = io.BytesIO()
     figure.savefig(buffer, format="png", dpi=DPI)
     plt.close(figure)
     return buffer.getvalue()
+
+
+JOINT_USE_WIDTH_INCHES = 8.0
+JOINT_USE_MARGINS_INCHES = (0.75, 0.5, 0.4)  # left, bottom, top of the panels' axes
+PANEL_GAP_INCHES = 0.25
+"""Fixed margins, not matplotlib's constrained layout (half the picture's rendering time)."""
+LEGEND_POINTS = 8
+LEGEND_LABEL_CHARACTERS = 32
+"""A legend label's longest text: a longer joint name is cut, its end marked (the picture only)."""
+
+
+def _legend_label(text: str) -> str:
+    """``text`` cut to LEGEND_LABEL_CHARACTERS, an ellipsis where it was cut."""
+    if len(text) <= LEGEND_LABEL_CHARACTERS:
+        return text
+    return text[: LEGEND_LABEL_CHARACTERS - 1] + "\N{HORIZONTAL ELLIPSIS}"
+
+
+def _joint_use_layout(panels: int, height: float, labels: list[str]) -> list[Box]:
+    """The axes boxes of the joint-use panels, top first; the legend's room at the right.
+
+    The legend's width is estimated from its longest label (about half an em a character, the
+    line's handle and padding 0.6 in), so no text is measured before the figure is drawn. Only
+    the top panel has a title and only the bottom one tick labels under it.
+    """
+    longest = max((len(label) for label in labels), default=0)
+    legend = 0.6 + 0.5 * LEGEND_POINTS / 72 * longest
+    left, bottom, top = JOINT_USE_MARGINS_INCHES
+    width = JOINT_USE_WIDTH_INCHES
+    inner = (height - bottom - top - PANEL_GAP_INCHES * (panels - 1)) / panels
+    return [
+        (
+            left / width,
+            (bottom + (inner + PANEL_GAP_INCHES) * (panels - 1 - k)) / height,
+            (width - left - legend) / width,
+            inner / height,
+        )
+        for k in range(panels)
+    ]
