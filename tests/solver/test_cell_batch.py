@@ -8,11 +8,14 @@ the single check's pack; and the checkers shared by content (:mod:`solver.path.c
 
 from __future__ import annotations
 
+import dataclasses
 from typing import Any
 
 import numpy as np
+import pinocchio as pin
 import pytest
 
+from solver.core.family import Branch
 from solver.core.spatial import Placement
 from solver.path.capability_map import capability_map, grid_axis
 from solver.path.cell import sweep
@@ -166,12 +169,39 @@ def test_chosen_joint_paths_equal_a_run_on_each_branch(name: str) -> None:
     assert tracked_joint_paths(free, placements, rows) is None  # the spin schedule's path
 
 
+def _ball_at_the_elbow(problem: PathProblem, placement: Placement, branch: Branch) -> Cell:
+    """``problem``'s cell and a ball around ``branch``'s elbow at its first waypoint there.
+
+    The elbow's position from pinocchio's forward kinematics of the branch's joint path (the
+    robot's base is its model's world): that branch collides there, others may not.
+    """
+    run = evaluate_path(problem.with_options(branch=branch, cell=Cell()), placement)
+    assert run.q is not None
+    model = problem.robot.model
+    data = model.createData()
+    pin.forwardKinematics(model, data, run.q[0])
+    elbow = data.oMi[model.getJointId("elbow_joint")].translation
+    ball = Sphere(0.05, _pose(*elbow), name="ball at an elbow")
+    return dataclasses.replace(problem.options.cell, fixed=(*problem.options.cell.fixed, ball))
+
+
 def test_free_spin_map_cells_equal_evaluate() -> None:
-    """Free spin (each branch's run: its spin schedule's path): map cells = evaluate's answers."""
+    """Free spin (each branch's run: its spin schedule's path): map cells = evaluate's answers.
+
+    The cell's table collides with the elbow-down branches, which tie the elbow-up ones exactly
+    in free spin here (the first in the family's order taken: up); a ball around an elbow-up
+    branch's elbow makes best branches collide, so that the next one is taken.
+    """
     problem = PathProblem.of(
         _arm("ur5e"), load_path("curved_line"), PathOptions(cell=CELL, spin_mode="free")
     )
     xs, ys = grid_axis(-0.2, 0.2, 0.1, field="x"), grid_axis(0.3, 0.6, 0.1, field="y")
+    plain = capability_map(
+        problem.with_options(cell=Cell()), xs=xs, ys=ys, z=0.1, yaws=np.array([0.0])
+    )
+    best = problem.family.branches[plain.branch[0, 0, 1, 0]]
+    cell = _ball_at_the_elbow(problem, Placement(-0.2, 0.4, 0.1, 0.0), best)
+    problem = problem.with_options(cell=cell)
     cells = capability_map(problem, xs=xs, ys=ys, z=0.1, yaws=np.array([0.0]))
     for index in zip(*np.nonzero(np.ones_like(cells.reason, dtype=bool)), strict=True):
         _, _, iy, ix = index
@@ -183,10 +213,9 @@ def test_free_spin_map_cells_equal_evaluate() -> None:
         else:
             assert evaluation.failed_waypoint == cells.failed_waypoint[index]
     assert (cells.reason == -1).sum() >= 4
-    plain = capability_map(
-        problem.with_options(cell=Cell()), xs=xs, ys=ys, z=0.1, yaws=np.array([0.0])
-    )
-    assert (cells.branch != plain.branch).any()  # a best branch collides: the next one taken
+    assert (cells.reason != -1).any()  # every branch collides at the ball's placement
+    taken = (cells.reason == -1) & (plain.reason == -1) & (cells.branch != plain.branch)
+    assert taken.any()  # a best branch collides: the next one taken
     # The map's batch and evaluate's walk share the sweep's one compiled signature (a second one
     # doubled its compile time, 20 s of CPU, in every process that ran both). Counted in this
     # process and in numba's disk cache: a caller loaded from the cache links the sweep in
