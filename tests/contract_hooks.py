@@ -7,13 +7,13 @@ operation's description), and these hooks meet them in the schema-valid ("positi
 schemathesis generates, so that ``positive_data_acceptance`` checks that the service accepts
 everything the spec and its words allow. Negative cases are left as generated.
 
-Two ways, both counted per rule in ``tests/artifacts/contract.txt``:
+Two ways, both counted per rule in ``tests/artifacts/contract-*.txt``:
 
 - normalised (``NORMALISED``): the case is moved onto the rule (a vector scaled to unit length,
   a pair put in order, a grid coarsened to the server's limits) and then must be accepted;
 - kept out (``KEPT_OUT``, the rules in ``KEEP_OUT``): the case is left as generated and runs
   with every check but ``positive_data_acceptance``; the share of generated requests kept out
-  is printed and must stay under 2 % (tests/test_contract.py).
+  is printed and must stay under 2 % (tests/contract_live.py).
 
 Each rule is computed here independently of the service's code:
 

@@ -2,7 +2,7 @@
 
 Seeded and bounded (issue 9). Here the generated requests go in as generated, the rules the
 spec states in words (unit vectors, one q per joint...) not met, so only the server-error check
-runs; ``tests/test_contract.py`` runs every check on a live server.
+runs; ``tests/contract_live.py`` runs every check on a live server.
 """
 
 from __future__ import annotations
@@ -28,7 +28,7 @@ def _fuzz_test(method: str, path: str) -> Callable[..., None]:
     @schema.include(method=method, path=path).parametrize()
     @hypothesis.settings(
         max_examples=40,
-        phases=[hypothesis.Phase.generate],  # the spec's examples run in tests/test_contract.py
+        phases=[hypothesis.Phase.generate],  # the spec's examples run in tests/contract_live.py
         deadline=None,
         derandomize=True,
         suppress_health_check=list(hypothesis.HealthCheck),

@@ -1,5 +1,11 @@
 """The committed OpenAPI spec against a live server, with every schemathesis check (issue 9).
 
+The operations' tests are in two modules, ``tests/test_contract_evaluate_and_jobs.py`` and
+``tests/test_contract_other_routes.py`` (split by :func:`evaluate_or_jobs`), each with its own
+live server, so that the suite's two workers share them (in one module they were about 60 % of
+the suite's test time on one worker, the other idle for minutes at the end); this module makes
+both.
+
 A uvicorn server is started with small work limits (so that a generated request cannot take
 minutes); schemathesis generates requests from ``openapi/openapi.json`` in every phase
 (examples, coverage, fuzzing), seeded, a bounded number per operation, and runs all its checks:
@@ -11,7 +17,8 @@ positive cases are moved onto them, except those breaking a cross-field rule of
 stay under 2 % of the generated requests (MAX_KEPT_OUT).
 
 The figures (cases and statuses per operation, the cases normalised and kept out per rule, the
-share kept out) are written to ``tests/artifacts/contract.txt``; ``.ci/run`` prints them.
+share kept out) are written to ``tests/artifacts/contract-<part>.txt``, one file per module;
+``.ci/run`` prints them.
 """
 
 from __future__ import annotations
@@ -20,7 +27,6 @@ import json
 from collections.abc import Callable, Iterator
 
 import hypothesis
-import pytest
 import schemathesis
 from schemathesis.specs.openapi.checks import positive_data_acceptance
 
@@ -36,16 +42,20 @@ LIMITS = {
     "max_png_panels": 6,  # a PNG of 24 panels takes 2 s: the contract, not the drawing, is tested
 }
 """The live server's work limits: small, so that every generated request answers in seconds."""
-ARTIFACT = ROOT / "tests" / "artifacts" / "contract.txt"
+ARTIFACTS = ROOT / "tests" / "artifacts"
 MAX_KEPT_OUT = 0.02
 """The largest share of generated requests kept out of positive_data_acceptance."""
 READ_TIMEOUT = 120
 """Seconds a request may take (a PNG of six panels on a loaded 2-core machine: over 10 s)."""
 
 
-@pytest.fixture(scope="module")
-def live_url() -> Iterator[str]:
-    """The URL of a live server with the contract limits; the figures written at the end."""
+def live_server(part: str) -> Iterator[str]:
+    """The URL of a live server with the contract limits; the figures written at the end.
+
+    The body of each contract module's ``live_url`` fixture; ``part`` names its figures' file.
+    """
+    for counts in (contract_hooks.STATUSES, contract_hooks.KEPT_OUT, contract_hooks.NORMALISED):
+        counts.clear()  # this module's figures only, where both run in one process
     env = {f"DTF_{name.upper()}": str(value) for name, value in LIMITS.items()}
     env |= {  # jobs: as small as the routes (the hooks size their requests alike), never refused
         "DTF_MAX_JOB_CELLS": str(LIMITS["max_map_cells"]),
@@ -56,7 +66,7 @@ def live_url() -> Iterator[str]:
     yield url
     process.terminate()
     process.wait(timeout=30)
-    ARTIFACT.parent.mkdir(exist_ok=True)
+    ARTIFACTS.mkdir(exist_ok=True)
     lines = [
         f"{n:6d}  {status}  {mode:8s}  {label}"
         for (label, mode, status), n in sorted(contract_hooks.STATUSES.items())
@@ -75,8 +85,8 @@ def live_url() -> Iterator[str]:
         f"kept out: {kept} of {total} generated requests = {100 * share:.2f} % "
         f"(limit {100 * MAX_KEPT_OUT:.0f} %)"
     ]
-    ARTIFACT.write_text(
-        f"schemathesis {schemathesis.__version__}, all checks, seed 1: {total} cases\n"
+    (ARTIFACTS / f"contract-{part}.txt").write_text(
+        f"{part}: schemathesis {schemathesis.__version__}, all checks, seed 1: {total} cases\n"
         + "\n".join(lines)
         + "\n"
     )
@@ -111,5 +121,20 @@ def _contract_test(method: str, path: str) -> Callable[..., None]:
     return test
 
 
-for _method, _path, _name in contract_hooks.operations(schema):
-    globals()["test_contract_" + _name] = _contract_test(_method, _path)
+def evaluate_or_jobs(name: str) -> bool:
+    """Whether an operation (its test-name suffix) is ``POST /v1/evaluate`` or of ``/v1/jobs``.
+
+    The split of the two contract modules: about 1,100 and 1,000 s of test time under load
+    (2026-12-02; the evaluate route's JSON about 680 s, the jobs' 430 s, the evaluate route's
+    PNG 650 s, the map's PNG 220 s, the optimisation 130 s).
+    """
+    return name == "post_v1_evaluate" or "_v1_jobs" in name
+
+
+def contract_tests(names: Callable[[str], bool]) -> dict[str, Callable[..., None]]:
+    """The contract tests of the operations whose test-name suffix ``names`` accepts, by name."""
+    return {
+        "test_contract_" + name: _contract_test(method, path)
+        for method, path, name in contract_hooks.operations(schema)
+        if names(name)
+    }
