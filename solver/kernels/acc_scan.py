@@ -93,20 +93,36 @@ def joint_steps(cq, sq, qs, b, moves, joint_path):  # type: ignore[no-untyped-de
     The bits of :func:`solver.kernels.accelerations.moved_steps`: the pair's step plus the
     move times J^-1 [0; z_tool] (``moves``: shape (W,); zeros in fixed spin), brought into
     [-pi, pi]. Every step by the series first; the steps it does not give are made again.
+    Without moves (fixed spin) the series alone: adding a zero move changes at most the sign
+    of a zero step, which no |D| sees.
     ``cq``, ``sq``, ``qs``: shape (8, 6, W); ``joint_path``: shape (6, >= W), columns 1 to W - 1
     written.
     """
     n_waypoints = cq.shape[2]
+    unmoved = True
+    for w in range(1, n_waypoints):
+        unmoved = unmoved & (moves[w] == 0.0)
     for j in range(N_JOINTS):
         cj, sj, qj, out = cq[b, j], sq[b, j], qs[b, j], joint_path[j]
         others = 0
-        for w in range(1, n_waypoints):
-            c0, s0, c1, s1 = cj[w - 1], sj[w - 1], cj[w], sj[w]
-            cross = c0 * s1 - s0 * c1
-            others += not series_holds(cross, c0 * c1 + s0 * s1)
-            step = small_step(cross) + moves[w] * qj[w - 1]
-            step = step - _TWO_PI if step > math.pi else step
-            out[w] = step + _TWO_PI if step < -math.pi else step
+        plain = unmoved
+        if plain:  # no move (fixed spin): a zero move of a finite J^-1 [0; z_tool] adds +-0.0
+            for w in range(1, n_waypoints):
+                plain = plain & (abs(qj[w - 1]) < np.inf)
+        if plain:  # the series alone (a step it gives is within half a turn: no wrap)
+            for w in range(1, n_waypoints):
+                c0, s0, c1, s1 = cj[w - 1], sj[w - 1], cj[w], sj[w]
+                cross = c0 * s1 - s0 * c1
+                others += not series_holds(cross, c0 * c1 + s0 * s1)
+                out[w] = small_step(cross)
+        else:
+            for w in range(1, n_waypoints):
+                c0, s0, c1, s1 = cj[w - 1], sj[w - 1], cj[w], sj[w]
+                cross = c0 * s1 - s0 * c1
+                others += not series_holds(cross, c0 * c1 + s0 * s1)
+                step = small_step(cross) + moves[w] * qj[w - 1]
+                step = step - _TWO_PI if step > math.pi else step
+                out[w] = step + _TWO_PI if step < -math.pi else step
         if others == 0:
             continue
         for w in range(1, n_waypoints):
@@ -149,8 +165,10 @@ def row_ratios(rows, qddot_max):  # type: ignore[no-untyped-def]  # pragma: no c
 
 @njit(cache=True, error_model="numpy", nogil=True, inline="always")
 def row_joint(rows, k, qddot_max):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
-    """The joint of stencil row k's max_j |D_j| / a_j (the first at a tie), as
-    :func:`row_ratios` forms each ratio (the same sums, in the same order: the same bits)."""
+    """The joint of stencil row k's max_j |D_j| / a_j (the first at a tie).
+
+    Each ratio as :func:`row_ratios` forms it: the same sums, in the same order (the same bits).
+    """
     first, _, weights, joint_path, _, _, _ = rows
     largest, joint = -1.0, 0
     for j in range(N_JOINTS):
