@@ -21,7 +21,9 @@ followed and scanned to the end after all, so every reported field is the full l
 are theirs. Each call in them names its arrays: a call written with ``*tuple`` (or with more than
 30 arguments, which Python passes as one tuple) builds a tuple of its arguments, each array's
 reference count up and down once per call, and the calls made per branch were most of the
-limits' cost (the ERK-size map, 2026-12-02).
+limits' cost (the ERK-size map, 2026-12-02). The two cells themselves keep numba's reference
+counting: compiled without it (``_nrt=False``), a cold cache failed to compile the kernels
+(functions that allocate, typed from them, were refused).
 """
 
 from __future__ import annotations
@@ -38,6 +40,15 @@ from solver.kernels.accelerations import (
 )
 from solver.kernels.cell import PRUNED, choice_holds, next_row, set_limits, start_again, write_cell
 from solver.kernels.fixed_follow import follow_rows, probe_rows
+
+
+@njit(cache=True, error_model="numpy", nogil=True, inline="always")
+def any_left(remaining, alive):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
+    """Whether a row is still to be followed (a probe of none would still solve a waypoint)."""
+    for i in range(remaining.shape[0]):
+        if remaining[i] and alive[i]:
+            return True
+    return False
 
 
 @njit(cache=True, error_model="numpy", nogil=True)
@@ -88,7 +99,7 @@ def fixed_cell(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
         if followed:
             probes = (acc_hint[best] if best >= 0 else -1, acc_hint[row])
             b = branches[row]
-            if not left_at_probes(
+            if best < 0 or not left_at_probes(  # the first row has no bar to be left under
                 row, limit[row], probes, b, 0.0, cq, sq, qd, qd, inverse_qdot, inverse_qdot,
                 index, steps_c, qddot_max, steps, alive, why, where, slowest, acc_hint,
             ):  # fmt: skip
@@ -112,11 +123,6 @@ def fixed_cell(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
                     status, need, alive, why, where, slowest, acc_hint, bound, index, steps_c,
                     qddot_max, steps,
                 )  # fmt: skip
-            probe_rows(
-                remaining, limit, slowest_at[row], family, par, poses, branches, pure_rotation,
-                inverse_qdot, scratch, cq, sq, qd, status, need, alive, why, where, slowest,
-                hint, bound,
-            )  # fmt: skip
             todo[:] = False  # the rows whose acc_hint was probed
             for i in range(branches.shape[0]):  # where each row was least before, once each
                 if remaining[i] and alive[i] and not probed_before(i, acc_hint, todo, k):
@@ -126,6 +132,12 @@ def fixed_cell(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
                         index, steps_c, qddot_max, steps,
                     )  # fmt: skip
                     todo[i] = True
+            if any_left(remaining, alive):  # V_max where the best is least, after V_acc
+                probe_rows(
+                    remaining, limit, slowest_at[row], family, par, poses, branches,
+                    pure_rotation, inverse_qdot, scratch, cq, sq, qd, status, need, alive, why,
+                    where, slowest, hint, bound,
+                )  # fmt: skip
             todo[:] = False  # the rows whose hint was probed
             for i in range(branches.shape[0]):
                 if remaining[i] and alive[i] and not probed_before(i, hint, todo, slowest_at[row]):

@@ -79,7 +79,7 @@ def free_cell(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
         if followed:
             probes = (acc_hint[best] if best >= 0 else -1, acc_hint[row])
             b, rate = branches[row], spin_rate_of(slowest[row], True)
-            if not left_at_probes(
+            if best < 0 or not left_at_probes(  # the first row has no bar to be left under
                 row, limit[row], probes, b, rate, cq, sq, qd, qs, length, qdot_max, index,
                 steps_c, qddot_max, steps, alive, why, where, slowest, acc_hint,
             ):  # fmt: skip

@@ -56,7 +56,7 @@ def scan_work(index, c, n_waypoints, segment_checked, max_joint_step, qddot_max)
         first[k] = first[0] + k (one pass, rows on consecutive waypoints); weights: shape
         (S, K), c transposed; joint_path: shape (6, W + S), rad, a branch's steps by joint (the
         last S columns stay 0: the zero weights of a short row read there); sums: shape (K,);
-        worst: shape (K,), max_j |D_j| / a_j per row; joint: shape (K,), its joint; floor:
+        worst: shape (K,), max_j |D_j| / a_j per row; floor:
         m/s, a lower bound of V_acc on every row of a branch that passed the step test (0:
         none, where a row reads a step the test does not bound or the bound is a half turn).
     """
@@ -83,8 +83,7 @@ def scan_work(index, c, n_waypoints, segment_checked, max_joint_step, qddot_max)
     joint_path = np.zeros((N_JOINTS, n_waypoints + span))
     sums = np.empty(n_rows)
     worst = np.empty(n_rows)
-    joint = np.empty(n_rows, dtype=np.int64)
-    return first, contiguous, weights, joint_path, sums, worst, joint, floor
+    return first, contiguous, weights, joint_path, sums, worst, floor
 
 
 @njit(cache=True, error_model="numpy", nogil=True)
@@ -94,20 +93,36 @@ def joint_steps(cq, sq, qs, b, moves, joint_path):  # type: ignore[no-untyped-de
     The bits of :func:`solver.kernels.accelerations.moved_steps`: the pair's step plus the
     move times J^-1 [0; z_tool] (``moves``: shape (W,); zeros in fixed spin), brought into
     [-pi, pi]. Every step by the series first; the steps it does not give are made again.
+    Without moves (fixed spin) the series alone: adding a zero move changes at most the sign
+    of a zero step, which no |D| sees.
     ``cq``, ``sq``, ``qs``: shape (8, 6, W); ``joint_path``: shape (6, >= W), columns 1 to W - 1
     written.
     """
     n_waypoints = cq.shape[2]
+    unmoved = True
+    for w in range(1, n_waypoints):
+        unmoved = unmoved & (moves[w] == 0.0)
     for j in range(N_JOINTS):
         cj, sj, qj, out = cq[b, j], sq[b, j], qs[b, j], joint_path[j]
         others = 0
-        for w in range(1, n_waypoints):
-            c0, s0, c1, s1 = cj[w - 1], sj[w - 1], cj[w], sj[w]
-            cross = c0 * s1 - s0 * c1
-            others += not series_holds(cross, c0 * c1 + s0 * s1)
-            step = small_step(cross) + moves[w] * qj[w - 1]
-            step = step - _TWO_PI if step > math.pi else step
-            out[w] = step + _TWO_PI if step < -math.pi else step
+        plain = unmoved
+        if plain:  # no move (fixed spin): a zero move of a finite J^-1 [0; z_tool] adds +-0.0
+            for w in range(1, n_waypoints):
+                plain = plain & (abs(qj[w - 1]) < np.inf)
+        if plain:  # the series alone (a step it gives is within half a turn: no wrap)
+            for w in range(1, n_waypoints):
+                c0, s0, c1, s1 = cj[w - 1], sj[w - 1], cj[w], sj[w]
+                cross = c0 * s1 - s0 * c1
+                others += not series_holds(cross, c0 * c1 + s0 * s1)
+                out[w] = small_step(cross)
+        else:
+            for w in range(1, n_waypoints):
+                c0, s0, c1, s1 = cj[w - 1], sj[w - 1], cj[w], sj[w]
+                cross = c0 * s1 - s0 * c1
+                others += not series_holds(cross, c0 * c1 + s0 * s1)
+                step = small_step(cross) + moves[w] * qj[w - 1]
+                step = step - _TWO_PI if step > math.pi else step
+                out[w] = step + _TWO_PI if step < -math.pi else step
         if others == 0:
             continue
         for w in range(1, n_waypoints):
@@ -118,14 +133,16 @@ def joint_steps(cq, sq, qs, b, moves, joint_path):  # type: ignore[no-untyped-de
 
 @njit(cache=True, error_model="numpy", nogil=True)
 def row_ratios(rows, qddot_max):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
-    """Every stencil row's max_j |D_j| / a_j and its joint (the first at a tie) into ``rows``.
+    """Every stencil row's max_j |D_j| / a_j into ``rows``' ``worst``.
 
     D_j = sum_t c[k, t] steps[first[k] + t, j], summed in t's order from 0.0 as
     :func:`solver.kernels.limits.acceleration_at` sums it (a short row's zero weights add
-    zeros: the same bits). ``rows``: from :func:`scan_work`, the joint path filled
-    (:func:`joint_steps`); ``qddot_max``: shape (6,), rad/s^2.
+    zeros: the same bits). The maximum is taken without its joint (a select the compiler
+    vectorises, where keeping the joint was a branch per row and joint): the joint is read
+    only where a row binds (:func:`row_joint`). ``rows``: from :func:`scan_work`, the joint
+    path filled (:func:`joint_steps`); ``qddot_max``: shape (6,), rad/s^2.
     """
-    first, contiguous, weights, joint_path, sums, worst, joint, _ = rows
+    first, contiguous, weights, joint_path, sums, worst, _ = rows
     n_rows = first.shape[0]
     worst[:] = -1.0
     for j in range(N_JOINTS):
@@ -140,11 +157,28 @@ def row_ratios(rows, qddot_max):  # type: ignore[no-untyped-def]  # pragma: no c
                 path = joint_path[j]
                 for k in range(n_rows):
                     sums[k] += weight[k] * path[first[k] + t]
+        limit = qddot_max[j]
         for k in range(n_rows):
-            ratio = abs(sums[k]) / qddot_max[j]
-            if ratio > worst[k]:
-                worst[k] = ratio
-                joint[k] = j
+            ratio = abs(sums[k]) / limit
+            worst[k] = ratio if ratio > worst[k] else worst[k]
+
+
+@njit(cache=True, error_model="numpy", nogil=True, inline="always")
+def row_joint(rows, k, qddot_max):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
+    """The joint of stencil row k's max_j |D_j| / a_j (the first at a tie).
+
+    Each ratio as :func:`row_ratios` forms it: the same sums, in the same order (the same bits).
+    """
+    first, _, weights, joint_path, _, _, _ = rows
+    largest, joint = -1.0, 0
+    for j in range(N_JOINTS):
+        second = 0.0
+        for t in range(weights.shape[0]):
+            second += weights[t, k] * joint_path[j, first[k] + t]
+        ratio = abs(second) / qddot_max[j]
+        if ratio > largest:
+            largest, joint = ratio, j
+    return joint
 
 
 @njit(cache=True, error_model="numpy", nogil=True, _nrt=False)
@@ -169,13 +203,13 @@ def scan_row(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
     atomic increment and decrement of each array argument at every call.
     """
     keep = acc_speeds.shape[1] > 0
-    if slowest[i] < rows[7] and not keep:  # below the floor: the speeds bind, as a scan finds
+    if slowest[i] < rows[6] and not keep:  # below the floor: the speeds bind, as a scan finds
         feed[i] = slowest[i]
         acc_at[i], acc_joint[i], acc_hint[i] = -1, -1, -1
         return
     joint_steps(cq, sq, qs, b, moves, rows[3])
     row_ratios(rows, qddot_max)
-    worst, joint = rows[5], rows[6]
+    worst = rows[5]
     if keep:
         acc_speeds[i, :] = np.inf
     largest, at, left = -1.0, -1, False
@@ -193,5 +227,5 @@ def scan_row(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
         return
     feed[i] = min(slowest[i], least)
     acc_at[i] = waypoints[at] if at >= 0 else -1
-    acc_joint[i] = joint[at] if at >= 0 else -1
+    acc_joint[i] = row_joint(rows, at, qddot_max) if at >= 0 else -1
     acc_hint[i] = at
