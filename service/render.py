@@ -27,6 +27,13 @@ MAX_COLUMNS = 3
 TITLE_INCHES = 0.3  # the figure's title, above the panels
 LEGEND_INCHES = 0.3  # the legend, below them
 PANEL_MARGINS_INCHES = (0.75, 0.2, 0.5, 0.3)  # left, right, bottom, top of each panel's axes
+JOINT_USE_WIDTH_INCHES = 8.0
+JOINT_USE_MARGINS_INCHES = (0.75, 0.5, 0.4)  # left, bottom, top of the panels' axes
+PANEL_GAP_INCHES = 0.25
+"""Fixed margins, not matplotlib's constrained layout (half the picture's rendering time)."""
+LEGEND_POINTS = 8
+LEGEND_LABEL_CHARACTERS = 32
+"""A legend label's longest text: a longer joint name is cut, its end marked (the picture only)."""
 
 
 def figure_pixels(n_panels: int) -> tuple[int, int]:
@@ -207,15 +214,6 @@ def render_joint_use(
     figure.savefig(buffer, format="png", dpi=DPI)
     plt.close(figure)
     return buffer.getvalue()
-
-
-JOINT_USE_WIDTH_INCHES = 8.0
-JOINT_USE_MARGINS_INCHES = (0.75, 0.5, 0.4)  # left, bottom, top of the panels' axes
-PANEL_GAP_INCHES = 0.25
-"""Fixed margins, not matplotlib's constrained layout (half the picture's rendering time)."""
-LEGEND_POINTS = 8
-LEGEND_LABEL_CHARACTERS = 32
-"""A legend label's longest text: a longer joint name is cut, its end marked (the picture only)."""
 
 
 def _legend_label(text: str) -> str:
