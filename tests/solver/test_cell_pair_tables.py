@@ -16,11 +16,14 @@ import pytest
 
 import solver.path.cell.cache as cache_module
 import solver.path.cell.fast as fast_module
+import solver.path.cell.pair_tables as pair_tables_module
 from solver.path.capability_map import capability_map, grid_axis
+from solver.path.cell import kept_tables
 from solver.path.cell.checker import CellChecker
 from solver.path.cell.fast import MARGIN
-from solver.path.cell.pair_tables import empty_tables, table_bound
-from solver.path.cell.shapes import Halfspace
+from solver.path.cell.pair_tables import build_tables, empty_tables, table_bound
+from solver.path.cell.robot_geometry import robot_geometry
+from solver.path.cell.shapes import Halfspace, Tool
 from solver.path.problem import PathOptions, PathProblem
 from tests.solver.test_cell_fast import CELL, _arm
 from tests.solver.test_evaluate import load_path
@@ -113,3 +116,66 @@ def test_map_with_tables_equals_without(name: str, monkeypatch: pytest.MonkeyPat
         np.testing.assert_array_equal(getattr(tabled, field), getattr(plain, field))
         np.testing.assert_array_equal(getattr(tabled, field), getattr(reference, field))
     assert (tabled.reason == 4).any() or name == "ur5e"
+
+
+def test_tables_made_at_first_use_and_kept(monkeypatch: pytest.MonkeyPatch) -> None:
+    """An evaluation makes no table; a map makes the UR5's once; other cells reuse them.
+
+    Another cell (other obstacles, so other checked pairs) makes none; a larger clearance makes
+    only the tables of the pairs it adds (capsules within the clearance more often). The kept
+    tables equal those each checker makes with nothing kept, bit for bit.
+    """
+    made: list[int] = []
+    tabulate = pair_tables_module._tabulate
+
+    def counted(*args: object) -> np.ndarray:
+        made.append(1)
+        return tabulate(*args)  # type: ignore[arg-type]
+
+    monkeypatch.setattr(pair_tables_module, "_tabulate", counted)
+    kept_tables.forget()
+    arm = _arm("ur5")
+    first = CellChecker(arm, CELL)
+    q = np.random.default_rng(3).uniform(-np.pi, np.pi, (6, 6))
+    first.check(q, np.ones(5, dtype=np.bool_), np.eye(4), closest=True)  # coal alone
+    assert first._fast is not None and not made
+    seen = _tabled(first)
+    assert len(seen) >= 4 and len(made) == len(seen)
+    for cell in (
+        dataclasses.replace(ON_TABLE, workpiece=()),
+        dataclasses.replace(ON_TABLE, clearance=CELL.clearance + 0.05),
+    ):
+        before = len(made)
+        checker = CellChecker(arm, cell)
+        assert checker._fast is not None and len(checker._fast.pairs) != len(first._fast.pairs)
+        kept = checker._fast.tables
+        assert len(made) - before == len(_tabled(checker) - seen)
+        seen |= _tabled(checker)
+        model, geometry, weights, near, _ = checker._fast._table_inputs
+        pairs = checker._fast.pairs
+        fresh = build_tables(model, geometry, checker._fast.robot, pairs, weights, near)
+        for ours, theirs in zip(kept, fresh, strict=True):
+            np.testing.assert_array_equal(ours, theirs)
+    assert len(seen) > len(_tabled(first))  # the larger clearance tabulates more pairs
+
+
+def _tabled(checker: CellChecker) -> set[tuple[str, str]]:
+    """The names of the checker's tabulated pairs (its tables made here)."""
+    assert checker._fast is not None
+    objects, pairs = checker.geometry.geometryObjects, checker._fast.pairs
+    return {
+        (objects[int(pairs[p, 0])].name, objects[int(pairs[p, 1])].name)
+        for p in np.flatnonzero(checker._fast.tables[0] >= 0)
+    }
+
+
+def test_part_keys_name_the_arm_and_the_tool() -> None:
+    """The arm's parts' keys do not change with the tool; the tool's do; another arm's differ."""
+    short = robot_geometry(_arm("ur5"), tool=Tool(radius=0.03, length=0.12), link_radii=None)
+    long = robot_geometry(_arm("ur5"), tool=Tool(radius=0.03, length=0.2), link_radii=None)
+    other = robot_geometry(_arm("ur10"), tool=Tool(radius=0.03, length=0.12), link_radii=None)
+    arm = short.geometry.ngeoms - 2  # the tool: a holder and a cutting part, last
+    assert short.keys[:arm] == long.keys[:arm]
+    assert not set(short.keys[arm:]) & set(long.keys[arm:])
+    assert not set(short.keys) & set(other.keys)
+    assert len(set(short.keys)) == len(short.keys)

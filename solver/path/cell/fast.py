@@ -15,14 +15,15 @@ UR5e, loaded machine).
 
 from __future__ import annotations
 
-from collections.abc import Callable
+import threading
+from collections.abc import Callable, Sequence
 
 import numpy as np
 import pinocchio as pin
 
 from solver.path.cell import sweep
 from solver.path.cell.capsules import Primitive, primitive
-from solver.path.cell.pair_tables import build_tables
+from solver.path.cell.pair_tables import TablePack, build_tables
 
 # m: a bound within this of the clearance (or of an evaluation's closest distance) goes to
 # coal, whose GJK distances for boxes and meshes may differ from the exact ones by its
@@ -74,7 +75,8 @@ class FastCell:
     Attributes:
         robot: the sweep's robot pack.
         pairs: shape (P, 2), the checked pairs (robot parts; obstacles after them).
-        tables: the self pairs' tables (:mod:`solver.path.cell.pair_tables`).
+        tables: the self pairs' tables (:mod:`solver.path.cell.pair_tables`), made at first
+            use: an evaluation (coal alone) never needs them.
     """
 
     def __init__(
@@ -86,6 +88,7 @@ class FastCell:
         *,
         weights: np.ndarray,
         clearance: float,
+        keys: Sequence[str] | None = None,
     ) -> None:
         """Build the packs; raise NotImplementedError for a joint or shape the sweep lacks.
 
@@ -96,6 +99,8 @@ class FastCell:
             pairs: the checked pairs (geometry indices).
             weights: shape (P, nv), :func:`solver.path.cell.bounds.pair_weights` of the pairs.
             clearance: m, the cell's.
+            keys: the robot parts' content keys (RobotGeometry.keys), whose tables are kept
+                across checkers; None makes them anew.
         """
         joints = _joint_pack(model)
         if joints is None:
@@ -121,9 +126,20 @@ class FastCell:
             [s.placed(at) for s, at in zip(self.obstacles, placements, strict=True)], placements
         )
         self.pairs = np.array(pairs, dtype=np.int64).reshape(-1, 2)
-        self.tables = build_tables(
-            model, geometry, self.robot, self.pairs, weights, clearance + MARGIN
-        )
+        self._table_inputs = (model, geometry, weights, clearance + MARGIN, keys)
+        self._tables: TablePack | None = None
+        self._tables_lock = threading.Lock()  # threads share a checker: one of them makes them
+
+    @property
+    def tables(self) -> TablePack:
+        """The self pairs' tables, made at the first call."""
+        with self._tables_lock:
+            if self._tables is None:
+                model, geometry, weights, near, keys = self._table_inputs
+                self._tables = build_tables(
+                    model, geometry, self.robot, self.pairs, weights, near, keys
+                )
+            return self._tables
 
     @staticmethod
     def _packed(placed: list[Primitive], placements: list[pin.SE3]) -> tuple[np.ndarray, ...]:

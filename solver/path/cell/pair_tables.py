@@ -29,6 +29,7 @@ weight 0), the offsets (T + 1,) into the values (V,), row-major.
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 
 import coal
 import numpy as np
@@ -37,6 +38,7 @@ from numba import njit
 
 from solver.path.cell.bounds import pair_weights
 from solver.path.cell.closed_form import segment_segment
+from solver.path.cell.kept_tables import Row, keep_row, kept_row
 from solver.path.cell.kernel_cache import drop_stale_cell_kernels
 
 drop_stale_cell_kernels()  # the kernels here take callees and constants of other modules in
@@ -163,6 +165,7 @@ def build_tables(
     pairs: np.ndarray,
     weights: np.ndarray,
     near: float,
+    keys: Sequence[str] | None = None,
 ) -> TablePack:
     """The tables of the self pairs that need them (module docstring).
 
@@ -173,11 +176,14 @@ def build_tables(
         pairs: shape (P, 2), the checked pairs.
         weights: shape (P, nv), :func:`solver.path.cell.bounds.pair_weights`.
         near: m, the clearance plus the margin: capsules within it go to the meshes.
+        keys: the robot parts' content keys (:class:`solver.path.cell.robot_geometry.
+            RobotGeometry`): a table of two parts already made is taken from those kept; None
+            makes every table.
     """
     n_robot, kind, axes = len(robot[8]), robot[3], robot[4]
     objects = geometry.geometryObjects
     table_of = np.full(len(pairs), -1, dtype=np.int64)
-    rows: list[tuple[list[int], list[int], list[float], np.ndarray]] = []
+    rows: list[Row] = []
     for p, (a, b) in enumerate(pairs):
         if b >= n_robot or (robot[9][a] and robot[9][b]):
             continue
@@ -189,24 +195,14 @@ def build_tables(
         chain = _chain(model, ja, jb, kind)
         if chain is None or _overlap(robot, model, first, second, near) < OVERLAP:
             continue
-        a_obj, b_obj, row = objects[first], objects[second], weights[p]
-        if len(chain) == 3:  # the last joint's part as the cylinder it sweeps
-            b_obj, chain = _revolved(model, b_obj, chain[2], axes[chain[2]]), chain[:2]
-            probe = pin.GeometryModel()
-            probe.addGeometryObject(a_obj)
-            probe.addGeometryObject(b_obj)
-            row = pair_weights(model, probe, [(0, 1)], 2)[0]
-        w = [float(row[model.joints[k].idx_v]) for k in chain]
-        placement = model.jointPlacements[chain[0]]
-        axis = np.asarray(placement.rotation) @ axes[chain[0]]
-        w[0] = min(w[0], _largest_from_axis(a_obj, placement.translation, axis))
-        w[-1] = min(w[-1], _largest_from_axis(b_obj, np.zeros(3), axes[chain[-1]]))
-        if not all(math.isfinite(wk) and wk > 0.0 for wk in w):
-            continue  # a joint moving neither part: no grid to size; the sweep's bounds decide
-        scale = (BUDGET / math.prod(w)) ** (1.0 / len(chain))
-        counts = [max(4, int(scale * wk)) for wk in w]
-        q_index = [model.joints[k].idx_q for k in chain]
-        rows.append((q_index, counts, w, _tabulate(model, a_obj, b_obj, q_index, counts)))
+        key = None if keys is None else (keys[first], keys[second])
+        made = kept_row(key)
+        if made is None:
+            made = _row(model, objects[first], objects[second], chain, weights[p], axes)
+            if made is None:
+                continue
+            keep_row(key, made)
+        rows.append(made)
         table_of[p] = len(rows) - 1
     if not rows:
         return empty_tables(len(pairs))
@@ -219,6 +215,43 @@ def build_tables(
         np.concatenate([[0], np.cumsum([r[3].size for r in rows])]).astype(np.int64),
         np.concatenate([r[3].ravel() for r in rows]),
     )
+
+
+def _row(
+    model: pin.Model,
+    a_obj: pin.GeometryObject,
+    b_obj: pin.GeometryObject,
+    chain: list[int],
+    row: np.ndarray,
+    axes: np.ndarray,
+) -> Row | None:
+    """A pair's table: q indices, grid counts, weights, coal's distances; None if it has none.
+
+    Args:
+        model: the robot's model.
+        a_obj: the part on the ancestor joint.
+        b_obj: the other part.
+        chain: the joints after a_obj's up to b_obj's (:func:`_chain`).
+        row: the pair's weights (P's row of :func:`solver.path.cell.bounds.pair_weights`).
+        axes: the sweep's joint axes (its robot pack's).
+    """
+    if len(chain) == 3:  # the last joint's part as the cylinder it sweeps
+        b_obj, chain = _revolved(model, b_obj, chain[2], axes[chain[2]]), chain[:2]
+        probe = pin.GeometryModel()
+        probe.addGeometryObject(a_obj)
+        probe.addGeometryObject(b_obj)
+        row = pair_weights(model, probe, [(0, 1)], 2)[0]
+    w = [float(row[model.joints[k].idx_v]) for k in chain]
+    placement = model.jointPlacements[chain[0]]
+    axis = np.asarray(placement.rotation) @ axes[chain[0]]
+    w[0] = min(w[0], _largest_from_axis(a_obj, placement.translation, axis))
+    w[-1] = min(w[-1], _largest_from_axis(b_obj, np.zeros(3), axes[chain[-1]]))
+    if not all(math.isfinite(wk) and wk > 0.0 for wk in w):
+        return None  # a joint moving neither part: no grid to size; the sweep's bounds decide
+    scale = (BUDGET / math.prod(w)) ** (1.0 / len(chain))
+    counts = [max(4, int(scale * wk)) for wk in w]
+    q_index = [model.joints[k].idx_q for k in chain]
+    return q_index, counts, w, _tabulate(model, a_obj, b_obj, q_index, counts)
 
 
 def _tabulate(

@@ -14,6 +14,8 @@
 
 from __future__ import annotations
 
+import hashlib
+import pickle
 import re
 from dataclasses import dataclass
 
@@ -48,11 +50,15 @@ class RobotGeometry:
         geometry: the objects, each on the joint that carries it (0: the base).
         approximated: the links (joint names, ``base``) given capsules.
         cutting: index of the tool's cutting part, or -1 without a tool.
+        keys: per object, a digest of everything it and its place on the model are made of (the
+            model, the URDF, the arm's name, the link radii; the tool for the tool's parts):
+            two objects of equal keys are the same, whatever the cell around them.
     """
 
     geometry: pin.GeometryModel
     approximated: tuple[str, ...]
     cutting: int
+    keys: tuple[str, ...]
 
 
 def robot_geometry(
@@ -76,10 +82,27 @@ def robot_geometry(
         name = "base" if joint == 0 else model.names[joint]
         geometry.addGeometryObject(_capsule(f"{name}_capsule", joint, start, end, radius))
         approximated.append(name)
+    n_arm = geometry.ngeoms
     cutting = -1
     if tool is not None:
         cutting = _add_tool(robot, geometry, tool)
-    return RobotGeometry(geometry, tuple(approximated), cutting)
+    arm = _digest(pickle.dumps(robot.model), (robot.urdf or "").encode(), robot.name.encode(),
+                  pickle.dumps(link_radii))  # fmt: skip
+    with_tool = _digest(arm.encode(), pickle.dumps(tool))
+    keys = tuple(
+        f"{arm if g < n_arm else with_tool}:{g}:{obj.name}"
+        for g, obj in enumerate(geometry.geometryObjects)
+    )
+    return RobotGeometry(geometry, tuple(approximated), cutting, keys)
+
+
+def _digest(*parts: bytes) -> str:
+    """A sha256 digest of ``parts``, each length-prefixed."""
+    digest = hashlib.sha256()
+    for part in parts:
+        digest.update(len(part).to_bytes(8, "little"))
+        digest.update(part)
+    return digest.hexdigest()
 
 
 def _urdf_geometry(robot: Robot) -> pin.GeometryModel:

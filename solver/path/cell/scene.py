@@ -82,7 +82,13 @@ def build_scene(robot: Robot, cell: Cell) -> CellScene:
     weights = pair_weights(robot.model, geometry, pairs, n_robot, n_fixed=len(cell.fixed))
     try:
         compiled: fast.FastCell | None = fast.FastCell(
-            robot.model, geometry, n_robot, pairs, weights=weights, clearance=cell.clearance
+            robot.model,
+            geometry,
+            n_robot,
+            pairs,
+            weights=weights,
+            clearance=cell.clearance,
+            keys=made.keys,
         )
     except NotImplementedError:
         compiled = None  # a joint or shape the compiled sweep lacks: coal alone
