@@ -18,7 +18,6 @@ takes it away gets a checker of coal alone, not a cached one).
 
 from __future__ import annotations
 
-import hashlib
 import pickle
 import threading
 from collections import OrderedDict
@@ -26,6 +25,7 @@ from collections import OrderedDict
 from solver.core.robots import Robot
 from solver.path.cell import fast
 from solver.path.cell.checker import CellChecker
+from solver.path.cell.robot_geometry import content_digest
 from solver.path.cell.shapes import Cell
 
 # Checkers kept, the least recently used dropped first (a UR5's holds its link hulls, ~1 MB, and
@@ -38,17 +38,13 @@ _lock = threading.Lock()
 
 def _content(robot: Robot, cell: Cell) -> str:
     """A digest of everything a checker is built from."""
-    digest = hashlib.sha256()
-    for part in (
+    return content_digest(
         pickle.dumps(robot.model),
         (robot.urdf or "").encode(),
         robot.name.encode(),
         robot.transform_world_to_base.tobytes(),
         pickle.dumps(cell),
-    ):
-        digest.update(len(part).to_bytes(8, "little"))
-        digest.update(part)
-    return digest.hexdigest()
+    )
 
 
 def checker_for(robot: Robot, cell: Cell) -> CellChecker:

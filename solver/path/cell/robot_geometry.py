@@ -86,9 +86,13 @@ def robot_geometry(
     cutting = -1
     if tool is not None:
         cutting = _add_tool(robot, geometry, tool)
-    arm = _digest(pickle.dumps(robot.model), (robot.urdf or "").encode(), robot.name.encode(),
-                  pickle.dumps(link_radii))  # fmt: skip
-    with_tool = _digest(arm.encode(), pickle.dumps(tool))
+    arm = content_digest(
+        pickle.dumps(robot.model),
+        (robot.urdf or "").encode(),
+        robot.name.encode(),
+        pickle.dumps(link_radii),
+    )
+    with_tool = content_digest(arm.encode(), pickle.dumps(tool))
     keys = tuple(
         f"{arm if g < n_arm else with_tool}:{g}:{obj.name}"
         for g, obj in enumerate(geometry.geometryObjects)
@@ -96,8 +100,8 @@ def robot_geometry(
     return RobotGeometry(geometry, tuple(approximated), cutting, keys)
 
 
-def _digest(*parts: bytes) -> str:
-    """A sha256 digest of ``parts``, each length-prefixed."""
+def content_digest(*parts: bytes) -> str:
+    """A sha256 digest of ``parts``, each length-prefixed (the keys of kept checkers, tables)."""
     digest = hashlib.sha256()
     for part in parts:
         digest.update(len(part).to_bytes(8, "little"))
