@@ -23,7 +23,9 @@ from solver.families.ur.dh import UR_DH
 
 UR_KERNEL = 0
 OPW_KERNEL = 1
-SCRATCH_ROWS = max(ur.SCRATCH_ROWS, opw.SCRATCH_ROWS)  # what every family's kernel may use
+# The pose kernels' work space, flat: the UR kernel's rows of fixed length (ur.SCRATCH_SIZE), the
+# OPW kernel's rows as long as the path (opw.SCRATCH_ROWS a waypoint).
+SCRATCH_SIZE, SCRATCH_ROWS = ur.SCRATCH_SIZE, opw.SCRATCH_ROWS
 # The pose kernels' out arrays are (N_BRANCHES, N_JOINTS, W): six-joint arms, eight branches.
 N_BRANCHES, N_JOINTS = 8, 6
 # The modules whose compiled code :func:`pose_block` takes into itself, callees first: a map

@@ -47,7 +47,7 @@ def opw_block(par, poses, w0, w1, need, scratch, cq, sq, status, qd):  # type: i
     k = math.sqrt(k2)
     c_psi, s_psi = unit_pair(c3_len, a2)  # psi3 = atan2(a2, c3)
     k_h = math.hypot(a2, c3_len)
-    t = scratch
+    t = scratch[: SCRATCH_ROWS * poses.shape[1]].reshape((SCRATCH_ROWS, poses.shape[1]))
     for w in range(w0, w1):
         cx = poses[9, w] - c4 * poses[2, w]
         cy = poses[10, w] - c4 * poses[5, w]
