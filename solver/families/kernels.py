@@ -16,7 +16,7 @@ from types import ModuleType
 import numpy as np
 from numba import njit
 
-from solver.families import pairs
+from solver.families import lanes, pairs
 from solver.families.opw import kernel as opw
 from solver.families.ur import kernel as ur
 from solver.families.ur.dh import UR_DH
@@ -30,7 +30,7 @@ SCRATCH_SIZE, SCRATCH_ROWS = ur.SCRATCH_SIZE, opw.SCRATCH_ROWS
 N_BRANCHES, N_JOINTS = 8, 6
 # The modules whose compiled code :func:`pose_block` takes into itself, callees first: a map
 # kernel's disk cache is stale when one of them changes (solver.kernels.cache).
-KERNEL_SOURCES: tuple[ModuleType, ...] = (pairs, ur, opw, sys.modules[__name__])
+KERNEL_SOURCES: tuple[ModuleType, ...] = (pairs, lanes, ur, opw, sys.modules[__name__])
 
 
 def warm_up_arm() -> tuple[int, np.ndarray]:

@@ -1,11 +1,12 @@
 """The compiled pose kernels (:mod:`solver.families.kernels`) on any span of waypoints.
 
-The UR kernel works LANES waypoints at a time in a work space of fixed-length rows (so the
-compiler runs four waypoints in one vector instruction). Its answers must not depend on where a
-span starts or ends: a span of one waypoint (the map's probes), spans that cross a LANES
-boundary, and the whole path give the same bits. And they are the numpy IK's and Jacobian's
-(:mod:`solver.families.ur.ik`, :mod:`solver.families.ur.jacobian`): the same statuses, the
-same angles and joint speeds to rounding.
+The UR kernel works LANES waypoints at a time in a work space of fixed-length rows
+(:mod:`solver.families.lanes`: the compiler runs four waypoints in one vector instruction).
+Its answers must not depend on where a span starts or ends: a span of one waypoint (the map's
+probes), spans that cross a LANES boundary, and the whole path give the same bits. And they
+are the numpy IK's and Jacobian's (:mod:`solver.families.ur.ik`,
+:mod:`solver.families.ur.jacobian`): the same statuses, the same angles and joint speeds to
+rounding.
 """
 
 from __future__ import annotations
@@ -15,11 +16,11 @@ import pytest
 
 from solver.core.codes import OK, SINGULAR, UNREACHABLE
 from solver.families.kernels import OPW_KERNEL, UR_KERNEL, pose_block
+from solver.families.lanes import LANES
 from solver.families.opw.kernel import kernel_parameters as opw_parameters
 from solver.families.ur.dh import UR_DH
 from solver.families.ur.ik import forward_kinematics_dh, solve_batch
 from solver.families.ur.jacobian import joint_speeds_per_unit_twist
-from solver.families.ur.kernel import LANES
 from solver.families.ur.kernel import kernel_parameters as ur_parameters
 from solver.kernels.cell import pose_work
 from tests.solver.families.test_opw import build

@@ -20,6 +20,7 @@ import numpy as np
 from numba import njit
 
 from solver.core.codes import OK, SINGULAR, UNREACHABLE
+from solver.families.lanes import ANSWER_ROWS, LANES, POSE_ROWS, lanes_in, lanes_out
 from solver.families.pairs import unit_pair
 from solver.families.ur.dh import UrDh
 from solver.families.ur.ik import REACH_TOLERANCE, SINGULAR_TOLERANCE
@@ -30,30 +31,17 @@ def kernel_parameters(dh: UrDh) -> np.ndarray:
     return np.array([dh.d1, dh.a2, dh.a3, dh.d4, dh.d5, dh.d6])
 
 
-LANES = 32
-"""Waypoints one pass of :func:`ur_block`'s levels works on.
-
-Why: the work space holds each quantity as a row of LANES values, so its rows lie a constant
-distance apart, and the compiler (LLVM, through numba) can see that a level's loop over the
-waypoints reads and writes no value of another iteration: it runs four waypoints in one set of
-AVX2 instructions, with the same IEEE operations in the same order, so the same bits. Rows of
-the path's own arrays lie a run-time distance apart; there the loops stayed scalar ("too many
-memory checks"). The copies in and out cost less than they save: 2.5x faster on all eight
-branches, 1.8x on one (2026-12-03, ``bench/run.py``). Indices into the path's arrays are
-unsigned (``np.uint64``): a signed index may be negative for all numba knows, and the
-wrap-around it then computes also stops the vectoriser.
-"""
 L = LANES  # short, for the row offsets below
 P = 29  # the work space's rows from P on: the poses' 21 rows, copied in
-Q = 50  # from Q on: one branch's cos (6), sin (6), J^-1 t (6) and status, copied out
-SCRATCH_SIZE = 69 * LANES  # the work space ur_block needs (float64 values)
+Q = P + POSE_ROWS  # from Q on: one branch's answer (ANSWER_ROWS), copied out
+SCRATCH_SIZE = (Q + ANSWER_ROWS) * LANES  # the work space ur_block needs (float64 values)
 
 
 @njit(cache=True, error_model="numpy", nogil=True)
 def ur_block(par, poses, w0, w1, need, scratch, cq, sq, status, qd):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
     """IK on all eight branches and J^-1 t on each, for the waypoints w0..w1 of a path.
 
-    LANES waypoints at a time (:func:`ur_lanes`).
+    LANES waypoints at a time (:func:`ur_lanes`, :mod:`solver.families.lanes`).
 
     Args:
         par: shape (6,), the DH lengths.
@@ -73,27 +61,6 @@ def ur_block(par, poses, w0, w1, need, scratch, cq, sq, status, qd):  # type: ig
         ur_lanes(par, poses, c0, min(LANES, w1 - c0), need, scratch, cq, sq, status, qd)
 
 
-@njit(cache=True, error_model="numpy", nogil=True, inline="always")
-def lanes_in(poses, c0, n, t):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
-    """Copy the poses of waypoints c0..c0 + n into the work space's rows P on."""
-    for r in range(21):
-        for k in range(n):
-            t[(P + r) * L + k] = poses[r, c0 + np.uint64(k)]
-
-
-@njit(cache=True, error_model="numpy", nogil=True, inline="always")
-def lanes_out(t, n, c0, b, cq, sq, status, qd):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
-    """Copy branch b's answers from the work space's rows Q on to waypoints c0..c0 + n."""
-    for j in range(6):
-        for k in range(n):
-            w = c0 + np.uint64(k)
-            cq[b, j, w] = t[(Q + j) * L + k]
-            sq[b, j, w] = t[(Q + 6 + j) * L + k]
-            qd[b, j, w] = t[(Q + 12 + j) * L + k]
-    for k in range(n):
-        status[b, c0 + np.uint64(k)] = np.int64(t[(Q + 18) * L + k])
-
-
 @njit(cache=True, error_model="numpy", nogil=True)
 def ur_lanes(par, poses, c0, n, need, t, cq, sq, status, qd):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
     """:func:`ur_block` for the n <= LANES waypoints from c0, in the work space ``t``.
@@ -103,7 +70,7 @@ def ur_lanes(par, poses, c0, n, need, t, cq, sq, status, qd):  # type: ignore[no
     overlaps (one loop body over all levels per waypoint was three times slower).
     """
     d1, a2, a3, d4, d5, d6 = par[0], par[1], par[2], par[3], par[4], par[5]
-    lanes_in(poses, np.uint64(c0), n, t)
+    lanes_in(poses, c0, n, t, P)
     for k in range(n):
         a_x, a_y, a_z = t[(P + 2) * L + k], t[(P + 5) * L + k], t[(P + 8) * L + k]
         w_x = t[(P + 9) * L + k] - d6 * a_x
@@ -245,4 +212,4 @@ def ur_lanes(par, poses, c0, n, need, t, cq, sq, status, qd):  # type: ignore[no
                         qd5,
                         qd6,
                     )
-                lanes_out(t, n, np.uint64(c0), b, cq, sq, status, qd)
+                lanes_out(t, Q, n, c0, b, cq, sq, status, qd)
