@@ -36,7 +36,7 @@ import httpx
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-from real_size import ERK_GRID, EXAMPLE  # noqa: E402 - bench/real_size.py, beside this
+from erk_http import ERK_GRID, EXAMPLE  # noqa: E402 - bench/erk_http.py, beside this
 
 from service.config import Settings  # noqa: E402
 from service.convert.map_json import map_json  # noqa: E402
