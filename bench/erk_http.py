@@ -25,7 +25,7 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
 from run import load_path, scalar_cell  # noqa: E402 - bench/run.py, beside this script
-from timing import best_time  # noqa: E402
+from timing import best_time, plain_post  # noqa: E402
 
 from solver.core.spatial import Placement  # noqa: E402
 from solver.families import get_robot  # noqa: E402
@@ -51,17 +51,12 @@ def _map_seconds(body: dict[str, Any], threads: int | None, repeats: int) -> dic
     """
     process, url = start_server({} if threads is None else {"DTF_THREADS": str(threads)})
     raw = json.dumps(body).encode()
-    headers = {"Content-Type": "application/json"}
     try:
         connection = http.client.HTTPConnection("127.0.0.1", int(url.rsplit(":", 1)[1]))
         with httpx.Client(base_url=url, timeout=120) as client:
 
             def plain() -> None:
-                connection.request("POST", "/v1/map", body=raw, headers=headers)
-                answer = connection.getresponse()
-                answer.read()
-                if answer.status != 200:
-                    raise RuntimeError(f"/v1/map answered {answer.status}")
+                plain_post(connection, "/v1/map", raw)
 
             def with_httpx() -> None:
                 client.post("/v1/map", json=body).raise_for_status()

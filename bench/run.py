@@ -40,7 +40,7 @@ from acceleration import acceleration_lines
 from active_set import active_set_lines
 from cell import cell_lines
 from numeric_optimisation import numeric_optimisation_lines
-from timing import best_time
+from timing import best_time, plain_post
 
 from solver.core.kinematics import jacobian_in_base
 from solver.core.parallel import SERIAL, ThreadRunner
@@ -233,11 +233,7 @@ def evaluate_over_http(*, requests: int) -> None:
             connection = http.client.HTTPConnection("127.0.0.1", port, timeout=30)
 
             def plain() -> None:
-                connection.request("POST", "/v1/evaluate", body=body, headers=headers)
-                answer = connection.getresponse()
-                answer.read()
-                if answer.status != 200:
-                    raise RuntimeError(f"/v1/evaluate answered {answer.status}")
+                plain_post(connection, "/v1/evaluate", body)
 
             def with_httpx() -> None:
                 client.post("/v1/evaluate", content=body, headers=headers).raise_for_status()
