@@ -32,20 +32,25 @@ WORK_NICENESS = 10
 
 
 def lower_this_thread() -> None:
-    """Run the calling thread below the event loop's priority, once; threads it starts inherit it.
+    """Run the calling thread WORK_NICENESS below the process; threads it starts inherit it.
 
     On a machine whose cores are all busy with solver work, the event loop otherwise waits
     for a time slice like any worker, and /healthz takes tens of milliseconds. Linux only: a
-    thread's nice value is its own; elsewhere nothing changes.
+    thread's nice value is its own; elsewhere nothing changes. A thread already that low (one
+    started by a lowered thread) is left as it is.
     """
     if getattr(_lowered, "done", False) or not sys.platform.startswith("linux"):
         return
     thread = threading.get_native_id()
-    os.setpriority(os.PRIO_PROCESS, thread, os.getpriority(os.PRIO_PROCESS, thread) + WORK_NICENESS)
+    lowered = min(_PROCESS_NICENESS + WORK_NICENESS, 19)
+    if os.getpriority(os.PRIO_PROCESS, thread) < lowered:
+        os.setpriority(os.PRIO_PROCESS, thread, lowered)
     _lowered.done = True
 
 
 _lowered = threading.local()
+_PROCESS_NICENESS = os.getpriority(os.PRIO_PROCESS, 0) if sys.platform.startswith("linux") else 0
+"""The nice value of the thread that imports this module (the process's main thread)."""
 
 
 def json_response(answer: BaseModel) -> Response:

@@ -6,9 +6,10 @@ from typing import NamedTuple
 
 from service import convert
 from service.config import Settings
+from service.operations.threads import thread_runner
 from service.render import render_png
 from service.schemas import MapRequest, MapResponse, PathRead
-from solver.core.parallel import TaskRunner, ThreadRunner
+from solver.core.parallel import TaskRunner
 from solver.core.progress import Progress
 from solver.core.robots import Robot
 from solver.path.capability_map import CapabilityMap, capability_map, map_cost
@@ -93,7 +94,7 @@ def computed_map(
         yaws=grid.yaws,
         spins=grid.spins,
         progress=progress,
-        runner=ThreadRunner(settings.threads) if runner is None else runner,
+        runner=thread_runner(settings.threads) if runner is None else runner,
     )
     return ComputedMap(result, robot, problem.options.spin_mode, path_read)
 

@@ -4,9 +4,10 @@ from __future__ import annotations
 
 from service import convert
 from service.config import Settings
+from service.operations.threads import thread_runner
 from service.schemas import OptimizeRequest, OptimizeResponse
 from solver.core.exceptions import InvalidInputError
-from solver.core.parallel import TaskRunner, ThreadRunner
+from solver.core.parallel import TaskRunner
 from solver.core.progress import Progress
 from solver.optimise.optimize import optimize_placement
 from solver.optimise.search_space import PlacementBounds
@@ -45,7 +46,7 @@ def optimum_of(
         max_search_poses=settings.max_search_poses,
         max_solver_seconds=settings.max_solver_seconds,
         progress=progress,
-        runner=ThreadRunner(settings.threads) if runner is None else runner,
+        runner=thread_runner(settings.threads) if runner is None else runner,
     )
     return convert.optimize_response(
         optimum,

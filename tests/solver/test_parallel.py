@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import math
 import threading
+import time
 
 import numpy as np
 import pytest
@@ -120,6 +121,71 @@ def test_a_task_that_raises_in_a_helper_is_raised_and_stops_the_work() -> None:
     with pytest.raises(ValueError, match="task [01]"):
         ThreadRunner(2).run(work, list(range(50)), done)
     assert sorted(started) == [0, 1]  # one task each; none started after the failure
+
+
+def _helper_of_a_run(runner: ThreadRunner) -> threading.Thread:
+    """The thread that helped a run of ``runner`` (both first tasks held until both run)."""
+    caller = threading.current_thread()
+    helpers: set[threading.Thread] = set()
+    barrier = threading.Barrier(2, timeout=5)
+
+    def work(task: int) -> int:
+        if threading.current_thread() is not caller:
+            helpers.add(threading.current_thread())
+        if task < 2:
+            barrier.wait()
+        return task
+
+    assert runner.run(work, list(range(4)), lambda i: None) == [0, 1, 2, 3]
+    (helper,) = helpers
+    return helper
+
+
+def test_the_helper_threads_are_kept_for_the_next_run() -> None:
+    runner = ThreadRunner(2)
+    first = _helper_of_a_run(runner)
+    assert _helper_of_a_run(runner) is first
+    assert _helper_of_a_run(ThreadRunner(2)) is not first  # another runner, its own helper
+
+
+def test_a_stopped_run_returns_only_once_its_helper_s_task_has_ended() -> None:
+    caller = threading.get_ident()
+    helper_started, helper_ended = threading.Event(), threading.Event()
+
+    def work(task: int) -> int:
+        if threading.get_ident() != caller:
+            helper_started.set()
+            time.sleep(0.3)
+            helper_ended.set()
+        else:
+            helper_started.wait(5)  # the caller's first report comes once the helper computes
+        return task
+
+    def done(i: int) -> None:
+        raise Cancelled
+
+    with pytest.raises(Cancelled):
+        ThreadRunner(2).run(work, list(range(10)), done)
+    assert helper_ended.is_set()  # no thread computes for the run after it has returned
+
+
+def test_runs_at_the_same_time_share_the_helpers_and_each_gets_its_answer() -> None:
+    runner = ThreadRunner(2)
+    answers: dict[int, list[int]] = {}
+
+    def run(k: int) -> None:
+        def work(task: int) -> int:
+            time.sleep(0.001)
+            return k * 1000 + task
+
+        answers[k] = runner.run(work, list(range(40)), lambda i: None)
+
+    threads = [threading.Thread(target=run, args=(k,)) for k in range(4)]
+    for thread in threads:
+        thread.start()
+    for thread in threads:
+        thread.join(10)
+    assert answers == {k: [k * 1000 + t for t in range(40)] for k in range(4)}
 
 
 def test_task_sizes_are_whole_chunks_within_the_cap() -> None:
