@@ -12,7 +12,7 @@ equal (tests/service/test_map_json.py).
 
 from __future__ import annotations
 
-import itertools
+import functools
 from typing import Any
 
 import numpy as np
@@ -22,11 +22,14 @@ from service import schemas
 from service.convert.common import branch_to_api
 from service.convert.maps import acceleration_columns, extreme
 from solver.core.codes import FEASIBLE, REASONS
+from solver.core.family import Branch
 from solver.core.robots import Robot
 from solver.path.capability_map import CapabilityMap
 from solver.path.problem import SpinMode, require_family
 
 _NO_CELLS = b'{"cells":[]'
+_REASON_TEXTS = [to_json(r).decode() for r in REASONS]
+"""Each reason as the model writes it."""
 
 
 def map_json(
@@ -47,8 +50,7 @@ def map_json(
         recognised=family.recognised,
         path_read=path_read,
     ).model_dump_json()
-    branches = [to_json(_dumped(branch_to_api(b))).decode() for b in family.branches]
-    reasons = [to_json(r).decode() for r in REASONS]
+    branches = [_branch_text(b) for b in family.branches]
     feasible = (cmap.reason == FEASIBLE).ravel().tolist()
     reason, branch = cmap.reason.ravel().tolist(), cmap.branch.ravel().tolist()
     mu, failed, at, joint = (
@@ -62,21 +64,23 @@ def map_json(
     )
     mu_acc, limited_by = (_texts(column) for column in acceleration_columns(cmap))
     xs, ys, yaws, spins = (_texts(a.tolist()) for a in (cmap.xs, cmap.ys, cmap.yaws, cmap.spins))
-    cells = []
-    for c, (s, k, j, i) in enumerate(itertools.product(*map(range, cmap.mu_path.shape))):
-        place = f'{{"x":{xs[i]},"y":{ys[j]},"yaw":{yaws[k]},"spin":{spins[s]},"mu_path":'
-        if feasible[c]:
-            cells.append(
-                f'{place}{mu[c]},"reason":null,"failed_waypoint":null,"bottleneck_waypoint":'
-                f'{at[c]},"bottleneck_joint":{joint[c]},"branch":{branches[branch[c]]},'
-                f'"mu_acc":{mu_acc[c]},"limited_by":{limited_by[c]}}}'
-            )
-        else:
-            cells.append(
-                f'{place}null,"reason":{reasons[reason[c]]},"failed_waypoint":{failed[c]},'
-                '"bottleneck_waypoint":null,"bottleneck_joint":null,"branch":null,'
-                '"mu_acc":null,"limited_by":null}'
-            )
+    places = [  # C order of the map's (spin, yaw, y, x) axes, x fastest
+        f'{{"x":{x},"y":{y},"yaw":{yaw},"spin":{spin},"mu_path":'
+        for spin in spins
+        for yaw in yaws
+        for y in ys
+        for x in xs
+    ]
+    columns = (places, feasible, mu, reason, failed, at, joint, branch, mu_acc, limited_by)
+    cells = [
+        f'{place}{m},"reason":null,"failed_waypoint":null,"bottleneck_waypoint":{a},'
+        f'"bottleneck_joint":{jt},"branch":{branches[b]},"mu_acc":{ma},"limited_by":{lb}}}'
+        if ok
+        else f'{place}null,"reason":{_REASON_TEXTS[r]},"failed_waypoint":{f},'
+        '"bottleneck_waypoint":null,"bottleneck_joint":null,"branch":null,"mu_acc":null,'
+        '"limited_by":null}'
+        for place, ok, m, r, f, a, jt, b, ma, lb in zip(*columns, strict=True)
+    ]
     if not rest.startswith(_NO_CELLS.decode()):  # not reached: cells is the model's first field
         raise RuntimeError(f"MapResponse JSON starts {rest[:20]!r}")
     return ('{"cells":[' + ",".join(cells) + "]" + rest[len(_NO_CELLS) :]).encode()
@@ -88,6 +92,12 @@ def _texts(column: list[Any]) -> list[str]:
     One ``to_json`` call for the column, split at its commas (no value written holds one).
     """
     return to_json(column).decode()[1:-1].split(",") if column else []
+
+
+@functools.lru_cache(maxsize=256)
+def _branch_text(branch: Branch) -> str:
+    """A branch as the model writes it, made once a branch (eight models a request otherwise)."""
+    return to_json(_dumped(branch_to_api(branch))).decode()
 
 
 def _dumped(branch: schemas.Branch | schemas.NumericBranch | None) -> dict[str, Any] | None:

@@ -63,23 +63,32 @@ def controller_frames(transform_workpiece_to_base: np.ndarray) -> ControllerFram
     Raises:
         InvalidInputError: not a finite rigid transform.
     """
-    transform = check_transform(transform_workpiece_to_base, field="placement")
+    return _frames_of_rigid(check_transform(transform_workpiece_to_base, field="placement"))
+
+
+def frames_of_placement(placement: Placement) -> ControllerFrames:
+    """:func:`controller_frames` of a placement's T_B_O (its spin is not part of it).
+
+    Its transform is rigid by construction (a turn about z, a checked position), so it is not
+    checked again: the map's best and worst cells take this at every request.
+    """
+    return _frames_of_rigid(placement.transform_workpiece_to_base())
+
+
+def _frames_of_rigid(transform: np.ndarray) -> ControllerFrames:
+    """:func:`controller_frames` of a transform already known to be rigid."""
     rotation, position = transform[:3, :3], transform[:3, 3]
     yaw, pitch, roll = (math.degrees(v) for v in zyx_angles(rotation))
     pitch = min(max(pitch, -90.0), 90.0)  # degrees(pi / 2) is 90.00000000000001
     x, y, z = (float(v) * _MM for v in position)
+    quaternion = quaternion_wxyz(rotation)
     return ControllerFrames(
         matrix=transform.tolist(),
-        ur=[*map(float, position), *map(float, rotation_vector(rotation))],
+        ur=[*map(float, position), *map(float, _vector_of_quaternion(quaternion))],
         kuka={"X": x, "Y": y, "Z": z, "A": yaw, "B": pitch, "C": roll},
-        abb=[[x, y, z], [float(v) for v in quaternion_wxyz(rotation)]],
+        abb=[[x, y, z], [float(v) for v in quaternion]],
         fanuc={"X": x, "Y": y, "Z": z, "W": roll, "P": pitch, "R": yaw},
     )
-
-
-def frames_of_placement(placement: Placement) -> ControllerFrames:
-    """:func:`controller_frames` of a placement's T_B_O (its spin is not part of it)."""
-    return controller_frames(placement.transform_workpiece_to_base())
 
 
 def check_transform(transform: np.ndarray, *, field: str) -> np.ndarray:
@@ -192,7 +201,12 @@ def quaternions_wxyz(rotations: np.ndarray) -> np.ndarray:
 
 def rotation_vector(rotation: np.ndarray) -> np.ndarray:
     """The rotation vector (axis times angle, rad) of a rotation, length in [0, pi], (3,)."""
-    w, *v = quaternion_wxyz(rotation)
+    return _vector_of_quaternion(quaternion_wxyz(rotation))
+
+
+def _vector_of_quaternion(quaternion_wxyz: np.ndarray) -> np.ndarray:
+    """The rotation vector (rad) of a unit quaternion (w, x, y, z) with w >= 0, shape (3,)."""
+    w, *v = quaternion_wxyz
     vector = np.array(v)
     sine = float(np.linalg.norm(vector))  # sin(angle / 2)
     scale = 2.0 * math.atan2(sine, w) / sine if sine > 0.0 else 2.0

@@ -161,6 +161,15 @@ def test_frames_of_a_placement() -> None:
     np.testing.assert_array_equal(frames.matrix, placement.transform_workpiece_to_base())
 
 
+@pytest.mark.parametrize("yaw", [0.0, 0.3, -2.0, math.pi, -math.pi, 3.0 * math.pi])
+def test_a_placement_s_frames_equal_the_checked_transform_s(yaw: float) -> None:
+    """frames_of_placement skips the rigidity check; its answer is controller_frames' exactly."""
+    placement = Placement(x=-0.3, y=0.52, z=0.11, yaw=yaw, spin=0.4)
+    assert frames_of_placement(placement) == controller_frames(
+        placement.transform_workpiece_to_base()
+    )
+
+
 @pytest.mark.parametrize(
     "transform",
     [
