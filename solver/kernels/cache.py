@@ -9,6 +9,7 @@ import solver.kernels.acc_cells
 import solver.kernels.acc_free
 import solver.kernels.acc_scan
 import solver.kernels.accelerations
+import solver.kernels.borrow
 import solver.kernels.cell
 import solver.kernels.fixed_follow
 import solver.kernels.free_follow
@@ -33,6 +34,7 @@ def drop_stale_compiled_code(name: str) -> None:
     """
     modules = (
         *KERNEL_SOURCES,
+        solver.kernels.borrow,
         solver.kernels.positions,
         solver.kernels.limits,
         solver.kernels.cell,

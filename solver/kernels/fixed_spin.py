@@ -57,6 +57,7 @@ from solver.families.kernels import N_JOINTS
 from solver.kernels.acc_cells import fixed_cell
 from solver.kernels.acc_scan import scan_work
 from solver.kernels.accelerations import acc_work, write_acc
+from solver.kernels.borrow import borrowed_all, keep
 from solver.kernels.cache import drop_stale_compiled_code
 from solver.kernels.cell import (
     PRUNED,
@@ -162,19 +163,33 @@ def map_cells(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
     n_cells = cos_yaw.shape[0]
     n_waypoints = flange_rotation.shape[0]
     n_branches = branches.shape[0]
-    cq, sq, qd, status, poses, scratch, need = pose_work(n_waypoints)
-    alive, why, where, slowest, slowest_at, slowest_joint, speeds = branch_work(
-        n_branches, n_waypoints, v_out.shape[1] > 0
+    # Every array goes down the loop's calls as a view without a reference count
+    # (solver.kernels.borrow): the arguments are the caller's, the work arrays kept to the end.
+    (par, offset, flange_rotation, flange_position, tool_position, twist, pure_rotation,
+     segment_checked, branches, lower, upper, modes, arc, mu, reason, failed, branch,
+     bottleneck_waypoint, bottleneck_joint, v_out) = borrowed_all((
+        par, offset, flange_rotation, flange_position, tool_position, twist, pure_rotation,
+        segment_checked, branches, lower, upper, modes, arc, mu, reason, failed, branch,
+        bottleneck_waypoint, bottleneck_joint, v_out,
+    ))  # fmt: skip
+    work_poses = pose_work(n_waypoints)
+    cq, sq, qd, status, poses, scratch, need = borrowed_all(work_poses)
+    work_branches = branch_work(n_branches, n_waypoints, v_out.shape[1] > 0)
+    alive, why, where, slowest, slowest_at, slowest_joint, speeds = borrowed_all(work_branches)
+    work_rows = (
+        np.empty((n_branches, N_JOINTS)),  # chords2
+        np.empty((n_branches, N_JOINTS)),  # largest2
+        np.empty((n_branches, N_JOINTS)),  # inside
+        np.empty((n_branches, N_JOINTS), dtype=np.bool_),  # crossed
+        np.empty(n_branches, dtype=np.bool_),  # todo
+        np.full(n_branches, -1),  # hint
+        np.empty(n_branches),  # limit
+        np.empty(n_branches),  # bound
+        np.empty(n_branches, dtype=np.bool_),  # remaining
+        1.0 / qdot_max,  # inverse_qdot
     )
-    chords2 = np.empty((n_branches, N_JOINTS))
-    largest2 = np.empty((n_branches, N_JOINTS))
-    inside = np.empty((n_branches, N_JOINTS))
-    crossed = np.empty((n_branches, N_JOINTS), dtype=np.bool_)
-    todo = np.empty(n_branches, dtype=np.bool_)
-    hint = np.full(n_branches, -1)
-    limit = np.empty(n_branches)
-    bound = np.empty(n_branches)
-    remaining = np.empty(n_branches, dtype=np.bool_)
+    (chords2, largest2, inside, crossed, todo, hint, limit, bound, remaining,
+     inverse_qdot) = borrowed_all(work_rows)  # fmt: skip
     probed = (slowest, hint, bound)
     accelerations = qddot_max.shape[0] > 0
     acc = acc_work(n_branches, n_waypoints, v_acc.shape[1] > 0)
@@ -185,7 +200,6 @@ def map_cells(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
     )
     stencil = (stencil_index, steps_c, stencil_waypoints, rows)
     work = (todo, limit, remaining, bound)
-    inverse_qdot = 1.0 / qdot_max
     guess = np.int64(0)  # not the literal 0: the callees get one compiled signature, not two
     for c in range(n_cells):
         start_cell(alive, why, where)
@@ -241,6 +255,9 @@ def map_cells(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
                 c, pick, reason, slowest, slowest_at, slowest_joint, feed, acc_at, acc_by,
                 acc_speeds, mu_acc, limited_by, acc_waypoint, acc_joint, v_acc,
             )  # fmt: skip
+    keep(work_poses)  # the work arrays live until the loop has ended
+    keep(work_branches)
+    keep(work_rows)
 
 
 def warm_up() -> None:

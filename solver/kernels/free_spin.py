@@ -39,6 +39,7 @@ from solver.families.kernels import N_JOINTS
 from solver.kernels.acc_free import free_cell
 from solver.kernels.acc_scan import scan_work
 from solver.kernels.accelerations import acc_work, write_acc
+from solver.kernels.borrow import borrowed_all, keep
 from solver.kernels.cache import drop_stale_compiled_code
 from solver.kernels.cell import (
     PRUNED,
@@ -141,13 +142,25 @@ def free_cells(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
     n_cells = cos_yaw.shape[0]
     n_waypoints = flange_rotation.shape[0]
     n_branches = branches.shape[0]
-    cq, sq, qd, status, poses, scratch, need = pose_work(n_waypoints)  # qd: J^-1 t_hat
-    qs = np.empty_like(qd)  # J^-1 [0; z_tool]
-    spin_poses = np.empty_like(poses)
-    alive, why, where, slowest, slowest_at, slowest_joint, speeds = branch_work(
-        n_branches, n_waypoints, v_out.shape[1] > 0
+    # Every array goes down the loop's calls as a view without a reference count
+    # (solver.kernels.borrow): the arguments are the caller's, the work arrays kept to the end.
+    (par, offset, flange_rotation, flange_position, tool_position, twist, tool_axis, length,
+     pure_rotation, segment_checked, branches, lower, upper, qdot_max, mu, reason, failed,
+     branch, bottleneck_waypoint, bottleneck_joint, v_out) = borrowed_all((
+        par, offset, flange_rotation, flange_position, tool_position, twist, tool_axis, length,
+        pure_rotation, segment_checked, branches, lower, upper, qdot_max, mu, reason, failed,
+        branch, bottleneck_waypoint, bottleneck_joint, v_out,
+    ))  # fmt: skip
+    work_poses = pose_work(n_waypoints)
+    cq, sq, qd, status, poses, scratch, need = borrowed_all(work_poses)  # qd: J^-1 t_hat
+    work_branches = branch_work(n_branches, n_waypoints, v_out.shape[1] > 0)
+    alive, why, where, slowest, slowest_at, slowest_joint, speeds = borrowed_all(work_branches)
+    work_spin = (
+        np.empty_like(work_poses[2]),  # qs: J^-1 [0; z_tool]
+        np.empty_like(work_poses[4]),  # spin_poses
+        np.empty((n_waypoints, N_JOINTS)),  # spun
     )
-    spun = np.empty((n_waypoints, N_JOINTS))
+    qs, spin_poses, spun = borrowed_all(work_spin)
     accelerations = qddot_max.shape[0] > 0
     keep_acc = v_acc.shape[1] > 0
     acc = acc_work(n_branches, n_waypoints, keep_acc)
@@ -157,12 +170,16 @@ def free_cells(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
         stencil_index, steps_c, n_waypoints, segment_checked, max_joint_step, qddot_max
     )
     stencil = (stencil_index, steps_c, stencil_waypoints, rows)
-    todo = np.empty(n_branches, dtype=np.bool_)
-    remaining = np.empty(n_branches, dtype=np.bool_)
-    hint = np.full(n_branches, -1)
-    limit = np.empty(n_branches)
-    bound = np.empty(n_branches)
-    work = (todo, limit, remaining, bound, np.empty(n_branches))
+    work_rows = (
+        np.empty(n_branches, dtype=np.bool_),  # todo
+        np.empty(n_branches, dtype=np.bool_),  # remaining
+        np.full(n_branches, -1),  # hint
+        np.empty(n_branches),  # limit
+        np.empty(n_branches),  # bound
+        np.empty(n_branches),
+    )
+    todo, remaining, hint, limit, bound, spare = borrowed_all(work_rows)
+    work = (todo, limit, remaining, bound, spare)
     guess = np.int64(0)  # not the literal 0: the callees get one compiled signature, not two
     for c in range(n_cells):
         ca, sa = cos_yaw[c], sin_yaw[c]
@@ -241,6 +258,10 @@ def free_cells(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
                 c, pick, reason, slowest, slowest_at, slowest_joint, feed, acc_at, acc_by,
                 acc_speeds, mu_acc, limited_by, acc_waypoint, acc_joint, v_acc,
             )  # fmt: skip
+    keep(work_poses)  # the work arrays live until the loop has ended
+    keep(work_branches)
+    keep(work_spin)
+    keep(work_rows)
 
 
 def warm_up() -> None:
