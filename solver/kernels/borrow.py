@@ -9,6 +9,11 @@ inputs they share. :func:`borrowed_all` gives views of arrays that carry no coun
 the count of an array without one), so the calls below take none. The caller keeps the owners
 alive while the views are used: arguments are its caller's, and work arrays are passed to
 :func:`keep` at the end.
+
+A function that allocates nothing, nor anything it calls, is compiled without the counting
+instead (``_nrt=False``: the acceleration helpers, the numeric families' kernels). The map
+kernels' helpers call functions that allocate (the exact position-limit test), which that
+flag refuses, so their arguments are borrowed.
 """
 
 from __future__ import annotations
