@@ -168,6 +168,8 @@ def _task(
             refuse_colliding(problem, rows, part, columns_of)
             for rows, part in zip(pieces, parts, strict=True)
         ]
+    if len(parts) == 1:  # evaluate_placements concatenates the tasks' columns (a copy) anyway
+        return tuple(parts[0])
     return tuple(np.concatenate(c) for c in zip(*parts, strict=True))
 
 
@@ -179,12 +181,12 @@ def _pieces(placements: np.ndarray, size: int) -> list[np.ndarray]:
     is per chunk): the Panda's scipy search on 10 waypoints took 55 s cut by yaw, one placement
     a chunk.
     """
-    cuts = np.flatnonzero(np.diff(placements[:, 4]) != 0.0) + 1
-    return [
-        run[start : start + size]
-        for run in np.split(placements, cuts)
-        for start in range(0, len(run), size)
-    ]
+    spins = placements[:, 4]
+    if not len(spins) or (spins == spins[0]).all():  # one spin: slices, not numpy's split
+        runs = [placements]
+    else:
+        runs = np.split(placements, np.flatnonzero(np.diff(spins) != 0.0) + 1)
+    return [run[start : start + size] for run in runs for start in range(0, len(run), size)]
 
 
 def evaluate_placements(
