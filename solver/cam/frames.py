@@ -204,9 +204,9 @@ def rotation_vector(rotation: np.ndarray) -> np.ndarray:
     return _vector_of_quaternion(quaternion_wxyz(rotation))
 
 
-def _vector_of_quaternion(quaternion_wxyz: np.ndarray) -> np.ndarray:
+def _vector_of_quaternion(quaternion: np.ndarray) -> np.ndarray:
     """The rotation vector (rad) of a unit quaternion (w, x, y, z) with w >= 0, shape (3,)."""
-    w, *v = quaternion_wxyz
+    w, *v = quaternion
     vector = np.array(v)
     sine = float(np.linalg.norm(vector))  # sin(angle / 2)
     scale = 2.0 * math.atan2(sine, w) / sine if sine > 0.0 else 2.0

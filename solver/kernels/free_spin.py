@@ -176,10 +176,10 @@ def free_cells(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
         np.full(n_branches, -1),  # hint
         np.empty(n_branches),  # limit
         np.empty(n_branches),  # bound
-        np.empty(n_branches),
+        np.empty(n_branches),  # reach (solver.kernels.acc_free.free_cell)
     )
-    todo, remaining, hint, limit, bound, spare = borrowed_all(work_rows)
-    work = (todo, limit, remaining, bound, spare)
+    todo, remaining, hint, limit, bound, reach = borrowed_all(work_rows)
+    work = (todo, limit, remaining, bound, reach)
     guess = np.int64(0)  # not the literal 0: the callees get one compiled signature, not two
     for c in range(n_cells):
         ca, sa = cos_yaw[c], sin_yaw[c]

@@ -10,7 +10,6 @@ import pytest
 
 from service.operations.threads import thread_runner
 from service.work import WORK_NICENESS, lower_this_thread
-from solver.core.parallel import ThreadRunner
 
 pytestmark = pytest.mark.skipif(not sys.platform.startswith("linux"), reason="Linux thread nice")
 
@@ -24,6 +23,8 @@ def test_a_worker_thread_is_lowered_once_and_its_threads_inherit_it() -> None:
 
     def child() -> None:
         seen["child"] = _nice()
+        lower_this_thread()  # a thread a lowered thread started is not lowered again
+        seen["child lowered"] = _nice()
 
     def worker() -> None:
         seen["before"] = _nice()
@@ -38,13 +39,13 @@ def test_a_worker_thread_is_lowered_once_and_its_threads_inherit_it() -> None:
     thread.start()
     thread.join()
     assert seen["after"] == min(seen["before"] + WORK_NICENESS, 19)
-    assert seen["child"] == seen["after"]
+    assert seen["child"] == seen["child lowered"] == seen["after"]
     assert _nice() == seen["before"]  # the calling thread (the event loop's stand-in) is not
 
 
 def test_the_routes_runner_lowers_its_helpers_whoever_runs_it_first() -> None:
     """thread_runner's helpers run below the event loop, once, as the routes' worker threads."""
-    runner = ThreadRunner(2, initializer=lower_this_thread)
+    runner = thread_runner(2)
     seen: dict[str, int] = {}
     caller = threading.current_thread()
     barrier = threading.Barrier(2, timeout=5)
@@ -60,24 +61,4 @@ def test_the_routes_runner_lowers_its_helpers_whoever_runs_it_first() -> None:
     assert runner.run(work, [0, 1, 2], lambda i: None) == [0, 1, 2]  # from the unlowered thread
     assert seen["helper"] == min(base + WORK_NICENESS, 19)
     assert _nice() == base
-    assert thread_runner(2) is thread_runner(2)
-
-
-def test_a_lowered_thread_is_not_lowered_again_by_a_thread_it_starts() -> None:
-    seen: dict[str, int] = {}
-
-    def child() -> None:
-        lower_this_thread()
-        seen["child"] = _nice()
-
-    def worker() -> None:
-        lower_this_thread()
-        seen["worker"] = _nice()
-        started = threading.Thread(target=child)
-        started.start()
-        started.join()
-
-    thread = threading.Thread(target=worker)
-    thread.start()
-    thread.join()
-    assert seen["child"] == seen["worker"] == min(_nice() + WORK_NICENESS, 19)
+    assert thread_runner(2) is runner  # one runner a thread count, its helpers kept
