@@ -15,6 +15,7 @@ import numpy as np
 
 from solver.kernels.fixed_spin import map_cells
 from solver.kernels.free_spin import free_cells
+from solver.kernels.joint_paths import branch_paths
 from solver.kernels.positions import limit_modes
 from solver.path.limits import JointAccelerationLimit
 from solver.path.placed import flange_at_spin
@@ -170,6 +171,34 @@ def run_kernel(
     if not accelerations:
         return (mu, *codes, v_max, *no_acc_columns(n_cells, v_max.shape[1]))
     return (mu, *codes, v_max, mu_acc, *acc_codes, v_acc)
+
+
+def kernel_joint_paths(
+    inputs: KernelInputs, placements: np.ndarray, rows: np.ndarray
+) -> np.ndarray:
+    """The joint path of the family's branch ``rows[c]`` at each placement c, (C, W, 6), rad.
+
+    As :func:`solver.path.chosen_paths.tracked_joint_paths` gives them (fixed spin; the
+    compiled :func:`solver.kernels.joint_paths.branch_paths`); meaningful where that branch is
+    feasible at its placement.
+    """
+    out = np.empty((len(placements), inputs.rotation.shape[0], 6))
+    branch_paths(
+        inputs.code,
+        inputs.parameters,
+        np.cos(placements[:, 3]),
+        np.sin(placements[:, 3]),
+        np.ascontiguousarray(placements[:, :3]),
+        inputs.rotation,
+        inputs.position,
+        inputs.tool_position,
+        inputs.twist,
+        np.ascontiguousarray(rows, dtype=np.int64),
+        inputs.lower,
+        inputs.upper,
+        out,
+    )
+    return out
 
 
 def no_acc_columns(n_cells: int, n_waypoints: int) -> tuple[np.ndarray, ...]:

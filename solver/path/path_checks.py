@@ -9,20 +9,21 @@ placement is infeasible with the check's reason, at the best branch's refused wa
 
 from __future__ import annotations
 
-import dataclasses
-from collections.abc import Callable
-
 import numpy as np
 
 from solver.core.codes import FEASIBLE
 from solver.core.family import PathSolutions
+from solver.path.branch_candidates import (
+    Candidates,
+    Columns,
+    CompiledBranches,
+    branch_order,
+    pipeline_candidates,
+)
 from solver.path.chosen_paths import chosen_joint_paths, chunk_solutions, per_placement
 from solver.path.limits import PathVerdict
 from solver.path.pipeline import ChunkResult, run_chunk
 from solver.path.problem import PathProblem
-
-# The columns of a pipeline run's placements, each at its ``pick`` (the branch to report).
-Columns = Callable[[ChunkResult], tuple[np.ndarray, ...]]
 
 
 def check_path(
@@ -38,18 +39,6 @@ def check_path(
         if verdict.failed_waypoint is not None:
             return verdict
     return verdict
-
-
-def branch_order(run: ChunkResult, cell: int) -> list[int]:
-    """The feasible branches of placement ``cell`` (indices on axis B), best index first.
-
-    The pipeline's pick first (its tie rule), then the others by falling index.
-    """
-    index = run.mu_path if run.mu_acc is None else run.mu_acc
-    feasible = np.flatnonzero(run.tracked.reason[:, cell] == FEASIBLE)
-    pick = int(run.pick[cell])
-    others = sorted((b for b in feasible if b != pick), key=lambda b: -index[b, cell])
-    return ([pick] if pick in feasible else []) + [int(b) for b in others]
 
 
 def clear_pick(
@@ -113,6 +102,7 @@ def refuse_colliding(
     placements: np.ndarray,
     columns: tuple[np.ndarray, ...],
     columns_of: Columns,
+    compiled: CompiledBranches | None = None,
 ) -> tuple[np.ndarray, ...]:
     """The placements' columns with the path checks applied (cell.md section 3).
 
@@ -125,6 +115,8 @@ def refuse_colliding(
         columns: mu, reason, failed waypoint, branch (family index), ... as
             :func:`solver.path.placements._chunk` gives them.
         columns_of: the columns of a pipeline run, each placement at its ``pick``.
+        compiled: the compiled kernel's joint paths and next branches (fixed spin, a family
+            with a kernel: the columns are the kernel's); None: the numpy pipeline's.
     """
     if not problem.path_checks:
         return columns
@@ -132,8 +124,13 @@ def refuse_colliding(
     reason, branch = out[1], out[3]
     family = problem.family
     order = np.flatnonzero(reason == FEASIBLE)
-    solutions = chunk_solutions(problem, placements[order])
-    joint_paths = chosen_joint_paths(problem, placements[order], branch[order], solutions)
+    solutions = None
+    joint_paths: np.ndarray | None
+    if compiled is not None:
+        joint_paths = compiled.joint_paths(placements[order], branch[order])
+    else:
+        solutions = chunk_solutions(problem, placements[order])
+        joint_paths = chosen_joint_paths(problem, placements[order], branch[order], solutions)
     if joint_paths is None:  # one run per branch taken
         joint_paths = np.empty((len(order), problem.prepared.n_waypoints, problem.robot.dof))
         for b in np.unique(branch[order]):
@@ -147,9 +144,19 @@ def refuse_colliding(
         for c, q, verdict in zip(order, joint_paths, verdicts, strict=True)
         if verdict is not None and verdict.failed_waypoint is not None
     }
-    if refused:
-        known = (order, solutions) if solutions is not None and per_placement(solutions) else None
-        _next_branches(problem, placements, out, refused, columns_of, known)
+    if not refused:
+        return tuple(out)
+    cells = np.array(sorted(refused))
+    candidates = None
+    if problem.options.branch is None and compiled is not None:
+        candidates = compiled.candidates(problem, placements[cells], branch[cells])
+    elif problem.options.branch is None:
+        known = None
+        if solutions is not None and per_placement(solutions):
+            at = np.searchsorted(order, cells)  # the refused are among the checked
+            known = PathSolutions(solutions.q[:, :, at], solutions.status[:, at])
+        candidates = pipeline_candidates(problem, placements[cells], columns_of, known)
+    _next_branches(problem, placements, out, refused, candidates)
     return tuple(out)
 
 
@@ -158,36 +165,33 @@ def _next_branches(
     placements: np.ndarray,
     out: list[np.ndarray],
     refused: dict[int, tuple[np.ndarray, PathVerdict]],
-    columns_of: Columns,
-    known: tuple[np.ndarray, PathSolutions] | None = None,
+    candidates: Candidates | None,
 ) -> None:
     """The refused placements' columns from their best branches that pass (auto), else refused.
 
-    One pipeline run for all of them (a chunk's placements share a spin; its IK taken from
-    ``known``, the checked placements' indices and an analytic family's solutions there, where
-    given); then, round by round, each placement's next branch in :func:`branch_order` is
-    checked, all of a round together (:func:`check_paths`): the branch :func:`clear_pick`
-    takes. The refused joint path is not checked again.
+    Round by round, each placement's next branch in its ``candidates`` order is checked, all of
+    a round together (:func:`check_paths`): the branch :func:`clear_pick` takes. The refused
+    joint path is not checked again. ``candidates`` None (a fixed branch): refused.
     """
     cells = np.array(sorted(refused))
     taken = np.zeros(len(cells), dtype=bool)
-    if problem.options.branch is None:
+    if candidates is not None:
         rows = placements[cells]
-        solutions = None
-        if known is not None:
-            at = np.searchsorted(known[0], cells)  # the refused are among the checked
-            solutions = PathSolutions(known[1].q[:, :, at], known[1].status[:, at])
-        run = run_chunk(problem, rows, solutions=solutions)
-        chosen = np.array(run.pick, copy=True)
-        orders = [branch_order(run, k) for k in range(len(cells))]
+        chosen = np.full(len(cells), -1)
+        orders = candidates.orders
         step = [0] * len(cells)
         hints = [refused[int(c)][1] for c in cells]  # each placement's last refusal
         while True:
+            if candidates.prepare is not None:  # this round's first look at each placement
+                candidates.prepare(
+                    [(k, orders[k][step[k]]) for k in range(len(cells))
+                     if not taken[k] and step[k] < len(orders[k])]
+                )  # fmt: skip
             due: list[tuple[int, int]] = []  # (placement k, branch) checked this round
             for k, c in enumerate(cells):
                 while not taken[k] and step[k] < len(orders[k]):
                     b = orders[k][step[k]]
-                    q = run.tracked.q[:, b, k].T
+                    q = candidates.joint_path(k, b)
                     if not np.array_equal(q, refused[int(c)][0]) and not _refused_again(
                         problem, q, rows[k], hints[k]
                     ):
@@ -196,7 +200,7 @@ def _next_branches(
                     step[k] += 1  # the refused joint path itself, or one refused where it was
             if not due:
                 break
-            joint_paths = np.array([run.tracked.q[:, b, k].T for k, b in due])
+            joint_paths = np.array([candidates.joint_path(k, b) for k, b in due])
             verdicts = check_paths(problem, joint_paths, rows[[k for k, _ in due]])
             for (k, b), verdict in zip(due, verdicts, strict=True):
                 step[k] += 1
@@ -205,7 +209,7 @@ def _next_branches(
                 elif verdict is not None:
                     hints[k] = verdict
         if taken.any():
-            picked = columns_of(dataclasses.replace(run, pick=chosen))
+            picked = candidates.columns(chosen)
             for column, value in zip(out, picked, strict=True):
                 column[cells[taken]] = value[taken]
     for c in cells[~taken]:

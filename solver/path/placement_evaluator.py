@@ -10,6 +10,7 @@ from functools import partial
 
 import numpy as np
 
+from solver.path.kernel_branches import KernelBranches
 from solver.path.kernel_cells import KernelInputs, kernel_inputs, kernel_of, run_kernel
 from solver.path.path_checks import refuse_colliding
 from solver.path.placed import check_placements
@@ -55,5 +56,7 @@ class PlacementEvaluator:
         columns = run_kernel(self._last[1], cells, False)
         if self._problem.path_checks:
             columns_of = partial(columns_of_run, self._problem, with_speeds=False)
-            columns = refuse_colliding(self._problem, cells, columns, columns_of)
+            inputs = self._last[1]
+            compiled = None if inputs.free_spin else KernelBranches(inputs, False)
+            columns = refuse_colliding(self._problem, cells, columns, columns_of, compiled)
         return results_of_columns(self._problem, list(columns), False)

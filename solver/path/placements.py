@@ -17,6 +17,7 @@ from solver.core.codes import FEASIBLE
 from solver.core.malloc import raise_malloc_thresholds
 from solver.core.parallel import SERIAL, TaskRunner
 from solver.path.bounded import one_pass_chunk
+from solver.path.kernel_branches import KernelBranches
 from solver.path.kernel_cells import (
     KernelInputs,
     kernel_inputs,
@@ -165,12 +166,22 @@ def _task(
         columns_of = partial(columns_of_run, problem, with_speeds=with_speeds)
         pieces = _pieces(placements, chunk)
         parts = [
-            refuse_colliding(problem, rows, part, columns_of)
+            refuse_colliding(problem, rows, part, columns_of, _compiled(inputs, rows, with_speeds))
             for rows, part in zip(pieces, parts, strict=True)
         ]
     if len(parts) == 1:  # evaluate_placements concatenates the tasks' columns (a copy) anyway
         return tuple(parts[0])
     return tuple(np.concatenate(c) for c in zip(*parts, strict=True))
+
+
+def _compiled(
+    inputs: dict[float, KernelInputs] | None, rows: np.ndarray, with_speeds: bool
+) -> KernelBranches | None:
+    """The path checks' compiled side at the spin of ``rows``; None: the numpy pipeline's."""
+    if inputs is None:
+        return None
+    chosen = inputs[float(rows[0, 4])]
+    return None if chosen.free_spin else KernelBranches(chosen, with_speeds)
 
 
 def _pieces(placements: np.ndarray, size: int) -> list[np.ndarray]:

@@ -1,0 +1,91 @@
+"""The branches a refused placement may take next, best first: numpy's or the kernel's answers.
+
+Where the path checks (:mod:`solver.path.path_checks`) refuse a placement's chosen branch, an
+``auto`` placement takes its next feasible branch that passes. :class:`Candidates` holds what
+that search reads: each placement's feasible branches in order, their joint paths and the
+columns of the branch taken. :func:`pipeline_candidates` makes them by a numpy pipeline run; a
+family with a compiled kernel gives them by the kernel (:class:`CompiledBranches`,
+:mod:`solver.path.kernel_branches`).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from collections.abc import Callable
+from typing import Protocol
+
+import numpy as np
+
+from solver.core.codes import FEASIBLE
+from solver.core.family import PathSolutions
+from solver.path.pipeline import ChunkResult, run_chunk
+from solver.path.problem import PathProblem
+
+# The columns of a pipeline run's placements, each at its ``pick`` (the branch to report).
+Columns = Callable[[ChunkResult], tuple[np.ndarray, ...]]
+
+
+def branch_order(run: ChunkResult, cell: int) -> list[int]:
+    """The feasible branches of placement ``cell`` (indices on axis B), best index first.
+
+    The pipeline's pick first (its tie rule), then the others by falling index.
+    """
+    index = run.mu_path if run.mu_acc is None else run.mu_acc
+    feasible = np.flatnonzero(run.tracked.reason[:, cell] == FEASIBLE)
+    pick = int(run.pick[cell])
+    others = sorted((b for b in feasible if b != pick), key=lambda b: -index[b, cell])
+    return ([pick] if pick in feasible else []) + [int(b) for b in others]
+
+
+@dataclasses.dataclass(frozen=True)
+class Candidates:
+    """The refused placements' feasible branches, best first, with their joint paths and columns.
+
+    Attributes:
+        orders: per refused placement k, its feasible branches (indices on axis B, the
+            problem's branches) in :func:`branch_order`.
+        joint_path: (k, b) -> shape (W, n), rad, branch b's joint path at placement k.
+        columns: shape (K,) branches chosen (axis B; -1 where none is) -> the columns of the
+            K placements (those with -1: any values), as :func:`refuse_colliding` takes them.
+        prepare: (k, b) pairs whose joint paths are asked for next: made together where that
+            is cheaper than one by one (None: nothing to do).
+    """
+
+    orders: list[list[int]]
+    joint_path: Callable[[int, int], np.ndarray]
+    columns: Callable[[np.ndarray], tuple[np.ndarray, ...]]
+    prepare: Callable[[list[tuple[int, int]]], None] | None = None
+
+
+class CompiledBranches(Protocol):
+    """The compiled kernel's side of the path checks (:mod:`solver.path.kernel_branches`)."""
+
+    def joint_paths(self, placements: np.ndarray, rows: np.ndarray) -> np.ndarray:
+        """The joint paths (C, W, n) of the family's branch ``rows[c]`` at each placement."""
+
+    def candidates(
+        self, problem: PathProblem, placements: np.ndarray, picks: np.ndarray
+    ) -> Candidates:
+        """The :class:`Candidates` of placements (K, 5) whose chosen branches ``picks`` failed."""
+
+
+def pipeline_candidates(
+    problem: PathProblem,
+    rows: np.ndarray,
+    columns_of: Columns,
+    solutions: PathSolutions | None = None,
+) -> Candidates:
+    """The :class:`Candidates` of placements ``rows`` (K, 5) by one numpy pipeline run.
+
+    Its IK taken from ``solutions`` (an analytic family's, at these placements) where given.
+    """
+    run = run_chunk(problem, rows, solutions=solutions)
+
+    def columns(chosen: np.ndarray) -> tuple[np.ndarray, ...]:
+        return columns_of(dataclasses.replace(run, pick=np.where(chosen >= 0, chosen, run.pick)))
+
+    return Candidates(
+        [branch_order(run, k) for k in range(len(rows))],
+        lambda k, b: run.tracked.q[:, b, k].T,
+        columns,
+    )
