@@ -116,17 +116,7 @@ def run_kernel(
         inputs.stencil_weight,
         inputs.stencil_waypoints,
     )
-    placed = (
-        inputs.code,
-        inputs.parameters,
-        np.cos(placements[:, 3]),
-        np.sin(placements[:, 3]),
-        np.ascontiguousarray(placements[:, :3]),
-        inputs.rotation,
-        inputs.position,
-        inputs.tool_position,
-        inputs.twist,
-    )
+    placed = _placed(inputs, placements)
     followed = inputs.branches
     if inputs.free_spin:
         free_cells(
@@ -184,6 +174,18 @@ def kernel_joint_paths(
     """
     out = np.empty((len(placements), inputs.rotation.shape[0], 6))
     branch_paths(
+        *_placed(inputs, placements),
+        np.ascontiguousarray(rows, dtype=np.int64),
+        inputs.lower,
+        inputs.upper,
+        out,
+    )
+    return out
+
+
+def _placed(inputs: KernelInputs, placements: np.ndarray) -> tuple[object, ...]:
+    """The kernels' first nine arguments: the family, the placements, the path at the spin."""
+    return (
         inputs.code,
         inputs.parameters,
         np.cos(placements[:, 3]),
@@ -193,12 +195,7 @@ def kernel_joint_paths(
         inputs.position,
         inputs.tool_position,
         inputs.twist,
-        np.ascontiguousarray(rows, dtype=np.int64),
-        inputs.lower,
-        inputs.upper,
-        out,
     )
-    return out
 
 
 def no_acc_columns(n_cells: int, n_waypoints: int) -> tuple[np.ndarray, ...]:
