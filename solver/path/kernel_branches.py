@@ -38,6 +38,11 @@ class KernelBranches:
     inputs: KernelInputs
     with_speeds: bool
 
+    @classmethod
+    def of(cls, inputs: KernelInputs, with_speeds: bool) -> KernelBranches | None:
+        """The compiled side at these inputs' spin; None in free spin (the numpy route's)."""
+        return None if inputs.free_spin else cls(inputs, with_speeds)
+
     def joint_paths(self, placements: np.ndarray, rows: np.ndarray) -> np.ndarray:
         """The joint paths (C, W, 6) of the family's branch ``rows[c]`` at each placement."""
         return kernel_joint_paths(self.inputs, placements, rows)
@@ -72,7 +77,7 @@ class KernelBranches:
             orders.append(others)  # the pick's joint path is the one refused (the same bits)
         found: dict[tuple[int, int], np.ndarray] = {}
 
-        def joint_paths(pairs: list[tuple[int, int]]) -> None:
+        def prepare(pairs: list[tuple[int, int]]) -> None:
             pairs = [pair for pair in pairs if pair not in found]
             paths = self.joint_paths(
                 placements[[k for k, _ in pairs]],
@@ -82,7 +87,7 @@ class KernelBranches:
 
         def joint_path(k: int, b: int) -> np.ndarray:
             if (k, b) not in found:
-                joint_paths([(k, b)])
+                prepare([(k, b)])
             return found[(k, b)]
 
         def columns(chosen: np.ndarray) -> tuple[np.ndarray, ...]:
@@ -93,4 +98,4 @@ class KernelBranches:
                         column[k] = source[k]
             return tuple(out)
 
-        return Candidates(orders, joint_path, columns, joint_paths)
+        return Candidates(orders, joint_path, columns, prepare)

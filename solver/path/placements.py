@@ -178,10 +178,7 @@ def _compiled(
     inputs: dict[float, KernelInputs] | None, rows: np.ndarray, with_speeds: bool
 ) -> KernelBranches | None:
     """The path checks' compiled side at the spin of ``rows``; None: the numpy pipeline's."""
-    if inputs is None:
-        return None
-    chosen = inputs[float(rows[0, 4])]
-    return None if chosen.free_spin else KernelBranches(chosen, with_speeds)
+    return None if inputs is None else KernelBranches.of(inputs[float(rows[0, 4])], with_speeds)
 
 
 def _pieces(placements: np.ndarray, size: int) -> list[np.ndarray]:
