@@ -1,0 +1,191 @@
+"""The capability map as a PNG: one panel per yaw and spin, drawn on figures kept between maps.
+
+A map's picture was about 60 % matplotlib making its figure (axes, tick objects, the colour
+bar, the legend) and 40 % drawing and encoding it (2026-12-03: 176 ms for two panels, 116 ms
+to draw the same figure again). The figures are kept: a figure drawn for one map is given the
+next map of the same number of panels (its images' data, extent and colour range, its markers,
+titles and colour-bar label) and drawn again. A figure is used by one thread at a time (taken
+from :data:`_KEPT` under a lock, given back after its PNG is written); at most KEPT_FIGURES
+are kept. The bytes are those of a new figure (tests/service/test_map_picture.py).
+"""
+
+from __future__ import annotations
+
+import io
+import math
+import threading
+
+import matplotlib
+
+matplotlib.use("Agg")  # no display: render to memory
+
+import numpy as np  # noqa: E402
+from matplotlib.axes import Axes  # noqa: E402
+from matplotlib.backends.backend_agg import FigureCanvasAgg  # noqa: E402
+from matplotlib.figure import Figure  # noqa: E402
+from matplotlib.image import AxesImage  # noqa: E402
+from matplotlib.lines import Line2D  # noqa: E402
+from matplotlib.patches import Patch  # noqa: E402
+
+from solver.path.capability_map import CapabilityMap  # noqa: E402
+
+PANEL_INCHES = (4.0, 3.6)
+COLOUR_BAR_INCHES = 1.2
+DPI = 100
+MAX_COLUMNS = 3
+TITLE_INCHES = 0.3  # the figure's title, above the panels
+LEGEND_INCHES = 0.3  # the legend, below them
+PANEL_MARGINS_INCHES = (0.75, 0.2, 0.5, 0.3)  # left, right, bottom, top of each panel's axes
+KEPT_FIGURES = 4
+"""Figures kept for the next maps, in all (a six-panel figure holds about 6 MB of pixels)."""
+_COLOURS = matplotlib.colormaps["viridis"].with_extremes(bad="white")
+_MARKERS = (("*", "red"), ("X", "black"))  # the best, the worst
+
+Box = tuple[float, float, float, float]
+"""An axes box: left, bottom, width, height, as fractions of the figure."""
+
+
+def figure_pixels(n_panels: int) -> tuple[int, int]:
+    """Width and height (pixels) of the PNG of a map with ``n_panels`` (yaw, spin) pairs."""
+    columns = min(n_panels, MAX_COLUMNS)
+    rows = math.ceil(n_panels / MAX_COLUMNS)
+    width = PANEL_INCHES[0] * columns + COLOUR_BAR_INCHES
+    height = PANEL_INCHES[1] * rows
+    return round(width * DPI), round(height * DPI)
+
+
+def _layout(rows: int, columns: int, width: float, height: float) -> tuple[list[Box], Box]:
+    """Each panel's axes box, row by row, and the colour bar's, in a figure of width x height in.
+
+    Fixed margins in inches, not matplotlib's constrained layout: that layout measured every
+    tick label of every panel and was half the rendering time (0.8 of 1.6 s for six panels).
+    """
+    cell_height = (height - TITLE_INCHES - LEGEND_INCHES) / rows
+    left, right, bottom, top = PANEL_MARGINS_INCHES
+    boxes = []
+    for row in range(rows):
+        for column in range(columns):
+            x0 = PANEL_INCHES[0] * column + left
+            y0 = LEGEND_INCHES + cell_height * (rows - 1 - row) + bottom
+            boxes.append(
+                (
+                    x0 / width,
+                    y0 / height,
+                    (PANEL_INCHES[0] - left - right) / width,
+                    (cell_height - bottom - top) / height,
+                )
+            )
+    bar_bottom = LEGEND_INCHES + bottom
+    bar = (
+        (PANEL_INCHES[0] * columns + 0.15) / width,
+        bar_bottom / height,
+        0.2 / width,
+        (height - TITLE_INCHES - top - bar_bottom) / height,
+    )
+    return boxes, bar
+
+
+class MapFigure:
+    """A figure of ``n_panels`` map panels with its colour bar and legend, drawn map by map."""
+
+    def __init__(self, n_panels: int) -> None:
+        """The figure, its panels (an empty image, a best and a worst marker each), bar, legend."""
+        self.n_panels = n_panels
+        columns = min(n_panels, MAX_COLUMNS)
+        rows = math.ceil(n_panels / MAX_COLUMNS)
+        width_px, height_px = figure_pixels(n_panels)
+        self.height_in = height_px / DPI
+        self.figure = Figure(figsize=(width_px / DPI, self.height_in), dpi=DPI)
+        FigureCanvasAgg(self.figure)
+        boxes, bar = _layout(rows, columns, width_px / DPI, self.height_in)
+        self.panels: list[Axes] = []
+        self.images: list[AxesImage] = []
+        self.markers: list[tuple[Line2D, Line2D]] = []
+        for box in boxes[:n_panels]:
+            axes = self.figure.add_axes(box)
+            image = axes.imshow(
+                np.ma.masked_invalid(np.full((1, 1), np.nan)),
+                origin="lower",
+                cmap=_COLOURS,
+                interpolation="nearest",
+                aspect="equal",
+            )
+            best, worst = (
+                axes.plot([], [], marker, color=colour, ms=12, visible=False)[0]
+                for marker, colour in _MARKERS
+            )
+            axes.set_xlabel("x (m)")
+            axes.set_ylabel("y (m)")
+            self.panels.append(axes)
+            self.images.append(image)
+            self.markers.append((best, worst))
+        self.colour_bar = self.figure.colorbar(self.images[0], cax=self.figure.add_axes(bar))
+        self.figure.legend(
+            handles=[
+                Line2D([], [], marker="*", color="red", ls="", ms=10, label="best"),
+                Line2D([], [], marker="X", color="black", ls="", ms=8, label="worst"),
+                Patch(facecolor="white", edgecolor="grey", label="infeasible"),
+            ],
+            loc="lower right",
+            ncols=3,
+            fontsize=8,
+            frameon=False,
+            borderaxespad=0.1,
+        )
+
+    def png(self, cmap: CapabilityMap, *, title: str) -> bytes:
+        """The map drawn on this figure (whatever it showed before), as PNG bytes."""
+        colour_of = cmap.feed_index  # mu_acc with acceleration limits, else mu_path
+        feasible = ~np.isnan(colour_of)
+        low = float(np.nanmin(colour_of)) if feasible.any() else 0.0
+        high = float(np.nanmax(colour_of)) if feasible.any() else 1.0
+        best, worst = cmap.extreme(best=True), cmap.extreme(best=False)
+        half_x = (cmap.xs[1] - cmap.xs[0]) / 2 if len(cmap.xs) > 1 else 0.005
+        half_y = (cmap.ys[1] - cmap.ys[0]) / 2 if len(cmap.ys) > 1 else 0.005
+        extent = (
+            cmap.xs[0] - half_x,
+            cmap.xs[-1] + half_x,
+            cmap.ys[0] - half_y,
+            cmap.ys[-1] + half_y,
+        )
+        for panel, (s, k) in enumerate(np.ndindex(len(cmap.spins), len(cmap.yaws))):
+            axes, image = self.panels[panel], self.images[panel]
+            image.set_data(np.ma.masked_invalid(colour_of[s, k]))
+            image.set_clim(low, high if high > low else low + 1e-9)
+            image.set_extent(extent)  # and the axes' limits to it, a kept figure's too
+            for index, marker in zip((best, worst), self.markers[panel], strict=True):
+                shown = index is not None and index[:2] == (s, k)
+                marker.set_visible(shown)
+                if index is not None and shown:
+                    marker.set_data([cmap.xs[index[3]]], [cmap.ys[index[2]]])
+            spin = f", spin {math.degrees(float(cmap.spins[s])):.1f} deg" if cmap.spins[s] else ""
+            axes.set_title(
+                f"yaw {math.degrees(float(cmap.yaws[k])):.1f} deg{spin}, z = {cmap.z:.3f} m",
+                fontsize=9,
+            )
+        label = "mu_path (m/s)" if cmap.mu_acc is None else "mu_acc (m/s)"
+        self.colour_bar.set_label(label)
+        self.figure.suptitle(title, fontsize=10, y=1.0 - 0.08 / self.height_in, va="top")
+        buffer = io.BytesIO()
+        self.figure.savefig(buffer, format="png", dpi=DPI)
+        return buffer.getvalue()
+
+
+_KEPT: dict[int, list[MapFigure]] = {}
+"""Figures not in use, by number of panels."""
+_KEPT_LOCK = threading.Lock()
+
+
+def render_png(cmap: CapabilityMap, *, title: str) -> bytes:
+    """The map as PNG bytes: colour bar in m/s, infeasible cells blank, best and worst marked."""
+    n_panels = len(cmap.spins) * len(cmap.yaws)
+    with _KEPT_LOCK:
+        kept = _KEPT.get(n_panels)
+        figure = kept.pop() if kept else None
+    if figure is None:
+        figure = MapFigure(n_panels)
+    picture = figure.png(cmap, title=title)  # on an error the figure is dropped
+    with _KEPT_LOCK:
+        if sum(len(figures) for figures in _KEPT.values()) < KEPT_FIGURES:
+            _KEPT.setdefault(n_panels, []).append(figure)
+    return picture

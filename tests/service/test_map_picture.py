@@ -1,0 +1,144 @@
+"""The map's picture drawn on a kept figure is the picture a new figure draws (service/render)."""
+
+from __future__ import annotations
+
+import threading
+
+import numpy as np
+import pytest
+
+from service.render import map_picture
+from service.render.map_picture import KEPT_FIGURES, MapFigure, render_png
+from solver.path.capability_map import CapabilityMap
+
+
+def _map(
+    nx: int,
+    ny: int,
+    *,
+    yaws: int = 1,
+    spins: int = 1,
+    x0: float = 0.0,
+    seed: int = 0,
+    mu_acc: bool = False,
+) -> CapabilityMap:
+    """A map of made-up speeds (a third of the cells infeasible), shape (spins, yaws, ny, nx).
+
+    With ``mu_acc``, mu_acc too (a different order of the cells: it colours the map).
+    """
+    shape = (spins, yaws, ny, nx)
+    rng = np.random.default_rng(seed)
+    mu = rng.uniform(0.1, 0.4, size=shape)
+    mu[rng.random(shape) < 1 / 3] = np.nan
+    feasible = ~np.isnan(mu)
+    where = np.where(feasible, 1, -1)
+    return CapabilityMap(
+        xs=x0 + np.arange(nx) * 0.02,
+        ys=0.3 + np.arange(ny) * 0.05,
+        yaws=np.linspace(0.0, 0.5, yaws),
+        z=0.1,
+        spins=np.linspace(0.0, 0.3, spins),
+        mu_path=mu,
+        reason=np.where(feasible, -1, 0),
+        failed_waypoint=np.where(feasible, -1, 3),
+        branch=np.where(feasible, 0, -1),
+        bottleneck_waypoint=where,
+        bottleneck_joint=where,
+        mu_acc=mu * rng.uniform(0.5, 1.0, size=shape) if mu_acc else None,
+    )
+
+
+def _nowhere(nx: int, ny: int) -> CapabilityMap:
+    """A map with no feasible cell (no best, no worst, no colour range)."""
+    cmap = _map(nx, ny)
+    cmap.mu_path[:] = np.nan
+    cmap.reason[:] = 0
+    return cmap
+
+
+MAPS = [  # one after the other on the kept figures: extents, panels, markers and labels change
+    _map(26, 9, seed=1),
+    _map(5, 3, x0=0.4, seed=2),  # another extent on the same figure
+    _nowhere(7, 4),  # no marker, no colour range
+    _map(26, 9, seed=3),
+    _map(4, 6, yaws=2, seed=4),
+    _map(6, 4, yaws=2, seed=5, x0=-0.3),  # the best and worst in other panels
+    _map(3, 3, yaws=3, spins=2, seed=6),
+    _map(8, 5, seed=7, mu_acc=True),  # colour and label by mu_acc
+]
+
+
+def test_a_kept_figure_draws_each_map_as_a_new_figure_does(monkeypatch) -> None:
+    monkeypatch.setattr(map_picture, "_KEPT", {})
+    for k, cmap in enumerate(MAPS):
+        n_panels = len(cmap.spins) * len(cmap.yaws)
+        drawn = render_png(cmap, title=f"map {k}")
+        assert drawn == MapFigure(n_panels).png(cmap, title=f"map {k}"), k
+    assert sum(len(kept) for kept in map_picture._KEPT.values()) <= KEPT_FIGURES
+
+
+def test_the_maps_differ_so_the_test_above_can_fail() -> None:
+    pictures = {MapFigure(1).png(cmap, title="same") for cmap in (MAPS[0], MAPS[1], MAPS[3])}
+    assert len(pictures) == 3
+
+
+def test_a_figure_is_drawn_by_one_thread_at_a_time(monkeypatch) -> None:
+    monkeypatch.setattr(map_picture, "_KEPT", {})
+    maps = [_map(10 + k, 6, seed=10 + k) for k in range(6)]
+    expected = [MapFigure(1).png(cmap, title=str(k)) for k, cmap in enumerate(maps)]
+    drawn: dict[int, list[bytes]] = {k: [] for k in range(len(maps))}
+    failures: list[BaseException] = []
+
+    def draw(k: int) -> None:
+        try:
+            for _ in range(3):
+                drawn[k].append(render_png(maps[k], title=str(k)))
+        except BaseException as error:  # noqa: BLE001 - reported below
+            failures.append(error)
+
+    threads = [threading.Thread(target=draw, args=(k,)) for k in range(len(maps))]
+    for thread in threads:
+        thread.start()
+    for thread in threads:
+        thread.join()
+    assert not failures
+    for k, pictures in drawn.items():
+        assert pictures == [expected[k]] * 3, k
+    assert sum(len(kept) for kept in map_picture._KEPT.values()) <= KEPT_FIGURES
+
+
+def _extreme(cmap: CapabilityMap, best: bool) -> tuple[int, int, float, float] | None:
+    """(spin, yaw, x, y) of the fastest or slowest cell, from numpy (no ties in these maps)."""
+    values = cmap.feed_index
+    if np.isnan(values).all():
+        return None
+    s, k, i, j = np.unravel_index((np.nanargmax if best else np.nanargmin)(values), values.shape)
+    return int(s), int(k), float(cmap.xs[j]), float(cmap.ys[i])
+
+
+def test_each_panel_shows_its_maps_extent_markers_and_colour_range(monkeypatch) -> None:
+    monkeypatch.setattr(map_picture, "_KEPT", {})
+    figures: dict[int, MapFigure] = {}
+    for cmap in MAPS:  # drawn one after the other on kept figures, as render_png does
+        n_panels = len(cmap.spins) * len(cmap.yaws)
+        figure = figures.setdefault(n_panels, MapFigure(n_panels))
+        figure.png(cmap, title="t")
+        values = cmap.feed_index
+        half_x, half_y = 0.01, 0.025  # half the grid steps of _map
+        colour_range = (
+            (np.nanmin(values), np.nanmax(values)) if not np.isnan(values).all() else (0.0, 1.0)
+        )
+        marked = {"*": _extreme(cmap, True), "X": _extreme(cmap, False)}
+        for panel, (s, k) in enumerate(np.ndindex(len(cmap.spins), len(cmap.yaws))):
+            axes = figure.panels[panel]
+            assert axes.get_xlim() == pytest.approx((cmap.xs[0] - half_x, cmap.xs[-1] + half_x))
+            assert axes.get_ylim() == pytest.approx((cmap.ys[0] - half_y, cmap.ys[-1] + half_y))
+            assert figure.images[panel].get_clim() == pytest.approx(colour_range)
+            for marker in figure.markers[panel]:
+                where = marked[marker.get_marker()]
+                here = where is not None and where[:2] == (s, k)
+                assert marker.get_visible() == here
+                if here:
+                    assert (marker.get_xdata()[0], marker.get_ydata()[0]) == where[2:]
+        label = "mu_path (m/s)" if cmap.mu_acc is None else "mu_acc (m/s)"
+        assert figure.colour_bar.ax.get_ylabel() == label
