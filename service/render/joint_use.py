@@ -12,7 +12,11 @@ matplotlib.use("Agg")  # no display: render to memory
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 from matplotlib.axes import Axes  # noqa: E402
+from matplotlib.backends.backend_agg import FigureCanvasAgg  # noqa: E402
+from matplotlib.figure import Figure  # noqa: E402
+from matplotlib.lines import Line2D  # noqa: E402
 
+from service.render.kept import KeptFigures  # noqa: E402
 from service.render.map_picture import DPI, Box  # noqa: E402
 from solver.path.evaluate import PathEvaluation  # noqa: E402
 from solver.path.feed import FeedCheck  # noqa: E402
@@ -25,20 +29,6 @@ LEGEND_LABEL_CHARACTERS = 32
 """A legend label's longest text: a longer joint name is cut, its end marked (the picture only)."""
 
 
-def _acceleration_panel(axes: Axes, use: np.ndarray, evaluation: PathEvaluation) -> None:
-    """Each joint's |qdd| / qddot_max along the path (NaN gaps at the pass ends)."""
-    waypoints = np.arange(len(use))
-    for j in range(use.shape[1]):
-        axes.plot(waypoints, use[:, j], lw=1.2)
-    axes.axhline(1.0, color="red", ls="--", lw=1.0)
-    acc = evaluation.acceleration
-    if acc is not None and acc.limited_by == "acceleration":
-        axes.plot(acc.waypoint, use[acc.waypoint, acc.joint], "s", color="black", ms=7)
-    axes.set_xlabel("waypoint")
-    axes.set_ylabel("|qdd| / qddot_max")
-    axes.set_ylim(bottom=0.0)
-
-
 def render_message(text: str) -> bytes:
     """A PNG that says ``text`` where there is nothing to plot (a path that does not run)."""
     figure = plt.figure(figsize=(8.0, 1.5), dpi=DPI)
@@ -47,6 +37,87 @@ def render_message(text: str) -> bytes:
     figure.savefig(buffer, format="png", dpi=DPI)
     plt.close(figure)
     return buffer.getvalue()
+
+
+class JointUseFigure:
+    """A joint-use figure for one set of legend labels, with or without the acceleration panel.
+
+    Made once per layout (:mod:`service.render.kept`): each path's lines, markers and title are
+    set on it, its panels' limits scaled to them as a new figure's are, and it is drawn again.
+    """
+
+    def __init__(self, labels: tuple[str, ...], n_joints: int, accelerations: bool) -> None:
+        """The panels, one line a joint (and the bottleneck's marker where labelled), the legend."""
+        self.height = 7.0 if accelerations else 4.0
+        self.figure = Figure(figsize=(JOINT_USE_WIDTH_INCHES, self.height), dpi=DPI)
+        FigureCanvasAgg(self.figure)
+        panels = _joint_use_layout(2 if accelerations else 1, self.height, list(labels))
+        self.axes = self.figure.add_axes(panels[0])
+        self.below: Axes | None = None
+        self.acc_lines: list[Line2D] = []
+        self.acc_marker: Line2D | None = None
+        if accelerations:
+            self.below = below = self.figure.add_axes(panels[1], sharex=self.axes)
+            self.acc_lines = [below.plot([], [], lw=1.2)[0] for _ in range(n_joints)]
+            below.axhline(1.0, color="red", ls="--", lw=1.0)
+            self.acc_marker = below.plot([], [], "s", color="black", ms=7, visible=False)[0]
+            below.set_xlabel("waypoint")
+            below.set_ylabel("|qdd| / qddot_max")
+            self.axes.tick_params(labelbottom=False)
+        else:
+            self.axes.set_xlabel("waypoint")
+        self.lines = [self.axes.plot([], [], label=label, lw=1.2)[0] for label in labels[:n_joints]]
+        self.axes.axhline(1.0, color="red", ls="--", lw=1.0, label="limit")
+        self.marker = (
+            self.axes.plot([], [], "o", color="black", ms=8, label=labels[-1])[0]
+            if len(labels) > n_joints
+            else None
+        )
+        self.axes.set_ylabel("|qdot| / qdot_max")
+        self.figure.legend(
+            loc="upper right",
+            bbox_to_anchor=(1.0, 1.0 - JOINT_USE_MARGINS_INCHES[2] / self.height),
+            fontsize=LEGEND_POINTS,
+            frameon=False,
+        )
+
+    def png(self, check: FeedCheck, evaluation: PathEvaluation, *, title: str) -> bytes:
+        """This path's joint use drawn on the figure (whatever it showed before), as PNG."""
+        use = np.abs(check.use) if check.use is not None else np.zeros((0, len(self.lines)))
+        waypoints = np.arange(len(use))
+        for j, line in enumerate(self.lines):
+            line.set_data(waypoints, use[:, j])
+        w, b = evaluation.bottleneck_waypoint, evaluation.bottleneck_joint
+        if self.marker is not None and w is not None and b is not None:
+            self.marker.set_data([w], [use[w, b]])
+        state = "runs" if check.feasible else "does NOT run"
+        self.axes.set_title(
+            f"{title}: feed {check.feed:.4g} m/s {state} (margin {check.margin:.3g})", fontsize=10
+        )
+        scaled = [self.axes]
+        acc_use = check.acceleration_use  # given when the figure has the panel (its layout key)
+        if self.below is not None and self.acc_marker is not None and acc_use is not None:
+            for j, line in enumerate(self.acc_lines):
+                line.set_data(np.arange(len(acc_use)), acc_use[:, j])
+            acc = evaluation.acceleration
+            marked = acc is not None and acc.limited_by == "acceleration"
+            self.acc_marker.set_visible(marked)
+            if acc is not None and marked:
+                self.acc_marker.set_data([acc.waypoint], [acc_use[acc.waypoint, acc.joint]])
+            scaled.append(self.below)
+        for axes in scaled:  # the limits a new figure's autoscaling gives, from 0 up
+            axes.relim(visible_only=True)
+            axes.set_autoscale_on(True)
+        for axes in scaled:
+            axes.autoscale_view()
+            axes.set_ylim(bottom=0.0)
+        buffer = io.BytesIO()
+        self.figure.savefig(buffer, format="png", dpi=DPI)
+        return buffer.getvalue()
+
+
+KEPT: KeptFigures[JointUseFigure] = KeptFigures(4)
+"""The joint-use figures kept, by legend labels and panels."""
 
 
 def render_joint_use(
@@ -59,43 +130,17 @@ def render_joint_use(
     below shows each joint's use of its acceleration limit at that constant feed
     (motion.md section 2), the waypoint where mu_acc binds marked.
     """
-    use = np.abs(check.use) if check.use is not None else np.zeros((0, len(joint_names)))
     labels = [_legend_label(name) for name in joint_names]
     w, b = evaluation.bottleneck_waypoint, evaluation.bottleneck_joint
     if w is not None and b is not None:
         labels.append(_legend_label(f"bottleneck: {joint_names[b]}"))
-    height = 7.0 if check.acceleration_use is not None else 4.0
-    figure = plt.figure(figsize=(JOINT_USE_WIDTH_INCHES, height), dpi=DPI)
-    panels = _joint_use_layout(2 if check.acceleration_use is not None else 1, height, labels)
-    axes = figure.add_axes(panels[0])
-    if check.acceleration_use is not None:
-        below = figure.add_axes(panels[1], sharex=axes)
-        _acceleration_panel(below, check.acceleration_use, evaluation)
-        axes.tick_params(labelbottom=False)
-    else:
-        axes.set_xlabel("waypoint")
-    waypoints = np.arange(len(use))
-    for j, label in enumerate(labels[: len(joint_names)]):
-        axes.plot(waypoints, use[:, j], label=label, lw=1.2)
-    axes.axhline(1.0, color="red", ls="--", lw=1.0, label="limit")
-    if w is not None and b is not None:
-        axes.plot(w, use[w, b], "o", color="black", ms=8, label=labels[-1])
-    state = "runs" if check.feasible else "does NOT run"
-    axes.set_title(
-        f"{title}: feed {check.feed:.4g} m/s {state} (margin {check.margin:.3g})", fontsize=10
+    accelerations = check.acceleration_use is not None
+    key = (tuple(labels), len(joint_names), accelerations)
+    return KEPT.drawn(
+        key,
+        lambda: JointUseFigure(*key),
+        lambda figure: figure.png(check, evaluation, title=title),
     )
-    axes.set_ylabel("|qdot| / qdot_max")
-    axes.set_ylim(bottom=0.0)
-    figure.legend(
-        loc="upper right",
-        bbox_to_anchor=(1.0, 1.0 - JOINT_USE_MARGINS_INCHES[2] / height),
-        fontsize=LEGEND_POINTS,
-        frameon=False,
-    )
-    buffer = io.BytesIO()
-    figure.savefig(buffer, format="png", dpi=DPI)
-    plt.close(figure)
-    return buffer.getvalue()
 
 
 def _legend_label(text: str) -> str:

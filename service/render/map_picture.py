@@ -4,16 +4,14 @@ A map's picture was about 60 % matplotlib making its figure (axes, tick objects,
 bar, the legend) and 40 % drawing and encoding it (2026-12-03: 176 ms for two panels, 116 ms
 to draw the same figure again). The figures are kept: a figure drawn for one map is given the
 next map of the same number of panels (its images' data, extent and colour range, its markers,
-titles and colour-bar label) and drawn again. A figure is used by one thread at a time (taken
-from :data:`_KEPT` under a lock, given back after its PNG is written); at most KEPT_FIGURES
-are kept. The bytes are those of a new figure (tests/service/test_map_picture.py).
+titles and colour-bar label) and drawn again (:mod:`service.render.kept`). The bytes are those
+of a new figure (tests/service/test_map_picture.py).
 """
 
 from __future__ import annotations
 
 import io
 import math
-import threading
 
 import matplotlib
 
@@ -27,6 +25,7 @@ from matplotlib.image import AxesImage  # noqa: E402
 from matplotlib.lines import Line2D  # noqa: E402
 from matplotlib.patches import Patch  # noqa: E402
 
+from service.render.kept import KeptFigures  # noqa: E402
 from solver.path.capability_map import CapabilityMap  # noqa: E402
 
 PANEL_INCHES = (4.0, 3.6)
@@ -36,8 +35,6 @@ MAX_COLUMNS = 3
 TITLE_INCHES = 0.3  # the figure's title, above the panels
 LEGEND_INCHES = 0.3  # the legend, below them
 PANEL_MARGINS_INCHES = (0.75, 0.2, 0.5, 0.3)  # left, right, bottom, top of each panel's axes
-KEPT_FIGURES = 4
-"""Figures kept for the next maps, in all (a six-panel figure holds about 6 MB of pixels)."""
 _COLOURS = matplotlib.colormaps["viridis"].with_extremes(bad="white")
 _MARKERS = (("*", "red"), ("X", "black"))  # the best, the worst
 
@@ -171,21 +168,13 @@ class MapFigure:
         return buffer.getvalue()
 
 
-_KEPT: dict[int, list[MapFigure]] = {}
-"""Figures not in use, by number of panels."""
-_KEPT_LOCK = threading.Lock()
+KEPT: KeptFigures[MapFigure] = KeptFigures(4)
+"""The map figures kept, by number of panels (a six-panel figure holds about 6 MB of pixels)."""
 
 
 def render_png(cmap: CapabilityMap, *, title: str) -> bytes:
     """The map as PNG bytes: colour bar in m/s, infeasible cells blank, best and worst marked."""
     n_panels = len(cmap.spins) * len(cmap.yaws)
-    with _KEPT_LOCK:
-        kept = _KEPT.get(n_panels)
-        figure = kept.pop() if kept else None
-    if figure is None:
-        figure = MapFigure(n_panels)
-    picture = figure.png(cmap, title=title)  # on an error the figure is dropped
-    with _KEPT_LOCK:
-        if sum(len(figures) for figures in _KEPT.values()) < KEPT_FIGURES:
-            _KEPT.setdefault(n_panels, []).append(figure)
-    return picture
+    return KEPT.drawn(
+        n_panels, lambda: MapFigure(n_panels), lambda figure: figure.png(cmap, title=title)
+    )

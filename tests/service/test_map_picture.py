@@ -8,7 +8,8 @@ import numpy as np
 import pytest
 
 from service.render import map_picture
-from service.render.map_picture import KEPT_FIGURES, MapFigure, render_png
+from service.render.kept import KeptFigures
+from service.render.map_picture import MapFigure, render_png
 from solver.path.capability_map import CapabilityMap
 
 
@@ -69,12 +70,12 @@ MAPS = [  # one after the other on the kept figures: extents, panels, markers an
 
 
 def test_a_kept_figure_draws_each_map_as_a_new_figure_does(monkeypatch) -> None:
-    monkeypatch.setattr(map_picture, "_KEPT", {})
+    monkeypatch.setattr(map_picture, "KEPT", KeptFigures(4))
     for k, cmap in enumerate(MAPS):
         n_panels = len(cmap.spins) * len(cmap.yaws)
         drawn = render_png(cmap, title=f"map {k}")
         assert drawn == MapFigure(n_panels).png(cmap, title=f"map {k}"), k
-    assert sum(len(kept) for kept in map_picture._KEPT.values()) <= KEPT_FIGURES
+    assert map_picture.KEPT.count() <= 4
 
 
 def test_the_maps_differ_so_the_test_above_can_fail() -> None:
@@ -83,7 +84,7 @@ def test_the_maps_differ_so_the_test_above_can_fail() -> None:
 
 
 def test_a_figure_is_drawn_by_one_thread_at_a_time(monkeypatch) -> None:
-    monkeypatch.setattr(map_picture, "_KEPT", {})
+    monkeypatch.setattr(map_picture, "KEPT", KeptFigures(4))
     maps = [_map(10 + k, 6, seed=10 + k) for k in range(6)]
     expected = [MapFigure(1).png(cmap, title=str(k)) for k, cmap in enumerate(maps)]
     drawn: dict[int, list[bytes]] = {k: [] for k in range(len(maps))}
@@ -104,7 +105,7 @@ def test_a_figure_is_drawn_by_one_thread_at_a_time(monkeypatch) -> None:
     assert not failures
     for k, pictures in drawn.items():
         assert pictures == [expected[k]] * 3, k
-    assert sum(len(kept) for kept in map_picture._KEPT.values()) <= KEPT_FIGURES
+    assert map_picture.KEPT.count() <= 4
 
 
 def _extreme(cmap: CapabilityMap, best: bool) -> tuple[int, int, float, float] | None:
@@ -117,7 +118,7 @@ def _extreme(cmap: CapabilityMap, best: bool) -> tuple[int, int, float, float] |
 
 
 def test_each_panel_shows_its_maps_extent_markers_and_colour_range(monkeypatch) -> None:
-    monkeypatch.setattr(map_picture, "_KEPT", {})
+    monkeypatch.setattr(map_picture, "KEPT", KeptFigures(4))
     figures: dict[int, MapFigure] = {}
     for cmap in MAPS:  # drawn one after the other on kept figures, as render_png does
         n_panels = len(cmap.spins) * len(cmap.yaws)
