@@ -13,7 +13,8 @@ the 8-yaw map against the 1-yaw map; the numeric IK family's map on the same gri
 plain URDF, checked equal to the analytic map, and the Panda) against the analytic one; the
 2-waypoint optimisation of the Jaco2 (numeric IK) against the UR5's
 (``bench/numeric_optimisation.py``); the map and the optimisers with joint acceleration limits
-(``bench/acceleration.py``); the optimisation of
+(``bench/acceleration.py``); the map's picture on a new figure and on a kept one
+(``bench/pictures.py``); the optimisation of
 published-size programs on active sets (``bench/active_set.py``). Then the
 placement optimisation of the same problem
 (yaw free): each method's time and optimum, against the best cell of a fine grid (10 mm,
@@ -40,6 +41,7 @@ from acceleration import acceleration_lines
 from active_set import active_set_lines
 from cell import cell_lines
 from numeric_optimisation import numeric_optimisation_lines
+from pictures import picture_lines
 from timing import best_time, plain_post
 
 from solver.core.kinematics import jacobian_in_base
@@ -194,6 +196,7 @@ def main() -> None:
     )
     acceleration_lines(robot, path, xs, ys, z, repeats=repeats, smoke=args.smoke)
     cell_lines(robot, path, xs, ys, z, repeats=repeats, smoke=args.smoke)
+    picture_lines(robot, path, xs, ys, z, smoke=args.smoke)
     numeric_maps(path, xs, ys, z, t_map)
     numeric_optimisation_lines(path, smoke=args.smoke)
     optimisation(robot, path, smoke=args.smoke)
