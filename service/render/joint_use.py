@@ -2,24 +2,16 @@
 
 from __future__ import annotations
 
-import io
 import textwrap
 
-import matplotlib
+import numpy as np
+from matplotlib.axes import Axes
+from matplotlib.lines import Line2D
 
-matplotlib.use("Agg")  # no display: render to memory
-
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
-from matplotlib.axes import Axes  # noqa: E402
-from matplotlib.backends.backend_agg import FigureCanvasAgg  # noqa: E402
-from matplotlib.figure import Figure  # noqa: E402
-from matplotlib.lines import Line2D  # noqa: E402
-
-from service.render.kept import KeptFigures  # noqa: E402
-from service.render.map_picture import DPI, Box  # noqa: E402
-from solver.path.evaluate import PathEvaluation  # noqa: E402
-from solver.path.feed import FeedCheck  # noqa: E402
+from service.render.kept import KeptFigures, new_figure, png_of
+from service.render.map_picture import Box
+from solver.path.evaluate import PathEvaluation
+from solver.path.feed import FeedCheck
 
 JOINT_USE_WIDTH_INCHES = 8.0
 JOINT_USE_MARGINS_INCHES = (0.75, 0.5, 0.4)  # left, bottom, top of the panels' axes
@@ -31,12 +23,9 @@ LEGEND_LABEL_CHARACTERS = 32
 
 def render_message(text: str) -> bytes:
     """A PNG that says ``text`` where there is nothing to plot (a path that does not run)."""
-    figure = plt.figure(figsize=(8.0, 1.5), dpi=DPI)
+    figure = new_figure(8.0, 1.5)
     figure.text(0.5, 0.5, textwrap.fill(text, 90), ha="center", va="center", fontsize=10)
-    buffer = io.BytesIO()
-    figure.savefig(buffer, format="png", dpi=DPI)
-    plt.close(figure)
-    return buffer.getvalue()
+    return png_of(figure)
 
 
 class JointUseFigure:
@@ -49,8 +38,7 @@ class JointUseFigure:
     def __init__(self, labels: tuple[str, ...], n_joints: int, accelerations: bool) -> None:
         """The panels, one line a joint (and the bottleneck's marker where labelled), the legend."""
         self.height = 7.0 if accelerations else 4.0
-        self.figure = Figure(figsize=(JOINT_USE_WIDTH_INCHES, self.height), dpi=DPI)
-        FigureCanvasAgg(self.figure)
+        self.figure = new_figure(JOINT_USE_WIDTH_INCHES, self.height)
         panels = _joint_use_layout(2 if accelerations else 1, self.height, list(labels))
         self.axes = self.figure.add_axes(panels[0])
         self.below: Axes | None = None
@@ -111,9 +99,7 @@ class JointUseFigure:
         for axes in scaled:
             axes.autoscale_view()
             axes.set_ylim(bottom=0.0)
-        buffer = io.BytesIO()
-        self.figure.savefig(buffer, format="png", dpi=DPI)
-        return buffer.getvalue()
+        return png_of(self.figure)
 
 
 KEPT: KeptFigures[JointUseFigure] = KeptFigures(4)

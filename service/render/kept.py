@@ -3,15 +3,40 @@
 A picture's figure (its axes, tick objects, colour bar, legend) is made once per layout and
 given the next picture of that layout: :class:`KeptFigures` hands a figure to one thread at a
 time (taken under a lock, given back after its PNG is written) and keeps at most ``most``.
+Every picture's figure is made by :func:`new_figure` (no pyplot: its registry of figures is
+global, shared by the routes' threads) and written by :func:`png_of`.
 """
 
 from __future__ import annotations
 
+import io
 import threading
 from collections.abc import Callable, Hashable
 from typing import Generic, TypeVar
 
+import matplotlib
+
+matplotlib.use("Agg")  # no display: render to memory
+
+from matplotlib.backends.backend_agg import FigureCanvasAgg  # noqa: E402
+from matplotlib.figure import Figure  # noqa: E402
+
 F = TypeVar("F")
+DPI = 100
+
+
+def new_figure(width: float, height: float) -> Figure:
+    """A figure of width x height inches at DPI, on its own Agg canvas."""
+    figure = Figure(figsize=(width, height), dpi=DPI)
+    FigureCanvasAgg(figure)
+    return figure
+
+
+def png_of(figure: Figure) -> bytes:
+    """The figure drawn, as PNG bytes."""
+    buffer = io.BytesIO()
+    figure.savefig(buffer, format="png", dpi=DPI)
+    return buffer.getvalue()
 
 
 class KeptFigures(Generic[F]):

@@ -12,27 +12,20 @@ and drawn again (:mod:`service.render.kept`). The bytes are those of a new figur
 
 from __future__ import annotations
 
-import io
 import math
 
 import matplotlib
+import numpy as np
+from matplotlib.axes import Axes
+from matplotlib.image import AxesImage
+from matplotlib.lines import Line2D
+from matplotlib.patches import Patch
 
-matplotlib.use("Agg")  # no display: render to memory
-
-import numpy as np  # noqa: E402
-from matplotlib.axes import Axes  # noqa: E402
-from matplotlib.backends.backend_agg import FigureCanvasAgg  # noqa: E402
-from matplotlib.figure import Figure  # noqa: E402
-from matplotlib.image import AxesImage  # noqa: E402
-from matplotlib.lines import Line2D  # noqa: E402
-from matplotlib.patches import Patch  # noqa: E402
-
-from service.render.kept import KeptFigures  # noqa: E402
-from solver.path.capability_map import CapabilityMap  # noqa: E402
+from service.render.kept import DPI, KeptFigures, new_figure, png_of
+from solver.path.capability_map import CapabilityMap
 
 PANEL_INCHES = (4.0, 3.6)
 COLOUR_BAR_INCHES = 1.2
-DPI = 100
 MAX_COLUMNS = 3
 TITLE_INCHES = 0.3  # the figure's title, above the panels
 LEGEND_INCHES = 0.3  # the legend, below them
@@ -89,13 +82,11 @@ class MapFigure:
 
     def __init__(self, n_panels: int) -> None:
         """The figure, its panels (an empty image, a best and a worst marker each), bar, legend."""
-        self.n_panels = n_panels
         columns = min(n_panels, MAX_COLUMNS)
         rows = math.ceil(n_panels / MAX_COLUMNS)
         width_px, height_px = figure_pixels(n_panels)
         self.height_in = height_px / DPI
-        self.figure = Figure(figsize=(width_px / DPI, self.height_in), dpi=DPI)
-        FigureCanvasAgg(self.figure)
+        self.figure = new_figure(width_px / DPI, self.height_in)
         boxes, bar = _layout(rows, columns, width_px / DPI, self.height_in)
         self.panels: list[Axes] = []
         self.images: list[AxesImage] = []
@@ -165,9 +156,7 @@ class MapFigure:
         label = "mu_path (m/s)" if cmap.mu_acc is None else "mu_acc (m/s)"
         self.colour_bar.set_label(label)
         self.figure.suptitle(title, fontsize=10, y=1.0 - 0.08 / self.height_in, va="top")
-        buffer = io.BytesIO()
-        self.figure.savefig(buffer, format="png", dpi=DPI)
-        return buffer.getvalue()
+        return png_of(self.figure)
 
 
 KEPT: KeptFigures[MapFigure] = KeptFigures(4)
