@@ -175,27 +175,36 @@ def choice_holds(alive, why, slowest, feed, tie, pick):  # type: ignore[no-untyp
 
 
 @njit(cache=True, error_model="numpy", nogil=True)
-def turned_poses(c, ca, sa, offset, flange_rotation, flange_position, tool_position, twist, poses):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
+def turned_poses(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
+    c, cos_yaw, sin_yaw, offset, flange_rotation, flange_position, tool_position, twist, poses
+):  # fmt: skip
     """Fill ``poses`` (21, W) for placement c: the path turned by its yaw and moved.
 
     Rows: R_B_F row by row (0-8), p_B_F (9-11), t_hat in {B} (12-17), the tool point (18-20);
-    the same arithmetic as :func:`solver.path.placed.turn_by_yaw`.
+    the same arithmetic as :func:`solver.path.placed.turn_by_yaw`. Called for the placements
+    in order, ``poses`` holding placement c - 1's when c > 0: where c - 1 had the same yaw (a
+    map's cells share one), the rows only the yaw sets (the rotation and the twist) are kept
+    and only the positions written (the turn was 0.3 ms of the ERK-size map's 5.4 ms on one
+    thread, 2026-12-03).
     """
+    ca, sa = cos_yaw[c], sin_yaw[c]
+    if c == 0 or ca != cos_yaw[c - 1] or sa != sin_yaw[c - 1]:
+        for w in range(flange_rotation.shape[0]):
+            for k in range(3):  # R_B_F = Rz(yaw) R_O_F, row by row
+                x, y = flange_rotation[w, 0, k], flange_rotation[w, 1, k]
+                poses[k, w] = ca * x - sa * y
+                poses[3 + k, w] = sa * x + ca * y
+                poses[6 + k, w] = flange_rotation[w, 2, k]
+            for k in range(0, 6, 3):
+                x, y = twist[w, k], twist[w, k + 1]
+                poses[12 + k, w] = ca * x - sa * y
+                poses[13 + k, w] = sa * x + ca * y
+                poses[14 + k, w] = twist[w, k + 2]
     for w in range(flange_rotation.shape[0]):
-        for k in range(3):  # R_B_F = Rz(yaw) R_O_F, row by row
-            x, y = flange_rotation[w, 0, k], flange_rotation[w, 1, k]
-            poses[k, w] = ca * x - sa * y
-            poses[3 + k, w] = sa * x + ca * y
-            poses[6 + k, w] = flange_rotation[w, 2, k]
         x, y = flange_position[w, 0], flange_position[w, 1]
         poses[9, w] = ca * x - sa * y + offset[c, 0]
         poses[10, w] = sa * x + ca * y + offset[c, 1]
         poses[11, w] = flange_position[w, 2] + offset[c, 2]
-        for k in range(0, 6, 3):
-            x, y = twist[w, k], twist[w, k + 1]
-            poses[12 + k, w] = ca * x - sa * y
-            poses[13 + k, w] = sa * x + ca * y
-            poses[14 + k, w] = twist[w, k + 2]
         x, y = tool_position[w, 0], tool_position[w, 1]
         poses[18, w] = ca * x - sa * y + offset[c, 0]
         poses[19, w] = sa * x + ca * y + offset[c, 1]

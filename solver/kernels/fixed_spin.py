@@ -204,8 +204,8 @@ def map_cells(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
     for c in range(n_cells):
         start_cell(alive, why, where)
         turned_poses(
-            c, cos_yaw[c], sin_yaw[c], offset, flange_rotation, flange_position, tool_position,
-            twist, poses,
+            c, cos_yaw, sin_yaw, offset, flange_rotation, flange_position, tool_position, twist,
+            poses,
         )  # fmt: skip
         posed = (family, par, poses, branches, pure_rotation)
         found = (scratch, cq, sq, qd, status, need, alive, why, where)

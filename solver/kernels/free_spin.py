@@ -184,8 +184,9 @@ def free_cells(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
     for c in range(n_cells):
         ca, sa = cos_yaw[c], sin_yaw[c]
         turned_poses(
-            c, ca, sa, offset, flange_rotation, flange_position, tool_position, twist, poses
-        )
+            c, cos_yaw, sin_yaw, offset, flange_rotation, flange_position, tool_position, twist,
+            poses,
+        )  # fmt: skip
         spin_poses[:] = poses
         for w in range(n_waypoints):  # the spin twist [0; z_tool] in {B}
             x, y = tool_axis[w, 0], tool_axis[w, 1]

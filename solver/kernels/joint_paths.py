@@ -61,8 +61,8 @@ def branch_paths(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
     cq, sq, qd, status, poses, scratch, need = pose_work(n_waypoints)
     for c in range(cos_yaw.shape[0]):
         turned_poses(
-            c, cos_yaw[c], sin_yaw[c], offset, flange_rotation, flange_position, tool_position,
-            twist, poses,
+            c, cos_yaw, sin_yaw, offset, flange_rotation, flange_position, tool_position, twist,
+            poses,
         )  # fmt: skip
         need[:] = False
         need[rows[c]] = True
