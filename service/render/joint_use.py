@@ -102,7 +102,7 @@ class JointUseFigure:
         return png_of(self.figure)
 
 
-KEPT: KeptFigures[JointUseFigure] = KeptFigures(4)
+KEPT: KeptFigures[JointUseFigure] = KeptFigures(4, 16 * 2**20)
 """The joint-use figures kept, by legend labels and panels."""
 
 

@@ -159,8 +159,9 @@ class MapFigure:
         return png_of(self.figure)
 
 
-KEPT: KeptFigures[MapFigure] = KeptFigures(4)
-"""The map figures kept, by number of panels (a six-panel figure holds about 6 MB of pixels)."""
+KEPT: KeptFigures[MapFigure] = KeptFigures(4, 16 * 2**20)
+"""The map figures kept, by number of panels: four, of 16 MiB of pixels in all (a figure of six
+panels holds 3.6 MiB, of 24 panels 14.5 MiB)."""
 
 
 def render_png(cmap: CapabilityMap, *, title: str) -> bytes:

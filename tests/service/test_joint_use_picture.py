@@ -38,7 +38,7 @@ BODIES = [  # one after the other: the speeds, bottleneck, feed and acceleration
 
 
 def _pictures(client: TestClient, monkeypatch, kept: int) -> list[bytes]:
-    monkeypatch.setattr(joint_use, "KEPT", KeptFigures(kept))
+    monkeypatch.setattr(joint_use, "KEPT", KeptFigures(kept, 2**30))
     answers = [client.post("/v1/evaluate/png", json=body) for body in BODIES]
     assert all(answer.status_code == 200 for answer in answers), [a.text for a in answers]
     return [answer.content for answer in answers]
@@ -53,11 +53,11 @@ def test_a_kept_figure_draws_each_path_as_a_new_figure_does(client, monkeypatch)
 
 def test_the_kept_figures_panel_is_scaled_to_each_path(client, monkeypatch) -> None:
     """The speed panel from 0 to just over the largest use (F / mu_path), every waypoint in x."""
-    monkeypatch.setattr(joint_use, "KEPT", KeptFigures(1))
+    monkeypatch.setattr(joint_use, "KEPT", KeptFigures(1, 2**30))
     for body in (BODIES[0], BODIES[5], BODIES[1], BODIES[6]):  # no acceleration limits
         answer = client.post("/v1/evaluate", json=body).json()
         assert client.post("/v1/evaluate/png", json=body).status_code == 200
-        (figure,) = [f for figures in joint_use.KEPT._kept.values() for f in figures]
+        ((figure, _),) = [f for figures in joint_use.KEPT._kept.values() for f in figures]
         check = answer["feed_check"]  # None without a feed: the picture's feed is mu_path
         largest = 1.0 if check is None else 1.0 / check["margin"]  # margin = mu_path / F
         assert max(np.nanmax(line.get_ydata()) for line in figure.lines) == pytest.approx(
@@ -76,10 +76,10 @@ def test_the_kept_figures_panel_is_scaled_to_each_path(client, monkeypatch) -> N
 
 def test_the_acceleration_panel_marks_where_mu_acc_binds_only_there(client, monkeypatch) -> None:
     for body in (BODIES[2], BODIES[3], BODIES[4]):  # accelerations bind, speeds bind, accelerations
-        monkeypatch.setattr(joint_use, "KEPT", KeptFigures(1))
+        monkeypatch.setattr(joint_use, "KEPT", KeptFigures(1, 2**30))
         acceleration = client.post("/v1/evaluate", json=body).json()["acceleration"]
         assert client.post("/v1/evaluate/png", json=body).status_code == 200
-        (figure,) = [f for figures in joint_use.KEPT._kept.values() for f in figures]
+        ((figure, _),) = [f for figures in joint_use.KEPT._kept.values() for f in figures]
         binds = acceleration["limited_by"] == "acceleration"
         assert figure.acc_marker.get_visible() == binds
         most = max(np.nanmax(line.get_ydata()) for line in figure.acc_lines)

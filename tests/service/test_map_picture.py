@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import struct
 import threading
 
 import numpy as np
@@ -70,7 +71,7 @@ MAPS = [  # one after the other on the kept figures: extents, panels, markers an
 
 
 def test_a_kept_figure_draws_each_map_as_a_new_figure_does(monkeypatch) -> None:
-    monkeypatch.setattr(map_picture, "KEPT", KeptFigures(4))
+    monkeypatch.setattr(map_picture, "KEPT", KeptFigures(4, 2**30))
     for k, cmap in enumerate(MAPS):
         n_panels = len(cmap.spins) * len(cmap.yaws)
         drawn = render_png(cmap, title=f"map {k}")
@@ -84,7 +85,7 @@ def test_the_maps_differ_so_the_test_above_can_fail() -> None:
 
 
 def test_a_figure_is_drawn_by_one_thread_at_a_time(monkeypatch) -> None:
-    monkeypatch.setattr(map_picture, "KEPT", KeptFigures(4))
+    monkeypatch.setattr(map_picture, "KEPT", KeptFigures(4, 2**30))
     maps = [_map(10 + k, 6, seed=10 + k) for k in range(6)]
     expected = [MapFigure(1).png(cmap, title=str(k)) for k, cmap in enumerate(maps)]
     drawn: dict[int, list[bytes]] = {k: [] for k in range(len(maps))}
@@ -118,7 +119,7 @@ def _extreme(cmap: CapabilityMap, best: bool) -> tuple[int, int, float, float] |
 
 
 def test_each_panel_shows_its_maps_extent_markers_and_colour_range(monkeypatch) -> None:
-    monkeypatch.setattr(map_picture, "KEPT", KeptFigures(4))
+    monkeypatch.setattr(map_picture, "KEPT", KeptFigures(4, 2**30))
     figures: dict[int, MapFigure] = {}
     for cmap in MAPS:  # drawn one after the other on kept figures, as render_png does
         n_panels = len(cmap.spins) * len(cmap.yaws)
@@ -143,3 +144,26 @@ def test_each_panel_shows_its_maps_extent_markers_and_colour_range(monkeypatch) 
                     assert (marker.get_xdata()[0], marker.get_ydata()[0]) == where[2:]
         label = "mu_path (m/s)" if cmap.mu_acc is None else "mu_acc (m/s)"
         assert figure.colour_bar.ax.get_ylabel() == label
+
+
+def _png_size(png: bytes) -> tuple[int, int]:
+    """Width and height from the PNG's IHDR chunk (bytes 16-24), read without matplotlib."""
+    assert png[:8] == b"\x89PNG\r\n\x1a\n" and png[12:16] == b"IHDR"
+    return struct.unpack(">II", png[16:24])
+
+
+def test_the_kept_figures_hold_no_more_pixels_than_their_bound(monkeypatch) -> None:
+    # one, two and six panels: 4 x 520 x 360, 4 x 920 x 360 and 4 x 1320 x 720 bytes of RGBA
+    maps = [_map(6, 4, yaws=yaws, seed=yaws) for yaws in (1, 2, 6, 1, 2, 6)]
+    sizes = {}
+    for cmap in maps[:3]:
+        width, height = _png_size(render_png(cmap, title="sizes"))
+        sizes[len(cmap.yaws)] = 4 * width * height
+    bound = sizes[1] + sizes[2] + sizes[1] // 2  # room for the one- and two-panel figures only
+    monkeypatch.setattr(map_picture, "KEPT", KeptFigures(4, bound))
+    for k, cmap in enumerate(maps):
+        assert render_png(cmap, title=str(k)) == MapFigure(len(cmap.yaws)).png(cmap, title=str(k))
+        assert map_picture.KEPT.held() <= bound
+    kept = {key: len(figures) for key, figures in map_picture.KEPT._kept.items()}
+    assert kept == {1: 1, 2: 1}  # the six-panel figure is drawn, then dropped: too large
+    assert map_picture.KEPT.held() == sizes[1] + sizes[2]
