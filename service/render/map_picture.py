@@ -37,10 +37,14 @@ Box = tuple[float, float, float, float]
 """An axes box: left, bottom, width, height, as fractions of the figure."""
 
 
+def _rows_and_columns(n_panels: int) -> tuple[int, int]:
+    """The rows and columns of a map's panels: up to MAX_COLUMNS a row."""
+    return math.ceil(n_panels / MAX_COLUMNS), min(n_panels, MAX_COLUMNS)
+
+
 def figure_pixels(n_panels: int) -> tuple[int, int]:
     """Width and height (pixels) of the PNG of a map with ``n_panels`` (yaw, spin) pairs."""
-    columns = min(n_panels, MAX_COLUMNS)
-    rows = math.ceil(n_panels / MAX_COLUMNS)
+    rows, columns = _rows_and_columns(n_panels)
     width = PANEL_INCHES[0] * columns + COLOUR_BAR_INCHES
     height = PANEL_INCHES[1] * rows
     return round(width * DPI), round(height * DPI)
@@ -82,8 +86,7 @@ class MapFigure:
 
     def __init__(self, n_panels: int) -> None:
         """The figure, its panels (an empty image, a best and a worst marker each), bar, legend."""
-        columns = min(n_panels, MAX_COLUMNS)
-        rows = math.ceil(n_panels / MAX_COLUMNS)
+        rows, columns = _rows_and_columns(n_panels)
         width_px, height_px = figure_pixels(n_panels)
         self.height_in = height_px / DPI
         self.figure = new_figure(width_px / DPI, self.height_in)
