@@ -9,7 +9,8 @@
    minutes on the 2-core development machine, over the 10-minute goal.
 3. The tests that bound a live server's latency (``/healthz`` under load, a cancel within a
    second, SIGTERM within seconds: marked ``latency``), alone: beside a second worker's
-   CPU-bound tests they fail, since those take the server's time slices.
+   CPU-bound tests they fail, since those take the server's time slices. Only their modules
+   (``LATENCY_MODULES``) are collected, unless arguments are given.
 
 ``--coverage`` adds a coverage report of ``solver`` and ``service`` (both runs, combined): it
 makes the suite about half as long again, so it is asked for, not the default. Other arguments
@@ -27,6 +28,15 @@ ROOT = Path(__file__).resolve().parents[1]
 COMPILE_GROUPS = (("numeric6",), ("analytic", "cell", "numeric7"))
 """scripts/compile_kernels.py's groups in two processes: about 70 and 85 s of CPU, cold."""
 COVERAGE = ["--cov=solver", "--cov=service", "--cov-report=term:skip-covered"]
+LATENCY_MODULES = (
+    "tests/test_live_server.py",
+    "tests/test_jobs.py",
+    "tests/test_jobs_dask.py",
+    "tests/service/test_job_runner.py",
+)
+"""The modules with tests marked ``latency``, the only ones the latency run collects: collecting
+every module (the contract tests build their cases then) took 27 of its 82 s, 2026-12-03.
+tests/test_run_tests.py holds the list to the modules that use the mark."""
 
 
 def compile_kernels() -> int:
@@ -49,7 +59,13 @@ def main(arguments: list[str]) -> int:
     workers = ["-n", "2", "--dist", "loadscope", "--no-loadscope-reorder", "-m", "not latency"]
     runs = [
         [*pytest, *workers, *(COVERAGE if coverage else []), *arguments],
-        [*pytest, "-m", "latency", *([*COVERAGE, "--cov-append"] if coverage else []), *arguments],
+        [
+            *pytest,
+            "-m",
+            "latency",
+            *([*COVERAGE, "--cov-append"] if coverage else []),
+            *(arguments or LATENCY_MODULES),  # the modules, where no argument chooses tests
+        ],
     ]
     print("$ scripts/compile_kernels.py", flush=True)
     status = compile_kernels()
