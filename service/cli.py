@@ -12,7 +12,10 @@ the route answers:
   controller frames.
 
 PROGRAM is CL data, or a CSV when its name ends in ``.csv`` (``--units`` then required). R is a
-catalogue name (``ur5e``) or a JSON file holding the API's ``robot`` object. Settings come from
+catalogue name (``ur5e``) or a JSON file holding the API's ``robot`` object (its acceleration
+limits add mu_acc and the cycle time); ``--cell FILE``, a JSON file holding the API's ``cell``
+object (cell.md: the table, fixtures, the part, the tool, the clearance), checks the robot
+against it on evaluate, map and optimise as the routes do. Settings come from
 the environment as for the service (``DTF_*``). Exit codes: :data:`OK` (0), :data:`USAGE` (2),
 :data:`INVALID` (3), :data:`INFEASIBLE` (4); 1 is Python's own, for a crash. Errors name the
 field (and waypoint, line) as the API does.
@@ -64,8 +67,6 @@ def main(argv: Sequence[str] | None = None) -> int:
     except SolverError as error:
         where = ".".join(str(part) for part in solver_error_location(error)[1:])
         print(f"error: {where}: {error.message}", file=sys.stderr)  # noqa: T201
-    except json.JSONDecodeError as error:
-        print(f"error: robot: the file is not JSON ({error})", file=sys.stderr)  # noqa: T201
     except OSError as error:
         print(f"error: {error}", file=sys.stderr)  # noqa: T201
     return INVALID
@@ -91,8 +92,27 @@ def _robot(name: str) -> Any:
     """The request's ``robot``: a JSON file's object, or a catalogue model name."""
     file = Path(name)
     if name.lower().endswith(".json") and file.is_file():
-        return json.loads(file.read_text(encoding="utf-8"))
+        return _json_file(file, "robot")
     return {"model": name}
+
+
+def _json_file(file: Path, field: str) -> Any:
+    """The JSON value in ``file``, the request's ``field``.
+
+    Raises:
+        InvalidInputError: on ``field``, when the file is not JSON.
+    """
+    try:
+        return json.loads(file.read_text(encoding="utf-8"))
+    except json.JSONDecodeError as error:
+        raise InvalidInputError(field, f"the file is not JSON ({error})") from error
+
+
+def _with_cell(body: dict[str, Any], args: argparse.Namespace) -> dict[str, Any]:
+    """``body`` with the ``cell`` of ``--cell``'s file, when given."""
+    if args.cell is not None:
+        body["cell"] = _json_file(Path(args.cell), "cell")
+    return body
 
 
 def _validated(model: type[Model], body: dict[str, Any]) -> Model:
@@ -124,10 +144,11 @@ def _evaluate(args: argparse.Namespace) -> int:
         body["spin_mode"] = args.spin_mode
     if args.feed is not None:
         body["feed"] = args.feed
-    request = _validated(EvaluateRequest, body)
+    request = _validated(EvaluateRequest, _with_cell(body, args))
     with ProgressBar(enabled=args.progress) as bar:
         answer = evaluation_of(request, get_settings(), bar)
-    _print(answer, args, lambda: evaluation_text(answer))
+    clearance = None if request.cell is None else request.cell.clearance
+    _print(answer, args, lambda: evaluation_text(answer, clearance))
     runs = answer.feasible and (answer.feed_check is None or answer.feed_check.feasible)
     return OK if runs else INFEASIBLE
 
@@ -137,7 +158,7 @@ def _map(args: argparse.Namespace) -> int:
     body: dict[str, Any] = {"robot": _robot(args.robot), "path": _path(args), "grid": grid}
     if args.spin_mode is not None:
         body["spin_mode"] = args.spin_mode
-    request = _validated(MapRequest, body)
+    request = _validated(MapRequest, _with_cell(body, args))
     with ProgressBar(enabled=args.progress) as bar:
         result, robot, spin_mode, path_read = computed_map(
             request, get_settings(), png=True, progress=bar
@@ -159,7 +180,7 @@ def _optimise(args: argparse.Namespace) -> int:
     }
     if args.spin_mode is not None:
         body["spin_mode"] = args.spin_mode
-    request = _validated(OptimizeRequest, body)
+    request = _validated(OptimizeRequest, _with_cell(body, args))
     with ProgressBar(enabled=args.progress) as bar:
         answer = optimum_of(request, get_settings(), bar)
     _print(answer, args, lambda: optimum_text(answer))
@@ -210,6 +231,12 @@ def _parser() -> argparse.ArgumentParser:
     solving = argparse.ArgumentParser(add_help=False, parents=[common])
     solving.add_argument("--robot", required=True, help="a catalogue name or a robot JSON file")
     solving.add_argument("--spin-mode", choices=["fixed", "free"])
+    solving.add_argument(
+        "--cell",
+        metavar="FILE",
+        help="a JSON file holding the API's cell object (the table, fixtures, the part, the "
+        "tool, the clearance): collisions are checked against it",
+    )
     solving.add_argument(
         "--progress",
         action=argparse.BooleanOptionalAction,

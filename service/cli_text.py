@@ -13,6 +13,7 @@ from service.schemas import (
     PathRead,
     PlacementResult,
 )
+from service.schemas.cell import Contact
 from service.schemas.paths_import import PathImportResponse
 
 _MM_PER_MIN = 60e3
@@ -27,6 +28,35 @@ def _fixed(value: float, digits: int) -> str:
 def _feed(feed: float | None) -> str:
     """A feed in mm/min, or a dash."""
     return "-" if feed is None else f"{feed * _MM_PER_MIN:.1f} mm/min"
+
+
+def _contact(contact: Contact) -> str:
+    """A robot part and what it comes closest to: where, and how far apart or into each other."""
+    depth = contact.distance * 1e3
+    apart = f"{_fixed(depth, 1)} mm apart" if depth >= 0.0 else f"{_fixed(-depth, 1)} mm into it"
+    where = f"at waypoint {contact.waypoint}"
+    return f"{contact.robot_part} and {contact.obstacle_name} {where}, {apart}"
+
+
+def _motion_and_cell(answer: EvaluateResponse) -> list[str]:
+    """mu_acc and the cycle time (with acceleration limits), the least clearance (with a cell)."""
+    lines = []
+    acceleration = answer.acceleration
+    if acceleration is not None:
+        lines.append(
+            f"mu_acc: {acceleration.mu_acc:.4f} m/s (a joint {acceleration.limited_by} limit "
+            f"binds: {acceleration.joint_name} at waypoint {acceleration.waypoint})"
+        )
+    if answer.cycle_time is not None:
+        lines.append(
+            f"cycle time: {answer.cycle_time.ramp:.2f} s at mu_acc with its ramps "
+            f"(time-optimal {answer.cycle_time.time_optimal:.2f} s)"
+        )
+    if answer.min_clearance is not None:
+        lines.append(f"least clearance: {_contact(answer.min_clearance)}")
+    if answer.cell_approximated:
+        lines.append("cell: approximated by capsules: " + ", ".join(answer.cell_approximated))
+    return lines
 
 
 def import_text(answer: PathImportResponse, name: str) -> str:
@@ -74,21 +104,29 @@ def read_text(read: PathRead | None) -> list[str]:
     return lines
 
 
-def evaluation_text(answer: EvaluateResponse) -> str:
-    """How the program was read; mu_path, the bottleneck and the feed check, or why not."""
+def evaluation_text(answer: EvaluateResponse, clearance: float | None = None) -> str:
+    """How the program was read; mu_path, the bottleneck and the feed check, or why not.
+
+    ``clearance``: the cell's (m), named beside a collision.
+    """
     lines = read_text(answer.path_read)
     if not answer.feasible:
         where = "" if answer.failed_waypoint is None else f" at waypoint {answer.failed_waypoint}"
         if answer.failed_pass is not None:
             named = "" if answer.failed_operation is None else f", {answer.failed_operation}"
             where += f" (pass {answer.failed_pass}{named})"
-        return "\n".join([*lines, f"infeasible: {answer.reason}{where}"])
+        lines.append(f"infeasible: {answer.reason}{where}")
+        if answer.collision is not None:
+            limit = "" if clearance is None else f" (clearance {_fixed(clearance * 1e3, 1)} mm)"
+            lines.append(f"collision: {_contact(answer.collision)}{limit}")
+        return "\n".join(lines)
     lines.append(f"mu_path: {answer.mu_path:.4f} m/s (spin {answer.spin_mode})")
     if answer.bottleneck is not None:
         lines.append(
             f"bottleneck: waypoint {answer.bottleneck.waypoint}, joint "
             f"{answer.bottleneck.joint_name}"
         )
+    lines += _motion_and_cell(answer)
     check = answer.feed_check
     if check is not None:
         verdict = "runs" if check.feasible else "does not run"
@@ -121,7 +159,11 @@ def _placement(placement: PlacementResult) -> list[str]:
 def map_text(answer: MapResponse, png: str) -> str:
     """How the program was read; the map's size, its best placement, the picture's file."""
     lines = read_text(answer.path_read)
-    lines.append(f"map: {answer.feasible_cells} of {len(answer.cells)} placements feasible; {png}")
+    collide = sum(cell.reason == "collision" for cell in answer.cells)
+    with_cell = f" ({collide} in collision)" if collide else ""
+    lines.append(
+        f"map: {answer.feasible_cells} of {len(answer.cells)} placements feasible{with_cell}; {png}"
+    )
     if answer.best is not None:
         lines.append(f"best: mu_path {answer.best.mu_path:.4f} m/s")
         lines += _placement(answer.best.placement)
@@ -140,6 +182,8 @@ def optimum_text(answer: OptimizeResponse) -> str:
         + ("" if gain is None else f" ({gain:+.1f} % over the start)"),
         *_placement(answer.placement),
     ]
+    if answer.evaluation is not None:
+        lines += _motion_and_cell(answer.evaluation)
     check = None if answer.evaluation is None else answer.evaluation.feed_check
     if check is not None:
         lines.append(f"feed {_feed(check.feed)}: {'runs' if check.feasible else 'does not run'}")

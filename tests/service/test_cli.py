@@ -22,6 +22,21 @@ from tests.solver.cam.dialects import NX_LISTING, text
 PROGRAM = ROOT / "examples" / "cam" / "nx_slot_plate.cls"
 ROBOT = {"model": "ur5e"}
 AT = {"x": 0.0, "y": 0.3, "z": 0.0, "yaw": 0.0}
+CELL = {  # a table 5 cm below the base, a fixture box beside the part, a 10 cm spindle
+    "fixed": [
+        {"shape": "halfspace", "name": "table", "normal": [0, 0, 1], "offset": -0.05},
+        {
+            "shape": "box",
+            "name": "fixture",
+            "size": [0.1, 0.1, 0.3],
+            "pose": {"position": [0.3, 0.0, 0.1], "orientation": [0, 0, 0, 1]},
+        },
+    ],
+    "tool": {"radius": 0.03, "length": 0.1},
+}
+RAISED_TABLE = {  # its top 5 cm above the base's foot: every placement collides (cell.md s. 5)
+    "fixed": [{"shape": "halfspace", "name": "raised table", "normal": [0, 0, 1], "offset": 0.05}]
+}
 
 
 def run(capsys: pytest.CaptureFixture[str], *argv: str) -> tuple[int, str, str]:
@@ -210,3 +225,109 @@ def test_the_command_runs_as_a_process(tmp_path: Path) -> None:
 
 def test_the_console_script_is_declared() -> None:
     assert 'dtf-place = "service.cli:main_exit"' in (ROOT / "pyproject.toml").read_text()
+
+
+def _file(tmp_path: Path, name: str, value: Any) -> str:
+    file = tmp_path / name
+    file.write_text(json.dumps(value))
+    return str(file)
+
+
+def _contact(contact: dict[str, Any]) -> str:
+    """A contact as the command prints it, from the route's JSON."""
+    mm = 1e3 * contact["distance"]
+    apart = f"{mm:.1f} mm apart" if mm >= 0 else f"{-mm:.1f} mm into it"
+    return (
+        f"{contact['robot_part']} and {contact['obstacle_name']} at waypoint "
+        f"{contact['waypoint']}, {apart}"
+    )
+
+
+def test_a_cell_file_is_checked_as_the_routes_cell(
+    client: TestClient, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    cell = _file(tmp_path, "cell.json", CELL)
+    at = ["evaluate", str(PROGRAM), "--robot", "ur5e", "--at=0,0.3,0,0", "--cell", cell]
+    code, out, _ = run(capsys, *at, "--json")
+    body = {"robot": ROBOT, "path": {"cl_data": PROGRAM.read_text()}, "placement": AT}
+    expected = api(client, "/v1/evaluate", {**body, "cell": CELL, "detail": "summary"})
+    assert code == OK
+    assert json.loads(out) == expected
+    assert expected["feasible"] and expected["min_clearance"]["distance"] >= 0.005
+    code, out, _ = run(capsys, *at)
+    assert code == OK
+    assert f"least clearance: {_contact(expected['min_clearance'])}" in out.splitlines()
+    assert "cell: approximated by capsules: " in out  # the UR5e's links (no meshes ship)
+
+
+def test_a_table_above_the_base_makes_evaluate_and_map_infeasible_by_collision(
+    client: TestClient, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    cell = _file(tmp_path, "raised.json", RAISED_TABLE)
+    code, out, _ = run(
+        capsys, "evaluate", str(PROGRAM), "--robot", "ur5e", "--at=0,0.3,0,0", "--cell", cell
+    )
+    body = {"robot": ROBOT, "path": {"cl_data": PROGRAM.read_text()}, "placement": AT}
+    answer = api(client, "/v1/evaluate", {**body, "cell": RAISED_TABLE, "detail": "summary"})
+    assert code == INFEASIBLE and answer["reason"] == "collision"
+    assert answer["collision"]["obstacle_name"] == "raised table"
+    assert out.splitlines()[-2].startswith("infeasible: collision at waypoint ")
+    assert out.splitlines()[-1] == (
+        f"collision: {_contact(answer['collision'])} (clearance 5.0 mm)"
+    )
+    code, out, _ = run(
+        capsys, "map", str(PROGRAM), "--robot", "ur5e", "--x=-0.1:0.1:0.1", "--y", "0.3:0.4:0.1",
+        "--png", str(tmp_path / "map.png"), "--cell", cell,
+    )  # fmt: skip
+    assert code == INFEASIBLE
+    assert f"map: 0 of 6 placements feasible (6 in collision); {tmp_path / 'map.png'}" in out
+
+
+def test_optimise_in_a_cell_prints_the_routes_collision_free_optimum(
+    client: TestClient, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    code, out, _ = run(
+        capsys, "optimise", str(PROGRAM), "--robot", "ur5e", "--x=-0.1:0.1", "--y", "0.25:0.35",
+        "--yaw=-0.5:0.5", "--cell", _file(tmp_path, "cell.json", CELL),
+    )  # fmt: skip
+    bounds = {"x": [-0.1, 0.1], "y": [0.25, 0.35], "yaw": [-0.5, 0.5]}
+    body = {"robot": ROBOT, "path": {"cl_data": PROGRAM.read_text()}, "bounds": bounds, "z": 0.0}
+    answer = api(client, "/v1/optimize", {**body, "method": "scipy", "cell": CELL})
+    assert code == OK and answer["found"]
+    nearest = answer["evaluation"]["min_clearance"]
+    assert nearest["distance"] >= 0.005  # collision-free, the default clearance kept
+    assert f"optimum: mu_path {answer['mu_path']:.4f} m/s" in out
+    assert f"least clearance: {_contact(nearest)}" in out.splitlines()
+
+
+def test_acceleration_limits_print_mu_acc_and_the_cycle_time(
+    client: TestClient, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    robot = {"model": "ur5e", "joint_acceleration_limits": [3.0] * 6}
+    file = _file(tmp_path, "robot.json", robot)
+    code, out, _ = run(capsys, "evaluate", str(PROGRAM), "--robot", file, "--at=0,0.3,0,0")
+    body = {"robot": robot, "path": {"cl_data": PROGRAM.read_text()}, "placement": AT}
+    answer = api(client, "/v1/evaluate", {**body, "detail": "summary"})
+    acceleration, cycle = answer["acceleration"], answer["cycle_time"]
+    assert code == OK and acceleration["mu_acc"] < answer["mu_path"]
+    assert (
+        f"mu_acc: {acceleration['mu_acc']:.4f} m/s (a joint {acceleration['limited_by']} limit "
+        f"binds: {acceleration['joint_name']} at waypoint {acceleration['waypoint']})"
+    ) in out.splitlines()
+    assert (
+        f"cycle time: {cycle['ramp']:.2f} s at mu_acc with its ramps "
+        f"(time-optimal {cycle['time_optimal']:.2f} s)"
+    ) in out.splitlines()
+
+
+def test_a_cell_file_that_is_not_json_or_not_a_cell_exits_invalid(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    at = ["evaluate", str(PROGRAM), "--robot", "ur5e", "--at=0,0.3,0,0", "--cell"]
+    broken = tmp_path / "broken.json"
+    broken.write_text("{fixed: [")
+    code, out, err = run(capsys, *at, str(broken))
+    assert (code, out) == (INVALID, "") and err.startswith("error: cell: the file is not JSON")
+    flat = {"fixed": [{"shape": "box", "size": [0.1, -1.0, 0.1]}]}
+    code, out, err = run(capsys, *at, _file(tmp_path, "flat.json", flat))
+    assert (code, out) == (INVALID, "") and err.startswith("error: cell.fixed.0.box.size.1: ")
