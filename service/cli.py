@@ -12,13 +12,14 @@ the route answers:
   controller frames.
 
 PROGRAM is CL data, or a CSV when its name ends in ``.csv`` (``--units`` then required). R is a
-catalogue name (``ur5e``) or a JSON file holding the API's ``robot`` object (its acceleration
-limits add mu_acc and the cycle time); ``--cell FILE``, a JSON file holding the API's ``cell``
-object (cell.md: the table, fixtures, the part, the tool, the clearance), checks the robot
-against it on evaluate, map and optimise as the routes do. Settings come from
-the environment as for the service (``DTF_*``). Exit codes: :data:`OK` (0), :data:`USAGE` (2),
-:data:`INVALID` (3), :data:`INFEASIBLE` (4); 1 is Python's own, for a crash. Errors name the
-field (and waypoint, line) as the API does.
+catalogue name (``ur5e``), a JSON file holding the API's ``robot`` object (its acceleration
+limits add mu_acc and the cycle time), or a URDF file (``.urdf``: its chain from
+``--base-frame`` to ``--tool-frame``, base_link and tool0 unless given, its own velocity
+limits). ``--cell FILE``, a JSON file holding the API's ``cell`` object (cell.md: the table,
+fixtures, the part, the tool, the clearance), checks the robot against it on evaluate, map and
+optimise as the routes do. Settings come from the environment as for the service (``DTF_*``).
+Exit codes: :data:`OK` (0), :data:`USAGE` (2), :data:`INVALID` (3), :data:`INFEASIBLE` (4); 1 is
+Python's own, for a crash. Errors name the field (and waypoint, line) as the API does.
 """
 
 from __future__ import annotations
@@ -51,6 +52,11 @@ USAGE = 2
 """The command line is wrong (argparse's code)."""
 INVALID = 3
 """The input is refused, as the API refuses it with a 422: the message names the field."""
+
+BASE_FRAME = "base_link"
+"""A URDF robot's default base frame (ROS-Industrial's REP 199: base_link and tool0)."""
+TOOL_FRAME = "tool0"
+"""A URDF robot's default tool frame, the flange."""
 
 Model = TypeVar("Model", bound=BaseModel)
 
@@ -88,12 +94,32 @@ def _path(args: argparse.Namespace) -> dict[str, Any]:
     return path
 
 
-def _robot(name: str) -> Any:
-    """The request's ``robot``: a JSON file's object, or a catalogue model name."""
-    file = Path(name)
+def _robot(args: argparse.Namespace) -> Any:
+    """The request's ``robot``: a JSON file's object, a URDF file's chain, or a catalogue name.
+
+    A URDF's chain runs from ``--base-frame`` to ``--tool-frame`` (base_link and tool0 by
+    default, the ROS-Industrial frames); given with another robot, those options are refused
+    rather than ignored.
+    """
+    name, file = args.robot, Path(args.robot)
+    if name.lower().endswith(".urdf"):
+        frames = {"base_frame": args.base_frame or BASE_FRAME, "tool_frame": args.tool_frame}
+        return {"urdf": file.read_text(encoding="utf-8"), **frames}
+    if args.base_frame is not None or args.tool_frame != TOOL_FRAME:
+        message = "--base-frame and --tool-frame choose a URDF file's chain: give a .urdf robot"
+        raise InvalidInputError("robot", message)
     if name.lower().endswith(".json") and file.is_file():
         return _json_file(file, "robot")
     return {"model": name}
+
+
+def _chain(args: argparse.Namespace, recognised: str | None) -> list[str]:
+    """A URDF robot's chain and how its IK is solved (printed first), else nothing."""
+    if not args.robot.lower().endswith(".urdf"):
+        return []
+    how = "numeric IK" if recognised is None else recognised
+    base = args.base_frame or BASE_FRAME
+    return [f"robot: {args.robot}, from {base} to {args.tool_frame}; {how}"]
 
 
 def _json_file(file: Path, field: str) -> Any:
@@ -135,7 +161,7 @@ def _import(args: argparse.Namespace) -> int:
 def _evaluate(args: argparse.Namespace) -> int:
     x, y, z, yaw = args.at
     body: dict[str, Any] = {
-        "robot": _robot(args.robot),
+        "robot": _robot(args),
         "path": _path(args),
         "placement": {"x": x, "y": y, "z": z, "yaw": yaw, "spin": args.spin},
         "detail": "summary",
@@ -148,14 +174,15 @@ def _evaluate(args: argparse.Namespace) -> int:
     with ProgressBar(enabled=args.progress) as bar:
         answer = evaluation_of(request, get_settings(), bar)
     clearance = None if request.cell is None else request.cell.clearance
-    _print(answer, args, lambda: evaluation_text(answer, clearance))
+    chain = _chain(args, answer.ik.recognised)
+    _print(answer, args, lambda: "\n".join([*chain, evaluation_text(answer, clearance)]))
     runs = answer.feasible and (answer.feed_check is None or answer.feed_check.feasible)
     return OK if runs else INFEASIBLE
 
 
 def _map(args: argparse.Namespace) -> int:
     grid = {"x": args.x, "y": args.y, "z": args.z, "yaw": args.yaw}
-    body: dict[str, Any] = {"robot": _robot(args.robot), "path": _path(args), "grid": grid}
+    body: dict[str, Any] = {"robot": _robot(args), "path": _path(args), "grid": grid}
     if args.spin_mode is not None:
         body["spin_mode"] = args.spin_mode
     request = _validated(MapRequest, _with_cell(body, args))
@@ -165,14 +192,15 @@ def _map(args: argparse.Namespace) -> int:
         )
     answer = convert.map_response(result, robot, spin_mode=spin_mode, path_read=path_read)
     Path(args.png).write_bytes(map_png(result, robot))
-    _print(answer, args, lambda: map_text(answer, args.png))
+    chain = _chain(args, answer.recognised)
+    _print(answer, args, lambda: "\n".join([*chain, map_text(answer, args.png)]))
     return OK if answer.feasible_cells else INFEASIBLE
 
 
 def _optimise(args: argparse.Namespace) -> int:
     bounds = {"x": args.x, "y": args.y, "yaw": args.yaw}
     body: dict[str, Any] = {
-        "robot": _robot(args.robot),
+        "robot": _robot(args),
         "path": _path(args),
         "bounds": bounds,
         "z": args.z,
@@ -183,7 +211,9 @@ def _optimise(args: argparse.Namespace) -> int:
     request = _validated(OptimizeRequest, _with_cell(body, args))
     with ProgressBar(enabled=args.progress) as bar:
         answer = optimum_of(request, get_settings(), bar)
-    _print(answer, args, lambda: optimum_text(answer))
+    recognised = None if answer.evaluation is None else answer.evaluation.ik.recognised
+    chain = _chain(args, recognised)
+    _print(answer, args, lambda: "\n".join([*chain, optimum_text(answer)]))
     return OK if answer.found else INFEASIBLE
 
 
@@ -229,7 +259,20 @@ def _parser() -> argparse.ArgumentParser:
     common.add_argument("--arc-tolerance", type=float, help="m, chordal (default 1e-5)")
     common.add_argument("--json", action="store_true", help="print the API's JSON answer")
     solving = argparse.ArgumentParser(add_help=False, parents=[common])
-    solving.add_argument("--robot", required=True, help="a catalogue name or a robot JSON file")
+    solving.add_argument(
+        "--robot",
+        required=True,
+        help="a catalogue name, a robot JSON file (the API's robot object) or a URDF file",
+    )
+    solving.add_argument(
+        "--base-frame",
+        help=f"a URDF robot's base frame, its poses' frame (default {BASE_FRAME})",
+    )
+    solving.add_argument(
+        "--tool-frame",
+        default=TOOL_FRAME,
+        help=f"a URDF robot's tool flange frame (default {TOOL_FRAME})",
+    )
     solving.add_argument("--spin-mode", choices=["fixed", "free"])
     solving.add_argument(
         "--cell",

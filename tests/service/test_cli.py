@@ -16,6 +16,7 @@ import pytest
 from fastapi.testclient import TestClient
 
 from service.cli import INFEASIBLE, INVALID, OK, USAGE, main
+from solver.core.robots import example_robot_data_dir
 from tests.cases import ROOT
 from tests.solver.cam.dialects import NX_LISTING, text
 
@@ -331,3 +332,39 @@ def test_a_cell_file_that_is_not_json_or_not_a_cell_exits_invalid(
     flat = {"fixed": [{"shape": "box", "size": [0.1, -1.0, 0.1]}]}
     code, out, err = run(capsys, *at, _file(tmp_path, "flat.json", flat))
     assert (code, out) == (INVALID, "") and err.startswith("error: cell.fixed.0.box.size.1: ")
+
+
+UR5_URDF = example_robot_data_dir() / "ur_description" / "urdf" / "ur5_robot.urdf"
+
+
+def test_a_urdf_file_is_the_routes_urdf_robot_from_base_link_to_tool0(
+    client: TestClient, capsys: pytest.CaptureFixture[str]
+) -> None:
+    at = ["evaluate", str(PROGRAM), "--robot", str(UR5_URDF), "--at=0,0.3,0,0"]
+    path = {"cl_data": PROGRAM.read_text()}
+    for frames, options in (
+        ({"base_frame": "base_link", "tool_frame": "tool0"}, []),  # the defaults
+        ({"base_frame": "base", "tool_frame": "tool0"}, ["--base-frame", "base"]),
+    ):
+        code, out, _ = run(capsys, *at, *options, "--json")
+        robot = {"urdf": UR5_URDF.read_text(), **frames}
+        body = {"robot": robot, "path": path, "placement": AT, "detail": "summary"}
+        expected = api(client, "/v1/evaluate", body)
+        assert code == OK and json.loads(out) == expected
+        code, out, _ = run(capsys, *at, *options)
+        how = expected["ik"]["recognised"] or "numeric IK"
+        chain = f"from {frames['base_frame']} to {frames['tool_frame']}"
+        assert out.splitlines()[0] == f"robot: {UR5_URDF}, {chain}; {how}"
+    assert expected["ik"]["family"] == "ur"  # from its DH base frame, the closed form
+
+
+def test_frames_with_a_robot_that_is_no_urdf_or_not_in_it_exit_invalid(
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    at = ["evaluate", str(PROGRAM), "--at=0,0.3,0,0", "--robot"]
+    code, out, err = run(capsys, *at, "ur5e", "--base-frame", "base")
+    assert (code, out) == (INVALID, "")  # refused, not ignored
+    assert err.startswith("error: robot: --base-frame and --tool-frame choose a URDF file's")
+    code, out, err = run(capsys, *at, str(UR5_URDF), "--tool-frame", "nowhere")
+    assert (code, out) == (INVALID, "")
+    assert err.startswith("error: robot.tool_frame: no frame 'nowhere' in the model")
