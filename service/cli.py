@@ -181,7 +181,7 @@ def _evaluate(args: argparse.Namespace) -> int:
 
 
 def _map(args: argparse.Namespace) -> int:
-    grid = {"x": args.x, "y": args.y, "z": args.z, "yaw": args.yaw}
+    grid = {"x": args.x, "y": args.y, "z": args.z, "yaw": args.yaw, "spin": args.spin}
     body: dict[str, Any] = {"robot": _robot(args), "path": _path(args), "grid": grid}
     if args.spin_mode is not None:
         body["spin_mode"] = args.spin_mode
@@ -232,6 +232,13 @@ def _numbers(count: int, separator: str) -> Callable[[str], list[float]]:
         return values
 
     return parse
+
+
+def _one_or_list(text: str) -> float | list[float]:
+    """An argparse type: one number, or a list of numbers joined by commas (each mapped)."""
+    count = text.count(",") + 1
+    values = _numbers(count, ",")(text)
+    return values[0] if count == 1 else values
 
 
 def _axis(text: str) -> dict[str, float]:
@@ -297,7 +304,15 @@ def _parser() -> argparse.ArgumentParser:
     run.add_argument("--x", type=_axis, required=True, metavar="MIN:MAX:STEP")
     run.add_argument("--y", type=_axis, required=True, metavar="MIN:MAX:STEP")
     run.add_argument("--z", type=float, default=0.0, help="m, the table height")
-    run.add_argument("--yaw", type=float, default=0.0, help="rad")
+    run.add_argument(
+        "--yaw", type=_one_or_list, default=0.0, help="rad, one or a list (0,1.57): a panel each"
+    )
+    run.add_argument(
+        "--spin",
+        type=_one_or_list,
+        default=0.0,
+        help="rad, a constant tool spin (fixed spin), one or a list: a panel each",
+    )
     run.add_argument("--png", required=True, help="the file to write the map to")
     run.set_defaults(run=_map)
     run = commands.add_parser(

@@ -368,3 +368,25 @@ def test_frames_with_a_robot_that_is_no_urdf_or_not_in_it_exit_invalid(
     code, out, err = run(capsys, *at, str(UR5_URDF), "--tool-frame", "nowhere")
     assert (code, out) == (INVALID, "")
     assert err.startswith("error: robot.tool_frame: no frame 'nowhere' in the model")
+
+
+def test_map_takes_lists_of_yaws_and_spins_a_panel_each(
+    client: TestClient, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    png = tmp_path / "map.png"
+    code, out, _ = run(
+        capsys, "map", str(PROGRAM), "--robot", "ur5e", "--x=-0.1:0.1:0.1", "--y", "0.3:0.4:0.1",
+        "--yaw", "0,1.5708", "--spin=-0.3,0.3", "--spin-mode", "fixed", "--png", str(png),
+        "--json",
+    )  # fmt: skip
+    grid = {"x": {"min": -0.1, "max": 0.1, "step": 0.1}, "y": {"min": 0.3, "max": 0.4, "step": 0.1}}
+    grid |= {"z": 0.0, "yaw": [0.0, 1.5708], "spin": [-0.3, 0.3]}
+    body = {"robot": ROBOT, "path": {"cl_data": PROGRAM.read_text()}, "grid": grid}
+    expected = api(client, "/v1/map", {**body, "spin_mode": "fixed"})
+    assert code == OK and json.loads(out) == expected
+    assert {(c["yaw"], c["spin"]) for c in expected["cells"]} == {
+        (yaw, spin) for yaw in (0.0, 1.5708) for spin in (-0.3, 0.3)
+    }
+    header = png.read_bytes()[16:24]  # the IHDR chunk's width and height
+    width, height = int.from_bytes(header[:4], "big"), int.from_bytes(header[4:], "big")
+    assert width > 1.5 * height  # panels side by side (one panel is about 1.4 times as wide)
