@@ -198,14 +198,17 @@ def _map(args: argparse.Namespace) -> int:
 
 
 def _optimise(args: argparse.Namespace) -> int:
-    bounds = {"x": args.x, "y": args.y, "yaw": args.yaw}
+    bounds: dict[str, Any] = {"x": args.x, "y": args.y, "yaw": args.yaw, "spin": args.spin}
     body: dict[str, Any] = {
         "robot": _robot(args),
         "path": _path(args),
         "bounds": bounds,
-        "z": args.z,
         "method": args.method,
     }
+    if isinstance(args.z, list):  # a range: the height is searched too
+        bounds["z"] = args.z
+    else:
+        body["z"] = args.z
     if args.spin_mode is not None:
         body["spin_mode"] = args.spin_mode
     request = _validated(OptimizeRequest, _with_cell(body, args))
@@ -239,6 +242,11 @@ def _one_or_list(text: str) -> float | list[float]:
     count = text.count(",") + 1
     values = _numbers(count, ",")(text)
     return values[0] if count == 1 else values
+
+
+def _height(text: str) -> float | list[float]:
+    """An argparse type: a height ``Z``, or a range ``MIN:MAX`` to search (m)."""
+    return _numbers(2, ":")(text) if ":" in text else _numbers(1, ":")(text)[0]
 
 
 def _axis(text: str) -> dict[str, float]:
@@ -321,7 +329,20 @@ def _parser() -> argparse.ArgumentParser:
     run.add_argument("--x", type=_numbers(2, ":"), required=True, metavar="MIN:MAX")
     run.add_argument("--y", type=_numbers(2, ":"), required=True, metavar="MIN:MAX")
     run.add_argument("--yaw", type=_numbers(2, ":"), default=[-math.pi, math.pi], metavar="MIN:MAX")
-    run.add_argument("--z", type=float, default=0.0, help="m, the table height")
+    run.add_argument(
+        "--z",
+        type=_height,
+        default=0.0,
+        metavar="Z or MIN:MAX",
+        help="m, the table height, or a range to search it in",
+    )
+    run.add_argument(
+        "--spin",
+        type=_numbers(2, ":"),
+        default=[0.0, 0.0],
+        metavar="MIN:MAX",
+        help="rad, the constant tool spin's range (default 0:0, no spin)",
+    )
     run.add_argument("--method", choices=["scipy", "casadi"], default="scipy")
     run.set_defaults(run=_optimise)
     return parser

@@ -390,3 +390,22 @@ def test_map_takes_lists_of_yaws_and_spins_a_panel_each(
     header = png.read_bytes()[16:24]  # the IHDR chunk's width and height
     width, height = int.from_bytes(header[:4], "big"), int.from_bytes(header[4:], "big")
     assert width > 1.5 * height  # panels side by side (one panel is about 1.4 times as wide)
+
+
+def test_optimise_searches_a_height_range_and_a_spin_range_as_the_route(
+    client: TestClient, capsys: pytest.CaptureFixture[str]
+) -> None:
+    code, out, _ = run(
+        capsys, "optimise", str(PROGRAM), "--robot", "ur5e", "--x=-0.1:0.1", "--y", "0.25:0.35",
+        "--yaw=-0.5:0.5", "--z", "0:0.1", "--spin=-0.5:0.5", "--spin-mode", "fixed", "--json",
+    )  # fmt: skip
+    bounds = {"x": [-0.1, 0.1], "y": [0.25, 0.35], "yaw": [-0.5, 0.5]}
+    bounds |= {"z": [0.0, 0.1], "spin": [-0.5, 0.5]}
+    body = {"robot": ROBOT, "path": {"cl_data": PROGRAM.read_text()}, "bounds": bounds}
+    theirs = api(client, "/v1/optimize", {**body, "method": "scipy", "spin_mode": "fixed"})
+    mine = json.loads(out)
+    for answer in (mine, theirs):
+        answer["solver"].pop("seconds")
+    assert code == OK and mine == theirs
+    at = theirs["placement"]
+    assert 0.0 <= at["z"] <= 0.1 and -0.5 <= at["spin"] <= 0.5
