@@ -103,9 +103,12 @@ def _robot(args: argparse.Namespace) -> Any:
     """
     name, file = args.robot, Path(args.robot)
     if name.lower().endswith(".urdf"):
-        frames = {"base_frame": args.base_frame or BASE_FRAME, "tool_frame": args.tool_frame}
+        frames = {
+            "base_frame": args.base_frame or BASE_FRAME,
+            "tool_frame": args.tool_frame or TOOL_FRAME,
+        }
         return {"urdf": file.read_text(encoding="utf-8"), **frames}
-    if args.base_frame is not None or args.tool_frame != TOOL_FRAME:
+    if args.base_frame is not None or args.tool_frame is not None:
         message = "--base-frame and --tool-frame choose a URDF file's chain: give a .urdf robot"
         raise InvalidInputError("robot", message)
     if name.lower().endswith(".json") and file.is_file():
@@ -118,8 +121,8 @@ def _chain(args: argparse.Namespace, recognised: str | None) -> list[str]:
     if not args.robot.lower().endswith(".urdf"):
         return []
     how = "numeric IK" if recognised is None else recognised
-    base = args.base_frame or BASE_FRAME
-    return [f"robot: {args.robot}, from {base} to {args.tool_frame}; {how}"]
+    base, tool = args.base_frame or BASE_FRAME, args.tool_frame or TOOL_FRAME
+    return [f"robot: {args.robot}, from {base} to {tool}; {how}"]
 
 
 def _json_file(file: Path, field: str) -> Any:
@@ -284,9 +287,7 @@ def _parser() -> argparse.ArgumentParser:
         help=f"a URDF robot's base frame, its poses' frame (default {BASE_FRAME})",
     )
     solving.add_argument(
-        "--tool-frame",
-        default=TOOL_FRAME,
-        help=f"a URDF robot's tool flange frame (default {TOOL_FRAME})",
+        "--tool-frame", help=f"a URDF robot's tool flange frame (default {TOOL_FRAME})"
     )
     solving.add_argument("--spin-mode", choices=["fixed", "free"])
     solving.add_argument(
@@ -319,7 +320,7 @@ def _parser() -> argparse.ArgumentParser:
         "--spin",
         type=_one_or_list,
         default=0.0,
-        help="rad, a constant tool spin (fixed spin), one or a list: a panel each",
+        help="rad, a constant tool spin, one or a list: a panel each",
     )
     run.add_argument("--png", required=True, help="the file to write the map to")
     run.set_defaults(run=_map)

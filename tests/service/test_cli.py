@@ -362,9 +362,10 @@ def test_frames_with_a_robot_that_is_no_urdf_or_not_in_it_exit_invalid(
     capsys: pytest.CaptureFixture[str],
 ) -> None:
     at = ["evaluate", str(PROGRAM), "--at=0,0.3,0,0", "--robot"]
-    code, out, err = run(capsys, *at, "ur5e", "--base-frame", "base")
-    assert (code, out) == (INVALID, "")  # refused, not ignored
-    assert err.startswith("error: robot: --base-frame and --tool-frame choose a URDF file's")
+    for option in (["--base-frame", "base"], ["--tool-frame", "tool0"]):
+        code, out, err = run(capsys, *at, "ur5e", *option)
+        assert (code, out) == (INVALID, "")  # refused, not ignored (even the default's name)
+        assert err.startswith("error: robot: --base-frame and --tool-frame choose a URDF file's")
     code, out, err = run(capsys, *at, str(UR5_URDF), "--tool-frame", "nowhere")
     assert (code, out) == (INVALID, "")
     assert err.startswith("error: robot.tool_frame: no frame 'nowhere' in the model")
