@@ -171,6 +171,8 @@ def _evaluate(args: argparse.Namespace) -> int:
     }
     if args.spin_mode is not None:
         body["spin_mode"] = args.spin_mode
+    if args.branch is not None:
+        body["ik"] = {"branch": args.branch}
     if args.feed is not None:
         body["feed"] = args.feed
     request = _validated(EvaluateRequest, _with_cell(body, args))
@@ -188,6 +190,8 @@ def _map(args: argparse.Namespace) -> int:
     body: dict[str, Any] = {"robot": _robot(args), "path": _path(args), "grid": grid}
     if args.spin_mode is not None:
         body["spin_mode"] = args.spin_mode
+    if args.branch is not None:
+        body["ik"] = {"branch": args.branch}
     request = _validated(MapRequest, _with_cell(body, args))
     with ProgressBar(enabled=args.progress) as bar:
         result, robot, spin_mode, path_read = computed_map(
@@ -214,6 +218,8 @@ def _optimise(args: argparse.Namespace) -> int:
         body["z"] = args.z
     if args.spin_mode is not None:
         body["spin_mode"] = args.spin_mode
+    if args.branch is not None:
+        body["ik"] = {"branch": args.branch}
     request = _validated(OptimizeRequest, _with_cell(body, args))
     with ProgressBar(enabled=args.progress) as bar:
         answer = optimum_of(request, get_settings(), bar)
@@ -245,6 +251,20 @@ def _one_or_list(text: str) -> float | list[float]:
     count = text.count(",") + 1
     values = _numbers(count, ",")(text)
     return values[0] if count == 1 else values
+
+
+def _branch(text: str) -> str | dict[str, Any]:
+    """An argparse type: ``auto``, a named branch ``SHOULDER/ELBOW/WRIST`` or a solution index."""
+    if text == "auto":
+        return text
+    if text.isdigit():
+        return {"solution": int(text)}
+    parts = text.split("/")
+    if len(parts) != 3:
+        raise argparse.ArgumentTypeError(
+            f"{text!r}: auto, SHOULDER/ELBOW/WRIST (front/up/noflip) or a solution index"
+        )
+    return dict(zip(("shoulder", "elbow", "wrist"), parts, strict=True))
 
 
 def _height(text: str) -> float | list[float]:
@@ -290,6 +310,12 @@ def _parser() -> argparse.ArgumentParser:
         "--tool-frame", help=f"a URDF robot's tool flange frame (default {TOOL_FRAME})"
     )
     solving.add_argument("--spin-mode", choices=["fixed", "free"])
+    solving.add_argument(
+        "--branch",
+        type=_branch,
+        help="the IK branch to follow: auto (the default: the fastest), SHOULDER/ELBOW/WRIST "
+        "(left/up/noflip on a UR, front/up/noflip on an OPW arm) or a numeric arm's solution index",
+    )
     solving.add_argument(
         "--cell",
         metavar="FILE",

@@ -14,6 +14,7 @@ from service.schemas import (
     PlacementResult,
 )
 from service.schemas.cell import Contact
+from service.schemas.ik import NumericBranch
 from service.schemas.paths_import import PathImportResponse
 
 _MM_PER_MIN = 60e3
@@ -39,8 +40,13 @@ def _contact(contact: Contact) -> str:
 
 
 def _motion_and_cell(answer: EvaluateResponse) -> list[str]:
-    """mu_acc and the cycle time (with acceleration limits), the least clearance (with a cell)."""
+    """The branch; mu_acc and the cycle time (with acceleration limits); the least clearance."""
     lines = []
+    branch = answer.branch
+    if isinstance(branch, NumericBranch):
+        lines.append(f"branch: solution {branch.solution} (numeric IK, in seed order)")
+    elif branch is not None:
+        lines.append(f"branch: {branch.shoulder}/{branch.elbow}/{branch.wrist}")
     acceleration = answer.acceleration
     if acceleration is not None:
         lines.append(

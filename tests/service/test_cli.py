@@ -410,3 +410,43 @@ def test_optimise_searches_a_height_range_and_a_spin_range_as_the_route(
     assert code == OK and mine == theirs
     at = theirs["placement"]
     assert 0.0 <= at["z"] <= 0.1 and -0.5 <= at["spin"] <= 0.5
+
+
+def test_a_branch_is_followed_as_the_routes_ik_branch_and_printed(
+    client: TestClient, capsys: pytest.CaptureFixture[str]
+) -> None:
+    urdf = {"urdf": UR5_URDF.read_text(), "base_frame": "base_link", "tool_frame": "tool0"}
+    named = {"shoulder": "left", "elbow": "up", "wrist": "flip"}
+    for robot, body_robot, option, branch, printed in (
+        ("ur5e", ROBOT, "left/up/flip", named, "branch: left/up/flip"),
+        (
+            str(UR5_URDF),
+            urdf,
+            "0",
+            {"solution": 0},
+            "branch: solution 0 (numeric IK, in seed order)",
+        ),
+    ):
+        at = ["evaluate", str(PROGRAM), "--robot", robot, "--at=0,0.3,0,0", "--branch", option]
+        code, out, _ = run(capsys, *at, "--json")
+        body = {"robot": body_robot, "path": {"cl_data": PROGRAM.read_text()}, "placement": AT}
+        expected = api(
+            client, "/v1/evaluate", {**body, "detail": "summary", "ik": {"branch": branch}}
+        )
+        assert code == OK and json.loads(out) == expected
+        assert expected["branch"] == branch  # the branch asked for is the one followed
+        code, out, _ = run(capsys, *at)
+        assert printed in out.splitlines()
+
+
+def test_a_branch_that_is_no_branch_exits_usage_or_invalid(
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    at = ["evaluate", str(PROGRAM), "--robot", "ur5e", "--at=0,0.3,0,0", "--branch"]
+    with pytest.raises(SystemExit) as caught:
+        main([*at, "up"])
+    assert caught.value.code == USAGE
+    assert "SHOULDER/ELBOW/WRIST" in capsys.readouterr().err
+    code, out, err = run(capsys, *at, "front/up/flip")  # an OPW arm's names on a UR
+    assert (code, out) == (INVALID, "")
+    assert err.startswith("error: ik.branch: {shoulder=front, elbow=up, wrist=flip} is not a")
