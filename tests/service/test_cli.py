@@ -23,6 +23,9 @@ from tests.solver.cam.dialects import NX_LISTING, text
 PROGRAM = ROOT / "examples" / "cam" / "nx_slot_plate.cls"
 ROBOT = {"model": "ur5e"}
 AT = {"x": 0.0, "y": 0.3, "z": 0.0, "yaw": 0.0}
+MAP = ["map", str(PROGRAM), "--robot", "ur5e", "--x=-0.1:0.1:0.1", "--y", "0.3:0.4:0.1"]
+"""A 3 x 2 map of the program (GRID the route's)."""
+GRID = {"x": {"min": -0.1, "max": 0.1, "step": 0.1}, "y": {"min": 0.3, "max": 0.4, "step": 0.1}}
 CELL = {  # a table 5 cm below the base, a fixture box beside the part, a 10 cm spindle
     "fixed": [
         {"shape": "halfspace", "name": "table", "normal": [0, 0, 1], "offset": -0.05},
@@ -119,17 +122,13 @@ def test_map_writes_the_png_and_answers_the_api_json(
     client: TestClient, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
     png = tmp_path / "map.png"
-    code, out, _ = run(
-        capsys, "map", str(PROGRAM), "--robot", "ur5e", "--x=-0.1:0.1:0.1", "--y", "0.3:0.4:0.1",
-        "--png", str(png), "--json",
-    )  # fmt: skip
+    code, out, _ = run(capsys, *MAP, "--png", str(png), "--json")
     assert code == OK
     assert png.read_bytes().startswith(b"\x89PNG\r\n\x1a\n")
-    grid = {"x": {"min": -0.1, "max": 0.1, "step": 0.1}, "y": {"min": 0.3, "max": 0.4, "step": 0.1}}
     body = {
         "robot": ROBOT,
         "path": {"cl_data": PROGRAM.read_text()},
-        "grid": {**grid, "z": 0.0, "yaw": 0.0},
+        "grid": {**GRID, "z": 0.0, "yaw": 0.0},
     }
     assert json.loads(out) == api(client, "/v1/map", body)
 
@@ -202,7 +201,7 @@ def test_usage_errors_exit_usage(capsys: pytest.CaptureFixture[str]) -> None:
 
 
 def test_a_progress_bar_only_when_asked(capsys: pytest.CaptureFixture[str]) -> None:
-    args = ["map", str(PROGRAM), "--robot", "ur5e", "--x=-0.1:0.1:0.1", "--y", "0.3:0.4:0.1"]
+    args = MAP
     quiet = run(capsys, *args, "--png", "/dev/null", "--no-progress")
     assert quiet[2] == ""
     shown = run(capsys, *args, "--png", "/dev/null", "--progress")
@@ -276,10 +275,7 @@ def test_a_table_above_the_base_makes_evaluate_and_map_infeasible_by_collision(
     assert out.splitlines()[-1] == (
         f"collision: {_contact(answer['collision'])} (clearance 5.0 mm)"
     )
-    code, out, _ = run(
-        capsys, "map", str(PROGRAM), "--robot", "ur5e", "--x=-0.1:0.1:0.1", "--y", "0.3:0.4:0.1",
-        "--png", str(tmp_path / "map.png"), "--cell", cell,
-    )  # fmt: skip
+    code, out, _ = run(capsys, *MAP, "--png", str(tmp_path / "map.png"), "--cell", cell)
     assert code == INFEASIBLE
     assert f"map: 0 of 6 placements feasible (6 in collision); {tmp_path / 'map.png'}" in out
 
@@ -375,13 +371,9 @@ def test_map_takes_lists_of_yaws_and_spins_a_panel_each(
     client: TestClient, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
     png = tmp_path / "map.png"
-    code, out, _ = run(
-        capsys, "map", str(PROGRAM), "--robot", "ur5e", "--x=-0.1:0.1:0.1", "--y", "0.3:0.4:0.1",
-        "--yaw", "0,1.5708", "--spin=-0.3,0.3", "--spin-mode", "fixed", "--png", str(png),
-        "--json",
-    )  # fmt: skip
-    grid = {"x": {"min": -0.1, "max": 0.1, "step": 0.1}, "y": {"min": 0.3, "max": 0.4, "step": 0.1}}
-    grid |= {"z": 0.0, "yaw": [0.0, 1.5708], "spin": [-0.3, 0.3]}
+    lists = ["--yaw", "0,1.5708", "--spin=-0.3,0.3", "--spin-mode", "fixed"]
+    code, out, _ = run(capsys, *MAP, *lists, "--png", str(png), "--json")
+    grid = {**GRID, "z": 0.0, "yaw": [0.0, 1.5708], "spin": [-0.3, 0.3]}
     body = {"robot": ROBOT, "path": {"cl_data": PROGRAM.read_text()}, "grid": grid}
     expected = api(client, "/v1/map", {**body, "spin_mode": "fixed"})
     assert code == OK and json.loads(out) == expected
