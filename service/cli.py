@@ -42,6 +42,7 @@ from service.operations import computed_map, evaluation_of, import_of, map_png, 
 from service.schemas import EvaluateRequest, MapRequest, OptimizeRequest
 from service.schemas.paths_import import PathImportRequest
 from solver.core.exceptions import InvalidInputError, SolverError
+from solver.families import closed_form_bases
 
 OK = 0
 """The answer was printed (and the path runs, for evaluate, map and optimise)."""
@@ -117,12 +118,22 @@ def _robot(args: argparse.Namespace) -> Any:
 
 
 def _chain(args: argparse.Namespace, recognised: str | None) -> list[str]:
-    """A URDF robot's chain and how its IK is solved (printed first), else nothing."""
+    """A URDF robot's chain and how its IK is solved (printed first), else nothing.
+
+    Solved numerically, the base frames from which the chain has a closed form are named.
+    """
     if not args.robot.lower().endswith(".urdf"):
         return []
-    how = "numeric IK" if recognised is None else recognised
     base, tool = args.base_frame or BASE_FRAME, args.tool_frame or TOOL_FRAME
-    return [f"robot: {args.robot}, from {base} to {tool}; {how}"]
+    line = f"robot: {args.robot}, from {base} to {tool}; "
+    if recognised is not None:
+        return [line + recognised]
+    urdf = Path(args.robot).read_text(encoding="utf-8")
+    others = [frame for frame in closed_form_bases(urdf, tool_frame=tool) if frame != base]
+    if not others:
+        return [line + "numeric IK"]
+    named = " or ".join(f"--base-frame {frame}" for frame in others)
+    return [line + f"numeric IK (the closed form from another base frame: {named})"]
 
 
 def _json_file(file: Path, field: str) -> Any:

@@ -62,6 +62,32 @@ def default_family(
         return None
 
 
+def closed_form_bases(urdf: str, *, tool_frame: str) -> list[str]:
+    """The frames fixed to a URDF's root from which its chain to ``tool_frame`` is recognised.
+
+    A UR arm's URDF read from ``base_link`` (ROS's root; the DH base frame is ``base``, a half
+    turn about z from it) is solved numerically, from ``base`` in closed form: this names the
+    base frames that get the closed form (:mod:`solver.families.recognise`), to say so.
+
+    Raises:
+        RobotModelError: the URDF cannot be parsed or has no ``tool_frame``.
+    """
+    model = chain_from_urdf(urdf, tool_frame=tool_frame)
+    if model.nv != 6:  # the closed forms are six-joint arms'
+        return []
+    found = []
+    for frame in model.frames:
+        if frame.parentJoint != 0 or frame.type not in (pin.FrameType.BODY, pin.OP_FRAME):
+            continue  # a link or a frame fixed to the root, not a joint's own frame
+        try:
+            chain = SerialChain.from_model(model, base_frame=frame.name, tool_frame=tool_frame)
+        except RobotModelError:
+            continue
+        if recognised_family(chain) is not None:
+            found.append(frame.name)
+    return found
+
+
 def get_robot(name: str) -> Robot:
     """The catalogue robot ``name``.
 

@@ -338,20 +338,25 @@ def test_a_urdf_file_is_the_routes_urdf_robot_from_base_link_to_tool0(
 ) -> None:
     at = ["evaluate", str(PROGRAM), "--robot", str(UR5_URDF), "--at=0,0.3,0,0"]
     path = {"cl_data": PROGRAM.read_text()}
-    for frames, options in (
-        ({"base_frame": "base_link", "tool_frame": "tool0"}, []),  # the defaults
-        ({"base_frame": "base", "tool_frame": "tool0"}, ["--base-frame", "base"]),
-    ):
+    answers = {}
+    for base, options in (("base_link", []), ("base", ["--base-frame", "base"])):
         code, out, _ = run(capsys, *at, *options, "--json")
-        robot = {"urdf": UR5_URDF.read_text(), **frames}
+        robot = {"urdf": UR5_URDF.read_text(), "base_frame": base, "tool_frame": "tool0"}
         body = {"robot": robot, "path": path, "placement": AT, "detail": "summary"}
-        expected = api(client, "/v1/evaluate", body)
-        assert code == OK and json.loads(out) == expected
+        answers[base] = api(client, "/v1/evaluate", body)
+        assert code == OK and json.loads(out) == answers[base]
         code, out, _ = run(capsys, *at, *options)
-        how = expected["ik"]["recognised"] or "numeric IK"
-        chain = f"from {frames['base_frame']} to {frames['tool_frame']}"
-        assert out.splitlines()[0] == f"robot: {UR5_URDF}, {chain}; {how}"
-    assert expected["ik"]["family"] == "ur"  # from its DH base frame, the closed form
+        answers[base]["printed"] = out.splitlines()[0]
+    # from ROS's root the UR5 is solved numerically, from its DH base frame in closed form,
+    # and the first says so
+    assert answers["base_link"]["ik"]["family"] == "numeric"
+    assert answers["base"]["ik"]["family"] == "ur"
+    assert answers["base_link"]["printed"] == (
+        f"robot: {UR5_URDF}, from base_link to tool0; numeric IK (the closed form from another "
+        "base frame: --base-frame base)"
+    )
+    recognised = answers["base"]["ik"]["recognised"]
+    assert answers["base"]["printed"] == f"robot: {UR5_URDF}, from base to tool0; {recognised}"
 
 
 def test_frames_with_a_robot_that_is_no_urdf_or_not_in_it_exit_invalid(

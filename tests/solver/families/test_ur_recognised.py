@@ -11,7 +11,7 @@ from __future__ import annotations
 import numpy as np
 
 from solver.core.robots import example_robot_data_dir
-from solver.families import get_robot, robot_from_urdf
+from solver.families import closed_form_bases, get_robot, robot_from_urdf
 from solver.families.ur.dh import UR_DH
 from tests.cases import MAP_EVALUATE_RTOL
 from tests.problems import capability_map
@@ -29,6 +29,17 @@ def test_the_ur5_urdf_is_recognised_with_its_lengths() -> None:
         assert abs(getattr(fitted, name) - getattr(UR_DH["ur5"], name)) < 1e-9, name
     other = robot_from_urdf(UR5, base_frame="base_link", tool_frame="tool0")
     assert other.family is not None and other.family.name == "numeric"
+
+
+def test_the_base_frames_with_a_closed_form_are_named() -> None:
+    # The URDF's links and frames fixed to its root: world, base_link and base (its DH frame);
+    # only from base is the chain the UR arm's, as each frame's own robot says.
+    named = closed_form_bases(UR5, tool_frame="tool0")
+    assert named == ["base"]
+    for frame in ("world", "base_link"):
+        robot = robot_from_urdf(UR5, base_frame=frame, tool_frame="tool0")
+        assert robot.family is not None and robot.family.name == "numeric", frame
+    assert closed_form_bases(UR5, tool_frame="wrist_2_link") == []  # five joints: no closed form
 
 
 def test_the_ur5_urdf_map_equals_the_catalogue_map_on_the_erk_grid() -> None:
