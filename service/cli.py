@@ -117,23 +117,23 @@ def _robot(args: argparse.Namespace) -> Any:
     return {"model": name}
 
 
-def _chain(args: argparse.Namespace, recognised: str | None) -> list[str]:
-    """A URDF robot's chain and how its IK is solved (printed first), else nothing.
+def _chained(
+    args: argparse.Namespace, robot: dict[str, Any], recognised: str | None, text: str
+) -> str:
+    """``text`` after a URDF file's chain and how its IK is solved; a text as it is otherwise.
 
-    Solved numerically, the base frames from which the chain has a closed form are named.
+    ``robot``: the request's (:func:`_robot`). Solved numerically, the base frames from which
+    the chain has a closed form are named.
     """
     if not args.robot.lower().endswith(".urdf"):
-        return []
-    base, tool = args.base_frame or BASE_FRAME, args.tool_frame or TOOL_FRAME
-    line = f"robot: {args.robot}, from {base} to {tool}; "
-    if recognised is not None:
-        return [line + recognised]
-    urdf = Path(args.robot).read_text(encoding="utf-8")
-    others = [frame for frame in closed_form_bases(urdf, tool_frame=tool) if frame != base]
-    if not others:
-        return [line + "numeric IK"]
-    named = " or ".join(f"--base-frame {frame}" for frame in others)
-    return [line + f"numeric IK (the closed form from another base frame: {named})"]
+        return text
+    base, tool = robot["base_frame"], robot["tool_frame"]
+    how = recognised or "numeric IK"
+    others = [] if recognised else closed_form_bases(robot["urdf"], tool_frame=tool)
+    named = " or ".join(f"--base-frame {frame}" for frame in others if frame != base)
+    if named:
+        how += f" (the closed form from another base frame: {named})"
+    return f"robot: {args.robot}, from {base} to {tool}; {how}\n{text}"
 
 
 def _json_file(file: Path, field: str) -> Any:
@@ -148,8 +148,12 @@ def _json_file(file: Path, field: str) -> Any:
         raise InvalidInputError(field, f"the file is not JSON ({error})") from error
 
 
-def _with_cell(body: dict[str, Any], args: argparse.Namespace) -> dict[str, Any]:
-    """``body`` with the ``cell`` of ``--cell``'s file, when given."""
+def _with_options(body: dict[str, Any], args: argparse.Namespace) -> dict[str, Any]:
+    """``body`` with what the solving commands share, where given: spin mode, branch, cell."""
+    if args.spin_mode is not None:
+        body["spin_mode"] = args.spin_mode
+    if args.branch is not None:
+        body["ik"] = {"branch": args.branch}
     if args.cell is not None:
         body["cell"] = _json_file(Path(args.cell), "cell")
     return body
@@ -180,18 +184,16 @@ def _evaluate(args: argparse.Namespace) -> int:
         "placement": {"x": x, "y": y, "z": z, "yaw": yaw, "spin": args.spin},
         "detail": "summary",
     }
-    if args.spin_mode is not None:
-        body["spin_mode"] = args.spin_mode
-    if args.branch is not None:
-        body["ik"] = {"branch": args.branch}
     if args.feed is not None:
         body["feed"] = args.feed
-    request = _validated(EvaluateRequest, _with_cell(body, args))
+    request = _validated(EvaluateRequest, _with_options(body, args))
     with ProgressBar(enabled=args.progress) as bar:
         answer = evaluation_of(request, get_settings(), bar)
     clearance = None if request.cell is None else request.cell.clearance
-    chain = _chain(args, answer.ik.recognised)
-    _print(answer, args, lambda: "\n".join([*chain, evaluation_text(answer, clearance)]))
+    robot, recognised = body["robot"], answer.ik.recognised
+    _print(
+        answer, args, lambda: _chained(args, robot, recognised, evaluation_text(answer, clearance))
+    )
     runs = answer.feasible and (answer.feed_check is None or answer.feed_check.feasible)
     return OK if runs else INFEASIBLE
 
@@ -199,19 +201,15 @@ def _evaluate(args: argparse.Namespace) -> int:
 def _map(args: argparse.Namespace) -> int:
     grid = {"x": args.x, "y": args.y, "z": args.z, "yaw": args.yaw, "spin": args.spin}
     body: dict[str, Any] = {"robot": _robot(args), "path": _path(args), "grid": grid}
-    if args.spin_mode is not None:
-        body["spin_mode"] = args.spin_mode
-    if args.branch is not None:
-        body["ik"] = {"branch": args.branch}
-    request = _validated(MapRequest, _with_cell(body, args))
+    request = _validated(MapRequest, _with_options(body, args))
     with ProgressBar(enabled=args.progress) as bar:
         result, robot, spin_mode, path_read = computed_map(
             request, get_settings(), png=True, progress=bar
         )
     answer = convert.map_response(result, robot, spin_mode=spin_mode, path_read=path_read)
     Path(args.png).write_bytes(map_png(result, robot))
-    chain = _chain(args, answer.recognised)
-    _print(answer, args, lambda: "\n".join([*chain, map_text(answer, args.png)]))
+    robot, recognised = body["robot"], answer.recognised
+    _print(answer, args, lambda: _chained(args, robot, recognised, map_text(answer, args.png)))
     return OK if answer.feasible_cells else INFEASIBLE
 
 
@@ -227,16 +225,12 @@ def _optimise(args: argparse.Namespace) -> int:
         bounds["z"] = args.z
     else:
         body["z"] = args.z
-    if args.spin_mode is not None:
-        body["spin_mode"] = args.spin_mode
-    if args.branch is not None:
-        body["ik"] = {"branch": args.branch}
-    request = _validated(OptimizeRequest, _with_cell(body, args))
+    request = _validated(OptimizeRequest, _with_options(body, args))
     with ProgressBar(enabled=args.progress) as bar:
         answer = optimum_of(request, get_settings(), bar)
     recognised = None if answer.evaluation is None else answer.evaluation.ik.recognised
-    chain = _chain(args, recognised)
-    _print(answer, args, lambda: "\n".join([*chain, optimum_text(answer)]))
+    robot = body["robot"]
+    _print(answer, args, lambda: _chained(args, robot, recognised, optimum_text(answer)))
     return OK if answer.found else INFEASIBLE
 
 

@@ -39,7 +39,7 @@ def _contact(contact: Contact) -> str:
     return f"{contact.robot_part} and {contact.obstacle_name} {where}, {apart}"
 
 
-def _motion_and_cell(answer: EvaluateResponse) -> list[str]:
+def _how_it_runs(answer: EvaluateResponse) -> list[str]:
     """The branch; mu_acc and the cycle time (with acceleration limits); the least clearance."""
     lines = []
     branch = answer.branch
@@ -132,7 +132,7 @@ def evaluation_text(answer: EvaluateResponse, clearance: float | None = None) ->
             f"bottleneck: waypoint {answer.bottleneck.waypoint}, joint "
             f"{answer.bottleneck.joint_name}"
         )
-    lines += _motion_and_cell(answer)
+    lines += _how_it_runs(answer)
     check = answer.feed_check
     if check is not None:
         verdict = "runs" if check.feasible else "does not run"
@@ -166,10 +166,9 @@ def map_text(answer: MapResponse, png: str) -> str:
     """How the program was read; the map's size, its best placement, the picture's file."""
     lines = read_text(answer.path_read)
     collide = sum(cell.reason == "collision" for cell in answer.cells)
-    with_cell = f" ({collide} in collision)" if collide else ""
-    lines.append(
-        f"map: {answer.feasible_cells} of {len(answer.cells)} placements feasible{with_cell}; {png}"
-    )
+    collisions = f" ({collide} in collision)" if collide else ""
+    feasible = f"{answer.feasible_cells} of {len(answer.cells)} placements feasible"
+    lines.append(f"map: {feasible}{collisions}; {png}")
     if answer.best is not None:
         lines.append(f"best: mu_path {answer.best.mu_path:.4f} m/s")
         lines += _placement(answer.best.placement)
@@ -189,7 +188,7 @@ def optimum_text(answer: OptimizeResponse) -> str:
         *_placement(answer.placement),
     ]
     if answer.evaluation is not None:
-        lines += _motion_and_cell(answer.evaluation)
+        lines += _how_it_runs(answer.evaluation)
     check = None if answer.evaluation is None else answer.evaluation.feed_check
     if check is not None:
         lines.append(f"feed {_feed(check.feed)}: {'runs' if check.feasible else 'does not run'}")

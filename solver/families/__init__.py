@@ -77,7 +77,7 @@ def closed_form_bases(urdf: str, *, tool_frame: str) -> list[str]:
         return []
     found = []
     for frame in model.frames:
-        if frame.parentJoint != 0 or frame.type not in (pin.FrameType.BODY, pin.OP_FRAME):
+        if frame.parentJoint != 0 or frame.type not in (pin.FrameType.BODY, pin.FrameType.OP_FRAME):
             continue  # a link or a frame fixed to the root, not a joint's own frame
         try:
             chain = SerialChain.from_model(model, base_frame=frame.name, tool_frame=tool_frame)
