@@ -22,7 +22,7 @@ from solver.path import capability_map as capability
 from solver.path import evaluate, placements
 from solver.path.problem import PathOptions, PathProblem
 
-OPTIONS = ("branch", "max_joint_step", "spin_mode", "blend_length")
+OPTIONS = ("branch", "max_joint_step", "spin_mode", "blend_length", "cell")
 
 
 def problem(

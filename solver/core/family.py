@@ -21,6 +21,7 @@ import numpy as np
 
 from solver.core.exceptions import InvalidInputError
 from solver.core.progress import Progress
+from solver.core.spatial import BaseTurn
 
 
 @dataclass(frozen=True)
@@ -91,6 +92,12 @@ class KinematicsFamily(abc.ABC):
     #: How the family was chosen, when not by the caller: a sentence for the answer (an OPW arm
     #: recognised in a URDF's chain, :mod:`solver.families.recognise`); ``None`` otherwise.
     recognised: str | None = None
+    #: The frame the family solves in, where it is not {B}: a turn about {B}'s z and a shift
+    #: (a URDF chain recognised from a base frame other than the arm's own). :meth:`solve` and
+    #: :meth:`joint_speeds_per_unit_twist` still take {B}; a compiled map kernel, which places
+    #: the path itself, takes its placements in that frame
+    #: (:meth:`solver.core.spatial.BaseTurn.placements_in`). ``None``: {B}.
+    base_turn: BaseTurn | None = None
 
     @property
     @abc.abstractmethod

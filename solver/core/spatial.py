@@ -230,3 +230,46 @@ def rotation_vectors(rotations: np.ndarray) -> np.ndarray:
     for i in np.flatnonzero(theta.ravel() >= NEAR_HALF_TURN):
         flat_v[i] = pin.log3(flat_r[i])
     return vectors
+
+
+@dataclass(frozen=True)
+class BaseTurn:
+    """A frame {A} that is {B} turned by ``angle`` about its z and moved to ``shift``.
+
+    Where a kinematics family solves when its own base frame is not {B}: a UR arm's URDF read
+    from ``base_link``, which ROS puts half a turn about z from the arm's DH base frame
+    (:mod:`solver.families.recognise`). A turn about z keeps a placement a placement: {O} at
+    (x, y, z, yaw) in {B} is at :meth:`placements_in` in {A}, so a map's kernels take it whole.
+
+    Attributes:
+        angle: rad, about {B}'s z.
+        shift: m, {A}'s origin in {B}.
+    """
+
+    angle: float
+    shift: tuple[float, float, float]
+
+    @property
+    def is_identity(self) -> bool:
+        """{A} is {B}."""
+        return self.angle == 0.0 and not any(self.shift)
+
+    def _inverse(self) -> np.ndarray:
+        """R_A_B (3, 3): Rz(-angle)."""
+        return rotation_about_z(-self.angle)
+
+    def vectors_in(self, vectors: np.ndarray) -> np.ndarray:
+        """Directions (3, ...) in {B} axes, in {A} axes."""
+        return np.tensordot(self._inverse(), vectors, axes=1)
+
+    def points_in(self, points: np.ndarray) -> np.ndarray:
+        """Points (3, ...) in {B}, in {A}."""
+        shift = np.asarray(self.shift).reshape((3,) + (1,) * (np.ndim(points) - 1))
+        return self.vectors_in(points - shift)
+
+    def placements_in(self, placements: np.ndarray) -> np.ndarray:
+        """Placements (P, 5) [x, y, z, yaw, spin] of {O} in {B}, as placements in {A}."""
+        turned = np.array(placements, dtype=float)
+        turned[:, :3] = self.points_in(turned[:, :3].T).T
+        turned[:, 3] = turned[:, 3] - self.angle
+        return turned

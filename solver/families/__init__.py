@@ -65,9 +65,9 @@ def default_family(
 def closed_form_bases(urdf: str, *, tool_frame: str) -> list[str]:
     """The frames fixed to a URDF's root from which its chain to ``tool_frame`` is recognised.
 
-    A UR arm's URDF read from ``base_link`` (ROS's root; the DH base frame is ``base``, a half
-    turn about z from it) is solved numerically, from ``base`` in closed form: this names the
-    base frames that get the closed form (:mod:`solver.families.recognise`), to say so.
+    A chain read from a frame that is no turn about z of the arm's own (a frame tilted from
+    it: a wall-mounted arm read from the floor's frame) is solved numerically; this names the
+    base frames from which it gets the closed form (:mod:`solver.families.recognise`), to say so.
 
     Raises:
         RobotModelError: the URDF cannot be parsed or has no ``tool_frame``.

@@ -45,7 +45,10 @@ class ClosedFormFamily(KinematicsFamily):
         return self.branch_labels
 
     def solve(self, rotation: np.ndarray, position: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """All branches in closed form (see :meth:`KinematicsFamily.solve`)."""
+        """All branches in closed form (see :meth:`KinematicsFamily.solve`), in its base turn."""
+        if self.base_turn is not None:
+            rotation = self.base_turn.vectors_in(rotation)
+            position = self.base_turn.points_in(position)
         return type(self).solve_function(self.parameters, rotation, position)
 
     def map_kernel(self) -> tuple[int, np.ndarray] | None:
@@ -66,6 +69,12 @@ class ClosedFormFamily(KinematicsFamily):
     ) -> np.ndarray:
         """J^-1 t in closed form (see :meth:`KinematicsFamily.joint_speeds_per_unit_twist`).
 
-        It takes milliseconds for a whole path: ``progress`` is not called.
+        It takes milliseconds for a whole path: ``progress`` is not called. In a base turn the
+        twist's two parts and the point are turned into it (joint speeds do not depend on the
+        frame they are written in).
         """
+        if self.base_turn is not None:
+            turn = self.base_turn
+            twist = np.concatenate([turn.vectors_in(twist[:3]), turn.vectors_in(twist[3:])])
+            tool_point = turn.points_in(tool_point)
         return type(self).speeds_function(self.parameters, q, twist, tool_point)

@@ -7,6 +7,9 @@ has all eight in closed form. The chain proposes the parameters (OPW: its joint 
 :func:`solver.families.ur.fit.fit_ur`); they are kept only when the family's forward formula
 equals the chain's forward kinematics at ``CHECK_CONFIGURATIONS`` random configurations to
 ``FIT_ATOL``. The family then says so (:attr:`KinematicsFamily.recognised`), and answers name it.
+A UR arm is also recognised in a turn of {B} about z (ROS's ``base_link`` is half a turn from
+the DH frame ``base``): the family then solves in the DH frame
+(:attr:`KinematicsFamily.base_turn`), which its answers name.
 """
 
 from __future__ import annotations
@@ -16,10 +19,12 @@ import math
 import numpy as np
 
 from solver.core.family import KinematicsFamily
+from solver.core.spatial import BaseTurn
 from solver.families.numeric.chain import SerialChain
 from solver.families.opw.family import OpwFamily
 from solver.families.opw.fit import fit_opw
 from solver.families.opw.ik import forward_kinematics
+from solver.families.ur.dh import UrDh
 from solver.families.ur.family import UrFamily
 from solver.families.ur.fit import fit_ur
 from solver.families.ur.ik import forward_kinematics_dh
@@ -29,6 +34,7 @@ from solver.families.ur.ik import forward_kinematics_dh
 FIT_ATOL = 1e-9
 CHECK_CONFIGURATIONS = 32
 CHECK_SEED = 27
+_NO_LENGTHS = UrDh(0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
 
 
 def recognised_opw(chain: SerialChain) -> OpwFamily | None:
@@ -67,7 +73,10 @@ def recognised_opw(chain: SerialChain) -> OpwFamily | None:
 
 
 def recognised_ur(chain: SerialChain) -> UrFamily | None:
-    """The UR family of ``chain``, when the chain is a UR arm's in {B} (the DH base frame).
+    """The UR family of ``chain``, when the chain is a UR arm's in {B} or in a turn of {B}.
+
+    The DH base frame may be {B} turned about z and moved (ROS's ``base_link`` is half a turn
+    from it: :func:`ur_base_turn`); the family then solves in that frame (its ``base_turn``).
 
     Args:
         chain: a serial chain from {B} to the flange.
@@ -77,13 +86,16 @@ def recognised_ur(chain: SerialChain) -> UrFamily | None:
     """
     if chain.dof != 6 or not chain.revolute.all():
         return None
+    turn = ur_base_turn(chain)
+    if turn is None:
+        return None
     q = np.random.default_rng(CHECK_SEED).uniform(-math.pi, math.pi, (CHECK_CONFIGURATIONS, 6))
-    rotation, position = chain.forward(q)
+    rotation, position = _in_turn(turn, *chain.forward(q))
     lengths = fit_ur(q, rotation, position)
     if lengths is None:
         return None
     check = np.random.default_rng(CHECK_SEED + 1).uniform(-math.pi, math.pi, (16, 6))
-    chain_rotation, chain_position = chain.forward(check)
+    chain_rotation, chain_position = _in_turn(turn, *chain.forward(check))
     dh = forward_kinematics_dh(lengths, check)
     error = max(
         float(np.abs(chain_rotation - dh[:, :3, :3]).max()),
@@ -92,13 +104,57 @@ def recognised_ur(chain: SerialChain) -> UrFamily | None:
     if error > FIT_ATOL:
         return None
     family = UrFamily(lengths)
+    family.base_turn = None if turn.is_identity else turn
+    where = "in its DH base frame" if turn.is_identity else f"whose DH base frame is {_said(turn)}"
     family.recognised = (
-        "the URDF chain is a UR arm in its DH base frame (forward kinematics equal to "
+        f"the URDF chain is a UR arm {where} (forward kinematics equal to "
         f"{FIT_ATOL:g} at random configurations): closed-form IK with d1={lengths.d1:.6g}, "
         f"a2={lengths.a2:.6g}, a3={lengths.a3:.6g}, d4={lengths.d4:.6g}, d5={lengths.d5:.6g}, "
         f"d6={lengths.d6:.6g} m"
     )
     return family
+
+
+def ur_base_turn(chain: SerialChain) -> BaseTurn | None:
+    """The turn of {B} about z in which a six-joint chain may be a UR arm.
+
+    A UR arm's flange orientation at q = 0 does not depend on its lengths (dtf.md section 8),
+    so the chain's there, against the DH formula's, gives the turn; joint 1's axis passes
+    through the DH frame's origin, which gives the shift in x and y (a shift along z is the
+    length d1's). Whether the chain is a UR arm in that frame is for the fit and its check.
+
+    Returns:
+        The turn (the identity within 1e-12 where {B} is the DH frame); None where the chain's
+        orientation at q = 0 is no turn about z of a UR arm's (it is no UR arm in such a frame).
+    """
+    _, origins, rotation, _ = chain.frames(np.zeros((1, 6)))
+    zero = forward_kinematics_dh(_NO_LENGTHS, np.zeros(6))[:3, :3]
+    turn = rotation[0] @ zero.T
+    if abs(turn[2, 2] - 1.0) > FIT_ATOL:
+        return None
+    angle = math.atan2(turn[1, 0], turn[0, 0])
+    x, y = float(origins[0, 0, 0]), float(origins[0, 0, 1])
+    if max(abs(angle), abs(x), abs(y)) <= 1e-12:
+        return BaseTurn(0.0, (0.0, 0.0, 0.0))
+    return BaseTurn(angle, (x, y, 0.0))
+
+
+def _in_turn(
+    turn: BaseTurn, rotation: np.ndarray, position: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
+    """Flange rotations (M, 3, 3) and positions (M, 3) in {B}, in the turn's frame."""
+    if turn.is_identity:
+        return rotation, position
+    turned = turn.vectors_in(rotation.transpose(1, 2, 0)).transpose(2, 0, 1)
+    return turned, turn.points_in(position.T).T
+
+
+def _said(turn: BaseTurn) -> str:
+    """A turn in words: {B} turned by 180 deg about z (and moved to (x, y, z) m)."""
+    said = f"{{B}} turned by {math.degrees(turn.angle):.6g} deg about z"
+    if any(turn.shift):
+        said += " and moved to ({:.6g}, {:.6g}, {:.6g}) m".format(*turn.shift)
+    return said
 
 
 def recognised_family(chain: SerialChain) -> KinematicsFamily | None:

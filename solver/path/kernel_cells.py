@@ -13,6 +13,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from solver.core.spatial import BaseTurn
 from solver.kernels.fixed_spin import map_cells
 from solver.kernels.free_spin import free_cells
 from solver.kernels.joint_paths import branch_paths
@@ -48,6 +49,7 @@ class KernelInputs:
     stencil_index: np.ndarray  # (K, 5), the blend stencil (K = 0 without limits)
     stencil_weight: np.ndarray  # (K, 5), 1/m^2
     stencil_waypoints: np.ndarray  # (K,)
+    base_turn: BaseTurn | None  # the family's, where it solves in a frame turned from {B}
 
 
 def kernel_inputs(
@@ -89,6 +91,7 @@ def kernel_inputs(
         stencil_index=index,
         stencil_weight=weight,
         stencil_waypoints=waypoints,
+        base_turn=problem.family.base_turn,
     )
 
 
@@ -184,7 +187,13 @@ def kernel_joint_paths(
 
 
 def _placed(inputs: KernelInputs, placements: np.ndarray) -> tuple[object, ...]:
-    """The kernels' first nine arguments: the family, the placements, the path at the spin."""
+    """The kernels' first nine arguments: the family, the placements, the path at the spin.
+
+    The placements in the family's own frame where it solves in a turn of {B} (the kernels
+    place the path in the frame they solve in).
+    """
+    if inputs.base_turn is not None:
+        placements = inputs.base_turn.placements_in(placements)
     return (
         inputs.code,
         inputs.parameters,

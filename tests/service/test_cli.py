@@ -333,30 +333,44 @@ def test_a_cell_file_that_is_not_json_or_not_a_cell_exits_invalid(
 UR5_URDF = example_robot_data_dir() / "ur_description" / "urdf" / "ur5_robot.urdf"
 
 
+def _tilted_ur5(folder: Path) -> Path:
+    """The UR5's URDF with a frame ``tilted``: base_link turned by a mrad about x (numeric IK)."""
+    tilted = '<link name="tilted"/><joint name="tilt" type="fixed"><parent link="base_link"/>'
+    tilted += '<child link="tilted"/><origin xyz="0 0 0" rpy="0.001 0 0"/></joint></robot>'
+    file = folder / "ur5.urdf"
+    file.write_text(UR5_URDF.read_text().replace("</robot>", tilted))
+    return file
+
+
 def test_a_urdf_file_is_the_routes_urdf_robot_from_base_link_to_tool0(
-    client: TestClient, capsys: pytest.CaptureFixture[str]
+    client: TestClient, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    at = ["evaluate", str(PROGRAM), "--robot", str(UR5_URDF), "--at=0,0.3,0,0"]
+    # From ROS's root and from the DH frame the UR5 is solved in closed form, from a tilted
+    # frame numerically, and that answer says where the closed form is.
+    file = _tilted_ur5(tmp_path)
+    at = ["evaluate", str(PROGRAM), "--robot", str(file), "--at=0,0.3,0,0"]
     path = {"cl_data": PROGRAM.read_text()}
     answers = {}
-    for base, options in (("base_link", []), ("base", ["--base-frame", "base"])):
+    for base in ("base_link", "base", "tilted"):
+        options = [] if base == "base_link" else ["--base-frame", base]
         code, out, _ = run(capsys, *at, *options, "--json")
-        robot = {"urdf": UR5_URDF.read_text(), "base_frame": base, "tool_frame": "tool0"}
+        robot = {"urdf": file.read_text(), "base_frame": base, "tool_frame": "tool0"}
         body = {"robot": robot, "path": path, "placement": AT, "detail": "summary"}
         answers[base] = api(client, "/v1/evaluate", body)
-        assert code == OK and json.loads(out) == answers[base]
+        assert code == (OK if answers[base]["feasible"] else INFEASIBLE)
+        assert json.loads(out) == answers[base]
         code, out, _ = run(capsys, *at, *options)
         answers[base]["printed"] = out.splitlines()[0]
-    # from ROS's root the UR5 is solved numerically, from its DH base frame in closed form,
-    # and the first says so
-    assert answers["base_link"]["ik"]["family"] == "numeric"
-    assert answers["base"]["ik"]["family"] == "ur"
-    assert answers["base_link"]["printed"] == (
-        f"robot: {UR5_URDF}, from base_link to tool0; numeric IK (the closed form from another "
-        "base frame: --base-frame base)"
+    for base in ("base_link", "base"):
+        assert answers[base]["ik"]["family"] == "ur"
+        recognised = answers[base]["ik"]["recognised"]
+        assert answers[base]["printed"] == f"robot: {file}, from {base} to tool0; {recognised}"
+    assert "turned by 180 deg about z" in answers["base_link"]["ik"]["recognised"]
+    assert answers["tilted"]["ik"]["family"] == "numeric"
+    assert answers["tilted"]["printed"] == (
+        f"robot: {file}, from tilted to tool0; numeric IK (the closed form from another base "
+        "frame: --base-frame world or --base-frame base_link or --base-frame base)"
     )
-    recognised = answers["base"]["ik"]["recognised"]
-    assert answers["base"]["printed"] == f"robot: {UR5_URDF}, from base to tool0; {recognised}"
 
 
 def test_frames_with_a_robot_that_is_no_urdf_or_not_in_it_exit_invalid(
@@ -410,21 +424,22 @@ def test_optimise_searches_a_height_range_and_a_spin_range_as_the_route(
 
 
 def test_a_branch_is_followed_as_the_routes_ik_branch_and_printed(
-    client: TestClient, capsys: pytest.CaptureFixture[str]
+    client: TestClient, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    urdf = {"urdf": UR5_URDF.read_text(), "base_frame": "base_link", "tool_frame": "tool0"}
+    file = _tilted_ur5(tmp_path)  # numeric IK from its frame "tilted"
+    urdf = {"urdf": file.read_text(), "base_frame": "tilted", "tool_frame": "tool0"}
     named = {"shoulder": "left", "elbow": "up", "wrist": "flip"}
     for robot, body_robot, option, branch, printed in (
-        ("ur5e", ROBOT, "left/up/flip", named, "branch: left/up/flip"),
+        ("ur5e", ROBOT, ["left/up/flip"], named, "branch: left/up/flip"),
         (
-            str(UR5_URDF),
+            str(file),
             urdf,
-            "0",
+            ["0", "--base-frame", "tilted"],
             {"solution": 0},
             "branch: solution 0 (numeric IK, in seed order)",
         ),
     ):
-        at = ["evaluate", str(PROGRAM), "--robot", robot, "--at=0,0.3,0,0", "--branch", option]
+        at = ["evaluate", str(PROGRAM), "--robot", robot, "--at=0,0.3,0,0", "--branch", *option]
         code, out, _ = run(capsys, *at, "--json")
         body = {"robot": body_robot, "path": {"cl_data": PROGRAM.read_text()}, "placement": AT}
         expected = api(
