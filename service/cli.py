@@ -18,8 +18,9 @@ limits add mu_acc and the cycle time), or a URDF file (``.urdf``: its chain from
 limits). ``--cell FILE``, a JSON file holding the API's ``cell`` object (cell.md: the table,
 fixtures, the part, the tool, the clearance), checks the robot against it on evaluate, map and
 optimise as the routes do. Settings come from the environment as for the service (``DTF_*``).
-Exit codes: :data:`OK` (0), :data:`USAGE` (2), :data:`INVALID` (3), :data:`INFEASIBLE` (4); 1 is
-Python's own, for a crash. Errors name the field (and waypoint, line) as the API does.
+Exit codes: :data:`OK` (0), :data:`USAGE` (2), :data:`INVALID` (3), :data:`INFEASIBLE` (4),
+:data:`CLOSED_PIPE` (141, the output's reader closed it early); 1 is Python's own, for a
+crash. Errors name the field (and waypoint, line) as the API does.
 """
 
 from __future__ import annotations
@@ -27,6 +28,7 @@ from __future__ import annotations
 import argparse
 import json
 import math
+import os
 import sys
 from collections.abc import Callable, Sequence
 from pathlib import Path
@@ -53,6 +55,9 @@ USAGE = 2
 """The command line is wrong (argparse's code)."""
 INVALID = 3
 """The input is refused, as the API refuses it with a 422: the message names the field."""
+CLOSED_PIPE = 141
+"""The reader of the output closed it early (``dtf-place ... | head``): nothing more is printed,
+as a shell reports a process the pipe's signal ends (128 + SIGPIPE)."""
 
 BASE_FRAME = "base_link"
 """A URDF robot's default base frame (ROS-Industrial's REP 199: base_link and tool0)."""
@@ -66,7 +71,12 @@ def main(argv: Sequence[str] | None = None) -> int:
     """Run one subcommand; return its exit code."""
     args = _parser().parse_args(argv)
     try:
-        return int(args.run(args))
+        code = int(args.run(args))
+        sys.stdout.flush()  # a closed pipe is seen here, not at the interpreter's exit
+        return code
+    except BrokenPipeError:
+        _quiet_stdout()
+        return CLOSED_PIPE
     except ValidationError as error:
         for item in error.errors():
             where = ".".join(str(part) for part in request_location(item["loc"]))
@@ -77,6 +87,19 @@ def main(argv: Sequence[str] | None = None) -> int:
     except OSError as error:
         print(f"error: {error}", file=sys.stderr)  # noqa: T201
     return INVALID
+
+
+def _quiet_stdout() -> None:
+    """Point standard output at the null device, the pipe being closed.
+
+    The rest of its buffer is then not flushed into the pipe at exit (which Python would
+    report as an error of its own).
+    """
+    try:
+        null = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(null, sys.stdout.fileno())
+    except (OSError, ValueError):  # no file descriptor (a test's captured stream): nothing to do
+        pass
 
 
 def _path(args: argparse.Namespace) -> dict[str, Any]:

@@ -15,7 +15,7 @@ from typing import Any
 import pytest
 from fastapi.testclient import TestClient
 
-from service.cli import INFEASIBLE, INVALID, OK, USAGE, main
+from service.cli import CLOSED_PIPE, INFEASIBLE, INVALID, OK, USAGE, main
 from solver.core.robots import example_robot_data_dir
 from tests.cases import ROOT
 from tests.solver.cam.dialects import NX_LISTING, text
@@ -221,6 +221,23 @@ def test_the_command_runs_as_a_process(tmp_path: Path) -> None:
         capture_output=True, text=True, cwd=ROOT, timeout=300,
     )  # fmt: skip
     assert failed.returncode == INVALID and "missing.cl" in failed.stderr
+
+
+def test_a_reader_that_closes_the_output_early_ends_the_command_quietly(tmp_path: Path) -> None:
+    # `dtf-place map ... --json | head`: the map's JSON (about 0.4 MB) is more than the pipe
+    # holds; the reader takes ten bytes and closes it. No "error: [Errno 32] Broken pipe" as
+    # an invalid input (exit 3), no Python complaint at exit: the shell's 141, nothing said.
+    grid = ["--x=-0.2:0.2:0.01", "--y", "0.2:0.6:0.01", "--png", str(tmp_path / "map.png")]
+    command = [sys.executable, "-m", "service.cli", *MAP[:4], *grid, "--json"]
+    with subprocess.Popen(
+        command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, cwd=ROOT
+    ) as process:
+        assert process.stdout is not None and process.stderr is not None
+        assert process.stdout.read(10).startswith(b"{")
+        process.stdout.close()
+        said = process.stderr.read()
+        code = process.wait(timeout=300)
+    assert (code, said) == (CLOSED_PIPE, b"")
 
 
 def test_the_console_script_is_declared() -> None:
