@@ -14,10 +14,11 @@ the route answers:
 PROGRAM is CL data, or a CSV when its name ends in ``.csv`` (``--units`` then required). R is a
 catalogue name (``ur5e``), a JSON file holding the API's ``robot`` object (its acceleration
 limits add mu_acc and the cycle time), or a URDF file (``.urdf``: its chain from
-``--base-frame`` to ``--tool-frame``, base_link and tool0 unless given, its own velocity
-limits). ``--cell FILE``, a JSON file holding the API's ``cell`` object (cell.md: the table,
-fixtures, the part, the tool, the clearance), checks the robot against it on evaluate, map and
-optimise as the routes do. Settings come from the environment as for the service (``DTF_*``).
+``--base-frame`` to ``--tool-frame``, unless given REP 199's ``base`` (the controller's frame,
+where the URDF has it; else ``base_link``) and ``tool0``, its own velocity limits).
+``--cell FILE``, a JSON file holding the API's ``cell`` object (cell.md: the table, fixtures,
+the part, the tool, the clearance), checks the robot against it on evaluate, map and optimise
+as the routes do. Settings come from the environment as for the service (``DTF_*``).
 Exit codes: :data:`OK` (0), :data:`USAGE` (2), :data:`INVALID` (3), :data:`INFEASIBLE` (4),
 :data:`CLOSED_PIPE` (141, the output's reader closed it early); 1 is Python's own, for a
 crash. Errors name the field (and waypoint, line) as the API does.
@@ -44,6 +45,7 @@ from service.operations import computed_map, evaluation_of, import_of, map_png, 
 from service.schemas import EvaluateRequest, MapRequest, OptimizeRequest
 from service.schemas.paths_import import PathImportRequest
 from solver.core.exceptions import InvalidInputError, SolverError
+from solver.core.urdf_structure import fixed_to_root
 from solver.families import closed_form_bases
 
 OK = 0
@@ -59,8 +61,13 @@ CLOSED_PIPE = 141
 """The reader of the output closed it early (``dtf-place ... | head``): nothing more is printed,
 as a shell reports a process the pipe's signal ends (128 + SIGPIPE)."""
 
+CONTROLLER_FRAME = "base"
+"""A URDF robot's default base frame where the URDF has it fixed to its root: REP 199's
+``base``, the frame the controller's Cartesian poses are in, so the controller frames the
+answers print are the controller's (base_link is half a turn from it on a UR arm, and below it
+by the height of joint 2 on a FANUC arm)."""
 BASE_FRAME = "base_link"
-"""A URDF robot's default base frame (ROS-Industrial's REP 199: base_link and tool0)."""
+"""A URDF robot's default base frame otherwise (REP 199's first link)."""
 TOOL_FRAME = "tool0"
 """A URDF robot's default tool frame, the flange."""
 
@@ -121,17 +128,19 @@ def _path(args: argparse.Namespace) -> dict[str, Any]:
 def _robot(args: argparse.Namespace) -> Any:
     """The request's ``robot``: a JSON file's object, a URDF file's chain, or a catalogue name.
 
-    A URDF's chain runs from ``--base-frame`` to ``--tool-frame`` (base_link and tool0 by
-    default, the ROS-Industrial frames); given with another robot, those options are refused
-    rather than ignored.
+    A URDF's chain runs from ``--base-frame`` to ``--tool-frame`` (by default REP 199's frames:
+    ``base`` where the URDF has it fixed to its root, else ``base_link``; ``tool0``); given with
+    another robot, those options are refused rather than ignored.
     """
     name, file = args.robot, Path(args.robot)
     if name.lower().endswith(".urdf"):
+        urdf = file.read_text(encoding="utf-8")
+        controller = CONTROLLER_FRAME if fixed_to_root(urdf, CONTROLLER_FRAME) else BASE_FRAME
         frames = {
-            "base_frame": args.base_frame or BASE_FRAME,
+            "base_frame": args.base_frame or controller,
             "tool_frame": args.tool_frame or TOOL_FRAME,
         }
-        return {"urdf": file.read_text(encoding="utf-8"), **frames}
+        return {"urdf": urdf, **frames}
     if args.base_frame is not None or args.tool_frame is not None:
         message = "--base-frame and --tool-frame choose a URDF file's chain: give a .urdf robot"
         raise InvalidInputError("robot", message)
@@ -332,7 +341,8 @@ def _parser() -> argparse.ArgumentParser:
     )
     solving.add_argument(
         "--base-frame",
-        help=f"a URDF robot's base frame, its poses' frame (default {BASE_FRAME})",
+        help=f"a URDF robot's base frame, its poses' frame (default {CONTROLLER_FRAME}, the "
+        f"controller's, where the URDF has it, else {BASE_FRAME})",
     )
     solving.add_argument(
         "--tool-frame", help=f"a URDF robot's tool flange frame (default {TOOL_FRAME})"

@@ -50,6 +50,28 @@ def root_links(urdf: str) -> list[str]:
     return [name for name in links if name not in children]
 
 
+def fixed_to_root(urdf: str, link: str) -> bool:
+    """Whether ``link`` is in the document and joined to its root by fixed joints only.
+
+    REP 199's ``base``, the frame a controller's Cartesian poses are in, is such a link.
+    """
+    root = _tree(urdf)
+    if root is None or link not in {element.get("name") for element in root.iter("link")}:
+        return False
+    parents = {}  # child link: (parent link, joint type)
+    for joint in root.iter("joint"):
+        child, parent = joint.find("child"), joint.find("parent")
+        if child is not None and parent is not None:
+            parents[child.get("link", "")] = (parent.get("link", ""), joint.get("type"))
+    seen = set()
+    while link in parents and link not in seen:
+        seen.add(link)
+        link, kind = parents[link]
+        if kind != "fixed":
+            return False
+    return link not in seen
+
+
 def joint_count(urdf: str) -> int:
     """How many ``<joint>`` elements the document's robot has (0 where it is no XML)."""
     root = _tree(urdf)

@@ -359,17 +359,18 @@ def _tilted_ur5(folder: Path) -> Path:
     return file
 
 
-def test_a_urdf_file_is_the_routes_urdf_robot_from_base_link_to_tool0(
+def test_a_urdf_file_is_the_routes_urdf_robot_from_its_controller_frame_to_tool0(
     client: TestClient, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    # From ROS's root and from the DH frame the UR5 is solved in closed form, from a tilted
-    # frame numerically, and that answer says where the closed form is.
+    # By default from REP 199's base (the controller's frame: the UR5's DH frame) to tool0;
+    # from ROS's base_link, half a turn from it, and from base the UR5 is solved in closed
+    # form, from a tilted frame numerically, and that answer says where the closed form is.
     file = _tilted_ur5(tmp_path)
     at = ["evaluate", str(PROGRAM), "--robot", str(file), "--at=0,0.3,0,0"]
     path = {"cl_data": PROGRAM.read_text()}
     answers = {}
-    for base in ("base_link", "base", "tilted"):
-        options = [] if base == "base_link" else ["--base-frame", base]
+    for base in ("base", "base_link", "tilted"):
+        options = [] if base == "base" else ["--base-frame", base]
         code, out, _ = run(capsys, *at, *options, "--json")
         robot = {"urdf": file.read_text(), "base_frame": base, "tool_frame": "tool0"}
         body = {"robot": robot, "path": path, "placement": AT, "detail": "summary"}
@@ -388,6 +389,23 @@ def test_a_urdf_file_is_the_routes_urdf_robot_from_base_link_to_tool0(
         f"robot: {file}, from tilted to tool0; numeric IK (the closed form from another base "
         "frame: --base-frame world or --base-frame base_link or --base-frame base)"
     )
+
+
+def test_a_urdf_without_the_controllers_frame_starts_from_base_link(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # The UR5's URDF with its link "base" (REP 199's controller frame) taken out: the chain
+    # starts from base_link, and the first line says so.
+    without = tmp_path / "ur5_no_base.urdf"
+    text = UR5_URDF.read_text()
+    joint = text.index('"base_link-base_fixed_joint"')
+    without.write_text(
+        text.replace(text[text.index('<link name="base">') : text.index("</joint>", joint) + 8], "")
+    )
+    at = ["evaluate", str(PROGRAM), "--at=0,0.3,0,0", "--robot", str(without)]
+    code, out, _ = run(capsys, *at)
+    assert code == OK
+    assert out.splitlines()[0].startswith(f"robot: {without}, from base_link to tool0; ")
 
 
 def test_frames_with_a_robot_that_is_no_urdf_or_not_in_it_exit_invalid(

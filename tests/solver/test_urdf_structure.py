@@ -11,7 +11,7 @@ import pytest
 
 from solver.core.exceptions import RobotModelError
 from solver.core.robots import example_robot_data_dir
-from solver.core.urdf_structure import mimic_joints, root_links
+from solver.core.urdf_structure import fixed_to_root, mimic_joints, root_links
 from solver.families import catalogue, robot_from_urdf
 
 UR5 = (example_robot_data_dir() / "ur_description" / "urdf" / "ur5_robot.urdf").read_text()
@@ -28,6 +28,17 @@ def with_mimic(joint: str, leader: str) -> str:
 def test_the_ur5_has_one_root_and_no_mimic() -> None:
     assert root_links(UR5) == ["world"]  # example-robot-data's UR5 hangs off its own world
     assert mimic_joints(UR5) == {}
+
+
+def test_the_links_fixed_to_the_root_are_told_from_those_a_joint_moves() -> None:
+    # world (the root) -> base_link -> base by fixed joints; tool0 after six revolute joints
+    assert [fixed_to_root(UR5, link) for link in ("world", "base_link", "base")] == [True] * 3
+    assert not fixed_to_root(UR5, "tool0") and not fixed_to_root(UR5, "shoulder_link")
+    assert not fixed_to_root(UR5, "nowhere") and not fixed_to_root("<robot", "base")
+    turned = UR5.replace(
+        'name="base_link-base_fixed_joint" type="fixed"', 'name="b" type="revolute"'
+    )
+    assert not fixed_to_root(turned, "base")
 
 
 def test_two_root_links_are_named_in_the_error() -> None:
