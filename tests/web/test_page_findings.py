@@ -297,7 +297,7 @@ def test_a_urdf_file_is_taken_as_written_and_a_missing_frame_says_so_once(
     page.click("#own-urdf summary")
     choose_file(page, "#urdf-file", "ur5_robot.urdf", ur5_urdf())
     page.wait_for_function("document.getElementById('urdf').value.length > 0")
-    assert page.input_value("#base-frame") == "world"  # the chain's one root link
+    assert page.input_value("#base-frame") == "base"  # REP 199's, the controller's frame
     assert page.input_value("#tool-frame") == ""  # three tip links: the user chooses
     assert page.is_visible("#urdf-note") and page.is_disabled("#robot-model")
     small = {**SMALL, "x-step": "0.1", "y-step": "0.1", "yaws": "0"}
@@ -310,12 +310,24 @@ def test_a_urdf_file_is_taken_as_written_and_a_missing_frame_says_so_once(
     page.fill("#tool-frame", "tool0")
     page.click("#run")
     page.wait_for_function("document.getElementById('summary').dataset.cells", timeout=120_000)
-    robot = {"urdf": ur5_urdf(), "base_frame": "world", "tool_frame": "tool0"}
+    robot = {"urdf": ur5_urdf(), "base_frame": "base", "tool_frame": "tool0"}
     grid = {**grid_of(small), "yaw": [0.0]}
     api = httpx.post(
         f"{url}/v1/map", json={"robot": robot, "path": EXAMPLE_PATH, "grid": grid}, timeout=120
     ).json()
     assert page.text_content("#best-mu") == f"{api['best']['mu_path']:.6f} m/s"
+
+
+def test_a_urdf_without_the_controllers_frame_gets_its_root_link(page: Page) -> None:
+    text = ur5_urdf()  # without its link base (REP 199's controller frame) and that link's joint
+    joint = text.index('"base_link-base_fixed_joint"')
+    text = text.replace(
+        text[text.index('<link name="base">') : text.index("</joint>", joint) + 8], ""
+    )
+    page.click("#own-urdf summary")
+    choose_file(page, "#urdf-file", "ur5_no_base.urdf", text)
+    page.wait_for_function("document.getElementById('urdf').value.length > 0")
+    assert page.input_value("#base-frame") == "world"  # the chain's one root link
 
 
 @pytest.mark.parametrize("button", ["#run", "#optimize"])

@@ -53,7 +53,10 @@ function robotBody() {
 }
 
 // The links of a URDF, for the frame fields' suggestions; the base and tool frames filled in
-// when the chain's root, and its tip, are each a single link (and the field is empty).
+// (where the field is empty): the base frame REP 199's "base", the controller's frame, where
+// fixed joints join it to the root (the controller frames of the optimum are then the
+// controller's, as dtf-place's), else the chain's root when it is a single link; the tool
+// frame the chain's tip when it is a single link.
 function readUrdfLinks() {
   const list = $("urdf-links");
   list.textContent = "";
@@ -67,7 +70,19 @@ function readUrdfLinks() {
   for (const name of [...roots, ...links.filter((l) => !roots.includes(l))]) {
     list.appendChild(Object.assign(document.createElement("option"), { value: name }));
   }
-  if (roots.length === 1 && !$("base-frame").value.trim()) $("base-frame").value = roots[0];
+  const joinedBy = new Map(joints.map((j) => [j.querySelector("child")?.getAttribute("link"), j]));
+  const fixedToRoot = (link) => {
+    const seen = new Set();
+    while (joinedBy.has(link) && !seen.has(link)) {
+      seen.add(link);
+      const joint = joinedBy.get(link);
+      if (joint.getAttribute("type") !== "fixed") return false;
+      link = joint.querySelector("parent")?.getAttribute("link");
+    }
+    return !seen.has(link);
+  };
+  const base = links.includes("base") && fixedToRoot("base") ? "base" : roots.length === 1 ? roots[0] : "";
+  if (base && !$("base-frame").value.trim()) $("base-frame").value = base;
   if (tips.length === 1 && !$("tool-frame").value.trim()) $("tool-frame").value = tips[0];
 }
 
