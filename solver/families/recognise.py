@@ -7,9 +7,10 @@ has all eight in closed form. The chain proposes the parameters (OPW: its joint 
 :func:`solver.families.ur.fit.fit_ur`); they are kept only when the family's forward formula
 equals the chain's forward kinematics at ``CHECK_CONFIGURATIONS`` random configurations to
 ``FIT_ATOL``. The family then says so (:attr:`KinematicsFamily.recognised`), and answers name it.
-A UR arm is also recognised in a turn of {B} about z (ROS's ``base_link`` is half a turn from
-the DH frame ``base``): the family then solves in the DH frame
-(:attr:`KinematicsFamily.base_turn`), which its answers name.
+A UR arm is also recognised in a turn of {B} about z and a shift (ROS's ``base_link`` is half a
+turn from the DH frame ``base``), an OPW arm in a shift of {B} (a turn about z is its joint 1's
+offset): the family then solves in its own frame (:attr:`KinematicsFamily.base_turn`), which
+its answers name.
 """
 
 from __future__ import annotations
@@ -49,11 +50,14 @@ def recognised_opw(chain: SerialChain) -> OpwFamily | None:
     if chain.dof != 6 or not chain.revolute.all():
         return None
     axes, origins, rotation, position = chain.frames(np.zeros((1, 6)))
-    parameters = fit_opw(axes[0], origins[0], rotation[0], position[0])
+    turn = opw_base_shift(axes[0, 0], origins[0, 0])
+    parameters = fit_opw(
+        axes[0], turn.points_in(origins[0].T).T, rotation[0], turn.points_in(position[0])
+    )
     if parameters is None:
         return None
     q = np.random.default_rng(CHECK_SEED).uniform(-math.pi, math.pi, (CHECK_CONFIGURATIONS, 6))
-    chain_rotation, chain_position = chain.forward(q)
+    chain_rotation, chain_position = _in_turn(turn, *chain.forward(q))
     paper = forward_kinematics(parameters, q)
     error = max(
         float(np.abs(chain_rotation - paper[:, :3, :3]).max()),
@@ -62,14 +66,35 @@ def recognised_opw(chain: SerialChain) -> OpwFamily | None:
     if error > FIT_ATOL:
         return None
     family = OpwFamily(parameters)
+    family.base_turn = None if turn.is_identity else turn
     p = parameters
+    where = "" if turn.is_identity else f" whose base frame is {_said(turn)}"
     family.recognised = (
-        "the URDF chain is an OPW arm (forward kinematics equal to "
+        f"the URDF chain is an OPW arm{where} (forward kinematics equal to "
         f"{FIT_ATOL:g} at {CHECK_CONFIGURATIONS} random configurations): closed-form IK with "
         f"a1={p.a1:.6g}, a2={p.a2:.6g}, b={p.b:.6g}, c1={p.c1:.6g}, c2={p.c2:.6g}, "
         f"c3={p.c3:.6g}, c4={p.c4:.6g} m"
     )
     return family
+
+
+def opw_base_shift(axis: np.ndarray, point: np.ndarray) -> BaseTurn:
+    """The shift of {B} to an OPW arm's base frame, from joint 1's axis at q = 0.
+
+    The OPW base frame's origin is on joint 1's axis (its height is the length c1's; a turn
+    about z is joint 1's offset's): where the axis is upright, the shift is its x and y (the
+    identity within 1e-12); elsewhere none (the fit then finds no OPW arm).
+
+    Args:
+        axis: shape (3,), joint 1's unit axis in {B}.
+        point: shape (3,), m, a point of it.
+    """
+    if abs(abs(float(axis[2])) - 1.0) > FIT_ATOL:
+        return BaseTurn(0.0, (0.0, 0.0, 0.0))
+    x, y = float(point[0]), float(point[1])
+    if max(abs(x), abs(y)) <= 1e-12:
+        return BaseTurn(0.0, (0.0, 0.0, 0.0))
+    return BaseTurn(0.0, (x, y, 0.0))
 
 
 def recognised_ur(chain: SerialChain) -> UrFamily | None:
@@ -150,11 +175,11 @@ def _in_turn(
 
 
 def _said(turn: BaseTurn) -> str:
-    """A turn in words: {B} turned by 180 deg about z (and moved to (x, y, z) m)."""
-    said = f"{{B}} turned by {math.degrees(turn.angle):.6g} deg about z"
+    """A turn in words: {B} turned by 180 deg about z and moved to (x, y, z) m, either part."""
+    parts = [f"turned by {math.degrees(turn.angle):.6g} deg about z"] if turn.angle else []
     if any(turn.shift):
-        said += " and moved to ({:.6g}, {:.6g}, {:.6g}) m".format(*turn.shift)
-    return said
+        parts.append("moved to ({:.6g}, {:.6g}, {:.6g}) m".format(*turn.shift))
+    return "{B} " + " and ".join(parts)
 
 
 def recognised_family(chain: SerialChain) -> KinematicsFamily | None:

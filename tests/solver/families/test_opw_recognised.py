@@ -17,13 +17,14 @@ import pytest
 from solver.core.codes import UNREACHABLE
 from solver.core.kinematics import tool_pose_in_base
 from solver.core.robots import Robot
+from solver.core.spatial import Placement
 from solver.families import get_robot, robot_from_urdf
 from solver.families.opw.arms import ARMS, OpwArm
 from solver.families.opw.ik import forward_kinematics
 from solver.families.opw.parameters import OpwParameters
 from solver.path.capability_map import grid_axis
 from tests.cases import FK_IK_ATOL, MAP_EVALUATE_RTOL
-from tests.problems import capability_map
+from tests.problems import capability_map, evaluate_path, evaluate_placements, prepare_path
 from tests.solver.families.opw_urdf import opw_urdf
 from tests.solver.test_evaluate import load_path
 
@@ -141,3 +142,57 @@ def test_any_offsets_signs_and_lateral_offset_are_recognised(seed: int) -> None:
     # Each pose's own q is one of its branches (to a turn): the closed form missed none.
     turned = np.angle(np.exp(1j * (solutions - q.T[:, None, :])))  # (6, 8, 30), wrapped
     assert np.all(np.nanmin(np.abs(turned).max(axis=0), axis=0) < 1e-6)
+
+
+@pytest.mark.parametrize("arm", ARMS[:2], ids=[a.name for a in ARMS[:2]])
+def test_a_base_moved_and_turned_on_its_cell_gives_the_same_answer_at_the_same_place(
+    arm: OpwArm,
+) -> None:
+    # A frame "cell" in which base_link stands at (0.9, -0.4, 0.05) turned by 30 deg (the arm
+    # mounted in a workcell): the chain from cell is the OPW arm in a shift of cell (joint 1's
+    # offset takes the turn, c1 the height). The placement (X, Y, Z, YAW) in base_link is
+    # t + Rz(30 deg) (X, Y, Z), YAW + 30 deg in cell: the same joint path and feed there,
+    # through evaluate and the map kernel.
+    t, turn = np.array([0.9, -0.4, 0.05]), math.radians(30.0)
+    c, s = math.cos(turn), math.sin(turn)
+    back = [-(c * t[0] + s * t[1]), s * t[0] - c * t[1], -t[2]]  # Rz(-turn) (-t)
+    at_base = urdf_robot(arm)
+    text = opw_urdf(
+        arm.parameters,
+        limits=np.array(arm.position_limits),
+        speeds=np.array(arm.velocity_limits),
+        joint_names=arm.joint_names,
+        slide_seed=len(arm.name),
+    ).replace(
+        "</robot>",
+        '<link name="cell"/><joint name="cell_joint" type="fixed"><parent link="base_link"/>'
+        f'<child link="cell"/><origin xyz="{" ".join(repr(float(v)) for v in back)}" '
+        f'rpy="0 0 {-turn!r}"/></joint></robot>',
+    )
+    in_cell = robot_from_urdf(text, base_frame="cell", tool_frame="tool0", name=arm.name)
+    assert in_cell.family is not None and in_cell.family.name == "opw"
+    assert in_cell.family.recognised is not None
+    assert "moved to (0.9, -0.4, 0) m" in in_cell.family.recognised
+    reach = arm.parameters.c2 + arm.parameters.c3
+    path = load_path("curved_line")
+    checked = 0
+    for x, y in ((0.4, 0.0), (0.5, 0.1), (0.35, -0.15)):
+        x_base, y_base, z_base, yaw_base = x * reach, y * reach, 0.1 * reach, 0.2
+        expected = evaluate_path(at_base, path, Placement(x_base, y_base, z_base, yaw_base))
+        placement = Placement(
+            t[0] + c * x_base - s * y_base,
+            t[1] + s * x_base + c * y_base,
+            t[2] + z_base,
+            yaw_base + turn,
+        )
+        answer = evaluate_path(in_cell, path, placement)
+        assert answer.feasible == expected.feasible and answer.reason == expected.reason
+        if not expected.feasible:
+            continue
+        checked += 1
+        assert answer.mu_path == pytest.approx(expected.mu_path, rel=MAP_EVALUATE_RTOL)
+        assert answer.q is not None and expected.q is not None
+        np.testing.assert_allclose(answer.q, expected.q, atol=1e-9)
+        kernel = evaluate_placements(in_cell, prepare_path(in_cell, path), placement.as_row()[None])
+        assert kernel.mu_path[0] == pytest.approx(expected.mu_path, rel=MAP_EVALUATE_RTOL)
+    assert checked >= 2
