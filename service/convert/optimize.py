@@ -33,7 +33,8 @@ def failure_to_api(
     k, operation = (None, None) if path is None else pass_at(path, failure.failed_waypoint)
     where = ""
     if failure.failed_waypoint is not None:
-        where = f", most often first at waypoint {failure.failed_waypoint}"
+        often = "" if failure.judged == 1 else "most often "
+        where = f", {often}first at waypoint {failure.failed_waypoint}"
         if k is not None:
             where += f" (pass {k}" + ("" if operation is None else f", {operation}") + ")"
     return schemas.SearchFailure(
@@ -43,8 +44,20 @@ def failure_to_api(
         failed_operation=operation,
         count=failure.count,
         judged=failure.judged,
-        message=f"none of the {failure.judged} placement(s) judged on the whole path (the start "
-        f"included) runs it; {failure.count} of them {failure.reason}{where}",
+        message=_failure_message(failure, where),
+    )
+
+
+def _failure_message(failure: SearchFailure, where: str) -> str:
+    """Why nothing was found, in a sentence: the search's placements, or its start alone."""
+    if failure.judged == 1:  # the search found no placement of its own to judge
+        return (
+            "the search proposed no placement but the start, and the start does not run it: "
+            f"{failure.reason}{where}"
+        )
+    return (
+        f"none of the {failure.judged} placements judged on the whole path (the start "
+        f"included) runs it; {failure.count} of them {failure.reason}{where}"
     )
 
 

@@ -177,9 +177,8 @@ class SearchFailure(ResponseModel):
                     "failed_operation": "ROTARY_SPIN",
                     "count": 1,
                     "judged": 1,
-                    "message": "none of the 1 placement(s) judged on the whole path (the start "
-                    "included) runs it; 1 of them joint_limits, most often first at waypoint "
-                    "39 (pass 1, ROTARY_SPIN)",
+                    "message": "the search proposed no placement but the start, and the start "
+                    "does not run it: joint_limits, first at waypoint 39 (pass 1, ROTARY_SPIN)",
                 }
             ]
         }
@@ -196,7 +195,8 @@ class SearchFailure(ResponseModel):
     count: int = Field(description="How many of the placements judged failed for reason.")
     judged: int = Field(
         description="How many placements the search judged on the whole path (its candidates "
-        "and the start), none feasible."
+        "and the start), none feasible; 1: the search proposed none of its own (no placement "
+        "of its coarse map or evolution was worth judging), the start alone was."
     )
     message: str = Field(description="The same in a sentence.")
 

@@ -56,7 +56,11 @@ def test_bounds_out_of_reach_say_unreachable_at_the_first_waypoint(client: TestC
     assert (failure["reason"], failure["failed_waypoint"]) == ("unreachable", 0)
     assert failure["count"] == failure["judged"] >= 1
     assert (failure["failed_pass"], failure["failed_operation"]) == (None, None)  # poses
-    assert "unreachable" in failure["message"] and "waypoint 0" in failure["message"]
+    assert failure["judged"] == 1  # the coarse map has no placement to propose: the start alone
+    assert failure["message"] == (
+        "the search proposed no placement but the start, and the start does not run it: "
+        "unreachable, first at waypoint 0"
+    )
     start = answer["start"]
     assert (start["mu_path"], start["reason"], start["failed_waypoint"]) == (
         None,
@@ -111,5 +115,6 @@ def test_the_cli_says_why(tmp_path: Any, capsys: pytest.CaptureFixture[str]) -> 
     )
     out = capsys.readouterr().out
     assert code == INFEASIBLE
-    assert out.splitlines()[-1].startswith("no feasible placement inside the bounds: none of")
-    assert "ROTARY_SPIN" in out.splitlines()[-1]
+    last = out.splitlines()[-1]
+    assert last.startswith("no feasible placement inside the bounds: the search proposed no")
+    assert "ROTARY_SPIN" in last
