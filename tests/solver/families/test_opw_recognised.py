@@ -29,15 +29,20 @@ from tests.solver.families.opw_urdf import opw_urdf
 from tests.solver.test_evaluate import load_path
 
 
-def urdf_robot(arm: OpwArm, parameters: OpwParameters | None = None) -> Robot:
-    """The arm from a URDF written from its (or the given) parameters, limits and speeds."""
-    text = opw_urdf(
+def urdf_text(arm: OpwArm, parameters: OpwParameters | None = None) -> str:
+    """The URDF written from the arm's (or the given) parameters, limits and speeds."""
+    return opw_urdf(
         parameters or arm.parameters,
         limits=np.array(arm.position_limits),
         speeds=np.array(arm.velocity_limits),
         joint_names=arm.joint_names,
         slide_seed=len(arm.name),
     )
+
+
+def urdf_robot(arm: OpwArm, parameters: OpwParameters | None = None) -> Robot:
+    """The arm from :func:`urdf_text`, from base_link to tool0."""
+    text = urdf_text(arm, parameters)
     return robot_from_urdf(text, base_frame="base_link", tool_frame="tool0", name=arm.name)
 
 
@@ -157,13 +162,7 @@ def test_a_base_moved_and_turned_on_its_cell_gives_the_same_answer_at_the_same_p
     c, s = math.cos(turn), math.sin(turn)
     back = [-(c * t[0] + s * t[1]), s * t[0] - c * t[1], -t[2]]  # Rz(-turn) (-t)
     at_base = urdf_robot(arm)
-    text = opw_urdf(
-        arm.parameters,
-        limits=np.array(arm.position_limits),
-        speeds=np.array(arm.velocity_limits),
-        joint_names=arm.joint_names,
-        slide_seed=len(arm.name),
-    ).replace(
+    text = urdf_text(arm).replace(
         "</robot>",
         '<link name="cell"/><joint name="cell_joint" type="fixed"><parent link="base_link"/>'
         f'<child link="cell"/><origin xyz="{" ".join(repr(float(v)) for v in back)}" '
