@@ -44,6 +44,7 @@ from service.errors import request_location, solver_error_location
 from service.operations import computed_map, evaluation_of, import_of, map_png, optimum_of
 from service.schemas import EvaluateRequest, MapRequest, OptimizeRequest
 from service.schemas.paths_import import PathImportRequest
+from solver.core import native_stderr
 from solver.core.exceptions import InvalidInputError, SolverError
 from solver.core.urdf_structure import fixed_to_root
 from solver.families import closed_form_bases
@@ -77,6 +78,7 @@ Model = TypeVar("Model", bound=BaseModel)
 def main(argv: Sequence[str] | None = None) -> int:
     """Run one subcommand; return its exit code."""
     args = _parser().parse_args(argv)
+    echo = native_stderr.ECHO.set(False)  # a refused URDF's reason is in the error printed
     try:
         code = int(args.run(args))
         sys.stdout.flush()  # a closed pipe is seen here, not at the interpreter's exit
@@ -93,6 +95,8 @@ def main(argv: Sequence[str] | None = None) -> int:
         print(f"error: {where}: {error.message}", file=sys.stderr)  # noqa: T201
     except OSError as error:
         print(f"error: {error}", file=sys.stderr)  # noqa: T201
+    finally:
+        native_stderr.ECHO.reset(echo)
     return INVALID
 
 

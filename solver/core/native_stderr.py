@@ -5,12 +5,13 @@ raises a generic "The XML stream does not contain a valid URDF model". To put th
 answer (robots.md section 4), the descriptor is pointed at a temporary file for the call. The
 capture holds a lock (one capture at a time in the process), and whatever was written, by this
 call or by another thread meanwhile, is written on to the real stderr afterwards: nothing is
-lost from the server's log.
+lost from the server's log (:data:`ECHO`).
 """
 
 from __future__ import annotations
 
 import contextlib
+import contextvars
 import os
 import sys
 import tempfile
@@ -18,6 +19,10 @@ import threading
 from collections.abc import Iterator
 
 _LOCK = threading.Lock()
+ECHO: contextvars.ContextVar[bool] = contextvars.ContextVar("echo_native_stderr", default=True)
+"""Whether what a capture took is written on to the real stderr afterwards (the server's log
+keeps it). A command line whose own error carries the reason sets it False for its run: the
+parser's lines (with its source file and line) would repeat it above the error."""
 
 
 @contextlib.contextmanager
@@ -44,7 +49,7 @@ def native_stderr() -> Iterator[list[str]]:
             os.close(saved)
             sink.seek(0)
             written = sink.read()
-            if written:
+            if written and ECHO.get():
                 os.write(2, written)
             said.append(written.decode("utf-8", errors="replace"))
 

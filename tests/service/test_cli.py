@@ -408,6 +408,22 @@ def test_a_urdf_without_the_controllers_frame_starts_from_base_link(
     assert out.splitlines()[0].startswith(f"robot: {without}, from base_link to tool0; ")
 
 
+def test_a_refused_urdf_is_said_once_without_the_parsers_own_lines(
+    tmp_path: Path, capfd: pytest.CaptureFixture[str]
+) -> None:
+    # urdfdom writes its reason and its source line on the process's stderr; the server's log
+    # keeps them (tests/solver/test_urdf_structure.py), the command's error says the reason.
+    file = tmp_path / "two_roots.urdf"
+    file.write_text(UR5_URDF.read_text().replace("</robot>", '<link name="stray"/></robot>'))
+    code = main(["evaluate", str(PROGRAM), "--robot", str(file), "--at=0,0.3,0,0"])
+    out, err = capfd.readouterr()
+    assert (code, out) == (INVALID, "")
+    assert err.splitlines() == [
+        "error: robot.urdf: cannot parse the URDF: 2 root links ('world', 'stray'): every link "
+        "but one must be a joint's child; remove the stray link or attach it with a fixed joint"
+    ]
+
+
 def test_frames_with_a_robot_that_is_no_urdf_or_not_in_it_exit_invalid(
     capsys: pytest.CaptureFixture[str],
 ) -> None:

@@ -41,12 +41,14 @@ def test_the_links_fixed_to_the_root_are_told_from_those_a_joint_moves() -> None
     assert not fixed_to_root(turned, "base")
 
 
-def test_two_root_links_are_named_in_the_error() -> None:
+def test_two_root_links_are_named_in_the_error(capfd: pytest.CaptureFixture[str]) -> None:
     urdf = UR5.replace("</robot>", '  <link name="stray"/>\n</robot>')
     with pytest.raises(RobotModelError) as error:
         robot_from_urdf(urdf, **FRAMES)
     assert error.value.field == "robot.urdf"
     assert "2 root links ('world', 'stray')" in error.value.message
+    # the parser's own lines go on to the process's stderr (a server's log), as it wrote them
+    assert "Two root links found" in capfd.readouterr().err
 
 
 def test_a_mimic_joint_whose_leader_is_off_the_chain_is_refused_naming_both_joints() -> None:
