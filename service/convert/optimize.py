@@ -33,8 +33,7 @@ def failure_to_api(
     k, operation = (None, None) if path is None else pass_at(path, failure.failed_waypoint)
     where = ""
     if failure.failed_waypoint is not None:
-        often = "" if failure.judged == 1 else "most often "
-        where = f", {often}first at waypoint {failure.failed_waypoint}"
+        where = f"first at waypoint {failure.failed_waypoint}"
         if k is not None:
             where += f" (pass {k}" + ("" if operation is None else f", {operation}") + ")"
     return schemas.SearchFailure(
@@ -49,15 +48,19 @@ def failure_to_api(
 
 
 def _failure_message(failure: SearchFailure, where: str) -> str:
-    """Why nothing was found, in a sentence: the search's placements, or its start alone."""
+    """Why nothing was found, in a sentence: the search's placements, or its start alone.
+
+    ``where``: the first failing waypoint (with its pass and operation), or empty.
+    """
     if failure.judged == 1:  # the search found no placement of its own to judge
         return (
             "the search proposed no placement but the start, and the start does not run it: "
-            f"{failure.reason}{where}"
+            f"{failure.reason}" + (where and f", {where}")
         )
     return (
         f"none of the {failure.judged} placements judged on the whole path (the start "
-        f"included) runs it; {failure.count} of them {failure.reason}{where}"
+        f"included) runs it; {failure.count} of them {failure.reason}"
+        + (where and f", most often {where}")
     )
 
 

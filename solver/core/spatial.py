@@ -249,6 +249,17 @@ class BaseTurn:
     angle: float
     shift: tuple[float, float, float]
 
+    @classmethod
+    def read(cls, angle: float, x: float, y: float) -> BaseTurn:
+        """The turn by ``angle`` (rad) about z to (x, y, 0) (m), as read off a chain.
+
+        The identity where all three are within 1e-12 (a chain's rounding: {B} itself reads
+        as no turn).
+        """
+        if max(abs(angle), abs(x), abs(y)) <= 1e-12:
+            return cls(0.0, (0.0, 0.0, 0.0))
+        return cls(float(angle), (float(x), float(y), 0.0))
+
     @property
     def is_identity(self) -> bool:
         """{A} is {B}."""

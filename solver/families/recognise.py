@@ -90,11 +90,8 @@ def opw_base_shift(axis: np.ndarray, point: np.ndarray) -> BaseTurn:
         point: shape (3,), m, a point of it.
     """
     if abs(abs(float(axis[2])) - 1.0) > FIT_ATOL:
-        return BaseTurn(0.0, (0.0, 0.0, 0.0))
-    x, y = float(point[0]), float(point[1])
-    if max(abs(x), abs(y)) <= 1e-12:
-        return BaseTurn(0.0, (0.0, 0.0, 0.0))
-    return BaseTurn(0.0, (x, y, 0.0))
+        return BaseTurn.read(0.0, 0.0, 0.0)
+    return BaseTurn.read(0.0, point[0], point[1])
 
 
 def recognised_ur(chain: SerialChain) -> UrFamily | None:
@@ -157,11 +154,7 @@ def ur_base_turn(chain: SerialChain) -> BaseTurn | None:
     turn = rotation[0] @ zero.T
     if abs(turn[2, 2] - 1.0) > FIT_ATOL:
         return None
-    angle = math.atan2(turn[1, 0], turn[0, 0])
-    x, y = float(origins[0, 0, 0]), float(origins[0, 0, 1])
-    if max(abs(angle), abs(x), abs(y)) <= 1e-12:
-        return BaseTurn(0.0, (0.0, 0.0, 0.0))
-    return BaseTurn(angle, (x, y, 0.0))
+    return BaseTurn.read(math.atan2(turn[1, 0], turn[0, 0]), origins[0, 0, 0], origins[0, 0, 1])
 
 
 def _in_turn(
