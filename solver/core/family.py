@@ -21,7 +21,7 @@ import numpy as np
 
 from solver.core.exceptions import InvalidInputError
 from solver.core.progress import Progress
-from solver.core.spatial import BaseTurn
+from solver.core.spatial import BaseTurn, FlangeOffset
 
 
 @dataclass(frozen=True)
@@ -98,6 +98,11 @@ class KinematicsFamily(abc.ABC):
     #: the path itself, takes its placements in that frame
     #: (:meth:`solver.core.spatial.BaseTurn.placements_in`). ``None``: {B}.
     base_turn: BaseTurn | None = None
+    #: Where the chain's flange sits on the family's own, where they differ (a URDF whose tool
+    #: frame is turned or moved on the last link): :meth:`solve` still takes the chain's flange;
+    #: a compiled map kernel takes the family's (:meth:`FlangeOffset.family_flange_rows`).
+    #: ``None``: the same frame.
+    flange_offset: FlangeOffset | None = None
 
     @property
     @abc.abstractmethod

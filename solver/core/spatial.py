@@ -284,3 +284,38 @@ class BaseTurn:
         turned[:, :3] = self.points_in(turned[:, :3].T).T
         turned[:, 3] = turned[:, 3] - self.angle
         return turned
+
+
+@dataclass(frozen=True)
+class FlangeOffset:
+    """Where a chain's flange frame {F} sits on a kinematics family's own flange {F'}.
+
+    A closed-form family's IK solves for its own flange (an OPW arm's: on joint 6's axis, z
+    along it); a URDF's tool frame may be anywhere on the last link (turned, or off the axis, as
+    CAD exports write ``tool0``). {F} = {F'} E, E fixed: a pose of {F} is one of {F'}
+    (:meth:`family_flange`), the joints the same (:mod:`solver.families.recognise`).
+
+    Attributes:
+        rotation: R_F'_F, shape (3, 3).
+        translation: m, {F}'s origin in {F'}, shape (3,).
+    """
+
+    rotation: np.ndarray
+    translation: np.ndarray
+
+    def family_flange(
+        self, rotation: np.ndarray, position: np.ndarray
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """Poses of {F}, R_B_F (3, 3, ...) and p_B_F (3, ...): those of {F'}, same shapes.
+
+        R_B_F' = R_B_F E_R^T and p_B_F' = p_B_F - R_B_F' E_p.
+        """
+        turned = np.einsum("ij...,kj->ik...", rotation, self.rotation)
+        return turned, position - np.einsum("ik...,k->i...", turned, self.translation)
+
+    def family_flange_rows(
+        self, rotation: np.ndarray, position: np.ndarray
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """:meth:`family_flange` of poses in rows: R (W, 3, 3) and p (W, 3)."""
+        turned, moved = self.family_flange(np.moveaxis(rotation, 0, -1), position.T)
+        return np.ascontiguousarray(np.moveaxis(turned, -1, 0)), np.ascontiguousarray(moved.T)

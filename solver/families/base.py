@@ -45,7 +45,13 @@ class ClosedFormFamily(KinematicsFamily):
         return self.branch_labels
 
     def solve(self, rotation: np.ndarray, position: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """All branches in closed form (see :meth:`KinematicsFamily.solve`), in its base turn."""
+        """All branches in closed form (see :meth:`KinematicsFamily.solve`), in its base turn.
+
+        The chain's flange poses are the family's own flange's first, where they differ
+        (:attr:`KinematicsFamily.flange_offset`).
+        """
+        if self.flange_offset is not None:
+            rotation, position = self.flange_offset.family_flange(rotation, position)
         if self.base_turn is not None:
             rotation = self.base_turn.vectors_in(rotation)
             position = self.base_turn.points_in(position)

@@ -20,7 +20,7 @@ import math
 import numpy as np
 
 from solver.core.family import KinematicsFamily
-from solver.core.spatial import BaseTurn
+from solver.core.spatial import BaseTurn, FlangeOffset
 from solver.families.numeric.chain import SerialChain
 from solver.families.opw.family import OpwFamily
 from solver.families.opw.fit import fit_opw
@@ -51,14 +51,17 @@ def recognised_opw(chain: SerialChain) -> OpwFamily | None:
         return None
     axes, origins, rotation, position = chain.frames(np.zeros((1, 6)))
     turn = opw_base_shift(axes[0, 0], origins[0, 0])
-    parameters = fit_opw(
+    fitted = fit_opw(
         axes[0], turn.points_in(origins[0].T).T, rotation[0], turn.points_in(position[0])
     )
-    if parameters is None:
+    if fitted is None:
         return None
+    parameters, offset = fitted
     q = np.random.default_rng(CHECK_SEED).uniform(-math.pi, math.pi, (CHECK_CONFIGURATIONS, 6))
     chain_rotation, chain_position = _in_turn(turn, *chain.forward(q))
     paper = forward_kinematics(parameters, q)
+    if offset is not None:  # the chain's flange on the OPW flange
+        paper = paper @ _matrix(offset)
     error = max(
         float(np.abs(chain_rotation - paper[:, :3, :3]).max()),
         float(np.abs(chain_position - paper[:, :3, 3]).max()),
@@ -67,8 +70,11 @@ def recognised_opw(chain: SerialChain) -> OpwFamily | None:
         return None
     family = OpwFamily(parameters)
     family.base_turn = None if turn.is_identity else turn
+    family.flange_offset = offset
     p = parameters
     where = "" if turn.is_identity else f" whose base frame is {_said(turn)}"
+    if offset is not None:
+        where += f"{' and' if where else ''} whose tool frame is {_said_flange(offset)}"
     family.recognised = (
         f"the URDF chain is an OPW arm{where} (forward kinematics equal to "
         f"{FIT_ATOL:g} at {CHECK_CONFIGURATIONS} random configurations): closed-form IK with "
@@ -173,6 +179,23 @@ def _said(turn: BaseTurn) -> str:
     if any(turn.shift):
         parts.append("moved to ({:.6g}, {:.6g}, {:.6g}) m".format(*turn.shift))
     return "{B} " + " and ".join(parts)
+
+
+def _said_flange(offset: FlangeOffset) -> str:
+    """A flange offset in words: the OPW flange moved by (x, y, z) m and turned by a deg."""
+    cosine = (float(np.trace(offset.rotation)) - 1.0) / 2.0
+    angle = math.degrees(math.acos(min(1.0, max(-1.0, cosine))))
+    moved = [round(float(v), 9) + 0.0 for v in offset.translation]  # to the nanometre
+    parts = ["moved by ({:.6g}, {:.6g}, {:.6g}) m".format(*moved)] if any(moved) else []
+    parts += [f"turned by {angle:.6g} deg"] if angle else []
+    return "the OPW flange " + " and ".join(parts)
+
+
+def _matrix(offset: FlangeOffset) -> np.ndarray:
+    """E as a homogeneous matrix (4, 4)."""
+    matrix = np.eye(4)
+    matrix[:3, :3], matrix[:3, 3] = offset.rotation, offset.translation
+    return matrix
 
 
 def recognised_family(chain: SerialChain) -> KinematicsFamily | None:

@@ -58,6 +58,8 @@ def kernel_inputs(
     """The kernel's inputs of the problem's robot and path at ``spin``, as contiguous arrays."""
     robot, path = problem.robot, problem.prepared
     rotation, position = flange_at_spin(path, spin)
+    if problem.family.flange_offset is not None:  # the poses the family's IK solves for
+        rotation, position = problem.family.flange_offset.family_flange_rows(rotation, position)
     modes, arc = limit_modes(robot.q_lower, robot.q_upper)
     contiguous = np.ascontiguousarray
     qddot_max = np.zeros(0)

@@ -8,18 +8,22 @@ the makers' datasheets:
   -0.0175..3.7525 rad; 2.175 rad/s on joints 1-4, 2.61 rad/s on 5-7).
 - ``xarm7`` (UFactory xArm7): {B} ``link_base``, flange ``link_eef``; joints 1, 3, 5, 7 +-2 pi,
   the others limited; 3.14 rad/s on every joint (datasheet: 180 deg/s).
-- ``kinova_jaco2`` (Kinova Jaco2 j2s6s200, 6 joints, non-spherical wrist): {B}
+- ``kinova_jaco2`` (Kinova Jaco2 j2s6s200, 6 joints, spherical wrist): {B}
   ``j2s6s200_link_base``, flange ``j2s6s200_end_effector``; speeds 0.628 rad/s (joints 1-3,
   36 deg/s) and 0.838 rad/s (4-6, 48 deg/s). The URDF's continuous joints (1, 4, 6) are read as
   revolute with the +-2 pi its ``<limit>`` tags give, as UR joints are: a path needs no more.
+  Its chain is an OPW arm's whose flange is turned half a turn on the OPW flange: the same URDF
+  in a request is recognised (:mod:`solver.families.recognise`; maps equal cell for cell). The
+  catalogue entry keeps numeric IK, given here, as the catalogue's six-joint numeric arm.
 """
 
 from __future__ import annotations
 
 import re
 
-from solver.core.robots import Robot, example_robot_data_dir
+from solver.core.robots import Robot, chain_from_urdf, example_robot_data_dir
 from solver.families import robot_from_urdf
+from solver.families.numeric.family import NumericFamily
 
 # name: (file under example-robot-data's robots/, base frame, flange)
 ARMS = {
@@ -47,5 +51,12 @@ def robots() -> dict[str, Robot]:
     arms: dict[str, Robot] = {}
     for name, (file, base_frame, tool_frame) in ARMS.items():
         urdf = continuous_as_revolute((example_robot_data_dir() / file).read_text())
-        arms[name] = robot_from_urdf(urdf, base_frame=base_frame, tool_frame=tool_frame, name=name)
+        family = NumericFamily(
+            chain_from_urdf(urdf, tool_frame=tool_frame),
+            base_frame=base_frame,
+            tool_frame=tool_frame,
+        )
+        arms[name] = robot_from_urdf(
+            urdf, base_frame=base_frame, tool_frame=tool_frame, name=name, family=family
+        )
     return arms

@@ -11,6 +11,11 @@ the joint axes are the lines of the paper's chain there:
   R5 z with R5 = R3 Rz(theta4) Ry(theta5);
 - the flange is c4 along R5 z from C, turned by Rz(theta6).
 
+A chain whose flange frame is not there (a tool frame turned on the last link, or off joint
+6's axis, as CAD exports write ``tool0``) is the OPW arm up to a fixed offset E: the OPW flange
+is then the point of axis 6 nearest the chain's, with theta6 = 0, and E the chain's flange in
+it (:class:`solver.core.spatial.FlangeOffset`).
+
 Each step reads one angle or length; the sign corrections are the signs that make the URDF's
 axis directions those of the paper's axes. Where a choice is free (joint 2's sign with
 theta1 + pi, joint 5's with theta4 + pi) the angle nearer zero is taken; where it is forced
@@ -26,12 +31,15 @@ import math
 import numpy as np
 
 from solver.core.exceptions import InvalidInputError
+from solver.core.spatial import FlangeOffset
 from solver.families.opw.parameters import OpwParameters
 
 # Lines closer than this (m), or directions within this (rad), are taken as meeting or
 # parallel; the forward-kinematics check decides in the end.
 GEOMETRY_TOLERANCE = 1e-9
 _X, _Y, _Z = np.eye(3)
+_SNAP = 1e-12
+"""A flange offset's entries within this of zero are zero (a chain's rounding)."""
 
 
 def _rz(angle: float) -> np.ndarray:
@@ -77,7 +85,7 @@ def fit_opw(
     origins: np.ndarray,
     flange_rotation: np.ndarray,
     flange_position: np.ndarray,
-) -> OpwParameters | None:
+) -> tuple[OpwParameters, FlangeOffset | None] | None:
     """The OPW parameters of a six-joint revolute chain at q = 0, or None if it is not one.
 
     Args:
@@ -87,7 +95,8 @@ def fit_opw(
         flange_position: shape (3,), m in {B} at q = 0.
 
     Returns:
-        Parameters whose geometry is the chain's line by line; forward kinematics must still be
+        Parameters whose geometry is the chain's line by line, and where the chain's flange
+        sits on the OPW flange (None: it is the OPW flange); forward kinematics must still be
         compared (the caller does), since lines do not fix every sign.
     """
     tol = GEOMETRY_TOLERANCE
@@ -139,15 +148,20 @@ def fit_opw(
     lever = r1.T @ flange_position - centre
     c4 = float(lever @ r5[:, 2])
     turn = r5.T @ flange_local
+    offset = None
     if np.linalg.norm(lever - c4 * r5[:, 2]) > tol or np.linalg.norm(turn[2] - _Z) > tol:
-        return None
+        # The chain's flange in the OPW flange (theta6 = 0: its axes are R5's): E
+        snapped = [np.where(np.abs(a) <= _SNAP, 0.0, a) for a in (turn, r5.T @ lever)]
+        offset = FlangeOffset(snapped[0], snapped[1] - (0.0, 0.0, c4))
+        turn = np.eye(3)
     theta6 = math.atan2(turn[1, 0], turn[0, 0])
     # Paper angle = s q - offset; at q = 0 it is theta, so offset = -theta (wrapped).
     thetas = (theta1, theta2, theta23 - theta2, theta4, theta5, theta6)
     offsets = tuple(_clean(-math.remainder(t, 2 * math.pi)) for t in thetas)
     try:
-        return OpwParameters(
+        parameters = OpwParameters(
             a1, float(a2), b, c1, c2, float(c3), c4, offsets=offsets, sign_corrections=tuple(signs)
         )
     except InvalidInputError:  # a length beyond the parameters' range: not an arm we model
         return None
+    return parameters, offset

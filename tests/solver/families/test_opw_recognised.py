@@ -12,6 +12,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
+import pinocchio as pin
 import pytest
 
 from solver.core.codes import UNREACHABLE
@@ -44,6 +45,35 @@ def urdf_robot(arm: OpwArm, parameters: OpwParameters | None = None) -> Robot:
     """The arm from :func:`urdf_text`, from base_link to tool0."""
     text = urdf_text(arm, parameters)
     return robot_from_urdf(text, base_frame="base_link", tool_frame="tool0", name=arm.name)
+
+
+def with_fixed_frame(text: str, name: str, parent: str, xyz: object, rpy: object) -> str:
+    """URDF text with a frame ``name`` fixed to ``parent`` at (xyz, rpy)."""
+    xyz_text, rpy_text = (" ".join(repr(float(v)) for v in values) for values in (xyz, rpy))
+    return text.replace(
+        "</robot>",
+        f'<link name="{name}"/><joint name="{name}_joint" type="fixed"><parent link="{parent}"/>'
+        f'<child link="{name}"/><origin xyz="{xyz_text}" rpy="{rpy_text}"/></joint></robot>',
+    )
+
+
+def answers_alike(robot: Robot, path: np.ndarray, placement: Placement, expected: object) -> bool:
+    """Whether ``robot``'s answer at ``placement`` is feasible, after asserting it is ``expected``.
+
+    The same feasibility and reason; where feasible, mu_path and the joint path, and the map
+    kernel's mu_path at the placement.
+    """
+    answer = evaluate_path(robot, path, placement)
+    assert isinstance(expected, type(answer))
+    assert answer.feasible == expected.feasible and answer.reason == expected.reason
+    if not expected.feasible:
+        return False
+    assert answer.mu_path == pytest.approx(expected.mu_path, rel=MAP_EVALUATE_RTOL)
+    assert answer.q is not None and expected.q is not None
+    np.testing.assert_allclose(answer.q, expected.q, atol=1e-9)
+    kernel = evaluate_placements(robot, prepare_path(robot, path), placement.as_row()[None])
+    assert kernel.mu_path[0] == pytest.approx(expected.mu_path, rel=MAP_EVALUATE_RTOL)
+    return True
 
 
 @pytest.mark.parametrize("arm", ARMS, ids=[a.name for a in ARMS])
@@ -162,12 +192,7 @@ def test_a_base_moved_and_turned_on_its_cell_gives_the_same_answer_at_the_same_p
     c, s = math.cos(turn), math.sin(turn)
     back = [-(c * t[0] + s * t[1]), s * t[0] - c * t[1], -t[2]]  # Rz(-turn) (-t)
     at_base = urdf_robot(arm)
-    text = urdf_text(arm).replace(
-        "</robot>",
-        '<link name="cell"/><joint name="cell_joint" type="fixed"><parent link="base_link"/>'
-        f'<child link="cell"/><origin xyz="{" ".join(repr(float(v)) for v in back)}" '
-        f'rpy="0 0 {-turn!r}"/></joint></robot>',
-    )
+    text = with_fixed_frame(urdf_text(arm), "cell", "base_link", back, (0.0, 0.0, -turn))
     in_cell = robot_from_urdf(text, base_frame="cell", tool_frame="tool0", name=arm.name)
     assert in_cell.family is not None and in_cell.family.name == "opw"
     assert in_cell.family.recognised is not None
@@ -184,14 +209,47 @@ def test_a_base_moved_and_turned_on_its_cell_gives_the_same_answer_at_the_same_p
             t[2] + z_base,
             yaw_base + turn,
         )
-        answer = evaluate_path(in_cell, path, placement)
-        assert answer.feasible == expected.feasible and answer.reason == expected.reason
-        if not expected.feasible:
+        checked += answers_alike(in_cell, path, placement, expected)
+    assert checked >= 2
+
+
+@pytest.mark.parametrize("arm", ARMS[:2], ids=[a.name for a in ARMS[:2]])
+def test_a_tool_frame_off_the_opw_flange_gives_the_tool0_answer_with_that_tool_point(
+    arm: OpwArm,
+) -> None:
+    # A tool frame turned and moved on the last link, as CAD exports write tool0 (the corpus's
+    # KR210 R2700: turned by 90 deg, 0.24 mm off joint 6's axis). The chain to it is the OPW
+    # arm up to a fixed E: recognised, and at the same placements it must answer what the
+    # chain to tool0 answers with E as its tool point (the catalogue-tested path: feasibility,
+    # mu_path, the joint path), through evaluate and the map kernel; FK of the joint path
+    # (pinocchio) must put the tool frame on every placed waypoint.
+    xyz, rpy = np.array([0.03, -0.02, 0.05]), np.array([0.3, -1.2, 0.7])
+    text = with_fixed_frame(urdf_text(arm), "tool_cad", "tool0", xyz, rpy)
+    cad = robot_from_urdf(text, base_frame="base_link", tool_frame="tool_cad", name=arm.name)
+    assert cad.family is not None and cad.family.name == "opw"
+    assert cad.family.flange_offset is not None
+    assert cad.family.recognised is not None and "tool frame is the OPW flange" in (
+        cad.family.recognised
+    )
+    offset = np.eye(4)
+    offset[:3, :3], offset[:3, 3] = pin.rpy.rpyToMatrix(*rpy), xyz
+    at_tool0 = robot_from_urdf(text, base_frame="base_link", tool_frame="tool0", name=arm.name)
+    at_tool0 = at_tool0.with_options(transform_tool_to_tcp=offset)
+    reach = arm.parameters.c2 + arm.parameters.c3
+    path = load_path("curved_line")
+    placements = [Placement(x * reach, y * reach, 0.1 * reach, yaw) for x, y, yaw in (
+        (0.4, 0.0, 0.2), (0.5, 0.1, -0.4), (0.35, -0.15, 1.0), (0.45, 0.05, 2.5)
+    )]  # fmt: skip
+    checked = 0
+    for placement in placements:
+        expected = evaluate_path(at_tool0, path, placement)
+        if not answers_alike(cad, path, placement, expected):
             continue
         checked += 1
-        assert answer.mu_path == pytest.approx(expected.mu_path, rel=MAP_EVALUATE_RTOL)
-        assert answer.q is not None and expected.q is not None
-        np.testing.assert_allclose(answer.q, expected.q, atol=1e-9)
-        kernel = evaluate_placements(in_cell, prepare_path(in_cell, path), placement.as_row()[None])
-        assert kernel.mu_path[0] == pytest.approx(expected.mu_path, rel=MAP_EVALUATE_RTOL)
+        poses = placement.transform_workpiece_to_base() @ path
+        assert expected.q is not None
+        for w in range(0, len(path), 11):
+            np.testing.assert_allclose(
+                tool_pose_in_base(cad, expected.q[w]), poses[w], atol=FK_IK_ATOL
+            )
     assert checked >= 2
