@@ -303,6 +303,15 @@ class FlangeOffset:
     rotation: np.ndarray
     translation: np.ndarray
 
+    @classmethod
+    def read(cls, rotation: np.ndarray, translation: np.ndarray) -> FlangeOffset:
+        """E as read off a chain: entries within 1e-12 of zero are zero (its rounding)."""
+        rotation, translation = (
+            np.where(np.abs(a) <= 1e-12, 0.0, np.asarray(a, dtype=float))
+            for a in (rotation, translation)
+        )
+        return cls(rotation, translation)
+
     def family_flange(
         self, rotation: np.ndarray, position: np.ndarray
     ) -> tuple[np.ndarray, np.ndarray]:

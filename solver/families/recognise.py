@@ -27,7 +27,7 @@ from solver.families.opw.fit import fit_opw
 from solver.families.opw.ik import forward_kinematics
 from solver.families.ur.dh import UrDh
 from solver.families.ur.family import UrFamily
-from solver.families.ur.fit import fit_ur
+from solver.families.ur.fit import fit_ur, fit_ur_flange
 from solver.families.ur.ik import forward_kinematics_dh
 
 # Forward kinematics of the fitted parameters must equal the chain's to this (m, and rad as
@@ -105,6 +105,9 @@ def recognised_ur(chain: SerialChain) -> UrFamily | None:
 
     The DH base frame may be {B} turned about z and moved (ROS's ``base_link`` is half a turn
     from it: :func:`ur_base_turn`); the family then solves in that frame (its ``base_turn``).
+    The chain's flange may be the DH flange turned or moved on the last link (ROS's
+    ``ee_link``, ``wrist_3_link``): the turn is then read off joint 2's axis
+    (:func:`ur_axis_turn`) and the family solves for the DH flange (its ``flange_offset``).
 
     Args:
         chain: a serial chain from {B} to the flange.
@@ -115,16 +118,30 @@ def recognised_ur(chain: SerialChain) -> UrFamily | None:
     if chain.dof != 6 or not chain.revolute.all():
         return None
     turn = ur_base_turn(chain)
-    if turn is None:
-        return None
+    family = None if turn is None else _ur_fitted(chain, turn, on_flange=True)
+    if family is None and (turn := ur_axis_turn(chain)) is not None:
+        family = _ur_fitted(chain, turn, on_flange=False)
+    return family
+
+
+def _ur_fitted(chain: SerialChain, turn: BaseTurn, *, on_flange: bool) -> UrFamily | None:
+    """The UR family of ``chain`` in ``turn``, its flange the DH flange or fixed on it."""
     q = np.random.default_rng(CHECK_SEED).uniform(-math.pi, math.pi, (CHECK_CONFIGURATIONS, 6))
     rotation, position = _in_turn(turn, *chain.forward(q))
-    lengths = fit_ur(q, rotation, position)
+    offset = None
+    if on_flange:
+        lengths = fit_ur(q, rotation, position)
+    elif (fitted := fit_ur_flange(q, rotation, position)) is not None:
+        lengths, offset = fitted[0], FlangeOffset.read(fitted[1], fitted[2])
+    else:
+        lengths = None
     if lengths is None:
         return None
     check = np.random.default_rng(CHECK_SEED + 1).uniform(-math.pi, math.pi, (16, 6))
     chain_rotation, chain_position = _in_turn(turn, *chain.forward(check))
     dh = forward_kinematics_dh(lengths, check)
+    if offset is not None:  # the chain's flange on the DH flange
+        dh = dh @ _matrix(offset)
     error = max(
         float(np.abs(chain_rotation - dh[:, :3, :3]).max()),
         float(np.abs(chain_position - dh[:, :3, 3]).max()),
@@ -133,7 +150,10 @@ def recognised_ur(chain: SerialChain) -> UrFamily | None:
         return None
     family = UrFamily(lengths)
     family.base_turn = None if turn.is_identity else turn
+    family.flange_offset = offset
     where = "in its DH base frame" if turn.is_identity else f"whose DH base frame is {_said(turn)}"
+    if offset is not None:
+        where += f", whose tool frame is {_said_flange(offset, 'DH')}"
     family.recognised = (
         f"the URDF chain is a UR arm {where} (forward kinematics equal to "
         f"{FIT_ATOL:g} at random configurations): closed-form IK with d1={lengths.d1:.6g}, "
@@ -141,6 +161,21 @@ def recognised_ur(chain: SerialChain) -> UrFamily | None:
         f"d6={lengths.d6:.6g} m"
     )
     return family
+
+
+def ur_axis_turn(chain: SerialChain) -> BaseTurn | None:
+    """The turn of {B} about z in which a chain may be a UR arm, from joint 2's axis.
+
+    Where the flange is not the DH flange its orientation says nothing of the turn
+    (:func:`ur_base_turn`), but joint 2's axis does: it is the DH frame's -y at q = 0
+    (alpha1 = pi/2), and joint 1's axis {B}'s z. None where the chain's axes are not so.
+    """
+    axes, origins, _, _ = chain.frames(np.zeros((1, 6)))
+    first, second = axes[0, 0], axes[0, 1]
+    if abs(first[2] - 1.0) > FIT_ATOL or abs(second[2]) > FIT_ATOL:
+        return None
+    angle = math.remainder(math.atan2(second[1], second[0]) + math.pi / 2, 2 * math.pi)
+    return BaseTurn.read(angle, origins[0, 0, 0], origins[0, 0, 1])
 
 
 def ur_base_turn(chain: SerialChain) -> BaseTurn | None:
@@ -181,14 +216,14 @@ def _said(turn: BaseTurn) -> str:
     return "{B} " + " and ".join(parts)
 
 
-def _said_flange(offset: FlangeOffset) -> str:
-    """A flange offset in words: the OPW flange moved by (x, y, z) m and turned by a deg."""
+def _said_flange(offset: FlangeOffset, family: str = "OPW") -> str:
+    """A flange offset in words: the OPW (or DH) flange moved by (x, y, z) m and turned by a deg."""
     cosine = (float(np.trace(offset.rotation)) - 1.0) / 2.0
     angle = math.degrees(math.acos(min(1.0, max(-1.0, cosine))))
     moved = [round(float(v), 9) + 0.0 for v in offset.translation]  # to the nanometre
     parts = ["moved by ({:.6g}, {:.6g}, {:.6g}) m".format(*moved)] if any(moved) else []
     parts += [f"turned by {angle:.6g} deg"] if angle else []
-    return "the OPW flange " + " and ".join(parts)
+    return f"the {family} flange " + " and ".join(parts)
 
 
 def _matrix(offset: FlangeOffset) -> np.ndarray:

@@ -38,8 +38,6 @@ from solver.families.opw.parameters import OpwParameters
 # parallel; the forward-kinematics check decides in the end.
 GEOMETRY_TOLERANCE = 1e-9
 _X, _Y, _Z = np.eye(3)
-_SNAP = 1e-12
-"""A flange offset's entries within this of zero are zero (a chain's rounding)."""
 
 
 def _rz(angle: float) -> np.ndarray:
@@ -151,8 +149,7 @@ def fit_opw(
     offset = None
     if np.linalg.norm(lever - c4 * r5[:, 2]) > tol or np.linalg.norm(turn[2] - _Z) > tol:
         # The chain's flange in the OPW flange (theta6 = 0: its axes are R5's): E
-        snapped = [np.where(np.abs(a) <= _SNAP, 0.0, a) for a in (turn, r5.T @ lever)]
-        offset = FlangeOffset(snapped[0], snapped[1] - (0.0, 0.0, c4))
+        offset = FlangeOffset.read(turn, r5.T @ (lever - c4 * r5[:, 2]))
         turn = np.eye(3)
     theta6 = math.atan2(turn[1, 0], turn[0, 0])
     # Paper angle = s q - offset; at q = 0 it is theta, so offset = -theta (wrapped).

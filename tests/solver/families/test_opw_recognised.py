@@ -25,8 +25,9 @@ from solver.families.opw.ik import forward_kinematics
 from solver.families.opw.parameters import OpwParameters
 from solver.path.capability_map import grid_axis
 from tests.cases import FK_IK_ATOL, MAP_EVALUATE_RTOL
-from tests.problems import capability_map, evaluate_path, evaluate_placements, prepare_path
+from tests.problems import capability_map, evaluate_path
 from tests.solver.families.opw_urdf import opw_urdf
+from tests.solver.families.recognised import answers_alike, with_fixed_frame
 from tests.solver.test_evaluate import load_path
 
 
@@ -45,35 +46,6 @@ def urdf_robot(arm: OpwArm, parameters: OpwParameters | None = None) -> Robot:
     """The arm from :func:`urdf_text`, from base_link to tool0."""
     text = urdf_text(arm, parameters)
     return robot_from_urdf(text, base_frame="base_link", tool_frame="tool0", name=arm.name)
-
-
-def with_fixed_frame(text: str, name: str, parent: str, xyz: object, rpy: object) -> str:
-    """URDF text with a frame ``name`` fixed to ``parent`` at (xyz, rpy)."""
-    xyz_text, rpy_text = (" ".join(repr(float(v)) for v in values) for values in (xyz, rpy))
-    return text.replace(
-        "</robot>",
-        f'<link name="{name}"/><joint name="{name}_joint" type="fixed"><parent link="{parent}"/>'
-        f'<child link="{name}"/><origin xyz="{xyz_text}" rpy="{rpy_text}"/></joint></robot>',
-    )
-
-
-def answers_alike(robot: Robot, path: np.ndarray, placement: Placement, expected: object) -> bool:
-    """Whether ``robot``'s answer at ``placement`` is feasible, after asserting it is ``expected``.
-
-    The same feasibility and reason; where feasible, mu_path and the joint path, and the map
-    kernel's mu_path at the placement.
-    """
-    answer = evaluate_path(robot, path, placement)
-    assert isinstance(expected, type(answer))
-    assert answer.feasible == expected.feasible and answer.reason == expected.reason
-    if not expected.feasible:
-        return False
-    assert answer.mu_path == pytest.approx(expected.mu_path, rel=MAP_EVALUATE_RTOL)
-    assert answer.q is not None and expected.q is not None
-    np.testing.assert_allclose(answer.q, expected.q, atol=1e-9)
-    kernel = evaluate_placements(robot, prepare_path(robot, path), placement.as_row()[None])
-    assert kernel.mu_path[0] == pytest.approx(expected.mu_path, rel=MAP_EVALUATE_RTOL)
-    return True
 
 
 @pytest.mark.parametrize("arm", ARMS, ids=[a.name for a in ARMS])

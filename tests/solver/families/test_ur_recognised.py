@@ -14,6 +14,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
+import pinocchio as pin
 import pytest
 
 from solver.core.codes import REASONS
@@ -25,6 +26,7 @@ from solver.families.ur.dh import UR_DH
 from solver.path.cell.shapes import Box, Cell
 from tests.cases import MAP_EVALUATE_RTOL
 from tests.problems import capability_map, evaluate_path, evaluate_placements, prepare_path
+from tests.solver.families.recognised import answers_alike
 from tests.solver.test_evaluate import load_path
 
 UR5 = (example_robot_data_dir() / "ur_description" / "urdf" / "ur5_robot.urdf").read_text()
@@ -164,3 +166,44 @@ def test_from_base_link_the_cell_sees_the_joint_paths_numeric_ik_finds() -> None
     assert 0 < collides.sum() < collides.size - 1  # both kinds of cell
     np.testing.assert_array_equal(answer.reason, by_numeric.reason)
     np.testing.assert_allclose(answer.mu_path, by_numeric.mu_path, rtol=MAP_EVALUATE_RTOL)
+
+
+@pytest.mark.parametrize(("base", "tool"), [("base_link", "ee_link"), ("base", "wrist_3_link")])
+def test_a_tool_frame_on_the_last_link_gives_the_tool0_answer_with_that_tool_point(
+    base: str, tool: str
+) -> None:
+    # ROS's UR descriptions end in ee_link (MoveIt's classic tip: x along the tool axis) and
+    # wrist_3_link (the joint's own frame) beside tool0: the DH flange turned or moved on the
+    # last link. Recognised with that offset: at the same placements it must answer what the
+    # chain to tool0 answers with the frame as its tool point (the pose of the frame in tool0,
+    # from pinocchio), through evaluate and the map kernel; and its map must be the numeric
+    # family's on the same chain.
+    robot = robot_from_urdf(UR5, base_frame=base, tool_frame=tool)
+    assert robot.family is not None and robot.family.name == "ur"
+    assert robot.family.flange_offset is not None
+    assert robot.family.recognised is not None and "whose tool frame is the DH flange" in (
+        robot.family.recognised
+    )
+    for name in ("d1", "a2", "a3", "d4", "d5"):
+        assert abs(getattr(robot.family.parameters, name) - getattr(UR_DH["ur5"], name)) < 1e-9
+    model = pin.buildModelFromXML(UR5)
+    data = model.createData()
+    pin.framesForwardKinematics(model, data, pin.neutral(model))
+    frame = {name: data.oMf[model.getFrameId(name)] for name in ("tool0", tool)}
+    at_tool0 = robot_from_urdf(UR5, base_frame=base, tool_frame="tool0").with_options(
+        transform_tool_to_tcp=(frame["tool0"].inverse() * frame[tool]).homogeneous
+    )
+    path = load_path("curved_line")
+    checked = 0
+    for x, y, yaw in ((0.0, 0.4, 0.0), (-0.2, 0.55, 0.4), (0.15, 0.3, 2.0)):
+        placement = Placement(x, y, 0.1, yaw)
+        expected = evaluate_path(at_tool0, path, placement)
+        checked += answers_alike(robot, path, placement, expected)
+    assert checked >= 2
+    frames = {"base_frame": base, "tool_frame": tool}
+    numeric_family = NumericFamily(chain_from_urdf(UR5, tool_frame=tool), **frames)
+    numeric = robot_from_urdf(UR5, **frames, family=numeric_family)
+    grid = {"xs": XS[::4], "ys": YS[::4], "z": 0.1, "yaws": np.array([0.0, 2.0])}
+    answer, by_numeric = (capability_map(arm, path, **grid) for arm in (robot, numeric))
+    assert np.isfinite(answer.mu_path).sum() >= 20
+    np.testing.assert_allclose(by_numeric.mu_path, answer.mu_path, rtol=MAP_EVALUATE_RTOL)
