@@ -280,7 +280,7 @@ function clearMap() {
   state.map = null; state.optimum = null; state.cursor = null; state.tipCell = null;
   $("panels").textContent = "";
   $("tooltip").hidden = true;
-  for (const id of ["summary", "best-mu", "best-where", "cb-label", "cb-min", "cb-max"]) $(id).textContent = "";
+  for (const id of ["summary", "ik-line", "best-mu", "best-where", "cb-label", "cb-min", "cb-max"]) $(id).textContent = "";
   delete $("summary").dataset.cells;
   delete $("summary").dataset.key;
   const bar = $("colourbar-canvas");
@@ -387,6 +387,13 @@ function drawMap(answer) {
   $("summary").textContent = `${cells.length} cells, ${answer.feasible_cells} feasible`
     + (key === "mu_acc" ? `; colour: mu_acc, limited by acceleration in ${byAcc} cells, by speed in ${answer.feasible_cells - byAcc}` : "")
     + (state.mapBody && state.mapBody.cell ? `; ${collisions} in collision with the cell` : "");
+  // How a URDF's IK was solved: the closed form where its chain was recognised (the API's
+  // sentence: the arm, its frames, its parameters), else numeric IK, said as plainly.
+  const urdf = state.mapBody && state.mapBody.robot && state.mapBody.robot.urdf;
+  $("ik-line").textContent = !urdf ? ""
+    : answer.recognised ? `IK in closed form: ${answer.recognised}`
+    : "IK numeric (damped least squares from seeds covering every joint's range): the URDF chain "
+      + "from this base frame to this tool frame is no OPW or UR arm's";
   $("summary").dataset.collisions = String(collisions);
   $("summary").dataset.cells = String(cells.length);
   $("summary").dataset.key = key;
