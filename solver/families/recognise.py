@@ -78,8 +78,7 @@ def recognised_opw(chain: SerialChain) -> OpwFamily | None:
     family.recognised = (
         f"the URDF chain is an OPW arm{where} (forward kinematics equal to "
         f"{FIT_ATOL:g} at {CHECK_CONFIGURATIONS} random configurations): closed-form IK with "
-        f"a1={p.a1:.6g}, a2={p.a2:.6g}, b={p.b:.6g}, c1={p.c1:.6g}, c2={p.c2:.6g}, "
-        f"c3={p.c3:.6g}, c4={p.c4:.6g} m"
+        + _lengths(a1=p.a1, a2=p.a2, b=p.b, c1=p.c1, c2=p.c2, c3=p.c3, c4=p.c4)
     )
     return family
 
@@ -156,9 +155,10 @@ def _ur_fitted(chain: SerialChain, turn: BaseTurn, *, on_flange: bool) -> UrFami
         where += f", whose tool frame is {_said_flange(offset, 'DH')}"
     family.recognised = (
         f"the URDF chain is a UR arm {where} (forward kinematics equal to "
-        f"{FIT_ATOL:g} at random configurations): closed-form IK with d1={lengths.d1:.6g}, "
-        f"a2={lengths.a2:.6g}, a3={lengths.a3:.6g}, d4={lengths.d4:.6g}, d5={lengths.d5:.6g}, "
-        f"d6={lengths.d6:.6g} m"
+        f"{FIT_ATOL:g} at random configurations): closed-form IK with "
+        + _lengths(
+            **{name: getattr(lengths, name) for name in ("d1", "a2", "a3", "d4", "d5", "d6")}
+        )
     )
     return family
 
@@ -220,10 +220,20 @@ def _said_flange(offset: FlangeOffset, family: str = "OPW") -> str:
     """A flange offset in words: the OPW (or DH) flange moved by (x, y, z) m and turned by a deg."""
     cosine = (float(np.trace(offset.rotation)) - 1.0) / 2.0
     angle = math.degrees(math.acos(min(1.0, max(-1.0, cosine))))
-    moved = [round(float(v), 9) + 0.0 for v in offset.translation]  # to the nanometre
+    moved = [_nanometres(v) for v in offset.translation]
     parts = ["moved by ({:.6g}, {:.6g}, {:.6g}) m".format(*moved)] if any(moved) else []
     parts += [f"turned by {angle:.6g} deg"] if angle else []
     return f"the {family} flange " + " and ".join(parts)
+
+
+def _nanometres(value: float) -> float:
+    """A length read off a chain, to the nanometre: a fit's 1e-14 m said as 0."""
+    return round(float(value), 9) + 0.0
+
+
+def _lengths(**lengths: float) -> str:
+    """Fitted lengths in words: ``a1=0.15, a2=-0.2, ... m``, each to the nanometre."""
+    return ", ".join(f"{name}={_nanometres(value):.6g}" for name, value in lengths.items()) + " m"
 
 
 def _matrix(offset: FlangeOffset) -> np.ndarray:

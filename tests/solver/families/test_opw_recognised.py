@@ -225,3 +225,29 @@ def test_a_tool_frame_off_the_opw_flange_gives_the_tool0_answer_with_that_tool_p
                 tool_pose_in_base(cad, expected.q[w]), poses[w], atol=FK_IK_ATOL
             )
     assert checked >= 2
+
+
+def test_the_jaco2s_urdf_is_an_opw_arm_and_maps_as_the_catalogues_numeric_jaco2() -> None:
+    # The Kinova Jaco2 j2s6s200 (spherical wrist) from example-robot-data: its chain is an OPW
+    # arm's whose flange is turned half a turn on the OPW flange. Sent as a URDF it is solved
+    # in closed form; the catalogue's kinova_jaco2 (the same URDF, numeric IK) maps the same.
+    numeric = get_robot("kinova_jaco2")
+    assert numeric.family is not None and numeric.family.name == "numeric"
+    assert numeric.urdf is not None
+    frames = {"base_frame": "j2s6s200_link_base", "tool_frame": "j2s6s200_end_effector"}
+    robot = robot_from_urdf(numeric.urdf, **frames)
+    assert robot.family is not None and robot.family.name == "opw"
+    sentence = robot.family.recognised or ""
+    assert "whose tool frame is the OPW flange turned by 180 deg" in sentence
+    assert "a1=0, a2=0, b=-0.0098" in sentence  # a fit's 1e-14 m said as 0
+    path = load_path("curved_line")
+    grid = {
+        "xs": grid_axis(-0.3, 0.3, 0.1, field="x"),
+        "ys": grid_axis(-0.5, -0.2, 0.1, field="y"),
+        "z": 0.0,
+        "yaws": np.array([0.0, 1.0]),
+    }
+    answer, expected = (capability_map(arm, path, **grid) for arm in (robot, numeric))
+    assert np.isfinite(expected.mu_path).sum() >= 10
+    same = np.isclose(answer.mu_path, expected.mu_path, rtol=MAP_EVALUATE_RTOL, atol=0)
+    assert np.all(same | (np.isnan(answer.mu_path) & np.isnan(expected.mu_path)))
