@@ -14,7 +14,7 @@ import pytest
 from service.config import Settings
 from service.jobs import worker
 from service.jobs.job import Job, JobStoreUnavailable
-from service.jobs.runner import KILL_AFTER, JobRunner
+from service.jobs.runner import IDLE_POLL_SECONDS, KILL_AFTER, POLL_SECONDS, JobRunner
 from service.jobs.store import JobStore
 from service.logs import log
 from tests.cases import ROOT
@@ -163,3 +163,31 @@ def test_a_job_error_keeps_its_real_type(tmp_path: Path) -> None:
     assert failed is not None and failed.status == "failed" and failed.error is not None
     assert failed.error[0]["type"] == "invalid_line"
     assert failed.error[0]["loc"][:3] == ["body", "path", "csv"]
+
+
+def test_an_idle_supervisor_looks_seldom_and_still_finds_another_process_s_job(
+    tmp_path: Path,
+) -> None:
+    # No job: the store is looked at every IDLE_POLL_SECONDS, not every POLL_SECONDS (2 s:
+    # 40 looks; a slow machine looks less often, never more). A job queued through another
+    # handle on the same file (another service process), with no wake, still runs.
+    runner = JobRunner(settings(tmp_path))
+    looks: list[float] = []
+    queued = runner.store.queued
+
+    def counted(**keywords: Any) -> list[str]:
+        looks.append(time.monotonic())
+        return queued(**keywords)
+
+    runner.store.queued = counted  # type: ignore[method-assign]
+    try:
+        time.sleep(0.3)  # the first look (the store opened) is behind
+        looks.clear()
+        time.sleep(2.0)
+        assert len(looks) <= 2.0 / IDLE_POLL_SECONDS + 1, len(looks)
+        assert IDLE_POLL_SECONDS >= 10 * POLL_SECONDS
+        other = JobStore(tmp_path / "jobs.sqlite3")
+        job = other.create("evaluate", EVALUATE)
+        assert wait_for(other, job.id, lambda j: j.status == "done").status == "done"
+    finally:
+        runner.close()
