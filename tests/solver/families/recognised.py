@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from collections.abc import Iterable
+from typing import Any
 
 import numpy as np
 import pytest
@@ -25,13 +26,15 @@ def with_fixed_frame(
     )
 
 
-def answers_alike(robot: Robot, path: np.ndarray, placement: Placement, expected: object) -> bool:
+def answers_alike(
+    robot: Robot, path: np.ndarray, placement: Placement, expected: object, **options: Any
+) -> bool:
     """Whether ``robot``'s answer at ``placement`` is feasible, after asserting it is ``expected``.
 
     The same feasibility and reason; where feasible, mu_path and the joint path, and the map
-    kernel's mu_path at the placement.
+    kernel's mu_path at the placement; ``options`` as the problem's (``spin_mode``).
     """
-    answer = evaluate_path(robot, path, placement)
+    answer = evaluate_path(robot, path, placement, **options)
     assert isinstance(expected, type(answer))
     assert answer.feasible == expected.feasible and answer.reason == expected.reason
     if not expected.feasible:
@@ -39,6 +42,7 @@ def answers_alike(robot: Robot, path: np.ndarray, placement: Placement, expected
     assert answer.mu_path == pytest.approx(expected.mu_path, rel=MAP_EVALUATE_RTOL)
     assert answer.q is not None and expected.q is not None
     np.testing.assert_allclose(answer.q, expected.q, atol=1e-9)
-    kernel = evaluate_placements(robot, prepare_path(robot, path), placement.as_row()[None])
+    cells = placement.as_row()[None]
+    kernel = evaluate_placements(robot, prepare_path(robot, path), cells, **options)
     assert kernel.mu_path[0] == pytest.approx(expected.mu_path, rel=MAP_EVALUATE_RTOL)
     return True

@@ -214,6 +214,8 @@ def test_a_tool_frame_off_the_opw_flange_gives_the_tool0_answer_with_that_tool_p
     )]  # fmt: skip
     checked = 0
     for placement in placements:
+        free = evaluate_path(at_tool0, path, placement, spin_mode="free")
+        answers_alike(cad, path, placement, free, spin_mode="free")  # free spin: [0; z_tool]
         expected = evaluate_path(at_tool0, path, placement)
         if not answers_alike(cad, path, placement, expected):
             continue
