@@ -286,7 +286,7 @@ class BaseTurn:
         return turned
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class FlangeOffset:
     """Where a chain's flange frame {F} sits on a kinematics family's own flange {F'}.
 
@@ -298,6 +298,8 @@ class FlangeOffset:
     Attributes:
         rotation: R_F'_F, shape (3, 3).
         translation: m, {F}'s origin in {F'}, shape (3,).
+
+    Compared by identity (its fields are arrays).
     """
 
     rotation: np.ndarray
@@ -311,6 +313,13 @@ class FlangeOffset:
             for a in (rotation, translation)
         )
         return cls(rotation, translation)
+
+    @property
+    def matrix(self) -> np.ndarray:
+        """E as a homogeneous matrix (4, 4)."""
+        matrix = np.eye(4)
+        matrix[:3, :3], matrix[:3, 3] = self.rotation, self.translation
+        return matrix
 
     def family_flange(
         self, rotation: np.ndarray, position: np.ndarray

@@ -61,7 +61,7 @@ def recognised_opw(chain: SerialChain) -> OpwFamily | None:
     chain_rotation, chain_position = _in_turn(turn, *chain.forward(q))
     paper = forward_kinematics(parameters, q)
     if offset is not None:  # the chain's flange on the OPW flange
-        paper = paper @ _matrix(offset)
+        paper = paper @ offset.matrix
     error = max(
         float(np.abs(chain_rotation - paper[:, :3, :3]).max()),
         float(np.abs(chain_position - paper[:, :3, 3]).max()),
@@ -140,7 +140,7 @@ def _ur_fitted(chain: SerialChain, turn: BaseTurn, *, on_flange: bool) -> UrFami
     chain_rotation, chain_position = _in_turn(turn, *chain.forward(check))
     dh = forward_kinematics_dh(lengths, check)
     if offset is not None:  # the chain's flange on the DH flange
-        dh = dh @ _matrix(offset)
+        dh = dh @ offset.matrix
     error = max(
         float(np.abs(chain_rotation - dh[:, :3, :3]).max()),
         float(np.abs(chain_position - dh[:, :3, 3]).max()),
@@ -234,13 +234,6 @@ def _nanometres(value: float) -> float:
 def _lengths(**lengths: float) -> str:
     """Fitted lengths in words: ``a1=0.15, a2=-0.2, ... m``, each to the nanometre."""
     return ", ".join(f"{name}={_nanometres(value):.6g}" for name, value in lengths.items()) + " m"
-
-
-def _matrix(offset: FlangeOffset) -> np.ndarray:
-    """E as a homogeneous matrix (4, 4)."""
-    matrix = np.eye(4)
-    matrix[:3, :3], matrix[:3, 3] = offset.rotation, offset.translation
-    return matrix
 
 
 def recognised_family(chain: SerialChain) -> KinematicsFamily | None:
