@@ -298,6 +298,7 @@ def test_a_urdf_file_is_taken_as_written_and_a_missing_frame_says_so_once(
     choose_file(page, "#urdf-file", "ur5_robot.urdf", ur5_urdf())
     page.wait_for_function("document.getElementById('urdf').value.length > 0")
     assert page.input_value("#base-frame") == "base"  # REP 199's, the controller's frame
+    assert "REP 199's controller frame" in (page.text_content("#base-frame-hint") or "")
     assert page.input_value("#tool-frame") == ""  # three tip links: the user chooses
     assert page.is_visible("#urdf-note") and page.is_disabled("#robot-model")
     small = {**SMALL, "x-step": "0.1", "y-step": "0.1", "yaws": "0"}
@@ -360,6 +361,10 @@ def test_a_urdf_without_the_controllers_frame_gets_its_root_link(page: Page) -> 
     choose_file(page, "#urdf-file", "ur5_no_base.urdf", text)
     page.wait_for_function("document.getElementById('urdf').value.length > 0")
     assert page.input_value("#base-frame") == "world"  # the chain's one root link
+    hint = page.text_content("#base-frame-hint") or ""
+    assert hint.startswith("world: the URDF's root link") and "no REP 199" in hint
+    page.fill("#base-frame", "base_link")  # a frame of the user's: no hint of ours
+    assert page.text_content("#base-frame-hint") == ""
 
 
 @pytest.mark.parametrize("button", ["#run", "#optimize"])

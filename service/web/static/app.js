@@ -81,9 +81,23 @@ function readUrdfLinks() {
     }
     return !seen.has(link);
   };
-  const base = links.includes("base") && fixedToRoot("base") ? "base" : roots.length === 1 ? roots[0] : "";
+  const controller = links.includes("base") && fixedToRoot("base");
+  const base = controller ? "base" : roots.length === 1 ? roots[0] : "";
   if (base && !$("base-frame").value.trim()) $("base-frame").value = base;
+  state.baseHint = !base ? null : {
+    frame: base,
+    text: controller
+      ? "base: REP 199's controller frame, fixed to the URDF's root; placements and the optimum's controller frames are in it"
+      : `${base}: the URDF's root link (it has no REP 199 controller frame "base" fixed to its root)`,
+  };
   if (tips.length === 1 && !$("tool-frame").value.trim()) $("tool-frame").value = tips[0];
+  showBaseHint();
+}
+
+// Why the base frame holds what the page filled in; gone once the field says another frame.
+function showBaseHint() {
+  const hint = state.baseHint;
+  $("base-frame-hint").textContent = hint && $("base-frame").value.trim() === hint.frame ? hint.text : "";
 }
 
 function ikBody() {
@@ -632,6 +646,7 @@ async function start() {
   $("robot-json").addEventListener("input", showOwnRobot);
   $("urdf").addEventListener("input", showOwnRobot);
   $("urdf").addEventListener("change", readUrdfLinks);
+  $("base-frame").addEventListener("input", showBaseHint);
   $("urdf-file").addEventListener("change", async () => {
     const file = $("urdf-file").files[0];
     if (!file) return;
