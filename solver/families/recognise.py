@@ -20,7 +20,7 @@ import math
 import numpy as np
 
 from solver.core.family import KinematicsFamily
-from solver.core.spatial import BaseTurn, FlangeOffset
+from solver.core.spatial import BaseTurn, FlangeOffset, rotation_vectors
 from solver.families.numeric.chain import SerialChain
 from solver.families.opw.family import OpwFamily
 from solver.families.opw.fit import fit_opw
@@ -218,8 +218,7 @@ def _said(turn: BaseTurn) -> str:
 
 def _said_flange(offset: FlangeOffset, family: str = "OPW") -> str:
     """A flange offset in words: the OPW (or DH) flange moved by (x, y, z) m and turned by a deg."""
-    cosine = (float(np.trace(offset.rotation)) - 1.0) / 2.0
-    angle = math.degrees(math.acos(min(1.0, max(-1.0, cosine))))
+    angle = math.degrees(float(np.linalg.norm(rotation_vectors(offset.rotation))))
     moved = [_nanometres(v) for v in offset.translation]
     parts = ["moved by ({:.6g}, {:.6g}, {:.6g}) m".format(*moved)] if any(moved) else []
     parts += [f"turned by {angle:.6g} deg"] if angle else []
