@@ -27,15 +27,29 @@ def bounds_of(bounds: schemas.Bounds, *, z: float | None) -> PlacementBounds:
 def failure_to_api(
     failure: SearchFailure | None, path: PathInput | None
 ) -> schemas.SearchFailure | None:
-    """The answer's ``failure``: the most common failure, its pass and operation, a sentence."""
+    """The answer's ``failure``: the most common failure, its pass and operation, a sentence.
+
+    With what the search tried on its way, by reason, each with its pass and operation.
+    """
     if failure is None:
         return None
-    k, operation = (None, None) if path is None else pass_at(path, failure.failed_waypoint)
-    where = ""
-    if failure.failed_waypoint is not None:
-        where = f"first at waypoint {failure.failed_waypoint}"
-        if k is not None:
-            where += f" (pass {k}" + ("" if operation is None else f", {operation}") + ")"
+    k, operation = _pass_of(path, failure.failed_waypoint)
+    tried = None
+    if failure.tried is not None:
+        tried = schemas.TriedPlacements(
+            placements=failure.tried.placements,
+            feasible=failure.tried.feasible,
+            reasons=[
+                schemas.ReasonCount(
+                    reason=schemas.FailureReason(t.reason),
+                    count=t.count,
+                    failed_waypoint=t.failed_waypoint,
+                    failed_pass=(where := _pass_of(path, t.failed_waypoint))[0],
+                    failed_operation=where[1],
+                )
+                for t in failure.tried.reasons
+            ],
+        )
     return schemas.SearchFailure(
         reason=schemas.FailureReason(failure.reason),
         failed_waypoint=failure.failed_waypoint,
@@ -43,8 +57,25 @@ def failure_to_api(
         failed_operation=operation,
         count=failure.count,
         judged=failure.judged,
-        message=_failure_message(failure, where),
+        tried=tried,
+        message=_failure_message(failure, _where(failure.failed_waypoint, k, operation))
+        + ("" if tried is None else _tried_message(tried)),
     )
+
+
+def _pass_of(path: PathInput | None, waypoint: int | None) -> tuple[int | None, str | None]:
+    """The pass and operation of a waypoint of the request's path (None, None for none)."""
+    return (None, None) if path is None else pass_at(path, waypoint)
+
+
+def _where(waypoint: int | None, k: int | None, operation: str | None) -> str:
+    """``first at waypoint W (pass K, OPERATION)``, or empty without a waypoint."""
+    if waypoint is None:
+        return ""
+    where = f"first at waypoint {waypoint}"
+    if k is not None:
+        where += f" (pass {k}" + ("" if operation is None else f", {operation}") + ")"
+    return where
 
 
 def _failure_message(failure: SearchFailure, where: str) -> str:
@@ -61,6 +92,28 @@ def _failure_message(failure: SearchFailure, where: str) -> str:
         f"none of the {failure.judged} placements judged on the whole path (the start "
         f"included) runs it; {failure.count} of them {failure.reason}"
         + (where and f", most often {where}")
+    )
+
+
+def _tried_message(tried: schemas.TriedPlacements) -> str:
+    """The sentence's end: the placements the search tried, by reason (most common first)."""
+    reasons = ", ".join(
+        f"{r.count} {r.reason.value}"
+        + (
+            ""
+            if r.failed_waypoint is None
+            else f", most often {_where(r.failed_waypoint, r.failed_pass, r.failed_operation)}"
+        )
+        for r in tried.reasons
+    )
+    if not tried.feasible:
+        return (
+            f"; none of the {tried.placements} placements it tried on the whole path runs it: "
+            + reasons
+        )
+    return (
+        f"; of the {tried.placements} placements it tried on the whole path, {tried.feasible} "
+        f"run it (no candidate from them did)" + (reasons and f", the others: {reasons}")
     )
 
 

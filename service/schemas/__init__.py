@@ -48,10 +48,12 @@ from service.schemas.optimize import (
     Bounds,
     OptimizeRequest,
     OptimizeResponse,
+    ReasonCount,
     SearchFailure,
     SolverInfo,
     SpinPath,
     StartInfo,
+    TriedPlacements,
 )
 from service.schemas.opw_robot import OpwGeometry, OpwRobot
 from service.schemas.path import Path, PosePath, ToolAxisPath
@@ -140,10 +142,12 @@ __all__ = [
     "Robot",
     "RobotInfo",
     "RobotsResponse",
+    "ReasonCount",
     "SearchFailure",
     "SolverInfo",
     "SpinPath",
     "StartInfo",
+    "TriedPlacements",
     "ToolAxisPath",
     "ToolAxisWaypoint",
     "UrdfRobot",

@@ -164,6 +164,77 @@ class StartInfo(ResponseModel):
     )
 
 
+class ReasonCount(ResponseModel):
+    """The placements a search tried that failed for one reason."""
+
+    model_config = ConfigDict(
+        json_schema_extra={
+            "examples": [
+                {
+                    "reason": "joint_limits",
+                    "count": 412,
+                    "failed_waypoint": 39,
+                    "failed_pass": 1,
+                    "failed_operation": "ROTARY_SPIN",
+                }
+            ]
+        }
+    )
+
+    reason: FailureReason = Field(description="The reason.")
+    count: int = Field(description="How many placements tried failed for it.")
+    failed_waypoint: int | None = Field(
+        description="The most common first failing waypoint among them (the lowest of equals)."
+    )
+    failed_pass: int | None = Field(description=FAILED_PASS)
+    failed_operation: str | None = Field(description=FAILED_OPERATION)
+
+
+class TriedPlacements(ResponseModel):
+    """What the search tried on the whole path on its way, by outcome."""
+
+    model_config = ConfigDict(
+        json_schema_extra={
+            "examples": [
+                {
+                    "placements": 600,
+                    "feasible": 0,
+                    "reasons": [
+                        {
+                            "reason": "joint_limits",
+                            "count": 412,
+                            "failed_waypoint": 39,
+                            "failed_pass": 1,
+                            "failed_operation": "ROTARY_SPIN",
+                        },
+                        {
+                            "reason": "unreachable",
+                            "count": 188,
+                            "failed_waypoint": 0,
+                            "failed_pass": 0,
+                            "failed_operation": "FLAT_PASS",
+                        },
+                    ],
+                }
+            ]
+        }
+    )
+
+    placements: int = Field(
+        description="How many distinct placements the search evaluated on the whole path on "
+        "its way: the casadi method's coarse map cells, the scipy method's differential "
+        "evolution members (a program beyond 2,000 waypoints: only those of its placements "
+        "evaluated on the whole path, not its maps or evolutions on a set of its waypoints)."
+    )
+    feasible: int = Field(
+        description="How many of them run the path (its optimiser's candidates from them did not)."
+    )
+    reasons: list[ReasonCount] = Field(
+        description="The others by reason, most common first: which limit closes the bounds "
+        "and where along the path."
+    )
+
+
 class SearchFailure(ResponseModel):
     """Why no placement was found: the most common failure of the placements judged."""
 
@@ -177,8 +248,31 @@ class SearchFailure(ResponseModel):
                     "failed_operation": "ROTARY_SPIN",
                     "count": 1,
                     "judged": 1,
+                    "tried": {
+                        "placements": 600,
+                        "feasible": 0,
+                        "reasons": [
+                            {
+                                "reason": "joint_limits",
+                                "count": 412,
+                                "failed_waypoint": 39,
+                                "failed_pass": 1,
+                                "failed_operation": "ROTARY_SPIN",
+                            },
+                            {
+                                "reason": "unreachable",
+                                "count": 188,
+                                "failed_waypoint": 0,
+                                "failed_pass": 0,
+                                "failed_operation": "FLAT_PASS",
+                            },
+                        ],
+                    },
                     "message": "the search proposed no placement but the start, and the start "
-                    "does not run it: joint_limits, first at waypoint 39 (pass 1, ROTARY_SPIN)",
+                    "does not run it: joint_limits, first at waypoint 39 (pass 1, ROTARY_SPIN); "
+                    "none of the 600 placements it tried on the whole path runs it: 412 "
+                    "joint_limits, most often first at waypoint 39 (pass 1, ROTARY_SPIN), 188 "
+                    "unreachable, most often first at waypoint 0 (pass 0, FLAT_PASS)",
                 }
             ]
         }
@@ -197,6 +291,11 @@ class SearchFailure(ResponseModel):
         description="How many placements the search judged on the whole path (its candidates "
         "and the start), none feasible; 1: the search proposed none of its own (no placement "
         "of its coarse map or evolution was worth judging), the start alone was."
+    )
+    tried: TriedPlacements | None = Field(
+        default=None,
+        description="What the search tried on the whole path on its way (its coarse map's "
+        "cells or its evolution's members), by reason; null where it kept none.",
     )
     message: str = Field(description="The same in a sentence.")
 

@@ -13,6 +13,7 @@ import numpy as np
 
 from solver.core.parallel import SERIAL, TaskRunner
 from solver.core.progress import Progress
+from solver.optimise.failures import Tried
 
 # The candidate of a search whose path turns on the spot somewhere: no placement is better.
 ZERO_SPEED = "mu_path is 0 everywhere: the path turns on the spot"
@@ -57,6 +58,9 @@ class Search:
         runner: where the placements of maps and generations run; the same answer on any.
         active_set: the local solves work on the waypoints that bind
             (:mod:`solver.optimise.active_set`); False solves the whole path (the reference).
+        tried: where the search keeps the placements it tries on the whole path (its coarse
+            map's, its evolution's), for a failure's tally (:mod:`solver.optimise.failures`);
+            None keeps none.
     """
 
     symmetric: bool
@@ -69,3 +73,4 @@ class Search:
     progress: Progress | None = None
     runner: TaskRunner = SERIAL
     active_set: bool = True
+    tried: Tried | None = None

@@ -29,6 +29,7 @@ import numpy as np
 from solver.core.parallel import SERIAL, TaskRunner
 from solver.core.progress import Progress, span
 from solver.optimise.active_set import ACTIVE_SET_RTOL, FIRST_ROWS, closure, lowest
+from solver.optimise.failures import Tried
 from solver.path.placements import PlacementResults, evaluate_placements
 from solver.path.problem import PathProblem
 from solver.path.subset import on_waypoints
@@ -68,6 +69,7 @@ def map_values(
     *,
     progress: Progress | None = None,
     runner: TaskRunner = SERIAL,
+    tried: Tried | None = None,
 ) -> MapValues:
     """The coarse map's values: of the whole path, or of its verified maxima (see the module).
 
@@ -78,13 +80,18 @@ def map_values(
             placement indices, best first.
         progress: called with the fraction done.
         runner: where the placements run.
+        tried: keeps the placements evaluated on the whole path: every one of a whole-path
+            map, a long program's sample and verified cells (not its maps on a set).
     """
+    tried = Tried() if tried is None else tried
     n = problem.prepared.n_waypoints
     if n <= MAX_MAP_ROWS:
         whole = evaluate_placements(problem, placements, progress=progress, runner=runner)
+        tried.record(placements, whole.reason, whole.failed_waypoint)
         return MapValues(whole.feed_index, whole.branch)
     sample = np.unique(np.linspace(0, len(placements) - 1, SAMPLE_CELLS).round().astype(int))
-    first = binding_rows(problem, placements[sample], None, runner)[0]
+    first, sampled = binding_rows(problem, placements[sample], None, runner)
+    tried.record(placements[sample], sampled.reason, sampled.failed_waypoint)
     rows = closure(problem, first, neighbours=False)
     feed_index = np.full(len(placements), np.nan)
     branch = np.zeros(len(placements), dtype=int)
@@ -97,6 +104,7 @@ def map_values(
         added, whole = binding_rows(
             problem, placements[best], on_set.feed_index[best], runner, rows
         )
+        tried.record(placements[best], whole.reason, whole.failed_waypoint)
         feed_index[:] = np.nan
         feed_index[best], branch[best] = whole.feed_index, whole.branch
         grown = closure(problem, np.union1d(rows, added), neighbours=False)

@@ -18,6 +18,7 @@ from solver.core.parallel import SERIAL, TaskRunner
 from solver.core.progress import Progress
 from solver.core.spatial import MAX_COORDINATE
 from solver.optimise.coarse_rows import map_values, mapped_waypoints
+from solver.optimise.failures import Tried
 from solver.optimise.search_space import PlacementBounds, decision_vector
 from solver.optimise.symmetry import arc_point
 from solver.path.problem import PathProblem
@@ -194,6 +195,7 @@ def coarse_cells(
     max_poses: int | None = None,
     progress: Progress | None = None,
     runner: TaskRunner = SERIAL,
+    tried: Tried | None = None,
 ) -> list[Cell]:
     """Local maxima of a coarse map over the bounds, best first.
 
@@ -202,7 +204,8 @@ def coarse_cells(
     is free. Every cell on the problem's branch policy (``auto``, for the optimisers). A
     program longer than :data:`solver.optimise.coarse_rows.MAX_MAP_ROWS` is mapped on the
     waypoints that bind its best cells, and only those cells, verified on the whole path, are
-    returned (:mod:`solver.optimise.coarse_rows`).
+    returned (:mod:`solver.optimise.coarse_rows`). ``tried`` keeps the cells evaluated on the
+    whole path (:mod:`solver.optimise.failures`).
 
     Raises:
         InvalidInputError: the map would have more than ``max_cells`` cells, or more than
@@ -246,7 +249,9 @@ def coarse_cells(
             found = _local_maxima(full.reshape(full_shape), periodic_axes)
             return [int(position[np.ravel_multi_index(i, full_shape)]) for i in found]
 
-        result = map_values(problem, np.array(rows), maxima, progress=progress, runner=runner)
+        result = map_values(
+            problem, np.array(rows), maxima, progress=progress, runner=runner, tried=tried
+        )
         mu[inside_index], branch[inside_index] = result.feed_index, result.branch
     cells = []
     for index in _local_maxima(mu.reshape(full_shape), periodic_axes):

@@ -28,7 +28,7 @@ from solver.core.robots import Robot
 from solver.core.spatial import Placement, spun_waypoints
 from solver.optimise.candidate import Candidate, Search
 from solver.optimise.coarse_search import MAX_COARSE_CELLS
-from solver.optimise.failures import search_failure
+from solver.optimise.failures import Tried, search_failure
 from solver.optimise.methods import Method, method_named
 from solver.optimise.optimum import PlacementOptimum, SolverReport
 from solver.optimise.search_space import PlacementBounds, variables_of, vector_of
@@ -159,6 +159,7 @@ def optimize_placement(
         progress=progress,
         runner=runner,
         active_set=active_set,
+        tried=Tried(),
     )
     chosen_method.check(problem, bounds, settings)
     prepared = problem.prepared  # the path is checked before the options (evaluate_path's)
@@ -186,7 +187,9 @@ def optimize_placement(
             solver=dataclasses.replace(report, status="no feasible placement inside the bounds"),
             symmetric=settings.symmetric,
             start_evaluation=start_evaluation,
-            failure=search_failure(judged),
+            failure=search_failure(
+                judged, None if settings.tried is None else settings.tried.summary()
+            ),
         )
     index, placement, evaluation, chosen = best
     status = chosen.status

@@ -57,9 +57,23 @@ def test_bounds_out_of_reach_say_unreachable_at_the_first_waypoint(client: TestC
     assert failure["count"] == failure["judged"] >= 1
     assert (failure["failed_pass"], failure["failed_operation"]) == (None, None)  # poses
     assert failure["judged"] == 1  # the coarse map has no placement to propose: the start alone
+    # Every placement its coarse map tried is 5 m from a 0.85 m arm: out of reach at once.
+    tried = failure["tried"]
+    n = tried["placements"]
+    assert n > 1 and tried["feasible"] == 0
+    assert tried["reasons"] == [
+        {
+            "reason": "unreachable",
+            "count": n,
+            "failed_waypoint": 0,
+            "failed_pass": None,
+            "failed_operation": None,
+        }
+    ]
     assert failure["message"] == (
         "the search proposed no placement but the start, and the start does not run it: "
-        "unreachable, first at waypoint 0"
+        f"unreachable, first at waypoint 0; none of the {n} placements it tried on the whole "
+        f"path runs it: {n} unreachable, most often first at waypoint 0"
     )
     start = answer["start"]
     assert (start["mu_path"], start["reason"], start["failed_waypoint"]) == (
@@ -69,13 +83,30 @@ def test_bounds_out_of_reach_say_unreachable_at_the_first_waypoint(client: TestC
     )
 
 
-def test_a_rotary_table_operation_is_named_as_why_nothing_is_found(client: TestClient) -> None:
-    answer = post(client, "/v1/optimize", {"path": {"cl_data": program()}, **BOUNDS})
+@pytest.mark.parametrize("method", ["casadi", "scipy"])
+def test_a_rotary_table_operation_is_named_as_why_nothing_is_found(
+    client: TestClient, method: str
+) -> None:
+    body = {"path": {"cl_data": program()}, **BOUNDS, "method": method}
+    answer = post(client, "/v1/optimize", body)
     assert not answer["found"] and answer["solver"]["status"].startswith("no feasible")
     failure = answer["failure"]
     assert failure["failed_waypoint"] >= FLAT  # in the second operation
     assert (failure["failed_pass"], failure["failed_operation"]) == (1, "ROTARY_SPIN")
     assert "(pass 1, ROTARY_SPIN)" in failure["message"]
+    # What the search tried (its coarse map, its evolution) fails in the rotary operation too,
+    # each reason most often there; the sentence says it, most common first.
+    tried = failure["tried"]
+    assert tried["feasible"] == 0
+    counts = [r["count"] for r in tried["reasons"]]
+    assert sum(counts) == tried["placements"] > 1 and counts == sorted(counts, reverse=True)
+    for r in tried["reasons"]:
+        assert r["failed_waypoint"] >= FLAT
+        assert (r["failed_pass"], r["failed_operation"]) == (1, "ROTARY_SPIN")
+        assert (
+            f"{r['count']} {r['reason']}, most often first at waypoint {r['failed_waypoint']} "
+            "(pass 1, ROTARY_SPIN)" in failure["message"]
+        )
     assert answer["start"]["reason"] is not None and answer["start"]["failed_waypoint"] >= FLAT
     alone = post(
         client, "/v1/evaluate", {"path": {"cl_data": program(rotary=False)}, "placement": AT}

@@ -64,6 +64,7 @@ def search(
         max_poses=settings.max_coarse_poses,
         progress=span(progress, 0.0, 0.25),
         runner=runner,
+        tried=settings.tried,
     )
     cells = refine_cells(problem, bounds, cells, progress=span(progress, 0.25, 0.3), runner=runner)
     if not cells:

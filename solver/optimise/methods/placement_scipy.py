@@ -23,6 +23,7 @@ import scipy.optimize
 
 from solver.core.parallel import SERIAL, TaskRunner
 from solver.core.progress import Progress
+from solver.optimise.failures import Tried
 from solver.optimise.search_space import PlacementBounds, variables_of
 from solver.path.placements import evaluate_placements
 from solver.path.problem import PathProblem
@@ -138,17 +139,20 @@ def global_search(
     size: SearchSize = FULL_SEARCH,
     progress: Progress | None = None,
     runner: TaskRunner = SERIAL,
+    tried: Tried | None = None,
 ) -> tuple[list[Basin], int]:
     """Differential evolution over the free variables; the best point of each distinct basin.
 
-    Every placement DE evaluates is kept; the best ones that lie apart (:func:`distinct_best`)
-    are returned, up to ``size.basins``: DE settles in one basin, and the landscape has
-    near-equal mirror-image optima.
+    Every placement DE evaluates is kept (in ``tried`` too, with its outcome); the best ones
+    that lie apart (:func:`distinct_best`) are returned, up to ``size.basins``: DE settles in
+    one basin, and the landscape has near-equal mirror-image optima.
 
     Returns:
         ([(decision vector, mu_path, branch index), ...] best first, generations).
     """
-    seen, generations = evolve(problem, bounds, size=size, progress=progress, runner=runner)
+    seen, generations = evolve(
+        problem, bounds, size=size, progress=progress, runner=runner, tried=tried
+    )
     chosen = distinct_best(seen, symmetric, size.basins)
     return [(seen.vectors[i].copy(), float(seen.mu[i]), int(seen.branch[i])) for i in chosen], (
         generations
@@ -177,8 +181,12 @@ def evolve(
     size: SearchSize = FULL_SEARCH,
     progress: Progress | None = None,
     runner: TaskRunner = SERIAL,
+    tried: Tried | None = None,
 ) -> tuple[Seen, int]:
     """Differential evolution over the free variables of ``bounds``, on ``problem``'s path.
+
+    ``tried`` keeps every placement evaluated with its outcome (pass it only where
+    ``problem`` is the whole path: :mod:`solver.optimise.failures`).
 
     With a cell, a placement in collision scores worse than any feasible one but by its
     mu_path without the cell (``collisions_scored``), not as flat as the kinematics'
@@ -192,7 +200,10 @@ def evolve(
 
     def objective(points: np.ndarray) -> np.ndarray:  # points: (F, S)
         vectors = full_vectors(bounds, points.T)
-        result = evaluate_placements(problem, bounds.rows(vectors), runner=runner)
+        rows = bounds.rows(vectors)
+        result = evaluate_placements(problem, rows, runner=runner)
+        if tried is not None:
+            tried.record(rows, result.reason, result.failed_waypoint)
         seen.append((vectors, result.feed_index, result.branch))
         if progress is not None:
             progress(len(seen) / (size.generations + 1))

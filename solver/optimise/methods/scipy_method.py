@@ -149,6 +149,7 @@ def _global(
             size=size,
             progress=progress,
             runner=settings.runner,
+            tried=settings.tried,
         )
     found = search_on_rows(
         problem,
