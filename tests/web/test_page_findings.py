@@ -437,3 +437,23 @@ def test_an_empty_feed_is_left_unset_and_a_zero_feed_is_the_apis_error_beside_it
     assert [d["loc"] for d in detail] == [["body", "feed"]]
     assert error_beside(page, "feed") == detail[0]["msg"]
     assert page.get_attribute("#plot", "data-drawn") is None  # the previous cell's plot is gone
+
+
+def test_an_optimisation_that_finds_nothing_says_why(page: Page, url: str) -> None:
+    """Bounds 5 m from a UR5: the page says no placement, and why, in the API's words."""
+    far = {**SMALL, "x-min": "5", "x-max": "5.1", "y-min": "5", "y-max": "5.1", "z": "0"}
+    fill(page, {**far, "yaws": "0, 0.5"})
+    page.click("#optimize")
+    page.wait_for_selector("#opt-why:not([hidden])", timeout=120_000)
+    body = {
+        "robot": {"model": "ur5"},
+        "path": EXAMPLE_PATH,
+        "method": "casadi",
+        "z": 0.0,
+        "bounds": {"x": [5.0, 5.1], "y": [5.0, 5.1], "yaw": [0.0, 0.5]},
+    }
+    api = httpx.post(f"{url}/v1/optimize", json=body, timeout=120).json()
+    assert not api["found"] and api["failure"]["tried"]["reasons"][0]["reason"] == "unreachable"
+    assert page.text_content("#opt-mu") == "no feasible placement"
+    assert page.text_content("#opt-why") == f"Why: {api['failure']['message']}."
+    snapshot(page, "optimum-not-found-says-why")

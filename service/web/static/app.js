@@ -312,9 +312,10 @@ function clearCell() {
 }
 
 function clearOptimum() {
-  for (const id of ["opt-mu", "opt-acc", "opt-acc-binds", "opt-improvement", "opt-where", "opt-clearance"]) $(id).textContent = "";
+  for (const id of ["opt-mu", "opt-acc", "opt-acc-binds", "opt-improvement", "opt-where", "opt-clearance", "opt-why"]) $(id).textContent = "";
   $("opt-acc-line").hidden = true;
   $("opt-clearance").hidden = true;
+  $("opt-why").hidden = true;
   $("opt-mu-line").hidden = true;
   $("frames").tBodies[0].textContent = "";
   $("frames").hidden = true;

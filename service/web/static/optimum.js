@@ -55,6 +55,10 @@ async function optimize() {
   if (!answer) { $("opt-mu").textContent = "no optimum: see the errors above"; return; }
   if (!answer.found) {
     $("opt-mu").textContent = body.cell ? "no feasible placement free of collisions" : "no feasible placement";
+    if (answer.failure) {  // why: the start's failure and what the search tried, by reason
+      $("opt-why").textContent = `Why: ${answer.failure.message}.`;
+      $("opt-why").hidden = false;
+    }
     return;
   }
   if (body.cell && answer.evaluation) {
