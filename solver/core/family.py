@@ -93,10 +93,11 @@ class KinematicsFamily(abc.ABC):
     #: recognised in a URDF's chain, :mod:`solver.families.recognise`); ``None`` otherwise.
     recognised: str | None = None
     #: The frame the family solves in, where it is not {B}: a turn about {B}'s z and a shift
-    #: (a URDF chain recognised from a base frame other than the arm's own). :meth:`solve` and
-    #: :meth:`joint_speeds_per_unit_twist` still take {B}; a compiled map kernel, which places
-    #: the path itself, takes its placements in that frame
-    #: (:meth:`solver.core.spatial.BaseTurn.placements_in`). ``None``: {B}.
+    #: (a URDF chain recognised from a base frame other than the arm's own), after a tilt where
+    #: joint 1 is not upright in {B}. :meth:`solve` and :meth:`joint_speeds_per_unit_twist`
+    #: still take {B}; a compiled map kernel, which places the path itself, takes its
+    #: placements in that frame (:meth:`solver.core.spatial.BaseTurn.placements_in`), and none
+    #: takes a tilted one. ``None``: {B}.
     base_turn: BaseTurn | None = None
     #: Where the chain's flange sits on the family's own, where they differ (a URDF whose tool
     #: frame is turned or moved on the last link): :meth:`solve` still takes the chain's flange;

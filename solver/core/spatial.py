@@ -241,13 +241,21 @@ class BaseTurn:
     (:mod:`solver.families.recognise`). A turn about z keeps a placement a placement: {O} at
     (x, y, z, yaw) in {B} is at :meth:`placements_in` in {A}, so a map's kernels take it whole.
 
+    A family whose first joint is not upright in {B} (an arm on a wall or a ceiling, read from
+    its cell's frame) solves in a frame whose z is that joint's axis: {B} is first tilted by
+    ``tilt`` (R_B_T), then turned about the tilted z. A placement is then no placement of {A}
+    (its yaw is about {B}'s z), so the map kernels cannot take it (:meth:`placements_in`
+    refuses) and the numpy pipeline runs.
+
     Attributes:
-        angle: rad, about {B}'s z.
+        angle: rad, about {B}'s z (about the tilted z where there is a tilt).
         shift: m, {A}'s origin in {B}.
+        tilt: R_B_T row by row (9 values), where {A}'s z is not {B}'s; None: no tilt.
     """
 
     angle: float
     shift: tuple[float, float, float]
+    tilt: tuple[float, ...] | None = None
 
     @classmethod
     def read(cls, angle: float, x: float, y: float) -> BaseTurn:
@@ -260,14 +268,27 @@ class BaseTurn:
             return cls(0.0, (0.0, 0.0, 0.0))
         return cls(float(angle), (float(x), float(y), 0.0))
 
+    def tilted(self, rotation: np.ndarray) -> BaseTurn:
+        """This turn, read in {T} = {B} turned by ``rotation`` (R_B_T), as a turn of {B}."""
+        shift = np.asarray(rotation, dtype=float) @ np.asarray(self.shift, dtype=float)
+        rows = tuple(float(v) for v in np.asarray(rotation, dtype=float).ravel())
+        return BaseTurn(self.angle, (float(shift[0]), float(shift[1]), float(shift[2])), rows)
+
     @property
     def is_identity(self) -> bool:
         """{A} is {B}."""
-        return self.angle == 0.0 and not any(self.shift)
+        return self.angle == 0.0 and not any(self.shift) and self.tilt is None
+
+    @property
+    def tilt_matrix(self) -> np.ndarray | None:
+        """R_B_T (3, 3), or None without a tilt."""
+        return None if self.tilt is None else np.array(self.tilt).reshape(3, 3)
 
     def _inverse(self) -> np.ndarray:
-        """R_A_B (3, 3): Rz(-angle)."""
-        return rotation_about_z(-self.angle)
+        """R_A_B (3, 3): Rz(-angle), after R_T_B where there is a tilt."""
+        turn = rotation_about_z(-self.angle)
+        tilt = self.tilt_matrix
+        return turn if tilt is None else turn @ tilt.T
 
     def vectors_in(self, vectors: np.ndarray) -> np.ndarray:
         """Directions (3, ...) in {B} axes, in {A} axes."""
@@ -279,7 +300,13 @@ class BaseTurn:
         return self.vectors_in(points - shift)
 
     def placements_in(self, placements: np.ndarray) -> np.ndarray:
-        """Placements (P, 5) [x, y, z, yaw, spin] of {O} in {B}, as placements in {A}."""
+        """Placements (P, 5) [x, y, z, yaw, spin] of {O} in {B}, as placements in {A}.
+
+        Raises:
+            ValueError: the turn has a tilt (no placement of {A} is one of {B}).
+        """
+        if self.tilt is not None:
+            raise ValueError("a tilted base frame takes no placement of {B} whole")
         turned = np.array(placements, dtype=float)
         turned[:, :3] = self.points_in(turned[:, :3].T).T
         turned[:, 3] = turned[:, 3] - self.angle

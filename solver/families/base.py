@@ -13,6 +13,11 @@ import numpy as np
 from solver.core.family import Branch, KinematicsFamily
 from solver.core.progress import Progress
 
+UNCOMPILED_MAP_COST = 40.0
+"""A closed-form map's work a pose on the numpy pipeline, in poses of the compiled kernel: the
+ERK-size UR5 map took 37.5 times the kernel's time in fixed spin, 26.7 in free spin (one
+thread, 2026-12-04, the machine loaded by a test run; the KR6 R700's 3.5 and 5.5)."""
+
 
 class ClosedFormFamily(KinematicsFamily):
     """A six-joint family whose IK and J^-1 t are closed-form functions of its parameters.
@@ -57,12 +62,31 @@ class ClosedFormFamily(KinematicsFamily):
             position = self.base_turn.points_in(position)
         return type(self).solve_function(self.parameters, rotation, position)
 
+    @property
+    def tilted(self) -> bool:
+        """Whether the family solves in a frame whose z is not {B}'s (its base turn's tilt)."""
+        return self.base_turn is not None and self.base_turn.tilt is not None
+
     def map_kernel(self) -> tuple[int, np.ndarray] | None:
-        """The family's pose kernel code and this arm's kernel parameters (see the base)."""
+        """The family's pose kernel code and this arm's kernel parameters (see the base).
+
+        None where the family's frame is tilted from {B}: the kernels place a path by a turn
+        about z (:meth:`solver.core.spatial.BaseTurn.placements_in`); the numpy pipeline runs.
+        """
         make = type(self).kernel_parameters_function
-        if self.kernel_code is None or make is None:
+        if self.kernel_code is None or make is None or self.tilted:
             return None
         return self.kernel_code, make(self.parameters)
+
+    def path_cost(self, n_waypoints: int, *, free_spin: bool = False) -> float:
+        """A pose a waypoint (the unit), UNCOMPILED_MAP_COST poses where the family is tilted.
+
+        A tilted family's maps, coarse maps and evolutions run the numpy pipeline
+        (:meth:`map_kernel`); its evaluation of one placement is charged alike (it runs the
+        same pipeline as an upright family's: over-charged, far below any limit).
+        """
+        cost = float(n_waypoints)
+        return cost * UNCOMPILED_MAP_COST if self.tilted else cost
 
     def joint_speeds_per_unit_twist(
         self,

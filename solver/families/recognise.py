@@ -10,11 +10,15 @@ equals the chain's forward kinematics at ``CHECK_CONFIGURATIONS`` random configu
 A UR arm is also recognised in a turn of {B} about z and a shift (ROS's ``base_link`` is half a
 turn from the DH frame ``base``), an OPW arm in a shift of {B} (a turn about z is its joint 1's
 offset): the family then solves in its own frame (:attr:`KinematicsFamily.base_turn`), which
-its answers name.
+its answers name. Where joint 1 is not upright in {B} (an arm on a wall or a ceiling, read from
+its cell's frame), the chain is read in {B} tilted so that joint 1's axis is z
+(:func:`first_axis_tilt`) and recognised there; its maps then run the numpy pipeline (the
+compiled kernels place a path by a turn about {B}'s z only).
 """
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
 import numpy as np
@@ -38,17 +42,19 @@ CHECK_SEED = 27
 _NO_LENGTHS = UrDh(0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
 
 
-def recognised_opw(chain: SerialChain) -> OpwFamily | None:
+def recognised_opw(chain: SerialChain, tilt: np.ndarray | None = None) -> OpwFamily | None:
     """The OPW family of ``chain``, when the chain is an OPW arm's (forward kinematics equal).
 
     Args:
         chain: a serial chain from {B} to the flange.
+        tilt: R_B_T, where the chain is read in {B} tilted by it (:func:`first_axis_tilt`).
 
     Returns:
         An :class:`OpwFamily` whose ``recognised`` says where its parameters came from, or None.
     """
     if chain.dof != 6 or not chain.revolute.all():
         return None
+    chain = chain if tilt is None else tilted_chain(chain, tilt)
     axes, origins, rotation, position = chain.frames(np.zeros((1, 6)))
     turn = opw_base_shift(axes[0, 0], origins[0, 0])
     fitted = fit_opw(
@@ -69,6 +75,7 @@ def recognised_opw(chain: SerialChain) -> OpwFamily | None:
     if error > FIT_ATOL:
         return None
     family = OpwFamily(parameters)
+    turn = turn if tilt is None else turn.tilted(tilt)
     family.base_turn = None if turn.is_identity else turn
     family.flange_offset = offset
     p = parameters
@@ -99,7 +106,7 @@ def opw_base_shift(axis: np.ndarray, point: np.ndarray) -> BaseTurn:
     return BaseTurn.read(0.0, point[0], point[1])
 
 
-def recognised_ur(chain: SerialChain) -> UrFamily | None:
+def recognised_ur(chain: SerialChain, tilt: np.ndarray | None = None) -> UrFamily | None:
     """The UR family of ``chain``, when the chain is a UR arm's in {B} or in a turn of {B}.
 
     The DH base frame may be {B} turned about z and moved (ROS's ``base_link`` is half a turn
@@ -110,21 +117,29 @@ def recognised_ur(chain: SerialChain) -> UrFamily | None:
 
     Args:
         chain: a serial chain from {B} to the flange.
+        tilt: R_B_T, where the chain is read in {B} tilted by it (:func:`first_axis_tilt`).
 
     Returns:
         A :class:`UrFamily` whose ``recognised`` says where its lengths came from, or None.
     """
     if chain.dof != 6 or not chain.revolute.all():
         return None
+    chain = chain if tilt is None else tilted_chain(chain, tilt)
     turn = ur_base_turn(chain)
-    family = None if turn is None else _ur_fitted(chain, turn, on_flange=True)
+    family = None if turn is None else _ur_fitted(chain, turn, on_flange=True, tilt=tilt)
     if family is None and (turn := ur_axis_turn(chain)) is not None:
-        family = _ur_fitted(chain, turn, on_flange=False)
+        family = _ur_fitted(chain, turn, on_flange=False, tilt=tilt)
     return family
 
 
-def _ur_fitted(chain: SerialChain, turn: BaseTurn, *, on_flange: bool) -> UrFamily | None:
-    """The UR family of ``chain`` in ``turn``, its flange the DH flange or fixed on it."""
+def _ur_fitted(
+    chain: SerialChain, turn: BaseTurn, *, on_flange: bool, tilt: np.ndarray | None
+) -> UrFamily | None:
+    """The UR family of ``chain`` in ``turn``, its flange the DH flange or fixed on it.
+
+    ``tilt``: the chain is read in {B} tilted by it (:func:`tilted_chain`); the family's turn
+    is then that too.
+    """
     q = np.random.default_rng(CHECK_SEED).uniform(-math.pi, math.pi, (CHECK_CONFIGURATIONS, 6))
     rotation, position = _in_turn(turn, *chain.forward(q))
     offset = None
@@ -148,6 +163,7 @@ def _ur_fitted(chain: SerialChain, turn: BaseTurn, *, on_flange: bool) -> UrFami
     if error > FIT_ATOL:
         return None
     family = UrFamily(lengths)
+    turn = turn if tilt is None else turn.tilted(tilt)
     family.base_turn = None if turn.is_identity else turn
     family.flange_offset = offset
     where = "in its DH base frame" if turn.is_identity else f"whose DH base frame is {_said(turn)}"
@@ -209,8 +225,22 @@ def _in_turn(
 
 
 def _said(turn: BaseTurn) -> str:
-    """A turn in words: {B} turned by 180 deg about z and moved to (x, y, z) m, either part."""
-    parts = [f"turned by {math.degrees(turn.angle):.6g} deg about z"] if turn.angle else []
+    """A turn in words: {B} turned by 180 deg about z and moved to (x, y, z) m, either part.
+
+    A tilt first: {B} tilted by 90 deg about (1, 0, 0), then turned about the tilted z.
+    """
+    parts = []
+    tilt = turn.tilt_matrix
+    if tilt is not None:
+        vector = rotation_vectors(tilt)
+        angle = float(np.linalg.norm(vector))
+        axis = vector / angle
+        parts.append(
+            f"tilted by {math.degrees(angle):.6g} deg about "
+            "({:.6g}, {:.6g}, {:.6g}) (joint 1's axis its z)".format(*(axis + 0.0))
+        )
+    about = "the tilted z" if tilt is not None else "z"
+    parts += [f"turned by {math.degrees(turn.angle):.6g} deg about {about}"] if turn.angle else []
     if any(turn.shift):
         parts.append("moved to ({:.6g}, {:.6g}, {:.6g}) m".format(*turn.shift))
     return "{B} " + " and ".join(parts)
@@ -242,4 +272,43 @@ def recognised_family(chain: SerialChain) -> KinematicsFamily | None:
     """
     if chain.coupling is not None:
         return None
-    return recognised_opw(chain) or recognised_ur(chain)
+    found = recognised_opw(chain) or recognised_ur(chain)
+    if found is not None or (tilt := first_axis_tilt(chain)) is None:
+        return found
+    return recognised_opw(chain, tilt) or recognised_ur(chain, tilt)
+
+
+def first_axis_tilt(chain: SerialChain) -> np.ndarray | None:
+    """R_B_T turning {B}'s z onto joint 1's axis at q = 0, where it is not upright (else None).
+
+    The least turn that does it (about z x axis; half a turn about x for an axis along -z);
+    the turn about the new z that is left is the family's own (an OPW arm's joint 1 offset, a
+    UR arm's base turn).
+    """
+    if not len(chain.revolute):
+        return None
+    axes, _, _, _ = chain.frames(np.zeros((1, chain.dof)))
+    axis = axes[0, 0] / np.linalg.norm(axes[0, 0])
+    if abs(float(axis[2]) - 1.0) <= FIT_ATOL:
+        return None
+    if abs(float(axis[2]) + 1.0) <= FIT_ATOL:  # hanging from a ceiling: half a turn about x
+        return np.diag([1.0, -1.0, -1.0])
+    normal = np.cross([0.0, 0.0, 1.0], axis)
+    sine, cosine = float(np.linalg.norm(normal)), float(axis[2])
+    k = normal / sine
+    cross = np.array([[0.0, -k[2], k[1]], [k[2], 0.0, -k[0]], [-k[1], k[0], 0.0]])
+    tilt: np.ndarray = np.eye(3) + sine * cross + (1.0 - cosine) * cross @ cross
+    return tilt
+
+
+def tilted_chain(chain: SerialChain, tilt: np.ndarray) -> SerialChain:
+    """``chain`` read in {T} = {B} turned by ``tilt`` (R_B_T): its base pose taken into {T}.
+
+    {T}'s origin is {B}'s: the lengths along joint 1's axis (UR d1, OPW c1) are then from the
+    plane through {B}'s origin normal to it.
+    """
+    return dataclasses.replace(
+        chain,
+        base_rotation=tilt.T @ chain.base_rotation,
+        base_translation=tilt.T @ chain.base_translation,
+    )

@@ -351,7 +351,7 @@ UR5_URDF = example_robot_data_dir() / "ur_description" / "urdf" / "ur5_robot.urd
 
 
 def _tilted_ur5(folder: Path) -> Path:
-    """The UR5's URDF with a frame ``tilted``: base_link turned by a mrad about x (numeric IK)."""
+    """The UR5's URDF with a frame ``tilted``: base_link turned by a mrad about x."""
     tilted = '<link name="tilted"/><joint name="tilt" type="fixed"><parent link="base_link"/>'
     tilted += '<child link="tilted"/><origin xyz="0 0 0" rpy="0.001 0 0"/></joint></robot>'
     file = folder / "ur5.urdf"
@@ -359,12 +359,23 @@ def _tilted_ur5(folder: Path) -> Path:
     return file
 
 
+def _bent_ur5(folder: Path) -> Path:
+    """The UR5's URDF with its elbow's axis turned by a mrad: no UR or OPW arm (numeric IK)."""
+    text = UR5_URDF.read_text()
+    elbow = '<origin rpy="0.0 0.0 0.0" xyz="0.0 -0.1197 0.425"/>'
+    assert text.count(elbow) == 1
+    file = folder / "ur5_bent.urdf"
+    file.write_text(text.replace(elbow, elbow.replace('rpy="0.0 0.0 0.0"', 'rpy="0.001 0 0"')))
+    return file
+
+
 def test_a_urdf_file_is_the_routes_urdf_robot_from_its_controller_frame_to_tool0(
     client: TestClient, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
     # By default from REP 199's base (the controller's frame: the UR5's DH frame) to tool0;
-    # from ROS's base_link, half a turn from it, and from base the UR5 is solved in closed
-    # form, from a tilted frame numerically, and that answer says where the closed form is.
+    # from ROS's base_link, half a turn from it, from base, and from a frame tilted by a mrad
+    # (joint 1 not upright in it; {B} is that frame, so the arm is tilted by -1 mrad from it)
+    # the UR5 is solved in closed form, and the answer says how.
     file = _tilted_ur5(tmp_path)
     at = ["evaluate", str(PROGRAM), "--robot", str(file), "--at=0,0.3,0,0"]
     path = {"cl_data": PROGRAM.read_text()}
@@ -379,16 +390,15 @@ def test_a_urdf_file_is_the_routes_urdf_robot_from_its_controller_frame_to_tool0
         assert json.loads(out) == answers[base]
         code, out, _ = run(capsys, *at, *options)
         answers[base]["printed"] = out.splitlines()[0]
-    for base in ("base_link", "base"):
+    for base in ("base_link", "base", "tilted"):
         assert answers[base]["ik"]["family"] == "ur"
         recognised = answers[base]["ik"]["recognised"]
         assert answers[base]["printed"] == f"robot: {file}, from {base} to tool0; {recognised}"
     assert "turned by 180 deg about z" in answers["base_link"]["ik"]["recognised"]
-    assert answers["tilted"]["ik"]["family"] == "numeric"
-    assert answers["tilted"]["printed"] == (
-        f"robot: {file}, from tilted to tool0; numeric IK (the closed form from another base "
-        "frame: --base-frame world or --base-frame base_link or --base-frame base)"
-    )
+    assert "tilted by 0.0572958 deg about (-1, 0, 0)" in answers["tilted"]["ik"]["recognised"]
+    bent = _bent_ur5(tmp_path)
+    code, out, _ = run(capsys, "evaluate", str(PROGRAM), "--robot", str(bent), "--at=0,0.3,0,0")
+    assert out.splitlines()[0] == f"robot: {bent}, from base to tool0; numeric IK"
 
 
 def test_a_urdf_without_the_controllers_frame_starts_from_base_link(
@@ -477,15 +487,15 @@ def test_optimise_searches_a_height_range_and_a_spin_range_as_the_route(
 def test_a_branch_is_followed_as_the_routes_ik_branch_and_printed(
     client: TestClient, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    file = _tilted_ur5(tmp_path)  # numeric IK from its frame "tilted"
-    urdf = {"urdf": file.read_text(), "base_frame": "tilted", "tool_frame": "tool0"}
+    file = _bent_ur5(tmp_path)  # numeric IK
+    urdf = {"urdf": file.read_text(), "base_frame": "base", "tool_frame": "tool0"}
     named = {"shoulder": "left", "elbow": "up", "wrist": "flip"}
     for robot, body_robot, option, branch, printed in (
         ("ur5e", ROBOT, ["left/up/flip"], named, "branch: left/up/flip"),
         (
             str(file),
             urdf,
-            ["0", "--base-frame", "tilted"],
+            ["0"],
             {"solution": 0},
             "branch: solution 0 (numeric IK, in seed order)",
         ),

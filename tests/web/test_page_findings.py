@@ -321,30 +321,41 @@ def test_a_urdf_file_is_taken_as_written_and_a_missing_frame_says_so_once(
 
 
 def test_how_a_urdfs_ik_is_solved_is_said_under_the_map(page: Page, url: str) -> None:
-    # ee_link (a tool frame turned on the DH flange) is recognised: the API's sentence; from a
-    # frame tilted about x the chain is no UR arm's: numeric IK, said so.
+    # ee_link (a tool frame turned on the DH flange) and a frame tilted about x (joint 1 not
+    # upright in it) are recognised: the API's sentence; with its elbow's axis turned by a mrad
+    # the chain is no UR arm's: numeric IK, said so.
     joint = (
         '<link name="tilted"/><joint name="tilted_joint" type="fixed"><parent link="base_link"/>'
         '<child link="tilted"/><origin xyz="0 0 0" rpy="0.3 0 0"/></joint>'
     )
     text = ur5_urdf().replace("</robot>", joint + "</robot>")
+    elbow = '<origin rpy="0.0 0.0 0.0" xyz="0.0 -0.1197 0.425"/>'
+    assert text.count(elbow) == 1
+    bent = text.replace(elbow, elbow.replace('rpy="0.0 0.0 0.0"', 'rpy="0.001 0 0"'))
     page.click("#own-urdf summary")
-    choose_file(page, "#urdf-file", "ur5_tilted.urdf", text)
-    page.wait_for_function("document.getElementById('urdf').value.length > 0")
     small = {**SMALL, "x-step": "0.1", "y-step": "0.1", "yaws": "0"}
-    fill(page, small)
     grid = {**grid_of(small), "yaw": [0.0]}
-    for base, tool in (("base_link", "ee_link"), ("tilted", "tool0")):
+    for urdf, base, tool in (
+        (text, "base_link", "ee_link"),
+        (text, "tilted", "tool0"),
+        (bent, "base_link", "tool0"),
+    ):
+        choose_file(page, "#urdf-file", "ur5_variant.urdf", urdf)
+        page.wait_for_function("document.getElementById('urdf').value.length > 0")
+        fill(page, small)
         page.fill("#base-frame", base)
         page.fill("#tool-frame", tool)
         page.click("#run")
         page.wait_for_function("document.getElementById('summary').dataset.cells", timeout=120_000)
-        robot = {"urdf": text, "base_frame": base, "tool_frame": tool}
+        robot = {"urdf": urdf, "base_frame": base, "tool_frame": tool}
         body = {"robot": robot, "path": EXAMPLE_PATH, "grid": grid}
         api = httpx.post(f"{url}/v1/map", json=body, timeout=120).json()
         shown = page.text_content("#ik-line") or ""
         if tool == "ee_link":
             assert "whose tool frame is the DH flange turned by 120 deg" in api["recognised"]
+            assert shown == f"IK in closed form: {api['recognised']}"
+        elif urdf is text:
+            assert "tilted by 17.1887 deg about (-1, 0, 0)" in api["recognised"]
             assert shown == f"IK in closed form: {api['recognised']}"
         else:
             assert api["recognised"] is None

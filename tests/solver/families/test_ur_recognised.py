@@ -61,12 +61,16 @@ def test_the_ur5_urdf_is_recognised_with_its_lengths_from_base_and_base_link() -
 
 def test_the_base_frames_with_a_closed_form_are_named() -> None:
     # The URDF's links and frames fixed to its root: world, base_link and base (its DH frame),
-    # each a turn about z of the DH frame; a frame tilted about x is none, and stays numeric.
+    # each a turn about z of the DH frame, and a frame tilted about x (joint 1 not upright in
+    # it: the closed form in that frame tilted back, tests/solver/families/test_tilted_base).
     urdf = _with_frame("tilted", "0 0 0", "0.3 0 0")
     named = closed_form_bases(urdf, tool_frame="tool0")
-    assert sorted(named) == ["base", "base_link", "world"]
+    assert sorted(named) == ["base", "base_link", "tilted", "world"]
     robot = robot_from_urdf(urdf, base_frame="tilted", tool_frame="tool0")
-    assert robot.family is not None and robot.family.name == "numeric"
+    assert robot.family is not None and robot.family.name == "ur"
+    assert (
+        robot.family.recognised is not None and "tilted by 17.1887 deg" in robot.family.recognised
+    )
     assert closed_form_bases(UR5, tool_frame="wrist_2_link") == []  # five joints: no closed form
 
 
