@@ -164,22 +164,29 @@ class StartInfo(ResponseModel):
     )
 
 
+_REASON_COUNTS: list[JsonDict] = [
+    {
+        "reason": "joint_limits",
+        "count": 412,
+        "failed_waypoint": 39,
+        "failed_pass": 1,
+        "failed_operation": "ROTARY_SPIN",
+    },
+    {
+        "reason": "unreachable",
+        "count": 188,
+        "failed_waypoint": 0,
+        "failed_pass": 0,
+        "failed_operation": "FLAT_PASS",
+    },
+]
+_TRIED: JsonDict = {"placements": 600, "feasible": 0, "reasons": list(_REASON_COUNTS)}
+
+
 class ReasonCount(ResponseModel):
     """The placements a search tried that failed for one reason."""
 
-    model_config = ConfigDict(
-        json_schema_extra={
-            "examples": [
-                {
-                    "reason": "joint_limits",
-                    "count": 412,
-                    "failed_waypoint": 39,
-                    "failed_pass": 1,
-                    "failed_operation": "ROTARY_SPIN",
-                }
-            ]
-        }
-    )
+    model_config = ConfigDict(json_schema_extra={"examples": [_REASON_COUNTS[0]]})
 
     reason: FailureReason = Field(description="The reason.")
     count: int = Field(description="How many placements tried failed for it.")
@@ -193,32 +200,7 @@ class ReasonCount(ResponseModel):
 class TriedPlacements(ResponseModel):
     """What the search tried on the whole path on its way, by outcome."""
 
-    model_config = ConfigDict(
-        json_schema_extra={
-            "examples": [
-                {
-                    "placements": 600,
-                    "feasible": 0,
-                    "reasons": [
-                        {
-                            "reason": "joint_limits",
-                            "count": 412,
-                            "failed_waypoint": 39,
-                            "failed_pass": 1,
-                            "failed_operation": "ROTARY_SPIN",
-                        },
-                        {
-                            "reason": "unreachable",
-                            "count": 188,
-                            "failed_waypoint": 0,
-                            "failed_pass": 0,
-                            "failed_operation": "FLAT_PASS",
-                        },
-                    ],
-                }
-            ]
-        }
-    )
+    model_config = ConfigDict(json_schema_extra={"examples": [_TRIED]})
 
     placements: int = Field(
         description="How many distinct placements the search evaluated on the whole path on "
@@ -248,26 +230,7 @@ class SearchFailure(ResponseModel):
                     "failed_operation": "ROTARY_SPIN",
                     "count": 1,
                     "judged": 1,
-                    "tried": {
-                        "placements": 600,
-                        "feasible": 0,
-                        "reasons": [
-                            {
-                                "reason": "joint_limits",
-                                "count": 412,
-                                "failed_waypoint": 39,
-                                "failed_pass": 1,
-                                "failed_operation": "ROTARY_SPIN",
-                            },
-                            {
-                                "reason": "unreachable",
-                                "count": 188,
-                                "failed_waypoint": 0,
-                                "failed_pass": 0,
-                                "failed_operation": "FLAT_PASS",
-                            },
-                        ],
-                    },
+                    "tried": _TRIED,
                     "message": "the search proposed no placement but the start, and the start "
                     "does not run it: joint_limits, first at waypoint 39 (pass 1, ROTARY_SPIN); "
                     "none of the 600 placements it tried on the whole path runs it: 412 "
