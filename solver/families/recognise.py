@@ -237,12 +237,13 @@ def _said(turn: BaseTurn) -> str:
         axis = vector / angle
         parts.append(
             f"tilted by {math.degrees(angle):.6g} deg about "
-            "({:.6g}, {:.6g}, {:.6g}) (joint 1's axis its z)".format(*(axis + 0.0))
+            "({:.6g}, {:.6g}, {:.6g}) (joint 1's axis its z)".format(*map(_nanometres, axis))
         )
     about = "the tilted z" if tilt is not None else "z"
     parts += [f"turned by {math.degrees(turn.angle):.6g} deg about {about}"] if turn.angle else []
-    if any(turn.shift):
-        parts.append("moved to ({:.6g}, {:.6g}, {:.6g}) m".format(*turn.shift))
+    shift = [_nanometres(v) for v in turn.shift]  # a tilt's 2e-16 m said as 0
+    if any(shift):
+        parts.append("moved to ({:.6g}, {:.6g}, {:.6g}) m".format(*shift))
     return "{B} " + " and ".join(parts)
 
 
