@@ -7,6 +7,7 @@ The outcome kept for each placement a search tried is checked against the evalua
 from __future__ import annotations
 
 import dataclasses
+import math
 
 import numpy as np
 import pytest
@@ -15,7 +16,7 @@ from solver.core.codes import FEASIBLE, REASONS
 from solver.core.spatial import Placement
 from solver.families import get_robot
 from solver.optimise import coarse_rows
-from solver.optimise.coarse_search import coarse_cells
+from solver.optimise.coarse_search import coarse_cells, coarse_map_cells
 from solver.optimise.failures import ReasonTally, Tried
 from solver.optimise.methods.placement_scipy import global_search
 from solver.optimise.search_space import PlacementBounds
@@ -63,8 +64,9 @@ def test_the_coarse_maps_placements_are_kept_with_the_evaluators_outcome(
     assert {"None", "unreachable", "joint_limits"} <= met
     summary = tried.summary()
     assert summary is not None
-    # 31 x 41 x 4 cells of 20 mm and 15 degrees (yaws -0.5 + 15 deg * k <= 0.5: k = 0..3)
-    assert summary.placements == len(tried.outcomes()[0]) == 31 * 41 * 4
+    # 31 x 41 x 5 cells of 20 mm and 15 degrees (yaws -0.5 + 15 deg * k <= 0.5: k = 0..3, and
+    # the range's end, 0.5)
+    assert summary.placements == len(tried.outcomes()[0]) == 31 * 41 * 5
     assert summary.feasible + sum(t.count for t in summary.reasons) == summary.placements
     assert 0 < summary.feasible < summary.placements
 
@@ -110,3 +112,24 @@ def test_the_tally_by_construction() -> None:
     summary = ties.summary()
     assert summary is not None  # equal counts: in the order of REASONS; no waypoint: None
     assert summary.reasons == (ReasonTally("singular", 1, 4), ReasonTally("discontinuous", 1, None))
+
+
+def test_the_coarse_map_samples_the_far_end_of_the_yaw_range() -> None:
+    """A yaw range that is no whole number of coarse steps (15 degrees) ends in a sample of
+    its own (an optimum the bounds stop lies on an edge); the lengths' 20 mm steps do not."""
+    bounds = PlacementBounds(x=(-0.25, 0.26), y=(0.25, 0.655), yaw=(-0.5, 0.5), z=0.1)
+    tried = Tried()
+    problem = PathProblem.of(get_robot("ur5"), load_path("curved_line"))
+    coarse_cells(problem, bounds, symmetric=False, near=0.0, tried=tried)
+    rows = tried.outcomes()[0]
+    xs, ys, yaws = (np.unique(rows[:, k].round(12)) for k in (0, 1, 3))
+    # -0.25 + 0.02 k up to 0.25 (26); 0.25 + 0.02 k up to 0.65 (21); -0.5 + 15 deg k up to
+    # 0.285 (4), then 0.5
+    assert (len(xs), len(ys), len(yaws)) == (26, 21, 5)
+    assert (xs[-1], ys[-1], yaws[-1]) == pytest.approx((0.25, 0.65, 0.5))
+    # Where the last step stops within half a step (7.5 degrees) of the end, no sample is added:
+    # -0.3, -0.038, 0.224 (0.076 rad short of 0.3); -0.5 .. 0.285 (0.215 short of 0.5), then 0.5
+    # A whole turn adds nothing to its 24 steps (-pi to pi, both ends: 25).
+    for yaw, samples in (((-0.3, 0.3), 3), ((-0.5, 0.5), 5), ((-math.pi, math.pi), 25)):
+        box = PlacementBounds(x=(0.0, 0.0), y=(0.4, 0.4), yaw=yaw, z=0.1)
+        assert coarse_map_cells(box, symmetric=False) == samples

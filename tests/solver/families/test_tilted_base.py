@@ -25,9 +25,10 @@ from solver.families import robot_from_urdf
 from solver.families.base import UNCOMPILED_MAP_COST, ClosedFormFamily
 from solver.families.numeric.family import NumericFamily
 from solver.families.opw.arms import ARMS
+from solver.optimise.search_space import PlacementBounds
 from solver.path.capability_map import CapabilityMap, grid_axis
 from tests.cases import FK_IK_ATOL, MAP_EVALUATE_RTOL
-from tests.problems import capability_map, evaluate_path
+from tests.problems import capability_map, evaluate_path, optimize_placement
 from tests.solver.families.test_opw_recognised import urdf_text
 from tests.solver.test_evaluate import load_path
 
@@ -164,3 +165,23 @@ def test_numeric_ik_on_the_tilted_chain_maps_it_alike() -> None:
     np.testing.assert_array_equal(np.isnan(closed), np.isnan(by_seeds))
     np.testing.assert_allclose(closed, by_seeds, rtol=1e-9)
     assert np.isfinite(closed).any()
+
+
+@pytest.mark.parametrize("method", ["casadi", "scipy"])
+def test_the_optimisers_reach_the_best_cell_of_a_map_on_the_wall(method: str) -> None:
+    """The UR5 on a wall: its best placement lies on the box's yaw bound, which both methods
+    reach (the casadi method's coarse map samples the box's edges)."""
+    tilted, _ = robots("ur5", ((0.0, 0.0, 0.6), (math.pi / 2, 0.0, 0.0)))
+    path = load_path("curved_line")
+    bounds = PlacementBounds(x=(-0.3, 0.3), y=(-0.7, -0.1), yaw=(-0.5, 0.5), z=0.4)
+    grid = capability_map(
+        tilted,
+        path,
+        xs=grid_axis(-0.3, 0.3, 0.05, field="x"),
+        ys=grid_axis(-0.7, -0.1, 0.05, field="y"),
+        z=0.4,
+        yaws=np.linspace(-0.5, 0.5, 11),
+    )
+    optimum = optimize_placement(tilted, path, bounds=bounds, method=method)
+    assert optimum.found and optimum.mu_path is not None
+    assert optimum.mu_path >= float(np.nanmax(grid.mu_path))
