@@ -10,7 +10,8 @@ y = 0.25..0.65 m, step 0.02 m, z = 0.1 m, 133 waypoints, all IK branches), the s
 scalar loop (ur-analytic-ik IK, pinocchio Jacobian and numpy solve per pose and branch) timed
 on a subset in the same run and extrapolated, their ratio, the time per pose and branch, and
 the 8-yaw map against the 1-yaw map; the numeric IK family's map on the same grid (UR5 read as a
-plain URDF, checked equal to the analytic map, and the Panda) against the analytic one; the
+plain URDF, checked equal to the analytic map, and the Panda) against the analytic one, and
+the UR5 read from a frame 1 mrad off level (its closed form, tilted, on the numpy pipeline); the
 2-waypoint optimisation of the Jaco2 (numeric IK) against the UR5's
 (``bench/numeric_optimisation.py``); the map and the optimisers with joint acceleration limits
 (``bench/acceleration.py``); the map's picture on a new figure and on a kept one
@@ -50,6 +51,7 @@ from solver.core.robots import Robot, chain_from_urdf, example_robot_data_dir
 from solver.core.spatial import Placement, pose_matrix
 from solver.core.task import task_requirements
 from solver.families import get_robot, robot_from_urdf
+from solver.families.base import UNCOMPILED_MAP_COST
 from solver.families.numeric.family import NumericFamily
 from solver.optimise.optimize import optimize_placement
 from solver.optimise.search_space import PlacementBounds
@@ -304,6 +306,22 @@ def numeric_maps(path: np.ndarray, xs: np.ndarray, ys: np.ndarray, z: float, t_m
             )
             line += f"; equal to it on {same.mean():.1%} of the cells"
         print(line)
+    # Read from a frame 1 mrad off level (a cell measured a little out of true) the UR5 keeps
+    # its closed form, tilted (solver.families.recognise.first_axis_tilt), but the kernels
+    # place a path by a turn about z only: its map runs the numpy pipeline, weighed
+    # solver.families.base.UNCOMPILED_MAP_COST poses a waypoint.
+    mount = '<link name="cell"/><joint name="mount" type="fixed"><parent link="cell"/>'
+    mount += '<child link="world"/><origin xyz="0 0 0" rpy="0.001 0 0"/></joint></robot>'
+    tilted = robot_from_urdf(urdf.replace("</robot>", mount), base_frame="cell", tool_frame="tool0")
+    start = time.perf_counter()
+    capability_map(PathProblem.of(tilted, path), xs=xs, ys=ys, z=z, yaws=np.zeros(1))
+    seconds = time.perf_counter() - start
+    label = "UR5 tilted"
+    print(
+        f"  {label:14s} {seconds:8.3f} s   {seconds / t_map:6.1f}x the analytic UR5 map "
+        f"(1 mrad off level: the closed form on the numpy pipeline, weighed "
+        f"{UNCOMPILED_MAP_COST:g}x)"
+    )
     # The Panda's map prunes branches that cannot be a cell's best in one compiled pass
     # (solver/families/numeric/bounded_redundant_kernel.py): the same map following every
     # branch, for the ratio.
