@@ -244,7 +244,7 @@ def _said(turn: BaseTurn) -> str:
     shift = [_nanometres(v) for v in turn.shift]  # a tilt's 2e-16 m said as 0
     if any(shift):
         parts.append("moved to ({:.6g}, {:.6g}, {:.6g}) m".format(*shift))
-    return "{B} " + " and ".join(parts)
+    return "{B} " + (" and ".join(parts) or "moved by less than a nanometre")
 
 
 def _said_flange(offset: FlangeOffset, family: str = "OPW") -> str:
