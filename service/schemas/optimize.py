@@ -205,8 +205,8 @@ class TriedPlacements(ResponseModel):
     placements: int = Field(
         description="How many distinct placements the search evaluated on the whole path on "
         "its way: the casadi method's coarse map cells, the scipy method's differential "
-        "evolution members (a program beyond 2,000 waypoints: only those of its placements "
-        "evaluated on the whole path, not its maps or evolutions on a set of its waypoints)."
+        "evolution members (a long program, mapped or evolved on a set of its waypoints: only "
+        "its placements evaluated on the whole path, the samples and best ones checked)."
     )
     feasible: int = Field(
         description="How many of them run the path (its optimiser's candidates from them did not)."

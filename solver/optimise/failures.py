@@ -10,7 +10,8 @@ the casadi method's coarse map, the members of the scipy method's differential e
 and a failure tallies them by reason (:class:`TriedSummary`): which limit closes the bounds,
 and where along the path. A long program's maps and evolutions on a set of its waypoints are
 not kept (their first failing waypoint is the set's, not the path's): only its placements
-evaluated on the whole path are.
+evaluated on the whole path are (the samples that make its first set, the best cells or
+members checked each round).
 """
 
 from __future__ import annotations

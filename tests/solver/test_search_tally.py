@@ -18,7 +18,8 @@ from solver.families import get_robot
 from solver.optimise import coarse_rows
 from solver.optimise.coarse_search import coarse_cells, coarse_map_cells
 from solver.optimise.failures import ReasonTally, Tried
-from solver.optimise.methods.placement_scipy import global_search
+from solver.optimise.methods import search_rows
+from solver.optimise.methods.placement_scipy import FULL_SEARCH, global_search
 from solver.optimise.search_space import PlacementBounds
 from solver.path.evaluate import evaluate_path
 from solver.path.problem import PathProblem
@@ -82,6 +83,20 @@ def test_a_long_programs_map_on_a_set_keeps_only_what_it_evaluated_on_the_whole_
     _agrees_with_the_evaluator(problem, tried, every=1)
     most = coarse_rows.SAMPLE_CELLS + coarse_rows.MAP_ROUNDS * coarse_rows.VERIFIED_CELLS
     assert coarse_rows.SAMPLE_CELLS <= len(tried.outcomes()[0]) <= most
+
+
+def test_a_long_programs_evolution_on_a_set_keeps_only_what_it_checked_on_the_whole_path(
+    problem: PathProblem,
+) -> None:
+    """The scipy method on a long program evolves on a set of its waypoints (here called on the
+    path's 133 directly): only its sample and each round's best, checked on the whole path, are
+    kept."""
+    tried = Tried()
+    search_rows.search_on_rows(problem, BOUNDS, symmetric=False, tried=tried)
+    _agrees_with_the_evaluator(problem, tried, every=1)
+    rounds, verified = search_rows.SEARCH_ROUNDS, search_rows.VERIFIED
+    most = search_rows.SAMPLE_CELLS + rounds * max(verified, FULL_SEARCH.basins)
+    assert search_rows.SAMPLE_CELLS <= len(tried.outcomes()[0]) <= most
 
 
 def test_differential_evolutions_members_are_kept_with_the_evaluators_outcome(

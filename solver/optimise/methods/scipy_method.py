@@ -158,6 +158,7 @@ def _global(
         size=size,
         progress=progress,
         runner=settings.runner,
+        tried=settings.tried,
     )
     return found.basins, found.generations
 

@@ -33,6 +33,7 @@ from solver.core.parallel import SERIAL, TaskRunner
 from solver.core.progress import Progress, span
 from solver.optimise.active_set import ACTIVE_SET_RTOL, closure
 from solver.optimise.coarse_rows import binding_rows
+from solver.optimise.failures import Tried
 from solver.optimise.methods.placement_scipy import (
     FULL_SEARCH,
     Basin,
@@ -86,14 +87,19 @@ def sample(bounds: PlacementBounds) -> np.ndarray:
     return np.vstack([bounds.centre(), vectors])
 
 
-def first_set(problem: PathProblem, bounds: PlacementBounds, runner: TaskRunner) -> np.ndarray:
+def first_set(
+    problem: PathProblem, bounds: PlacementBounds, runner: TaskRunner, tried: Tried | None = None
+) -> np.ndarray:
     """The slowest waypoints of the whole path (or where it fails) at :func:`sample`'s placements.
 
     With their acceleration stencils (:func:`solver.optimise.active_set.closure`); where that
     is over SET_ROWS (long stencils), the first half along the path is kept until it is not:
     the rounds add what binds.
     """
-    found = binding_rows(problem, bounds.rows(sample(bounds)), None, runner)[0]
+    placements = bounds.rows(sample(bounds))
+    found, whole = binding_rows(problem, placements, None, runner)
+    if tried is not None:  # whole-path evaluations: kept for a failure's tally
+        tried.record(placements, whole.reason, whole.failed_waypoint)
     rows = closure(problem, found, neighbours=False)
     while len(rows) > SET_ROWS and len(found) > 1:
         found = found[: len(found) // 2]
@@ -109,6 +115,7 @@ def search_on_rows(
     size: SearchSize = FULL_SEARCH,
     progress: Progress | None = None,
     runner: TaskRunner = SERIAL,
+    tried: Tried | None = None,
 ) -> RowsSearch:
     """Differential evolution on a set of the waypoints, grown until its best holds (module doc).
 
@@ -119,8 +126,10 @@ def search_on_rows(
         size: the evolution's size.
         progress: called with the fraction done.
         runner: where the placements run.
+        tried: keeps the placements evaluated on the whole path (the sample that makes the
+            first set, each round's best; not the evolutions on the set).
     """
-    rows = first_set(problem, bounds, runner)
+    rows = first_set(problem, bounds, runner, tried)
     generations = 0
     for round_ in range(1, SEARCH_ROUNDS + 1):
         part = span(progress, (round_ - 1) / SEARCH_ROUNDS, round_ / SEARCH_ROUNDS)
@@ -130,7 +139,10 @@ def search_on_rows(
         generations += steps
         best = np.array(distinct_best(seen, symmetric, max(VERIFIED, size.basins)), dtype=int)
         on_set = seen.mu[best]
-        added, whole = binding_rows(problem, bounds.rows(seen.vectors[best]), on_set, runner, rows)
+        checked = bounds.rows(seen.vectors[best])
+        added, whole = binding_rows(problem, checked, on_set, runner, rows)
+        if tried is not None:
+            tried.record(checked, whole.reason, whole.failed_waypoint)
         holds = best.size and whole.feed_index[0] >= on_set[0] * (1.0 - ACTIVE_SET_RTOL)
         grown = closure(problem, np.union1d(rows, added), neighbours=False)
         if holds or not added.size or round_ == SEARCH_ROUNDS or len(grown) > SET_ROWS:
