@@ -75,8 +75,12 @@ def _map_seconds(body: dict[str, Any], threads: int | None, repeats: int) -> dic
         process.wait()
 
 
-def erk_map_over_http(*, repeats: int, subset: int) -> None:
-    """The ERK-size map through POST /v1/map (1 thread, all cores) against the scalar loop."""
+def erk_map_over_http(*, repeats: int, subset: int, smoke: bool = False) -> None:
+    """The ERK-size map through POST /v1/map (1 thread, all cores) against the scalar loop.
+
+    ``smoke``: the line says its figures are a smoke run's (a scalar loop of ``subset`` cells,
+    best of ``repeats``), not a measurement.
+    """
     body = {"robot": {"model": "ur5"}, "path": EXAMPLE["path"], "grid": ERK_GRID}
     t_one = _map_seconds(body, 1, repeats)["http.client"]
     t_http = _map_seconds(body, None, repeats)
@@ -97,4 +101,9 @@ def erk_map_over_http(*, repeats: int, subset: int) -> None:
         f"{t_one * 1e3:.1f} ms on 1 ({t_one / plain:.2f}x); scalar loop {t_scalar:.1f} s "
         f"(extrapolated from {subset} cells): {t_scalar / plain:,.0f}x (goal >= 5,000x); "
         f"from httpx {heavy * 1e3:.1f} ms, {t_scalar / heavy:,.0f}x"
+        + (
+            " [smoke run: too few repeats and cells to measure; run without --smoke]"
+            if smoke
+            else ""
+        )
     )

@@ -242,7 +242,9 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--smoke", action="store_true", help="small sizes: check the script runs")
     args = parser.parse_args()
-    erk_map_over_http(repeats=2 if args.smoke else 10, subset=2 if args.smoke else 12)
+    erk_map_over_http(
+        repeats=2 if args.smoke else 10, subset=2 if args.smoke else 12, smoke=args.smoke
+    )
     erk_route_parts(repeats=2 if args.smoke else 10)
     job_listing(jobs=5 if args.smoke else 50, cells=2_000 if args.smoke else 20_000)
     healthz_during_the_largest_body(waypoints=2_000 if args.smoke else 20_000)
