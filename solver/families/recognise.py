@@ -22,6 +22,7 @@ import dataclasses
 import math
 
 import numpy as np
+import pinocchio as pin
 
 from solver.core.family import KinematicsFamily
 from solver.core.spatial import BaseTurn, FlangeOffset, rotation_vectors
@@ -295,11 +296,8 @@ def first_axis_tilt(chain: SerialChain) -> np.ndarray | None:
     if abs(float(axis[2]) + 1.0) <= FIT_ATOL:  # hanging from a ceiling: half a turn about x
         return np.diag([1.0, -1.0, -1.0])
     normal = np.cross([0.0, 0.0, 1.0], axis)
-    sine, cosine = float(np.linalg.norm(normal)), float(axis[2])
-    k = normal / sine
-    cross = np.array([[0.0, -k[2], k[1]], [k[2], 0.0, -k[0]], [-k[1], k[0], 0.0]])
-    tilt: np.ndarray = np.eye(3) + sine * cross + (1.0 - cosine) * cross @ cross
-    return tilt
+    sine = float(np.linalg.norm(normal))
+    return np.asarray(pin.exp3(normal / sine * math.atan2(sine, float(axis[2]))))
 
 
 def tilted_chain(chain: SerialChain, tilt: np.ndarray) -> SerialChain:
