@@ -76,8 +76,13 @@ def _local_maxima(values: np.ndarray, periodic: tuple[bool, ...]) -> list[tuple[
     return [tuple(int(i) for i in idx) for idx in np.argwhere(is_max)[order]]
 
 
-def _axis(low: float, high: float, step: float, *, ends: bool = False) -> np.ndarray:
+def _axis(
+    low: float, high: float, step: float, *, ends: bool = False, slack: float = 1e-9
+) -> np.ndarray:
     """A coarse axis: ``low`` and every ``step`` after it up to ``high`` (and its end).
+
+    ``slack``: a step that ends within it past ``high`` still counts (the box's axes take
+    1e-9 for rounding; the symmetric search's radius axis has always taken none).
 
     With ``ends`` (the yaw's, unless the range is a whole turn, whose end is its start), the
     range's end is a sample of its own where the last step stops more than half a step short
@@ -87,7 +92,7 @@ def _axis(low: float, high: float, step: float, *, ends: bool = False) -> np.nda
     tests/solver/families/test_tilted_base.py: 10 % lower). The lengths' 20 mm steps leave
     little to their ends; none is added there (a map's size is its work).
     """
-    axis = low + step * np.arange(math.floor((high - low) / step + 1e-9) + 1)
+    axis = low + step * np.arange(math.floor((high - low) / step + slack) + 1)
     if ends and high - axis[-1] > step / 2:
         axis = np.append(axis, high)
     return axis
@@ -104,7 +109,7 @@ def _map_sizes(
         inside_x = min(max(0.0, bounds.x[0]), bounds.x[1])
         inside_y = min(max(0.0, bounds.y[0]), bounds.y[1])
         radii = (math.hypot(inside_x, inside_y), max(corners))
-        sizes = [len(_axis(*radii, COARSE_STEP)), n_psi]
+        sizes = [len(_axis(*radii, COARSE_STEP, slack=0.0)), n_psi]
     else:
         sizes = [
             len(_axis(*bounds.x, COARSE_STEP)),
@@ -171,7 +176,7 @@ def _one_spin_cells(
     if symmetric:
         r_low, r_high = radii
         n_psi = round(2 * math.pi / COARSE_YAW_STEP)
-        radius = _axis(r_low, r_high, COARSE_STEP)
+        radius = _axis(r_low, r_high, COARSE_STEP, slack=0.0)
         psis = -math.pi + COARSE_YAW_STEP * np.arange(n_psi)
         points = [arc_point(float(r), float(p), bounds, near=near) for p in psis for r in radius]
         # mu_path is the same all along an arc: evaluate every cell at the polar angle `near`,
