@@ -19,6 +19,7 @@ from service.cli import CLOSED_PIPE, INFEASIBLE, INVALID, OK, USAGE, main
 from solver.core.robots import example_robot_data_dir
 from tests.cases import ROOT
 from tests.solver.cam.dialects import NX_LISTING, text
+from tests.solver.families.recognised import bent_elbow
 
 PROGRAM = ROOT / "examples" / "cam" / "nx_slot_plate.cls"
 ROBOT = {"model": "ur5e"}
@@ -361,11 +362,8 @@ def _tilted_ur5(folder: Path) -> Path:
 
 def _bent_ur5(folder: Path) -> Path:
     """The UR5's URDF with its elbow's axis turned by a mrad: no UR or OPW arm (numeric IK)."""
-    text = UR5_URDF.read_text()
-    elbow = '<origin rpy="0.0 0.0 0.0" xyz="0.0 -0.1197 0.425"/>'
-    assert text.count(elbow) == 1
     file = folder / "ur5_bent.urdf"
-    file.write_text(text.replace(elbow, elbow.replace('rpy="0.0 0.0 0.0"', 'rpy="0.001 0 0"')))
+    file.write_text(bent_elbow(UR5_URDF.read_text()))
     return file
 
 

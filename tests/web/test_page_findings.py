@@ -18,6 +18,7 @@ import pytest
 from playwright.sync_api import Browser, Page
 
 from tests.cases import ROOT
+from tests.solver.families.recognised import bent_elbow
 from tests.web.conftest import ARTIFACTS, snapshot
 from tests.web.test_page import EXAMPLE_PATH, SMALL, cell_point, fill, grid_of, run_small_map
 
@@ -329,9 +330,7 @@ def test_how_a_urdfs_ik_is_solved_is_said_under_the_map(page: Page, url: str) ->
         '<child link="tilted"/><origin xyz="0 0 0" rpy="0.3 0 0"/></joint>'
     )
     text = ur5_urdf().replace("</robot>", joint + "</robot>")
-    elbow = '<origin rpy="0.0 0.0 0.0" xyz="0.0 -0.1197 0.425"/>'
-    assert text.count(elbow) == 1
-    bent = text.replace(elbow, elbow.replace('rpy="0.0 0.0 0.0"', 'rpy="0.001 0 0"'))
+    bent = bent_elbow(text)
     page.click("#own-urdf summary")
     small = {**SMALL, "x-step": "0.1", "y-step": "0.1", "yaws": "0"}
     grid = {**grid_of(small), "yaw": [0.0]}

@@ -26,6 +26,13 @@ def with_fixed_frame(
     )
 
 
+def bent_elbow(ur5_text: str) -> str:
+    """The UR5's URDF text with its elbow's axis turned by a mrad: no UR or OPW arm (numeric IK)."""
+    elbow = '<origin rpy="0.0 0.0 0.0" xyz="0.0 -0.1197 0.425"/>'
+    assert ur5_text.count(elbow) == 1
+    return ur5_text.replace(elbow, elbow.replace('rpy="0.0 0.0 0.0"', 'rpy="0.001 0 0"'))
+
+
 def answers_alike(
     robot: Robot, path: np.ndarray, placement: Placement, expected: object, **options: Any
 ) -> bool:
