@@ -96,8 +96,8 @@ class KinematicsFamily(abc.ABC):
     #: (a URDF chain recognised from a base frame other than the arm's own), after a tilt where
     #: joint 1 is not upright in {B}. :meth:`solve` and :meth:`joint_speeds_per_unit_twist`
     #: still take {B}; a compiled map kernel, which places the path itself, takes its
-    #: placements in that frame (:meth:`solver.core.spatial.BaseTurn.placements_in`), and none
-    #: takes a tilted one. ``None``: {B}.
+    #: placements in that frame (:meth:`solver.core.spatial.BaseTurn.placements_in`), or, where
+    #: it is tilted, the frame in its parameters (:meth:`map_kernel`). ``None``: {B}.
     base_turn: BaseTurn | None = None
     #: Where the chain's flange sits on the family's own, where they differ (a URDF whose tool
     #: frame is turned or moved on the last link): :meth:`solve` still takes the chain's flange;

@@ -244,8 +244,8 @@ class BaseTurn:
     A family whose first joint is not upright in {B} (an arm on a wall or a ceiling, read from
     its cell's frame) solves in a frame whose z is that joint's axis: {B} is first tilted by
     ``tilt`` (R_B_T), then turned about the tilted z. A placement is then no placement of {A}
-    (its yaw is about {B}'s z), so the map kernels cannot take it (:meth:`placements_in`
-    refuses) and the numpy pipeline runs.
+    (its yaw is about {B}'s z; :meth:`placements_in` refuses): the map kernels place the path
+    in {B} and write each block's poses in {A} (:func:`solver.families.kernels.pose_block`).
 
     Attributes:
         angle: rad, about {B}'s z (about the tilted z where there is a tilt).

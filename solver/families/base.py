@@ -12,11 +12,7 @@ import numpy as np
 
 from solver.core.family import Branch, KinematicsFamily
 from solver.core.progress import Progress
-
-UNCOMPILED_MAP_COST = 40.0
-"""A closed-form map's work a pose on the numpy pipeline, in poses of the compiled kernel: the
-ERK-size UR5 map took 37.5 times the kernel's time in fixed spin, 26.7 in free spin (one
-thread, 2026-12-04, the machine loaded by a test run; the KR6 R700's 3.5 and 5.5)."""
+from solver.families.kernels import TILTED
 
 
 class ClosedFormFamily(KinematicsFamily):
@@ -70,23 +66,25 @@ class ClosedFormFamily(KinematicsFamily):
     def map_kernel(self) -> tuple[int, np.ndarray] | None:
         """The family's pose kernel code and this arm's kernel parameters (see the base).
 
-        None where the family's frame is tilted from {B}: the kernels place a path by a turn
-        about z (:meth:`solver.core.spatial.BaseTurn.placements_in`); the numpy pipeline runs.
+        Where the family's frame {A} is tilted from {B}, the code plus
+        :data:`solver.families.kernels.TILTED`, and R_A_B and {A}'s origin before the
+        parameters: the kernels place a path in {B} (a turn about its z) and write each block's
+        poses in {A} (:func:`solver.families.kernels.pose_block`).
         """
         make = type(self).kernel_parameters_function
-        if self.kernel_code is None or make is None or self.tilted:
+        if self.kernel_code is None or make is None:
             return None
-        return self.kernel_code, make(self.parameters)
+        if not self.tilted:
+            return self.kernel_code, make(self.parameters)
+        assert self.base_turn is not None  # tilted
+        frame = np.concatenate(
+            [self.base_turn.vectors_in(np.eye(3)).ravel(), np.asarray(self.base_turn.shift)]
+        )
+        return self.kernel_code + TILTED, np.concatenate([frame, make(self.parameters)])
 
     def path_cost(self, n_waypoints: int, *, free_spin: bool = False) -> float:
-        """A pose a waypoint (the unit), UNCOMPILED_MAP_COST poses where the family is tilted.
-
-        A tilted family's maps, coarse maps and evolutions run the numpy pipeline
-        (:meth:`map_kernel`); its evaluation of one placement is charged alike (it runs the
-        same pipeline as an upright family's: over-charged, far below any limit).
-        """
-        cost = float(n_waypoints)
-        return cost * UNCOMPILED_MAP_COST if self.tilted else cost
+        """A pose a waypoint (the unit): the compiled kernel's, tilted or not."""
+        return float(n_waypoints)
 
     def joint_speeds_per_unit_twist(
         self,

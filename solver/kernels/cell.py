@@ -18,7 +18,7 @@ import numpy as np
 from numba import njit
 
 from solver.core.codes import FEASIBLE
-from solver.families.kernels import N_BRANCHES, N_JOINTS, SCRATCH_ROWS, SCRATCH_SIZE, warm_up_arm
+from solver.families.kernels import N_BRANCHES, N_JOINTS, scratch_size, warm_up_arm
 
 # A pruned branch's ``why``: never reported (see :func:`prune`).
 PRUNED = -2
@@ -41,7 +41,7 @@ def pose_work(n_waypoints):  # type: ignore[no-untyped-def]  # pragma: no cover 
     qd = np.empty((N_BRANCHES, N_JOINTS, n_waypoints))
     status = np.empty((N_BRANCHES, n_waypoints), dtype=np.int64)
     poses = np.empty((21, n_waypoints))
-    scratch = np.empty(max(SCRATCH_SIZE, SCRATCH_ROWS * n_waypoints))
+    scratch = np.empty(scratch_size(n_waypoints))
     need = np.empty(N_BRANCHES, dtype=np.bool_)
     return cq, sq, qd, status, poses, scratch, need
 

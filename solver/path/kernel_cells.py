@@ -191,10 +191,11 @@ def kernel_joint_paths(
 def _placed(inputs: KernelInputs, placements: np.ndarray) -> tuple[object, ...]:
     """The kernels' first nine arguments: the family, the placements, the path at the spin.
 
-    The placements in the family's own frame where it solves in a turn of {B} (the kernels
-    place the path in the frame they solve in).
+    The placements in the family's own frame where it solves in a turn of {B} about its z (the
+    kernels place the path in the frame they solve in); a tilted family's stay in {B} (its
+    kernel code writes the placed poses in its frame, :func:`solver.families.kernels.pose_block`).
     """
-    if inputs.base_turn is not None:
+    if inputs.base_turn is not None and inputs.base_turn.tilt is None:
         placements = inputs.base_turn.placements_in(placements)
     return (
         inputs.code,

@@ -18,11 +18,13 @@ import numpy as np
 import pinocchio as pin
 import pytest
 
+import solver.path.placements
 from solver.core.kinematics import tool_pose_in_base
 from solver.core.robots import Robot, chain_from_urdf, example_robot_data_dir
 from solver.core.spatial import Placement
 from solver.families import robot_from_urdf
-from solver.families.base import UNCOMPILED_MAP_COST, ClosedFormFamily
+from solver.families.base import ClosedFormFamily
+from solver.families.kernels import TILT_PARAMETERS, TILTED
 from solver.families.numeric.family import NumericFamily
 from solver.families.opw.arms import ARMS
 from solver.optimise.search_space import PlacementBounds
@@ -31,6 +33,8 @@ from tests.cases import FK_IK_ATOL, MAP_EVALUATE_RTOL
 from tests.problems import capability_map, evaluate_path, optimize_placement
 from tests.solver.families.test_opw_recognised import urdf_text
 from tests.solver.test_evaluate import load_path
+from tests.solver.test_map_kernel import grid as map_grid
+from tests.solver.test_map_kernel import same_cells
 
 WALL = ((0.1, 0.2, 0.6), (math.pi / 2, 0.3, 0.2))  # xyz, rpy: on a wall, turned a little
 CEILING = ((0.0, 0.1, 1.2), (math.pi, 0.0, 0.4))  # hanging: joint 1's axis along -z
@@ -99,16 +103,64 @@ IDS = [
 
 
 @pytest.mark.parametrize(("name", "mount"), CASES, ids=IDS)
-def test_the_tilted_chain_is_recognised_and_mapped_without_the_kernel(
+def test_the_tilted_chain_is_recognised_and_mapped_by_the_kernel(
     name: str, mount: tuple[tuple[float, ...], tuple[float, ...]]
 ) -> None:
     tilted, own = robots(name, mount)
     family = tilted.family
     assert isinstance(family, ClosedFormFamily) and family.name == own.family.name
     assert family.recognised is not None and "tilted by" in family.recognised
-    assert family.tilted and family.map_kernel() is None  # the numpy pipeline maps it
-    assert family.path_cost(10) == 10 * UNCOMPILED_MAP_COST
-    assert own.family.path_cost(10) == 10
+    kernel, upright = family.map_kernel(), own.family.map_kernel()
+    assert family.tilted and kernel is not None and upright is not None
+    assert kernel[0] == upright[0] + TILTED  # the family's own pose kernel, the frame first
+    frame = kernel[1][:TILT_PARAMETERS]
+    turn = frame[:9].reshape(3, 3)  # R_A_B: a rotation whose z row is joint 1's axis in {B}
+    np.testing.assert_allclose(turn @ turn.T, np.eye(3), atol=1e-12)
+    assert np.linalg.det(turn) == pytest.approx(1.0, abs=1e-12)
+    make = type(family).kernel_parameters_function
+    assert make is not None  # the family's own parameters after the frame
+    np.testing.assert_array_equal(kernel[1][TILT_PARAMETERS:], make(family.parameters))
+    assert family.path_cost(10) == own.family.path_cost(10) == 10
+
+
+@pytest.mark.parametrize("spin_mode", ["fixed", "free"])
+def test_a_tilted_arms_map_never_runs_the_numpy_pipeline(
+    monkeypatch: pytest.MonkeyPatch, spin_mode: str
+) -> None:
+    def refuse(*args: object, **kwargs: object) -> None:
+        raise AssertionError("the numpy pipeline ran")
+
+    monkeypatch.setattr(solver.path.placements, "run_chunk", refuse)
+    tilted, _ = robots("ur5", WALL)
+    cmap = capability_map(
+        tilted, load_path("curved_line"), spin_mode=spin_mode, **grid("ur5", WALL)
+    )
+    assert np.isfinite(cmap.mu_path).any()
+
+
+@pytest.mark.parametrize("accelerations", [None, 10.0])
+@pytest.mark.parametrize("spin_mode", ["fixed", "free"])
+@pytest.mark.parametrize(("name", "mount"), CASES, ids=IDS)
+def test_the_kernels_map_equals_the_numpy_pipelines(
+    name: str,
+    mount: tuple[tuple[float, ...], tuple[float, ...]],
+    spin_mode: str,
+    accelerations: float | None,
+) -> None:
+    """The compiled kernel of a tilted family against the numpy pipeline (which solves in the
+    family's frame by :meth:`BaseTurn.vectors_in` and ``points_in``), cell by cell, as
+    tests/solver/test_map_kernel.py compares an upright arm's."""
+    tilted, _ = robots(name, mount)
+    cells = grid(name, mount)
+    placements = map_grid(cells["xs"], cells["ys"], cells["z"], cells["yaws"])  # type: ignore[arg-type]
+    _, reasons = same_cells(
+        tilted,
+        load_path("curved_line"),
+        placements,
+        spin_mode=spin_mode,
+        accelerations=accelerations,
+    )
+    assert "feasible" in reasons and len(reasons) > 1  # feasible cells and failures both
 
 
 @pytest.mark.parametrize("spin_mode", ["fixed", "free"])
