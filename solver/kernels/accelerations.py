@@ -66,9 +66,9 @@ def write_acc(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
 ):  # fmt: skip
     """Placement c's acceleration columns from its chosen branch row ``pick``.
 
-    As :func:`solver.path.placements._chunk`: mu_acc; what binds it (0 the speed limits, 1 the
-    acceleration limits, -1 infeasible); its waypoint and joint (those of mu_path where the
-    speed limits bind); V_acc along the path (NaN where infeasible).
+    As :func:`solver.path.placements.columns_of_run`: mu_acc; what binds it (0 the speed
+    limits, 1 the acceleration limits, -1 infeasible); its waypoint and joint (those of mu_path
+    where the speed limits bind); V_acc along the path (NaN where infeasible).
     """
     if reason[c] != FEASIBLE:
         mu_acc[c] = np.nan

@@ -3,8 +3,9 @@
 Where the path checks (:mod:`solver.path.path_checks`) refuse a placement's chosen branch, an
 ``auto`` placement takes its next feasible branch that passes. :class:`Candidates` holds what
 that search reads: each placement's feasible branches in order, their joint paths and the
-columns of the branch taken. :func:`pipeline_candidates` makes them by a numpy pipeline run; a
-family with a compiled kernel gives them by the kernel (:class:`CompiledBranches`,
+columns of the branch taken. :func:`run_candidates` reads them off a numpy pipeline run
+(the map's own, or :func:`pipeline_candidates`' of the refused placements); a family with a
+compiled kernel gives them by the kernel (:class:`CompiledBranches`,
 :mod:`solver.path.kernel_branches`).
 """
 
@@ -17,7 +18,6 @@ from typing import Protocol
 import numpy as np
 
 from solver.core.codes import FEASIBLE
-from solver.core.family import PathSolutions
 from solver.path.pipeline import ChunkResult, run_chunk
 from solver.path.problem import PathProblem
 
@@ -69,23 +69,26 @@ class CompiledBranches(Protocol):
         """The :class:`Candidates` of placements (K, 5) whose chosen branches ``picks`` failed."""
 
 
-def pipeline_candidates(
-    problem: PathProblem,
-    rows: np.ndarray,
-    columns_of: Columns,
-    solutions: PathSolutions | None = None,
-) -> Candidates:
-    """The :class:`Candidates` of placements ``rows`` (K, 5) by one numpy pipeline run.
+def run_candidates(run: ChunkResult, cells: np.ndarray, columns_of: Columns) -> Candidates:
+    """The :class:`Candidates` of a pipeline run's placements ``cells`` (K,), from the run itself.
 
-    Its IK taken from ``solutions`` (an analytic family's, at these placements) where given.
+    Every branch of the run was tracked at every placement (a map with path checks drops
+    none), so the refused placements' next branches are its rows: no IK is solved again.
     """
-    run = run_chunk(problem, rows, solutions=solutions)
 
     def columns(chosen: np.ndarray) -> tuple[np.ndarray, ...]:
-        return columns_of(dataclasses.replace(run, pick=np.where(chosen >= 0, chosen, run.pick)))
+        pick = np.array(run.pick, copy=True)
+        pick[cells] = np.where(chosen >= 0, chosen, pick[cells])
+        return tuple(column[cells] for column in columns_of(dataclasses.replace(run, pick=pick)))
 
     return Candidates(
-        [branch_order(run, k) for k in range(len(rows))],
-        lambda k, b: run.tracked.q[:, b, k].T,
+        [branch_order(run, int(c)) for c in cells],
+        lambda k, b: run.tracked.q[:, b, cells[k]].T,
         columns,
     )
+
+
+def pipeline_candidates(problem: PathProblem, rows: np.ndarray, columns_of: Columns) -> Candidates:
+    """The :class:`Candidates` of placements ``rows`` (K, 5) by one numpy pipeline run."""
+    run = run_chunk(problem, rows)
+    return run_candidates(run, np.arange(len(rows)), columns_of)

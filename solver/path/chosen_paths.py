@@ -1,9 +1,10 @@
-"""The joint paths of the branches the speed limits chose, for the path checks (the cell).
+"""The joint path a run on one branch gives, each placement on its own branch (a reference).
 
 A map with a cell checks each feasible placement's chosen joint path
-(:mod:`solver.path.path_checks`): the family's IK at the chunk's placements, once
-(:func:`chunk_solutions`), tracked on each placement's own branch (:func:`tracked_joint_paths`)
-as the pipeline tracks it, without the joint speeds (a path check needs the angles alone).
+(:mod:`solver.path.path_checks`): the compiled kernel's (:mod:`solver.path.kernel_branches`),
+or the numpy pipeline run's own. :func:`tracked_joint_paths` tracks an analytic family's IK on
+each placement's own branch as the pipeline tracks it, without the joint speeds: what the
+kernel's joint paths are tested against (tests/solver/test_cell_batch.py).
 """
 
 from __future__ import annotations
@@ -14,23 +15,6 @@ from solver.core.family import PathSolutions
 from solver.path.placed import placed_flange
 from solver.path.problem import PathProblem
 from solver.path.tracking import track
-
-
-def chunk_solutions(problem: PathProblem, placements: np.ndarray) -> PathSolutions | None:
-    """The family's IK at placements (C, 5) of one spin; None in free spin (its own path)."""
-    if problem.options.spin_mode == "free" or not len(placements):
-        return None
-    _, rotation, flange_position = placed_flange(problem, placements)
-    return problem.family.solve_path(rotation, flange_position)
-
-
-def per_placement(solutions: PathSolutions | None) -> bool:
-    """An analytic family's solutions: each placement solved on its own, every branch a row.
-
-    A subset's solutions are then these arrays' columns, the same floats (a numeric family
-    seeds a chunk together).
-    """
-    return solutions is not None and solutions.seeds is None and solutions.slots is None
 
 
 def tracked_joint_paths(
@@ -49,7 +33,7 @@ def tracked_joint_paths(
         problem: the problem (fixed spin: free spin tracks its spin schedule's path).
         placements: shape (C, 5), one spin, checked.
         rows: shape (C,), an index into the family's branches per placement.
-        solutions: :func:`chunk_solutions` at the placements, if already made.
+        solutions: the family's IK at the placements, if already solved.
 
     Returns:
         shape (C, W, n), rad; None where the family answers in slots (numeric IK) or the
@@ -74,15 +58,3 @@ def tracked_joint_paths(
     )
     joint_paths: np.ndarray = tracked.q[:, 0].transpose(1, 2, 0)
     return joint_paths
-
-
-def chosen_joint_paths(
-    problem: PathProblem,
-    placements: np.ndarray,
-    branch: np.ndarray,
-    solutions: PathSolutions | None,
-) -> np.ndarray | None:
-    """The joint paths (C, W, n) of each placement's branch (family indices); None: run each."""
-    if not len(placements):
-        return np.zeros((0, problem.prepared.n_waypoints, problem.robot.dof))
-    return tracked_joint_paths(problem, placements, branch, solutions)

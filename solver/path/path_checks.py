@@ -12,15 +12,14 @@ from __future__ import annotations
 import numpy as np
 
 from solver.core.codes import FEASIBLE
-from solver.core.family import PathSolutions
 from solver.path.branch_candidates import (
     Candidates,
     Columns,
     CompiledBranches,
     branch_order,
     pipeline_candidates,
+    run_candidates,
 )
-from solver.path.chosen_paths import chosen_joint_paths, chunk_solutions, per_placement
 from solver.path.limits import PathVerdict
 from solver.path.pipeline import ChunkResult, run_chunk
 from solver.path.problem import PathProblem
@@ -102,7 +101,9 @@ def refuse_colliding(
     placements: np.ndarray,
     columns: tuple[np.ndarray, ...],
     columns_of: Columns,
+    *,
     compiled: CompiledBranches | None = None,
+    run: ChunkResult | None = None,
 ) -> tuple[np.ndarray, ...]:
     """The placements' columns with the path checks applied (cell.md section 3).
 
@@ -113,31 +114,27 @@ def refuse_colliding(
         problem: the robot, the path, the options (with the cell).
         placements: shape (C, 5), one spin, as the columns were computed.
         columns: mu, reason, failed waypoint, branch (family index), ... as
-            :func:`solver.path.placements._chunk` gives them.
+            :func:`solver.path.placements.columns_of_run` gives them.
         columns_of: the columns of a pipeline run, each placement at its ``pick``.
         compiled: the compiled kernel's joint paths and next branches (fixed spin, a family
-            with a kernel: the columns are the kernel's); None: the numpy pipeline's.
+            with a kernel: the columns are the kernel's).
+        run: the numpy pipeline's run of these placements (the columns are its own), whose
+            tracked joint paths are checked, as :func:`clear_pick` checks an evaluation's: no
+            IK solved again (a numeric family's map with a cell solved it three times).
+            Neither (a kernel's columns in free spin): a pipeline run on each branch taken,
+            then one of the refused placements for their next branches.
     """
     if not problem.path_checks:
         return columns
     out = [np.array(c, copy=True) for c in columns]
     reason, branch = out[1], out[3]
-    family = problem.family
     order = np.flatnonzero(reason == FEASIBLE)
-    solutions = None
-    joint_paths: np.ndarray | None
     if compiled is not None:
         joint_paths = compiled.joint_paths(placements[order], branch[order])
+    elif run is not None:
+        joint_paths = run.tracked.q[:, run.pick[order], order].transpose(1, 2, 0)
     else:
-        solutions = chunk_solutions(problem, placements[order])
-        joint_paths = chosen_joint_paths(problem, placements[order], branch[order], solutions)
-    if joint_paths is None:  # one run per branch taken
-        joint_paths = np.empty((len(order), problem.prepared.n_waypoints, problem.robot.dof))
-        for b in np.unique(branch[order]):
-            taken = branch[order] == b
-            single = run_chunk(problem.with_options(branch=family.branches[int(b)]),
-                               placements[order[taken]])  # fmt: skip
-            joint_paths[taken] = single.tracked.q[:, 0].transpose(1, 2, 0)
+        joint_paths = _runs_per_branch(problem, placements[order], branch[order])
     verdicts = check_paths(problem, joint_paths, placements[order])
     refused = {
         int(c): (q, verdict)
@@ -150,14 +147,25 @@ def refuse_colliding(
     candidates = None
     if problem.options.branch is None and compiled is not None:
         candidates = compiled.candidates(problem, placements[cells], branch[cells])
+    elif problem.options.branch is None and run is not None:
+        candidates = run_candidates(run, cells, columns_of)
     elif problem.options.branch is None:
-        known = None
-        if solutions is not None and per_placement(solutions):
-            at = np.searchsorted(order, cells)  # the refused are among the checked
-            known = PathSolutions(solutions.q[:, :, at], solutions.status[:, at])
-        candidates = pipeline_candidates(problem, placements[cells], columns_of, known)
+        candidates = pipeline_candidates(problem, placements[cells], columns_of)
     _next_branches(problem, placements, out, refused, candidates)
     return tuple(out)
+
+
+def _runs_per_branch(
+    problem: PathProblem, placements: np.ndarray, branch: np.ndarray
+) -> np.ndarray:
+    """The joint paths (C, W, n) of each placement's branch (family indices): one run a branch."""
+    family = problem.family
+    joint_paths = np.empty((len(placements), problem.prepared.n_waypoints, problem.robot.dof))
+    for b in np.unique(branch):
+        taken = branch == b
+        single = run_chunk(problem.with_options(branch=family.branches[int(b)]), placements[taken])
+        joint_paths[taken] = single.tracked.q[:, 0].transpose(1, 2, 0)
+    return joint_paths
 
 
 def _next_branches(

@@ -89,21 +89,15 @@ class PlacementResults:
         return least
 
 
-def _chunk(
-    problem: PathProblem, placements: np.ndarray, with_speeds: bool, prune: bool = True
-) -> tuple[np.ndarray, ...]:
-    """Evaluate C placements: per placement mu, reason, failed, branch, bottleneck, V_max.
-
-    V_max along the path is (C, W) when ``with_speeds``, else (C, 0): a map of millions of
-    placements keeps nothing per waypoint. Then the acceleration columns of :func:`_acc_columns`.
-    """
-    return columns_of_run(problem, run_chunk(problem, placements, prune=prune), with_speeds)
-
-
 def columns_of_run(
     problem: PathProblem, run: ChunkResult, with_speeds: bool
 ) -> tuple[np.ndarray, ...]:
-    """The columns of :func:`_chunk` from a pipeline run, each placement at its ``pick``."""
+    """A pipeline run's columns, each placement at its ``pick``.
+
+    Per placement mu, reason, failed waypoint, branch, bottleneck waypoint and joint, V_max
+    ((C, W) when ``with_speeds``, else (C, 0): a map of millions of placements keeps nothing per
+    waypoint), then the acceleration columns.
+    """
     branches = problem.branches
     pick, columns = run.pick, np.arange(len(run.pick))
     any_feasible = (run.tracked.reason == FEASIBLE).any(axis=0)
@@ -142,7 +136,7 @@ def _task(
     prune: bool,
     placements: np.ndarray,
 ) -> tuple[np.ndarray, ...]:
-    """Evaluate a task's placements in chunks: the columns of :func:`_chunk`, concatenated.
+    """Evaluate a task's placements in chunks: the columns of :func:`columns_of_run`, concatenated.
 
     The compiled kernel (:mod:`solver.kernels.fixed_spin`, in free spin
     :mod:`solver.kernels.free_spin`) where ``inputs`` holds its inputs (one per spin of the
@@ -151,34 +145,42 @@ def _task(
     sets the malloc thresholds itself.
     """
     raise_malloc_thresholds()
+    columns_of = partial(columns_of_run, problem, with_speeds=with_speeds)
     if inputs is not None:
         # The kernel keeps no array per placement: one call per spin of the task (a call costs
         # about 15 us, and each starts its pruning afresh), in chunks only where the path checks
-        # run the numpy pipeline on the chunk's placements after it.
+        # run on the chunk's placements after it.
         size = chunk if problem.path_checks else max(1, len(placements))
         parts = [
             run_kernel(inputs[float(rows[0, 4])], rows, with_speeds)
             for rows in _pieces(placements, size)
         ]
+        if problem.path_checks:  # free spin: compiled None, pipeline runs (path_checks.py)
+            pieces = _pieces(placements, chunk)
+            parts = [
+                refuse_colliding(
+                    problem, rows, part, columns_of, compiled=_compiled(inputs, rows, with_speeds)
+                )
+                for rows, part in zip(pieces, parts, strict=True)
+            ]
     else:
-        parts = [_chunk(problem, rows, with_speeds, prune) for rows in _pieces(placements, chunk)]
-    if problem.path_checks:
-        columns_of = partial(columns_of_run, problem, with_speeds=with_speeds)
-        pieces = _pieces(placements, chunk)
-        parts = [
-            refuse_colliding(problem, rows, part, columns_of, _compiled(inputs, rows, with_speeds))
-            for rows, part in zip(pieces, parts, strict=True)
-        ]
+        parts = []
+        for rows in _pieces(placements, chunk):
+            run = run_chunk(problem, rows, prune=prune)
+            part = columns_of(run)
+            if problem.path_checks:  # on the run's own joint paths: no IK solved again
+                part = refuse_colliding(problem, rows, part, columns_of, run=run)
+            parts.append(part)
     if len(parts) == 1:  # evaluate_placements concatenates the tasks' columns (a copy) anyway
         return tuple(parts[0])
     return tuple(np.concatenate(c) for c in zip(*parts, strict=True))
 
 
 def _compiled(
-    inputs: dict[float, KernelInputs] | None, rows: np.ndarray, with_speeds: bool
+    inputs: dict[float, KernelInputs], rows: np.ndarray, with_speeds: bool
 ) -> KernelBranches | None:
-    """The path checks' compiled side at the spin of ``rows``; None: the numpy pipeline's."""
-    return None if inputs is None else KernelBranches.of(inputs[float(rows[0, 4])], with_speeds)
+    """The path checks' compiled side at the spin of ``rows``; None in free spin."""
+    return KernelBranches.of(inputs[float(rows[0, 4])], with_speeds)
 
 
 def _pieces(placements: np.ndarray, size: int) -> list[np.ndarray]:
@@ -258,7 +260,7 @@ def evaluate_placements(
 def results_of_columns(
     problem: PathProblem, columns: list[np.ndarray], with_speeds: bool
 ) -> PlacementResults:
-    """The results of the columns of :func:`_chunk` (the acceleration ones where limits are)."""
+    """The results of :func:`columns_of_run`'s columns (the acceleration ones where limits are)."""
     mu, reason, failed, chosen, bottleneck_waypoint, bottleneck_joint, v_max = columns[:7]
     mu_acc, limited_by, acc_waypoint, acc_joint, v_acc = columns[7:]
     accelerations = bool(problem.final_path_limits)

@@ -1,14 +1,12 @@
-"""The path checks' joint paths and next branches: compiled, and the numpy route's IK reuse.
+"""The path checks' joint paths and next branches: the kernel's, and the numpy pipeline run's.
 
 A map with a cell checks each feasible placement's chosen joint path, and the refused
 placements' next branches. Where the family has a compiled kernel (fixed spin), the kernel
 answers both (:mod:`solver.path.kernel_branches`); its map equals the numpy pipeline route's,
 every reason, branch and waypoint identical and mu_path, mu_acc and V_max to 1e-12. On the numpy
-route the refused placements run the pipeline again, taking the IK already solved for the chunk
-(:func:`solver.path.chosen_paths.chunk_solutions`). That rests on an analytic family solving
-each placement on its own: a subset's solutions equal to the bit the full set's columns
-(checked here against the family solving the subset alone); and the map is the map without the
-reuse, every field to the bit.
+route the chunk's own run answers both (every branch tracked at every placement): no IK solved
+again; each cell is then what an evaluation at that placement answers, and a numeric arm's map
+with a cell is the closed form's.
 """
 
 from __future__ import annotations
@@ -20,16 +18,18 @@ import numpy as np
 import pytest
 
 import solver.path.branch_candidates as branch_candidates
-import solver.path.chosen_paths as chosen_paths
 import solver.path.path_checks as path_checks
 import solver.path.placements as placements_module
+from solver.core.codes import REASONS
 from solver.core.robots import Robot
+from solver.core.spatial import Placement
 from solver.families import get_robot, robot_from_urdf
 from solver.path.capability_map import capability_map, grid_axis
-from solver.path.placed import placed_flange
+from solver.path.evaluate import evaluate_path
+from solver.path.pipeline import run_chunk
 from solver.path.problem import PathOptions, PathProblem
 from tests.cases import KERNEL_ACC_ULPS
-from tests.solver.families.numeric_maps import opw_urdf
+from tests.solver.families.numeric_maps import opw_urdf, ur5_from_urdf
 from tests.solver.test_cell_fast import _arm
 from tests.solver.test_cell_pair_tables import ON_TABLE
 from tests.solver.test_evaluate import load_path
@@ -42,31 +42,6 @@ def _robot(name: str) -> Robot:
     return get_robot(name)
 
 
-@pytest.mark.parametrize("name", ["ur5", "ur5e", "kr6"])
-def test_subset_solutions_are_the_full_sets_columns(name: str) -> None:
-    """Seeded random placements and subsets: the same floats and statuses."""
-    problem = PathProblem.of(_robot(name), load_path("curved_line"), PathOptions())
-    rng = np.random.default_rng(5)
-    for _ in range(10):
-        count = int(rng.integers(5, 40))
-        placements = np.column_stack(
-            [
-                rng.uniform(-0.3, 0.3, count),
-                rng.uniform(0.2, 0.7, count),
-                np.full(count, 0.1),
-                rng.uniform(-1.0, 1.0, count),
-                np.zeros(count),
-            ]
-        )
-        solutions = chosen_paths.chunk_solutions(problem, placements)
-        assert solutions is not None and chosen_paths.per_placement(solutions)
-        subset = np.sort(rng.choice(count, int(rng.integers(1, count + 1)), replace=False))
-        _, rotation, position = placed_flange(problem, placements[subset])
-        alone = problem.family.solve_path(rotation, position)
-        np.testing.assert_array_equal(solutions.q[:, :, subset], alone.q)
-        np.testing.assert_array_equal(solutions.status[:, subset], alone.status)
-
-
 AXES = {
     "xs": grid_axis(-0.25, 0.25, 0.05, field="x"),
     "ys": grid_axis(0.25, 0.65, 0.05, field="y"),
@@ -75,32 +50,69 @@ AXES = {
 }
 
 
+def _numpy_route(monkeypatch: pytest.MonkeyPatch) -> list[str]:
+    """Maps on the numpy pipeline from here on; the pipeline runs' callers, as they run."""
+    monkeypatch.setattr(placements_module, "kernel_of", lambda problem: None)
+    runs: list[str] = []
+    for module in (placements_module, branch_candidates, path_checks):
+
+        def spy(*args: object, _module: object = module, **kwargs: object) -> object:
+            runs.append(getattr(_module, "__name__", ""))
+            return run_chunk(*args, **kwargs)  # type: ignore[arg-type]
+
+        monkeypatch.setattr(module, "run_chunk", spy)
+    return runs
+
+
 @pytest.mark.parametrize("name", ["ur5", "ur5e"])
-def test_map_reusing_the_ik_equals_without(name: str, monkeypatch: pytest.MonkeyPatch) -> None:
-    """The ERK path's map with a cell on the numpy route, every field to the bit, next branches."""
-    monkeypatch.setattr(placements_module, "_compiled", lambda *args: None)
-    given: list[bool] = []  # per pipeline run of refused placements: was the IK handed over?
-    run_chunk = branch_candidates.run_chunk
-
-    def spy(*args: object, **kwargs: object) -> object:
-        given.append(kwargs.get("solutions") is not None)
-        return run_chunk(*args, **kwargs)  # type: ignore[arg-type]
-
-    monkeypatch.setattr(branch_candidates, "run_chunk", spy)
+def test_the_numpy_routes_map_checks_its_own_runs_joint_paths(
+    name: str, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """On the numpy pipeline a map with a cell checks the joint paths its run tracked, and takes
+    next branches from the same run: one run a chunk, no IK solved again; every cell is what
+    an evaluation of that placement answers (:func:`clear_pick` on its own run)."""
     problem = PathProblem.of(_arm(name), load_path("curved_line"), PathOptions(cell=ON_TABLE))
     plain = PathProblem.of(_arm(name), load_path("curved_line"), PathOptions())
-    reused = capability_map(problem, **AXES)  # type: ignore[arg-type]
-    assert given and all(given)
-    given.clear()
+    runs = _numpy_route(monkeypatch)
+    cmap = capability_map(problem, **AXES)  # type: ignore[arg-type]
+    assert runs and set(runs) == {placements_module.__name__}  # the chunks' runs alone
     free = capability_map(plain, **AXES)  # type: ignore[arg-type]
-    assert ((reused.branch != free.branch) & (reused.reason == -1)).any()  # next branches
-    monkeypatch.setattr(path_checks, "per_placement", lambda solutions: False)
-    again = capability_map(problem, **AXES)  # type: ignore[arg-type]
-    assert given and not any(given)
-    fields = [k for k, v in vars(reused).items() if isinstance(v, np.ndarray)]
-    assert "mu_path" in fields and "branch" in fields
-    for field in fields:
-        np.testing.assert_array_equal(getattr(reused, field), getattr(again, field), field)
+    feasible = cmap.reason == -1
+    assert ((cmap.branch != free.branch) & feasible).any()  # next branches were taken
+    assert (cmap.reason == 4).any()  # and some cells refused
+    for index in zip(*np.nonzero(np.ones_like(feasible)), strict=True):
+        _, w, iy, ix = index
+        placement = Placement(float(cmap.xs[ix]), float(cmap.ys[iy]), cmap.z, float(cmap.yaws[w]))
+        answer = evaluate_path(problem, placement)
+        if feasible[index]:
+            assert answer.feasible, placement
+            assert answer.mu_path == pytest.approx(cmap.mu_path[index], rel=1e-12), placement
+            assert answer.branch == problem.family.branches[int(cmap.branch[index])], placement
+        else:
+            assert not answer.feasible and answer.reason == REASONS[cmap.reason[index]]
+            assert answer.failed_waypoint == cmap.failed_waypoint[index], placement
+
+
+def test_a_numeric_arms_map_with_a_cell_is_the_closed_forms(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """The UR5 read from its URDF as a numeric arm (its map on the numpy pipeline, its joint
+    paths numeric IK's) against the catalogue UR5 (closed form, compiled) in the same cell:
+    the same feasibility, reasons and mu_path on every cell."""
+    tool = _arm("ur5").transform_tool_to_tcp
+    numeric = ur5_from_urdf().with_options(transform_tool_to_tcp=tool)
+    path = load_path("curved_line")
+    reference = capability_map(
+        PathProblem.of(_arm("ur5"), path, PathOptions(cell=ON_TABLE)),
+        **AXES,  # type: ignore[arg-type]
+    )
+    runs = _numpy_route(monkeypatch)
+    cmap = capability_map(PathProblem.of(numeric, path, PathOptions(cell=ON_TABLE)), **AXES)  # type: ignore[arg-type]
+    assert set(runs) == {placements_module.__name__}
+    assert (reference.reason == 4).any() and (reference.reason == -1).any()
+    np.testing.assert_array_equal(cmap.reason, reference.reason)
+    np.testing.assert_array_equal(cmap.failed_waypoint, reference.failed_waypoint)
+    np.testing.assert_allclose(cmap.mu_path, reference.mu_path, rtol=1e-9)
 
 
 @pytest.mark.parametrize(
@@ -137,9 +149,8 @@ def test_compiled_path_checks_equal_the_pipeline_route(
     feasible = compiled.reason == -1
     assert ((compiled.branch != plain.branch) & feasible).any()  # next branches were taken
     assert (compiled.reason == 4).any()  # and some cells refused
-    monkeypatch.setattr(placements_module, "_compiled", lambda *args: None)
+    monkeypatch.setattr(placements_module, "kernel_of", lambda problem: None)
     reference = capability_map(problem, **axes)  # type: ignore[arg-type]
-    assert runs  # the numpy route ran the pipeline for the refused placements
     for field, value in vars(reference).items():
         if not isinstance(value, np.ndarray):
             continue
