@@ -30,6 +30,7 @@ import argparse
 import json
 import math
 import os
+import re
 import sys
 from collections.abc import Callable, Sequence
 from pathlib import Path
@@ -75,9 +76,36 @@ TOOL_FRAME = "tool0"
 Model = TypeVar("Model", bound=BaseModel)
 
 
+# The options whose values may start with a minus sign (a range or a list of numbers).
+_SIGNED_VALUES = frozenset({"--at", "--x", "--y", "--z", "--yaw", "--spin", "--feed"})
+_STARTS_SIGNED = re.compile(r"-[0-9.]")
+
+
+def _signed_values_joined(argv: Sequence[str]) -> list[str]:
+    """``--y -1:-0.4:0.02`` as ``--y=-1:-0.4:0.02``, for each option of :data:`_SIGNED_VALUES`.
+
+    argparse takes a value that starts with ``-`` for an option unless it is one plain negative
+    number, so a range from a negative bound (``-1:-0.4``) or a list (``-0.3,0.2,0,0``) was
+    refused with "expected one argument" unless written with ``=``, which a post-processor
+    writing the command line cannot guess.
+    """
+    joined: list[str] = []
+    index = 0
+    while index < len(argv):
+        arg = argv[index]
+        following = argv[index + 1] if index + 1 < len(argv) else None
+        if arg in _SIGNED_VALUES and following is not None and _STARTS_SIGNED.match(following):
+            joined.append(f"{arg}={following}")
+            index += 2
+            continue
+        joined.append(arg)
+        index += 1
+    return joined
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Run one subcommand; return its exit code."""
-    args = _parser().parse_args(argv)
+    args = _parser().parse_args(_signed_values_joined(sys.argv[1:] if argv is None else argv))
     echo = native_stderr.ECHO.set(False)  # a refused URDF's reason is in the error printed
     try:
         code = int(args.run(args))

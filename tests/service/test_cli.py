@@ -90,6 +90,28 @@ def test_evaluate_json_is_the_api_answer(
     assert expected["feasible"] and expected["feed_check"]["feasible"]
 
 
+def test_values_from_a_negative_number_need_no_equals_sign(
+    client: TestClient, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """``--at -0.05,0.3,0,0`` and ``--x -0.1:0.1:0.1`` as a post-processor writes them: the
+    answers of the ``=`` forms argparse always took (it refused these, "expected one
+    argument"), the placement the API's."""
+    at = ["evaluate", str(PROGRAM), "--robot", "ur5e", "--json"]
+    code, spaced, _ = run(capsys, *at, "--at", "-0.05,0.3,0,0")
+    _, joined, _ = run(capsys, *at, "--at=-0.05,0.3,0,0")
+    assert code == OK and spaced == joined
+    body = {"robot": ROBOT, "path": {"cl_data": PROGRAM.read_text()}, "detail": "summary"}
+    placement = {**AT, "x": -0.05}
+    assert json.loads(spaced) == api(client, "/v1/evaluate", {**body, "placement": placement})
+    grid = ["map", str(PROGRAM), "--robot", "ur5e", "--json", "--png", "/dev/null"]
+    code, spaced, _ = run(
+        capsys, *grid, "--x", "-0.1:0.1:0.1", "--y", "0.3:0.4:0.1", "--yaw", "-0.2"
+    )
+    _, joined, _ = run(capsys, *grid, "--x=-0.1:0.1:0.1", "--y", "0.3:0.4:0.1", "--yaw=-0.2")
+    assert code in (OK, INFEASIBLE) and spaced == joined
+    assert {cell["x"] for cell in json.loads(spaced)["cells"]} == {-0.1, 0.0, 0.1}
+
+
 def test_an_unreachable_placement_is_exit_infeasible(capsys: pytest.CaptureFixture[str]) -> None:
     code, out, _ = run(capsys, "evaluate", str(PROGRAM), "--robot", "ur5e", "--at=3,0,0,0")
     assert code == INFEASIBLE
