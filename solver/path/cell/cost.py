@@ -16,9 +16,14 @@ from solver.path.cell.shapes import DEFAULT_COLLISION_STEP, Cell
 # when this weight was set (bench/cell.py, CPU time, loaded machine, 2026-12-02). 50, within the
 # UR5's range then: the optimisers in a cell search (x, y, yaw) past a fixture (no arc symmetry),
 # and 80 refused the README's cell optimisation (7.0 million weighted poses; 50 weighs it 4.4
-# million). Measured since (the pair tables, the sweep's skips): about 31 to 36 times (UR5) and
-# 21 to 24 times (UR5e), so 50 over-weighs the check a little; it is kept, since lowering it
-# changes which requests the size limits refuse.
+# million). Measured since (the pair tables, the sweep's skips, the sweep inlined into its batch
+# on 2026-12-04): 35 to 39 times (UR5) and 18 to 19 times (UR5e), wall time, kernels loaded
+# from numba's disk cache as the service loads them; 50 over-weighs the check, and is kept, since
+# lowering it changes which requests the size limits refuse. A numeric arm's map with a cell
+# weighs its family's figure times this: 2,683 a waypoint for the UR5 read as a numeric URDF
+# (7,136 a placement without), against a measured 4.2 times its map without (bench/cell.py); a
+# sum (the family's figure plus this) would under-weigh it (its map with a cell follows every
+# branch, which the figure without does not).
 CELL_POSE_COST = 50.0
 
 
