@@ -173,9 +173,9 @@ def kernel_joint_paths(
 ) -> np.ndarray:
     """The joint path of the family's branch ``rows[c]`` at each placement c, (C, W, 6), rad.
 
-    As :func:`solver.path.chosen_paths.tracked_joint_paths` gives them (fixed spin; the
-    compiled :func:`solver.kernels.joint_paths.branch_paths`); meaningful where that branch is
-    feasible at its placement.
+    As :func:`solver.path.pipeline.run_chunk` tracks that branch (fixed spin; the compiled
+    :func:`solver.kernels.joint_paths.branch_paths`, tests/solver/test_joint_paths_kernel.py);
+    meaningful where that branch is feasible at its placement.
     """
     out = np.empty((len(placements), inputs.rotation.shape[0], 6))
     branch_paths(

@@ -24,9 +24,7 @@ from solver.path.cell.cache import checker_for
 from solver.path.cell.checker import CellChecker
 from solver.path.cell.limit import workpiece_to_base
 from solver.path.cell.shapes import Box, Cell, Cylinder, Halfspace, Mesh, Sphere, Tool
-from solver.path.chosen_paths import tracked_joint_paths
 from solver.path.evaluate import evaluate_path
-from solver.path.pipeline import run_chunk
 from solver.path.problem import PathOptions, PathProblem
 from tests.solver.test_cell_fast import CELL, _arm, _pose, _same
 from tests.solver.test_evaluate import load_path
@@ -141,32 +139,6 @@ def test_checkers_are_shared_by_content() -> None:
         checker_for(_arm("ur10e"), Cell(fixed=CELL.fixed, tool=Tool(0.03, 0.12))),
     ]
     assert len({id(first), *map(id, others)}) == 1 + len(others)
-
-
-@pytest.mark.parametrize("name", ["ur5", "ur5e"])
-def test_chosen_joint_paths_equal_a_run_on_each_branch(name: str) -> None:
-    """One IK solve for a chunk gives each placement's branch's joint path bit for bit."""
-    problem = PathProblem.of(_arm(name), load_path("curved_line"), PathOptions(cell=CELL))
-    rng = np.random.default_rng(4)
-    placements = np.column_stack(
-        [rng.uniform(-0.25, 0.25, (24, 2)) + [0.0, 0.45], np.full(24, 0.1), np.zeros((24, 2))]
-    )
-    placements[12:, 3] = rng.uniform(-1.0, 1.0, 12)  # yaws of their own, as a search's
-    rows = rng.integers(0, 8, 24)
-    joint_paths = tracked_joint_paths(problem, placements, rows)
-    assert joint_paths is not None
-    checked = 0
-    for b in np.unique(rows):
-        cells = np.flatnonzero(rows == b)
-        taken = problem.with_options(branch=problem.family.branches[int(b)])
-        run = run_chunk(taken, placements[cells])
-        feasible = run.tracked.reason[0] == -1
-        expected = run.tracked.q[:, 0].transpose(1, 2, 0)
-        np.testing.assert_array_equal(joint_paths[cells][feasible], expected[feasible])
-        checked += int(feasible.sum())
-    assert checked >= 6  # feasible paths of several branches compared
-    free = problem.with_options(spin_mode="free")
-    assert tracked_joint_paths(free, placements, rows) is None  # the spin schedule's path
 
 
 def _ball_at_the_elbow(problem: PathProblem, placement: Placement, branch: Branch) -> Cell:
