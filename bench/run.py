@@ -11,7 +11,8 @@ scalar loop (ur-analytic-ik IK, pinocchio Jacobian and numpy solve per pose and 
 on a subset in the same run and extrapolated, their ratio, the time per pose and branch, and
 the 8-yaw map against the 1-yaw map; the numeric IK family's map on the same grid (UR5 read as a
 plain URDF, checked equal to the analytic map, and the Panda) against the analytic one, and
-the UR5 read from a frame 1 mrad off level (its closed form, tilted, on the numpy pipeline); the
+the UR5 read from a frame 1 mrad off level (its closed form, tilted, on the kernels and on the
+numpy pipeline); the
 2-waypoint optimisation of the Jaco2 (numeric IK) against the UR5's
 (``bench/numeric_optimisation.py``); the map and the optimisers with joint acceleration limits
 (``bench/acceleration.py``); the map's picture on a new figure and on a kept one

@@ -12,8 +12,8 @@ turn from the DH frame ``base``), an OPW arm in a shift of {B} (a turn about z i
 offset): the family then solves in its own frame (:attr:`KinematicsFamily.base_turn`), which
 its answers name. Where joint 1 is not upright in {B} (an arm on a wall or a ceiling, read from
 its cell's frame), the chain is read in {B} tilted so that joint 1's axis is z
-(:func:`first_axis_tilt`) and recognised there; its maps then run the numpy pipeline (the
-compiled kernels place a path by a turn about {B}'s z only).
+(:func:`first_axis_tilt`) and recognised there; the compiled kernels take that frame in the
+family's kernel parameters (:meth:`solver.families.base.ClosedFormFamily.map_kernel`).
 """
 
 from __future__ import annotations
