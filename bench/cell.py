@@ -23,12 +23,12 @@ from contextlib import contextmanager
 from pathlib import Path
 
 import numpy as np
+from arms import ur5_as_numeric, ur5_urdf
 from timing import best_time
 
 import solver.path.cell.checker as checker_module
-from solver.core.robots import Robot, chain_from_urdf, example_robot_data_dir
-from solver.families import get_robot, robot_from_urdf
-from solver.families.numeric.family import NumericFamily
+from solver.core.robots import Robot
+from solver.families import get_robot
 from solver.optimise.optimize import optimize_placement
 from solver.optimise.search_space import PlacementBounds
 from solver.path.capability_map import capability_map, grid_axis
@@ -86,12 +86,8 @@ def _numeric_line(path: np.ndarray, xs: np.ndarray, ys: np.ndarray, z: float) ->
     One run each. Its map runs the numpy pipeline and, with a cell, follows every branch (no
     pruning) and checks the run's own joint paths (solver.path.path_checks.refuse_colliding).
     """
-    file = example_robot_data_dir() / "ur_description" / "urdf" / "ur5_robot.urdf"
-    urdf = file.read_text()
-    frames = {"base_frame": "base", "tool_frame": "tool0"}
-    family = NumericFamily(chain_from_urdf(urdf, tool_frame="tool0"), **frames)
-    arm = robot_from_urdf(urdf, **frames, family=family)
-    arm = arm.with_options(transform_tool_to_tcp=_pose(0.0, 0.0, TOOL_LENGTH))
+    tool = _pose(0.0, 0.0, TOOL_LENGTH)
+    arm = ur5_as_numeric(ur5_urdf()).with_options(transform_tool_to_tcp=tool)
     seconds = {}
     for cell in (None, CELL):
         problem = PathProblem.of(arm, path, PathOptions(cell=cell))

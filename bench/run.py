@@ -41,6 +41,7 @@ import parallel
 import ur_analytic_ik
 from acceleration import acceleration_lines
 from active_set import active_set_lines
+from arms import UR5_FRAMES, ur5_as_numeric, ur5_urdf
 from cell import cell_lines
 from numeric_optimisation import numeric_optimisation_lines
 from pictures import picture_lines
@@ -48,11 +49,10 @@ from timing import best_time, plain_post
 
 from solver.core.kinematics import jacobian_in_base
 from solver.core.parallel import SERIAL, ThreadRunner
-from solver.core.robots import Robot, chain_from_urdf, example_robot_data_dir
+from solver.core.robots import Robot
 from solver.core.spatial import Placement, pose_matrix
 from solver.core.task import task_requirements
 from solver.families import get_robot, robot_from_urdf
-from solver.families.numeric.family import NumericFamily
 from solver.optimise.optimize import optimize_placement
 from solver.optimise.search_space import PlacementBounds
 from solver.path.capability_map import capability_map, grid_axis
@@ -277,14 +277,10 @@ def numeric_maps(path: np.ndarray, xs: np.ndarray, ys: np.ndarray, z: float, t_m
     (solver.families.recognise): that line shows what a user sending the URDF gets.
     """
     analytic = get_robot("ur5")
-    file = example_robot_data_dir() / "ur_description" / "urdf" / "ur5_robot.urdf"
-    urdf = file.read_text().replace("1.57079632679", repr(math.pi / 2))
-    urdf = urdf.replace("3.14159265359", repr(math.pi))
-    frames = {"base_frame": "base", "tool_frame": "tool0"}
-    numeric = NumericFamily(chain_from_urdf(urdf, tool_frame="tool0"), **frames)
+    urdf = ur5_urdf()
     arms = {
-        "UR5 as a URDF": (robot_from_urdf(urdf, **frames, family=numeric), "goal <= 30x"),
-        "UR5 recognised": (robot_from_urdf(urdf, **frames), "the UR closed form"),
+        "UR5 as a URDF": (ur5_as_numeric(urdf), "goal <= 30x"),
+        "UR5 recognised": (robot_from_urdf(urdf, **UR5_FRAMES), "the UR closed form"),
         "Panda": (get_robot("panda"), "goal <= 60x"),
     }
     reference = capability_map(
