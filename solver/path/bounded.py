@@ -95,16 +95,23 @@ def bounded_solutions(
     flange_position: np.ndarray,
     twist: np.ndarray,
     tool_position: np.ndarray,
+    *,
+    excluded: np.ndarray | None = None,
 ) -> PathSolutions:
     """The family's solutions along a chunk's paths, slots that cannot be the pick dropped.
 
-    Args and returns as :func:`solver.path.pruning.pruned_solutions`.
+    Args and returns as :func:`solver.path.pruning.pruned_solutions`; ``excluded``: shape
+    (C, K), bool, slots left out at each placement (the path checks refused them: their
+    following is not started, their rows come back unreachable, and the pick is the best of
+    the others, :func:`solver.path.path_checks.refuse_colliding`).
     """
     chunk = Chunk(problem, rotation, flange_position, twist, tool_position)
     family = chunk.family
     current, count = family.seed_first(chunk.rotations[:, 0], chunk.positions[:, 0])
     n_seeds = current.shape[1]
-    current = np.ascontiguousarray(current[:, : max(int(count.max()), 1)])
+    current = np.array(current[:, : max(int(count.max()), 1)], order="C")
+    if excluded is not None:
+        current[excluded[:, : current.shape[1]]] = np.nan  # a slot without a start: not followed
     speeds = (
         np.moveaxis(chunk.twist, 0, -1),
         np.moveaxis(chunk.tool, 0, -1),

@@ -17,7 +17,7 @@ from typing import Protocol
 
 import numpy as np
 
-from solver.core.codes import FEASIBLE
+from solver.core.codes import ACC_TIE_RTOL, FEASIBLE, TIE_RTOL
 from solver.path.pipeline import ChunkResult, run_chunk
 from solver.path.problem import PathProblem
 
@@ -25,16 +25,40 @@ from solver.path.problem import PathProblem
 Columns = Callable[[ChunkResult], tuple[np.ndarray, ...]]
 
 
-def branch_order(run: ChunkResult, cell: int) -> list[int]:
-    """The feasible branches of placement ``cell`` (indices on axis B), best index first.
+def tie_order(index: np.ndarray, rows: list[int], tie_rtol: float) -> list[int]:
+    """``rows`` in the order ``auto`` takes them as each one before is refused.
 
-    The pipeline's pick first (its tie rule), then the others by falling index.
+    :func:`solver.path.tracking.choose_branch`'s rule again and again: the highest ``index``
+    (mu_path, or mu_acc) of the rows left, the first in ``rows``' order within ``tie_rtol`` of
+    it. So the branch taken where the best ones collide is the one ``auto`` would choose among
+    those that do not (cell.md section 3), whichever pass finds it (a run of every branch, or
+    runs that leave the refused ones out).
+
+    Args:
+        index: shape (B,), the rows' index (any value at rows not in ``rows``).
+        rows: the feasible rows (indices on axis B), in the family's order.
+        tie_rtol: ``TIE_RTOL`` for mu_path, ``ACC_TIE_RTOL`` for mu_acc.
+    """
+    left, order = list(rows), []
+    while left:
+        top = max(float(index[b]) for b in left)
+        taken = next(b for b in left if index[b] >= top - tie_rtol * abs(top))
+        order.append(taken)
+        left.remove(taken)
+    return order
+
+
+def branch_order(run: ChunkResult, cell: int) -> list[int]:
+    """The feasible branches of placement ``cell`` (indices on axis B), best first.
+
+    The pipeline's pick first (its tie rule), then the others in :func:`tie_order`.
     """
     index = run.mu_path if run.mu_acc is None else run.mu_acc
-    feasible = np.flatnonzero(run.tracked.reason[:, cell] == FEASIBLE)
+    tie_rtol = TIE_RTOL if run.mu_acc is None else ACC_TIE_RTOL
+    feasible = [int(b) for b in np.flatnonzero(run.tracked.reason[:, cell] == FEASIBLE)]
     pick = int(run.pick[cell])
-    others = sorted((b for b in feasible if b != pick), key=lambda b: -index[b, cell])
-    return ([pick] if pick in feasible else []) + [int(b) for b in others]
+    others = tie_order(index[:, cell], [b for b in feasible if b != pick], tie_rtol)
+    return ([pick] if pick in feasible else []) + others
 
 
 @dataclasses.dataclass(frozen=True)
@@ -72,8 +96,9 @@ class CompiledBranches(Protocol):
 def run_candidates(run: ChunkResult, cells: np.ndarray, columns_of: Columns) -> Candidates:
     """The :class:`Candidates` of a pipeline run's placements ``cells`` (K,), from the run itself.
 
-    Every branch of the run was tracked at every placement (a map with path checks drops
-    none), so the refused placements' next branches are its rows: no IK is solved again.
+    Every branch of the run was tracked at every placement (a run that is not
+    :attr:`ChunkResult.pruned`), so the refused placements' next branches are its rows: no IK
+    is solved again.
     """
 
     def columns(chosen: np.ndarray) -> tuple[np.ndarray, ...]:
@@ -88,7 +113,15 @@ def run_candidates(run: ChunkResult, cells: np.ndarray, columns_of: Columns) -> 
     )
 
 
-def pipeline_candidates(problem: PathProblem, rows: np.ndarray, columns_of: Columns) -> Candidates:
-    """The :class:`Candidates` of placements ``rows`` (K, 5) by one numpy pipeline run."""
-    run = run_chunk(problem, rows)
+def pipeline_candidates(
+    problem: PathProblem,
+    rows: np.ndarray,
+    columns_of: Columns,
+    excluded: np.ndarray | None = None,
+) -> Candidates:
+    """The :class:`Candidates` of placements ``rows`` (K, 5) by one numpy pipeline run.
+
+    ``excluded``: shape (K, branches), bool, branches left out (refused already).
+    """
+    run = run_chunk(problem, rows, excluded=excluded)
     return run_candidates(run, np.arange(len(rows)), columns_of)

@@ -214,7 +214,8 @@ def map_cost(problem: PathProblem) -> float:
 
     The family's map figure (:meth:`solver.core.family.KinematicsFamily.map_cost`), told
     whether the map may drop branches (:func:`solver.path.pruning.can_prune`), times the
-    collision check's with a cell (such a map never drops branches).
+    collision check's with a cell. A map with a cell is given the figure of following every
+    branch: it may drop branches, but runs every branch again where the pick collides.
     """
     n_waypoints = problem.prepared.n_waypoints
     free_spin = problem.options.spin_mode == "free"

@@ -18,8 +18,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from solver.core.codes import FEASIBLE
-from solver.path.branch_candidates import Candidates
+from solver.core.codes import ACC_TIE_RTOL, FEASIBLE, TIE_RTOL
+from solver.path.branch_candidates import Candidates, tie_order
 from solver.path.kernel_cells import KernelInputs, kernel_joint_paths, run_kernel
 from solver.path.problem import PathProblem
 
@@ -52,8 +52,9 @@ class KernelBranches:
     ) -> Candidates:
         """Each placement's feasible branches but its chosen one ``picks[k]`` (family index).
 
-        By falling mu_path (mu_acc with acceleration limits), the branch order at a
-        tie, as :func:`solver.path.branch_candidates.branch_order` orders a pipeline run's.
+        In :func:`solver.path.branch_candidates.tie_order` of mu_path (mu_acc with
+        acceleration limits), as :func:`~solver.path.branch_candidates.branch_order` orders a
+        pipeline run's.
         """
         branches = problem.branches  # axis B: family indices
         per_branch = [
@@ -64,17 +65,18 @@ class KernelBranches:
             )
             for b in range(len(branches))
         ]
-        index_column = _MU_ACC if self.inputs.qddot_max.shape[0] else _MU
+        accelerations = self.inputs.qddot_max.shape[0] > 0
+        index_column = _MU_ACC if accelerations else _MU
+        tie_rtol = ACC_TIE_RTOL if accelerations else TIE_RTOL
         feasible = np.array([columns[_REASON] == FEASIBLE for columns in per_branch])
         index = np.array([columns[index_column] for columns in per_branch])
         axis = {int(family_index): b for b, family_index in enumerate(branches)}
         orders = []
         for k in range(len(placements)):
             pick = axis.get(int(picks[k]), -1)
-            falling = -index[:, k]
-            others = sorted((int(b) for b in np.flatnonzero(feasible[:, k]) if b != pick),
-                            key=falling.__getitem__)  # fmt: skip
-            orders.append(others)  # the pick's joint path is the one refused (the same bits)
+            # the pick left out: its joint path is the one refused (the same bits)
+            others = [int(b) for b in np.flatnonzero(feasible[:, k]) if b != pick]
+            orders.append(tie_order(index[:, k], others, tie_rtol))
         found: dict[tuple[int, int], np.ndarray] = {}
 
         def prepare(pairs: list[tuple[int, int]]) -> None:

@@ -16,7 +16,7 @@ branches are one set of component-first arrays with waypoints last. Free spin's 
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -73,6 +73,9 @@ class ChunkResult:
         branch_of: shape (B, C), the index on :attr:`PathProblem.branches` of each row at each
             placement, where the rows are a pruned map's (``PathSolutions.slots``); None:
             row b is branch b.
+        pruned: branches that could not be the pick were dropped (a map's run,
+            :func:`solver.path.pruning.can_prune`): they come back unreachable, so only the
+            pick's row is the branch's answer. False: every branch was followed.
     """
 
     tracked: Tracked
@@ -92,6 +95,7 @@ class ChunkResult:
     final_binding: np.ndarray | None = None
     mu_acc: np.ndarray | None = None
     branch_of: np.ndarray | None = None
+    pruned: bool = False
 
 
 def run_chunk(
@@ -101,6 +105,7 @@ def run_chunk(
     progress: Progress | None = None,
     prune: bool = False,
     solutions: PathSolutions | None = None,
+    excluded: np.ndarray | None = None,
 ) -> ChunkResult:
     """The pipeline at C placements on the problem's branches.
 
@@ -117,6 +122,10 @@ def run_chunk(
             the IK). False: every branch followed (an evaluation reports them).
         solutions: the family's IK at these placements, already solved (an analytic family's,
             the same arrays; not with ``prune``).
+        excluded: shape (C, K), bool, the family's branches left out at each placement (K:
+            its branches; the path checks refused them there): unreachable from the first
+            waypoint, so the pick is the best of the others. A pruned run then does not follow
+            them (a family that follows bounded; another runs unpruned).
     """
     robot, path, branches = problem.robot, problem.prepared, problem.branches
     family = problem.family
@@ -128,14 +137,20 @@ def run_chunk(
     )
     free = problem.options.spin_mode == "free"
     shares = REDUNDANT_FREE_SHARES if free and robot.dof > 6 else SHARES
-    if prune and can_prune(problem):
-        bounded = isinstance(family, FollowsInSteps) and family.follows_bounded
-        prune_with = bounded_solutions if bounded else pruned_solutions
-        solutions = prune_with(problem, rotation, flange_position, twist, tool_position)
+    bounded = isinstance(family, FollowsInSteps) and family.follows_bounded
+    pruned = prune and can_prune(problem) and (excluded is None or bounded)
+    if pruned and bounded:
+        solutions = bounded_solutions(
+            problem, rotation, flange_position, twist, tool_position, excluded=excluded
+        )
+    elif pruned:
+        solutions = pruned_solutions(problem, rotation, flange_position, twist, tool_position)
     elif solutions is None:
         solutions = family.solve_path(
             rotation, flange_position, progress=_part(progress, shares, 0)
         )
+    if excluded is not None and not pruned:
+        solutions = _without(solutions, excluded)
     q, status = solutions.q, solutions.status  # (n, B_all, C, W), (B_all, C, W)
     branches = without_empty_slots(branches, status)
     # In free mode the position limits hold along the spin schedule, checked there, not here.
@@ -174,7 +189,7 @@ def run_chunk(
     feasible = tracked.reason == FEASIBLE  # (B, C)
     mu_path = np.where(feasible, v_max.min(axis=-1), -np.inf)
     if solutions.bound is not None and not pick_stands(solutions, branches, mu_path):
-        return run_chunk(problem, placements, progress=progress)  # every branch followed
+        return run_chunk(problem, placements, progress=progress, excluded=excluded)  # unpruned
     spins = None
     if qd_spin is not None:
         spins, tracked = spin_schedule(
@@ -208,6 +223,7 @@ def run_chunk(
         final_binding=final[2],
         mu_acc=mu_acc,
         branch_of=None if solutions.slots is None else solutions.slots[branches],
+        pruned=pruned,
     )
 
 
@@ -222,6 +238,17 @@ REDUNDANT_FREE_SHARES = (0.55, 0.6, 0.7, 0.75, 0.8, 0.9, 1.0)
 def _part(progress: Progress | None, shares: tuple[float, ...], k: int) -> Progress | None:
     """The progress callback of part ``k`` of a chunk's work (:data:`SHARES`)."""
     return span(progress, shares[k - 1] if k else 0.0, shares[k])
+
+
+def _without(solutions: PathSolutions, excluded: np.ndarray) -> PathSolutions:
+    """``solutions`` with the ``excluded`` (C, K) branches unreachable everywhere (no q)."""
+    out = replace(
+        solutions, q=np.array(solutions.q, copy=True), status=np.array(solutions.status, copy=True)
+    )
+    gone = excluded.T  # (K, C): the rows of q and status
+    out.q[:, gone] = np.nan
+    out.status[gone] = UNREACHABLE
+    return out
 
 
 def without_empty_slots(branches: np.ndarray, status: np.ndarray) -> np.ndarray:

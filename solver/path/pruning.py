@@ -22,8 +22,10 @@ pipeline as unreachable at its first waypoint: it is not the chosen branch, so n
 field of the cell changes (tested cell by cell against following every branch).
 
 Only where that argument holds: the map's ``auto`` branch, fixed spin, limits that bound each
-waypoint by its own configuration (the joint speeds), no final-path limit (mu_acc ranks the
-branches) and no path check (the cell takes the next branch when the best collides).
+waypoint by its own configuration (the joint speeds) and no final-path limit (mu_acc ranks the
+branches). A path check (the cell) judges the pick's joint path, which is followed to the end;
+where it refuses the pick, the placement's next branches come from a run of the refused
+placements that follows every branch (:func:`solver.path.path_checks.refuse_colliding`).
 Evaluations follow every branch: their answer reports the whole joint paths. A family that
 follows bounded (six and seven joints, :attr:`FollowsInSteps.follows_bounded`) is pruned under
 the same conditions in one compiled pass instead (:mod:`solver.path.bounded`); this serves arms
@@ -71,7 +73,6 @@ def can_prune(problem: PathProblem) -> bool:
         and (family.follows_in_steps or family.follows_bounded)
         and problem.options.spin_mode == "fixed"
         and not problem.final_path_limits
-        and not problem.path_checks
         and all(type(limit) is JointSpeedLimit for limit in problem.waypoint_limits)
         and n_branches > 1
         and problem.prepared.n_waypoints > 1

@@ -4,9 +4,12 @@ A map with a cell checks each feasible placement's chosen joint path, and the re
 placements' next branches. Where the family has a compiled kernel (fixed spin), the kernel
 answers both (:mod:`solver.path.kernel_branches`); its map equals the numpy pipeline route's,
 every reason, branch and waypoint identical and mu_path, mu_acc and V_max to 1e-12. On the numpy
-route the chunk's own run answers both (every branch tracked at every placement): no IK solved
-again; each cell is then what an evaluation at that placement answers, and a numeric arm's map
-with a cell is the closed form's.
+route the chunk's own run answers both where it tracked every branch at every placement: no IK
+solved again; each cell is then what an evaluation at that placement answers, and a numeric
+arm's map with a cell is the closed form's. A numeric arm's map drops the branches that cannot
+be the pick, then runs the refused placements again without the refused branches: the same
+map as following every branch. The next branch is the one ``auto`` takes among those left
+(:func:`tie_order`, against :func:`choose_branch`).
 """
 
 from __future__ import annotations
@@ -24,10 +27,13 @@ from solver.core.codes import REASONS
 from solver.core.robots import Robot
 from solver.core.spatial import Placement
 from solver.families import get_robot, robot_from_urdf
+from solver.path.branch_candidates import tie_order
 from solver.path.capability_map import capability_map, grid_axis
 from solver.path.evaluate import evaluate_path
 from solver.path.pipeline import run_chunk
+from solver.path.placements import evaluate_placements
 from solver.path.problem import PathOptions, PathProblem
+from solver.path.tracking import choose_branch
 from tests.cases import KERNEL_ACC_ULPS
 from tests.solver.families.numeric_maps import opw_urdf, ur5_from_urdf
 from tests.solver.test_cell_fast import _arm
@@ -108,7 +114,12 @@ def test_a_numeric_arms_map_with_a_cell_is_the_closed_forms(
     )
     runs = _numpy_route(monkeypatch)
     cmap = capability_map(PathProblem.of(numeric, path, PathOptions(cell=ON_TABLE)), **AXES)  # type: ignore[arg-type]
-    assert set(runs) == {placements_module.__name__}
+    # the chunks' runs, then the refused placements' (pruned, then every branch left)
+    assert set(runs) == {
+        placements_module.__name__,
+        path_checks.__name__,
+        branch_candidates.__name__,
+    }
     assert (reference.reason == 4).any() and (reference.reason == -1).any()
     np.testing.assert_array_equal(cmap.reason, reference.reason)
     np.testing.assert_array_equal(cmap.failed_waypoint, reference.failed_waypoint)
@@ -163,3 +174,94 @@ def test_compiled_path_checks_equal_the_pipeline_route(
             np.testing.assert_allclose(getattr(compiled, field), value, rtol=1e-12, err_msg=field)
         else:
             np.testing.assert_array_equal(getattr(compiled, field), value, field)
+
+
+def _spy_runs(monkeypatch: pytest.MonkeyPatch) -> list[tuple[str, int, bool, bool]]:
+    """The pipeline runs from here on: (caller, placements, pruned asked, branches excluded)."""
+    runs: list[tuple[str, int, bool, bool]] = []
+    for module in (placements_module, branch_candidates, path_checks):
+
+        def spy(
+            problem: PathProblem, rows: np.ndarray, _module: object = module, **kwargs: object
+        ) -> object:
+            excluded = kwargs.get("excluded")
+            runs.append(
+                (
+                    getattr(_module, "__name__", ""),
+                    len(rows),
+                    bool(kwargs.get("prune")),
+                    excluded is not None,
+                )
+            )
+            return run_chunk(problem, rows, **kwargs)  # type: ignore[arg-type]
+
+        monkeypatch.setattr(module, "run_chunk", spy)
+    return runs
+
+
+@pytest.mark.parametrize("name", ["ur5_urdf", "panda"])
+def test_a_pruned_numeric_map_with_a_cell_equals_following_every_branch(
+    name: str, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Six and seven joints (each family's bounded pass): the map with a cell, pruned, then
+    the refused placements run again without their refused branches, equals the map of runs
+    that follow every branch at every placement (the next branches read off those runs), on
+    every field; the runs after the chunks' cover only refused placements and exclude their
+    refused branches."""
+    tool = _arm("ur5").transform_tool_to_tcp
+    robot = ur5_from_urdf() if name == "ur5_urdf" else get_robot("panda")
+    problem = PathProblem.of(
+        robot.with_options(transform_tool_to_tcp=tool),
+        load_path("curved_line"),
+        PathOptions(cell=ON_TABLE),
+    )
+    axes = {**AXES, "yaws": np.array([0.0])}
+    plain = capability_map(dataclasses.replace(problem, options=PathOptions()), **axes)  # type: ignore[arg-type]
+    runs = _spy_runs(monkeypatch)
+    pruned = capability_map(problem, **axes)  # type: ignore[arg-type]
+    chunks = [run for run in runs if run[0] == placements_module.__name__]
+    again = [run for run in runs if run[0] != placements_module.__name__]
+    assert chunks and all(prune and not excluded for _, _, prune, excluded in chunks)
+    assert again and all(excluded for *_, excluded in again)
+    feasible = plain.reason == -1
+    moved = feasible & ((pruned.branch != plain.branch) | (pruned.reason == 4))
+    assert moved.any() and (pruned.reason == -1).any()  # picks refused, next branches taken
+    assert max(count for _, count, _, _ in again) <= moved.sum()  # only refused placements
+    runs.clear()
+    full = evaluate_placements(problem, _rows(pruned), prune=False)
+    assert runs and not any(prune for _, _, prune, _ in runs)  # every branch followed
+    for field in ("mu_path", "reason", "failed_waypoint", "branch", "bottleneck_waypoint",
+                  "bottleneck_joint"):  # fmt: skip
+        ours, theirs = getattr(pruned, field).ravel(), getattr(full, field)
+        np.testing.assert_array_equal(ours, theirs, err_msg=field)
+
+
+def _rows(cmap: object) -> np.ndarray:
+    """A map's placements (P, 5) in its cells' order (yaw, y, x)."""
+    yaws, ys, xs = np.meshgrid(cmap.yaws, cmap.ys, cmap.xs, indexing="ij")  # type: ignore[attr-defined]
+    count = xs.size
+    return np.column_stack(
+        [xs.ravel(), ys.ravel(), np.full(count, cmap.z), yaws.ravel(), np.zeros(count)]  # type: ignore[attr-defined]
+    )
+
+
+def test_the_next_branch_is_autos_choice_among_those_left() -> None:
+    """tie_order against choose_branch (tracking's rule) on the branches left, round by round:
+    near ties go to the first branch in order, as auto's first choice does (a sort by falling
+    mu_path would take the higher of two tied values)."""
+    rng = np.random.default_rng(7)
+    tie = 1e-12
+    cases = [np.array([1.0, 1.0 + 1e-13, 0.5, 1.0 - 1e-13, 0.25])]
+    cases += [np.round(rng.uniform(0.2, 0.3, 8), 2) * (1 + rng.uniform(-1, 1, 8) * 1e-13)
+              for _ in range(50)]  # fmt: skip
+    for index in cases:
+        rows = [b for b in range(len(index)) if b != 2]  # one infeasible branch left out
+        order = tie_order(index, rows, tie)
+        left = np.array([b in rows for b in range(len(index))])
+        expected = []
+        while left.any():
+            b = int(choose_branch(index, left, np.zeros(len(index), dtype=int), tie))
+            expected.append(b)
+            left[b] = False
+        assert order == expected
+    assert tie_order(cases[0], [0, 1, 3, 4], tie) == [0, 1, 3, 4]  # not [1, 0, 3, 4]
