@@ -81,24 +81,27 @@ def _coal_only() -> Iterator[None]:
 
 
 def _numeric_line(path: np.ndarray, xs: np.ndarray, ys: np.ndarray, z: float) -> None:
-    """The UR5 read from its URDF as a numeric arm: its map with the cell and without.
+    """Numeric IK arms, the UR5 read from its URDF and the Panda: maps with the cell and without.
 
-    One run each. Its map runs the numpy pipeline and, with a cell, follows every branch (no
-    pruning) and checks the run's own joint paths (solver.path.path_checks.refuse_colliding).
+    One run each. Their maps run the numpy pipeline, dropping the branches that cannot be the
+    pick; with a cell the refused placements run again without their refused branches
+    (solver.path.path_checks.refuse_colliding).
     """
     tool = _pose(0.0, 0.0, TOOL_LENGTH)
-    arm = ur5_as_numeric(ur5_urdf()).with_options(transform_tool_to_tcp=tool)
-    seconds = {}
-    for cell in (None, CELL):
-        problem = PathProblem.of(arm, path, PathOptions(cell=cell))
-        capability_map(problem, xs=xs[:1], ys=ys[:1], z=z, yaws=np.zeros(1))  # seeds compiled
-        start = time.perf_counter()
-        capability_map(problem, xs=xs, ys=ys, z=z, yaws=np.zeros(1))
-        seconds[cell is not None] = time.perf_counter() - start
-    print(
-        f"  UR5 as a numeric URDF: with the cell {seconds[True]:7.3f} s, without "
-        f"{seconds[False]:7.3f} s (one run each): {seconds[True] / seconds[False]:.1f}x"
-    )
+    arms = {"UR5 as a numeric URDF": ur5_as_numeric(ur5_urdf()), "Panda": get_robot("panda")}
+    for name, bare in arms.items():
+        arm = bare.with_options(transform_tool_to_tcp=tool)
+        seconds = {}
+        for cell in (None, CELL):
+            problem = PathProblem.of(arm, path, PathOptions(cell=cell))
+            capability_map(problem, xs=xs[:1], ys=ys[:1], z=z, yaws=np.zeros(1))  # compiled
+            start = time.perf_counter()
+            capability_map(problem, xs=xs, ys=ys, z=z, yaws=np.zeros(1))
+            seconds[cell is not None] = time.perf_counter() - start
+        print(
+            f"  {name}: with the cell {seconds[True]:7.3f} s, without "
+            f"{seconds[False]:7.3f} s (one run each): {seconds[True] / seconds[False]:.1f}x"
+        )
 
 
 def cell_lines(
