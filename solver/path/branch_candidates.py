@@ -84,8 +84,13 @@ class Candidates:
 class CompiledBranches(Protocol):
     """The compiled kernel's side of the path checks (:mod:`solver.path.kernel_branches`)."""
 
-    def joint_paths(self, placements: np.ndarray, rows: np.ndarray) -> np.ndarray:
-        """The joint paths (C, W, n) of the family's branch ``rows[c]`` at each placement."""
+    def joint_paths(
+        self, placements: np.ndarray, rows: np.ndarray, feeds: np.ndarray
+    ) -> np.ndarray:
+        """The joint paths (C, W, n) of the family's branch ``rows[c]`` at each placement.
+
+        ``feeds`` (C,), m/s: each branch's mu_path there (free spin's schedule runs at it).
+        """
 
     def candidates(
         self, problem: PathProblem, placements: np.ndarray, picks: np.ndarray

@@ -1,4 +1,4 @@
-"""The path checks' joint paths and next branches by the compiled kernels (fixed spin).
+"""The path checks' joint paths and next branches by the compiled kernels.
 
 A map with a cell checks the joint path of each feasible placement's chosen branch, and where
 the check refuses it, the placement's next feasible branches (:mod:`solver.path.path_checks`).
@@ -7,8 +7,9 @@ tracking, which cost a map about as much as the collision checks themselves (202
 170 ms of a 420 ms ERK-size UR5e map with a cell, against 10 ms for the map without). Here the
 map kernel answers each branch of the refused placements alone (its columns, the same as the
 kernel gives when that branch is the one chosen) and :func:`solver.kernels.joint_paths.branch_paths`
-makes the joint paths, both compiled. The numpy route stays for free spin (a spin schedule's
-paths) and for the families without a kernel.
+makes the joint paths (in free spin :func:`~solver.kernels.joint_paths.spun_branch_paths`, along
+each branch's spin schedule at its mu_path), all compiled. The numpy route stays for the
+families without a kernel.
 """
 
 from __future__ import annotations
@@ -31,7 +32,7 @@ class KernelBranches:
     """The compiled kernel at one spin, as :class:`solver.path.branch_candidates.CompiledBranches`.
 
     Attributes:
-        inputs: the kernel's inputs of the problem at the chunk's spin (fixed spin).
+        inputs: the kernel's inputs of the problem at the chunk's spin.
         with_speeds: whether the columns carry V_max (and V_acc) along the path.
     """
 
@@ -39,13 +40,18 @@ class KernelBranches:
     with_speeds: bool
 
     @classmethod
-    def of(cls, inputs: KernelInputs, with_speeds: bool) -> KernelBranches | None:
-        """The compiled side at these inputs' spin; None in free spin (the numpy route's)."""
-        return None if inputs.free_spin else cls(inputs, with_speeds)
+    def of(cls, inputs: KernelInputs, with_speeds: bool) -> KernelBranches:
+        """The compiled side at these inputs' spin (fixed or free)."""
+        return cls(inputs, with_speeds)
 
-    def joint_paths(self, placements: np.ndarray, rows: np.ndarray) -> np.ndarray:
-        """The joint paths (C, W, 6) of the family's branch ``rows[c]`` at each placement."""
-        return kernel_joint_paths(self.inputs, placements, rows)
+    def joint_paths(
+        self, placements: np.ndarray, rows: np.ndarray, feeds: np.ndarray
+    ) -> np.ndarray:
+        """The joint paths (C, W, 6) of the family's branch ``rows[c]`` at each placement.
+
+        ``feeds`` (C,), m/s: each branch's mu_path there (free spin's schedule runs at it).
+        """
+        return kernel_joint_paths(self.inputs, placements, rows, feeds)
 
     def candidates(
         self, problem: PathProblem, placements: np.ndarray, picks: np.ndarray
@@ -84,6 +90,7 @@ class KernelBranches:
             paths = self.joint_paths(
                 placements[[k for k, _ in pairs]],
                 np.array([branches[b] for _, b in pairs], dtype=np.int64),
+                np.array([per_branch[b][_MU][k] for k, b in pairs]),
             )
             found.update(zip(pairs, paths, strict=True))
 

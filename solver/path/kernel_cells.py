@@ -16,7 +16,7 @@ import numpy as np
 from solver.core.spatial import BaseTurn
 from solver.kernels.fixed_spin import map_cells
 from solver.kernels.free_spin import free_cells
-from solver.kernels.joint_paths import branch_paths
+from solver.kernels.joint_paths import branch_paths, spun_branch_paths
 from solver.kernels.positions import limit_modes
 from solver.path.limits import JointAccelerationLimit
 from solver.path.placed import flange_at_spin
@@ -169,20 +169,37 @@ def run_kernel(
 
 
 def kernel_joint_paths(
-    inputs: KernelInputs, placements: np.ndarray, rows: np.ndarray
+    inputs: KernelInputs,
+    placements: np.ndarray,
+    rows: np.ndarray,
+    feeds: np.ndarray | None = None,
 ) -> np.ndarray:
     """The joint path of the family's branch ``rows[c]`` at each placement c, (C, W, 6), rad.
 
-    As :func:`solver.path.pipeline.run_chunk` tracks that branch (fixed spin; the compiled
+    As :func:`solver.path.pipeline.run_chunk` tracks that branch (the compiled
     :func:`solver.kernels.joint_paths.branch_paths`, tests/solver/test_joint_paths_kernel.py);
-    meaningful where that branch is feasible at its placement.
+    in free spin along its spin schedule at ``feeds`` (C,), m/s, each branch's mu_path there
+    (:func:`~solver.kernels.joint_paths.spun_branch_paths`). Meaningful where that branch is
+    feasible at its placement.
     """
     out = np.empty((len(placements), inputs.rotation.shape[0], 6))
-    branch_paths(
+    rows = np.ascontiguousarray(rows, dtype=np.int64)
+    if not inputs.free_spin:
+        branch_paths(*_placed(inputs, placements), rows, inputs.lower, inputs.upper, out)
+        return out
+    if feeds is None:
+        raise ValueError("a joint path in free spin needs its feed (the branch's mu_path)")
+    spun_branch_paths(
         *_placed(inputs, placements),
-        np.ascontiguousarray(rows, dtype=np.int64),
+        inputs.tool_axis,
+        rows,
+        np.ascontiguousarray(feeds, dtype=float),
+        inputs.length,
+        inputs.segment_checked,
         inputs.lower,
         inputs.upper,
+        inputs.qdot_max,
+        inputs.max_joint_step,
         out,
     )
     return out

@@ -116,29 +116,29 @@ def refuse_colliding(
         columns: mu, reason, failed waypoint, branch (family index), ... as
             :func:`solver.path.placements.columns_of_run` gives them.
         columns_of: the columns of a pipeline run, each placement at its ``pick``.
-        compiled: the compiled kernel's joint paths and next branches (fixed spin, a family
-            with a kernel: the columns are the kernel's).
+        compiled: the compiled kernel's joint paths and next branches (a family with a
+            kernel: the columns are the kernel's; in free spin, its paths along the spin
+            schedules).
         run: the numpy pipeline's run of these placements (the columns are its own), whose
             tracked joint paths are checked, as :func:`clear_pick` checks an evaluation's: no
             IK solved again (a numeric family's map with a cell solved it three times). The
             refused placements' next branches are its rows where it followed every branch;
             after a pruned run (:attr:`ChunkResult.pruned`: its dropped rows are not branches'
             answers) they come from pruned runs that leave the refused branches out
-            (:func:`_next_by_pruned_runs`). Neither (a kernel's columns in free spin): a
-            pipeline run on each branch taken, then one of the refused placements for their
-            next branches.
+            (:func:`_next_by_pruned_runs`). One of ``compiled`` and ``run`` is given.
     """
     if not problem.path_checks:
         return columns
+    if (compiled is None) == (run is None):
+        raise ValueError("refuse_colliding takes the kernel's branches or a run, one of them")
     out = [np.array(c, copy=True) for c in columns]
     reason, branch = out[1], out[3]
     order = np.flatnonzero(reason == FEASIBLE)
     if compiled is not None:
-        joint_paths = compiled.joint_paths(placements[order], branch[order])
-    elif run is not None:
-        joint_paths = run.tracked.q[:, run.pick[order], order].transpose(1, 2, 0)
+        joint_paths = compiled.joint_paths(placements[order], branch[order], out[0][order])
     else:
-        joint_paths = _runs_per_branch(problem, placements[order], branch[order])
+        assert run is not None
+        joint_paths = run.tracked.q[:, run.pick[order], order].transpose(1, 2, 0)
     verdicts = check_paths(problem, joint_paths, placements[order])
     refused = {
         int(c): (q, verdict)
@@ -156,23 +156,8 @@ def refuse_colliding(
         candidates = compiled.candidates(problem, placements[cells], branch[cells])
     elif problem.options.branch is None and run is not None:
         candidates = run_candidates(run, cells, columns_of)
-    elif problem.options.branch is None:
-        candidates = pipeline_candidates(problem, placements[cells], columns_of)
     _next_branches(problem, placements, out, refused, candidates)
     return tuple(out)
-
-
-def _runs_per_branch(
-    problem: PathProblem, placements: np.ndarray, branch: np.ndarray
-) -> np.ndarray:
-    """The joint paths (C, W, n) of each placement's branch (family indices): one run a branch."""
-    family = problem.family
-    joint_paths = np.empty((len(placements), problem.prepared.n_waypoints, problem.robot.dof))
-    for b in np.unique(branch):
-        taken = branch == b
-        single = run_chunk(problem.with_options(branch=family.branches[int(b)]), placements[taken])
-        joint_paths[taken] = single.tracked.q[:, 0].transpose(1, 2, 0)
-    return joint_paths
 
 
 def _next_branches(

@@ -155,11 +155,15 @@ def _task(
             run_kernel(inputs[float(rows[0, 4])], rows, with_speeds)
             for rows in _pieces(placements, size)
         ]
-        if problem.path_checks:  # free spin: compiled None, pipeline runs (path_checks.py)
+        if problem.path_checks:  # the kernel's joint paths and next branches (path_checks.py)
             pieces = _pieces(placements, chunk)
             parts = [
                 refuse_colliding(
-                    problem, rows, part, columns_of, compiled=_compiled(inputs, rows, with_speeds)
+                    problem,
+                    rows,
+                    part,
+                    columns_of,
+                    compiled=KernelBranches.of(inputs[float(rows[0, 4])], with_speeds),
                 )
                 for rows, part in zip(pieces, parts, strict=True)
             ]
@@ -174,13 +178,6 @@ def _task(
     if len(parts) == 1:  # evaluate_placements concatenates the tasks' columns (a copy) anyway
         return tuple(parts[0])
     return tuple(np.concatenate(c) for c in zip(*parts, strict=True))
-
-
-def _compiled(
-    inputs: dict[float, KernelInputs], rows: np.ndarray, with_speeds: bool
-) -> KernelBranches | None:
-    """The path checks' compiled side at the spin of ``rows``; None in free spin."""
-    return KernelBranches.of(inputs[float(rows[0, 4])], with_speeds)
 
 
 def _pieces(placements: np.ndarray, size: int) -> list[np.ndarray]:

@@ -4,7 +4,8 @@
 against :func:`solver.path.pipeline.run_chunk` with every branch followed: the family's numpy IK
 (checked against ur-analytic-ik and py-opw-kinematics elsewhere) and
 :func:`solver.path.tracking.track`. On every branch feasible at a placement, every joint and
-waypoint agrees to 1e-12 rad, the 2 pi copy included.
+waypoint agrees to 1e-12 rad, the 2 pi copy included. In free spin the paths along each branch's
+spin schedule at its own mu_path (the pipeline's ``tracked`` in free mode).
 """
 
 from __future__ import annotations
@@ -20,7 +21,7 @@ from solver.core.robots import Robot
 from solver.families import get_robot
 from solver.path.kernel_cells import kernel_inputs, kernel_joint_paths, kernel_of
 from solver.path.pipeline import run_chunk
-from solver.path.problem import PathProblem
+from solver.path.problem import PathOptions, PathProblem
 from tests.solver.test_evaluate import load_path
 from tests.solver.test_parallel import grid_placements
 
@@ -43,10 +44,11 @@ def _narrow(name: str) -> Robot:
     ],
     ids=["ur5", "ur5-s", "ur5e-narrow", "kr16", "irb2400-s"],
 )
+@pytest.mark.parametrize("spin", ["fixed", "free"])
 def test_kernel_joint_paths_equal_the_tracked_paths(
-    robot: Robot, path: str, shift: tuple[float, float]
+    robot: Robot, path: str, shift: tuple[float, float], spin: str
 ) -> None:
-    problem = PathProblem.of(robot, load_path(path))
+    problem = PathProblem.of(robot, load_path(path), PathOptions(spin_mode=spin))  # type: ignore[arg-type]
     placements = grid_placements()
     placements[:, 0] += shift[0]
     placements[:, 1] += shift[1]
@@ -56,16 +58,23 @@ def test_kernel_joint_paths_equal_the_tracked_paths(
     inputs = kernel_inputs(problem, 0.0, kernel)
     reference = run_chunk(problem, placements)  # every branch followed to the end
     feasible = reference.tracked.reason == FEASIBLE  # (B, C)
-    compared = 0
+    compared, moved = 0, 0.0
     for b, branch in enumerate(problem.branches):
         cells = np.flatnonzero(feasible[b])
         if not len(cells):
             continue
-        paths = kernel_joint_paths(inputs, placements[cells], np.full(len(cells), branch))
+        feeds = reference.mu_path[b, cells]  # the free spin schedule's feed
+        paths = kernel_joint_paths(inputs, placements[cells], np.full(len(cells), branch), feeds)
         expected = reference.tracked.q[:, b, cells].transpose(1, 2, 0)  # (C, W, 6)
         np.testing.assert_allclose(paths, expected, rtol=0.0, atol=1e-12)
         compared += len(cells)
+        if spin == "free":  # the schedule moves the joints (not the fixed path at zero spin)
+            still = kernel_joint_paths(
+                inputs, placements[cells], np.full(len(cells), branch), 0 * feeds
+            )
+            moved = max(moved, float(np.abs(paths - still).max()))
     assert compared >= 20, compared  # enough feasible (branch, placement) pairs to mean much
+    assert spin == "fixed" or moved > 0.05, moved
 
 
 def test_each_placement_takes_its_own_branch() -> None:
@@ -88,3 +97,15 @@ def test_each_placement_takes_its_own_branch() -> None:
     paths = kernel_joint_paths(inputs, placements, rows)
     for k, (b, c) in enumerate((first, second)):
         np.testing.assert_allclose(paths[k], reference.tracked.q[:, b, c].T, rtol=0.0, atol=1e-12)
+
+
+def test_a_free_spin_path_needs_its_feed() -> None:
+    """In free spin the schedule runs at the branch's mu_path: without it, a ValueError."""
+    problem = PathProblem.of(
+        get_robot("ur5"), load_path("curved_line"), PathOptions(spin_mode="free")
+    )
+    kernel = kernel_of(problem)
+    assert kernel is not None
+    inputs = kernel_inputs(problem, 0.0, kernel)
+    with pytest.raises(ValueError, match="feed"):
+        kernel_joint_paths(inputs, np.array([[0.0, 0.45, 0.1, 0.0, 0.0]]), np.array([0]))

@@ -127,12 +127,21 @@ def test_a_numeric_arms_map_with_a_cell_is_the_closed_forms(
 
 
 @pytest.mark.parametrize(
-    ("name", "qddot_max"), [("ur5", None), ("ur5e", None), ("ur5", 4.0), ("kr6", None)]
+    ("name", "qddot_max", "spin"),
+    [
+        ("ur5", None, "fixed"),
+        ("ur5e", None, "fixed"),
+        ("ur5", 4.0, "fixed"),
+        ("kr6", None, "fixed"),
+        ("ur5", None, "free"),
+        ("ur5e", 4.0, "free"),
+    ],
 )
 def test_compiled_path_checks_equal_the_pipeline_route(
-    name: str, qddot_max: float | None, monkeypatch: pytest.MonkeyPatch
+    name: str, qddot_max: float | None, spin: str, monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    """The map with a cell by the kernel's joint paths and branches = by the numpy pipeline."""
+    """The map with a cell by the kernel's joint paths and branches = by the numpy pipeline; in
+    free spin the kernel's paths run along each branch's spin schedule."""
     robot, cell, axes = _robot(name), ON_TABLE, AXES
     robot = robot.with_options(transform_tool_to_tcp=_arm("ur5").transform_tool_to_tcp)
     if name == "kr6":  # in front of the KR6, turned; its URDF's base reaches below the table
@@ -145,7 +154,8 @@ def test_compiled_path_checks_equal_the_pipeline_route(
         }
     if qddot_max is not None:
         robot = robot.with_options(qddot_max=[qddot_max] * 6)
-    problem = PathProblem.of(robot, load_path("curved_line"), PathOptions(cell=cell))
+    options = PathOptions(cell=cell, spin_mode=spin)  # type: ignore[arg-type]
+    problem = PathProblem.of(robot, load_path("curved_line"), options)
     runs: list[int] = []
     run_chunk = branch_candidates.run_chunk
 
@@ -154,9 +164,11 @@ def test_compiled_path_checks_equal_the_pipeline_route(
         return run_chunk(*args, **kwargs)  # type: ignore[arg-type]
 
     monkeypatch.setattr(branch_candidates, "run_chunk", spy)
+    monkeypatch.setattr(path_checks, "run_chunk", spy)
     compiled = capability_map(problem, **axes)  # type: ignore[arg-type]
     assert not runs  # no numpy pipeline run: the kernel's answers
-    plain = capability_map(dataclasses.replace(problem, options=PathOptions()), **axes)  # type: ignore[arg-type]
+    bare = PathOptions(spin_mode=spin)  # type: ignore[arg-type]
+    plain = capability_map(dataclasses.replace(problem, options=bare), **axes)  # type: ignore[arg-type]
     feasible = compiled.reason == -1
     assert ((compiled.branch != plain.branch) & feasible).any()  # next branches were taken
     assert (compiled.reason == 4).any()  # and some cells refused
