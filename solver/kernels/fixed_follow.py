@@ -29,6 +29,14 @@ from solver.kernels.cell import BLOCK, fail, prune
 from solver.kernels.limits import joint_speed_bound
 from solver.kernels.positions import NARROW, WIDE, first_outside_pairs
 
+OUTSIDE = 1e-9
+"""A waypoint whose joint is outside a narrow range's arc by more than this (cos of the angle
+from the range's middle below cos of its half width) has no 2 pi copy within the limits (the
+exact test's slack is EDGE, 1e-12 rad): its branch fails the position limits there or before.
+Where the cell has a feasible branch (a finite ``limit``), the branch is then left, its bound
+-inf, as an unreachable one is: an OPW arm's branches out of their joint ranges were followed
+to the end, where their limits are tested, for nothing."""
+
 
 @njit(cache=True, error_model="numpy", nogil=True)
 def follow_rows(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
@@ -101,10 +109,16 @@ def follow_rows(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
                     fail(i, code, w, alive, why, where)
                     n_live -= 1
                     break
+                outside = False
                 for j in range(N_JOINTS):
                     if modes[j] == NARROW:
                         margin = cq[b, j, w] * arc[j, 0] + sq[b, j, w] * arc[j, 1] - arc[j, 2]
                         inside[i, j] = min(inside[i, j], margin)
+                        outside = outside or margin < -OUTSIDE
+                if outside and limit[i] > -np.inf:  # out of a narrow range: infeasible
+                    prune(i, w, -np.inf, alive, why, where, slowest, hint)
+                    n_live -= 1
+                    break
                 speed, limiting = joint_speed_bound(qd, b, w, inverse_qdot)
                 v = 0.0 if pure_rotation[w] else speed
                 if w == 0 or v < slowest[i]:
