@@ -104,11 +104,11 @@ def first_outside_pairs(  # type: ignore[no-untyped-def]  # pragma: no cover - c
 
     The fast tests on the sums of row i that the kernel keeps along the path (``chords2`` and
     ``largest2`` of the wide joints' steps, ``inside`` and ``crossed`` of the narrow ones, shape
-    (B, n)); only where they do not clear every joint, the angles and the exact test
-    (:func:`first_outside`).
+    (B, n)); only for the joints they do not clear, the angles and the exact test
+    (:func:`first_outside_joint`).
     """
     n_waypoints = cq.shape[2]
-    exact = False
+    first = n_waypoints
     for j in range(N_JOINTS):
         if modes[j] == NO_LIMIT:
             continue
@@ -118,11 +118,40 @@ def first_outside_pairs(  # type: ignore[no-untyped-def]  # pragma: no cover - c
             small = largest2[i, j] <= _CHORD_SMALL * _CHORD_SMALL
             factor = _TURN_PER_CHORD_SMALL if small else math.pi / 2
             turning = factor * math.sqrt((n_waypoints - 1) * chords2[i, j])
-            exact = exact or turning > upper[j] - lower[j] - _TWO_PI - _MARGIN
+            exact = turning > upper[j] - lower[j] - _TWO_PI - _MARGIN
         else:  # every waypoint inside the arc, no step through the gap
-            exact = exact or inside[i, j] <= _MARGIN or crossed[i, j]
-    if exact:
-        return first_outside(unwrapped(cq, sq, b), lower, upper)
+            exact = inside[i, j] <= _MARGIN or crossed[i, j]
+        if exact:  # this joint's angles and its exact test (the others fit: proven above)
+            first = min(first, first_outside_joint(cq, sq, b, j, lower[j], upper[j]))
+    return first
+
+
+@njit(cache=True, error_model="numpy", nogil=True)
+def first_outside_joint(cq, sq, b, j, low, high):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
+    """:func:`first_outside` of joint j of :func:`unwrapped`'s path, its angles formed as it goes.
+
+    The same arithmetic as both, one joint: a path leaves its limits at the first waypoint where
+    some joint does, so :func:`first_outside_pairs` takes the least over the joints its fast
+    tests do not clear (an OPW arm's wrist with 10 degrees of room beyond a turn fails them
+    on most paths; its five other joints no longer form their angles).
+    """
+    n_waypoints = cq.shape[2]
+    first = math.atan2(sq[b, j, 0], cq[b, j, 0])
+    previous, total = first, 0.0
+    low_run, high_run = first, first
+    for w in range(n_waypoints):
+        value = first
+        if w > 0:
+            angle = math.atan2(sq[b, j, w], cq[b, j, w])
+            total += wrapped_step(angle - previous)
+            value = first + total
+            previous = angle
+        low_run = min(low_run, value)
+        high_run = max(high_run, value)
+        k_low = math.ceil((low - low_run) / _TWO_PI - EDGE)
+        k_high = math.floor((high - high_run) / _TWO_PI + EDGE)
+        if k_low > k_high:
+            return w
     return n_waypoints
 
 
