@@ -211,6 +211,25 @@ def turned_poses(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
         poses[20, w] = tool_position[w, 2] + offset[c, 2]
 
 
+@njit(cache=True, error_model="numpy", nogil=True, inline="always")
+def spin_poses_of(poses, tool_axis, ca, sa, spin_poses):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
+    """``poses`` (21, W) with the twist rows the spin's, [0; z_tool] in {B}, into ``spin_poses``.
+
+    The path turned by the placement's yaw (cos ``ca``, sin ``sa``): the pose kernel then gives
+    J^-1 [0; z_tool] (free spin, cam.md section 2). ``tool_axis``: shape (W, 3), z of the tool
+    in {O}.
+    """
+    spin_poses[:] = poses
+    for w in range(poses.shape[1]):
+        x, y = tool_axis[w, 0], tool_axis[w, 1]
+        spin_poses[12, w] = 0.0
+        spin_poses[13, w] = 0.0
+        spin_poses[14, w] = 0.0
+        spin_poses[15, w] = ca * x - sa * y
+        spin_poses[16, w] = sa * x + ca * y
+        spin_poses[17, w] = tool_axis[w, 2]
+
+
 @njit(cache=True, error_model="numpy", nogil=True)
 def write_cell(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
     c, branches, alive, why, where, feed, tie, slowest, slowest_at, slowest_joint, speeds,

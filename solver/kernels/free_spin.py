@@ -48,6 +48,7 @@ from solver.kernels.cell import (
     next_row,
     pose_work,
     set_limits,
+    spin_poses_of,
     start_again,
     start_cell,
     turned_poses,
@@ -187,15 +188,7 @@ def free_cells(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
             c, cos_yaw, sin_yaw, offset, flange_rotation, flange_position, tool_position, twist,
             poses,
         )  # fmt: skip
-        spin_poses[:] = poses
-        for w in range(n_waypoints):  # the spin twist [0; z_tool] in {B}
-            x, y = tool_axis[w, 0], tool_axis[w, 1]
-            spin_poses[12, w] = 0.0
-            spin_poses[13, w] = 0.0
-            spin_poses[14, w] = 0.0
-            spin_poses[15, w] = ca * x - sa * y
-            spin_poses[16, w] = sa * x + ca * y
-            spin_poses[17, w] = tool_axis[w, 2]
+        spin_poses_of(poses, tool_axis, ca, sa, spin_poses)  # the spin twist [0; z_tool]
         start_cell(alive, why, where)
         posed = (family, par, poses, spin_poses, branches, pure_rotation)
         found = (scratch, cq, sq, qd, qs, status, need, alive, why, where, slowest)

@@ -21,7 +21,7 @@ from numba import njit
 
 from solver.families.kernels import pose_block
 from solver.kernels.cache import drop_stale_compiled_code
-from solver.kernels.cell import BLOCK, pose_work, turned_poses
+from solver.kernels.cell import BLOCK, pose_work, spin_poses_of, turned_poses
 from solver.kernels.positions import shift_to_copy, unwrapped
 from solver.kernels.spin_schedule import spun_failure
 
@@ -144,15 +144,7 @@ def spun_branch_paths(  # type: ignore[no-untyped-def]  # pragma: no cover - com
             c, cos_yaw, sin_yaw, offset, flange_rotation, flange_position, tool_position, twist,
             poses,
         )  # fmt: skip
-        spin_poses[:] = poses
-        for w in range(n_waypoints):  # the spin twist [0; z_tool] in {B}, as free_cells sets it
-            x, y = tool_axis[w, 0], tool_axis[w, 1]
-            spin_poses[12, w] = 0.0
-            spin_poses[13, w] = 0.0
-            spin_poses[14, w] = 0.0
-            spin_poses[15, w] = ca * x - sa * y
-            spin_poses[16, w] = sa * x + ca * y
-            spin_poses[17, w] = tool_axis[w, 2]
+        spin_poses_of(poses, tool_axis, ca, sa, spin_poses)  # as free_cells makes them
         need[:] = False
         need[rows[c]] = True
         for w0 in range(0, n_waypoints, BLOCK):

@@ -56,18 +56,10 @@ AXES = {
 }
 
 
-def _numpy_route(monkeypatch: pytest.MonkeyPatch) -> list[str]:
-    """Maps on the numpy pipeline from here on; the pipeline runs' callers, as they run."""
+def _numpy_route(monkeypatch: pytest.MonkeyPatch) -> list[tuple[str, int, bool, bool]]:
+    """Maps on the numpy pipeline from here on; the pipeline runs, as :func:`_spy_runs`."""
     monkeypatch.setattr(placements_module, "kernel_of", lambda problem: None)
-    runs: list[str] = []
-    for module in (placements_module, branch_candidates, path_checks):
-
-        def spy(*args: object, _module: object = module, **kwargs: object) -> object:
-            runs.append(getattr(_module, "__name__", ""))
-            return run_chunk(*args, **kwargs)  # type: ignore[arg-type]
-
-        monkeypatch.setattr(module, "run_chunk", spy)
-    return runs
+    return _spy_runs(monkeypatch)
 
 
 @pytest.mark.parametrize("name", ["ur5", "ur5e"])
@@ -81,7 +73,7 @@ def test_the_numpy_routes_map_checks_its_own_runs_joint_paths(
     plain = PathProblem.of(_arm(name), load_path("curved_line"), PathOptions())
     runs = _numpy_route(monkeypatch)
     cmap = capability_map(problem, **AXES)  # type: ignore[arg-type]
-    assert runs and set(runs) == {placements_module.__name__}  # the chunks' runs alone
+    assert runs and {caller for caller, *_ in runs} == {placements_module.__name__}  # the chunks
     free = capability_map(plain, **AXES)  # type: ignore[arg-type]
     feasible = cmap.reason == -1
     assert ((cmap.branch != free.branch) & feasible).any()  # next branches were taken
@@ -115,7 +107,7 @@ def test_a_numeric_arms_map_with_a_cell_is_the_closed_forms(
     runs = _numpy_route(monkeypatch)
     cmap = capability_map(PathProblem.of(numeric, path, PathOptions(cell=ON_TABLE)), **AXES)  # type: ignore[arg-type]
     # the chunks' runs, then the refused placements' (pruned, then every branch left)
-    assert set(runs) == {
+    assert {caller for caller, *_ in runs} == {
         placements_module.__name__,
         path_checks.__name__,
         branch_candidates.__name__,
