@@ -12,6 +12,7 @@ from __future__ import annotations
 import numpy as np
 
 from solver.core.codes import FEASIBLE
+from solver.core.follows_in_steps import FollowsInSteps
 from solver.path.branch_candidates import (
     Candidates,
     Columns,
@@ -243,8 +244,9 @@ def _next_by_pruned_runs(
     (the pick is followed to the end, the same bits). The picks of a round are checked
     together; a refused one is excluded in the next round. After :data:`PRUNED_ROUNDS`, the
     placements still refused take their next branches from one run of every branch left
-    (:func:`pipeline_candidates`). A placement left without a branch is refused where its
-    first pick was.
+    (:func:`pipeline_candidates`); a family that does not follow bounded (more than seven
+    joints: its runs would not leave the refused branches out) goes there at once. A placement
+    left without a branch is refused where its first pick was.
     """
     cells = np.array(sorted(refused))
     rows = placements[cells]
@@ -253,7 +255,9 @@ def _next_by_pruned_runs(
     hints = [refused[int(c)][1] for c in cells]  # each placement's last refusal
     taken = np.zeros(len(cells), dtype=bool)
     open_ = np.arange(len(cells))
-    for _ in range(PRUNED_ROUNDS):
+    family = problem.family
+    bounded = isinstance(family, FollowsInSteps) and family.follows_bounded
+    for _ in range(PRUNED_ROUNDS if bounded else 0):
         if not len(open_):
             break
         run = run_chunk(problem, rows[open_], prune=True, excluded=excluded[open_])

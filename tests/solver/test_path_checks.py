@@ -36,6 +36,7 @@ from solver.path.problem import PathOptions, PathProblem
 from solver.path.tracking import choose_branch
 from tests.cases import KERNEL_ACC_ULPS
 from tests.solver.families.numeric_maps import opw_urdf, ur5_from_urdf
+from tests.solver.families.test_numeric_pruned_map import stepped
 from tests.solver.test_cell_fast import _arm
 from tests.solver.test_cell_pair_tables import ON_TABLE
 from tests.solver.test_evaluate import load_path
@@ -203,7 +204,7 @@ def _spy_runs(monkeypatch: pytest.MonkeyPatch) -> list[tuple[str, int, bool, boo
     return runs
 
 
-@pytest.mark.parametrize("name", ["ur5_urdf", "panda"])
+@pytest.mark.parametrize("name", ["ur5_urdf", "panda", "panda_in_steps"])
 def test_a_pruned_numeric_map_with_a_cell_equals_following_every_branch(
     name: str, monkeypatch: pytest.MonkeyPatch
 ) -> None:
@@ -211,9 +212,12 @@ def test_a_pruned_numeric_map_with_a_cell_equals_following_every_branch(
     the refused placements run again without their refused branches, equals the map of runs
     that follow every branch at every placement (the next branches read off those runs), on
     every field; the runs after the chunks' cover only refused placements and exclude their
-    refused branches."""
+    refused branches. A family pruned in steps (arms of more joints; the Panda made to) runs
+    the refused placements once, every branch left followed."""
     tool = _arm("ur5").transform_tool_to_tcp
     robot = ur5_from_urdf() if name == "ur5_urdf" else get_robot("panda")
+    if name == "panda_in_steps":
+        robot = stepped(robot, only=True)
     problem = PathProblem.of(
         robot.with_options(transform_tool_to_tcp=tool),
         load_path("curved_line"),
@@ -227,6 +231,8 @@ def test_a_pruned_numeric_map_with_a_cell_equals_following_every_branch(
     again = [run for run in runs if run[0] != placements_module.__name__]
     assert chunks and all(prune and not excluded for _, _, prune, excluded in chunks)
     assert again and all(excluded for *_, excluded in again)
+    if name == "panda_in_steps":  # no pruned round: one run of the refused placements
+        assert len(again) <= len(chunks) and not any(prune for _, _, prune, _ in again)
     feasible = plain.reason == -1
     moved = feasible & ((pruned.branch != plain.branch) | (pruned.reason == 4))
     assert moved.any() and (pruned.reason == -1).any()  # picks refused, next branches taken
