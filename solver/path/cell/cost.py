@@ -21,9 +21,11 @@ from solver.path.cell.shapes import DEFAULT_COLLISION_STEP, Cell
 # from numba's disk cache as the service loads them; 50 over-weighs the check, and is kept, since
 # lowering it changes which requests the size limits refuse. A numeric arm's map with a cell
 # weighs its family's figure times this: 2,683 a waypoint for the UR5 read as a numeric URDF
-# (7,136 a placement without), against a measured 4.2 times its map without (bench/cell.py); a
-# sum (the family's figure plus this) would under-weigh it (its map with a cell follows every
-# branch, which the figure without does not).
+# (7,136 a placement without). When that map followed every branch it took 4.2 times its map
+# without; since it drops branches as without a cell (2026-12-04) 3.0 to 3.2 times, and a mimic
+# arm on the numpy chain (the corpus IRB 5400) about 1.0 times, weighed 23 times over the size
+# limit where its map without a cell is under it: the product over-weighs numeric arms, the sum
+# (the family's figure plus this) has not been measured since. Kept until it is.
 CELL_POSE_COST = 50.0
 
 
