@@ -55,6 +55,19 @@ def wrapped_step(step):  # type: ignore[no-untyped-def]  # pragma: no cover - co
     return step
 
 
+@njit(cache=True, error_model="numpy", nogil=True, inline="always")
+def unwrap_joint(cq, sq, b, j, out):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
+    """Joint j of :func:`unwrapped`'s path into ``out`` (W,), rad."""
+    first = math.atan2(sq[b, j, 0], cq[b, j, 0])
+    previous, total = first, 0.0
+    out[0] = first
+    for w in range(1, out.shape[0]):
+        angle = math.atan2(sq[b, j, w], cq[b, j, w])
+        total += wrapped_step(angle - previous)
+        out[w] = first + total
+        previous = angle
+
+
 @njit(cache=True, error_model="numpy", nogil=True)
 def unwrapped(cq, sq, b):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
     """Branch b's joint path (W, 6), rad: the angles of its pairs, unwrapped by the wrapped steps.
@@ -65,15 +78,22 @@ def unwrapped(cq, sq, b):  # type: ignore[no-untyped-def]  # pragma: no cover - 
     dof, n_waypoints = cq.shape[1], cq.shape[2]
     path = np.empty((n_waypoints, dof))
     for j in range(dof):
-        first = math.atan2(sq[b, j, 0], cq[b, j, 0])
-        previous, total = first, 0.0
-        path[0, j] = first
-        for w in range(1, n_waypoints):
-            angle = math.atan2(sq[b, j, w], cq[b, j, w])
-            total += wrapped_step(angle - previous)
-            path[w, j] = first + total
-            previous = angle
+        unwrap_joint(cq, sq, b, j, path[:, j])
     return path
+
+
+@njit(cache=True, error_model="numpy", nogil=True, inline="always")
+def first_outside_one(values, low, high):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
+    """:func:`first_outside` of one joint's path ``values`` (W,) and its limits."""
+    low_run, high_run = values[0], values[0]
+    for w in range(values.shape[0]):
+        low_run = min(low_run, values[w])
+        high_run = max(high_run, values[w])
+        k_low = math.ceil((low - low_run) / _TWO_PI - EDGE)
+        k_high = math.floor((high - high_run) / _TWO_PI + EDGE)
+        if k_low > k_high:
+            return w
+    return values.shape[0]
 
 
 @njit(cache=True, error_model="numpy", nogil=True)
@@ -81,19 +101,13 @@ def first_outside(path, lower, upper):  # type: ignore[no-untyped-def]  # pragma
     """The first waypoint of a joint path (W, n) whose range no 2 pi copy holds (W: none).
 
     :func:`solver.path.tracking.track`'s test: the running range of each joint (a range that fits
-    holds every shorter one, so no test of the whole path is needed first).
+    holds every shorter one, so no test of the whole path is needed first); the path leaves its
+    limits where its first joint does.
     """
-    n_waypoints, dof = path.shape
-    low_run, high_run = path[0].copy(), path[0].copy()
-    for w in range(n_waypoints):
-        for j in range(dof):
-            low_run[j] = min(low_run[j], path[w, j])
-            high_run[j] = max(high_run[j], path[w, j])
-            k_low = math.ceil((lower[j] - low_run[j]) / _TWO_PI - EDGE)
-            k_high = math.floor((upper[j] - high_run[j]) / _TWO_PI + EDGE)
-            if k_low > k_high:
-                return w
-    return n_waypoints
+    first = path.shape[0]
+    for j in range(path.shape[1]):
+        first = min(first, first_outside_one(path[:, j], lower[j], upper[j]))
+    return first
 
 
 @njit(cache=True, error_model="numpy", nogil=True)
@@ -104,11 +118,13 @@ def first_outside_pairs(  # type: ignore[no-untyped-def]  # pragma: no cover - c
 
     The fast tests on the sums of row i that the kernel keeps along the path (``chords2`` and
     ``largest2`` of the wide joints' steps, ``inside`` and ``crossed`` of the narrow ones, shape
-    (B, n)); only for the joints they do not clear, the angles and the exact test
-    (:func:`first_outside_joint`).
+    (B, n)); only for the joints they do not clear, the angles and the exact test (a path
+    leaves its limits where its first joint does: an OPW arm's wrist with 10 degrees of room
+    beyond a turn fails the fast test on most paths, and its five other joints need no angle).
     """
     n_waypoints = cq.shape[2]
     first = n_waypoints
+    values = np.empty(0)
     for j in range(N_JOINTS):
         if modes[j] == NO_LIMIT:
             continue
@@ -122,37 +138,11 @@ def first_outside_pairs(  # type: ignore[no-untyped-def]  # pragma: no cover - c
         else:  # every waypoint inside the arc, no step through the gap
             exact = inside[i, j] <= _MARGIN or crossed[i, j]
         if exact:  # this joint's angles and its exact test (the others fit: proven above)
-            first = min(first, first_outside_joint(cq, sq, b, j, lower[j], upper[j]))
+            if values.shape[0] == 0:
+                values = np.empty(n_waypoints)
+            unwrap_joint(cq, sq, b, j, values)
+            first = min(first, first_outside_one(values, lower[j], upper[j]))
     return first
-
-
-@njit(cache=True, error_model="numpy", nogil=True)
-def first_outside_joint(cq, sq, b, j, low, high):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
-    """:func:`first_outside` of joint j of :func:`unwrapped`'s path, its angles formed as it goes.
-
-    The same arithmetic as both, one joint: a path leaves its limits at the first waypoint where
-    some joint does, so :func:`first_outside_pairs` takes the least over the joints its fast
-    tests do not clear (an OPW arm's wrist with 10 degrees of room beyond a turn fails them
-    on most paths; its five other joints no longer form their angles).
-    """
-    n_waypoints = cq.shape[2]
-    first = math.atan2(sq[b, j, 0], cq[b, j, 0])
-    previous, total = first, 0.0
-    low_run, high_run = first, first
-    for w in range(n_waypoints):
-        value = first
-        if w > 0:
-            angle = math.atan2(sq[b, j, w], cq[b, j, w])
-            total += wrapped_step(angle - previous)
-            value = first + total
-            previous = angle
-        low_run = min(low_run, value)
-        high_run = max(high_run, value)
-        k_low = math.ceil((low - low_run) / _TWO_PI - EDGE)
-        k_high = math.floor((high - high_run) / _TWO_PI + EDGE)
-        if k_low > k_high:
-            return w
-    return n_waypoints
 
 
 @njit(cache=True, error_model="numpy", nogil=True)
