@@ -71,6 +71,16 @@ ONE_PASS_WAYPOINTS = 4 * 32 * 133
 task of the ERK path (four chunks of 32 placements, 133 waypoints; :func:`one_pass_chunk`)."""
 
 
+def in_one_pass(problem: PathProblem) -> bool:
+    """Whether the problem's family is pruned in this module's one compiled pass.
+
+    Six and seven joints (:attr:`FollowsInSteps.follows_bounded`); other families that follow
+    in steps are pruned in steps (:mod:`solver.path.pruning`).
+    """
+    family = problem.family
+    return isinstance(family, FollowsInSteps) and family.follows_bounded
+
+
 def one_pass_chunk(problem: PathProblem, chunk: int) -> int:
     """Placements a map's chunk takes: ``chunk``, more where this module follows them.
 
@@ -82,9 +92,7 @@ def one_pass_chunk(problem: PathProblem, chunk: int) -> int:
     from one placement to the next only orders the work). Up to :data:`ONE_PASS_WAYPOINTS`
     placement-waypoints, at least ``chunk`` placements.
     """
-    family = problem.family
-    bounded = isinstance(family, FollowsInSteps) and family.follows_bounded
-    if not (bounded and problem.robot.dof == 6 and can_prune(problem)):
+    if not (in_one_pass(problem) and problem.robot.dof == 6 and can_prune(problem)):
         return chunk
     return max(chunk, ONE_PASS_WAYPOINTS // problem.prepared.n_waypoints)
 

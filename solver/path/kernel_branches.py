@@ -39,11 +39,6 @@ class KernelBranches:
     inputs: KernelInputs
     with_speeds: bool
 
-    @classmethod
-    def of(cls, inputs: KernelInputs, with_speeds: bool) -> KernelBranches:
-        """The compiled side at these inputs' spin (fixed or free)."""
-        return cls(inputs, with_speeds)
-
     def joint_paths(
         self, placements: np.ndarray, rows: np.ndarray, feeds: np.ndarray
     ) -> np.ndarray:

@@ -12,7 +12,7 @@ from __future__ import annotations
 import numpy as np
 
 from solver.core.codes import FEASIBLE
-from solver.core.follows_in_steps import FollowsInSteps
+from solver.path.bounded import in_one_pass
 from solver.path.branch_candidates import (
     Candidates,
     Columns,
@@ -255,9 +255,7 @@ def _next_by_pruned_runs(
     hints = [refused[int(c)][1] for c in cells]  # each placement's last refusal
     taken = np.zeros(len(cells), dtype=bool)
     open_ = np.arange(len(cells))
-    family = problem.family
-    bounded = isinstance(family, FollowsInSteps) and family.follows_bounded
-    for _ in range(PRUNED_ROUNDS if bounded else 0):
+    for _ in range(PRUNED_ROUNDS if in_one_pass(problem) else 0):
         if not len(open_):
             break
         run = run_chunk(problem, rows[open_], prune=True, excluded=excluded[open_])

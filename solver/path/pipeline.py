@@ -22,9 +22,8 @@ import numpy as np
 
 from solver.core.codes import ACC_TIE_RTOL, FEASIBLE, UNREACHABLE
 from solver.core.family import PathSolutions
-from solver.core.follows_in_steps import FollowsInSteps
 from solver.core.progress import Progress, span
-from solver.path.bounded import bounded_solutions, pick_stands
+from solver.path.bounded import bounded_solutions, in_one_pass, pick_stands
 from solver.path.in_pieces import bound_in_pieces, track_in_pieces
 from solver.path.limits import JointMotion, bound_by_limits
 from solver.path.placed import placed_flange, turn_by_yaw
@@ -137,7 +136,7 @@ def run_chunk(
     )
     free = problem.options.spin_mode == "free"
     shares = REDUNDANT_FREE_SHARES if free and robot.dof > 6 else SHARES
-    bounded = isinstance(family, FollowsInSteps) and family.follows_bounded
+    bounded = in_one_pass(problem)
     pruned = prune and can_prune(problem) and (excluded is None or bounded)
     if pruned and bounded:
         solutions = bounded_solutions(

@@ -56,6 +56,6 @@ class PlacementEvaluator:
         columns = run_kernel(self._last[1], cells, False)
         if self._problem.path_checks:
             columns_of = partial(columns_of_run, self._problem, with_speeds=False)
-            compiled = KernelBranches.of(self._last[1], False)
+            compiled = KernelBranches(self._last[1], False)
             columns = refuse_colliding(self._problem, cells, columns, columns_of, compiled=compiled)
         return results_of_columns(self._problem, list(columns), False)

@@ -163,7 +163,7 @@ def _task(
                     rows,
                     part,
                     columns_of,
-                    compiled=KernelBranches.of(inputs[float(rows[0, 4])], with_speeds),
+                    compiled=KernelBranches(inputs[float(rows[0, 4])], with_speeds),
                 )
                 for rows, part in zip(pieces, parts, strict=True)
             ]

@@ -24,8 +24,8 @@ field of the cell changes (tested cell by cell against following every branch).
 Only where that argument holds: the map's ``auto`` branch, fixed spin, limits that bound each
 waypoint by its own configuration (the joint speeds) and no final-path limit (mu_acc ranks the
 branches). A path check (the cell) judges the pick's joint path, which is followed to the end;
-where it refuses the pick, the placement's next branches come from a run of the refused
-placements that follows every branch (:func:`solver.path.path_checks.refuse_colliding`).
+where it refuses the pick, the refused placements run again without their refused branches
+(:func:`solver.path.path_checks.refuse_colliding`).
 Evaluations follow every branch: their answer reports the whole joint paths. A family that
 follows bounded (six and seven joints, :attr:`FollowsInSteps.follows_bounded`) is pruned under
 the same conditions in one compiled pass instead (:mod:`solver.path.bounded`); this serves arms

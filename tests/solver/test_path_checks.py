@@ -40,6 +40,7 @@ from tests.solver.families.test_numeric_pruned_map import stepped
 from tests.solver.test_cell_fast import _arm
 from tests.solver.test_cell_pair_tables import ON_TABLE
 from tests.solver.test_evaluate import load_path
+from tests.solver.test_map_kernel import grid
 
 
 def _robot(name: str) -> Robot:
@@ -238,21 +239,13 @@ def test_a_pruned_numeric_map_with_a_cell_equals_following_every_branch(
     assert moved.any() and (pruned.reason == -1).any()  # picks refused, next branches taken
     assert max(count for _, count, _, _ in again) <= moved.sum()  # only refused placements
     runs.clear()
-    full = evaluate_placements(problem, _rows(pruned), prune=False)
+    rows = grid(pruned.xs, pruned.ys, pruned.z, pruned.yaws)  # the map's placements, in order
+    full = evaluate_placements(problem, rows, prune=False)
     assert runs and not any(prune for _, _, prune, _ in runs)  # every branch followed
     for field in ("mu_path", "reason", "failed_waypoint", "branch", "bottleneck_waypoint",
                   "bottleneck_joint"):  # fmt: skip
         ours, theirs = getattr(pruned, field).ravel(), getattr(full, field)
         np.testing.assert_array_equal(ours, theirs, err_msg=field)
-
-
-def _rows(cmap: object) -> np.ndarray:
-    """A map's placements (P, 5) in its cells' order (yaw, y, x)."""
-    yaws, ys, xs = np.meshgrid(cmap.yaws, cmap.ys, cmap.xs, indexing="ij")  # type: ignore[attr-defined]
-    count = xs.size
-    return np.column_stack(
-        [xs.ravel(), ys.ravel(), np.full(count, cmap.z), yaws.ravel(), np.zeros(count)]  # type: ignore[attr-defined]
-    )
 
 
 def test_the_next_branch_is_autos_choice_among_those_left() -> None:
