@@ -49,8 +49,8 @@ def _check_work(problem: PathProblem, settings: Settings) -> None:
     """Refuse an evaluation whose work, weighed as a map's, is over the map limit (before it).
 
     One placement of the path costs the problem's ``path_cost`` in closed-form poses (one a
-    waypoint for a closed-form family, far more for numeric IK, times the collision check's
-    weight with a cell), the unit of the map limit.
+    waypoint for a closed-form family, far more for numeric IK, plus the collision check's
+    with a cell), the unit of the map limit.
 
     Raises:
         InvalidInputError: on ``path``, saying the work and the limit.

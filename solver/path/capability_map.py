@@ -16,7 +16,7 @@ from solver.core.codes import REASONS
 from solver.core.exceptions import InvalidInputError
 from solver.core.parallel import SERIAL, TaskRunner
 from solver.core.spatial import Placement
-from solver.path.cell.cost import cell_pose_cost
+from solver.path.cell.cost import with_cell
 from solver.path.placements import DEFAULT_CHUNK, evaluate_placements
 from solver.path.problem import PathProblem
 from solver.path.pruning import can_prune
@@ -213,14 +213,15 @@ def map_cost(problem: PathProblem) -> float:
     """The work of one placement of ``problem``'s map, in closed-form poses (the size limits').
 
     The family's map figure (:meth:`solver.core.family.KinematicsFamily.map_cost`), told
-    whether the map may drop branches (:func:`solver.path.pruning.can_prune`), times the
-    collision check's with a cell. A map with a cell is given the figure of following every
-    branch: it may drop branches, but runs every branch again where the pick collides.
+    whether the map may drop branches (:func:`solver.path.pruning.can_prune`), plus the
+    collision check's with a cell (:func:`solver.path.cell.cost.with_cell`). A map with a cell
+    is given the figure of following every branch: it drops branches too, but follows a
+    refused placement's next branches again (:mod:`solver.path.path_checks`).
     """
     n_waypoints = problem.prepared.n_waypoints
     free_spin = problem.options.spin_mode == "free"
     if problem.options.cell is not None:
         cost = problem.family.map_cost(n_waypoints, free_spin=free_spin)
-        return cost * cell_pose_cost(problem.options.cell)
+        return with_cell(cost, n_waypoints, problem.options.cell)
     pruned = can_prune(problem)
     return problem.family.map_cost(n_waypoints, free_spin=free_spin, pruned=pruned)

@@ -26,7 +26,7 @@ from solver.core.family import Branch, KinematicsFamily
 from solver.core.robots import Robot
 from solver.path.blend_stencil import BlendStencil
 from solver.path.cell.cache import checker_for
-from solver.path.cell.cost import cell_pose_cost
+from solver.path.cell.cost import with_cell
 from solver.path.cell.limit import CellLimit
 from solver.path.cell.shapes import Cell
 from solver.path.limits import JointAccelerationLimit, JointSpeedLimit, Limit, PathCheck
@@ -178,13 +178,12 @@ class PathProblem:
     def path_cost(self, n_waypoints: int) -> float:
         """The work of one placement of ``n_waypoints``, in poses of a closed-form family's map.
 
-        The family's cost (:meth:`KinematicsFamily.path_cost`), times the collision check's
-        (:func:`solver.path.cell.cost.cell_pose_cost`) with a cell: what the size limits of
-        the maps and searches weigh.
+        The family's cost (:meth:`KinematicsFamily.path_cost`), plus the collision check's
+        with a cell (:func:`solver.path.cell.cost.with_cell`): what the size limits of the maps
+        and searches weigh.
         """
         cost = self.family.path_cost(n_waypoints, free_spin=self.options.spin_mode == "free")
-        cell = self.options.cell
-        return cost * cell_pose_cost(cell) if cell is not None else cost
+        return with_cell(cost, n_waypoints, self.options.cell)
 
     @property
     def waypoint_limits(self) -> tuple[Limit, ...]:

@@ -14,12 +14,16 @@ from fastapi.testclient import TestClient
 from service.config import get_settings
 from solver.core.spatial import Placement
 from solver.families import get_robot
+from solver.path.cell.cost import CELL_POSE_COST
 from solver.path.cell.shapes import Box, Cell, Halfspace
 from solver.path.evaluate import evaluate_path
 from solver.path.problem import PathOptions, PathProblem
 from tests.cases import EXAMPLES
 from tests.service.test_errors import assert_names
 from tests.service.test_job_routes import EXAMPLE, route_body
+from tests.service.test_urdf_mimic_limits import MIMIC_SPEED
+from tests.service.test_urdf_mimic_limits import body as mimic_body
+from tests.solver.families.test_mimic import arm as mimic_arm
 from tests.solver.test_cell import binary_stl, cube_triangles
 from tests.solver.test_evaluate import load_path
 
@@ -181,6 +185,34 @@ def test_a_map_in_a_cell_weighs_its_collision_work(
     assert "in a cell" in response.json()["detail"][0]["msg"]
     del request["cell"]
     assert client.post("/v1/map", json=request).status_code == 200
+
+
+def test_a_numeric_arm_in_a_cell_adds_the_check_to_its_ik_work(
+    client: TestClient, setting: Any
+) -> None:
+    """The check's weight (50 a pose) is added to a numeric arm's (tens of thousands a
+    placement), not multiplied by it: the mimic fixture arm (numpy chain, 40 waypoints) maps 3 x 3
+    placements with a far table where its map without a cell is admitted, and is refused by a
+    limit just under the two together. Until 2026-12-04 the product (50 times the IK's) refused
+    the corpus IRB 5400's 3 x 3 map with a cell whose 9 x 11 map without ran in the same time."""
+    request = mimic_body(None)
+    del request["placement"]
+    axis = {"min": -0.1, "max": 0.1, "step": 0.1}
+    request["grid"] = {"x": axis, "y": axis, "z": 0.0, "yaw": 0.0}
+    far = {"fixed": [{"shape": "halfspace", "normal": [0, 0, 1], "offset": -5.0}]}
+    family = mimic_arm(MIMIC_SPEED)[0].family
+    assert family is not None
+    bare = 9 * family.map_cost(40)  # each placement's figure, every branch followed
+    with_cell = bare + 9 * 40 * CELL_POSE_COST
+    setting(max_map_poses=int(with_cell) + 1)  # the product would be 50 times ``bare``
+    answer = client.post("/v1/map", json={**request, "cell": far})
+    assert answer.status_code == 200, answer.text
+    assert "collision" not in {cell["reason"] for cell in answer.json()["cells"]}
+    setting(max_map_poses=int(with_cell) - 1)
+    refused = client.post("/v1/map", json={**request, "cell": far})
+    assert_names(refused, 422, ["body", "grid"])
+    assert "(numeric IK in a cell)" in refused.json()["detail"][0]["msg"]
+    assert client.post("/v1/map", json=request).status_code == 200  # bare fits that limit
 
 
 def test_a_finer_collision_step_weighs_its_sub_steps(
