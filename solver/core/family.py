@@ -44,6 +44,9 @@ class PathSolutions:
             least V_max followed of each of the family's branches; ``None`` otherwise.
         dropped: shape (K, *batch), bool, with ``bound``: the branches whose following was
             stopped (their rows unreachable); the caller checks that the pick stands.
+        first: shape (*batch, K, dof), with ``bound``: the seeding's solutions at each path's
+            first waypoint (``seed_first``, NaN in slots without one; ``branches_found`` its
+            counts), so that a run of the same paths again need not seed them again.
     """
 
     q: np.ndarray
@@ -53,6 +56,7 @@ class PathSolutions:
     slots: np.ndarray | None = None
     bound: np.ndarray | None = None
     dropped: np.ndarray | None = None
+    first: np.ndarray | None = None
 
 
 @dataclass(frozen=True)

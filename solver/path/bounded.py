@@ -105,19 +105,24 @@ def bounded_solutions(
     tool_position: np.ndarray,
     *,
     excluded: np.ndarray | None = None,
+    first: tuple[np.ndarray, np.ndarray] | None = None,
 ) -> PathSolutions:
     """The family's solutions along a chunk's paths, slots that cannot be the pick dropped.
 
     Args and returns as :func:`solver.path.pruning.pruned_solutions`; ``excluded``: shape
     (C, K), bool, slots left out at each placement (the path checks refused them: their
     following is not started, their rows come back unreachable, and the pick is the best of
-    the others, :func:`solver.path.path_checks.refuse_colliding`).
+    the others, :func:`solver.path.path_checks.refuse_colliding`); ``first``: the seeding of
+    these paths' first waypoints from an earlier run of them (:attr:`PathSolutions.first`
+    and ``branches_found``: the same arrays ``seed_first`` gives), else they are seeded.
     """
     chunk = Chunk(problem, rotation, flange_position, twist, tool_position)
     family = chunk.family
-    current, count = family.seed_first(chunk.rotations[:, 0], chunk.positions[:, 0])
-    n_seeds = current.shape[1]
-    current = np.array(current[:, : max(int(count.max()), 1)], order="C")
+    if first is None:
+        first = family.seed_first(chunk.rotations[:, 0], chunk.positions[:, 0])
+    seeded, count = first
+    n_seeds = seeded.shape[1]
+    current = np.array(seeded[:, : max(int(count.max()), 1)], order="C")
     if excluded is not None:
         current[excluded[:, : current.shape[1]]] = np.nan  # a slot without a start: not followed
     speeds = (
@@ -148,6 +153,7 @@ def bounded_solutions(
         slots=order,
         bound=bound,
         dropped=dropped,
+        first=seeded,
     )
 
 

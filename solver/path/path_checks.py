@@ -151,7 +151,7 @@ def refuse_colliding(
     cells = np.array(sorted(refused))
     candidates = None
     if problem.options.branch is None and run is not None and run.pruned:
-        _next_by_pruned_runs(problem, placements, out, refused, columns_of)
+        _next_by_pruned_runs(problem, placements, out, refused, columns_of, run)
         return tuple(out)
     if problem.options.branch is None and compiled is not None:
         candidates = compiled.candidates(problem, placements[cells], branch[cells])
@@ -234,6 +234,7 @@ def _next_by_pruned_runs(
     out: list[np.ndarray],
     refused: dict[int, tuple[np.ndarray, PathVerdict]],
     columns_of: Columns,
+    run: ChunkResult,
 ) -> None:
     """:func:`_next_branches` after a pruned run: its refused branches left out of the next runs.
 
@@ -246,9 +247,15 @@ def _next_by_pruned_runs(
     placements still refused take their next branches from one run of every branch left
     (:func:`pipeline_candidates`); a family that does not follow bounded (more than seven
     joints: its runs would not leave the refused branches out) goes there at once. A placement
-    left without a branch is refused where its first pick was.
+    left without a branch is refused where its first pick was. The pruned runs take the
+    placements' first-waypoint seeding from ``run`` (:attr:`ChunkResult.first`), where it has
+    it, rather than seeding again: the same solutions (a fifth of the UR5-as-URDF's map with a
+    cell was seeding the refused placements again).
     """
     cells = np.array(sorted(refused))
+    seeded = None
+    if run.first is not None and run.branches_found is not None:
+        seeded = (run.first[cells], run.branches_found[cells])
     rows = placements[cells]
     excluded = np.zeros((len(cells), len(problem.family.branches)), dtype=bool)
     excluded[np.arange(len(cells)), out[3][cells]] = True  # the refused picks (family indices)
@@ -258,14 +265,15 @@ def _next_by_pruned_runs(
     for _ in range(PRUNED_ROUNDS if in_one_pass(problem) else 0):
         if not len(open_):
             break
-        run = run_chunk(problem, rows[open_], prune=True, excluded=excluded[open_])
-        picked = columns_of(run)
+        first = None if seeded is None else (seeded[0][open_], seeded[1][open_])
+        again = run_chunk(problem, rows[open_], prune=True, excluded=excluded[open_], first=first)
+        picked = columns_of(again)
         due: list[tuple[int, int, np.ndarray]] = []  # (row of the run, placement k, joint path)
         still: list[int] = []
         for i, k in enumerate(open_.tolist()):
             if picked[1][i] != FEASIBLE:  # no feasible branch left
                 continue
-            q = run.tracked.q[:, run.pick[i], i].T
+            q = again.tracked.q[:, again.pick[i], i].T
             excluded[k, picked[3][i]] = True
             if _refused_again(problem, q, rows[k], hints[k]):
                 still.append(k)

@@ -75,6 +75,10 @@ class ChunkResult:
         pruned: branches that could not be the pick were dropped (a map's run,
             :func:`solver.path.pruning.can_prune`): they come back unreachable, so only the
             pick's row is the branch's answer. False: every branch was followed.
+        first: shape (C, K, n), a run pruned in one compiled pass: the seeding's solutions
+            at each placement's first waypoint (:attr:`PathSolutions.first`; its counts in
+            ``branches_found``), which a run of the same placements again may take (``first``
+            of :func:`run_chunk`); None otherwise.
     """
 
     tracked: Tracked
@@ -95,6 +99,7 @@ class ChunkResult:
     mu_acc: np.ndarray | None = None
     branch_of: np.ndarray | None = None
     pruned: bool = False
+    first: np.ndarray | None = None
 
 
 def run_chunk(
@@ -105,6 +110,7 @@ def run_chunk(
     prune: bool = False,
     solutions: PathSolutions | None = None,
     excluded: np.ndarray | None = None,
+    first: tuple[np.ndarray, np.ndarray] | None = None,
 ) -> ChunkResult:
     """The pipeline at C placements on the problem's branches.
 
@@ -125,6 +131,9 @@ def run_chunk(
             its branches; the path checks refused them there): unreachable from the first
             waypoint, so the pick is the best of the others. A pruned run then does not follow
             them (a family that follows bounded; another runs unpruned).
+        first: these placements' first-waypoint seeding from an earlier run of them
+            (:attr:`ChunkResult.first` and ``branches_found``), taken by a run pruned in one
+            pass instead of seeding again (the same arrays); ignored by other runs.
     """
     robot, path, branches = problem.robot, problem.prepared, problem.branches
     family = problem.family
@@ -140,7 +149,13 @@ def run_chunk(
     pruned = prune and can_prune(problem) and (excluded is None or bounded)
     if pruned and bounded:
         solutions = bounded_solutions(
-            problem, rotation, flange_position, twist, tool_position, excluded=excluded
+            problem,
+            rotation,
+            flange_position,
+            twist,
+            tool_position,
+            excluded=excluded,
+            first=first,
         )
     elif pruned:
         solutions = pruned_solutions(problem, rotation, flange_position, twist, tool_position)
@@ -223,6 +238,7 @@ def run_chunk(
         mu_acc=mu_acc,
         branch_of=None if solutions.slots is None else solutions.slots[branches],
         pruned=pruned,
+        first=solutions.first,
     )
 
 

@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+from typing import Any
 
 import numpy as np
 import pytest
@@ -27,6 +28,7 @@ from solver.core.codes import REASONS
 from solver.core.robots import Robot
 from solver.core.spatial import Placement
 from solver.families import get_robot, robot_from_urdf
+from solver.families.numeric.family import NumericFamily
 from solver.path.branch_candidates import tie_order
 from solver.path.capability_map import capability_map, grid_axis
 from solver.path.evaluate import evaluate_path
@@ -227,11 +229,25 @@ def test_a_pruned_numeric_map_with_a_cell_equals_following_every_branch(
     axes = {**AXES, "yaws": np.array([0.0])}
     plain = capability_map(dataclasses.replace(problem, options=PathOptions()), **axes)  # type: ignore[arg-type]
     runs = _spy_runs(monkeypatch)
+    seeded: list[int] = []  # placements seeded at their first waypoint, call by call
+    seed_first = NumericFamily.seed_first
+
+    def counted(self: NumericFamily, *args: Any) -> tuple[np.ndarray, np.ndarray]:
+        seeded.append(len(args[0]))
+        return seed_first(self, *args)
+
+    monkeypatch.setattr(NumericFamily, "seed_first", counted)
     pruned = capability_map(problem, **axes)  # type: ignore[arg-type]
     chunks = [run for run in runs if run[0] == placements_module.__name__]
     again = [run for run in runs if run[0] != placements_module.__name__]
     assert chunks and all(prune and not excluded for _, _, prune, excluded in chunks)
     assert again and all(excluded for *_, excluded in again)
+    # The pruned runs again take the chunk's seeding: a placement is seeded by its chunk's
+    # run, and again only by a run of every branch left.
+    every_left = sum(count for _, count, prune, _ in again if not prune)
+    assert sum(seeded) == pruned.reason.size + every_left
+    if name != "panda_in_steps":
+        assert any(prune for _, _, prune, _ in again)  # pruned rounds ran, not seeded
     if name == "panda_in_steps":  # no pruned round: one run of the refused placements
         assert len(again) <= len(chunks) and not any(prune for _, _, prune, _ in again)
     feasible = plain.reason == -1
