@@ -39,7 +39,7 @@ from solver.kernels.accelerations import (
     probed_before,
 )
 from solver.kernels.cell import PRUNED, choice_holds, next_row, set_limits, start_again, write_cell
-from solver.kernels.fixed_follow import follow_rows, probe_rows
+from solver.kernels.fixed_follow import fail_first_rows, follow_rows, probe_rows
 
 
 @njit(cache=True, error_model="numpy", nogil=True, inline="always")
@@ -95,6 +95,11 @@ def fixed_cell(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
             alive, why, where, slowest, slowest_at, slowest_joint, speeds, chords2, largest2,
             inside, crossed, hint,
         )  # fmt: skip
+        if row == guess and where[row] == 0:  # out of reach, most likely: all at once
+            fail_first_rows(
+                remaining, family, par, poses, branches, scratch, cq, sq, qd, status, need,
+                alive, why, where,
+            )  # fmt: skip
         followed = alive[row]
         if followed:
             probes = (acc_hint[best] if best >= 0 else -1, acc_hint[row])

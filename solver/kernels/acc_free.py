@@ -19,6 +19,7 @@ from solver.kernels.accelerations import (
     spin_rate_of,
 )
 from solver.kernels.cell import PRUNED, choice_holds, next_row, set_limits, start_again, write_cell
+from solver.kernels.fixed_follow import fail_first_rows
 from solver.kernels.free_follow import follow_free_rows, moved_check, probe_free_rows
 from solver.kernels.spin_schedule import spin_moves
 
@@ -75,6 +76,11 @@ def free_cell(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
             qdot_max, max_joint_step, scratch, cq, sq, qd, qs, status, need, alive, why, where,
             slowest, slowest_at, slowest_joint, speeds, hint,
         )  # fmt: skip
+        if row == guess and where[row] == 0:  # out of reach, most likely: all at once
+            fail_first_rows(
+                remaining, family, par, poses, branches, scratch, cq, sq, qd, status, need,
+                alive, why, where,
+            )  # fmt: skip
         followed = alive[row]
         if followed:
             probes = (acc_hint[best] if best >= 0 else -1, acc_hint[row])

@@ -143,6 +143,31 @@ def follow_rows(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
 
 
 @njit(cache=True, error_model="numpy", nogil=True)
+def fail_first_rows(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
+    todo, family, par, poses, branches, scratch, cq, sq, qd, status, need, alive, why, where,
+):  # fmt: skip
+    """The rows marked in ``todo`` without a regular solution at the first waypoint fail there.
+
+    :func:`follow_rows`' first tests (unreachable, then singular) at waypoint 0, for all the
+    rows at once: one pose kernel call of one waypoint, where following them one by one solves
+    a block of BLOCK waypoints each. A placement whose first branch fails at its first
+    waypoint is mostly out of reach on every branch (the KUKA KR6's ERK grid: 116 of its 546
+    cells, each of whose eight branches solved a block).
+    """
+    need[:] = False
+    for i in range(branches.shape[0]):
+        need[branches[i]] = need[branches[i]] or (todo[i] and alive[i])
+    pose_block(family, par, poses, 0, 1, need, scratch, cq, sq, status, qd)
+    for i in range(branches.shape[0]):
+        if not (todo[i] and alive[i]):
+            continue
+        if status[branches[i], 0] == UNREACHABLE:
+            fail(i, REASON_UNREACHABLE, 0, alive, why, where)
+        elif status[branches[i], 0] == SINGULAR:
+            fail(i, REASON_SINGULAR, 0, alive, why, where)
+
+
+@njit(cache=True, error_model="numpy", nogil=True)
 def probe_rows(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
     todo, limit, w, family, par, poses, branches, pure_rotation, inverse_qdot, scratch, cq, sq,
     qd, status, need, alive, why, where, slowest, hint, bound,

@@ -74,7 +74,7 @@ from solver.kernels.cell import (
     warm_up_placement,
     write_cell,
 )
-from solver.kernels.fixed_follow import follow_rows, probe_rows
+from solver.kernels.fixed_follow import fail_first_rows, follow_rows, probe_rows
 from solver.kernels.limits import step_stencil
 from solver.kernels.positions import limit_modes
 
@@ -229,6 +229,8 @@ def map_cells(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
                 todo[:] = False
                 todo[row] = True
                 follow_rows(todo, limit, *posed, *path_tests, *found, *kept, hint)
+                if row == guess and where[row] == 0:  # out of reach, most likely: all at once
+                    fail_first_rows(remaining, family, par, poses, branches, *found)
                 if alive[row] and (best < 0 or slowest[row] > slowest[best]):
                     best = row
                     set_limits(limit, row, slowest[row], TIE_RTOL)

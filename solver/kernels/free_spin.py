@@ -57,6 +57,7 @@ from solver.kernels.cell import (
     warm_up_placement,
     write_cell,
 )
+from solver.kernels.fixed_follow import fail_first_rows
 from solver.kernels.free_follow import follow_free_rows, probe_free_rows, spun_check
 from solver.kernels.limits import step_stencil
 
@@ -221,6 +222,11 @@ def free_cells(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
                 follow_free_rows(todo, limit, *posed, *steps_tests, *found, *kept)
                 if alive[row]:
                     spun_check(row, *spun_args)
+                if row == guess and where[row] == 0:  # out of reach, most likely: all at once
+                    fail_first_rows(
+                        remaining, family, par, poses, branches, scratch, cq, sq, qd, status,
+                        need, alive, why, where,
+                    )  # fmt: skip
                 if alive[row] and (best < 0 or slowest[row] > slowest[best]):
                     best = row
                     set_limits(limit, row, slowest[row], TIE_RTOL)
