@@ -4,9 +4,9 @@ Where the path checks (:mod:`solver.path.path_checks`) refuse a placement's chos
 ``auto`` placement takes its next feasible branch that passes. :class:`Candidates` holds what
 that search reads: each placement's feasible branches in order, their joint paths and the
 columns of the branch taken. :func:`run_candidates` reads them off a numpy pipeline run
-(the map's own, or :func:`pipeline_candidates`' of the refused placements); a family with a
-compiled kernel gives them by the kernel (:class:`CompiledBranches`,
-:mod:`solver.path.kernel_branches`).
+(the map's own, or :func:`pipeline_candidates`' of the refused placements). A family with a
+compiled kernel finds them round by round instead, the kernel run without the refused
+branches (:class:`CompiledBranches`, :mod:`solver.path.kernel_branches`).
 """
 
 from __future__ import annotations
@@ -71,14 +71,11 @@ class Candidates:
         joint_path: (k, b) -> shape (W, n), rad, branch b's joint path at placement k.
         columns: shape (K,) branches chosen (axis B; -1 where none is) -> the columns of the
             K placements (those with -1: any values), as :func:`refuse_colliding` takes them.
-        prepare: (k, b) pairs whose joint paths are asked for next: made together where that
-            is cheaper than one by one (None: nothing to do).
     """
 
     orders: list[list[int]]
     joint_path: Callable[[int, int], np.ndarray]
     columns: Callable[[np.ndarray], tuple[np.ndarray, ...]]
-    prepare: Callable[[list[tuple[int, int]]], None] | None = None
 
 
 class CompiledBranches(Protocol):
@@ -92,10 +89,10 @@ class CompiledBranches(Protocol):
         ``feeds`` (C,), m/s: each branch's mu_path there (free spin's schedule runs at it).
         """
 
-    def candidates(
-        self, problem: PathProblem, placements: np.ndarray, picks: np.ndarray
-    ) -> Candidates:
-        """The :class:`Candidates` of placements (K, 5) whose chosen branches ``picks`` failed."""
+    def excluding(
+        self, problem: PathProblem, placements: np.ndarray, excluded: np.ndarray
+    ) -> tuple[np.ndarray, ...]:
+        """The columns at placements (C, 5) of the branches left, ``excluded`` (C, K) left out."""
 
 
 def run_candidates(run: ChunkResult, cells: np.ndarray, columns_of: Columns) -> Candidates:

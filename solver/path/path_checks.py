@@ -9,6 +9,8 @@ placement is infeasible with the check's reason, at the best branch's refused wa
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 import numpy as np
 
 from solver.core.codes import FEASIBLE
@@ -154,8 +156,9 @@ def refuse_colliding(
         _next_by_pruned_runs(problem, placements, out, refused, columns_of, run)
         return tuple(out)
     if problem.options.branch is None and compiled is not None:
-        candidates = compiled.candidates(problem, placements[cells], branch[cells])
-    elif problem.options.branch is None and run is not None:
+        _next_by_kernel_runs(problem, placements, out, refused, compiled)
+        return tuple(out)
+    if problem.options.branch is None and run is not None:
         candidates = run_candidates(run, cells, columns_of)
     _next_branches(problem, placements, out, refused, candidates)
     return tuple(out)
@@ -183,11 +186,6 @@ def _next_branches(
         step = [0] * len(cells)
         hints = [refused[int(c)][1] for c in cells]  # each placement's last refusal
         while True:
-            if candidates.prepare is not None:  # this round's first look at each placement
-                candidates.prepare(
-                    [(k, orders[k][step[k]]) for k in range(len(cells))
-                     if not taken[k] and step[k] < len(orders[k])]
-                )  # fmt: skip
             due: list[tuple[int, int]] = []  # (placement k, branch) checked this round
             for k, c in enumerate(cells):
                 while not taken[k] and step[k] < len(orders[k]):
@@ -213,7 +211,80 @@ def _next_branches(
             picked = candidates.columns(chosen)
             for column, value in zip(out, picked, strict=True):
                 column[cells[taken]] = value[taken]
-    for c in cells[~taken]:
+    _refuse_the_rest(problem, out, refused, cells[~taken])
+
+
+# The next picks of the placements still refused, given their rows (k) and placements and the
+# branches excluded there: their columns, and the joint path of the pick of row i.
+NextPicks = Callable[
+    [np.ndarray, np.ndarray, np.ndarray],
+    tuple[tuple[np.ndarray, ...], Callable[[int], np.ndarray]],
+]
+
+
+def _next_in_rounds(
+    problem: PathProblem,
+    placements: np.ndarray,
+    out: list[np.ndarray],
+    refused: dict[int, tuple[np.ndarray, PathVerdict]],
+    next_picks: NextPicks,
+    rounds: int,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Up to ``rounds`` rounds of next picks for the refused placements, their refused branches out.
+
+    Each round's pick is the best branch left by ``auto``'s rule
+    (:func:`~solver.path.branch_candidates.tie_order`), as the order of a run of every branch
+    gives it; the picks of a round are checked together, a refused one (or one whose joint
+    path is the first refused one) is excluded in the next round. A placement whose pick
+    passes takes its columns. Returns the refused placements (sorted), their branches excluded
+    (K, the family's branches), the rows still refused with a branch left and those taken.
+    """
+    cells = np.array(sorted(refused))
+    rows = placements[cells]
+    excluded = np.zeros((len(cells), len(problem.family.branches)), dtype=bool)
+    excluded[np.arange(len(cells)), out[3][cells]] = True  # the refused picks (family indices)
+    hints = [refused[int(c)][1] for c in cells]  # each placement's last refusal
+    taken = np.zeros(len(cells), dtype=bool)
+    open_ = np.arange(len(cells))
+    for _ in range(rounds):
+        if not len(open_):
+            break
+        picked, path_of = next_picks(open_, rows[open_], excluded[open_])
+        due: list[tuple[int, int, np.ndarray]] = []  # (row of the picks, placement k, joint path)
+        still: list[int] = []
+        for i, k in enumerate(open_.tolist()):
+            if picked[1][i] != FEASIBLE:  # no feasible branch left
+                continue
+            q = path_of(i)
+            excluded[k, picked[3][i]] = True
+            first = refused[int(cells[k])][0]
+            if np.array_equal(q, first) or _refused_again(problem, q, rows[k], hints[k]):
+                still.append(k)
+            else:
+                due.append((i, k, q))
+        verdicts = check_paths(
+            problem, np.array([q for _, _, q in due]), rows[[k for _, k, _ in due]]
+        )
+        for (i, k, _), verdict in zip(due, verdicts, strict=True):
+            if not _refused(verdict):
+                taken[k] = True
+                for column, value in zip(out, picked, strict=True):
+                    column[cells[k]] = value[i]
+            else:
+                hints[k] = verdict if verdict is not None else hints[k]
+                still.append(k)
+        open_ = np.array(sorted(still), dtype=int)
+    return cells, excluded, open_, taken
+
+
+def _refuse_the_rest(
+    problem: PathProblem,
+    out: list[np.ndarray],
+    refused: dict[int, tuple[np.ndarray, PathVerdict]],
+    cells: np.ndarray,
+) -> None:
+    """The ``cells`` among the refused placements refused where their first pick was."""
+    for c in cells.tolist():
         verdict = refused[int(c)][1]
         _refuse(out, int(c), problem.path_checks[0].reason, int(verdict.failed_waypoint or 0))
 
@@ -238,67 +309,71 @@ def _next_by_pruned_runs(
 ) -> None:
     """:func:`_next_branches` after a pruned run: its refused branches left out of the next runs.
 
-    Round by round, the refused placements run again pruned with every branch refused there
-    excluded (:func:`solver.path.pipeline.run_chunk`'s ``excluded``): each run's pick is the
-    best branch left by ``auto``'s rule (:func:`~solver.path.branch_candidates.tie_order`), as
-    the order of a run of every branch gives it, and its joint path and columns are that run's
-    (the pick is followed to the end, the same bits). The picks of a round are checked
-    together; a refused one is excluded in the next round. After :data:`PRUNED_ROUNDS`, the
-    placements still refused take their next branches from one run of every branch left
-    (:func:`pipeline_candidates`); a family that does not follow bounded (more than seven
-    joints: its runs would not leave the refused branches out) goes there at once. A placement
-    left without a branch is refused where its first pick was. The pruned runs take the
-    placements' first-waypoint seeding from ``run`` (:attr:`ChunkResult.first`), where it has
-    it, rather than seeding again: the same solutions (a fifth of the UR5-as-URDF's map with a
-    cell was seeding the refused placements again).
+    :data:`PRUNED_ROUNDS` rounds (:func:`_next_in_rounds`) of pruned runs of the refused
+    placements with every branch refused there excluded (:func:`solver.path.pipeline.run_chunk`'s
+    ``excluded``): each pick's joint path and columns are that run's (the pick is followed to
+    the end, the same bits). Then the placements still refused take their next branches from
+    one run of every branch left (:func:`pipeline_candidates`); a family that does not follow
+    bounded (more than seven joints: its runs would not leave the refused branches out) goes
+    there at once. A placement left without a branch is refused where its first pick was. The
+    pruned runs take the placements' first-waypoint seeding from ``run``
+    (:attr:`ChunkResult.first`), where it has it, rather than seeding again: the same solutions
+    (a fifth of the UR5-as-URDF's map with a cell was seeding the refused placements again).
     """
     cells = np.array(sorted(refused))
     seeded = None
     if run.first is not None and run.branches_found is not None:
         seeded = (run.first[cells], run.branches_found[cells])
-    rows = placements[cells]
-    excluded = np.zeros((len(cells), len(problem.family.branches)), dtype=bool)
-    excluded[np.arange(len(cells)), out[3][cells]] = True  # the refused picks (family indices)
-    hints = [refused[int(c)][1] for c in cells]  # each placement's last refusal
-    taken = np.zeros(len(cells), dtype=bool)
-    open_ = np.arange(len(cells))
-    for _ in range(PRUNED_ROUNDS if in_one_pass(problem) else 0):
-        if not len(open_):
-            break
+
+    def next_picks(
+        open_: np.ndarray, rows: np.ndarray, excluded: np.ndarray
+    ) -> tuple[tuple[np.ndarray, ...], Callable[[int], np.ndarray]]:
         first = None if seeded is None else (seeded[0][open_], seeded[1][open_])
-        again = run_chunk(problem, rows[open_], prune=True, excluded=excluded[open_], first=first)
-        picked = columns_of(again)
-        due: list[tuple[int, int, np.ndarray]] = []  # (row of the run, placement k, joint path)
-        still: list[int] = []
-        for i, k in enumerate(open_.tolist()):
-            if picked[1][i] != FEASIBLE:  # no feasible branch left
-                continue
-            q = again.tracked.q[:, again.pick[i], i].T
-            excluded[k, picked[3][i]] = True
-            if _refused_again(problem, q, rows[k], hints[k]):
-                still.append(k)
-            else:
-                due.append((i, k, q))
-        verdicts = check_paths(
-            problem, np.array([q for _, _, q in due]), rows[[k for _, k, _ in due]]
-        )
-        for (i, k, _), verdict in zip(due, verdicts, strict=True):
-            if not _refused(verdict):
-                taken[k] = True
-                for column, value in zip(out, picked, strict=True):
-                    column[cells[k]] = value[i]
-            else:
-                hints[k] = verdict if verdict is not None else hints[k]
-                still.append(k)
-        open_ = np.array(sorted(still), dtype=int)
+        again = run_chunk(problem, rows, prune=True, excluded=excluded, first=first)
+        return columns_of(again), lambda i: again.tracked.q[:, again.pick[i], i].T
+
+    rounds = PRUNED_ROUNDS if in_one_pass(problem) else 0
+    cells, excluded, open_, taken = _next_in_rounds(
+        problem, placements, out, refused, next_picks, rounds
+    )
+    decided = taken.copy()
     if len(open_):  # every branch left in one run: their candidates in auto's order
         rest = {int(cells[k]): refused[int(cells[k])] for k in open_}
-        candidates = pipeline_candidates(problem, rows[open_], columns_of, excluded[open_])
+        rows = placements[cells[open_]]
+        candidates = pipeline_candidates(problem, rows, columns_of, excluded[open_])
         _next_branches(problem, placements, out, rest, candidates)
-        taken[open_] = True  # decided there, taken or refused
-    for k in np.flatnonzero(~taken).tolist():
-        verdict = refused[int(cells[k])][1]
-        _refuse(out, int(cells[k]), problem.path_checks[0].reason, verdict.failed_waypoint or 0)
+        decided[open_] = True  # decided there, taken or refused
+    _refuse_the_rest(problem, out, refused, cells[~decided])
+
+
+def _next_by_kernel_runs(
+    problem: PathProblem,
+    placements: np.ndarray,
+    out: list[np.ndarray],
+    refused: dict[int, tuple[np.ndarray, PathVerdict]],
+    compiled: CompiledBranches,
+) -> None:
+    """:func:`_next_branches` by the compiled kernel: rounds of runs without the refused branches.
+
+    Each round runs the kernel on the placements still refused with their refused branches
+    left out (:meth:`CompiledBranches.excluding`): its pick is ``auto``'s among the branches
+    left, pruned as the map's own run is, where running every branch alone at each refused
+    placement to order them cost as much again. Rounds until every placement passes or has no
+    feasible branch left (at most one a branch); those are refused where their first pick was.
+    """
+
+    def next_picks(
+        open_: np.ndarray, rows: np.ndarray, excluded: np.ndarray
+    ) -> tuple[tuple[np.ndarray, ...], Callable[[int], np.ndarray]]:
+        picked = compiled.excluding(problem, rows, excluded)
+        feasible = np.flatnonzero(picked[1] == FEASIBLE)
+        paths = compiled.joint_paths(rows[feasible], picked[3][feasible], picked[0][feasible])
+        at = {int(i): n for n, i in enumerate(feasible)}
+        return picked, lambda i: paths[at[i]]
+
+    rounds = len(problem.family.branches)
+    cells, _, _, taken = _next_in_rounds(problem, placements, out, refused, next_picks, rounds)
+    _refuse_the_rest(problem, out, refused, cells[~taken])
 
 
 def _refused_again(

@@ -32,6 +32,7 @@ from solver.families.numeric.family import NumericFamily
 from solver.path.branch_candidates import tie_order
 from solver.path.capability_map import capability_map, grid_axis
 from solver.path.evaluate import evaluate_path
+from solver.path.kernel_branches import KernelBranches
 from solver.path.pipeline import run_chunk
 from solver.path.placements import evaluate_placements
 from solver.path.problem import PathOptions, PathProblem
@@ -161,8 +162,19 @@ def test_compiled_path_checks_equal_the_pipeline_route(
 
     monkeypatch.setattr(branch_candidates, "run_chunk", spy)
     monkeypatch.setattr(path_checks, "run_chunk", spy)
+    left_out: list[np.ndarray] = []  # per call of the kernel's next picks: branches left out
+    excluding = KernelBranches.excluding
+
+    def spy_excluding(self: KernelBranches, *args: Any) -> tuple[np.ndarray, ...]:
+        left_out.append(args[2].sum(axis=1))
+        return excluding(self, *args)
+
+    monkeypatch.setattr(KernelBranches, "excluding", spy_excluding)
     compiled = capability_map(problem, **axes)  # type: ignore[arg-type]
     assert not runs  # no numpy pipeline run: the kernel's answers
+    # the next picks: kernel runs without the refused branches, more of them round by round
+    assert left_out and all((counts >= 1).all() for counts in left_out)
+    assert max(int(counts.max()) for counts in left_out) > 1
     bare = PathOptions(spin_mode=spin)  # type: ignore[arg-type]
     plain = capability_map(dataclasses.replace(problem, options=bare), **axes)  # type: ignore[arg-type]
     feasible = compiled.reason == -1
