@@ -37,13 +37,14 @@ class Settings(BaseSettings):
         gt=0,
         description="Most placement-waypoint pairs one /v1/map request, or the coarse map of one "
         "/v1/optimize request, may ask for (each is 8 IK solutions; on one thread of the "
-        "2-core development machine the default, 5 million, takes 1.5 to 5 s for a UR or OPW "
-        "arm in fixed spin, depending on the day, by the compiled kernel, and about 2.3 times "
-        "as long in free spin, by its own; /v1/map computes on DTF_THREADS threads). A pair "
-        "of a numeric-IK arm counts as the work of many (its family's path_cost: about 50 a "
-        "waypoint for 6 joints, 200 for 7, plus 800 to 1,000 or 2,600 a placement for the "
-        "seeds), so its limit is about the same time; /v1/evaluate weighs its one placement "
-        "the same way against this limit.",
+        "2-core development machine the default, 5 million, takes about 0.4 s for a UR arm "
+        "and 1.4 to 3.6 s for the catalogue's OPW arms in fixed spin by the compiled kernel "
+        "(2026-12-04; the speed varies from day to day), and about 3.5 times as long in free "
+        "spin, by its own; /v1/map computes on DTF_THREADS threads). A pair of a numeric-IK "
+        "arm counts as the work of many (its family's path_cost: about 50 a waypoint for 6 "
+        "joints, 200 for 7, plus 800 to 1,000 or 2,600 a placement for the seeds), so its "
+        "limit is about 0.5 to 1.2 s; a cell adds 50 a pair for its collision check. "
+        "/v1/evaluate weighs its one placement the same way against this limit.",
     )
     max_search_poses: int = Field(
         default=6_100_000,
