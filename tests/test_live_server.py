@@ -141,21 +141,30 @@ def _cpu_seconds(pid: int) -> float:
     return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
 
 
-def long_map(pairs: int) -> dict[str, Any]:
-    """A UR5 map of about ``pairs`` placement-waypoint pairs along a 1,000-waypoint cut.
+LONG_WAYPOINTS = 4_000
+"""The cut of :func:`long_map`: a longer path is more work for the same placements (the map's
+answer stays small)."""
 
-    Its time must outlast each test's window whatever the machine: 20 million pairs took 3.9 s
-    on 2 threads on a fast day. (A map at the shared server's limit, 2 million, took under
-    0.5 s there, and ended before the client left.)
+
+def long_map(pairs: int) -> dict[str, Any]:
+    """A UR5 map of about ``pairs`` placement-waypoint pairs along a 4,000-waypoint cut.
+
+    Its time must outlast each test's window whatever the machine, and the kernels keep getting
+    faster: 20 million pairs took 3.9 s on 2 threads on a fast day of 2026-11; on 2026-12-04 40
+    million took about 1.3 s, and once answered before the SIGTERM test's signal at 1 s. About
+    60 ns a pair on one thread that day: 80 million pairs about 2.5 s on 2 threads, 160 million
+    about 5 s. (A map at the shared server's limit, 2 million, took under 0.5 s, and ended
+    before the client left.)
     """
-    return {"robot": {"model": "ur5"}, "path": line_path(1_000), "grid": grid_of(pairs // 1_000)}
+    cut = line_path(LONG_WAYPOINTS, 2.5e-5)  # 10 cm, as the 1,000-waypoint cut was
+    return {"robot": {"model": "ur5"}, "path": cut, "grid": grid_of(pairs // LONG_WAYPOINTS)}
 
 
 def test_a_client_that_leaves_stops_its_work() -> None:
-    process, url = start_server({"DTF_MAX_MAP_POSES": "20000000"})
+    process, url = start_server({"DTF_MAX_MAP_POSES": "80000000"})
     try:
         with pytest.raises(httpx.ReadTimeout):
-            httpx.post(url + "/v1/map", json=long_map(20_000_000), timeout=0.5)  # left at 0.5 s
+            httpx.post(url + "/v1/map", json=long_map(80_000_000), timeout=0.5)  # left at 0.5 s
         time.sleep(0.5)
         before = _cpu_seconds(process.pid)
         time.sleep(1.0)
@@ -255,11 +264,11 @@ def test_an_evaluate_whose_client_leaves_stops_within_a_second() -> None:
 
 def test_sigterm_stops_the_service_within_seconds() -> None:
     process, url = start_server(
-        {"DTF_MAX_MAP_POSES": "40000000"}, "--timeout-graceful-shutdown", "2"
+        {"DTF_MAX_MAP_POSES": "160000000"}, "--timeout-graceful-shutdown", "2"
     )
     answers: list[int] = []
-    work = threading.Thread(target=_post, args=(url, "/v1/map", long_map(40_000_000), answers))
-    work.start()  # about 8 s of work on a fast day: still running at the signal
+    work = threading.Thread(target=_post, args=(url, "/v1/map", long_map(160_000_000), answers))
+    work.start()  # about 5 s of work on a fast day: still running at the signal
     time.sleep(1.0)
     process.send_signal(signal.SIGTERM)
     began = time.monotonic()
