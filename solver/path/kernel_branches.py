@@ -65,20 +65,17 @@ class KernelBranches:
         groups: dict[bytes, list[int]] = {}
         for c in range(len(placements)):
             groups.setdefault(left[c].tobytes(), []).append(c)
-        columns: list[np.ndarray] | None = None
+        parts = []
         for members in groups.values():
             kept = branches[left[members[0]]]
-            if not len(kept):
-                continue
-            inputs = dataclasses.replace(self.inputs, branches=np.ascontiguousarray(kept))
-            part = run_kernel(inputs, placements[members], self.with_speeds)
-            if columns is None:
-                columns = [np.empty((len(placements), *c.shape[1:]), c.dtype) for c in part]
-                columns[_REASON][:] = REASON_UNREACHABLE  # overwritten where a branch is left
+            if len(kept):
+                inputs = dataclasses.replace(self.inputs, branches=np.ascontiguousarray(kept))
+                parts.append((members, run_kernel(inputs, placements[members], self.with_speeds)))
+        # the columns' shapes and types: any part's, or a run of no placement where none ran
+        like = parts[0][1] if parts else run_kernel(self.inputs, placements[:0], self.with_speeds)
+        columns = [np.empty((len(placements), *c.shape[1:]), c.dtype) for c in like]
+        columns[_REASON][:] = REASON_UNREACHABLE  # where no branch is left
+        for members, part in parts:
             for column, values in zip(columns, part, strict=True):
                 column[members] = values
-        if columns is None:  # no branch left anywhere
-            part = run_kernel(self.inputs, placements[:0], self.with_speeds)
-            columns = [np.empty((len(placements), *c.shape[1:]), c.dtype) for c in part]
-            columns[_REASON][:] = REASON_UNREACHABLE
         return tuple(columns)
