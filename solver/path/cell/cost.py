@@ -23,7 +23,7 @@ from solver.path.cell.shapes import DEFAULT_COLLISION_STEP, Cell
 # The check's work does not grow with the family's, so it is added to the family's figure, not
 # multiplied (until 2026-12-04 it was multiplied: a numeric arm's map with a cell was weighed 14
 # to 19 times its measured work, and a mimic arm's refused at 3 x 3 placements where its map
-# without a cell ran 9 x 11 in the same time). Measured on 2026-12-04 (/tmp scripts, CPU time,
+# without a cell ran 9 x 11 in the same time). Measured on 2026-12-04 (scripts not kept, CPU time,
 # the ERK grid with bench/cell.py's cell, placements x 133 waypoints, in this unit: the analytic
 # UR5 map's 83 ns a pose that day), the cell's extra work a placement against the map without:
 # UR5 4,510 (34 a waypoint), UR5e 2,360 (18); numeric arms, whose refused placements follow
