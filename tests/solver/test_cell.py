@@ -170,6 +170,41 @@ def test_collision_and_min_clearance_agree_with_coal(shapes: tuple, collides: bo
         assert evaluation.min_clearance.robot_part == closest[2]
 
 
+FAR_FLOOR = Halfspace((0.0, 0.0, 1.0), -1.0, name="floor")
+
+
+@pytest.mark.parametrize(
+    "joints",
+    [(-1.2, 1.6, -1.57, 1.57, 0.0), (-1.5, 1.5, -1.0, -1.57, 0.5)],
+    ids=["wrist-3-nearest", "wrist-2-nearest"],
+)
+def test_the_closest_pair_is_the_closest_of_coal_at_every_configuration(joints: tuple) -> None:
+    # An evaluation's closest pair. Coal computes only the pairs that may come nearer than the
+    # closest so far; here the shoulder turns 0.4 rad in 200 steps past a box 10 cm outside the
+    # wrist's circle (slowly: a pair proven clear of the clearance alone would be skipped at
+    # its least distance), and the answer is the least of coal at every configuration and pair.
+    q = np.tile([0.0, *joints], (201, 1))
+    q[:, 0] = np.linspace(0.0, 0.4, 201)
+    model = get_robot("ur5").model
+    data = model.createData()
+    pin.forwardKinematics(model, data, q[100])
+    base = get_robot("ur5").transform_world_to_base
+    wrist = np.linalg.solve(base, np.append(data.oMi[6].translation, 1.0))[:3]
+    out = wrist[:2] * (1.0 + 0.1 / np.hypot(*wrist[:2]))
+    shapes = (FAR_FLOOR, Box((0.05, 0.05, 0.05), pose(*out, wrist[2]), name="box"))
+    verdict = CellChecker(get_robot("ur5"), Cell(fixed=shapes)).check(
+        q, np.ones(200, dtype=bool), PLACEMENT.transform_workpiece_to_base(), closest=True
+    )
+    distance, waypoint, part, other = min(
+        coal_distances(q, [(s.geometry(), s.pose) for s in shapes], PLACEMENT)
+    )
+    assert other == "o1"  # the box (coal_distances' name): not a pair proven clear throughout
+    assert verdict.collision is None and verdict.closest is not None
+    assert verdict.closest.distance == pytest.approx(distance, abs=DISTANCE_ATOL)
+    assert (verdict.closest.waypoint, verdict.closest.robot_part) == (waypoint, part)
+    assert verdict.closest.obstacle_name == "box"
+
+
 def small_map(cell: Cell | None, robot: str = "ur5", tcp: float = 0.0) -> CapabilityMap:
     """A 3 x 3 map of the curved line at yaw 0."""
     return capability_map(problem(cell, robot, tcp), xs=XS, ys=YS, z=0.1, yaws=np.zeros(1))
