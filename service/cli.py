@@ -18,7 +18,9 @@ limits add mu_acc and the cycle time), or a URDF file (``.urdf``: its chain from
 where the URDF has it; else ``base_link``) and ``tool0``, its own velocity limits).
 ``--cell FILE``, a JSON file holding the API's ``cell`` object (cell.md: the table, fixtures,
 the part, the tool, the clearance), checks the robot against it on evaluate, map and optimise
-as the routes do. Settings come from the environment as for the service (``DTF_*``).
+as the routes do. Settings come from the environment as for the service (``DTF_*``); a
+command's work is bounded as a job's is (DTF_MAX_JOB_CELLS, DTF_MAX_JOB_POSES), not as a
+synchronous request's (:func:`_settings`).
 Exit codes: :data:`OK` (0), :data:`USAGE` (2), :data:`INVALID` (3), :data:`INFEASIBLE` (4),
 :data:`CLOSED_PIPE` (141, the output's reader closed it early); 1 is Python's own, for a
 crash. Errors name the field (and waypoint, line) as the API does.
@@ -40,7 +42,7 @@ from pydantic import BaseModel, ValidationError
 
 from service import convert
 from service.cli_text import ProgressBar, evaluation_text, import_text, map_text, optimum_text
-from service.config import get_settings
+from service.config import Settings, get_settings
 from service.errors import request_location, solver_error_location
 from service.operations import computed_map, evaluation_of, import_of, map_png, optimum_of
 from service.schemas import EvaluateRequest, MapRequest, OptimizeRequest
@@ -223,6 +225,19 @@ def _with_options(body: dict[str, Any], args: argparse.Namespace) -> dict[str, A
     return body
 
 
+def _settings() -> Settings:
+    """The service's settings (``DTF_*``) with the job limits in force (``Settings.for_jobs``).
+
+    A command runs as a job does, not as a request a shared service answers while its client
+    waits: on the caller's own machine, with a progress bar on a terminal and Ctrl-C to stop
+    it. So its work is bounded by DTF_MAX_JOB_CELLS and DTF_MAX_JOB_POSES, which its refusals
+    name; a real-size program the synchronous routes refuse runs here (a 17,073-move CL
+    program optimised on a KR16-2 with a cell over a 0.3 x 0.4 m box, yaw within 0.5 rad:
+    1,680 coarse placements, about 7 s of work; POST /v1/optimize refuses it).
+    """
+    return get_settings().for_jobs()
+
+
 def _validated(model: type[Model], body: dict[str, Any]) -> Model:
     """The body validated from JSON, as the service validates a request."""
     return model.model_validate_json(json.dumps(body))
@@ -235,7 +250,7 @@ def _print(answer: BaseModel, args: argparse.Namespace, text: Callable[[], str])
 
 def _import(args: argparse.Namespace) -> int:
     body = _validated(PathImportRequest, {"path": _path(args)})
-    answer = import_of(body, get_settings())
+    answer = import_of(body, _settings())
     _print(answer, args, lambda: import_text(answer, args.program))
     return OK
 
@@ -252,7 +267,7 @@ def _evaluate(args: argparse.Namespace) -> int:
         body["feed"] = args.feed
     request = _validated(EvaluateRequest, _with_options(body, args))
     with ProgressBar(enabled=args.progress) as bar:
-        answer = evaluation_of(request, get_settings(), bar)
+        answer = evaluation_of(request, _settings(), bar)
     clearance = None if request.cell is None else request.cell.clearance
     robot, recognised = body["robot"], answer.ik.recognised
     _print(
@@ -268,7 +283,7 @@ def _map(args: argparse.Namespace) -> int:
     request = _validated(MapRequest, _with_options(body, args))
     with ProgressBar(enabled=args.progress) as bar:
         result, robot, spin_mode, path_read = computed_map(
-            request, get_settings(), png=True, progress=bar
+            request, _settings(), png=True, progress=bar
         )
     answer = convert.map_response(result, robot, spin_mode=spin_mode, path_read=path_read)
     Path(args.png).write_bytes(map_png(result, robot))
@@ -291,7 +306,7 @@ def _optimise(args: argparse.Namespace) -> int:
         body["z"] = args.z
     request = _validated(OptimizeRequest, _with_options(body, args))
     with ProgressBar(enabled=args.progress) as bar:
-        answer = optimum_of(request, get_settings(), bar)
+        answer = optimum_of(request, _settings(), bar)
     recognised = None if answer.evaluation is None else answer.evaluation.ik.recognised
     robot = body["robot"]
     _print(answer, args, lambda: _chained(args, robot, recognised, optimum_text(answer)))
@@ -353,7 +368,9 @@ def _parser() -> argparse.ArgumentParser:
         prog="dtf-place",
         description="Workpiece placement for robot machining, from a CL or CSV program: "
         "the import, mu_path at a placement, the capability map, the best placement. "
-        f"Exit codes: {OK} ok, {INFEASIBLE} infeasible, {USAGE} usage, {INVALID} invalid input.",
+        f"Exit codes: {OK} ok, {INFEASIBLE} infeasible, {USAGE} usage, {INVALID} invalid input. "
+        "Settings come from DTF_* variables as for the service; the work of a command is "
+        "bounded as a job's (DTF_MAX_JOB_CELLS, DTF_MAX_JOB_POSES).",
     )
     commands = parser.add_subparsers(required=True, metavar="COMMAND")
     common = argparse.ArgumentParser(add_help=False)

@@ -16,6 +16,7 @@ import pytest
 from fastapi.testclient import TestClient
 
 from service.cli import CLOSED_PIPE, INFEASIBLE, INVALID, OK, USAGE, main
+from service.config import get_settings
 from solver.core.robots import example_robot_data_dir
 from tests.cases import ROOT
 from tests.solver.cam.dialects import NX_LISTING, text
@@ -543,3 +544,32 @@ def test_a_branch_that_is_no_branch_exits_usage_or_invalid(
     code, out, err = run(capsys, *at, "front/up/flip")  # an OPW arm's names on a UR
     assert (code, out) == (INVALID, "")
     assert err.startswith("error: ik.branch: {shoulder=front, elbow=up, wrist=flip} is not a")
+
+
+def test_a_command_is_bounded_by_the_job_limits_not_the_routes(
+    client: TestClient,
+    tmp_path: Path,
+    capsys: pytest.CaptureFixture[str],
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    # Six placements of the program (89 waypoints) are 534 pairs: over a route limit of 100, which
+    # POST /v1/map refuses; the command runs as a job does, under the job limit.
+    monkeypatch.setenv("DTF_MAX_MAP_POSES", "100")
+    get_settings.cache_clear()
+    try:
+        body = {
+            "robot": ROBOT,
+            "path": {"cl_data": PROGRAM.read_text()},
+            "grid": {**GRID, "z": 0.0, "yaw": 0.0},
+        }
+        refused = client.post("/v1/map", json=body)
+        assert refused.status_code == 422 and "DTF_MAX_MAP_POSES" in refused.text
+        code, _, _ = run(capsys, *MAP, "--png", str(tmp_path / "map.png"))
+        assert code == OK
+        monkeypatch.setenv("DTF_MAX_JOB_POSES", "100")
+        get_settings.cache_clear()
+        code, out, err = run(capsys, *MAP, "--png", str(tmp_path / "map.png"))
+        assert (code, out) == (INVALID, "")
+        assert "DTF_MAX_JOB_POSES" in err
+    finally:
+        get_settings.cache_clear()
