@@ -29,6 +29,7 @@ sys.path.insert(0, str(ROOT))
 
 from solver.core.spatial import Placement, pose_matrix  # noqa: E402
 from solver.families import get_robot  # noqa: E402
+from solver.kernels import feed_profile  # noqa: E402
 from solver.path.capability_map import capability_map  # noqa: E402
 from solver.path.cell.shapes import Box, Cell, Halfspace, Tool  # noqa: E402
 from solver.path.evaluate import evaluate_path  # noqa: E402
@@ -86,6 +87,7 @@ def _cell() -> Cell:
 def _analytic() -> None:
     for name in ("ur5", "kuka_kr6_r700_sixx"):
         _run(name)
+    feed_profile.warm_up()  # the cycle time's (an evaluation with acceleration limits)
 
 
 def _with_cell() -> None:

@@ -90,8 +90,9 @@ class PassCycleTime(ResponseModel):
     time_optimal: float = Field(
         description="The shortest time rest to rest with the feed free along the pass (s): "
         "time-optimal path parameterisation under the joint speed and acceleration limits "
-        "(toppra), on the same blended joint path: parabolic blends of length b around the "
-        "waypoints, straight in between, where the feed may rise again."
+        "(TOPP-RA, the profile toppra computes), on the same blended joint path: parabolic "
+        "blends of length b around the waypoints, straight in between, where the feed may rise "
+        "again."
     )
 
 

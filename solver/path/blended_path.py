@@ -31,7 +31,7 @@ MIN_GRID = 64  # grid points a pass at least: rest to rest needs room to speed u
 
 def blended_path(
     q: np.ndarray, s: np.ndarray, blend_length: float
-) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """One pass's blended joint path on its grid (see the module).
 
     Args:
@@ -42,8 +42,7 @@ def blended_path(
     Returns:
         grid: shape (G,), m, from 0 to s_end: every waypoint and every blend's ends within
         the pass, in steps of b / :data:`BLEND_STEPS` (at most :data:`MAX_STEPS_A_WAYPOINT`
-        a waypoint) and at least :data:`MIN_GRID` points; q (G, n), rad, the unblended path
-        there (toppra's path of order 0; no limit reads it); q_s (G, n), rad/m; q_ss (G, n),
+        a waypoint) and at least :data:`MIN_GRID` points; q_s (G, n), rad/m; q_ss (G, n),
         rad/m^2, on the stretch after each grid point (the last: before it).
     """
     b, end = blend_length, float(s[-1])
@@ -67,13 +66,24 @@ def blended_path(
     ends = np.unique(np.clip(ends, 0.0, end))
     step = max(b / BLEND_STEPS, end / (MAX_STEPS_A_WAYPOINT * len(s)))
     step = min(step, end / (MIN_GRID - 1)) if end > 0.0 else 1.0
-    pieces = [
-        np.linspace(left, right, max(int(np.ceil((right - left) / step - 1e-9)), 1) + 1)[:-1]
-        for left, right in zip(ends[:-1], ends[1:], strict=True)
-    ]
-    grid = np.concatenate([*pieces, [end]]) if pieces else np.array([0.0, end])
+    grid = np.append(interval_points(ends, step), end) if len(ends) > 1 else np.array([0.0, end])
     middle = (grid[:-1] + grid[1:]) / 2
     middle = np.append(middle, middle[-1:])
     q_s = (path_at(grid + b / 2) - path_at(grid - b / 2)) / b
     q_ss = (slope_at(middle + b / 2) - slope_at(middle - b / 2)) / b
-    return grid, path_at(grid), q_s, q_ss
+    return grid, q_s, q_ss
+
+
+def interval_points(ends: np.ndarray, step: float) -> np.ndarray:
+    """Each interval between consecutive ``ends`` cut in equal steps of at most ``step``.
+
+    The points of ``np.linspace(left, right, k + 1)[:-1]`` for each interval, k its steps, the
+    same floats (left + i (right - left) / k), made at once: one linspace an interval took
+    0.5 s of a 17,073-move program's cycle time (50,000 intervals).
+    """
+    left, width = ends[:-1], np.diff(ends)
+    counts = np.maximum(np.ceil(width / step - 1e-9).astype(np.int64), 1)
+    owner = np.repeat(np.arange(len(left)), counts)
+    index = np.arange(len(owner)) - np.repeat(np.cumsum(counts) - counts, counts)
+    points: np.ndarray = index * (width / counts)[owner] + left[owner]
+    return points

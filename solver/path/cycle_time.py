@@ -8,8 +8,9 @@ Each pass starts and ends at rest. Three figures a pass, and their totals:
   joint's speed and acceleration limit lets it (a forward integration on the path's grid),
   and the pass's time at mu_acc with those ramps (mu_acc in between: the index holds it at
   every waypoint);
-- ``time_optimal``: the shortest time rest to rest with the feed free along the pass, by toppra
-  (TOPP-RA, Pham & Pham, T-RO 2018) on the same grid.
+- ``time_optimal``: the shortest time rest to rest with the feed free along the pass, by
+  TOPP-RA (Pham & Pham, T-RO 2018) on the same grid, as toppra computes it
+  (:mod:`solver.kernels.feed_profile`, compiled; tests/solver/test_cycle_time.py runs toppra).
 
 All three run on one blended joint path, the one mu_acc is defined on
 (:mod:`solver.path.blended_path`): the pass's tracked joint path with every corner rounded by a
@@ -23,10 +24,8 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-import toppra
-import toppra.algorithm
-import toppra.constraint
 
+from solver.kernels import feed_profile
 from solver.path.blended_path import blended_path
 from solver.path.evaluate import PathEvaluation
 from solver.path.prepare import check_passes
@@ -45,7 +44,7 @@ class PassTime:
             short to reach it); ramp_up_time: s, the time that takes.
         ramp_down_length: m, from mu_acc to rest at the end; ramp_down_time: s.
         ramp_time: s, the pass at mu_acc with its ramps.
-        time_optimal: s, the time-optimal feed profile rest to rest (toppra).
+        time_optimal: s, the time-optimal feed profile rest to rest (TOPP-RA).
     """
 
     start: int
@@ -96,21 +95,18 @@ def _ramp_from_rest(
 
     x_{i+1} = min(cap_{i+1}, x_i + 2 (s_{i+1} - s_i) u_i), u_i the largest sddot with
     |q_s,ij u + q_ss,ij x_i| <= a_j for every joint (x_i <= cap_i makes u = 0 feasible).
-    It stops at the first point where x reaches ``until`` (the rest of x left 0).
+    It stops at the first point where x reaches ``until`` (the rest of x left 0); compiled
+    (:func:`solver.kernels.feed_profile.ramp_from_rest`: a Python step a grid point took
+    seconds on a real-size program).
 
     Returns:
         x, and that point (-1 where x never reaches ``until``).
     """
-    x = np.zeros(len(s))
-    with np.errstate(divide="ignore", invalid="ignore"):
-        for i in range(len(s) - 1):
-            room = np.where(q_s[i] > 0.0, qddot_max, -qddot_max) - q_ss[i] * x[i]
-            bounds = np.where(q_s[i] != 0.0, room / q_s[i], np.inf)
-            u = max(float(np.min(bounds)), 0.0)
-            x[i + 1] = min(cap[i + 1], x[i] + 2.0 * (s[i + 1] - s[i]) * u)
-            if x[i + 1] >= until:
-                return x, i + 1
-    return x, -1
+    x, reached = feed_profile.ramp_from_rest(
+        *(np.ascontiguousarray(a, dtype=float) for a in (s, q_s, q_ss, cap, qddot_max)),
+        float(until),
+    )
+    return x, int(reached)
 
 
 def _time(s: np.ndarray, x: np.ndarray) -> float:
@@ -122,41 +118,19 @@ def _time(s: np.ndarray, x: np.ndarray) -> float:
 
 
 def _time_optimal(
-    s: np.ndarray, q: np.ndarray, q_s: np.ndarray, q_ss: np.ndarray, limits: tuple[np.ndarray, ...]
+    s: np.ndarray, q_s: np.ndarray, q_ss: np.ndarray, limits: tuple[np.ndarray, ...]
 ) -> float:
-    """The time-optimal rest-to-rest time (s) by toppra, on the grid ``s`` of the blended path."""
+    """The time-optimal rest-to-rest time (s) on the grid ``s`` of the blended path.
+
+    TOPP-RA as toppra computes it on that grid (:func:`solver.kernels.feed_profile.time_optimal`:
+    the same profile, compiled; toppra took about 25 us a grid point, 7 s of a 17,073-move
+    program's evaluation).
+    """
     qdot_max, qddot_max = limits
-    path = _GridPath(s, q, q_s, q_ss)
-    constraints = [
-        toppra.constraint.JointVelocityConstraint(np.column_stack([-qdot_max, qdot_max])),
-        toppra.constraint.JointAccelerationConstraint(np.column_stack([-qddot_max, qddot_max])),
-    ]
-    instance = toppra.algorithm.TOPPRA(constraints, path, gridpoints=s)
-    _, sd, _ = instance.compute_parameterization(0.0, 0.0)
-    if sd is None:  # toppra found no feasible profile (not expected: rest is feasible)
-        return math.nan
-    return _time(s, np.asarray(sd, dtype=float) ** 2)
-
-
-class _GridPath(toppra.interpolator.AbstractGeometricPath):  # type: ignore[misc]
-    """The blended joint path as toppra sees it: q, q_s, q_ss at the grid, linear in between."""
-
-    def __init__(self, s: np.ndarray, q: np.ndarray, q_s: np.ndarray, q_ss: np.ndarray) -> None:
-        self._s, self._values = s, (q, q_s, q_ss)
-
-    def __call__(self, path_positions: float | np.ndarray, order: int = 0) -> np.ndarray:
-        values = self._values[order]
-        at = np.atleast_1d(np.asarray(path_positions, dtype=float))
-        out = np.column_stack([np.interp(at, self._s, values[:, j]) for j in range(self.dof)])
-        return out if np.ndim(path_positions) else out[0]
-
-    @property
-    def dof(self) -> int:
-        return int(self._values[0].shape[1])
-
-    @property
-    def path_interval(self) -> np.ndarray:
-        return np.array([self._s[0], self._s[-1]])
+    x = feed_profile.time_optimal(
+        *(np.ascontiguousarray(a, dtype=float) for a in (s, q_s, q_ss, qdot_max, qddot_max))
+    )
+    return _time(s, x)
 
 
 def pass_time(
@@ -176,7 +150,7 @@ def pass_time(
         blend_length: b, m.
     """
     s = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(positions, axis=0), axis=1))])
-    s, q, q_s, q_ss = blended_path(q, s, blend_length)
+    s, q_s, q_ss = blended_path(q, s, blend_length)
     before = np.vstack([q_ss[:1], q_ss[:-1]])  # a grid point ends the stretch before it too
     cap = np.minimum(
         np.minimum(*(_largest_squared_speeds(q_s, c, *limits) for c in (q_ss, before))),
@@ -207,7 +181,7 @@ def pass_time(
         float(s[-1] - s[last]),
         down_time,
         up_time + float(s[last] - s[first]) / mu_acc + down_time,
-        _time_optimal(s, q, q_s, q_ss, limits),
+        _time_optimal(s, q_s, q_ss, limits),
     )
 
 
@@ -223,7 +197,7 @@ def cycle_time(problem: PathProblem, evaluation: PathEvaluation) -> CycleTime | 
     Returns:
         None without acceleration limits, where the path is infeasible, where mu_acc is 0
         (the tool turns on the spot: no feed, no finite time), or where a figure is not
-        finite (toppra found no profile).
+        finite.
     """
     robot, acc = problem.robot, evaluation.acceleration
     if acc is None or evaluation.q is None or robot.qddot_max is None or acc.mu_acc <= 0.0:

@@ -15,6 +15,8 @@ import toppra.algorithm
 import toppra.constraint
 
 from solver.families import get_robot
+from solver.kernels.feed_profile import time_optimal
+from solver.path.blended_path import blended_path, interval_points
 from solver.path.cycle_time import cycle_time
 from solver.path.evaluate import evaluate_path
 from solver.path.problem import PathProblem
@@ -127,6 +129,58 @@ def test_time_optimal_agrees_with_toppra_on_the_blended_path(case: str) -> None:
     assert times.time_optimal <= times.ramp_time  # the ramped constant feed is one profile
 
 
+class GridPath(toppra.interpolator.AbstractGeometricPath):  # type: ignore[misc]
+    """q_s and q_ss given at grid points, linear in between, as toppra reads a path.
+
+    Order 0 is zero: joint speed and acceleration limits read only orders 1 and 2.
+    """
+
+    def __init__(self, s: np.ndarray, q_s: np.ndarray, q_ss: np.ndarray) -> None:
+        self.s, self.values = s, (np.zeros_like(q_s), q_s, q_ss)
+
+    def __call__(self, at: float | np.ndarray, order: int = 0) -> np.ndarray:
+        values, where = self.values[order], np.atleast_1d(np.asarray(at, dtype=float))
+        out = np.column_stack([np.interp(where, self.s, values[:, j]) for j in range(6)])
+        return out if np.ndim(at) else out[0]
+
+    @property
+    def dof(self) -> int:
+        return 6
+
+    @property
+    def path_interval(self) -> np.ndarray:
+        return np.array([self.s[0], self.s[-1]])
+
+
+@pytest.mark.parametrize("case", ["readme at 3", "readme at 10", "readme at 100", "smooth"])
+def test_the_time_optimal_profile_is_toppras_on_the_same_grid(case: str) -> None:
+    """The compiled TOPP-RA against toppra itself, on the blended path's own grid.
+
+    The profile to 1e-7 m^2/s^2 (toppra lowers each step's x by 1e-8 and solves its LPs to
+    tolerances of that order; the kernel keeps the first), the time to 1e-9.
+    """
+    at = {"readme at 3": 3.0, "readme at 10": 10.0, "readme at 100": 100.0}
+    path, limits = (WAYPOINTS, np.full(6, at[case])) if case in at else (smooth_path(), LIMITS)
+    robot, evaluation, times = evaluated(path, limits)
+    assert times is not None and evaluation.q is not None and evaluation.acceleration is not None
+    positions = path[:, :3, 3]
+    s = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(positions, axis=0), axis=1))])
+    grid, q_s, q_ss = blended_path(evaluation.q, s, evaluation.acceleration.blend_length)
+    constraints = [
+        toppra.constraint.JointVelocityConstraint(
+            np.column_stack([-robot.qdot_max, robot.qdot_max])
+        ),
+        toppra.constraint.JointAccelerationConstraint(np.column_stack([-limits, limits])),
+    ]
+    instance = toppra.algorithm.TOPPRA(constraints, GridPath(grid, q_s, q_ss), gridpoints=grid)
+    _, speeds, _ = instance.compute_parameterization(0.0, 0.0)
+    expected = np.asarray(speeds) ** 2
+    profile = time_optimal(grid, q_s, q_ss, robot.qdot_max, limits)
+    np.testing.assert_allclose(profile, expected, rtol=0.0, atol=1e-7)
+    duration = float(np.sum(2.0 * np.diff(grid) / (speeds[1:] + speeds[:-1])))
+    assert times.time_optimal == pytest.approx(duration, rel=1e-9)
+
+
 def test_ramped_constant_feed_agrees_with_toppra_capped_at_mu_acc() -> None:
     """The pass at mu_acc with its ramps: toppra with a virtual joint q = s limited to mu_acc."""
     path = smooth_path()
@@ -181,3 +235,20 @@ def test_passes_add_up(passes: list[tuple[int, int]]) -> None:
 def test_none_without_acceleration_limits() -> None:
     _, evaluation, times = evaluated(WAYPOINTS, None)
     assert evaluation.acceleration is None and times is None
+
+
+def test_the_grid_is_numpys_linspace_of_every_interval() -> None:
+    """The blended path's grid, made at once, is one linspace an interval: the same floats."""
+    rng = np.random.default_rng(48)
+    for _ in range(50):
+        ends = np.unique(np.append(0.0, rng.uniform(0.0, rng.uniform(0.001, 3.0), 300)))
+        step = float(rng.uniform(1e-5, 0.05))
+        expected = np.concatenate(
+            [
+                np.linspace(left, right, max(int(np.ceil((right - left) / step - 1e-9)), 1) + 1)[
+                    :-1
+                ]
+                for left, right in zip(ends[:-1], ends[1:], strict=True)
+            ]
+        )
+        np.testing.assert_array_equal(interval_points(ends, step), expected)
