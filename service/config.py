@@ -50,18 +50,18 @@ class Settings(BaseSettings):
         default=6_100_000,
         gt=0,
         description="Most placement-waypoint pairs, weighed as for DTF_MAX_MAP_POSES, that the "
-        "scipy method's search of one /v1/optimize request may evaluate: its differential "
-        "evolution (61 populations of 20 placements per free variable, rounded up to a power "
-        "of two, for a closed-form arm; a costlier IK family gets a smaller search, down to 11 "
-        "of 5 per free variable), its refinement, Nelder-Mead climbs and whole-path checks. "
-        "The default admits every search of a closed-form arm over x, y and yaw on a path of "
-        "1,000 waypoints (about 5 million: 61 * 64 * 1000 of them the differential "
-        "evolution's), and with the spin or z free too up to about 600 waypoints; a "
-        "program over 1,000 waypoints is searched on a set of the waypoints that bind (three "
-        "evolutions on at most 300, their best placements checked on the whole path), which "
-        "admits a closed-form arm over x, y and yaw up to about 18,000 waypoints; "
-        "with numeric IK it admits a short path (the Panda on 10 waypoints: about 20 s) and "
-        "refuses a search that would take much longer.",
+        "scipy method's search of one /v1/optimize request (DTF_MAX_JOB_POSES in a job) may "
+        "evaluate: its differential evolution (61 populations of 20 placements per free "
+        "variable, rounded up to a power of two, for a closed-form arm; a costlier IK family "
+        "gets a smaller search, down to 11 of 5 per free variable), its refinement, "
+        "Nelder-Mead climbs and whole-path checks. The default admits every search of a "
+        "closed-form arm over x, y and yaw on a path of 1,000 waypoints (about 5 million: 61 "
+        "* 64 * 1000 of them the differential evolution's), and with the spin or z free too "
+        "up to about 600 waypoints; a program over 1,000 waypoints is searched on a set of "
+        "the waypoints that bind (three evolutions on at most 300, their best placements "
+        "checked on the whole path), which admits a closed-form arm over x, y and yaw up to "
+        "about 18,000 waypoints; with numeric IK it admits a short path (the Panda on 10 "
+        "waypoints: about 20 s) and refuses a search that would take much longer.",
     )
     max_path_waypoints: int = Field(
         default=20_000,
@@ -167,8 +167,9 @@ class Settings(BaseSettings):
         default=500_000_000,
         gt=0,
         description="Most placement-waypoint pairs one map or optimize job may ask for (its "
-        "max_map_poses; about 6 minutes on 2 cores for a UR or OPW arm in fixed spin, by the "
-        "compiled kernel, on a slow day; free spin takes about 2.3 times as long).",
+        "max_map_poses, and its max_search_poses with method scipy; about 6 minutes on 2 "
+        "cores for a UR or OPW arm in fixed spin, by the compiled kernel, on a slow day; free "
+        "spin takes about 2.3 times as long). dtf-place's commands take these limits too.",
     )
 
     _for_jobs: bool = PrivateAttr(default=False)
@@ -176,7 +177,11 @@ class Settings(BaseSettings):
     def for_jobs(self) -> Settings:
         """These settings with the job limits in place of the synchronous routes' limits."""
         copy = self.model_copy(
-            update={"max_map_cells": self.max_job_cells, "max_map_poses": self.max_job_poses}
+            update={
+                "max_map_cells": self.max_job_cells,
+                "max_map_poses": self.max_job_poses,
+                "max_search_poses": self.max_job_poses,
+            }
         )
         copy._for_jobs = True
         return copy
@@ -185,7 +190,13 @@ class Settings(BaseSettings):
         """The map size limits in force, named as their settings (a route's or a job's)."""
         if self._for_jobs:
             return MapLimits(
-                self.max_map_cells, self.max_map_poses, "DTF_MAX_JOB_CELLS", "DTF_MAX_JOB_POSES", ""
+                self.max_map_cells,
+                self.max_map_poses,
+                "DTF_MAX_JOB_CELLS",
+                "DTF_MAX_JOB_POSES",
+                "",
+                self.max_search_poses,
+                "DTF_MAX_JOB_POSES",
             )
         return MapLimits(
             self.max_map_cells,
@@ -193,6 +204,8 @@ class Settings(BaseSettings):
             "DTF_MAX_MAP_CELLS",
             "DTF_MAX_MAP_POSES",
             "; POST /v1/jobs runs bigger maps",
+            self.max_search_poses,
+            "DTF_MAX_SEARCH_POSES",
         )
 
 
@@ -202,6 +215,7 @@ class MapLimits:
 
     Attributes:
         hint: appended to a refusal (a route's points to /v1/jobs; a job's has none).
+        search_poses: the weighed pairs of the scipy method's search; search_setting: its name.
     """
 
     cells: int
@@ -209,6 +223,8 @@ class MapLimits:
     cells_setting: str
     poses_setting: str
     hint: str
+    search_poses: int
+    search_setting: str
 
 
 @functools.cache

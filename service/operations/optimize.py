@@ -63,8 +63,9 @@ def check_work(
     Every phase's placements at most (:func:`solver.optimise.work.work_of`: the start, the
     coarse map or differential evolution, the refinement, the Nelder-Mead climbs, the local
     solves' whole-path checks, the candidates), each weighed by the problem's ``path_cost``:
-    against DTF_MAX_MAP_POSES for casadi (DTF_MAX_JOB_POSES in a job), DTF_MAX_SEARCH_POSES
-    for scipy; a coarse map of more cells than DTF_MAX_MAP_CELLS (DTF_MAX_JOB_CELLS) first.
+    against DTF_MAX_MAP_POSES for casadi, DTF_MAX_SEARCH_POSES for scipy (DTF_MAX_JOB_POSES
+    for either in a job); a coarse map of more cells than DTF_MAX_MAP_CELLS (DTF_MAX_JOB_CELLS)
+    first.
 
     Raises:
         InvalidInputError: on ``bounds``, saying the phases, the work and the limit.
@@ -73,11 +74,11 @@ def check_work(
     spin_step = None if body.spin_path is None else body.spin_path.max_spin_step
     work = work_of(problem, bounds, method=body.method, max_spin_step=spin_step)
     weighed = work.weighed(problem)
+    limits = settings.map_limits()
     if body.method == "scipy":
-        limit, setting = settings.max_search_poses, "DTF_MAX_SEARCH_POSES"
+        limit, setting = limits.search_poses, limits.search_setting
         hint = "; fix a variable, shorten the path, or use method casadi"
     else:
-        limits = settings.map_limits()
         limit, setting, hint = limits.poses, limits.poses_setting, "; narrow the bounds"
         cells = work.placements(COARSE_MAP)
         if cells > limits.cells:

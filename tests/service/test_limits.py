@@ -168,3 +168,24 @@ def test_a_coarse_map_over_the_cell_limit_names_the_setting(
     assert_names(response, 422, ["body", "bounds"])
     message = response.json()["detail"][0]["msg"]
     assert "a coarse map of 198 cells" in message and "100 (DTF_MAX_MAP_CELLS)" in message
+
+
+def test_an_optimize_job_takes_the_job_limit_for_the_scipy_search_too(
+    client: TestClient, request_body: dict, setting: Any
+) -> None:
+    """A scipy search over DTF_MAX_SEARCH_POSES, refused by POST /v1/optimize, is a job's to
+    run under DTF_MAX_JOB_POSES (the job limits replace the routes'); over that, refused at
+    submit naming it."""
+    waypoints = request_body["path"]["waypoints"][:2]
+    body = {**JACO2_BODY, "path": {"waypoints": waypoints}, "method": "scipy"}
+    setting(max_search_poses=1000, max_job_poses=10**8)
+    refused = client.post("/v1/optimize", json=body)
+    assert_names(refused, 422, ["body", "bounds"])
+    assert "(DTF_MAX_SEARCH_POSES)" in refused.json()["detail"][0]["msg"]
+    submitted = client.post("/v1/jobs", json={"kind": "optimize", "request": body})
+    assert submitted.status_code == 202, submitted.text
+    assert client.delete(f"/v1/jobs/{submitted.json()['id']}").status_code == 204
+    setting(max_job_poses=1000)
+    refused = client.post("/v1/jobs", json={"kind": "optimize", "request": body})
+    assert_names(refused, 422, ["body", "request", "bounds"])
+    assert "(DTF_MAX_JOB_POSES)" in refused.json()["detail"][0]["msg"]

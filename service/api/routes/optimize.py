@@ -35,7 +35,8 @@ async def post_optimize(
     (the coarse map or the scipy method's differential evolution, the refinement, the
     Nelder-Mead climbs, the whole-path checks of the local solves), in placement-waypoint
     pairs weighed by the IK family's cost, would exceed DTF_MAX_MAP_POSES (casadi) or
-    DTF_MAX_SEARCH_POSES (scipy), is a 422 on ``bounds``, before any work. The height is ``z``
+    DTF_MAX_SEARCH_POSES (scipy), is a 422 on ``bounds``, before any work (an optimize job
+    takes DTF_MAX_JOB_CELLS and DTF_MAX_JOB_POSES instead). The height is ``z``
     or ``bounds.z``, exactly one of them (both or neither is a 422).
     """
     return await run_stoppable(
