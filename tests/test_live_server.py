@@ -201,11 +201,12 @@ def _busy(pid: int, seconds: float) -> float:
 
 
 def _guarded_cut(n: int) -> dict[str, Any]:
-    """A Panda evaluation of a 5 cm cut of ``n`` waypoints in a cell that it never touches.
+    """An xArm7 evaluation of a 5 cm cut of ``n`` waypoints, free spin, in a cell it never touches.
 
-    Numeric IK on seven joints, then the cell's check at every waypoint against 24 boxes far
-    away (there to be checked: the evaluation runs to the path's end): both report as they go,
-    so a client that leaves stops the work (run_stoppable).
+    Numeric IK on seven joints with the spin's three-variable LP at every waypoint (it reports
+    as it goes, so a client that leaves stops the work: run_stoppable), then the cell's check
+    against 24 boxes far away (there to be checked: the evaluation runs to the path's end;
+    since the closest-pair check skips what cannot come nearer, they cost little).
     """
     boxes = [
         {
@@ -217,20 +218,22 @@ def _guarded_cut(n: int) -> dict[str, Any]:
         for k in range(24)
     ]
     return {
-        "robot": {"model": "panda"},
+        "robot": {"model": "xarm7"},
         "path": line_path(n, 0.05 / n),
         "placement": EXAMPLE["placement"],
+        "spin_mode": "free",
         "cell": {"fixed": boxes},
     }
 
 
 def test_an_evaluate_whose_client_leaves_stops_within_a_second() -> None:
     # The work is known to outlast the window: the whole path, run to its end on the same
-    # server first, takes LONG_ENOUGH or more (20,000 waypoints, 24 boxes: about 7 s on the
-    # idle development machine, 2026-12-02), so it would keep the server busy past the window
+    # server first, takes LONG_ENOUGH or more (20,000 waypoints: about 5.8 s in process on the
+    # idle development machine, 2026-12-04), so it would keep the server busy past the window
     # (1.5 s to 3.5 s after the request) had the client's leaving not stopped it; a test that
-    # cannot tell a stop from an end says so instead of passing. (Half the path, as before,
-    # took 3.7 s once the cell's check got faster: under LONG_ENOUGH, though the whole was not.)
+    # cannot tell a stop from an end says so instead of passing. (The Panda in fixed spin took
+    # 7 s until the closest-pair check skipped the far boxes, then 3.2 s, under LONG_ENOUGH;
+    # in free spin 4.3 s, too near it.)
     # The idle server is not quite still (the job supervisor looks at its store every 50 ms).
     process, url = start_server({"DTF_MAX_MAP_POSES": "1000000000"})
     full = _guarded_cut(20_000)
