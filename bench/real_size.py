@@ -17,6 +17,8 @@ run:
   ``GET /v1/jobs/{id}`` and one page of cells of one of them;
 - the scipy method on 5,000- and 10,487-move programs (its differential evolution on sets of
   the waypoints), and on a 2,000-move one against the whole-path evolution;
+- the cycle time of a 10,487-move program under acceleration limits, its TOPP-RA compiled
+  against toppra on the same grids (``bench/cycle_time.py``);
 - ``/healthz`` every 20 ms while the largest body (20,000 waypoints, DTF_MAX_PATH_WAYPOINTS)
   is read, validated and computed: a UR5 evaluation to its end, and a Panda evaluation (numeric
   IK, a minute of work) for its first seconds, after which the client leaves.
@@ -41,6 +43,7 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
 from active_set import _line, _optimised  # noqa: E402 - bench/active_set.py, beside this
+from cycle_time import cycle_time_lines  # noqa: E402 - bench/cycle_time.py
 from erk_http import ERK_GRID, EXAMPLE, erk_map_over_http  # noqa: E402 - bench/erk_http.py
 from timing import best_time  # noqa: E402
 
@@ -249,6 +252,7 @@ def main() -> None:
     job_listing(jobs=5 if args.smoke else 50, cells=2_000 if args.smoke else 20_000)
     healthz_during_the_largest_body(waypoints=2_000 if args.smoke else 20_000)
     scipy_on_sets(smoke=args.smoke)
+    cycle_time_lines(smoke=args.smoke)
 
 
 if __name__ == "__main__":
