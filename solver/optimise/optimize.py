@@ -33,7 +33,7 @@ from solver.optimise.methods import Method, method_named
 from solver.optimise.optimum import PlacementOptimum, SolverReport
 from solver.optimise.search_space import PlacementBounds, variables_of, vector_of
 from solver.optimise.symmetry import arc_coordinates, arc_point, symmetric_search
-from solver.path.evaluate import PathEvaluation, evaluate_path
+from solver.path.evaluate import PathEvaluation, evaluate_path, with_min_clearance
 from solver.path.joint_path import EXACT_POSE_TOLERANCE, evaluate_joint_path
 from solver.path.problem import PathProblem
 
@@ -165,7 +165,7 @@ def optimize_placement(
     prepared = problem.prepared  # the path is checked before the options (evaluate_path's)
     if max_spin_step is not None and not prepared.segment_in_pass.all():
         raise InvalidInputError("spin_path", "a spin path needs a program of one pass")
-    start_evaluation = evaluate_path(problem, start)
+    start_evaluation = evaluate_path(problem, start, thorough=False)  # its reason and mu
     candidates, iterations = chosen_method.search(problem, bounds, settings)
     # The start last: it is the answer only when nothing the solver found is better.
     candidates = [
@@ -192,6 +192,7 @@ def optimize_placement(
             ),
         )
     index, placement, evaluation, chosen = best
+    evaluation = with_min_clearance(problem, placement, evaluation)
     status = chosen.status
     if chosen.joint_path is not None and evaluation.branch is not None:
         status += " (at the placement its tracked joint path is faster than its own)"
@@ -264,7 +265,7 @@ def _best_candidate(
                 )
             except InvalidInputError:  # off its poses, limits or steps: only tracking counts
                 pass
-        judged.append(evaluate_path(judged_problem, placement))
+        judged.append(evaluate_path(judged_problem, placement, thorough=False))
         judged_all.extend(judged)
         for evaluation in judged:
             index = evaluation.feed_index  # mu_acc with acceleration limits, else mu_path

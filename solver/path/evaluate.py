@@ -24,7 +24,7 @@ from solver.core.two_variable_lp import spin_rate_nearest_zero
 from solver.kernels.spin_lp import spin_rate_at_feed
 from solver.path.cell.verdict import CellVerdict, Contact
 from solver.path.limits import JointAccelerationLimit, JointMotion, PathVerdict, bound_by_limits
-from solver.path.path_checks import clear_pick
+from solver.path.path_checks import check_path, clear_pick
 from solver.path.pipeline import run_chunk
 from solver.path.placed import check_placements
 from solver.path.problem import PathProblem, SpinMode
@@ -161,7 +161,11 @@ def _turned(vectors: np.ndarray, yaw: float) -> np.ndarray:
 
 
 def evaluate_path(
-    problem: PathProblem, placement: Placement, *, progress: Progress | None = None
+    problem: PathProblem,
+    placement: Placement,
+    *,
+    progress: Progress | None = None,
+    thorough: bool = True,
 ) -> PathEvaluation:
     """mu_path of a path at a placement (spec sections 1-4).
 
@@ -172,6 +176,9 @@ def evaluate_path(
         progress: called with the fraction done while a numeric family solves the path (a
             closed-form family's evaluation takes milliseconds); it may raise
             :class:`solver.core.progress.Cancelled` to stop the work.
+        thorough: with a cell, its closest pair too (``min_clearance``); False: whether the
+            path collides only, as a map checks it (the same verdict, ``min_clearance`` None:
+            the optimisers' evaluations, :func:`with_min_clearance` adding it to the answer's).
 
     Raises:
         NoAnalyticIkError: the robot has no kinematics family.
@@ -189,7 +196,7 @@ def evaluate_path(
     verdict: PathVerdict | None = None
     collision, approximated = None, None
     if reason == FEASIBLE and problem.path_checks:
-        chosen, verdict, refusal = clear_pick(problem, run, cell, 0, thorough=True)
+        chosen, verdict, refusal = clear_pick(problem, run, cell, 0, thorough=thorough)
         if chosen is None and refusal is not None:
             reason = problem.path_checks[0].reason
             collision = cell_detail(refusal).collision
@@ -257,6 +264,24 @@ def evaluate_path(
         spins=spins,
         min_clearance=None if verdict is None else cell_detail(verdict).closest,
     )
+
+
+def with_min_clearance(
+    problem: PathProblem, placement: Placement, evaluation: PathEvaluation
+) -> PathEvaluation:
+    """``evaluation`` (:func:`evaluate_path`, not thorough) with the closest pair of its cell.
+
+    What a thorough evaluation answers: the path's verdict is the same (the first collision
+    along it, found by either check), so only ``min_clearance`` is added, from the thorough
+    check of the answer's own joint path. An evaluation without a cell, infeasible, or
+    already thorough is returned as it is.
+    """
+    if evaluation.q is None or not problem.path_checks or evaluation.min_clearance is not None:
+        return evaluation
+    verdict = check_path(problem, evaluation.q, placement.as_row(), thorough=True)
+    if verdict is None:
+        return evaluation
+    return dataclasses.replace(evaluation, min_clearance=cell_detail(verdict).closest)
 
 
 def cell_detail(verdict: PathVerdict) -> CellVerdict:

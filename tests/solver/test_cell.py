@@ -436,6 +436,10 @@ def test_the_optimisers_answer_collision_free_placements(blocked: dict, method: 
     q = optimum.evaluation.q
     reference = coal_distances(q, [(s.geometry(), s.pose) for s in shapes], optimum.placement)
     assert min(reference)[0] >= cell.clearance  # coal: no configuration closer than clearance
+    closest = optimum.evaluation.min_clearance  # the answer's clearance: coal's least
+    assert closest is not None
+    assert closest.distance == pytest.approx(min(reference)[0], abs=DISTANCE_ATOL)
+    assert (closest.waypoint, closest.robot_part) == min(reference)[1:3]
     grid = capability_map(
         problem(cell),
         xs=grid_axis(*OPT_BOUNDS.x, 0.02, field="x"),

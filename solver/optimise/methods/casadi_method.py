@@ -138,7 +138,9 @@ def _solve_from(
     """
     branch = problem.family.branches[cell.branch]
     at_start = evaluate_path(
-        problem.with_options(branch=branch, spin_mode="fixed"), bounds.placement(cell.vector)
+        problem.with_options(branch=branch, spin_mode="fixed"),
+        bounds.placement(cell.vector),
+        thorough=False,  # its joint path and speeds only
     )
     # With acceleration limits the NLP's rows hold at mu_acc, not at mu_path: start there.
     q, qdot, v_max, speed = at_start.q, at_start.qdot, at_start.v_max, at_start.feed_index
