@@ -19,8 +19,8 @@ where the URDF has it; else ``base_link``) and ``tool0``, its own velocity limit
 ``--cell FILE``, a JSON file holding the API's ``cell`` object (cell.md: the table, fixtures,
 the part, the tool, the clearance), checks the robot against it on evaluate, map and optimise
 as the routes do. Settings come from the environment as for the service (``DTF_*``); a
-command's work is bounded as a job's is (DTF_MAX_JOB_CELLS, DTF_MAX_JOB_POSES), not as a
-synchronous request's (:func:`_settings`).
+command's work is bounded as a job's is (DTF_MAX_JOB_CELLS, DTF_MAX_JOB_POSES; a route's
+limit where larger), not as a synchronous request's (:func:`_settings`).
 Exit codes: :data:`OK` (0), :data:`USAGE` (2), :data:`INVALID` (3), :data:`INFEASIBLE` (4),
 :data:`CLOSED_PIPE` (141, the output's reader closed it early); 1 is Python's own, for a
 crash. Errors name the field (and waypoint, line) as the API does.
@@ -226,16 +226,17 @@ def _with_options(body: dict[str, Any], args: argparse.Namespace) -> dict[str, A
 
 
 def _settings() -> Settings:
-    """The service's settings (``DTF_*``) with the job limits in force (``Settings.for_jobs``).
+    """The service's settings (``DTF_*``) with a command's limits (``Settings.for_commands``).
 
     A command runs as a job does, not as a request a shared service answers while its client
     waits: on the caller's own machine, with a progress bar on a terminal and Ctrl-C to stop
-    it. So its work is bounded by DTF_MAX_JOB_CELLS and DTF_MAX_JOB_POSES, which its refusals
-    name; a real-size program the synchronous routes refuse runs here (a 17,073-move CL
-    program optimised on a KR16-2 with a cell over a 0.3 x 0.4 m box, yaw within 0.5 rad:
-    1,680 coarse placements, about 7 s of work; POST /v1/optimize refuses it).
+    it. So its work is bounded by DTF_MAX_JOB_CELLS and DTF_MAX_JOB_POSES (or by the routes'
+    limits where a deployment set those higher), which its refusals name; a real-size program
+    the synchronous routes refuse runs here (a 17,073-move CL program optimised on a KR16-2
+    with a cell over a 0.3 x 0.4 m box, yaw within 0.5 rad: 1,680 coarse placements, about 7 s
+    of work; POST /v1/optimize refuses it).
     """
-    return get_settings().for_jobs()
+    return get_settings().for_commands()
 
 
 def _validated(model: type[Model], body: dict[str, Any]) -> Model:
@@ -370,7 +371,8 @@ def _parser() -> argparse.ArgumentParser:
         "the import, mu_path at a placement, the capability map, the best placement. "
         f"Exit codes: {OK} ok, {INFEASIBLE} infeasible, {USAGE} usage, {INVALID} invalid input. "
         "Settings come from DTF_* variables as for the service; the work of a command is "
-        "bounded as a job's (DTF_MAX_JOB_CELLS, DTF_MAX_JOB_POSES).",
+        "bounded as a job's (DTF_MAX_JOB_CELLS, DTF_MAX_JOB_POSES, or a route's limit where "
+        "larger).",
     )
     commands = parser.add_subparsers(required=True, metavar="COMMAND")
     common = argparse.ArgumentParser(add_help=False)

@@ -10,6 +10,17 @@ from pathlib import Path
 from pydantic import Field, PrivateAttr
 from pydantic_settings import BaseSettings, SettingsConfigDict
 
+_ROUTE_LIMIT_NAMES = (
+    "DTF_MAX_MAP_CELLS",
+    "DTF_MAX_MAP_POSES",
+    "DTF_MAX_SEARCH_POSES",
+    "; POST /v1/jobs runs bigger maps",
+)
+"""The synchronous routes' limits as their settings (cells, poses, the scipy search), and the
+hint a refusal ends with."""
+_JOB_LIMIT_NAMES = ("DTF_MAX_JOB_CELLS", "DTF_MAX_JOB_POSES", "DTF_MAX_JOB_POSES", "")
+"""A job's."""
+
 
 class Settings(BaseSettings):
     """Settings of the service; each one can be set as ``DTF_<NAME>`` in the environment."""
@@ -169,10 +180,11 @@ class Settings(BaseSettings):
         description="Most placement-waypoint pairs one map or optimize job may ask for (its "
         "max_map_poses, and its max_search_poses with method scipy; about 6 minutes on 2 "
         "cores for a UR or OPW arm in fixed spin, by the compiled kernel, on a slow day; free "
-        "spin takes about 2.3 times as long). dtf-place's commands take these limits too.",
+        "spin takes about 2.3 times as long). dtf-place's commands take these limits (the "
+        "routes' where larger).",
     )
 
-    _for_jobs: bool = PrivateAttr(default=False)
+    _limit_names: tuple[str, str, str, str] = PrivateAttr(default=_ROUTE_LIMIT_NAMES)
 
     def for_jobs(self) -> Settings:
         """These settings with the job limits in place of the synchronous routes' limits."""
@@ -183,29 +195,41 @@ class Settings(BaseSettings):
                 "max_search_poses": self.max_job_poses,
             }
         )
-        copy._for_jobs = True
+        copy._limit_names = _JOB_LIMIT_NAMES
+        return copy
+
+    def for_commands(self) -> Settings:
+        """These settings with a dtf-place command's limits: a job's, or a route's if larger.
+
+        A command runs as a job does (on the caller's machine, for the caller alone, with a
+        progress bar and Ctrl-C), and may always do what a synchronous request may: each limit
+        is the larger of the two, named as its setting.
+        """
+        cells = max(self.max_map_cells, self.max_job_cells)
+        poses = max(self.max_map_poses, self.max_job_poses)
+        search = max(self.max_search_poses, self.max_job_poses)
+        copy = self.model_copy(
+            update={"max_map_cells": cells, "max_map_poses": poses, "max_search_poses": search}
+        )
+        copy._limit_names = (
+            "DTF_MAX_JOB_CELLS" if cells == self.max_job_cells else "DTF_MAX_MAP_CELLS",
+            "DTF_MAX_JOB_POSES" if poses == self.max_job_poses else "DTF_MAX_MAP_POSES",
+            "DTF_MAX_JOB_POSES" if search == self.max_job_poses else "DTF_MAX_SEARCH_POSES",
+            "",
+        )
         return copy
 
     def map_limits(self) -> MapLimits:
         """The map size limits in force, named as their settings (a route's or a job's)."""
-        if self._for_jobs:
-            return MapLimits(
-                self.max_map_cells,
-                self.max_map_poses,
-                "DTF_MAX_JOB_CELLS",
-                "DTF_MAX_JOB_POSES",
-                "",
-                self.max_search_poses,
-                "DTF_MAX_JOB_POSES",
-            )
+        cells, poses, search, hint = self._limit_names
         return MapLimits(
             self.max_map_cells,
             self.max_map_poses,
-            "DTF_MAX_MAP_CELLS",
-            "DTF_MAX_MAP_POSES",
-            "; POST /v1/jobs runs bigger maps",
+            cells,
+            poses,
+            hint,
             self.max_search_poses,
-            "DTF_MAX_SEARCH_POSES",
+            search,
         )
 
 
