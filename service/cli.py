@@ -44,7 +44,7 @@ from service import convert
 from service.cli_text import ProgressBar, evaluation_text, import_text, map_text, optimum_text
 from service.config import Settings, get_settings
 from service.errors import request_location, solver_error_location
-from service.operations import computed_map, evaluation_of, import_of, map_png, optimum_of
+from service.operations import computed_map, evaluation_of, import_of, map_png
 from service.schemas import EvaluateRequest, MapRequest, OptimizeRequest
 from service.schemas.paths_import import PathImportRequest
 from solver.core import native_stderr
@@ -305,6 +305,8 @@ def _optimise(args: argparse.Namespace) -> int:
         bounds["z"] = args.z
     else:
         body["z"] = args.z
+    from service.operations.optimize import optimum_of  # the optimisers' libraries: here only
+
     request = _validated(OptimizeRequest, _with_options(body, args))
     with ProgressBar(enabled=args.progress) as bar:
         answer = optimum_of(request, _settings(), bar)

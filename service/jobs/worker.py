@@ -27,7 +27,8 @@ from service.errors import request_location, solver_error_location, solver_error
 from service.jobs.job import JobStoreUnavailable
 from service.jobs.store import JobStore
 from service.logs import log, log_to_stderr
-from service.operations import evaluation_of, map_of, optimum_of
+from service.operations import evaluation_of, map_of
+from service.operations.optimize import optimum_of
 from service.schemas import EvaluateRequest, MapRequest, OptimizeRequest
 from solver.core.exceptions import SolverError
 from solver.core.parallel import TaskRunner, ThreadRunner

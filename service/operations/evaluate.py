@@ -4,7 +4,6 @@ from __future__ import annotations
 
 from service import convert
 from service.config import Settings
-from service.render import render_joint_use, render_message
 from service.schemas import EvaluateRequest, EvaluateResponse, PathInput
 from solver.core.exceptions import InvalidInputError
 from solver.core.progress import Progress
@@ -78,6 +77,8 @@ def joint_use_png(
     Where the path does not run (an unreachable placement is not an input error, api.md) the
     picture says so: why, and at which waypoint.
     """
+    from service.render import render_joint_use, render_message  # matplotlib only where drawn
+
     robot, _, evaluation, feed, _ = _evaluated(body, settings, progress)
     index = evaluation.feed_index  # mu_acc with acceleration limits
     if index is None or index <= 0.0:

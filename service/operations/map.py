@@ -7,7 +7,6 @@ from typing import NamedTuple
 from service import convert
 from service.config import Settings
 from service.operations.threads import thread_runner
-from service.render import render_png
 from service.schemas import MapRequest, MapResponse, PathRead
 from solver.core.parallel import TaskRunner
 from solver.core.progress import Progress
@@ -111,5 +110,7 @@ def map_of(
 
 def map_png(result: CapabilityMap, robot: Robot) -> bytes:
     """The colour map of a computed map, as PNG bytes."""
+    from service.render import render_png  # matplotlib only where a picture is drawn
+
     index = "mu_path" if result.mu_acc is None else "mu_acc"
     return render_png(result, title=f"{robot.name}: {index}")

@@ -16,7 +16,6 @@ from dataclasses import dataclass
 from typing import Literal
 
 import numpy as np
-import scipy.optimize
 
 from solver.core.exceptions import InvalidInputError
 
@@ -164,6 +163,8 @@ def lp_speed(
     """
     # Solved in scaled variables, x = qdot / qdot_max in [-1, 1] and t / max|t|, so that a tiny h
     # (u_R / h large) or unusual limits do not reach HiGHS as extreme coefficients.
+    import scipy.optimize  # 0.27 s to import: only where a redundant or singular arm needs it
+
     n = jacobian.shape[1]
     scale = float(np.max(np.abs(twist)))
     cost = np.zeros(n + 1)

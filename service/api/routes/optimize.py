@@ -9,7 +9,7 @@ from fastapi import APIRouter, Request, Response
 from service.body import body_in_thread, body_openapi
 from service.deps import SettingsDep
 from service.errors import ERROR_RESPONSES
-from service.operations import optimum_of
+from service.operations.optimize import optimum_of
 from service.schemas import OptimizeRequest, OptimizeResponse
 from service.work import json_response, run_stoppable
 
