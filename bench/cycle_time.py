@@ -17,9 +17,6 @@ import time
 from pathlib import Path
 
 import numpy as np
-import toppra
-import toppra.algorithm
-import toppra.constraint
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
@@ -35,51 +32,23 @@ from solver.path.cycle_time import cycle_time  # noqa: E402
 from solver.path.evaluate import evaluate_path  # noqa: E402
 from solver.path.prepare import check_passes  # noqa: E402
 from solver.path.problem import PathOptions, PathProblem  # noqa: E402
+from tests.toppra_grid import duration, toppra_speeds  # noqa: E402
 
 LIMIT = 10.0  # rad/s^2, every joint
 AT = Placement(-0.107, 0.428, 0.0, -0.8)  # bench/active_set.py's optimum, rounded
-
-
-class _Grid(toppra.interpolator.AbstractGeometricPath):  # type: ignore[misc]
-    """A pass's blended path as toppra reads it: q_s and q_ss at the grid, linear between."""
-
-    def __init__(self, s: np.ndarray, q_s: np.ndarray, q_ss: np.ndarray) -> None:
-        self.s, self.orders = s, (np.zeros_like(q_s), q_s, q_ss)
-
-    def __call__(self, at: float | np.ndarray, order: int = 0) -> np.ndarray:
-        table, where = self.orders[order], np.atleast_1d(np.asarray(at, dtype=float))
-        values = np.column_stack([np.interp(where, self.s, column) for column in table.T])
-        return values if np.ndim(at) else values[0]
-
-    @property
-    def dof(self) -> int:
-        return int(self.orders[1].shape[1])
-
-    @property
-    def path_interval(self) -> np.ndarray:
-        return np.array([self.s[0], self.s[-1]])
 
 
 def _toppra_total(problem: PathProblem, q: np.ndarray, blend: float) -> float:
     """The time-optimal time of every pass by toppra, rest to rest, on the cycle time's grids."""
     robot, positions = problem.robot, problem.prepared.tool_position
     assert robot.qddot_max is not None
-    constraints = [
-        toppra.constraint.JointVelocityConstraint(
-            np.column_stack([-robot.qdot_max, robot.qdot_max])
-        ),
-        toppra.constraint.JointAccelerationConstraint(
-            np.column_stack([-robot.qddot_max, robot.qddot_max])
-        ),
-    ]
     total = 0.0
     for start, stop in check_passes(problem.passes, len(positions)):
         steps = np.linalg.norm(np.diff(positions[start:stop], axis=0), axis=1)
         s = np.concatenate([[0.0], np.cumsum(steps)])
         grid, q_s, q_ss = blended_path(q[start:stop], s, blend)
-        algorithm = toppra.algorithm.TOPPRA(constraints, _Grid(grid, q_s, q_ss), gridpoints=grid)
-        _, speed, _ = algorithm.compute_parameterization(0.0, 0.0)
-        total += float(np.sum(2.0 * np.diff(grid) / (speed[1:] + speed[:-1])))
+        speeds = toppra_speeds(grid, q_s, q_ss, robot.qdot_max, robot.qddot_max)
+        total += duration(grid, speeds)
     return total
 
 

@@ -27,6 +27,7 @@ from tests.cases import (
     TOPPRA_TIME_RTOL,
 )
 from tests.solver.test_acceleration import PLACEMENT, WAYPOINTS, smooth_path
+from tests.toppra_grid import duration, toppra_speeds
 
 LIMITS = np.array([3.0, 3.0, 10.0, 10.0, 10.0, 10.0])
 
@@ -129,29 +130,6 @@ def test_time_optimal_agrees_with_toppra_on_the_blended_path(case: str) -> None:
     assert times.time_optimal <= times.ramp_time  # the ramped constant feed is one profile
 
 
-class GridPath(toppra.interpolator.AbstractGeometricPath):  # type: ignore[misc]
-    """q_s and q_ss given at grid points, linear in between, as toppra reads a path.
-
-    Order 0 is zero: joint speed and acceleration limits read only orders 1 and 2.
-    """
-
-    def __init__(self, s: np.ndarray, q_s: np.ndarray, q_ss: np.ndarray) -> None:
-        self.s, self.values = s, (np.zeros_like(q_s), q_s, q_ss)
-
-    def __call__(self, at: float | np.ndarray, order: int = 0) -> np.ndarray:
-        values, where = self.values[order], np.atleast_1d(np.asarray(at, dtype=float))
-        out = np.column_stack([np.interp(where, self.s, values[:, j]) for j in range(6)])
-        return out if np.ndim(at) else out[0]
-
-    @property
-    def dof(self) -> int:
-        return 6
-
-    @property
-    def path_interval(self) -> np.ndarray:
-        return np.array([self.s[0], self.s[-1]])
-
-
 @pytest.mark.parametrize("case", ["readme at 3", "readme at 10", "readme at 100", "smooth"])
 def test_the_time_optimal_profile_is_toppras_on_the_same_grid(case: str) -> None:
     """The compiled TOPP-RA against toppra itself, on the blended path's own grid.
@@ -166,19 +144,10 @@ def test_the_time_optimal_profile_is_toppras_on_the_same_grid(case: str) -> None
     positions = path[:, :3, 3]
     s = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(positions, axis=0), axis=1))])
     grid, q_s, q_ss = blended_path(evaluation.q, s, evaluation.acceleration.blend_length)
-    constraints = [
-        toppra.constraint.JointVelocityConstraint(
-            np.column_stack([-robot.qdot_max, robot.qdot_max])
-        ),
-        toppra.constraint.JointAccelerationConstraint(np.column_stack([-limits, limits])),
-    ]
-    instance = toppra.algorithm.TOPPRA(constraints, GridPath(grid, q_s, q_ss), gridpoints=grid)
-    _, speeds, _ = instance.compute_parameterization(0.0, 0.0)
-    expected = np.asarray(speeds) ** 2
+    speeds = toppra_speeds(grid, q_s, q_ss, robot.qdot_max, limits)
     profile = time_optimal(grid, q_s, q_ss, robot.qdot_max, limits)
-    np.testing.assert_allclose(profile, expected, rtol=0.0, atol=1e-7)
-    duration = float(np.sum(2.0 * np.diff(grid) / (speeds[1:] + speeds[:-1])))
-    assert times.time_optimal == pytest.approx(duration, rel=1e-9)
+    np.testing.assert_allclose(profile, speeds**2, rtol=0.0, atol=1e-7)
+    assert times.time_optimal == pytest.approx(duration(grid, speeds), rel=1e-9)
 
 
 def test_ramped_constant_feed_agrees_with_toppra_capped_at_mu_acc() -> None:
