@@ -33,10 +33,14 @@ def _feed(feed: float | None) -> str:
 
 def _contact(contact: Contact) -> str:
     """A robot part and what it comes closest to: where, and how far apart or into each other."""
-    depth = contact.distance * 1e3
-    apart = f"{_fixed(depth, 1)} mm apart" if depth >= 0.0 else f"{_fixed(-depth, 1)} mm into it"
     where = f"at waypoint {contact.waypoint}"
-    return f"{contact.robot_part} and {contact.obstacle_name} {where}, {apart}"
+    return f"{contact.robot_part} and {contact.obstacle_name} {where}, {_apart(contact.distance)}"
+
+
+def _apart(distance: float) -> str:
+    """A distance (m) in mm, apart or into it."""
+    depth = distance * 1e3
+    return f"{_fixed(depth, 1)} mm apart" if depth >= 0.0 else f"{_fixed(-depth, 1)} mm into it"
 
 
 def _how_it_runs(answer: EvaluateResponse) -> list[str]:
@@ -62,6 +66,12 @@ def _how_it_runs(answer: EvaluateResponse) -> list[str]:
         lines.append(f"least clearance: {_contact(answer.min_clearance)}")
     if answer.cell_approximated:
         lines.append("cell: approximated by capsules: " + ", ".join(answer.cell_approximated))
+    if answer.cell_unchecked:
+        pairs = ", ".join(
+            f"{pair.robot_part} and {pair.obstacle_name} ({_apart(pair.distance)})"
+            for pair in answer.cell_unchecked
+        )
+        lines.append(f"cell: not checked, no joint moves them relative to each other: {pairs}")
     return lines
 
 

@@ -162,6 +162,9 @@ def evaluate_response(
         collision=schemas.Contact.from_solver(ev.collision),
         min_clearance=schemas.Contact.from_solver(ev.min_clearance),
         cell_approximated=None if ev.cell_approximated is None else list(ev.cell_approximated),
+        cell_unchecked=None
+        if ev.cell_unchecked is None
+        else [schemas.UncheckedPair.from_solver(pair) for pair in ev.cell_unchecked],
         feed_check=None
         if feed is None
         else schemas.FeedCheckResult(feed=feed.feed, feasible=feed.feasible, margin=feed.margin),

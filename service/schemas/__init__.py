@@ -4,7 +4,7 @@ Request models are strict, refuse unknown fields and refuse NaN and infinities; 
 its unit, and every model carries an example, so ``/docs`` reads as a manual.
 """
 
-from service.schemas.cell import CellSpec, Contact, ToolSpec
+from service.schemas.cell import CellSpec, Contact, ToolSpec, UncheckedPair
 from service.schemas.cell_objects import (
     BoxObject,
     CylinderObject,
@@ -151,5 +151,6 @@ __all__ = [
     "ToolAxisPath",
     "ToolAxisWaypoint",
     "UrdfRobot",
+    "UncheckedPair",
     "WaypointResult",
 ]

@@ -23,6 +23,7 @@ from solver.path.cell.shapes import (
     Tool,
 )
 from solver.path.cell.verdict import Contact as SolverContact
+from solver.path.cell.verdict import Unchecked as SolverUnchecked
 
 MAX_CELL_OBJECTS = 1_000  # the schema's bound; the setting DTF_MAX_CELL_OBJECTS is lower
 MAX_LINK_RADII = 64
@@ -169,4 +170,42 @@ class Contact(ResponseModel):
             obstacle=contact.obstacle,
             obstacle_name=contact.obstacle_name,
             distance=contact.distance,
+        )
+
+
+class UncheckedPair(ResponseModel):
+    """A robot part not checked against a fixed object: no joint moves it relative to it."""
+
+    model_config = ConfigDict(
+        json_schema_extra={
+            "examples": [
+                {
+                    "robot_part": "joint_1_capsule",
+                    "obstacle": 0,
+                    "obstacle_name": "table",
+                    "distance": -0.05,
+                }
+            ]
+        }
+    )
+
+    robot_part: str = Field(
+        description="The robot's geometry object: the base's, or a link only joint 1 turns "
+        "about the normal of a fixed halfspace (joint 1's link of an arm on its table)."
+    )
+    obstacle: int = Field(description="The fixed object's index.")
+    obstacle_name: str = Field(description="Its name, or its place (fixed[0]).")
+    distance: float = Field(
+        description="m, coal's distance at the zero configuration, the same at every "
+        "configuration and placement (negative: they overlap, as a base stands on its table)."
+    )
+
+    @classmethod
+    def from_solver(cls, pair: SolverUnchecked) -> UncheckedPair:
+        """The schema of a solver record."""
+        return cls(
+            robot_part=pair.robot_part,
+            obstacle=pair.obstacle,
+            obstacle_name=pair.obstacle_name,
+            distance=pair.distance,
         )

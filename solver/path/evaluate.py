@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import dataclasses
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -22,7 +23,7 @@ from solver.core.progress import Progress
 from solver.core.spatial import Placement, rotation_about_z
 from solver.core.two_variable_lp import spin_rate_nearest_zero
 from solver.kernels.spin_lp import spin_rate_at_feed
-from solver.path.cell.verdict import CellVerdict, Contact
+from solver.path.cell.verdict import CellVerdict, Contact, Unchecked
 from solver.path.limits import JointAccelerationLimit, JointMotion, PathVerdict, bound_by_limits
 from solver.path.path_checks import check_path, clear_pick
 from solver.path.pipeline import run_chunk
@@ -83,6 +84,9 @@ class PathEvaluation:
             closer than the clearance (cell.md section 3); else ``None``.
         min_clearance: with a cell, the closest pair of a feasible path; else ``None``.
         cell_approximated: with a cell, the robot's links given capsules; else ``None``.
+        cell_unchecked: with a cell, the robot parts not checked against a ``fixed`` object
+            (no joint moves them relative to it: the base, joint 1's link on its table), with
+            their distance; else ``None``.
     """
 
     feasible: bool
@@ -108,6 +112,7 @@ class PathEvaluation:
     collision: Contact | None = None
     min_clearance: Contact | None = None
     cell_approximated: tuple[str, ...] | None = None
+    cell_unchecked: tuple[Unchecked, ...] | None = None
 
     @property
     def feed_index(self) -> float | None:
@@ -194,16 +199,16 @@ def evaluate_path(
     pick = int(run.pick[0])
     reason = int(run.tracked.reason[pick, 0])
     verdict: PathVerdict | None = None
-    collision, approximated = None, None
+    collision, model = None, {}
     if reason == FEASIBLE and problem.path_checks:
         chosen, verdict, refusal = clear_pick(problem, run, cell, 0, thorough=thorough)
         if chosen is None and refusal is not None:
             reason = problem.path_checks[0].reason
             collision = cell_detail(refusal).collision
-            approximated = cell_detail(refusal).approximated
+            model = cell_model(refusal)
         else:
             pick = int(chosen) if chosen is not None else pick
-            approximated = None if verdict is None else cell_detail(verdict).approximated
+            model = cell_model(verdict)
     infeasible = PathEvaluation(
         feasible=False,
         mu_path=None,
@@ -221,7 +226,7 @@ def evaluate_path(
         ik_seeds=run.ik_seeds,
         ik_branches_found=None if run.branches_found is None else int(run.branches_found[0]),
         collision=collision,
-        cell_approximated=approximated,
+        **model,
     )
     if reason != FEASIBLE:
         return infeasible
@@ -282,6 +287,14 @@ def with_min_clearance(
     if verdict is None:
         return evaluation
     return dataclasses.replace(evaluation, min_clearance=cell_detail(verdict).closest)
+
+
+def cell_model(verdict: PathVerdict | None) -> dict[str, Any]:
+    """The cell's model in a verdict, as :class:`PathEvaluation`'s fields; none without one."""
+    if verdict is None:
+        return {}
+    detail = cell_detail(verdict)
+    return {"cell_approximated": detail.approximated, "cell_unchecked": detail.unchecked}
 
 
 def cell_detail(verdict: PathVerdict) -> CellVerdict:

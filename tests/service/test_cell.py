@@ -265,6 +265,31 @@ def test_the_answer_names_the_links_given_capsules(
     assert len(answer["cell_approximated"]) == count
 
 
+def test_an_opw_arm_on_its_table_says_which_parts_are_not_checked(
+    client: TestClient, body: dict
+) -> None:
+    # Its capsules (5 cm) along the kinematic segments: the base's a ball at the foot, joint 1's
+    # from there to joint 2; both 5 cm into the table whatever the joints (joint 1 turns about
+    # its normal), so neither is checked, and the answer says so.
+    body["robot"] = {"model": "abb_irb2400"}
+    body["placement"] = {"x": 0.9, "y": 0.0, "z": 0.3, "yaw": 0.0}
+    body["cell"] = {"fixed": [TABLE], "link_radii": [0.05] * 7}
+    answer = client.post("/v1/evaluate", json=body).json()
+    assert answer["feasible"] is True
+    pairs = {(p["robot_part"], p["obstacle"], p["obstacle_name"]) for p in answer["cell_unchecked"]}
+    assert pairs == {("base_capsule", 0, "table"), ("joint_1_capsule", 0, "table")}
+    assert [p["distance"] for p in answer["cell_unchecked"]] == pytest.approx([-0.05] * 2)
+    body["robot"], body["placement"] = {"model": "ur5"}, {"x": 0.0, "y": 0.45, "z": 0.1, "yaw": 0}
+    body["cell"] = {"fixed": [TABLE, FIXTURE]}  # the UR5's meshes: the base and the shoulder
+    answer = client.post("/v1/evaluate", json=body).json()
+    parts = {(p["robot_part"], p["obstacle_name"]) for p in answer["cell_unchecked"]}
+    assert parts == {
+        ("base_link_0", "table"),
+        ("base_link_0", "fixture"),
+        ("shoulder_link_0", "table"),
+    }
+
+
 @pytest.mark.parametrize("kind", ["evaluate", "map", "optimize"])
 def test_a_job_with_a_bad_cell_is_refused_at_submit_as_its_route_refuses_it(
     client: TestClient, kind: str

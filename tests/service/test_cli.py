@@ -276,12 +276,16 @@ def _file(tmp_path: Path, name: str, value: Any) -> str:
 
 def _contact(contact: dict[str, Any]) -> str:
     """A contact as the command prints it, from the route's JSON."""
-    mm = 1e3 * contact["distance"]
-    apart = f"{mm:.1f} mm apart" if mm >= 0 else f"{-mm:.1f} mm into it"
     return (
         f"{contact['robot_part']} and {contact['obstacle_name']} at waypoint "
-        f"{contact['waypoint']}, {apart}"
+        f"{contact['waypoint']}, {_apart(contact['distance'])}"
     )
+
+
+def _apart(distance: float) -> str:
+    """A distance (m) as the command prints it."""
+    mm = 1e3 * distance
+    return f"{mm:.1f} mm apart" if mm >= 0 else f"{-mm:.1f} mm into it"
 
 
 def test_a_cell_file_is_checked_as_the_routes_cell(
@@ -299,6 +303,13 @@ def test_a_cell_file_is_checked_as_the_routes_cell(
     assert code == OK
     assert f"least clearance: {_contact(expected['min_clearance'])}" in out.splitlines()
     assert "cell: approximated by capsules: " in out  # the UR5e's links (no meshes ship)
+    unchecked = [  # the base, and the shoulder joint 1 turns about the table's normal
+        f"{p['robot_part']} and {p['obstacle_name']} ({_apart(p['distance'])})"
+        for p in expected["cell_unchecked"]
+    ]
+    assert len(unchecked) == 3
+    line = "cell: not checked, no joint moves them relative to each other: " + ", ".join(unchecked)
+    assert line in out.splitlines()
 
 
 def test_a_table_above_the_base_makes_evaluate_and_map_infeasible_by_collision(

@@ -17,7 +17,7 @@ import pytest
 
 from solver.core.exceptions import InvalidInputError
 from solver.core.parallel import SERIAL, ThreadRunner
-from solver.core.robots import example_robot_data_dir
+from solver.core.robots import Robot, example_robot_data_dir
 from solver.core.spatial import Placement
 from solver.families import get_robot, robot_from_urdf
 from solver.optimise.optimize import optimize_placement
@@ -84,8 +84,10 @@ def coal_distances(
 ) -> list[tuple[float, int, str, str]]:
     """Per configuration, the least distance, its waypoint, robot part and other object.
 
-    Pairs of cell.md: every robot link but the base against the fixed objects; links on joints
-    neither the same nor adjacent, apart (> clearance) at the zero configuration.
+    Pairs of cell.md: every robot link a joint moves relative to a fixed object (not the base;
+    not the shoulder, which joint 1 turns about the base's z, against a halfspace whose normal
+    is z); links on joints neither the same nor adjacent, apart (> clearance) at the zero
+    configuration.
     """
     model, geometry = ur5_geometry()
     data = model.createData()
@@ -98,7 +100,7 @@ def coal_distances(
         )
     objects = geometry.geometryObjects
     pairs = [(a, n_robot + k) for a in range(n_robot) for k in range(len(fixed))]
-    pairs = [(a, b) for a, b in pairs if objects[a].parentJoint != 0]
+    pairs = [(a, b) for a, b in pairs if not _still(objects[a].parentJoint, fixed[b - n_robot][0])]
     candidates = []
     for a in range(n_robot):
         for b in range(a + 1, n_robot):
@@ -116,6 +118,12 @@ def coal_distances(
         other = objects[best[2]].name
         out.append((best[0], int(owner), objects[best[1]].name, other))
     return out
+
+
+def _still(joint: int, shape: coal.CollisionGeometry) -> bool:
+    """Whether a part on ``joint`` keeps its distance to ``shape`` (a fixed object) whatever q."""
+    upright = isinstance(shape, coal.Halfspace) and abs(abs(float(shape.n[2])) - 1.0) < 1e-12
+    return joint == 0 or (joint == 1 and upright)
 
 
 def _distance(geometry: pin.GeometryModel, gdata: pin.GeometryData, a: int, b: int) -> float:
@@ -468,6 +476,55 @@ def test_a_urdf_whose_meshes_cannot_be_read_gets_capsules_where_it_has_no_primit
     )
     assert CellChecker(get_robot("ur5"), Cell()).approximated == ()
     assert len(CellChecker(get_robot("ur5e"), Cell()).approximated) == 7
+
+
+def joint_1_capsule(arm: Robot, radius: float) -> pin.GeometryObject:
+    """A capsule on joint 1 from its origin to joint 2's, made here with coal."""
+    end = np.asarray(arm.model.jointPlacements[2].translation)
+    turn = pin.Quaternion.FromTwoVectors(np.array([0.0, 0.0, 1.0]), end / np.linalg.norm(end))
+    placement = pin.SE3(turn.matrix(), end / 2.0)
+    return pin.GeometryObject("j1", 1, placement, coal.Capsule(radius, np.linalg.norm(end)))
+
+
+@pytest.mark.parametrize("name", ["abb_irb2400", "kuka_kr16_2"])
+def test_a_link_joint_1_turns_about_the_tables_normal_is_reported_not_checked(name: str) -> None:
+    # An OPW arm has no collision geometry: capsules along its kinematic segments, joint 1's
+    # from its origin at the foot to joint 2's, so 5 cm into a table at z = 0 whatever joint 1's
+    # angle. Checked, it made every placement collide: every OPW arm on its table, and the
+    # ROS-Industrial ABB and FANUC URDFs whose meshes are elsewhere.
+    arm, radius = get_robot(name), 0.05
+    cell = Cell(fixed=(TABLE,), link_radii=(radius,) * 7)
+    geometry = pin.GeometryModel()
+    geometry.addGeometryObject(joint_1_capsule(arm, radius))
+    table = pin.SE3(arm.transform_world_to_base)
+    geometry.addGeometryObject(pin.GeometryObject("table", 0, table, TABLE.geometry()))
+    model, data, gdata = arm.model, arm.model.createData(), geometry.createData()
+    distances = []
+    for q in np.random.default_rng(4).uniform(-3.0, 3.0, (6, model.nq)):
+        pin.forwardKinematics(model, data, q)
+        pin.updateGeometryPlacements(model, data, geometry, gdata)
+        distances.append(_distance(geometry, gdata, 0, 1))
+    assert distances == pytest.approx([-radius] * 6, abs=1e-12)  # into the table, at every q
+    checker = CellChecker(arm, cell)
+    unchecked = {pair.robot_part: pair for pair in checker.unchecked}
+    assert sorted(unchecked) == ["base_capsule", f"{arm.joint_names[0]}_capsule"]
+    shoulder = unchecked[f"{arm.joint_names[0]}_capsule"]
+    assert (shoulder.obstacle, shoulder.obstacle_name) == (0, "table")
+    assert shoulder.distance == pytest.approx(distances[0], abs=DISTANCE_ATOL)
+    on_table = PathProblem.of(arm, load_path("curved_line"), PathOptions(cell=cell))
+    plain = PathProblem.of(arm, load_path("curved_line"))
+    evaluation = evaluate_path(on_table, Placement(0.9, 0.0, 0.3, 0.0))
+    assert evaluation.feasible and evaluation.cell_unchecked == checker.unchecked
+    assert evaluation.mu_path == evaluate_path(plain, Placement(0.9, 0.0, 0.3, 0.0)).mu_path
+    # the link is checked against what it turns past: a post around joint 1's segment
+    post = Box((0.1, 0.1, 0.1), pose(0.0, 0.0, 0.3), name="post")
+    posted = Cell(fixed=(TABLE, post), link_radii=(radius,) * 7)
+    hit = evaluate_path(
+        PathProblem.of(arm, load_path("curved_line"), PathOptions(cell=posted)),
+        Placement(0.9, 0.0, 0.3, 0.0),
+    )
+    assert hit.reason == "collision" and hit.collision is not None
+    assert (hit.collision.robot_part, hit.collision.obstacle_name) == (shoulder.robot_part, "post")
 
 
 def test_threads_give_the_serial_map() -> None:

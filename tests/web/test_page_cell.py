@@ -237,6 +237,15 @@ def readme_figures() -> dict[str, str]:
     return found.groupdict()
 
 
+def not_checked(evaluation: dict[str, Any]) -> str:
+    """The page's words for an answer's parts no joint moves relative to a fixed object."""
+    pairs = (
+        f"{p['robot_part']} and {p['obstacle_name']} ({mm(p['distance'])})"
+        for p in evaluation["cell_unchecked"]
+    )
+    return "; not checked, no joint moves them relative to each other: " + ", ".join(pairs)
+
+
 def optimise(page: Page) -> dict[str, Any]:
     """Optimise from the page; the request it sent."""
     with page.expect_request(lambda r: r.url.endswith("/v1/optimize")) as sent:
@@ -281,9 +290,24 @@ def test_the_readme_fixture_makes_the_velocity_best_placement_collide(page: Page
     ) in text
     page.mouse.click(*cell_point(page, 1, fast, api).values())
     page.wait_for_function("document.getElementById('cell-verdict').textContent", timeout=60_000)
-    assert (page.text_content("#cell-verdict") or "").startswith(
+    verdict = page.text_content("#cell-verdict") or ""
+    assert verdict.startswith(
         f"collision: {readme['part']} hits {readme['obstacle']} ({placed(readme['obstacle'])})"
     )
+    # the parts no joint moves relative to a fixed object, as the route reports them
+    placement = {"x": fast["x"], "y": fast["y"], "z": 0.1, "yaw": fast["yaw"]}
+    evaluated = httpx.post(
+        f"{url}/v1/evaluate",
+        json={**{k: request[k] for k in ("robot", "path", "cell")}, "placement": placement},
+        timeout=60,
+    ).json()
+    unchecked = {(p["robot_part"], p["obstacle_name"]) for p in evaluated["cell_unchecked"]}
+    assert unchecked == {
+        ("base_link_0", "table"),
+        ("base_link_0", "fixture"),
+        ("shoulder_link_0", "table"),
+    }
+    assert verdict.endswith(not_checked(evaluated))
     sent = optimise(page)
     assert sent["cell"] == request["cell"]
     answer = httpx.post(f"{url}/v1/optimize", json=sent, timeout=300).json()
@@ -293,7 +317,7 @@ def test_the_readme_fixture_makes_the_velocity_best_placement_collide(page: Page
         f"min clearance {mm(near['distance'])}: {near['robot_part']} to "
         f"{readme['near_obstacle']} ({placed(readme['near_obstacle'])}) "
         f"at waypoint {near['waypoint']} "
-        "(clearance asked 5.0 mm)"
+        "(clearance asked 5.0 mm)" + not_checked(answer["evaluation"])
     )
     assert mm(near["distance"]) == f"{readme['clear']} mm"
     assert near["robot_part"] == readme["near"]

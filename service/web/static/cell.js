@@ -180,15 +180,21 @@ function clearanceText(contact, cell) {
     + ` at waypoint ${contact.waypoint} (clearance asked ${millimetres(clearanceOf(cell))})`;
 }
 
-// What an evaluation says of the cell: the collision, or the least clearance, and the links
-// given capsules for want of collision geometry; empty without a cell.
+// What an evaluation says of the cell: the collision, or the least clearance, the links
+// given capsules for want of collision geometry, and the parts not checked against a fixed
+// object because no joint moves them relative to it; empty without a cell.
 function cellVerdict(answer, cell) {
   if (!cell) return "";
   const text = answer.collision ? `collision: ${collisionText(answer.collision, cell)}`
     : answer.min_clearance ? clearanceText(answer.min_clearance, cell) : "";
   const approximated = answer.cell_approximated && answer.cell_approximated.length
     ? `; links approximated by capsules: ${answer.cell_approximated.join(", ")}` : "";
-  return text + approximated;
+  const unchecked = answer.cell_unchecked && answer.cell_unchecked.length
+    ? "; not checked, no joint moves them relative to each other: " + answer.cell_unchecked
+      .map((pair) => `${pair.robot_part} and ${pair.obstacle_name} (${millimetres(pair.distance)})`)
+      .join(", ")
+    : "";
+  return text + approximated + unchecked;
 }
 
 function startCellEditor() {

@@ -12,7 +12,9 @@ dq about an axis k moves every point within the plane normal to k, whose compone
 at most |n x k| of the move. For a joint whose axis is fixed in the world (its parent is the
 root: a serial arm's first joint), |n x k| is a constant, and w_pj takes that factor: the first
 joint of an arm standing on its table (k = n) does not move any part towards the table at all,
-so the shoulder's distance to it is checked once a path, the upper arm's when q2 moves.
+so the upper arm's distance to it is checked when q2 moves, and the shoulder's, all of whose
+weights are zero, not at all (:mod:`solver.path.cell.scene`: it stands on the table, as the
+base does).
 """
 
 from __future__ import annotations

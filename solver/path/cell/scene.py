@@ -3,11 +3,18 @@
 One pinocchio ``GeometryModel`` holds the robot's geometry (:mod:`robot_geometry`) and the
 obstacles, on the base joint: ``fixed`` ones at their pose in {B}, ``workpiece`` ones at the
 placement's T_B_O times their pose (placed by the checker, :mod:`solver.path.cell.checker`).
-The pairs: every robot part (the tool included) against every obstacle, except the base against
-``fixed`` objects (it stands on them, whatever the placement) and the tool's cutting part
-against ``workpiece`` objects (that is machining); and the robot's parts against each other
-where they are on joints that are neither the same nor adjacent and do not come within the
-clearance at the zero configuration.
+The pairs: every robot part (the tool included) against every obstacle, except the tool's
+cutting part against ``workpiece`` objects (that is machining) and a part against a ``fixed``
+object no joint moves it relative to (its weights in :func:`solver.path.cell.bounds.pair_weights`
+all zero): the base, which stands on them whatever the placement, and a link only joint 1
+turns about a fixed halfspace's normal (joint 1's link of an arm on its table). Such a pair's
+distance is the same at every configuration and placement: were it checked, an arm whose
+joint-1 link touches its table (a capsule along that link from joint 1's origin at the foot,
+as given to a URDF whose meshes are elsewhere: ROS-Industrial's ABB IRB 2400 and FANUC M-10iA
+read with a table at z = 0) would collide at every placement, whatever the path. Those pairs
+and their distance are reported (:attr:`CellScene.unchecked`), not silently dropped. And the
+robot's parts against each other where they are on joints that are neither the same nor
+adjacent and do not come within the clearance at the zero configuration.
 """
 
 from __future__ import annotations
@@ -22,6 +29,10 @@ from solver.path.cell import fast
 from solver.path.cell.bounds import pair_weights
 from solver.path.cell.robot_geometry import robot_geometry
 from solver.path.cell.shapes import Cell
+from solver.path.cell.verdict import Unchecked
+
+STILL = 1e-9
+"""m/rad: a pair whose every weight is below this is one no joint moves (1e-9 m a turn at most)."""
 
 
 @dataclass(frozen=True)
@@ -38,6 +49,8 @@ class CellScene:
         weights: :func:`solver.path.cell.bounds.pair_weights` of the pairs.
         compiled: the compiled sweep's model; None where it lacks a joint or shape (coal alone).
         approximated: the robot's links given capsules (no readable collision geometry).
+        unchecked: the robot parts not checked against a ``fixed`` object because no joint
+            moves them relative to it, with their distance (the same at every configuration).
     """
 
     geometry: pin.GeometryModel
@@ -48,6 +61,7 @@ class CellScene:
     weights: np.ndarray
     compiled: fast.FastCell | None
     approximated: tuple[str, ...]
+    unchecked: tuple[Unchecked, ...] = ()
 
 
 def build_scene(robot: Robot, cell: Cell) -> CellScene:
@@ -68,14 +82,13 @@ def build_scene(robot: Robot, cell: Cell) -> CellScene:
         gid = geometry.addGeometryObject(obj)
         if k >= len(cell.fixed):
             workpiece_ids.append((gid, pin.SE3(np.asarray(shape.pose, dtype=float))))
-    pairs: list[tuple[int, int]] = []
-    for part in range(n_robot):
-        joint = int(geometry.geometryObjects[part].parentJoint)
-        for k in range(len(shapes)):
-            workpiece = k >= len(cell.fixed)
-            if (joint == 0 and not workpiece) or (part == made.cutting and workpiece):
-                continue
-            pairs.append((part, n_robot + k))
+    pairs = [
+        (part, n_robot + k)
+        for part in range(n_robot)
+        for k in range(len(shapes))
+        if not (part == made.cutting and k >= len(cell.fixed))
+    ]
+    pairs, still = _moving(robot.model, geometry, pairs, n_robot, len(cell.fixed))
     pairs += _self_pairs(robot.model, geometry, n_robot, cell.clearance)
     for a, b in pairs:
         geometry.addCollisionPair(pin.CollisionPair(a, b))
@@ -101,7 +114,45 @@ def build_scene(robot: Robot, cell: Cell) -> CellScene:
         weights=weights,
         compiled=compiled,
         approximated=made.approximated,
+        unchecked=tuple(
+            Unchecked(
+                geometry.geometryObjects[a].name, b - n_robot, cell.obstacle_name(b - n_robot), d
+            )
+            for (a, b), d in zip(still, _distances(robot.model, geometry, still), strict=True)
+        ),
     )
+
+
+def _moving(
+    model: pin.Model,
+    geometry: pin.GeometryModel,
+    pairs: list[tuple[int, int]],
+    n_robot: int,
+    n_fixed: int,
+) -> tuple[list[tuple[int, int]], list[tuple[int, int]]]:
+    """The pairs a joint can bring nearer, and the ``fixed`` ones none can (see the docstring)."""
+    weights = pair_weights(model, geometry, pairs, n_robot, n_fixed=n_fixed)
+    still = (weights.max(axis=1, initial=0.0) < STILL) & (
+        np.array([b for _, b in pairs]) < n_robot + n_fixed
+    )
+    return (
+        [p for p, s in zip(pairs, still, strict=True) if not s],
+        [p for p, s in zip(pairs, still, strict=True) if s],
+    )
+
+
+def _distances(
+    model: pin.Model, geometry: pin.GeometryModel, pairs: list[tuple[int, int]]
+) -> list[float]:
+    """The coal distance of each pair at the zero configuration (obstacles as placed in {B})."""
+    probe = pin.GeometryModel()
+    for obj in geometry.geometryObjects:
+        probe.addGeometryObject(obj)
+    for a, b in pairs:
+        probe.addCollisionPair(pin.CollisionPair(a, b))
+    data = probe.createData()
+    pin.computeDistances(model, model.createData(), probe, data, pin.neutral(model))
+    return [float(r.min_distance) for r in data.distanceResults]
 
 
 def _self_pairs(
@@ -116,12 +167,5 @@ def _self_pairs(
             if ja == jb or model.parents[ja] == jb or model.parents[jb] == ja:
                 continue
             pairs.append((a, b))
-    probe = pin.GeometryModel()
-    for obj in geometry.geometryObjects[:n_robot]:
-        probe.addGeometryObject(obj)
-    for a, b in pairs:
-        probe.addCollisionPair(pin.CollisionPair(a, b))
-    data = probe.createData()
-    pin.computeDistances(model, model.createData(), probe, data, pin.neutral(model))
-    distances = [r.min_distance for r in data.distanceResults]
+    distances = _distances(model, geometry, pairs)
     return [p for p, d in zip(pairs, distances, strict=True) if d > clearance]

@@ -30,6 +30,25 @@ class Contact:
 
 
 @dataclass(frozen=True)
+class Unchecked:
+    """A robot part not checked against a ``fixed`` object: no joint moves it relative to it.
+
+    Attributes:
+        robot_part: the robot's geometry object (the base's, or a link only joint 1 turns about
+            a fixed halfspace's normal).
+        obstacle: the obstacle's index among the ``fixed`` objects.
+        obstacle_name: its name, or its place (``fixed[0]``).
+        distance: m, coal's distance at the zero configuration, the same at every one
+            (negative: they overlap, as a base stands on its table).
+    """
+
+    robot_part: str
+    obstacle: int
+    obstacle_name: str
+    distance: float
+
+
+@dataclass(frozen=True)
 class CellVerdict:
     """A joint path against the cell: the first contact closer than the clearance, or the closest.
 
@@ -40,9 +59,12 @@ class CellVerdict:
             stopped at the first collision).
         checks: how many configurations were checked (by coal, in a fast map check).
         approximated: the robot's links given capsules (no readable collision geometry).
+        unchecked: the robot parts not checked against a ``fixed`` object (no joint moves them
+            relative to it), with their distance.
     """
 
     collision: Contact | None
     closest: Contact | None
     checks: int
     approximated: tuple[str, ...] = ()
+    unchecked: tuple[Unchecked, ...] = ()
