@@ -15,7 +15,9 @@ PROGRAM is CL data, or a CSV when its name ends in ``.csv`` (``--units`` then re
 catalogue name (``ur5e``), a JSON file holding the API's ``robot`` object (its acceleration
 limits add mu_acc and the cycle time), or a URDF file (``.urdf``: its chain from
 ``--base-frame`` to ``--tool-frame``, unless given REP 199's ``base`` (the controller's frame,
-where the URDF has it; else ``base_link``) and ``tool0``, its own velocity limits).
+where the URDF has it; else ``base_link``) and ``tool0``, its own velocity limits). A
+ROS-Industrial OPW parameter file (``.yaml``) is refused with the ``opw`` object read from it,
+since it has no joint limits (:mod:`service.cli_opw`).
 ``--cell FILE``, a JSON file holding the API's ``cell`` object (cell.md: the table, fixtures,
 the part, the tool, the clearance), checks the robot against it on evaluate, map and optimise
 as the routes do. Settings come from the environment as for the service (``DTF_*``); a
@@ -180,6 +182,16 @@ def _robot(args: argparse.Namespace) -> Any:
         raise InvalidInputError("robot", message)
     if name.lower().endswith(".json") and file.is_file():
         return _json_file(file, "robot")
+    if file.is_file() and file.suffix:
+        from service.cli_opw import is_opw_file, refuse_opw_file  # noqa: PLC0415 - its reader
+
+        if is_opw_file(name):
+            refuse_opw_file(file)
+        message = (
+            f"{file.name} is neither a URDF (.urdf) nor a JSON file of the API's robot object "
+            "(.json): give one of those, or a catalogue name"
+        )
+        raise InvalidInputError("robot", message)
     return {"model": name}
 
 

@@ -7,6 +7,7 @@ codes are the ones a script tests (0 ok, 2 usage, 3 invalid input, 4 infeasible)
 from __future__ import annotations
 
 import json
+import math
 import subprocess
 import sys
 from pathlib import Path
@@ -18,6 +19,7 @@ from fastapi.testclient import TestClient
 from service.cli import CLOSED_PIPE, INFEASIBLE, INVALID, OK, USAGE, main
 from service.config import get_settings
 from solver.core.robots import example_robot_data_dir
+from solver.families.opw.arms import ARMS
 from tests.cases import ROOT
 from tests.solver.cam.dialects import NX_LISTING, text
 from tests.solver.families.recognised import bent_elbow
@@ -271,6 +273,12 @@ def test_the_console_script_is_declared() -> None:
 def _file(tmp_path: Path, name: str, value: Any) -> str:
     file = tmp_path / name
     file.write_text(json.dumps(value))
+    return str(file)
+
+
+def _text_file(tmp_path: Path, name: str, text: str) -> str:
+    file = tmp_path / name
+    file.write_text(text)
     return str(file)
 
 
@@ -599,3 +607,73 @@ def test_a_command_loads_the_optimisers_and_matplotlib_only_when_it_needs_them()
         [sys.executable, "-c", code], capture_output=True, text=True, check=True, cwd=ROOT
     )
     assert run_.stdout.splitlines()[-1] == "[]"
+
+
+OPW_FILE = """# as ROS-Industrial's support packages write them for moveit_opw_kinematics_plugin
+opw_kinematics_geometric_parameters:
+    a1:  0.15
+    a2:  -0.25
+    b:   0.0
+    c1:  0.525
+    c2:  0.79
+    c3:  0.835
+    c4:  0.1
+opw_kinematics_joint_offsets: [0.0, 0.0, deg(-90.0), 0.0, 0.0, rad(3.141592653589793)]
+opw_kinematics_joint_sign_corrections: [1, 1, -1, -1, -1, -1]
+"""
+"""The FANUC M-20iA's geometry (the catalogue's fanuc_m20ia), angles in rosparam's forms."""
+
+
+def test_an_opw_parameter_file_is_refused_with_the_robot_object_it_gives(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # It has no joint limits: the command prints the opw object read from it, for a robot JSON
+    # file beside the maker's limits, and names the catalogue arm of that geometry.
+    program, at = str(ROOT / "examples" / "cam" / "sweep_mm.cl"), "--at=0.9,0.2,0.3,0"
+    code, _, err = run(
+        capsys, "evaluate", program, "--robot", _text_file(tmp_path, "m20ia.yaml", OPW_FILE), at
+    )
+    assert code == INVALID
+    assert "m20ia.yaml is a ROS-Industrial OPW parameter file" in err
+    assert err.rstrip().endswith("its geometry is the catalogue's fanuc_m20ia: --robot fanuc_m20ia")
+    opw = json.loads(err.split('{"opw": ', 1)[1].split(', "joint_position_limits"', 1)[0])
+    offsets = [0.0, 0.0, math.radians(-90.0), 0.0, 0.0, math.pi]
+    assert opw == {
+        "a1": 0.15, "a2": -0.25, "b": 0.0, "c1": 0.525, "c2": 0.79, "c3": 0.835, "c4": 0.1,
+        "offsets": offsets, "sign_corrections": [1, 1, -1, -1, -1, -1],
+    }  # fmt: skip
+    # that object with the arm's limits (the catalogue's) is the arm
+    arm = next(arm for arm in ARMS if arm.name == "fanuc_m20ia")
+    limits = {
+        "joint_position_limits": [list(pair) for pair in arm.position_limits],
+        "joint_velocity_limits": list(arm.velocity_limits),
+    }
+    robot = _file(tmp_path, "m20ia.json", {"opw": opw, **limits})
+    code, out, _ = run(capsys, "evaluate", program, "--robot", robot, at, "--json")
+    assert code == OK
+    code, catalogue, _ = run(capsys, "evaluate", program, "--robot", "fanuc_m20ia", at, "--json")
+    assert code == OK
+    assert json.loads(out)["mu_path"] == json.loads(catalogue)["mu_path"] > 0.0
+
+
+@pytest.mark.parametrize(
+    ("name", "content", "message"),
+    [
+        ("arm.yaml", "robot: {a1: 0.1}\n", "arm.yaml is not an OPW parameter file"),
+        ("arm.yaml", "a: [1, 2\n", "arm.yaml is not YAML"),
+        (
+            "arm.yaml",
+            OPW_FILE.replace("deg(-90.0)", "degrees(-90)"),
+            "opw_kinematics_joint_offsets[2] is 'degrees(-90)', not a number, deg(x) or rad(x)",
+        ),
+        ("arm.xml", "<robot/>", "arm.xml is neither a URDF (.urdf) nor a JSON file"),
+    ],
+    ids=["not-opw", "not-yaml", "bad-angle", "other-file"],
+)
+def test_a_robot_file_of_another_kind_is_refused_naming_it(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], name: str, content: str, message: str
+) -> None:
+    robot = _text_file(tmp_path, name, content)
+    code, _, err = run(capsys, "evaluate", str(PROGRAM), "--robot", robot, "--at=0,0.3,0,0")
+    assert code == INVALID
+    assert message in err

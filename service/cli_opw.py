@@ -1,0 +1,114 @@
+"""A ROS-Industrial OPW parameter file given to ``dtf-place --robot``: read, and refused.
+
+The support packages of ROS-Industrial (kuka_experimental, fanuc) ship ``opw_parameters_*.yaml``
+for moveit_opw_kinematics_plugin: ``opw_kinematics_geometric_parameters`` (a1, a2, b, c1, c2,
+c3, c4 in m), ``opw_kinematics_joint_offsets`` and ``opw_kinematics_joint_sign_corrections``,
+angles in radians or written ``deg(x)`` / ``rad(x)`` as rosparam evaluates them. Such a file has
+no joint limits, and the service guesses none: the command refuses it, printing the API's
+``opw`` object read from it, to go into a robot JSON file beside the maker's limits, and names
+the catalogue arm of the same geometry where there is one.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import re
+from pathlib import Path
+from typing import Any
+
+import yaml
+
+from solver.core.exceptions import InvalidInputError
+from solver.families.opw.arms import ARMS
+
+GEOMETRY = "opw_kinematics_geometric_parameters"
+OFFSETS = "opw_kinematics_joint_offsets"
+SIGNS = "opw_kinematics_joint_sign_corrections"
+LENGTHS = ("a1", "a2", "b", "c1", "c2", "c3", "c4")
+SAME = 1e-9
+"""m or rad: a file's geometry within this of a catalogue arm's is that arm's."""
+_ANGLE = re.compile(r"^\s*(deg|rad)\(\s*([-+]?[0-9.]+(?:[eE][-+]?[0-9]+)?)\s*\)\s*$")
+
+
+def is_opw_file(name: str) -> bool:
+    """Whether ``--robot`` names a YAML file (the OPW parameter files' form)."""
+    return name.lower().endswith((".yaml", ".yml"))
+
+
+def refuse_opw_file(file: Path) -> None:
+    """Refuse an OPW parameter file, saying what to give instead (see the module docstring).
+
+    Raises:
+        InvalidInputError: on ``robot``, always: the file's ``opw`` object and the limits it
+            lacks, or why it is not such a file.
+    """
+    geometry = opw_object(file)
+    same = [arm.name for arm in ARMS if _same(arm.parameters, geometry)]
+    also = f"; its geometry is the catalogue's {same[0]}: --robot {same[0]}" if same else ""
+    raise InvalidInputError(
+        "robot",
+        f"{file.name} is a ROS-Industrial OPW parameter file: it gives the arm's geometry but "
+        "no joint limits, and none is guessed. Give --robot a JSON file of the API's robot "
+        f'object: {{"opw": {json.dumps(geometry)}, "joint_position_limits": [[lower, upper], '
+        '... 6, rad], "joint_velocity_limits": [... 6, rad/s]}, the limits from the maker'
+        f"{also}",
+    )
+
+
+def opw_object(file: Path) -> dict[str, Any]:
+    """The API's ``opw`` object written by an OPW parameter file.
+
+    Raises:
+        InvalidInputError: on ``robot``: not YAML, or not an OPW parameter file.
+    """
+    try:
+        data = yaml.safe_load(file.read_text(encoding="utf-8"))
+    except yaml.YAMLError as error:
+        raise InvalidInputError("robot", f"{file.name} is not YAML ({error})") from error
+    lengths = data.get(GEOMETRY) if isinstance(data, dict) else None
+    if not isinstance(lengths, dict):
+        raise InvalidInputError(
+            "robot",
+            f"{file.name} is not an OPW parameter file (no {GEOMETRY}): give a catalogue name, "
+            "a URDF file or a JSON file of the API's robot object",
+        )
+    out: dict[str, Any] = {
+        key: _number(lengths.get(key), f"{GEOMETRY}.{key}", file) for key in LENGTHS
+    }
+    out["offsets"] = [
+        _number(v, f"{OFFSETS}[{i}]", file) for i, v in enumerate(_six(data, OFFSETS, file))
+    ]
+    out["sign_corrections"] = [
+        int(_number(v, f"{SIGNS}[{i}]", file)) for i, v in enumerate(_six(data, SIGNS, file))
+    ]
+    return out
+
+
+def _six(data: dict[str, Any], key: str, file: Path) -> list[Any]:
+    """The file's list ``key``, six values (six defaults where the file has none)."""
+    values = data.get(key, [1 if key == SIGNS else 0.0] * 6)
+    if not isinstance(values, list) or len(values) != 6:
+        raise InvalidInputError("robot", f"{file.name}: {key} must be a list of 6 values")
+    return values
+
+
+def _number(value: Any, where: str, file: Path) -> float:
+    """A length or an angle: a number, ``deg(x)`` or ``rad(x)`` (rosparam's forms); m or rad."""
+    if isinstance(value, (int, float)) and not isinstance(value, bool):
+        return float(value)
+    match = _ANGLE.match(value) if isinstance(value, str) else None
+    if match is None:
+        raise InvalidInputError(
+            "robot", f"{file.name}: {where} is {value!r}, not a number, deg(x) or rad(x)"
+        )
+    number = float(match.group(2))
+    return math.radians(number) if match.group(1) == "deg" else number
+
+
+def _same(parameters: Any, geometry: dict[str, Any]) -> bool:
+    """Whether a catalogue arm's OpwParameters are the file's geometry (to SAME)."""
+    ours = [getattr(parameters, key) for key in LENGTHS] + list(parameters.offsets)
+    theirs = [geometry[key] for key in LENGTHS] + list(geometry["offsets"])
+    close = all(abs(a - b) <= SAME for a, b in zip(ours, theirs, strict=True))
+    return close and list(parameters.sign_corrections) == geometry["sign_corrections"]
