@@ -2,9 +2,11 @@
 
 from __future__ import annotations
 
+import io
 import struct
 import threading
 
+import matplotlib.image as mpimg
 import numpy as np
 import pytest
 
@@ -23,10 +25,12 @@ def _map(
     x0: float = 0.0,
     seed: int = 0,
     mu_acc: bool = False,
+    collisions: bool = False,
 ) -> CapabilityMap:
     """A map of made-up speeds (a third of the cells infeasible), shape (spins, yaws, ny, nx).
 
-    With ``mu_acc``, mu_acc too (a different order of the cells: it colours the map).
+    With ``mu_acc``, mu_acc too (a different order of the cells: it colours the map). With
+    ``collisions``, half the infeasible cells are in collision (reason 4), the rest unreachable.
     """
     shape = (spins, yaws, ny, nx)
     rng = np.random.default_rng(seed)
@@ -41,7 +45,7 @@ def _map(
         z=0.1,
         spins=np.linspace(0.0, 0.3, spins),
         mu_path=mu,
-        reason=np.where(feasible, -1, 0),
+        reason=np.where(feasible, -1, np.where(collisions & (rng.random(shape) < 0.5), 4, 0)),
         failed_waypoint=np.where(feasible, -1, 3),
         branch=np.where(feasible, 0, -1),
         bottleneck_waypoint=where,
@@ -67,6 +71,8 @@ MAPS = [  # one after the other on the kept figures: extents, panels, markers an
     _map(6, 4, yaws=2, seed=5, x0=-0.3),  # the best and worst in other panels
     _map(3, 3, yaws=3, spins=2, seed=6),
     _map(8, 5, seed=7, mu_acc=True),  # colour and label by mu_acc
+    _map(8, 5, seed=8, collisions=True),  # collision cells coloured, the legend says so
+    _map(8, 5, seed=9),  # and not after them
 ]
 
 
@@ -144,6 +150,34 @@ def test_each_panel_shows_its_maps_extent_markers_and_colour_range(monkeypatch) 
                     assert (marker.get_xdata()[0], marker.get_ydata()[0]) == where[2:]
         label = "mu_path (m/s)" if cmap.mu_acc is None else "mu_acc (m/s)"
         assert figure.colour_bar.ax.get_ylabel() == label
+
+
+COLLISION_RGB = (0xC6, 0x28, 0x28)  # the page's collision colour (service/web/static/app.js)
+
+
+def test_collision_cells_take_the_collision_colour_and_the_legend_names_it() -> None:
+    # cell.md section 3: the map colours collision cells as a reason of their own; the PNG's
+    # pixels at each cell's centre, read back, against the map's reasons.
+    figure = MapFigure(1)
+    for cmap in (_map(8, 5, seed=8, collisions=True), _map(8, 5, seed=9)):
+        png = figure.png(cmap, title="t")
+        pixels = np.round(255 * mpimg.imread(io.BytesIO(png), format="png")[..., :3]).astype(int)
+        height = pixels.shape[0]
+        collided = cmap.reason[0, 0] == 4
+        for i, j in np.ndindex(collided.shape):
+            x, y = figure.panels[0].transData.transform((cmap.xs[j], cmap.ys[i]))
+            rgb = tuple(pixels[height - 1 - int(y), int(x)])
+            if collided[i, j]:
+                assert rgb == COLLISION_RGB, (i, j)
+            elif cmap.reason[0, 0, i, j] == 0:
+                assert rgb == (255, 255, 255), (i, j)  # infeasible otherwise: blank
+            else:
+                assert rgb not in (COLLISION_RGB, (255, 255, 255)), (i, j)
+        assert figure.legends[True].get_visible() == bool(collided.any())
+        assert figure.legends[False].get_visible() != bool(collided.any())
+        labels = [t.get_text() for t in figure.legends[True].get_texts()]
+        assert labels == ["best", "worst", "infeasible", "collision"]
+    # the second map has none: on the same figure, no cell keeps the first map's colour
 
 
 def _png_size(png: bytes) -> tuple[int, int]:
