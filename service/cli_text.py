@@ -64,6 +64,12 @@ def _how_it_runs(answer: EvaluateResponse) -> list[str]:
         )
     if answer.min_clearance is not None:
         lines.append(f"least clearance: {_contact(answer.min_clearance)}")
+    return lines + _cell_model(answer)
+
+
+def _cell_model(answer: EvaluateResponse | MapResponse) -> list[str]:
+    """The links given capsules and the parts not checked, where the answer has a cell."""
+    lines = []
     if answer.cell_approximated:
         lines.append("cell: approximated by capsules: " + ", ".join(answer.cell_approximated))
     if answer.cell_unchecked:
@@ -182,7 +188,7 @@ def map_text(answer: MapResponse, png: str) -> str:
     if answer.best is not None:
         lines.append(f"best: mu_path {answer.best.mu_path:.4f} m/s")
         lines += _placement(answer.best.placement)
-    return "\n".join(lines)
+    return "\n".join(lines + _cell_model(answer))
 
 
 def optimum_text(answer: OptimizeResponse) -> str:

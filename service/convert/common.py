@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+from typing import Any
 
 import numpy as np
 
@@ -19,6 +20,7 @@ from solver.core.spatial import (
 )
 from solver.core.urdf_structure import joint_count
 from solver.path.cell.shapes import Cell
+from solver.path.cell.verdict import Unchecked
 from solver.path.problem import PathOptions, PathProblem, SpinMode
 
 
@@ -233,3 +235,15 @@ def wants_png(accept: str) -> bool:
     png = weight("image/png", "image/*", "*/*")
     json_ = weight("application/json", "application/*", "*/*")
     return png[0] > 0.0 and png > json_
+
+
+def cell_model_to_api(
+    approximated: tuple[str, ...] | None, unchecked: tuple[Unchecked, ...] | None
+) -> dict[str, Any]:
+    """An answer's ``cell_approximated`` and ``cell_unchecked`` (None without a cell)."""
+    return {
+        "cell_approximated": None if approximated is None else list(approximated),
+        "cell_unchecked": None
+        if unchecked is None
+        else [schemas.UncheckedPair.from_solver(pair) for pair in unchecked],
+    }

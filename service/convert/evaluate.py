@@ -9,7 +9,7 @@ import numpy as np
 from pydantic import TypeAdapter
 
 from service import schemas
-from service.convert.common import branch_to_api
+from service.convert.common import branch_to_api, cell_model_to_api
 from solver.core.robots import Robot
 from solver.path.cycle_time import CycleTime
 from solver.path.evaluate import AccelerationIndex, PathEvaluation
@@ -161,10 +161,7 @@ def evaluate_response(
         cycle_time=cycle_time_to_api(cycle_time),
         collision=schemas.Contact.from_solver(ev.collision),
         min_clearance=schemas.Contact.from_solver(ev.min_clearance),
-        cell_approximated=None if ev.cell_approximated is None else list(ev.cell_approximated),
-        cell_unchecked=None
-        if ev.cell_unchecked is None
-        else [schemas.UncheckedPair.from_solver(pair) for pair in ev.cell_unchecked],
+        **cell_model_to_api(ev.cell_approximated, ev.cell_unchecked),
         feed_check=None
         if feed is None
         else schemas.FeedCheckResult(feed=feed.feed, feasible=feed.feasible, margin=feed.margin),

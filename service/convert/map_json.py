@@ -19,7 +19,7 @@ import numpy as np
 from pydantic_core import to_json
 
 from service import schemas
-from service.convert.common import branch_to_api
+from service.convert.common import branch_to_api, cell_model_to_api
 from service.convert.maps import acceleration_columns, extreme
 from solver.core.codes import FEASIBLE, REASONS
 from solver.core.family import Branch
@@ -49,6 +49,7 @@ def map_json(
         spin_mode=spin_mode,
         recognised=family.recognised,
         path_read=path_read,
+        **cell_model_to_api(cmap.cell_approximated, cmap.cell_unchecked),
     ).model_dump_json()
     branches = [_branch_text(b) for b in family.branches]
     feasible = (cmap.reason == FEASIBLE).ravel().tolist()

@@ -173,6 +173,20 @@ class Contact(ResponseModel):
         )
 
 
+CELL_APPROXIMATED = (
+    "With a cell: the robot's links given capsules along their kinematic segments, having no "
+    "collision geometry the service can read (an arm built from DH or OPW parameters, a URDF "
+    "whose meshes are elsewhere)."
+)
+CELL_UNCHECKED = (
+    "With a cell: the robot parts not checked against a fixed object because no joint moves "
+    "them relative to it, with their distance (the same at every configuration and placement): "
+    "the base, which stands on the fixed objects, and a link only joint 1 turns about a fixed "
+    "halfspace's normal (joint 1's link of an arm on its table, which a capsule from joint 1's "
+    "origin at the foot would otherwise cut at every placement)."
+)
+
+
 class UncheckedPair(ResponseModel):
     """A robot part not checked against a fixed object: no joint moves it relative to it."""
 

@@ -8,7 +8,7 @@ from typing import Literal
 from pydantic import ConfigDict, Field
 from pydantic.config import JsonDict
 
-from service.schemas.cell import Contact, UncheckedPair
+from service.schemas.cell import CELL_APPROXIMATED, CELL_UNCHECKED, Contact, UncheckedPair
 from service.schemas.common import ResponseModel, SpinMode
 from service.schemas.evaluate_request import DetailLevel
 from service.schemas.ik import Branch, NumericBranch
@@ -251,19 +251,11 @@ class EvaluateResponse(ResponseModel):
     )
     cell_approximated: list[str] | None = Field(
         default=None,
-        description="With a cell: the robot's links given capsules along their kinematic "
-        "segments, having no collision geometry the service can read (an arm built from DH or "
-        "OPW parameters, a URDF whose meshes are elsewhere); null without a cell or when the "
-        "path was not checked.",
+        description=f"{CELL_APPROXIMATED} Null without a cell or when the path was not checked.",
     )
     cell_unchecked: list[UncheckedPair] | None = Field(
         default=None,
-        description="With a cell: the robot parts not checked against a fixed object because "
-        "no joint moves them relative to it, with their distance (the same at every "
-        "configuration and placement): the base, which stands on the fixed objects, and a link "
-        "only joint 1 turns about a fixed halfspace's normal (joint 1's link of an arm on its "
-        "table, which a capsule from joint 1's origin at the foot would otherwise cut at every "
-        "placement); null without a cell or when the path was not checked.",
+        description=f"{CELL_UNCHECKED} Null without a cell or when the path was not checked.",
     )
     feed_check: FeedCheckResult | None = Field(
         default=None,

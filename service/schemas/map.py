@@ -7,7 +7,7 @@ from typing import Annotated
 from pydantic import ConfigDict, Field
 from pydantic.config import JsonDict
 
-from service.schemas.cell import CellSpec
+from service.schemas.cell import CELL_APPROXIMATED, CELL_UNCHECKED, CellSpec, UncheckedPair
 from service.schemas.common import Angle, Coordinate, RequestModel, ResponseModel, SpinMode
 from service.schemas.evaluate_request import _REQUEST_EXAMPLE
 from service.schemas.evaluate_response import FailureReason
@@ -245,3 +245,9 @@ class MapResponse(ResponseModel):
         "and solved in closed form (as /v1/evaluate's ik.recognised); null otherwise.",
     )
     path_read: PathRead | None = Field(default=None, description=PATH_READ)
+    cell_approximated: list[str] | None = Field(
+        default=None, description=f"{CELL_APPROXIMATED} Null without a cell."
+    )
+    cell_unchecked: list[UncheckedPair] | None = Field(
+        default=None, description=f"{CELL_UNCHECKED} Null without a cell."
+    )

@@ -9,6 +9,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -17,6 +18,7 @@ from solver.core.exceptions import InvalidInputError
 from solver.core.parallel import SERIAL, TaskRunner
 from solver.core.spatial import Placement
 from solver.path.cell.cost import with_cell
+from solver.path.cell.verdict import Unchecked
 from solver.path.placements import DEFAULT_CHUNK, evaluate_placements
 from solver.path.problem import PathProblem
 from solver.path.pruning import can_prune
@@ -50,6 +52,9 @@ class CapabilityMap:
             infeasible; None without acceleration limits. The map's colour when given.
         limited_by: what binds mu_acc: 0 speed, 1 acceleration, -1 where infeasible (None
             likewise); acc_waypoint, acc_joint: where, and which joint (-1 where infeasible).
+        cell_approximated: with a cell, the robot's links given capsules; else None.
+        cell_unchecked: with a cell, the robot parts not checked against a ``fixed`` object
+            (no joint moves them relative to it), with their distance; else None.
     """
 
     xs: np.ndarray
@@ -67,6 +72,8 @@ class CapabilityMap:
     limited_by: np.ndarray | None = None
     acc_waypoint: np.ndarray | None = None
     acc_joint: np.ndarray | None = None
+    cell_approximated: tuple[str, ...] | None = None
+    cell_unchecked: tuple[Unchecked, ...] | None = None
 
     @property
     def feed_index(self) -> np.ndarray:
@@ -185,6 +192,17 @@ def capability_map(
         runner=runner,
         compiled=compiled,
     )
+    optional: dict[str, Any] = {  # acceleration limits' columns; the path checks' models
+        name: None if value is None else value.reshape(shape)
+        for name, value in (
+            ("mu_acc", result.mu_acc),
+            ("limited_by", result.limited_by),
+            ("acc_waypoint", result.acc_waypoint),
+            ("acc_joint", result.acc_joint),
+        )
+    }
+    for check in problem.path_checks:  # the cell's: its capsules and unchecked pairs
+        optional.update(check.model())
     return CapabilityMap(
         xs=xs,
         ys=ys,
@@ -197,15 +215,7 @@ def capability_map(
         branch=result.branch.reshape(shape),
         bottleneck_waypoint=result.bottleneck_waypoint.reshape(shape),
         bottleneck_joint=result.bottleneck_joint.reshape(shape),
-        **{
-            name: None if value is None else value.reshape(shape)
-            for name, value in (
-                ("mu_acc", result.mu_acc),
-                ("limited_by", result.limited_by),
-                ("acc_waypoint", result.acc_waypoint),
-                ("acc_joint", result.acc_joint),
-            )
-        },
+        **optional,
     )
 
 

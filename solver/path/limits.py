@@ -23,6 +23,7 @@ from __future__ import annotations
 
 import abc
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -156,6 +157,14 @@ class PathCheck(abc.ABC):
             self.check(q, placement, thorough=False)
             for q, placement in zip(joint_paths, placements, strict=True)
         ]
+
+    def model(self) -> dict[str, Any]:
+        """What a map's answer reports of this check's model, as its fields (none here).
+
+        The cell: the links given capsules and the parts not checked
+        (:meth:`solver.path.cell.limit.CellLimit.model`), whatever the placement.
+        """
+        return {}
 
     def refuses_at(self, q: np.ndarray, placement: np.ndarray, refusal: PathVerdict) -> bool:
         """A quick test: True only where :meth:`check` refuses ``q`` too (none here).

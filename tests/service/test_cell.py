@@ -116,6 +116,35 @@ def test_the_map_marks_collision_cells(client: TestClient, body: dict) -> None:
     assert reasons == {"collision"}
 
 
+def test_the_map_names_its_capsules_and_unchecked_parts_as_an_evaluation_does(
+    client: TestClient, body: dict
+) -> None:
+    request = map_request(body)
+    request["robot"] = {"model": "abb_irb2400"}
+    request["grid"] = {**request["grid"], "x": {"min": 0.8, "max": 1.0, "step": 0.1}}
+    request["grid"]["y"] = {"min": 0.0, "max": 0.0, "step": 0.1}
+    request["grid"]["z"] = 0.3
+    request["cell"] = {"fixed": [TABLE], "link_radii": [0.05] * 7}
+    answer = client.post("/v1/map", json=request).json()
+    assert answer["feasible_cells"] > 0
+    at = {"x": 0.9, "y": 0.0, "z": 0.3, "yaw": 0.0}
+    evaluated = client.post(
+        "/v1/evaluate",
+        json={k: request[k] for k in ("robot", "path", "cell")} | {"placement": at},
+    ).json()
+    assert evaluated["feasible"] is True
+    for field in ("cell_approximated", "cell_unchecked"):
+        assert answer[field] == evaluated[field]
+    assert [p["robot_part"] for p in answer["cell_unchecked"]] == [
+        "base_capsule",
+        "joint_1_capsule",
+    ]
+    assert len(answer["cell_approximated"]) == 7  # the base and six links, no geometry
+    del request["cell"]
+    plain = client.post("/v1/map", json=request).json()
+    assert plain["cell_approximated"] is None and plain["cell_unchecked"] is None
+
+
 def mesh(stl: str, units: str = "m") -> dict[str, Any]:
     """A mesh object of an STL."""
     return {"shape": "mesh", "stl": stl, "units": units}

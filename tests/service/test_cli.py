@@ -338,6 +338,14 @@ def test_a_table_above_the_base_makes_evaluate_and_map_infeasible_by_collision(
     code, out, _ = run(capsys, *MAP, "--png", str(tmp_path / "map.png"), "--cell", cell)
     assert code == INFEASIBLE
     assert f"map: 0 of 6 placements feasible (6 in collision); {tmp_path / 'map.png'}" in out
+    assert out.splitlines()[-2].startswith("cell: approximated by capsules: base, ")  # the UR5e
+    # the UR5e's base capsule (radius 0.06 m) from its foot up to joint 1 (d1 = 0.1625 m), the
+    # shoulder's from there, level: 0.05 + 0.06 m into the table, 0.1625 - 0.06 - 0.05 m above
+    assert out.splitlines()[-1] == (
+        "cell: not checked, no joint moves them relative to each other: base_capsule and "
+        "raised table (110.0 mm into it), shoulder_pan_joint_capsule and raised table (52.5 mm "
+        "apart)"
+    )
 
 
 def test_optimise_in_a_cell_prints_the_routes_collision_free_optimum(

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+from typing import Any
 
 import numpy as np
 
@@ -36,6 +37,13 @@ class CellLimit(PathCheck):
         verdict = self.checker.check(q, self.segment_in_pass, transform, closest=thorough)
         failed = None if verdict.collision is None else verdict.collision.waypoint
         return PathVerdict(failed, verdict)
+
+    def model(self) -> dict[str, Any]:
+        """The links given capsules and the parts not checked (``CapabilityMap``'s fields)."""
+        return {
+            "cell_approximated": self.checker.approximated,
+            "cell_unchecked": self.checker.unchecked,
+        }
 
     def refuses_at(self, q: np.ndarray, placement: np.ndarray, refusal: PathVerdict) -> bool:
         """Whether ``q`` collides on the refusal's pair at its waypoint (``PathCheck.refuses_at``).
