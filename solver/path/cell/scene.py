@@ -88,11 +88,12 @@ def build_scene(robot: Robot, cell: Cell) -> CellScene:
         for k in range(len(shapes))
         if not (part == made.cutting and k >= len(cell.fixed))
     ]
-    pairs, still = _moving(robot.model, geometry, pairs, n_robot, len(cell.fixed))
-    pairs += _self_pairs(robot.model, geometry, n_robot, cell.clearance)
+    pairs, weights, still = _moving(robot.model, geometry, pairs, n_robot, len(cell.fixed))
+    own = _self_pairs(robot.model, geometry, n_robot, cell.clearance)
+    pairs += own
+    weights = np.vstack([weights, pair_weights(robot.model, geometry, own, n_robot)])
     for a, b in pairs:
         geometry.addCollisionPair(pin.CollisionPair(a, b))
-    weights = pair_weights(robot.model, geometry, pairs, n_robot, n_fixed=len(cell.fixed))
     try:
         compiled: fast.FastCell | None = fast.FastCell(
             robot.model,
@@ -129,16 +130,16 @@ def _moving(
     pairs: list[tuple[int, int]],
     n_robot: int,
     n_fixed: int,
-) -> tuple[list[tuple[int, int]], list[tuple[int, int]]]:
-    """The pairs a joint can bring nearer, and the ``fixed`` ones none can (see the docstring)."""
+) -> tuple[list[tuple[int, int]], np.ndarray, list[tuple[int, int]]]:
+    """The pairs a joint can bring nearer with their weights; the ``fixed`` ones none can.
+
+    See the module docstring; the weights are :func:`pair_weights`' (P, nv).
+    """
     weights = pair_weights(model, geometry, pairs, n_robot, n_fixed=n_fixed)
-    still = (weights.max(axis=1, initial=0.0) < STILL) & (
-        np.array([b for _, b in pairs]) < n_robot + n_fixed
-    )
-    return (
-        [p for p, s in zip(pairs, still, strict=True) if not s],
-        [p for p, s in zip(pairs, still, strict=True) if s],
-    )
+    fixed = np.array([b < n_robot + n_fixed for _, b in pairs], dtype=bool)
+    still = (weights.max(axis=1, initial=0.0) < STILL) & fixed
+    moving = [p for p, s in zip(pairs, still, strict=True) if not s]
+    return moving, weights[~still], [p for p, s in zip(pairs, still, strict=True) if s]
 
 
 def _distances(
