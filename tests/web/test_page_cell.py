@@ -404,3 +404,27 @@ def test_the_table_tool_and_clearance_errors_show_beside_their_fields(
     assert [".".join(map(str, d["loc"][2:])) for d in detail] == [api_loc]
     assert page.text_content(selector) == detail[0]["msg"]
     assert page.text_content("#form-error") == ""
+
+
+def test_an_arm_without_geometry_takes_its_link_radii_from_the_editor(page: Page, url: str) -> None:
+    # An OPW arm has no collision geometry nor published radii: with a table and no radii the
+    # API's 422 names cell.link_radii, beside the field; with them the map runs.
+    page.select_option("#robot-model", "kuka_kr16_2")
+    open_editor(page)
+    fill(page, {**SMALL, "table-height": "0"})
+    with page.expect_request(lambda r: r.method == "POST" and r.url.endswith("/v1/jobs")) as sent:
+        page.click("#run")
+    selector = ".field[data-loc='cell.link_radii'] .error"
+    page.wait_for_function(f'document.querySelector("{selector}").textContent', timeout=60_000)
+    refused = httpx.post(f"{url}/v1/jobs", json=sent_json(sent.value), timeout=60)
+    assert refused.status_code == 422
+    assert page.text_content(selector) == refused.json()["detail"][0]["msg"]
+    radii = [0.2, 0.15, 0.12, 0.1, 0.08, 0.06, 0.05]
+    fill(page, {"link-radii": ", ".join(map(str, radii))})
+    request = run_map(page)
+    assert request["robot"] == {"model": "kuka_kr16_2"}
+    assert request["cell"]["link_radii"] == radii
+    answer = httpx.post(f"{url}/v1/map", json=request, timeout=120)
+    assert answer.status_code == 200, answer.text
+    assert answer.json()["cell_unchecked"][0]["robot_part"] == "base_capsule"
+    assert page.get_attribute("#summary", "data-cells") == str(len(answer.json()["cells"]))

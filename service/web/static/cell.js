@@ -138,6 +138,7 @@ function cellBody() {
   const cell = { fixed, workpiece };
   if (tool) cell.tool = tool;
   if ($("clearance").value.trim() !== "") cell.clearance = value("clearance");
+  if ($("link-radii").value.trim() !== "") cell.link_radii = numbers($("link-radii").value);
   return cell;
 }
 
