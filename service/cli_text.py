@@ -141,7 +141,7 @@ def evaluation_text(answer: EvaluateResponse, clearance: float | None = None) ->
         if answer.collision is not None:
             limit = "" if clearance is None else f" (clearance {_fixed(clearance * 1e3, 1)} mm)"
             lines.append(f"collision: {_contact(answer.collision)}{limit}")
-        return "\n".join(lines)
+        return "\n".join(lines + _cell_model(answer))
     lines.append(f"mu_path: {answer.mu_path:.4f} m/s (spin {answer.spin_mode})")
     if answer.bottleneck is not None:
         lines.append(

@@ -331,10 +331,11 @@ def test_a_table_above_the_base_makes_evaluate_and_map_infeasible_by_collision(
     answer = api(client, "/v1/evaluate", {**body, "cell": RAISED_TABLE, "detail": "summary"})
     assert code == INFEASIBLE and answer["reason"] == "collision"
     assert answer["collision"]["obstacle_name"] == "raised table"
-    assert out.splitlines()[-2].startswith("infeasible: collision at waypoint ")
-    assert out.splitlines()[-1] == (
-        f"collision: {_contact(answer['collision'])} (clearance 5.0 mm)"
-    )
+    lines = out.splitlines()
+    assert lines[-4].startswith("infeasible: collision at waypoint ")
+    assert lines[-3] == f"collision: {_contact(answer['collision'])} (clearance 5.0 mm)"
+    assert lines[-2].startswith("cell: approximated by capsules: base, ")  # the UR5e's
+    assert lines[-1].startswith("cell: not checked, no joint moves them relative to each other: ")
     code, out, _ = run(capsys, *MAP, "--png", str(tmp_path / "map.png"), "--cell", cell)
     assert code == INFEASIBLE
     assert f"map: 0 of 6 placements feasible (6 in collision); {tmp_path / 'map.png'}" in out
