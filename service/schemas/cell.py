@@ -182,8 +182,9 @@ CELL_UNCHECKED = (
     "With a cell: the robot parts not checked against a fixed object because no joint moves "
     "them relative to it, with their distance (the same at every configuration and placement): "
     "the base, which stands on the fixed objects, and a link only joint 1 turns about a fixed "
-    "halfspace's normal (joint 1's link of an arm on its table, which a capsule from joint 1's "
-    "origin at the foot would otherwise cut at every placement)."
+    "halfspace's normal, joint 1 on or above the halfspace's boundary (joint 1's link of an arm "
+    "on its table, which a capsule from joint 1's origin at the foot would otherwise cut at "
+    "every placement; a table top above joint 1 is checked, and collides)."
 )
 
 

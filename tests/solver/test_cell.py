@@ -525,6 +525,18 @@ def test_a_link_joint_1_turns_about_the_tables_normal_is_reported_not_checked(na
     )
     assert hit.reason == "collision" and hit.collision is not None
     assert (hit.collision.robot_part, hit.collision.obstacle_name) == (shoulder.robot_part, "post")
+    # a table top 6 cm above joint 1's origin cuts the arm's turning part (cell.md section 5:
+    # a halfspace above the base collides everywhere): checked, 0.06 + r into it at waypoint 0
+    above = Halfspace((0.0, 0.0, 1.0), 0.06, name="above")
+    raised = Cell(fixed=(above,), link_radii=(radius,) * 7)
+    assert [p.robot_part for p in CellChecker(arm, raised).unchecked] == ["base_capsule"]
+    cut = evaluate_path(
+        PathProblem.of(arm, load_path("curved_line"), PathOptions(cell=raised)),
+        Placement(0.9, 0.0, 0.3, 0.0),
+    )
+    assert cut.reason == "collision" and cut.collision is not None
+    assert (cut.collision.waypoint, cut.collision.robot_part) == (0, shoulder.robot_part)
+    assert cut.collision.distance == pytest.approx(-(0.06 + radius), abs=DISTANCE_ATOL)
 
 
 def test_threads_give_the_serial_map() -> None:

@@ -6,11 +6,13 @@ placement's T_B_O times their pose (placed by the checker, :mod:`solver.path.cel
 The pairs: every robot part (the tool included) against every obstacle, except the tool's
 cutting part against ``workpiece`` objects (that is machining) and a part against a ``fixed``
 object no joint moves it relative to (its weights in :func:`solver.path.cell.bounds.pair_weights`
-all zero): the base, which stands on them whatever the placement, and a link only joint 1
-turns about a fixed halfspace's normal (joint 1's link of an arm on its table). Such a pair's
+all zero) and that stands on it: the base, whatever the placement, and a link only joint 1
+turns about a fixed halfspace's normal, joint 1's origin on or above the halfspace's boundary
+(joint 1's link of an arm on its table; a table top above joint 1 cuts the arm's turning part,
+and is checked: it collides everywhere, as cell.md section 5 has it). Such a pair's
 distance is the same at every configuration and placement: were it checked, an arm whose
 joint-1 link touches its table (a capsule along that link from joint 1's origin at the foot,
-as given to a URDF whose meshes are elsewhere: ROS-Industrial's ABB IRB 2400 and FANUC M-10iA
+as given to a URDF whose meshes are elsewhere: ROS-Industrial's ABB IRB 2400 and IRB 5400
 read with a table at z = 0) would collide at every placement, whatever the path. Those pairs
 and their distance are reported (:attr:`CellScene.unchecked`), not silently dropped. And the
 robot's parts against each other where they are on joints that are neither the same nor
@@ -21,6 +23,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+import coal
 import numpy as np
 import pinocchio as pin
 
@@ -136,10 +139,38 @@ def _moving(
     See the module docstring; the weights are :func:`pair_weights`' (P, nv).
     """
     weights = pair_weights(model, geometry, pairs, n_robot, n_fixed=n_fixed)
-    fixed = np.array([b < n_robot + n_fixed for _, b in pairs], dtype=bool)
-    still = (weights.max(axis=1, initial=0.0) < STILL) & fixed
+    data = model.createData()
+    pin.forwardKinematics(model, data, pin.neutral(model))
+    still = np.array(
+        [
+            b < n_robot + n_fixed
+            and bool(w.max(initial=0.0) < STILL)
+            and _stands(geometry, data, a, b)
+            for (a, b), w in zip(pairs, weights, strict=True)
+        ],
+        dtype=bool,
+    )
     moving = [p for p, s in zip(pairs, still, strict=True) if not s]
     return moving, weights[~still], [p for p, s in zip(pairs, still, strict=True) if s]
+
+
+def _stands(geometry: pin.GeometryModel, data: pin.Data, part: int, obstacle: int) -> bool:
+    """Whether ``part`` stands on the fixed ``obstacle`` (a pair no joint moves).
+
+    The base does; so does a link on a joint whose origin is on or above a halfspace's boundary
+    (the table top at or below joint 1): joint 1 turning the link about the table's normal
+    keeps its distance to the table. Where joint 1's origin is inside the table (a table top
+    above it: cell.md section 5's halfspace above the base), the table cuts the arm's turning
+    part, and the pair is checked (it collides at every placement).
+    """
+    joint = int(geometry.geometryObjects[part].parentJoint)
+    if joint == 0:
+        return True
+    obj = geometry.geometryObjects[obstacle]
+    if not isinstance(obj.geometry, coal.Halfspace):
+        return False
+    local = obj.placement.actInv(data.oMi[joint].translation)  # joint's origin, in its frame
+    return float(np.dot(obj.geometry.n, local) - obj.geometry.d) >= -STILL
 
 
 def _distances(
