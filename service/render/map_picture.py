@@ -9,9 +9,10 @@ panels (its images' data, extent and colour range, its markers, titles and colou
 and drawn again (:mod:`service.render.kept`). The bytes are those of a new figure
 (tests/service/test_map_picture.py).
 
-Infeasible cells are blank, but those in collision with the cell (cell.md section 3: a reason
-of their own) take the page's collision colour, above the speeds, and the legend names it
-when the map has any.
+Each infeasible cell takes its reason's colour, the page's (``REASON_COLOURS``: unreachable,
+joint limits, singular, discontinuous, and collision with the cell, a reason of its own as
+cell.md section 3 has it), from an image above the speeds; the legend names them, as the page
+does, in a second row.
 """
 
 from __future__ import annotations
@@ -21,25 +22,32 @@ import math
 import matplotlib
 import numpy as np
 from matplotlib.axes import Axes
-from matplotlib.colors import ListedColormap
+from matplotlib.colors import BoundaryNorm, ListedColormap
 from matplotlib.image import AxesImage
 from matplotlib.lines import Line2D
 from matplotlib.patches import Patch
 
 from service.render.kept import DPI, KeptFigures, new_figure, png_of
-from solver.core.codes import REASON_COLLISION
+from solver.core.codes import REASONS
 from solver.path.capability_map import CapabilityMap
 
 PANEL_INCHES = (4.0, 3.6)
 COLOUR_BAR_INCHES = 1.2
 MAX_COLUMNS = 3
 TITLE_INCHES = 0.3  # the figure's title, above the panels
-LEGEND_INCHES = 0.3  # the legend, below them
+LEGEND_INCHES = 0.5  # the legend, below them: two rows
 PANEL_MARGINS_INCHES = (0.75, 0.2, 0.5, 0.3)  # left, right, bottom, top of each panel's axes
 _COLOURS = matplotlib.colormaps["viridis"].with_extremes(bad="white")
 _MARKERS = (("*", "red"), ("X", "black"))  # the best, the worst
-COLLISION_COLOUR = "#c62828"  # the page's (service/web/static/app.js, REASON_COLOURS)
-_COLLISIONS = ListedColormap([COLLISION_COLOUR])
+REASON_COLOURS = {  # the page's (service/web/static/app.js, REASON_COLOURS), in REASONS' order
+    "unreachable": "#e0e0e0",
+    "joint_limits": "#f4a6c0",
+    "singular": "#555555",
+    "discontinuous": "#ffb74d",
+    "collision": "#c62828",
+}
+_REASONS = ListedColormap([REASON_COLOURS[reason] for reason in REASONS])
+_REASON_NORM = BoundaryNorm(np.arange(len(REASONS) + 1) - 0.5, len(REASONS))
 
 Box = tuple[float, float, float, float]
 """An axes box: left, bottom, width, height, as fractions of the figure."""
@@ -101,7 +109,7 @@ class MapFigure:
         boxes, bar = _layout(rows, columns, width_px / DPI, self.height_in)
         self.panels: list[Axes] = []
         self.images: list[AxesImage] = []
-        self.collisions: list[AxesImage] = []
+        self.reasons: list[AxesImage] = []
         self.markers: list[tuple[Line2D, Line2D]] = []
         for box in boxes[:n_panels]:
             axes = self.figure.add_axes(box)
@@ -112,12 +120,11 @@ class MapFigure:
                 interpolation="nearest",
                 aspect="equal",
             )
-            collisions = axes.imshow(
+            reasons = axes.imshow(
                 np.ma.masked_array(np.zeros((1, 1)), mask=True),
                 origin="lower",
-                cmap=_COLLISIONS,
-                vmin=0.0,
-                vmax=1.0,
+                cmap=_REASONS,
+                norm=_REASON_NORM,
                 interpolation="nearest",
                 aspect="equal",
             )
@@ -129,27 +136,24 @@ class MapFigure:
             axes.set_ylabel("y (m)")
             self.panels.append(axes)
             self.images.append(image)
-            self.collisions.append(collisions)
+            self.reasons.append(reasons)
             self.markers.append((best, worst))
         self.colour_bar = self.figure.colorbar(self.images[0], cax=self.figure.add_axes(bar))
-        handles = [
-            Line2D([], [], marker="*", color="red", ls="", ms=10, label="best"),
-            Line2D([], [], marker="X", color="black", ls="", ms=8, label="worst"),
-            Patch(facecolor="white", edgecolor="grey", label="infeasible"),
-        ]
-        collision = Patch(facecolor=COLLISION_COLOUR, edgecolor="grey", label="collision")
-        # one legend each, shown by whether the map has collision cells
-        self.legends = {
-            with_collisions: self.figure.legend(
-                handles=[*handles, collision] if with_collisions else handles,
-                loc="lower right",
-                ncols=4 if with_collisions else 3,
-                fontsize=8,
-                frameon=False,
-                borderaxespad=0.1,
-            )
-            for with_collisions in (False, True)
-        }
+        self.legend = self.figure.legend(
+            handles=[
+                Line2D([], [], marker="*", color="red", ls="", ms=10, label="best"),
+                Line2D([], [], marker="X", color="black", ls="", ms=8, label="worst"),
+                *(
+                    Patch(facecolor=colour, edgecolor="grey", label=reason.replace("_", " "))
+                    for reason, colour in REASON_COLOURS.items()
+                ),
+            ],
+            loc="lower right",
+            ncols=4,
+            fontsize=8,
+            frameon=False,
+            borderaxespad=0.1,
+        )
 
     def png(self, cmap: CapabilityMap, *, title: str) -> bytes:
         """The map drawn on this figure (whatever it showed before), as PNG bytes."""
@@ -171,9 +175,9 @@ class MapFigure:
             image.set_data(np.ma.masked_invalid(colour_of[s, k]))
             image.set_clim(low, high if high > low else low + 1e-9)
             image.set_extent(extent)  # and the axes' limits to it, a kept figure's too
-            collided = cmap.reason[s, k] == REASON_COLLISION
-            self.collisions[panel].set_data(np.ma.masked_array(np.ones(collided.shape), ~collided))
-            self.collisions[panel].set_extent(extent)
+            reason = cmap.reason[s, k]
+            self.reasons[panel].set_data(np.ma.masked_array(reason, reason < 0))
+            self.reasons[panel].set_extent(extent)
             for index, marker in zip((best, worst), self.markers[panel], strict=True):
                 shown = index is not None and index[:2] == (s, k)
                 marker.set_visible(shown)
@@ -184,9 +188,6 @@ class MapFigure:
                 f"yaw {math.degrees(float(cmap.yaws[k])):.1f} deg{spin}, z = {cmap.z:.3f} m",
                 fontsize=9,
             )
-        any_collision = bool((cmap.reason == REASON_COLLISION).any())
-        for with_collisions, legend in self.legends.items():
-            legend.set_visible(with_collisions == any_collision)
         label = "mu_path (m/s)" if cmap.mu_acc is None else "mu_acc (m/s)"
         self.colour_bar.set_label(label)
         self.figure.suptitle(title, fontsize=10, y=1.0 - 0.08 / self.height_in, va="top")
@@ -199,7 +200,7 @@ panels holds 3.6 MiB, of 24 panels 14.5 MiB)."""
 
 
 def render_png(cmap: CapabilityMap, *, title: str) -> bytes:
-    """The map as PNG bytes: colour bar in m/s, infeasible cells blank (collisions coloured)."""
+    """The map as PNG bytes: colour bar in m/s, infeasible cells in their reason's colour."""
     n_panels = len(cmap.spins) * len(cmap.yaws)
     return KEPT.drawn(
         n_panels, lambda: MapFigure(n_panels), lambda figure: figure.png(cmap, title=title)

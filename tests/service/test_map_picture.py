@@ -25,12 +25,12 @@ def _map(
     x0: float = 0.0,
     seed: int = 0,
     mu_acc: bool = False,
-    collisions: bool = False,
+    reasons: bool = False,
 ) -> CapabilityMap:
     """A map of made-up speeds (a third of the cells infeasible), shape (spins, yaws, ny, nx).
 
     With ``mu_acc``, mu_acc too (a different order of the cells: it colours the map). With
-    ``collisions``, half the infeasible cells are in collision (reason 4), the rest unreachable.
+    ``reasons``, the infeasible cells' reasons drawn from all five (else all unreachable).
     """
     shape = (spins, yaws, ny, nx)
     rng = np.random.default_rng(seed)
@@ -45,7 +45,7 @@ def _map(
         z=0.1,
         spins=np.linspace(0.0, 0.3, spins),
         mu_path=mu,
-        reason=np.where(feasible, -1, np.where(collisions & (rng.random(shape) < 0.5), 4, 0)),
+        reason=np.where(feasible, -1, rng.integers(0, 5, size=shape) if reasons else 0),
         failed_waypoint=np.where(feasible, -1, 3),
         branch=np.where(feasible, 0, -1),
         bottleneck_waypoint=where,
@@ -71,8 +71,8 @@ MAPS = [  # one after the other on the kept figures: extents, panels, markers an
     _map(6, 4, yaws=2, seed=5, x0=-0.3),  # the best and worst in other panels
     _map(3, 3, yaws=3, spins=2, seed=6),
     _map(8, 5, seed=7, mu_acc=True),  # colour and label by mu_acc
-    _map(8, 5, seed=8, collisions=True),  # collision cells coloured, the legend says so
-    _map(8, 5, seed=9),  # and not after them
+    _map(8, 5, seed=8, reasons=True),  # each infeasible cell in its reason's colour
+    _map(8, 5, seed=9),  # and the next map's own
 ]
 
 
@@ -152,32 +152,37 @@ def test_each_panel_shows_its_maps_extent_markers_and_colour_range(monkeypatch) 
         assert figure.colour_bar.ax.get_ylabel() == label
 
 
-COLLISION_RGB = (0xC6, 0x28, 0x28)  # the page's collision colour (service/web/static/app.js)
+REASON_RGB = {  # the page's colours (service/web/static/app.js, REASON_COLOURS), written again
+    0: (0xE0, 0xE0, 0xE0),  # unreachable
+    1: (0xF4, 0xA6, 0xC0),  # joint limits
+    2: (0x55, 0x55, 0x55),  # singular
+    3: (0xFF, 0xB7, 0x4D),  # discontinuous
+    4: (0xC6, 0x28, 0x28),  # collision (cell.md section 3: a reason of its own)
+}
 
 
-def test_collision_cells_take_the_collision_colour_and_the_legend_names_it() -> None:
-    # cell.md section 3: the map colours collision cells as a reason of their own; the PNG's
-    # pixels at each cell's centre, read back, against the map's reasons.
+def test_each_infeasible_cell_takes_its_reasons_colour_and_the_legend_names_them() -> None:
+    # The PNG's pixels at each cell's centre, read back, against the map's reasons; on the
+    # same figure a second map's cells show its own reasons, none of the first's.
     figure = MapFigure(1)
-    for cmap in (_map(8, 5, seed=8, collisions=True), _map(8, 5, seed=9)):
+    for cmap in (_map(8, 5, seed=8, reasons=True), _map(8, 5, seed=9)):
         png = figure.png(cmap, title="t")
         pixels = np.round(255 * mpimg.imread(io.BytesIO(png), format="png")[..., :3]).astype(int)
         height = pixels.shape[0]
-        collided = cmap.reason[0, 0] == 4
-        for i, j in np.ndindex(collided.shape):
+        reason = cmap.reason[0, 0]
+        for i, j in np.ndindex(reason.shape):
             x, y = figure.panels[0].transData.transform((cmap.xs[j], cmap.ys[i]))
             rgb = tuple(pixels[height - 1 - int(y), int(x)])
-            if collided[i, j]:
-                assert rgb == COLLISION_RGB, (i, j)
-            elif cmap.reason[0, 0, i, j] == 0:
-                assert rgb == (255, 255, 255), (i, j)  # infeasible otherwise: blank
+            if reason[i, j] >= 0:
+                assert rgb == REASON_RGB[reason[i, j]], (i, j)
             else:
-                assert rgb not in (COLLISION_RGB, (255, 255, 255)), (i, j)
-        assert figure.legends[True].get_visible() == bool(collided.any())
-        assert figure.legends[False].get_visible() != bool(collided.any())
-        labels = [t.get_text() for t in figure.legends[True].get_texts()]
-        assert labels == ["best", "worst", "infeasible", "collision"]
-    # the second map has none: on the same figure, no cell keeps the first map's colour
+                assert rgb not in REASON_RGB.values(), (i, j)  # a speed's colour
+        labels = [t.get_text() for t in figure.legend.get_texts()]
+        assert labels == [
+            "best", "worst", "unreachable", "joint limits", "singular", "discontinuous",
+            "collision",
+        ]  # fmt: skip
+    assert set(np.unique(_map(8, 5, seed=8, reasons=True).reason)) == {-1, 0, 1, 2, 3, 4}
 
 
 def _png_size(png: bytes) -> tuple[int, int]:

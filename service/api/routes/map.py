@@ -72,8 +72,9 @@ async def post_map(
         200: {
             "content": {"image/png": {"schema": {"type": "string", "format": "binary"}}},
             "description": "The colour map: one panel per yaw and spin, colour bar in m/s, "
-            "infeasible cells blank (those in collision with the cell red, #c62828, as on "
-            "the page), the best and worst placements marked.",
+            "each infeasible cell in its reason's colour, as on the page (unreachable, joint "
+            "limits, singular, discontinuous, collision with the cell), the best and worst "
+            "placements marked.",
         }
     },
     openapi_extra=body_openapi(MapRequest),
