@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import io
+import re
 import struct
 import threading
 
@@ -206,3 +207,25 @@ def test_the_kept_figures_hold_no_more_pixels_than_their_bound(monkeypatch) -> N
     kept = {key: len(figures) for key, figures in map_picture.KEPT._kept.items()}
     assert kept == {1: 1, 2: 1}  # the six-panel figure is drawn, then dropped: too large
     assert map_picture.KEPT.held() == sizes[1] + sizes[2]
+
+
+def test_a_urdf_robots_picture_is_titled_by_the_urdfs_own_name(monkeypatch) -> None:
+    # A request's URDF is "urdf" in the solver; its picture names the arm the URDF declares.
+    import service.render
+    from service.convert import shown_name
+    from service.operations.map import map_png
+    from solver.core.robots import example_robot_data_dir
+    from solver.families import get_robot, robot_from_urdf
+
+    text = (example_robot_data_dir() / "ur_description" / "urdf" / "ur5_robot.urdf").read_text()
+    renamed = re.sub(r'<robot\s+name="[^"]*"', '<robot name="cell_7_arm"', text, count=1)
+    arm = robot_from_urdf(renamed, base_frame="base", tool_frame="tool0")
+    titles: list[str] = []
+    monkeypatch.setattr(service.render, "render_png", lambda cmap, *, title: titles.append(title))
+    map_png(MAPS[0], arm)
+    map_png(MAPS[0], get_robot("ur5"))
+    assert titles == ["cell_7_arm (URDF): mu_path", "ur5: mu_path"]
+    assert arm.name == "urdf"  # the solver's name, which keys nothing of the catalogue's
+    nameless = robot_from_urdf(re.sub(r'name="cell_7_arm"', 'name=""', renamed, count=1),
+                               base_frame="base", tool_frame="tool0")  # fmt: skip
+    assert shown_name(nameless) == "URDF"
