@@ -426,5 +426,11 @@ def test_an_arm_without_geometry_takes_its_link_radii_from_the_editor(page: Page
     assert request["cell"]["link_radii"] == radii
     answer = httpx.post(f"{url}/v1/map", json=request, timeout=120)
     assert answer.status_code == 200, answer.text
-    assert answer.json()["cell_unchecked"][0]["robot_part"] == "base_capsule"
-    assert page.get_attribute("#summary", "data-cells") == str(len(answer.json()["cells"]))
+    mapped = answer.json()
+    assert mapped["cell_unchecked"][0]["robot_part"] == "base_capsule"
+    assert page.get_attribute("#summary", "data-cells") == str(len(mapped["cells"]))
+    # the map's summary names the capsules and the parts not checked, as the answer does
+    assert (page.text_content("#summary") or "").endswith(
+        f"; links approximated by capsules: {', '.join(mapped['cell_approximated'])}"
+        + not_checked(mapped)
+    )

@@ -401,7 +401,8 @@ function drawMap(answer) {
   const collisions = cells.filter((c) => c.reason === "collision").length;
   $("summary").textContent = `${cells.length} cells, ${answer.feasible_cells} feasible`
     + (key === "mu_acc" ? `; colour: mu_acc, limited by acceleration in ${byAcc} cells, by speed in ${answer.feasible_cells - byAcc}` : "")
-    + (state.mapBody && state.mapBody.cell ? `; ${collisions} in collision with the cell` : "");
+    + (state.mapBody && state.mapBody.cell ? `; ${collisions} in collision with the cell` : "")
+    + cellModel(answer);
   // How a URDF's IK was solved: the closed form where its chain was recognised (the API's
   // sentence: the arm, its frames, its parameters), else numeric IK, said as plainly.
   const urdf = state.mapBody && state.mapBody.robot && state.mapBody.robot.urdf;

@@ -181,13 +181,19 @@ function clearanceText(contact, cell) {
     + ` at waypoint ${contact.waypoint} (clearance asked ${millimetres(clearanceOf(cell))})`;
 }
 
-// What an evaluation says of the cell: the collision, or the least clearance, the links
-// given capsules for want of collision geometry, and the parts not checked against a fixed
-// object because no joint moves them relative to it; empty without a cell.
+// What an evaluation says of the cell: the collision, or the least clearance, then its model
+// (cellModel); empty without a cell.
 function cellVerdict(answer, cell) {
   if (!cell) return "";
   const text = answer.collision ? `collision: ${collisionText(answer.collision, cell)}`
     : answer.min_clearance ? clearanceText(answer.min_clearance, cell) : "";
+  return text + cellModel(answer);
+}
+
+// What an evaluation or a map says of the cell's model: the links given capsules for want of
+// collision geometry, and the parts not checked against a fixed object because no joint moves
+// them relative to it; each after "; ", empty where the answer has none.
+function cellModel(answer) {
   const approximated = answer.cell_approximated && answer.cell_approximated.length
     ? `; links approximated by capsules: ${answer.cell_approximated.join(", ")}` : "";
   const unchecked = answer.cell_unchecked && answer.cell_unchecked.length
@@ -195,7 +201,7 @@ function cellVerdict(answer, cell) {
       .map((pair) => `${pair.robot_part} and ${pair.obstacle_name} (${millimetres(pair.distance)})`)
       .join(", ")
     : "";
-  return text + approximated + unchecked;
+  return approximated + unchecked;
 }
 
 function startCellEditor() {
