@@ -19,6 +19,7 @@ from solver.core.parallel import SERIAL, TaskRunner
 from solver.core.spatial import Placement
 from solver.path.cell.cost import with_cell
 from solver.path.cell.verdict import Unchecked
+from solver.path.path_checks import checks_model
 from solver.path.placements import DEFAULT_CHUNK, evaluate_placements
 from solver.path.problem import PathProblem
 from solver.path.pruning import can_prune
@@ -193,16 +194,17 @@ def capability_map(
         compiled=compiled,
     )
     optional: dict[str, Any] = {  # acceleration limits' columns; the path checks' models
-        name: None if value is None else value.reshape(shape)
-        for name, value in (
-            ("mu_acc", result.mu_acc),
-            ("limited_by", result.limited_by),
-            ("acc_waypoint", result.acc_waypoint),
-            ("acc_joint", result.acc_joint),
-        )
+        **{
+            name: None if value is None else value.reshape(shape)
+            for name, value in (
+                ("mu_acc", result.mu_acc),
+                ("limited_by", result.limited_by),
+                ("acc_waypoint", result.acc_waypoint),
+                ("acc_joint", result.acc_joint),
+            )
+        },
+        **checks_model(problem),
     }
-    for check in problem.path_checks:  # the cell's: its capsules and unchecked pairs
-        optional.update(check.model())
     return CapabilityMap(
         xs=xs,
         ys=ys,

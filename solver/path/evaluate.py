@@ -13,7 +13,6 @@ from __future__ import annotations
 
 import dataclasses
 from dataclasses import dataclass
-from typing import Any
 
 import numpy as np
 
@@ -25,7 +24,7 @@ from solver.core.two_variable_lp import spin_rate_nearest_zero
 from solver.kernels.spin_lp import spin_rate_at_feed
 from solver.path.cell.verdict import CellVerdict, Contact, Unchecked
 from solver.path.limits import JointAccelerationLimit, JointMotion, PathVerdict, bound_by_limits
-from solver.path.path_checks import check_path, clear_pick
+from solver.path.path_checks import check_path, checks_model, clear_pick
 from solver.path.pipeline import run_chunk
 from solver.path.placed import check_placements
 from solver.path.problem import PathProblem, SpinMode
@@ -202,13 +201,12 @@ def evaluate_path(
     collision, model = None, {}
     if reason == FEASIBLE and problem.path_checks:
         chosen, verdict, refusal = clear_pick(problem, run, cell, 0, thorough=thorough)
+        model = checks_model(problem)
         if chosen is None and refusal is not None:
             reason = problem.path_checks[0].reason
             collision = cell_detail(refusal).collision
-            model = cell_model(refusal)
         else:
             pick = int(chosen) if chosen is not None else pick
-            model = cell_model(verdict)
     infeasible = PathEvaluation(
         feasible=False,
         mu_path=None,
@@ -287,14 +285,6 @@ def with_min_clearance(
     if verdict is None:
         return evaluation
     return dataclasses.replace(evaluation, min_clearance=cell_detail(verdict).closest)
-
-
-def cell_model(verdict: PathVerdict | None) -> dict[str, Any]:
-    """The cell's model in a verdict, as :class:`PathEvaluation`'s fields; none without one."""
-    if verdict is None:
-        return {}
-    detail = cell_detail(verdict)
-    return {"cell_approximated": detail.approximated, "cell_unchecked": detail.unchecked}
 
 
 def cell_detail(verdict: PathVerdict) -> CellVerdict:

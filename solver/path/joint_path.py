@@ -21,9 +21,9 @@ from solver.core.exceptions import InvalidInputError
 from solver.core.kinematics import tool_pose_in_base
 from solver.core.progress import Progress
 from solver.core.spatial import Placement, rotation_about_z
-from solver.path.evaluate import PathEvaluation, acceleration_index, cell_detail, cell_model
+from solver.path.evaluate import PathEvaluation, acceleration_index, cell_detail
 from solver.path.limits import JointMotion, bound_by_limits
-from solver.path.path_checks import check_path
+from solver.path.path_checks import check_path, checks_model
 from solver.path.placed import turn_by_yaw
 from solver.path.problem import PathProblem
 
@@ -171,7 +171,7 @@ def evaluate_joint_path(
             reason="collision",
             failed_waypoint=verdict.failed_waypoint,
             collision=cell_detail(verdict).collision,
-            **cell_model(verdict),
+            **checks_model(problem),
         )
     v_max = np.where(path.pure_rotation, 0.0, speed)
     with np.errstate(divide="ignore", invalid="ignore"):
@@ -195,7 +195,7 @@ def evaluate_joint_path(
         qdot=(qd_unit * speed).T,
         limiting_joint=limiting,
         min_clearance=None if verdict is None else cell_detail(verdict).closest,
-        **cell_model(verdict),
+        **({} if verdict is None else checks_model(problem)),
     )
 
 

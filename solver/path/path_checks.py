@@ -10,6 +10,7 @@ placement is infeasible with the check's reason, at the best branch's refused wa
 from __future__ import annotations
 
 from collections.abc import Callable
+from typing import Any
 
 import numpy as np
 
@@ -26,6 +27,19 @@ from solver.path.branch_candidates import (
 from solver.path.limits import PathVerdict
 from solver.path.pipeline import ChunkResult, run_chunk
 from solver.path.problem import PathProblem
+
+
+def checks_model(problem: PathProblem) -> dict[str, Any]:
+    """What the problem's path checks report of their model, as an answer's fields.
+
+    :meth:`solver.path.limits.PathCheck.model` of each check (the cell's capsules and the
+    parts it does not check); the same for every placement, so an evaluation and a map take
+    it from the checks, not from each verdict.
+    """
+    model: dict[str, Any] = {}
+    for check in problem.path_checks:
+        model.update(check.model())
+    return model
 
 
 def check_path(

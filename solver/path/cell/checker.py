@@ -106,7 +106,7 @@ class CellChecker:
         """
         placed = self._world_to_base * pin.SE3(np.asarray(transform_workpiece_to_base, float))
         if not self._pairs:
-            return CellVerdict(None, None, 0, self.approximated, self.unchecked)
+            return CellVerdict(None, None, 0)
         if self._fast is not None and not reference and not closest:
             configurations, owners = kinematics.substeps(
                 np.ascontiguousarray(q, dtype=float),
@@ -186,7 +186,7 @@ class CellChecker:
     ) -> CellVerdict:
         """The verdict of the compiled sweep's answer (configuration, pair, coal's distance)."""
         collision = None if hit is None else self._contact(int(owners[hit[0]]), hit[1], hit[2])
-        return CellVerdict(collision, None, checks, self.approximated, self.unchecked)
+        return CellVerdict(collision, None, checks)
 
     def _coal_distances(self, configurations: np.ndarray, placed: pin.SE3) -> fast.CoalDistances:
         """The coal distances of some pairs at a configuration, the workpiece at ``placed``."""
@@ -242,7 +242,7 @@ class CellChecker:
             low = int(np.argmin(distances))
             if distances[low] < clearance:
                 hit = self._contact(int(owners[index]), int(due[low]), float(distances[low]))
-                return CellVerdict(hit, None, checks, self.approximated, self.unchecked)
+                return CellVerdict(hit, None, checks)
             if closest and (best is None or distances[low] < best[0]):
                 best = (float(distances[low]), index, int(due[low]))
             window = configurations[index + 1 : index + 1 + _WINDOW]
@@ -255,7 +255,7 @@ class CellChecker:
             clear_until[due] = index + first
             index = int(clear_until.min()) + 1
         near = None if best is None else self._contact(int(owners[best[1]]), best[2], best[0])
-        return CellVerdict(None, near, checks, self.approximated, self.unchecked)
+        return CellVerdict(None, near, checks)
 
     def collides_at(
         self, configuration: np.ndarray, transform_workpiece_to_base: np.ndarray, contact: Contact

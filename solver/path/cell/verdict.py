@@ -58,13 +58,11 @@ class CellVerdict:
         closest: the closest pair over every checked configuration (None when the check
             stopped at the first collision).
         checks: how many configurations were checked (by coal, in a fast map check).
-        approximated: the robot's links given capsules (no readable collision geometry).
-        unchecked: the robot parts not checked against a ``fixed`` object (no joint moves them
-            relative to it), with their distance.
+
+    The checker's model (the links given capsules, the parts not checked) is the same for
+    every verdict: answers take it from the check (:meth:`solver.path.cell.limit.CellLimit.model`).
     """
 
     collision: Contact | None
     closest: Contact | None
     checks: int
-    approximated: tuple[str, ...] = ()
-    unchecked: tuple[Unchecked, ...] = ()
