@@ -47,7 +47,7 @@ from service.cli_text import ProgressBar, evaluation_text, import_text, map_text
 from service.config import Settings, get_settings
 from service.errors import request_location, solver_error_location
 from service.operations import computed_map, evaluation_of, import_of, map_png
-from service.schemas import EvaluateRequest, MapRequest, OptimizeRequest
+from service.schemas import EvaluateRequest, MapRequest, OptimizeRequest, RobotRead
 from service.schemas.paths_import import PathImportRequest
 from solver.core import native_stderr
 from solver.core.exceptions import InvalidInputError, SolverError
@@ -196,13 +196,18 @@ def _robot(args: argparse.Namespace) -> Any:
 
 
 def _chained(
-    args: argparse.Namespace, robot: dict[str, Any], recognised: str | None, text: str
+    args: argparse.Namespace,
+    robot: dict[str, Any],
+    read: tuple[str | None, RobotRead | None],
+    text: str,
 ) -> str:
     """``text`` after a URDF file's chain and how its IK is solved; a text as it is otherwise.
 
-    ``robot``: the request's (:func:`_robot`). Solved numerically, the base frames from which
-    the chain has a closed form are named.
+    ``robot``: the request's (:func:`_robot`); ``read``: the answer's ``recognised`` and
+    ``robot_read``. Solved numerically, the base frames from which the chain has a closed form
+    are named; links taken out of the file are named on a line of their own.
     """
+    recognised, robot_read = read
     if not args.robot.lower().endswith(".urdf"):
         return text
     base, tool = robot["base_frame"], robot["tool_frame"]
@@ -211,7 +216,15 @@ def _chained(
     named = " or ".join(f"--base-frame {frame}" for frame in others if frame != base)
     if named:
         how += f" (the closed form from another base frame: {named})"
-    return f"robot: {args.robot}, from {base} to {tool}; {how}\n{text}"
+    lines = [f"robot: {args.robot}, from {base} to {tool}; {how}"]
+    if robot_read is not None:
+        names = ", ".join(f"'{name}'" for name in robot_read.left_out_links)
+        more = robot_read.left_out_count - len(robot_read.left_out_links)
+        lines.append(
+            f"robot: left out of the URDF, no joint names them: {names}"
+            + (f" and {more} more" if more else "")
+        )
+    return "\n".join([*lines, text])
 
 
 def _json_file(file: Path, field: str) -> Any:
@@ -282,10 +295,8 @@ def _evaluate(args: argparse.Namespace) -> int:
     with ProgressBar(enabled=args.progress) as bar:
         answer = evaluation_of(request, _settings(), bar)
     clearance = None if request.cell is None else request.cell.clearance
-    robot, recognised = body["robot"], answer.ik.recognised
-    _print(
-        answer, args, lambda: _chained(args, robot, recognised, evaluation_text(answer, clearance))
-    )
+    robot, read = body["robot"], (answer.ik.recognised, answer.robot_read)
+    _print(answer, args, lambda: _chained(args, robot, read, evaluation_text(answer, clearance)))
     runs = answer.feasible and (answer.feed_check is None or answer.feed_check.feasible)
     return OK if runs else INFEASIBLE
 
@@ -300,8 +311,8 @@ def _map(args: argparse.Namespace) -> int:
         )
     answer = convert.map_response(result, robot, spin_mode=spin_mode, path_read=path_read)
     Path(args.png).write_bytes(map_png(result, robot))
-    robot, recognised = body["robot"], answer.recognised
-    _print(answer, args, lambda: _chained(args, robot, recognised, map_text(answer, args.png)))
+    robot, read = body["robot"], (answer.recognised, answer.robot_read)
+    _print(answer, args, lambda: _chained(args, robot, read, map_text(answer, args.png)))
     return OK if answer.feasible_cells else INFEASIBLE
 
 
@@ -323,8 +334,8 @@ def _optimise(args: argparse.Namespace) -> int:
     with ProgressBar(enabled=args.progress) as bar:
         answer = optimum_of(request, _settings(), bar)
     recognised = None if answer.evaluation is None else answer.evaluation.ik.recognised
-    robot = body["robot"]
-    _print(answer, args, lambda: _chained(args, robot, recognised, optimum_text(answer)))
+    robot, read = body["robot"], (recognised, answer.robot_read)
+    _print(answer, args, lambda: _chained(args, robot, read, optimum_text(answer)))
     return OK if answer.found else INFEASIBLE
 
 

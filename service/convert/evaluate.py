@@ -119,13 +119,16 @@ def evaluate_response(
     feed: FeedCheck | None = None,
     cycle_time: CycleTime | None = None,
     path_read: schemas.PathRead | None = None,
+    robot_read: schemas.RobotRead | None = None,
     failed_in: tuple[int | None, str | None] = (None, None),
 ) -> schemas.EvaluateResponse:
     """The response of ``POST /v1/evaluate`` (per-waypoint detail when ``with_waypoints``).
 
     ``path_read``: how the CAM program was read, None for poses and tool axes (and in
-    ``/v1/optimize``'s evaluation, whose answer has it); ``failed_in``: the pass and operation
-    of the failed waypoint, of CAM input (:func:`service.convert.path_read.pass_at`).
+    ``/v1/optimize``'s evaluation, whose answer has it); ``robot_read``: what was taken out of
+    the robot's URDF (:func:`service.convert.robots.robot_read_of`; None in that evaluation
+    too); ``failed_in``: the pass and operation of the failed waypoint, of CAM input
+    (:func:`service.convert.path_read.pass_at`).
     """
     ev = evaluation
     bottleneck = None
@@ -166,4 +169,5 @@ def evaluate_response(
         if feed is None
         else schemas.FeedCheckResult(feed=feed.feed, feasible=feed.feasible, margin=feed.margin),
         path_read=path_read,
+        robot_read=robot_read,
     )

@@ -21,6 +21,7 @@ from pydantic_core import to_json
 from service import schemas
 from service.convert.common import branch_to_api, cell_model_to_api
 from service.convert.maps import acceleration_columns, extreme
+from service.convert.robots import robot_read_of
 from solver.core.codes import FEASIBLE, REASONS
 from solver.core.family import Branch
 from solver.core.robots import Robot
@@ -49,6 +50,7 @@ def map_json(
         spin_mode=spin_mode,
         recognised=family.recognised,
         path_read=path_read,
+        robot_read=robot_read_of(robot),
         **cell_model_to_api(cmap.cell_approximated, cmap.cell_unchecked),
     ).model_dump_json()
     branches = [_branch_text(b) for b in family.branches]

@@ -10,6 +10,7 @@ import numpy as np
 from service import schemas
 from service.config import Settings
 from service.convert.common import api_placement, branch_to_api, cell_model_to_api
+from service.convert.robots import robot_read_of
 from solver.core.codes import FEASIBLE, REASONS
 from solver.core.exceptions import InvalidInputError
 from solver.core.robots import Robot
@@ -175,5 +176,6 @@ def map_response(
         spin_mode=spin_mode,
         recognised=require_family(robot).recognised,
         path_read=path_read,
+        robot_read=robot_read_of(robot),
         **cell_model_to_api(cmap.cell_approximated, cmap.cell_unchecked),
     )

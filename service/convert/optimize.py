@@ -6,6 +6,7 @@ from service import schemas
 from service.convert.common import api_placement
 from service.convert.evaluate import evaluate_response
 from service.convert.path_read import pass_at, path_read_of
+from service.convert.robots import robot_read_of
 from service.schemas.path_input import PathInput
 from solver.core.robots import Robot
 from solver.optimise.failures import SearchFailure
@@ -162,5 +163,6 @@ def optimize_response(
             seconds=report.seconds,
         ),
         path_read=None if path is None else path_read_of(path),
+        robot_read=robot_read_of(robot),
         failure=failure_to_api(optimum.failure, path),
     )

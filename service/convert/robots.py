@@ -1,10 +1,16 @@
-"""``GET /v1/robots``: a catalogue robot as the API shows it; a robot's name in pictures."""
+"""The robot in answers: a catalogue entry, a robot's name in pictures, its URDF's reading.
+
+``GET /v1/robots`` shows catalogue robots (:func:`robot_info`); pictures name a request's URDF
+by its own name (:func:`shown_name`); answers say what was taken out of a request's URDF
+(:func:`robot_read_of`).
+"""
 
 from __future__ import annotations
 
 import re
 
 from service import schemas
+from solver.core.exceptions import MAX_LISTED_NAMES, cut
 from solver.core.robots import Robot
 
 _URDF_NAME = re.compile(r"<robot\b[^>]*?\bname\s*=\s*([\"'])(.*?)\1", re.S)
@@ -24,6 +30,17 @@ def shown_name(robot: Robot) -> str:
     match = _URDF_NAME.search(robot.urdf)
     own = match.group(2).strip()[:SHOWN_NAME_CHARACTERS] if match else ""
     return f"{own} (URDF)" if own else "URDF"
+
+
+def robot_read_of(robot: Robot) -> schemas.RobotRead | None:
+    """What was taken out of the robot's URDF before it was read; None where nothing was."""
+    left_out = robot.left_out_links
+    if not left_out:
+        return None
+    return schemas.RobotRead(
+        left_out_links=[cut(name) for name in left_out[:MAX_LISTED_NAMES]],
+        left_out_count=len(left_out),
+    )
 
 
 def robot_info(robot: Robot) -> schemas.RobotInfo:

@@ -114,5 +114,6 @@ def evaluation_of(
         feed=None if feed is None else check_feed(evaluation, feed, robot.qdot_max),
         cycle_time=cycle_time(problem, evaluation),
         path_read=convert.path_read_of(path),
+        robot_read=convert.robot_read_of(robot),
         failed_in=convert.pass_at(path, evaluation.failed_waypoint),
     )

@@ -67,6 +67,7 @@ from service.schemas.paths_import import (
 )
 from service.schemas.placement import ControllerFrames, Placement, PlacementResult
 from service.schemas.robot import CatalogueRobot, Robot, UrdfRobot
+from service.schemas.robot_read import RobotRead
 from service.schemas.robots import BranchLevel, HealthResponse, RobotInfo, RobotsResponse
 
 __all__ = [
@@ -141,6 +142,7 @@ __all__ = [
     "ResponseModel",
     "Robot",
     "RobotInfo",
+    "RobotRead",
     "RobotsResponse",
     "ReasonCount",
     "SearchFailure",

@@ -14,6 +14,7 @@ from service.schemas.evaluate_request import DetailLevel
 from service.schemas.ik import Branch, NumericBranch
 from service.schemas.motion import AccelerationResult, CycleTimeResult
 from service.schemas.path_read import FAILED_OPERATION, FAILED_PASS, PATH_READ, PathRead
+from service.schemas.robot_read import ROBOT_READ, RobotRead
 
 _RESPONSE_EXAMPLE_WAYPOINT: JsonDict = {
     "index": 0,
@@ -265,6 +266,10 @@ class EvaluateResponse(ResponseModel):
     path_read: PathRead | None = Field(
         default=None,
         description=f"{PATH_READ} In /v1/optimize's evaluation, null: that answer has it.",
+    )
+    robot_read: RobotRead | None = Field(
+        default=None,
+        description=f"{ROBOT_READ} In /v1/optimize's evaluation, null: that answer has it.",
     )
     detail: DetailLevel = Field(
         default="waypoints", description="Whether waypoints holds the per-waypoint detail."

@@ -17,6 +17,7 @@ from service.schemas.path import Path
 from service.schemas.path_read import PATH_READ, PathRead
 from service.schemas.placement import PlacementResult, placement_example
 from service.schemas.robot import Robot
+from service.schemas.robot_read import ROBOT_READ, RobotRead
 from solver.core.spatial import MAX_COORDINATE
 from solver.path.capability_map import axis_length
 
@@ -245,6 +246,7 @@ class MapResponse(ResponseModel):
         "and solved in closed form (as /v1/evaluate's ik.recognised); null otherwise.",
     )
     path_read: PathRead | None = Field(default=None, description=PATH_READ)
+    robot_read: RobotRead | None = Field(default=None, description=ROBOT_READ)
     cell_approximated: list[str] | None = Field(
         default=None, description=f"{CELL_APPROXIMATED} Null without a cell."
     )

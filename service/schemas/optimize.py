@@ -18,6 +18,7 @@ from service.schemas.path import Path
 from service.schemas.path_read import FAILED_OPERATION, FAILED_PASS, PATH_READ, PathRead
 from service.schemas.placement import Placement, PlacementResult, placement_example
 from service.schemas.robot import Robot
+from service.schemas.robot_read import ROBOT_READ, RobotRead
 
 Range = Annotated[list[Coordinate], Field(min_length=2, max_length=2)]
 AngleRange = Annotated[list[Angle], Field(min_length=2, max_length=2)]
@@ -342,6 +343,7 @@ class OptimizeResponse(ResponseModel):
         "joint_path gives this mu_path. null for six joints.",
     )
     path_read: PathRead | None = Field(default=None, description=PATH_READ)
+    robot_read: RobotRead | None = Field(default=None, description=ROBOT_READ)
     failure: SearchFailure | None = Field(
         default=None,
         description="When found is false: why, the most common failure of the placements the "

@@ -59,6 +59,9 @@ class Robot:
             kinematic parameters.
         mimics: the chain's mimic joints (URDF ``<mimic>``), whose own speed limits bound
             any speed limits given for their leaders (:func:`check_mimic_speed_limits`).
+        left_out_links: links of the URDF document that no joint names, left out of ``urdf``
+            so that it has one root (:func:`solver.core.urdf_chain.without_stray_links`);
+            answers say so.
     """
 
     name: str
@@ -75,6 +78,7 @@ class Robot:
     qddot_max: np.ndarray | None = None
     urdf: str | None = None
     mimics: tuple[Mimic, ...] = ()
+    left_out_links: tuple[str, ...] = ()
 
     @property
     def dof(self) -> int:

@@ -3,6 +3,8 @@
 pinocchio's parser (urdfdom) is run with its stderr captured (:mod:`solver.core.native_stderr`)
 so that a refusal carries its reason; what pinocchio leaves unsaid (two root links, mimic joints
 between base and tool) is read from the document itself (:mod:`solver.core.urdf_structure`).
+A link no joint names (a ROS 2 generated UR5e's ``world``) is taken out of the document before
+it is read (:func:`without_stray_links`), and answers name it.
 A request's speed limits, one per coordinate, cannot name a mimic joint: they are checked
 against the mimic joints' own (:func:`check_mimic_speed_limits`). Names in messages are cut (a
 request may send a name of megabytes).
@@ -17,12 +19,44 @@ import pinocchio as pin
 
 from solver.core.exceptions import InvalidInputError, RobotModelError, quoted, quoted_names
 from solver.core.native_stderr import first_error, native_stderr
-from solver.core.urdf_structure import Mimic, mimic_joints, root_links
+from solver.core.urdf_structure import (
+    Mimic,
+    mimic_joints,
+    root_links,
+    stray_links,
+    without_links,
+)
 
 
 def frame_names(model: pin.Model) -> str:
     """The model's frame names for a message, each cut and at most 20 (:func:`quoted_names`)."""
     return quoted_names([f.name for f in model.frames if f.name != "universe"])
+
+
+def without_stray_links(urdf: str, *, frames: tuple[str, ...]) -> tuple[str, tuple[str, ...]]:
+    """The document without the links no joint names, where that leaves it one root; their names.
+
+    A link that no joint names has no pose: it is not part of the robot, and pinocchio refuses
+    the document for it (two root links). It is taken out, and the caller says so, unless it
+    carries collision geometry (a cell would check what has no place) or is one of ``frames``
+    (the request's base or tool frame): then, as where two joined trees have a root each, the
+    document is returned as it is, and :func:`chain_from_urdf` refuses it naming the roots.
+
+    Args:
+        urdf: the URDF document.
+        frames: the frames the request names (its base and tool frames).
+
+    Returns:
+        The document to read (``urdf`` itself where nothing is taken out) and the names of the
+        links taken out, in the document's order.
+    """
+    roots = root_links(urdf)
+    if len(roots) < 2:
+        return urdf, ()
+    stray = [s.name for s in stray_links(urdf) if not s.collision and s.name not in frames]
+    if len([root for root in roots if root not in stray]) != 1:
+        return urdf, ()
+    return without_links(urdf, set(stray)), tuple(stray)
 
 
 def chain_from_urdf(urdf: str, *, tool_frame: str) -> pin.Model:

@@ -4,7 +4,9 @@ pinocchio refuses a URDF with two root links with "The XML stream does not conta
 model", the cause going to the server's stderr only; and it reads a ``<mimic>`` joint as a free
 joint of its own, so an arm whose joints are coupled (ABB IRB 5400's joint5b follows joint5)
 would be answered with joint paths that break the coupling. This module reads the document's
-structure itself, so that both are said in the answer (robots.md section 4).
+structure itself, so that both are said in the answer (robots.md section 4), and finds the
+links joined to nothing (:func:`stray_links`: a ROS 2 generated UR5e's ``<link name="world"/>``,
+whose joint the generator left out), which :func:`without_links` takes out of the document.
 """
 
 from __future__ import annotations
@@ -48,6 +50,55 @@ def root_links(urdf: str) -> list[str]:
         child.get("link", "") for joint in root.iter("joint") for child in joint.iter("child")
     }
     return [name for name in links if name not in children]
+
+
+@dataclass(frozen=True)
+class StrayLink:
+    """A link no joint names, as parent or child: joined to nothing, so it has no pose.
+
+    ``collision``: it carries ``<collision>`` elements (geometry a cell would check, which a
+    link without a pose cannot give).
+    """
+
+    name: str
+    collision: bool
+
+
+def stray_links(urdf: str) -> list[StrayLink]:
+    """The links of the document that no joint names, in its order, where it has joints.
+
+    A document of one link and no joint has none (that link is the whole robot).
+    """
+    root = _tree(urdf)
+    if root is None:
+        return []
+    joints = root.findall("joint")
+    named = {
+        end.get("link", "")
+        for joint in joints
+        for end in (*joint.findall("parent"), *joint.findall("child"))
+    }
+    if not joints:
+        return []
+    return [
+        StrayLink(link.get("name", ""), link.find("collision") is not None)
+        for link in root.findall("link")
+        if link.get("name", "") not in named
+    ]
+
+
+def without_links(urdf: str, names: set[str]) -> str:
+    """The document with its top-level links named in ``names`` taken out (as XML text).
+
+    Comments and the XML declaration are not kept; every element and attribute is.
+    """
+    root = _tree(urdf)
+    if root is None:
+        return urdf
+    for link in root.findall("link"):
+        if link.get("name", "") in names:
+            root.remove(link)
+    return ElementTree.tostring(root, encoding="unicode")
 
 
 def fixed_to_root(urdf: str, link: str) -> bool:

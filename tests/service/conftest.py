@@ -11,7 +11,8 @@ from typing import Any
 import pytest
 from fastapi.testclient import TestClient
 
-from service.config import get_settings
+from service.config import Settings, get_settings
+from service.deps import _settings
 from service.main import app
 from service.schemas import DtfRequest, EvaluateRequest
 
@@ -62,3 +63,20 @@ def body_limit(monkeypatch: pytest.MonkeyPatch) -> Iterator[int]:
 def sent_back(placement: dict[str, Any]) -> dict[str, Any]:
     """An answer's placement as a request takes it: x, y, z, yaw, spin (its frames left out)."""
     return {key: placement[key] for key in ("x", "y", "z", "yaw", "spin")}
+
+
+@pytest.fixture
+def own_store(tmp_path: Path) -> Iterator[Path]:
+    """The app with its jobs in ``tmp_path``: a queue no other test of this process fills.
+
+    The session's store is shared with the in-process fuzz, whose queued jobs may fill the
+    queue to its limit (checked in the insert's transaction): a POST would then be a 429.
+    """
+    settings = Settings(data_dir=tmp_path, workers=1)
+
+    async def own() -> Settings:
+        return settings
+
+    app.dependency_overrides[_settings] = own
+    yield tmp_path
+    app.dependency_overrides.pop(_settings)

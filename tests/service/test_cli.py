@@ -473,14 +473,42 @@ def test_a_refused_urdf_is_said_once_without_the_parsers_own_lines(
     # urdfdom writes its reason and its source line on the process's stderr; the server's log
     # keeps them (tests/solver/test_urdf_structure.py), the command's error says the reason.
     file = tmp_path / "two_roots.urdf"
-    file.write_text(UR5_URDF.read_text().replace("</robot>", '<link name="stray"/></robot>'))
+    second = (
+        '<link name="cart"/><link name="top"/><joint name="j" type="fixed"><parent link="cart"/>'
+    )
+    second += '<child link="top"/></joint>'  # a second tree, joined to the arm by nothing
+    file.write_text(UR5_URDF.read_text().replace("</robot>", second + "</robot>"))
     code = main(["evaluate", str(PROGRAM), "--robot", str(file), "--at=0,0.3,0,0"])
     out, err = capfd.readouterr()
     assert (code, out) == (INVALID, "")
     assert err.splitlines() == [
-        "error: robot.urdf: cannot parse the URDF: 2 root links ('world', 'stray'): every link "
+        "error: robot.urdf: cannot parse the URDF: 2 root links ('world', 'cart'): every link "
         "but one must be a joint's child; remove the stray link or attach it with a fixed joint"
     ]
+
+
+def test_a_link_no_joint_names_is_left_out_and_said_under_the_robots_line(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # As the ROS 2 generated UR5e: <link name="world"/> and no joint to it (its generator left
+    # the joint out). The answer is the same URDF's with the link deleted by hand.
+    text = UR5_URDF.read_text()
+    start = text.index('<joint name="world_joint"')
+    stray = tmp_path / "ur5_stray_world.urdf"
+    stray.write_text(text[:start] + text[text.index("</joint>", start) + len("</joint>") :])
+    by_hand = tmp_path / "ur5_by_hand.urdf"
+    by_hand.write_text(stray.read_text().replace('<link name="world"/>', ""))
+    at = ["evaluate", str(PROGRAM), "--at=0,0.3,0,0", "--robot"]
+    code, out, _ = run(capsys, *at, str(stray))
+    assert code == OK
+    lines = out.splitlines()
+    assert lines[0].startswith(f"robot: {stray}, from base to tool0; the URDF chain is a UR arm")
+    assert lines[1] == "robot: left out of the URDF, no joint names them: 'world'"
+    code, plain, _ = run(capsys, *at, str(by_hand))
+    assert code == OK and "left out" not in plain
+    assert lines[2:] == plain.splitlines()[1:]
+    code, out, _ = run(capsys, *at, str(stray), "--json")
+    assert json.loads(out)["robot_read"] == {"left_out_links": ["world"], "left_out_count": 1}
 
 
 def test_frames_with_a_robot_that_is_no_urdf_or_not_in_it_exit_invalid(

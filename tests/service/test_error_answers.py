@@ -32,6 +32,9 @@ LONG = 5_000
 """Characters of a client's name (a link, a CL word) that must not come back whole."""
 
 
+SPHERE = '<collision><geometry><sphere radius="0.1"/></geometry></collision>'
+
+
 def _longest_run(text: str, letter: str) -> int:
     """The longest run of ``letter`` in ``text`` (how much of an echoed name came back)."""
     return max((len(run) for run in re.findall(f"{letter}+", text)), default=0)
@@ -57,8 +60,10 @@ def long_link_urdf(panda_urdf: str) -> str:
     ("edit", "loc"),
     [
         (lambda urdf: urdf, ["body", "robot", "tool_frame"]),  # listed among the frames
-        (  # a second root link, named in the message
-            lambda urdf: urdf.replace("</robot>", f'<link name="{"M" * LONG}"/></robot>'),
+        (  # a second root link (with collision geometry: not left out), named in the message
+            lambda urdf: urdf.replace(
+                "</robot>", f'<link name="{"M" * LONG}">{SPHERE}</link></robot>'
+            ),
             ["body", "robot", "urdf"],
         ),
     ],
@@ -72,6 +77,28 @@ def test_a_long_link_name_is_echoed_cut(
     assert answer.status_code == 422, answer.text[:300]
     assert answer.json()["detail"][0]["loc"] == loc
     assert max(_longest_run(answer.text, "L"), _longest_run(answer.text, "M")) == 100
+
+
+def test_links_left_out_of_a_urdf_are_named_cut_and_counted(
+    client: TestClient, panda_urdf: str
+) -> None:
+    # 25 links no joint names, each named with 5,000 characters: left out (robot_read), the
+    # first 20 named, each cut to 100 characters, all 25 counted; the arm answers as without
+    # them.
+    names = [f"{k:02d}{'N' * LONG}" for k in range(25)]
+    strays = "".join(f'<link name="{name}"/>' for name in names)
+    robot = {"urdf": panda_urdf, "base_frame": "panda_link0", "tool_frame": "panda_link8"}
+    body = {**EXAMPLE, "robot": robot, "detail": "summary"}
+    plain = client.post("/v1/evaluate", json=body)
+    robot = {**robot, "urdf": panda_urdf.replace("</robot>", strays + "</robot>")}
+    answer = client.post("/v1/evaluate", json={**body, "robot": robot})
+    assert plain.status_code == answer.status_code == 200, answer.text[:300]
+    read = answer.json()["robot_read"]
+    assert read["left_out_count"] == 25
+    assert read["left_out_links"] == [name[:100] + "..." for name in names[:20]]
+    assert _longest_run(answer.text, "N") == 98
+    assert plain.json()["robot_read"] is None
+    assert {**answer.json(), "robot_read": None} == plain.json()
 
 
 def test_a_post_without_content_type_is_415(client: TestClient) -> None:

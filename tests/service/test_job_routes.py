@@ -69,23 +69,6 @@ def wait_for(client: TestClient, job_id: str, done: Any) -> dict[str, Any]:
         time.sleep(0.05)
 
 
-@pytest.fixture
-def own_store(tmp_path: Path) -> Iterator[Path]:
-    """The app with its jobs in ``tmp_path``: a queue no other test of this process fills.
-
-    The session's store is shared with the in-process fuzz, whose queued jobs may fill the
-    queue to its limit (checked in the insert's transaction): a POST would then be a 429.
-    """
-    settings = Settings(data_dir=tmp_path, workers=1)
-
-    async def own() -> Settings:
-        return settings
-
-    app.dependency_overrides[_settings] = own
-    yield tmp_path
-    app.dependency_overrides.pop(_settings)
-
-
 def test_delete_removes_a_job_and_cancel_keeps_it(client: TestClient, own_store: Path) -> None:
     job = {"kind": "map", "request": route_body("map", EXAMPLE["path"])}
     submitted = client.post("/v1/jobs", json=job)

@@ -1,4 +1,4 @@
-"""A URDF's structure said in the answer: two root links, and mimic joints in the chain.
+"""A URDF's structure said in the answer: links joined to nothing, two root links, mimic joints.
 
 The fixtures are the UR5 URDF of example-robot-data, edited as the published files that showed
 each case (a ROS 2 generated UR5e with a stray ``world`` link; a mimic joint between base and
@@ -7,11 +7,21 @@ tool, as ABB IRB 5400's joint5b, here following a joint that is not there).
 
 from __future__ import annotations
 
+from typing import Any
+
+import numpy as np
 import pytest
 
 from solver.core.exceptions import RobotModelError
+from solver.core.kinematics import tool_pose_in_base
 from solver.core.robots import example_robot_data_dir
-from solver.core.urdf_structure import fixed_to_root, mimic_joints, root_links
+from solver.core.urdf_structure import (
+    StrayLink,
+    fixed_to_root,
+    mimic_joints,
+    root_links,
+    stray_links,
+)
 from solver.families import catalogue, robot_from_urdf
 
 UR5 = (example_robot_data_dir() / "ur_description" / "urdf" / "ur5_robot.urdf").read_text()
@@ -41,12 +51,61 @@ def test_the_links_fixed_to_the_root_are_told_from_those_a_joint_moves() -> None
     assert not fixed_to_root(turned, "base")
 
 
-def test_two_root_links_are_named_in_the_error(capfd: pytest.CaptureFixture[str]) -> None:
-    urdf = UR5.replace("</robot>", '  <link name="stray"/>\n</robot>')
+def without_world_joint(urdf: str) -> str:
+    """The UR5 as a ROS 2 generator wrote the UR5e: ``<link name="world"/>`` joined to nothing."""
+    start = urdf.index('<joint name="world_joint"')
+    return urdf[:start] + urdf[urdf.index("</joint>", start) + len("</joint>") :]
+
+
+STRAY = without_world_joint(UR5)
+JOINED_TREE = (  # a second tree: two links and a joint, joined to the arm by nothing
+    '<link name="cart"/><link name="cart_top"/><joint name="cart_joint" type="fixed">'
+    '<parent link="cart"/><child link="cart_top"/></joint>'
+)
+TABLE = (  # a link with collision geometry that no joint names
+    '<link name="table"><collision><geometry><box size="1 1 0.1"/></geometry></collision></link>'
+)
+
+
+def test_a_link_no_joint_names_is_left_out_and_the_arm_reads_as_without_it() -> None:
+    assert root_links(STRAY) == ["base_link", "world"]
+    assert stray_links(STRAY) == [StrayLink("world", collision=False)]
+    robot = robot_from_urdf(STRAY, **FRAMES)
+    assert robot.left_out_links == ("world",)
+    assert robot.urdf is not None and root_links(robot.urdf) == ["base_link"]
+    # The same arm as the document with the link deleted by hand (and as the catalogue's UR5,
+    # whose world is base_link's parent at the identity): forward kinematics at random q.
+    by_hand = robot_from_urdf(STRAY.replace('<link name="world"/>', ""), **FRAMES)
+    assert by_hand.left_out_links == ()
+    q = np.random.default_rng(5).uniform(-np.pi, np.pi, (8, 6))
+    for row in q:
+        left = tool_pose_in_base(robot, row)
+        np.testing.assert_array_equal(left, tool_pose_in_base(by_hand, row))
+        np.testing.assert_allclose(left, tool_pose_in_base(catalogue()["ur5"], row), atol=1e-12)
+    assert robot.family is not None and by_hand.family is not None
+    assert robot.family.recognised == by_hand.family.recognised
+
+
+@pytest.mark.parametrize(
+    ("edit", "frames", "roots"),
+    [
+        (lambda u: u.replace("</robot>", JOINED_TREE + "</robot>"), FRAMES, "'world', 'cart'"),
+        (lambda u: u.replace("</robot>", TABLE + "</robot>"), FRAMES, "'world', 'table'"),
+        (
+            lambda u: without_world_joint(u),
+            {**FRAMES, "base_frame": "world"},
+            "'base_link', 'world'",
+        ),
+    ],
+    ids=["a second tree", "a link with collision geometry", "a link named as the base frame"],
+)
+def test_two_root_links_are_refused_naming_both_where_one_is_more_than_a_stray_link(
+    capfd: pytest.CaptureFixture[str], edit: Any, frames: dict[str, str], roots: str
+) -> None:
     with pytest.raises(RobotModelError) as error:
-        robot_from_urdf(urdf, **FRAMES)
+        robot_from_urdf(edit(UR5), **frames)
     assert error.value.field == "robot.urdf"
-    assert "2 root links ('world', 'stray')" in error.value.message
+    assert f"2 root links ({roots})" in error.value.message
     # the parser's own lines go on to the process's stderr (a server's log), as it wrote them
     assert "Two root links found" in capfd.readouterr().err
 

@@ -1,0 +1,92 @@
+"""A URDF link no joint names is left out and said, on every route (issue 27's corpus).
+
+The ROS 2 generated UR5e of the acceptance corpus has ``<link name="world"/>`` and no joint to it
+(its generator left the joint out): pinocchio refuses such a document (two root links), though
+the link has no pose and is no part of the arm. The fixture is example-robot-data's UR5 with its
+``world_joint`` taken out, the same case; each route's answer must be the one of the same URDF
+with the link deleted by hand, and say what was left out (``robot_read``); a map job's result
+too. A UR5 with a link that carries collision geometry and no joint is refused, naming the roots.
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+from typing import Any
+
+import pinocchio as pin
+import pytest
+from fastapi.testclient import TestClient
+
+from solver.core.native_stderr import native_stderr
+from solver.core.robots import example_robot_data_dir
+from tests.cases import ROOT
+from tests.service.test_job_results import done_job
+
+UR5 = (example_robot_data_dir() / "ur_description" / "urdf" / "ur5_robot.urdf").read_text()
+_START = UR5.index('<joint name="world_joint"')
+STRAY = UR5[:_START] + UR5[UR5.index("</joint>", _START) + len("</joint>") :]
+BY_HAND = STRAY.replace('<link name="world"/>', "")
+PATH = json.loads((ROOT / "examples" / "evaluate_request.json").read_text())["path"]
+AXIS = {"min": -0.1, "max": 0.1, "step": 0.1}
+EXTRA = {
+    "evaluate": {"placement": {"x": 0.0, "y": 0.45, "z": 0.1, "yaw": 0.0}, "detail": "summary"},
+    "map": {"grid": {"x": AXIS, "y": {"min": 0.4, "max": 0.5, "step": 0.1}, "z": 0.1, "yaw": 0.0}},
+    "optimize": {"bounds": {"x": [-0.1, 0.1], "y": [0.4, 0.5], "yaw": [-0.2, 0.2]}, "z": 0.1},
+}
+READ = {"left_out_links": ["world"], "left_out_count": 1}
+
+
+def body(route: str, urdf: str) -> dict[str, Any]:
+    robot = {"urdf": urdf, "base_frame": "base", "tool_frame": "tool0"}
+    return {"robot": robot, "path": PATH, **EXTRA[route]}
+
+
+def answer(client: TestClient, route: str, urdf: str) -> dict[str, Any]:
+    response = client.post(f"/v1/{route}", json=body(route, urdf))
+    assert response.status_code == 200, response.text[:300]
+    result: dict[str, Any] = response.json()
+    return result
+
+
+def test_the_document_has_a_stray_link_pinocchio_refuses() -> None:
+    # The fixture is the corpus's case: a second root that no joint names, which pinocchio's
+    # parser refuses; deleted by hand, the document is read.
+    assert STRAY.count('<link name="world"/>') == 1 and "world_joint" not in STRAY
+    with native_stderr(), pytest.raises((RuntimeError, ValueError)):
+        pin.buildModelFromXML(STRAY)
+    assert pin.buildModelFromXML(BY_HAND).nq == 6
+
+
+@pytest.mark.parametrize("route", ["evaluate", "map", "optimize"])
+def test_each_route_answers_as_without_the_link_and_says_it(client: TestClient, route: str) -> None:
+    left_out, by_hand = answer(client, route, STRAY), answer(client, route, BY_HAND)
+    assert left_out["robot_read"] == READ and by_hand["robot_read"] is None
+    if route == "optimize":
+        assert left_out["evaluation"]["robot_read"] is None  # said once, at the top
+        for key in ("solver",):  # its wall time differs
+            left_out.pop(key), by_hand.pop(key)
+    assert {**left_out, "robot_read": None} == by_hand
+
+
+def test_the_map_picture_of_it_is_drawn(client: TestClient) -> None:
+    response = client.post("/v1/map/png", json=body("map", STRAY))
+    assert response.status_code == 200 and response.content.startswith(b"\x89PNG")
+
+
+def test_a_map_job_says_it_as_the_route(client: TestClient, own_store: Path) -> None:
+    submitted = client.post("/v1/jobs", json={"kind": "map", "request": body("map", STRAY)})
+    assert submitted.status_code in (200, 201, 202), submitted.text
+    job = done_job(client, submitted.json()["id"])
+    assert job["status"] == "done", job
+    assert job["result"] == answer(client, "map", STRAY)
+
+
+def test_a_link_with_collision_geometry_and_no_joint_is_refused(client: TestClient) -> None:
+    table = '<link name="table"><collision><geometry><box size="1 1 0.1"/></geometry></collision>'
+    urdf = STRAY.replace('<link name="world"/>', table + "</link>")
+    response = client.post("/v1/evaluate", json=body("evaluate", urdf))
+    assert response.status_code == 422, response.text[:300]
+    (detail,) = response.json()["detail"]
+    assert detail["loc"] == ["body", "robot", "urdf"]
+    assert "2 root links ('base_link', 'table')" in detail["msg"]
