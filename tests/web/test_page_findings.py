@@ -377,6 +377,42 @@ def test_a_urdf_without_the_controllers_frame_gets_its_root_link(page: Page) -> 
     assert page.text_content("#base-frame-hint") == ""
 
 
+def test_a_link_no_joint_names_is_no_frame_and_the_map_says_it_was_left_out(
+    page: Page, url: str
+) -> None:
+    # As the ROS 2 generated UR5e: <link name="world"/> joined to nothing; here without the
+    # controller frame "base" too. The page fills the base frame with the chain's one root,
+    # base_link (the stray link is no root: with it, there would be two and none filled), and
+    # under the map says what the API left out, as its answer's robot_read says.
+    text = ur5_urdf()
+    for name in ("world_joint", "base_link-base_fixed_joint"):
+        start = text.index(f'<joint name="{name}"')
+        text = text[:start] + text[text.index("</joint>", start) + len("</joint>") :]
+    start = text.index('<link name="base">')
+    text = text[:start] + text[text.index("</link>", start) + len("</link>") :]
+    page.click("#own-urdf summary")
+    choose_file(page, "#urdf-file", "ur5e_ros2_like.urdf", text)
+    page.wait_for_function("document.getElementById('urdf').value.length > 0")
+    assert page.input_value("#base-frame") == "base_link"
+    page.fill("#tool-frame", "tool0")
+    small = {**SMALL, "x-step": "0.1", "y-step": "0.1", "yaws": "0"}
+    fill(page, small)
+    page.click("#run")
+    page.wait_for_function("document.getElementById('summary').dataset.cells", timeout=120_000)
+    robot = {"urdf": text, "base_frame": "base_link", "tool_frame": "tool0"}
+    grid = {**grid_of(small), "yaw": [0.0]}
+    api = httpx.post(
+        f"{url}/v1/map", json={"robot": robot, "path": EXAMPLE_PATH, "grid": grid}, timeout=120
+    ).json()
+    assert api["robot_read"] == {"left_out_links": ["world"], "left_out_count": 1}
+    shown = page.text_content("#ik-line") or ""
+    assert shown == (
+        f"IK in closed form: {api['recognised']}; left out of the URDF, no joint names them: "
+        "'world'"
+    )
+    snapshot(page, "urdf-left-out-link")
+
+
 @pytest.mark.parametrize("button", ["#run", "#optimize"])
 def test_an_empty_z_is_refused_beside_the_field_not_read_as_zero(
     page: Page, url: str, button: str

@@ -56,7 +56,7 @@ function robotBody() {
 // (where the field is empty): the base frame REP 199's "base", the controller's frame, where
 // fixed joints join it to the root (the controller frames of the optimum are then the
 // controller's, as dtf-place's), else the chain's root when it is a single link; the tool
-// frame the chain's tip when it is a single link.
+// frame the chain's tip when it is a single link. Links no joint names are neither.
 function readUrdfLinks() {
   const list = $("urdf-links");
   list.textContent = "";
@@ -66,7 +66,10 @@ function readUrdfLinks() {
   const joints = [...doc.querySelectorAll("robot > joint")];
   const children = new Set(joints.map((j) => j.querySelector("child")?.getAttribute("link")));
   const parents = new Set(joints.map((j) => j.querySelector("parent")?.getAttribute("link")));
-  const roots = links.filter((l) => !children.has(l)), tips = links.filter((l) => !parents.has(l));
+  // A link no joint names is left out by the API (robot_read): no root, no tip of the chain.
+  const joined = (l) => !joints.length || children.has(l) || parents.has(l);
+  const roots = links.filter((l) => joined(l) && !children.has(l));
+  const tips = links.filter((l) => joined(l) && !parents.has(l));
   for (const name of [...roots, ...links.filter((l) => !roots.includes(l))]) {
     list.appendChild(Object.assign(document.createElement("option"), { value: name }));
   }
@@ -384,6 +387,14 @@ function colour(fraction) {  // dark blue -> green -> yellow
   return `rgb(${mix.join(",")})`;
 }
 
+// The links the API left out of the URDF (no joint names them), said after how its IK is solved.
+function leftOut(read) {
+  if (!read) return "";
+  const names = read.left_out_links.map((n) => `'${n}'`).join(", ");
+  const more = read.left_out_count - read.left_out_links.length;
+  return `; left out of the URDF, no joint names them: ${names}` + (more ? ` and ${more} more` : "");
+}
+
 // The map's colour: mu_acc when the request gave acceleration limits (the API then fills it in
 // every feasible cell and ranks best and worst by it), else mu_path.
 function drawMap(answer) {
@@ -407,9 +418,10 @@ function drawMap(answer) {
   // sentence: the arm, its frames, its parameters), else numeric IK, said as plainly.
   const urdf = state.mapBody && state.mapBody.robot && state.mapBody.robot.urdf;
   $("ik-line").textContent = !urdf ? ""
-    : answer.recognised ? `IK in closed form: ${answer.recognised}`
-    : "IK numeric (damped least squares from seeds covering every joint's range): the URDF chain "
-      + "from this base frame to this tool frame is no OPW or UR arm's";
+    : (answer.recognised ? `IK in closed form: ${answer.recognised}`
+      : "IK numeric (damped least squares from seeds covering every joint's range): the URDF "
+        + "chain from this base frame to this tool frame is no OPW or UR arm's")
+      + leftOut(answer.robot_read);
   $("summary").dataset.collisions = String(collisions);
   $("summary").dataset.cells = String(cells.length);
   $("summary").dataset.key = key;
