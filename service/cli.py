@@ -218,13 +218,29 @@ def _chained(
         how += f" (the closed form from another base frame: {named})"
     lines = [f"robot: {args.robot}, from {base} to {tool}; {how}"]
     if robot_read is not None:
-        names = ", ".join(f"'{name}'" for name in robot_read.left_out_links)
-        more = robot_read.left_out_count - len(robot_read.left_out_links)
+        lines.extend(_read_lines(robot_read))
+    return "\n".join([*lines, text])
+
+
+def _read_lines(read: RobotRead) -> list[str]:
+    """What the answer's ``robot_read`` says was changed in the URDF, a line a change."""
+    lines = []
+    if read.left_out_links:
+        more = read.left_out_count - len(read.left_out_links)
         lines.append(
-            f"robot: left out of the URDF, no joint names them: {names}"
+            f"robot: left out of the URDF, no joint names them: {_names(read.left_out_links)}"
             + (f" and {more} more" if more else "")
         )
-    return "\n".join([*lines, text])
+    if read.continuous_joints:
+        line = f"robot: continuous joints read as revolute: {_names(read.continuous_joints)}"
+        if read.unlimited_joints:
+            line += f"; no position limit (the URDF gives none): {_names(read.unlimited_joints)}"
+        lines.append(line)
+    return lines
+
+
+def _names(names: list[str]) -> str:
+    return ", ".join(f"'{name}'" for name in names)
 
 
 def _json_file(file: Path, field: str) -> Any:

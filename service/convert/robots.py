@@ -1,7 +1,7 @@
 """The robot in answers: a catalogue entry, a robot's name in pictures, its URDF's reading.
 
 ``GET /v1/robots`` shows catalogue robots (:func:`robot_info`); pictures name a request's URDF
-by its own name (:func:`shown_name`); answers say what was taken out of a request's URDF
+by its own name (:func:`shown_name`); answers say what was changed in a request's URDF
 (:func:`robot_read_of`).
 """
 
@@ -33,13 +33,16 @@ def shown_name(robot: Robot) -> str:
 
 
 def robot_read_of(robot: Robot) -> schemas.RobotRead | None:
-    """What was taken out of the robot's URDF before it was read; None where nothing was."""
-    left_out = robot.left_out_links
-    if not left_out:
+    """What was changed in the robot's URDF before it was read; None where nothing was."""
+    reading = robot.reading
+    left_out = reading.left_out_links
+    if not (left_out or reading.continuous_joints):
         return None
     return schemas.RobotRead(
         left_out_links=[cut(name) for name in left_out[:MAX_LISTED_NAMES]],
         left_out_count=len(left_out),
+        continuous_joints=[cut(name) for name in reading.continuous_joints],
+        unlimited_joints=[cut(name) for name in reading.unlimited_joints],
     )
 
 

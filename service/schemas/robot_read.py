@@ -1,10 +1,11 @@
-"""How a request's URDF was read, where the service took anything out of it (robots.md 4).
+"""How a request's URDF was read, where the service changed anything in it (robots.md 4).
 
-``/v1/evaluate``, ``/v1/map`` and ``/v1/optimize`` (and their jobs) give it as ``robot_read``:
+``/v1/evaluate``, ``/v1/map`` and ``/v1/optimize`` (and their jobs) give it as ``robot_read``,
+rather than refusing a file as its generator wrote it or reading it otherwise without a word:
 a link that no joint names has no pose and is no part of the robot, and pinocchio refuses the
-document for it (two root links); the service takes it out and says so here, rather than refusing
-a file as its generator wrote it (a ROS 2 generated UR5e's ``<link name="world"/>``, whose joint
-the generator left out) or reading it without a word.
+document for it (two root links), so the service takes it out (a ROS 2 generated UR5e's
+``<link name="world"/>``, whose joint the generator left out); a ``continuous`` joint (Kinova's
+arms) is read as a revolute joint, with no position limit where the file gives none.
 """
 
 from __future__ import annotations
@@ -15,10 +16,19 @@ from service.schemas.common import ResponseModel
 
 
 class RobotRead(ResponseModel):
-    """What the service took out of the request's URDF before reading it."""
+    """What the service changed in the request's URDF before reading it."""
 
     model_config = ConfigDict(
-        json_schema_extra={"examples": [{"left_out_links": ["world"], "left_out_count": 1}]}
+        json_schema_extra={
+            "examples": [
+                {
+                    "left_out_links": ["world"],
+                    "left_out_count": 1,
+                    "continuous_joints": [],
+                    "unlimited_joints": [],
+                }
+            ]
+        }
     )
 
     left_out_links: list[str] = Field(
@@ -29,10 +39,20 @@ class RobotRead(ResponseModel):
         "tool_frame, is not left out: the request is refused naming the root links."
     )
     left_out_count: int = Field(description="How many links were left out (all of them).")
+    continuous_joints: list[str] = Field(
+        description="The chain's continuous joints (names cut at 100 characters), read as "
+        "revolute joints: one angle each, with the lower and upper limits the file gives "
+        "anyway (as Kinova's do), else none (unlimited_joints)."
+    )
+    unlimited_joints: list[str] = Field(
+        description="Those continuous joints whose <limit> gives no lower or upper: no "
+        "position limit on that side (a continuous joint has none in URDF's own terms), only "
+        "the speed limit."
+    )
 
 
 ROBOT_READ = (
-    "When the robot is a URDF out of which the service took something before reading it (links "
-    "no joint names): what, as robot_read.left_out_links; null otherwise."
+    "When the robot is a URDF the service changed before reading it (links no joint names left "
+    "out, continuous joints read as revolute ones): what; null otherwise."
 )
 """The description of every answer's ``robot_read`` field."""

@@ -22,7 +22,12 @@ import pinocchio as pin
 from solver.core.exceptions import InvalidInputError, RobotModelError, quoted
 from solver.core.family import KinematicsFamily
 from solver.core.joint_limits import check_acceleration_limits, check_speed_limits
-from solver.core.urdf_chain import chain_from_urdf, check_mimic_speed_limits, frame_names
+from solver.core.urdf_chain import (
+    UrdfReading,
+    chain_from_urdf,
+    check_mimic_speed_limits,
+    frame_names,
+)
 from solver.core.urdf_structure import Mimic
 
 __all__ = [
@@ -59,9 +64,9 @@ class Robot:
             kinematic parameters.
         mimics: the chain's mimic joints (URDF ``<mimic>``), whose own speed limits bound
             any speed limits given for their leaders (:func:`check_mimic_speed_limits`).
-        left_out_links: links of the URDF document that no joint names, left out of ``urdf``
-            so that it has one root (:func:`solver.core.urdf_chain.without_stray_links`);
-            answers say so.
+        reading: what was changed in the URDF document before it was read (links no joint
+            names left out, continuous joints read as revolute ones;
+            :func:`solver.core.urdf_chain.readable_urdf`); answers say so.
     """
 
     name: str
@@ -78,7 +83,7 @@ class Robot:
     qddot_max: np.ndarray | None = None
     urdf: str | None = None
     mimics: tuple[Mimic, ...] = ()
-    left_out_links: tuple[str, ...] = ()
+    reading: UrdfReading = UrdfReading()
 
     @property
     def dof(self) -> int:

@@ -13,6 +13,7 @@ request may send a name of megabytes).
 from __future__ import annotations
 
 from collections.abc import Sequence
+from dataclasses import dataclass
 
 import numpy as np
 import pinocchio as pin
@@ -20,10 +21,13 @@ import pinocchio as pin
 from solver.core.exceptions import InvalidInputError, RobotModelError, quoted, quoted_names
 from solver.core.native_stderr import first_error, native_stderr
 from solver.core.urdf_structure import (
+    ContinuousJoint,
     Mimic,
+    continuous_as_revolute,
     mimic_joints,
     root_links,
     stray_links,
+    uses_xacro,
     without_links,
 )
 
@@ -31,6 +35,57 @@ from solver.core.urdf_structure import (
 def frame_names(model: pin.Model) -> str:
     """The model's frame names for a message, each cut and at most 20 (:func:`quoted_names`)."""
     return quoted_names([f.name for f in model.frames if f.name != "universe"])
+
+
+@dataclass(frozen=True)
+class UrdfReading:
+    """What was changed in a URDF document before it was read, as answers say it.
+
+    Attributes:
+        left_out_links: links no joint names, taken out (:func:`without_stray_links`).
+        continuous_joints: the chain's ``continuous`` joints, read as revolute joints
+            (:func:`solver.core.urdf_structure.continuous_as_revolute`).
+        unlimited_joints: those of them whose ``<limit>`` gives no lower or upper: that side
+            has no position limit (a continuous joint has none in URDF's own terms).
+    """
+
+    left_out_links: tuple[str, ...] = ()
+    continuous_joints: tuple[str, ...] = ()
+    unlimited_joints: tuple[str, ...] = ()
+
+
+def readable_urdf(
+    urdf: str, *, frames: tuple[str, ...]
+) -> tuple[str, list[ContinuousJoint], tuple[str, ...]]:
+    """The document pinocchio reads for a request's URDF: stray links out, continuous revolute.
+
+    Returns the document, its continuous joints (:func:`unlimit` takes them once the model is
+    read) and the links left out (:func:`without_stray_links`, ``frames`` as there).
+    """
+    urdf, left_out = without_stray_links(urdf, frames=frames)
+    urdf, continuous = continuous_as_revolute(urdf)
+    return urdf, continuous, left_out
+
+
+def unlimit(model: pin.Model, continuous: Sequence[ContinuousJoint]) -> tuple[str, ...]:
+    """Give the model's continuous joints no position limit where their URDF gives none.
+
+    pinocchio read 0 for a missing ``lower`` or ``upper`` of a continuous joint made revolute;
+    that side becomes -inf or +inf. Returns the joints of ``model`` so changed.
+    """
+    changed = []
+    for joint in continuous:
+        if not model.existJointName(joint.name) or (
+            joint.lower is not None and joint.upper is not None
+        ):
+            continue
+        index = model.joints[model.getJointId(joint.name)].idx_q
+        if joint.lower is None:
+            model.lowerPositionLimit[index] = -np.inf
+        if joint.upper is None:
+            model.upperPositionLimit[index] = np.inf
+        changed.append(joint.name)
+    return tuple(changed)
 
 
 def without_stray_links(urdf: str, *, frames: tuple[str, ...]) -> tuple[str, tuple[str, ...]]:
@@ -89,6 +144,11 @@ def chain_from_urdf(urdf: str, *, tool_frame: str) -> pin.Model:
                 "it with a fixed joint",
             ) from error
         reason = first_error(said[0]) or quoted(str(error))
+        if uses_xacro(urdf):  # the parser's reason (no links, an unknown element) hides why
+            reason += (
+                "; the document is xacro (it has xacro: elements), not a URDF: expand it first "
+                "(ROS: xacro file.urdf.xacro > file.urdf)"
+            )
         raise RobotModelError("robot.urdf", f"cannot parse the URDF: {reason}") from error
     if not full.existFrame(tool_frame):
         names = frame_names(full)

@@ -101,6 +101,49 @@ def without_links(urdf: str, names: set[str]) -> str:
     return ElementTree.tostring(root, encoding="unicode")
 
 
+@dataclass(frozen=True)
+class ContinuousJoint:
+    """A ``continuous`` joint: a hinge with no position limits in URDF's own terms.
+
+    ``lower`` and ``upper`` (rad) are what its ``<limit>`` gives anyway (Kinova's files give
+    +-2 pi), None where it gives none.
+    """
+
+    name: str
+    lower: float | None
+    upper: float | None
+
+
+def continuous_as_revolute(urdf: str) -> tuple[str, list[ContinuousJoint]]:
+    """The document with its ``continuous`` joints made ``revolute``, and those joints.
+
+    pinocchio models a continuous joint by (cos, sin), two coordinates for one angle; the
+    solver takes one angle a joint. A revolute joint needs a ``<limit>``: one is added where the
+    joint has none (no speed limit: the request must give one); where ``lower`` or ``upper`` is
+    missing, pinocchio reads 0, which the caller replaces (:func:`ContinuousJoint`). The
+    document is returned as it is where it has no continuous joint.
+    """
+    root = _tree(urdf)
+    if root is None:
+        return urdf, []
+    found = []
+    for joint in root.findall("joint"):
+        if joint.get("type") != "continuous":
+            continue
+        joint.set("type", "revolute")
+        limit = joint.find("limit")
+        if limit is None:
+            limit = ElementTree.SubElement(joint, "limit", {"effort": "0", "velocity": "0"})
+        found.append(
+            ContinuousJoint(
+                joint.get("name", ""), _number(limit.get("lower")), _number(limit.get("upper"))
+            )
+        )
+    if not found:
+        return urdf, []
+    return ElementTree.tostring(root, encoding="unicode"), found
+
+
 def fixed_to_root(urdf: str, link: str) -> bool:
     """Whether ``link`` is in the document and joined to its root by fixed joints only.
 
@@ -121,6 +164,18 @@ def fixed_to_root(urdf: str, link: str) -> bool:
         if kind != "fixed":
             return False
     return link not in seen
+
+
+XACRO_NAMESPACE = "http://www.ros.org/wiki/xacro"
+
+
+def uses_xacro(urdf: str) -> bool:
+    """Whether the document has xacro elements (a macro file ROS expands into a URDF)."""
+    root = _tree(urdf)
+    if root is None:
+        return False
+    prefix = "{" + XACRO_NAMESPACE + "}"
+    return any(element.tag.startswith(prefix) for element in root.iter())
 
 
 def joint_count(urdf: str) -> int:

@@ -17,7 +17,7 @@ import pinocchio as pin
 from solver.core.exceptions import RobotModelError, UnknownRobotError
 from solver.core.family import KinematicsFamily
 from solver.core.robots import Robot, chain_from_urdf, robot_from_model
-from solver.core.urdf_chain import chain_mimics, without_stray_links
+from solver.core.urdf_chain import UrdfReading, chain_mimics, readable_urdf, unlimit
 from solver.families.numeric.chain import SerialChain
 from solver.families.numeric.family import NumericFamily
 from solver.families.recognise import recognised_family
@@ -72,8 +72,9 @@ def closed_form_bases(urdf: str, *, tool_frame: str) -> list[str]:
     Raises:
         RobotModelError: the URDF cannot be parsed or has no ``tool_frame``.
     """
-    urdf, _ = without_stray_links(urdf, frames=(tool_frame,))
+    urdf, continuous, _ = readable_urdf(urdf, frames=(tool_frame,))
     model = chain_from_urdf(urdf, tool_frame=tool_frame)
+    unlimit(model, continuous)
     if model.nv != 6:  # the closed forms are six-joint arms'
         return []
     found = []
@@ -114,8 +115,9 @@ def robot_from_urdf(
 
     The chain is the one from the root to ``tool_frame``
     (:func:`solver.core.robots.chain_from_urdf`: other joints are locked at their neutral
-    position). Links no joint names are left out of the document first, and named in the
-    robot's ``left_out_links`` (:func:`solver.core.urdf_chain.without_stray_links`).
+    position). Links no joint names are left out of the document first, and ``continuous``
+    joints read as revolute ones (no position limit where the file gives none); the robot's
+    ``reading`` says so (:func:`solver.core.urdf_chain.readable_urdf`).
 
     Args:
         urdf: the URDF document.
@@ -133,8 +135,9 @@ def robot_from_urdf(
         InvalidInputError: ``qdot_max`` is unusable, or a leader's would let its mimic joint
             pass the mimic's own limit (:func:`solver.core.urdf_chain.check_mimic_speed_limits`).
     """
-    urdf, left_out = without_stray_links(urdf, frames=(base_frame, tool_frame))
+    urdf, continuous, left_out = readable_urdf(urdf, frames=(base_frame, tool_frame))
     model = chain_from_urdf(urdf, tool_frame=tool_frame)
+    unlimited = unlimit(model, continuous)
     if family is None and model.existFrame(base_frame) and model.existFrame(tool_frame):
         family = default_family(model, base_frame=base_frame, tool_frame=tool_frame)
     robot = robot_from_model(
@@ -146,4 +149,6 @@ def robot_from_urdf(
         family=family,
         mimics=chain_mimics(urdf, model),
     )
-    return dataclasses.replace(robot, urdf=urdf, left_out_links=left_out)
+    on_chain = [j.name for j in continuous if model.existJointName(j.name)]
+    reading = UrdfReading(left_out, tuple(on_chain), unlimited)
+    return dataclasses.replace(robot, urdf=urdf, reading=reading)

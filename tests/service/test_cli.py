@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import json
 import math
+import re
 import subprocess
 import sys
 from pathlib import Path
@@ -508,7 +509,29 @@ def test_a_link_no_joint_names_is_left_out_and_said_under_the_robots_line(
     assert code == OK and "left out" not in plain
     assert lines[2:] == plain.splitlines()[1:]
     code, out, _ = run(capsys, *at, str(stray), "--json")
-    assert json.loads(out)["robot_read"] == {"left_out_links": ["world"], "left_out_count": 1}
+    assert json.loads(out)["robot_read"] == {
+        "left_out_links": ["world"],
+        "left_out_count": 1,
+        "continuous_joints": [],
+        "unlimited_joints": [],
+    }
+
+
+def test_continuous_joints_read_as_revolute_are_said_under_the_robots_line(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    text = UR5_URDF.read_text()
+    start = text.index('<joint name="wrist_3_joint"')
+    end = text.index("</joint>", start)
+    joint = re.sub(r' (lower|upper)="[^"]*"', "", text[start:end])
+    file = tmp_path / "ur5_continuous_wrist.urdf"
+    file.write_text(text[:start] + joint.replace('"revolute"', '"continuous"') + text[end:])
+    code, out, _ = run(capsys, "evaluate", str(PROGRAM), "--at=0,0.3,0,0", "--robot", str(file))
+    assert code == OK
+    assert out.splitlines()[1] == (
+        "robot: continuous joints read as revolute: 'wrist_3_joint'; no position limit (the "
+        "URDF gives none): 'wrist_3_joint'"
+    )
 
 
 def test_frames_with_a_robot_that_is_no_urdf_or_not_in_it_exit_invalid(

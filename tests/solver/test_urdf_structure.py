@@ -1,4 +1,4 @@
-"""A URDF's structure said in the answer: links joined to nothing, two root links, mimic joints.
+"""A URDF's structure said in the answer: stray links, continuous joints, two roots, mimics.
 
 The fixtures are the UR5 URDF of example-robot-data, edited as the published files that showed
 each case (a ROS 2 generated UR5e with a stray ``world`` link; a mimic joint between base and
@@ -7,14 +7,18 @@ tool, as ABB IRB 5400's joint5b, here following a joint that is not there).
 
 from __future__ import annotations
 
+import re
 from typing import Any
 
 import numpy as np
 import pytest
 
+from solver.cam.csv_path import read_csv_path
 from solver.core.exceptions import RobotModelError
 from solver.core.kinematics import tool_pose_in_base
 from solver.core.robots import example_robot_data_dir
+from solver.core.spatial import Placement
+from solver.core.tool_axis import poses_from_tool_axes
 from solver.core.urdf_structure import (
     StrayLink,
     fixed_to_root,
@@ -23,9 +27,14 @@ from solver.core.urdf_structure import (
     stray_links,
 )
 from solver.families import catalogue, robot_from_urdf
+from solver.path.evaluate import evaluate_path
+from solver.path.problem import PathOptions, PathProblem
+from tests.service.test_urdf_recognised import fan_csv
 
 UR5 = (example_robot_data_dir() / "ur_description" / "urdf" / "ur5_robot.urdf").read_text()
 FRAMES = {"base_frame": "base", "tool_frame": "tool0"}
+FAN = fan_csv()  # a fan-shaped 5-axis path whose tool turns about its axis
+PLACEMENT = Placement(0.45, 0.1, 0.1, 0.0)
 
 
 def with_mimic(joint: str, leader: str) -> str:
@@ -71,12 +80,12 @@ def test_a_link_no_joint_names_is_left_out_and_the_arm_reads_as_without_it() -> 
     assert root_links(STRAY) == ["base_link", "world"]
     assert stray_links(STRAY) == [StrayLink("world", collision=False)]
     robot = robot_from_urdf(STRAY, **FRAMES)
-    assert robot.left_out_links == ("world",)
+    assert robot.reading.left_out_links == ("world",)
     assert robot.urdf is not None and root_links(robot.urdf) == ["base_link"]
     # The same arm as the document with the link deleted by hand (and as the catalogue's UR5,
     # whose world is base_link's parent at the identity): forward kinematics at random q.
     by_hand = robot_from_urdf(STRAY.replace('<link name="world"/>', ""), **FRAMES)
-    assert by_hand.left_out_links == ()
+    assert by_hand.reading.left_out_links == ()
     q = np.random.default_rng(5).uniform(-np.pi, np.pi, (8, 6))
     for row in q:
         left = tool_pose_in_base(robot, row)
@@ -128,3 +137,107 @@ def test_a_mimic_joint_off_the_chain_is_locked_as_before() -> None:
     panda = (example_robot_data_dir() / "panda_description" / "urdf" / "panda.urdf").read_text()
     assert any(m.leader == "panda_finger_joint1" for m in mimic_joints(panda).values())
     assert catalogue()["panda"].dof == 7
+
+
+XACRO = """<?xml version="1.0"?>
+<robot xmlns:xacro="http://www.ros.org/wiki/xacro" name="kr16_2">
+  <xacro:include filename="$(find kuka_kr16_support)/urdf/kr16_2_macro.xacro"/>
+  <xacro:kuka_kr16_2 prefix=""/>
+</robot>
+"""
+
+
+def test_a_xacro_file_is_refused_saying_it_must_be_expanded_first() -> None:
+    # As ROS-Industrial's support packages ship an arm (kr16_2.xacro): macros, no links.
+    with pytest.raises(RobotModelError) as error:
+        robot_from_urdf(XACRO, **FRAMES)
+    assert error.value.field == "robot.urdf"
+    message = error.value.message
+    assert message.startswith("cannot parse the URDF: No link elements found in urdf file; ")
+    assert "the document is xacro (it has xacro: elements), not a URDF: expand it first" in message
+    plain = XACRO.replace("xacro:", "").replace(' xmlns:xacro="http://www.ros.org/wiki/xacro"', "")
+    with pytest.raises(RobotModelError) as error:
+        robot_from_urdf(plain, **FRAMES)
+    assert "xacro" not in error.value.message  # no links, and nothing says it is a macro file
+
+
+def continuous(urdf: str, joint: str, limits: str | None) -> str:
+    """``joint`` made continuous, its <limit>'s lower and upper replaced by ``limits`` (or none)."""
+    start = urdf.index(f'<joint name="{joint}"')
+    end = urdf.index("</joint>", start)
+    part = urdf[start:end].replace('type="revolute"', 'type="continuous"')
+    part = re.sub(r' (lower|upper)="[^"]*"', "", part)
+    if limits is not None:
+        part = part.replace("<limit ", f"<limit {limits} ")
+    return urdf[:start] + part + urdf[end:]
+
+
+def test_a_continuous_joint_without_limits_has_none_and_answers_as_a_very_wide_one() -> None:
+    # As Kinova's Gen3 files write joints 1, 3, 5 and 7; here the UR5's wrist 3. The same arm
+    # with wrist 3 revolute over +-1000 rad (which no path of a few turns reaches) is the
+    # independent answer: the same mu_path, branch and joint path.
+    robot = robot_from_urdf(continuous(UR5, "wrist_3_joint", None), **FRAMES)
+    wide = robot_from_urdf(
+        continuous(UR5, "wrist_3_joint", 'lower="-1000" upper="1000"').replace(
+            'name="wrist_3_joint" type="continuous"', 'name="wrist_3_joint" type="revolute"'
+        ),
+        **FRAMES,
+    )
+    assert (robot.q_lower[5], robot.q_upper[5]) == (-np.inf, np.inf)
+    assert (wide.q_lower[5], wide.q_upper[5]) == (-1000.0, 1000.0)
+    np.testing.assert_array_equal(robot.q_lower[:5], wide.q_lower[:5])
+    assert robot.reading.continuous_joints == ("wrist_3_joint",)
+    assert robot.reading.unlimited_joints == ("wrist_3_joint",)
+    assert wide.reading.continuous_joints == ()
+    cam = read_csv_path(FAN, units="mm")
+    assert cam.axes is not None
+    poses, _ = poses_from_tool_axes(cam.positions, cam.axes)
+    for spin_mode in ("fixed", "free"):
+        options = PathOptions(spin_mode=spin_mode)
+        left, right = (
+            evaluate_path(PathProblem.of(arm, poses, options), PLACEMENT) for arm in (robot, wide)
+        )
+        assert left.feasible and right.feasible
+        assert left.mu_path == right.mu_path and left.branch == right.branch
+        np.testing.assert_array_equal(left.q, right.q)
+        np.testing.assert_array_equal(left.v_max, right.v_max)
+
+
+def test_a_continuous_joints_own_limits_are_kept_and_one_without_a_limit_needs_a_speed() -> None:
+    # Kinova's files give their continuous joints +-2 pi: kept, as the revolute joint's.
+    kept = robot_from_urdf(continuous(UR5, "wrist_3_joint", 'lower="-3.0" upper="3.0"'), **FRAMES)
+    assert (kept.q_lower[5], kept.q_upper[5]) == (-3.0, 3.0)
+    assert kept.reading.continuous_joints == ("wrist_3_joint",)
+    assert kept.reading.unlimited_joints == ()
+    start = UR5.index('<joint name="wrist_3_joint"')
+    end = UR5.index("</joint>", start)
+    bare = UR5[:start] + re.sub(r"<limit [^>]*/>", "", UR5[start:end]) + UR5[end:]
+    bare = bare.replace(
+        'name="wrist_3_joint" type="revolute"', 'name="wrist_3_joint" type="continuous"'
+    )
+    with pytest.raises(RobotModelError) as error:
+        robot_from_urdf(bare, **FRAMES)
+    assert error.value.field == "robot.urdf" and "joint_velocity_limits" in error.value.message
+    given = robot_from_urdf(bare, **FRAMES, qdot_max=[3.0] * 6)
+    assert (given.q_lower[5], given.q_upper[5]) == (-np.inf, np.inf)
+    assert given.qdot_max.tolist() == [3.0] * 6
+
+
+def test_a_path_of_three_turns_fits_an_unlimited_wrist_and_not_the_ur5s() -> None:
+    # The tool turns three times about its own axis along 0.1 m: the UR5's wrist 3 (+-2 pi)
+    # runs out of range, the same joint continuous without limits turns 6 pi (geometry: the
+    # tool's turn about its axis is wrist 3's, the arm's other joints moving little).
+    s = np.linspace(0.0, 1.0, 241)
+    poses = np.repeat(np.eye(4)[None], len(s), axis=0)
+    angle = 6 * np.pi * s
+    poses[:, 0, 0], poses[:, 0, 1] = np.cos(angle), -np.sin(angle)
+    poses[:, 1, 0], poses[:, 1, 1] = -np.sin(angle), -np.cos(angle)
+    poses[:, 2, 2] = -1.0  # tool z down: diag(1, -1, -1) Rz(angle)
+    poses[:, 0, 3] = 0.1 * s
+    at = Placement(0.3, 0.3, 0.1, 0.0)
+    plain = evaluate_path(PathProblem.of(robot_from_urdf(UR5, **FRAMES), poses), at)
+    assert not plain.feasible and plain.reason == "joint_limits"
+    unlimited = robot_from_urdf(continuous(UR5, "wrist_3_joint", None), **FRAMES)
+    answer = evaluate_path(PathProblem.of(unlimited, poses), at)
+    assert answer.feasible and answer.q is not None
+    assert abs(np.ptp(answer.q[:, 5]) - 6 * np.pi) < 0.5

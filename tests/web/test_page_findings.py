@@ -377,7 +377,7 @@ def test_a_urdf_without_the_controllers_frame_gets_its_root_link(page: Page) -> 
     assert page.text_content("#base-frame-hint") == ""
 
 
-def test_a_link_no_joint_names_is_no_frame_and_the_map_says_it_was_left_out(
+def test_a_link_no_joint_names_is_no_frame_and_the_map_says_what_the_api_changed(
     page: Page, url: str
 ) -> None:
     # As the ROS 2 generated UR5e: <link name="world"/> joined to nothing; here without the
@@ -390,6 +390,10 @@ def test_a_link_no_joint_names_is_no_frame_and_the_map_says_it_was_left_out(
         text = text[:start] + text[text.index("</joint>", start) + len("</joint>") :]
     start = text.index('<link name="base">')
     text = text[:start] + text[text.index("</link>", start) + len("</link>") :]
+    start = text.index('<joint name="wrist_3_joint"')  # and, as Kinova's, a continuous joint
+    end = text.index("</joint>", start)
+    joint = re.sub(r' (lower|upper)="[^"]*"', "", text[start:end])
+    text = text[:start] + joint.replace('"revolute"', '"continuous"') + text[end:]
     page.click("#own-urdf summary")
     choose_file(page, "#urdf-file", "ur5e_ros2_like.urdf", text)
     page.wait_for_function("document.getElementById('urdf').value.length > 0")
@@ -404,11 +408,17 @@ def test_a_link_no_joint_names_is_no_frame_and_the_map_says_it_was_left_out(
     api = httpx.post(
         f"{url}/v1/map", json={"robot": robot, "path": EXAMPLE_PATH, "grid": grid}, timeout=120
     ).json()
-    assert api["robot_read"] == {"left_out_links": ["world"], "left_out_count": 1}
+    assert api["robot_read"] == {
+        "left_out_links": ["world"],
+        "left_out_count": 1,
+        "continuous_joints": ["wrist_3_joint"],
+        "unlimited_joints": ["wrist_3_joint"],
+    }
     shown = page.text_content("#ik-line") or ""
     assert shown == (
         f"IK in closed form: {api['recognised']}; left out of the URDF, no joint names them: "
-        "'world'"
+        "'world'; continuous joints read as revolute: 'wrist_3_joint' (no position limit: "
+        "'wrist_3_joint')"
     )
     snapshot(page, "urdf-left-out-link")
 

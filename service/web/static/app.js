@@ -387,12 +387,16 @@ function colour(fraction) {  // dark blue -> green -> yellow
   return `rgb(${mix.join(",")})`;
 }
 
-// The links the API left out of the URDF (no joint names them), said after how its IK is solved.
-function leftOut(read) {
+// What the API changed in the URDF (robot_read: links no joint names left out, continuous
+// joints read as revolute), said after how its IK is solved.
+function urdfRead(read) {
   if (!read) return "";
-  const names = read.left_out_links.map((n) => `'${n}'`).join(", ");
+  const names = (list) => list.map((n) => `'${n}'`).join(", ");
   const more = read.left_out_count - read.left_out_links.length;
-  return `; left out of the URDF, no joint names them: ${names}` + (more ? ` and ${more} more` : "");
+  return (read.left_out_links.length
+    ? `; left out of the URDF, no joint names them: ${names(read.left_out_links)}` + (more ? ` and ${more} more` : "") : "")
+    + (read.continuous_joints.length ? `; continuous joints read as revolute: ${names(read.continuous_joints)}` : "")
+    + (read.unlimited_joints.length ? ` (no position limit: ${names(read.unlimited_joints)})` : "");
 }
 
 // The map's colour: mu_acc when the request gave acceleration limits (the API then fills it in
@@ -421,7 +425,7 @@ function drawMap(answer) {
     : (answer.recognised ? `IK in closed form: ${answer.recognised}`
       : "IK numeric (damped least squares from seeds covering every joint's range): the URDF "
         + "chain from this base frame to this tool frame is no OPW or UR arm's")
-      + leftOut(answer.robot_read);
+      + urdfRead(answer.robot_read);
   $("summary").dataset.collisions = String(collisions);
   $("summary").dataset.cells = String(cells.length);
   $("summary").dataset.key = key;

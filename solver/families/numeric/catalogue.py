@@ -11,7 +11,8 @@ the makers' datasheets:
 - ``kinova_jaco2`` (Kinova Jaco2 j2s6s200, 6 joints, spherical wrist): {B}
   ``j2s6s200_link_base``, flange ``j2s6s200_end_effector``; speeds 0.628 rad/s (joints 1-3,
   36 deg/s) and 0.838 rad/s (4-6, 48 deg/s). The URDF's continuous joints (1, 4, 6) are read as
-  revolute with the +-2 pi its ``<limit>`` tags give, as UR joints are: a path needs no more.
+  revolute with the +-2 pi its ``<limit>`` tags give, as UR joints are (as a request's URDF is
+  read: :func:`solver.core.urdf_structure.continuous_as_revolute`).
   Its chain is an OPW arm's whose flange is turned half a turn on the OPW flange: the same URDF
   in a request is recognised (:mod:`solver.families.recognise`; maps equal cell for cell). The
   catalogue entry keeps numeric IK, given here, as the catalogue's six-joint numeric arm.
@@ -19,9 +20,8 @@ the makers' datasheets:
 
 from __future__ import annotations
 
-import re
-
 from solver.core.robots import Robot, chain_from_urdf, example_robot_data_dir
+from solver.core.urdf_structure import continuous_as_revolute
 from solver.families import robot_from_urdf
 from solver.families.numeric.family import NumericFamily
 
@@ -37,20 +37,12 @@ ARMS = {
 }
 
 
-def continuous_as_revolute(urdf: str) -> str:
-    """URDF text with every ``type="continuous"`` joint made ``revolute`` (it keeps its limits).
-
-    Pinocchio models a continuous joint by (cos, sin), two coordinates for one joint; the solver
-    needs one angle per joint.
-    """
-    return re.sub(r'type="continuous"', 'type="revolute"', urdf)
-
-
 def robots() -> dict[str, Robot]:
     """The numeric-IK arms by name."""
     arms: dict[str, Robot] = {}
     for name, (file, base_frame, tool_frame) in ARMS.items():
-        urdf = continuous_as_revolute((example_robot_data_dir() / file).read_text())
+        # read as a request's URDF reads it (its answers then say nothing of it)
+        urdf, _ = continuous_as_revolute((example_robot_data_dir() / file).read_text())
         family = NumericFamily(
             chain_from_urdf(urdf, tool_frame=tool_frame),
             base_frame=base_frame,

@@ -1,16 +1,22 @@
-"""A URDF link no joint names is left out and said, on every route (issue 27's corpus).
+"""A URDF changed before it is read says so on every route: stray links, continuous joints.
 
+Stray links (issue 27's corpus):
 The ROS 2 generated UR5e of the acceptance corpus has ``<link name="world"/>`` and no joint to it
 (its generator left the joint out): pinocchio refuses such a document (two root links), though
 the link has no pose and is no part of the arm. The fixture is example-robot-data's UR5 with its
 ``world_joint`` taken out, the same case; each route's answer must be the one of the same URDF
 with the link deleted by hand, and say what was left out (``robot_read``); a map job's result
 too. A UR5 with a link that carries collision geometry and no joint is refused, naming the roots.
+
+Continuous joints (Kinova's files): read as revolute joints, with no position limit where the
+file gives none; the answer is the one of the same arm with that joint revolute over +-1000 rad
+(which no path here reaches), and says which joints.
 """
 
 from __future__ import annotations
 
 import json
+import re
 from pathlib import Path
 from typing import Any
 
@@ -34,7 +40,12 @@ EXTRA = {
     "map": {"grid": {"x": AXIS, "y": {"min": 0.4, "max": 0.5, "step": 0.1}, "z": 0.1, "yaw": 0.0}},
     "optimize": {"bounds": {"x": [-0.1, 0.1], "y": [0.4, 0.5], "yaw": [-0.2, 0.2]}, "z": 0.1},
 }
-READ = {"left_out_links": ["world"], "left_out_count": 1}
+READ = {
+    "left_out_links": ["world"],
+    "left_out_count": 1,
+    "continuous_joints": [],
+    "unlimited_joints": [],
+}
 
 
 def body(route: str, urdf: str) -> dict[str, Any]:
@@ -90,3 +101,21 @@ def test_a_link_with_collision_geometry_and_no_joint_is_refused(client: TestClie
     (detail,) = response.json()["detail"]
     assert detail["loc"] == ["body", "robot", "urdf"]
     assert "2 root links ('base_link', 'table')" in detail["msg"]
+
+
+def test_a_continuous_joint_is_read_as_revolute_and_said(client: TestClient) -> None:
+    start = UR5.index('<joint name="wrist_3_joint"')
+    end = UR5.index("</joint>", start)
+    joint = re.sub(r' (lower|upper)="[^"]*"', "", UR5[start:end])
+    unlimited = UR5[:start] + joint.replace('type="revolute"', 'type="continuous"') + UR5[end:]
+    wide = UR5[:start] + joint.replace("<limit ", '<limit lower="-1000" upper="1000" ') + UR5[end:]
+    for route in ("evaluate", "map"):
+        read, plain = answer(client, route, unlimited), answer(client, route, wide)
+        assert read["robot_read"] == {
+            "left_out_links": [],
+            "left_out_count": 0,
+            "continuous_joints": ["wrist_3_joint"],
+            "unlimited_joints": ["wrist_3_joint"],
+        }
+        assert plain["robot_read"] is None
+        assert {**read, "robot_read": None} == plain
