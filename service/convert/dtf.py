@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from service import schemas
+from service.convert.robots import robot_read_of
 from solver.core.dtf import DtfResult
 from solver.core.robots import Robot
 
@@ -20,4 +21,5 @@ def dtf_response(
         method=result.method,
         yoshikawa=yoshikawa,
         chiu=chiu,
+        robot_read=robot_read_of(robot),
     )

@@ -9,6 +9,7 @@ from pydantic_core import PydanticCustomError
 
 from service.schemas.common import RequestModel, ResponseModel, UnitVector
 from service.schemas.robot import Robot
+from service.schemas.robot_read import ROBOT_READ, RobotRead
 
 MIN_H = 1e-300  # m: below it (subnormal numbers) 1 / h overflows
 MAX_H = 1e300
@@ -124,3 +125,4 @@ class DtfResponse(ResponseModel):
         description="Chiu's directional index [t^T (J J^T)^-1 t]^(-1/2), t = [u_T; u_R / h] "
         "normalised (mixed units), for comparison; 0 when t is out of reach."
     )
+    robot_read: RobotRead | None = Field(default=None, description=ROBOT_READ)

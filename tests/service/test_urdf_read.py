@@ -24,9 +24,11 @@ import pinocchio as pin
 import pytest
 from fastapi.testclient import TestClient
 
+from service.schemas import DtfRequest
 from solver.core.native_stderr import native_stderr
 from solver.core.robots import example_robot_data_dir
 from tests.cases import ROOT
+from tests.service.conftest import example_body
 from tests.service.test_job_results import done_job
 
 UR5 = (example_robot_data_dir() / "ur_description" / "urdf" / "ur5_robot.urdf").read_text()
@@ -50,6 +52,8 @@ READ = {
 
 def body(route: str, urdf: str) -> dict[str, Any]:
     robot = {"urdf": urdf, "base_frame": "base", "tool_frame": "tool0"}
+    if route == "dtf":  # the example's configuration and direction, on this robot
+        return {**example_body(DtfRequest), "robot": robot}
     return {"robot": robot, "path": PATH, **EXTRA[route]}
 
 
@@ -69,7 +73,7 @@ def test_the_document_has_a_stray_link_pinocchio_refuses() -> None:
     assert pin.buildModelFromXML(BY_HAND).nq == 6
 
 
-@pytest.mark.parametrize("route", ["evaluate", "map", "optimize"])
+@pytest.mark.parametrize("route", ["evaluate", "map", "optimize", "dtf"])
 def test_each_route_answers_as_without_the_link_and_says_it(client: TestClient, route: str) -> None:
     left_out, by_hand = answer(client, route, STRAY), answer(client, route, BY_HAND)
     assert left_out["robot_read"] == READ and by_hand["robot_read"] is None
@@ -109,7 +113,7 @@ def test_a_continuous_joint_is_read_as_revolute_and_said(client: TestClient) -> 
     joint = re.sub(r' (lower|upper)="[^"]*"', "", UR5[start:end])
     unlimited = UR5[:start] + joint.replace('type="revolute"', 'type="continuous"') + UR5[end:]
     wide = UR5[:start] + joint.replace("<limit ", '<limit lower="-1000" upper="1000" ') + UR5[end:]
-    for route in ("evaluate", "map"):
+    for route in ("evaluate", "map", "dtf"):
         read, plain = answer(client, route, unlimited), answer(client, route, wide)
         assert read["robot_read"] == {
             "left_out_links": [],
