@@ -81,7 +81,7 @@ def joint_path_of(rows: list[list[float]], robot: Robot) -> np.ndarray:
         if len(row) != robot.dof:
             raise InvalidInputError(
                 "joint_path",
-                f"{len(row)} values but {robot.name!r} has {robot.dof} joints",
+                f"{len(row)} values but {robot.shown_name!r} has {robot.dof} joints",
                 waypoint=i,
             )
     return np.array(rows, dtype=float)

@@ -7,29 +7,14 @@ by its own name (:func:`shown_name`); answers say what was changed in a request'
 
 from __future__ import annotations
 
-import re
-
 from service import schemas
 from solver.core.exceptions import MAX_LISTED_NAMES, cut
 from solver.core.robots import Robot
 
-_URDF_NAME = re.compile(r"<robot\b[^>]*?\bname\s*=\s*([\"'])(.*?)\1", re.S)
-SHOWN_NAME_CHARACTERS = 60
-"""A URDF's own name is cut to this length in a picture's title."""
-
 
 def shown_name(robot: Robot) -> str:
-    """The robot's name in a picture's title: a request's URDF by its own ``<robot name>``.
-
-    A robot read from a request's URDF is named ``urdf`` in the solver (a name that keys
-    nothing of the catalogue's, as the published capsule radii); its picture says which arm
-    it is: ``abb_irb2400 (URDF)``. Any other robot keeps its name.
-    """
-    if robot.name != "urdf" or robot.urdf is None:
-        return robot.name
-    match = _URDF_NAME.search(robot.urdf)
-    own = match.group(2).strip()[:SHOWN_NAME_CHARACTERS] if match else ""
-    return f"{own} (URDF)" if own else "URDF"
+    """The robot's name in a picture's title (:attr:`solver.core.robots.Robot.shown_name`)."""
+    return robot.shown_name
 
 
 def robot_read_of(robot: Robot) -> schemas.RobotRead | None:

@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import dataclasses
 import importlib.metadata
+import re
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -29,6 +30,10 @@ from solver.core.urdf_chain import (
     frame_names,
 )
 from solver.core.urdf_structure import Mimic
+
+_URDF_NAME = re.compile(r"<robot\b[^>]*?\bname\s*=\s*([\"'])(.*?)\1", re.S)
+SHOWN_NAME_CHARACTERS = 60
+"""A URDF's own name is cut to this length where it is shown (:attr:`Robot.shown_name`)."""
 
 __all__ = [
     "Robot",
@@ -89,6 +94,22 @@ class Robot:
     def dof(self) -> int:
         """Number of joints n."""
         return len(self.joint_names)
+
+    @property
+    def shown_name(self) -> str:
+        """The robot's name as answers and pictures show it: a request's URDF by its own name.
+
+        A robot read from a request's URDF is named ``urdf`` (a name that keys nothing of the
+        catalogue's, as the published capsule radii); shown, it says which arm it is:
+        ``abb_irb2400 (URDF)`` from ``<robot name="abb_irb2400">`` (cut to
+        SHOWN_NAME_CHARACTERS), ``URDF`` where the document names none. Any other robot
+        keeps its name.
+        """
+        if self.name != "urdf" or self.urdf is None:
+            return self.name
+        match = _URDF_NAME.search(self.urdf)
+        own = match.group(2).strip()[:SHOWN_NAME_CHARACTERS] if match else ""
+        return f"{own} (URDF)" if own else "URDF"
 
     @property
     def tool_point_frame(self) -> int:

@@ -237,7 +237,7 @@ def check_spin_mode(robot: Robot, spin_mode: str) -> None:
     if spin_mode == "free" and robot.dof not in (6, 7):
         raise InvalidInputError(
             "spin_mode",
-            f"free spin is solved for six- and seven-joint arms; {robot.name!r} has "
+            f"free spin is solved for six- and seven-joint arms; {robot.shown_name!r} has "
             f"{robot.dof} joints",
         )
 
@@ -248,6 +248,6 @@ def require_family(robot: Robot) -> KinematicsFamily:
         raise NoAnalyticIkError(
             "robot",
             f"path evaluation needs an arm with an IK family (UR, OPW, or numeric for a serial "
-            f"chain of six joints or more); {robot.name!r} has none",
+            f"chain of six joints or more); {robot.shown_name!r} has none",
         )
     return robot.family

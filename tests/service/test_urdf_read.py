@@ -123,3 +123,24 @@ def test_a_continuous_joint_is_read_as_revolute_and_said(client: TestClient) -> 
         }
         assert plain["robot_read"] is None
         assert {**read, "robot_read": None} == plain
+
+
+def test_errors_name_a_urdf_robot_by_its_own_name(client: TestClient) -> None:
+    # Not "urdf" (the solver's name of every request's URDF): <robot name="ur5"> as "ur5 (URDF)".
+    assert '<robot name="ur5"' in UR5
+    rails = "".join(
+        f'<link name="rail{k}"/><joint name="rail{k}_joint" type="prismatic">'
+        f'<parent link="rail{k}"/><child link="{child}"/><axis xyz="1 0 0"/>'
+        '<limit lower="0" upper="2" effort="100" velocity="1"/></joint>'
+        for k, child in ((0, "rail1"), (1, "world"))
+    )  # two rails under the arm's root: eight joints
+    request = body("evaluate", UR5.replace("</robot>", rails + "</robot>"))
+    request["robot"]["base_frame"] = "rail0"
+    response = client.post("/v1/evaluate", json={**request, "spin_mode": "free"})
+    assert response.status_code == 422, response.text[:300]
+    assert "six- and seven-joint arms; 'ur5 (URDF)' has 8 joints" in response.text
+    rows = [[0.0] * 5] * len(PATH["waypoints"])  # five values a row for a six-joint arm
+    request = {**body("evaluate", UR5), "joint_path": rows}
+    response = client.post("/v1/evaluate", json=request)
+    assert response.status_code == 422, response.text[:300]
+    assert "5 values but 'ur5 (URDF)' has 6 joints" in response.text

@@ -143,8 +143,8 @@ def _radii(
         if len(link_radii) != count:
             raise InvalidInputError(
                 "cell.link_radii",
-                f"{len(link_radii)} radii for {robot.name!r}: give {count}, the base's and one "
-                f"per joint ({', '.join(robot.joint_names)})",
+                f"{len(link_radii)} radii for {robot.shown_name!r}: give {count}, the base's and "
+                f"one per joint ({', '.join(robot.joint_names)})",
             )
         return tuple(link_radii)
     if robot.name in PUBLISHED_RADII:
@@ -152,7 +152,7 @@ def _radii(
     if needed:
         raise InvalidInputError(
             "cell.link_radii",
-            f"{robot.name!r} has no collision geometry and no published link radii: give "
+            f"{robot.shown_name!r} has no collision geometry and no published link radii: give "
             f"link_radii, {count} values in m (the base's, then one per joint)",
         )
     return None
