@@ -4,7 +4,9 @@ pinocchio's parser (urdfdom) is run with its stderr captured (:mod:`solver.core.
 so that a refusal carries its reason; what pinocchio leaves unsaid (two root links, mimic joints
 between base and tool) is read from the document itself (:mod:`solver.core.urdf_structure`).
 A link no joint names (a ROS 2 generated UR5e's ``world``) is taken out of the document before
-it is read (:func:`without_stray_links`), and answers name it.
+it is read (:func:`without_stray_links`), continuous joints are read as revolute ones with no
+position limit where the file gives none (:func:`readable_urdf`, :func:`unlimit`), and answers
+say both (:class:`UrdfReading`).
 A request's speed limits, one per coordinate, cannot name a mimic joint: they are checked
 against the mimic joints' own (:func:`check_mimic_speed_limits`). Names in messages are cut (a
 request may send a name of megabytes).

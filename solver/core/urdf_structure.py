@@ -6,7 +6,9 @@ joint of its own, so an arm whose joints are coupled (ABB IRB 5400's joint5b fol
 would be answered with joint paths that break the coupling. This module reads the document's
 structure itself, so that both are said in the answer (robots.md section 4), and finds the
 links joined to nothing (:func:`stray_links`: a ROS 2 generated UR5e's ``<link name="world"/>``,
-whose joint the generator left out), which :func:`without_links` takes out of the document.
+whose joint the generator left out), which :func:`without_links` takes out of the document, and
+the ``continuous`` joints, which :func:`continuous_as_revolute` makes revolute (pinocchio gives
+such a joint two coordinates, the solver takes one angle a joint).
 """
 
 from __future__ import annotations
@@ -120,7 +122,7 @@ def continuous_as_revolute(urdf: str) -> tuple[str, list[ContinuousJoint]]:
     pinocchio models a continuous joint by (cos, sin), two coordinates for one angle; the
     solver takes one angle a joint. A revolute joint needs a ``<limit>``: one is added where the
     joint has none (no speed limit: the request must give one); where ``lower`` or ``upper`` is
-    missing, pinocchio reads 0, which the caller replaces (:func:`ContinuousJoint`). The
+    missing, pinocchio reads 0, which the caller replaces (:class:`ContinuousJoint`). The
     document is returned as it is where it has no continuous joint.
     """
     root = _tree(urdf)
