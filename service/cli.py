@@ -205,7 +205,8 @@ def _chained(
 
     ``robot``: the request's (:func:`_robot`); ``read``: the answer's ``recognised`` and
     ``robot_read``. Solved numerically, the base frames from which the chain has a closed form
-    are named; links taken out of the file are named on a line of their own.
+    are named; what the service changed in the file (links left out, continuous joints) is
+    said on lines of their own.
     """
     recognised, robot_read = read
     if not args.robot.lower().endswith(".urdf"):

@@ -29,7 +29,7 @@ from service.convert.evaluate import evaluate_response
 from service.convert.maps import MapGrid, check_png_size, map_grid, map_response
 from service.convert.optimize import bounds_of, optimize_response
 from service.convert.path_read import pass_at, path_read_of
-from service.convert.robots import robot_info, robot_read_of, shown_name
+from service.convert.robots import robot_info, robot_read_of
 
 __all__ = [
     "MapGrid",
@@ -56,7 +56,6 @@ __all__ = [
     "robot_from_schema",
     "robot_info",
     "robot_read_of",
-    "shown_name",
     "spin_mode_of",
     "spun_poses",
     "wants_png",

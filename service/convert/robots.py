@@ -1,8 +1,8 @@
-"""The robot in answers: a catalogue entry, a robot's name in pictures, its URDF's reading.
+"""The robot in answers: a catalogue entry, and what was changed in a request's URDF.
 
-``GET /v1/robots`` shows catalogue robots (:func:`robot_info`); pictures name a request's URDF
-by its own name (:func:`shown_name`); answers say what was changed in a request's URDF
-(:func:`robot_read_of`).
+``GET /v1/robots`` shows catalogue robots (:func:`robot_info`); answers say what was changed in
+a request's URDF (:func:`robot_read_of`). Pictures and messages name a request's URDF robot by
+its own name (:attr:`solver.core.robots.Robot.shown_name`).
 """
 
 from __future__ import annotations
@@ -10,11 +10,6 @@ from __future__ import annotations
 from service import schemas
 from solver.core.exceptions import MAX_LISTED_NAMES, cut
 from solver.core.robots import Robot
-
-
-def shown_name(robot: Robot) -> str:
-    """The robot's name in a picture's title (:attr:`solver.core.robots.Robot.shown_name`)."""
-    return robot.shown_name
 
 
 def robot_read_of(robot: Robot) -> schemas.RobotRead | None:

@@ -89,13 +89,13 @@ def joint_use_png(
         )
         why = f"{evaluation.reason}{where}" if evaluation.reason else "mu_path is 0"
         return render_message(
-            f"{convert.shown_name(robot)}: the path does not run at this placement ({why}); no "
+            f"{robot.shown_name}: the path does not run at this placement ({why}); no "
             "joint speeds to draw (POST /v1/evaluate says more)"
         )
     check = check_feed(
         evaluation, index if feed is None else feed, robot.qdot_max, qddot_max=robot.qddot_max
     )
-    return render_joint_use(check, evaluation, robot.joint_names, title=convert.shown_name(robot))
+    return render_joint_use(check, evaluation, robot.joint_names, title=robot.shown_name)
 
 
 def evaluation_of(

@@ -113,4 +113,4 @@ def map_png(result: CapabilityMap, robot: Robot) -> bytes:
     from service.render import render_png  # matplotlib only where a picture is drawn
 
     index = "mu_path" if result.mu_acc is None else "mu_acc"
-    return render_png(result, title=f"{convert.shown_name(robot)}: {index}")
+    return render_png(result, title=f"{robot.shown_name}: {index}")

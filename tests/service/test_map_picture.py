@@ -212,7 +212,6 @@ def test_the_kept_figures_hold_no_more_pixels_than_their_bound(monkeypatch) -> N
 def test_a_urdf_robots_picture_is_titled_by_the_urdfs_own_name(monkeypatch) -> None:
     # A request's URDF is "urdf" in the solver; its picture names the arm the URDF declares.
     import service.render
-    from service.convert import shown_name
     from service.operations.map import map_png
     from solver.core.robots import example_robot_data_dir
     from solver.families import get_robot, robot_from_urdf
@@ -228,4 +227,4 @@ def test_a_urdf_robots_picture_is_titled_by_the_urdfs_own_name(monkeypatch) -> N
     assert arm.name == "urdf"  # the solver's name, which keys nothing of the catalogue's
     nameless = robot_from_urdf(re.sub(r'name="cell_7_arm"', 'name=""', renamed, count=1),
                                base_frame="base", tool_frame="tool0")  # fmt: skip
-    assert shown_name(nameless) == "URDF"
+    assert nameless.shown_name == "URDF"
