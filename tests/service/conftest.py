@@ -5,6 +5,7 @@ from __future__ import annotations
 import copy
 import importlib.metadata
 from collections.abc import Iterator
+from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
 
@@ -65,6 +66,20 @@ def sent_back(placement: dict[str, Any]) -> dict[str, Any]:
     return {key: placement[key] for key in ("x", "y", "z", "yaw", "spin")}
 
 
+@contextmanager
+def served_with(settings: Settings) -> Iterator[None]:
+    """The app's routes and jobs run with ``settings`` while the block runs."""
+
+    async def given() -> Settings:
+        return settings
+
+    app.dependency_overrides[_settings] = given
+    try:
+        yield
+    finally:
+        app.dependency_overrides.pop(_settings)
+
+
 @pytest.fixture
 def own_store(tmp_path: Path) -> Iterator[Path]:
     """The app with its jobs in ``tmp_path``: a queue no other test of this process fills.
@@ -72,11 +87,5 @@ def own_store(tmp_path: Path) -> Iterator[Path]:
     The session's store is shared with the in-process fuzz, whose queued jobs may fill the
     queue to its limit (checked in the insert's transaction): a POST would then be a 429.
     """
-    settings = Settings(data_dir=tmp_path, workers=1)
-
-    async def own() -> Settings:
-        return settings
-
-    app.dependency_overrides[_settings] = own
-    yield tmp_path
-    app.dependency_overrides.pop(_settings)
+    with served_with(Settings(data_dir=tmp_path, workers=1)):
+        yield tmp_path

@@ -19,9 +19,8 @@ from fastapi.testclient import TestClient
 
 from service.cli import OK, main
 from service.config import Settings
-from service.deps import _settings
-from service.main import app
 from tests.cases import ROOT
+from tests.service.conftest import served_with
 
 PROGRAM = ROOT / "examples" / "cam" / "nx_slot_plate.cls"
 TEXT = PROGRAM.read_text()
@@ -102,14 +101,8 @@ def test_a_path_of_poses_or_axes_has_no_reading(client: TestClient, route: str, 
 @pytest.fixture
 def own_store(tmp_path: Path) -> Iterator[Path]:
     """The app with its jobs in ``tmp_path`` (a queue no other test fills), room for the search."""
-    settings = Settings(data_dir=tmp_path, workers=1, max_job_poses=1_000_000)
-
-    async def own() -> Settings:
-        return settings
-
-    app.dependency_overrides[_settings] = own
-    yield tmp_path
-    app.dependency_overrides.pop(_settings)
+    with served_with(Settings(data_dir=tmp_path, workers=1, max_job_poses=1_000_000)):
+        yield tmp_path
 
 
 @pytest.mark.parametrize("kind", ["evaluate", "optimize", "map"])

@@ -13,10 +13,9 @@ import pytest
 from fastapi.testclient import TestClient
 
 from service.config import Settings
-from service.deps import _settings
 from service.jobs.store import JobStore
-from service.main import app
 from tests.cases import ROOT
+from tests.service.conftest import served_with
 
 EXAMPLE = json.loads((ROOT / "examples" / "evaluate_request.json").read_text())
 SHORT_PATH = {"waypoints": EXAMPLE["path"]["waypoints"][:20]}
@@ -79,13 +78,8 @@ def paged_store(tmp_path: Path) -> Iterator[Settings]:
         max_job_cells=2500,
         max_job_poses=50_000,
     )
-
-    async def own() -> Settings:
-        return settings
-
-    app.dependency_overrides[_settings] = own
-    yield settings
-    app.dependency_overrides.pop(_settings)
+    with served_with(settings):
+        yield settings
 
 
 def done_job(client: TestClient, job_id: str) -> dict[str, Any]:

@@ -13,9 +13,8 @@ import pytest
 from fastapi.testclient import TestClient
 
 from service.config import Settings
-from service.deps import _settings
-from service.main import app
 from tests.cases import ROOT
+from tests.service.conftest import served_with
 
 EXAMPLE = json.loads((ROOT / "examples" / "evaluate_request.json").read_text())
 GRID = {"x": {"min": -0.1, "max": 0.1, "step": 0.1}, "y": 0.45, "z": 0.1, "yaw": 0.0}
@@ -92,14 +91,8 @@ def corrupt_store(tmp_path: Path) -> Iterator[Path]:
     """The app with its jobs in ``tmp_path``, whose store file is not a database."""
     path = tmp_path / "jobs.sqlite3"
     path.write_bytes(b"not a database" * 100)
-    settings = Settings(data_dir=tmp_path, workers=1)
-
-    async def corrupt() -> Settings:
-        return settings
-
-    app.dependency_overrides[_settings] = corrupt
-    yield path
-    app.dependency_overrides.pop(_settings)
+    with served_with(Settings(data_dir=tmp_path, workers=1)):
+        yield path
 
 
 def test_a_corrupt_store_takes_down_the_job_routes_only(
