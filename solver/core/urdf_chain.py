@@ -61,33 +61,36 @@ def readable_urdf(
 ) -> tuple[str, list[ContinuousJoint], tuple[str, ...]]:
     """The document pinocchio reads for a request's URDF: stray links out, continuous revolute.
 
-    Returns the document, its continuous joints (:func:`unlimit` takes them once the model is
-    read) and the links left out (:func:`without_stray_links`, ``frames`` as there).
+    Returns the document, its continuous joints (for :func:`chain_from_urdf`) and the links
+    left out (:func:`without_stray_links`, ``frames`` as there).
     """
     urdf, left_out = without_stray_links(urdf, frames=frames)
     urdf, continuous = continuous_as_revolute(urdf)
     return urdf, continuous, left_out
 
 
-def unlimit(model: pin.Model, continuous: Sequence[ContinuousJoint]) -> tuple[str, ...]:
+def unlimited(model: pin.Model, continuous: Sequence[ContinuousJoint]) -> tuple[str, ...]:
+    """The joints of ``model`` among ``continuous`` whose URDF gives no lower or no upper."""
+    return tuple(
+        joint.name
+        for joint in continuous
+        if model.existJointName(joint.name) and (joint.lower is None or joint.upper is None)
+    )
+
+
+def unlimit(model: pin.Model, continuous: Sequence[ContinuousJoint]) -> None:
     """Give the model's continuous joints no position limit where their URDF gives none.
 
     pinocchio read 0 for a missing ``lower`` or ``upper`` of a continuous joint made revolute;
-    that side becomes -inf or +inf. Returns the joints of ``model`` so changed.
+    that side becomes -inf or +inf (:func:`chain_from_urdf` calls this).
     """
-    changed = []
-    for joint in continuous:
-        if not model.existJointName(joint.name) or (
-            joint.lower is not None and joint.upper is not None
-        ):
-            continue
-        index = model.joints[model.getJointId(joint.name)].idx_q
-        if joint.lower is None:
+    by_name = {joint.name: joint for joint in continuous}
+    for name in unlimited(model, continuous):
+        index = model.joints[model.getJointId(name)].idx_q
+        if by_name[name].lower is None:
             model.lowerPositionLimit[index] = -np.inf
-        if joint.upper is None:
+        if by_name[name].upper is None:
             model.upperPositionLimit[index] = np.inf
-        changed.append(joint.name)
-    return tuple(changed)
 
 
 def without_stray_links(urdf: str, *, frames: tuple[str, ...]) -> tuple[str, tuple[str, ...]]:
@@ -116,7 +119,9 @@ def without_stray_links(urdf: str, *, frames: tuple[str, ...]) -> tuple[str, tup
     return without_links(urdf, set(stray)), tuple(stray)
 
 
-def chain_from_urdf(urdf: str, *, tool_frame: str) -> pin.Model:
+def chain_from_urdf(
+    urdf: str, *, tool_frame: str, continuous: Sequence[ContinuousJoint] = ()
+) -> pin.Model:
     """Read the serial chain from the root to ``tool_frame`` out of URDF text.
 
     Joints that do not move the tool frame (grippers, fingers) are locked at their neutral
@@ -125,6 +130,9 @@ def chain_from_urdf(urdf: str, *, tool_frame: str) -> pin.Model:
     Args:
         urdf: the URDF document.
         tool_frame: link or frame of the tool flange.
+        continuous: the document's continuous joints made revolute (:func:`readable_urdf`):
+            those without limits get none (:func:`unlimit`) before a mimic joint's own limits
+            narrow its leader's.
 
     Raises:
         RobotModelError: the URDF cannot be parsed, the frame is missing or no joint moves it.
@@ -176,6 +184,7 @@ def chain_from_urdf(urdf: str, *, tool_frame: str) -> pin.Model:
     model = pin.buildReducedModel(full, locked, pin.neutral(full)) if locked else full
     if model.nv == 0:
         raise RobotModelError("robot.tool_frame", f"no joint moves frame {quoted(tool_frame)}")
+    unlimit(model, continuous)
     for mimic in coupled:
         _limit_leader(model, mimic)
     return model

@@ -17,7 +17,7 @@ import pinocchio as pin
 from solver.core.exceptions import RobotModelError, UnknownRobotError
 from solver.core.family import KinematicsFamily
 from solver.core.robots import Robot, chain_from_urdf, robot_from_model
-from solver.core.urdf_chain import UrdfReading, chain_mimics, readable_urdf, unlimit
+from solver.core.urdf_chain import UrdfReading, chain_mimics, readable_urdf, unlimited
 from solver.families.numeric.chain import SerialChain
 from solver.families.numeric.family import NumericFamily
 from solver.families.recognise import recognised_family
@@ -73,8 +73,7 @@ def closed_form_bases(urdf: str, *, tool_frame: str) -> list[str]:
         RobotModelError: the URDF cannot be parsed or has no ``tool_frame``.
     """
     urdf, continuous, _ = readable_urdf(urdf, frames=(tool_frame,))
-    model = chain_from_urdf(urdf, tool_frame=tool_frame)
-    unlimit(model, continuous)
+    model = chain_from_urdf(urdf, tool_frame=tool_frame, continuous=continuous)
     if model.nv != 6:  # the closed forms are six-joint arms'
         return []
     found = []
@@ -136,8 +135,7 @@ def robot_from_urdf(
             pass the mimic's own limit (:func:`solver.core.urdf_chain.check_mimic_speed_limits`).
     """
     urdf, continuous, left_out = readable_urdf(urdf, frames=(base_frame, tool_frame))
-    model = chain_from_urdf(urdf, tool_frame=tool_frame)
-    unlimited = unlimit(model, continuous)
+    model = chain_from_urdf(urdf, tool_frame=tool_frame, continuous=continuous)
     if family is None and model.existFrame(base_frame) and model.existFrame(tool_frame):
         family = default_family(model, base_frame=base_frame, tool_frame=tool_frame)
     robot = robot_from_model(
@@ -150,5 +148,5 @@ def robot_from_urdf(
         mimics=chain_mimics(urdf, model),
     )
     on_chain = [j.name for j in continuous if model.existJointName(j.name)]
-    reading = UrdfReading(left_out, tuple(on_chain), unlimited)
+    reading = UrdfReading(left_out, tuple(on_chain), unlimited(model, continuous))
     return dataclasses.replace(robot, urdf=urdf, reading=reading)

@@ -102,6 +102,21 @@ def test_the_chain_reads_six_coordinates_and_the_mimics_limits_narrow_its_leader
     assert narrow.q_upper[4] == pytest.approx(1.2 / 1.5)
 
 
+def test_a_continuous_leader_without_limits_takes_its_mimics_limits() -> None:
+    # j5 continuous with no lower or upper (no position limit of its own): the mimic joint's
+    # own limits still narrow it, as for a revolute leader (not left at -inf..inf, not at the
+    # 0..0 pinocchio reads for a revolute joint without them).
+    text = arm_urdf(0.5, mimic_limit=1.0)
+    start = text.index('<joint name="j5" type="revolute">')
+    end = text.index("</joint>", start)
+    j5 = text[start:end].replace('type="revolute"', 'type="continuous"')
+    j5 = j5.replace('lower="-2.5" upper="2.5" ', "")
+    robot = robot_from_urdf(text[:start] + j5 + text[end:], base_frame="l0", tool_frame="tool0")
+    assert robot.reading.continuous_joints == ("j5",) == robot.reading.unlimited_joints
+    assert robot.q_lower[4] == pytest.approx(-0.8 / 1.5)  # -1 <= -1.5 q5 + 0.2 <= 1
+    assert robot.q_upper[4] == pytest.approx(1.2 / 1.5)
+
+
 @pytest.mark.parametrize("mimic_speed", [0.5, 100.0])  # the tighter limit, and a loose one
 def test_the_path_keeps_the_coupling_and_runs_at_the_coupled_lp(mimic_speed: float) -> None:
     robot, path = arm(mimic_speed)
