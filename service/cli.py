@@ -205,8 +205,8 @@ def _chained(
 
     ``robot``: the request's (:func:`_robot`); ``read``: the answer's ``recognised`` and
     ``robot_read``. Solved numerically, the base frames from which the chain has a closed form
-    are named; what the service changed in the file (links left out, continuous joints) is
-    said on lines of their own.
+    are named; what the service changed in the file (links left out, continuous joints, joints
+    locked) is said on lines of their own.
     """
     recognised, robot_read = read
     if not args.robot.lower().endswith(".urdf"):
@@ -237,6 +237,8 @@ def _read_lines(read: RobotRead) -> list[str]:
         if read.unlimited_joints:
             line += f"; no position limit (the URDF gives none): {_names(read.unlimited_joints)}"
         lines.append(line)
+    if read.locked_joints:
+        lines.append(f"robot: locked at 0, they move no tool: {_names(read.locked_joints)}")
     return lines
 
 

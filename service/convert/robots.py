@@ -13,16 +13,22 @@ from solver.core.robots import Robot
 
 
 def robot_read_of(robot: Robot) -> schemas.RobotRead | None:
-    """What was changed in the robot's URDF before it was read; None where nothing was."""
+    """What was changed in a request's URDF before it was read; None where nothing was.
+
+    None for a catalogue robot too (the catalogue says how each arm is read: the Panda's
+    fingers locked, the Jaco2's continuous joints revolute).
+    """
     reading = robot.reading
     left_out = reading.left_out_links
-    if not (left_out or reading.continuous_joints):
+    changed = left_out or reading.continuous_joints or reading.locked_joints
+    if robot.name != "urdf" or not changed:
         return None
     return schemas.RobotRead(
         left_out_links=[cut(name) for name in left_out[:MAX_LISTED_NAMES]],
         left_out_count=len(left_out),
         continuous_joints=[cut(name) for name in reading.continuous_joints],
         unlimited_joints=[cut(name) for name in reading.unlimited_joints],
+        locked_joints=[cut(name) for name in reading.locked_joints],
     )
 
 

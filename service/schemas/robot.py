@@ -85,9 +85,9 @@ class UrdfRobot(RobotOptions):
     urdf: str = Field(
         min_length=1,
         description="URDF document of a serial arm (lengths in m, angles in rad); joints that do "
-        "not move tool_frame are locked; links no joint names are left out and continuous joints "
-        "read as revolute ones (no position limit where the file gives none), answers saying so "
-        "in robot_read.",
+        "not move tool_frame are locked at 0; links no joint names are left out and continuous "
+        "joints read as revolute ones (no position limit where the file gives none); answers "
+        "say all three in robot_read.",
     )
     base_frame: str = Field(
         min_length=1,

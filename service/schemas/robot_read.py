@@ -5,7 +5,8 @@ rather than refusing a file as its generator wrote it or reading it otherwise wi
 a link that no joint names has no pose and is no part of the robot, and pinocchio refuses the
 document for it (two root links), so the service takes it out (a ROS 2 generated UR5e's
 ``<link name="world"/>``, whose joint the generator left out); a ``continuous`` joint (Kinova's
-arms) is read as a revolute joint, with no position limit where the file gives none.
+arms) is read as a revolute joint, with no position limit where the file gives none; a joint
+that moves but not the tool frame (a gripper's fingers) is locked at 0.
 """
 
 from __future__ import annotations
@@ -26,6 +27,7 @@ class RobotRead(ResponseModel):
                     "left_out_count": 1,
                     "continuous_joints": [],
                     "unlimited_joints": [],
+                    "locked_joints": [],
                 }
             ]
         }
@@ -49,10 +51,16 @@ class RobotRead(ResponseModel):
         "position limit on that side (a continuous joint has none in URDF's own terms), only "
         "the speed limit."
     )
+    locked_joints: list[str] = Field(
+        description="The document's joints that move but not tool_frame (a gripper's fingers, "
+        "an arm's second branch), in its order: locked at 0 (their geometry, in a cell, "
+        "where 0 puts it)."
+    )
 
 
 ROBOT_READ = (
-    "When the robot is a URDF the service changed before reading it (links no joint names left "
-    "out, continuous joints read as revolute ones): what; null otherwise."
+    "When the robot is a request's URDF the service changed before reading it (links no joint "
+    "names left out, continuous joints read as revolute ones, joints off the chain locked): "
+    "what; null otherwise (and for catalogue robots)."
 )
 """The description of every answer's ``robot_read`` field."""

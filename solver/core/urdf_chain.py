@@ -49,11 +49,14 @@ class UrdfReading:
             (:func:`solver.core.urdf_structure.continuous_as_revolute`).
         unlimited_joints: those of them whose ``<limit>`` gives no lower or upper: that side
             has no position limit (a continuous joint has none in URDF's own terms).
+        locked_joints: the document's joints that move but not the tool frame (a gripper's
+            fingers), held at 0 (:func:`chain_from_urdf`).
     """
 
     left_out_links: tuple[str, ...] = ()
     continuous_joints: tuple[str, ...] = ()
     unlimited_joints: tuple[str, ...] = ()
+    locked_joints: tuple[str, ...] = ()
 
 
 def readable_urdf(
@@ -125,7 +128,8 @@ def chain_from_urdf(
     """Read the serial chain from the root to ``tool_frame`` out of URDF text.
 
     Joints that do not move the tool frame (grippers, fingers) are locked at their neutral
-    position, so the model is the chain from the root to ``tool_frame``.
+    position (0: pinocchio's for a revolute or prismatic joint), so the model is the chain from
+    the root to ``tool_frame``.
 
     Args:
         urdf: the URDF document.

@@ -180,6 +180,14 @@ def uses_xacro(urdf: str) -> bool:
     return any(element.tag.startswith(prefix) for element in root.iter())
 
 
+def movable_joints(urdf: str) -> list[str]:
+    """The names of the document's joints that are not ``fixed``, in its order."""
+    root = _tree(urdf)
+    if root is None:
+        return []
+    return [j.get("name", "") for j in root.findall("joint") if j.get("type") != "fixed"]
+
+
 def joint_count(urdf: str) -> int:
     """How many ``<joint>`` elements the document's robot has (0 where it is no XML)."""
     root = _tree(urdf)

@@ -18,6 +18,7 @@ from solver.core.exceptions import RobotModelError, UnknownRobotError
 from solver.core.family import KinematicsFamily
 from solver.core.robots import Robot, chain_from_urdf, robot_from_model
 from solver.core.urdf_chain import UrdfReading, chain_mimics, readable_urdf, unlimited
+from solver.core.urdf_structure import movable_joints
 from solver.families.numeric.chain import SerialChain
 from solver.families.numeric.family import NumericFamily
 from solver.families.recognise import recognised_family
@@ -116,7 +117,7 @@ def robot_from_urdf(
     (:func:`solver.core.robots.chain_from_urdf`: other joints are locked at their neutral
     position). Links no joint names are left out of the document first, and ``continuous``
     joints read as revolute ones (no position limit where the file gives none); the robot's
-    ``reading`` says so (:func:`solver.core.urdf_chain.readable_urdf`).
+    ``reading`` says so, and which joints are locked (:func:`solver.core.urdf_chain.readable_urdf`).
 
     Args:
         urdf: the URDF document.
@@ -148,5 +149,8 @@ def robot_from_urdf(
         mimics=chain_mimics(urdf, model),
     )
     on_chain = [j.name for j in continuous if model.existJointName(j.name)]
-    reading = UrdfReading(left_out, tuple(on_chain), unlimited(model, continuous))
+    locked = [name for name in movable_joints(urdf) if not model.existJointName(name)]
+    reading = UrdfReading(
+        left_out, tuple(on_chain), unlimited(model, continuous), locked_joints=tuple(locked)
+    )
     return dataclasses.replace(robot, urdf=urdf, reading=reading)

@@ -514,6 +514,7 @@ def test_a_link_no_joint_names_is_left_out_and_said_under_the_robots_line(
         "left_out_count": 1,
         "continuous_joints": [],
         "unlimited_joints": [],
+        "locked_joints": [],
     }
 
 
@@ -531,6 +532,19 @@ def test_continuous_joints_read_as_revolute_are_said_under_the_robots_line(
     assert out.splitlines()[1] == (
         "robot: continuous joints read as revolute: 'wrist_3_joint'; no position limit (the "
         "URDF gives none): 'wrist_3_joint'"
+    )
+
+
+def test_joints_that_move_no_tool_are_said_locked_under_the_robots_line(
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    panda = example_robot_data_dir() / "panda_description" / "urdf" / "panda.urdf"
+    frames = ["--base-frame", "panda_link0", "--tool-frame", "panda_link8"]
+    at = ["evaluate", str(PROGRAM), "--at=0.4,0,0.1,0", "--robot", str(panda), *frames]
+    code, out, _ = run(capsys, *at)
+    assert code in (OK, INFEASIBLE)
+    assert out.splitlines()[1] == (
+        "robot: locked at 0, they move no tool: 'panda_finger_joint1', 'panda_finger_joint2'"
     )
 
 

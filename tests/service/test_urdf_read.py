@@ -47,6 +47,7 @@ READ = {
     "left_out_count": 1,
     "continuous_joints": [],
     "unlimited_joints": [],
+    "locked_joints": [],
 }
 
 
@@ -120,6 +121,7 @@ def test_a_continuous_joint_is_read_as_revolute_and_said(client: TestClient) -> 
             "left_out_count": 0,
             "continuous_joints": ["wrist_3_joint"],
             "unlimited_joints": ["wrist_3_joint"],
+            "locked_joints": [],
         }
         assert plain["robot_read"] is None
         assert {**read, "robot_read": None} == plain
@@ -144,3 +146,20 @@ def test_errors_name_a_urdf_robot_by_its_own_name(client: TestClient) -> None:
     response = client.post("/v1/evaluate", json=request)
     assert response.status_code == 422, response.text[:300]
     assert "5 values but 'ur5 (URDF)' has 6 joints" in response.text
+
+
+def test_joints_that_move_no_tool_are_named_locked_and_catalogue_robots_say_nothing(
+    client: TestClient, panda_urdf: str
+) -> None:
+    # The Panda's URDF with its hand: the fingers move, not the flange (panda_link8). The
+    # oracle is a regex reading of the file: its joints that are not fixed, less the chain's.
+    moving = re.findall(r'<joint name="([^"]+)" type="(?!fixed)[a-z]+"', panda_urdf)
+    chain = [f"panda_joint{k}" for k in range(1, 8)]
+    assert set(chain) < set(moving)
+    robot = {"urdf": panda_urdf, "base_frame": "panda_link0", "tool_frame": "panda_link8"}
+    request = {"robot": robot, "path": PATH, **EXTRA["evaluate"]}
+    read = client.post("/v1/evaluate", json=request).json()["robot_read"]
+    assert read["locked_joints"] == [name for name in moving if name not in chain]
+    assert read["locked_joints"] == ["panda_finger_joint1", "panda_finger_joint2"]
+    catalogue = client.post("/v1/evaluate", json={**request, "robot": {"model": "panda"}})
+    assert catalogue.json()["robot_read"] is None  # the same fingers, the catalogue's own

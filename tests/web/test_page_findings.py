@@ -413,6 +413,7 @@ def test_a_link_no_joint_names_is_no_frame_and_the_map_says_what_the_api_changed
         "left_out_count": 1,
         "continuous_joints": ["wrist_3_joint"],
         "unlimited_joints": ["wrist_3_joint"],
+        "locked_joints": [],
     }
     shown = page.text_content("#ik-line") or ""
     assert shown == (

@@ -388,7 +388,7 @@ function colour(fraction) {  // dark blue -> green -> yellow
 }
 
 // What the API changed in the URDF (robot_read: links no joint names left out, continuous
-// joints read as revolute), said after how its IK is solved.
+// joints read as revolute, joints off the chain locked), said after how its IK is solved.
 function urdfRead(read) {
   if (!read) return "";
   const names = (list) => list.map((n) => `'${n}'`).join(", ");
@@ -396,7 +396,8 @@ function urdfRead(read) {
   return (read.left_out_links.length
     ? `; left out of the URDF, no joint names them: ${names(read.left_out_links)}` + (more ? ` and ${more} more` : "") : "")
     + (read.continuous_joints.length ? `; continuous joints read as revolute: ${names(read.continuous_joints)}` : "")
-    + (read.unlimited_joints.length ? ` (no position limit: ${names(read.unlimited_joints)})` : "");
+    + (read.unlimited_joints.length ? ` (no position limit: ${names(read.unlimited_joints)})` : "")
+    + (read.locked_joints.length ? `; locked at 0, they move no tool: ${names(read.locked_joints)}` : "");
 }
 
 // The map's colour: mu_acc when the request gave acceleration limits (the API then fills it in
