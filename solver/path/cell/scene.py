@@ -92,7 +92,11 @@ def build_scene(robot: Robot, cell: Cell) -> CellScene:
         if not (part == made.cutting and k >= len(cell.fixed))
     ]
     pairs, weights, still = _moving(robot.model, geometry, pairs, n_robot, len(cell.fixed))
-    own = _self_pairs(robot.model, geometry, n_robot, cell.clearance)
+    candidates = _self_candidates(robot.model, geometry, n_robot)
+    # one coal probe for the unchecked pairs' distances and the self pairs' at q = 0
+    distances = _distances(robot.model, geometry, still + candidates)
+    apart = distances[len(still) :]
+    own = [p for p, d in zip(candidates, apart, strict=True) if d > cell.clearance]
     pairs += own
     weights = np.vstack([weights, pair_weights(robot.model, geometry, own, n_robot)])
     for a, b in pairs:
@@ -122,7 +126,7 @@ def build_scene(robot: Robot, cell: Cell) -> CellScene:
             Unchecked(
                 geometry.geometryObjects[a].name, b - n_robot, cell.obstacle_name(b - n_robot), d
             )
-            for (a, b), d in zip(still, _distances(robot.model, geometry, still), strict=True)
+            for (a, b), d in zip(still, distances[: len(still)], strict=True)
         ),
     )
 
@@ -187,10 +191,10 @@ def _distances(
     return [float(r.min_distance) for r in data.distanceResults]
 
 
-def _self_pairs(
-    model: pin.Model, geometry: pin.GeometryModel, n_robot: int, clearance: float
+def _self_candidates(
+    model: pin.Model, geometry: pin.GeometryModel, n_robot: int
 ) -> list[tuple[int, int]]:
-    """Robot parts on joints neither the same nor adjacent, apart at the zero configuration."""
+    """Robot parts on joints neither the same nor adjacent (checked where apart at q = 0)."""
     pairs = []
     for a in range(n_robot):
         for b in range(a + 1, n_robot):
@@ -199,5 +203,4 @@ def _self_pairs(
             if ja == jb or model.parents[ja] == jb or model.parents[jb] == ja:
                 continue
             pairs.append((a, b))
-    distances = _distances(model, geometry, pairs)
-    return [p for p, d in zip(pairs, distances, strict=True) if d > clearance]
+    return pairs
