@@ -125,7 +125,7 @@ def evaluate_response(
     """The response of ``POST /v1/evaluate`` (per-waypoint detail when ``with_waypoints``).
 
     ``path_read``: how the CAM program was read, None for poses and tool axes (and in
-    ``/v1/optimize``'s evaluation, whose answer has it); ``robot_read``: what was taken out of
+    ``/v1/optimize``'s evaluation, whose answer has it); ``robot_read``: what was changed in
     the robot's URDF (:func:`service.convert.robots.robot_read_of`; None in that evaluation
     too); ``failed_in``: the pass and operation of the failed waypoint, of CAM input
     (:func:`service.convert.path_read.pass_at`).

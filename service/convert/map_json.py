@@ -15,13 +15,11 @@ from __future__ import annotations
 import functools
 from typing import Any
 
-import numpy as np
 from pydantic_core import to_json
 
 from service import schemas
-from service.convert.common import branch_to_api, cell_model_to_api
-from service.convert.maps import acceleration_columns, extreme
-from service.convert.robots import robot_read_of
+from service.convert.common import branch_to_api
+from service.convert.maps import acceleration_columns, answer_fields
 from solver.core.codes import FEASIBLE, REASONS
 from solver.core.family import Branch
 from solver.core.robots import Robot
@@ -43,15 +41,7 @@ def map_json(
     """``map_response(cmap, robot, spin_mode=..., path_read=...).model_dump_json()``, as bytes."""
     family = require_family(robot)
     rest = schemas.MapResponse(
-        cells=[],
-        best=extreme(cmap, best=True),
-        worst=extreme(cmap, best=False),
-        feasible_cells=int(np.sum(cmap.reason == FEASIBLE)),
-        spin_mode=spin_mode,
-        recognised=family.recognised,
-        path_read=path_read,
-        robot_read=robot_read_of(robot),
-        **cell_model_to_api(cmap.cell_approximated, cmap.cell_unchecked),
+        cells=[], **answer_fields(cmap, robot, spin_mode=spin_mode, path_read=path_read)
     ).model_dump_json()
     branches = [_branch_text(b) for b in family.branches]
     feasible = (cmap.reason == FEASIBLE).ravel().tolist()

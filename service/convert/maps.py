@@ -169,13 +169,29 @@ def map_response(
             )
         )
     return schemas.MapResponse(
-        cells=cells,
-        best=extreme(cmap, best=True),
-        worst=extreme(cmap, best=False),
-        feasible_cells=int(np.sum(cmap.reason == FEASIBLE)),
-        spin_mode=spin_mode,
-        recognised=require_family(robot).recognised,
-        path_read=path_read,
-        robot_read=robot_read_of(robot),
-        **cell_model_to_api(cmap.cell_approximated, cmap.cell_unchecked),
+        cells=cells, **answer_fields(cmap, robot, spin_mode=spin_mode, path_read=path_read)
     )
+
+
+def answer_fields(
+    cmap: CapabilityMap,
+    robot: Robot,
+    *,
+    spin_mode: SpinMode,
+    path_read: schemas.PathRead | None,
+) -> dict[str, Any]:
+    """The map answer's fields but its cells, as both writers give them.
+
+    :func:`map_response` and :func:`service.convert.map_json.map_json` take them from here, so a
+    field added reaches both.
+    """
+    return {
+        "best": extreme(cmap, best=True),
+        "worst": extreme(cmap, best=False),
+        "feasible_cells": int(np.sum(cmap.reason == FEASIBLE)),
+        "spin_mode": spin_mode,
+        "recognised": require_family(robot).recognised,
+        "path_read": path_read,
+        "robot_read": robot_read_of(robot),
+        **cell_model_to_api(cmap.cell_approximated, cmap.cell_unchecked),
+    }
