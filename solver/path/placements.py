@@ -7,6 +7,7 @@ keeps the arrays in cache, and each placement is reduced to its chosen branch.
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Callable
 from dataclasses import dataclass
 from functools import partial
@@ -71,6 +72,13 @@ class PlacementResults:
     acc_waypoint: np.ndarray | None = None
     acc_joint: np.ndarray | None = None
     v_acc: np.ndarray | None = None
+
+    def taken(self, index: np.ndarray) -> PlacementResults:
+        """The results at the placements ``index`` (an integer array), in its order."""
+        columns = {field.name: getattr(self, field.name) for field in dataclasses.fields(self)}
+        return dataclasses.replace(
+            self, **{name: value[index] for name, value in columns.items() if value is not None}
+        )
 
     @property
     def feed_index(self) -> np.ndarray:

@@ -13,9 +13,9 @@ from solver.core.exceptions import InvalidInputError
 from solver.core.family import Branch
 from solver.families import get_robot
 from solver.families.ur.ik import BRANCHES
-from solver.path.capability_map import grid_axis
+from solver.path.capability_map import grid_axis, serpentine
 from tests.cases import MAP_EVALUATE_RTOL
-from tests.problems import capability_map, evaluate_path
+from tests.problems import capability_map, evaluate_path, evaluate_placements, prepare_path
 from tests.solver.test_evaluate import load_path, wrist_singular_path
 
 
@@ -180,3 +180,30 @@ def test_joint_limit_and_singular_cells_equal_evaluate() -> None:
     assert REASONS[cmap.reason[0, 0, 0, 1]] == "singular"
     cells = [tuple(int(v) for v in c) for c in np.ndindex(cmap.mu_path.shape)]
     assert "singular" in _compare_cells(robot, singular_path, cmap, cells, **kwargs)
+
+
+def test_serpentine_order_is_its_own_inverse() -> None:
+    """Rows alternate direction, so each cell follows a neighbour; applied twice: the identity."""
+    order = serpentine(3, 4)
+    assert order.tolist() == [0, 1, 2, 3, 7, 6, 5, 4, 8, 9, 10, 11]
+    assert order[order].tolist() == list(range(12))
+
+
+@pytest.mark.parametrize("robot_name", ["ur5", "kuka_kr6_r700_sixx", "panda"])
+def test_map_cells_equal_the_placements_in_grid_order(robot_name: str) -> None:
+    """The map evaluates its cells in serpentine order; each answer lands on its own cell.
+
+    Against ``evaluate_placements`` of the placements in C order (x fastest), two yaws and an
+    odd number of rows: every column equal bit for bit (a cell's answer does not depend on
+    the order, only the kernels' work does).
+    """
+    robot, path = get_robot(robot_name), load_path("curved_line")
+    xs, ys, yaws = np.linspace(-0.3, 0.3, 7), np.linspace(0.3, 0.6, 5), np.array([0.0, 2.0])
+    cmap = capability_map(robot, path, xs=xs, ys=ys, z=0.1, yaws=yaws)
+    rows = np.array([[x, y, 0.1, yaw, 0.0] for yaw in yaws for y in ys for x in xs])
+    expected = evaluate_placements(robot, prepare_path(robot, path), rows)
+    for name in ("mu_path", "reason", "failed_waypoint", "branch"):
+        assert np.array_equal(getattr(cmap, name).ravel(), getattr(expected, name), equal_nan=True)
+    for name in ("bottleneck_waypoint", "bottleneck_joint"):
+        assert np.array_equal(getattr(cmap, name).ravel(), getattr(expected, name))
+    assert len(np.unique(cmap.branch[cmap.branch >= 0])) >= 2  # the order changes the work
