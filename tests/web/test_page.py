@@ -203,6 +203,16 @@ def test_the_page_shows_what_the_import_read(page: Page, url: str) -> None:
     )
 
 
+def test_a_path_that_skips_no_record_says_none(page: Page, url: str) -> None:
+    """The README example (a JSON path) has no record to skip: the list says so, not nothing."""
+    page.wait_for_function(
+        "document.getElementById('import').dataset.waypoints === '133'", timeout=30_000
+    )
+    api = httpx.post(f"{url}/v1/paths/import", json={"path": EXAMPLE_PATH}).json()
+    assert api["skipped_records"] == []
+    assert page.locator("#import-skipped li").all_text_contents() == ["none"]
+
+
 def test_a_program_without_units_asks_for_them_beside_the_field(page: Page, url: str) -> None:
     page.set_input_files(
         "#path-file",

@@ -244,6 +244,11 @@ async function showImport(name) {
       + (s.recognised ? "" : " - not recognised: check that it moves nothing");
     $("import-skipped").appendChild(item);
   }
+  if (!read.skipped_records.length) {  // said, not left as an empty list
+    const item = document.createElement("li");
+    item.textContent = "none";
+    $("import-skipped").appendChild(item);
+  }
   box.dataset.waypoints = String(read.waypoints.length);
 }
 
