@@ -9,6 +9,8 @@ from __future__ import annotations
 
 import math
 import struct
+import subprocess
+import sys
 
 import coal
 import numpy as np
@@ -29,6 +31,7 @@ from solver.path.cell.shapes import Box, Cell, Halfspace, Mesh, Tool
 from solver.path.cell.stl import read_stl
 from solver.path.evaluate import evaluate_path
 from solver.path.problem import PathOptions, PathProblem
+from tests.cases import ROOT
 from tests.solver.test_evaluate import load_path
 
 PLACEMENT = Placement(0.0, 0.45, 0.1, 0.0)
@@ -410,6 +413,45 @@ def test_a_flat_mesh_is_a_sheet_not_a_crash() -> None:
         coal.DistanceResult(),
     )
     assert distance == pytest.approx(0.2, abs=1e-6)
+
+
+_LARGE_SHEET = """
+import coal, numpy as np
+from solver.path.cell.shapes import Mesh
+sheet = np.array([[[20.0, 0, 0], [-20.0, 0, 0], [0, 20.0, 0]]])
+above = coal.Transform3s(np.eye(3), np.array([0.0, 1.0, 0.3]))
+print(coal.distance(Mesh(sheet).geometry(), coal.Transform3s(), coal.Sphere(0.1), above,
+                    coal.DistanceRequest(), coal.DistanceResult()))
+"""
+
+
+def test_a_large_flat_mesh_is_a_slab_not_a_crash() -> None:
+    """A 40 m triangle in the plane z = 0: its hull killed the process (coal, a 1 um slab).
+
+    Run in a process of its own, which a crash ends with a signal. The sheet is made a slab
+    FLAT_RATIO of its 40 m extent thick, 20 um each side: a sphere of 0.1 m at 0.3 m above it
+    is 0.2 m - 20 um away (geometry).
+    """
+    done = subprocess.run(
+        [sys.executable, "-c", _LARGE_SHEET], capture_output=True, text=True, cwd=ROOT, timeout=120
+    )
+    assert done.returncode == 0, (done.returncode, done.stderr[-500:])
+    assert float(done.stdout) == pytest.approx(0.2 - 2e-5, abs=1e-6)
+
+
+def test_an_stl_corner_beyond_the_coordinate_limit_is_an_input_error() -> None:
+    """1e308 mm (about 1e305 m) was taken, its hull's arithmetic overflowing; 999 m is taken."""
+
+    def corners(size: float) -> bytes:
+        return (
+            f"solid t\nfacet normal 0 0 1\nouter loop\nvertex {size} 0 0\nvertex {-size} 0 0\n"
+            f"vertex 0 {size} 0\nendloop\nendfacet\nendsolid t\n"
+        ).encode()
+
+    with pytest.raises(InvalidInputError, match="beyond") as caught:
+        read_stl(corners(1e308), max_triangles=10, units="mm", field="cell.workpiece.0.stl")
+    assert caught.value.field == "cell.workpiece.0.stl"
+    assert read_stl(corners(999.0), max_triangles=10)[0, 0, 0] == 999.0
 
 
 OPT_BOUNDS = PlacementBounds(x=(-0.1, 0.1), y=(0.35, 0.55), yaw=(-0.3, 0.3), z=0.1)

@@ -140,22 +140,30 @@ class Mesh(Shape):
 
 
 FLAT = 1e-6  # m: a mesh thinner than this in a direction is given that thickness (a sheet)
+FLAT_RATIO = 1e-6
+"""A mesh thinner than this fraction of its size in a direction is given that thickness too.
+
+coal's hull of a slab thinner than some 1e-7 of its size kills the process (a 20 m triangle
+made 1 um thick: a segmentation fault in ``ConvexBase.convexHull``; measured: slabs of 5e6 to
+1 built, 2e7 to 1 crashed). A sheet of 20 m is so 40 um thick, 20 um each side of its plane."""
 
 
 def _solid(points: np.ndarray) -> np.ndarray:
-    """The points, with copies moved by +-FLAT / 2 along each direction in which they are flat.
+    """The points, with copies moved by +-t / 2 along each direction in which they are flat.
 
     qhull cannot make the hull of a flat set (and coal's binding then crashes): a sheet, or a
-    line, becomes a slab FLAT thick.
+    line, becomes a slab t thick, t = max(FLAT, FLAT_RATIO times the set's largest extent).
     """
     centred = points - points.mean(axis=0)
     # Only the right singular vectors are used: U stays thin (full, it is P x P: 0.2 s for a
     # robot's meshes); below three points the full set of three directions is needed.
     _, _, directions = np.linalg.svd(centred, full_matrices=len(centred) < 3)
-    for direction in directions:
-        extent = centred @ direction
-        if extent.max() - extent.min() < FLAT:
-            points = np.concatenate([points + FLAT / 2 * direction, points - FLAT / 2 * direction])
+    extents = [np.ptp(centred @ direction) for direction in directions]
+    thickness = max(FLAT, FLAT_RATIO * max(extents))
+    for direction, extent in zip(directions, extents, strict=True):
+        if extent < thickness:
+            shift = thickness / 2 * direction
+            points = np.concatenate([points + shift, points - shift])
     return points
 
 

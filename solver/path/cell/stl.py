@@ -12,6 +12,7 @@ import re
 import numpy as np
 
 from solver.core.exceptions import InvalidInputError
+from solver.core.spatial import MAX_COORDINATE
 
 UNITS = {"m": 1.0, "mm": 0.001, "cm": 0.01, "in": 0.0254}
 _HEADER = 80
@@ -40,7 +41,8 @@ def read_stl(
         shape (T, 3, 3), m, the corners of each triangle.
 
     Raises:
-        InvalidInputError: not an STL, no triangles, too many, or a corner not finite.
+        InvalidInputError: not an STL, no triangles, too many, or a corner not finite or beyond
+            +-MAX_COORDINATE m.
     """
     if units not in UNITS:
         raise InvalidInputError(f"{field}.units", f"unknown unit {units!r}; use {', '.join(UNITS)}")
@@ -53,6 +55,10 @@ def read_stl(
     if not np.all(np.isfinite(triangles)):
         raise InvalidInputError(field, "the STL has a corner that is not a finite number")
     scaled: np.ndarray = triangles * UNITS[units]
+    if np.abs(scaled).max() > MAX_COORDINATE:  # as a waypoint's position (and no hull of it)
+        raise InvalidInputError(
+            field, f"the STL has a corner beyond +-{MAX_COORDINATE:g} m (units: {units})"
+        )
     return scaled
 
 
