@@ -16,13 +16,13 @@ at a time, between which the event loop gets its turn, then the rest of the mode
 
 from __future__ import annotations
 
-import json
 from typing import Any, TypeVar
 
 import anyio
 from fastapi import Depends, Request
 from fastapi.exceptions import RequestValidationError
 from pydantic import BaseModel, TypeAdapter, ValidationError
+from pydantic_core import from_json
 
 from service.schemas import Pose, ToolAxisWaypoint
 
@@ -61,7 +61,10 @@ def validated_in_pieces(model: type[M] | TypeAdapter[T], raw: bytes) -> Any:
     """
     adapter = model if isinstance(model, TypeAdapter) else TypeAdapter(model)
     try:
-        data = json.loads(raw)
+        # pydantic-core's parser, as validate_json's: the same floats, a lone surrogate refused
+        # and nesting bounded (json.loads took "\ud800", and raised RecursionError on 17,000
+        # nested arrays: a 500)
+        data = from_json(raw)
         path = _path_of(data)
         if isinstance(path, dict):
             for name, pieces in PIECES.items():

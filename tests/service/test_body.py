@@ -117,3 +117,37 @@ def test_bad_json_is_the_same_error() -> None:
     with pytest.raises(ValidationError) as whole:
         PathImportRequest.model_validate_json(raw)
     assert pieces.value.errors() == whole.value.errors()
+
+
+ROUTES = ["/v1/evaluate", "/v1/evaluate/png", "/v1/map", "/v1/map/png", "/v1/optimize"]
+ROUTES += ["/v1/paths/import", "/v1/jobs", "/v1/dtf"]
+
+
+@pytest.mark.parametrize("route", ROUTES)
+def test_json_nested_too_deep_is_a_422_on_every_route(client: TestClient, route: str) -> None:
+    """17,000 nested arrays (34 kB, over INLINE_BODY_BYTES): json.loads raised RecursionError."""
+    raw = b"[" * 17_000 + b"]" * 17_000
+    answer = client.post(route, content=raw, headers={"content-type": "application/json"})
+    assert answer.status_code == 422, answer.text[:300]
+    assert answer.json()["detail"][0]["type"] == "json_invalid"
+
+
+@pytest.mark.parametrize("route", ROUTES)
+@pytest.mark.parametrize("large", [False, True], ids=["small", "large"])
+def test_a_lone_surrogate_is_a_422_on_every_route(
+    client: TestClient, route: str, large: bool
+) -> None:
+    r"""A string holding "\ud800" (no UTF-8 for it): /v1/dtf answered 500 (its error not writable).
+
+    Large: the README example's path with 300 waypoints more (over INLINE_BODY_BYTES), whose
+    pieces json.loads read, surrogate and all.
+    """
+    path = EXAMPLE["path"]
+    if large:
+        path = {"waypoints": path["waypoints"] + POSES["waypoints"][:300]}
+    sent = json.dumps({"robot": {"model": "ur5"}, "path": path, "q": [0.0] * 6})
+    raw = sent.replace('"ur5"', '"ur5\\ud800"').encode()
+    assert (len(raw) > body.INLINE_BODY_BYTES) == large
+    answer = client.post(route, content=raw, headers={"content-type": "application/json"})
+    assert answer.status_code == 422, answer.text[:300]
+    assert answer.json()["detail"][0]["type"] == "json_invalid"

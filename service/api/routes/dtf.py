@@ -3,10 +3,12 @@
 from __future__ import annotations
 
 import math
+from typing import Annotated
 
 from fastapi import APIRouter
 
 from service import convert
+from service.body import body_in_thread, body_openapi
 from service.errors import ERROR_RESPONSES
 from service.schemas import DtfRequest, DtfResponse
 from solver.core.dtf import chiu, dtf, twist_per_unit_speed, yoshikawa
@@ -16,9 +18,12 @@ router = APIRouter(prefix="/dtf", tags=["dtf"], responses=ERROR_RESPONSES)
 
 
 @router.post(
-    "", operation_id="dtf", summary="Largest tool speed along a direction at one configuration"
+    "",
+    operation_id="dtf",
+    summary="Largest tool speed along a direction at one configuration",
+    openapi_extra=body_openapi(DtfRequest),
 )
-def post_dtf(body: DtfRequest) -> DtfResponse:
+def post_dtf(body: Annotated[DtfRequest, body_in_thread(DtfRequest)]) -> DtfResponse:
     """V_max, Omega_max and the joint speeds there, plus Yoshikawa and Chiu for comparison."""
     robot = convert.robot_from_schema(body.robot)
     q = check_configuration(robot, body.q)
