@@ -27,6 +27,7 @@ from solver.core.urdf_structure import (
     Mimic,
     continuous_as_revolute,
     mimic_joints,
+    nesting_depth,
     root_links,
     stray_links,
     uses_xacro,
@@ -59,6 +60,12 @@ class UrdfReading:
     locked_joints: tuple[str, ...] = ()
 
 
+MAX_URDF_DEPTH = 100
+"""The deepest nesting of elements a request's URDF may have (a URDF's is 4 or 5: robot,
+joint, limit; a link's collision, geometry, mesh). pinocchio's parser refuses far less deep
+documents than this module's ElementTree writes back by recursion (1,000: RecursionError)."""
+
+
 def readable_urdf(
     urdf: str, *, frames: tuple[str, ...]
 ) -> tuple[str, list[ContinuousJoint], tuple[str, ...]]:
@@ -67,6 +74,13 @@ def readable_urdf(
     Returns the document, its continuous joints (for :func:`chain_from_urdf`) and the links
     left out (:func:`without_stray_links`, ``frames`` as there).
     """
+    depth = nesting_depth(urdf)
+    if depth > MAX_URDF_DEPTH:
+        raise RobotModelError(
+            "robot.urdf",
+            f"cannot parse the URDF: its elements nest {depth} deep, more than "
+            f"{MAX_URDF_DEPTH} (a URDF's nest a few levels)",
+        )
     urdf, left_out = without_stray_links(urdf, frames=frames)
     urdf, continuous = continuous_as_revolute(urdf)
     return urdf, continuous, left_out

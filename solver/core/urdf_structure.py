@@ -42,6 +42,23 @@ def _tree(urdf: str) -> ElementTree.Element | None:
         return None
 
 
+def nesting_depth(urdf: str) -> int:
+    """How deep the document's elements nest (the root alone: 1; 0 where it is no XML).
+
+    Counted without recursion: ElementTree writes a document back by recursion, which a
+    document nested a thousand deep ended with RecursionError (a 500).
+    """
+    root = _tree(urdf)
+    if root is None:
+        return 0
+    deepest, stack = 0, [(root, 1)]
+    while stack:
+        element, depth = stack.pop()
+        deepest = max(deepest, depth)
+        stack.extend((child, depth + 1) for child in element)
+    return deepest
+
+
 def root_links(urdf: str) -> list[str]:
     """The links no joint has as its child, in the document's order (one for a valid arm)."""
     root = _tree(urdf)

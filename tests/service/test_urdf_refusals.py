@@ -113,3 +113,22 @@ def test_a_mimic_joint_following_no_joint_of_the_chain_is_a_422_naming_it(
     coupled = UR5[:end] + '<mimic joint="nowhere_joint" multiplier="-1"/>' + UR5[end:]
     message = refusal(client, evaluate_body, coupled)["msg"]
     assert "'wrist_2_joint' mimics 'nowhere_joint'" in message
+
+
+def test_a_urdf_nested_1000_deep_is_a_422_on_evaluate_and_dtf(
+    client: TestClient, evaluate_body: dict[str, Any]
+) -> None:
+    """A continuous joint and elements 1,001 deep: a RecursionError, answered 500, on both."""
+    urdf = (
+        '<robot name="r"><link name="a"/><link name="b"/><joint name="j" type="continuous">'
+        '<parent link="a"/><child link="b"/><axis xyz="0 0 1"/></joint>'
+        + "<x>" * 1000
+        + "</x>" * 1000
+        + "</robot>"
+    )
+    robot = {"urdf": urdf, "base_frame": "a", "tool_frame": "b", "joint_velocity_limits": [1.0]}
+    dtf = client.post("/v1/dtf", json={"robot": robot, "q": [0.0], "u_T": [1, 0, 0], "h": 0})
+    assert dtf.status_code == 422, dtf.text[:300]
+    assert dtf.json()["detail"][0]["loc"] == ["body", "robot", "urdf"]
+    detail = refusal(client, evaluate_body, urdf.replace('name="a"', 'name="base"', 1))
+    assert "nest 1001 deep, more than 100" in detail["msg"]

@@ -241,3 +241,30 @@ def test_a_path_of_three_turns_fits_an_unlimited_wrist_and_not_the_ur5s() -> Non
     answer = evaluate_path(PathProblem.of(unlimited, poses), at)
     assert answer.feasible and answer.q is not None
     assert abs(np.ptp(answer.q[:, 5]) - 6 * np.pi) < 0.5
+
+
+def nested(urdf: str, depth: int) -> str:
+    """The document with elements ``depth`` deep in all (a gazebo tag nesting depth - 1 more)."""
+    inner = "<x>" * (depth - 2) + "</x>" * (depth - 2)
+    return urdf.replace("</robot>", f"<gazebo>{inner}</gazebo></robot>")
+
+
+@pytest.mark.parametrize("stray", [False, True], ids=["continuous", "continuous-and-stray"])
+def test_a_document_nested_too_deep_is_refused_not_a_recursion_error(stray: bool) -> None:
+    """1,001 deep with a continuous joint: ElementTree wrote it back by recursion (a 500).
+
+    With a link no joint names too (the other document written back). 100 deep reads as the
+    document without the nesting: the same limits, the same forward kinematics.
+    """
+    urdf = continuous(UR5, "wrist_3_joint", None)
+    if stray:
+        urdf = urdf.replace("</robot>", '<link name="stray"/></robot>')
+    with pytest.raises(RobotModelError) as error:
+        robot_from_urdf(nested(urdf, 1001), **FRAMES)
+    assert error.value.field == "robot.urdf"
+    assert "nest 1001 deep, more than 100" in error.value.message
+    robot, plain = (robot_from_urdf(u, **FRAMES) for u in (nested(urdf, 100), urdf))
+    np.testing.assert_array_equal(robot.q_lower, plain.q_lower)
+    q = np.random.default_rng(4).uniform(-3.0, 3.0, (5, 6))
+    for row in q:
+        np.testing.assert_array_equal(tool_pose_in_base(robot, row), tool_pose_in_base(plain, row))
