@@ -26,6 +26,7 @@ from solver.core.urdf_structure import (
     ContinuousJoint,
     Mimic,
     continuous_as_revolute,
+    joint_axes,
     mimic_joints,
     nesting_depth,
     root_links,
@@ -66,6 +67,12 @@ joint, limit; a link's collision, geometry, mesh). pinocchio's parser refuses fa
 documents than this module's ElementTree writes back by recursion (1,000: RecursionError)."""
 
 
+AXIS_LENGTHS = (1e-6, 1e6)
+"""The lengths of a joint's ``<axis xyz>`` taken (and normalised, as the parser does). A zero
+axis has no direction, and pinocchio's normalisation of one of length 1e-300 or 1e308 gave
+NaN: a chain of NaN, refused deep in the kernels (LinAlgError, a 500)."""
+
+
 def readable_urdf(
     urdf: str, *, frames: tuple[str, ...]
 ) -> tuple[str, list[ContinuousJoint], tuple[str, ...]]:
@@ -81,6 +88,15 @@ def readable_urdf(
             f"cannot parse the URDF: its elements nest {depth} deep, more than "
             f"{MAX_URDF_DEPTH} (a URDF's nest a few levels)",
         )
+    for axis in joint_axes(urdf):
+        if not AXIS_LENGTHS[0] <= axis.length <= AXIS_LENGTHS[1]:
+            x, y, z = axis.xyz
+            raise RobotModelError(
+                "robot.urdf",
+                f"joint {quoted(axis.joint)}: its axis ({x:.6g} {y:.6g} {z:.6g}) has length "
+                f"{axis.length:.3g}; an axis is a direction, a unit vector (lengths from "
+                "1e-6 to 1e6 are normalised)",  # AXIS_LENGTHS
+            )
     urdf, left_out = without_stray_links(urdf, frames=frames)
     urdf, continuous = continuous_as_revolute(urdf)
     return urdf, continuous, left_out

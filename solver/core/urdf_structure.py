@@ -13,6 +13,7 @@ such a joint two coordinates, the solver takes one angle a joint).
 
 from __future__ import annotations
 
+import math
 import xml.etree.ElementTree as ElementTree
 from dataclasses import dataclass
 
@@ -203,6 +204,38 @@ def movable_joints(urdf: str) -> list[str]:
     if root is None:
         return []
     return [j.get("name", "") for j in root.findall("joint") if j.get("type") != "fixed"]
+
+
+@dataclass(frozen=True)
+class JointAxis:
+    """A joint's ``<axis xyz>``, as three numbers, and their length (``math.hypot``)."""
+
+    joint: str
+    xyz: tuple[float, float, float]
+    length: float
+
+
+def joint_axes(urdf: str) -> list[JointAxis]:
+    """The axes of the document's joints that are not ``fixed`` and give three finite numbers.
+
+    A joint without ``<axis>`` (URDF's default, 1 0 0) or whose ``xyz`` is not three finite
+    numbers is left out: the parser names the latter.
+    """
+    root = _tree(urdf)
+    if root is None:
+        return []
+    axes = []
+    for joint in root.findall("joint"):
+        element = joint.find("axis")
+        if joint.get("type") == "fixed" or element is None:
+            continue
+        try:
+            xyz = tuple(float(v) for v in element.get("xyz", "1 0 0").split())
+        except ValueError:
+            continue
+        if len(xyz) == 3 and all(math.isfinite(v) for v in xyz):
+            axes.append(JointAxis(joint.get("name", ""), xyz, math.hypot(*xyz)))
+    return axes
 
 
 def joint_count(urdf: str) -> int:

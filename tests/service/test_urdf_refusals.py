@@ -132,3 +132,21 @@ def test_a_urdf_nested_1000_deep_is_a_422_on_evaluate_and_dtf(
     assert dtf.json()["detail"][0]["loc"] == ["body", "robot", "urdf"]
     detail = refusal(client, evaluate_body, urdf.replace('name="a"', 'name="base"', 1))
     assert "nest 1001 deep, more than 100" in detail["msg"]
+
+
+@pytest.mark.parametrize("route", ["/v1/evaluate", "/v1/map"])
+def test_a_zero_joint_axis_is_a_422_naming_the_joint(
+    client: TestClient, evaluate_body: dict[str, Any], route: str
+) -> None:
+    """The numeric kernels met a chain of NaN: LinAlgError, answered 500 (and a job failed)."""
+    urdf = UR5.replace('<axis xyz="0 0 1"/>', '<axis xyz="0 0 0"/>', 1)
+    body = {**evaluate_body, "robot": {"urdf": urdf, "base_frame": "base", "tool_frame": "tool0"}}
+    if route == "/v1/map":
+        axis = {"min": 0.0, "max": 0.1, "step": 0.1}
+        body = {k: v for k, v in body.items() if k != "placement"}
+        body["grid"] = {"x": axis, "y": axis, "z": 0.1, "yaw": 0.0}
+    response = client.post(route, json=body)
+    assert response.status_code == 422, response.text[:300]
+    detail = response.json()["detail"][0]
+    assert detail["loc"] == ["body", "robot", "urdf"]
+    assert detail["msg"].startswith("joint 'shoulder_pan_joint': its axis (0 0 0) has length 0")

@@ -268,3 +268,26 @@ def test_a_document_nested_too_deep_is_refused_not_a_recursion_error(stray: bool
     q = np.random.default_rng(4).uniform(-3.0, 3.0, (5, 6))
     for row in q:
         np.testing.assert_array_equal(tool_pose_in_base(robot, row), tool_pose_in_base(plain, row))
+
+
+@pytest.mark.parametrize("axis", ["0 0 0", "0 0 1e-300", "1e308 0 1"])
+def test_a_joint_axis_of_no_direction_is_refused_naming_the_joint(axis: str) -> None:
+    """Zero, or so short or long that normalising it gave NaN: a chain of NaN, a 500 later."""
+    urdf = UR5.replace('<axis xyz="0 0 1"/>', f'<axis xyz="{axis}"/>', 1)
+    with pytest.raises(RobotModelError) as error:
+        robot_from_urdf(urdf, **FRAMES)
+    assert error.value.field == "robot.urdf"
+    assert error.value.message.startswith("joint 'shoulder_pan_joint': its axis (")
+    assert "an axis is a direction" in error.value.message
+
+
+def test_an_axis_of_length_two_reads_as_the_unit_one() -> None:
+    """URDF's axes are normalised by the parser: 0 0 2 is the arm of 0 0 1 (forward kinematics)."""
+    long, plain = (
+        robot_from_urdf(UR5.replace('<axis xyz="0 0 1"/>', f'<axis xyz="{a}"/>', 1), **FRAMES)
+        for a in ("0 0 2", "0 0 1")
+    )
+    for row in np.random.default_rng(5).uniform(-3.0, 3.0, (5, 6)):
+        np.testing.assert_allclose(
+            tool_pose_in_base(long, row), tool_pose_in_base(plain, row), atol=1e-15
+        )
