@@ -8,6 +8,7 @@ from collections.abc import Iterator
 from typing import Any
 
 import numpy as np
+import pinocchio as pin
 import pytest
 from fastapi.testclient import TestClient
 
@@ -24,7 +25,8 @@ from tests.service.test_job_routes import EXAMPLE, route_body
 from tests.service.test_urdf_mimic_limits import MIMIC_SPEED
 from tests.service.test_urdf_mimic_limits import body as mimic_body
 from tests.solver.families.test_mimic import arm as mimic_arm
-from tests.solver.test_cell import binary_stl, cube_triangles
+from tests.solver.test_cell import _distance as coal_distance
+from tests.solver.test_cell import binary_stl, cube_triangles, ur5_geometry
 from tests.solver.test_evaluate import load_path
 
 TABLE = {"shape": "halfspace", "name": "table", "normal": [0, 0, 1], "offset": 0.0}
@@ -331,3 +333,43 @@ def test_a_job_with_a_bad_cell_is_refused_at_submit_as_its_route_refuses_it(
     assert submitted.status_code == 422, submitted.text
     (expected,), (detail,) = direct.json()["detail"], submitted.json()["detail"]
     assert detail == {**expected, "loc": ["body", "request", *expected["loc"][1:]]}
+
+
+SWEEP = "UNITS/MM\nMULTAX/ON\nFEDRAT/MMPM,1000\n" + "".join(
+    f"GOTO/{10 * i},0,0,0,0,1\n" for i in range(11)
+)
+
+
+def test_a_larger_clearance_never_checks_fewer_self_pairs(client: TestClient) -> None:
+    """The UR5's upper arm through its wrist 2 at the path's start, at every clearance.
+
+    The self pairs were those apart by more than the request's clearance at q = 0: at 0.5 m
+    another contact was named and at 0.9 m no pair was left, the path feasible. Independent:
+    coal's distance between the two parts at the answer's first configuration, in a
+    GeometryModel built here from the URDF (tests/solver/test_cell.py).
+    """
+    body: dict[str, Any] = {
+        "robot": {"model": "ur5"},
+        "path": {"cl_data": SWEEP},
+        "placement": {"x": 0.1, "y": 0.1, "z": 0.0, "yaw": 0.0},
+        "ik": {"branch": {"shoulder": "left", "elbow": "up", "wrist": "noflip"}},
+    }
+    free = client.post("/v1/evaluate", json=body).json()
+    assert free["feasible"], free
+    model, geometry = ur5_geometry()
+    data, gdata = model.createData(), geometry.createData()
+    pin.updateGeometryPlacements(model, data, geometry, gdata, np.array(free["waypoints"][0]["q"]))
+    names = [o.name for o in geometry.geometryObjects]
+    a, b = names.index("upper_arm_link_0"), names.index("wrist_2_link_0")
+    expected = coal_distance(geometry, gdata, a, b)
+    assert expected < -0.02  # they overlap
+    for clearance in (0.005, 0.05, 0.5, 0.9):
+        answer = client.post("/v1/evaluate", json={**body, "cell": {"clearance": clearance}})
+        found = answer.json()
+        assert not found["feasible"] and found["reason"] == "collision", (clearance, found)
+        collision = found["collision"]
+        assert collision["waypoint"] == 0
+        assert {collision["robot_part"], collision["obstacle_name"]} == set(
+            names[k] for k in (a, b)
+        )
+        assert collision["distance"] == pytest.approx(expected, abs=1e-6)

@@ -121,9 +121,11 @@ def test_map_with_tables_equals_without(name: str, monkeypatch: pytest.MonkeyPat
 def test_tables_made_at_first_use_and_kept(monkeypatch: pytest.MonkeyPatch) -> None:
     """An evaluation makes no table; a map makes the UR5's once; other cells reuse them.
 
-    Another cell (other obstacles, so other checked pairs) makes none; a larger clearance makes
-    only the tables of the pairs it adds (capsules within the clearance more often). The kept
-    tables equal those each checker makes with nothing kept, bit for bit.
+    Another cell (other obstacles, so other checked pairs) makes none; a larger clearance checks
+    the same pairs (the self pairs are those apart at q = 0 by more than a fixed TOUCH, not by
+    the clearance) and makes only the tables of the pairs it tabulates anew (capsules within
+    the clearance more often). The kept tables equal those each checker makes with nothing
+    kept, bit for bit.
     """
     made: list[int] = []
     tabulate = pair_tables_module._tabulate
@@ -147,7 +149,13 @@ def test_tables_made_at_first_use_and_kept(monkeypatch: pytest.MonkeyPatch) -> N
     ):
         before = len(made)
         checker = CellChecker(arm, cell)
-        assert checker._fast is not None and len(checker._fast.pairs) != len(first._fast.pairs)
+        assert checker._fast is not None
+        if cell.clearance == ON_TABLE.clearance:
+            assert len(checker._fast.pairs) != len(first._fast.pairs)
+        else:  # the same pairs as at the table's own clearance
+            at_own = CellChecker(arm, ON_TABLE)._fast
+            assert at_own is not None
+            np.testing.assert_array_equal(checker._fast.pairs, at_own.pairs)
         kept = checker._fast.tables
         assert len(made) - before == len(_tabled(checker) - seen)
         seen |= _tabled(checker)

@@ -16,7 +16,9 @@ as given to a URDF whose meshes are elsewhere: ROS-Industrial's ABB IRB 2400 and
 read with a table at z = 0) would collide at every placement, whatever the path. Those pairs
 and their distance are reported (:attr:`CellScene.unchecked`), not silently dropped. And the
 robot's parts against each other where they are on joints that are neither the same nor
-adjacent and do not come within the clearance at the zero configuration.
+adjacent and do not touch at the zero configuration (come within :data:`TOUCH` there): a
+choice of the robot and the cell's shapes, not of the request's clearance, so that a larger
+clearance never checks fewer pairs.
 """
 
 from __future__ import annotations
@@ -31,9 +33,15 @@ from solver.core.robots import Robot
 from solver.path.cell import fast
 from solver.path.cell.bounds import pair_weights
 from solver.path.cell.robot_geometry import robot_geometry
-from solver.path.cell.shapes import Cell
+from solver.path.cell.shapes import DEFAULT_CLEARANCE, Cell
 from solver.path.cell.verdict import Unchecked
 
+TOUCH = DEFAULT_CLEARANCE
+"""m: robot parts this close at the zero configuration touch there (cell.md section 2: such
+a pair is no self-collision pair). It was the request's clearance: a clearance of 0.9 m left
+the UR5 no self pair, and a path whose upper arm went through its wrist was feasible. At
+5 mm (the default clearance) the catalogue arms keep the pairs they had at every clearance
+up to 5 mm (none has a pair between 0 and 5 mm at q = 0, 2026-12-05)."""
 STILL = 1e-9
 """m/rad: a pair whose every weight is below this is one no joint moves (1e-9 m a turn at most)."""
 
@@ -96,7 +104,7 @@ def build_scene(robot: Robot, cell: Cell) -> CellScene:
     # one coal probe for the unchecked pairs' distances and the self pairs' at q = 0
     distances = _distances(robot.model, geometry, still + candidates)
     apart = distances[len(still) :]
-    own = [p for p, d in zip(candidates, apart, strict=True) if d > cell.clearance]
+    own = [p for p, d in zip(candidates, apart, strict=True) if d > TOUCH]
     pairs += own
     weights = np.vstack([weights, pair_weights(robot.model, geometry, own, n_robot)])
     for a, b in pairs:
