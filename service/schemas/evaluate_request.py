@@ -20,6 +20,7 @@ from service.schemas.path_input import MAX_PATH_WAYPOINTS
 from service.schemas.placement import Placement
 from service.schemas.robot import Robot
 from service.schemas.robot_options import MAX_JOINTS
+from solver.cam.cam_path import FEED_RANGE
 
 DetailLevel = TypeAliasType(
     "DetailLevel",
@@ -89,8 +90,8 @@ class EvaluateRequest(RequestModel):
     )
     feed: float | None = Field(
         default=None,
-        ge=1e-6,
-        le=100.0,
+        ge=FEED_RANGE[0],
+        le=FEED_RANGE[1],
         description="A feed to check (m/s, 1e-6 to 100): the answer then says whether the path "
         "runs at it, the margin, and every waypoint's joint speeds and use of their limits at it. "
         "Default: the program's feed (its highest FEDRAT) for CL data, else none.",

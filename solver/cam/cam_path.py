@@ -21,6 +21,10 @@ from solver.core.tool_axis import poses_from_tool_axes
 
 Units = Literal["mm", "inches", "m"]
 METRES_PER_UNIT: dict[str, float] = {"mm": 1e-3, "inches": 0.0254, "m": 1.0}
+FEED_RANGE = (1e-6, 100.0)
+"""m/s, the feeds taken: a program's FEDRAT and a request's ``feed`` (0.06 mm/min to 6 km/min).
+A FEDRAT of 1e-310 mm/min was taken, the feed check's margin (mu_path over it) then infinite:
+a 500 where the answer was written."""
 
 
 @dataclass(frozen=True)

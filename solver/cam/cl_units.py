@@ -13,7 +13,7 @@ from __future__ import annotations
 from collections.abc import Sequence
 from dataclasses import dataclass
 
-from solver.cam.cam_path import METRES_PER_UNIT, Units
+from solver.cam.cam_path import FEED_RANGE, METRES_PER_UNIT, Units
 from solver.cam.cl_records import Record
 from solver.cam.read_report import UnitsSource
 from solver.cam.reading import parse_number
@@ -127,7 +127,8 @@ def feed_of(record: Record, *, units: Units, field: str) -> float:
         field: the input's name, for the errors.
 
     Raises:
-        InvalidLineError: another form (a feed per revolution), or a feed that is not > 0.
+        InvalidLineError: another form (a feed per revolution), or a feed that is not > 0 or
+            outside FEED_RANGE once in m/s.
     """
     args = record.arguments(field)
     words = [a.upper() for a in args]
@@ -149,4 +150,14 @@ def feed_of(record: Record, *, units: Units, field: str) -> float:
         raise InvalidLineError(
             field, f"the feed {value:g} must be > 0", line=record.line, text=record.text
         )
-    return value * METRES_PER_UNIT[unit] / 60.0
+    feed = value * METRES_PER_UNIT[unit] / 60.0
+    low, high = FEED_RANGE
+    if not low <= feed <= high:
+        raise InvalidLineError(
+            field,
+            f"the feed {value:g} ({unit} per minute) is {feed:.3g} m/s; a feed is taken from "
+            f"{low:g} to {high:g} m/s ({low * 60e3:g} to {high * 60e3:g} mm/min)",
+            line=record.line,
+            text=record.text,
+        )
+    return feed

@@ -131,8 +131,15 @@ def test_import_shows_the_program(client: TestClient) -> None:
         ("UNITS/MM\nMULTAX/ON\nGOTO/0, 0, 0, 0, 0, 1\nGODLTA/3\n", 4),
         ("UNITS/MM\nMULTAX/ON\nGOTO/0, 0, 0, 0, 0\n", 3),
         ("UNITS/MM\nFEDRAT/0\nGOTO/0, 0, 0\nGOTO/1, 0, 0\n", 2),
+        ("UNITS/MM\nFEDRAT/MMPM,1e-310\nGOTO/0, 0, 0\nGOTO/1, 0, 0\n", 2),
     ],
-    ids=["circle without its end", "record not applied", "goto of 5 numbers", "zero feed"],
+    ids=[
+        "circle without its end",
+        "record not applied",
+        "goto of 5 numbers",
+        "zero feed",
+        "subnormal feed (a 500: its margin infinite)",
+    ],
 )
 def test_a_record_that_cannot_be_read_is_a_422_naming_its_line(
     client: TestClient, text: str, line: int

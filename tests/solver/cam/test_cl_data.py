@@ -248,6 +248,10 @@ def test_a_nearly_unit_axis_is_normalised_and_the_correction_reported() -> None:
         ("FEDRAT/IPR, 0.1", ["FEDRAT needs"]),
         ("FEDRAT/0", ["must be > 0"]),
         ("FEDRAT/-100", ["must be > 0"]),
+        ("FEDRAT/MMPM, 1e-310", ["is 1.67e-315 m/s", "taken from 1e-06 to 100 m/s"]),
+        ("FEDRAT/1e-320", ["is 0 m/s", "taken from 1e-06 to 100 m/s"]),
+        ("FEDRAT/IPM, 1e308", ["is 4.23e+304 m/s", "(0.06 to 6e+06 mm/min)"]),
+        ("FEDRAT/MMPM, 6.1e6", ["is 102 m/s"]),
         ("GOTO/0, 0, 0, 0", ["x, y, z, i, j, k", "got 4"]),
         ("GOTO/0, 0, 0, 0, 0", ["got 5"]),
         ("GOTO/1.2.3, 0, 0, 0, 0, 1", ["'1.2.3' is not a number"]),
@@ -269,6 +273,13 @@ def test_bad_record_names_its_line(record: str, words: list[str]) -> None:
     assert str(error).startswith("path.cl_data: line 4: ")
     for word in words:
         assert word in error.message
+
+
+def test_the_feeds_at_the_ends_of_the_range_are_read() -> None:
+    """6e6 mm/min is 100 m/s, 0.1 mm/min 1.67e-6 m/s: both taken (the request's feed range)."""
+    for record, feed in (("FEDRAT/MMPM, 6e6", 100.0), ("FEDRAT/MMPM, 0.1", 0.1e-3 / 60)):
+        path = read_cl_data(multax(record, *TWO_CUTS))
+        assert path.feed == pytest.approx(feed, rel=1e-12)
 
 
 def test_units_may_not_change_after_a_goto() -> None:
