@@ -61,7 +61,8 @@ class ClReader:
         """Take one record into the state."""
         word = record.word
         kind = kind_of(word)
-        if kind in ("skipped", "unknown") or (word == "CYCLE" and record.rest.upper() == "/OFF"):
+        cycle_off = word == "CYCLE" and "".join(record.rest.split()).upper() == "/OFF"
+        if kind in ("skipped", "unknown") or cycle_off:  # CYCLE / OFF as CYCLE/OFF
             self.skip(record, recognised=kind != "unknown")
             return
         if kind == "refused":

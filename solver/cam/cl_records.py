@@ -27,6 +27,7 @@ import re
 from collections.abc import Iterator
 from dataclasses import dataclass
 
+from solver.cam.reading import BOM
 from solver.core.exceptions import InvalidLineError
 
 READ = frozenset(
@@ -167,6 +168,7 @@ def records(text: str, *, field: str) -> Iterator[Record]:
         InvalidLineError: a line that is no record, or a continuation past the end.
     """
     start, parts = 0, list[str]()
+    text = text.removeprefix(BOM)  # the encoding's mark (Windows editors write it), not text
     for number, raw in enumerate(text.splitlines(), start=1):
         content, hash_, comment = raw.partition(COMMENT)
         if hash_:

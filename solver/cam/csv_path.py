@@ -14,7 +14,7 @@ from __future__ import annotations
 import math
 
 from solver.cam.cam_path import METRES_PER_UNIT, CamPath, Units, assemble_cam_path
-from solver.cam.reading import checked_position, is_number, near_unit_vector, parse_numbers
+from solver.cam.reading import BOM, checked_position, is_number, near_unit_vector, parse_numbers
 from solver.core.exceptions import InvalidInputError, InvalidLineError
 from solver.core.spatial import rotation_from_quaternion
 
@@ -48,6 +48,7 @@ def read_csv_path(text: str, *, units: str, field: str = "path.csv") -> CamPath:
             "units", f"units {units!r}: a CSV path is in mm or m (metric) or inch"
         )
     scale = METRES_PER_UNIT[_UNITS[units]]
+    text = text.removeprefix(BOM)  # Excel's "CSV UTF-8" starts with it
     rows = [(n, raw.strip()) for n, raw in enumerate(text.splitlines(), start=1) if raw.strip()]
     columns = None
     if rows and not all(is_number(cell) for cell in rows[0][1].split(",")):

@@ -16,7 +16,12 @@ from solver.core.exceptions import InvalidLineError
 from solver.core.spatial import MAX_COORDINATE
 from solver.core.tool_axis import NEAR_UNIT_TOLERANCE
 
-_NUMBER = re.compile(r"[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?")
+_NUMBER = re.compile(r"[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?", re.ASCII)  # no other digits
+
+
+BOM = "\ufeff"
+"""The byte order mark a file saved as UTF-8 by Windows tools starts with, once decoded: the
+CL reader refused such a program ('line 1: not a record'), the CSV reader its header."""
 
 
 def is_number(token: str) -> bool:

@@ -274,3 +274,26 @@ def test_catia_program_with_blanks_before_the_slash_reads_with_the_request_units
     }
     with pytest.raises(InvalidInputError, match="FEDRAT/MMPM at line 16"):
         read_cl_data("\n".join(CATIA))
+
+
+def test_cycle_off_with_spaces_is_skipped_as_cycle_off() -> None:
+    """``CYCLE / OFF`` was refused as a canned cycle where ``CYCLE/OFF`` was skipped."""
+    for record in ("CYCLE/OFF", "CYCLE / OFF", "CYCLE/ off"):
+        path = read_cl_data("\n".join(["UNITS/MM", *BARE, record]))
+        assert path.report is not None
+        assert path.report.skipped_records == (SkippedRecord("CYCLE", 1, 6, True),)
+
+
+def test_a_byte_order_mark_is_the_files_encoding_not_its_first_record() -> None:
+    """A program saved as UTF-8 by a Windows editor starts with U+FEFF: 'line 1: not a record'."""
+    text = "\n".join(["UNITS/MM", *BARE])
+    marked, plain = read_cl_data("\ufeff" + text), read_cl_data(text)
+    np.testing.assert_array_equal(marked.positions, plain.positions)
+    assert marked.passes == plain.passes and marked.report == plain.report
+
+
+def test_digits_other_than_ascii_are_no_number() -> None:
+    """A full-width 1 (U+FF11) read as 1 (Python's float takes every script's digits)."""
+    with pytest.raises(InvalidLineError, match="is not a number") as caught:
+        read_cl_data("\n".join(["UNITS/MM", "GOTO/\uff11,0,0", *BARE[1:]]))
+    assert caught.value.line == 2

@@ -112,3 +112,12 @@ def test_units_other_than_mm_or_m() -> None:
     with pytest.raises(InvalidInputError, match="mm or m") as caught:
         read_csv_path("0,0,0,0,0,1\n1,0,0,0,0,1\n", units="inches")
     assert caught.value.field == "units"
+
+
+def test_a_csv_saved_by_excel_with_its_byte_order_mark_reads_as_without() -> None:
+    """Excel's "CSV UTF-8" starts with U+FEFF: the header then named no column it knew."""
+    text = (CAM_EXAMPLES / "sweep_pass1.csv").read_text()
+    marked, plain = (read_csv_path(t, units="mm") for t in ("\ufeff" + text, text))
+    np.testing.assert_array_equal(marked.positions, plain.positions)
+    np.testing.assert_array_equal(marked.axes, plain.axes)
+    assert marked.lines.tolist() == plain.lines.tolist()
