@@ -31,6 +31,7 @@ crash. Errors name the field (and waypoint, line) as the API does.
 from __future__ import annotations
 
 import argparse
+import codecs
 import json
 import math
 import os
@@ -50,7 +51,7 @@ from service.operations import computed_map, evaluation_of, import_of, map_png
 from service.schemas import EvaluateRequest, MapRequest, OptimizeRequest, RobotRead
 from service.schemas.paths_import import PathImportRequest
 from solver.core import native_stderr
-from solver.core.exceptions import InvalidInputError, SolverError
+from solver.core.exceptions import InvalidInputError, SolverError, cut
 from solver.core.urdf_structure import fixed_to_root
 from solver.families import closed_form_bases
 
@@ -113,7 +114,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     echo = native_stderr.ECHO.set(False)  # a refused URDF's reason is in the error printed
     try:
         code = int(args.run(args))
-        sys.stdout.flush()  # a closed pipe is seen here, not at the interpreter's exit
+        if sys.stdout is not None:  # None: started with its standard output closed
+            sys.stdout.flush()  # a closed pipe is seen here, not at the interpreter's exit
         return code
     except BrokenPipeError:
         _quiet_stdout()
@@ -147,7 +149,7 @@ def _quiet_stdout() -> None:
 
 def _path(args: argparse.Namespace) -> dict[str, Any]:
     """The request's ``path`` object of the program file."""
-    text = Path(args.program).read_text(encoding="utf-8", errors="replace")
+    text = _decoded(Path(args.program).read_bytes(), errors="replace")
     if args.program.lower().endswith(".csv"):
         if args.units is None:  # a CSV says nothing of its units: never assumed
             message = "a CSV states no units: give --units mm, inch or m"
@@ -170,7 +172,7 @@ def _robot(args: argparse.Namespace) -> Any:
     """
     name, file = args.robot, Path(args.robot)
     if name.lower().endswith(".urdf"):
-        urdf = file.read_text(encoding="utf-8")
+        urdf = _text_file(file, "robot")
         controller = CONTROLLER_FRAME if fixed_to_root(urdf, CONTROLLER_FRAME) else BASE_FRAME
         frames = {
             "base_frame": args.base_frame or controller,
@@ -252,10 +254,34 @@ def _json_file(file: Path, field: str) -> Any:
     Raises:
         InvalidInputError: on ``field``, when the file is not JSON.
     """
+    text = _text_file(file, field)
     try:
-        return json.loads(file.read_text(encoding="utf-8"))
-    except json.JSONDecodeError as error:
-        raise InvalidInputError(field, f"the file is not JSON ({error})") from error
+        return json.loads(text)
+    except (ValueError, RecursionError) as error:  # JSONDecodeError; too many digits; too deep
+        raise InvalidInputError(field, f"the file is not JSON ({cut(str(error))})") from error
+
+
+def _text_file(file: Path, field: str) -> str:
+    """The text of ``file`` (UTF-8, or UTF-16 where it starts with its byte order mark).
+
+    Raises:
+        InvalidInputError: on ``field``, when the file is not such text.
+    """
+    try:
+        return _decoded(file.read_bytes())
+    except UnicodeDecodeError as error:
+        message = f"the file is not UTF-8 text ({error.reason} at byte {error.start})"
+        raise InvalidInputError(field, message) from error
+
+
+def _decoded(data: bytes, *, errors: str = "strict") -> str:
+    """Bytes as text: UTF-16 after its byte order mark, else UTF-8 without its mark.
+
+    Windows PowerShell writes files as UTF-16 (with the mark), Windows editors UTF-8 with one.
+    """
+    if data[:2] in (codecs.BOM_UTF16_LE, codecs.BOM_UTF16_BE):
+        return data.decode("utf-16", errors=errors)
+    return data.decode("utf-8-sig", errors=errors)
 
 
 def _with_options(body: dict[str, Any], args: argparse.Namespace) -> dict[str, Any]:
@@ -458,7 +484,7 @@ def _parser() -> argparse.ArgumentParser:
     solving.add_argument(
         "--progress",
         action=argparse.BooleanOptionalAction,
-        default=sys.stderr.isatty(),
+        default=sys.stderr is not None and sys.stderr.isatty(),  # None: closed at the start
         help="a progress bar on stderr (default: when stderr is a terminal)",
     )
     run = commands.add_parser("import", parents=[common], help="what the program reads as")

@@ -34,7 +34,8 @@ def native_stderr() -> Iterator[list[str]]:
     """
     said: list[str] = []
     with _LOCK, tempfile.TemporaryFile() as sink:
-        sys.stderr.flush()
+        if sys.stderr is not None:  # None: a process started with its stderr closed
+            sys.stderr.flush()
         try:
             saved = os.dup(2)
         except OSError:  # no stderr to capture (a closed descriptor): run as is

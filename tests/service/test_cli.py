@@ -751,3 +751,68 @@ def test_a_robot_file_of_another_kind_is_refused_naming_it(
     code, _, err = run(capsys, "evaluate", str(PROGRAM), "--robot", robot, "--at=0,0.3,0,0")
     assert code == INVALID
     assert message in err
+
+
+UR5_URDF = example_robot_data_dir() / "ur_description" / "urdf" / "ur5_robot.urdf"
+
+
+def test_windows_encoded_files_read_as_their_utf8_selves(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A cell JSON saved by PowerShell (UTF-16 with its mark), a URDF and a program with
+    UTF-8's mark (Windows editors): each was a traceback or a refusal of line 1.
+
+    The answer equals the one of the same files in plain UTF-8.
+    """
+    plain, windows = tmp_path / "plain", tmp_path / "windows"
+    for folder in (plain, windows):
+        folder.mkdir()
+    cell, urdf, program = json.dumps(CELL), UR5_URDF.read_text(), PROGRAM.read_text()
+    (plain / "cell.json").write_text(cell)
+    (windows / "cell.json").write_bytes(cell.encode("utf-16"))  # with its byte order mark
+    for folder, mark in ((plain, ""), (windows, "\ufeff")):
+        (folder / "ur5.urdf").write_text(mark + urdf, encoding="utf-8")
+        (folder / "slot.cls").write_text(mark + program, encoding="utf-8")
+    answers = []
+    for folder in (plain, windows):
+        code, out, err = run(
+            capsys, "evaluate", str(folder / "slot.cls"), "--robot", str(folder / "ur5.urdf"),
+            "--cell", str(folder / "cell.json"), "--at=0.3,0.3,0,0", "--json",
+        )  # fmt: skip
+        assert code in (OK, INFEASIBLE), err
+        answers.append(json.loads(out))
+    assert answers[0] == answers[1]
+    assert (windows / "cell.json").read_bytes()[:2] in (b"\xff\xfe", b"\xfe\xff")
+
+
+@pytest.mark.parametrize(
+    ("content", "said"),
+    [
+        (b"[" * 100_000, "the file is not JSON (maximum recursion depth"),
+        (b'{"clearance": ' + b"1" * 5000 + b"}", "the file is not JSON (Exceeds the limit"),
+        (b'{"clearance": 0.01, "name": "caf\xe9"}', "the file is not UTF-8 text (invalid"),
+    ],
+    ids=["nested 100,000 deep", "an integer of 5,000 digits", "Latin-1"],
+)
+def test_a_cell_file_that_cannot_be_read_is_an_invalid_input(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], content: bytes, said: str
+) -> None:
+    """Each was a Python traceback and exit 1 (RecursionError, ValueError, UnicodeDecodeError)."""
+    cell = tmp_path / "cell.json"
+    cell.write_bytes(content)
+    code, _, err = run(
+        capsys, "evaluate", str(PROGRAM), "--robot", "ur5e", "--cell", str(cell), "--at=0,0.3,0,0"
+    )
+    assert code == INVALID
+    assert err.startswith(f"error: cell: {said}")
+
+
+@pytest.mark.parametrize("closed", ["1", "2"], ids=["stdout", "stderr"])
+def test_a_command_started_with_a_standard_stream_closed_runs(tmp_path: Path, closed: str) -> None:
+    """`dtf-place import f >&-` (or `2>&-`): AttributeError on None's flush, exit 1."""
+    marker = tmp_path / "rc"
+    command = (
+        f'"{sys.executable}" -m service.cli import "{PROGRAM}" {closed}>&-; echo $? > "{marker}"'
+    )
+    subprocess.run(["bash", "-c", command], cwd=ROOT, timeout=300, capture_output=True)
+    assert marker.read_text().strip() == str(OK)
