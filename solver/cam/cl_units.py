@@ -82,6 +82,14 @@ def units_of(
     inch_feed = next((r for r in feeds if _feed_unit(r, field) == "inches"), None)
     if requested is not None:
         return UnitsReading(requested, "request", "the request's units (the file states none)")
+    mm_feed = next((r for r in feeds if _feed_unit(r, field) == "mm"), None)
+    if inch_feed is not None and mm_feed is not None:  # no single unit is suggested
+        raise InvalidInputError(
+            units_field,
+            "the program states no units (no UNITS or UNIT record) and its feeds are in inches "
+            f"per minute (FEDRAT/IPM at line {inch_feed.line}) and in mm per minute "
+            f"(FEDRAT/MMPM at line {mm_feed.line}): give units (mm or inch) with the program",
+        )
     if inch_feed is not None:
         return UnitsReading(
             "inches",

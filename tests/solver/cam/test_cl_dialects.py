@@ -148,6 +148,18 @@ def test_no_unit_and_no_inch_feed_is_refused_on_path_units_saying_what_the_file_
     assert "FEDRAT/MMPM at line 2" in caught.value.message
 
 
+def test_feeds_in_both_units_and_no_statement_are_refused_naming_both_lines() -> None:
+    """An mm feed, then an inch feed: read as inches, the mm feed's evidence unsaid."""
+    records = [*BARE, "FEDRAT/IPM,40", "GOTO/20,5,0"]
+    with pytest.raises(InvalidInputError) as caught:
+        read_cl_data("\n".join(records))
+    assert caught.value.field == "path.units"
+    assert "FEDRAT/IPM at line 5" in caught.value.message
+    assert "FEDRAT/MMPM at line 2" in caught.value.message
+    path = read_cl_data("\n".join(records), units="mm")  # the request settles it
+    assert path.report is not None and path.report.units_source == "request"
+
+
 @pytest.mark.parametrize(("units", "scale"), [("mm", MM), ("inches", INCH)])
 def test_the_request_gives_the_units_a_file_does_not_state(units: str, scale: float) -> None:
     path = read_cl_data("\n".join(BARE), units=units)  # type: ignore[arg-type]
