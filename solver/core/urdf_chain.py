@@ -80,6 +80,10 @@ def readable_urdf(
 
     Returns the document, its continuous joints (for :func:`chain_from_urdf`) and the links
     left out (:func:`without_stray_links`, ``frames`` as there).
+
+    Raises:
+        RobotModelError: on ``robot.urdf``, elements nested deeper than MAX_URDF_DEPTH, or a
+            joint whose axis has a length outside AXIS_LENGTHS (naming the joint).
     """
     depth = nesting_depth(urdf)
     if depth > MAX_URDF_DEPTH:
