@@ -31,7 +31,6 @@ crash. Errors name the field (and waypoint, line) as the API does.
 from __future__ import annotations
 
 import argparse
-import codecs
 import json
 import math
 import os
@@ -44,6 +43,7 @@ from typing import Any, TypeVar
 from pydantic import BaseModel, ValidationError
 
 from service import convert
+from service.cli_files import decoded, text_file
 from service.cli_text import ProgressBar, evaluation_text, import_text, map_text, optimum_text
 from service.config import Settings, get_settings
 from service.errors import request_location, solver_error_location
@@ -149,7 +149,7 @@ def _quiet_stdout() -> None:
 
 def _path(args: argparse.Namespace) -> dict[str, Any]:
     """The request's ``path`` object of the program file."""
-    text = _decoded(Path(args.program).read_bytes(), errors="replace")
+    text = decoded(Path(args.program).read_bytes(), errors="replace")
     if args.program.lower().endswith(".csv"):
         if args.units is None:  # a CSV says nothing of its units: never assumed
             message = "a CSV states no units: give --units mm, inch or m"
@@ -172,7 +172,7 @@ def _robot(args: argparse.Namespace) -> Any:
     """
     name, file = args.robot, Path(args.robot)
     if name.lower().endswith(".urdf"):
-        urdf = _text_file(file, "robot")
+        urdf = text_file(file, "robot")
         controller = CONTROLLER_FRAME if fixed_to_root(urdf, CONTROLLER_FRAME) else BASE_FRAME
         frames = {
             "base_frame": args.base_frame or controller,
@@ -254,34 +254,11 @@ def _json_file(file: Path, field: str) -> Any:
     Raises:
         InvalidInputError: on ``field``, when the file is not JSON.
     """
-    text = _text_file(file, field)
+    text = text_file(file, field)
     try:
         return json.loads(text)
     except (ValueError, RecursionError) as error:  # JSONDecodeError; too many digits; too deep
         raise InvalidInputError(field, f"the file is not JSON ({cut(str(error))})") from error
-
-
-def _text_file(file: Path, field: str) -> str:
-    """The text of ``file`` (UTF-8, or UTF-16 where it starts with its byte order mark).
-
-    Raises:
-        InvalidInputError: on ``field``, when the file is not such text.
-    """
-    try:
-        return _decoded(file.read_bytes())
-    except UnicodeDecodeError as error:
-        message = f"the file is not UTF-8 text ({error.reason} at byte {error.start})"
-        raise InvalidInputError(field, message) from error
-
-
-def _decoded(data: bytes, *, errors: str = "strict") -> str:
-    """Bytes as text: UTF-16 after its byte order mark, else UTF-8 without its mark.
-
-    Windows PowerShell writes files as UTF-16 (with the mark), Windows editors UTF-8 with one.
-    """
-    if data[:2] in (codecs.BOM_UTF16_LE, codecs.BOM_UTF16_BE):
-        return data.decode("utf-16", errors=errors)
-    return data.decode("utf-8-sig", errors=errors)
 
 
 def _with_options(body: dict[str, Any], args: argparse.Namespace) -> dict[str, Any]:

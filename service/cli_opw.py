@@ -19,7 +19,8 @@ from typing import Any
 
 import yaml
 
-from solver.core.exceptions import InvalidInputError
+from service.cli_files import text_file
+from solver.core.exceptions import InvalidInputError, cut
 from solver.families.opw.arms import ARMS
 
 GEOMETRY = "opw_kinematics_geometric_parameters"
@@ -62,10 +63,22 @@ def opw_object(file: Path) -> dict[str, Any]:
     Raises:
         InvalidInputError: on ``robot``: not YAML, or not an OPW parameter file.
     """
+    text = text_file(file, "robot")
+    deepest = _bracket_depth(text)
+    if deepest > MAX_YAML_DEPTH:  # PyYAML takes time square in the depth: 20,000 deep, 37 s
+        raise InvalidInputError(
+            "robot", f"{file.name}: lists or maps nested {deepest} deep (at most {MAX_YAML_DEPTH})"
+        )
     try:
-        data = yaml.safe_load(file.read_text(encoding="utf-8"))
-    except yaml.YAMLError as error:
-        raise InvalidInputError("robot", f"{file.name} is not YAML ({error})") from error
+        if any(isinstance(event, yaml.AliasEvent) for event in yaml.parse(text)):
+            # nine anchors of nine aliases each: 9^9 values, 8 GB, a minute to load
+            raise InvalidInputError(
+                "robot", f"{file.name}: YAML aliases (*name) are not read in a parameter file"
+            )
+        data = yaml.safe_load(text)
+    except (yaml.YAMLError, RecursionError) as error:  # RecursionError: nested too deep
+        reason = cut(str(error) or type(error).__name__)
+        raise InvalidInputError("robot", f"{file.name} is not YAML ({reason})") from error
     lengths = data.get(GEOMETRY) if isinstance(data, dict) else None
     if not isinstance(lengths, dict):
         raise InvalidInputError(
@@ -80,9 +93,32 @@ def opw_object(file: Path) -> dict[str, Any]:
         _number(v, f"{OFFSETS}[{i}]", file) for i, v in enumerate(_six(data, OFFSETS, file))
     ]
     out["sign_corrections"] = [
-        int(_number(v, f"{SIGNS}[{i}]", file)) for i, v in enumerate(_six(data, SIGNS, file))
+        _sign(v, f"{SIGNS}[{i}]", file) for i, v in enumerate(_six(data, SIGNS, file))
     ]
     return out
+
+
+MAX_YAML_DEPTH = 10
+"""The deepest nesting of flow lists and maps (brackets) read in a parameter file (its own: 1)."""
+
+
+def _bracket_depth(text: str) -> int:
+    """How deep the text's brackets nest, counted as written (quotes and comments not told)."""
+    depth = deepest = 0
+    for char in text:
+        if char in "[{":
+            depth += 1
+            deepest = max(deepest, depth)
+        elif char in "]}":
+            depth -= 1
+    return deepest
+
+
+def _sign(value: Any, where: str, file: Path) -> int:
+    """A sign correction: 1 or -1 (-1.5 was cut to -1, 2 passed on, NaN a traceback)."""
+    if isinstance(value, (int, float)) and not isinstance(value, bool) and value in (1, -1):
+        return int(value)
+    raise InvalidInputError("robot", f"{file.name}: {where} is {cut(repr(value))}, not 1 or -1")
 
 
 def _six(data: dict[str, Any], key: str, file: Path) -> list[Any]:
@@ -95,14 +131,17 @@ def _six(data: dict[str, Any], key: str, file: Path) -> list[Any]:
 
 def _number(value: Any, where: str, file: Path) -> float:
     """A length or an angle: a number, ``deg(x)`` or ``rad(x)`` (rosparam's forms); m or rad."""
+    number = None
     if isinstance(value, (int, float)) and not isinstance(value, bool):
-        return float(value)
+        number = float(value) if abs(value) < 1e300 else math.inf  # a 400-digit int: no float
     match = _ANGLE.match(value) if isinstance(value, str) else None
+    if match is not None:
+        number = float(match.group(2))
+    if number is None or not math.isfinite(number):  # the value cut: a nested one may be long
+        what = "not a number, deg(x) or rad(x)" if number is None else "not a finite number"
+        raise InvalidInputError("robot", f"{file.name}: {where} is {cut(repr(value))}, {what}")
     if match is None:
-        raise InvalidInputError(
-            "robot", f"{file.name}: {where} is {value!r}, not a number, deg(x) or rad(x)"
-        )
-    number = float(match.group(2))
+        return number
     return math.radians(number) if match.group(1) == "deg" else number
 
 

@@ -741,8 +741,46 @@ def test_an_opw_parameter_file_is_refused_with_the_robot_object_it_gives(
             "opw_kinematics_joint_offsets[2] is 'degrees(-90)', not a number, deg(x) or rad(x)",
         ),
         ("arm.xml", "<robot/>", "arm.xml is neither a URDF (.urdf) nor a JSON file"),
+        (
+            "arm.yaml",
+            OPW_FILE.replace("sign_corrections: [1,", "sign_corrections: [.nan,"),
+            "opw_kinematics_joint_sign_corrections[0] is nan, not 1 or -1",
+        ),
+        (
+            "arm.yaml",
+            OPW_FILE.replace("sign_corrections: [1,", "sign_corrections: [-1.5,"),
+            "opw_kinematics_joint_sign_corrections[0] is -1.5, not 1 or -1",
+        ),
+        (
+            "arm.yaml",
+            OPW_FILE.replace("a1: ", "a1: " + "1" * 400 + "  # "),
+            "opw_kinematics_geometric_parameters.a1 is 1111111111",
+        ),
+        (
+            "arm.yaml",
+            "a: " + "[" * 20_000 + "]" * 20_000,
+            "arm.yaml: lists or maps nested 20000 deep (at most 10)",
+        ),
+        (
+            "arm.yaml",
+            "".join(
+                f"l{k}: &l{k} [{', '.join([f'*l{k - 1}'] * 9)}]\n" for k in range(1, 9)
+            ).replace("*l0", "1")
+            + "opw_kinematics_geometric_parameters: {a1: *l8}\n",
+            "YAML aliases (*name) are not read in a parameter file",
+        ),
     ],
-    ids=["not-opw", "not-yaml", "bad-angle", "other-file"],
+    ids=[
+        "not-opw",
+        "not-yaml",
+        "bad-angle",
+        "other-file",
+        "nan-sign (a traceback)",
+        "fractional sign (cut to -1)",
+        "400-digit length (a traceback)",
+        "nested 20,000 deep (a traceback after 37 s)",
+        "alias bomb (8 GB, a minute)",
+    ],
 )
 def test_a_robot_file_of_another_kind_is_refused_naming_it(
     tmp_path: Path, capsys: pytest.CaptureFixture[str], name: str, content: str, message: str
