@@ -26,6 +26,7 @@ from solver.core.urdf_structure import (
     ContinuousJoint,
     Mimic,
     continuous_as_revolute,
+    inverted_limits,
     joint_axes,
     mimic_joints,
     nesting_depth,
@@ -82,8 +83,9 @@ def readable_urdf(
     left out (:func:`without_stray_links`, ``frames`` as there).
 
     Raises:
-        RobotModelError: on ``robot.urdf``, elements nested deeper than MAX_URDF_DEPTH, or a
-            joint whose axis has a length outside AXIS_LENGTHS (naming the joint).
+        RobotModelError: on ``robot.urdf``, elements nested deeper than MAX_URDF_DEPTH, a
+            joint whose axis has a length outside AXIS_LENGTHS, or one whose limit's lower is
+            above its upper (naming the joint).
     """
     depth = nesting_depth(urdf)
     if depth > MAX_URDF_DEPTH:
@@ -101,6 +103,13 @@ def readable_urdf(
                 f"{axis.length:.3g}; an axis is a direction, a unit vector (lengths from "
                 "1e-6 to 1e6 are normalised)",  # AXIS_LENGTHS
             )
+    inverted = inverted_limits(urdf)
+    if inverted:  # it was read, and the joint then fitted nowhere (joint_limits at waypoint 0)
+        name, lower, upper = inverted[0]
+        raise RobotModelError(
+            "robot.urdf",
+            f"joint {quoted(name)}: its limit's lower {lower:.6g} is above its upper {upper:.6g}",
+        )
     urdf, left_out = without_stray_links(urdf, frames=frames)
     urdf, continuous = continuous_as_revolute(urdf)
     return urdf, continuous, left_out

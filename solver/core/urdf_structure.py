@@ -238,6 +238,22 @@ def joint_axes(urdf: str) -> list[JointAxis]:
     return axes
 
 
+def inverted_limits(urdf: str) -> list[tuple[str, float, float]]:
+    """The movable joints whose ``<limit>`` gives a lower above its upper: (name, lower, upper)."""
+    root = _tree(urdf)
+    if root is None:
+        return []
+    inverted = []
+    for joint in root.findall("joint"):
+        limit = joint.find("limit")
+        if joint.get("type") == "fixed" or limit is None:
+            continue
+        lower, upper = _number(limit.get("lower")), _number(limit.get("upper"))
+        if lower is not None and upper is not None and lower > upper:
+            inverted.append((joint.get("name", ""), lower, upper))
+    return inverted
+
+
 def joint_count(urdf: str) -> int:
     """How many ``<joint>`` elements the document's robot has (0 where it is no XML)."""
     root = _tree(urdf)

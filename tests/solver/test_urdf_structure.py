@@ -291,3 +291,20 @@ def test_an_axis_of_length_two_reads_as_the_unit_one() -> None:
         np.testing.assert_allclose(
             tool_pose_in_base(long, row), tool_pose_in_base(plain, row), atol=1e-15
         )
+
+
+def test_a_joint_limit_whose_lower_is_above_its_upper_is_refused_naming_the_joint() -> None:
+    """It was read: every path then failed on joint_limits at waypoint 0 (numeric arms:
+    unreachable), where a request's OPW arm with such limits is a 422. Equal limits still read."""
+    start = UR5.index('<joint name="wrist_1_joint"')
+    end = UR5.index("</joint>", start)
+    part = re.sub(r'lower="[^"]*"', 'lower="1.0"', UR5[start:end])
+    with pytest.raises(RobotModelError) as error:
+        robot_from_urdf(
+            UR5[:start] + re.sub(r'upper="[^"]*"', 'upper="-1.0"', part) + UR5[end:], **FRAMES
+        )
+    assert error.value.field == "robot.urdf"
+    assert error.value.message == "joint 'wrist_1_joint': its limit's lower 1 is above its upper -1"
+    equal = UR5[:start] + re.sub(r'upper="[^"]*"', 'upper="1.0"', part) + UR5[end:]
+    robot = robot_from_urdf(equal, **FRAMES)
+    assert (robot.q_lower[3], robot.q_upper[3]) == (1.0, 1.0)
