@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import math
 import xml.etree.ElementTree as ElementTree
+from collections.abc import Iterator
 from dataclasses import dataclass
 
 
@@ -215,42 +216,39 @@ class JointAxis:
     length: float
 
 
+def _movable_with(urdf: str, tag: str) -> Iterator[tuple[str, ElementTree.Element]]:
+    """Each joint that is not ``fixed`` and has a ``tag`` element: its name and that element."""
+    root = _tree(urdf)
+    for joint in [] if root is None else root.findall("joint"):
+        element = joint.find(tag)
+        if joint.get("type") != "fixed" and element is not None:
+            yield joint.get("name", ""), element
+
+
 def joint_axes(urdf: str) -> list[JointAxis]:
     """The axes of the document's joints that are not ``fixed`` and give three finite numbers.
 
     A joint without ``<axis>`` (URDF's default, 1 0 0) or whose ``xyz`` is not three finite
     numbers is left out: the parser names the latter.
     """
-    root = _tree(urdf)
-    if root is None:
-        return []
     axes = []
-    for joint in root.findall("joint"):
-        element = joint.find("axis")
-        if joint.get("type") == "fixed" or element is None:
-            continue
+    for name, element in _movable_with(urdf, "axis"):
         try:
             xyz = tuple(float(v) for v in element.get("xyz", "1 0 0").split())
         except ValueError:
             continue
         if len(xyz) == 3 and all(math.isfinite(v) for v in xyz):
-            axes.append(JointAxis(joint.get("name", ""), xyz, math.hypot(*xyz)))
+            axes.append(JointAxis(name, xyz, math.hypot(*xyz)))
     return axes
 
 
 def inverted_limits(urdf: str) -> list[tuple[str, float, float]]:
     """The movable joints whose ``<limit>`` gives a lower above its upper: (name, lower, upper)."""
-    root = _tree(urdf)
-    if root is None:
-        return []
     inverted = []
-    for joint in root.findall("joint"):
-        limit = joint.find("limit")
-        if joint.get("type") == "fixed" or limit is None:
-            continue
+    for name, limit in _movable_with(urdf, "limit"):
         lower, upper = _number(limit.get("lower")), _number(limit.get("upper"))
         if lower is not None and upper is not None and lower > upper:
-            inverted.append((joint.get("name", ""), lower, upper))
+            inverted.append((name, lower, upper))
     return inverted
 
 
