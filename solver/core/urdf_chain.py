@@ -14,6 +14,7 @@ request may send a name of megabytes).
 
 from __future__ import annotations
 
+import xml.etree.ElementTree as ElementTree
 from collections.abc import Sequence
 from dataclasses import dataclass
 
@@ -30,6 +31,7 @@ from solver.core.urdf_structure import (
     joint_axes,
     mimic_joints,
     nesting_depth,
+    parsed,
     root_links,
     stray_links,
     uses_xacro,
@@ -87,14 +89,28 @@ def readable_urdf(
             joint whose axis has a length outside AXIS_LENGTHS, or one whose limit's lower is
             above its upper (naming the joint).
     """
-    depth = nesting_depth(urdf)
+    root = parsed(urdf)
+    if root is not None:  # no XML at all: the parser says why (chain_from_urdf)
+        _refuse_unreadable(root)
+    urdf, left_out = without_stray_links(urdf, frames=frames)
+    urdf, continuous = continuous_as_revolute(urdf)
+    return urdf, continuous, left_out
+
+
+def _refuse_unreadable(root: ElementTree.Element) -> None:
+    """:func:`readable_urdf`'s refusals of a parsed request URDF, naming the joint.
+
+    Elements nested too deep, a joint axis of no direction, a limit whose lower is above its
+    upper.
+    """
+    depth = nesting_depth(root)
     if depth > MAX_URDF_DEPTH:
         raise RobotModelError(
             "robot.urdf",
             f"cannot parse the URDF: its elements nest {depth} deep, more than "
             f"{MAX_URDF_DEPTH} (a URDF's nest a few levels)",
         )
-    for axis in joint_axes(urdf):
+    for axis in joint_axes(root):
         if not AXIS_LENGTHS[0] <= axis.length <= AXIS_LENGTHS[1]:
             x, y, z = axis.xyz
             raise RobotModelError(
@@ -103,16 +119,13 @@ def readable_urdf(
                 f"{axis.length:.3g}; an axis is a direction, a unit vector (lengths from "
                 "1e-6 to 1e6 are normalised)",  # AXIS_LENGTHS
             )
-    inverted = inverted_limits(urdf)
+    inverted = inverted_limits(root)
     if inverted:  # it was read, and the joint then fitted nowhere (joint_limits at waypoint 0)
         name, lower, upper = inverted[0]
         raise RobotModelError(
             "robot.urdf",
             f"joint {quoted(name)}: its limit's lower {lower:.6g} is above its upper {upper:.6g}",
         )
-    urdf, left_out = without_stray_links(urdf, frames=frames)
-    urdf, continuous = continuous_as_revolute(urdf)
-    return urdf, continuous, left_out
 
 
 def unlimited(model: pin.Model, continuous: Sequence[ContinuousJoint]) -> tuple[str, ...]:

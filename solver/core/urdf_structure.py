@@ -44,15 +44,20 @@ def _tree(urdf: str) -> ElementTree.Element | None:
         return None
 
 
-def nesting_depth(urdf: str) -> int:
-    """How deep the document's elements nest (the root alone: 1; 0 where it is no XML).
+def parsed(urdf: str) -> ElementTree.Element | None:
+    """The document's root element, or None where it is no XML.
+
+    For the readers below that take a parsed document: one parse for all of them.
+    """
+    return _tree(urdf)
+
+
+def nesting_depth(root: ElementTree.Element) -> int:
+    """How deep a parsed document's elements nest (the root alone: 1).
 
     Counted without recursion: ElementTree writes a document back by recursion, which a
     document nested a thousand deep ended with RecursionError (a 500).
     """
-    root = _tree(urdf)
-    if root is None:
-        return 0
     deepest, stack = 0, [(root, 1)]
     while stack:
         element, depth = stack.pop()
@@ -216,23 +221,22 @@ class JointAxis:
     length: float
 
 
-def _movable_with(urdf: str, tag: str) -> Iterator[tuple[str, ElementTree.Element]]:
+def _movable_with(root: ElementTree.Element, tag: str) -> Iterator[tuple[str, ElementTree.Element]]:
     """Each joint that is not ``fixed`` and has a ``tag`` element: its name and that element."""
-    root = _tree(urdf)
-    for joint in [] if root is None else root.findall("joint"):
+    for joint in root.findall("joint"):
         element = joint.find(tag)
         if joint.get("type") != "fixed" and element is not None:
             yield joint.get("name", ""), element
 
 
-def joint_axes(urdf: str) -> list[JointAxis]:
-    """The axes of the document's joints that are not ``fixed`` and give three finite numbers.
+def joint_axes(root: ElementTree.Element) -> list[JointAxis]:
+    """The axes of a parsed document's joints that are not ``fixed`` and give three finite numbers.
 
     A joint without ``<axis>`` (URDF's default, 1 0 0) or whose ``xyz`` is not three finite
     numbers is left out: the parser names the latter.
     """
     axes = []
-    for name, element in _movable_with(urdf, "axis"):
+    for name, element in _movable_with(root, "axis"):
         try:
             xyz = tuple(float(v) for v in element.get("xyz", "1 0 0").split())
         except ValueError:
@@ -242,10 +246,10 @@ def joint_axes(urdf: str) -> list[JointAxis]:
     return axes
 
 
-def inverted_limits(urdf: str) -> list[tuple[str, float, float]]:
-    """The movable joints whose ``<limit>`` gives a lower above its upper: (name, lower, upper)."""
+def inverted_limits(root: ElementTree.Element) -> list[tuple[str, float, float]]:
+    """(name, lower, upper) of each movable joint whose ``<limit>`` has lower above upper."""
     inverted = []
-    for name, limit in _movable_with(urdf, "limit"):
+    for name, limit in _movable_with(root, "limit"):
         lower, upper = _number(limit.get("lower")), _number(limit.get("upper"))
         if lower is not None and upper is not None and lower > upper:
             inverted.append((name, lower, upper))
