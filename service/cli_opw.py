@@ -131,18 +131,18 @@ def _six(data: dict[str, Any], key: str, file: Path) -> list[Any]:
 
 def _number(value: Any, where: str, file: Path) -> float:
     """A length or an angle: a number, ``deg(x)`` or ``rad(x)`` (rosparam's forms); m or rad."""
-    number = None
+    match = _ANGLE.match(value) if isinstance(value, str) else None
     if isinstance(value, (int, float)) and not isinstance(value, bool):
         number = float(value) if abs(value) < 1e300 else math.inf  # a 400-digit int: no float
-    match = _ANGLE.match(value) if isinstance(value, str) else None
-    if match is not None:
+    elif match is not None:
         number = float(match.group(2))
+        number = math.radians(number) if match.group(1) == "deg" else number
+    else:
+        number = None
     if number is None or not math.isfinite(number):  # the value cut: a nested one may be long
         what = "not a number, deg(x) or rad(x)" if number is None else "not a finite number"
         raise InvalidInputError("robot", f"{file.name}: {where} is {cut(repr(value))}, {what}")
-    if match is None:
-        return number
-    return math.radians(number) if match.group(1) == "deg" else number
+    return number
 
 
 def _same(parameters: Any, geometry: dict[str, Any]) -> bool:

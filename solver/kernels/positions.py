@@ -40,9 +40,7 @@ def limit_modes(lower: np.ndarray, upper: np.ndarray) -> tuple[np.ndarray, np.nd
     wide = width > _TWO_PI + 1e-12
     modes = np.where(~np.isfinite(width), NO_LIMIT, np.where(wide, WIDE, NARROW))
     finite = np.isfinite(width)  # an unlimited side (-inf or inf) has no middle: no NaN made
-    middle = np.where(
-        finite, (np.where(finite, lower, 0.0) + np.where(finite, upper, 0.0)) / 2, 0.0
-    )
+    middle = (np.where(finite, lower, 0.0) + np.where(finite, upper, 0.0)) / 2
     half = np.where(finite, width / 2, 0.0)
     arc = np.column_stack([np.cos(middle), np.sin(middle), np.cos(half)])
     return modes.astype(np.int64), arc
