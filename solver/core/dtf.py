@@ -181,7 +181,8 @@ def lp_speed(
     )
     if result.status != 0:  # The origin is always feasible and s is bounded: not expected.
         raise RuntimeError(f"HiGHS failed on the DTF LP: {result.message}")
-    return float(result.x[-1]) / scale, np.asarray(result.x[:n]) * qdot_max
+    # + 0.0: HiGHS answers -0.0 where the optimum is 0 (a chain that cannot move along t_hat)
+    return float(result.x[-1]) / scale + 0.0, np.asarray(result.x[:n]) * qdot_max + 0.0
 
 
 def dtf(

@@ -77,7 +77,7 @@ def jacobian_in_base(robot: Robot, q: np.ndarray) -> np.ndarray:
         np.asarray(q, dtype=float),
         robot.tool_point_frame,
         pin.ReferenceFrame.LOCAL_WORLD_ALIGNED,
-    )
+    ).reshape(6, -1)  # a chain of one joint: eigenpy gives its 6 x 1 matrix as a vector
     rotation_base_world = robot.transform_world_to_base[:3, :3].T
     jacobian: np.ndarray = np.empty_like(jacobian_world)
     jacobian[:3] = rotation_base_world @ jacobian_world[:3]

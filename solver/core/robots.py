@@ -206,9 +206,13 @@ def robot_from_model(
         for j in range(1, model.njoints)
         if model.joints[j].shortname() != "JointModelMimic"  # a mimic joint follows another
     ]
-    if any(model.joints[j].nq != 1 or model.joints[j].nv != 1 for j in coordinates):
+    several = [j for j in coordinates if model.joints[j].nq != 1 or model.joints[j].nv != 1]
+    if several:
         raise RobotModelError(
-            "robot.urdf", "only revolute and prismatic joints are supported between base and tool"
+            "robot.urdf",
+            f"joint {quoted(model.names[several[0]])} moves in {model.joints[several[0]].nv} "
+            "degrees of freedom (a planar or floating joint); only revolute and prismatic "
+            "joints are supported between base and tool",
         )
     data = model.createData()
     pin.framesForwardKinematics(model, data, pin.neutral(model))

@@ -29,11 +29,13 @@ from solver.core.urdf_structure import (
     continuous_as_revolute,
     inverted_limits,
     joint_axes,
+    joint_problem,
     mimic_joints,
     nesting_depth,
     parsed,
     root_links,
     stray_links,
+    tree_problem,
     uses_xacro,
     without_links,
 )
@@ -86,8 +88,9 @@ def readable_urdf(
 
     Raises:
         RobotModelError: on ``robot.urdf``, elements nested deeper than MAX_URDF_DEPTH, a
-            joint whose axis has a length outside AXIS_LENGTHS, or one whose limit's lower is
-            above its upper (naming the joint).
+            joint whose axis has a length outside AXIS_LENGTHS, joints that are no tree, a
+            joint with two mimics, a mimic multiplier, a negative velocity or an origin out of
+            bounds, or a limit whose lower is above its upper (naming the joint or link).
     """
     root = parsed(urdf)
     if root is not None:  # no XML at all: the parser says why (chain_from_urdf)
@@ -100,8 +103,10 @@ def readable_urdf(
 def _refuse_unreadable(root: ElementTree.Element) -> None:
     """:func:`readable_urdf`'s refusals of a parsed request URDF, naming the joint.
 
-    Elements nested too deep, a joint axis of no direction, a limit whose lower is above its
-    upper.
+    Elements nested too deep, a joint axis of no direction, joints that do not form a tree
+    (:func:`~solver.core.urdf_structure.tree_problem`), a joint's mimic, velocity or origin the
+    parser reads wrongly or unsaid (:func:`~solver.core.urdf_structure.joint_problem`), a limit
+    whose lower is above its upper.
     """
     depth = nesting_depth(root)
     if depth > MAX_URDF_DEPTH:
@@ -119,6 +124,9 @@ def _refuse_unreadable(root: ElementTree.Element) -> None:
                 f"{axis.length:.3g}; an axis is a direction, a unit vector (lengths from "
                 "1e-6 to 1e6 are normalised)",  # AXIS_LENGTHS
             )
+    problem = tree_problem(root) or joint_problem(root)
+    if problem is not None:
+        raise RobotModelError("robot.urdf", f"cannot read the URDF: {problem}")
     inverted = inverted_limits(root)
     if inverted:  # it was read, and the joint then fitted nowhere (joint_limits at waypoint 0)
         name, lower, upper = inverted[0]
@@ -220,6 +228,7 @@ def chain_from_urdf(
                 "(ROS: xacro file.urdf.xacro > file.urdf)"
             )
         raise RobotModelError("robot.urdf", f"cannot parse the URDF: {reason}") from error
+    _links_keep_their_names(full)
     if not full.existFrame(tool_frame):
         names = frame_names(full)
         raise RobotModelError(
@@ -240,6 +249,7 @@ def chain_from_urdf(
             )
     if coupled:  # pinocchio couples them: one coordinate per leader
         full = pin.buildModelFromXML(urdf, mimic=True)
+        _links_keep_their_names(full)
     locked = [j for j in range(1, full.njoints) if full.names[j] not in chain]
     model = pin.buildReducedModel(full, locked, pin.neutral(full)) if locked else full
     if model.nv == 0:
@@ -248,6 +258,25 @@ def chain_from_urdf(
     for mimic in coupled:
         _limit_leader(model, mimic)
     return model
+
+
+JOINT_FRAME_SUFFIX = " (joint)"
+"""Appended to the name of a joint's frame that a link's frame also has."""
+
+
+def _links_keep_their_names(model: pin.Model) -> None:
+    """Rename each joint's frame that has a link's name to ``name (joint)``, in place.
+
+    A URDF may name a joint as a link (its child, or another): pinocchio then has two frames of
+    that name, and looking it up raised "Several frames match the filter" (a 500). A frame a
+    request names (``base_frame``, ``tool_frame``) is the link's, as REP 199 names them; the
+    joint's frame stays reachable by its new name, which the frames listed in messages show.
+    """
+    links = {frame.name for frame in model.frames if frame.type == pin.FrameType.BODY}
+    for index, frame in enumerate(model.frames):
+        if frame.type != pin.FrameType.BODY and frame.name in links:
+            frame.name += JOINT_FRAME_SUFFIX
+            model.frames[index] = frame
 
 
 def _limit_leader(model: pin.Model, mimic: Mimic) -> None:

@@ -18,6 +18,8 @@ import xml.etree.ElementTree as ElementTree
 from collections.abc import Iterator
 from dataclasses import dataclass
 
+from solver.core.exceptions import quoted, quoted_names
+
 
 @dataclass(frozen=True)
 class Mimic:
@@ -254,6 +256,96 @@ def inverted_limits(root: ElementTree.Element) -> list[tuple[str, float, float]]
         if lower is not None and upper is not None and lower > upper:
             inverted.append((name, lower, upper))
     return inverted
+
+
+def tree_problem(root: ElementTree.Element) -> str | None:
+    """What keeps a parsed document's joints from forming a tree, or None where they do.
+
+    A link that is the child of two joints, or joints that lead back to where they started,
+    close a loop: pinocchio's parser crashed the process on such a document (a segmentation
+    fault) or read one of the two joints twice and dropped the other.
+    """
+    parents: dict[str, list[str]] = {}  # child link: the joints that have it as their child
+    parent_link: dict[str, str] = {}
+    for joint in root.findall("joint"):
+        parent, child = joint.find("parent"), joint.find("child")
+        if parent is None or child is None:
+            continue  # the parser names the joint
+        name, child_link = joint.get("name", ""), child.get("link", "")
+        parents.setdefault(child_link, []).append(name)
+        parent_link[child_link] = parent.get("link", "")
+    for link, joints in parents.items():
+        if len(joints) > 1:
+            return (
+                f"link {quoted(link)} is the child of {len(joints)} joints "
+                f"({quoted_names(joints)}): a URDF is a tree, each link the child of one joint "
+                "(a closed chain cannot be read)"
+            )
+    for start in parent_link:
+        link, seen = start, {start}
+        while link in parent_link:
+            link = parent_link[link]
+            if link in seen:
+                return (
+                    f"the joints above link {quoted(start)} lead back to link {quoted(link)}: "
+                    "a URDF is a tree, with no loop of joints"
+                )
+            seen.add(link)
+    return None
+
+
+def joint_problem(root: ElementTree.Element) -> str | None:
+    """What a parsed document's joint elements say that the parser reads wrongly or unsaid.
+
+    A joint with two ``<mimic>`` elements (the parser couples it to the first; a reading of the
+    last would narrow the wrong joint's limits), a mimic multiplier outside MULTIPLIERS, a
+    negative velocity limit (the parser's refusal names no joint), a joint origin farther than
+    MAX_ORIGIN (an LP of such a chain misses its twist: no arm is that big).
+    """
+    for joint in root.findall("joint"):
+        name = quoted(joint.get("name", ""))
+        mimics = joint.findall("mimic")
+        if len(mimics) > 1:
+            return f"joint {name} has {len(mimics)} <mimic> elements; a joint mimics one joint"
+        multiplier = _number(mimics[0].get("multiplier")) if mimics else None
+        if (
+            multiplier is not None
+            and 0.0 < abs(multiplier)
+            and not (MULTIPLIERS[0] <= abs(multiplier) <= MULTIPLIERS[1])
+        ):
+            return (
+                f"joint {name}: its mimic multiplier {multiplier:.6g} is outside +-1e-6 to "
+                "+-1e6 (a gear ratio)"  # MULTIPLIERS
+            )
+        limit = joint.find("limit")
+        velocity = _number(limit.get("velocity")) if limit is not None else None
+        if velocity is not None and velocity < 0.0:
+            return f"joint {name}: its velocity limit {velocity:.6g} is negative"
+        origin = joint.find("origin")
+        xyz = _numbers(origin.get("xyz", "")) if origin is not None else None
+        if xyz is not None and not max(abs(v) for v in xyz) <= MAX_ORIGIN:
+            return (
+                f"joint {name}: its origin xyz has a value beyond +-{MAX_ORIGIN:g} m (no arm is "
+                "that big; a URDF's lengths are in metres)"
+            )
+    return None
+
+
+MULTIPLIERS = (1e-6, 1e6)
+"""The magnitudes a ``<mimic multiplier>`` may have (0 is refused where the coupling is read)."""
+MAX_ORIGIN = 100.0
+"""m, the largest coordinate of a joint's ``<origin xyz>``: an OPW arm's lengths have the same
+bound (solver.families.opw.parameters.MAX_LENGTH). At 1e8 m the DTF's LP answered a twist 11 %
+off the one asked, at 1e10 m HiGHS failed (a 500)."""
+
+
+def _numbers(text: str) -> list[float] | None:
+    """Finite numbers separated by spaces, None where any is not one (the parser names it)."""
+    try:
+        values = [float(v) for v in text.split()]
+    except ValueError:
+        return None
+    return values if values and all(math.isfinite(v) for v in values) else None
 
 
 def joint_count(urdf: str) -> int:

@@ -1,7 +1,8 @@
 """The robot's own geometry in a cell (cell.md section 2), as a pinocchio ``GeometryModel``.
 
 - An arm read from a URDF: its ``<collision>`` elements (pinocchio's URDF reader, coal shapes).
-  ``package://`` meshes resolve inside example-robot-data's share folder; every mesh is taken
+  ``package://`` meshes resolve inside example-robot-data's share folder (no other file is
+  read: an element with a mesh elsewhere is left out, its link approximated); every mesh is taken
   as its convex hull (:func:`solver.path.cell.shapes.convex_hull`), which contains it. A URDF
   whose meshes cannot be read keeps its primitive elements.
 - Any link left without geometry (an arm built from DH or OPW parameters, a URDF link with
@@ -15,6 +16,8 @@
 from __future__ import annotations
 
 import hashlib
+import html
+import os
 import pickle
 import re
 from dataclasses import dataclass
@@ -111,8 +114,13 @@ def content_digest(*parts: bytes) -> str:
 
 def _urdf_geometry(robot: Robot) -> pin.GeometryModel:
     """The URDF's collision elements with meshes as convex hulls; primitives only if unreadable."""
-    urdf = robot.urdf or ""
     share = str(example_robot_data_dir().parent.parent)  # package://example-robot-data/...
+    urdf = re.sub(
+        r"<collision\b.*?</collision>",
+        lambda match: _inside_share(match, share),
+        robot.urdf or "",
+        flags=re.S,
+    )
     try:
         geometry = pin.buildGeomFromUrdfString(
             robot.model, urdf, pin.COLLISION, package_dirs=[share]
@@ -127,6 +135,28 @@ def _urdf_geometry(robot: Robot) -> pin.GeometryModel:
             mesh = obj.geometry
             obj.geometry = convex_hull(np.array([mesh.vertex(k) for k in range(mesh.num_vertices)]))
     return geometry
+
+
+_MESH_FILE = re.compile(r"""<mesh\b[^>]*?\bfilename\s*=\s*(["'])(.*?)\1""", re.S)
+
+
+def _inside_share(match: re.Match[str], share: str) -> str:
+    """A ``<collision>`` element unless it holds a mesh that is not a file of the share folder.
+
+    Only ``package://`` meshes are read, and only inside ``share`` (cell.md section 2): a
+    request's URDF named any file of the server (``/etc/...``, ``file://``, a relative path,
+    ``package://`` with ``..``) and the answer's approximated links told whether it was a
+    readable mesh. Without the element its link is approximated, and the answer says so.
+    """
+    element = match.group(0)
+    for mesh in _MESH_FILE.finditer(element):
+        name = html.unescape(mesh.group(2)).strip()
+        if not name.startswith("package://"):
+            return ""
+        resolved = os.path.realpath(os.path.join(share, name.removeprefix("package://")))
+        if not resolved.startswith(os.path.realpath(share) + os.sep):
+            return ""
+    return element
 
 
 def _keep_primitive(match: re.Match[str]) -> str:
@@ -144,7 +174,7 @@ def _radii(
             raise InvalidInputError(
                 "cell.link_radii",
                 f"{len(link_radii)} radii for {robot.shown_name!r}: give {count}, the base's and "
-                f"one per joint ({', '.join(robot.joint_names)})",
+                f"one per joint ({', '.join(robot.model.names[1:])})",
             )
         return tuple(link_radii)
     if robot.name in PUBLISHED_RADII:
