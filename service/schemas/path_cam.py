@@ -15,8 +15,7 @@ from service.schemas.common import RequestModel
 from service.schemas.path_input import MAX_PATH_WAYPOINTS, PathInput
 from solver.cam.cam_path import CamPath, Units
 from solver.cam.cl_data import DEFAULT_ARC_TOLERANCE, read_cl_data
-from solver.cam.csv_path import read_csv_path
-from solver.cam.reading import is_number
+from solver.cam.csv_path import csv_waypoints, read_csv_path
 
 ProgramUnits = TypeAliasType(
     "ProgramUnits",
@@ -132,9 +131,7 @@ class CsvPath(RequestModel):
 
     def n_waypoints(self) -> int:
         """The number of waypoints as read: the non-blank lines after any header (cam.md 9)."""
-        rows = [row for row in self.csv.splitlines() if row.strip()]
-        header = bool(rows) and not all(is_number(cell) for cell in rows[0].split(","))
-        return len(rows) - int(header)
+        return csv_waypoints(self.csv)
 
     def to_solver(self) -> PathInput:
         """The path's poses (one pass, no feed).

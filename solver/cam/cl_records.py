@@ -85,6 +85,11 @@ SKIPPED = frozenset(
 """Words without geometry or feed. ``CUTCOM``: CL points are cutter locations already (the
 tool centre the CAM system computed); compensation is the controller's wear offset."""
 
+LITERAL = frozenset({"PARTNO", "PPRINT", "INSERT", "REMARK"})
+"""Words whose text is taken as written, to the end of its line: APT does not continue them,
+so a ``$`` ending one is text (``PPRINT/TOOL COST 5$`` joined the next line's GOTO to the
+operation's name: a move lost without a word)."""
+
 SKIPPED_PREFIXES = ("CSI_",)
 """SolidWorks CAM's ``CSI_SET_*`` tool data."""
 
@@ -105,6 +110,9 @@ REFUSED: dict[str, str] = {
     "PIVOTZ": "a pivot offset of the tool point",
     "CYCLE": "a canned cycle, whose plunges are not written as GOTOs",
     "THREAD": "a threading cycle",
+    "GOHOME": "a move to the FROM point, outside the GOTOs read",
+    "INDIRV": "the direction of the next arc, which the reader takes the shorter way",
+    "INDIRP": "the direction of the next arc, which the reader takes the shorter way",
 }
 """Words that change the geometry in ways the reader does not apply, and what they do."""
 
@@ -179,7 +187,7 @@ def records(text: str, *, field: str) -> Iterator[Record]:
             continue
         if not parts:
             start = number
-        if content.endswith("$"):
+        if content.endswith("$") and not (not parts and _literal(content)):
             parts.append(content[:-1])
             continue
         parts.append(content)
@@ -194,6 +202,12 @@ def records(text: str, *, field: str) -> Iterator[Record]:
             line=start,
             text="".join(parts),
         )
+
+
+def _literal(line: str) -> bool:
+    """Whether a line starts a record of a :data:`LITERAL` word."""
+    match = _WORD.match(line)
+    return match is not None and match.group(1).upper() in LITERAL
 
 
 def _record(line: int, text: str, *, field: str) -> Record:

@@ -48,10 +48,9 @@ def read_csv_path(text: str, *, units: str, field: str = "path.csv") -> CamPath:
             "units", f"units {units!r}: a CSV path is in mm or m (metric) or inch"
         )
     scale = METRES_PER_UNIT[_UNITS[units]]
-    text = text.removeprefix(BOM)  # Excel's "CSV UTF-8" starts with it
-    rows = [(n, raw.strip()) for n, raw in enumerate(text.splitlines(), start=1) if raw.strip()]
+    rows = _rows(text)
     columns = None
-    if rows and not all(is_number(cell) for cell in rows[0][1].split(",")):
+    if _has_header(rows):
         line, header = rows.pop(0)
         columns = _header_columns(header, line=line, field=field)
     positions, directions, lines = [], [], []
@@ -88,6 +87,30 @@ def read_csv_path(text: str, *, units: str, field: str = "path.csv") -> CamPath:
         axis_correction=correction,
         field=field,
     )
+
+
+def csv_waypoints(text: str) -> int:
+    """How many waypoints :func:`read_csv_path` reads from ``text``: its rows after any header.
+
+    The waypoint limit counts this (cam.md section 9: one counting rule).
+    """
+    rows = _rows(text)
+    return len(rows) - int(_has_header(rows))
+
+
+def _rows(text: str) -> list[tuple[int, str]]:
+    """The non-blank lines, stripped, with their numbers (from 1), the BOM dropped.
+
+    Excel's "CSV UTF-8" starts with the mark: a headerless file's first row, counted as a
+    header with it, let 20,001 waypoints past a limit of 20,000.
+    """
+    text = text.removeprefix(BOM)
+    return [(n, raw.strip()) for n, raw in enumerate(text.splitlines(), start=1) if raw.strip()]
+
+
+def _has_header(rows: list[tuple[int, str]]) -> bool:
+    """Whether the first row is a header: not all numbers."""
+    return bool(rows) and not all(is_number(cell) for cell in rows[0][1].split(","))
 
 
 def _forms(columns: int | None) -> str:

@@ -15,6 +15,8 @@ import pytest
 from fastapi.testclient import TestClient
 
 from service.config import get_settings
+from service.schemas.path_cam import CsvPath
+from solver.cam.csv_path import read_csv_path
 from tests.solver.cam.dialects import NX_LISTING, SOLIDWORKS, text
 
 PLACEMENT = {"x": 0.0, "y": 0.45, "z": 0.1, "yaw": 0.0}
@@ -171,3 +173,12 @@ def test_a_csv_counts_its_waypoints_not_its_lines(client: TestClient, setting: A
     answer = client.post("/v1/paths/import", json={"path": more})
     assert answer.status_code == 422
     assert "4 waypoints; the limit is 3" in answer.json()["detail"][0]["msg"]
+
+
+def test_a_byte_order_mark_does_not_make_the_first_row_a_header_in_the_count() -> None:
+    """The waypoint count (the limit's) took a headerless file's marked first row for a
+    header: 20,001 rows passed a limit of 20,000. The count is the reader's rows."""
+    rows = "\n".join(f"{k},0,0,0,0,1" for k in range(5))
+    for csv in (rows, "\ufeff" + rows, "x,y,z,i,j,k\n" + rows, "\ufeffx,y,z,i,j,k\n" + rows):
+        assert CsvPath(csv=csv, units="mm").n_waypoints() == 5
+        assert len(read_csv_path(csv, units="mm").positions) == 5

@@ -10,6 +10,9 @@ fixture states (the MSYS or CSYS frame applied by hand below), never by the read
 from __future__ import annotations
 
 import math
+import subprocess
+import sys
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -309,3 +312,62 @@ def test_digits_other_than_ascii_are_no_number() -> None:
     with pytest.raises(InvalidLineError, match="is not a number") as caught:
         read_cl_data("\n".join(["UNITS/MM", "GOTO/\uff11,0,0", *BARE[1:]]))
     assert caught.value.line == 2
+
+
+_LONG_TOKEN = """
+import sys
+from solver.cam.cl_data import read_cl_data
+from solver.cam.csv_path import read_csv_path
+from solver.core.exceptions import InvalidLineError
+digits = "1" * 200_000 + "x"
+for read in (
+    lambda: read_cl_data("UNITS/MM\\nGOTO/0,0,0\\nGOTO/" + digits + ",0,0\\n"),
+    lambda: read_csv_path("0,0,0,0,0,1\\n" + digits + ",0,0,0,0,1\\n", units="mm"),
+):
+    try:
+        read()
+    except InvalidLineError as error:
+        print(error.line, error.message.split(" (in ")[0][-30:])
+"""
+
+
+def test_a_long_malformed_number_is_refused_in_one_pass_over_it() -> None:
+    """200,000 digits and an x: the number pattern tried every split of the run of digits
+    between its two digit classes (time square in its length: 32,000 digits took 16 s and
+    held the event loop; 200,000 about 10 min). Refused naming the line, the echo cut; run in
+    a process of its own, ended if it takes more than a minute (linear: milliseconds)."""
+    done = subprocess.run(
+        [sys.executable, "-c", _LONG_TOKEN],
+        capture_output=True,
+        text=True,
+        cwd=Path(__file__).resolve().parents[3],
+        timeout=60,
+    )
+    assert done.returncode == 0, done.stderr[-500:]
+    lines = done.stdout.splitlines()
+    assert [line.split()[0] for line in lines] == ["3", "2"]
+    assert all("is not a number" in line for line in lines)
+
+
+@pytest.mark.parametrize("record", ["PPRINT/TOOL COST 5$", "PARTNO BRACKET REV $", "INSERT/M01$"])
+def test_a_dollar_ending_a_text_record_is_text_not_a_continuation(record: str) -> None:
+    """APT takes these records literally to the end of their line: the next GOTO was joined
+    to the text (the operation 'TOOL COST 5GOTO/0,0,0'), a move lost without a word."""
+    path = read_cl_data("\n".join(["UNITS/MM", record, *BARE]))
+    plain = read_cl_data("\n".join(["UNITS/MM", *BARE]))
+    np.testing.assert_array_equal(path.positions, plain.positions)
+    assert len(path.positions) == 3  # BARE's three GOTOs
+
+
+@pytest.mark.parametrize(
+    ("record", "what"),
+    [("GOHOME", "FROM point"), ("INDIRV/0,-1,0", "direction of the next arc")],
+)
+def test_moves_and_arc_directions_the_reader_does_not_apply_are_refused(
+    record: str, what: str
+) -> None:
+    """GOHOME's move was read as part of the cut to the next GOTO; INDIRV's direction was
+    dropped, its arc taken the shorter way: both listed as 'not recognised' only."""
+    with pytest.raises(InvalidLineError, match=what) as caught:
+        read_cl_data("\n".join(["UNITS/MM", *BARE[:2], record, *BARE[2:]]))
+    assert caught.value.line == 4
