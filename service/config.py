@@ -3,11 +3,14 @@
 from __future__ import annotations
 
 import functools
+import importlib.util
 import os
+import re
+import sys
 from dataclasses import dataclass
 from pathlib import Path
 
-from pydantic import Field, PrivateAttr
+from pydantic import Field, PrivateAttr, ValidationError, field_validator
 from pydantic_settings import BaseSettings, SettingsConfigDict
 
 _ROUTE_LIMIT_NAMES = (
@@ -147,6 +150,26 @@ class Settings(BaseSettings):
         description="The address of a Dask scheduler (tcp://host:8786) on whose workers the "
         "jobs' placement tasks run; unset, they run in the local worker processes.",
     )
+
+    @field_validator("dask_scheduler")
+    @classmethod
+    def _scheduler_address(cls, address: str | None) -> str | None:
+        """A scheduler's address, ``[scheme://]host:port``, with the dask extra installed.
+
+        A malformed one was taken at startup, and every map job then failed as internal
+        ('missing port number in address').
+        """
+        if address is None:
+            return None
+        if not _SCHEDULER_ADDRESS.fullmatch(address):
+            raise ValueError(
+                f"{address[:100]!r} is not a scheduler address: [scheme://]host:port, as "
+                "tcp://host1:8786"
+            )
+        if importlib.util.find_spec("distributed") is None:
+            raise ValueError("jobs on a Dask cluster need the dask extra: pip install -e '.[dask]'")
+        return address
+
     max_queued_jobs: int = Field(
         default=100,
         gt=0,
@@ -255,3 +278,28 @@ class MapLimits:
 def get_settings() -> Settings:
     """The settings, read from the environment on first use and kept."""
     return Settings()
+
+
+def settings_or_exit() -> Settings:
+    """:func:`get_settings`, or each bad ``DTF_`` variable named on stderr and exit status 3.
+
+    Called where the service starts, before any warm-up: a bad value was refused only after
+    it (30 s on a first start), by a traceback through the lifespan that named the field
+    (``workers``), not the variable a deployment sets (``DTF_WORKERS``).
+    """
+    try:
+        return get_settings()
+    except ValidationError as error:
+        for item in error.errors():
+            name = "DTF_" + "_".join(str(part) for part in item["loc"]).upper()
+            value = os.environ.get(name, "")
+            message = item["msg"].removeprefix("Value error, ")
+            print(f"error: {name}={value[:100]!r}: {message}", file=sys.stderr)  # noqa: T201
+        raise SystemExit(INVALID_SETTINGS) from None
+
+
+INVALID_SETTINGS = 3
+"""The exit status of a service started with a bad ``DTF_`` variable (the CLI's for input)."""
+_SCHEDULER_ADDRESS = re.compile(
+    r"(?:[a-z][a-z0-9+.-]*://)?(?:\[[0-9A-Fa-f:.]+\]|[^:/\s\[\]]+):\d{1,5}"
+)

@@ -28,7 +28,7 @@ from service.api import api_router
 from service.api.routes import health
 from service.body import BODY_MODELS
 from service.body_limits import BodySizeLimitMiddleware
-from service.config import get_settings
+from service.config import get_settings, settings_or_exit
 from service.errors import (
     SERVER_ERROR_RESPONSE,
     cancelled_handler,
@@ -151,7 +151,12 @@ def _stop_work_on(signum: signal.Signals) -> None:
 
 
 def create_app() -> FastAPI:
-    """Build the app: routers, the error handlers, the body size limit and offline docs."""
+    """Build the app: routers, the error handlers, the body size limit and offline docs.
+
+    The ``DTF_`` settings are read first: a bad one ends the process here, named, before any
+    warm-up (:func:`service.config.settings_or_exit`).
+    """
+    settings_or_exit()
     # Swagger UI and ReDoc served from the fastapi-offline package, not a CDN: /docs works
     # on a machine with no internet.
     app = FastAPIOffline(

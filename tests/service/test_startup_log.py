@@ -3,11 +3,17 @@
 from __future__ import annotations
 
 import logging
+import os
+import subprocess
+import sys
+from pathlib import Path
 
 import pytest
 from fastapi.testclient import TestClient
 
+from service.config import Settings
 from service.main import app
+from tests.cases import ROOT
 
 
 def test_the_warm_up_is_logged_before_and_after(caplog: pytest.LogCaptureFixture) -> None:
@@ -17,3 +23,37 @@ def test_the_warm_up_is_logged_before_and_after(caplog: pytest.LogCaptureFixture
     assert len(lines) == 2, lines
     assert "compiles them, about 30 s" in lines[0]
     assert lines[1].startswith("ready after ")
+
+
+@pytest.mark.parametrize(
+    ("variable", "value", "said"),
+    [
+        ("DTF_WORKERS", "abc", "Input should be a valid integer"),
+        ("DTF_MAX_BODY_BYTES", "-5", "Input should be greater than 0"),
+        ("DTF_DASK_SCHEDULER", "garbage", "'garbage' is not a scheduler address"),
+    ],
+)
+def test_a_bad_setting_stops_the_start_naming_its_variable(
+    variable: str, value: str, said: str, tmp_path: Path
+) -> None:
+    """They were refused after the warm-up (30 s on a first start) by a traceback through the
+    lifespan naming the field (workers); a malformed scheduler address was taken, and every
+    map job then failed as internal. Now: exit 3 before the warm-up, one line naming each."""
+    env = {**os.environ, variable: value, "DTF_DATA_DIR": str(tmp_path)}
+    done = subprocess.run(
+        [sys.executable, "-m", "uvicorn", "service.main:app", "--port", "0"],
+        capture_output=True,
+        text=True,
+        cwd=ROOT,
+        env=env,
+        timeout=120,
+    )
+    assert done.returncode == 3, done.stderr[-800:]
+    lines = done.stderr.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith(f"error: {variable}={value!r}: {said}"), lines
+    assert "Traceback" not in done.stderr and "warming up" not in done.stderr
+
+
+def test_a_scheduler_address_of_host_and_port_is_taken() -> None:
+    for address in ("tcp://127.0.0.1:8786", "host1:8786", "tls://[::1]:8786"):
+        assert Settings(dask_scheduler=address).dask_scheduler == address
