@@ -6,6 +6,7 @@ import math
 from typing import Any
 
 import numpy as np
+from pydantic import BaseModel
 
 from service import schemas
 from service.config import Settings, get_settings
@@ -54,6 +55,25 @@ def path_of(path: schemas.Path) -> PathInput:
         InvalidInputError, RepeatedWaypointError: naming the field and the waypoint.
     """
     return path.to_solver()
+
+
+def quaternion_correction(*parts: BaseModel | None) -> float:
+    """The largest |norm - 1| of the quaternions of every Pose in ``parts`` (0 for none).
+
+    A Pose's quaternion within 1e-3 of unit is normalised (api.md, Pose) and the answer says
+    by how much: the path's own are in its ``axis_correction``; these are the robot's TCP and
+    the cell's object poses (``parts``: the request's robot and cell), which went unsaid.
+    """
+    largest, stack = 0.0, [part for part in parts if part is not None]
+    while stack:
+        item = stack.pop()
+        if isinstance(item, schemas.Pose):
+            largest = max(largest, abs(math.hypot(*item.orientation) - 1.0))
+        elif isinstance(item, BaseModel):
+            stack.extend(getattr(item, name) for name in type(item).model_fields)
+        elif isinstance(item, list | tuple):
+            stack.extend(item)
+    return largest
 
 
 def spun_poses(path: PathInput, spins: list[float] | None) -> np.ndarray:

@@ -128,7 +128,8 @@ def optimize_response(
     """The answer of ``POST /v1/optimize`` (``found: false`` when nothing was feasible).
 
     ``path``: the request's path, for how a CAM program was read (``path_read``) and the pass
-    and operation of a failure; its ``axis_correction`` is the answer's.
+    and operation of a failure; the answer's ``axis_correction`` is the larger of its and
+    ``axis_correction`` (the request's other quaternions).
     """
     report = optimum.solver
     start = optimum.start_evaluation
@@ -142,7 +143,7 @@ def optimize_response(
         else evaluate_response(
             optimum.evaluation,
             robot,
-            axis_correction=axis_correction if path is None else path.axis_correction,
+            axis_correction=max(axis_correction, 0.0 if path is None else path.axis_correction),
         ),
         start=schemas.StartInfo(
             placement=api_placement(optimum.start),

@@ -51,6 +51,7 @@ def optimum_of(
     return convert.optimize_response(
         optimum,
         robot,
+        axis_correction=convert.quaternion_correction(body.robot, body.cell),
         path=path,
     )
 

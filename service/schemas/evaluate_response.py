@@ -225,8 +225,10 @@ class EvaluateResponse(ResponseModel):
     )
     axis_correction: float = Field(
         default=0.0,
-        description="The largest correction made to a tool axis's length when normalising it "
-        "(dimensionless; 0 when none was needed or the path is given by poses).",
+        description="The largest correction made in normalising the request's unit vectors "
+        "and quaternions: the path's tool axes (their length) or pose quaternions (their "
+        "norm), the robot's tcp and the cell's object poses (dimensionless; 0 when none was "
+        "needed).",
     )
     acceleration: AccelerationResult | None = Field(
         default=None,

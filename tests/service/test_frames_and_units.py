@@ -114,3 +114,28 @@ def test_quaternions_typed_with_four_decimals_evaluate_as_exact_ones(client: Tes
     assert as_typed["mu_path"] == pytest.approx(
         client.post("/v1/evaluate", json=exact).json()["mu_path"], rel=1e-12
     )
+
+
+def test_a_tcp_or_cell_quaternion_normalised_is_reported(client: TestClient) -> None:
+    """api.md: a Pose within 1e-3 of unit is normalised and the response reports the largest
+    correction. The robot's tcp and the cell's object poses were normalised unsaid (the path's
+    own quaternions were reported). The corrections are the norms given, less 1."""
+    tcp = {"position": [0.0, 0.0, 0.05], "orientation": [0.0, 0.0, 0.0, 1.0009]}
+    box = {
+        "shape": "box",
+        "size": [0.1, 0.1, 0.1],
+        "pose": {"position": [3.0, 3.0, 3.0], "orientation": [0.0, 0.0, 0.9994, 0.0]},
+    }
+    robot = {**REQUEST["robot"], "tcp": tcp}
+    with_tcp = client.post("/v1/evaluate", json={**REQUEST, "robot": robot}).json()
+    assert with_tcp["axis_correction"] == pytest.approx(9e-4, rel=1e-9)
+    with_cell = client.post("/v1/evaluate", json={**REQUEST, "cell": {"fixed": [box]}}).json()
+    assert with_cell["axis_correction"] == pytest.approx(6e-4, rel=1e-9)
+    fixed = {"x": [0.0, 0.0], "y": [0.45, 0.45], "yaw": [0.0, 0.0]}
+    short = {"waypoints": REQUEST["path"]["waypoints"][:10]}
+    optimum = client.post(
+        "/v1/optimize", json={"robot": robot, "path": short, "bounds": fixed, "z": 0.1}
+    ).json()
+    assert optimum["found"] and optimum["evaluation"]["axis_correction"] == pytest.approx(
+        9e-4, rel=1e-9
+    )
