@@ -1,8 +1,8 @@
 """The request body's limits, checked before a route reads it: media type, size, arrival time.
 
-A body not declared as JSON is a ``415``, one over ``Settings.max_body_bytes`` a ``413``, one
-that stops short of its length a ``408``; each in the validation-error shape of every error
-answer (:mod:`service.errors`).
+A body not declared as JSON, or sent compressed, is a ``415``, one over
+``Settings.max_body_bytes`` a ``413``, one that stops short of its length a ``408``; each in
+the validation-error shape of every error answer (:mod:`service.errors`).
 """
 
 from __future__ import annotations
@@ -34,6 +34,18 @@ def _not_json(content_type: str) -> JSONResponse:
     detail = ErrorDetail(
         loc=["header", "content-type"],
         msg=f"the body must be JSON (content-type application/json), not {shown!r}",
+        type="unsupported_media_type",
+    )
+    return error_response(status.HTTP_415_UNSUPPORTED_MEDIA_TYPE, [detail])
+
+
+def _encoded(encoding: str) -> JSONResponse:
+    """The ``415`` answer to a body sent compressed (a Content-Encoding other than identity)."""
+    shown = encoding if len(encoding) <= 100 else encoding[:100] + "..."
+    detail = ErrorDetail(
+        loc=["header", "content-encoding"],
+        msg=f"the body must be sent as it is, not encoded ({shown!r}): no content coding is "
+        "read (the JSON parser saw the compressed bytes: 'Invalid JSON')",
         type="unsupported_media_type",
     )
     return error_response(status.HTTP_415_UNSUPPORTED_MEDIA_TYPE, [detail])
@@ -80,10 +92,11 @@ def is_json(content_type: str) -> bool:
 class BodySizeLimitMiddleware:
     """Answer ``413`` to a body over ``Settings.max_body_bytes``, ``415`` to one not JSON.
 
-    Pure ASGI. A body declared as something other than JSON, or sent without a Content-Type,
-    is refused unread. A declared ``Content-Length`` over the limit is refused before reading;
-    otherwise the body is read (counting the bytes as they stream in, so a chunked body cannot
-    slip through) and handed on in one piece. A body that stops short of its length is
+    Pure ASGI. A body declared as something other than JSON, sent without a Content-Type or
+    with a Content-Encoding (gzip: nothing decodes it), is refused unread. A declared
+    ``Content-Length`` over the limit is refused before reading; otherwise the body is read
+    (counting the bytes as they stream in, so a chunked body cannot slip through) and handed
+    on in one piece. A body that stops short of its length is
     answered ``408`` after ``Settings.body_read_seconds`` instead of holding the connection.
     """
 
@@ -103,6 +116,10 @@ class BodySizeLimitMiddleware:
         if scope["method"] in ("POST", "PUT", "PATCH"):
             if content_type and not is_json(content_type):
                 await _not_json(content_type)(scope, receive, send)
+                return
+            encoding = headers.get("content-encoding", "").strip()
+            if encoding and encoding.lower() != "identity":
+                await _encoded(encoding)(scope, receive, send)
                 return
             if not content_type and _has_body(headers):
                 await _no_content_type()(scope, receive, send)

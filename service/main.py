@@ -18,7 +18,7 @@ from typing import Any
 
 import anyio
 import numpy as np
-from fastapi import FastAPI
+from fastapi import Depends, FastAPI
 from fastapi.exceptions import RequestValidationError
 from fastapi_offline import FastAPIOffline
 from pydantic.json_schema import models_json_schema
@@ -42,6 +42,7 @@ from service.jobs.job import JobStoreUnavailable
 from service.jobs.runner import close_runners, get_runner
 from service.logs import log, log_to_stderr, startup_log
 from service.metrics import instrument
+from service.query import known_query_parameters
 from service.spec import defaults_in_words
 from service.web import mount_page
 from service.work import STOPPING
@@ -76,8 +77,9 @@ Feasibility index, Sensors 2022; the path index mu_path, ERK 2021).
 Every placement in an answer also comes as a controller frame (UR, KUKA, ABB, FANUC).
 SI units throughout (m, rad, s). Paths are poses, tool points with tool axes, APT CL data or
 CSV (passes split at rapids; /v1/evaluate checks the programmed feed). Input errors
-are `422` with a `detail` list whose `loc` names the field (and waypoint index); oversized
-bodies are `413`; bodies not declared as JSON (or sent without a Content-Type) are `415`; a body
+are `422` with a `detail` list whose `loc` names the field (and waypoint index), a query
+parameter an operation does not take too; oversized bodies are `413`; bodies not declared as
+JSON (or sent without a Content-Type, or compressed: a Content-Encoding) are `415`; a body
 that stops short of its length is `408`. Every error answer (404, 429, 500 too) is a JSON object
 with the same `detail` list. These pages load nothing from the internet.
 """
@@ -173,6 +175,7 @@ def create_app() -> FastAPI:
         },
         responses=SERVER_ERROR_RESPONSE,
         lifespan=lifespan,
+        dependencies=[Depends(known_query_parameters)],
     )
     app.include_router(health.router)
     app.include_router(api_router)

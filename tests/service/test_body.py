@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import gzip
 import json
 from typing import Any
 
@@ -151,3 +152,48 @@ def test_a_lone_surrogate_is_a_422_on_every_route(
     answer = client.post(route, content=raw, headers={"content-type": "application/json"})
     assert answer.status_code == 422, answer.text[:300]
     assert answer.json()["detail"][0]["type"] == "json_invalid"
+
+
+def test_a_compressed_body_is_a_415_naming_the_encoding(client: TestClient) -> None:
+    """A gzip body was read as JSON: 422 'Invalid JSON', the encoding never named."""
+    example = (ROOT / "examples" / "evaluate_request.json").read_bytes()
+    answer = client.post(
+        "/v1/evaluate",
+        content=gzip.compress(example),
+        headers={"content-type": "application/json", "content-encoding": "gzip"},
+    )
+    assert answer.status_code == 415
+    detail = answer.json()["detail"][0]
+    assert detail["loc"] == ["header", "content-encoding"] and "'gzip'" in detail["msg"]
+    plain = client.post(
+        "/v1/evaluate",
+        content=example,
+        headers={"content-type": "application/json", "content-encoding": "identity"},
+    )
+    assert plain.status_code == 200
+
+
+@pytest.mark.parametrize(
+    ("method", "url", "name"),
+    [
+        ("POST", "/v1/evaluate?detail=summary", "detail"),
+        ("GET", "/v1/robots?family=ur", "family"),
+        ("GET", "/v1/jobs?limit=2&stauts=done", "stauts"),
+    ],
+)
+def test_a_query_parameter_an_operation_does_not_take_is_a_422(
+    client: TestClient, method: str, url: str, name: str
+) -> None:
+    """FastAPI drops them: POST /v1/evaluate?detail=summary answered every waypoint."""
+    example = json.loads((ROOT / "examples" / "evaluate_request.json").read_text())
+    answer = client.request(method, url, json=example if method == "POST" else None)
+    assert answer.status_code == 422, answer.text
+    detail = answer.json()["detail"]
+    assert [d["loc"] for d in detail] == [["query", name]]
+    assert f"takes no query parameter {name!r}" in detail[0]["msg"]
+
+
+def test_the_page_its_docs_and_metrics_take_any_query_string(client: TestClient) -> None:
+    for url in ("/?from=mail", "/docs?x=1", "/metrics?name[]=dtf_placements_total"):
+        assert client.get(url).status_code == 200, url
+    assert client.get("/v1/jobs?limit=2").status_code == 200
