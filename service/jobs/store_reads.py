@@ -44,13 +44,27 @@ class JobReads(StoreFile):
             row = db.execute(f"SELECT {STATE_COLUMNS} FROM jobs WHERE id = ?", (job_id,)).fetchone()
         return None if row is None else state_of_row(row)
 
-    def jobs(self, *, status: str | None, limit: int) -> list[JobState]:
-        """The newest jobs first, optionally of one status, without requests and results."""
-        query, args = f"SELECT {STATE_COLUMNS} FROM jobs", []
+    def jobs(self, *, status: str | None, limit: int, after: str | None = None) -> list[JobState]:
+        """The newest jobs first, optionally of one status, without requests and results.
+
+        Jobs submitted in the same instant are in the order of their ids, so the order is total.
+
+        Args:
+            status: only the jobs of this status (None: all).
+            limit: at most this many.
+            after: the listing goes on after this job's place in it (the last id of a page);
+                an id the store does not hold gives no jobs.
+        """
+        conditions, args = [], []
         if status is not None:
-            query, args = query + " WHERE status = ?", [status]
+            conditions, args = ["status = ?"], [status]
+        if after is not None:
+            conditions.append("(created, id) < (SELECT created, id FROM jobs WHERE id = ?)")
+            args.append(after)
+        where = f" WHERE {' AND '.join(conditions)}" if conditions else ""
+        query = f"SELECT {STATE_COLUMNS} FROM jobs{where} ORDER BY created DESC, id DESC LIMIT ?"
         with self._connection() as db:
-            rows = db.execute(query + " ORDER BY created DESC LIMIT ?", [*args, limit]).fetchall()
+            rows = db.execute(query, [*args, limit]).fetchall()
         return [state_of_row(row) for row in rows]
 
     def request(self, job_id: str) -> dict[str, Any] | None:

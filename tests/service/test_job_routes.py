@@ -86,6 +86,22 @@ def test_delete_removes_a_job_and_cancel_keeps_it(client: TestClient, own_store:
     assert client.post(f"/v1/jobs/{uuid.uuid4()}/cancel").status_code == 404
 
 
+def test_the_job_listing_is_read_in_pages_with_after(client: TestClient, own_store: Path) -> None:
+    job = {"kind": "evaluate", "request": route_body("evaluate", EXAMPLE["path"])}
+    submitted = [client.post("/v1/jobs", json=job) for _ in range(3)]
+    assert all(answer.status_code == 202 for answer in submitted), submitted[-1].text
+    everything = [j["id"] for j in client.get("/v1/jobs").json()["jobs"]]
+    assert sorted(everything) == sorted(answer.json()["id"] for answer in submitted)
+    first = client.get("/v1/jobs", params={"limit": 2}).json()["jobs"]
+    second = client.get("/v1/jobs", params={"limit": 2, "after": first[-1]["id"]}).json()["jobs"]
+    assert [j["id"] for j in first + second] == everything
+    last = client.get("/v1/jobs", params={"after": everything[-1]})
+    assert last.status_code == 200 and last.json()["jobs"] == []
+    unknown = client.get("/v1/jobs", params={"after": str(uuid.uuid4())})
+    assert unknown.status_code == 422, unknown.text
+    assert unknown.json()["detail"][0]["loc"] == ["query", "after"]
+
+
 @pytest.fixture
 def corrupt_store(tmp_path: Path) -> Iterator[Path]:
     """The app with its jobs in ``tmp_path``, whose store file is not a database."""
