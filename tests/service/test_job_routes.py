@@ -59,6 +59,32 @@ def test_an_optimize_job_with_a_start_outside_its_bounds_is_refused(client: Test
     assert submitted.json()["detail"][0]["loc"] == ["body", "request", "start"]
 
 
+SPIN_PATH = {"max_spin_step": 0.05}
+REFUSED_SEARCHES = {  # each refused by the optimiser's own checks, not by the schema
+    "scipy": {"method": "scipy", "spin_path": SPIN_PATH},
+    "free-spin": {"spin_mode": "free", "spin_path": SPIN_PATH},
+    "two-passes": {
+        "path": {"cl_data": (ROOT / "examples" / "cam" / "nx_slot_plate.cls").read_text()},
+        "spin_mode": "fixed",
+        "spin_path": SPIN_PATH,
+    },
+}
+
+
+@pytest.mark.parametrize("changes", REFUSED_SEARCHES.values(), ids=REFUSED_SEARCHES.keys())
+def test_an_optimize_job_is_refused_as_the_optimiser_refuses_its_spin_path(
+    client: TestClient, changes: dict[str, Any]
+) -> None:
+    body = route_body("optimize", EXAMPLE["path"]) | changes
+    direct = client.post("/v1/optimize", json=body)
+    assert direct.status_code == 422, direct.text
+    submitted = client.post("/v1/jobs", json={"kind": "optimize", "request": body})
+    assert submitted.status_code == 422, submitted.text
+    (expected,), (detail,) = direct.json()["detail"], submitted.json()["detail"]
+    assert expected["loc"] == ["body", "spin_path"]
+    assert detail == {**expected, "loc": ["body", "request", "spin_path"]}
+
+
 def wait_for(client: TestClient, job_id: str, done: Any) -> dict[str, Any]:
     deadline = time.monotonic() + 60
     while True:
