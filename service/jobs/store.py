@@ -12,6 +12,7 @@ the runner's and the workers' updates, cancel, delete, recovery after a restart 
 from __future__ import annotations
 
 import json
+import sqlite3
 import time
 import uuid
 from typing import Any
@@ -97,30 +98,47 @@ class JobStore(JobReads):
         error: list[dict[str, Any]] | None = None,
         if_running: bool = False,
     ) -> None:
-        """Record how a job ended (with ``if_running``, only if it is still running)."""
+        """Record how a job ended (with ``if_running``, only if it is still running).
+
+        A job deleted meanwhile (or, with ``if_running``, not running) is left alone: nothing is
+        written, its result's cells neither, in the transaction that looks for it.
+        """
         condition = " AND status = 'running'" if if_running else ""
         with self._connection() as db:
-            db.execute("BEGIN IMMEDIATE")
+            db.execute("BEGIN IMMEDIATE")  # the write lock, before the look
             try:
-                text, cells = (None, None) if result is None else write_result(db, job_id, result)
-                db.execute(
-                    "UPDATE jobs SET status = ?, result = ?, cells = ?, error = ?, finished = ?, "
-                    "done = CASE WHEN ? = 'done' THEN 1 ELSE done END WHERE id = ?" + condition,
-                    (
-                        status,
-                        text,
-                        cells,
-                        None if error is None else json.dumps(error),
-                        time.time(),
-                        status,
-                        job_id,
-                    ),
-                )
+                if db.execute("SELECT 1 FROM jobs WHERE id = ?" + condition, (job_id,)).fetchone():
+                    self._finish(db, job_id, status, result=result, error=error)
                 db.execute("COMMIT")
             except BaseException:
                 if db.in_transaction:
                     db.execute("ROLLBACK")
                 raise
+
+    @staticmethod
+    def _finish(
+        db: sqlite3.Connection,
+        job_id: str,
+        status: Status,
+        *,
+        result: dict[str, Any] | None,
+        error: list[dict[str, Any]] | None,
+    ) -> None:
+        """Write a job's end, its result's cells in pages (inside the caller's transaction)."""
+        text, cells = (None, None) if result is None else write_result(db, job_id, result)
+        db.execute(
+            "UPDATE jobs SET status = ?, result = ?, cells = ?, error = ?, finished = ?, "
+            "done = CASE WHEN ? = 'done' THEN 1 ELSE done END WHERE id = ?",
+            (
+                status,
+                text,
+                cells,
+                None if error is None else json.dumps(error),
+                time.time(),
+                status,
+                job_id,
+            ),
+        )
 
     def queued(self, *, exclude: set[str], limit: int) -> list[str]:
         """The ids of the oldest queued jobs not in ``exclude``, at most ``limit``."""
@@ -166,8 +184,11 @@ class JobStore(JobReads):
         cancel (the supervisor stops a worker that does not).
         """
         with self._connection() as db:
+            # The row first: a finish() after it writes nothing; one before it wrote cells that
+            # the second statement removes.
+            deleted = db.execute("DELETE FROM jobs WHERE id = ?", (job_id,)).rowcount
             db.execute("DELETE FROM job_cells WHERE job_id = ?", (job_id,))
-            return bool(db.execute("DELETE FROM jobs WHERE id = ?", (job_id,)).rowcount)
+        return bool(deleted)
 
     def recover(self, *, attempts: int) -> list[str]:
         """After a restart: jobs left running are queued again (or failed after ``attempts``).

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import os
+import sqlite3
 import subprocess
 import sys
 import threading
@@ -130,3 +131,23 @@ def test_a_deleted_job_is_gone_and_its_worker_is_told_to_stop(tmp_path: Path) ->
     assert not store.delete(job.id)
     assert store.progress(job.id, 0.5)  # a worker stops at its next report
     assert store.cancel_asked([job.id]) == {job.id}  # the supervisor stops one that does not
+
+
+def stored_cells(path: Path) -> int:
+    """Rows of result pages in the store's file, of any job."""
+    with sqlite3.connect(path) as db:
+        return int(db.execute("SELECT COUNT(*) FROM job_cells").fetchone()[0])
+
+
+def test_a_job_deleted_while_it_runs_leaves_no_result_when_its_worker_finishes(
+    tmp_path: Path,
+) -> None:
+    store = JobStore(tmp_path / "jobs.sqlite3")
+    job = store.create("map", {"robot": EXAMPLE["robot"]})
+    assert store.start(job.id)
+    assert store.delete(job.id)
+    cells = [{"x": 0.1 * i, "y": 0.4, "yaw": 0.0, "mu_path": 1.0, "reason": None} for i in range(5)]
+    store.finish(job.id, "done", result={"cells": cells, "best": None, "worst": None})
+    assert store.get(job.id) is None
+    assert store.jobs(status=None, limit=10) == []
+    assert stored_cells(store.path) == 0
