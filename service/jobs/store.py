@@ -193,6 +193,8 @@ class JobStore(JobReads):
     def recover(self, *, attempts: int) -> list[str]:
         """After a restart: jobs left running are queued again (or failed after ``attempts``).
 
+        Result pages of no job (an older release's) are removed.
+
         Returns:
             The ids of the queued jobs, oldest first, to run.
         """
@@ -204,6 +206,8 @@ class JobStore(JobReads):
                 (now, json.dumps([_interrupted(attempts)]), attempts),
             )
             db.execute("UPDATE jobs SET status = 'queued' WHERE status = 'running'")
+            # Pages of no job: left by an older release, whose finish() wrote a deleted job's.
+            db.execute("DELETE FROM job_cells WHERE job_id NOT IN (SELECT id FROM jobs)")
             rows = db.execute(
                 "SELECT id FROM jobs WHERE status = 'queued' ORDER BY created"
             ).fetchall()
@@ -220,14 +224,20 @@ class JobStore(JobReads):
         return {str(k): int(v) for k, v in counts.items()}, [float(r[0]) for r in rows]
 
     def expire(self, *, ttl: float) -> int:
-        """Forget finished jobs older than ``ttl`` seconds; how many."""
+        """Forget finished jobs older than ``ttl`` seconds, and their results' pages; how many.
+
+        The jobs are found by their end time (an index) and the pages by their job, so its
+        cost is that of the jobs expired, not of the store (the supervisor runs it every
+        minute).
+        """
+        expired = (
+            "SELECT id FROM jobs WHERE finished < ? AND status IN ('done', 'failed', 'cancelled')"
+        )
+        cutoff = time.time() - ttl
         with self._connection() as db:
-            expired = db.execute(
-                "DELETE FROM jobs WHERE status IN ('done', 'failed', 'cancelled') AND finished < ?",
-                (time.time() - ttl,),
-            ).rowcount
-            db.execute("DELETE FROM job_cells WHERE job_id NOT IN (SELECT id FROM jobs)")
-        return int(expired)
+            db.execute(f"DELETE FROM job_cells WHERE job_id IN ({expired})", (cutoff,))
+            count = db.execute(f"DELETE FROM jobs WHERE id IN ({expired})", (cutoff,)).rowcount
+        return int(count)
 
 
 def _interrupted(attempts: int) -> dict[str, Any]:

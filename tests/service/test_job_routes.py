@@ -85,8 +85,8 @@ def test_an_optimize_job_is_refused_as_the_optimiser_refuses_its_spin_path(
     assert detail == {**expected, "loc": ["body", "request", "spin_path"]}
 
 
-def wait_for(client: TestClient, job_id: str, done: Any) -> dict[str, Any]:
-    deadline = time.monotonic() + 60
+def wait_for(client: TestClient, job_id: str, done: Any, timeout: float = 60) -> dict[str, Any]:
+    deadline = time.monotonic() + timeout
     while True:
         job: dict[str, Any] = client.get(f"/v1/jobs/{job_id}").json()
         if done(job) or time.monotonic() > deadline:
@@ -126,6 +126,18 @@ def test_the_job_listing_is_read_in_pages_with_after(client: TestClient, own_sto
     unknown = client.get("/v1/jobs", params={"after": str(uuid.uuid4())})
     assert unknown.status_code == 422, unknown.text
     assert unknown.json()["detail"][0]["loc"] == ["query", "after"]
+
+
+def test_a_finished_job_expires_while_the_service_runs(client: TestClient, tmp_path: Path) -> None:
+    job = {"kind": "evaluate", "request": route_body("evaluate", EXAMPLE["path"])}
+    with served_with(Settings(data_dir=tmp_path, workers=1, job_ttl=1.0)):
+        job_id = client.post("/v1/jobs", json=job).json()["id"]
+        done = wait_for(client, job_id, lambda j: j.get("status") == "done")
+        assert done["status"] == "done", done
+        # expired while the service runs, not only at its next startup
+        gone = wait_for(client, job_id, lambda j: "status" not in j, timeout=10)
+        assert "status" not in gone and gone["detail"][0]["type"] == "not_found", gone
+        assert job_id not in [j["id"] for j in client.get("/v1/jobs").json()["jobs"]]
 
 
 @pytest.fixture

@@ -151,3 +151,18 @@ def test_a_job_deleted_while_it_runs_leaves_no_result_when_its_worker_finishes(
     assert store.get(job.id) is None
     assert store.jobs(status=None, limit=10) == []
     assert stored_cells(store.path) == 0
+
+
+def test_an_expired_job_goes_with_its_result_pages(tmp_path: Path) -> None:
+    store = JobStore(tmp_path / "jobs.sqlite3")
+    kept, expired = (store.create("map", {"robot": EXAMPLE["robot"]}) for _ in range(2))
+    cells = [{"x": 0.1, "y": 0.4, "yaw": 0.0, "mu_path": 1.0, "reason": None}]
+    for job in (kept, expired):
+        assert store.start(job.id)
+        store.finish(job.id, "done", result={"cells": cells, "best": None, "worst": None})
+    with sqlite3.connect(store.path) as db:
+        db.execute("UPDATE jobs SET finished = finished - 100 WHERE id = ?", (expired.id,))
+    assert store.expire(ttl=50.0) == 1
+    assert store.get(expired.id) is None and store.cells(expired.id, offset=0, limit=9) == []
+    assert store.cells(kept.id, offset=0, limit=9) == cells
+    assert stored_cells(store.path) == 1
