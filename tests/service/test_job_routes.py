@@ -85,6 +85,20 @@ def test_an_optimize_job_is_refused_as_the_optimiser_refuses_its_spin_path(
     assert detail == {**expected, "loc": ["body", "request", "spin_path"]}
 
 
+@pytest.mark.parametrize(
+    "kind", [{}, {"kind": "optimise"}, {"kind": None}, {"kind": ["map"]}], ids=str
+)
+def test_a_job_without_a_known_kind_is_refused_on_kind(
+    client: TestClient, kind: dict[str, Any]
+) -> None:
+    body = kind | {"request": route_body("optimize", EXAMPLE["path"])}
+    submitted = client.post("/v1/jobs", json=body)
+    assert submitted.status_code == 422, submitted.text
+    (detail,) = submitted.json()["detail"]
+    assert detail["loc"] == ["body", "kind"]
+    assert all(f'"{name}"' in detail["msg"] for name in ("map", "optimize", "evaluate"))
+
+
 def wait_for(client: TestClient, job_id: str, done: Any, timeout: float = 60) -> dict[str, Any]:
     deadline = time.monotonic() + timeout
     while True:
