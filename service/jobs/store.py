@@ -73,11 +73,11 @@ class JobStore(JobReads):
         return job_of_row(row, None)
 
     def start(self, job_id: str) -> bool:
-        """Mark a queued job running (one more attempt); False if it is not queued."""
+        """Mark a queued job running (one more attempt, from no progress); False if not queued."""
         with self._connection() as db:
             changed = db.execute(
-                "UPDATE jobs SET status = 'running', started = ?, attempts = attempts + 1 "
-                "WHERE id = ? AND status = 'queued' AND cancel = 0",
+                "UPDATE jobs SET status = 'running', started = ?, done = 0, "
+                "attempts = attempts + 1 WHERE id = ? AND status = 'queued' AND cancel = 0",
                 (time.time(), job_id),
             ).rowcount
         return bool(changed)
@@ -193,6 +193,8 @@ class JobStore(JobReads):
     def recover(self, *, attempts: int) -> list[str]:
         """After a restart: jobs left running are queued again (or failed after ``attempts``).
 
+        A job queued again has no progress and no start time until it runs again.
+
         Result pages of no job (an older release's) are removed.
 
         Returns:
@@ -205,7 +207,11 @@ class JobStore(JobReads):
                 "status = 'running' AND attempts >= ?",
                 (now, json.dumps([_interrupted(attempts)]), attempts),
             )
-            db.execute("UPDATE jobs SET status = 'queued' WHERE status = 'running'")
+            # the interrupted run's progress and start time are not the next run's
+            db.execute(
+                "UPDATE jobs SET status = 'queued', done = 0, started = NULL "
+                "WHERE status = 'running'"
+            )
             # Pages of no job: left by an older release, whose finish() wrote a deleted job's.
             db.execute("DELETE FROM job_cells WHERE job_id NOT IN (SELECT id FROM jobs)")
             rows = db.execute(

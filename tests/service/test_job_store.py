@@ -166,3 +166,17 @@ def test_an_expired_job_goes_with_its_result_pages(tmp_path: Path) -> None:
     assert store.get(expired.id) is None and store.cells(expired.id, offset=0, limit=9) == []
     assert store.cells(kept.id, offset=0, limit=9) == cells
     assert stored_cells(store.path) == 1
+
+
+def test_a_job_queued_again_after_a_restart_starts_its_progress_again(tmp_path: Path) -> None:
+    store = JobStore(tmp_path / "jobs.sqlite3")
+    job = store.create("evaluate", EVALUATE)
+    assert store.start(job.id)
+    assert not store.progress(job.id, 0.4)
+    assert store.recover(attempts=3) == [job.id]  # the service was killed while it ran
+    queued = store.state(job.id)
+    assert queued is not None and queued.status == "queued"
+    assert queued.fraction == 0.0 and queued.started is None
+    assert store.start(job.id)
+    running = store.state(job.id)
+    assert running is not None and running.fraction == 0.0 and running.started is not None
