@@ -70,7 +70,7 @@ class JobStore(JobReads):
                 if db.in_transaction:
                     db.execute("ROLLBACK")
                 raise
-        return job_of_row(row, None)
+        return job_of_row(row, store=self.path)
 
     def start(self, job_id: str) -> bool:
         """Mark a queued job running (one more attempt, from no progress); False if not queued."""

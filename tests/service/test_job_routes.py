@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import sqlite3
 import time
 import uuid
 from collections.abc import Iterator
@@ -13,6 +14,7 @@ import pytest
 from fastapi.testclient import TestClient
 
 from service.config import Settings
+from service.jobs.store import JobStore
 from tests.cases import ROOT
 from tests.service.conftest import served_with
 
@@ -183,6 +185,42 @@ def test_a_corrupt_store_takes_down_the_job_routes_only(
     assert client.get("/healthz").status_code == 200
     evaluated = client.post("/v1/evaluate", json=job["request"])
     assert evaluated.status_code == 200, evaluated.text
+
+
+DAMAGES = {  # what a hand edit may leave in a row; whether the job's state (not only its result)
+    "status": ("status = 'paused'", True),
+    "error": ("status = 'failed', error = '5'", True),
+    "result": ("status = 'done', result = '{'", False),
+}
+
+
+@pytest.mark.parametrize("damage", DAMAGES.values(), ids=DAMAGES.keys())
+def test_a_damaged_job_is_a_503_naming_it_and_the_others_are_served(
+    client: TestClient, tmp_path: Path, damage: tuple[str, bool]
+) -> None:
+    change, in_state = damage
+    store = JobStore(tmp_path / "jobs.sqlite3")  # filled before the service looks at it
+    good, bad = (store.create("evaluate", route_body("evaluate", EXAMPLE["path"])) for _ in "ab")
+    with sqlite3.connect(store.path) as db:
+        db.execute("UPDATE jobs SET status = 'cancelled', finished = created")
+        db.execute(f"UPDATE jobs SET {change} WHERE id = ?", (bad.id,))
+    with served_with(Settings(data_dir=tmp_path, workers=1)):
+        listed = client.get("/v1/jobs")
+        assert listed.status_code == 200, listed.text
+        ids = [job["id"] for job in listed.json()["jobs"]]
+        assert good.id in ids and (bad.id in ids) == (not in_state)  # left out, not a 500
+        assert client.get(f"/v1/jobs/{good.id}").status_code == 200
+        for method, url in [("GET", f"/v1/jobs/{bad.id}"), ("POST", f"/v1/jobs/{bad.id}/cancel")]:
+            answer = client.request(method, url)
+            if method == "POST" and not in_state:
+                assert answer.status_code == 200, answer.text  # a cancel reads no result
+                continue
+            assert answer.status_code == 503, (method, answer.text)
+            (detail,) = answer.json()["detail"]
+            assert detail["type"] == "job_store_unavailable"
+            assert str(store.path) in detail["msg"] and bad.id in detail["msg"]
+        assert client.delete(f"/v1/jobs/{bad.id}").status_code == 204
+        assert client.get(f"/v1/jobs/{bad.id}").status_code == 404
 
 
 def test_the_spec_declares_the_503_of_the_job_routes_and_metrics(client: TestClient) -> None:
