@@ -22,7 +22,7 @@ import anyio
 from fastapi import Depends, Request
 from fastapi.exceptions import RequestValidationError
 from pydantic import BaseModel, TypeAdapter, ValidationError
-from pydantic_core import from_json
+from pydantic_core import ErrorDetails, from_json
 
 from service.schemas import Pose, ToolAxisWaypoint
 
@@ -102,10 +102,21 @@ def _parsed(adapter: TypeAdapter[Any]) -> Any:
                 return adapter.validate_json(raw)
             return await anyio.to_thread.run_sync(validated_in_pieces, adapter, raw)
         except ValidationError as error:
-            errors = [{**e, "loc": ("body", *e["loc"])} for e in error.errors()]
+            errors = [{**e, "loc": _location(e)} for e in error.errors()]
             raise RequestValidationError(errors) from None
 
     return Depends(parse)
+
+
+def _location(error: ErrorDetails) -> tuple[str | int, ...]:
+    """Where an error is in the request.
+
+    A union told apart by a field of its object (a job's ``kind``) names the field in its
+    error's context (``tag_field``): a missing or unknown tag is an error on that field.
+    """
+    loc = ("body", *error["loc"])
+    field = error.get("ctx", {}).get("tag_field")
+    return (*loc, field) if isinstance(field, str) and isinstance(error["input"], dict) else loc
 
 
 def body_openapi(model: type[BaseModel]) -> dict[str, Any]:

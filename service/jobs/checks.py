@@ -12,13 +12,12 @@ from __future__ import annotations
 from service import convert
 from service.config import Settings
 from service.operations import checked_grid
-from service.operations.optimize import check_work
+from service.operations.optimize import check_work, max_spin_step_of
 from service.schemas import EvaluateRequest, MapRequest, OptimizeRequest
 from service.schemas.jobs import EvaluateJob, JobRequest, MapJob
 from solver.core.exceptions import InvalidInputError, SolverError
 from solver.core.robots import Robot
-from solver.optimise.methods import method_named
-from solver.optimise.search_space import vector_of
+from solver.optimise.optimize import check_search
 from solver.path.problem import PathProblem
 
 
@@ -79,22 +78,19 @@ def _check_evaluate(body: EvaluateRequest, settings: Settings) -> None:
 
 
 def _check_optimize(body: OptimizeRequest, settings: Settings) -> None:
+    """The route's own checks: the optimiser's arguments (``check_search``), then the work."""
     convert.check_path_size(
         body.path, limit=settings.max_optimize_waypoints, setting="DTF_MAX_OPTIMIZE_WAYPOINTS"
     )
     robot = convert.robot_from_schema(body.robot)
     problem = _problem(robot, body, settings)
     bounds = convert.bounds_of(body.bounds, z=body.z)
-    bounds.check()
-    method_named(body.method)
-    if problem.options.branch is not None:
-        raise InvalidInputError("ik.branch", "the optimisers choose the branch: it must be auto")
-    if body.start is not None:
-        start = convert.placement_of(body.start)
-        if not bounds.contains(vector_of(start)):
-            raise InvalidInputError(
-                "start",
-                f"x {start.x:g} m, y {start.y:g} m, z {start.z:g} m, yaw {start.yaw:g} rad, "
-                f"spin {start.spin:g} rad is outside the bounds",
-            )
+    start = None if body.start is None else convert.placement_of(body.start)
+    check_search(
+        problem,
+        bounds=bounds,
+        start=start,
+        method=body.method,
+        max_spin_step=max_spin_step_of(body),
+    )
     check_work(problem, bounds, body, settings)

@@ -4,8 +4,16 @@ from __future__ import annotations
 
 import json
 import sqlite3
+from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Any, Literal
+from pathlib import Path
+from typing import Any, Literal, TypeVar
+
+from pydantic import TypeAdapter, ValidationError
+
+from service.schemas import ErrorDetail
+
+T = TypeVar("T")
 
 Status = Literal["queued", "running", "done", "failed", "cancelled"]
 Kind = Literal["map", "optimize", "evaluate"]
@@ -28,6 +36,24 @@ class JobStoreUnavailable(Exception):
         """Keep the reason."""
         super().__init__(reason)
         self.reason = reason
+
+
+class DamagedJob(JobStoreUnavailable):
+    """One job's row holds what the service never writes (a file edited by hand, or damaged).
+
+    A 503 for that job, as for a corrupt file; a job listing leaves the job out.
+
+    Attributes:
+        job_id: the job's id, as stored.
+    """
+
+    def __init__(self, store: Path, job_id: object, what: str) -> None:
+        """Say which store, which job and what is wrong, and how to be rid of it."""
+        super().__init__(
+            f"the job store {str(store)!r} holds job {str(job_id)!r} damaged ({what}); "
+            f"DELETE /v1/jobs/{job_id} removes it"
+        )
+        self.job_id = job_id
 
 
 class QueueFull(Exception):
@@ -81,28 +107,68 @@ class Job(JobState):
     result: dict[str, Any] | None
 
 
+_STATE = TypeAdapter(JobState)
+_JOB = TypeAdapter(Job)
+_ERRORS = TypeAdapter(list[ErrorDetail])
+
+
 def _state_fields(row: sqlite3.Row) -> dict[str, Any]:
+    """A row's state, its error read (and checked to be a list of error details)."""
+    error = None if row["error"] is None else json.loads(row["error"])
+    if error is not None:
+        _ERRORS.validate_python(error)
     return {
         "id": row["id"],
         "kind": row["kind"],
         "status": row["status"],
-        "error": None if row["error"] is None else json.loads(row["error"]),
-        "fraction": float(row["done"]),
+        "error": error,
+        "fraction": row["done"],
         "total": row["total"],
         "cells": row["cells"],
         "created": row["created"],
         "started": row["started"],
         "finished": row["finished"],
         "attempts": row["attempts"],
-        "cancel": bool(row["cancel"]),
+        "cancel": row["cancel"],
     }
 
 
-def state_of_row(row: sqlite3.Row) -> JobState:
-    """The state a row of the ``jobs`` table holds (its STATE_COLUMNS)."""
-    return JobState(**_state_fields(row))
+def _checked(row: sqlite3.Row, store: Path, read: Callable[[], T]) -> T:
+    """What ``read`` makes of a row, or DamagedJob when the row holds what is never written.
+
+    A status or kind unknown, an error not a list of error details, a time or fraction not a
+    number, a request or result not a JSON object.
+    """
+    try:
+        return read()
+    except (ValueError, TypeError) as error:  # ValidationError and JSONDecodeError included
+        if isinstance(error, ValidationError):
+            first = error.errors()[0]
+            what = f"{'.'.join(map(str, first['loc']))}: {first['msg']}"
+        else:
+            what = f"{type(error).__name__}: {error}"
+        raise DamagedJob(store, row["id"], what) from error
 
 
-def job_of_row(row: sqlite3.Row, result: dict[str, Any] | None) -> Job:
-    """The job a whole row of the ``jobs`` table holds, with its result as read."""
-    return Job(**_state_fields(row), request=json.loads(row["request"]), result=result)
+def state_of_row(row: sqlite3.Row, *, store: Path) -> JobState:
+    """The state a row of the ``jobs`` table holds (its STATE_COLUMNS).
+
+    Raises:
+        DamagedJob: the row holds what the service never writes.
+    """
+    return _checked(row, store, lambda: _STATE.validate_python(_state_fields(row)))
+
+
+def job_of_row(row: sqlite3.Row, *, store: Path) -> Job:
+    """The job a whole row of the ``jobs`` table holds (a map's result without its cells).
+
+    Raises:
+        DamagedJob: the row holds what the service never writes.
+    """
+
+    def read() -> Job:
+        request = json.loads(row["request"])
+        result = None if row["result"] is None else json.loads(row["result"])
+        return _JOB.validate_python({**_state_fields(row), "request": request, "result": result})
+
+    return _checked(row, store, read)

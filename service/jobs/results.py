@@ -33,6 +33,7 @@ CREATE TABLE IF NOT EXISTS jobs (
     cells INTEGER
 );
 CREATE INDEX IF NOT EXISTS jobs_created ON jobs (created);
+CREATE INDEX IF NOT EXISTS jobs_finished ON jobs (finished);
 CREATE TABLE IF NOT EXISTS job_cells (
     job_id TEXT NOT NULL,
     page INTEGER NOT NULL,

@@ -13,6 +13,7 @@ logs once more when the store is back; the web process and its compute routes go
 
 from __future__ import annotations
 
+import math
 import multiprocessing
 import threading
 import time
@@ -41,6 +42,10 @@ KILL_AFTER = 0.5
 
 MAX_BACKOFF = 5.0
 """The longest wait between two looks at a store that is failing (s)."""
+
+EXPIRE_SECONDS = 60.0
+"""How often the supervisor forgets the jobs older than DTF_JOB_TTL (s; more often for a
+shorter TTL): a finished job stays readable for at most this long past its TTL."""
 
 
 @dataclass
@@ -108,13 +113,20 @@ class JobRunner:
     def _supervise(self) -> None:
         """Watch and dispatch every POLL_SECONDS; after a failure, log once and back off.
 
-        When no job runs or waits, every IDLE_POLL_SECONDS (a wake looks at once).
+        When no job runs or waits, every IDLE_POLL_SECONDS (a wake looks at once). Every
+        EXPIRE_SECONDS (or DTF_JOB_TTL if shorter) it also forgets the expired jobs, so that a
+        long-running service does not keep them past their TTL.
         """
         delay, failing = POLL_SECONDS, False
+        expired = -math.inf  # when the supervisor last forgot expired jobs (monotonic, s)
         while not self._stop.is_set():
             self._wake.wait(delay)
             self._wake.clear()
             try:
+                now = time.monotonic()
+                if now - expired >= min(self.settings.job_ttl, EXPIRE_SECONDS):
+                    self.store.expire(ttl=self.settings.job_ttl)
+                    expired = now
                 self._watch()
                 waiting = self._dispatch()
             except JobStoreUnavailable as error:

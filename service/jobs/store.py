@@ -12,6 +12,7 @@ the runner's and the workers' updates, cancel, delete, recovery after a restart 
 from __future__ import annotations
 
 import json
+import sqlite3
 import time
 import uuid
 from typing import Any
@@ -69,14 +70,14 @@ class JobStore(JobReads):
                 if db.in_transaction:
                     db.execute("ROLLBACK")
                 raise
-        return job_of_row(row, None)
+        return job_of_row(row, store=self.path)
 
     def start(self, job_id: str) -> bool:
-        """Mark a queued job running (one more attempt); False if it is not queued."""
+        """Mark a queued job running (one more attempt, from no progress); False if not queued."""
         with self._connection() as db:
             changed = db.execute(
-                "UPDATE jobs SET status = 'running', started = ?, attempts = attempts + 1 "
-                "WHERE id = ? AND status = 'queued' AND cancel = 0",
+                "UPDATE jobs SET status = 'running', started = ?, done = 0, "
+                "attempts = attempts + 1 WHERE id = ? AND status = 'queued' AND cancel = 0",
                 (time.time(), job_id),
             ).rowcount
         return bool(changed)
@@ -97,30 +98,47 @@ class JobStore(JobReads):
         error: list[dict[str, Any]] | None = None,
         if_running: bool = False,
     ) -> None:
-        """Record how a job ended (with ``if_running``, only if it is still running)."""
+        """Record how a job ended (with ``if_running``, only if it is still running).
+
+        A job deleted meanwhile (or, with ``if_running``, not running) is left alone: nothing is
+        written, its result's cells neither, in the transaction that looks for it.
+        """
         condition = " AND status = 'running'" if if_running else ""
         with self._connection() as db:
-            db.execute("BEGIN IMMEDIATE")
+            db.execute("BEGIN IMMEDIATE")  # the write lock, before the look
             try:
-                text, cells = (None, None) if result is None else write_result(db, job_id, result)
-                db.execute(
-                    "UPDATE jobs SET status = ?, result = ?, cells = ?, error = ?, finished = ?, "
-                    "done = CASE WHEN ? = 'done' THEN 1 ELSE done END WHERE id = ?" + condition,
-                    (
-                        status,
-                        text,
-                        cells,
-                        None if error is None else json.dumps(error),
-                        time.time(),
-                        status,
-                        job_id,
-                    ),
-                )
+                if db.execute("SELECT 1 FROM jobs WHERE id = ?" + condition, (job_id,)).fetchone():
+                    self._finish(db, job_id, status, result=result, error=error)
                 db.execute("COMMIT")
             except BaseException:
                 if db.in_transaction:
                     db.execute("ROLLBACK")
                 raise
+
+    @staticmethod
+    def _finish(
+        db: sqlite3.Connection,
+        job_id: str,
+        status: Status,
+        *,
+        result: dict[str, Any] | None,
+        error: list[dict[str, Any]] | None,
+    ) -> None:
+        """Write a job's end, its result's cells in pages (inside the caller's transaction)."""
+        text, cells = (None, None) if result is None else write_result(db, job_id, result)
+        db.execute(
+            "UPDATE jobs SET status = ?, result = ?, cells = ?, error = ?, finished = ?, "
+            "done = CASE WHEN ? = 'done' THEN 1 ELSE done END WHERE id = ?",
+            (
+                status,
+                text,
+                cells,
+                None if error is None else json.dumps(error),
+                time.time(),
+                status,
+                job_id,
+            ),
+        )
 
     def queued(self, *, exclude: set[str], limit: int) -> list[str]:
         """The ids of the oldest queued jobs not in ``exclude``, at most ``limit``."""
@@ -166,11 +184,18 @@ class JobStore(JobReads):
         cancel (the supervisor stops a worker that does not).
         """
         with self._connection() as db:
+            # The row first: a finish() after it writes nothing; one before it wrote cells that
+            # the second statement removes.
+            deleted = db.execute("DELETE FROM jobs WHERE id = ?", (job_id,)).rowcount
             db.execute("DELETE FROM job_cells WHERE job_id = ?", (job_id,))
-            return bool(db.execute("DELETE FROM jobs WHERE id = ?", (job_id,)).rowcount)
+        return bool(deleted)
 
     def recover(self, *, attempts: int) -> list[str]:
         """After a restart: jobs left running are queued again (or failed after ``attempts``).
+
+        A job queued again has no progress and no start time until it runs again.
+
+        Result pages of no job (an older release's) are removed.
 
         Returns:
             The ids of the queued jobs, oldest first, to run.
@@ -182,7 +207,13 @@ class JobStore(JobReads):
                 "status = 'running' AND attempts >= ?",
                 (now, json.dumps([_interrupted(attempts)]), attempts),
             )
-            db.execute("UPDATE jobs SET status = 'queued' WHERE status = 'running'")
+            # the interrupted run's progress and start time are not the next run's
+            db.execute(
+                "UPDATE jobs SET status = 'queued', done = 0, started = NULL "
+                "WHERE status = 'running'"
+            )
+            # Pages of no job: left by an older release, whose finish() wrote a deleted job's.
+            db.execute("DELETE FROM job_cells WHERE job_id NOT IN (SELECT id FROM jobs)")
             rows = db.execute(
                 "SELECT id FROM jobs WHERE status = 'queued' ORDER BY created"
             ).fetchall()
@@ -199,14 +230,20 @@ class JobStore(JobReads):
         return {str(k): int(v) for k, v in counts.items()}, [float(r[0]) for r in rows]
 
     def expire(self, *, ttl: float) -> int:
-        """Forget finished jobs older than ``ttl`` seconds; how many."""
+        """Forget finished jobs older than ``ttl`` seconds, and their results' pages; how many.
+
+        The jobs are found by their end time (an index) and the pages by their job, so its
+        cost is that of the jobs expired, not of the store (the supervisor runs it every
+        minute).
+        """
+        expired = (
+            "SELECT id FROM jobs WHERE finished < ? AND status IN ('done', 'failed', 'cancelled')"
+        )
+        cutoff = time.time() - ttl
         with self._connection() as db:
-            expired = db.execute(
-                "DELETE FROM jobs WHERE status IN ('done', 'failed', 'cancelled') AND finished < ?",
-                (time.time() - ttl,),
-            ).rowcount
-            db.execute("DELETE FROM job_cells WHERE job_id NOT IN (SELECT id FROM jobs)")
-        return int(expired)
+            db.execute(f"DELETE FROM job_cells WHERE job_id IN ({expired})", (cutoff,))
+            count = db.execute(f"DELETE FROM jobs WHERE id IN ({expired})", (cutoff,)).rowcount
+        return int(count)
 
 
 def _interrupted(attempts: int) -> dict[str, Any]:

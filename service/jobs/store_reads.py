@@ -8,12 +8,21 @@ only that page. The changes (submit, run, finish, cancel, expire) are
 
 from __future__ import annotations
 
+import dataclasses
 import json
 from typing import Any
 
-from service.jobs.job import STATE_COLUMNS, Job, JobState, job_of_row, state_of_row
+from service.jobs.job import (
+    STATE_COLUMNS,
+    DamagedJob,
+    Job,
+    JobState,
+    job_of_row,
+    state_of_row,
+)
 from service.jobs.results import cells_text, read_cells, with_cells
 from service.jobs.store_file import StoreFile
+from service.logs import log
 
 
 class JobReads(StoreFile):
@@ -31,27 +40,48 @@ class JobReads(StoreFile):
             row = db.execute("SELECT * FROM jobs WHERE id = ?", (job_id,)).fetchone()
             if row is None:
                 return None
-            result = None if row["result"] is None else json.loads(row["result"])
-            count = row["cells"]
-            if result is not None and count is not None:
+            job = job_of_row(row, store=self.path)
+            count = job.cells
+            if job.result is not None and count is not None:
                 if inline_cells is None or count <= inline_cells:
-                    result = with_cells(result, read_cells(db, job_id, offset=0, limit=count))
-        return job_of_row(row, result)
+                    cells = read_cells(db, job_id, offset=0, limit=count)
+                    job = dataclasses.replace(job, result=with_cells(job.result, cells))
+        return job
 
     def state(self, job_id: str) -> JobState | None:
         """The job without its request and result, or None for an unknown id."""
         with self._connection() as db:
             row = db.execute(f"SELECT {STATE_COLUMNS} FROM jobs WHERE id = ?", (job_id,)).fetchone()
-        return None if row is None else state_of_row(row)
+        return None if row is None else state_of_row(row, store=self.path)
 
-    def jobs(self, *, status: str | None, limit: int) -> list[JobState]:
-        """The newest jobs first, optionally of one status, without requests and results."""
-        query, args = f"SELECT {STATE_COLUMNS} FROM jobs", []
+    def jobs(self, *, status: str | None, limit: int, after: str | None = None) -> list[JobState]:
+        """The newest jobs first, optionally of one status, without requests and results.
+
+        Jobs submitted in the same instant are in the order of their ids, so the order is total.
+
+        Args:
+            status: only the jobs of this status (None: all).
+            limit: at most this many.
+            after: the listing goes on after this job's place in it (the last id of a page);
+                an id the store does not hold gives no jobs.
+        """
+        conditions, args = [], []
         if status is not None:
-            query, args = query + " WHERE status = ?", [status]
+            conditions, args = ["status = ?"], [status]
+        if after is not None:
+            conditions.append("(created, id) < (SELECT created, id FROM jobs WHERE id = ?)")
+            args.append(after)
+        where = f" WHERE {' AND '.join(conditions)}" if conditions else ""
+        query = f"SELECT {STATE_COLUMNS} FROM jobs{where} ORDER BY created DESC, id DESC LIMIT ?"
         with self._connection() as db:
-            rows = db.execute(query + " ORDER BY created DESC LIMIT ?", [*args, limit]).fetchall()
-        return [state_of_row(row) for row in rows]
+            rows = db.execute(query, [*args, limit]).fetchall()
+        states = []
+        for row in rows:
+            try:
+                states.append(state_of_row(row, store=self.path))
+            except DamagedJob as error:  # the others are still listed
+                log.warning("job listing: %s; left out", error.reason)
+        return states
 
     def request(self, job_id: str) -> dict[str, Any] | None:
         """The job's request (the route's body), or None for an unknown id."""

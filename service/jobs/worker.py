@@ -24,7 +24,7 @@ from pydantic import ValidationError
 
 from service.config import Settings
 from service.errors import request_location, solver_error_location, solver_error_type
-from service.jobs.job import JobStoreUnavailable
+from service.jobs.job import DamagedJob, JobStoreUnavailable
 from service.jobs.store import JobStore
 from service.logs import log, log_to_stderr
 from service.operations import evaluation_of, map_of
@@ -92,7 +92,12 @@ def run_job(store: JobStore, job_id: str, settings: Settings) -> None:
     if not store.start(job_id):
         return  # cancelled while queued, or taken by another worker
     log.info("job %s running", job_id)
-    job = store.get(job_id)
+    try:
+        job = store.get(job_id)
+    except DamagedJob as error:  # not run, and not left running either
+        store.finish(job_id, "failed", error=[{"loc": [], "msg": error.reason, "type": "damaged"}])
+        log.error("job %s failed: %s", job_id, error.reason)
+        return
     if job is None:
         return
     last = [time.monotonic()]

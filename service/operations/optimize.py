@@ -40,7 +40,7 @@ def optimum_of(
         bounds=bounds,
         start=start,
         method=body.method,
-        max_spin_step=None if body.spin_path is None else body.spin_path.max_spin_step,
+        max_spin_step=max_spin_step_of(body),
         max_coarse_cells=settings.max_map_cells,
         max_coarse_poses=settings.max_map_poses,
         max_search_poses=settings.max_search_poses,
@@ -54,6 +54,11 @@ def optimum_of(
         axis_correction=convert.quaternion_correction(body.robot, body.cell),
         path=path,
     )
+
+
+def max_spin_step_of(body: OptimizeRequest) -> float | None:
+    """The spin path's largest step (rad), or None without a spin path."""
+    return None if body.spin_path is None else body.spin_path.max_spin_step
 
 
 def check_work(
@@ -72,8 +77,7 @@ def check_work(
         InvalidInputError: on ``bounds``, saying the phases, the work and the limit.
     """
     bounds.check()
-    spin_step = None if body.spin_path is None else body.spin_path.max_spin_step
-    work = work_of(problem, bounds, method=body.method, max_spin_step=spin_step)
+    work = work_of(problem, bounds, method=body.method, max_spin_step=max_spin_step_of(body))
     weighed = work.weighed(problem)
     limits = settings.map_limits()
     if body.method == "scipy":

@@ -72,17 +72,26 @@ class EvaluateJob(RequestModel):
     request: EvaluateRequest = Field(description="The body POST /v1/evaluate takes.")
 
 
+JOB_KINDS = ("map", "optimize", "evaluate")
+"""The kinds of job, in JobRequest's order."""
+
+
 def _job_kind(value: object) -> str | None:
     """Tag of a job: ``job:<kind>`` (the tag is left out of error locs)."""
     kind = value.get("kind") if isinstance(value, dict) else getattr(value, "kind", None)
-    return f"job:{kind}" if kind in ("map", "optimize", "evaluate") else None
+    return f"job:{kind}" if kind in JOB_KINDS else None
 
 
 JobRequest = Annotated[
     Annotated[MapJob, Tag("job:map")]
     | Annotated[OptimizeJob, Tag("job:optimize")]
     | Annotated[EvaluateJob, Tag("job:evaluate")],
-    Discriminator(_job_kind),
+    Discriminator(
+        _job_kind,
+        custom_error_type="job_kind",
+        custom_error_message='give kind: "map", "optimize" or "evaluate"',
+        custom_error_context={"tag_field": "kind"},  # the error's loc (service.body)
+    ),
 ]
 """A job: its kind and the route's own request body."""
 

@@ -134,20 +134,11 @@ def optimize_placement(
             ``max_coarse_poses``, or whose search is over ``max_search_poses`` (on ``bounds``).
     """
     began = time.perf_counter()
-    bounds.check()
-    chosen_method = method_named(method)
-    if problem.options.branch is not None:
-        raise InvalidInputError("ik.branch", "the optimisers choose the branch: it must be auto")
-    if max_spin_step is not None:
-        _check_spin_path(max_spin_step, chosen_method, problem)
+    chosen_method = check_search(
+        problem, bounds=bounds, start=start, method=method, max_spin_step=max_spin_step
+    )
     if start is None:
         start = bounds.placement(bounds.centre())
-    if not bounds.contains(vector_of(start)):
-        raise InvalidInputError(
-            "start",
-            f"x {start.x:g} m, y {start.y:g} m, z {start.z:g} m, yaw {start.yaw:g} rad, spin "
-            f"{start.spin:g} rad is outside the bounds",
-        )
     settings = Search(
         symmetric=symmetric_search(problem),
         near=math.atan2(start.y, start.x),
@@ -162,9 +153,7 @@ def optimize_placement(
         tried=Tried(),
     )
     chosen_method.check(problem, bounds, settings)
-    prepared = problem.prepared  # the path is checked before the options (evaluate_path's)
-    if max_spin_step is not None and not prepared.segment_in_pass.all():
-        raise InvalidInputError("spin_path", "a spin path needs a program of one pass")
+    problem.prepared  # noqa: B018 - the path is checked before the options (evaluate_path's)
     start_evaluation = evaluate_path(problem, start, thorough=False)  # its reason and mu
     candidates, iterations = chosen_method.search(problem, bounds, settings)
     # The start last: it is the answer only when nothing the solver found is better.
@@ -218,10 +207,55 @@ def optimize_placement(
     )
 
 
+def check_search(
+    problem: PathProblem,
+    *,
+    bounds: PlacementBounds,
+    start: Placement | None,
+    method: str,
+    max_spin_step: float | None,
+) -> Method:
+    """Refuse the arguments :func:`optimize_placement` refuses before any search.
+
+    The same checks in the same order, so that a caller that queues the search for later (an
+    optimize job) refuses what the search would, before it is queued. The size of the search
+    (the method's own ``check``) is the caller's: it depends on its limits.
+
+    Args:
+        problem: the problem, as :func:`optimize_placement` takes it.
+        bounds: the box.
+        start: the start placement, or None (the centre of the box).
+        method: a method's name.
+        max_spin_step: rad: a spin path's largest step, or None without a spin path.
+
+    Returns:
+        The method named.
+
+    Raises:
+        InvalidInputError: bad bounds, an unknown method, a branch other than auto, a spin path
+            the method, the spin mode or the program cannot have (on ``spin_path``), or a
+            start outside the bounds. The path is prepared (its own errors) for a spin path.
+    """
+    bounds.check()
+    chosen_method = method_named(method)
+    if problem.options.branch is not None:
+        raise InvalidInputError("ik.branch", "the optimisers choose the branch: it must be auto")
+    if max_spin_step is not None:
+        _check_spin_path(max_spin_step, chosen_method, problem)
+    if start is not None and not bounds.contains(vector_of(start)):
+        raise InvalidInputError(
+            "start",
+            f"x {start.x:g} m, y {start.y:g} m, z {start.z:g} m, yaw {start.yaw:g} rad, spin "
+            f"{start.spin:g} rad is outside the bounds",
+        )
+    return chosen_method
+
+
 def _check_spin_path(max_spin_step: float, method: Method, problem: PathProblem) -> None:
     """Raise InvalidInputError on ``spin_path``: no spin paths in the method, or a bad step.
 
-    A spin path needs a method that gives one (casadi), fixed spin, and a finite step > 0.
+    A spin path needs a method that gives one (casadi), fixed spin, a finite step > 0 and a
+    program of one pass (the path is prepared here: its own errors first).
     """
     if not method.spin_path or problem.options.spin_mode != "fixed":
         raise InvalidInputError("spin_path", "a spin path needs method casadi and spin_mode fixed")
@@ -229,6 +263,8 @@ def _check_spin_path(max_spin_step: float, method: Method, problem: PathProblem)
         raise InvalidInputError(
             "spin_path.max_spin_step", f"{max_spin_step:.6g} rad must be finite and > 0"
         )
+    if not problem.prepared.segment_in_pass.all():
+        raise InvalidInputError("spin_path", "a spin path needs a program of one pass")
 
 
 def _best_candidate(

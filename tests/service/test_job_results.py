@@ -13,6 +13,7 @@ import pytest
 from fastapi.testclient import TestClient
 
 from service.config import Settings
+from service.jobs.job import DamagedJob
 from service.jobs.store import JobStore
 from tests.cases import ROOT
 from tests.service.conftest import served_with
@@ -45,7 +46,7 @@ def test_a_listing_reads_no_request_and_no_result(tmp_path: Path) -> None:
     (listed,) = store.jobs(status=None, limit=10)
     assert (listed.id, listed.status, listed.total, listed.cells) == (job.id, "done", 2500, 2500)
     assert not hasattr(listed, "result") and not hasattr(listed, "request")
-    with pytest.raises(json.JSONDecodeError):  # what a listing that read them would meet
+    with pytest.raises(DamagedJob):  # what a listing that read them would meet
         store.get(job.id)
 
 

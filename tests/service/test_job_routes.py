@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import sqlite3
 import time
 import uuid
 from collections.abc import Iterator
@@ -13,6 +14,7 @@ import pytest
 from fastapi.testclient import TestClient
 
 from service.config import Settings
+from service.jobs.store import JobStore
 from tests.cases import ROOT
 from tests.service.conftest import served_with
 
@@ -59,8 +61,48 @@ def test_an_optimize_job_with_a_start_outside_its_bounds_is_refused(client: Test
     assert submitted.json()["detail"][0]["loc"] == ["body", "request", "start"]
 
 
-def wait_for(client: TestClient, job_id: str, done: Any) -> dict[str, Any]:
-    deadline = time.monotonic() + 60
+SPIN_PATH = {"max_spin_step": 0.05}
+REFUSED_SEARCHES = {  # each refused by the optimiser's own checks, not by the schema
+    "scipy": {"method": "scipy", "spin_path": SPIN_PATH},
+    "free-spin": {"spin_mode": "free", "spin_path": SPIN_PATH},
+    "two-passes": {
+        "path": {"cl_data": (ROOT / "examples" / "cam" / "nx_slot_plate.cls").read_text()},
+        "spin_mode": "fixed",
+        "spin_path": SPIN_PATH,
+    },
+}
+
+
+@pytest.mark.parametrize("changes", REFUSED_SEARCHES.values(), ids=REFUSED_SEARCHES.keys())
+def test_an_optimize_job_is_refused_as_the_optimiser_refuses_its_spin_path(
+    client: TestClient, changes: dict[str, Any]
+) -> None:
+    body = route_body("optimize", EXAMPLE["path"]) | changes
+    direct = client.post("/v1/optimize", json=body)
+    assert direct.status_code == 422, direct.text
+    submitted = client.post("/v1/jobs", json={"kind": "optimize", "request": body})
+    assert submitted.status_code == 422, submitted.text
+    (expected,), (detail,) = direct.json()["detail"], submitted.json()["detail"]
+    assert expected["loc"] == ["body", "spin_path"]
+    assert detail == {**expected, "loc": ["body", "request", "spin_path"]}
+
+
+@pytest.mark.parametrize(
+    "kind", [{}, {"kind": "optimise"}, {"kind": None}, {"kind": ["map"]}], ids=str
+)
+def test_a_job_without_a_known_kind_is_refused_on_kind(
+    client: TestClient, kind: dict[str, Any]
+) -> None:
+    body = kind | {"request": route_body("optimize", EXAMPLE["path"])}
+    submitted = client.post("/v1/jobs", json=body)
+    assert submitted.status_code == 422, submitted.text
+    (detail,) = submitted.json()["detail"]
+    assert detail["loc"] == ["body", "kind"]
+    assert all(f'"{name}"' in detail["msg"] for name in ("map", "optimize", "evaluate"))
+
+
+def wait_for(client: TestClient, job_id: str, done: Any, timeout: float = 60) -> dict[str, Any]:
+    deadline = time.monotonic() + timeout
     while True:
         job: dict[str, Any] = client.get(f"/v1/jobs/{job_id}").json()
         if done(job) or time.monotonic() > deadline:
@@ -84,6 +126,34 @@ def test_delete_removes_a_job_and_cancel_keeps_it(client: TestClient, own_store:
     ended = wait_for(client, second, lambda j: j["status"] not in ("queued", "running"))
     assert ended["status"] in ("cancelled", "done")  # done if it ended before the cancel
     assert client.post(f"/v1/jobs/{uuid.uuid4()}/cancel").status_code == 404
+
+
+def test_the_job_listing_is_read_in_pages_with_after(client: TestClient, own_store: Path) -> None:
+    job = {"kind": "evaluate", "request": route_body("evaluate", EXAMPLE["path"])}
+    submitted = [client.post("/v1/jobs", json=job) for _ in range(3)]
+    assert all(answer.status_code == 202 for answer in submitted), submitted[-1].text
+    everything = [j["id"] for j in client.get("/v1/jobs").json()["jobs"]]
+    assert sorted(everything) == sorted(answer.json()["id"] for answer in submitted)
+    first = client.get("/v1/jobs", params={"limit": 2}).json()["jobs"]
+    second = client.get("/v1/jobs", params={"limit": 2, "after": first[-1]["id"]}).json()["jobs"]
+    assert [j["id"] for j in first + second] == everything
+    last = client.get("/v1/jobs", params={"after": everything[-1]})
+    assert last.status_code == 200 and last.json()["jobs"] == []
+    unknown = client.get("/v1/jobs", params={"after": str(uuid.uuid4())})
+    assert unknown.status_code == 422, unknown.text
+    assert unknown.json()["detail"][0]["loc"] == ["query", "after"]
+
+
+def test_a_finished_job_expires_while_the_service_runs(client: TestClient, tmp_path: Path) -> None:
+    job = {"kind": "evaluate", "request": route_body("evaluate", EXAMPLE["path"])}
+    with served_with(Settings(data_dir=tmp_path, workers=1, job_ttl=1.0)):
+        job_id = client.post("/v1/jobs", json=job).json()["id"]
+        done = wait_for(client, job_id, lambda j: j.get("status") == "done")
+        assert done["status"] == "done", done
+        # expired while the service runs, not only at its next startup
+        gone = wait_for(client, job_id, lambda j: "status" not in j, timeout=10)
+        assert "status" not in gone and gone["detail"][0]["type"] == "not_found", gone
+        assert job_id not in [j["id"] for j in client.get("/v1/jobs").json()["jobs"]]
 
 
 @pytest.fixture
@@ -115,6 +185,42 @@ def test_a_corrupt_store_takes_down_the_job_routes_only(
     assert client.get("/healthz").status_code == 200
     evaluated = client.post("/v1/evaluate", json=job["request"])
     assert evaluated.status_code == 200, evaluated.text
+
+
+DAMAGES = {  # what a hand edit may leave in a row; whether the job's state (not only its result)
+    "status": ("status = 'paused'", True),
+    "error": ("status = 'failed', error = '5'", True),
+    "result": ("status = 'done', result = '{'", False),
+}
+
+
+@pytest.mark.parametrize("damage", DAMAGES.values(), ids=DAMAGES.keys())
+def test_a_damaged_job_is_a_503_naming_it_and_the_others_are_served(
+    client: TestClient, tmp_path: Path, damage: tuple[str, bool]
+) -> None:
+    change, in_state = damage
+    store = JobStore(tmp_path / "jobs.sqlite3")  # filled before the service looks at it
+    good, bad = (store.create("evaluate", route_body("evaluate", EXAMPLE["path"])) for _ in "ab")
+    with sqlite3.connect(store.path) as db:
+        db.execute("UPDATE jobs SET status = 'cancelled', finished = created")
+        db.execute(f"UPDATE jobs SET {change} WHERE id = ?", (bad.id,))
+    with served_with(Settings(data_dir=tmp_path, workers=1)):
+        listed = client.get("/v1/jobs")
+        assert listed.status_code == 200, listed.text
+        ids = [job["id"] for job in listed.json()["jobs"]]
+        assert good.id in ids and (bad.id in ids) == (not in_state)  # left out, not a 500
+        assert client.get(f"/v1/jobs/{good.id}").status_code == 200
+        for method, url in [("GET", f"/v1/jobs/{bad.id}"), ("POST", f"/v1/jobs/{bad.id}/cancel")]:
+            answer = client.request(method, url)
+            if method == "POST" and not in_state:
+                assert answer.status_code == 200, answer.text  # a cancel reads no result
+                continue
+            assert answer.status_code == 503, (method, answer.text)
+            (detail,) = answer.json()["detail"]
+            assert detail["type"] == "job_store_unavailable"
+            assert str(store.path) in detail["msg"] and bad.id in detail["msg"]
+        assert client.delete(f"/v1/jobs/{bad.id}").status_code == 204
+        assert client.get(f"/v1/jobs/{bad.id}").status_code == 404
 
 
 def test_the_spec_declares_the_503_of_the_job_routes_and_metrics(client: TestClient) -> None:

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import logging
+import sqlite3
 import time
 from collections.abc import Callable, Iterator
 from pathlib import Path
@@ -163,6 +164,17 @@ def test_a_job_error_keeps_its_real_type(tmp_path: Path) -> None:
     assert failed is not None and failed.status == "failed" and failed.error is not None
     assert failed.error[0]["type"] == "invalid_line"
     assert failed.error[0]["loc"][:3] == ["body", "path", "csv"]
+
+
+def test_a_job_whose_request_is_damaged_fails_rather_than_stays_running(tmp_path: Path) -> None:
+    store = JobStore(tmp_path / "jobs.sqlite3")
+    job = store.create("evaluate", EVALUATE)
+    with sqlite3.connect(store.path) as db:
+        db.execute("UPDATE jobs SET request = '{' WHERE id = ?", (job.id,))
+    worker.run_job(store, job.id, settings(tmp_path))
+    failed = store.state(job.id)
+    assert failed is not None and failed.status == "failed" and failed.error is not None
+    assert failed.error[0]["type"] == "damaged" and job.id in failed.error[0]["msg"]
 
 
 def test_an_idle_supervisor_looks_seldom_and_still_finds_another_process_s_job(

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import os
+import sqlite3
 import subprocess
 import sys
 import threading
@@ -130,3 +131,52 @@ def test_a_deleted_job_is_gone_and_its_worker_is_told_to_stop(tmp_path: Path) ->
     assert not store.delete(job.id)
     assert store.progress(job.id, 0.5)  # a worker stops at its next report
     assert store.cancel_asked([job.id]) == {job.id}  # the supervisor stops one that does not
+
+
+def stored_cells(path: Path) -> int:
+    """Rows of result pages in the store's file, of any job."""
+    with sqlite3.connect(path) as db:
+        return int(db.execute("SELECT COUNT(*) FROM job_cells").fetchone()[0])
+
+
+def test_a_job_deleted_while_it_runs_leaves_no_result_when_its_worker_finishes(
+    tmp_path: Path,
+) -> None:
+    store = JobStore(tmp_path / "jobs.sqlite3")
+    job = store.create("map", {"robot": EXAMPLE["robot"]})
+    assert store.start(job.id)
+    assert store.delete(job.id)
+    cells = [{"x": 0.1 * i, "y": 0.4, "yaw": 0.0, "mu_path": 1.0, "reason": None} for i in range(5)]
+    store.finish(job.id, "done", result={"cells": cells, "best": None, "worst": None})
+    assert store.get(job.id) is None
+    assert store.jobs(status=None, limit=10) == []
+    assert stored_cells(store.path) == 0
+
+
+def test_an_expired_job_goes_with_its_result_pages(tmp_path: Path) -> None:
+    store = JobStore(tmp_path / "jobs.sqlite3")
+    kept, expired = (store.create("map", {"robot": EXAMPLE["robot"]}) for _ in range(2))
+    cells = [{"x": 0.1, "y": 0.4, "yaw": 0.0, "mu_path": 1.0, "reason": None}]
+    for job in (kept, expired):
+        assert store.start(job.id)
+        store.finish(job.id, "done", result={"cells": cells, "best": None, "worst": None})
+    with sqlite3.connect(store.path) as db:
+        db.execute("UPDATE jobs SET finished = finished - 100 WHERE id = ?", (expired.id,))
+    assert store.expire(ttl=50.0) == 1
+    assert store.get(expired.id) is None and store.cells(expired.id, offset=0, limit=9) == []
+    assert store.cells(kept.id, offset=0, limit=9) == cells
+    assert stored_cells(store.path) == 1
+
+
+def test_a_job_queued_again_after_a_restart_starts_its_progress_again(tmp_path: Path) -> None:
+    store = JobStore(tmp_path / "jobs.sqlite3")
+    job = store.create("evaluate", EVALUATE)
+    assert store.start(job.id)
+    assert not store.progress(job.id, 0.4)
+    assert store.recover(attempts=3) == [job.id]  # the service was killed while it ran
+    queued = store.state(job.id)
+    assert queued is not None and queued.status == "queued"
+    assert queued.fraction == 0.0 and queued.started is None
+    assert store.start(job.id)
+    running = store.state(job.id)
+    assert running is not None and running.fraction == 0.0 and running.started is not None

@@ -14,6 +14,7 @@ from uuid import UUID
 
 import anyio
 from fastapi import APIRouter, HTTPException, Path, Query, Response, status
+from fastapi.exceptions import RequestValidationError
 from fastapi.responses import JSONResponse
 
 from service.body import union_body_in_thread, union_body_openapi
@@ -136,15 +137,35 @@ def get_jobs(
     settings: SettingsDep,
     job_status: Annotated[JobStatus | None, Query(alias="status")] = None,
     limit: Annotated[int, Query(ge=1, le=1000)] = 100,
+    after: Annotated[
+        UUID | None,
+        Query(
+            description="A job's id: the listing goes on after that job (the last id of the "
+            "previous page). An id the store does not hold (deleted or expired) is a 422 "
+            "naming ``after``."
+        ),
+    ] = None,
 ) -> JobList:
     """Every job the store holds (finished ones until DTF_JOB_TTL), newest first.
 
-    Results are not read: ``result`` is null here; ``GET /v1/jobs/{id}`` gives it.
+    Results are not read: ``result`` is null here; ``GET /v1/jobs/{id}`` gives it. A listing
+    longer than ``limit`` is read in pages: ``after`` the last id of one page gives the next
+    (jobs submitted in the same instant are in the order of their ids).
     """
     store = get_runner(settings).store
-    return JobList(
-        jobs=[job_info(state, store) for state in store.jobs(status=job_status, limit=limit)]
-    )
+    if after is not None and store.state(str(after)) is None:
+        raise RequestValidationError(
+            [
+                {
+                    "loc": ("query", "after"),
+                    "msg": f"no job {str(after)!r} (deleted, or expired after DTF_JOB_TTL)",
+                    "type": "not_found",
+                    "input": str(after),
+                }
+            ]
+        )
+    states = store.jobs(status=job_status, limit=limit, after=None if after is None else str(after))
+    return JobList(jobs=[job_info(state, store) for state in states])
 
 
 @router.get(
