@@ -104,7 +104,7 @@ function showBaseHint() {
 }
 
 function ikBody() {
-  return { blend_length: Number($("blend-length").value) };
+  return { blend_length: value("blend-length") };  // empty: left out, the API's default
 }
 
 // A pasted robot object brings its own limits: the catalogue's fields are then greyed out.
