@@ -609,7 +609,7 @@ async function evaluateCell(c) {
   // The feed checked: the field's, else the program's (CL data), else none (the field empty).
   body.feed = answer.feed_check ? answer.feed_check.feed : undefined;
   const use = body.feed === undefined ? "; no feed to check"
-    : `; at ${body.feed} m/s the largest joint use is ${(100 * body.feed / answer.mu_path).toFixed(1)} %`;
+    : `; at ${fixed(body.feed, 6)} m/s the largest joint use is ${(100 * body.feed / answer.mu_path).toFixed(1)} %`;
   $("cell-summary").textContent = answer.feasible
     ? `${where}: mu_path ${answer.mu_path.toFixed(6)} m/s${use}`
     : `${where}: infeasible (${answer.reason} at waypoint ${answer.failed_waypoint})`;
@@ -646,7 +646,7 @@ function showAcceleration(answer, body) {
     const use = accelerationUse(answer, body);
     const peak = use ? Math.max(...use.flatMap((row) => (row ? row : [])), 0) : null;
     line.textContent = `mu_acc ${acc.mu_acc.toFixed(6)} m/s (blend ${(1000 * acc.blend_length).toFixed(3)} mm): ${where}`
-      + (peak === null ? "" : `; at ${body.feed} m/s the largest acceleration use is ${(100 * peak).toFixed(1)} %`)
+      + (peak === null ? "" : `; at ${fixed(body.feed, 6)} m/s the largest acceleration use is ${(100 * peak).toFixed(1)} %`)
       + (answer.feed_check ? (answer.feed_check.feasible ? " (the feed runs)" : " (the feed does NOT run)") : "");
   }
   $("cycle-time").textContent = t
