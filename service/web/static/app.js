@@ -12,7 +12,7 @@ const REASON_COLOURS = {
 };
 const state = {
   robots: [], path: null, pathProblem: "no path loaded yet", source: null, map: null, grid: null,
-  job: null, cursor: null,
+  job: null, running: false, cursor: null,
 };
 
 // ---- inputs -------------------------------------------------------------------------------
@@ -347,19 +347,28 @@ function havePath() {
 }
 
 // ---- the map job ---------------------------------------------------------------------------
+// One map at a time: from the first submit until its job ends, Run is disabled and a second
+// submit (a double click, Enter in a field) is none, so Cancel reaches the only job.
 async function runMap(event) {
   event.preventDefault();
+  if (state.running) return;
   clearErrors();
   clearResults();
   if (!havePath()) return;
   let body;
   try { body = mapBody(); } catch (error) { showErrors([{ loc: ["robot"], msg: String(error) }]); return; }
+  state.running = true; $("run").disabled = true;
   $("job-status").textContent = "submitting the map…";
   const job = await api("POST", "/v1/jobs", { kind: "map", request: body }).catch(() => null);
-  if (!job) { $("job-status").textContent = "no map: see the errors above"; return; }
+  if (!job) { endRun(); $("job-status").textContent = "no map: see the errors above"; return; }
   state.job = job.id; state.grid = body.grid; state.mapBody = body;
-  $("cancel").disabled = false; $("run").disabled = true;
+  $("cancel").disabled = false;
   await watch(job.id);
+}
+
+function endRun() {
+  state.running = false; state.job = null;
+  $("cancel").disabled = true; $("run").disabled = false;
 }
 
 async function watch(id) {
@@ -370,7 +379,7 @@ async function watch(id) {
     $("eta").textContent = eta == null ? "" : `about ${eta.toFixed(1)} s left`;
     $("job-status").textContent = `${job.status}: ${job.progress.done} of ${job.progress.total} placements`;
     if (!["queued", "running"].includes(job.status)) {
-      $("cancel").disabled = true; $("run").disabled = false; state.job = null;
+      endRun();
       if (job.status === "done") drawMap(job.result);
       if (job.status === "failed") { showErrors(job.error); $("job-status").textContent += " (see the errors above)"; }
       return;
