@@ -7,7 +7,8 @@ is read in pages of GET /v1/jobs/{id}/result and drawn.
 
 from __future__ import annotations
 
-from playwright.sync_api import Page
+import httpx
+from playwright.sync_api import Page, Route
 
 from tests.web.test_page import SMALL, fill
 
@@ -30,3 +31,41 @@ def test_a_double_click_on_run_submits_one_job(page: Page) -> None:
     page.wait_for_timeout(300)
     assert len(posts) == 1
     assert page.is_enabled("#run") and page.is_disabled("#cancel")
+
+
+def test_a_failed_poll_is_asked_again_and_the_map_drawn(page: Page) -> None:
+    """One GET /v1/jobs/{id} that gets no answer (a network blip) ends nothing."""
+    failed: list[str] = []
+
+    def blip(route: Route) -> None:
+        if not failed and route.request.method == "GET":
+            failed.append(route.request.url)
+            route.abort()
+        else:
+            route.continue_()
+
+    page.route("**/v1/jobs/*", blip)
+    fill(page, SMALL)
+    page.click("#run")
+    page.wait_for_function("document.getElementById('summary').dataset.cells", timeout=20_000)
+    assert len(failed) == 1
+    assert page.is_enabled("#run") and page.is_disabled("#cancel")
+    assert (page.text_content("#job-status") or "").startswith("done: ")
+
+
+def test_a_job_deleted_by_another_client_says_so_and_run_is_back(page: Page, url: str) -> None:
+    deleted: list[int] = []
+
+    def delete_first(route: Route) -> None:  # another client deletes the job before a poll
+        if not deleted and route.request.method == "GET":
+            deleted.append(httpx.delete(route.request.url).status_code)
+        route.continue_()
+
+    page.route("**/v1/jobs/*", delete_first)
+    fill(page, SMALL)
+    page.click("#run")
+    page.wait_for_function("!document.getElementById('run').disabled", timeout=20_000)
+    assert deleted == [204]
+    job = page.text_content("#job-status") or ""
+    assert job.startswith("no map: job ") and "is gone (404" in job, job
+    assert page.is_disabled("#cancel") and page.locator(".panel").count() == 0

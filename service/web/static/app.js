@@ -371,9 +371,41 @@ function endRun() {
   $("cancel").disabled = true; $("run").disabled = false;
 }
 
+// A poll that gets no answer (the network, the service restarting: jobs survive a restart) is
+// asked again after these waits (ms); then the page says it lost the job and gives Run back.
+const POLL_RETRIES_MS = [500, 1000, 2000, 4000];
+
+// GET /v1/jobs/{id}: the job, or an error that carries the HTTP status (none: no answer).
+async function pollJob(id) {
+  const response = await fetch(`/v1/jobs/${id}`);
+  if (!response.ok) {
+    const error = new Error(`HTTP ${response.status} ${response.statusText}`.trim());
+    error.status = response.status;
+    throw error;
+  }
+  return response.json();
+}
+
 async function watch(id) {
+  let failed = 0;
   for (;;) {
-    const job = await api("GET", `/v1/jobs/${id}`);
+    let job;
+    try {
+      job = await pollJob(id);
+      failed = 0;
+    } catch (error) {
+      if (error.status === 404 || failed === POLL_RETRIES_MS.length) {
+        endRun();
+        $("bar").value = 0; $("eta").textContent = "";
+        $("job-status").textContent = error.status === 404
+          ? `no map: job ${id} is gone (404: deleted by another client, or expired)`
+          : `no map: the service gave no answer about job ${id} in ${failed + 1} tries (${error.message}); it may still run there`;
+        return;
+      }
+      $("eta").textContent = `no answer from the service (${error.message}): asking again`;
+      await new Promise((resolve) => setTimeout(resolve, POLL_RETRIES_MS[failed++]));
+      continue;
+    }
     $("bar").value = job.progress.fraction;
     const eta = job.progress.eta_seconds;
     $("eta").textContent = eta == null ? "" : `about ${eta.toFixed(1)} s left`;
