@@ -8,9 +8,11 @@ is read in pages of GET /v1/jobs/{id}/result and drawn.
 from __future__ import annotations
 
 import httpx
+import pytest
 from playwright.sync_api import Page, Route
 
 from tests.web.test_page import SMALL, fill
+from tests.web.test_page_findings import choose_file
 
 
 def map_posts(page: Page) -> list[str]:
@@ -69,3 +71,39 @@ def test_a_job_deleted_by_another_client_says_so_and_run_is_back(page: Page, url
     job = page.text_content("#job-status") or ""
     assert job.startswith("no map: job ") and "is gone (404" in job, job
     assert page.is_disabled("#cancel") and page.locator(".panel").count() == 0
+
+
+OTHER_PROGRAM = "UNITS/MM\nGOTO/0,0,0,0,0,1\nGOTO/50,0,0,0,0,1\nGOTO/50,50,0,0,0,1\n"
+
+
+@pytest.mark.parametrize("change", ["path", "robot"])
+def test_a_new_path_or_robot_drops_the_running_jobs_map(page: Page, change: str) -> None:
+    """The old job's polls are held until the new input is in: then its answer draws nothing."""
+    held: list[Route] = []
+    page.route(
+        "**/v1/jobs/*", lambda r: held.append(r) if r.request.method == "GET" else r.continue_()
+    )
+    fill(page, SMALL)
+    page.click("#run")
+    page.wait_for_function("!document.getElementById('cancel').disabled", timeout=20_000)
+    while not held:
+        page.wait_for_timeout(50)
+    job = held[0].request.url
+    cancels: list[str] = []
+    page.on("request", lambda r: cancels.append(r.url) if r.url.endswith("/cancel") else 0)
+    if change == "path":
+        choose_file(page, "#path-file", "other.cl", OTHER_PROGRAM)
+        page.wait_for_function("document.getElementById('import').dataset.waypoints === '3'")
+    else:
+        page.select_option("#robot-model", "ur10")
+    for route in held:  # the old job's answer comes now
+        route.continue_()
+    page.unroute("**/v1/jobs/*")
+    while httpx.get(job).json()["status"] in ("queued", "running"):
+        page.wait_for_timeout(100)
+    page.wait_for_timeout(500)  # the page's polls, were it still watching, have seen it end
+    assert page.locator(".panel").count() == 0
+    assert page.text_content("#summary") == ""
+    assert (page.text_content("#job-status") or "").startswith("cancelled: ")
+    assert page.is_enabled("#run") and page.is_disabled("#cancel")
+    assert cancels == [f"{job}/cancel"]  # and the job stopped on the service

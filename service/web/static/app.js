@@ -12,7 +12,7 @@ const REASON_COLOURS = {
 };
 const state = {
   robots: [], path: null, pathProblem: "no path loaded yet", source: null, map: null, grid: null,
-  job: null, running: false, cursor: null,
+  run: null, cursor: null,
 };
 
 // ---- inputs -------------------------------------------------------------------------------
@@ -162,6 +162,7 @@ function setPath(name, text) {
   state.source = { name, text };
   state.path = null;
   clearResults();
+  dropRun(`a new path, ${name}, was loaded`);
   clearImport();
   clearErrors();
   const units = $("path-units").value;
@@ -348,27 +349,47 @@ function havePath() {
 
 // ---- the map job ---------------------------------------------------------------------------
 // One map at a time: from the first submit until its job ends, Run is disabled and a second
-// submit (a double click, Enter in a field) is none, so Cancel reaches the only job.
+// submit (a double click, Enter in a field) is none, so Cancel reaches the only job. The run
+// under way is state.run ({id}: its job's, once submitted); a run no longer in state.run was
+// dropped (dropRun) and whatever its requests answer later is not shown.
 async function runMap(event) {
   event.preventDefault();
-  if (state.running) return;
+  if (state.run) return;
   clearErrors();
   clearResults();
   if (!havePath()) return;
   let body;
   try { body = mapBody(); } catch (error) { showErrors([{ loc: ["robot"], msg: String(error) }]); return; }
-  state.running = true; $("run").disabled = true;
+  const run = { id: null };
+  state.run = run; $("run").disabled = true;
   $("job-status").textContent = "submitting the map…";
   const job = await api("POST", "/v1/jobs", { kind: "map", request: body }).catch(() => null);
+  if (state.run !== run) { if (job) cancelJob(job.id); return; }  // dropped while submitted
   if (!job) { endRun(); $("job-status").textContent = "no map: see the errors above"; return; }
-  state.job = job.id; state.grid = body.grid; state.mapBody = body;
+  run.id = job.id; state.grid = body.grid; state.mapBody = body;
   $("cancel").disabled = false;
-  await watch(job.id);
+  await watch(run);
 }
 
 function endRun() {
-  state.running = false; state.job = null;
+  state.run = null;
   $("cancel").disabled = true; $("run").disabled = false;
+}
+
+// A new path or robot while a map is submitted or runs: its job is cancelled on the service and
+// its answer never drawn under the new inputs (whose map it is not).
+function dropRun(why) {
+  const run = state.run;
+  if (!run) return;
+  endRun();
+  if (run.id) cancelJob(run.id);
+  $("bar").value = 0; $("eta").textContent = "";
+  $("job-status").textContent = `cancelled: ${why}`;
+}
+
+// Asked, not awaited, and quiet: a job that ended meanwhile is left as it is (api.md).
+function cancelJob(id) {
+  fetch(`/v1/jobs/${id}/cancel`, { method: "POST" }).catch(() => null);
 }
 
 // A poll that gets no answer (the network, the service restarting: jobs survive a restart) is
@@ -386,7 +407,8 @@ async function pollJob(id) {
   return response.json();
 }
 
-async function watch(id) {
+async function watch(run) {
+  const id = run.id;
   let failed = 0;
   for (;;) {
     let job;
@@ -394,6 +416,7 @@ async function watch(id) {
       job = await pollJob(id);
       failed = 0;
     } catch (error) {
+      if (state.run !== run) return;
       if (error.status === 404 || failed === POLL_RETRIES_MS.length) {
         endRun();
         $("bar").value = 0; $("eta").textContent = "";
@@ -406,6 +429,7 @@ async function watch(id) {
       await new Promise((resolve) => setTimeout(resolve, POLL_RETRIES_MS[failed++]));
       continue;
     }
+    if (state.run !== run) return;  // dropped: a new path or robot came meanwhile
     $("bar").value = job.progress.fraction;
     const eta = job.progress.eta_seconds;
     $("eta").textContent = eta == null ? "" : `about ${eta.toFixed(1)} s left`;
@@ -420,8 +444,8 @@ async function watch(id) {
   }
 }
 
-async function cancelMap() {
-  if (state.job) await api("POST", `/v1/jobs/${state.job}/cancel`);  // DELETE would forget it
+async function cancelMap() {  // POST .../cancel: DELETE would forget the job
+  if (state.run && state.run.id) await api("POST", `/v1/jobs/${state.run.id}/cancel`).catch(() => null);
 }
 
 // ---- the colour map ------------------------------------------------------------------------
@@ -710,6 +734,12 @@ async function start() {
   select.addEventListener("change", showLimits);
   $("robot-json").addEventListener("input", showOwnRobot);
   $("urdf").addEventListener("input", showOwnRobot);
+  // Another robot (the catalogue's, a URDF and its frames, a robot object): the map running is
+  // not its map. Its speed and acceleration limits, edited, leave the job be.
+  for (const [id, event] of [["robot-model", "change"], ["robot-json", "input"], ["urdf", "input"],
+    ["urdf-file", "change"], ["base-frame", "input"], ["tool-frame", "input"]]) {
+    $(id).addEventListener(event, () => dropRun("the robot changed"));
+  }
   $("urdf").addEventListener("change", readUrdfLinks);
   $("base-frame").addEventListener("input", showBaseHint);
   $("urdf-file").addEventListener("change", async () => {
