@@ -7,11 +7,14 @@ is read in pages of GET /v1/jobs/{id}/result and drawn.
 
 from __future__ import annotations
 
+from typing import Any
+
 import httpx
 import pytest
 from playwright.sync_api import Page, Route
 
-from tests.web.test_page import SMALL, fill
+from tests.web.conftest import PAGE_CELLS
+from tests.web.test_page import EXAMPLE_PATH, SMALL, fill, grid_of, page_colour
 from tests.web.test_page_findings import choose_file
 
 
@@ -107,3 +110,78 @@ def test_a_new_path_or_robot_drops_the_running_jobs_map(page: Page, change: str)
     assert (page.text_content("#job-status") or "").startswith("cancelled: ")
     assert page.is_enabled("#run") and page.is_disabled("#cancel")
     assert cancels == [f"{job}/cancel"]  # and the job stopped on the service
+
+
+REASON_COLOURS = {  # app.js's
+    "unreachable": (224, 224, 224),
+    "joint_limits": (244, 166, 192),
+    "singular": (85, 85, 85),
+    "discontinuous": (255, 183, 77),
+}
+
+
+def test_a_map_over_the_page_size_is_read_in_pages_and_drawn(page: Page, url: str) -> None:
+    """11 x 6 cells at 2 yaws: 132 cells, the job's answer without them, 3 pages of 60."""
+    values = {**SMALL, "x-step": "0.02", "y-step": "0.04"}
+    pages = []
+    page.on("request", lambda r: pages.append(r.url) if "/result?" in r.url else 0)
+    first: list[Route] = []  # held until the page has said what it reads
+    page.route("**/result?*", lambda r: r.continue_() if first else first.append(r))
+    fill(page, values)
+    page.click("#run")
+    while not first:
+        page.wait_for_timeout(50)
+    assert page.text_content("#job-status") == "done: reading the map's cells, 0 of 132"
+    first[0].continue_()
+    page.wait_for_function("document.getElementById('summary').dataset.cells", timeout=30_000)
+    body = {"robot": {"model": "ur5"}, "path": EXAMPLE_PATH, "grid": grid_of(values)}
+    api = httpx.post(f"{url}/v1/map", json=body, timeout=60).json()
+    cells: list[dict[str, Any]] = api["cells"]
+    assert len(cells) == 132 and len(pages) == -(-132 // PAGE_CELLS)
+    assert page.get_attribute("#summary", "data-cells") == "132"
+    assert page.locator(".panel canvas").count() == 2
+    assert page.text_content("#best-mu") == f"{api['best']['mu_path']:.6f} m/s"
+    # Every cell painted in its colour, the last page's (the second panel's end) too.
+    mus = [c["mu_path"] for c in cells if c["mu_path"] is not None]
+    low, high = min(mus), max(mus)
+    painted = page.evaluate(
+        """() => [...document.querySelectorAll('.panel canvas')].flatMap((canvas) => {
+            const size = Number(canvas.dataset.cell), nx = Number(canvas.dataset.nx);
+            const ny = Number(canvas.dataset.ny), g = canvas.getContext('2d'), out = [];
+            for (let k = 0; k < nx * ny; k++) {
+                const i = k % nx, j = Math.floor(k / nx);
+                const at = [i * size + size / 2, (ny - 1 - j) * size + size / 2];
+                out.push([...g.getImageData(at[0], at[1], 1, 1).data.slice(0, 3)]);
+            }
+            return out;
+        })"""
+    )
+    want = [
+        list(REASON_COLOURS[c["reason"]])
+        if c["mu_path"] is None
+        else list(page_colour((c["mu_path"] - low) / (high - low)))
+        for c in cells
+    ]
+    assert painted == want
+    assert page.is_enabled("#run") and page.is_disabled("#cancel")
+
+
+def test_a_map_of_131044_cells_is_drawn(page: Page) -> None:
+    """The page's own drawMap on a 362 x 362 answer: Math.min(...cells) would throw."""
+    drawn = page.evaluate(
+        """() => {
+            const n = 362, cells = [];
+            for (let k = 0; k < n * n; k++) {
+                cells.push({ x: (k % n) / 1000, y: Math.floor(k / n) / 1000, yaw: 0, spin: 0,
+                    mu_path: 0.1 + k / 1e7, reason: null, bottleneck_joint: 0,
+                    bottleneck_waypoint: 0, branch: {} });
+            }
+            const top = cells[n * n - 1];
+            const best = { placement: { ...top, z: 0.1 }, mu_path: top.mu_path };
+            drawMap({ cells, feasible_cells: n * n, best, worst: best });
+            return [document.getElementById('summary').dataset.cells,
+                document.getElementById('cb-min').textContent,
+                document.getElementById('cb-max').textContent];
+        }"""
+    )
+    assert drawn == ["131044", "0.100 m/s", "0.113 m/s"]

@@ -392,13 +392,13 @@ function cancelJob(id) {
   fetch(`/v1/jobs/${id}/cancel`, { method: "POST" }).catch(() => null);
 }
 
-// A poll that gets no answer (the network, the service restarting: jobs survive a restart) is
-// asked again after these waits (ms); then the page says it lost the job and gives Run back.
+// A request about the job that gets no answer (the network, the service restarting: jobs
+// survive a restart) is asked again after these waits (ms); then the page gives up.
 const POLL_RETRIES_MS = [500, 1000, 2000, 4000];
 
-// GET /v1/jobs/{id}: the job, or an error that carries the HTTP status (none: no answer).
-async function pollJob(id) {
-  const response = await fetch(`/v1/jobs/${id}`);
+// GET url: its JSON, or an error that carries the HTTP status (none: no answer).
+async function getJson(url) {
+  const response = await fetch(url);
   if (!response.ok) {
     const error = new Error(`HTTP ${response.status} ${response.statusText}`.trim());
     error.status = response.status;
@@ -407,36 +407,50 @@ async function pollJob(id) {
   return response.json();
 }
 
-async function watch(run) {
-  const id = run.id;
-  let failed = 0;
-  for (;;) {
-    let job;
+// GET url for the run, asked again after POLL_RETRIES_MS when it fails. Null when the run was
+// dropped meanwhile, or when the page gives up (the job gone: 404; else 5 failures): then Run
+// is back and the status says why.
+async function ask(run, url) {
+  for (let failed = 0; ; failed++) {
+    let error;
     try {
-      job = await pollJob(id);
-      failed = 0;
-    } catch (error) {
-      if (state.run !== run) return;
-      if (error.status === 404 || failed === POLL_RETRIES_MS.length) {
-        endRun();
-        $("bar").value = 0; $("eta").textContent = "";
-        $("job-status").textContent = error.status === 404
-          ? `no map: job ${id} is gone (404: deleted by another client, or expired)`
-          : `no map: the service gave no answer about job ${id} in ${failed + 1} tries (${error.message}); it may still run there`;
-        return;
-      }
-      $("eta").textContent = `no answer from the service (${error.message}): asking again`;
-      await new Promise((resolve) => setTimeout(resolve, POLL_RETRIES_MS[failed++]));
-      continue;
+      const answer = await getJson(url);
+      return state.run === run ? answer : null;
+    } catch (caught) { error = caught; }
+    if (state.run !== run) return null;
+    if (error.status === 404 || failed === POLL_RETRIES_MS.length) {
+      endRun();
+      $("bar").value = 0; $("eta").textContent = "";
+      $("job-status").textContent = error.status === 404
+        ? `no map: job ${run.id} is gone (404: deleted by another client, or expired)`
+        : `no map: ${failed + 1} requests about job ${run.id} failed (${error.message})`
+          + (run.reading ? "" : "; it may still run on the service");
+      return null;
     }
-    if (state.run !== run) return;  // dropped: a new path or robot came meanwhile
+    $("eta").textContent = `no answer from the service (${error.message}): asking again`;
+    await new Promise((resolve) => setTimeout(resolve, POLL_RETRIES_MS[failed]));
+  }
+}
+
+async function watch(run) {
+  for (;;) {
+    const job = await ask(run, `/v1/jobs/${run.id}`);
+    if (!job) return;  // dropped (a new path or robot), or given up (said)
     $("bar").value = job.progress.fraction;
     const eta = job.progress.eta_seconds;
     $("eta").textContent = eta == null ? "" : `about ${eta.toFixed(1)} s left`;
-    $("job-status").textContent = `${job.status}: ${job.progress.done} of ${job.progress.total} placements`;
+    const status = `${job.status}: ${job.progress.done} of ${job.progress.total} placements`;
+    $("job-status").textContent = status;
+    if (job.status === "done") {
+      const cells = await readCells(run, job);
+      if (!cells) return;
+      endRun();
+      $("job-status").textContent = status; $("bar").value = 1;
+      drawMap({ ...job.result, cells });
+      return;
+    }
     if (!["queued", "running"].includes(job.status)) {
       endRun();
-      if (job.status === "done") drawMap(job.result);
       if (job.status === "failed") { showErrors(job.error); $("job-status").textContent += " (see the errors above)"; }
       return;
     }
@@ -444,11 +458,41 @@ async function watch(run) {
   }
 }
 
+// A map of over DTF_JOB_PAGE_CELLS cells comes without them (result_cells.in_result false):
+// they are read a page at a time from result_cells.first_page on, the count said as they come.
+async function readCells(run, job) {
+  const where = job.result_cells;
+  if (!where || where.in_result) return job.result.cells;
+  run.reading = true;
+  $("eta").textContent = "";
+  const cells = [];
+  for (let next = where.first_page; next;) {
+    $("job-status").textContent = `done: reading the map's cells, ${cells.length} of ${where.total}`;
+    $("bar").value = cells.length / where.total;
+    const page = await ask(run, next);
+    if (!page) return null;
+    for (const c of page.cells) cells.push(c);
+    next = page.next;
+  }
+  return cells;
+}
+
 async function cancelMap() {  // POST .../cancel: DELETE would forget the job
-  if (state.run && state.run.id) await api("POST", `/v1/jobs/${state.run.id}/cancel`).catch(() => null);
+  const run = state.run;
+  if (!run || !run.id) return;
+  if (run.reading) { dropRun("the map's cells were not all read"); return; }  // the job is done
+  await api("POST", `/v1/jobs/${run.id}/cancel`).catch(() => null);
 }
 
 // ---- the colour map ------------------------------------------------------------------------
+// The least and the largest of many numbers: Math.min(...values) throws a RangeError in
+// Chromium past about 100,000 of them, and a map has up to millions of cells.
+function extent(values) {
+  let low = Infinity, high = -Infinity;
+  for (const v of values) { if (v < low) low = v; if (v > high) high = v; }
+  return [low, high];
+}
+
 function colour(fraction) {  // dark blue -> green -> yellow
   const stops = [[68, 1, 84], [59, 82, 139], [33, 145, 140], [94, 201, 98], [253, 231, 37]];
   const t = Math.min(Math.max(fraction, 0), 1) * (stops.length - 1);
@@ -480,7 +524,7 @@ function drawMap(answer) {
   const xs = [...new Set(cells.map((c) => c.x))];
   const ys = [...new Set(cells.map((c) => c.y))];
   const feasible = cells.filter((c) => c.mu_path !== null).map((c) => c[key]);
-  const low = Math.min(...feasible), high = Math.max(...feasible);
+  const [low, high] = extent(feasible);
   const size = Math.min(48, Math.max(2, Math.floor(480 / Math.max(xs.length, ys.length))));
   state.scale = { low, high, xs, ys, size, key };
   const byAcc = cells.filter((c) => c.limited_by === "acceleration").length;
@@ -709,7 +753,7 @@ function showAcceleration(answer, body) {
     const where = acc.limited_by === "speed" ? "a speed limit binds (the bottleneck above)"
       : `the acceleration limit of joint ${acc.joint + 1} (${acc.joint_name}) binds at waypoint ${acc.waypoint}`;
     const use = accelerationUse(answer, body);
-    const peak = use ? Math.max(...use.flatMap((row) => (row ? row : [])), 0) : null;
+    const peak = use ? Math.max(extent(use.flatMap((row) => (row ? row : [])))[1], 0) : null;
     line.textContent = `mu_acc ${acc.mu_acc.toFixed(6)} m/s (blend ${(1000 * acc.blend_length).toFixed(3)} mm): ${where}`
       + (peak === null ? "" : `; at ${fixed(body.feed, 6)} m/s the largest acceleration use is ${(100 * peak).toFixed(1)} %`)
       + (answer.feed_check ? (answer.feed_check.feasible ? " (the feed runs)" : " (the feed does NOT run)") : "");
