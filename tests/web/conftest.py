@@ -14,6 +14,7 @@ from tests.live import start_server
 
 CHROMIUM = shutil.which("chromium") or "/usr/bin/chromium"
 ARTIFACTS = ROOT / "tests" / "artifacts"
+PAGE_CELLS = 60
 
 
 @pytest.fixture(scope="session")
@@ -23,6 +24,9 @@ def url(tmp_path_factory: pytest.TempPathFactory) -> Iterator[str]:
         "DTF_WORKERS": "1",
         "DTF_MAX_JOB_CELLS": "2000000",
         "DTF_MAX_JOB_POSES": "500000000",
+        # A map job's answer over 60 cells comes without them, read in pages of 60 (a small
+        # map's 50 cells come in it): as a map of over 10,000 does by default.
+        "DTF_JOB_PAGE_CELLS": str(PAGE_CELLS),
     }
     process, url = start_server(env, "--timeout-graceful-shutdown", "2")
     yield url

@@ -496,3 +496,15 @@ def test_a_zero_blend_length_shows_the_apis_error_beside_the_field(page: Page, u
     detail = httpx.post(f"{url}/v1/jobs", json=body).json()["detail"]
     assert [d["loc"][2:] for d in detail] == [["ik", "blend_length"]]
     assert page.text_content(selector) == detail[0]["msg"]
+
+
+def test_an_empty_blend_length_is_left_out_not_sent_as_zero(page: Page, url: str) -> None:
+    """As every other empty field: the API's default (0.002 m) applies, no error beside it."""
+    fill(page, {**SMALL, "acc-limits": ACC, "blend-length": ""})
+    with page.expect_request(lambda r: r.method == "POST" and r.url.endswith("/v1/jobs")) as sent:
+        page.click("#run")
+    body = sent.value.post_data_json
+    assert isinstance(body, dict) and body["request"]["ik"] == {}
+    page.wait_for_function("document.getElementById('summary').dataset.cells", timeout=60_000)
+    assert page.text_content(".field[data-loc='ik.blend_length'] .error") == ""
+    assert page.get_attribute("#summary", "data-key") == "mu_acc"

@@ -20,7 +20,7 @@ from playwright.sync_api import Browser, Page
 from tests.cases import ROOT
 from tests.solver.families.recognised import bent_elbow
 from tests.web.conftest import ARTIFACTS, snapshot
-from tests.web.test_page import EXAMPLE_PATH, SMALL, cell_point, fill, grid_of, run_small_map
+from tests.web.test_page import ACC, EXAMPLE_PATH, SMALL, cell_point, fill, grid_of, run_small_map
 
 README = (ROOT / "README.md").read_text()
 
@@ -455,6 +455,27 @@ def test_cell_summaries_are_rounded(page: Page, url: str) -> None:
     summary = page.text_content("#cell-summary") or ""
     assert summary.startswith(f"x {cell['x']:.4f} m, y {cell['y']:.4f} m, yaw 0.0000 rad: ")
     assert repr(cell["x"]) not in summary
+
+
+def test_a_programs_feed_is_shown_rounded_in_the_cell_summary(page: Page) -> None:
+    """NX's 20 in/min is 0.008466666666666667 m/s: said as every speed on the page, to 1e-6."""
+    page.select_option("#path-example", "nx_slot_plate.cls")
+    page.wait_for_function(
+        "document.getElementById('path-info').textContent.startsWith('nx_slot_plate') && "
+        "document.getElementById('import').dataset.waypoints",
+        timeout=30_000,
+    )
+    grid = {"x-min": "0.25", "x-max": "0.3", "x-step": "0.05", "y-min": "0.4", "y-max": "0.45"}
+    fill(page, {**SMALL, **grid, "y-step": "0.05", "yaws": "0", "feed": "", "acc-limits": ACC})
+    page.click("#run")
+    page.wait_for_function("document.getElementById('summary').dataset.cells", timeout=60_000)
+    page.locator(".panel canvas").first.focus()
+    page.keyboard.press("Enter")  # the cell at x 0.25 m, y 0.4 m: feasible
+    page.wait_for_selector("#plot[data-drawn='1']", timeout=60_000)
+    summary = page.text_content("#cell-summary") or ""
+    assert "; at 0.008467 m/s the largest joint use is " in summary, summary
+    acceleration = page.text_content("#acceleration") or ""
+    assert "; at 0.008467 m/s the largest acceleration use is " in acceleration, acceleration
 
 
 @pytest.mark.parametrize("width", [1280, 800])

@@ -2,7 +2,8 @@
 // with joint acceleration limits), a cell's joint speeds and accelerations, the cycle time, the
 // optimum. Plain JavaScript; it calls only this service's API. Its other scripts, loaded before
 // it: format.js (rounding, controller frames), axes.js (the panels' axes), plot.js (the clicked
-// placement's plot), cell.js (the cell editor and its words), optimum.js (the optimiser).
+// placement's plot), cell.js (the cell editor and its words), optimum.js (the optimiser), job.js
+// (the map job: submit, watch, read its cells, cancel).
 "use strict";
 
 const $ = (id) => document.getElementById(id);
@@ -12,7 +13,7 @@ const REASON_COLOURS = {
 };
 const state = {
   robots: [], path: null, pathProblem: "no path loaded yet", source: null, map: null, grid: null,
-  job: null, cursor: null,
+  run: null, cursor: null,
 };
 
 // ---- inputs -------------------------------------------------------------------------------
@@ -104,7 +105,7 @@ function showBaseHint() {
 }
 
 function ikBody() {
-  return { blend_length: Number($("blend-length").value) };
+  return { blend_length: value("blend-length") };  // empty: left out, the API's default
 }
 
 // A pasted robot object brings its own limits: the catalogue's fields are then greyed out.
@@ -162,6 +163,7 @@ function setPath(name, text) {
   state.source = { name, text };
   state.path = null;
   clearResults();
+  dropRun(`a new path, ${name}, was loaded`);
   clearImport();
   clearErrors();
   const units = $("path-units").value;
@@ -346,44 +348,15 @@ function havePath() {
   return false;
 }
 
-// ---- the map job ---------------------------------------------------------------------------
-async function runMap(event) {
-  event.preventDefault();
-  clearErrors();
-  clearResults();
-  if (!havePath()) return;
-  let body;
-  try { body = mapBody(); } catch (error) { showErrors([{ loc: ["robot"], msg: String(error) }]); return; }
-  $("job-status").textContent = "submitting the map…";
-  const job = await api("POST", "/v1/jobs", { kind: "map", request: body }).catch(() => null);
-  if (!job) { $("job-status").textContent = "no map: see the errors above"; return; }
-  state.job = job.id; state.grid = body.grid; state.mapBody = body;
-  $("cancel").disabled = false; $("run").disabled = true;
-  await watch(job.id);
-}
-
-async function watch(id) {
-  for (;;) {
-    const job = await api("GET", `/v1/jobs/${id}`);
-    $("bar").value = job.progress.fraction;
-    const eta = job.progress.eta_seconds;
-    $("eta").textContent = eta == null ? "" : `about ${eta.toFixed(1)} s left`;
-    $("job-status").textContent = `${job.status}: ${job.progress.done} of ${job.progress.total} placements`;
-    if (!["queued", "running"].includes(job.status)) {
-      $("cancel").disabled = true; $("run").disabled = false; state.job = null;
-      if (job.status === "done") drawMap(job.result);
-      if (job.status === "failed") { showErrors(job.error); $("job-status").textContent += " (see the errors above)"; }
-      return;
-    }
-    await new Promise((resolve) => setTimeout(resolve, 200));
-  }
-}
-
-async function cancelMap() {
-  if (state.job) await api("POST", `/v1/jobs/${state.job}/cancel`);  // DELETE would forget it
-}
-
 // ---- the colour map ------------------------------------------------------------------------
+// The least and the largest of many numbers: Math.min(...values) throws a RangeError in
+// Chromium past about 100,000 of them, and a map has up to millions of cells.
+function extent(values) {
+  let low = Infinity, high = -Infinity;
+  for (const v of values) { if (v < low) low = v; if (v > high) high = v; }
+  return [low, high];
+}
+
 function colour(fraction) {  // dark blue -> green -> yellow
   const stops = [[68, 1, 84], [59, 82, 139], [33, 145, 140], [94, 201, 98], [253, 231, 37]];
   const t = Math.min(Math.max(fraction, 0), 1) * (stops.length - 1);
@@ -415,7 +388,7 @@ function drawMap(answer) {
   const xs = [...new Set(cells.map((c) => c.x))];
   const ys = [...new Set(cells.map((c) => c.y))];
   const feasible = cells.filter((c) => c.mu_path !== null).map((c) => c[key]);
-  const low = Math.min(...feasible), high = Math.max(...feasible);
+  const [low, high] = extent(feasible);
   const size = Math.min(48, Math.max(2, Math.floor(480 / Math.max(xs.length, ys.length))));
   state.scale = { low, high, xs, ys, size, key };
   const byAcc = cells.filter((c) => c.limited_by === "acceleration").length;
@@ -609,7 +582,7 @@ async function evaluateCell(c) {
   // The feed checked: the field's, else the program's (CL data), else none (the field empty).
   body.feed = answer.feed_check ? answer.feed_check.feed : undefined;
   const use = body.feed === undefined ? "; no feed to check"
-    : `; at ${body.feed} m/s the largest joint use is ${(100 * body.feed / answer.mu_path).toFixed(1)} %`;
+    : `; at ${fixed(body.feed, 6)} m/s the largest joint use is ${(100 * body.feed / answer.mu_path).toFixed(1)} %`;
   $("cell-summary").textContent = answer.feasible
     ? `${where}: mu_path ${answer.mu_path.toFixed(6)} m/s${use}`
     : `${where}: infeasible (${answer.reason} at waypoint ${answer.failed_waypoint})`;
@@ -644,9 +617,9 @@ function showAcceleration(answer, body) {
     const where = acc.limited_by === "speed" ? "a speed limit binds (the bottleneck above)"
       : `the acceleration limit of joint ${acc.joint + 1} (${acc.joint_name}) binds at waypoint ${acc.waypoint}`;
     const use = accelerationUse(answer, body);
-    const peak = use ? Math.max(...use.flatMap((row) => (row ? row : [])), 0) : null;
+    const peak = use ? Math.max(extent(use.flatMap((row) => (row ? row : [])))[1], 0) : null;
     line.textContent = `mu_acc ${acc.mu_acc.toFixed(6)} m/s (blend ${(1000 * acc.blend_length).toFixed(3)} mm): ${where}`
-      + (peak === null ? "" : `; at ${body.feed} m/s the largest acceleration use is ${(100 * peak).toFixed(1)} %`)
+      + (peak === null ? "" : `; at ${fixed(body.feed, 6)} m/s the largest acceleration use is ${(100 * peak).toFixed(1)} %`)
       + (answer.feed_check ? (answer.feed_check.feasible ? " (the feed runs)" : " (the feed does NOT run)") : "");
   }
   $("cycle-time").textContent = t
@@ -669,6 +642,12 @@ async function start() {
   select.addEventListener("change", showLimits);
   $("robot-json").addEventListener("input", showOwnRobot);
   $("urdf").addEventListener("input", showOwnRobot);
+  // Another robot (the catalogue's, a URDF and its frames, a robot object): the map running is
+  // not its map. Its speed and acceleration limits, edited, leave the job be.
+  for (const [id, event] of [["robot-model", "change"], ["robot-json", "input"], ["urdf", "input"],
+    ["urdf-file", "change"], ["base-frame", "input"], ["tool-frame", "input"]]) {
+    $(id).addEventListener(event, () => dropRun("the robot changed"));
+  }
   $("urdf").addEventListener("change", readUrdfLinks);
   $("base-frame").addEventListener("input", showBaseHint);
   $("urdf-file").addEventListener("change", async () => {

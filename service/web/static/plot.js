@@ -31,7 +31,7 @@ function plot(answer, body) {
     g.fillStyle = "#222"; g.font = "12px sans-serif";
     g.fillText(label, left + 4, y0 + 14); g.fillText(max.toFixed(2), 4, y0 + 10); g.fillText("0", 30, y0 + height);
   };
-  const vmax = Math.max(...points.map((p) => p.v_max ?? 0));
+  const vmax = extent(points.map((p) => p.v_max ?? 0))[1];
   axes(top, "V_max (m/s) along the path", vmax);
   g.strokeStyle = "#1565c0"; g.beginPath();
   points.forEach((p, k) => { const y = top + height * (1 - (p.v_max ?? 0) / vmax); k ? g.lineTo(xOf(k), y) : g.moveTo(xOf(k), y); });
@@ -50,7 +50,7 @@ function plot(answer, body) {
   if (accUse) {  // the third panel: the joints' use of their acceleration limits at the feed
     const accTop = useTop + height + 30;
     bottom = accTop + height;
-    const peak = Math.max(...accUse.flatMap((row) => (row ? row.filter(Number.isFinite) : [])), 0);
+    const peak = Math.max(extent(accUse.flatMap((row) => (row ? row.filter(Number.isFinite) : [])))[1], 0);
     const ceiling = Math.max(1, Math.min(peak, 2));
     axes(accTop, "joint use of its acceleration limit at the feed (none within the blend of a pass end)", ceiling);
     g.strokeStyle = "#b00020"; g.setLineDash([2, 2]); g.beginPath();

@@ -1,0 +1,140 @@
+// The map job: submitted once, watched to its end (its polls retried), its cells read in pages
+// when there are many, dropped when the path or the robot changes, cancelled from the page.
+// Loaded before app.js, whose functions (api, mapBody, drawMap, ...) it calls.
+"use strict";
+
+// One map at a time: from the first submit until its job ends, Run is disabled and a second
+// submit (a double click, Enter in a field) is none, so Cancel reaches the only job. The run
+// under way is state.run ({id}: its job's, once submitted); a run no longer in state.run was
+// dropped (dropRun) and whatever its requests answer later is not shown.
+async function runMap(event) {
+  event.preventDefault();
+  if (state.run) return;
+  clearErrors();
+  clearResults();
+  if (!havePath()) return;
+  let body;
+  try { body = mapBody(); } catch (error) { showErrors([{ loc: ["robot"], msg: String(error) }]); return; }
+  const run = { id: null };
+  state.run = run; $("run").disabled = true;
+  $("job-status").textContent = "submitting the map…";
+  const job = await api("POST", "/v1/jobs", { kind: "map", request: body }).catch(() => null);
+  if (state.run !== run) { if (job) cancelJob(job.id); return; }  // dropped while submitted
+  if (!job) { endRun(); $("job-status").textContent = "no map: see the errors above"; return; }
+  run.id = job.id; state.grid = body.grid; state.mapBody = body;
+  $("cancel").disabled = false;
+  await watch(run);
+}
+
+function endRun() {
+  state.run = null;
+  $("cancel").disabled = true; $("run").disabled = false;
+}
+
+// A new path or robot while a map is submitted or runs: its job is cancelled on the service and
+// its answer never drawn under the new inputs (whose map it is not).
+function dropRun(why) {
+  const run = state.run;
+  if (!run) return;
+  endRun();
+  if (run.id) cancelJob(run.id);
+  $("bar").value = 0; $("eta").textContent = "";
+  $("job-status").textContent = `cancelled: ${why}`;
+}
+
+// Asked, not awaited, and quiet: a job that ended meanwhile is left as it is (api.md).
+function cancelJob(id) {
+  fetch(`/v1/jobs/${id}/cancel`, { method: "POST" }).catch(() => null);
+}
+
+// A request about the job that gets no answer (the network, the service restarting: jobs
+// survive a restart) is asked again after these waits (ms); then the page gives up.
+const POLL_RETRIES_MS = [500, 1000, 2000, 4000];
+
+// GET url: its JSON, or an error that carries the HTTP status (none: no answer).
+async function getJson(url) {
+  const response = await fetch(url);
+  if (!response.ok) {
+    const error = new Error(`HTTP ${response.status} ${response.statusText}`.trim());
+    error.status = response.status;
+    throw error;
+  }
+  return response.json();
+}
+
+// GET url for the run, asked again after POLL_RETRIES_MS when it fails. Null when the run was
+// dropped meanwhile, or when the page gives up (the job gone: 404; else 5 failures): then Run
+// is back and the status says why.
+async function ask(run, url) {
+  for (let failed = 0; ; failed++) {
+    let error;
+    try {
+      const answer = await getJson(url);
+      return state.run === run ? answer : null;
+    } catch (caught) { error = caught; }
+    if (state.run !== run) return null;
+    if (error.status === 404 || failed === POLL_RETRIES_MS.length) {
+      endRun();
+      $("bar").value = 0; $("eta").textContent = "";
+      $("job-status").textContent = error.status === 404
+        ? `no map: job ${run.id} is gone (404: deleted by another client, or expired)`
+        : `no map: ${failed + 1} requests about job ${run.id} failed (${error.message})`
+          + (run.reading ? "" : "; it may still run on the service");
+      return null;
+    }
+    $("eta").textContent = `no answer from the service (${error.message}): asking again`;
+    await new Promise((resolve) => setTimeout(resolve, POLL_RETRIES_MS[failed]));
+  }
+}
+
+async function watch(run) {
+  for (;;) {
+    const job = await ask(run, `/v1/jobs/${run.id}`);
+    if (!job) return;  // dropped (a new path or robot), or given up (said)
+    $("bar").value = job.progress.fraction;
+    const eta = job.progress.eta_seconds;
+    $("eta").textContent = eta == null ? "" : `about ${eta.toFixed(1)} s left`;
+    const status = `${job.status}: ${job.progress.done} of ${job.progress.total} placements`;
+    $("job-status").textContent = status;
+    if (job.status === "done") {
+      const cells = await readCells(run, job);
+      if (!cells) return;
+      endRun();
+      $("job-status").textContent = status; $("bar").value = 1;
+      drawMap({ ...job.result, cells });
+      return;
+    }
+    if (!["queued", "running"].includes(job.status)) {
+      endRun();
+      if (job.status === "failed") { showErrors(job.error); $("job-status").textContent += " (see the errors above)"; }
+      return;
+    }
+    await new Promise((resolve) => setTimeout(resolve, 200));
+  }
+}
+
+// A map of over DTF_JOB_PAGE_CELLS cells comes without them (result_cells.in_result false):
+// they are read a page at a time from result_cells.first_page on, the count said as they come.
+async function readCells(run, job) {
+  const where = job.result_cells;
+  if (!where || where.in_result) return job.result.cells;
+  run.reading = true;
+  $("eta").textContent = "";
+  const cells = [];
+  for (let next = where.first_page; next;) {
+    $("job-status").textContent = `done: reading the map's cells, ${cells.length} of ${where.total}`;
+    $("bar").value = cells.length / where.total;
+    const page = await ask(run, next);
+    if (!page) return null;
+    for (const c of page.cells) cells.push(c);
+    next = page.next;
+  }
+  return cells;
+}
+
+async function cancelMap() {  // POST .../cancel: DELETE would forget the job
+  const run = state.run;
+  if (!run || !run.id) return;
+  if (run.reading) { dropRun("the map's cells were not all read"); return; }  // the job is done
+  await api("POST", `/v1/jobs/${run.id}/cancel`).catch(() => null);
+}

@@ -1,0 +1,187 @@
+"""The page's map job from submit to drawing, when the user or the network does not wait.
+
+A double click submits one job; a poll that fails is asked again, and a job gone says so; a
+new path or robot while a job runs drops that job's answer; a map over DTF_JOB_PAGE_CELLS cells
+is read in pages of GET /v1/jobs/{id}/result and drawn.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import httpx
+import pytest
+from playwright.sync_api import Page, Route
+
+from tests.web.conftest import PAGE_CELLS
+from tests.web.test_page import EXAMPLE_PATH, SMALL, fill, grid_of, page_colour
+from tests.web.test_page_findings import choose_file
+
+
+def map_posts(page: Page) -> list[str]:
+    """The URLs of the page's map submissions (POST /v1/jobs), as they are sent."""
+    posts: list[str] = []
+    page.on(
+        "request",
+        lambda r: posts.append(r.url) if r.method == "POST" and r.url.endswith("/v1/jobs") else 0,
+    )
+    return posts
+
+
+def test_a_double_click_on_run_submits_one_job(page: Page) -> None:
+    posts = map_posts(page)
+    fill(page, SMALL)
+    page.dblclick("#run")
+    page.wait_for_function("document.getElementById('summary').dataset.cells", timeout=60_000)
+    page.wait_for_timeout(300)
+    assert len(posts) == 1
+    assert page.is_enabled("#run") and page.is_disabled("#cancel")
+
+
+def test_a_failed_poll_is_asked_again_and_the_map_drawn(page: Page) -> None:
+    """One GET /v1/jobs/{id} that gets no answer (a network blip) ends nothing."""
+    failed: list[str] = []
+
+    def blip(route: Route) -> None:
+        if not failed and route.request.method == "GET":
+            failed.append(route.request.url)
+            route.abort()
+        else:
+            route.continue_()
+
+    page.route("**/v1/jobs/*", blip)
+    fill(page, SMALL)
+    page.click("#run")
+    page.wait_for_function("document.getElementById('summary').dataset.cells", timeout=20_000)
+    assert len(failed) == 1
+    assert page.is_enabled("#run") and page.is_disabled("#cancel")
+    assert (page.text_content("#job-status") or "").startswith("done: ")
+
+
+def test_a_job_deleted_by_another_client_says_so_and_run_is_back(page: Page, url: str) -> None:
+    deleted: list[int] = []
+
+    def delete_first(route: Route) -> None:  # another client deletes the job before a poll
+        if not deleted and route.request.method == "GET":
+            deleted.append(httpx.delete(route.request.url).status_code)
+        route.continue_()
+
+    page.route("**/v1/jobs/*", delete_first)
+    fill(page, SMALL)
+    page.click("#run")
+    page.wait_for_function("!document.getElementById('run').disabled", timeout=20_000)
+    assert deleted == [204]
+    job = page.text_content("#job-status") or ""
+    assert job.startswith("no map: job ") and "is gone (404" in job, job
+    assert page.is_disabled("#cancel") and page.locator(".panel").count() == 0
+
+
+OTHER_PROGRAM = "UNITS/MM\nGOTO/0,0,0,0,0,1\nGOTO/50,0,0,0,0,1\nGOTO/50,50,0,0,0,1\n"
+
+
+@pytest.mark.parametrize("change", ["path", "robot"])
+def test_a_new_path_or_robot_drops_the_running_jobs_map(page: Page, change: str) -> None:
+    """The old job's polls are held until the new input is in: then its answer draws nothing."""
+    held: list[Route] = []
+    page.route(
+        "**/v1/jobs/*", lambda r: held.append(r) if r.request.method == "GET" else r.continue_()
+    )
+    fill(page, SMALL)
+    page.click("#run")
+    page.wait_for_function("!document.getElementById('cancel').disabled", timeout=20_000)
+    while not held:
+        page.wait_for_timeout(50)
+    job = held[0].request.url
+    cancels: list[str] = []
+    page.on("request", lambda r: cancels.append(r.url) if r.url.endswith("/cancel") else 0)
+    if change == "path":
+        choose_file(page, "#path-file", "other.cl", OTHER_PROGRAM)
+        page.wait_for_function("document.getElementById('import').dataset.waypoints === '3'")
+    else:
+        page.select_option("#robot-model", "ur10")
+    for route in held:  # the old job's answer comes now
+        route.continue_()
+    page.unroute("**/v1/jobs/*")
+    while httpx.get(job).json()["status"] in ("queued", "running"):
+        page.wait_for_timeout(100)
+    page.wait_for_timeout(500)  # the page's polls, were it still watching, have seen it end
+    assert page.locator(".panel").count() == 0
+    assert page.text_content("#summary") == ""
+    assert (page.text_content("#job-status") or "").startswith("cancelled: ")
+    assert page.is_enabled("#run") and page.is_disabled("#cancel")
+    assert cancels == [f"{job}/cancel"]  # and the job stopped on the service
+
+
+REASON_COLOURS = {  # app.js's
+    "unreachable": (224, 224, 224),
+    "joint_limits": (244, 166, 192),
+    "singular": (85, 85, 85),
+    "discontinuous": (255, 183, 77),
+}
+
+
+def test_a_map_over_the_page_size_is_read_in_pages_and_drawn(page: Page, url: str) -> None:
+    """11 x 6 cells at 2 yaws: 132 cells, the job's answer without them, 3 pages of 60."""
+    values = {**SMALL, "x-step": "0.02", "y-step": "0.04"}
+    pages = []
+    page.on("request", lambda r: pages.append(r.url) if "/result?" in r.url else 0)
+    first: list[Route] = []  # held until the page has said what it reads
+    page.route("**/result?*", lambda r: r.continue_() if first else first.append(r))
+    fill(page, values)
+    page.click("#run")
+    while not first:
+        page.wait_for_timeout(50)
+    assert page.text_content("#job-status") == "done: reading the map's cells, 0 of 132"
+    first[0].continue_()
+    page.wait_for_function("document.getElementById('summary').dataset.cells", timeout=30_000)
+    body = {"robot": {"model": "ur5"}, "path": EXAMPLE_PATH, "grid": grid_of(values)}
+    api = httpx.post(f"{url}/v1/map", json=body, timeout=60).json()
+    cells: list[dict[str, Any]] = api["cells"]
+    assert len(cells) == 132 and len(pages) == -(-132 // PAGE_CELLS)
+    assert page.get_attribute("#summary", "data-cells") == "132"
+    assert page.locator(".panel canvas").count() == 2
+    assert page.text_content("#best-mu") == f"{api['best']['mu_path']:.6f} m/s"
+    # Every cell painted in its colour, the last page's (the second panel's end) too.
+    mus = [c["mu_path"] for c in cells if c["mu_path"] is not None]
+    low, high = min(mus), max(mus)
+    painted = page.evaluate(
+        """() => [...document.querySelectorAll('.panel canvas')].flatMap((canvas) => {
+            const size = Number(canvas.dataset.cell), nx = Number(canvas.dataset.nx);
+            const ny = Number(canvas.dataset.ny), g = canvas.getContext('2d'), out = [];
+            for (let k = 0; k < nx * ny; k++) {
+                const i = k % nx, j = Math.floor(k / nx);
+                const at = [i * size + size / 2, (ny - 1 - j) * size + size / 2];
+                out.push([...g.getImageData(at[0], at[1], 1, 1).data.slice(0, 3)]);
+            }
+            return out;
+        })"""
+    )
+    want = [
+        list(REASON_COLOURS[c["reason"]])
+        if c["mu_path"] is None
+        else list(page_colour((c["mu_path"] - low) / (high - low)))
+        for c in cells
+    ]
+    assert painted == want
+    assert page.is_enabled("#run") and page.is_disabled("#cancel")
+
+
+def test_a_map_of_131044_cells_is_drawn(page: Page) -> None:
+    """The page's own drawMap on a 362 x 362 answer: Math.min(...cells) would throw."""
+    drawn = page.evaluate(
+        """() => {
+            const n = 362, cells = [];
+            for (let k = 0; k < n * n; k++) {
+                cells.push({ x: (k % n) / 1000, y: Math.floor(k / n) / 1000, yaw: 0, spin: 0,
+                    mu_path: 0.1 + k / 1e7, reason: null, bottleneck_joint: 0,
+                    bottleneck_waypoint: 0, branch: {} });
+            }
+            const top = cells[n * n - 1];
+            const best = { placement: { ...top, z: 0.1 }, mu_path: top.mu_path };
+            drawMap({ cells, feasible_cells: n * n, best, worst: best });
+            return [document.getElementById('summary').dataset.cells,
+                document.getElementById('cb-min').textContent,
+                document.getElementById('cb-max').textContent];
+        }"""
+    )
+    assert drawn == ["131044", "0.100 m/s", "0.113 m/s"]
