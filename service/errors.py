@@ -85,9 +85,11 @@ ERROR_RESPONSES: dict[int | str, dict[str, Any]] = {
 """OpenAPI entries of the error answers, for routers that take a body."""
 
 
-def job_not_found(job_id: object) -> StarletteHTTPException:
-    """The 404 of an unknown job id, naming the path parameter ``job_id``."""
-    detail = ErrorDetail(loc=["path", "job_id"], msg=f"no job {str(job_id)!r}", type="not_found")
+def job_not_found(
+    job_id: object, *, loc: tuple[str, str] = ("path", "job_id"), why: str = ""
+) -> StarletteHTTPException:
+    """The 404 of an unknown job id, naming the parameter (``job_id``, or ``after``)."""
+    detail = ErrorDetail(loc=list(loc), msg=f"no job {str(job_id)!r}{why}", type="not_found")
     return StarletteHTTPException(status.HTTP_404_NOT_FOUND, [detail.model_dump()])  # type: ignore[arg-type]
 
 

@@ -140,7 +140,7 @@ def test_the_job_listing_is_read_in_pages_with_after(client: TestClient, own_sto
     last = client.get("/v1/jobs", params={"after": everything[-1]})
     assert last.status_code == 200 and last.json()["jobs"] == []
     unknown = client.get("/v1/jobs", params={"after": str(uuid.uuid4())})
-    assert unknown.status_code == 422, unknown.text
+    assert unknown.status_code == 404, unknown.text
     assert unknown.json()["detail"][0]["loc"] == ["query", "after"]
 
 

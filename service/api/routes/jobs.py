@@ -14,7 +14,6 @@ from uuid import UUID
 
 import anyio
 from fastapi import APIRouter, HTTPException, Path, Query, Response, status
-from fastapi.exceptions import RequestValidationError
 from fastapi.responses import JSONResponse
 
 from service.body import union_body_in_thread, union_body_openapi
@@ -132,7 +131,12 @@ async def post_job(
     )
 
 
-@router.get("", operation_id="list_jobs", summary="The jobs, newest first, without results")
+@router.get(
+    "",
+    operation_id="list_jobs",
+    summary="The jobs, newest first, without results",
+    responses=NOT_FOUND,
+)
 def get_jobs(
     settings: SettingsDep,
     job_status: Annotated[JobStatus | None, Query(alias="status")] = None,
@@ -141,7 +145,7 @@ def get_jobs(
         UUID | None,
         Query(
             description="A job's id: the listing goes on after that job (the last id of the "
-            "previous page). An id the store does not hold (deleted or expired) is a 422 "
+            "previous page). An id the store does not hold (deleted or expired) is a 404 "
             "naming ``after``."
         ),
     ] = None,
@@ -154,15 +158,9 @@ def get_jobs(
     """
     store = get_runner(settings).store
     if after is not None and store.state(str(after)) is None:
-        raise RequestValidationError(
-            [
-                {
-                    "loc": ("query", "after"),
-                    "msg": f"no job {str(after)!r} (deleted, or expired after DTF_JOB_TTL)",
-                    "type": "not_found",
-                    "input": str(after),
-                }
-            ]
+        # a 404, as the same id in the path is: the job it names is not there
+        raise job_not_found(
+            after, loc=("query", "after"), why=" (deleted, or expired after DTF_JOB_TTL)"
         )
     states = store.jobs(status=job_status, limit=limit, after=None if after is None else str(after))
     return JobList(jobs=[job_info(state, store) for state in states])
