@@ -1,16 +1,18 @@
 """The page's map job from submit to drawing, when the user or the network does not wait.
 
 A double click submits one job; a poll that fails is asked again, and a job gone says so; a
-new path or robot while a job runs drops that job's answer; a map over DTF_JOB_PAGE_CELLS cells
-is read in pages of GET /v1/jobs/{id}/result and drawn.
+new path or robot while a job or an optimisation runs drops its answer; a map over
+DTF_JOB_PAGE_CELLS cells is read in pages of GET /v1/jobs/{id}/result and drawn.
 """
 
 from __future__ import annotations
 
+import contextlib
 from typing import Any
 
 import httpx
 import pytest
+from playwright.sync_api import Error as PlaywrightError
 from playwright.sync_api import Page, Route
 
 from tests.web.conftest import PAGE_CELLS
@@ -110,6 +112,31 @@ def test_a_new_path_or_robot_drops_the_running_jobs_map(page: Page, change: str)
     assert (page.text_content("#job-status") or "").startswith("cancelled: ")
     assert page.is_enabled("#run") and page.is_disabled("#cancel")
     assert cancels == [f"{job}/cancel"]  # and the job stopped on the service
+
+
+@pytest.mark.parametrize("change", ["path", "robot"])
+def test_a_new_path_or_robot_drops_the_running_optimisation(page: Page, change: str) -> None:
+    """The optimisation's request is held until the new input is in: its answer shows nothing."""
+    held: list[Route] = []
+    page.route("**/v1/optimize", lambda r: held.append(r))
+    failed: list[str] = []
+    page.on("requestfailed", lambda r: failed.append(r.url) if r.url.endswith("/optimize") else 0)
+    fill(page, SMALL)
+    page.click("#optimize")
+    while not held:
+        page.wait_for_timeout(50)
+    if change == "path":
+        choose_file(page, "#path-file", "other.cl", OTHER_PROGRAM)
+        page.wait_for_function("document.getElementById('import').dataset.waypoints === '3'")
+    else:
+        page.select_option("#robot-model", "ur10")
+    with contextlib.suppress(PlaywrightError):  # the page aborted it: nothing to answer
+        held[0].fulfill(response=held[0].fetch(timeout=60_000))  # the old optimum comes now
+    page.wait_for_timeout(300)  # the page, were it still waiting, has shown it
+    assert (page.text_content("#opt-mu") or "").startswith("cancelled: ")
+    assert page.text_content("#opt-where") == "" and page.is_hidden("#frames")
+    assert failed == [held[0].request.url]  # aborted: the service stops the search
+    assert page.text_content("#form-error") == ""
 
 
 REASON_COLOURS = {  # app.js's

@@ -13,7 +13,7 @@ const REASON_COLOURS = {
 };
 const state = {
   robots: [], path: null, pathProblem: "no path loaded yet", source: null, map: null, grid: null,
-  run: null, cursor: null,
+  run: null, optimization: null, cursor: null,
 };
 
 // ---- inputs -------------------------------------------------------------------------------
@@ -164,6 +164,7 @@ function setPath(name, text) {
   state.path = null;
   clearResults();
   dropRun(`a new path, ${name}, was loaded`);
+  dropOptimization(`a new path, ${name}, was loaded`);
   clearImport();
   clearErrors();
   const units = $("path-units").value;
@@ -283,10 +284,11 @@ function showErrors(details, aliases = {}) {
   }
 }
 
-async function api(method, url, body, aliases = {}) {
+// `signal` (an AbortSignal) aborts the request: it then throws before showing anything.
+async function api(method, url, body, aliases = {}, signal = undefined) {
   const response = await fetch(url, {
     method, headers: body ? { "Content-Type": "application/json" } : {},
-    body: body ? JSON.stringify(body) : undefined,
+    body: body ? JSON.stringify(body) : undefined, signal,
   });
   if (response.status === 204) return null;
   const answer = await response.json();
@@ -642,11 +644,12 @@ async function start() {
   select.addEventListener("change", showLimits);
   $("robot-json").addEventListener("input", showOwnRobot);
   $("urdf").addEventListener("input", showOwnRobot);
-  // Another robot (the catalogue's, a URDF and its frames, a robot object): the map running is
-  // not its map. Its speed and acceleration limits, edited, leave the job be.
+  // Another robot (the catalogue's, a URDF and its frames, a robot object): the map or the
+  // optimum being computed is not its own. Its speed and acceleration limits, edited, leave
+  // them be, as edited grid fields do.
   for (const [id, event] of [["robot-model", "change"], ["robot-json", "input"], ["urdf", "input"],
     ["urdf-file", "change"], ["base-frame", "input"], ["tool-frame", "input"]]) {
-    $(id).addEventListener(event, () => dropRun("the robot changed"));
+    $(id).addEventListener(event, () => { dropRun("the robot changed"); dropOptimization("the robot changed"); });
   }
   $("urdf").addEventListener("change", readUrdfLinks);
   $("base-frame").addEventListener("input", showBaseHint);
