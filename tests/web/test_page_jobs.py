@@ -139,6 +139,38 @@ def test_a_new_path_or_robot_drops_the_running_optimisation(page: Page, change: 
     assert page.text_content("#form-error") == ""
 
 
+@pytest.mark.parametrize("last", ["optimum", "map"])
+def test_a_map_and_an_optimisation_at_once_show_both_and_the_marker(page: Page, last: str) -> None:
+    """The later answer, whichever it is, leaves the other's display be and marks the optimum."""
+    held: list[Route] = []  # the request of the answer that comes last, until the other is in
+    late = ("POST", "/v1/optimize") if last == "optimum" else ("GET", "/v1/jobs/")
+    holding = True
+
+    def hold(route: Route) -> None:
+        request = route.request
+        if holding and request.method == late[0] and late[1] in request.url:
+            held.append(route)
+        else:
+            route.continue_()
+
+    page.route("**/v1/**", hold)
+    fill(page, SMALL)
+    page.click("#optimize" if last == "optimum" else "#run")
+    while not held:
+        page.wait_for_timeout(50)
+    page.click("#run" if last == "optimum" else "#optimize")
+    first = "summary').dataset.cells" if last == "optimum" else "opt-where').textContent"
+    page.wait_for_function(f"document.getElementById('{first}", timeout=20_000)
+    holding = False
+    for route in held:
+        route.continue_()
+    page.wait_for_selector(".panel canvas[data-optimum='1']", timeout=20_000)
+    assert page.is_visible("#opt-mu-line") and page.is_visible("#frames")
+    assert (page.text_content("#opt-mu") or "").endswith(" m/s")
+    assert (page.text_content("#job-status") or "").startswith("done: ")
+    assert page.get_attribute("#summary", "data-cells") == "50"
+
+
 REASON_COLOURS = {  # app.js's
     "unreachable": (224, 224, 224),
     "joint_limits": (244, 166, 192),

@@ -303,7 +303,8 @@ async function api(method, url, body, aliases = {}, signal = undefined) {
 
 // ---- stale results go ----------------------------------------------------------------------
 function clearMap() {
-  state.map = null; state.optimum = null; state.cursor = null; state.tipCell = null;
+  state.map = null; state.cursor = null; state.tipCell = null;
+  if (state.optimum) state.optimum.canvas = null;  // the optimum stays, to mark the next map
   $("panels").textContent = "";
   $("tooltip").hidden = true;
   for (const id of ["summary", "ik-line", "best-mu", "best-where", "cb-label", "cb-min", "cb-max"]) $(id).textContent = "";
@@ -337,10 +338,17 @@ function clearOptimum() {
   }
 }
 
-function clearResults() {
-  clearOptimum(); clearMap(); clearCell();
+// A new map: the old map and its clicked cell go. The optimiser's display is its own: an
+// optimisation under way goes on, and an optimum found stays, marked on the new map once drawn
+// (markOptimum), whichever of the two answers comes last.
+function clearMapResults() {
+  clearMap(); clearCell();
   $("bar").value = 0; $("eta").textContent = "";
   $("job-status").textContent = "no map yet";
+}
+
+function clearResults() {
+  clearOptimum(); clearMapResults();
 }
 
 // Nothing runs without a path: the reason there is none goes beside the path field.
@@ -448,6 +456,7 @@ function drawMap(answer) {
     canvas.addEventListener("click", (e) => { const c = cellAt(canvas, e); if (c) evaluateCell(c); });
     canvas.addEventListener("keydown", (e) => keys(canvas, e));
   }
+  markOptimum();
 }
 
 function paintPanel(canvas) {

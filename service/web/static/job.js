@@ -11,7 +11,9 @@ async function runMap(event) {
   event.preventDefault();
   if (state.run) return;
   clearErrors();
-  clearResults();
+  clearMapResults();
+  // Not a found optimum, nor one under way: a failure's words, whose errors have just gone.
+  if (!state.optimum && !state.optimization) clearOptimum();
   if (!havePath()) return;
   let body;
   try { body = mapBody(); } catch (error) { showErrors([{ loc: ["robot"], msg: String(error) }]); return; }

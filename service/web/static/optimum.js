@@ -108,14 +108,21 @@ async function optimize() {
     row.insertCell().appendChild(copy);
   }
   $("frames").hidden = false;
+  state.optimum = { canvas: null, placement: p };
+  markOptimum();
+}
+
+// The optimum shown (state.optimum), marked on the map drawn, if any, on the panel whose yaw
+// is nearest the optimum's: called by both answers, the optimiser's and the map's.
+function markOptimum() {
   const canvases = [...document.querySelectorAll(".panel canvas")];
-  if (state.map && canvases.length) {  // the panel whose yaw is nearest the optimum's
-    const yaws = canvases.map((c) => state.map.cells[Number(c.dataset.first)].yaw);
-    const k = yaws.reduce((best, y, i) => (Math.abs(y - p.yaw) < Math.abs(yaws[best] - p.yaw) ? i : best), 0);
-    state.optimum = { canvas: canvases[k], placement: p };
-    canvases.forEach(paintPanel);
-    canvases[k].dataset.optimum = "1";
-  }
+  if (!state.optimum || !state.map || !canvases.length) return;
+  const p = state.optimum.placement;
+  const yaws = canvases.map((c) => state.map.cells[Number(c.dataset.first)].yaw);
+  const k = yaws.reduce((best, y, i) => (Math.abs(y - p.yaw) < Math.abs(yaws[best] - p.yaw) ? i : best), 0);
+  state.optimum.canvas = canvases[k];
+  canvases.forEach(paintPanel);
+  canvases[k].dataset.optimum = "1";
 }
 
 // A new path or robot while an optimisation runs: its request is aborted (the service stops the
