@@ -16,7 +16,15 @@ from playwright.sync_api import Error as PlaywrightError
 from playwright.sync_api import Page, Route
 
 from tests.web.conftest import PAGE_CELLS
-from tests.web.test_page import EXAMPLE_PATH, SMALL, fill, grid_of, page_colour
+from tests.web.test_page import (
+    EXAMPLE_PATH,
+    SMALL,
+    cell_point,
+    fill,
+    grid_of,
+    page_colour,
+    run_small_map,
+)
 from tests.web.test_page_findings import choose_file
 
 
@@ -137,6 +145,34 @@ def test_a_new_path_or_robot_drops_the_running_optimisation(page: Page, change: 
     assert page.text_content("#opt-where") == "" and page.is_hidden("#frames")
     assert failed == [held[0].request.url]  # aborted: the service stops the search
     assert page.text_content("#form-error") == ""
+
+
+@pytest.mark.parametrize("change", ["path", "robot"])
+def test_a_new_path_or_robot_clears_the_map_the_optimum_and_the_cell(
+    page: Page, url: str, change: str
+) -> None:
+    """A cell clicked on the old map is being evaluated: its answer shows nothing either."""
+    api = run_small_map(page, url)
+    page.click("#optimize")
+    page.wait_for_selector(".panel canvas[data-optimum='1']", timeout=20_000)
+    held: list[Route] = []
+    page.route("**/v1/evaluate", lambda r: held.append(r))
+    cell = next(c for c in api["cells"] if c["mu_path"] is not None)
+    page.mouse.click(**cell_point(page, 0, cell, api))
+    while not held:
+        page.wait_for_timeout(50)
+    if change == "path":
+        choose_file(page, "#path-file", "other.cl", OTHER_PROGRAM)
+        page.wait_for_function("document.getElementById('import').dataset.waypoints === '3'")
+    else:
+        page.select_option("#robot-model", "ur10")
+    held[0].continue_()  # the old cell's evaluation comes now
+    page.wait_for_timeout(500)  # the page, were it still waiting, has shown it
+    assert (page.text_content("#cell-summary") or "").startswith("Click")
+    assert page.get_attribute("#plot", "data-drawn") is None
+    assert page.locator(".panel").count() == 0 and page.text_content("#summary") == ""
+    assert page.text_content("#opt-mu") == "" and page.is_hidden("#frames")
+    assert (page.text_content("#job-status") or "").startswith("map cleared: ")
 
 
 @pytest.mark.parametrize("last", ["optimum", "map"])
