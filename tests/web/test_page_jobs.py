@@ -1,8 +1,10 @@
 """The page's map job from submit to drawing, when the user or the network does not wait.
 
-A double click submits one job; a poll that fails is asked again, and a job gone says so; a
-new path or robot while a job or an optimisation runs drops its answer; a map over
-DTF_JOB_PAGE_CELLS cells is read in pages of GET /v1/jobs/{id}/result and drawn.
+A double click submits one job; a poll that fails is asked again, saying whether the service
+answered, and a job gone says so; a new path or robot while a job or an optimisation runs drops
+its answer, and clears the map, the optimum and the cell shown; a map and an optimisation at
+once show both; a map over DTF_JOB_PAGE_CELLS cells is read in pages of GET
+/v1/jobs/{id}/result and drawn.
 """
 
 from __future__ import annotations
@@ -65,6 +67,39 @@ def test_a_failed_poll_is_asked_again_and_the_map_drawn(page: Page) -> None:
     page.wait_for_function("document.getElementById('summary').dataset.cells", timeout=20_000)
     assert len(failed) == 1
     assert page.is_enabled("#run") and page.is_disabled("#cancel")
+    assert (page.text_content("#job-status") or "").startswith("done: ")
+
+
+def test_a_poll_answered_with_a_5xx_says_the_status_and_is_asked_again(page: Page) -> None:
+    """The service answered (a 503, the job store unusable): the note says so, not "no answer"."""
+    answered: list[str] = []
+    held: list[Route] = []  # the poll after the 503, until the note is read
+
+    def unavailable(route: Route) -> None:
+        if route.request.method != "GET":
+            route.continue_()
+        elif not answered:
+            answered.append(route.request.url)
+            detail = [
+                {"loc": [], "msg": "the job store is locked", "type": "job_store_unavailable"}
+            ]
+            route.fulfill(status=503, json={"detail": detail}, headers={"Retry-After": "30"})
+        elif not held:
+            held.append(route)
+        else:
+            route.continue_()
+
+    page.route("**/v1/jobs/*", unavailable)
+    fill(page, SMALL)
+    page.click("#run")
+    while not held:
+        page.wait_for_timeout(50)
+    eta = page.text_content("#eta") or ""
+    assert eta.startswith("the service answered 503 (") and eta.endswith(
+        "the job store is locked): asking again"
+    ), eta
+    held[0].continue_()
+    page.wait_for_function("document.getElementById('summary').dataset.cells", timeout=20_000)
     assert (page.text_content("#job-status") or "").startswith("done: ")
 
 
