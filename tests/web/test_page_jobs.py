@@ -1,20 +1,32 @@
 """The page's map job from submit to drawing, when the user or the network does not wait.
 
-A double click submits one job; a poll that fails is asked again, and a job gone says so; a
-new path or robot while a job runs drops that job's answer; a map over DTF_JOB_PAGE_CELLS cells
-is read in pages of GET /v1/jobs/{id}/result and drawn.
+A double click submits one job; a poll that fails is asked again, saying whether the service
+answered, and a job gone says so; a new path or robot while a job or an optimisation runs drops
+its answer, and clears the map, the optimum and the cell shown; a map and an optimisation at
+once show both; a map over DTF_JOB_PAGE_CELLS cells is read in pages of GET
+/v1/jobs/{id}/result and drawn.
 """
 
 from __future__ import annotations
 
+import contextlib
 from typing import Any
 
 import httpx
 import pytest
+from playwright.sync_api import Error as PlaywrightError
 from playwright.sync_api import Page, Route
 
 from tests.web.conftest import PAGE_CELLS
-from tests.web.test_page import EXAMPLE_PATH, SMALL, fill, grid_of, page_colour
+from tests.web.test_page import (
+    EXAMPLE_PATH,
+    SMALL,
+    cell_point,
+    fill,
+    grid_of,
+    page_colour,
+    run_small_map,
+)
 from tests.web.test_page_findings import choose_file
 
 
@@ -55,6 +67,39 @@ def test_a_failed_poll_is_asked_again_and_the_map_drawn(page: Page) -> None:
     page.wait_for_function("document.getElementById('summary').dataset.cells", timeout=20_000)
     assert len(failed) == 1
     assert page.is_enabled("#run") and page.is_disabled("#cancel")
+    assert (page.text_content("#job-status") or "").startswith("done: ")
+
+
+def test_a_poll_answered_with_a_5xx_says_the_status_and_is_asked_again(page: Page) -> None:
+    """The service answered (a 503, the job store unusable): the note says so, not "no answer"."""
+    answered: list[str] = []
+    held: list[Route] = []  # the poll after the 503, until the note is read
+
+    def unavailable(route: Route) -> None:
+        if route.request.method != "GET":
+            route.continue_()
+        elif not answered:
+            answered.append(route.request.url)
+            detail = [
+                {"loc": [], "msg": "the job store is locked", "type": "job_store_unavailable"}
+            ]
+            route.fulfill(status=503, json={"detail": detail}, headers={"Retry-After": "30"})
+        elif not held:
+            held.append(route)
+        else:
+            route.continue_()
+
+    page.route("**/v1/jobs/*", unavailable)
+    fill(page, SMALL)
+    page.click("#run")
+    while not held:
+        page.wait_for_timeout(50)
+    eta = page.text_content("#eta") or ""
+    assert eta.startswith("the service answered 503 (") and eta.endswith(
+        "the job store is locked): asking again"
+    ), eta
+    held[0].continue_()
+    page.wait_for_function("document.getElementById('summary').dataset.cells", timeout=20_000)
     assert (page.text_content("#job-status") or "").startswith("done: ")
 
 
@@ -110,6 +155,91 @@ def test_a_new_path_or_robot_drops_the_running_jobs_map(page: Page, change: str)
     assert (page.text_content("#job-status") or "").startswith("cancelled: ")
     assert page.is_enabled("#run") and page.is_disabled("#cancel")
     assert cancels == [f"{job}/cancel"]  # and the job stopped on the service
+
+
+@pytest.mark.parametrize("change", ["path", "robot"])
+def test_a_new_path_or_robot_drops_the_running_optimisation(page: Page, change: str) -> None:
+    """The optimisation's request is held until the new input is in: its answer shows nothing."""
+    held: list[Route] = []
+    page.route("**/v1/optimize", lambda r: held.append(r))
+    failed: list[str] = []
+    page.on("requestfailed", lambda r: failed.append(r.url) if r.url.endswith("/optimize") else 0)
+    fill(page, SMALL)
+    page.click("#optimize")
+    while not held:
+        page.wait_for_timeout(50)
+    if change == "path":
+        choose_file(page, "#path-file", "other.cl", OTHER_PROGRAM)
+        page.wait_for_function("document.getElementById('import').dataset.waypoints === '3'")
+    else:
+        page.select_option("#robot-model", "ur10")
+    with contextlib.suppress(PlaywrightError):  # the page aborted it: nothing to answer
+        held[0].fulfill(response=held[0].fetch(timeout=60_000))  # the old optimum comes now
+    page.wait_for_timeout(300)  # the page, were it still waiting, has shown it
+    assert (page.text_content("#opt-mu") or "").startswith("cancelled: ")
+    assert page.text_content("#opt-where") == "" and page.is_hidden("#frames")
+    assert failed == [held[0].request.url]  # aborted: the service stops the search
+    assert page.text_content("#form-error") == ""
+
+
+@pytest.mark.parametrize("change", ["path", "robot"])
+def test_a_new_path_or_robot_clears_the_map_the_optimum_and_the_cell(
+    page: Page, url: str, change: str
+) -> None:
+    """A cell clicked on the old map is being evaluated: its answer shows nothing either."""
+    api = run_small_map(page, url)
+    page.click("#optimize")
+    page.wait_for_selector(".panel canvas[data-optimum='1']", timeout=20_000)
+    held: list[Route] = []
+    page.route("**/v1/evaluate", lambda r: held.append(r))
+    cell = next(c for c in api["cells"] if c["mu_path"] is not None)
+    page.mouse.click(**cell_point(page, 0, cell, api))
+    while not held:
+        page.wait_for_timeout(50)
+    if change == "path":
+        choose_file(page, "#path-file", "other.cl", OTHER_PROGRAM)
+        page.wait_for_function("document.getElementById('import').dataset.waypoints === '3'")
+    else:
+        page.select_option("#robot-model", "ur10")
+    held[0].continue_()  # the old cell's evaluation comes now
+    page.wait_for_timeout(500)  # the page, were it still waiting, has shown it
+    assert (page.text_content("#cell-summary") or "").startswith("Click")
+    assert page.get_attribute("#plot", "data-drawn") is None
+    assert page.locator(".panel").count() == 0 and page.text_content("#summary") == ""
+    assert page.text_content("#opt-mu") == "" and page.is_hidden("#frames")
+    assert (page.text_content("#job-status") or "").startswith("map cleared: ")
+
+
+@pytest.mark.parametrize("last", ["optimum", "map"])
+def test_a_map_and_an_optimisation_at_once_show_both_and_the_marker(page: Page, last: str) -> None:
+    """The later answer, whichever it is, leaves the other's display be and marks the optimum."""
+    held: list[Route] = []  # the request of the answer that comes last, until the other is in
+    late = ("POST", "/v1/optimize") if last == "optimum" else ("GET", "/v1/jobs/")
+    holding = True
+
+    def hold(route: Route) -> None:
+        request = route.request
+        if holding and request.method == late[0] and late[1] in request.url:
+            held.append(route)
+        else:
+            route.continue_()
+
+    page.route("**/v1/**", hold)
+    fill(page, SMALL)
+    page.click("#optimize" if last == "optimum" else "#run")
+    while not held:
+        page.wait_for_timeout(50)
+    page.click("#run" if last == "optimum" else "#optimize")
+    first = "summary').dataset.cells" if last == "optimum" else "opt-where').textContent"
+    page.wait_for_function(f"document.getElementById('{first}", timeout=20_000)
+    holding = False
+    for route in held:
+        route.continue_()
+    page.wait_for_selector(".panel canvas[data-optimum='1']", timeout=20_000)
+    assert page.is_visible("#opt-mu-line") and page.is_visible("#frames")
+    assert (page.text_content("#opt-mu") or "").endswith(" m/s")
+    assert (page.text_content("#job-status") or "").startswith("done: ")
+    assert page.get_attribute("#summary", "data-cells") == "50"
 
 
 REASON_COLOURS = {  # app.js's

@@ -13,7 +13,7 @@ const REASON_COLOURS = {
 };
 const state = {
   robots: [], path: null, pathProblem: "no path loaded yet", source: null, map: null, grid: null,
-  run: null, cursor: null,
+  run: null, optimization: null, evaluation: null, cursor: null,
 };
 
 // ---- inputs -------------------------------------------------------------------------------
@@ -162,8 +162,7 @@ function setPath(name, text) {
   const lower = name.toLowerCase();
   state.source = { name, text };
   state.path = null;
-  clearResults();
-  dropRun(`a new path, ${name}, was loaded`);
+  inputsChanged(`a new path, ${name}, was loaded`);
   clearImport();
   clearErrors();
   const units = $("path-units").value;
@@ -283,10 +282,11 @@ function showErrors(details, aliases = {}) {
   }
 }
 
-async function api(method, url, body, aliases = {}) {
+// `signal` (an AbortSignal) aborts the request: it then throws before showing anything.
+async function api(method, url, body, aliases = {}, signal = undefined) {
   const response = await fetch(url, {
     method, headers: body ? { "Content-Type": "application/json" } : {},
-    body: body ? JSON.stringify(body) : undefined,
+    body: body ? JSON.stringify(body) : undefined, signal,
   });
   if (response.status === 204) return null;
   const answer = await response.json();
@@ -301,7 +301,8 @@ async function api(method, url, body, aliases = {}) {
 
 // ---- stale results go ----------------------------------------------------------------------
 function clearMap() {
-  state.map = null; state.optimum = null; state.cursor = null; state.tipCell = null;
+  state.map = null; state.cursor = null; state.tipCell = null;
+  if (state.optimum) state.optimum.canvas = null;  // the optimum stays, to mark the next map
   $("panels").textContent = "";
   $("tooltip").hidden = true;
   for (const id of ["summary", "ik-line", "best-mu", "best-where", "cb-label", "cb-min", "cb-max"]) $(id).textContent = "";
@@ -314,6 +315,7 @@ function clearMap() {
 }
 
 function clearCell() {
+  state.evaluation = null;  // an evaluation under way shows nothing (evaluateCell)
   $("cell-summary").textContent = "Click (or press Enter on) a cell to see V_max along the path and each joint's use of its limit at the feed.";
   for (const id of ["bottleneck", "acceleration", "cycle-time", "cell-verdict"]) $(id).textContent = "";
   const canvas = $("plot");
@@ -335,10 +337,28 @@ function clearOptimum() {
   }
 }
 
-function clearResults() {
-  clearOptimum(); clearMap(); clearCell();
+// A new map: the old map and its clicked cell go. The optimiser's display is its own: an
+// optimisation under way goes on, and an optimum found stays, marked on the new map once drawn
+// (markOptimum), whichever of the two answers comes last.
+function clearMapResults() {
+  clearMap(); clearCell();
   $("bar").value = 0; $("eta").textContent = "";
   $("job-status").textContent = "no map yet";
+}
+
+function clearResults() {
+  clearOptimum(); clearMapResults();
+}
+
+// Another path or robot: the map drawn (whose cells a click would evaluate with the new
+// inputs), the clicked cell and the optimum are the old inputs' and go, and so does a map job,
+// an optimisation or a cell's evaluation under way; the map's status says why.
+function inputsChanged(why) {
+  const drawn = state.map !== null;
+  clearResults();
+  dropRun(why);
+  dropOptimization(why);
+  if (drawn) $("job-status").textContent = `map cleared: ${why}`;
 }
 
 // Nothing runs without a path: the reason there is none goes beside the path field.
@@ -446,6 +466,7 @@ function drawMap(answer) {
     canvas.addEventListener("click", (e) => { const c = cellAt(canvas, e); if (c) evaluateCell(c); });
     canvas.addEventListener("keydown", (e) => keys(canvas, e));
   }
+  markOptimum();
 }
 
 function paintPanel(canvas) {
@@ -563,10 +584,14 @@ function keys(canvas, event) {
 }
 
 // ---- one placement: V_max and joint use along the path ---------------------------------------
+// The evaluation under way is state.evaluation, a token: one no longer there (clearCell: a new
+// click, map, path or robot came meanwhile) shows nothing of its answers.
 async function evaluateCell(c) {
   clearErrors();
   clearCell();
   if (!havePath()) return;
+  const evaluation = {};
+  state.evaluation = evaluation;
   const body = {
     robot: robotBody(), path: state.path,
     placement: placementOf(c),
@@ -577,6 +602,7 @@ async function evaluateCell(c) {
   };
   $("cell-summary").textContent = "evaluating…";
   const answer = await api("POST", "/v1/evaluate", body).catch(() => null);
+  if (state.evaluation !== evaluation) return;
   if (!answer) { clearCell(); return; }
   const where = `x ${metres(c.x)}, y ${metres(c.y)}, yaw ${radians(c.yaw)}`;
   // The feed checked: the field's, else the program's (CL data), else none (the field empty).
@@ -588,6 +614,7 @@ async function evaluateCell(c) {
     : `${where}: infeasible (${answer.reason} at waypoint ${answer.failed_waypoint})`;
   $("cell-verdict").textContent = cellVerdict(answer, body.cell);
   if (answer.feasible && answer.spin_mode === "free") await compareFixedSpin(body, answer);
+  if (state.evaluation !== evaluation) return;
   const b = answer.bottleneck;
   $("bottleneck").textContent = b ? `bottleneck: waypoint ${b.waypoint}, joint ${b.joint + 1} (${b.joint_name})` : "";
   $("bottleneck").dataset.waypoint = b ? String(b.waypoint) : "";
@@ -600,8 +627,9 @@ async function evaluateCell(c) {
 async function compareFixedSpin(body, answer) {
   const summary = { ...body, spin_mode: "fixed", detail: "summary" };
   delete summary.feed;
+  const evaluation = state.evaluation;
   const fixedSpin = await api("POST", "/v1/evaluate", summary).catch(() => null);
-  if (!fixedSpin) return;
+  if (!fixedSpin || state.evaluation !== evaluation) return;
   const gain = fixedSpin.feasible ? 100 * (answer.mu_path / fixedSpin.mu_path - 1) : 0;
   $("cell-summary").textContent += fixedSpin.feasible
     ? `; spin free: ${gain >= 0 ? "+" : ""}${fixed(gain, 0)} % over the spin fixed (${fixedSpin.mu_path.toFixed(6)} m/s)`
@@ -642,11 +670,12 @@ async function start() {
   select.addEventListener("change", showLimits);
   $("robot-json").addEventListener("input", showOwnRobot);
   $("urdf").addEventListener("input", showOwnRobot);
-  // Another robot (the catalogue's, a URDF and its frames, a robot object): the map running is
-  // not its map. Its speed and acceleration limits, edited, leave the job be.
+  // Another robot (the catalogue's, a URDF and its frames, a robot object): the map, the cell
+  // and the optimum, shown or being computed, are not its own. Its speed and acceleration
+  // limits, edited, leave them be, as edited grid fields do.
   for (const [id, event] of [["robot-model", "change"], ["robot-json", "input"], ["urdf", "input"],
     ["urdf-file", "change"], ["base-frame", "input"], ["tool-frame", "input"]]) {
-    $(id).addEventListener(event, () => dropRun("the robot changed"));
+    $(id).addEventListener(event, () => inputsChanged("the robot changed"));
   }
   $("urdf").addEventListener("change", readUrdfLinks);
   $("base-frame").addEventListener("input", showBaseHint);

@@ -11,7 +11,9 @@ async function runMap(event) {
   event.preventDefault();
   if (state.run) return;
   clearErrors();
-  clearResults();
+  clearMapResults();
+  // Not a found optimum, nor one under way: a failure's words, whose errors have just gone.
+  if (!state.optimum && !state.optimization) clearOptimum();
   if (!havePath()) return;
   let body;
   try { body = mapBody(); } catch (error) { showErrors([{ loc: ["robot"], msg: String(error) }]); return; }
@@ -48,15 +50,24 @@ function cancelJob(id) {
 }
 
 // A request about the job that gets no answer (the network, the service restarting: jobs
-// survive a restart) is asked again after these waits (ms); then the page gives up.
+// survive a restart) or an error (a 5xx: the job store unusable, the service stopping) is asked
+// again after these waits (ms); then the page gives up.
 const POLL_RETRIES_MS = [500, 1000, 2000, 4000];
 
-// GET url: its JSON, or an error that carries the HTTP status (none: no answer).
+// GET url: its JSON, or an error that carries the HTTP status (none: no answer) and, in
+// error.answered, the status and what the service said of it (its detail's messages).
 async function getJson(url) {
   const response = await fetch(url);
   if (!response.ok) {
-    const error = new Error(`HTTP ${response.status} ${response.statusText}`.trim());
+    let said = "";
+    try {
+      const detail = (await response.json()).detail;
+      said = Array.isArray(detail) ? detail.map((d) => d.msg).join("; ") : String(detail ?? "");
+    } catch { /* no JSON (a proxy's page): the status alone */ }
+    const why = [response.statusText, said].filter(Boolean).join(": ");
+    const error = new Error(`HTTP ${response.status}${why ? ` ${why}` : ""}`);
     error.status = response.status;
+    error.answered = `${response.status}${why ? ` (${why})` : ""}`;
     throw error;
   }
   return response.json();
@@ -82,7 +93,8 @@ async function ask(run, url) {
           + (run.reading ? "" : "; it may still run on the service");
       return null;
     }
-    $("eta").textContent = `no answer from the service (${error.message}): asking again`;
+    $("eta").textContent = (error.status ? `the service answered ${error.answered}`
+      : `no answer from the service (${error.message})`) + ": asking again";
     await new Promise((resolve) => setTimeout(resolve, POLL_RETRIES_MS[failed]));
   }
 }

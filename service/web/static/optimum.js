@@ -35,9 +35,13 @@ const BOUND_FIELDS = {
   "bounds.y.1": "grid.y.max", "bounds.x": "grid.x.min", "bounds.y": "grid.y.min", z: "grid.z",
 };
 
+// The optimisation under way is state.optimization ({abort}: its request's AbortController);
+// one no longer there was dropped (dropOptimization, or a newer click) and shows nothing.
 async function optimize() {
   clearErrors();
   clearOptimum();
+  if (state.optimization) state.optimization.abort.abort();  // a newer click: the older goes
+  state.optimization = null;
   if (!havePath()) return;
   const grid = gridBody();
   if (grid.z === undefined) {  // the API would take it for a search over the height
@@ -49,9 +53,13 @@ async function optimize() {
     bounds: { x: [grid.x.min, grid.x.max], y: [grid.y.min, grid.y.max], yaw: yawRange(grid) },
     spin_mode: spinMode(), cell: cellBody(),
   };
+  const run = { abort: new AbortController() };
+  state.optimization = run;
   $("opt-mu").textContent = "optimising…";
   $("opt-mu-line").hidden = false;
-  const answer = await api("POST", "/v1/optimize", body, BOUND_FIELDS).catch(() => null);
+  const answer = await api("POST", "/v1/optimize", body, BOUND_FIELDS, run.abort.signal).catch(() => null);
+  if (state.optimization !== run) return;  // dropped meanwhile: its answer is not the inputs'
+  state.optimization = null;
   if (!answer) { $("opt-mu").textContent = "no optimum: see the errors above"; return; }
   if (!answer.found) {
     $("opt-mu").textContent = body.cell ? "no feasible placement free of collisions" : "no feasible placement";
@@ -100,12 +108,31 @@ async function optimize() {
     row.insertCell().appendChild(copy);
   }
   $("frames").hidden = false;
+  state.optimum = { canvas: null, placement: p };
+  markOptimum();
+}
+
+// The optimum shown (state.optimum), marked on the map drawn, if any, on the panel whose yaw
+// is nearest the optimum's: called by both answers, the optimiser's and the map's.
+function markOptimum() {
   const canvases = [...document.querySelectorAll(".panel canvas")];
-  if (state.map && canvases.length) {  // the panel whose yaw is nearest the optimum's
-    const yaws = canvases.map((c) => state.map.cells[Number(c.dataset.first)].yaw);
-    const k = yaws.reduce((best, y, i) => (Math.abs(y - p.yaw) < Math.abs(yaws[best] - p.yaw) ? i : best), 0);
-    state.optimum = { canvas: canvases[k], placement: p };
-    canvases.forEach(paintPanel);
-    canvases[k].dataset.optimum = "1";
-  }
+  if (!state.optimum || !state.map || !canvases.length) return;
+  const p = state.optimum.placement;
+  const yaws = canvases.map((c) => state.map.cells[Number(c.dataset.first)].yaw);
+  const k = yaws.reduce((best, y, i) => (Math.abs(y - p.yaw) < Math.abs(yaws[best] - p.yaw) ? i : best), 0);
+  state.optimum.canvas = canvases[k];
+  canvases.forEach(paintPanel);
+  canvases[k].dataset.optimum = "1";
+}
+
+// A new path or robot while an optimisation runs: its request is aborted (the service stops the
+// search when its client goes) and its answer, of the old inputs, never shown; the status says so.
+function dropOptimization(why) {
+  const run = state.optimization;
+  if (!run) return;
+  state.optimization = null;
+  run.abort.abort();
+  clearOptimum();
+  $("opt-mu").textContent = `cancelled: ${why}`;
+  $("opt-mu-line").hidden = false;
 }
