@@ -337,9 +337,9 @@ function clearOptimum() {
   }
 }
 
-// A new map: the old map and its clicked cell go. The optimiser's display is its own: an
-// optimisation under way goes on, and an optimum found stays, marked on the new map once drawn
-// (markOptimum), whichever of the two answers comes last.
+// The map and its clicked cell go (clearResults adds the optimum: a new map, path or robot).
+// An optimum found while a map job runs is marked on its map once drawn (markOptimum),
+// whichever of the two answers comes last.
 function clearMapResults() {
   clearMap(); clearCell();
   $("bar").value = 0; $("eta").textContent = "";

@@ -11,9 +11,10 @@ async function runMap(event) {
   event.preventDefault();
   if (state.run) return;
   clearErrors();
-  clearMapResults();
-  // Not a found optimum, nor one under way: a failure's words, whose errors have just gone.
-  if (!state.optimum && !state.optimization) clearOptimum();
+  // A new map is asked with the inputs as they are now: an optimum found for earlier ones (the
+  // cell edited since, say) is not marked on it, and one under way is cancelled.
+  clearResults();
+  dropOptimization("a map was run; optimise again for its inputs");
   if (!havePath()) return;
   let body;
   try { body = mapBody(); } catch (error) { showErrors([{ loc: ["robot"], msg: String(error) }]); return; }
