@@ -2,9 +2,10 @@
 
 1. ``UNITS/MM``, ``UNITS/INCHES``, ``UNIT/MM``, ``UNIT/INCH`` (``INCH`` and ``INCHES`` alike)
    state it: ``stated``. The request's ``units``, when given, must agree.
-2. No statement but a feed in inches per minute (``FEDRAT/IPM, f``, as NX inch listings write):
-   inches, ``inferred`` (the request's ``units`` wins over an inference).
-3. Otherwise the request's ``units``: ``request``.
+2. No statement but a feed in inches per minute (``FEDRAT/IPM, f``, as NX inch listings write)
+   and none in mm: inches, ``inferred``; a request's other ``units`` are refused, naming the
+   feed (read as mm, an NX inch part came out 25.4 times too small, exit 0).
+3. Otherwise (feeds in both units too) the request's ``units``: ``request``.
 4. Otherwise a ``422`` on ``path.units`` saying what the file gave away.
 """
 
@@ -80,9 +81,16 @@ def units_of(
         return UnitsReading(units, "stated", note)
     feeds = [r for r in records if r.word == "FEDRAT"]
     inch_feed = next((r for r in feeds if _feed_unit(r, field) == "inches"), None)
-    if requested is not None:
-        return UnitsReading(requested, "request", "the request's units (the file states none)")
     mm_feed = next((r for r in feeds if _feed_unit(r, field) == "mm"), None)
+    if requested is not None:
+        if inch_feed is not None and mm_feed is None and requested != "inches":
+            raise InvalidInputError(
+                units_field,
+                f"the request says {requested}, but the file states no units and its feed is in "
+                f"inches per minute (FEDRAT/IPM at line {inch_feed.line}): such a program is "
+                "in inches (NX inch listings write no UNITS); give inch, or leave units out",
+            )
+        return UnitsReading(requested, "request", "the request's units (the file states none)")
     if inch_feed is not None and mm_feed is not None:  # no single unit is suggested
         raise InvalidInputError(
             units_field,

@@ -19,8 +19,10 @@ TWO_CUTS = ["GOTO/0, 0, 0, 0, 0, 1", "GOTO/10, 0, 0, 0, 0, 1"]
 
 
 def read_cl_data(text: str) -> CamPath:
-    """The reader, given mm by the request for a program that states no units (cam.md 9)."""
-    return read_program(text, units=None if "UNITS/" in text.upper() else "mm")
+    """The reader, given mm by the request for a program that states no units and writes no
+    inch feed (such a program is in inches, cam.md 9, and a request's mm is refused)."""
+    stated_or_inferred = "UNITS/" in text.upper() or "IPM" in text.upper()
+    return read_program(text, units=None if stated_or_inferred else "mm")
 
 
 def program(*records: str) -> str:

@@ -371,3 +371,20 @@ def test_moves_and_arc_directions_the_reader_does_not_apply_are_refused(
     with pytest.raises(InvalidLineError, match=what) as caught:
         read_cl_data("\n".join(["UNITS/MM", *BARE[:2], record, *BARE[2:]]))
     assert caught.value.line == 4
+
+
+def test_a_request_in_mm_for_a_program_whose_feed_is_in_inches_is_refused() -> None:
+    """A program with FEDRAT/IPM and no UNITS is in inches (cam.md 9); a request's mm was taken
+    over that, exit 0, the part 25.4 times too small, the reading saying 'the file states
+    none'. Inches or no units read it; with feeds in both units the request still settles it."""
+    inch = ["GOTO/0,0,0", "FEDRAT/IPM,20", "GOTO/1,0,0", "GOTO/1,1,0"]
+    with pytest.raises(InvalidInputError) as caught:
+        read_cl_data("\n".join(inch), units="mm")
+    assert caught.value.field == "path.units"
+    assert "FEDRAT/IPM at line 2" in caught.value.message
+    for units in ("inches", None):
+        np.testing.assert_allclose(
+            read_cl_data("\n".join(inch), units=units).positions[1], [INCH, 0.0, 0.0]
+        )
+    both = read_cl_data("\n".join([*inch, "FEDRAT/MMPM,500", "GOTO/2,1,0"]), units="mm")
+    np.testing.assert_allclose(both.positions[1], [MM, 0.0, 0.0])
