@@ -24,13 +24,16 @@ as the routes do. Settings come from the environment as for the service (``DTF_*
 command's work is bounded as a job's is (DTF_MAX_JOB_CELLS, DTF_MAX_JOB_POSES; a route's
 limit where larger), not as a synchronous request's (:func:`_settings`).
 Exit codes: :data:`OK` (0), :data:`USAGE` (2), :data:`INVALID` (3), :data:`INFEASIBLE` (4),
-:data:`CLOSED_PIPE` (141, the output's reader closed it early); 1 is Python's own, for a
-crash. Errors name the field (and waypoint, line) as the API does.
+:data:`INTERRUPTED` (130, Ctrl-C), :data:`CLOSED_PIPE` (141, the output's reader closed it
+early); 1 is Python's own, for a crash. Errors name the field (and waypoint, line) as the API
+does, or the option (``--png``, ``--robot``). ``--json`` is written in ASCII (JSON's escapes),
+the same JSON on any console's encoding.
 """
 
 from __future__ import annotations
 
 import argparse
+import io
 import json
 import math
 import os
@@ -43,10 +46,10 @@ from typing import Any, TypeVar
 from pydantic import BaseModel, ValidationError
 
 from service import convert
-from service.cli_files import decoded, text_file
+from service.cli_files import decoded, file_bytes, text_file
 from service.cli_text import ProgressBar, evaluation_text, import_text, map_text, optimum_text
-from service.config import Settings, get_settings
-from service.errors import request_location, solver_error_location
+from service.config import Settings, settings_or_exit
+from service.errors import request_errors, solver_error_location
 from service.operations import computed_map, evaluation_of, import_of, map_png
 from service.schemas import EvaluateRequest, MapRequest, OptimizeRequest, RobotRead
 from service.schemas.paths_import import PathImportRequest
@@ -64,6 +67,9 @@ USAGE = 2
 """The command line is wrong (argparse's code)."""
 INVALID = 3
 """The input is refused, as the API refuses it with a 422: the message names the field."""
+INTERRUPTED = 130
+"""Interrupted (Ctrl-C, SIGINT): the work stopped, ``interrupted`` on stderr (128 + SIGINT, as
+a shell reports it)."""
 CLOSED_PIPE = 141
 """The reader of the output closed it early (``dtf-place ... | head``): nothing more is printed,
 as a shell reports a process the pipe's signal ends (128 + SIGPIPE)."""
@@ -110,6 +116,7 @@ def _signed_values_joined(argv: Sequence[str]) -> list[str]:
 
 def main(argv: Sequence[str] | None = None) -> int:
     """Run one subcommand; return its exit code."""
+    _replacing_unencodable()
     args = _parser().parse_args(_signed_values_joined(sys.argv[1:] if argv is None else argv))
     echo = native_stderr.ECHO.set(False)  # a refused URDF's reason is in the error printed
     try:
@@ -120,10 +127,14 @@ def main(argv: Sequence[str] | None = None) -> int:
     except BrokenPipeError:
         _quiet_stdout()
         return CLOSED_PIPE
+    except KeyboardInterrupt:  # Ctrl-C: the work stopped, nothing more to say than that
+        if sys.stderr is not None:
+            print("interrupted", file=sys.stderr)  # noqa: T201
+        return INTERRUPTED
     except ValidationError as error:
-        for item in error.errors():
-            where = ".".join(str(part) for part in request_location(item["loc"]))
-            print(f"error: {where}: {item['msg']}", file=sys.stderr)  # noqa: T201
+        for detail in request_errors(error.errors()):
+            where = ".".join(str(part) for part in detail.loc)
+            print(f"error: {where}: {detail.msg}", file=sys.stderr)  # noqa: T201
     except SolverError as error:
         where = ".".join(str(part) for part in solver_error_location(error)[1:])
         print(f"error: {where}: {error.message}", file=sys.stderr)  # noqa: T201
@@ -132,6 +143,18 @@ def main(argv: Sequence[str] | None = None) -> int:
     finally:
         native_stderr.ECHO.reset(echo)
     return INVALID
+
+
+def _replacing_unencodable() -> None:
+    """Write what the output's encoding cannot as escapes, not a traceback.
+
+    A program's operation names are the CAM user's (Japanese, accents); on a console or a pipe
+    whose encoding is not UTF-8 (Windows' cp1252, an ASCII C locale) printing one raised
+    UnicodeEncodeError (exit 1).
+    """
+    for stream in (sys.stdout, sys.stderr):
+        if isinstance(stream, io.TextIOWrapper):
+            stream.reconfigure(errors="backslashreplace")
 
 
 def _quiet_stdout() -> None:
@@ -149,11 +172,14 @@ def _quiet_stdout() -> None:
 
 def _path(args: argparse.Namespace) -> dict[str, Any]:
     """The request's ``path`` object of the program file."""
-    text = decoded(Path(args.program).read_bytes(), errors="replace")
+    text = decoded(file_bytes(Path(args.program), "program"), errors="replace")
     if args.program.lower().endswith(".csv"):
         if args.units is None:  # a CSV says nothing of its units: never assumed
             message = "a CSV states no units: give --units mm, inch or m"
             raise InvalidInputError("path.units", message)
+        if getattr(args, "arc_tolerance", None) is not None:  # not ignored: said
+            message = "a CSV has no arcs to interpolate: leave --arc-tolerance out"
+            raise InvalidInputError("--arc-tolerance", message)
         return {"csv": text, "units": args.units}
     path: dict[str, Any] = {"cl_data": text}
     if args.units is not None:
@@ -171,6 +197,11 @@ def _robot(args: argparse.Namespace) -> Any:
     another robot, those options are refused rather than ignored.
     """
     name, file = args.robot, Path(args.robot)
+    for option, frame in (("--base-frame", args.base_frame), ("--tool-frame", args.tool_frame)):
+        if frame is not None and not frame.strip():  # '' was taken as not given
+            raise InvalidInputError(option, "is empty: name a frame of the URDF")
+    if name.lower().endswith(_ROBOT_FILES) and not file.is_file():  # not a catalogue name
+        file_bytes(file, "--robot")  # says why: no such file, a folder
     if name.lower().endswith(".urdf"):
         urdf = text_file(file, "robot")
         controller = CONTROLLER_FRAME if fixed_to_root(urdf, CONTROLLER_FRAME) else BASE_FRAME
@@ -195,6 +226,11 @@ def _robot(args: argparse.Namespace) -> Any:
         )
         raise InvalidInputError("robot", message)
     return {"model": name}
+
+
+_ROBOT_FILES = (".urdf", ".json", ".yaml", ".yml")
+"""The suffixes of the robot files ``--robot`` takes (a URDF, the API's robot as JSON, an OPW
+parameter file): such a name is a file, never a catalogue name."""
 
 
 def _chained(
@@ -283,7 +319,7 @@ def _settings() -> Settings:
     with a cell over a 0.3 x 0.4 m box, yaw within 0.5 rad: 1,680 coarse placements, about 7 s
     of work; POST /v1/optimize refuses it).
     """
-    return get_settings().for_commands()
+    return settings_or_exit().for_commands()  # a bad DTF_ variable named, exit 3
 
 
 def _validated(model: type[Model], body: dict[str, Any]) -> Model:
@@ -292,8 +328,21 @@ def _validated(model: type[Model], body: dict[str, Any]) -> Model:
 
 
 def _print(answer: BaseModel, args: argparse.Namespace, text: Callable[[], str]) -> None:
-    """The answer as the API's JSON (``--json``), or as text."""
-    print(answer.model_dump_json(indent=2) if args.json else text())  # noqa: T201
+    """The answer as the API's JSON (``--json``, in ASCII), or as text."""
+    print(_ascii(answer.model_dump_json(indent=2)) if args.json else text())  # noqa: T201
+
+
+def _ascii(json_text: str) -> str:
+    r"""JSON text with every character beyond ASCII written as its ``\u`` escape.
+
+    The same JSON on any output encoding: a CAM user's operation name (Japanese, an emoji) on a
+    cp1252 pipe came out as ``\U0001f527`` (the output's backslash escape, which JSON has
+    not) among cp1252 bytes, which no JSON reader takes. Outside strings JSON is ASCII, so
+    every such character is in a string, where the escape (``json.dumps``'s) means it.
+    """
+    if json_text.isascii():
+        return json_text
+    return "".join(char if char.isascii() else json.dumps(char)[1:-1] for char in json_text)
 
 
 def _import(args: argparse.Namespace) -> int:
@@ -324,6 +373,7 @@ def _evaluate(args: argparse.Namespace) -> int:
 
 
 def _map(args: argparse.Namespace) -> int:
+    png = _png_file(args)  # before the work: a map may take minutes
     grid = {"x": args.x, "y": args.y, "z": args.z, "yaw": args.yaw, "spin": args.spin}
     body: dict[str, Any] = {"robot": _robot(args), "path": _path(args), "grid": grid}
     request = _validated(MapRequest, _with_options(body, args))
@@ -332,10 +382,46 @@ def _map(args: argparse.Namespace) -> int:
             request, _settings(), png=True, progress=bar
         )
     answer = convert.map_response(result, robot, spin_mode=spin_mode, path_read=path_read)
-    Path(args.png).write_bytes(map_png(result, robot))
+    try:
+        png.write_bytes(map_png(result, robot))
+    except OSError as error:  # the folder went, the disk filled: said on --png
+        raise InvalidInputError("--png", f"cannot write {str(png)!r}: {error.strerror}") from error
     robot, read = body["robot"], (answer.recognised, answer.robot_read)
     _print(answer, args, lambda: _chained(args, robot, read, map_text(answer, args.png)))
     return OK if answer.feasible_cells else INFEASIBLE
+
+
+def _png_file(args: argparse.Namespace) -> Path:
+    """The ``--png`` file, checked before any work: writable, and none of the inputs.
+
+    An unwritable one was found after the whole map, its error naming neither the option nor
+    a field; ``--png`` given the program's own name overwrote the program with the picture.
+
+    Raises:
+        InvalidInputError: on ``--png``.
+    """
+    png = Path(args.png)
+    inputs = [args.program, *(f for f in (args.robot, args.cell) if f is not None)]
+    same = [name for name in inputs if Path(name).exists() and _same_file(Path(name), png)]
+    if same:
+        raise InvalidInputError("--png", f"{args.png!r} is an input ({same[0]!r}): name a new file")
+    if png.is_dir():
+        raise InvalidInputError("--png", f"{args.png!r} is a folder: name a file in it")
+    folder = png.parent
+    if not folder.is_dir():
+        raise InvalidInputError("--png", f"no folder {str(folder)!r} to write {png.name!r} in")
+    writable = os.access(png, os.W_OK) if png.exists() else os.access(folder, os.W_OK)
+    if not writable:
+        raise InvalidInputError("--png", f"{args.png!r} cannot be written (permissions)")
+    return png
+
+
+def _same_file(a: Path, b: Path) -> bool:
+    """Whether ``a`` and ``b`` name one file (links and relative names resolved)."""
+    try:
+        return b.exists() and a.samefile(b)
+    except OSError:
+        return False
 
 
 def _optimise(args: argparse.Namespace) -> int:
@@ -358,7 +444,8 @@ def _optimise(args: argparse.Namespace) -> int:
     recognised = None if answer.evaluation is None else answer.evaluation.ik.recognised
     robot, read = body["robot"], (recognised, answer.robot_read)
     _print(answer, args, lambda: _chained(args, robot, read, optimum_text(answer)))
-    return OK if answer.found else INFEASIBLE
+    check = None if answer.evaluation is None else answer.evaluation.feed_check
+    return OK if answer.found and (check is None or check.feasible) else INFEASIBLE
 
 
 def _numbers(count: int, separator: str) -> Callable[[str], list[float]]:

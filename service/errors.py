@@ -101,10 +101,21 @@ def error_response(status_code: int, details: list[ErrorDetail]) -> JSONResponse
 def request_location(loc: tuple[str | int, ...] | list[str | int]) -> list[str | int]:
     """A pydantic ``loc`` as a path into the request: the union variants' tags left out.
 
-    A ``oneOf`` variant is tagged ``"robot:model"``, ``"path:waypoints"``...; field names never
-    hold a colon, so the tags are the parts that do.
+    A ``oneOf`` variant is tagged ``"robot:model"``, ``"path:waypoints"``...; a union of types
+    (a number or a list of numbers: ``grid.yaw``) by pydantic's names of them,
+    ``"constrained-float"``, ``"list[constrained-float]"``, ``"float"``. The API's field names
+    are snake_case words (tests/service/test_errors.py holds every one to it), so the tags are
+    the parts with a colon, a bracket or a hyphen, and the bare type names.
     """
-    return [part for part in loc if not (isinstance(part, str) and ":" in part)]
+    return [part for part in loc if not (isinstance(part, str) and _is_tag(part))]
+
+
+_TYPE_NAMES = frozenset({"float", "int", "str", "bool"})
+
+
+def _is_tag(part: str) -> bool:
+    """Whether a ``loc`` part names a union variant, not a field."""
+    return any(c in part for c in ":[-(") or part in _TYPE_NAMES
 
 
 async def request_validation_error_handler(
@@ -115,11 +126,41 @@ async def request_validation_error_handler(
     FastAPI's own answer repeats each offending ``input``, which breaks on the NaN it is
     refusing (JSON has no NaN) and can run to megabytes for a whole path.
     """
-    details = [
-        ErrorDetail(loc=request_location(e["loc"]), msg=e["msg"], type=e["type"])
-        for e in error.errors()
+    return error_response(
+        status.HTTP_422_UNPROCESSABLE_CONTENT, request_errors(list(error.errors()))
+    )
+
+
+def request_errors(errors: list[Any]) -> list[ErrorDetail]:
+    """Pydantic's errors as details (``loc`` in the request), less what a union's variants add.
+
+    A value of a union of types (a number or a list: ``grid.yaw``) failing is refused by every
+    variant: ``[0, 5000]`` as 'not a valid number' at ``grid.yaw`` and as 'at most 1000' at
+    ``grid.yaw.1``; ``5000`` as 'at most 1000' and as 'not a valid array'. A variant's detail
+    goes where another detail says more: at a place inside its own, or at its place where it
+    only names the type it wanted (a ``*_type`` error) and the other does not. Details saying
+    the same of one place are given once.
+    """
+    found = [
+        (ErrorDetail(loc=request_location(e["loc"]), msg=e["msg"], type=e["type"]), len(e["loc"]))
+        for e in errors
     ]
-    return error_response(status.HTTP_422_UNPROCESSABLE_CONTENT, details)
+    places = [tuple(detail.loc) for detail, _ in found]
+
+    def says_more(other: int, than: int) -> bool:
+        mine, theirs = places[than], places[other]
+        if len(theirs) > len(mine):
+            return theirs[: len(mine)] == mine
+        wanted_type = found[than][0].type.endswith("_type")
+        return theirs == mine and wanted_type and not found[other][0].type.endswith("_type")
+
+    kept: dict[tuple[tuple[str | int, ...], str, str], ErrorDetail] = {}
+    for k, (detail, depth) in enumerate(found):
+        tagged = len(places[k]) < depth
+        if tagged and any(says_more(o, k) for o in range(len(found)) if o != k):
+            continue
+        kept.setdefault((places[k], detail.msg, detail.type), detail)
+    return list(kept.values())
 
 
 def http_error_type(status_code: int) -> str:

@@ -12,6 +12,7 @@ from solver.core.robots import Robot
 from solver.optimise.failures import SearchFailure
 from solver.optimise.optimum import PlacementOptimum
 from solver.optimise.search_space import PlacementBounds
+from solver.path.feed import check_feed
 
 
 def bounds_of(bounds: schemas.Bounds, *, z: float | None) -> PlacementBounds:
@@ -127,6 +128,8 @@ def optimize_response(
 ) -> schemas.OptimizeResponse:
     """The answer of ``POST /v1/optimize`` (``found: false`` when nothing was feasible).
 
+    The optimum's evaluation checks the program's feed (its FEDRAT) as ``/v1/evaluate`` does.
+
     ``path``: the request's path, for how a CAM program was read (``path_read``) and the pass
     and operation of a failure; the answer's ``axis_correction`` is the larger of its and
     ``axis_correction`` (the request's other quaternions).
@@ -144,6 +147,9 @@ def optimize_response(
             optimum.evaluation,
             robot,
             axis_correction=max(axis_correction, 0.0 if path is None else path.axis_correction),
+            feed=None
+            if path is None or path.feed is None
+            else check_feed(optimum.evaluation, path.feed, robot.qdot_max),
         ),
         start=schemas.StartInfo(
             placement=api_placement(optimum.start),

@@ -8,7 +8,9 @@ from __future__ import annotations
 
 import json
 import math
+import os
 import re
+import signal
 import subprocess
 import sys
 from pathlib import Path
@@ -17,7 +19,7 @@ from typing import Any
 import pytest
 from fastapi.testclient import TestClient
 
-from service.cli import CLOSED_PIPE, INFEASIBLE, INVALID, OK, USAGE, main
+from service.cli import CLOSED_PIPE, INFEASIBLE, INTERRUPTED, INVALID, OK, USAGE, main
 from service.config import get_settings
 from solver.core.robots import example_robot_data_dir
 from solver.families.opw.arms import ARMS
@@ -854,3 +856,137 @@ def test_a_command_started_with_a_standard_stream_closed_runs(tmp_path: Path, cl
     )
     subprocess.run(["bash", "-c", command], cwd=ROOT, timeout=300, capture_output=True)
     assert marker.read_text().strip() == str(OK)
+
+
+def test_ctrl_c_stops_a_map_with_one_line_and_the_shells_code(tmp_path: Path) -> None:
+    """SIGINT during a map printed a 30-line KeyboardInterrupt traceback (exit 1)."""
+    grid = ["--x=-0.8:0.8:0.002", "--y=-0.8:0.8:0.002", "--png", str(tmp_path / "map.png")]
+    command = [sys.executable, "-m", "service.cli", *MAP[:4], *grid, "--progress"]
+    big = {"DTF_MAX_MAP_CELLS": "1000000", "DTF_MAX_MAP_POSES": "100000000"}  # minutes of work
+    env = {**os.environ, **big}
+    with subprocess.Popen(command, stderr=subprocess.PIPE, cwd=ROOT, env=env) as process:
+        assert process.stderr is not None
+        seen = b""
+        while b"%" not in seen:  # the progress bar: the map is under way (not an import)
+            byte = process.stderr.read(1)
+            assert byte, seen.decode()  # it ended before its bar
+            seen += byte
+        process.send_signal(signal.SIGINT)
+        said = process.stderr.read().decode()
+        code = process.wait(timeout=120)
+    assert code == INTERRUPTED == 130
+    assert said.rstrip().endswith("interrupted") and "Traceback" not in said
+
+
+def test_an_operation_name_the_outputs_encoding_lacks_is_escaped_not_a_traceback(
+    tmp_path: Path,
+) -> None:
+    """A Japanese operation name on a cp1252 output (a Windows console or pipe) raised
+    UnicodeEncodeError (exit 1)."""
+    program = tmp_path / "op.cl"
+    program.write_text(
+        "UNITS/MM\nTOOL PATH/荒加工_ÉBAUCHE,TOOL,T1\nGOTO/0,0,0,0,0,1\nGOTO/10,0,0,0,0,1\n",
+        encoding="utf-8",
+    )
+    env = {**os.environ, "PYTHONIOENCODING": "cp1252"}
+    command = [sys.executable, "-m", "service.cli", "import", str(program)]
+    done = subprocess.run(command, capture_output=True, cwd=ROOT, env=env, timeout=120)
+    assert done.returncode == OK, done.stderr[-400:]
+    assert "\\u8352\\u52a0\\u5de5_\xc9BAUCHE".encode("cp1252") in done.stdout
+    # --json: JSON on any output (its escapes; the output's own, \U0001f527, are not JSON's)
+    program.write_text(program.read_text(encoding="utf-8").replace(",TOOL", "\U0001f527,TOOL"))
+    as_json = subprocess.run(
+        [*command, "--json"], capture_output=True, cwd=ROOT, env=env, timeout=120
+    )
+    assert as_json.returncode == OK, as_json.stderr[-400:]
+    assert as_json.stdout.isascii()
+    assert json.loads(as_json.stdout)["pass_details"][0]["operation"] == "荒加工_ÉBAUCHE\U0001f527"
+
+
+@pytest.mark.parametrize("where", ["the program", "a missing folder", "a folder"])
+def test_a_png_that_cannot_be_written_is_refused_before_the_map(
+    capsys: pytest.CaptureFixture[str],
+    monkeypatch: pytest.MonkeyPatch,
+    tmp_path: Path,
+    where: str,
+) -> None:
+    """--png naming the program overwrote it with the picture; an unwritable one was found
+    after the whole map, its error naming no option. Refused on --png before any work."""
+    program = tmp_path / "program.cls"
+    program.write_bytes(PROGRAM.read_bytes())
+    png = {"the program": program, "a missing folder": tmp_path / "no" / "m.png"}.get(
+        where, tmp_path
+    )
+
+    def no_work(*args: Any, **kwargs: Any) -> None:
+        raise AssertionError("the map was computed")
+
+    monkeypatch.setattr("service.cli.computed_map", no_work)
+    code, _, err = run(capsys, "map", str(program), *MAP[2:], "--png", str(png))
+    assert code == INVALID and err.startswith("error: --png: "), err
+    assert program.read_bytes() == PROGRAM.read_bytes()
+
+
+def test_optimise_checks_the_programs_feed_at_the_optimum_as_evaluate_does(
+    client: TestClient, capsys: pytest.CaptureFixture[str], tmp_path: Path
+) -> None:
+    """A program at 5 m/s was optimised with no feed check (exit 0, feed_check null) where
+    /v1/evaluate at the optimum says it does not run (cam.md section 7; api.md: optimize's
+    evaluation is as /v1/evaluate's)."""
+    source = (ROOT / "examples" / "cam" / "sweep_mm.cl").read_text()
+    fast = re.sub(r"FEDRAT/MMPM, *[0-9.]+", "FEDRAT/MMPM, 300000.0", source)
+    assert fast != source
+    program = _text_file(tmp_path, "fast.cl", fast)
+    fixed = ["--x=0.0:0.0", "--y", "0.45:0.45", "--yaw=0:0"]
+    code, out, _ = run(capsys, "optimise", program, "--robot", "ur5e", *fixed, "--json")
+    answer = json.loads(out)
+    at = answer["placement"]
+    placement = {k: at[k] for k in ("x", "y", "z", "yaw")}
+    body = {"robot": ROBOT, "path": {"cl_data": fast}, "placement": placement}
+    evaluated = api(client, "/v1/evaluate", body)
+    assert evaluated["feed_check"]["feasible"] is False
+    assert answer["evaluation"]["feed_check"] == evaluated["feed_check"]
+    assert code == INFEASIBLE
+
+
+def test_files_that_are_missing_huge_or_folders_are_named_on_their_option(
+    capsys: pytest.CaptureFixture[str], tmp_path: Path
+) -> None:
+    """A missing --robot x.json read as a catalogue name ('unknown robot'); a missing --cell or
+    program was a bare '[Errno 2]'; /dev/zero was read until memory ran out (exit 1)."""
+    huge = tmp_path / "huge.cl"
+    with huge.open("wb") as stream:  # sparse: 9 MB of zeros, none written
+        stream.truncate(9_000_000)
+    cases = [
+        (["import", str(tmp_path / "none.cl")], "program: no file"),
+        (["import", str(tmp_path)], "program: "),
+        (["import", str(huge)], "program: "),
+        ([*MAP[:2], "--robot", str(tmp_path / "arm.json"), *MAP[4:], "--png", "m.png"], "--robot"),
+        ([*MAP, "--png", str(tmp_path / "m.png"), "--cell", str(tmp_path / "c.json")], "cell: no"),
+    ]
+    for argv, said in cases:
+        code, _, err = run(capsys, *argv)
+        assert code == INVALID and err.startswith(f"error: {said}"), (argv, err)
+    assert "is longer than 8,000,000 bytes" in run(capsys, "import", str(huge))[2]
+
+
+def test_options_that_would_be_ignored_are_refused(
+    capsys: pytest.CaptureFixture[str], tmp_path: Path
+) -> None:
+    """--arc-tolerance on a CSV (no arcs: even -1 was taken) and an empty --base-frame (read as
+    not given) did nothing, exit 0."""
+    csv = _text_file(tmp_path, "p.csv", "0,0,0,0,0,1\n10,0,0,0,0,1\n")
+    code, _, err = run(capsys, "import", csv, "--units", "mm", "--arc-tolerance", "1e-5")
+    assert code == INVALID and err.startswith("error: --arc-tolerance: "), err
+    urdf = str(example_robot_data_dir() / "ur_description" / "urdf" / "ur5_robot.urdf")
+    at = ["--at=0.4,0.1,0,0"]
+    code, _, err = run(capsys, "evaluate", str(PROGRAM), "--robot", urdf, "--base-frame", "", *at)
+    assert code == INVALID and err.startswith("error: --base-frame: is empty"), err
+
+
+def test_a_bad_setting_is_named_by_its_variable(tmp_path: Path) -> None:
+    env = {**os.environ, "DTF_THREADS": "0"}
+    command = [sys.executable, "-m", "service.cli", "import", str(PROGRAM)]
+    done = subprocess.run(command, capture_output=True, text=True, cwd=ROOT, env=env, timeout=120)
+    assert done.returncode == INVALID
+    assert done.stderr.startswith("error: DTF_THREADS='0': Input should be greater than 0")

@@ -5,6 +5,7 @@ from __future__ import annotations
 import asyncio
 import copy
 import json
+import re
 from collections.abc import Callable
 from typing import Any
 
@@ -15,7 +16,7 @@ from starlette.types import Message, Receive, Scope, Send
 
 from service.body_limits import BodySizeLimitMiddleware
 from service.convert import wants_png
-from tests.cases import EXAMPLES
+from tests.cases import EXAMPLES, ROOT
 
 DELETE = object()
 RAW = "__raw__"  # stands for a token JSON writers refuse (NaN, Infinity), spliced into the text
@@ -507,3 +508,49 @@ def test_messages_say_plain_numbers_and_cut_echoes(
     }
     body = {"robot": path_body["robot"], "path": path_body["path"], "grid": grid}
     assert_names(client.post("/v1/map", json=body), 422, ["body", "grid", "x"])
+
+
+def test_every_field_name_is_a_word_no_union_tag_is() -> None:
+    """request_location leaves out the loc parts of union variants by their form (a colon, a
+    bracket, a hyphen, a bare type name): no field of the API has that form."""
+    spec = json.loads((ROOT / "openapi" / "openapi.json").read_text())
+    names: set[str] = set()
+
+    def walk(node: Any) -> None:
+        if isinstance(node, dict):
+            names.update(
+                node.get("properties", {}) if isinstance(node.get("properties"), dict) else {}
+            )
+            for value in node.values():
+                walk(value)
+        elif isinstance(node, list):
+            for value in node:
+                walk(value)
+
+    walk(spec)
+    assert len(names) > 100
+    assert [n for n in names if not re.fullmatch(r"[a-z][a-z0-9_]*|[a-z]+_[A-Z]", n)] == []
+    assert names.isdisjoint({"float", "int", "str", "bool"})
+
+
+@pytest.mark.parametrize(
+    ("yaw", "loc"), [([0.0, 5000.0], ["body", "grid", "yaw", 1]), (5000.0, ["body", "grid", "yaw"])]
+)
+def test_a_bad_yaw_is_named_once_where_it_is(client: TestClient, yaw: Any, loc: list[Any]) -> None:
+    """grid.yaw takes a number or a list: pydantic's loc carried its type names
+    ('list[constrained-float]'), and each variant's error was given ('not a valid number' of
+    a list, 'not a valid array' of a number)."""
+    body = json.loads((ROOT / "examples" / "evaluate_request.json").read_text())
+    grid: dict[str, Any] = {"x": {"min": 0.0, "max": 0.1, "step": 0.1}}
+    grid["y"] = {"min": 0.4, "max": 0.5, "step": 0.1}
+    answer = client.post(
+        "/v1/map",
+        json={
+            "robot": body["robot"],
+            "path": body["path"],
+            "grid": {**grid, "z": 0.1, "yaw": yaw},
+        },
+    )
+    assert answer.status_code == 422
+    (detail,) = answer.json()["detail"]
+    assert detail["loc"] == loc and detail["msg"] == "Input should be less than or equal to 1000"
