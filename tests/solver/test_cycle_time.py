@@ -246,3 +246,23 @@ def test_the_time_optimal_time_is_never_above_the_ramped_one(waypoints: int, ble
     for one in times.passes:
         assert one.time_optimal <= one.ramp_time
         assert one.constant_feed_time <= one.ramp_time
+
+
+def test_a_speed_limited_cruise_ramps_down_only_at_its_end() -> None:
+    """A straight 0.1 m line at 1e6 rad/s^2: the feed reaches mu_acc (= mu_path, the speed
+    limit binds) within a fraction of a mm and stops as fast, so the ramps are short and, the
+    line being run at one speed limit, alike. The capped profile sits 5e-9 below mu_acc^2 on
+    its cruise (TOPP-RA's margin): counted as not reaching it, the ramp down ran from the
+    start's one highest point, 99.75 of the 100 mm."""
+    line = np.repeat(np.diag([1.0, -1.0, -1.0, 1.0])[None], 21, axis=0)  # tool pointing down
+    line[:, 0, 3] = np.linspace(-0.05, 0.05, 21)
+    robot = get_robot("ur5").with_options(qddot_max=np.full(6, 1e6))
+    problem = PathProblem.of(robot, line)
+    evaluation = evaluate_path(problem, PLACEMENT)
+    times = cycle_time(problem, evaluation)
+    assert evaluation.feasible and times is not None
+    (one,) = times.passes
+    assert one.length == pytest.approx(0.1, rel=1e-12)
+    assert 0.0 < one.ramp_up_length < 1e-3 and 0.0 < one.ramp_down_length < 1e-3
+    assert one.ramp_down_length == pytest.approx(one.ramp_up_length, rel=0.1)
+    assert one.ramp_time == pytest.approx(one.constant_feed_time, rel=0.02)
