@@ -12,6 +12,7 @@ from solver.core.robots import Robot
 from solver.optimise.failures import SearchFailure
 from solver.optimise.optimum import PlacementOptimum
 from solver.optimise.search_space import PlacementBounds
+from solver.path.cycle_time import CycleTime
 from solver.path.feed import check_feed
 
 
@@ -125,10 +126,12 @@ def optimize_response(
     *,
     axis_correction: float = 0.0,
     path: PathInput | None = None,
+    cycle_time: CycleTime | None = None,
 ) -> schemas.OptimizeResponse:
     """The answer of ``POST /v1/optimize`` (``found: false`` when nothing was feasible).
 
-    The optimum's evaluation checks the program's feed (its FEDRAT) as ``/v1/evaluate`` does.
+    The optimum's evaluation checks the program's feed (its FEDRAT) and has the cycle time
+    (``cycle_time``, with acceleration limits) as ``/v1/evaluate`` does.
 
     ``path``: the request's path, for how a CAM program was read (``path_read``) and the pass
     and operation of a failure; the answer's ``axis_correction`` is the larger of its and
@@ -150,6 +153,7 @@ def optimize_response(
             feed=None
             if path is None or path.feed is None
             else check_feed(optimum.evaluation, path.feed, robot.qdot_max),
+            cycle_time=cycle_time,
         ),
         start=schemas.StartInfo(
             placement=api_placement(optimum.start),

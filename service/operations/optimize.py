@@ -12,6 +12,7 @@ from solver.core.progress import Progress
 from solver.optimise.optimize import optimize_placement
 from solver.optimise.search_space import PlacementBounds
 from solver.optimise.work import COARSE_MAP, work_of
+from solver.path.cycle_time import cycle_time
 from solver.path.problem import PathProblem
 
 
@@ -53,6 +54,7 @@ def optimum_of(
         robot,
         axis_correction=convert.quaternion_correction(body.robot, body.cell),
         path=path,
+        cycle_time=None if optimum.evaluation is None else cycle_time(problem, optimum.evaluation),
     )
 
 

@@ -283,3 +283,17 @@ def test_joint_use_picture_has_the_acceleration_panel(client: TestClient) -> Non
     assert pictures["with"].shape[0] == pytest.approx(
         pictures["without"].shape[0] * 7 / 4, rel=0.01
     )
+
+
+def test_the_optimums_evaluation_has_the_cycle_time_evaluate_gives(client: TestClient) -> None:
+    """api.md: optimize's evaluation is as /v1/evaluate's; with acceleration limits its
+    cycle_time was null where /v1/evaluate at the optimum gives one."""
+    fixed = {"x": [0.0, 0.0], "y": [0.45, 0.45], "yaw": [0.0, 0.0]}
+    short = {"waypoints": EXAMPLE["path"]["waypoints"][:20]}
+    body = limited({"robot": EXAMPLE["robot"], "path": short})
+    optimum = post(client, "/v1/optimize", {**body, "bounds": fixed, "z": 0.1})
+    assert optimum["found"]
+    at = sent_back(optimum["placement"])
+    evaluated = post(client, "/v1/evaluate", {**body, "placement": at})
+    assert evaluated["cycle_time"] is not None
+    assert optimum["evaluation"]["cycle_time"] == evaluated["cycle_time"]
