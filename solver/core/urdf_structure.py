@@ -281,9 +281,10 @@ def tree_problem(root: ElementTree.Element) -> str | None:
                 f"({quoted_names(joints)}): a URDF is a tree, each link the child of one joint "
                 "(a closed chain cannot be read)"
             )
+    rooted: set[str] = set()  # links whose joints lead up to a root: each walked once
     for start in parent_link:
         link, seen = start, {start}
-        while link in parent_link:
+        while link in parent_link and link not in rooted:
             link = parent_link[link]
             if link in seen:
                 return (
@@ -291,6 +292,7 @@ def tree_problem(root: ElementTree.Element) -> str | None:
                     "a URDF is a tree, with no loop of joints"
                 )
             seen.add(link)
+        rooted |= seen
     return None
 
 
