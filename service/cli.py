@@ -402,7 +402,7 @@ def _png_file(args: argparse.Namespace) -> Path:
     """
     png = Path(args.png)
     inputs = [args.program, *(f for f in (args.robot, args.cell) if f is not None)]
-    same = [name for name in inputs if Path(name).exists() and _same_file(Path(name), png)]
+    same = [name for name in inputs if _same_file(Path(name), png)]
     if same:
         raise InvalidInputError("--png", f"{args.png!r} is an input ({same[0]!r}): name a new file")
     if png.is_dir():
@@ -417,9 +417,9 @@ def _png_file(args: argparse.Namespace) -> Path:
 
 
 def _same_file(a: Path, b: Path) -> bool:
-    """Whether ``a`` and ``b`` name one file (links and relative names resolved)."""
+    """Whether ``a`` and ``b`` name one file (links resolved; a missing one names none)."""
     try:
-        return b.exists() and a.samefile(b)
+        return a.samefile(b)
     except OSError:
         return False
 
