@@ -146,20 +146,19 @@ def request_errors(errors: list[Any]) -> list[ErrorDetail]:
         for e in errors
     ]
     places = [tuple(detail.loc) for detail, _ in found]
-
-    def says_more(other: int, than: int) -> bool:
-        mine, theirs = places[than], places[other]
-        if len(theirs) > len(mine):
-            return theirs[: len(mine)] == mine
-        wanted_type = found[than][0].type.endswith("_type")
-        return theirs == mine and wanted_type and not found[other][0].type.endswith("_type")
-
+    inside = {place[:cut] for place in places for cut in range(len(place))}  # proper prefixes
+    said_more = {
+        place
+        for place, (detail, _) in zip(places, found, strict=True)
+        if not detail.type.endswith("_type")
+    }
     kept: dict[tuple[tuple[str | int, ...], str, str], ErrorDetail] = {}
-    for k, (detail, depth) in enumerate(found):
-        tagged = len(places[k]) < depth
-        if tagged and any(says_more(o, k) for o in range(len(found)) if o != k):
+    for place, (detail, depth) in zip(places, found, strict=True):
+        tagged = len(place) < depth
+        wanted_type = detail.type.endswith("_type")
+        if tagged and (place in inside or (wanted_type and place in said_more)):
             continue
-        kept.setdefault((places[k], detail.msg, detail.type), detail)
+        kept.setdefault((place, detail.msg, detail.type), detail)
     return list(kept.values())
 
 
