@@ -23,7 +23,7 @@ from typing import Any
 from pydantic import ValidationError
 
 from service.config import Settings
-from service.errors import request_location, solver_error_location, solver_error_type
+from service.errors import request_errors, solver_error_location, solver_error_type
 from service.jobs.job import DamagedJob, JobStoreUnavailable
 from service.jobs.store import JobStore
 from service.logs import log, log_to_stderr
@@ -121,10 +121,9 @@ def run_job(store: JobStore, job_id: str, settings: Settings) -> None:
         store.finish(job_id, "failed", error=[detail])
         log.info("job %s failed: %s", job_id, error.message[:200])
     except ValidationError as error:
-        details = [
-            {"loc": request_location(("body", *e["loc"])), "msg": e["msg"], "type": e["type"]}
-            for e in error.errors()
-        ]
+        # as the route's 422 gives them (errors.request_errors), under the route's body
+        located = [{**e, "loc": ("body", *e["loc"])} for e in error.errors()]
+        details = [detail.model_dump() for detail in request_errors(located)]
         store.finish(job_id, "failed", error=details)
         log.info("job %s failed: invalid request", job_id)
     except Exception as error:  # noqa: BLE001 - a job must end with a status, whatever happens
