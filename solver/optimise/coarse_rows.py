@@ -12,11 +12,14 @@ path's), and made exact where it matters, for the cells the search goes on from:
    whole-path value is below its value on the set (or the whole path fails there), the
    waypoints that bind it are added and the map is made again, MAP_ROUNDS times at most.
 
-The cells handed on are the verified maxima, with the whole path's mu_path and branch; every
-other cell is left out (NaN). When the best maximum holds, it is the whole path's best cell:
-no cell's whole-path value is above its value on the set. The work is bounded before it
-starts: MAP_ROUNDS maps of at most MAX_MAP_ROWS waypoints (the set stops growing there), and
-SAMPLE_CELLS + MAP_ROUNDS * VERIFIED_CELLS whole-path placements.
+The cells handed on are the last round's verified maxima, and any cell of the sample or an
+earlier round that runs faster on the whole path (there are such only when the best maximum
+does not hold), with the whole path's mu_path and branch; every other cell is left out (NaN).
+When the best maximum holds, it is the whole path's best cell: no cell's whole-path value is
+above its value on the set. Where a maximum does not hold, the waypoints added are those of the
+branch the set ran it on as well as the whole path's own (:func:`binding_rows`). The work is
+bounded before it starts: MAP_ROUNDS maps of at most MAX_MAP_ROWS waypoints (the set stops growing
+there), and at most :func:`whole_path_checks` whole-path placements.
 """
 
 from __future__ import annotations
@@ -39,6 +42,17 @@ SAMPLE_CELLS = 16
 SAMPLE_ROWS = 8  # the slowest waypoints of each sample cell in the first set
 VERIFIED_CELLS = 6
 MAP_ROUNDS = 6
+
+
+def whole_path_checks(n_waypoints: int) -> int:
+    """The most placements a coarse map of a path of ``n_waypoints`` evaluates on the whole path.
+
+    None for a path mapped whole (its map is the whole path's); for a longer one, the sample,
+    and each round's maxima, twice (on the whole path's branch and on the set's).
+    """
+    if n_waypoints <= MAX_MAP_ROWS:
+        return 0
+    return SAMPLE_CELLS + 2 * MAP_ROUNDS * VERIFIED_CELLS
 
 
 def mapped_waypoints(n_waypoints: int) -> int:
@@ -95,6 +109,8 @@ def map_values(
     rows = closure(problem, first, neighbours=False)
     feed_index = np.full(len(placements), np.nan)
     branch = np.zeros(len(placements), dtype=int)
+    earlier = MapValues(feed_index.copy(), branch.copy())  # the sample's and earlier rounds'
+    earlier.feed_index[sample], earlier.branch[sample] = sampled.feed_index, sampled.branch
     for round_ in range(MAP_ROUNDS):
         part = span(progress, round_ / MAP_ROUNDS, (round_ + 1) / MAP_ROUNDS)
         on_set = evaluate_placements(
@@ -102,9 +118,10 @@ def map_values(
         )
         best = np.array(maxima(on_set.feed_index)[:VERIFIED_CELLS], dtype=int)
         added, whole = binding_rows(
-            problem, placements[best], on_set.feed_index[best], runner, rows
+            problem, placements[best], on_set.feed_index[best], runner, rows, on_set.branch[best]
         )
         tried.record(placements[best], whole.reason, whole.failed_waypoint)
+        _keep(earlier, feed_index, branch)
         feed_index[:] = np.nan
         feed_index[best], branch[best] = whole.feed_index, whole.branch
         grown = closure(problem, np.union1d(rows, added), neighbours=False)
@@ -114,7 +131,19 @@ def map_values(
         if holds or not added.size or len(grown) > MAX_MAP_ROWS:
             break
         rows = grown
+    # When the last round's best maximum holds no cell is above it; when it does not (the
+    # rounds ran out, or none of its maxima runs on the whole path), a faster cell of the
+    # sample or an earlier round is known to run and is handed on too.
+    top = np.nanmax(feed_index, initial=-np.inf)
+    faster = np.nan_to_num(earlier.feed_index, nan=-np.inf) > top
+    feed_index[faster], branch[faster] = earlier.feed_index[faster], earlier.branch[faster]
     return MapValues(feed_index, branch, rows)
+
+
+def _keep(kept: MapValues, feed_index: np.ndarray, branch: np.ndarray) -> None:
+    """Copy a round's whole-path values (finite ``feed_index``) into ``kept``."""
+    runs = np.isfinite(feed_index)
+    kept.feed_index[runs], kept.branch[runs] = feed_index[runs], branch[runs]
 
 
 def binding_rows(
@@ -123,13 +152,16 @@ def binding_rows(
     on_set: np.ndarray | None,
     runner: TaskRunner,
     rows: np.ndarray | None = None,
+    branches: np.ndarray | None = None,
 ) -> tuple[np.ndarray, PlacementResults]:
     """The waypoints that bind the whole path at ``placements`` and are not in ``rows``.
 
     Without a set (the sample): each placement's SAMPLE_ROWS slowest waypoints, or its first
     failing one. With one: at each placement whose whole-path value is below ``on_set`` (its
     value on the set) by more than ACTIVE_SET_RTOL, the waypoints below the set's least, or
-    where the whole path fails.
+    where the whole path fails; and, where the set ran it on another branch (``branches``, the
+    set's branch indices), the same of the whole path on that branch
+    (:func:`_set_branch_rows`).
 
     Returns:
         the waypoints (whole-path indices) and the whole path's results at the placements.
@@ -139,6 +171,7 @@ def binding_rows(
     if speeds is None:  # not reached: asked for with_speeds
         raise RuntimeError("evaluate_placements returned no speeds")
     found: list[np.ndarray] = []
+    other_branch: list[int] = []  # placements the set ran on a branch the whole path did not
     for k in range(len(placements)):
         failed = int(whole.failed_waypoint[k])
         if rows is None or on_set is None:
@@ -147,13 +180,58 @@ def binding_rows(
         value = whole.feed_index[k]
         if np.isfinite(value) and value >= on_set[k] * (1.0 - ACTIVE_SET_RTOL):
             continue
-        if failed >= 0:
-            found.append(np.array([max(failed - 1, 0), failed]))
-            continue
-        least = on_set[k]
-        below = np.flatnonzero(np.nan_to_num(speeds[k], nan=np.inf) < least)
-        found.append(below[lowest(speeds[k, below], FIRST_ROWS)])
+        found.append(_binding(speeds[k], failed, on_set[k]))
+        if branches is not None and branches[k] != whole.branch[k]:
+            other_branch.append(k)
+    if other_branch:
+        assert branches is not None and on_set is not None  # a set's placements only
+        chosen = np.array(other_branch)
+        found += _set_branch_rows(
+            problem, placements[chosen], branches[chosen], on_set[chosen], runner
+        )
     added = np.unique(np.concatenate(found)) if found else np.zeros(0, dtype=int)
     if rows is not None:
         added = np.setdiff1d(added, rows)
     return added.astype(np.int64), whole
+
+
+def _binding(speeds: np.ndarray, failed: int, least: float) -> np.ndarray:
+    """Where a placement's whole path fails (the step into it too), or its bounds below ``least``.
+
+    ``speeds`` (N,) the whole path's bounds at the placement on one branch, ``failed`` its
+    first failing waypoint (-1: it runs), ``least`` the placement's value on the set.
+    """
+    if failed >= 0:
+        return np.array([max(failed - 1, 0), failed])
+    below = np.flatnonzero(np.nan_to_num(speeds, nan=np.inf) < least)
+    binding: np.ndarray = below[lowest(speeds[below], FIRST_ROWS)]
+    return binding
+
+
+def _set_branch_rows(
+    problem: PathProblem,
+    placements: np.ndarray,
+    branches: np.ndarray,
+    on_set: np.ndarray,
+    runner: TaskRunner,
+) -> list[np.ndarray]:
+    """The waypoints that bind the whole path on the branch the set ran each placement on.
+
+    The set's ``auto`` may run a placement on a branch other than the whole path's: one that
+    fails (or is slower) at waypoints the set lacks, which the whole path's own branch does
+    not name. Without those the next set runs the placement on that branch again, at the same
+    value, and the loop stalls (a 17,000-move program whose every verified cell failed so,
+    round after round, was answered with its start). Each placement's whole path is evaluated
+    once more, on its set's branch: where it fails there, or its bounds below its set value.
+    """
+    found: list[np.ndarray] = []
+    for branch in np.unique(branches):
+        chosen = np.flatnonzero(branches == branch)
+        on_branch = problem.with_options(branch=problem.family.branches[int(branch)])
+        result = evaluate_placements(on_branch, placements[chosen], with_speeds=True, runner=runner)
+        speeds = result.feed_bounds
+        if speeds is None:  # not reached: asked for with_speeds
+            raise RuntimeError("evaluate_placements returned no speeds")
+        for k, index in enumerate(chosen):
+            found.append(_binding(speeds[k], int(result.failed_waypoint[k]), on_set[index]))
+    return found

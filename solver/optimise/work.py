@@ -18,9 +18,7 @@ placement. The analytic UR5 on 2 waypoints took 3 to 5 times (22-44 us a placeme
 climbs' 1,208 placements take about 50 ms, far below any limit).
 
 Not counted: the local solvers' own iterations (IPOPT works on the NLP, bounded by its time
-limit; SLSQP's finite differences by its iterations), and, for a program longer than
-:data:`solver.optimise.coarse_rows.MAX_MAP_ROWS`, the coarse map's check of its best cells on
-the whole path.
+limit; SLSQP's finite differences by its iterations).
 """
 
 from __future__ import annotations
@@ -30,15 +28,15 @@ from dataclasses import dataclass
 from solver.optimise.active_set import MAX_ROUNDS
 from solver.optimise.back_off import BACK_OFF_PLACEMENTS, backs_off
 from solver.optimise.coarse_rows import mapped_waypoints
+from solver.optimise.coarse_rows import whole_path_checks as map_checks
 from solver.optimise.coarse_search import coarse_map_cells
 from solver.optimise.local_search import N_CLIMBS, REFINE_ROUNDS, climb_evaluations, refined_count
 from solver.optimise.methods import casadi_method, method_named, scipy_method
 from solver.optimise.methods.placement_scipy import search_placements
 from solver.optimise.methods.search_rows import (
-    SAMPLE_CELLS,
     SEARCH_ROUNDS,
-    VERIFIED,
     searched_waypoints,
+    whole_path_checks,
 )
 from solver.optimise.search_space import PlacementBounds
 from solver.optimise.symmetry import symmetric_search
@@ -135,7 +133,7 @@ def work_of(
         on_rows = scipy_method.rows_searched(problem, active_set)
         evolutions = SEARCH_ROUNDS if on_rows else 1
         searched = searched_waypoints(n) if on_rows else n
-        verified = SAMPLE_CELLS + SEARCH_ROUNDS * max(VERIFIED, size.basins) if on_rows else 0
+        verified = whole_path_checks(size.basins) if on_rows else 0
         return OptimisationWork(
             (
                 Phase("start", 1, n, one_at_a_time=True),
@@ -165,6 +163,9 @@ def work_of(
         (
             Phase("start", 1, n, one_at_a_time=True),
             Phase(COARSE_MAP, cells, mapped_waypoints(n)),
+            # A long program's map on a set: its sample and best cells checked on the whole path
+            # (solver.optimise.coarse_rows).
+            Phase("coarse map's whole-path checks", map_checks(n), n),
             Phase("refinement", refined_count(problem, bounds) * 2 * free * REFINE_ROUNDS, n),
             Phase("IPOPT starts and whole-path checks", solves, n, one_at_a_time=True),
             Phase("Nelder-Mead climbs", climbs, n, one_at_a_time=True),

@@ -93,7 +93,7 @@ def test_the_best_holds_over_every_placement_of_the_last_evolution(
 
     monkeypatch.setattr(search_rows, "evolve", recorded)
     if first == "two waypoints":
-        monkeypatch.setattr(search_rows, "first_set", lambda *args: np.array([0, 1]))
+        monkeypatch.setattr(search_rows, "first_set", lambda *args: (np.array([0, 1]), []))
     found = search_rows.search_on_rows(posed, BOX, symmetric=True)
     best_vector, best_mu, _ = found.basins[0]
     if first == "two waypoints":

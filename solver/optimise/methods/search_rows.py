@@ -13,14 +13,17 @@ method's coarse map of a long program is (:mod:`solver.optimise.coarse_rows`):
 2. differential evolution on the set; its best VERIFIED distinct placements evaluated on the
    whole path;
 3. until the best of them holds (its whole-path value is its value on the set), the waypoints
-   that bind them are added and the evolution made again, SEARCH_ROUNDS times at most.
+   that bind them are added (on the whole path's branch and on the set's:
+   :func:`solver.optimise.coarse_rows.binding_rows`) and the evolution made again,
+   SEARCH_ROUNDS times at most.
 
 When the best holds, it is the best whole-path placement of all that the last evolution
 evaluated: none has a whole-path value above its value on the set. The basins handed on are
-the verified placements with the whole path's mu_path and branch (never a value of the set).
-The work is bounded before it starts (:mod:`solver.optimise.work`): SEARCH_ROUNDS evolutions
-on at most SET_ROWS waypoints, and SAMPLE_CELLS + SEARCH_ROUNDS * VERIFIED whole-path
-placements.
+the last round's verified placements that run, and any faster placement the sample or an
+earlier round found running, with the whole path's mu_path and branch (never a value of the
+set). The work is bounded
+before it starts (:mod:`solver.optimise.work`): SEARCH_ROUNDS evolutions on at most SET_ROWS
+waypoints, and :func:`whole_path_checks` whole-path placements.
 """
 
 from __future__ import annotations
@@ -57,6 +60,15 @@ def on_rows(n_waypoints: int) -> bool:
     return n_waypoints > MAX_SEARCH_ROWS
 
 
+def whole_path_checks(basins: int) -> int:
+    """The most whole-path placements a search on sets evaluates, keeping ``basins`` a round.
+
+    The sample, and each round's verified placements twice (on the whole path's branch and on
+    the set's).
+    """
+    return SAMPLE_CELLS + 2 * SEARCH_ROUNDS * max(VERIFIED, basins)
+
+
 def searched_waypoints(n_waypoints: int) -> int:
     """The most waypoints one evolution of a path of ``n_waypoints`` evaluates a placement on."""
     return min(n_waypoints, SET_ROWS) if on_rows(n_waypoints) else n_waypoints
@@ -89,14 +101,18 @@ def sample(bounds: PlacementBounds) -> np.ndarray:
 
 def first_set(
     problem: PathProblem, bounds: PlacementBounds, runner: TaskRunner, tried: Tried | None = None
-) -> np.ndarray:
+) -> tuple[np.ndarray, list[Basin]]:
     """The slowest waypoints of the whole path (or where it fails) at :func:`sample`'s placements.
 
     With their acceleration stencils (:func:`solver.optimise.active_set.closure`); where that
     is over SET_ROWS (long stencils), the first half along the path is kept until it is not:
     the rounds add what binds.
+
+    Returns:
+        the set, and the sample's placements that run on the whole path, as basins.
     """
-    placements = bounds.rows(sample(bounds))
+    vectors = sample(bounds)
+    placements = bounds.rows(vectors)
     found, whole = binding_rows(problem, placements, None, runner)
     if tried is not None:  # whole-path evaluations: kept for a failure's tally
         tried.record(placements, whole.reason, whole.failed_waypoint)
@@ -104,7 +120,29 @@ def first_set(
     while len(rows) > SET_ROWS and len(found) > 1:
         found = found[: len(found) // 2]
         rows = closure(problem, found, neighbours=False)
-    return rows
+    return rows, _runs(vectors, whole.feed_index, whole.branch)
+
+
+def _basins(last: list[Basin], earlier: list[Basin], count: int) -> list[Basin]:
+    """The last round's placements that run, and any found before that is faster, best first.
+
+    When the last round's best holds, nothing found before is above it (its value on the set
+    is above every placement's whole-path value), so the basins are the last round's. When it
+    does not (the rounds ran out, or none of them ran on the whole path), a faster placement
+    of the sample or an earlier round is known to run and is handed on too.
+    """
+    top = max((value for _, value, _ in last), default=-np.inf)
+    kept = last + [basin for basin in earlier if basin[1] > top]
+    order = np.argsort([-value for _, value, _ in kept], kind="stable")
+    return [kept[k] for k in order[:count]]
+
+
+def _runs(vectors: np.ndarray, feed_index: np.ndarray, branch: np.ndarray) -> list[Basin]:
+    """The placements whose whole-path value is finite, as basins (in their order)."""
+    return [
+        (vectors[k].copy(), float(feed_index[k]), int(branch[k]))
+        for k in np.flatnonzero(np.isfinite(feed_index))
+    ]
 
 
 def search_on_rows(
@@ -129,7 +167,8 @@ def search_on_rows(
         tried: keeps the placements evaluated on the whole path (the sample that makes the
             first set, each round's best; not the evolutions on the set).
     """
-    rows = first_set(problem, bounds, runner, tried)
+    rows, earlier = first_set(problem, bounds, runner, tried)
+    last: list[Basin] = []
     generations = 0
     for round_ in range(1, SEARCH_ROUNDS + 1):
         part = span(progress, (round_ - 1) / SEARCH_ROUNDS, round_ / SEARCH_ROUNDS)
@@ -140,18 +179,15 @@ def search_on_rows(
         best = np.array(distinct_best(seen, symmetric, max(VERIFIED, size.basins)), dtype=int)
         on_set = seen.mu[best]
         checked = bounds.rows(seen.vectors[best])
-        added, whole = binding_rows(problem, checked, on_set, runner, rows)
+        added, whole = binding_rows(problem, checked, on_set, runner, rows, seen.branch[best])
         if tried is not None:
             tried.record(checked, whole.reason, whole.failed_waypoint)
+        earlier += last
+        last = _runs(seen.vectors[best], whole.feed_index, whole.branch)
         holds = best.size and whole.feed_index[0] >= on_set[0] * (1.0 - ACTIVE_SET_RTOL)
         grown = closure(problem, np.union1d(rows, added), neighbours=False)
         if holds or not added.size or round_ == SEARCH_ROUNDS or len(grown) > SET_ROWS:
             break
         rows = grown
-    feasible = np.flatnonzero(np.isfinite(whole.feed_index))
-    order = feasible[np.argsort(-whole.feed_index[feasible], kind="stable")][: size.basins]
-    basins = [
-        (seen.vectors[best[k]].copy(), float(whole.feed_index[k]), int(whole.branch[k]))
-        for k in order
-    ]
+    basins = _basins(last, earlier, size.basins)
     return RowsSearch(basins, generations, rows, round_)
