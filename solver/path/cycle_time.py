@@ -71,11 +71,23 @@ class CycleTime:
     passes: tuple[PassTime, ...]
 
 
-REACHED = 1e-6
-"""How close (relative, in squared speed) the capped profile comes to mu_acc^2 where it is at
-mu_acc: TOPP-RA's margin keeps it a hair below its cap (5e-9 relative on a straight 0.1 m line
-at 1e6 rad/s^2). At 1e-12 no point of such a cruise counted as reached, so the ramp down was
-taken from the one highest point on: 99.75 of the 100 mm."""
+REACHED = 1e-9
+"""Rounding allowed (relative, in squared speed) beyond TOPP-RA's margin where the capped profile
+is at mu_acc: see :func:`reached_from`."""
+
+
+def reached_from(top: float) -> float:
+    """The squared speed at and above which the capped profile is at its cap ``top`` (mu_acc^2).
+
+    TOPP-RA's margin keeps each step a hair below what it reaches
+    (:data:`solver.kernels.feed_profile.SHRINK`: 1e-8 m^2/s^2, or 1e-4 of it below 1 cm/s), so
+    a cruise at the cap sits that far below it: 5e-9 relative at 1.4 m/s, 2.2e-6 at 0.067 m/s.
+    A fixed relative bound missed slow cruises (at 1e-12 every one, at 1e-6 those below
+    0.1 m/s): the ramp down was then taken from the one highest point on, 0.269 of a 0.27 m
+    pass. Twice the margin, and rounding.
+    """
+    margin = min(feed_profile.SHRINK, feed_profile.SHRINK_SHARE * top)
+    return top - 2.0 * margin - REACHED * top
 
 
 def _time(s: np.ndarray, x: np.ndarray) -> float:
@@ -110,7 +122,7 @@ def pass_time(
     # The pass at mu_acc with its ramps: the fastest profile that never passes mu_acc, on the
     # time-optimal profile's own discretisation (so the time-optimal one is never slower).
     profile = feed_profile.capped_profile(s, q_s, q_ss, qdot_max, qddot_max, top)
-    reached = np.flatnonzero(profile >= top * (1.0 - REACHED))
+    reached = np.flatnonzero(profile >= reached_from(top))
     first = int(reached[0]) if reached.size else int(np.argmax(profile))
     last = int(reached[-1]) if reached.size else first
     length = float(s[-1])

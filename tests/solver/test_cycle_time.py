@@ -14,6 +14,7 @@ import toppra
 import toppra.algorithm
 import toppra.constraint
 
+from solver.core.spatial import Placement
 from solver.families import get_robot
 from solver.kernels.feed_profile import time_optimal
 from solver.path.blended_path import blended_path, interval_points
@@ -266,3 +267,36 @@ def test_a_speed_limited_cruise_ramps_down_only_at_its_end() -> None:
     assert 0.0 < one.ramp_up_length < 1e-3 and 0.0 < one.ramp_down_length < 1e-3
     assert one.ramp_down_length == pytest.approx(one.ramp_up_length, rel=0.1)
     assert one.ramp_time == pytest.approx(one.constant_feed_time, rel=0.02)
+
+
+def test_a_slow_cruise_ramps_as_joint_1_can_at_both_ends() -> None:
+    """The tool point 0.3 rad out on a 0.45 m arc about the base axis and back: joint 1 alone
+    moves (q1_s = 1/r), and the reversal's blend sets mu_acc = sqrt(a r b / 2) = 0.067 m/s.
+    From rest joint 1's acceleration bounds sddot by a r, so each ramp is mu_acc^2 / (2 a r)
+    long and takes mu_acc / (a r) (geometry), on the grid's b / 16 steps. The capped profile
+    cruises 2.2e-6 of mu_acc^2 below it there (TOPP-RA's 1e-8 margin): counted as not at
+    mu_acc, the ramp down ran from the one highest point, 0.269 m of the 0.27 m pass."""
+    radius, limit, blend = 0.45, 10.0, 0.002
+    turns = np.concatenate([np.linspace(0.0, 0.3, 31), np.linspace(0.3, 0.0, 31)[1:]])
+    arc = np.repeat(np.diag([1.0, -1.0, -1.0, 1.0])[None], len(turns), axis=0)  # tool down
+    for k, turn in enumerate(turns):
+        c, s = np.cos(turn), np.sin(turn)
+        arc[k, :3, :3] = np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]]) @ arc[k, :3, :3]
+        arc[k, :3, 3] = [radius * c, radius * s, 0.2]
+    robot = get_robot("ur5").with_options(qddot_max=np.full(6, limit))
+    problem = PathProblem.of(robot, arc, PathOptions(blend_length=blend))
+    evaluation = evaluate_path(problem, Placement(0.0, 0.0, 0.0, 0.0))
+    times = cycle_time(problem, evaluation)
+    assert evaluation.acceleration is not None and times is not None
+    mu = evaluation.acceleration.mu_acc
+    chord = np.linalg.norm(np.diff(arc[:31, :3, 3], axis=0), axis=1).sum() / 0.3  # r of the chords
+    assert mu == pytest.approx(np.sqrt(limit * chord * blend / 2), rel=1e-3)
+    ramp_length, ramp_time = mu**2 / (2 * limit * radius), mu / (limit * radius)
+    (one,) = times.passes
+    step = blend / 16
+    for length, seconds in (
+        (one.ramp_up_length, one.ramp_up_time),
+        (one.ramp_down_length, one.ramp_down_time),
+    ):
+        assert length == pytest.approx(ramp_length, abs=step)
+        assert seconds == pytest.approx(ramp_time, rel=1e-2)
