@@ -11,7 +11,7 @@ from typing import Annotated, Any, Literal
 from pydantic import BeforeValidator, ConfigDict, Discriminator, Field, Tag
 
 from service.schemas.common import RequestModel
-from solver.path.problem import DEFAULT_BLEND_LENGTH, DEFAULT_MAX_JOINT_STEP
+from solver.path.problem import BLEND_LENGTHS, DEFAULT_BLEND_LENGTH, DEFAULT_MAX_JOINT_STEP
 
 
 class Branch(RequestModel):
@@ -81,12 +81,12 @@ def _blend_length() -> Any:
     """The ``ik.blend_length`` field of both IK policies (motion.md section 1)."""
     return Field(
         default=DEFAULT_BLEND_LENGTH,
-        gt=0.0,
-        le=1000.0,
+        ge=BLEND_LENGTHS[0],
+        le=BLEND_LENGTHS[1],
         description="The length (m) over which the controller rounds a corner of the path (a "
         "zone of radius blend_length / 2: ABB z1, KUKA $APO.CDIS = 1, UR blend radius 1 mm), "
-        "> 0; the joint accelerations at a constant feed are taken over it (motion.md section "
-        "2). Used only with robot.joint_acceleration_limits.",
+        "1e-6 to 1; the joint accelerations at a constant feed are taken over it (motion.md "
+        "section 2). Used only with robot.joint_acceleration_limits.",
     )
 
 

@@ -34,6 +34,10 @@ from solver.path.prepare import PreparedPath, prepare_path
 
 DEFAULT_MAX_JOINT_STEP = 0.35
 DEFAULT_BLEND_LENGTH = 0.002  # m, the corner zone of motion.md section 1 (ABB z1, UR 1 mm)
+BLEND_LENGTHS = (1e-6, 1.0)
+"""m, the blend lengths taken: a controller's corner zone (ABB's largest, z200, is 0.4 m across)
+above CAM's rounding (1e-4 mm). Below 1e-100 s +- b rounded to s and mu_acc jumped back to
+mu_path (78,000 times 1e-12's); at 1000 m the blended path was no longer the pass's."""
 
 SpinMode = Literal["fixed", "free"]
 SPIN_MODES: tuple[SpinMode, ...] = ("fixed", "free")
@@ -50,8 +54,8 @@ class PathOptions:
             waypoints of one pass.
         spin_mode: ``fixed`` (the orientations as given) or ``free`` (the tool spin rate a free
             variable of the DTF).
-        blend_length: m, > 0 and finite, the length b over which a controller rounds a corner
-            (motion.md section 1); used only with joint acceleration limits.
+        blend_length: m, within BLEND_LENGTHS, the length b over which a controller rounds a
+            corner (motion.md section 1); used only with joint acceleration limits.
         cell: the robot's surroundings and tool (cell.md); None checks no collisions.
     """
 
@@ -78,15 +82,18 @@ class PathOptions:
     def check_step(self) -> None:
         """Raise InvalidInputError on ``ik.max_joint_step`` unless it is finite and > 0 (rad).
 
-        And on ``ik.blend_length`` unless it is finite and > 0 (m).
+        And on ``ik.blend_length`` unless it is within BLEND_LENGTHS (m).
         """
         if not (math.isfinite(self.max_joint_step) and self.max_joint_step > 0.0):
             raise InvalidInputError(
                 "ik.max_joint_step", f"{self.max_joint_step:.6g} rad must be > 0"
             )
-        if not (math.isfinite(self.blend_length) and self.blend_length > 0.0):
+        low, high = BLEND_LENGTHS
+        if not low <= self.blend_length <= high:  # NaN too
             raise InvalidInputError(
-                "ik.blend_length", f"{self.blend_length:.6g} m must be finite and > 0"
+                "ik.blend_length",
+                f"{self.blend_length:.6g} m is outside [{low:g}, {high:g}] m (a controller's "
+                "corner zone: ABB z1 is 2 mm across)",
             )
 
 

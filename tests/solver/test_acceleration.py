@@ -274,8 +274,10 @@ def test_bad_acceleration_limits_name_the_field_and_joint(limits: list[float], n
     assert named in error.value.message
 
 
-@pytest.mark.parametrize("blend", [0.0, -0.001, math.inf, math.nan])
+@pytest.mark.parametrize("blend", [0.0, -0.001, math.inf, math.nan, 1e-12, 1e-100, 2.0, 1000.0])
 def test_bad_blend_length_names_the_field(blend: float) -> None:
+    """Not a corner zone: at 1e-100 m s +- b rounded to s and mu_acc was mu_path (at 1e-12 it
+    was 3.8e-6 m/s); at 1000 m the blended path ran far beyond the 0.32 m pass."""
     problem = PathProblem.of(ur5(10.0), WAYPOINTS, PathOptions(blend_length=blend))
     with pytest.raises(InvalidInputError) as error:
         evaluate_path(problem, PLACEMENT)
