@@ -593,7 +593,13 @@ def _parser() -> argparse.ArgumentParser:
         metavar="MIN:MAX",
         help="rad, the constant tool spin's range (default 0:0, no spin)",
     )
-    run.add_argument("--method", choices=["scipy", "casadi"], default="scipy")
+    run.add_argument(
+        "--method",
+        choices=["scipy", "casadi"],
+        default="scipy",
+        help="scipy (the default here: differential evolution, then SLSQP) or casadi (IPOPT "
+        "from a coarse map's best cells: the API's default)",
+    )
     run.set_defaults(run=_optimise)
     return parser
 
