@@ -168,7 +168,7 @@ def climb_evaluations(problem: PathProblem, bounds: PlacementBounds) -> int:
 
 
 def climb(problem: PathProblem, bounds: PlacementBounds, start: Cell) -> Cell | None:
-    """Nelder-Mead on mu_path over the free variables, from ``start``, inside the bounds.
+    """Nelder-Mead on mu_path (mu_acc with acceleration limits) from ``start``, in the bounds.
 
     The first simplex spans half a coarse step along each free variable. Deterministic.
 
@@ -213,13 +213,19 @@ def climb(problem: PathProblem, bounds: PlacementBounds, start: Cell) -> Cell | 
 
 N_CLIMBS = 2  # Nelder-Mead climbs on mu_path, from the best refined cells
 CLIMB_STATUS = "Nelder-Mead on mu_path, from a refined cell"  # a climb's candidate status
+CLIMB_STATUS_ACC = "Nelder-Mead on mu_acc, from a refined cell"  # with acceleration limits
+
+
+def climb_status(problem: PathProblem) -> str:
+    """A climb's candidate status: the index it climbed (mu_acc with acceleration limits)."""
+    return CLIMB_STATUS if problem.robot.qddot_max is None else CLIMB_STATUS_ACC
 
 
 def climbs(problem: PathProblem, bounds: PlacementBounds, cells: list[Cell]) -> list[Candidate]:
-    """Nelder-Mead on mu_path from the best N_CLIMBS cells: across branches, to their tops."""
+    """Nelder-Mead on mu_path (mu_acc) from the best N_CLIMBS cells: across branches, to tops."""
     candidates = []
     for cell in cells[:N_CLIMBS]:
         top = climb(problem, bounds, cell)
         if top is not None:
-            candidates.append(Candidate(top.vector, CLIMB_STATUS))
+            candidates.append(Candidate(top.vector, climb_status(problem)))
     return candidates

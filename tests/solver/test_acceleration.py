@@ -17,6 +17,8 @@ import toppra
 from solver.core.exceptions import InvalidInputError
 from solver.core.spatial import Placement, pose_matrix
 from solver.families import get_robot
+from solver.optimise.coarse_search import Cell
+from solver.optimise.local_search import climbs
 from solver.optimise.methods.placement_nlp import PlacementNlp
 from solver.optimise.optimize import optimize_placement
 from solver.optimise.search_space import PlacementBounds, decision_vector, variables_of
@@ -355,3 +357,15 @@ def test_compiled_maps_equal_the_pipeline(spin_mode: str) -> None:
     assert reference.limited_by is not None and set(reference.limited_by) == {1}
     without = evaluate_placements(PathProblem.of(ur5(None), WAYPOINTS), cells)
     assert without.mu_acc is None and without.limited_by is None
+
+
+@pytest.mark.parametrize(("acceleration", "index"), [(10.0, "mu_acc"), (None, "mu_path")])
+def test_a_climb_names_the_index_it_climbed(acceleration: float | None, index: str) -> None:
+    """With acceleration limits the Nelder-Mead climb maximises mu_acc (the feed index), and its
+    candidate's status says so (it said mu_path, the index it did not climb)."""
+    posed = PathProblem.of(ur5(acceleration), WAYPOINTS[::8])
+    bounds = PlacementBounds(x=(-0.05, 0.05), y=(0.4, 0.5), yaw=(0.0, 0.0), z=0.1)
+    start = evaluate_placements(posed, bounds.rows(bounds.centre()[None]))
+    cell = Cell(bounds.centre(), float(start.feed_index[0]), int(start.branch[0]))
+    (climbed,) = climbs(posed, bounds, [cell])
+    assert climbed.status == f"Nelder-Mead on {index}, from a refined cell"
