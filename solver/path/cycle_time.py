@@ -71,9 +71,9 @@ class CycleTime:
     passes: tuple[PassTime, ...]
 
 
-REACHED = 1e-9
-"""Rounding allowed (relative, in squared speed) beyond TOPP-RA's margin where the capped profile
-is at mu_acc: see :func:`reached_from`."""
+REACHED = 1e-4
+"""How close (relative, in squared speed: 5e-5 of the feed) to mu_acc^2 the capped profile is at
+mu_acc, beyond TOPP-RA's margin on the cruise: see :func:`reached_from`."""
 
 
 def reached_from(top: float) -> float:
@@ -84,7 +84,8 @@ def reached_from(top: float) -> float:
     a cruise at the cap sits that far below it: 5e-9 relative at 1.4 m/s, 2.2e-6 at 0.067 m/s.
     A fixed relative bound missed slow cruises (at 1e-12 every one, at 1e-6 those below
     0.1 m/s): the ramp down was then taken from the one highest point on, 0.269 of a 0.27 m
-    pass. Twice the margin, and rounding.
+    pass. And a ramp's steps add their margins up (4e-8 m^2/s^2 after four): the point where the
+    ramp meets the cap is REACHED below it, the cruise twice the margin.
     """
     margin = min(feed_profile.SHRINK, feed_profile.SHRINK_SHARE * top)
     return top - 2.0 * margin - REACHED * top
