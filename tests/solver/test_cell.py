@@ -507,7 +507,8 @@ def test_a_urdf_whose_meshes_cannot_be_read_gets_capsules_where_it_has_no_primit
     elsewhere = urdf.replace("package://example-robot-data/", "package://not-installed/")
     arm = robot_from_urdf(elsewhere, base_frame="base", tool_frame="tool0", name="ur5-elsewhere")
     checker = CellChecker(arm, Cell())
-    # every link's collision element is a mesh but the ee_link's box, on the last joint
+    # every link's collision element is a mesh but the ee_link's box, fixed to wrist_3_link:
+    # wrist_3_link has none of its own, so it gets a capsule too
     assert checker.approximated == (
         "base",
         "shoulder_pan_joint",
@@ -515,9 +516,98 @@ def test_a_urdf_whose_meshes_cannot_be_read_gets_capsules_where_it_has_no_primit
         "elbow_joint",
         "wrist_1_joint",
         "wrist_2_joint",
+        "wrist_3_joint",
     )
     assert CellChecker(get_robot("ur5"), Cell()).approximated == ()
     assert len(CellChecker(get_robot("ur5e"), Cell()).approximated) == 7
+
+
+def test_a_link_without_geometry_is_a_capsule_whatever_its_fixed_links_carry() -> None:
+    """The UR5 whose meshes cannot be read keeps ee_link's 1 cm box on the wrist's joint, but
+    wrist_3_link, the link that joint moves, has nothing: a box 3 cm from the wrist's axis was
+    answered clear by 15.5 mm (ee_link to the box), 26 mm inside the wrist's capsule. The
+    distance is coal's, from a capsule made here: wrist_3_joint's origin to tool0, r = 0.05."""
+    robots = example_robot_data_dir()
+    urdf = (robots / "ur_description" / "urdf" / "ur5_robot.urdf").read_text()
+    elsewhere = urdf.replace("package://example-robot-data/", "package://not-installed/")
+    arm = robot_from_urdf(elsewhere, base_frame="base", tool_frame="tool0", name="ur5-elsewhere")
+    path, at = load_path("curved_line")[60:62], Placement(0.0, 0.45, 0.1, 0.0)
+    plain = evaluate_path(PathProblem.of(arm, path), at)
+    assert plain.q is not None
+    model, data = arm.model, arm.model.createData()
+    pin.framesForwardKinematics(model, data, plain.q[0])
+    wrist = model.getJointId("wrist_3_joint")
+    tool0 = model.frames[model.getFrameId("tool0")].placement.translation
+    side = data.oMi[wrist].rotation[:, 0]  # across the wrist's axis, 3 cm from it
+    centre = data.oMi[wrist].act(tool0 / 2) + 0.03 * side
+    base = data.oMf[model.getFrameId("base")]
+    pin_box = Box((0.01, 0.01, 0.01), base.actInv(pin.SE3(np.eye(3), centre)).homogeneous)
+    evaluation = evaluate_path(
+        PathProblem.of(arm, path, PathOptions(cell=Cell(fixed=(pin_box,)))), at
+    )
+    geometry = pin.GeometryModel()
+    length = float(np.linalg.norm(tool0))
+    turn = pin.Quaternion.FromTwoVectors(np.array([0.0, 0.0, 1.0]), tool0 / length).matrix()
+    capsule = coal.Capsule(0.05, length)
+    geometry.addGeometryObject(pin.GeometryObject("w3", wrist, pin.SE3(turn, tool0 / 2), capsule))
+    geometry.addGeometryObject(
+        pin.GeometryObject("box", 0, pin.SE3(np.eye(3), centre), pin_box.geometry())
+    )
+    gdata = geometry.createData()
+    pin.updateGeometryPlacements(model, data, geometry, gdata)
+    expected = _distance(geometry, gdata, 0, 1)
+    assert expected < -0.02
+    assert evaluation.reason == "collision" and evaluation.collision is not None
+    assert evaluation.collision.robot_part == "wrist_3_joint_capsule"
+    assert evaluation.collision.waypoint == 0
+    assert evaluation.collision.distance == pytest.approx(expected, abs=DISTANCE_ATOL)
+
+
+def test_a_table_top_between_the_pandas_base_and_joint_1_collides_with_link_1() -> None:
+    """cell.md section 5: a halfspace just above the base collides everywhere. The Panda's
+    joint 1 is at 0.333 m, above such a table, but its link 1 hangs down to its base: left
+    unchecked as a link joint 1 turns about the table's normal, the placements ran. The
+    distance is geometry: link 1's lowest convex-hull vertex, read here, below the table top."""
+    arm = get_robot("panda")
+    robots = example_robot_data_dir()
+    urdf = (robots / "panda_description" / "urdf" / "panda.urdf").read_text()
+    geometry = pin.buildGeomFromUrdfString(
+        arm.model, urdf, pin.COLLISION, package_dirs=[str(robots.parent.parent)]
+    )
+    data = arm.model.createData()
+    pin.framesForwardKinematics(arm.model, data, pin.neutral(arm.model))
+    gdata = geometry.createData()
+    pin.updateGeometryPlacements(arm.model, data, geometry, gdata)
+    base = data.oMf[arm.model.getFrameId("panda_link0")]
+
+    def lowest(name: str) -> tuple[float, float]:
+        """The z range in {B} of a collision object's mesh vertices."""
+        k = geometry.getGeometryId(name)
+        mesh = geometry.geometryObjects[k].geometry
+        vertices = np.array([mesh.vertex(i) for i in range(mesh.num_vertices)])
+        placed = base.actInv(gdata.oMg[k])
+        heights = (vertices @ placed.rotation.T + placed.translation)[:, 2]
+        return float(heights.min()), float(heights.max())
+
+    table = lowest("panda_link0_0")[1] + 0.01
+    assert lowest("panda_link1_0")[0] < table < arm.model.jointPlacements[1].translation[2]
+    top = Halfspace((0.0, 0.0, 1.0), table, name="table")
+    path = load_path("curved_line")
+    plain = PathProblem.of(arm, path)
+    xs, ys = np.array([0.35, 0.45, 0.55]), np.array([0.0, 0.1, 0.2])
+    free = capability_map(plain, xs=xs, ys=ys, z=table + 0.15, yaws=np.array([0.0, 0.5]))
+    assert (free.reason == -1).any()
+    cut = PathProblem.of(arm, path, PathOptions(cell=Cell(fixed=(top,))))
+    cells = capability_map(cut, xs=xs, ys=ys, z=table + 0.15, yaws=np.array([0.0, 0.5]))
+    runs = free.reason == -1
+    assert np.all(cells.reason[runs] == 4)  # REASONS.index("collision")
+    _, yaw, y, x = np.argwhere(runs)[0]  # [spin, yaw, y, x]
+    evaluation = evaluate_path(cut, Placement(xs[x], ys[y], table + 0.15, [0.0, 0.5][yaw]))
+    assert evaluation.collision is not None
+    assert evaluation.collision.robot_part == "panda_link1_0"
+    assert evaluation.collision.distance == pytest.approx(
+        lowest("panda_link1_0")[0] - table, abs=DISTANCE_ATOL
+    )
 
 
 def joint_1_capsule(arm: Robot, radius: float) -> pin.GeometryObject:

@@ -6,9 +6,10 @@
   as its convex hull (:func:`solver.path.cell.shapes.convex_hull`), which contains it. A URDF
   whose meshes cannot be read keeps its primitive elements.
 - Any link left without geometry (an arm built from DH or OPW parameters, a URDF link with
-  none): a capsule along the link's kinematic segment, from its joint to the next joint (the
-  flange for the last link; the base to the first joint for the base), with the request's
-  ``link_radii`` or the arm's published radii (:data:`PUBLISHED_RADII`).
+  none, whatever the links fixed to it carry): a capsule along the link's kinematic segment,
+  from its joint to the next joint (the flange for the last link; the base to the first joint
+  for the base), with the request's ``link_radii`` or the arm's published radii
+  (:data:`PUBLISHED_RADII`).
 - The tool (:class:`solver.path.cell.shapes.Tool`): two cylinders on the last joint along the
   tool point's z, the holder and the cutting part that ends at the tool point.
 """
@@ -43,6 +44,7 @@ PUBLISHED_RADII: dict[str, tuple[float, ...]] = {
 # request gives link_radii.
 DEFAULT_URDF_LINK_RADIUS = 0.05
 TOOL_HOLDER, TOOL_CUTTING = "tool", "tool_cutting"
+CAPSULE_SUFFIX = "_capsule"  # the name of a capsule made for a link without geometry ends so
 
 
 @dataclass(frozen=True)
@@ -75,15 +77,14 @@ def robot_geometry(
     """
     model = robot.model
     geometry = _urdf_geometry(robot) if robot.urdf is not None else pin.GeometryModel()
-    carried = {int(g.parentJoint) for g in geometry.geometryObjects}
-    bare = [j for j in range(model.njoints) if j not in carried]
+    bare = _bare_joints(model, geometry)
     radii = _radii(robot, link_radii, needed=bool(bare) and robot.urdf is None)
     approximated = []
     for joint in bare:
         start, end = _segment(robot, joint)
         radius = radii[joint] if radii is not None else DEFAULT_URDF_LINK_RADIUS
         name = "base" if joint == 0 else model.names[joint]
-        geometry.addGeometryObject(_capsule(f"{name}_capsule", joint, start, end, radius))
+        geometry.addGeometryObject(_capsule(name + CAPSULE_SUFFIX, joint, start, end, radius))
         approximated.append(name)
     n_arm = geometry.ngeoms
     cutting = -1
@@ -101,6 +102,31 @@ def robot_geometry(
         for g, obj in enumerate(geometry.geometryObjects)
     )
     return RobotGeometry(geometry, tuple(approximated), cutting, keys)
+
+
+def _bare_joints(model: pin.Model, geometry: pin.GeometryModel) -> list[int]:
+    """The joints whose link has no geometry (0: the base, when nothing stands on it).
+
+    A joint's link is the one it moves, the URDF child of the joint: links fixed to it (a
+    flange, ``ee_link``) carry geometry of their own but are not it. Counted by joint, a UR5
+    whose wrist_3_link mesh was left out kept ee_link's 1 cm box on that joint and got no
+    capsule there: a box 3 cm from the wrist's axis was 'clear by 15.5 mm' where the wrist is
+    (the cell audit, stop 53).
+    """
+    carried_joints = {int(g.parentJoint) for g in geometry.geometryObjects}
+    carried_frames = {int(g.parentFrame) for g in geometry.geometryObjects}
+    bare = [] if 0 in carried_joints else [0]
+    for joint in range(1, model.njoints):
+        links = [
+            k
+            for k, frame in enumerate(model.frames)
+            if frame.type == pin.FrameType.BODY
+            and model.frames[frame.parentFrame].type == pin.FrameType.JOINT
+            and int(model.frames[frame.parentFrame].parentJoint) == joint
+        ]
+        if not any(k in carried_frames for k in links) and (links or joint not in carried_joints):
+            bare.append(joint)
+    return bare
 
 
 def content_digest(*parts: bytes) -> str:

@@ -9,12 +9,15 @@ object no joint moves it relative to (its weights in :func:`solver.path.cell.bou
 all zero) and that stands on it: the base, whatever the placement, and a link only joint 1
 turns about a fixed halfspace's normal, joint 1's origin on or above the halfspace's boundary
 (joint 1's link of an arm on its table; a table top above joint 1 cuts the arm's turning part,
-and is checked: it collides everywhere, as cell.md section 5 has it). Such a pair's
-distance is the same at every configuration and placement: were it checked, an arm whose
-joint-1 link touches its table (a capsule along that link from joint 1's origin at the foot,
-as given to a URDF whose meshes are elsewhere: ROS-Industrial's ABB IRB 2400 and IRB 5400
-read with a table at z = 0) would collide at every placement, whatever the path. Those pairs
-and their distance are reported (:attr:`CellScene.unchecked`), not silently dropped. And the
+and is checked: it collides everywhere, as cell.md section 5 has it), clear of it or seated in
+it (:func:`_seated`: only a capsule made along the link, as deep as its radius; a link's own
+geometry reaching into the table, the Panda's link 1 hanging down to its base below a table
+top, is checked and collides everywhere). Such a pair's distance is the same at every
+configuration and placement: were it checked, an arm whose joint-1 link touches its table (a
+capsule along that link from joint 1's origin at the foot, as given to a URDF whose meshes are
+elsewhere: ROS-Industrial's ABB IRB 2400 and IRB 5400 read with a table at z = 0) would
+collide at every placement, whatever the path. Those pairs and their distance are reported
+(:attr:`CellScene.unchecked`), not silently dropped. And the
 robot's parts against each other where they are on joints that are neither the same nor
 adjacent and do not touch at the zero configuration (come within :data:`TOUCH` there): a
 choice of the robot and the cell's shapes, not of the request's clearance, so that a larger
@@ -32,7 +35,7 @@ import pinocchio as pin
 from solver.core.robots import Robot
 from solver.path.cell import fast
 from solver.path.cell.bounds import pair_weights
-from solver.path.cell.robot_geometry import robot_geometry
+from solver.path.cell.robot_geometry import CAPSULE_SUFFIX, robot_geometry
 from solver.path.cell.shapes import DEFAULT_CLEARANCE, Cell
 from solver.path.cell.verdict import Unchecked
 
@@ -99,11 +102,19 @@ def build_scene(robot: Robot, cell: Cell) -> CellScene:
         for k in range(len(shapes))
         if not (part == made.cutting and k >= len(cell.fixed))
     ]
-    pairs, weights, still = _moving(robot.model, geometry, pairs, n_robot, len(cell.fixed))
+    pairs, weights, standing = _moving(robot.model, geometry, pairs, n_robot, len(cell.fixed))
     candidates = _self_candidates(robot.model, geometry, n_robot)
-    # one coal probe for the unchecked pairs' distances and the self pairs' at q = 0
-    distances = _distances(robot.model, geometry, still + candidates)
-    apart = distances[len(still) :]
+    # one coal probe for the standing pairs' distances and the self pairs' at q = 0
+    distances = _distances(robot.model, geometry, [p for p, _ in standing] + candidates)
+    still, still_distances = [], []
+    for (pair, weight), distance in zip(standing, distances[: len(standing)], strict=True):
+        if _seated(geometry, pair[0], distance):
+            still.append(pair)
+            still_distances.append(distance)
+        else:  # a link that reaches into its table: in collision at every configuration
+            pairs.append(pair)
+            weights = np.vstack([weights, weight[None]])
+    apart = distances[len(standing) :]
     own = [p for p, d in zip(candidates, apart, strict=True) if d > TOUCH]
     pairs += own
     weights = np.vstack([weights, pair_weights(robot.model, geometry, own, n_robot)])
@@ -134,7 +145,7 @@ def build_scene(robot: Robot, cell: Cell) -> CellScene:
             Unchecked(
                 geometry.geometryObjects[a].name, b - n_robot, cell.obstacle_name(b - n_robot), d
             )
-            for (a, b), d in zip(still, distances[: len(still)], strict=True)
+            for (a, b), d in zip(still, still_distances, strict=True)
         ),
     )
 
@@ -145,10 +156,11 @@ def _moving(
     pairs: list[tuple[int, int]],
     n_robot: int,
     n_fixed: int,
-) -> tuple[list[tuple[int, int]], np.ndarray, list[tuple[int, int]]]:
+) -> tuple[list[tuple[int, int]], np.ndarray, list[tuple[tuple[int, int], np.ndarray]]]:
     """The pairs a joint can bring nearer with their weights; the ``fixed`` ones none can.
 
-    See the module docstring; the weights are :func:`pair_weights`' (P, nv).
+    See the module docstring; the weights are :func:`pair_weights`' (P, nv). The pairs no joint
+    moves, standing on their obstacle (:func:`_stands`), come last with their weights' rows.
     """
     weights = pair_weights(model, geometry, pairs, n_robot, n_fixed=n_fixed)
     data = model.createData()
@@ -163,7 +175,27 @@ def _moving(
         dtype=bool,
     )
     moving = [p for p, s in zip(pairs, still, strict=True) if not s]
-    return moving, weights[~still], [p for p, s in zip(pairs, still, strict=True) if s]
+    standing = [(p, w) for p, w, s in zip(pairs, weights, still, strict=True) if s]
+    return moving, weights[~still], standing
+
+
+def _seated(geometry: pin.GeometryModel, part: int, distance: float) -> bool:
+    """Whether a standing pair's overlap (``distance`` < 0, the same everywhere) is a seat.
+
+    The base is seated on whatever it stands in (cell.md section 3 checks it against nothing
+    fixed). A link's own geometry (a mesh, a URDF primitive) that reaches into the table below
+    its joint is in it at every configuration: a table top between the Panda's base (up to
+    0.141 m) and joint 1 (0.333 m) cut link 1, which hangs down to the base, and every placement
+    ran (the cell audit, stop 53): such a pair is checked. A capsule the service made along the
+    link (no geometry of its own) from joint 1's origin on the table is seated as deep as its
+    radius (the ROS-Industrial IRB 2400's from its foot).
+    """
+    obj = geometry.geometryObjects[part]
+    if int(obj.parentJoint) == 0 or distance >= 0.0:
+        return True
+    shape = obj.geometry
+    made = obj.name.endswith(CAPSULE_SUFFIX) and isinstance(shape, (coal.Capsule, coal.Sphere))
+    return made and distance >= -float(shape.radius) - STILL
 
 
 def _stands(geometry: pin.GeometryModel, data: pin.Data, part: int, obstacle: int) -> bool:
