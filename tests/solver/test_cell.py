@@ -340,7 +340,13 @@ def binary_stl(triangles: np.ndarray) -> bytes:
     return b"\0" * 80 + struct.pack("<I", len(triangles)) + body
 
 
-@pytest.mark.parametrize("writer", [ascii_stl, binary_stl])
+def upper_case_ascii_stl(triangles: np.ndarray) -> bytes:
+    """An ASCII STL of the triangles in upper case (SOLID, FACET NORMAL, VERTEX), as some CAD
+    exporters write it: it was read as a binary STL of 1,414,677,846 triangles and refused."""
+    return ascii_stl(triangles).upper()
+
+
+@pytest.mark.parametrize("writer", [ascii_stl, binary_stl, upper_case_ascii_stl])
 def test_an_stl_cube_is_the_box_for_coal(writer: object) -> None:
     triangles = read_stl(writer(cube_triangles(100.0)), max_triangles=12, units="mm")  # type: ignore[operator]
     np.testing.assert_allclose(triangles, cube_triangles(0.1), atol=1e-7)

@@ -17,7 +17,9 @@ from solver.core.spatial import MAX_COORDINATE
 UNITS = {"m": 1.0, "mm": 0.001, "cm": 0.01, "in": 0.0254}
 _HEADER = 80
 _RECORD = 50  # bytes per binary triangle: normal, three corners (float32), attribute
-_VERTEX = re.compile(rb"vertex\s+(\S+)\s+(\S+)\s+(\S+)")
+# ASCII STL's keywords in any case: exporters write SOLID, FACET NORMAL, VERTEX too
+_VERTEX = re.compile(rb"vertex\s+(\S+)\s+(\S+)\s+(\S+)", re.I)
+_FACET = re.compile(rb"facet\s+normal", re.I)
 
 
 def read_stl(
@@ -46,7 +48,7 @@ def read_stl(
     """
     if units not in UNITS:
         raise InvalidInputError(f"{field}.units", f"unknown unit {units!r}; use {', '.join(UNITS)}")
-    if data.lstrip()[:5].lower() == b"solid" and b"facet" in data[:4096]:
+    if data.lstrip()[:5].lower() == b"solid" and _FACET.search(data[:4096]):
         triangles = _ascii(data, (max_triangles, setting), field)
     else:
         triangles = _binary(data, (max_triangles, setting), field)
@@ -64,7 +66,7 @@ def read_stl(
 
 def _ascii(data: bytes, limit: tuple[int, str], field: str) -> np.ndarray:
     """Triangles of an ASCII STL: every three ``vertex`` lines."""
-    count = data.count(b"facet normal")
+    count = len(_FACET.findall(data))
     if count > limit[0]:
         raise _too_many(count, limit, field)
     try:
