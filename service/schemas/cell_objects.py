@@ -139,9 +139,16 @@ class HalfspaceObject(RequestModel):
     shape: Literal["halfspace"] = Field(description="The kind of object.")
     name: Name | None = Field(default=None, description="Named in a collision's report.")
     normal: list[UnitComponent] = Field(
-        min_length=3, max_length=3, description="Outward normal (made unit)."
+        min_length=3,
+        max_length=3,
+        description="n: the outward normal, each component within +-1.001 (a unit vector's).",
     )
-    offset: float = Field(ge=-MAX_SIZE, le=MAX_SIZE, description="d (m, along the unit normal).")
+    offset: float = Field(
+        ge=-MAX_SIZE,
+        le=MAX_SIZE,
+        description="d (m): the points p with n . p <= d (n as given: with a unit n, d is the "
+        "boundary's distance from the origin; n = [0, 0, 0.5] and d = 0.05 is z <= 0.1).",
+    )
 
     def to_solver(self, field: str, max_triangles: int) -> Shape:
         """The solver's halfspace."""
