@@ -221,7 +221,10 @@ class EvaluateResponse(ResponseModel):
     spins: list[float] | None = Field(
         default=None,
         description="In free spin mode, the tool spin (rad) about each waypoint's tool axis that "
-        "realises mu_path (the waypoints' q follow it); null in fixed mode or when infeasible.",
+        "realises mu_path (the waypoints' q follow it: exactly for a straight spindle; for an "
+        "angled or offset one, to first order in the spin, and mu_path is the instantaneous "
+        "bound at the given spin's configurations, cam.md section 2: these spins in fixed mode "
+        "give the exact joint path and its mu_path); null in fixed mode or when infeasible.",
     )
     axis_correction: float = Field(
         default=0.0,
