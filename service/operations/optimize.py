@@ -11,7 +11,7 @@ from solver.core.parallel import TaskRunner
 from solver.core.progress import Progress
 from solver.optimise.optimize import optimize_placement
 from solver.optimise.search_space import PlacementBounds
-from solver.optimise.work import COARSE_MAP, work_of
+from solver.optimise.work import COARSE_MAP, seeds_from_map, work_of
 from solver.path.cycle_time import cycle_time
 from solver.path.problem import PathProblem
 
@@ -79,9 +79,19 @@ def check_work(
         InvalidInputError: on ``bounds``, saying the phases, the work and the limit.
     """
     bounds.check()
-    work = work_of(problem, bounds, method=body.method, max_spin_step=max_spin_step_of(body))
-    weighed = work.weighed(problem)
     limits = settings.map_limits()
+    # the scipy method also starts from the coarse map where that fits (as it will decide)
+    seeded = body.method == "scipy" and seeds_from_map(
+        problem, bounds, max_cells=limits.cells, max_poses=limits.search_poses
+    )
+    work = work_of(
+        problem,
+        bounds,
+        method=body.method,
+        max_spin_step=max_spin_step_of(body),
+        seed_map=seeded,
+    )
+    weighed = work.weighed(problem)
     if body.method == "scipy":
         limit, setting = limits.search_poses, limits.search_setting
         hint = "; fix a variable, shorten the path, or use method casadi"

@@ -61,6 +61,8 @@ class Search:
         tried: where the search keeps the placements it tries on the whole path (its coarse
             map's, its evolution's), for a failure's tally (:mod:`solver.optimise.failures`);
             None keeps none.
+        seed_map: the scipy method also starts from the coarse map's maxima, as the casadi
+            method does (:func:`solver.optimise.work.seeds_from_map`: where they fit).
     """
 
     symmetric: bool
@@ -74,3 +76,4 @@ class Search:
     runner: TaskRunner = SERIAL
     active_set: bool = True
     tried: Tried | None = None
+    seed_map: bool = False

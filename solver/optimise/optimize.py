@@ -33,6 +33,7 @@ from solver.optimise.methods import Method, method_named
 from solver.optimise.optimum import PlacementOptimum, SolverReport
 from solver.optimise.search_space import PlacementBounds, variables_of, vector_of
 from solver.optimise.symmetry import arc_coordinates, arc_point, symmetric_search
+from solver.optimise.work import seeds_from_map
 from solver.path.evaluate import PathEvaluation, evaluate_path, with_min_clearance
 from solver.path.joint_path import EXACT_POSE_TOLERANCE, evaluate_joint_path
 from solver.path.problem import PathProblem
@@ -154,6 +155,15 @@ def optimize_placement(
     )
     chosen_method.check(problem, bounds, settings)
     problem.prepared  # noqa: B018 - the path is checked before the options (evaluate_path's)
+    if method == "scipy":
+        seeded = seeds_from_map(
+            problem,
+            bounds,
+            max_cells=max_coarse_cells,
+            max_poses=max_search_poses,
+            active_set=active_set,
+        )
+        settings = dataclasses.replace(settings, seed_map=seeded)
     start_evaluation = evaluate_path(problem, start, thorough=False)  # its reason and mu
     candidates, iterations = chosen_method.search(problem, bounds, settings)
     # The start last: it is the answer only when nothing the solver found is better.

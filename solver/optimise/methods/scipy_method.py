@@ -1,7 +1,9 @@
 """The ``scipy`` method: differential evolution, compass refinement, SLSQP, Nelder-Mead climbs.
 
 Differential evolution over the free variables, every generation one batch through
-:mod:`solver.path.placements`; each basin it saw is climbed by the compass search, then
+:mod:`solver.path.placements`, beside the casadi method's coarse map where it fits (its maxima
+ranked with the evolution's basins: :func:`solver.optimise.work.seeds_from_map`); each basin
+is climbed by the compass search, then
 polished by SLSQP on the epigraph form with finite-difference gradients on the branch it ends
 on (:mod:`solver.optimise.methods.placement_scipy`); Nelder-Mead climbs mu_path from the best.
 With a cell, a polish that is not clear of it is also backed off towards its start
@@ -23,8 +25,8 @@ from solver.optimise.active_set import (
 )
 from solver.optimise.back_off import back_off
 from solver.optimise.candidate import ZERO_SPEED, Candidate, Search
-from solver.optimise.coarse_search import Cell
-from solver.optimise.local_search import climbs, refine_cells
+from solver.optimise.coarse_search import Cell, coarse_cells
+from solver.optimise.local_search import REFINED_CELLS, climbs, refine_cells
 from solver.optimise.methods.placement_scipy import (
     Basin,
     SearchSize,
@@ -98,22 +100,28 @@ def search(
     placement costs more).
     """
     progress, size = settings.progress, size_of(problem, bounds)
-    basins, iterations = _global(problem, bounds, size, span(progress, 0.0, 0.6), settings)
+    evolved = span(progress, 0.0, 0.5 if settings.seed_map else 0.6)
+    basins, iterations = _global(problem, bounds, size, evolved, settings)
+    best = "best placement of differential evolution"
+    if settings.seed_map:
+        basins, best = _with_map(problem, bounds, basins, size, span(progress, 0.5, 0.6), settings)
     if not basins:
         return [], iterations
     if problem.prepared.pure_rotation.any() or basins[0][1] <= 0.0:
         return [Candidate(basins[0][0], ZERO_SPEED)], iterations
-    candidates = [Candidate(basins[0][0], "best placement of differential evolution")]
+    candidates = [Candidate(basins[0][0], best)]
     # Each basin's best point climbed by the compass search (which may change the branch),
     # then polished on the branch it ends on.
     refined = refine_cells(
         problem,
         bounds,
         [Cell(vector, mu, branch) for vector, mu, branch in basins],
+        count=refined_cells(settings.seed_map, size),
         runner=settings.runner,
     )
-    if refined:
+    if refined:  # the best size.basins polished (a coarse map's basin may start low)
         basins = [(cell.vector, cell.mu_path, cell.branch) for cell in refined]
+    basins = basins[: size.basins]
     for k, (placement, mu_path, branch) in enumerate(basins):
         part = span(progress, 0.6 + 0.35 * k / len(basins), 0.6 + 0.35 * (k + 1) / len(basins))
         on_branch = problem.family.branches[branch]
@@ -127,6 +135,49 @@ def search(
             candidates.append(backed)
     candidates += climbs(problem, bounds, refined)
     return candidates, iterations
+
+
+def refined_cells(seed_map: bool, size: SearchSize) -> int:
+    """How many basins the compass search climbs: the casadi method's count with the map."""
+    return REFINED_CELLS if seed_map else size.basins
+
+
+def _with_map(
+    problem: PathProblem,
+    bounds: PlacementBounds,
+    basins: list[Basin],
+    size: SearchSize,
+    progress: Progress | None,
+    settings: Search,
+) -> tuple[list[Basin], str]:
+    """Differential evolution's basins and the coarse map's maxima, best first.
+
+    The map is the casadi method's (:func:`solver.optimise.coarse_search.coarse_cells`), its
+    size checked before the search (:func:`solver.optimise.work.seeds_from_map`). Returns the
+    basins, best first (evolution's first among equals), and what the best one is. All go to
+    the compass search (its best REFINED_CELLS, as the casadi method's): a map's basin that
+    holds the optimum may start at its sixth maximum.
+    """
+    cells = coarse_cells(
+        problem,
+        bounds,
+        symmetric=settings.symmetric,
+        near=settings.near,
+        max_cells=settings.max_coarse_cells,
+        progress=progress,
+        runner=settings.runner,
+        tried=settings.tried,
+    )
+    mapped = [(cell.vector, cell.mu_path, cell.branch) for cell in cells]
+    merged = sorted(
+        [(basin, True) for basin in basins] + [(basin, False) for basin in mapped],
+        key=lambda item: -item[0][1],
+    )
+    if not merged:
+        return [], ""
+    evolved = merged[0][1]
+    best = "best placement of differential evolution" if evolved else "best cell of the coarse map"
+    return [basin for basin, _ in merged], best
 
 
 def _global(
