@@ -102,7 +102,8 @@ class OptimizeRequest(RequestModel):
     method: Literal["casadi", "scipy"] = Field(
         default="casadi",
         description="casadi: IPOPT from the best cells of a coarse map; scipy: differential "
-        "evolution, then SLSQP.",
+        "evolution, then SLSQP (from the coarse map's best cells too, where that map and the "
+        "search fit their limits).",
     )
     ik: AutoIkPolicy = Field(
         default_factory=AutoIkPolicy,
