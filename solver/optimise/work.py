@@ -44,6 +44,8 @@ from solver.path.problem import PathProblem
 
 COARSE_MAP = "coarse map"
 """The name of the casadi method's coarse map among the phases."""
+BOX_CORNERS = "box corners"
+"""The box's corners, evaluated beside the coarse map (:func:`coarse_search.box_corners`)."""
 SINGLE_PLACEMENT_COST = 2.5
 """The weight of a placement evaluated on its own, against one evaluated in a batch."""
 
@@ -168,6 +170,7 @@ def work_of(
                 Phase("start", 1, n, one_at_a_time=True),
                 Phase(COARSE_MAP, seeds, mapped_waypoints(n)),
                 Phase("coarse map's whole-path checks", map_checks(n) if seed_map else 0, n),
+                Phase(BOX_CORNERS, (1 << free) if seed_map else 0, n),
                 Phase(
                     "differential evolution", evolutions * search_placements(bounds, size), searched
                 ),
@@ -197,6 +200,7 @@ def work_of(
             # A long program's map on a set: its sample and best cells checked on the whole path
             # (solver.optimise.coarse_rows).
             Phase("coarse map's whole-path checks", map_checks(n), n),
+            Phase(BOX_CORNERS, 1 << free, n),
             Phase("refinement", refined_count(problem, bounds) * 2 * free * REFINE_ROUNDS, n),
             Phase("IPOPT starts and whole-path checks", solves, n, one_at_a_time=True),
             Phase("Nelder-Mead climbs", climbs, n, one_at_a_time=True),

@@ -21,7 +21,7 @@ import numpy as np
 import pytest
 
 from solver.families import get_robot
-from solver.optimise import active_set, back_off, coarse_rows, local_search
+from solver.optimise import active_set, back_off, coarse_rows, coarse_search, local_search
 from solver.optimise import optimize as front_door
 from solver.optimise.coarse_search import MAX_COARSE_CELLS, coarse_cells
 from solver.optimise.methods import casadi_method, placement_scipy
@@ -40,7 +40,7 @@ SMALL_BOX = PlacementBounds(x=(-0.1, 0.1), y=(0.4, 0.5), yaw=(-0.3, 0.3), z=0.1)
 PHASES = {
     "casadi": {
         "front door": ("start", "candidates"),
-        "global": ("coarse map",),
+        "global": ("coarse map", "box corners"),
         "refinement": ("refinement",),
         "climbs": ("Nelder-Mead climbs",),
         "solves": ("IPOPT starts and whole-path checks",),
@@ -48,7 +48,7 @@ PHASES = {
     },
     "scipy": {
         "front door": ("start", "candidates"),
-        "global": ("differential evolution", "coarse map"),
+        "global": ("differential evolution", "coarse map", "box corners"),
         "refinement": ("refinement",),
         "climbs": ("Nelder-Mead climbs",),
         "solves": ("whole-path checks",),
@@ -105,6 +105,11 @@ def counted(monkeypatch: pytest.MonkeyPatch) -> Counted:
     )
     monkeypatch.setattr(
         coarse_rows, "evaluate_placements", counts.wrap("global", coarse_rows.evaluate_placements)
+    )
+    monkeypatch.setattr(  # the box's corners
+        coarse_search,
+        "evaluate_placements",
+        counts.wrap("global", coarse_search.evaluate_placements),
     )
     monkeypatch.setattr(
         placement_scipy,
