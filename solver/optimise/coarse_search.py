@@ -18,6 +18,7 @@ from solver.core.exceptions import InvalidInputError
 from solver.core.parallel import SERIAL, TaskRunner
 from solver.core.progress import Progress
 from solver.core.spatial import MAX_COORDINATE
+from solver.optimise.candidate import Search
 from solver.optimise.coarse_rows import map_values, mapped_waypoints
 from solver.optimise.failures import Tried
 from solver.optimise.search_space import PlacementBounds, decision_vector
@@ -284,6 +285,28 @@ def coarse_cells(
             cells.append(Cell(vector, float(mu[k]), int(branch[k])))
     corners = box_corners(problem, bounds, runner=runner, tried=tried)
     return sorted(cells + corners, key=lambda cell: -cell.mu_path)  # stable: the map's first
+
+
+def search_cells(
+    problem: PathProblem,
+    bounds: PlacementBounds,
+    settings: Search,
+    *,
+    progress: Progress | None,
+    max_poses: int | None = None,
+) -> list[Cell]:
+    """:func:`coarse_cells` with a search's settings (its symmetry, start, limit, runner, tally)."""
+    return coarse_cells(
+        problem,
+        bounds,
+        symmetric=settings.symmetric,
+        near=settings.near,
+        max_cells=settings.max_coarse_cells,
+        max_poses=max_poses,
+        progress=progress,
+        runner=settings.runner,
+        tried=settings.tried,
+    )
 
 
 def corner_vectors(bounds: PlacementBounds) -> np.ndarray:

@@ -27,7 +27,7 @@ from solver.optimise.active_set import (
 )
 from solver.optimise.back_off import back_off
 from solver.optimise.candidate import ZERO_SPEED, Candidate, Search
-from solver.optimise.coarse_search import Cell, coarse_cells
+from solver.optimise.coarse_search import Cell, search_cells
 from solver.optimise.local_search import climbs, refine_cells
 from solver.optimise.methods.placement_nlp import NlpResult, PlacementNlp
 from solver.optimise.search_space import PlacementBounds
@@ -55,16 +55,12 @@ def search(
     spin rate 0 (a feasible start at the fixed-spin mu_path), and IPOPT frees the rate.
     """
     progress, runner = settings.progress, settings.runner
-    cells = coarse_cells(
+    cells = search_cells(
         problem,
         bounds,
-        symmetric=settings.symmetric,
-        near=settings.near,
-        max_cells=settings.max_coarse_cells,
-        max_poses=settings.max_coarse_poses,
+        settings,
         progress=span(progress, 0.0, 0.25),
-        runner=runner,
-        tried=settings.tried,
+        max_poses=settings.max_coarse_poses,
     )
     cells = refine_cells(problem, bounds, cells, progress=span(progress, 0.25, 0.3), runner=runner)
     if not cells:

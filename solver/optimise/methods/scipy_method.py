@@ -25,7 +25,7 @@ from solver.optimise.active_set import (
 )
 from solver.optimise.back_off import back_off
 from solver.optimise.candidate import ZERO_SPEED, Candidate, Search
-from solver.optimise.coarse_search import Cell, coarse_cells
+from solver.optimise.coarse_search import Cell, search_cells
 from solver.optimise.local_search import REFINED_CELLS, climbs, refine_cells
 from solver.optimise.methods.placement_scipy import (
     Basin,
@@ -158,16 +158,7 @@ def _with_map(
     the compass search (its best REFINED_CELLS, as the casadi method's): a map's basin that
     holds the optimum may start at its sixth maximum.
     """
-    cells = coarse_cells(
-        problem,
-        bounds,
-        symmetric=settings.symmetric,
-        near=settings.near,
-        max_cells=settings.max_coarse_cells,
-        progress=progress,
-        runner=settings.runner,
-        tried=settings.tried,
-    )
+    cells = search_cells(problem, bounds, settings, progress=progress)
     mapped = [(cell.vector, cell.mu_path, cell.branch) for cell in cells]
     merged = sorted(
         [(basin, True) for basin in basins] + [(basin, False) for basin in mapped],
