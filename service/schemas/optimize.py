@@ -318,7 +318,11 @@ class OptimizeResponse(ResponseModel):
     placement: PlacementResult | None = Field(
         description="The optimum, inside the bounds (m, rad)."
     )
-    mu_path: float | None = Field(description="mu_path there (m/s), as /v1/evaluate gives it.")
+    mu_path: float | None = Field(
+        description="mu_path there (m/s), as /v1/evaluate gives it (given the answer's spins or "
+        "joint_path where it has them: a redundant arm's casadi optimum is its NLP's joint path, "
+        "which the tracked IK of /v1/evaluate without it may run slower)."
+    )
     mu_acc: float | None = Field(
         default=None,
         description="With robot.joint_acceleration_limits: mu_acc there (m/s), as /v1/evaluate "
