@@ -9,6 +9,7 @@ from service.schemas import OptimizeRequest, OptimizeResponse
 from solver.core.exceptions import InvalidInputError
 from solver.core.parallel import TaskRunner
 from solver.core.progress import Progress
+from solver.optimise.methods import method_named
 from solver.optimise.optimize import optimize_placement
 from solver.optimise.search_space import PlacementBounds
 from solver.optimise.work import COARSE_MAP, seeds_from_map, work_of
@@ -81,7 +82,7 @@ def check_work(
     bounds.check()
     limits = settings.map_limits()
     # the scipy method also starts from the coarse map where that fits (as it will decide)
-    seeded = body.method == "scipy" and seeds_from_map(
+    seeded = method_named(body.method).map_seeds and seeds_from_map(
         problem, bounds, max_cells=limits.cells, max_poses=limits.search_poses
     )
     work = work_of(

@@ -155,7 +155,7 @@ def optimize_placement(
     )
     chosen_method.check(problem, bounds, settings)
     problem.prepared  # noqa: B018 - the path is checked before the options (evaluate_path's)
-    if method == "scipy":
+    if chosen_method.map_seeds:
         seeded = seeds_from_map(
             problem,
             bounds,

@@ -35,17 +35,23 @@ class Method:
         search: the entry point: candidates and the solver's iterations.
         check: refuses a search too large before any work.
         spin_path: whether it also gives each waypoint its own spin (cam.md section 4).
+        map_seeds: whether it also starts from the coarse map's maxima where the map fits, a
+            choice made before it runs (:func:`solver.optimise.work.seeds_from_map`; the casadi
+            method always starts from them).
     """
 
     description: str
     search: SearchFunction
     check: CheckFunction = _no_check
     spin_path: bool = False
+    map_seeds: bool = False
 
 
 METHODS: dict[str, Method] = {
     "casadi": Method(casadi_method.DESCRIPTION, casadi_method.search, spin_path=True),
-    "scipy": Method(scipy_method.DESCRIPTION, scipy_method.search, scipy_method.check),
+    "scipy": Method(
+        scipy_method.DESCRIPTION, scipy_method.search, scipy_method.check, map_seeds=True
+    ),
 }
 
 
