@@ -97,6 +97,24 @@ class OptimisationWork:
         )
 
 
+def _coarse_map_phases(problem: PathProblem, bounds: PlacementBounds) -> tuple[Phase, ...]:
+    """The coarse map's phases (:func:`solver.optimise.coarse_search.coarse_cells`).
+
+    Its cells; a long program's map on a set has its sample and best cells checked on the whole
+    path (:mod:`solver.optimise.coarse_rows`); the box's corners, on the whole path.
+    """
+    n = problem.prepared.n_waypoints
+    return (
+        Phase(
+            COARSE_MAP,
+            coarse_map_cells(bounds, symmetric=symmetric_search(problem)),
+            mapped_waypoints(n),
+        ),
+        Phase("coarse map's whole-path checks", map_checks(n), n),
+        Phase(BOX_CORNERS, 1 << int(bounds.free.sum()), n),
+    )
+
+
 def seeds_from_map(
     problem: PathProblem,
     bounds: PlacementBounds,
@@ -164,13 +182,10 @@ def work_of(
         evolutions = SEARCH_ROUNDS if on_rows else 1
         searched = searched_waypoints(n) if on_rows else n
         verified = whole_path_checks(size.basins) if on_rows else 0
-        seeds = coarse_map_cells(bounds, symmetric=symmetric_search(problem)) if seed_map else 0
         return OptimisationWork(
             (
                 Phase("start", 1, n, one_at_a_time=True),
-                Phase(COARSE_MAP, seeds, mapped_waypoints(n)),
-                Phase("coarse map's whole-path checks", map_checks(n) if seed_map else 0, n),
-                Phase(BOX_CORNERS, (1 << free) if seed_map else 0, n),
+                *(_coarse_map_phases(problem, bounds) if seed_map else ()),
                 Phase(
                     "differential evolution", evolutions * search_placements(bounds, size), searched
                 ),
@@ -188,7 +203,6 @@ def work_of(
                 Phase("candidates", 2 + (1 + backed) * size.basins + N_CLIMBS, n, True),
             )
         )
-    cells = coarse_map_cells(bounds, symmetric=symmetric_search(problem))
     starts = casadi_method.N_STARTS
     # Each IPOPT start: its cell evaluated on its branch, then (on active sets) the first
     # set's whole-path bounds and one whole-path check after each of its solves.
@@ -196,11 +210,7 @@ def work_of(
     return OptimisationWork(
         (
             Phase("start", 1, n, one_at_a_time=True),
-            Phase(COARSE_MAP, cells, mapped_waypoints(n)),
-            # A long program's map on a set: its sample and best cells checked on the whole path
-            # (solver.optimise.coarse_rows).
-            Phase("coarse map's whole-path checks", map_checks(n), n),
-            Phase(BOX_CORNERS, 1 << free, n),
+            *_coarse_map_phases(problem, bounds),
             Phase("refinement", refined_count(problem, bounds) * 2 * free * REFINE_ROUNDS, n),
             Phase("IPOPT starts and whole-path checks", solves, n, one_at_a_time=True),
             Phase("Nelder-Mead climbs", climbs, n, one_at_a_time=True),
