@@ -210,27 +210,41 @@ def test_a_new_path_or_robot_clears_the_map_the_optimum_and_the_cell(
     assert (page.text_content("#job-status") or "").startswith("map cleared: ")
 
 
+class Held:
+    """The page's API requests of one method to URLs holding ``part``, held while ``holding``;
+    every other request goes on."""
+
+    def __init__(self, page: Page, method: str, part: str) -> None:
+        self.routes: list[Route] = []
+        self.holding = True
+
+        def hold(route: Route) -> None:
+            request = route.request
+            if self.holding and request.method == method and part in request.url:
+                self.routes.append(route)
+            else:
+                route.continue_()
+
+        page.route("**/v1/**", hold)
+
+    def first(self, page: Page) -> None:
+        """Wait until one request is held."""
+        while not self.routes:
+            page.wait_for_timeout(50)
+
+
 def test_a_map_run_during_an_optimisation_cancels_it(page: Page) -> None:
     """Run asks a map of the inputs as they are now: an optimisation under way (of the inputs
     when Optimise was clicked) is cancelled and its answer never shown; its mu_path line says
     so. (An optimum kept across a Run was marked on a map of other inputs: the README's
     cell example then showed the no-cell optimum's marker on the collision cell.)"""
-    held: list[Route] = []
-
-    def hold(route: Route) -> None:
-        if route.request.method == "POST" and "/v1/optimize" in route.request.url:
-            held.append(route)
-        else:
-            route.continue_()
-
-    page.route("**/v1/**", hold)
+    held = Held(page, "POST", "/v1/optimize")
     fill(page, SMALL)
     page.click("#optimize")
-    while not held:
-        page.wait_for_timeout(50)
+    held.first(page)
     page.click("#run")
     page.wait_for_function("document.getElementById('summary').dataset.cells", timeout=20_000)
-    for route in held:
+    for route in held.routes:
         route.abort()
     assert (page.text_content("#opt-mu") or "").startswith("cancelled: a map was run")
     assert page.query_selector(".panel canvas[data-optimum='1']") is None
@@ -239,25 +253,14 @@ def test_a_map_run_during_an_optimisation_cancels_it(page: Page) -> None:
 
 def test_an_optimum_found_while_a_map_job_runs_is_marked_on_its_map(page: Page) -> None:
     """The optimum comes first, the map after: it is marked on the map once drawn."""
-    held: list[Route] = []
-    holding = True
-
-    def hold(route: Route) -> None:
-        request = route.request
-        if holding and request.method == "GET" and "/v1/jobs/" in request.url:
-            held.append(route)
-        else:
-            route.continue_()
-
-    page.route("**/v1/**", hold)
+    held = Held(page, "GET", "/v1/jobs/")
     fill(page, SMALL)
     page.click("#run")
-    while not held:
-        page.wait_for_timeout(50)
+    held.first(page)
     page.click("#optimize")
     page.wait_for_function("document.getElementById('opt-where').textContent", timeout=20_000)
-    holding = False
-    for route in held:
+    held.holding = False
+    for route in held.routes:
         route.continue_()
     page.wait_for_selector(".panel canvas[data-optimum='1']", timeout=20_000)
     assert page.is_visible("#opt-mu-line") and page.is_visible("#frames")
