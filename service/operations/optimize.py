@@ -98,7 +98,7 @@ def check_work(
         hint = "; fix a variable, shorten the path, or use method casadi"
     else:
         limit, setting, hint = limits.poses, limits.poses_setting, "; narrow the bounds"
-        cells = work.placements(COARSE_MAP)
+        cells = work.placements(COARSE_MAP, search="")  # a narrower search's map is smaller
         if cells > limits.cells:
             raise InvalidInputError(
                 "bounds",

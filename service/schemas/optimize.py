@@ -40,7 +40,8 @@ class Bounds(RequestModel):
         default=[0.0, 0.0],
         description="[min, max] of the constant tool spin about each waypoint's tool axis (rad, "
         "cam.md section 3), at most a turn wide; default [0, 0] (no spin). It matters for an "
-        "angled or offset spindle.",
+        "angled or offset spindle. A range containing 0 also runs the search without spin "
+        "(its work counted with the rest), so the answer is never below that search's.",
     )
 
     z: Range | None = Field(
@@ -125,7 +126,9 @@ class OptimizeRequest(RequestModel):
     spin_path: SpinPath | None = Field(
         default=None,
         description="With the casadi method and spin_mode fixed: give each waypoint its own "
-        "tool spin, its steps bounded (cam.md section 4); the answer's spins then hold them.",
+        "tool spin, its steps bounded (cam.md section 4); the answer's spins then hold them. "
+        "The constant-spin search runs too (its work counted): the answer is never below "
+        "that search's.",
     )
 
     @model_validator(mode="after")

@@ -23,17 +23,18 @@ import numpy as np
 
 from solver.core.exceptions import InvalidInputError
 from solver.core.parallel import SERIAL, TaskRunner
-from solver.core.progress import Progress
+from solver.core.progress import Progress, span
 from solver.core.robots import Robot
 from solver.core.spatial import Placement, spun_waypoints
 from solver.optimise.candidate import Candidate, Search
 from solver.optimise.coarse_search import MAX_COARSE_CELLS
 from solver.optimise.failures import Tried, search_failure
 from solver.optimise.methods import Method, method_named
+from solver.optimise.narrower import narrower_searches
 from solver.optimise.optimum import PlacementOptimum, SolverReport
 from solver.optimise.search_space import PlacementBounds, variables_of, vector_of
 from solver.optimise.symmetry import arc_coordinates, arc_point, symmetric_search
-from solver.optimise.work import seeds_from_map
+from solver.optimise.work import seeds_from_map, work_of
 from solver.path.evaluate import PathEvaluation, evaluate_path, with_min_clearance
 from solver.path.joint_path import EXACT_POSE_TOLERANCE, evaluate_joint_path
 from solver.path.problem import PathProblem
@@ -165,7 +166,7 @@ def optimize_placement(
         )
         settings = dataclasses.replace(settings, seed_map=seeded)
     start_evaluation = evaluate_path(problem, start, thorough=False)  # its reason and mu
-    candidates, iterations = chosen_method.search(problem, bounds, settings)
+    candidates, iterations = _searched(problem, bounds, chosen_method, settings, method)
     # The start last: it is the answer only when nothing the solver found is better.
     candidates = [
         *candidates,
@@ -215,6 +216,64 @@ def optimize_placement(
         active_waypoints=None if chosen.rows is None else len(chosen.rows),
         start_evaluation=start_evaluation,
     )
+
+
+def _searched(
+    problem: PathProblem,
+    bounds: PlacementBounds,
+    method: Method,
+    settings: Search,
+    name: str,
+) -> tuple[list[Candidate], int]:
+    """The method's candidates over the box, then each narrower search's; its iterations.
+
+    The narrower searches (:mod:`solver.optimise.narrower`: without spin, with a constant spin)
+    run with the same method and settings, each with its box's centre as its start, so the
+    answer is never below any of their own (cam.md sections 3 and 4). Progress goes to each in
+    proportion to its estimated work. Within a spin path each of their candidates carries
+    spins of 0 (the constant spin is the placement's).
+    """
+    narrower = narrower_searches(bounds, settings.max_spin_step)
+    if not narrower:
+        return method.search(problem, bounds, settings)
+    work = work_of(
+        problem,
+        bounds,
+        method=name,
+        max_spin_step=settings.max_spin_step,
+        active_set=settings.active_set,
+        seed_map=settings.seed_map,
+    )
+    shares = np.cumsum(
+        [work.weighed(problem, search) for search in ("", *(n.name for n in narrower))]
+    )
+    shares = np.concatenate([[0.0], shares / shares[-1]])
+    candidates, iterations = method.search(
+        problem,
+        bounds,
+        dataclasses.replace(settings, progress=span(settings.progress, 0.0, shares[1])),
+    )
+    for k, search in enumerate(narrower, start=1):
+        found, more = method.search(
+            problem,
+            search.bounds,
+            dataclasses.replace(
+                settings,
+                max_spin_step=search.max_spin_step,
+                progress=span(settings.progress, shares[k], shares[k + 1]),
+            ),
+        )
+        iterations += more
+        zero = None if settings.max_spin_step is None else np.zeros(len(problem.waypoints))
+        for candidate in [*found, Candidate(search.bounds.centre(), "the start")]:
+            candidates.append(
+                dataclasses.replace(
+                    candidate,
+                    status=f"{candidate.status} (in the search {search.name})",
+                    spins=zero if candidate.spins is None else candidate.spins,
+                )
+            )
+    return candidates, iterations
 
 
 def check_search(

@@ -4,9 +4,10 @@
 code fixes: the start; the coarse map (casadi) or the differential evolution (scipy); the compass
 refinement; the Nelder-Mead climbs, one placement a call; the checks of each local solve's
 answer on the whole path (the active set); with a cell, the back-off of each local solve's
-answer (:mod:`solver.optimise.back_off`); the judging of every candidate. :func:`work_of` gives
-each phase's placements at most, and :meth:`OptimisationWork.weighed` their work in poses of a
-closed-form family (:meth:`solver.path.problem.PathProblem.path_cost`), the unit of the
+answer (:mod:`solver.optimise.back_off`); the judging of every candidate; then each narrower
+search the request implies (:mod:`solver.optimise.narrower`), phase by phase. :func:`work_of`
+gives each phase's placements at most, and :meth:`OptimisationWork.weighed` their work in poses
+of a closed-form family (:meth:`solver.path.problem.PathProblem.path_cost`), the unit of the
 service's size limits, so that a search whose work is over a limit is refused before it starts.
 
 A placement evaluated on its own costs more than its share of a batch (the numeric family
@@ -23,6 +24,7 @@ limit; SLSQP's finite differences by its iterations).
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
 
 from solver.optimise.active_set import MAX_ROUNDS
@@ -38,6 +40,7 @@ from solver.optimise.methods.search_rows import (
     searched_waypoints,
     whole_path_checks,
 )
+from solver.optimise.narrower import narrower_searches
 from solver.optimise.search_space import PlacementBounds
 from solver.optimise.symmetry import symmetric_search
 from solver.path.problem import PathProblem
@@ -61,6 +64,8 @@ class Phase:
         one_at_a_time: whether each placement is a call of its own.
         without_cell: whether its placements are evaluated without the cell (the kinematics
             alone: weighed by the family's cost, not the cell's).
+        search: the narrower search it belongs to (:mod:`solver.optimise.narrower`), or "" for
+            the request's own.
     """
 
     name: str
@@ -68,6 +73,7 @@ class Phase:
     n_waypoints: int
     one_at_a_time: bool = False
     without_cell: bool = False
+    search: str = ""
 
 
 @dataclass(frozen=True)
@@ -76,24 +82,37 @@ class OptimisationWork:
 
     phases: tuple[Phase, ...]
 
-    def placements(self, name: str) -> int:
-        """The placements of the phase called ``name`` (0 where there is none)."""
-        return sum(phase.placements for phase in self.phases if phase.name == name)
+    def placements(self, name: str, search: str | None = None) -> int:
+        """The placements of the phases called ``name`` (0 where there is none).
 
-    def weighed(self, problem: PathProblem) -> float:
-        """The whole work in closed-form poses: each placement weighed by its path's cost."""
+        ``search``: of that search only ("" the request's own); None: of every search.
+        """
+        return sum(
+            phase.placements
+            for phase in self.phases
+            if phase.name == name and search in (None, phase.search)
+        )
+
+    def weighed(self, problem: PathProblem, search: str | None = None) -> float:
+        """The work in closed-form poses: each placement weighed by its path's cost.
+
+        ``search``: of that search only ("" the request's own); None: the whole work.
+        """
         clear = problem.with_options(cell=None)
         return sum(
             phase.placements
             * (clear if phase.without_cell else problem).path_cost(phase.n_waypoints)
             * (SINGLE_PLACEMENT_COST if phase.one_at_a_time else 1.0)
             for phase in self.phases
+            if search in (None, phase.search)
         )
 
     def describe(self) -> str:
         """The phases that evaluate anything, as a message says them."""
         return ", ".join(
-            f"{phase.placements} {phase.name}" for phase in self.phases if phase.placements
+            f"{phase.placements} {phase.name}" + (f" ({phase.search})" if phase.search else "")
+            for phase in self.phases
+            if phase.placements
         )
 
 
@@ -164,6 +183,26 @@ def work_of(
         InvalidInputError: an unknown method (on ``method``), a bad path.
     """
     method_named(method)
+    phases = _search_phases(problem, bounds, method, max_spin_step, active_set, seed_map)
+    for search in narrower_searches(bounds, max_spin_step):
+        phases += tuple(
+            dataclasses.replace(phase, search=search.name)
+            for phase in _search_phases(
+                problem, search.bounds, method, search.max_spin_step, active_set, seed_map
+            )
+        )
+    return OptimisationWork(phases)
+
+
+def _search_phases(
+    problem: PathProblem,
+    bounds: PlacementBounds,
+    method: str,
+    max_spin_step: float | None,
+    active_set: bool,
+    seed_map: bool,
+) -> tuple[Phase, ...]:
+    """The phases of one search (:func:`work_of`'s arguments), without its narrower ones."""
     n = problem.prepared.n_waypoints
     free = int(bounds.free.sum())
     climbs = N_CLIMBS * climb_evaluations(problem, bounds)
@@ -182,39 +221,33 @@ def work_of(
         evolutions = SEARCH_ROUNDS if on_rows else 1
         searched = searched_waypoints(n) if on_rows else n
         verified = whole_path_checks(size.basins) if on_rows else 0
-        return OptimisationWork(
-            (
-                Phase("start", 1, n, one_at_a_time=True),
-                *(_coarse_map_phases(problem, bounds) if seed_map else ()),
-                Phase(
-                    "differential evolution", evolutions * search_placements(bounds, size), searched
-                ),
-                Phase(
-                    "differential evolution's collisions, without the cell",
-                    backed * evolutions * search_placements(bounds, size),
-                    searched,
-                    without_cell=True,
-                ),
-                Phase("differential evolution's whole-path checks", verified, n),
-                Phase("refinement", refined * 2 * free * REFINE_ROUNDS, n),
-                Phase("whole-path checks", solves, n, one_at_a_time=True),
-                Phase("Nelder-Mead climbs", climbs, n, one_at_a_time=True),
-                Phase("back-offs", backed * size.basins * BACK_OFF_PLACEMENTS, n, True),
-                Phase("candidates", 2 + (1 + backed) * size.basins + N_CLIMBS, n, True),
-            )
+        return (
+            Phase("start", 1, n, one_at_a_time=True),
+            *(_coarse_map_phases(problem, bounds) if seed_map else ()),
+            Phase("differential evolution", evolutions * search_placements(bounds, size), searched),
+            Phase(
+                "differential evolution's collisions, without the cell",
+                backed * evolutions * search_placements(bounds, size),
+                searched,
+                without_cell=True,
+            ),
+            Phase("differential evolution's whole-path checks", verified, n),
+            Phase("refinement", refined * 2 * free * REFINE_ROUNDS, n),
+            Phase("whole-path checks", solves, n, one_at_a_time=True),
+            Phase("Nelder-Mead climbs", climbs, n, one_at_a_time=True),
+            Phase("back-offs", backed * size.basins * BACK_OFF_PLACEMENTS, n, True),
+            Phase("candidates", 2 + (1 + backed) * size.basins + N_CLIMBS, n, True),
         )
     starts = casadi_method.N_STARTS
     # Each IPOPT start: its cell evaluated on its branch, then (on active sets) the first
     # set's whole-path bounds and one whole-path check after each of its solves.
     solves = starts * (1 + (1 + MAX_ROUNDS if on_active_set else 0))
-    return OptimisationWork(
-        (
-            Phase("start", 1, n, one_at_a_time=True),
-            *_coarse_map_phases(problem, bounds),
-            Phase("refinement", refined_count(problem, bounds) * 2 * free * REFINE_ROUNDS, n),
-            Phase("IPOPT starts and whole-path checks", solves, n, one_at_a_time=True),
-            Phase("Nelder-Mead climbs", climbs, n, one_at_a_time=True),
-            Phase("back-offs", backed * starts * BACK_OFF_PLACEMENTS, n, one_at_a_time=True),
-            Phase("candidates", 2 + (1 + backed) * starts + N_CLIMBS, n, one_at_a_time=True),
-        )
+    return (
+        Phase("start", 1, n, one_at_a_time=True),
+        *_coarse_map_phases(problem, bounds),
+        Phase("refinement", refined_count(problem, bounds) * 2 * free * REFINE_ROUNDS, n),
+        Phase("IPOPT starts and whole-path checks", solves, n, one_at_a_time=True),
+        Phase("Nelder-Mead climbs", climbs, n, one_at_a_time=True),
+        Phase("back-offs", backed * starts * BACK_OFF_PLACEMENTS, n, one_at_a_time=True),
+        Phase("candidates", 2 + (1 + backed) * starts + N_CLIMBS, n, one_at_a_time=True),
     )
