@@ -98,7 +98,9 @@ class CellSpec(RequestModel):
         min_length=1,
         max_length=MAX_LINK_RADII,
         description="m, capsule radii of an arm without collision geometry: the base's, then one "
-        "per joint. Default: the arm's published radii (UR5e, UR10e) or its URDF's geometry.",
+        "per joint, each capsule along its link's kinematic segment. Default: the arm's "
+        "published collision capsules (UR5e, UR10e: MuJoCo Menagerie's, where the links are) or "
+        "its URDF's geometry; given for a UR5e or UR10e, they replace the published capsules.",
     )
 
     def to_solver(self, *, max_objects: int, max_triangles: int) -> Cell:

@@ -313,12 +313,12 @@ def test_a_cell_file_is_checked_as_the_routes_cell(
     code, out, _ = run(capsys, *at)
     assert code == OK
     assert f"least clearance: {_contact(expected['min_clearance'])}" in out.splitlines()
-    assert "cell: approximated by capsules: " in out  # the UR5e's links (no meshes ship)
-    unchecked = [  # the base, and the shoulder joint 1 turns about the table's normal
+    assert "cell: approximated by capsules" not in out  # the UR5e's published capsules
+    unchecked = [  # the shoulder, which joint 1 turns about the table's normal (no base geometry)
         f"{p['robot_part']} and {p['obstacle_name']} ({_apart(p['distance'])})"
         for p in expected["cell_unchecked"]
     ]
-    assert len(unchecked) == 3
+    assert len(unchecked) == 1
     line = "cell: not checked, no joint moves them relative to each other: " + ", ".join(unchecked)
     assert line in out.splitlines()
 
@@ -335,21 +335,18 @@ def test_a_table_above_the_base_makes_evaluate_and_map_infeasible_by_collision(
     assert code == INFEASIBLE and answer["reason"] == "collision"
     assert answer["collision"]["obstacle_name"] == "raised table"
     lines = out.splitlines()
-    assert lines[-4].startswith("infeasible: collision at waypoint ")
-    assert lines[-3] == f"collision: {_contact(answer['collision'])} (clearance 5.0 mm)"
-    assert lines[-2].startswith("cell: approximated by capsules: base, ")  # the UR5e's
-    assert lines[-1].startswith("cell: not checked, no joint moves them relative to each other: ")
+    assert lines[-2].startswith("infeasible: collision at waypoint ")
+    assert lines[-1] == f"collision: {_contact(answer['collision'])} (clearance 5.0 mm)"
     code, out, _ = run(capsys, *MAP, "--png", str(tmp_path / "map.png"), "--cell", cell)
     assert code == INFEASIBLE
-    assert f"map: 0 of 6 placements feasible (6 in collision); {tmp_path / 'map.png'}" in out
-    assert out.splitlines()[-2].startswith("cell: approximated by capsules: base, ")  # the UR5e
-    # the UR5e's base capsule (radius 0.06 m) from its foot up to joint 1 (d1 = 0.1625 m), the
-    # shoulder's from there, level: 0.05 + 0.06 m into the table, 0.1625 - 0.06 - 0.05 m above
     assert out.splitlines()[-1] == (
-        "cell: not checked, no joint moves them relative to each other: base_capsule and "
-        "raised table (110.0 mm into it), shoulder_pan_joint_capsule and raised table (52.5 mm "
-        "apart)"
+        f"map: 0 of 6 placements feasible (6 in collision); {tmp_path / 'map.png'}"
     )
+    # Nothing approximated, nothing left unchecked: Menagerie's UR5e shoulder capsule (radius
+    # 0.06 m, segment 0.12 m long, centred 0.04 m below joint 1 at 0.163 m) reaches 0.003 m
+    # above the foot, 0.047 m into this table: the arm's own geometry in its table is checked
+    # (it collides everywhere); the base has no geometry of its own in that model.
+    assert "cell: approximated" not in out and "cell: not checked" not in out
 
 
 def test_optimise_in_a_cell_prints_the_routes_collision_free_optimum(

@@ -141,7 +141,7 @@ def test_map_cells_taking_the_next_branch_equal_evaluate(name: str) -> None:
         "xs": grid_axis(-0.25, 0.25, 0.1, field="x"),
         "ys": grid_axis(0.25, 0.65, 0.1, field="y"),
         "z": 0.1,
-        "yaws": np.array([0.0, 0.6]),
+        "yaws": np.array([0.0, 0.6, 1.2, -0.6]),
     }
     cells = capability_map(problem, **axes)  # type: ignore[arg-type]
     free = capability_map(plain, **axes)  # type: ignore[arg-type]
@@ -150,7 +150,8 @@ def test_map_cells_taking_the_next_branch_equal_evaluate(name: str) -> None:
     refused = (cells.reason == 4) & (free.reason == -1)
     for index in zip(*np.nonzero(moved | refused), strict=True):
         _, yaw, iy, ix = index
-        placement = Placement(float(axes["xs"][ix]), float(axes["ys"][iy]), 0.1, 0.6 * yaw)
+        yaw_of = float(axes["yaws"][yaw])  # type: ignore[index]
+        placement = Placement(float(axes["xs"][ix]), float(axes["ys"][iy]), 0.1, yaw_of)
         evaluation = evaluate_path(problem, placement)
         if cells.reason[index] == -1:
             assert evaluation.feasible

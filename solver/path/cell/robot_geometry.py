@@ -5,6 +5,10 @@
   read: an element with a mesh elsewhere is left out, its link approximated); every mesh is taken
   as its convex hull (:func:`solver.path.cell.shapes.convex_hull`), which contains it. A URDF
   whose meshes cannot be read keeps its primitive elements.
+- The UR5e and UR10e (no URDF ships): their published collision capsules
+  (:mod:`solver.path.cell.published_geometry`, MuJoCo Menagerie's, nothing approximated),
+  unless the request gives ``link_radii``: then capsules along the kinematic segments with
+  those radii, as below.
 - Any link left without geometry (an arm built from DH or OPW parameters, a URDF link with
   none, whatever the links fixed to it carry): a capsule along the link's kinematic segment,
   from its joint to the next joint (the flange for the last link; the base to the first joint
@@ -29,13 +33,16 @@ import pinocchio as pin
 
 from solver.core.exceptions import InvalidInputError
 from solver.core.robots import Robot, example_robot_data_dir
+from solver.path.cell.published_geometry import published_geometry
 from solver.path.cell.shapes import Tool, convex_hull
 
-# Capsule radii (m): the base, then one per joint's link. UR5e and UR10e: the collision capsules
-# of MuJoCo Menagerie (google-deepmind/mujoco_menagerie, universal_robots_ur5e/ur5e.xml and
-# universal_robots_ur10e/ur10e.xml, `class="collision"` geoms: shoulder, upper arm, forearm,
-# wrist 1, wrist 2, wrist 3), the base taken as the shoulder's. Other arms without a URDF (ur3e,
-# ur16e, the OPW arms) have no published radii here: a cell needs ``link_radii`` for them.
+# Capsule radii (m): the base, then one per joint's link. UR5e and UR10e: the radii of MuJoCo
+# Menagerie's collision capsules (google-deepmind/mujoco_menagerie, universal_robots_ur5e/ur5e.xml
+# and universal_robots_ur10e/ur10e.xml, `class="collision"` geoms: shoulder, upper arm, forearm,
+# wrist 1, wrist 2, wrist 3), the base taken as the shoulder's. Their links carry Menagerie's
+# capsules themselves (published_geometry): these radii serve only where published_geometry
+# cannot place them. Other arms without a URDF (ur3e, ur16e, the OPW arms) have no published
+# radii here: a cell needs ``link_radii`` for them.
 PUBLISHED_RADII: dict[str, tuple[float, ...]] = {
     "ur5e": (0.06, 0.06, 0.05, 0.038, 0.04, 0.04, 0.04),
     "ur10e": (0.078, 0.078, 0.06, 0.043, 0.05, 0.046, 0.046),
@@ -76,8 +83,14 @@ def robot_geometry(
             without collision elements or published radii.
     """
     model = robot.model
-    geometry = _urdf_geometry(robot) if robot.urdf is not None else pin.GeometryModel()
-    bare = _bare_joints(model, geometry)
+    published = None if link_radii is not None else published_geometry(robot)
+    if published is not None:
+        geometry = published
+    elif robot.urdf is not None:
+        geometry = _urdf_geometry(robot)
+    else:
+        geometry = pin.GeometryModel()
+    bare = [] if published is not None else _bare_joints(model, geometry)
     radii = _radii(robot, link_radii, needed=bool(bare) and robot.urdf is None)
     approximated = []
     for joint in bare:
