@@ -20,6 +20,7 @@ from solver.path.cell.shapes import (
     DEFAULT_CUTTING_LENGTH,
     MIN_COLLISION_STEP,
     Cell,
+    Mesh,
     Tool,
 )
 from solver.path.cell.verdict import Contact as SolverContact
@@ -121,6 +122,18 @@ class CellSpec(RequestModel):
             )
             for group in ("fixed", "workpiece")
         }
+        pieces = sum(
+            len(shape.parts()) if isinstance(shape, Mesh) else 1
+            for group in shapes.values()
+            for shape in group
+        )
+        if pieces > max_objects:
+            raise InvalidInputError(
+                "cell",
+                f"{pieces} objects, each separate part of a mesh one (its convex hull); at most "
+                f"{max_objects} (DTF_MAX_CELL_OBJECTS): join a mesh's parts, or send the ones "
+                "near the robot",
+            )
         tool = None
         if self.tool is not None:
             tool = Tool(self.tool.radius, self.tool.length, self.tool.cutting_length)

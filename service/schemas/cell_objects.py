@@ -159,7 +159,7 @@ class HalfspaceObject(RequestModel):
 
 
 class MeshObject(_Object):
-    """A triangle mesh from an STL file (taken as its convex hull)."""
+    """A triangle mesh from an STL file, each separate part taken as its convex hull."""
 
     model_config = ConfigDict(
         json_schema_extra={

@@ -153,12 +153,21 @@ def mesh(stl: str, units: str = "m") -> dict[str, Any]:
 
 
 CUBE = base64.b64encode(binary_stl(cube_triangles(0.1))).decode()
+TWO_CUBES = base64.b64encode(
+    binary_stl(np.concatenate([cube_triangles(0.1), cube_triangles(0.1) + [0.5, 0.0, 0.0]]))
+).decode()
 
 
 @pytest.mark.parametrize(
     ("cell", "settings", "loc", "words"),
     [
         ({"fixed": [TABLE, FIXTURE]}, {"max_cell_objects": 1}, ["cell"], "DTF_MAX_CELL_OBJECTS"),
+        (  # one object, two separate parts: two hulls, two objects against the limit
+            {"fixed": [mesh(TWO_CUBES)]},
+            {"max_cell_objects": 1},
+            ["cell"],
+            "2 objects, each separate part of a mesh one",
+        ),
         (
             {"fixed": [mesh(CUBE)]},
             {"max_mesh_triangles": 11},
@@ -180,6 +189,7 @@ CUBE = base64.b64encode(binary_stl(cube_triangles(0.1))).decode()
     ],
     ids=[
         "objects",
+        "mesh parts",
         "triangles",
         "text",
         "base64-not-stl",

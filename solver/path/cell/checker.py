@@ -42,6 +42,7 @@ class CellChecker:
         self._n_robot = scene.n_robot
         self._world_to_base = scene.world_to_base
         self._workpiece_ids = scene.workpiece_ids
+        self._owners = scene.owners
         self._pairs = scene.pairs
         self._weights = scene.weights
         self._fast = scene.compiled
@@ -270,7 +271,8 @@ class CellChecker:
         objects = self.geometry.geometryObjects
         other = contact.obstacle_name if contact.obstacle is None else None
         if contact.obstacle is not None:
-            other = objects[self._n_robot + contact.obstacle].name
+            slot = contact.obstacle_slot
+            other = objects[self._n_robot + (contact.obstacle if slot is None else slot)].name
         pair = self._pair_of.get((contact.robot_part, other))
         if pair is None:
             return False
@@ -285,6 +287,8 @@ class CellChecker:
         a, b = self._pairs[pair]
         objects = self.geometry.geometryObjects
         if b >= self._n_robot:
-            k = b - self._n_robot
-            return Contact(waypoint, objects[a].name, k, self.cell.obstacle_name(k), distance)
+            slot = b - self._n_robot
+            k = self._owners[slot]
+            name = self.cell.obstacle_name(k)
+            return Contact(waypoint, objects[a].name, k, name, distance, obstacle_slot=slot)
         return Contact(waypoint, objects[a].name, None, objects[b].name, distance)

@@ -65,6 +65,8 @@ class CellScene:
         approximated: the robot's links given capsules (no readable collision geometry).
         unchecked: the robot parts not checked against a ``fixed`` object because no joint
             moves them relative to it, with their distance (the same at every configuration).
+        owners: per obstacle geometry object (index less ``n_robot``), the cell object it is
+            (an index into ``fixed`` then ``workpiece``): a mesh is one per separate part.
     """
 
     geometry: pin.GeometryModel
@@ -76,6 +78,7 @@ class CellScene:
     compiled: fast.FastCell | None
     approximated: tuple[str, ...]
     unchecked: tuple[Unchecked, ...] = ()
+    owners: tuple[int, ...] = ()
 
 
 def build_scene(robot: Robot, cell: Cell) -> CellScene:
@@ -89,20 +92,24 @@ def build_scene(robot: Robot, cell: Cell) -> CellScene:
     n_robot = geometry.ngeoms
     world_to_base = pin.SE3(robot.transform_world_to_base)
     shapes = cell.fixed + cell.workpiece
-    workpiece_ids = []
+    workpiece_ids, owners = [], []
     for k, shape in enumerate(shapes):
         place = world_to_base * pin.SE3(np.asarray(shape.pose, dtype=float))
-        obj = pin.GeometryObject(f"obstacle_{k}", 0, place, shape.geometry())
-        gid = geometry.addGeometryObject(obj)
-        if k >= len(cell.fixed):
-            workpiece_ids.append((gid, pin.SE3(np.asarray(shape.pose, dtype=float))))
+        pieces = shape.geometries()
+        for p, piece in enumerate(pieces):
+            name = f"obstacle_{k}" if len(pieces) == 1 else f"obstacle_{k}_part_{p}"
+            gid = geometry.addGeometryObject(pin.GeometryObject(name, 0, place, piece))
+            owners.append(k)
+            if k >= len(cell.fixed):
+                workpiece_ids.append((gid, pin.SE3(np.asarray(shape.pose, dtype=float))))
+    n_fixed = sum(1 for k in owners if k < len(cell.fixed))  # the fixed objects' pieces
     pairs = [
-        (part, n_robot + k)
+        (part, n_robot + slot)
         for part in range(n_robot)
-        for k in range(len(shapes))
-        if not (part == made.cutting and k >= len(cell.fixed))
+        for slot in range(len(owners))
+        if not (part == made.cutting and slot >= n_fixed)
     ]
-    pairs, weights, standing = _moving(robot.model, geometry, pairs, n_robot, len(cell.fixed))
+    pairs, weights, standing = _moving(robot.model, geometry, pairs, n_robot, n_fixed)
     candidates = _self_candidates(robot.model, geometry, n_robot)
     # one coal probe for the standing pairs' distances and the self pairs' at q = 0
     distances = _distances(robot.model, geometry, [p for p, _ in standing] + candidates)
@@ -143,10 +150,14 @@ def build_scene(robot: Robot, cell: Cell) -> CellScene:
         approximated=made.approximated,
         unchecked=tuple(
             Unchecked(
-                geometry.geometryObjects[a].name, b - n_robot, cell.obstacle_name(b - n_robot), d
+                geometry.geometryObjects[a].name,
+                owners[b - n_robot],
+                cell.obstacle_name(owners[b - n_robot]),
+                d,
             )
             for (a, b), d in zip(still, still_distances, strict=True)
         ),
+        owners=tuple(owners),
     )
 
 

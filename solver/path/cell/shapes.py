@@ -1,7 +1,8 @@
 """What a cell holds (cell.md section 1): obstacles, the tool, the clearance and the step.
 
-Obstacles are frozen dataclasses that make their coal shape (:meth:`Shape.geometry`) and their
-pose (4 x 4, in {B} for ``fixed`` objects, in {O} for ``workpiece`` objects). Sizes are in m.
+Obstacles are frozen dataclasses that make their coal shapes (:meth:`Shape.geometries`: one, or
+one per separate part of a mesh) and their pose (4 x 4, in {B} for ``fixed`` objects, in {O}
+for ``workpiece`` objects). Sizes are in m.
 """
 
 from __future__ import annotations
@@ -12,6 +13,8 @@ from dataclasses import dataclass, field
 
 import coal
 import numpy as np
+import scipy.sparse
+import scipy.sparse.csgraph
 
 from solver.core.exceptions import InvalidInputError
 
@@ -39,6 +42,10 @@ class Shape(abc.ABC):
     @abc.abstractmethod
     def geometry(self) -> coal.CollisionGeometry:
         """The coal shape, in its own frame."""
+
+    def geometries(self) -> list[coal.CollisionGeometry]:
+        """The coal shapes it is checked as, in its own frame: itself, or a mesh's parts."""
+        return [self.geometry()]
 
     def check(self, where: str) -> None:  # noqa: B027  (shapes without sizes check nothing)
         """Raise InvalidInputError on ``where`` when a size is not finite and > 0."""
@@ -135,8 +142,45 @@ class Mesh(Shape):
     name: str | None = None
 
     def geometry(self) -> coal.CollisionGeometry:
-        """The mesh as its convex hull (as the robot's meshes, :mod:`robot_geometry`)."""
+        """The whole mesh as its convex hull (as the robot's meshes, :mod:`robot_geometry`)."""
         return convex_hull(np.asarray(self.triangles, dtype=float).reshape(-1, 3))
+
+    def geometries(self) -> list[coal.CollisionGeometry]:
+        """Each separate part of the mesh as its convex hull (:meth:`parts`).
+
+        One hull of a fixture of two clamp blocks either side of the part filled the space
+        between them where the tool works: every placement of the cell audit's map (stop 53)
+        collided, where coal on the triangles keeps the wrist 19 mm clear. A part's own hull
+        still fills its concave pockets (an L-bracket, a vice's jaws): it contains the part.
+        """
+        return [convex_hull(part.reshape(-1, 3)) for part in self.parts()]
+
+    def parts(self) -> tuple[np.ndarray, ...]:
+        """The triangles of each connected part (triangles sharing a corner), in file order.
+
+        Corners are the same point when they are equal to JOIN_TOLERANCE of the mesh's size
+        (an STL repeats each shared corner, in binary as float32). Not kept on the mesh: a
+        cell's content is its pickle (the checkers' cache keys).
+        """
+        triangles = np.asarray(self.triangles, dtype=float)
+        corners = triangles.reshape(-1, 3)
+        size = float(np.ptp(corners, axis=0).max()) if len(corners) else 0.0
+        grid = np.round(corners / max(size * JOIN_TOLERANCE, 1e-12)).astype(np.int64)
+        _, point = np.unique(grid, axis=0, return_inverse=True)
+        point = point.reshape(-1, 3)
+        n = int(point.max()) + 1 if point.size else 0
+        edges = np.concatenate([point[:, [0, 1]], point[:, [1, 2]]])
+        graph = scipy.sparse.coo_matrix(
+            (np.ones(len(edges)), (edges[:, 0], edges[:, 1])), shape=(n, n)
+        )
+        _, label = scipy.sparse.csgraph.connected_components(graph, directed=False)
+        of_triangle = label[point[:, 0]]
+        _, first = np.unique(of_triangle, return_index=True)
+        return tuple(triangles[of_triangle == of_triangle[k]] for k in np.sort(first))
+
+
+JOIN_TOLERANCE = 1e-6
+"""Corners of a mesh this close (a fraction of its size) are one point (:meth:`Mesh.parts`)."""
 
 
 FLAT = 1e-6  # m: a mesh thinner than this in a direction is given that thickness (a sheet)

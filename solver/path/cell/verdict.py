@@ -20,6 +20,8 @@ class Contact:
             part (self-collision).
         obstacle_name: its name, its place (``fixed[0]``), or the other robot part's name.
         distance: m, the coal distance (negative: penetration depth as coal gives it).
+        obstacle_slot: the obstacle's geometry object among the cell's (a mesh has one per
+            separate part, :meth:`solver.path.cell.shapes.Mesh.parts`); None for a robot part.
     """
 
     waypoint: int
@@ -27,6 +29,7 @@ class Contact:
     obstacle: int | None
     obstacle_name: str
     distance: float
+    obstacle_slot: int | None = None
 
 
 @dataclass(frozen=True)
