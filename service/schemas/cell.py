@@ -38,7 +38,11 @@ class ToolSpec(RequestModel):
     )
 
     radius: Size = Field(description="m.")
-    length: Size = Field(description="m, from its start to the tool point.")
+    length: Size = Field(
+        description="m, from its start to the tool point, along tool z from the flange: the "
+        "robot's tcp puts the tool point at the tool's tip. A tool that would start behind the "
+        "flange (the tcp left at the flange) is refused, naming the length that fits."
+    )
     cutting_length: Size = Field(
         default=DEFAULT_CUTTING_LENGTH,
         description="m, the last part (ending at the tool point) that may touch workpiece objects.",

@@ -271,6 +271,7 @@ def test_a_finer_collision_step_weighs_its_sub_steps(
 
 def test_a_tool_without_thickness_is_checked(client: TestClient, body: dict) -> None:
     """A 5e-324 m tool (schemathesis found it: a table grid sized by 0 was a 500) answers."""
+    body["robot"]["tcp"] = {"position": [0.0, 0.0, 0.12], "orientation": [0, 0, 0, 1]}
     body["cell"] = {
         "fixed": [TABLE],
         "link_radii": [0.05] * 7,
@@ -279,6 +280,22 @@ def test_a_tool_without_thickness_is_checked(client: TestClient, body: dict) -> 
     }
     response = client.post("/v1/evaluate", json=body)
     assert response.status_code == 200, response.text
+
+
+def test_a_tool_behind_the_flange_is_a_422(client: TestClient, body: dict) -> None:
+    """cell.md: the tool runs from the flange to the tool point. A 12 cm tool with the tool
+    point left at the flange (no tcp) would start 120 mm behind it, inside the wrist."""
+    body["cell"] = {"tool": {"radius": 0.03, "length": 0.12}}
+    response = client.post("/v1/evaluate", json=body)
+    assert_names(response, 422, ["body", "cell", "tool", "length"])
+    message = response.json()["detail"][0]["msg"]
+    assert "120.0 mm behind the flange" in message and "at most 0 m" in message
+    body["robot"]["tcp"] = {"position": [0.0, 0.0, 0.1], "orientation": [0, 0, 0, 1]}
+    response = client.post("/v1/evaluate", json=body)
+    assert_names(response, 422, ["body", "cell", "tool", "length"])
+    assert "20.0 mm behind the flange" in response.json()["detail"][0]["msg"]
+    body["robot"]["tcp"] = {"position": [0.0, 0.0, 0.12], "orientation": [0, 0, 0, 1]}
+    assert client.post("/v1/evaluate", json=body).status_code == 200
 
 
 def test_an_optimisation_in_a_cell_weighs_its_collision_work(

@@ -45,6 +45,8 @@ CELL = {  # a table 5 cm below the base, a fixture box beside the part, a 10 cm 
     ],
     "tool": {"radius": 0.03, "length": 0.1},
 }
+TOOLED = {"model": "ur5e", "tcp": {"position": [0, 0, 0.1], "orientation": [0, 0, 0, 1]}}
+"""The UR5e with its tool point at the tip of CELL's 10 cm spindle (cell.md: from the flange)."""
 RAISED_TABLE = {  # its top 5 cm above the base's foot: every placement collides (cell.md s. 5)
     "fixed": [{"shape": "halfspace", "name": "raised table", "normal": [0, 0, 1], "offset": 0.05}]
 }
@@ -302,10 +304,10 @@ def _apart(distance: float) -> str:
 def test_a_cell_file_is_checked_as_the_routes_cell(
     client: TestClient, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    cell = _file(tmp_path, "cell.json", CELL)
-    at = ["evaluate", str(PROGRAM), "--robot", "ur5e", "--at=0,0.3,0,0", "--cell", cell]
+    cell, robot = _file(tmp_path, "cell.json", CELL), _file(tmp_path, "robot.json", TOOLED)
+    at = ["evaluate", str(PROGRAM), "--robot", robot, "--at=0,0.3,0,0", "--cell", cell]
     code, out, _ = run(capsys, *at, "--json")
-    body = {"robot": ROBOT, "path": {"cl_data": PROGRAM.read_text()}, "placement": AT}
+    body = {"robot": TOOLED, "path": {"cl_data": PROGRAM.read_text()}, "placement": AT}
     expected = api(client, "/v1/evaluate", {**body, "cell": CELL, "detail": "summary"})
     assert code == OK
     assert json.loads(out) == expected
@@ -353,11 +355,12 @@ def test_optimise_in_a_cell_prints_the_routes_collision_free_optimum(
     client: TestClient, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
     code, out, _ = run(
-        capsys, "optimise", str(PROGRAM), "--robot", "ur5e", "--x=-0.1:0.1", "--y", "0.25:0.35",
-        "--yaw=-0.5:0.5", "--cell", _file(tmp_path, "cell.json", CELL),
+        capsys, "optimise", str(PROGRAM), "--robot", _file(tmp_path, "robot.json", TOOLED),
+        "--x=-0.1:0.1", "--y", "0.25:0.35", "--yaw=-0.5:0.5",
+        "--cell", _file(tmp_path, "cell.json", CELL),
     )  # fmt: skip
     bounds = {"x": [-0.1, 0.1], "y": [0.25, 0.35], "yaw": [-0.5, 0.5]}
-    body = {"robot": ROBOT, "path": {"cl_data": PROGRAM.read_text()}, "bounds": bounds, "z": 0.0}
+    body = {"robot": TOOLED, "path": {"cl_data": PROGRAM.read_text()}, "bounds": bounds, "z": 0.0}
     answer = api(client, "/v1/optimize", {**body, "method": "scipy", "cell": CELL})
     assert code == OK and answer["found"]
     nearest = answer["evaluation"]["min_clearance"]
@@ -804,7 +807,8 @@ def test_windows_encoded_files_read_as_their_utf8_selves(
     plain, windows = tmp_path / "plain", tmp_path / "windows"
     for folder in (plain, windows):
         folder.mkdir()
-    cell, urdf, program = json.dumps(CELL), UR5_URDF.read_text(), PROGRAM.read_text()
+    no_tool = {name: value for name, value in CELL.items() if name != "tool"}  # tool0 is the TCP
+    cell, urdf, program = json.dumps(no_tool), UR5_URDF.read_text(), PROGRAM.read_text()
     (plain / "cell.json").write_text(cell)
     (windows / "cell.json").write_bytes(cell.encode("utf-16"))  # with its byte order mark
     for folder, mark in ((plain, ""), (windows, "\ufeff")):

@@ -131,7 +131,7 @@ def test_checkers_are_shared_by_content() -> None:
     others = [
         checker_for(_arm("ur5e"), Cell(fixed=CELL.fixed, tool=Tool(0.03, 0.12), clearance=0.01)),
         checker_for(_arm("ur5e"), Cell(fixed=CELL.fixed[:1], tool=Tool(0.03, 0.12))),
-        checker_for(_arm("ur5e"), Cell(fixed=CELL.fixed, tool=Tool(0.03, 0.13))),
+        checker_for(_arm("ur5e"), Cell(fixed=CELL.fixed, tool=Tool(0.03, 0.11))),
         checker_for(
             _arm("ur5e").with_options(transform_tool_to_tcp=_pose(0.0, 0.0, 0.15)),
             Cell(fixed=CELL.fixed, tool=Tool(0.03, 0.12)),

@@ -17,6 +17,7 @@ import numpy as np
 import pinocchio as pin
 import pytest
 
+from solver.core.robots import Robot
 from solver.families import get_robot
 from solver.path.cell.checker import CellChecker
 from solver.path.cell.shapes import Box, Cell, Halfspace, Tool
@@ -26,6 +27,11 @@ def _pose(x: float, y: float, z: float) -> np.ndarray:
     matrix = np.eye(4)
     matrix[:3, 3] = [x, y, z]
     return matrix
+
+
+def _tooled(name: str) -> Robot:
+    """The arm with its tool point at the end of _cell's 12 cm tool."""
+    return get_robot(name).with_options(transform_tool_to_tcp=_pose(0.0, 0.0, 0.12))
 
 
 def _cell(normal: tuple[float, float, float]) -> Cell:
@@ -52,7 +58,7 @@ def _distances(checker: CellChecker, q: np.ndarray) -> np.ndarray:
 @pytest.mark.parametrize("normal", [(0.0, 0.0, 1.0), (0.3, 0.0, 1.0)])
 def test_weights_bound_coal_distances(name: str, normal: tuple[float, float, float]) -> None:
     """|d(q') - d(q)| <= sum_j w_pj |q'_j - q_j| for every pair, on random nearby pairs."""
-    checker = CellChecker(get_robot(name), _cell(normal))
+    checker = CellChecker(_tooled(name), _cell(normal))
     weights = checker._weights
     rng = np.random.default_rng(7)
     for _ in range(40):
@@ -66,11 +72,11 @@ def test_weights_bound_coal_distances(name: str, normal: tuple[float, float, flo
 
 def test_first_joint_cannot_move_a_part_towards_an_upright_table() -> None:
     """The table's normal is the first joint's axis: no weight there, and coal agrees."""
-    checker = CellChecker(get_robot("ur5e"), _cell((0.0, 0.0, 1.0)))
+    checker = CellChecker(_tooled("ur5e"), _cell((0.0, 0.0, 1.0)))
     table = checker._n_robot  # the first obstacle
     rows = [p for p, (_, b) in enumerate(checker._pairs) if b == table]
     assert rows and np.all(checker._weights[rows, 0] == 0.0)
-    tilted = CellChecker(get_robot("ur5e"), _cell((0.3, 0.0, 1.0)))
+    tilted = CellChecker(_tooled("ur5e"), _cell((0.3, 0.0, 1.0)))
     assert np.all(tilted._weights[rows, 0] > 0.0)  # the same pairs, a table the turn tilts to
     q = np.array([0.0, -1.2, 1.0, -0.5, 1.3, 0.2])
     turned = q + np.array([2.0, 0, 0, 0, 0, 0])

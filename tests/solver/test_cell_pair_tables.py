@@ -180,7 +180,7 @@ def _tabled(checker: CellChecker) -> set[tuple[str, str]]:
 def test_part_keys_name_the_arm_and_the_tool() -> None:
     """The arm's parts' keys do not change with the tool; the tool's do; another arm's differ."""
     short = robot_geometry(_arm("ur5"), tool=Tool(radius=0.03, length=0.12), link_radii=None)
-    long = robot_geometry(_arm("ur5"), tool=Tool(radius=0.03, length=0.2), link_radii=None)
+    long = robot_geometry(_arm("ur5"), tool=Tool(radius=0.03, length=0.1), link_radii=None)
     other = robot_geometry(_arm("ur10"), tool=Tool(radius=0.03, length=0.12), link_radii=None)
     arm = short.geometry.ngeoms - 2  # the tool: a holder and a cutting part, last
     assert short.keys[:arm] == long.keys[:arm]

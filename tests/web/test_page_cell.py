@@ -8,6 +8,7 @@ fixture box makes the velocity-best placement collide. Screenshots go to ``tests
 
 from __future__ import annotations
 
+import json
 import re
 from typing import Any
 
@@ -204,6 +205,9 @@ def test_a_boxs_frame_and_angles_reach_the_request(page: Page, url: str) -> None
     page.fill("#tool-radius", "0.03")
     page.fill("#tool-length", "0.12")
     page.fill("#clearance", "0.002")
+    page.click("#own-json summary")  # the tool point at the tool's tip (cell.md: from the flange)
+    tcp = {"position": [0, 0, 0.12], "orientation": [0, 0, 0, 1]}
+    page.fill("#robot-json", json.dumps({"model": "ur5", "tcp": tcp}))
     request = run_map(page)
     cell = request["cell"]
     assert [o["name"] for o in cell["fixed"]] == ["wall"]
@@ -386,6 +390,8 @@ def test_the_open_editor_reads_at_1280_and_800_px(page: Page, width: int) -> Non
         ({"table-height": "200"}, "cell.fixed.0", "cell.fixed.0.halfspace.offset"),
         ({"tool-radius": "-0.03", "tool-length": "0.12"}, "cell.tool.radius", "cell.tool.radius"),
         ({"tool-radius": "0.03"}, "cell.tool.length", "cell.tool.length"),
+        # the catalogue arm's tool point is its flange: a 12 cm tool would start inside the wrist
+        ({"tool-radius": "0.03", "tool-length": "0.12"}, "cell.tool.length", "cell.tool.length"),
         ({"table-height": "0", "clearance": "2"}, "cell.clearance", "cell.clearance"),
     ],
 )

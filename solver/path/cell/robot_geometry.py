@@ -253,10 +253,19 @@ def _capsule(
     return pin.GeometryObject(name, joint, placement, coal.Capsule(radius, length))
 
 
+BEHIND_FLANGE = 1e-3
+"""m: how far behind the flange's plane a tool may start (cell.md: it runs from the flange)."""
+
+
 def _add_tool(robot: Robot, geometry: pin.GeometryModel, tool: Tool) -> int:
-    """Add the tool's holder (if longer than the cutting part) and cutting part; the latter's id."""
+    """Add the tool's holder (if longer than the cutting part) and cutting part; the latter's id.
+
+    Raises:
+        InvalidInputError: on ``cell.tool.length``, a tool that starts behind the flange.
+    """
     frame = robot.model.frames[robot.tool_point_frame]
     joint, tcp = int(frame.parentJoint), frame.placement
+    _check_from_flange(robot, tool, joint, tcp)
     holder = tool.length - tool.cutting_length
     if holder > 1e-9:
         centre = pin.SE3(np.eye(3), np.array([0.0, 0.0, -tool.cutting_length - holder / 2.0]))
@@ -268,3 +277,31 @@ def _add_tool(robot: Robot, geometry: pin.GeometryModel, tool: Tool) -> int:
     return int(
         geometry.addGeometryObject(pin.GeometryObject(TOOL_CUTTING, joint, tcp * centre, cutting))
     )
+
+
+def _check_from_flange(robot: Robot, tool: Tool, joint: int, tcp: pin.SE3) -> None:
+    """Refuse a tool whose start, ``length`` back from the tool point, is behind the flange.
+
+    cell.md section 1: the tool runs along tool z from the flange to the tool point, the two
+    statements one only when the TCP puts the tool point ``length`` out. The cylinder is laid
+    back from the tool point; with the TCP left at the flange (the default) a 12 cm spindle lay
+    inside the wrist, and a box 6 cm in front of the flange, inside the real spindle, was 'clear
+    by 49 mm' (the cell audit, stop 53). A tool that starts behind the flange's plane (by more
+    than BEHIND_FLANGE) is such a forgotten TCP.
+    """
+    model = robot.model
+    flange = model.frames[model.getFrameId(robot.tool_frame)]
+    if int(flange.parentJoint) != joint:
+        return
+    point = flange.placement.actInv(tcp.translation)  # the tool point in the flange frame
+    axis = flange.placement.rotation.T @ tcp.rotation[:, 2]  # tool z in the flange frame
+    start = float(point[2] - tool.length * axis[2])
+    if start < -BEHIND_FLANGE:
+        longest = max(float(point[2] / axis[2]), 0.0) if axis[2] > 1e-12 else 0.0
+        raise InvalidInputError(
+            "cell.tool.length",
+            f"{tool.length:.6g} m back along tool z from the tool point starts "
+            f"{-start * 1000:.1f} mm behind the flange (cell.md: the tool runs from the "
+            f"flange to the tool point): give the robot's tcp, the tool point at the tool's "
+            f"tip, or a length of at most {longest:.6g} m",
+        )
