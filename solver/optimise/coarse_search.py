@@ -21,7 +21,7 @@ from solver.core.spatial import MAX_COORDINATE
 from solver.optimise.candidate import Search
 from solver.optimise.coarse_rows import map_values, mapped_waypoints
 from solver.optimise.failures import Tried
-from solver.optimise.search_space import PlacementBounds, decision_vector
+from solver.optimise.search_space import VARIABLES, PlacementBounds, decision_vector
 from solver.optimise.symmetry import arc_point
 from solver.path.placements import evaluate_placements
 from solver.path.problem import PathProblem
@@ -283,7 +283,11 @@ def coarse_cells(
         vector = vectors[k]
         if vector is not None:
             cells.append(Cell(vector, float(mu[k]), int(branch[k])))
-    corners = box_corners(problem, bounds, runner=runner, tried=tried)
+    corners = [
+        corner
+        for corner in box_corners(problem, bounds, runner=runner, tried=tried)
+        if not any(_same_placement(corner.vector, cell.vector) for cell in cells)
+    ]  # a corner that is one of the map's maxima already is there once
     return sorted(cells + corners, key=lambda cell: -cell.mu_path)  # stable: the map's first
 
 
@@ -309,14 +313,39 @@ def search_cells(
     )
 
 
+_ANGLES = [VARIABLES.index("yaw"), VARIABLES.index("spin")]
+_TWO_PI = 2.0 * math.pi
+SAME_START = 1e-4
+"""m and rad: corners and cells closer than this (angles up to whole turns) are one start."""
+
+
+def _same_placement(a: np.ndarray, b: np.ndarray) -> bool:
+    """Whether two decision vectors are one start: within SAME_START, angles up to turns."""
+    apart = np.abs(np.asarray(a, dtype=float) - np.asarray(b, dtype=float))
+    turns = apart[_ANGLES] / _TWO_PI
+    apart[_ANGLES] = _TWO_PI * np.abs(turns - np.round(turns))
+    return bool(np.all(apart <= SAME_START))
+
+
 def corner_vectors(bounds: PlacementBounds) -> np.ndarray:
-    """The decision vectors of the box's corners: every free variable at either bound."""
-    free = np.flatnonzero(bounds.free)
-    vectors = np.tile(bounds.lower, (1 << len(free), 1))
+    """The decision vectors of the box's distinct corners: every free variable at either bound.
+
+    An angle whose range is whole turns (yaw over [-pi, pi], or [-3.1416, 3.1416] as typed)
+    has one corner value: its two bounds are one start, and twice the corners filled the
+    refinement's starts with pairs of the same placement (the optimiser audit, stop 53).
+    """
+    lower, upper = bounds.lower, bounds.upper
+    free: list[int] = []
+    for index in np.flatnonzero(bounds.free):
+        moved = lower.copy()
+        moved[index] = upper[index]
+        if int(index) not in _ANGLES or not _same_placement(moved, lower):
+            free.append(int(index))
+    vectors = np.tile(lower, (1 << len(free), 1))
     for k in range(len(vectors)):
         for bit, variable in enumerate(free):
             if k >> bit & 1:
-                vectors[k, variable] = bounds.upper[variable]
+                vectors[k, variable] = upper[variable]
     return vectors
 
 

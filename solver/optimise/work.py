@@ -31,7 +31,7 @@ from solver.optimise.active_set import MAX_ROUNDS
 from solver.optimise.back_off import BACK_OFF_PLACEMENTS, backs_off
 from solver.optimise.coarse_rows import mapped_waypoints
 from solver.optimise.coarse_rows import whole_path_checks as map_checks
-from solver.optimise.coarse_search import coarse_map_cells
+from solver.optimise.coarse_search import coarse_map_cells, corner_vectors
 from solver.optimise.local_search import N_CLIMBS, REFINE_ROUNDS, climb_evaluations, refined_count
 from solver.optimise.methods import casadi_method, method_named, scipy_method
 from solver.optimise.methods.placement_scipy import search_placements
@@ -130,7 +130,7 @@ def _coarse_map_phases(problem: PathProblem, bounds: PlacementBounds) -> tuple[P
             mapped_waypoints(n),
         ),
         Phase("coarse map's whole-path checks", map_checks(n), n),
-        Phase(BOX_CORNERS, 1 << int(bounds.free.sum()), n),
+        Phase(BOX_CORNERS, len(corner_vectors(bounds)), n),
     )
 
 
