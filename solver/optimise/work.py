@@ -31,7 +31,7 @@ from solver.optimise.active_set import MAX_ROUNDS
 from solver.optimise.back_off import BACK_OFF_PLACEMENTS, backs_off
 from solver.optimise.coarse_rows import mapped_waypoints
 from solver.optimise.coarse_rows import whole_path_checks as map_checks
-from solver.optimise.coarse_search import coarse_map_cells, corner_vectors
+from solver.optimise.coarse_search import box_edge_points, coarse_map_cells, corner_vectors
 from solver.optimise.local_search import N_CLIMBS, REFINE_ROUNDS, climb_evaluations, refined_count
 from solver.optimise.methods import casadi_method, method_named, scipy_method
 from solver.optimise.methods.placement_scipy import search_placements
@@ -49,6 +49,8 @@ COARSE_MAP = "coarse map"
 """The name of the casadi method's coarse map among the phases."""
 BOX_CORNERS = "box corners"
 """The box's corners, evaluated beside the coarse map (:func:`coarse_search.box_corners`)."""
+BOX_EDGES = "box edges"
+"""Points along the box's edges, mapped beside the coarse map (:func:`coarse_search.box_edges`)."""
 SINGLE_PLACEMENT_COST = 2.5
 """The weight of a placement evaluated on its own, against one evaluated in a batch."""
 
@@ -120,7 +122,8 @@ def _coarse_map_phases(problem: PathProblem, bounds: PlacementBounds) -> tuple[P
     """The coarse map's phases (:func:`solver.optimise.coarse_search.coarse_cells`).
 
     Its cells; a long program's map on a set has its sample and best cells checked on the whole
-    path (:mod:`solver.optimise.coarse_rows`); the box's corners, on the whole path.
+    path (:mod:`solver.optimise.coarse_rows`); the box's corners, on the whole path; the points
+    along its edges, mapped as the cells are.
     """
     n = problem.prepared.n_waypoints
     return (
@@ -131,6 +134,8 @@ def _coarse_map_phases(problem: PathProblem, bounds: PlacementBounds) -> tuple[P
         ),
         Phase("coarse map's whole-path checks", map_checks(n), n),
         Phase(BOX_CORNERS, len(corner_vectors(bounds)), n),
+        Phase(BOX_EDGES, box_edge_points(bounds), mapped_waypoints(n)),
+        Phase("box edges' whole-path checks", map_checks(n), n),
     )
 
 

@@ -16,7 +16,7 @@ import pytest
 
 from solver.families import get_robot
 from solver.optimise import active_set, coarse_rows
-from solver.optimise.coarse_search import coarse_cells, corner_vectors
+from solver.optimise.coarse_search import coarse_cells, corner_vectors, edge_lines
 from solver.optimise.methods import casadi_method
 from solver.optimise.optimize import optimize_placement
 from solver.optimise.optimum import PlacementOptimum
@@ -209,8 +209,11 @@ def test_a_long_programs_map_reports_whole_path_cells_and_the_best_one(
     monkeypatch.setattr(coarse_rows, "MAX_MAP_ROWS", 40)
     on_set = coarse_cells(posed, BOX, symmetric=True, near=near)
     corners = {tuple(v) for v in corner_vectors(BOX)}  # the box's corners: on the whole path
-    mapped = [cell for cell in on_set if tuple(cell.vector) not in corners]
+    edges = {tuple(v) for line in edge_lines(BOX) for v in line}  # mapped as the cells are
+    mapped = [cell for cell in on_set if tuple(cell.vector) not in corners | edges]
     assert mapped and len(mapped) <= coarse_rows.VERIFIED_CELLS
+    on_edges = [cell for cell in on_set if tuple(cell.vector) in edges]
+    assert len(on_edges) <= coarse_rows.VERIFIED_CELLS
     rows = BOX.rows(np.array([cell.vector for cell in on_set]))
     again = evaluate_placements(posed, rows)
     # each cell is evaluated at its arc's point at the polar angle `near`, and handed on at the

@@ -40,7 +40,7 @@ SMALL_BOX = PlacementBounds(x=(-0.1, 0.1), y=(0.4, 0.5), yaw=(-0.3, 0.3), z=0.1)
 PHASES = {
     "casadi": {
         "front door": ("start", "candidates"),
-        "global": ("coarse map", "box corners"),
+        "global": ("coarse map", "box corners", "box edges", "box edges' whole-path checks"),
         "refinement": ("refinement",),
         "climbs": ("Nelder-Mead climbs",),
         "solves": ("IPOPT starts and whole-path checks",),
@@ -48,7 +48,13 @@ PHASES = {
     },
     "scipy": {
         "front door": ("start", "candidates"),
-        "global": ("differential evolution", "coarse map", "box corners"),
+        "global": (
+            "differential evolution",
+            "coarse map",
+            "box corners",
+            "box edges",
+            "box edges' whole-path checks",
+        ),
         "refinement": ("refinement",),
         "climbs": ("Nelder-Mead climbs",),
         "solves": ("whole-path checks",),

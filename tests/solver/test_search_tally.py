@@ -16,7 +16,12 @@ from solver.core.codes import FEASIBLE, REASONS
 from solver.core.spatial import Placement
 from solver.families import get_robot
 from solver.optimise import coarse_rows
-from solver.optimise.coarse_search import coarse_cells, coarse_map_cells, corner_vectors
+from solver.optimise.coarse_search import (
+    coarse_cells,
+    coarse_map_cells,
+    corner_vectors,
+    edge_lines,
+)
 from solver.optimise.failures import ReasonTally, Tried
 from solver.optimise.methods import search_rows
 from solver.optimise.methods.placement_scipy import FULL_SEARCH, global_search
@@ -137,7 +142,8 @@ def test_the_coarse_map_samples_the_far_end_of_the_yaw_range() -> None:
     problem = PathProblem.of(get_robot("ur5"), load_path("curved_line"))
     coarse_cells(problem, bounds, symmetric=False, near=0.0, tried=tried)
     rows = tried.outcomes()[0]
-    corners = bounds.rows(corner_vectors(bounds))  # tried too, beside the map
+    beside = [corner_vectors(bounds), *edge_lines(bounds)]  # tried too, beside the map
+    corners = bounds.rows(np.concatenate(beside))
     rows = rows[~(rows[:, None, :] == corners[None]).all(axis=2).any(axis=1)]
     xs, ys, yaws = (np.unique(rows[:, k].round(12)) for k in (0, 1, 3))
     # -0.25 + 0.02 k up to 0.25 (26); 0.25 + 0.02 k up to 0.65 (21); -0.5 + 15 deg k up to
