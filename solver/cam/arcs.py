@@ -11,7 +11,8 @@ The sense of the turn:
 - ``clockwise_about_axis`` given (NX: "i,j,k is the circle or helix axis vector ... assuming a
   clockwise direction", NX CLSF documentation): that sense, plus ``extra_turns`` whole turns
   (NX's ``TIMES,n`` is n turns, the partial one included: n - 1 extra);
-- else the shorter way; a half turn (within :data:`HALF_TURN`), where the shorter way is not
+- else (no caller of the CL reader: it gives every file a sense, cam.md section 9) the
+  shorter way; a half turn (within :data:`HALF_TURN`), where the shorter way is not
   defined, and a full circle turn counter-clockwise about the axis (APT's right-hand rule).
 
 A full circle is an arc whose end equals its start (seen along the axis).

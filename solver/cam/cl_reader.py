@@ -31,7 +31,7 @@ class ClReader:
     units: Units
     scale: float
     tolerance: float
-    clockwise: bool | None
+    clockwise: bool
     max_waypoints: int | None
     system: CoordinateSystem = PART
     local_axis: np.ndarray = dataclasses.field(default_factory=lambda: np.array([0.0, 0.0, 1.0]))
@@ -42,6 +42,7 @@ class ClReader:
     pass_id: int = 0
     operation: str | None = None
     circle: Circle | None = None
+    finished: Record | None = None
     correction: float = 0.0
     repeated: int = 0
     arcs: int = 0
@@ -60,6 +61,12 @@ class ClReader:
     def read(self, record: Record) -> None:
         """Take one record into the state."""
         word = record.word
+        if word in ("GOTO", "CIRCLE", "FROM") and self.finished is not None:
+            raise self.error(
+                f"{word} after FINI (line {self.finished.line}), the end of the program", record
+            )
+        if word == "FINI":
+            self.finished = record
         kind = kind_of(word)
         cycle_off = word == "CYCLE" and "".join(record.rest.split()).upper() == "/OFF"
         if kind in ("skipped", "unknown") or cycle_off:  # CYCLE / OFF as CYCLE/OFF
@@ -172,7 +179,13 @@ class ClReader:
         """A new system, followed outside a pass (cam.md section 9)."""
         if system.same_as(self.system):
             return
-        if self.in_pass() or self.circle is not None:
+        if self.circle is not None:
+            raise self.error(
+                f"the coordinate system changes between a CIRCLE (line {self.circle.record.line}) "
+                "and the GOTO of its end; the reader follows a change only between passes",
+                record,
+            )
+        if self.in_pass():
             raise self.error(
                 f"the coordinate system changes between two cutting moves (after line "
                 f"{self.lines[-1]}); the reader follows a change only between passes",
@@ -212,7 +225,7 @@ class ClReader:
         if "TIMES" in upper:
             at = upper.index("TIMES")
             count = self.numbers(args[at + 1 :], record)
-            if self.clockwise is None or count.shape != (1,) or count[0] < 1 or count[0] % 1:
+            if not self.clockwise or count.shape != (1,) or count[0] < 1 or count[0] % 1:
                 raise self.error("TIMES, n (n >= 1 whole turns) is read in NX files only", record)
             turns, args = int(count[0]) - 1, args[:at]
         if not 6 <= len(args) <= 11:

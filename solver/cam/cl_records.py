@@ -27,7 +27,7 @@ import re
 from collections.abc import Iterator
 from dataclasses import dataclass
 
-from solver.cam.reading import BOM
+from solver.cam.reading import BOM, text_lines
 from solver.core.exceptions import InvalidLineError
 
 READ = frozenset(
@@ -111,8 +111,17 @@ REFUSED: dict[str, str] = {
     "CYCLE": "a canned cycle, whose plunges are not written as GOTOs",
     "THREAD": "a threading cycle",
     "GOHOME": "a move to the FROM point, outside the GOTOs read",
-    "INDIRV": "the direction of the next arc, which the reader takes the shorter way",
-    "INDIRP": "the direction of the next arc, which the reader takes the shorter way",
+    "INDIRV": "the direction of the next arc, which the reader takes from its CIRCLE",
+    "INDIRP": "the direction of the next arc, which the reader takes from its CIRCLE",
+    "RETRCT": "a retract move",
+    "GOFWD": "a move along a drive surface or curve",
+    "TLON": "a move along a drive surface or curve (TLON, GOFWD/...)",
+    "ARC": "an arc given by its end point",
+    "NURBS": "a spline move",
+    "SPLINE": "a spline move",
+    "REFSYS": "a reference system for the moves that follow",
+    "TRANS": "a translation of the moves that follow",
+    "GO": "GO TO written with a blank: APT ignores blanks, the reader does not (write GOTO)",
 }
 """Words that change the geometry in ways the reader does not apply, and what they do."""
 
@@ -177,7 +186,7 @@ def records(text: str, *, field: str) -> Iterator[Record]:
     """
     start, parts = 0, list[str]()
     text = text.removeprefix(BOM)  # the encoding's mark (Windows editors write it), not text
-    for number, raw in enumerate(text.splitlines(), start=1):
+    for number, raw in enumerate(text_lines(text), start=1):
         content, hash_, comment = raw.partition(COMMENT)
         if hash_:
             yield Record(number, COMMENT, comment.strip(), raw.strip())

@@ -73,6 +73,15 @@ def units_of(
     statement = next((r for r in records if r.word in ("UNITS", "UNIT")), None)
     if statement is not None:
         units = stated_units(statement, field=field)
+        move = next((r for r in records if r.word == "GOTO"), None)
+        if move is not None and move.line < statement.line:
+            raise InvalidLineError(
+                field,
+                f"{statement.word} comes after the first move (GOTO at line {move.line}): the "
+                "reader takes one unit for the whole program, stated before its moves",
+                line=statement.line,
+                text=statement.text,
+            )
         note = f"{statement.word}/{statement.arguments(field)[0].upper()} at line {statement.line}"
         if requested is not None and requested != units:
             raise InvalidInputError(

@@ -14,7 +14,14 @@ from __future__ import annotations
 import math
 
 from solver.cam.cam_path import METRES_PER_UNIT, CamPath, Units, assemble_cam_path
-from solver.cam.reading import BOM, checked_position, is_number, near_unit_vector, parse_numbers
+from solver.cam.reading import (
+    BOM,
+    checked_position,
+    is_number,
+    near_unit_vector,
+    parse_numbers,
+    text_lines,
+)
 from solver.core.exceptions import InvalidInputError, InvalidLineError
 from solver.core.spatial import rotation_from_quaternion
 
@@ -105,7 +112,7 @@ def _rows(text: str) -> list[tuple[int, str]]:
     header with it, let 20,001 waypoints past a limit of 20,000.
     """
     text = text.removeprefix(BOM)
-    return [(n, raw.strip()) for n, raw in enumerate(text.splitlines(), start=1) if raw.strip()]
+    return [(n, raw.strip()) for n, raw in enumerate(text_lines(text), start=1) if raw.strip()]
 
 
 def _has_header(rows: list[tuple[int, str]]) -> bool:

@@ -203,7 +203,7 @@ def test_rapids_split_passes_and_their_targets_belong_to_none() -> None:
     np.testing.assert_array_equal(path.pass_starts, [True, False, True, False, False])
 
 
-@pytest.mark.parametrize("word", sorted(IGNORED))
+@pytest.mark.parametrize("word", sorted(IGNORED - {"FINI"}))  # FINI ends the program
 def test_ignored_records(word: str) -> None:
     plain = read_cl_data(multax(*TWO_CUTS))
     for record in (word, f"{word}/1, ABC, 2.5", f"{word} some free text"):
