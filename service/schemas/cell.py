@@ -103,7 +103,9 @@ class CellSpec(RequestModel):
         min_length=1,
         max_length=MAX_LINK_RADII,
         description="m, capsule radii of an arm without collision geometry: the base's, then one "
-        "per joint, each capsule along its link's kinematic segment. Default: the arm's "
+        "per joint, each capsule along its link's kinematic segment (a UR e-series shoulder, "
+        "upper arm and forearm along the links, beside the DH line by Universal Robots' "
+        "shoulder and elbow offsets). Default: the arm's "
         "published collision capsules (UR5e, UR10e: MuJoCo Menagerie's, where the links are) or "
         "its URDF's geometry; given for a UR5e or UR10e, they replace the published capsules.",
     )

@@ -106,3 +106,35 @@ def _at(position: np.ndarray) -> np.ndarray:
     pose = np.eye(4)
     pose[:3, 3] = position
     return pose
+
+
+# Our capsule along the link, and the Menagerie part (index into menagerie_parts) on its line.
+ON_MENAGERIE_LINES = {
+    "shoulder_pan_joint_capsule": 1,  # the shoulder's housing, along joint 2's axis
+    "shoulder_lift_joint_capsule": 2,  # the upper arm's tube
+    "shoulder_lift_joint_housing_capsule": 3,  # the elbow's housing
+    "elbow_joint_capsule": 4,  # the forearm's tube
+    "elbow_joint_housing_capsule": 5,  # wrist 1's housing
+}
+
+
+@pytest.mark.parametrize("name", ["ur5e", "ur10e"])
+def test_link_radii_capsules_follow_the_links(name: str) -> None:
+    """With link_radii the capsules run along the links (UR's shoulder and elbow offsets), not
+    the DH segments: each on the axis of Menagerie's part there, to 1.5 mm, and parallel."""
+    robot = get_robot(name)
+    checker = CellChecker(robot, Cell(link_radii=(0.05,) * 7))
+    geometry = checker.geometry
+    names = [obj.name for obj in geometry.geometryObjects]
+    data, gdata = robot.model.createData(), geometry.createData()
+    rng = np.random.default_rng(2)
+    for _ in range(20):
+        q = rng.uniform(-np.pi, np.pi, 6)
+        pin.updateGeometryPlacements(robot.model, data, geometry, gdata, q)
+        parts = menagerie_parts(name, q)
+        for ours, theirs in ON_MENAGERIE_LINES.items():
+            placed = gdata.oMg[names.index(ours)]
+            axis, their = placed.rotation[:, 2], parts[theirs]
+            off_line = np.cross(their[:3, 3] - placed.translation, axis)
+            assert np.linalg.norm(off_line) < 1.5e-3, (ours, np.linalg.norm(off_line))
+            assert abs(abs(axis @ their[:3, 2]) - 1.0) < 1e-9

@@ -94,10 +94,11 @@ def robot_geometry(
     radii = _radii(robot, link_radii, needed=bool(bare) and robot.urdf is None)
     approximated = []
     for joint in bare:
-        start, end = _segment(robot, joint)
         radius = radii[joint] if radii is not None else DEFAULT_URDF_LINK_RADIUS
         name = "base" if joint == 0 else model.names[joint]
-        geometry.addGeometryObject(_capsule(name + CAPSULE_SUFFIX, joint, start, end, radius))
+        for k, (start, end) in enumerate(_link_segments(robot, joint)):
+            part = name if k == 0 else f"{name}_housing"
+            geometry.addGeometryObject(_capsule(part + CAPSULE_SUFFIX, joint, start, end, radius))
         approximated.append(name)
     n_arm = geometry.ngeoms
     cutting = -1
@@ -225,6 +226,60 @@ def _radii(
             f"link_radii, {count} values in m (the base's, then one per joint)",
         )
     return None
+
+
+UR_LINK_OFFSETS: dict[str, tuple[float, float]] = {
+    "ur3e": (0.120, 0.027),
+    "ur5e": (0.138, 0.007),
+    "ur10e": (0.1762, 0.0393),
+    "ur16e": (0.176, 0.040),
+}
+"""m: the UR e-series' upper arm and forearm beside the DH line, along joints 2 and 3's axes
+(Universal Robots' ROS 2 description, config/<arm>/physical_parameters.yaml: shoulder_offset,
+elbow_offset, 'measured from model'). The UR DH model folds them into d4: its upper-arm
+segment runs 0.138 m beside the UR5e's upper arm, its forearm segment crosses diagonally to
+the wrist."""
+
+
+def _link_segments(robot: Robot, joint: int) -> list[tuple[np.ndarray, np.ndarray]]:
+    """The segments of ``joint``'s link's capsules, in its frame: the kinematic segment.
+
+    A UR e-series arm's shoulder, upper arm and forearm follow the links instead
+    (:data:`UR_LINK_OFFSETS`): on joint 1 the shoulder's housing along joint 2's axis out to
+    the upper arm; on joint 2 the upper arm beside the DH line, and the elbow's housing along
+    joint 3's axis in to the forearm; on joint 3 the forearm, and the wrist's housing along
+    joint 4's axis out to the DH wrist point. The wrist links are their DH segments.
+    """
+    offsets = UR_LINK_OFFSETS.get(robot.name)
+    model = robot.model
+    if offsets is None or model.njoints != 7 or joint not in (1, 2, 3):
+        return [_segment(robot, joint)]
+    shoulder, elbow = offsets
+    frames = [model.jointPlacements[j] for j in range(1, 5)]  # each in its parent's frame
+    if joint == 1:  # joint 2's origin and axis in joint 1's frame
+        origin, axis = frames[1].translation, frames[1].rotation[:, 2]
+        side = _side(model, 2)
+        return [(origin, origin + side * shoulder * axis)]
+    if joint == 2:  # in joint 2's frame: its axis z, joint 3 at frames[2]
+        side, z = _side(model, 2), np.array([0.0, 0.0, 1.0])
+        elbow_point = frames[2].translation
+        return [
+            (side * shoulder * z, elbow_point + side * shoulder * z),
+            (elbow_point + side * shoulder * z, elbow_point + side * elbow * z),
+        ]
+    side, z = _side(model, 3), np.array([0.0, 0.0, 1.0])
+    wrist = frames[3].translation  # joint 4's origin (the DH wrist point) in joint 3's frame
+    lateral = float(wrist @ z)
+    beside = wrist + (side * elbow - lateral) * z  # on joint 4's axis, at the forearm's side
+    return [(side * elbow * z, beside), (beside, wrist)]
+
+
+def _side(model: pin.Model, joint: int) -> float:
+    """+1 or -1: the way along ``joint``'s axis (2 or 3) to the DH wrist point (joint 4)."""
+    data = model.createData()
+    pin.forwardKinematics(model, data, pin.neutral(model))
+    wrist = data.oMi[joint].actInv(data.oMi[4].translation)
+    return 1.0 if wrist[2] >= 0.0 else -1.0
 
 
 def _segment(robot: Robot, joint: int) -> tuple[np.ndarray, np.ndarray]:
