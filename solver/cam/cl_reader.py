@@ -43,6 +43,8 @@ class ClReader:
     operation: str | None = None
     circle: Circle | None = None
     finished: Record | None = None
+    pass_points: int = 0
+    singles: int = 0
     correction: float = 0.0
     repeated: int = 0
     arcs: int = 0
@@ -284,12 +286,18 @@ class ClReader:
             if moved @ moved < LINEAR_TOLERANCE**2 and turned @ turned < ANGULAR_TOLERANCE**2:
                 self.repeated += 1
                 return
-        if self.max_waypoints is not None and len(self.positions) >= self.max_waypoints:
+        starts = not self.in_pass()
+        if starts:  # the pass before, if of one point, is dropped (cam.md 9: counts are one rule)
+            self.singles += self.pass_points == 1
+            self.pass_points = 0
+        kept = len(self.positions) + 1 - self.singles - starts  # this pass's first point may go
+        if self.max_waypoints is not None and kept > self.max_waypoints:
             raise InvalidInputError(
                 "path",
                 f"more than {self.max_waypoints} waypoints by line {line}; the limit is "
                 f"{self.max_waypoints}",
             )
+        self.pass_points += 1
         self.position, self.axis = position, axis
         self.positions.append(position)
         self.axes.append(axis)

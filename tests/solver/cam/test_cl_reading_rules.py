@@ -107,3 +107,17 @@ def test_a_move_after_fini_is_refused() -> None:
 def test_units_after_the_first_move_are_refused() -> None:
     error = _refused("GOTO/1,0,0\nGOTO/2,0,0\nUNITS/INCHES\nGOTO/3,0,0\n")
     assert error.line == 3 and "GOTO at line 1" in str(error)
+
+
+def test_the_waypoint_limit_counts_what_import_shows() -> None:
+    """cam.md 9, 'counts are one rule': a pass of one point is dropped, so it does not count
+    (20,000 points and a one-point pass were refused as 'more than 20000 waypoints')."""
+    three = ["GOTO/0,0,0", "GOTO/1,0,0", "GOTO/2,0,0"]
+    single = ["RAPID", "GOTO/0,0,50", "GOTO/0,0,40"]  # a rapid, then a pass of one point
+    path = read_cl_data(_program(*three, *single), field="p", max_waypoints=3)
+    assert len(path.positions) == 3 and path.one_point_passes == 1
+    first = ["GOTO/0,0,40", "RAPID", "GOTO/0,0,50"]  # a pass of one point, then a rapid
+    path = read_cl_data(_program(*first, *three), field="p", max_waypoints=3)
+    assert len(path.positions) == 3 and path.one_point_passes == 1
+    with pytest.raises(Exception, match="more than 3 waypoints by line 5"):
+        read_cl_data(_program(*three, "GOTO/3,0,0"), field="p", max_waypoints=3)
