@@ -88,7 +88,8 @@ tool centre the CAM system computed); compensation is the controller's wear offs
 LITERAL = frozenset({"PARTNO", "PPRINT", "INSERT", "REMARK"})
 """Words whose text is taken as written, to the end of its line: APT does not continue them,
 so a ``$`` ending one is text (``PPRINT/TOOL COST 5$`` joined the next line's GOTO to the
-operation's name: a move lost without a word)."""
+operation's name: a move lost without a word), and so is a ``$$`` in it (``PPRINT/ROUGH $$ 2``
+was the operation ``ROUGH`` and a comment)."""
 
 SKIPPED_PREFIXES = ("CSI_",)
 """SolidWorks CAM's ``CSI_SET_*`` tool data."""
@@ -187,7 +188,8 @@ def records(text: str, *, field: str) -> Iterator[Record]:
     start, parts = 0, list[str]()
     text = text.removeprefix(BOM)  # the encoding's mark (Windows editors write it), not text
     for number, raw in enumerate(text_lines(text), start=1):
-        content, hash_, comment = raw.partition(COMMENT)
+        literal = not parts and _literal(raw.strip())  # its text runs to the end of the line
+        content, hash_, comment = (raw, "", "") if literal else raw.partition(COMMENT)
         if hash_:
             yield Record(number, COMMENT, comment.strip(), raw.strip())
         content = content.strip()

@@ -121,3 +121,9 @@ def test_the_waypoint_limit_counts_what_import_shows() -> None:
     assert len(path.positions) == 3 and path.one_point_passes == 1
     with pytest.raises(Exception, match="more than 3 waypoints by line 5"):
         read_cl_data(_program(*three, "GOTO/3,0,0"), field="p", max_waypoints=3)
+
+
+def test_pprint_text_keeps_its_double_dollar() -> None:
+    path = read_cl_data(_program("PPRINT/ROUGH $$ 2", "GOTO/0,0,0", "GOTO/1,0,0"), field="p")
+    assert path.pass_operations[0] == "ROUGH $$ 2"
+    assert all(record.word != "$$" for record in path.report.skipped_records)
