@@ -17,9 +17,11 @@ from scipy.spatial.transform import Rotation
 
 from solver.core.spatial import Placement
 from solver.families import get_robot
+from solver.path.capability_map import capability_map, grid_axis
 from solver.path.cell.checker import CellChecker
 from solver.path.cell.published_geometry import PUBLISHED, published_geometry
-from solver.path.cell.shapes import Cell, Sphere
+from solver.path.cell.shapes import Box, Cell, Halfspace, Sphere
+from solver.path.problem import PathOptions, PathProblem
 from tests.problems import evaluate_path
 from tests.solver.test_evaluate import load_path
 
@@ -138,3 +140,34 @@ def test_link_radii_capsules_follow_the_links(name: str) -> None:
             off_line = np.cross(their[:3, 3] - placed.translation, axis)
             assert np.linalg.norm(off_line) < 1.5e-3, (ours, np.linalg.norm(off_line))
             assert abs(abs(axis @ their[:3, 2]) - 1.0) < 1e-9
+
+
+def _table(kind: str, top: float) -> Halfspace | Box:
+    if kind == "halfspace":
+        return Halfspace((0.0, 0.0, 1.0), top, name="table")
+    return Box((3.0, 3.0, 0.1), _at(np.array([0.0, 0.0, top - 0.05])), name="table")
+
+
+@pytest.mark.parametrize("kind", ["halfspace", "box"])
+@pytest.mark.parametrize("name", ["ur5e", "ur10e"])
+def test_a_table_at_the_mounting_face_changes_nothing(name: str, kind: str) -> None:
+    """The contract audit (stop 54): Menagerie's UR10e shoulder capsule reaches 27 mm below the
+    face the arm stands on, and every placement on a table there collided; the UR5e's, 3 mm
+    above it, collided on a box table. Against a far sphere (self-collision on in both), the
+    same map cell for cell; a table top 5 cm up cuts the shoulder: every cell collides."""
+    robot, path = get_robot(name), load_path("curved_line")[::4]
+    axes = {
+        "xs": grid_axis(-0.2, 0.2, 0.2, field="x"),
+        "ys": grid_axis(0.4, 0.6, 0.2, field="y"),
+        "z": 0.1,
+        "yaws": np.array([0.0]),
+    }
+    far = Cell(fixed=(Sphere(0.005, _at(np.array([5.0, 5.0, 5.0])), name="far"),))
+    maps = [
+        capability_map(PathProblem.of(robot, path, PathOptions(cell=cell)), **axes)  # type: ignore[arg-type]
+        for cell in (far, Cell(fixed=(_table(kind, 0.0),)), Cell(fixed=(_table(kind, 0.05),)))
+    ]
+    assert (maps[0].reason == -1).sum() >= 4
+    np.testing.assert_array_equal(maps[1].reason, maps[0].reason)
+    np.testing.assert_array_equal(maps[1].mu_path, maps[0].mu_path)
+    assert np.all(maps[2].reason == 4)  # collision everywhere

@@ -65,12 +65,17 @@ class RobotGeometry:
         keys: per object, a digest of everything it and its place on the model are made of (the
             model, the URDF, the arm's name, the link radii; the tool for the tool's parts):
             two objects of equal keys are the same, whatever the cell around them.
+        seats: per object, m, how deep it may sit in a table it stands on and be seated there
+            rather than in collision (:func:`solver.path.cell.scene._seated`): a capsule made
+            along a link, its radius; a published capsule, how far it reaches below the
+            mounting face (z = 0 of {B}) at the zero configuration; anything else, 0.
     """
 
     geometry: pin.GeometryModel
     approximated: tuple[str, ...]
     cutting: int
     keys: tuple[str, ...]
+    seats: tuple[float, ...] = ()
 
 
 def robot_geometry(
@@ -90,6 +95,7 @@ def robot_geometry(
         geometry = _urdf_geometry(robot)
     else:
         geometry = pin.GeometryModel()
+    seats = _below_mount(robot, geometry) if published is not None else [0.0] * geometry.ngeoms
     bare = [] if published is not None else _bare_joints(model, geometry)
     radii = _radii(robot, link_radii, needed=bool(bare) and robot.urdf is None)
     approximated = []
@@ -99,6 +105,7 @@ def robot_geometry(
         for k, (start, end) in enumerate(_link_segments(robot, joint)):
             part = name if k == 0 else f"{name}_housing"
             geometry.addGeometryObject(_capsule(part + CAPSULE_SUFFIX, joint, start, end, radius))
+            seats.append(radius)
         approximated.append(name)
     n_arm = geometry.ngeoms
     cutting = -1
@@ -115,7 +122,30 @@ def robot_geometry(
         f"{arm if g < n_arm else with_tool}:{g}:{obj.name}"
         for g, obj in enumerate(geometry.geometryObjects)
     )
-    return RobotGeometry(geometry, tuple(approximated), cutting, keys)
+    seats += [0.0] * (geometry.ngeoms - len(seats))  # the tool's parts
+    return RobotGeometry(geometry, tuple(approximated), cutting, keys, tuple(seats))
+
+
+def _below_mount(robot: Robot, geometry: pin.GeometryModel) -> list[float]:
+    """m, how far each published capsule reaches below the mounting face at q = 0.
+
+    Menagerie's UR10e shoulder capsule ends 27 mm below the face the arm stands on (the UR5e's
+    3 mm above it): a rounded end around the shoulder's housing, not the arm. Standing on a
+    table at the face it is seated there; a table top above the face cuts the arm (cell.md
+    section 5) and collides everywhere.
+    """
+    data, gdata = robot.model.createData(), geometry.createData()
+    pin.updateGeometryPlacements(robot.model, data, geometry, gdata, pin.neutral(robot.model))
+    to_base = np.linalg.inv(robot.transform_world_to_base)
+    depths = []
+    for k, obj in enumerate(geometry.geometryObjects):
+        placed = gdata.oMg[k]
+        shape = obj.geometry
+        half = float(getattr(shape, "halfLength", 0.0))
+        ends = [placed.act(np.array([0.0, 0.0, side * half])) for side in (-1.0, 1.0)]
+        lowest = min(float((to_base @ [*end, 1.0])[2]) for end in ends) - float(shape.radius)
+        depths.append(max(0.0, -lowest))
+    return depths
 
 
 def _bare_joints(model: pin.Model, geometry: pin.GeometryModel) -> list[int]:

@@ -6,11 +6,14 @@ placement's T_B_O times their pose (placed by the checker, :mod:`solver.path.cel
 The pairs: every robot part (the tool included) against every obstacle, except the tool's
 cutting part against ``workpiece`` objects (that is machining) and a part against a ``fixed``
 object no joint moves it relative to (its weights in :func:`solver.path.cell.bounds.pair_weights`
-all zero) and that stands on it: the base, whatever the placement, and a link only joint 1
-turns about a fixed halfspace's normal, joint 1's origin on or above the halfspace's boundary
+all zero) and that stands on it: the base, whatever the placement, a part joint 1 turns onto
+itself (a sphere on its axis, a capsule or cylinder along it: :func:`_turns_in_place`), and
+a link only joint 1 turns about a fixed halfspace's normal, joint 1's origin on or above the
+halfspace's boundary
 (joint 1's link of an arm on its table; a table top above joint 1 cuts the arm's turning part,
 and is checked: it collides everywhere, as cell.md section 5 has it), clear of it or seated in
-it (:func:`_seated`: only a capsule made along the link, as deep as its radius; a link's own
+it (:func:`_seated`: a capsule made along the link, as deep as its radius, or a published
+capsule as deep as it reaches below the mounting face; a link's own
 geometry reaching into the table, the Panda's link 1 hanging down to its base below a table
 top, is checked and collides everywhere). Such a pair's distance is the same at every
 configuration and placement: were it checked, an arm whose joint-1 link touches its table (a
@@ -35,7 +38,7 @@ import pinocchio as pin
 from solver.core.robots import Robot
 from solver.path.cell import fast
 from solver.path.cell.bounds import pair_weights
-from solver.path.cell.robot_geometry import CAPSULE_SUFFIX, robot_geometry
+from solver.path.cell.robot_geometry import robot_geometry
 from solver.path.cell.shapes import DEFAULT_CLEARANCE, Cell
 from solver.path.cell.verdict import Unchecked
 
@@ -115,7 +118,7 @@ def build_scene(robot: Robot, cell: Cell) -> CellScene:
     distances = _distances(robot.model, geometry, [p for p, _ in standing] + candidates)
     still, still_distances = [], []
     for (pair, weight), distance in zip(standing, distances[: len(standing)], strict=True):
-        if _seated(geometry, pair[0], distance):
+        if _seated(geometry, pair[0], distance, made.seats):
             still.append(pair)
             still_distances.append(distance)
         else:  # a link that reaches into its table: in collision at every configuration
@@ -179,8 +182,10 @@ def _moving(
     still = np.array(
         [
             b < n_robot + n_fixed
-            and bool(w.max(initial=0.0) < STILL)
-            and _stands(geometry, data, a, b)
+            and (
+                (bool(w.max(initial=0.0) < STILL) and _stands(geometry, data, a, b))
+                or _turns_in_place(model, geometry, a)
+            )
             for (a, b), w in zip(pairs, weights, strict=True)
         ],
         dtype=bool,
@@ -190,7 +195,9 @@ def _moving(
     return moving, weights[~still], standing
 
 
-def _seated(geometry: pin.GeometryModel, part: int, distance: float) -> bool:
+def _seated(
+    geometry: pin.GeometryModel, part: int, distance: float, seats: tuple[float, ...]
+) -> bool:
     """Whether a standing pair's overlap (``distance`` < 0, the same everywhere) is a seat.
 
     The base is seated on whatever it stands in (cell.md section 3 checks it against nothing
@@ -199,14 +206,14 @@ def _seated(geometry: pin.GeometryModel, part: int, distance: float) -> bool:
     0.141 m) and joint 1 (0.333 m) cut link 1, which hangs down to the base, and every placement
     ran (the cell audit, stop 53): such a pair is checked. A capsule the service made along the
     link (no geometry of its own) from joint 1's origin on the table is seated as deep as its
-    radius (the ROS-Industrial IRB 2400's from its foot).
+    radius (the ROS-Industrial IRB 2400's from its foot); a published capsule as deep as it
+    reaches below the mounting face (Menagerie's UR10e shoulder, 27 mm): ``seats``
+    (:attr:`solver.path.cell.robot_geometry.RobotGeometry.seats`).
     """
     obj = geometry.geometryObjects[part]
     if int(obj.parentJoint) == 0 or distance >= 0.0:
         return True
-    shape = obj.geometry
-    made = obj.name.endswith(CAPSULE_SUFFIX) and isinstance(shape, (coal.Capsule, coal.Sphere))
-    return made and distance >= -float(shape.radius) - STILL
+    return distance >= -seats[part] - STILL
 
 
 def _stands(geometry: pin.GeometryModel, data: pin.Data, part: int, obstacle: int) -> bool:
@@ -226,6 +233,44 @@ def _stands(geometry: pin.GeometryModel, data: pin.Data, part: int, obstacle: in
         return False
     local = obj.placement.actInv(data.oMi[joint].translation)  # joint's origin, in its frame
     return float(np.dot(obj.geometry.n, local) - obj.geometry.d) >= -STILL
+
+
+def _turns_in_place(model: pin.Model, geometry: pin.GeometryModel, part: int) -> bool:
+    """Whether ``part`` is on the first joint and round about its axis (a pair no joint moves).
+
+    A sphere centred on joint 1's axis, or a capsule or cylinder along it: joint 1 turns it
+    onto itself, so its distance to anything fixed is the same at every configuration, whatever
+    the object's shape. Menagerie's UR5e shoulder capsule, 3 mm above a box table top at the
+    mounting face, collided at every placement (the contract audit, stop 54); on a halfspace
+    table it stood (:func:`_stands`).
+    """
+    obj = geometry.geometryObjects[part]
+    joint = int(obj.parentJoint)
+    if joint == 0 or int(model.parents[joint]) != 0:
+        return False
+    shape = obj.geometry
+    if not isinstance(shape, (coal.Sphere, coal.Capsule, coal.Cylinder)):
+        return False
+    axis = _joint_axis(model, joint)
+    centre = np.asarray(obj.placement.translation, dtype=float)
+    off_axis = np.linalg.norm(centre - (centre @ axis) * axis)
+    along = (
+        isinstance(shape, coal.Sphere)
+        or np.linalg.norm(np.cross(obj.placement.rotation[:, 2], axis)) < 1e-9
+    )
+    return bool(off_axis < 1e-9 and along)
+
+
+def _joint_axis(model: pin.Model, joint: int) -> np.ndarray:
+    """The unit axis of a revolute joint in its own frame; zeros for any other joint."""
+    name = model.joints[joint].shortname()
+    if name.startswith("JointModelR") and name[-1] in "XYZ":
+        unit: np.ndarray = np.eye(3)["XYZ".index(name[-1])]
+        return unit
+    if name.startswith("JointModelRevoluteUnaligned"):
+        axis: np.ndarray = np.asarray(model.joints[joint].extract().axis, dtype=float)
+        return axis / float(np.linalg.norm(axis))
+    return np.zeros(3)
 
 
 def _distances(
