@@ -21,10 +21,9 @@
 from __future__ import annotations
 
 import hashlib
-import html
 import os
 import pickle
-import re
+import xml.etree.ElementTree as ElementTree
 from dataclasses import dataclass
 
 import coal
@@ -33,6 +32,7 @@ import pinocchio as pin
 
 from solver.core.exceptions import InvalidInputError
 from solver.core.robots import Robot, example_robot_data_dir
+from solver.core.urdf_structure import parsed
 from solver.path.cell.published_geometry import published_geometry
 from solver.path.cell.shapes import Tool, convex_hull
 
@@ -185,20 +185,17 @@ def content_digest(*parts: bytes) -> str:
 def _urdf_geometry(robot: Robot) -> pin.GeometryModel:
     """The URDF's collision elements with meshes as convex hulls; primitives only if unreadable."""
     share = str(example_robot_data_dir().parent.parent)  # package://example-robot-data/...
-    urdf = re.sub(
-        r"<collision\b.*?</collision>",
-        lambda match: _inside_share(match, share),
-        robot.urdf or "",
-        flags=re.S,
-    )
     try:
         geometry = pin.buildGeomFromUrdfString(
-            robot.model, urdf, pin.COLLISION, package_dirs=[share]
-        )
+            robot.model, _collisions_in_share(robot.urdf or "", share), pin.COLLISION,
+            package_dirs=[share],
+        )  # fmt: skip
     except (ValueError, RuntimeError):
-        primitives = re.sub(r"<collision\b.*?</collision>", _keep_primitive, urdf, flags=re.S)
         geometry = pin.buildGeomFromUrdfString(
-            robot.model, primitives, pin.COLLISION, package_dirs=[share]
+            robot.model,
+            _collisions_in_share(robot.urdf or "", share, meshes=False),
+            pin.COLLISION,
+            package_dirs=[share],
         )
     for obj in geometry.geometryObjects:
         if isinstance(obj.geometry, coal.BVHModelBase):
@@ -207,31 +204,37 @@ def _urdf_geometry(robot: Robot) -> pin.GeometryModel:
     return geometry
 
 
-_MESH_FILE = re.compile(r"""<mesh\b[^>]*?\bfilename\s*=\s*(["'])(.*?)\1""", re.S)
-
-
-def _inside_share(match: re.Match[str], share: str) -> str:
-    """A ``<collision>`` element unless it holds a mesh that is not a file of the share folder.
+def _collisions_in_share(urdf: str, share: str, *, meshes: bool = True) -> str:
+    """The URDF, each ``<collision>`` element with a mesh that is not a file of ``share`` out.
 
     Only ``package://`` meshes are read, and only inside ``share`` (cell.md section 2): a
     request's URDF named any file of the server (``/etc/...``, ``file://``, a relative path,
     ``package://`` with ``..``) and the answer's approximated links told whether it was a
     readable mesh. Without the element its link is approximated, and the answer says so.
+    ``meshes`` False takes every mesh element out (the primitives alone).
+
+    Read as XML, written back without comments: a pattern over the text ended an element at a
+    ``</collision>`` inside a comment or CDATA before it, and the mesh after it was read from
+    anywhere (a file outside, or a FIFO, a folder: a 500; the contract audit, stop 54).
     """
-    element = match.group(0)
-    for mesh in _MESH_FILE.finditer(element):
-        name = html.unescape(mesh.group(2)).strip()
-        if not name.startswith("package://"):
-            return ""
-        resolved = os.path.realpath(os.path.join(share, name.removeprefix("package://")))
-        if not resolved.startswith(os.path.realpath(share) + os.sep):
-            return ""
-    return element
+    root = parsed(urdf)
+    if root is None:
+        return urdf
+    for parent in list(root.iter()):
+        for collision in [child for child in parent if child.tag == "collision"]:
+            files = [mesh.get("filename", "") for mesh in collision.iter("mesh")]
+            if files and (not meshes or not all(_in_share(name, share) for name in files)):
+                parent.remove(collision)
+    return ElementTree.tostring(root, encoding="unicode")
 
 
-def _keep_primitive(match: re.Match[str]) -> str:
-    """A ``<collision>`` element unless it holds a mesh."""
-    return "" if "<mesh" in match.group(0) else match.group(0)
+def _in_share(name: str, share: str) -> bool:
+    """Whether a mesh's file name is a ``package://`` file inside ``share``."""
+    name = name.strip()
+    if not name.startswith("package://"):
+        return False
+    resolved = os.path.realpath(os.path.join(share, name.removeprefix("package://")))
+    return resolved.startswith(os.path.realpath(share) + os.sep) and os.path.isfile(resolved)
 
 
 def _radii(
