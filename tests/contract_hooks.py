@@ -387,7 +387,7 @@ def _repair(body: dict[str, Any], route: str) -> str | None:
         body.pop("joint_path", None)
     if isinstance(body.get("cell"), dict):
         _noted(
-            "cell: checkable (radii, an STL, a tool, a normal, evaluate only)",
+            "cell: checkable (radii, an STL, a tool from the flange, a normal, evaluate only)",
             body,
             _repair_cell,
             body,
@@ -426,7 +426,8 @@ CUBE_STL = (
 
 def _repair_cell(body: dict[str, Any], route: str) -> None:
     """A cell the robot can be checked in: radii for every arm (7: all are 6-joint arms here),
-    an STL for a random string, a cutting length within the tool, a normal that is not 0, at
+    an STL for a random string, a cutting length within the tool, the robot's tcp at the tool's
+    tip (a tool starting behind the flange is refused), a normal that is not 0, at
     most three objects a group. Maps and optimisations drop it: their work with a cell is
     tested in tests/service/test_cell.py (a generated grid sized to the limits without a cell
     would be refused for its collision work)."""
@@ -438,6 +439,10 @@ def _repair_cell(body: dict[str, Any], route: str) -> None:
     tool = cell.get("tool")
     if isinstance(tool, dict) and tool.get("cutting_length") is not None:
         tool["cutting_length"] = min(tool["cutting_length"], tool["length"])
+    if isinstance(tool, dict) and isinstance(body.get("robot"), dict):
+        # the tool runs from the flange to the tool point (cell.md 1): the tcp at its tip
+        tip = {"position": [0.0, 0.0, tool.get("length", 0.1)], "orientation": [0, 0, 0, 1]}
+        body["robot"]["tcp"] = tip
     for group in ("fixed", "workpiece"):
         objects = cell[group] = (cell.get(group) or [])[:3]
         for item in objects:

@@ -285,7 +285,7 @@ def coarse_cells(
             cells.append(Cell(vector, float(mu[k]), int(branch[k])))
     for extra in (
         box_corners(problem, bounds, runner=runner, tried=tried),
-        box_edges(problem, bounds, runner=runner, tried=tried),
+        box_edges(problem, bounds, symmetric=symmetric, runner=runner, tried=tried),
     ):  # a corner or edge point that is one of the cells already is there once
         cells += [c for c in extra if not any(_same_placement(c.vector, o.vector) for o in cells)]
     return sorted(cells, key=lambda cell: -cell.mu_path)  # stable: the map's first
@@ -414,6 +414,7 @@ def box_edges(
     problem: PathProblem,
     bounds: PlacementBounds,
     *,
+    symmetric: bool,
     runner: TaskRunner = SERIAL,
     tried: Tried | None = None,
 ) -> list[Cell]:
@@ -425,9 +426,10 @@ def box_edges(
     below (the optimiser audit, stop 53). The samples are mapped as the coarse map is
     (:func:`solver.optimise.coarse_rows.map_values`: a long program on a set of waypoints,
     its maxima verified on the whole path); a point not below its neighbours on its line is a
-    maximum.
+    maximum. Only for the polar map (``symmetric``): the map over (x, y, yaw) has the box's
+    edges on its own axes (at the lower bounds and, where the range is whole steps, the upper).
     """
-    lines = edge_lines(bounds)
+    lines = edge_lines(bounds) if symmetric else []
     if not lines:
         return []
     vectors = np.concatenate(lines)
@@ -448,6 +450,6 @@ def box_edges(
     ]
 
 
-def box_edge_points(bounds: PlacementBounds) -> int:
+def box_edge_points(bounds: PlacementBounds, *, symmetric: bool) -> int:
     """How many placements :func:`box_edges` maps."""
-    return sum(len(line) for line in edge_lines(bounds))
+    return sum(len(line) for line in edge_lines(bounds)) if symmetric else 0

@@ -134,7 +134,11 @@ def _coarse_map_phases(problem: PathProblem, bounds: PlacementBounds) -> tuple[P
         ),
         Phase("coarse map's whole-path checks", map_checks(n), n),
         Phase(BOX_CORNERS, len(corner_vectors(bounds)), n),
-        Phase(BOX_EDGES, box_edge_points(bounds), mapped_waypoints(n)),
+        Phase(
+            BOX_EDGES,
+            box_edge_points(bounds, symmetric=symmetric_search(problem)),
+            mapped_waypoints(n),
+        ),
         Phase("box edges' whole-path checks", map_checks(n), n),
     )
 
