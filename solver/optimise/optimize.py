@@ -139,6 +139,7 @@ def optimize_placement(
     chosen_method = check_search(
         problem, bounds=bounds, start=start, method=method, max_spin_step=max_spin_step
     )
+    bounds = bounds.within_a_turn()
     if start is None:
         start = bounds.placement(bounds.centre())
     settings = Search(
@@ -170,7 +171,10 @@ def optimize_placement(
     # The start last: it is the answer only when nothing the solver found is better.
     candidates = [
         *candidates,
-        Candidate(vector_of(start), "no better placement found than the start"),
+        Candidate(
+            vector_of(dataclasses.replace(start, yaw=bounds.wrapped_yaw(start.yaw))),
+            "no better placement found than the start",
+        ),
     ]
     judged: list[PathEvaluation] = []
     best = _best_candidate(problem, bounds, candidates, settings, judged)

@@ -13,6 +13,7 @@ casadi alike) and turns them into placement rows with :func:`placement_rows`. Ad
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass
 from typing import Any, NamedTuple
@@ -98,6 +99,25 @@ class PlacementBounds:
                 "bounds.spin",
                 f"{self.spin[1] - self.spin[0]:.6g} rad is wider than a turn (2 pi rad)",
             )
+
+    def within_a_turn(self) -> PlacementBounds:
+        """The box, a yaw range over a turn cut to the turn centred on its middle.
+
+        The same placements (yaw is periodic) and the same reported copy (the one nearest the
+        middle of the range), with the work of one turn: a range of +-1000 rad made the coarse
+        map's yaw axis, the box's edges and the local searches a thousand times longer, 37 s
+        and more of one synchronous request (the contract audit, stop 54).
+        """
+        low, high = self.yaw
+        if high - low <= _TWO_PI:
+            return self
+        middle = (low + high) / 2.0
+        return dataclasses.replace(self, yaw=(middle - math.pi, middle + math.pi))
+
+    def wrapped_yaw(self, yaw: float) -> float:
+        """The copy of ``yaw`` (rad, up to whole turns) nearest the yaw range's middle."""
+        middle = (self.yaw[0] + self.yaw[1]) / 2.0
+        return middle + math.remainder(yaw - middle, _TWO_PI)
 
     @property
     def lower(self) -> np.ndarray:

@@ -160,6 +160,7 @@ def seeds_from_map(
     has at most ``max_cells`` cells and the whole search with it weighs at most ``max_poses``
     (None: no limit); elsewhere it searches as before, its work as before.
     """
+    bounds = bounds.within_a_turn()  # as the search is (optimize_placement)
     if coarse_map_cells(bounds, symmetric=symmetric_search(problem)) > max_cells:
         return False
     if max_poses is None:
@@ -192,6 +193,7 @@ def work_of(
         InvalidInputError: an unknown method (on ``method``), a bad path.
     """
     method_named(method)
+    bounds = bounds.within_a_turn()  # as the search is (optimize_placement)
     phases = _search_phases(problem, bounds, method, max_spin_step, active_set, seed_map)
     for search in narrower_searches(bounds, max_spin_step):
         phases += tuple(

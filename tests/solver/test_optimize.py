@@ -15,10 +15,13 @@ from solver.core.robots import Robot
 from solver.core.spatial import Placement
 from solver.families import get_robot
 from solver.optimise import local_search
+from solver.optimise.optimize import optimize_placement as optimise_problem
 from solver.optimise.optimum import PlacementOptimum
 from solver.optimise.search_space import PlacementBounds, vector_of
 from solver.optimise.symmetry import arc_coordinates, arc_point, turns_about_base_z
+from solver.optimise.work import work_of
 from solver.path.capability_map import grid_axis
+from solver.path.problem import PathProblem
 from tests.cases import OPTIMUM_EVALUATE_RTOL, OPTIMUM_METHODS_RTOL
 from tests.problems import capability_map, evaluate_path, optimize_placement
 from tests.solver.test_evaluate import load_path
@@ -306,3 +309,17 @@ def test_casadi_reaches_the_better_of_two_corner_maxima() -> None:
     optimum = optimize_placement(robot, path, bounds=bounds, method="casadi")
     assert optimum.mu_path is not None
     assert optimum.mu_path >= corner.mu_path * (1.0 - 1e-9)
+
+
+def test_a_yaw_range_of_many_turns_searches_one() -> None:
+    """The contract audit (stop 54): yaw bounds of +-1000 rad ran 37 s synchronously, the map's
+    yaw axis, the box's edges and the local searches over 318 turns of the same placements. The
+    search and its estimated work are the turn centred on the range's middle: the answer and
+    the work of yaw +-pi, the reported copy the one nearest the middle."""
+    problem = PathProblem.of(get_robot("ur5"), load_path("curved_line")[::4])
+    turn = PlacementBounds(x=(-0.1, 0.1), y=(0.4, 0.5), yaw=(-math.pi, math.pi), z=0.1)
+    many = dataclasses.replace(turn, yaw=(-1000.0, 1000.0))
+    assert work_of(problem, many).weighed(problem) == work_of(problem, turn).weighed(problem)
+    one, wide = (optimise_problem(problem, bounds=b) for b in (turn, many))
+    assert wide.mu_path == pytest.approx(one.mu_path, rel=1e-9)
+    assert -math.pi <= wide.placement.yaw <= math.pi
