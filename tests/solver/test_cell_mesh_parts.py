@@ -9,7 +9,9 @@ map with two boxes: a box's mesh hull is the box.
 from __future__ import annotations
 
 import numpy as np
+import pytest
 
+from solver.core.exceptions import InvalidInputError
 from solver.core.spatial import Placement
 from solver.families import get_robot
 from solver.path.capability_map import capability_map, grid_axis
@@ -18,7 +20,7 @@ from solver.path.cell.shapes import Box, Cell, Halfspace, Mesh
 from solver.path.cell.stl import read_stl
 from solver.path.evaluate import evaluate_path
 from solver.path.problem import PathOptions, PathProblem
-from tests.solver.test_cell import binary_stl, cube_triangles
+from tests.solver.test_cell import ascii_stl, binary_stl, cube_triangles
 from tests.solver.test_evaluate import load_path
 
 SIDE = 0.05
@@ -91,3 +93,16 @@ def test_a_contact_names_the_mesh_whichever_part() -> None:
     assert q0 is not None
     transform = placement.transform_workpiece_to_base()
     assert checker.collides_at(q0[0], transform, contact)
+
+
+def test_an_ascii_stl_with_a_long_solid_line_is_ascii() -> None:
+    """Its facets past the first 4 kB: it was refused as a binary STL of 2 billion triangles."""
+    text = ascii_stl(cube_triangles(0.1)).replace(b"solid cube", b"solid " + b"x" * 5000, 1)
+    np.testing.assert_allclose(read_stl(text, max_triangles=12), cube_triangles(0.1), atol=1e-12)
+
+
+def test_a_vertex_of_four_numbers_is_refused() -> None:
+    text = ascii_stl(cube_triangles(0.1)).replace(b"vertex -0.05 -0.05 -0.05", b"vertex 1 2 3 4", 1)
+    assert b"vertex 1 2 3 4" in text
+    with pytest.raises(InvalidInputError, match="a vertex is not three numbers"):
+        read_stl(text, max_triangles=12)
