@@ -107,7 +107,9 @@ class CellSpec(RequestModel):
         "upper arm and forearm along the links, beside the DH line by Universal Robots' "
         "shoulder and elbow offsets). Default: the arm's "
         "published collision capsules (UR5e, UR10e: MuJoCo Menagerie's, where the links are) or "
-        "its URDF's geometry; given for a UR5e or UR10e, they replace the published capsules.",
+        "its URDF's geometry; given for a UR5e or UR10e, they replace the published capsules. "
+        "They size the capsules of the links the answer's cell_approximated names: an arm whose "
+        "links all carry collision geometry (the UR5's URDF meshes, the Panda's) uses none.",
     )
 
     def to_solver(self, *, max_objects: int, max_triangles: int) -> Cell:
