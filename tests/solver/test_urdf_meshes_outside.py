@@ -14,6 +14,7 @@ from pathlib import Path
 
 import pytest
 
+from solver.core.exceptions import InvalidInputError
 from solver.core.robots import example_robot_data_dir
 from solver.families import robot_from_urdf
 from solver.path.cell.checker import CellChecker
@@ -43,3 +44,25 @@ def test_a_mesh_outside_the_share_is_never_read(tmp_path: Path, hide: str, targe
     checker = CellChecker(arm, Cell())
     assert "wrist_3_joint" in checker.approximated  # its only element was left out
     assert not any(obj.name.startswith("wrist_3_link") for obj in checker.geometry.geometryObjects)
+
+
+def test_the_meshes_a_urdf_has_read_are_bounded() -> None:
+    """Each collision mesh is read and made a hull per request: fifteen copies of a 28 MB mesh
+    (scaled differently, so no cache holds) took 41 s. The UR5's own reads 0.27 MB."""
+    share = example_robot_data_dir()
+    big = max(share.rglob("*.stl"), key=lambda path: path.stat().st_size)
+    name = "package://example-robot-data/robots/" + str(big.relative_to(share))
+    copies = 20_000_000 // big.stat().st_size + 1
+    elements = "".join(
+        f'<collision><geometry><mesh filename="{name}" scale="1 1 {1 + k / 100}"/></geometry>'
+        "</collision>"
+        for k in range(copies)
+    )
+    urdf = _ur5_urdf()
+    at = urdf.index("</link>", urdf.index('<link name="wrist_3_link">'))
+    arm = robot_from_urdf(
+        urdf[:at] + elements + urdf[at:], base_frame="base", tool_frame="tool0", name="ur5-heavy"
+    )
+    with pytest.raises(InvalidInputError, match="at most 20 MB") as refused:
+        CellChecker(arm, Cell())
+    assert refused.value.field == "robot.urdf"

@@ -50,6 +50,11 @@ PUBLISHED_RADII: dict[str, tuple[float, ...]] = {
 # Radius of the capsule of a URDF link that has no readable collision element (m), unless the
 # request gives link_radii.
 DEFAULT_URDF_LINK_RADIUS = 0.05
+MAX_MESH_BYTES = 20_000_000
+"""The most bytes of collision mesh files one URDF may have read (repeats counted): each is
+loaded and made a hull per request, 2.7 s for one 28 MB mesh; fifteen copies of one (at other
+scales, so no cache helps) held a 6 kB request 41 s and /healthz 2.9 s (the contract audit,
+stop 54). The catalogue's arms read 0.2 to 7 MB."""
 TOOL_HOLDER, TOOL_CUTTING = "tool", "tool_cutting"
 CAPSULE_SUFFIX = "_capsule"  # the name of a capsule made for a link without geometry ends so
 
@@ -220,20 +225,35 @@ def _collisions_in_share(urdf: str, share: str, *, meshes: bool = True) -> str:
     root = parsed(urdf)
     if root is None:
         return urdf
+    read, elements = 0, 0
     for parent in list(root.iter()):
         for collision in [child for child in parent if child.tag == "collision"]:
             files = [mesh.get("filename", "") for mesh in collision.iter("mesh")]
             if files and (not meshes or not all(_in_share(name, share) for name in files)):
                 parent.remove(collision)
+            elif files:
+                elements += 1
+                read += sum(os.path.getsize(_shared_file(name, share)) for name in files)
+    if read > MAX_MESH_BYTES:
+        raise InvalidInputError(
+            "robot.urdf",
+            f"its collision meshes are {read / 1e6:.1f} MB of files ({elements} elements), each "
+            f"read and made a hull; at most {MAX_MESH_BYTES / 1e6:g} MB (the catalogue's arms "
+            "read 7 MB at most)",
+        )
     return ElementTree.tostring(root, encoding="unicode")
+
+
+def _shared_file(name: str, share: str) -> str:
+    """The file a ``package://`` mesh name resolves to inside ``share`` (realpath)."""
+    return os.path.realpath(os.path.join(share, name.strip().removeprefix("package://")))
 
 
 def _in_share(name: str, share: str) -> bool:
     """Whether a mesh's file name is a ``package://`` file inside ``share``."""
-    name = name.strip()
-    if not name.startswith("package://"):
+    if not name.strip().startswith("package://"):
         return False
-    resolved = os.path.realpath(os.path.join(share, name.removeprefix("package://")))
+    resolved = _shared_file(name, share)
     return resolved.startswith(os.path.realpath(share) + os.sep) and os.path.isfile(resolved)
 
 
