@@ -93,11 +93,12 @@ def check_work(
         seed_map=seeded,
     )
     weighed = work.weighed(problem)
+    jobs = limits.hint.replace("maps", "searches")  # a route's: POST /v1/jobs; a job's: none
     if body.method == "scipy":
         limit, setting = limits.search_poses, limits.search_setting
-        hint = "; fix a variable, shorten the path, or use method casadi"
+        hint = "; fix a variable, shorten the path, or try method casadi" + jobs
     else:
-        limit, setting, hint = limits.poses, limits.poses_setting, "; narrow the bounds"
+        limit, setting, hint = limits.poses, limits.poses_setting, "; narrow the bounds" + jobs
         cells = work.placements(COARSE_MAP, search="")  # a narrower search's map is smaller
         if cells > limits.cells:
             raise InvalidInputError(

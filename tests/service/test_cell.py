@@ -311,6 +311,7 @@ def test_an_optimisation_in_a_cell_weighs_its_collision_work(
     response = client.post("/v1/optimize", json=box)  # 816 coarse cells x 133 x 50: over 5 M
     assert_names(response, 422, ["body", "bounds"])
     assert "coarse map" in response.json()["detail"][0]["msg"]
+    assert "POST /v1/jobs runs bigger searches" in response.json()["detail"][0]["msg"]
 
 
 @pytest.mark.parametrize(("model", "count"), [("ur5", 0), ("ur5e", 7)])
