@@ -56,3 +56,14 @@ def test_the_spindle_runs_from_the_flange() -> None:
     verdict = checker.check(q[None], np.zeros(0, dtype=bool), np.eye(4), closest=True)
     assert verdict.collision is not None
     assert verdict.collision.robot_part == "tool" and verdict.collision.obstacle_name == "box"
+
+
+def test_a_tool_turned_back_at_the_flange_is_refused() -> None:
+    """A tcp turned over (tool z at the arm) laid the tool beyond its point, away from the arm:
+    even a 0.5 m tool was 'feasible' (the contract audit, stop 54)."""
+    over = _at(0.0, 0.0, 0.12)
+    over[:3, :3] = np.diag([1.0, -1.0, -1.0])  # a half turn about x
+    robot = get_robot("ur5").with_options(transform_tool_to_tcp=over)
+    with pytest.raises(InvalidInputError, match="turns back at the flange") as refused:
+        CellChecker(robot, Cell(tool=SPINDLE))
+    assert refused.value.field == "cell.tool.length"

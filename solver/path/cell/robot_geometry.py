@@ -21,6 +21,7 @@
 from __future__ import annotations
 
 import hashlib
+import math
 import os
 import pickle
 import xml.etree.ElementTree as ElementTree
@@ -363,6 +364,8 @@ def _capsule(
 
 BEHIND_FLANGE = 1e-3
 """m: how far behind the flange's plane a tool may start (cell.md: it runs from the flange)."""
+STRAIGHT = math.radians(10.0)
+"""rad: a tool z this close to the flange's -z is turned back at the flange."""
 
 
 def _add_tool(robot: Robot, geometry: pin.GeometryModel, tool: Tool) -> int:
@@ -395,7 +398,11 @@ def _check_from_flange(robot: Robot, tool: Tool, joint: int, tcp: pin.SE3) -> No
     back from the tool point; with the TCP left at the flange (the default) a 12 cm spindle lay
     inside the wrist, and a box 6 cm in front of the flange, inside the real spindle, was 'clear
     by 49 mm' (the cell audit, stop 53). A tool that starts behind the flange's plane (by more
-    than BEHIND_FLANGE) is such a forgotten TCP.
+    than BEHIND_FLANGE) is such a forgotten TCP. A tool z turned back at the flange (within
+    STRAIGHT of its -z) lays the tool beyond its point, away from the arm, where even a 0.5 m
+    tool was 'feasible' (the contract audit, stop 54): refused too. A tool that starts in front
+    of the flange (a cutter shorter than the tcp's reach) is taken as given: what lies between
+    is the request's to model (cell.md says nothing of it).
     """
     model = robot.model
     flange = model.frames[model.getFrameId(robot.tool_frame)]
@@ -404,6 +411,13 @@ def _check_from_flange(robot: Robot, tool: Tool, joint: int, tcp: pin.SE3) -> No
     point = flange.placement.actInv(tcp.translation)  # the tool point in the flange frame
     axis = flange.placement.rotation.T @ tcp.rotation[:, 2]  # tool z in the flange frame
     start = float(point[2] - tool.length * axis[2])
+    if axis[2] <= -math.cos(STRAIGHT):
+        raise InvalidInputError(
+            "cell.tool.length",
+            "the tool point's z turns back at the flange (the tcp's z axis points at the arm): "
+            "the tool would lie beyond its point, away from the flange; give a tcp whose z "
+            "points out of the flange",
+        )
     if start < -BEHIND_FLANGE:
         longest = max(float(point[2] / axis[2]), 0.0) if axis[2] > 1e-12 else 0.0
         raise InvalidInputError(
