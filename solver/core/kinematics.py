@@ -83,3 +83,15 @@ def jacobian_in_base(robot: Robot, q: np.ndarray) -> np.ndarray:
     jacobian[:3] = rotation_base_world @ jacobian_world[:3]
     jacobian[3:] = rotation_base_world @ jacobian_world[3:]
     return jacobian
+
+
+def revolute_axis(model: pin.Model, joint: int) -> np.ndarray | None:
+    """A revolute joint's unit axis in its own frame (RX, RY, RZ or unaligned); else None."""
+    name = model.joints[joint].shortname().removeprefix("JointModel")
+    if name in ("RX", "RY", "RZ"):
+        unit: np.ndarray = np.eye(3)["XYZ".index(name[1])]
+        return unit
+    if name == "RevoluteUnaligned":
+        axis = np.asarray(model.joints[joint].extract().axis, dtype=float)
+        return axis / float(np.linalg.norm(axis))
+    return None

@@ -22,6 +22,8 @@ from __future__ import annotations
 import numpy as np
 import pinocchio as pin
 
+from solver.core.kinematics import revolute_axis
+
 
 def _lever(model: pin.Model, joint: int, carrier: int) -> float:
     """Bound on the distance from ``joint``'s origin to ``carrier``'s origin along the chain."""
@@ -47,12 +49,8 @@ def _world_axis(model: pin.Model, joint: int) -> np.ndarray | None:
     """A revolute joint's axis in the world where it is fixed there (its parent the root)."""
     if model.parents[joint] != 0:
         return None
-    name = model.joints[joint].shortname().removeprefix("JointModel")
-    if name in ("RX", "RY", "RZ"):
-        local = np.eye(3)["XYZ".index(name[1])]
-    elif name == "RevoluteUnaligned":
-        local = np.asarray(model.joints[joint].extract().axis, dtype=float)
-    else:
+    local = revolute_axis(model, joint)
+    if local is None:
         return None
     axis: np.ndarray = np.asarray(model.jointPlacements[joint].rotation) @ local
     unit: np.ndarray = axis / np.linalg.norm(axis)

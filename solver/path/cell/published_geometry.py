@@ -32,6 +32,7 @@ import coal
 import numpy as np
 import pinocchio as pin
 
+from solver.core.kinematics import revolute_axis
 from solver.core.robots import Robot
 
 Vector = tuple[float, float, float]
@@ -211,19 +212,12 @@ def _world_to_model(arm: PublishedArm, model: pin.Model, joints: list[pin.SE3]) 
     """The turn about z that takes the published world's joint-2 axis to the model's."""
     published = body_frames(arm, np.zeros(len(arm.bodies)))[1]
     theirs = published.rotation @ np.asarray(arm.bodies[1].axis, dtype=float)
-    ours = joints[1].rotation @ _joint_axis(model, 2)
+    axis = revolute_axis(model, 2)
+    if axis is None:
+        return pin.SE3.Identity()  # not the published arm: published_geometry's check refuses
+    ours = joints[1].rotation @ axis
     angle = np.arctan2(ours[1], ours[0]) - np.arctan2(theirs[1], theirs[0])
     return pin.SE3(pin.exp3(np.array([0.0, 0.0, angle])), np.zeros(3))
-
-
-def _joint_axis(model: pin.Model, joint: int) -> np.ndarray:
-    """The axis of a revolute joint in its frame (RX, RY, RZ or an unaligned one)."""
-    name = model.joints[joint].shortname()
-    if name.startswith("JointModelR") and name[-1] in "XYZ":
-        axis: np.ndarray = np.eye(3)["XYZ".index(name[-1])]
-    else:
-        axis = np.asarray(model.joints[joint].extract().axis, dtype=float)
-    return axis
 
 
 def published_geometry(robot: Robot) -> pin.GeometryModel | None:

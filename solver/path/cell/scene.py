@@ -35,6 +35,7 @@ import coal
 import numpy as np
 import pinocchio as pin
 
+from solver.core.kinematics import revolute_axis
 from solver.core.robots import Robot
 from solver.path.cell import fast
 from solver.path.cell.bounds import pair_weights
@@ -251,7 +252,9 @@ def _turns_in_place(model: pin.Model, geometry: pin.GeometryModel, part: int) ->
     shape = obj.geometry
     if not isinstance(shape, (coal.Sphere, coal.Capsule, coal.Cylinder)):
         return False
-    axis = _joint_axis(model, joint)
+    axis = revolute_axis(model, joint)
+    if axis is None:
+        return False
     centre = np.asarray(obj.placement.translation, dtype=float)
     off_axis = np.linalg.norm(centre - (centre @ axis) * axis)
     along = (
@@ -259,18 +262,6 @@ def _turns_in_place(model: pin.Model, geometry: pin.GeometryModel, part: int) ->
         or np.linalg.norm(np.cross(obj.placement.rotation[:, 2], axis)) < 1e-9
     )
     return bool(off_axis < 1e-9 and along)
-
-
-def _joint_axis(model: pin.Model, joint: int) -> np.ndarray:
-    """The unit axis of a revolute joint in its own frame; zeros for any other joint."""
-    name = model.joints[joint].shortname()
-    if name.startswith("JointModelR") and name[-1] in "XYZ":
-        unit: np.ndarray = np.eye(3)["XYZ".index(name[-1])]
-        return unit
-    if name.startswith("JointModelRevoluteUnaligned"):
-        axis: np.ndarray = np.asarray(model.joints[joint].extract().axis, dtype=float)
-        return axis / float(np.linalg.norm(axis))
-    return np.zeros(3)
 
 
 def _distances(
