@@ -327,6 +327,15 @@ def _same_placement(a: np.ndarray, b: np.ndarray) -> bool:
     return bool(np.all(apart <= SAME_START))
 
 
+def _whole_turns(bounds: PlacementBounds, variable: int) -> bool:
+    """Whether ``variable`` is an angle whose two bounds are one start (whole turns apart)."""
+    if variable not in _ANGLES:
+        return False
+    moved = bounds.lower.copy()
+    moved[variable] = bounds.upper[variable]
+    return _same_placement(moved, bounds.lower)
+
+
 def corner_vectors(bounds: PlacementBounds) -> np.ndarray:
     """The decision vectors of the box's distinct corners: every free variable at either bound.
 
@@ -335,12 +344,7 @@ def corner_vectors(bounds: PlacementBounds) -> np.ndarray:
     refinement's starts with pairs of the same placement (the optimiser audit, stop 53).
     """
     lower, upper = bounds.lower, bounds.upper
-    free: list[int] = []
-    for index in np.flatnonzero(bounds.free):
-        moved = lower.copy()
-        moved[index] = upper[index]
-        if int(index) not in _ANGLES or not _same_placement(moved, lower):
-            free.append(int(index))
+    free = [int(v) for v in np.flatnonzero(bounds.free) if not _whole_turns(bounds, int(v))]
     vectors = np.tile(lower, (1 << len(free), 1))
     for k in range(len(vectors)):
         for bit, variable in enumerate(free):
@@ -379,10 +383,7 @@ def _edge_samples(bounds: PlacementBounds, variable: int) -> np.ndarray:
     """A variable's samples along an edge at the coarse map's steps, without the corners."""
     low, high = bounds.lower[variable], bounds.upper[variable]
     if variable in _ANGLES:
-        whole = _same_placement(
-            np.where(np.arange(len(bounds.lower)) == variable, high, low), bounds.lower
-        )
-        samples = _axis(low, high, COARSE_YAW_STEP, ends=not whole)
+        samples = _axis(low, high, COARSE_YAW_STEP, ends=not _whole_turns(bounds, variable))
     else:
         samples = _axis(low, high, COARSE_STEP, ends=True)
     inner: np.ndarray = samples[(samples > low + SAME_START) & (samples < high - SAME_START)]
