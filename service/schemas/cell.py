@@ -131,7 +131,7 @@ class CellSpec(RequestModel):
             for group in ("fixed", "workpiece")
         }
         pieces = sum(
-            len(shape.parts()) if isinstance(shape, Mesh) else 1
+            shape.part_count() if isinstance(shape, Mesh) else 1
             for group in shapes.values()
             for shape in group
         )

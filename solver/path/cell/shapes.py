@@ -163,6 +163,23 @@ class Mesh(Shape):
         cell's content is its pickle (the checkers' cache keys).
         """
         triangles = np.asarray(self.triangles, dtype=float)
+        label = self.part_labels()
+        order = np.argsort(label, kind="stable")  # each part's triangles in file order
+        ends = np.cumsum(np.bincount(label))[:-1]
+        return tuple(triangles[rows] for rows in np.split(order, ends))
+
+    def part_count(self) -> int:
+        """How many connected parts the mesh has (:meth:`parts`), without gathering them."""
+        label = self.part_labels()
+        return int(label.max()) + 1 if label.size else 0
+
+    def part_labels(self) -> np.ndarray:
+        """Per triangle, its part's number, parts numbered in the order they start in the file.
+
+        Grouped by sorting: a mask a part over every triangle took 3.4 s for a soup of 50,000
+        unjoined triangles, before the object limit refused it.
+        """
+        triangles = np.asarray(self.triangles, dtype=float)
         corners = triangles.reshape(-1, 3)
         size = float(np.ptp(corners, axis=0).max()) if len(corners) else 0.0
         grid = np.round(corners / max(size * JOIN_TOLERANCE, 1e-12)).astype(np.int64)
@@ -175,8 +192,11 @@ class Mesh(Shape):
         )
         _, label = scipy.sparse.csgraph.connected_components(graph, directed=False)
         of_triangle = label[point[:, 0]]
-        _, first = np.unique(of_triangle, return_index=True)
-        return tuple(triangles[of_triangle == of_triangle[k]] for k in np.sort(first))
+        _, first, numbered = np.unique(of_triangle, return_index=True, return_inverse=True)
+        rank = np.empty(len(first), dtype=np.int64)
+        rank[np.argsort(first, kind="stable")] = np.arange(len(first))  # by first triangle
+        renumbered: np.ndarray = rank[numbered.reshape(-1)]
+        return renumbered
 
 
 JOIN_TOLERANCE = 1e-6
