@@ -269,10 +269,9 @@ class CellChecker:
         refuses the path too. ``configuration`` (n,), rad; T_B_O (4, 4).
         """
         objects = self.geometry.geometryObjects
-        other = contact.obstacle_name if contact.obstacle is None else None
-        if contact.obstacle is not None:
-            slot = contact.obstacle_slot
-            other = objects[self._n_robot + (contact.obstacle if slot is None else slot)].name
+        other = contact.obstacle_name  # another robot part's (self-collision)
+        if contact.obstacle_slot is not None:  # an obstacle: its geometry object (_contact)
+            other = objects[self._n_robot + contact.obstacle_slot].name
         pair = self._pair_of.get((contact.robot_part, other))
         if pair is None:
             return False
