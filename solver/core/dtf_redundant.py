@@ -160,11 +160,17 @@ def spin_speed(
 
 
 def spin_rate_at_feed(
-    a: np.ndarray, c: np.ndarray, b: np.ndarray, qdot_max: np.ndarray, feed: np.ndarray
+    a: np.ndarray,
+    c: np.ndarray,
+    b: np.ndarray,
+    qdot_max: np.ndarray,
+    feed: np.ndarray,
+    *,
+    inside: float = 1.0 - 1e-12,
 ) -> tuple[np.ndarray, np.ndarray]:
     """The spin rate nearest 0 at a feed, and the null-space rate then (seven joints).
 
-    At s = feed (1 - 1e-12) (a short interval, as in
+    At s = feed (1 - 1e-12) (``inside``; a short interval, as in
     :func:`solver.core.two_variable_lp.spin_rate_nearest_zero`), sigma ranges over an interval:
     its ends are two LPs in (sigma, lam) (:func:`vertex_lp`); sigma is the point of it nearest 0,
     and lam then the point of its own interval nearest 0.
@@ -175,6 +181,7 @@ def spin_rate_at_feed(
         b: shape (n, ...), as for :func:`spin_speed`.
         qdot_max: shape (n,), rad/s.
         feed: shape broadcasting to (...), at most the optimum of :func:`spin_speed`.
+        inside: the share of the feed the interval is taken at.
 
     Returns:
         sigma and lam, shape (...) (0 where the inputs are not finite or the feed is 0).
@@ -182,8 +189,8 @@ def spin_rate_at_feed(
     shape = a.shape[1:]
     n = len(a)
     columns = [np.moveaxis(v, 0, -1).reshape(-1, n) for v in (a, c, b)]
-    inside = (np.broadcast_to(feed, shape) * (1.0 - 1e-12)).reshape(-1)
-    offset = inside[:, None] * columns[0]
+    at = (np.broadcast_to(feed, shape) * inside).reshape(-1)
+    offset = at[:, None] * columns[0]
     directions = np.stack(columns[1:], axis=-1)  # (M, n, 2)
     sigma = np.zeros(len(offset))
     lam = np.zeros(len(offset))

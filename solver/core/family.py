@@ -202,6 +202,24 @@ class KinematicsFamily(abc.ABC):
         q, status = self.solve(rotation, position)
         return PathSolutions(q=q, status=status)
 
+    def follow_from(
+        self, start: np.ndarray, rotation: np.ndarray, position: np.ndarray
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """Paths followed from given solutions at their first waypoints (a numeric family).
+
+        A closed-form family solves any pose on its own (:meth:`solve`), its branches labelled
+        alike everywhere; a family that follows says how it follows from a given start.
+
+        Args:
+            start: shape (M, n), rad, each path's solution at its first waypoint.
+            rotation: shape (M, W, 3, 3), R_B_F of each path's flange.
+            position: shape (M, W, 3), m in {B}.
+
+        Returns:
+            q (n, M, W), rad, wrapped, NaN from where a path is lost; status (M, W).
+        """
+        raise NotImplementedError(f"the {self.name} family solves each pose on its own")
+
     def null_space(
         self, q: np.ndarray, tool_point: np.ndarray, *, progress: Progress | None = None
     ) -> np.ndarray:

@@ -95,3 +95,27 @@ def revolute_axis(model: pin.Model, joint: int) -> np.ndarray | None:
         axis = np.asarray(model.joints[joint].extract().axis, dtype=float)
         return axis / float(np.linalg.norm(axis))
     return None
+
+
+STRAIGHT_ATOL = 1e-9
+"""m, and rad as a unit vector's components: a tool z this close to the last joint's axis, and
+a tool point this close to that axis, make a straight spindle (the spin moves that joint only)."""
+
+
+def straight_spindle(robot: Robot) -> bool:
+    """Whether the tool turns about the last joint's own axis: tool z along it, the point on it.
+
+    The tool point's frame as the model places it on its joint (any joint that is not revolute
+    about one axis counts as not straight).
+    """
+    model = robot.model
+    frame = model.frames[robot.tool_point_frame]
+    joint = int(frame.parentJoint)
+    axis = revolute_axis(model, joint) if joint > 0 else None
+    if axis is None:
+        return False
+    tool_z = np.asarray(frame.placement.rotation)[:, 2]
+    point = np.asarray(frame.placement.translation)
+    along = abs(float(tool_z @ axis))
+    off_axis = float(np.linalg.norm(np.cross(point, axis)))
+    return along >= 1.0 - STRAIGHT_ATOL and off_axis <= STRAIGHT_ATOL

@@ -57,29 +57,36 @@ def two_variable_speed(
 
 
 def spin_rate_nearest_zero(
-    a: np.ndarray, b: np.ndarray, qdot_max: np.ndarray, speed: np.ndarray
+    a: np.ndarray,
+    b: np.ndarray,
+    qdot_max: np.ndarray,
+    speed: np.ndarray,
+    *,
+    inside: float = 1.0 - 1e-12,
 ) -> np.ndarray:
     """The sigma nearest 0 with |speed a_j + sigma b_j| <= qdot_max_j for every joint j.
 
     At the optimum of :func:`two_variable_speed` the interval of sigma is a point, which rounding
     can make empty, and a joint with b_j near 0 bounds it by (noise) / b_j: so the interval is
-    taken at speed (1 - 1e-12), where it is a short interval, and the joints are then within
-    their limits to about 1e-12.
+    taken at speed (1 - 1e-12) (``inside``), where it is a short interval, and the joints are
+    then within their limits to about 1e-12 (times |speed a_j| / qdot_max_j, up to a few
+    hundred where the spin offsets a large joint speed).
 
     Args:
         a: shape (n, ...), joint speeds per unit s, as for :func:`two_variable_speed`.
         b: shape (n, ...), joint speeds per unit sigma.
         qdot_max: shape (n,), rad/s.
         speed: shape (...), at most the optimum of :func:`two_variable_speed`.
+        inside: the share of the speed the interval is taken at.
 
     Returns:
         shape (...), sigma (0 where no joint constrains it or the inputs are not finite).
     """
     limits = np.asarray(qdot_max, dtype=float).reshape((-1,) + (1,) * (a.ndim - 1))
-    inside = np.asarray(speed) * (1.0 - 1e-12)
+    at = np.asarray(speed) * inside
     with np.errstate(divide="ignore", invalid="ignore"):
-        one = (-limits - inside * a) / b
-        other = (limits - inside * a) / b
+        one = (-limits - at * a) / b
+        other = (limits - at * a) / b
     low = np.where(b == 0.0, -np.inf, np.minimum(one, other)).max(axis=0)
     high = np.where(b == 0.0, np.inf, np.maximum(one, other)).min(axis=0)
     sigma = np.where(low > high, (low + high) / 2, np.clip(0.0, low, high))

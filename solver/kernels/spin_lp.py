@@ -206,7 +206,13 @@ def spin_speed(
 
 
 def spin_rate_at_feed(
-    a: np.ndarray, c: np.ndarray, b: np.ndarray, qdot_max: np.ndarray, feed: np.ndarray
+    a: np.ndarray,
+    c: np.ndarray,
+    b: np.ndarray,
+    qdot_max: np.ndarray,
+    feed: np.ndarray,
+    *,
+    inside: float = _INSIDE,
 ) -> tuple[np.ndarray, np.ndarray]:
     """:func:`solver.core.dtf_redundant.spin_rate_at_feed`, compiled: the same results.
 
@@ -216,12 +222,15 @@ def spin_rate_at_feed(
         b: shape (n, ...), as for :func:`spin_speed`.
         qdot_max: shape (n,), rad/s.
         feed: shape broadcasting to (...).
+        inside: the share of the feed the rates are taken at (the kernel's own, _INSIDE, by
+            default; another is given to the kernel as the feed scaled).
 
     Returns:
         sigma and lam, shape (...).
     """
     shape = np.broadcast_shapes(a.shape, c.shape, b.shape)
     a, c, b = (np.broadcast_to(v, shape) for v in (a, c, b))
-    feeds = kernel_array(np.broadcast_to(feed, shape[1:]).reshape(-1))
+    feeds = np.broadcast_to(feed, shape[1:]).reshape(-1)
+    feeds = kernel_array(feeds if inside == _INSIDE else feeds * (inside / _INSIDE))
     sigma, lam = spin_rates_at_feed(_rows(a), _rows(c), _rows(b), kernel_array(qdot_max), feeds)
     return sigma.reshape(shape[1:]), lam.reshape(shape[1:])

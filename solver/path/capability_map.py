@@ -241,15 +241,18 @@ def map_cost(problem: PathProblem) -> float:
     """The work of one placement of ``problem``'s map, in closed-form poses (the size limits').
 
     The family's map figure (:meth:`solver.core.family.KinematicsFamily.map_cost`), told
-    whether the map may drop branches (:func:`solver.path.pruning.can_prune`), plus the
-    collision check's with a cell (:func:`solver.path.cell.cost.with_cell`). A map with a cell
-    is given the figure of following every branch: it drops branches too, but follows a
-    refused placement's next branches again (:mod:`solver.path.path_checks`).
+    whether the map may drop branches (:func:`solver.path.pruning.can_prune`), times
+    :attr:`PathProblem.exact_spin_weight` in free spin with an angled or offset spindle or seven
+    joints (:attr:`PathProblem.exact_spin`), plus the collision check's with a cell
+    (:func:`solver.path.cell.cost.with_cell`). A map with a cell is given the figure of
+    following every branch: it drops branches too, but follows a refused placement's next
+    branches again (:mod:`solver.path.path_checks`).
     """
     n_waypoints = problem.prepared.n_waypoints
     free_spin = problem.options.spin_mode == "free"
+    pruned = problem.options.cell is None and can_prune(problem)
+    cost = problem.family.map_cost(n_waypoints, free_spin=free_spin, pruned=pruned)
+    cost *= problem.exact_spin_weight  # the spun poses solved again, on the numpy pipeline
     if problem.options.cell is not None:
-        cost = problem.family.map_cost(n_waypoints, free_spin=free_spin)
         return with_cell(cost, n_waypoints, problem.options.cell)
-    pruned = can_prune(problem)
-    return problem.family.map_cost(n_waypoints, free_spin=free_spin, pruned=pruned)
+    return cost

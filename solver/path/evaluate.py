@@ -236,8 +236,8 @@ def evaluate_path(
     limiting = run.limiting[pick, 0]
     bottleneck = int(np.argmin(v_max))
     qdot = run.qd_unit[:, pick, 0] * speed
-    spins = None
-    if run.spins is not None and run.qd_spin is not None:
+    spins = None if run.spins is None else run.spins[pick, 0]
+    if run.spins is not None and run.qd_spin is not None:  # else the spun path's own (exact_spin)
         a, c = run.qd_unit[:, pick, 0], run.qd_spin[:, pick, 0]
         if run.qd_null is None:
             spin_rate = spin_rate_nearest_zero(a, c, robot.qdot_max, speed)
@@ -246,7 +246,6 @@ def evaluate_path(
             spin_rate, null_rate = spin_rate_at_feed(a, c, b, robot.qdot_max, speed)
             qdot = qdot + null_rate * b
         qdot = qdot + spin_rate * c
-        spins = run.spins[pick, 0]
     q = run.tracked.q[:, pick, 0].T
     mu_path = float(v_max[bottleneck])
     return dataclasses.replace(

@@ -69,6 +69,8 @@ def spin_rates_in_pieces(
     qdot_max: np.ndarray,
     feed: np.ndarray,
     progress: Progress | None,
+    *,
+    inside: float = 1.0 - 1e-12,
 ) -> np.ndarray:
     """A seven-joint arm's spin rate at the feed (:func:`spin_rate_at_feed`), in pieces.
 
@@ -79,6 +81,7 @@ def spin_rates_in_pieces(
         qdot_max: shape (n,), rad/s.
         feed: shape broadcasting to (..., 1), m/s, constant along each path.
         progress: called after each piece with the fraction of waypoints done.
+        inside: the share of the feed the rate is taken at (:func:`spin_rate_at_feed`).
 
     Returns:
         shape (..., W), rad/s, the spin rate nearest zero at the feed.
@@ -87,7 +90,12 @@ def spin_rates_in_pieces(
     rate = np.empty(shape)
     for piece in waypoint_pieces(shape, progress):
         rate[..., piece], _ = spin_rate_at_feed(
-            qd_unit[..., piece], qd_spin[..., piece], qd_null[..., piece], qdot_max, feed
+            qd_unit[..., piece],
+            qd_spin[..., piece],
+            qd_null[..., piece],
+            qdot_max,
+            feed,
+            inside=inside,
         )
         if progress is not None:
             progress(piece.stop / shape[-1])

@@ -238,8 +238,12 @@ def kernel_of(problem: PathProblem) -> tuple[int, np.ndarray] | None:
 
     With or without joint acceleration limits: the kernels compute mu_acc as the numpy pipeline
     does (:mod:`solver.kernels.accelerations`). None where a final-path limit other than the
-    joint accelerations is given (no kernel has its hook): the numpy pipeline runs.
+    joint accelerations is given (no kernel has its hook), or in free spin with an angled or
+    offset spindle (the spun poses are solved again, :mod:`solver.path.exact_spin`, which the
+    free-spin kernel does not): the numpy pipeline runs.
     """
     if any(not isinstance(limit, JointAccelerationLimit) for limit in problem.final_path_limits):
+        return None
+    if problem.exact_spin:
         return None
     return problem.family.map_kernel()

@@ -24,12 +24,13 @@ from solver.core.codes import ACC_TIE_RTOL, FEASIBLE, UNREACHABLE
 from solver.core.family import PathSolutions
 from solver.core.progress import Progress, span
 from solver.path.bounded import bounded_solutions, in_one_pass, pick_stands
+from solver.path.exact_spin import SCHEDULE_INSIDE, spun_exactly
 from solver.path.in_pieces import bound_in_pieces, track_in_pieces
 from solver.path.limits import JointMotion, bound_by_limits
 from solver.path.placed import placed_flange, turn_by_yaw
 from solver.path.problem import PathProblem
 from solver.path.pruning import can_prune, pruned_solutions
-from solver.path.spin_schedule import spin_schedule
+from solver.path.spin_schedule import schedule, spin_schedule
 from solver.path.tracking import Tracked, choose_branch
 
 
@@ -205,7 +206,24 @@ def run_chunk(
     if solutions.bound is not None and not pick_stands(solutions, branches, mu_path):
         return run_chunk(problem, placements, progress=progress, excluded=excluded)  # unpruned
     spins = None
-    if qd_spin is not None:
+    if qd_spin is not None and problem.exact_spin:  # an angled or offset spindle
+        part = _part(progress, shares, 6)
+        spins, _ = schedule(
+            problem, motion, qd_spin, mu_path, span(part, 0.0, 0.5), inside=SCHEDULE_INSIDE
+        )
+        tracked, qd_unit, speed, limiting = _spun_exactly(
+            problem,
+            placements,
+            (spins, branches, np.isfinite(mu_path)),
+            tracked,
+            motion,
+            span(part, 0.5, 1.0),
+        )
+        v_max = np.where(path.pure_rotation, 0.0, speed)
+        feasible = tracked.reason == FEASIBLE
+        mu_path = np.where(feasible, v_max.min(axis=-1), -np.inf)
+        qd_spin = qd_null = None  # the spun path's joint speeds are its own, as in fixed spin
+    elif qd_spin is not None:
         spins, tracked = spin_schedule(
             problem, tracked, motion, qd_spin, mu_path, _part(progress, shares, 6)
         )
@@ -240,6 +258,35 @@ def run_chunk(
         pruned=pruned,
         first=solutions.first,
     )
+
+
+def _spun_exactly(
+    problem: PathProblem,
+    placements: np.ndarray,
+    schedules: tuple[np.ndarray, np.ndarray, np.ndarray],
+    tracked: Tracked,
+    motion: JointMotion,
+    progress: Progress | None,
+) -> tuple[Tracked, np.ndarray, np.ndarray, np.ndarray]:
+    """The branches with a schedule along it exactly; the rest as run.
+
+    :func:`solver.path.exact_spin.spun_exactly` of ``schedules`` (the spins (B, C, W), the
+    rows' branches (B,), which rows have one (B, C)), then the waypoint limits (fixed spin's:
+    the spun path's own t_hat; ``progress`` after each piece). Returns the tracking, J^-1 t_hat,
+    the speed and the limiting joint.
+    """
+    spins, branches, scheduled = schedules
+    spun, qd_spun = spun_exactly(problem, placements, spins, branches, scheduled, tracked.q)
+    rows, cells = np.nonzero(scheduled)
+    reason, failed = tracked.reason.copy(), tracked.failed_waypoint.copy()
+    q, qd_unit = tracked.q.copy(), motion.qd_unit.copy()
+    reason[rows, cells], failed[rows, cells] = spun.reason, spun.failed_waypoint
+    q[:, rows, cells], qd_unit[:, rows, cells] = spun.q, qd_spun
+    out = Tracked(reason=reason, failed_waypoint=failed, q=q)
+    speed, limiting = bound_in_pieces(
+        problem.waypoint_limits, JointMotion(q=out.q, qd_unit=qd_unit), progress
+    )
+    return out, qd_unit, speed, limiting
 
 
 SHARES = (0.8, 0.85, 0.95, 1.0, 1.0, 1.0, 1.0)

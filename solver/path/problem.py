@@ -23,6 +23,7 @@ import numpy as np
 
 from solver.core.exceptions import InvalidInputError, NoAnalyticIkError, quoted
 from solver.core.family import Branch, KinematicsFamily
+from solver.core.kinematics import straight_spindle
 from solver.core.robots import Robot
 from solver.path.blend_stencil import BlendStencil
 from solver.path.cell.cache import checker_for
@@ -35,6 +36,14 @@ from solver.path.prepare import PreparedPath, prepare_path
 DEFAULT_MAX_JOINT_STEP = 0.35
 DEFAULT_BLEND_LENGTH = 0.002  # m, the corner zone of motion.md section 1 (ABB z1, UR 1 mm)
 BLEND_LENGTHS = (1e-6, 1.0)
+EXACT_SPIN_COST = 10.0
+"""A placement's work in free spin with the spun poses solved again (:attr:`PathProblem.exact_spin`,
+on the numpy pipeline) against the closed-form unit (about 2 us a pose: DTF_MAX_MAP_POSES' 5
+million, about 10 s). Measured 15 us a pose: the UR5 with a tcp tilted 0.5 rad and 3 cm off
+its axis, the ERK map (546 placements, 133 waypoints), 1.1 s, 2026-12-05, idle machine."""
+NUMERIC_EXACT_SPIN_COST = 2.0
+"""The same for a numeric family, whose figure already weighs its following: the spun paths
+followed again from their first solutions."""
 """m, the blend lengths taken: a controller's corner zone (ABB's largest, z200, is 0.4 m across)
 above CAM's rounding (1e-4 mm). Below 1e-100 s +- b rounded to s and mu_acc jumped back to
 mu_path (78,000 times 1e-12's); at 1000 m the blended path was no longer the pass's."""
@@ -182,15 +191,36 @@ class PathProblem:
         checker = checker_for(self.robot, cell)
         return (CellLimit(checker, self.prepared.segment_in_pass),)
 
+    @functools.cached_property
+    def exact_spin(self) -> bool:
+        """Whether free spin's joint paths are solved again at the spun poses.
+
+        Free spin, unless six joints turn a straight spindle
+        (:func:`solver.core.kinematics.straight_spindle`), where only the last joint moves and
+        the schedule's joint paths are exact: an angled or offset spindle, or seven joints
+        (whose spin moves every joint): :mod:`solver.path.exact_spin`, on the numpy pipeline,
+        whose work :attr:`exact_spin_weight` weighs.
+        """
+        straight = self.robot.dof == 6 and straight_spindle(self.robot)
+        return self.options.spin_mode == "free" and not straight
+
     def path_cost(self, n_waypoints: int) -> float:
         """The work of one placement of ``n_waypoints``, in poses of a closed-form family's map.
 
-        The family's cost (:meth:`KinematicsFamily.path_cost`), plus the collision check's
+        The family's cost (:meth:`KinematicsFamily.path_cost`; times :attr:`exact_spin_weight`
+        where the spun poses are solved again, :attr:`exact_spin`), plus the collision check's
         with a cell (:func:`solver.path.cell.cost.with_cell`): what the size limits of the maps
         and searches weigh.
         """
         cost = self.family.path_cost(n_waypoints, free_spin=self.options.spin_mode == "free")
-        return with_cell(cost, n_waypoints, self.options.cell)
+        return with_cell(cost * self.exact_spin_weight, n_waypoints, self.options.cell)
+
+    @property
+    def exact_spin_weight(self) -> float:
+        """The work of :attr:`exact_spin` against the family's figure (1 without it)."""
+        if not self.exact_spin:
+            return 1.0
+        return EXACT_SPIN_COST if self.family.map_kernel() is not None else NUMERIC_EXACT_SPIN_COST
 
     @property
     def waypoint_limits(self) -> tuple[Limit, ...]:

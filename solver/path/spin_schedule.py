@@ -31,8 +31,9 @@ def spin_schedule(
     At the feed F = mu_path each waypoint admits an interval of spin rates; the one nearest zero
     is held over the segment (its duration |dp_i| / F), which gives the spins phi_i. The joints
     follow q_i + sum_k<i sigma_k dt_k J^-1 [0; z_tool]_k: exact for a straight spindle (only the
-    last joint moves), first order otherwise (cam.md section 2). Those joint paths are tracked
-    again, so the last joint's limits and steps are checked along the schedule.
+    last joint moves), first order otherwise (cam.md section 2; a closed-form family then
+    solves the spun poses instead, :mod:`solver.path.exact_spin`). Those joint paths are
+    tracked again, so the last joint's limits and steps are checked along the schedule.
 
     Args:
         problem: the robot, the prepared path and the options.
@@ -52,19 +53,7 @@ def spin_schedule(
         joint paths (where the branch was feasible).
     """
     robot, path = problem.robot, problem.prepared
-    feed = np.where(np.isfinite(mu_path) & (mu_path > 0.0), mu_path, 0.0)[..., None]
-    qd_unit = motion.qd_unit
-    if motion.qd_null is None:
-        rate = spin_rate_nearest_zero(qd_unit, qd_spin, robot.qdot_max, feed)
-    else:
-        rate = spin_rates_in_pieces(
-            qd_unit, qd_spin, motion.qd_null, robot.qdot_max, feed, span(progress, 0.0, 0.5)
-        )
-    length = np.linalg.norm(np.diff(path.tool_position, axis=0), axis=1)  # (W - 1,)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        step = np.where(feed > 0.0, rate[..., :-1] * length / feed, 0.0)  # (B, C, W - 1)
-    step = np.where(path.segment_in_pass, step, 0.0)  # each pass starts at the placement's spin
-    spins = cumsum_within_passes(step, path.segment_in_pass)
+    spins, step = schedule(problem, motion, qd_spin, mu_path, span(progress, 0.0, 0.5))
 
     def spun_joints(rows: slice) -> np.ndarray:
         """The joint paths of some branches moved by the spins, (n, b, C, W)."""
@@ -88,6 +77,38 @@ def spin_schedule(
         failed_waypoint=np.where(keep, spun.failed_waypoint, tracked.failed_waypoint),
         q=np.where(keep[None, ..., None], spun.q, tracked.q),
     )
+
+
+def schedule(
+    problem: PathProblem,
+    motion: JointMotion,
+    qd_spin: np.ndarray,
+    mu_path: np.ndarray,
+    progress: Progress | None = None,
+    *,
+    inside: float = 1.0 - 1e-12,
+) -> tuple[np.ndarray, np.ndarray]:
+    """The spins (B, C, W) of :func:`spin_schedule`, and each segment's spin (B, C, W - 1), rad.
+
+    At the feed F = mu_path (none where infeasible or 0), the spin rate nearest zero at each
+    segment's first waypoint held over the segment (|dp_i| / F), summed within each pass.
+    ``progress``: a seven-joint arm's spin LP, piece by piece. ``inside``: the share of the feed
+    the rates are taken at (:func:`solver.core.two_variable_lp.spin_rate_nearest_zero`).
+    """
+    robot, path = problem.robot, problem.prepared
+    feed = np.where(np.isfinite(mu_path) & (mu_path > 0.0), mu_path, 0.0)[..., None]
+    qd_unit = motion.qd_unit
+    if motion.qd_null is None:
+        rate = spin_rate_nearest_zero(qd_unit, qd_spin, robot.qdot_max, feed, inside=inside)
+    else:
+        rate = spin_rates_in_pieces(
+            qd_unit, qd_spin, motion.qd_null, robot.qdot_max, feed, progress, inside=inside
+        )
+    length = np.linalg.norm(np.diff(path.tool_position, axis=0), axis=1)  # (W - 1,)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        step = np.where(feed > 0.0, rate[..., :-1] * length / feed, 0.0)  # (B, C, W - 1)
+    step = np.where(path.segment_in_pass, step, 0.0)  # each pass starts at the placement's spin
+    return cumsum_within_passes(step, path.segment_in_pass), step
 
 
 def cumsum_within_passes(steps: np.ndarray, segment_in_pass: np.ndarray) -> np.ndarray:

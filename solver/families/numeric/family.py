@@ -223,6 +223,20 @@ class NumericFamily(KinematicsFamily, CompiledFollowing):
             branches_found=count.reshape(batch),
         )
 
+    def follow_from(
+        self, start: np.ndarray, rotation: np.ndarray, position: np.ndarray
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """Each path followed from its start (see KinematicsFamily.follow_from).
+
+        As :meth:`solve_path` follows a slot from its seeded solution.
+        """
+        if self.compiled:
+            q, status = self.follow_piece(start[:, None].copy(), rotation, position, False)
+            return q[:, 0], status[0]
+        followed = reference.followed(self.chain, start, rotation, position)
+        q, status = reference.wrapped_with_status(self.chain, followed)  # (M, W, n), (M, W)
+        return np.moveaxis(q, -1, 0), status
+
     def joint_speeds_per_unit_twist(
         self,
         q: np.ndarray,

@@ -1,0 +1,156 @@
+"""Free spin with an angled or offset spindle: the joint paths exactly along the spin schedule.
+
+cam.md section 2. The spin schedule (:mod:`solver.path.spin_schedule`) moves the joints by
+sigma dt J^-1 [0; z_tool] at each step: exact where the tool turns about the last joint's own
+axis (a straight spindle: only that joint moves), first order otherwise, and there the joint
+path drifted from the path (the published KR210 L150 URDF, whose tool z is square to joint 6,
+on the published fan-shaped CSV: 22.6 mm and 0.16 rad off) while mu_path, the LP's bound at the
+unspun configurations, promised a feed the spun path cannot run (0.5934 against 0.5288 m/s,
+12 % too high; the robots audit of stop 55). A closed-form family (UR, OPW, a URDF recognised
+as one) solves each branch again at the spun poses, R_i Rz(phi_i), and the spun path is then
+judged as in fixed mode with those spins (`/v1/evaluate` with the answer's ``spins`` gives the
+same answer): its own task requirements (the spin turns each segment's rotation), the step
+test, the position limits and V_max. The spins stay those the LP chose at the unspun
+configurations (the schedule realises that feed to first order); the feed reported is the one
+the spun path runs.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from solver.core.spatial import rotation_vectors
+from solver.core.task import ANGULAR_TOLERANCE, LINEAR_TOLERANCE
+from solver.path.problem import PathProblem
+from solver.path.tracking import Tracked, track
+
+SCHEDULE_INSIDE = 1.0 - 1e-9
+"""The share of the LP's feed the schedule's spin rates are taken at here (1 - 1e-12 where the
+schedule's joint speeds are the answer's). Where two joints' bounds on the rate are nearly
+parallel, the rates' interval at (1 - 1e-12) is within rounding of a point, and its place moves
+with the rounding: the UR5's URDF read to wrist_3_link (recognised) and to tool0 with that frame
+as its tcp, one arm, had spins 2 % apart and mu_path 4e-5. The spun path is judged on its own,
+so the rates need only be well placed: at (1 - 1e-9) the two agree to 2e-12."""
+
+
+def spun_twists(problem: PathProblem, spins: np.ndarray, spin: float) -> np.ndarray:
+    """t_hat in {O} of the path turned by ``spin`` + ``spins`` about each tool z, (6, ..., W).
+
+    As :func:`solver.core.task.task_requirements` forms it from the spun poses: the segment's
+    displacement (a spin leaves the tool point where it is) and the rotation vector of
+    R'_{i+1} R'_i^T with R'_i = R_i Rz(spin + phi_i); the last waypoint takes its segment's.
+
+    Args:
+        problem: the path.
+        spins: shape (..., W), rad.
+        spin: rad, the placement's constant spin.
+    """
+    path = problem.prepared
+    turned = _spun_rotations(path.tool_rotation, spins + spin)  # (..., W, 3, 3)
+    relative = np.einsum("...nij,...nkj->...nik", turned[..., 1:, :, :], turned[..., :-1, :, :])
+    rotation_vector = rotation_vectors(relative)  # (..., W - 1, 3)
+    displacement = np.diff(path.tool_position, axis=0)  # (W - 1, 3)
+    linear = np.linalg.norm(displacement, axis=1)
+    angular = np.linalg.norm(rotation_vector, axis=-1)
+    moving = linear >= LINEAR_TOLERANCE
+    turning = angular >= ANGULAR_TOLERANCE
+    with np.errstate(divide="ignore", invalid="ignore"):
+        u_t = np.where(moving[:, None], displacement / np.where(moving, linear, 1.0)[:, None], 0.0)
+        u_r = np.where(
+            turning[..., None], rotation_vector / np.where(turning, angular, 1.0)[..., None], 0.0
+        )
+        h = np.where(
+            turning, np.where(moving, linear, 0.0) / np.where(turning, angular, 1.0), math.inf
+        )
+        angular_part = np.where(
+            (h == 0.0)[..., None], u_r, np.where(np.isinf(h)[..., None], 0.0, u_r / h[..., None])
+        )
+    linear_part = np.broadcast_to(u_t, angular_part.shape)
+    twist = np.concatenate([linear_part, angular_part], axis=-1)  # (..., W - 1, 6)
+    twist = np.concatenate([twist, twist[..., -1:, :]], axis=-2)  # the last reuses its segment's
+    return np.moveaxis(twist, -1, 0)
+
+
+def _spun_rotations(rotation: np.ndarray, angles: np.ndarray) -> np.ndarray:
+    """R_i Rz(angle_i): rotations (W, 3, 3), angles (..., W) -> (..., W, 3, 3)."""
+    cos, sin = np.cos(angles)[..., None], np.sin(angles)[..., None]
+    x, y = rotation[..., :, 0], rotation[..., :, 1]  # (W, 3) each
+    out = np.empty(angles.shape + (3, 3))
+    out[..., :, 0] = cos * x + sin * y
+    out[..., :, 1] = -sin * x + cos * y
+    out[..., :, 2] = np.broadcast_to(rotation[..., :, 2], out[..., :, 2].shape)
+    return out
+
+
+def spun_exactly(
+    problem: PathProblem,
+    placements: np.ndarray,
+    spins: np.ndarray,
+    branches: np.ndarray,
+    which: np.ndarray,
+    start: np.ndarray,
+) -> tuple[Tracked, np.ndarray]:
+    """The ``which`` branches solved at their spun poses and tracked; their J^-1 t_hat.
+
+    Args:
+        problem: the robot (a closed-form family), the path and the options.
+        placements: shape (C, 5), one spin.
+        spins: shape (B, C, W), rad, each branch's schedule at each placement.
+        branches: shape (B,), the family's branch of each row.
+        which: shape (B, C), bool: the K rows at placements to solve (``np.nonzero`` order).
+        start: shape (n, B, C, W) or (n, B, C), rad: each row's solution at the first waypoint
+            (a numeric family follows from it; no spin turns a pass's first pose).
+
+    Returns:
+        The tracking of the K spun paths (q (n, K, W); the position limits and the step test
+        applied) and their joint speeds per unit feed (n, K, W), t_hat the spun path's own.
+    """
+    robot, path, family = problem.robot, problem.prepared, problem.family
+    rows, cells = np.nonzero(which)
+    start = start[..., 0] if start.ndim == 4 else start
+    angles = spins[rows, cells] + float(placements[0, 4])  # (K, W)
+    yaw = placements[cells, 3][:, None]  # (K, 1)
+    cos, sin = np.cos(yaw), np.sin(yaw)
+    offset = placements[cells, :3].T[:, :, None]  # (3, K, 1)
+    turned = _spun_rotations(path.tool_rotation, angles)  # (K, W, 3, 3) in {O}
+    flange_rotation = turned @ path.tool_to_flange[:3, :3]
+    flange_position = path.tool_position + turned @ path.tool_to_flange[:3, 3]  # (K, W, 3)
+
+    def to_base(vectors: np.ndarray) -> np.ndarray:
+        """Vectors (3, K, W, ...) in {O} turned by each one's placement's yaw into {B}."""
+        extra = (None,) * (vectors.ndim - 3)
+        c, s = cos[(...,) + extra], sin[(...,) + extra]
+        x, y = c * vectors[0] - s * vectors[1], s * vectors[0] + c * vectors[1]
+        return np.stack([x, y, np.broadcast_to(vectors[2], x.shape)])
+
+    rotation = np.moveaxis(to_base(np.moveaxis(flange_rotation, -2, 0)), -1, 1)  # (3, 3, K, W)
+    position = to_base(np.moveaxis(flange_position, -1, 0)) + offset  # (3, K, W)
+    if family.map_kernel() is not None:  # closed form: each branch's own label at any pose
+        q_all, status_all = family.solve(rotation, position)  # (n, B_all, K, W), (B_all, K, W)
+        k = np.arange(len(rows))
+        q, status = q_all[:, branches[rows], k], status_all[branches[rows], k]
+    else:  # numeric: each followed from its solution at the first waypoint, which no spin moves
+        q, status = family.follow_from(
+            np.ascontiguousarray(start[:, rows, cells].T),
+            np.ascontiguousarray(np.moveaxis(rotation, (0, 1), (-2, -1))),
+            np.ascontiguousarray(np.moveaxis(position, 0, -1)),
+        )
+    tracked = track(
+        q,
+        status,
+        lower=robot.q_lower,
+        upper=robot.q_upper,
+        max_joint_step=problem.options.max_joint_step,
+        segment_checked=path.segment_in_pass,
+    )
+    twist_o = spun_twists(problem, angles, 0.0)  # (6, K, W) in {O}
+    twist = np.concatenate([to_base(twist_o[:3]), to_base(twist_o[3:])])
+    tool_position = to_base(
+        np.broadcast_to(path.tool_position.T[:, None], (3, 1, path.n_waypoints))
+    )
+    qd_unit = family.joint_speeds_per_unit_twist(
+        tracked.q, twist, tool_position + offset, qdot_max=robot.qdot_max
+    )
+    return tracked, qd_unit

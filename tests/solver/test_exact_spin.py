@@ -1,0 +1,123 @@
+"""Free spin with an angled or offset spindle, and on seven joints: the joint path the spins give.
+
+cam.md section 2: the answer's spins realise its mu_path. Where the spin moves more than the
+last joint (a tool axis off the last joint's axis, or seven joints), the joint path is solved
+at the spun poses (solver/path/exact_spin.py); before, it was the schedule's first-order sum,
+off the path by millimetres, and mu_path the LP's bound at the unspun configurations, above
+what that joint path can run (the robots audit of stop 55: 12 % on the published KR210 L150).
+Checked here against forward kinematics and a DTF written in the test (pinocchio's Jacobian at
+the answer's joints, the twist of the spun poses from scipy's rotations).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from scipy.spatial.transform import Rotation
+
+from solver.core.kinematics import jacobian_in_base, straight_spindle, tool_pose_in_base
+from solver.core.robots import Robot
+from solver.core.spatial import Placement
+from solver.families import get_robot
+from solver.path.kernel_cells import kernel_of
+from tests.problems import capability_map, evaluate_path, problem
+from tests.solver.test_evaluate import load_path
+
+PLACEMENT = Placement(0.0, 0.45, 0.1, 0.0)
+
+
+def _tcp(tilt: float, offset: tuple[float, float, float]) -> np.ndarray:
+    """A tool point ``offset`` from the flange, its z turned ``tilt`` about the flange's y."""
+    tcp = np.eye(4)
+    tcp[:3, :3] = Rotation.from_rotvec([0.0, tilt, 0.0]).as_matrix()
+    tcp[:3, 3] = offset
+    return tcp
+
+
+def _angled_ur5() -> Robot:
+    return get_robot("ur5").with_options(transform_tool_to_tcp=_tcp(0.5, (0.03, 0.0, 0.12)))
+
+
+def _spun_poses(path: np.ndarray, placement: Placement, spins: np.ndarray) -> np.ndarray:
+    """The path in {B} with each tool pose turned by its spin about its own z."""
+    turn = np.tile(np.eye(4), (len(spins), 1, 1))
+    turn[:, :3, :3] = Rotation.from_rotvec(np.outer(spins, [0.0, 0.0, 1.0])).as_matrix()
+    out: np.ndarray = placement.transform_workpiece_to_base() @ path @ turn
+    return out
+
+
+def _independent_mu(robot: Robot, q: np.ndarray, poses: np.ndarray) -> float:
+    """min over waypoints of V_max = 1 / max_j |J^-1 t_hat|_j / qdot_max_j, at the given q.
+
+    t_hat of segment i from the poses (u_T, and u_R / h from scipy's rotation vector of
+    R_{i+1} R_i^T), the last waypoint its segment's; J pinocchio's at the tool point.
+    """
+    speeds = []
+    for i in range(len(poses)):
+        a, b = (i, i + 1) if i + 1 < len(poses) else (i - 1, i)
+        dp = poses[b, :3, 3] - poses[a, :3, 3]
+        dphi = Rotation.from_matrix(poses[b, :3, :3] @ poses[a, :3, :3].T).as_rotvec()
+        twist = np.concatenate([dp, dphi]) / np.linalg.norm(dp)
+        qd = np.linalg.solve(jacobian_in_base(robot, q[i]), twist)
+        speeds.append(1.0 / np.max(np.abs(qd) / robot.qdot_max))
+    return float(min(speeds))
+
+
+def test_a_straight_spindle_is_straight_and_an_angled_or_offset_one_is_not() -> None:
+    ur5 = get_robot("ur5")
+    assert straight_spindle(ur5)
+    assert straight_spindle(ur5.with_options(transform_tool_to_tcp=_tcp(0.0, (0.0, 0.0, 0.2))))
+    assert straight_spindle(ur5.with_options(transform_tool_to_tcp=_tcp(np.pi, (0.0, 0.0, 0.2))))
+    assert not straight_spindle(ur5.with_options(transform_tool_to_tcp=_tcp(0.3, (0, 0, 0.1))))
+    assert not straight_spindle(ur5.with_options(transform_tool_to_tcp=_tcp(0.0, (0.01, 0, 0.1))))
+
+
+def test_an_angled_spindles_free_spin_joint_path_follows_the_spun_path() -> None:
+    """FK of every waypoint's q is the path turned by the answer's spin there (was mm off)."""
+    robot, path = _angled_ur5(), load_path("curved_line")
+    answer = evaluate_path(robot, path, PLACEMENT, spin_mode="free")
+    assert answer.feasible and answer.q is not None and answer.spins is not None
+    assert np.ptp(answer.spins) > 0.05  # the schedule turns the tool: the case at stake
+    poses = _spun_poses(path, PLACEMENT, answer.spins)
+    reached = np.array([tool_pose_in_base(robot, q) for q in answer.q])
+    assert np.abs(reached - poses).max() < 1e-9
+
+
+def test_an_angled_spindles_free_spin_mu_path_is_what_its_joint_path_runs() -> None:
+    """mu_path = the DTF of the answer's own joint path along its spins (was the LP's bound)."""
+    robot, path = _angled_ur5(), load_path("curved_line")
+    answer = evaluate_path(robot, path, PLACEMENT, spin_mode="free")
+    assert answer.mu_path is not None and answer.q is not None and answer.spins is not None
+    poses = _spun_poses(path, PLACEMENT, answer.spins)
+    assert answer.mu_path == pytest.approx(_independent_mu(robot, answer.q, poses), rel=1e-9)
+    fixed = evaluate_path(robot, path, PLACEMENT, spin_mode="fixed")
+    assert fixed.mu_path is not None and answer.mu_path > fixed.mu_path  # the spin still pays
+
+
+def test_a_seven_joint_arms_free_spin_joint_path_follows_the_spun_path() -> None:
+    """The xArm7's spin moves every joint: its q were the schedule's first-order sum (5.9 mm)."""
+    robot, path = get_robot("xarm7"), load_path("curved_line")
+    placement = Placement(0.16355274202439468, 0.13315994603655779, 0.1, -0.717454380680806)
+    answer = evaluate_path(robot, path, placement, spin_mode="free")
+    assert answer.feasible and answer.q is not None and answer.spins is not None
+    assert np.ptp(answer.spins) > 0.05
+    poses = _spun_poses(path, placement, answer.spins)
+    reached = np.array([tool_pose_in_base(robot, q) for q in answer.q])
+    assert np.abs(reached - poses).max() < 1e-9
+
+
+def test_an_angled_spindles_free_spin_map_runs_the_pipeline_and_equals_evaluate() -> None:
+    """No compiled kernel there (it moves the joints to first order); every cell = evaluate."""
+    robot, path = _angled_ur5(), load_path("curved_line")
+    assert kernel_of(problem(robot, path, spin_mode="free")) is None
+    assert kernel_of(problem(robot, path, spin_mode="fixed")) is not None
+    assert kernel_of(problem(get_robot("ur5"), path, spin_mode="free")) is not None
+    xs, ys = np.array([-0.1, 0.05, 0.2]), np.array([0.35, 0.5])
+    cmap = capability_map(robot, path, xs=xs, ys=ys, z=0.1, yaws=np.zeros(1), spin_mode="free")
+    for j, y in enumerate(ys):
+        for i, x in enumerate(xs):
+            answer = evaluate_path(robot, path, Placement(x, y, 0.1, 0.0), spin_mode="free")
+            cell = cmap.mu_path[0, 0, j, i]
+            assert (np.isfinite(cell) and answer.mu_path == cell) or (
+                not np.isfinite(cell) and not answer.feasible
+            )
