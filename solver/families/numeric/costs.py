@@ -69,6 +69,19 @@ the pass's time share over its counted share (BOUNDED_MAP_SHARE's runs): Panda 1
 1.8 and 2.0."""
 
 
+GENERAL_LP_COST = 800.0
+"""Arms of more than seven joints: one slot's V_max at one waypoint, a general LP (the null space
+of J has two or more dimensions: scipy's HiGHS, :func:`solver.core.dtf.lp_speed`), in
+closed-form poses (the limits' unit, about 2 us). Measured 1.2 ms (8 joints) and 1.3 ms (20) of
+CPU an LP, the machine loaded, 2026-12-05; an 8-joint chain along 200 waypoints, about 50 slots
+found: 12.5 s of CPU. Before, the seven-joint figures scaled by (dof / 7)^2 weighed a 20-joint
+evaluation of 3,000 waypoints under the limit, and it ran 286 s (the robots audit of stop 55:
+8 joints took 113 times the estimate, 20 joints 26)."""
+GENERAL_LP_SLOTS = 64
+"""The slots an arm of more than seven joints may follow (its seeds,
+:func:`solver.families.numeric.family.seed_count`): each may be a branch with its LPs."""
+
+
 def _scale(dof: int) -> float:
     """Arms of more than seven joints: the seven-joint figures times (dof / 7)^2."""
     return max(dof / 7, 1.0) ** 2
@@ -82,8 +95,9 @@ def path_cost(dof: int, compiled: bool, n_waypoints: int, *, free_spin: bool = F
     :data:`FREE_SPIN_REDUNDANT_COST`.
 
     Arms of more than seven joints scale the seven-joint figures by (dof / 7)^2 (the
-    Jacobian products and solves grow about so); the numpy chain (mimic joints) costs
-    :data:`NUMPY_CHAIN_COST` times the compiled one.
+    Jacobian products and solves grow about so) and add their LPs (:data:`GENERAL_LP_COST` a
+    slot and a waypoint); the numpy chain (mimic joints) costs :data:`NUMPY_CHAIN_COST` times
+    the compiled one.
 
     Args:
         dof: the arm's joints.
@@ -95,6 +109,8 @@ def path_cost(dof: int, compiled: bool, n_waypoints: int, *, free_spin: bool = F
     following = max(n_waypoints - 1, 0)
     cost = _scale(dof) * max(seed + following * track for seed, track in COST_LINES[size])
     cost = cost if compiled else cost * NUMPY_CHAIN_COST
+    if dof > 7:  # every slot's V_max a general LP at every waypoint
+        cost += GENERAL_LP_COST * GENERAL_LP_SLOTS * n_waypoints
     return cost * FREE_SPIN_REDUNDANT_COST if free_spin and dof > 6 else cost
 
 
@@ -127,7 +143,7 @@ def map_cost(
         return path_cost(dof, compiled, n_waypoints, free_spin=free_spin) * (
             NUMPY_MAP_COST / NUMPY_CHAIN_COST
         )
-    if free_spin or not (pruned or bounded):
+    if free_spin or not (pruned or bounded) or dof > 7:  # more than seven: its LPs, unpruned
         return path_cost(dof, compiled, n_waypoints, free_spin=free_spin)
     following = max(n_waypoints - 1, 0)
     if bounded:
