@@ -18,13 +18,17 @@ and 1.8 for the analytic UR5 on 133 waypoints, so such phases weigh SINGLE_PLACE
 placement. The analytic UR5 on 2 waypoints took 3 to 5 times (22-44 us a placement: its
 climbs' 1,208 placements take about 50 ms, far below any limit).
 
-Not counted: the local solvers' own iterations (IPOPT works on the NLP, bounded by its time
-limit; SLSQP's finite differences by its iterations).
+IPOPT's own work is counted where its NLP holds the whole path (a spin path, an arm of more
+than six joints, no active sets): :func:`ipopt_solve_cost` a solve. Before, a spin path of 1,200
+waypoints with acceleration limits was weighed at 0.86 of the limit and ran 55 to 75 s, IPOPT
+nearly all of it (the work-bounds audit of stop 55). Not counted: IPOPT on active sets (a few
+dozen waypoints a solve), SLSQP's finite differences (bounded by its iterations).
 """
 
 from __future__ import annotations
 
 import dataclasses
+import math
 from dataclasses import dataclass
 
 from solver.optimise.active_set import MAX_ROUNDS
@@ -53,6 +57,17 @@ BOX_EDGES = "box edges"
 """Points along the box's edges, mapped beside the coarse map (:func:`coarse_search.box_edges`)."""
 SINGLE_PLACEMENT_COST = 2.5
 """The weight of a placement evaluated on its own, against one evaluated in a batch."""
+IPOPT_SOLVE = (14.0, 1.7)
+IPOPT_ACCELERATED_SOLVE = (4.0, 2.0)
+"""One IPOPT solve of an NLP over n waypoints weighs scale n^exponent closed-form poses (the
+limits' unit, about 2 us); with acceleration limits (their blend rows) the second pair.
+Measured by the work-bounds audit of stop 55 (casadi, four starts, loaded machine, 2026-12-05):
+the UR5 with a spin path, 300 waypoints 2.4 s and 1,200 waypoints 9 s (the UR10e 16.3 s), with
+acceleration limits 3.4 s and 55 to 75 s; the Panda with acceleration limits, 480 waypoints,
+10.9 to 13.9 s. With these the three runs over 9 s weigh 2.8, 5.5 and 1.6 times the limit
+(DTF_MAX_MAP_POSES' 5 million), the two under 3.5 s 0.74 and 0.85: the placements' own weight,
+far above a kernel's time, leaves IPOPT's about its measured share (a solve of 1,200 waypoints
+with acceleration limits weighs 11.5 s, measured 15 s)."""
 
 
 @dataclass(frozen=True)
@@ -68,6 +83,8 @@ class Phase:
             alone: weighed by the family's cost, not the cell's).
         search: the narrower search it belongs to (:mod:`solver.optimise.narrower`), or "" for
             the request's own.
+        solve_cost: where set, what each of its ``placements`` weighs instead of its path's cost
+            (an IPOPT solve, :func:`ipopt_solve_cost`).
     """
 
     name: str
@@ -76,6 +93,7 @@ class Phase:
     one_at_a_time: bool = False
     without_cell: bool = False
     search: str = ""
+    solve_cost: float | None = None
 
 
 @dataclass(frozen=True)
@@ -102,7 +120,9 @@ class OptimisationWork:
         """
         clear = problem.with_options(cell=None)
         return sum(
-            phase.placements
+            phase.placements * phase.solve_cost
+            if phase.solve_cost is not None
+            else phase.placements
             * (clear if phase.without_cell else problem).path_cost(phase.n_waypoints)
             * (SINGLE_PLACEMENT_COST if phase.one_at_a_time else 1.0)
             for phase in self.phases
@@ -141,6 +161,13 @@ def _coarse_map_phases(problem: PathProblem, bounds: PlacementBounds) -> tuple[P
         ),
         Phase("box edges' whole-path checks", map_checks(n), n),
     )
+
+
+def ipopt_solve_cost(problem: PathProblem, n_waypoints: int) -> float:
+    """One IPOPT solve of an NLP over ``n_waypoints``, in closed-form poses (IPOPT_SOLVE)."""
+    accelerated = problem.robot.qddot_max is not None
+    scale, exponent = IPOPT_ACCELERATED_SOLVE if accelerated else IPOPT_SOLVE
+    return float(scale * math.pow(n_waypoints, exponent))
 
 
 def seeds_from_map(
@@ -258,6 +285,12 @@ def _search_phases(
         *_coarse_map_phases(problem, bounds),
         Phase("refinement", refined_count(problem, bounds) * 2 * free * REFINE_ROUNDS, n),
         Phase("IPOPT starts and whole-path checks", solves, n, one_at_a_time=True),
+        Phase(
+            "IPOPT solves of the whole path",
+            0 if on_active_set else starts,
+            n,
+            solve_cost=ipopt_solve_cost(problem, n),
+        ),
         Phase("Nelder-Mead climbs", climbs, n, one_at_a_time=True),
         Phase("back-offs", backed * starts * BACK_OFF_PLACEMENTS, n, one_at_a_time=True),
         Phase("candidates", 2 + (1 + backed) * starts + N_CLIMBS, n, one_at_a_time=True),

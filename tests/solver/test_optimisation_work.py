@@ -206,3 +206,37 @@ def test_a_climb_runs_to_its_budget_one_placement_a_call(
     assert (
         budget <= counted.placements["climbs"] <= local_search.climb_evaluations(problem, ISSUE_BOX)
     )
+
+
+def _there_and_back(n_waypoints: int) -> np.ndarray:
+    """The README path run there and back until it has ``n_waypoints`` (no pose twice in a row)."""
+    path = load_path("curved_line")
+    legs = [path]
+    while sum(len(leg) for leg in legs) < n_waypoints:
+        legs.append(legs[-1][-2::-1])
+    out: np.ndarray = np.concatenate(legs)[:n_waypoints]
+    return out
+
+
+@pytest.mark.parametrize(
+    ("n_waypoints", "accelerations", "over"),
+    [(1200, True, True), (1200, False, True), (300, False, False), (300, True, False)],
+)
+def test_a_whole_path_nlp_weighs_its_ipopt_solves(
+    n_waypoints: int, accelerations: bool, over: bool
+) -> None:
+    """A spin path's NLP holds every waypoint: its IPOPT solves are weighed (n^1.7, n^2).
+
+    The work-bounds audit of stop 55: the UR5 with a spin path of 1,200 waypoints ran 55 to 75 s
+    with acceleration limits and 9 s without, weighed at 0.86 of DTF_MAX_MAP_POSES' 5 million;
+    300 waypoints ran 2.4 s. On active sets (no spin path) nothing is added.
+    """
+    robot = get_robot("ur5")
+    if accelerations:
+        robot = robot.with_options(qddot_max=[5.0] * 6)
+    problem = PathProblem.of(robot, _there_and_back(n_waypoints), PathOptions())
+    box = PlacementBounds(x=(-0.3, 0.3), y=(0.3, 0.6), yaw=(-math.pi, math.pi), z=0.1)
+    spun = work_of(problem, box, max_spin_step=0.05)
+    assert spun.placements("IPOPT solves of the whole path") == casadi_method.N_STARTS
+    assert (spun.weighed(problem) > 5_000_000) == over
+    assert work_of(problem, box).placements("IPOPT solves of the whole path") == 0
