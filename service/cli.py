@@ -33,6 +33,7 @@ the same JSON on any console's encoding.
 from __future__ import annotations
 
 import argparse
+import errno
 import io
 import json
 import math
@@ -67,6 +68,9 @@ USAGE = 2
 """The command line is wrong (argparse's code)."""
 INVALID = 3
 """The input is refused, as the API refuses it with a 422: the message names the field."""
+NOT_WRITTEN = 5
+"""The answer could not be written: the standard output is closed, or its device full (an
+answer a post-processor never gets is no success, and no input of its was wrong)."""
 INTERRUPTED = 130
 """Interrupted (Ctrl-C, SIGINT): the work stopped, ``interrupted`` on stderr (128 + SIGINT, as
 a shell reports it)."""
@@ -118,11 +122,14 @@ def main(argv: Sequence[str] | None = None) -> int:
     """Run one subcommand; return its exit code."""
     _replacing_unencodable()
     args = _parser().parse_args(_signed_values_joined(sys.argv[1:] if argv is None else argv))
+    if sys.stdout is None:  # started with its standard output closed: no answer can reach anyone
+        if sys.stderr is not None:
+            print("error: the standard output is closed: no answer can be written", file=sys.stderr)  # noqa: T201
+        return NOT_WRITTEN
     echo = native_stderr.ECHO.set(False)  # a refused URDF's reason is in the error printed
     try:
         code = int(args.run(args))
-        if sys.stdout is not None:  # None: started with its standard output closed
-            sys.stdout.flush()  # a closed pipe is seen here, not at the interpreter's exit
+        sys.stdout.flush()  # a closed pipe is seen here, not at the interpreter's exit
         return code
     except BrokenPipeError:
         _quiet_stdout()
@@ -139,10 +146,17 @@ def main(argv: Sequence[str] | None = None) -> int:
         where = ".".join(str(part) for part in solver_error_location(error)[1:])
         print(f"error: {where}: {error.message}", file=sys.stderr)  # noqa: T201
     except OSError as error:
+        if error.errno in _WRITE_ERRORS:  # the output's device: the answer was not written
+            print(f"error: the answer could not be written: {error}", file=sys.stderr)  # noqa: T201
+            return NOT_WRITTEN
         print(f"error: {error}", file=sys.stderr)  # noqa: T201
     finally:
         native_stderr.ECHO.reset(echo)
     return INVALID
+
+
+_WRITE_ERRORS = frozenset({errno.ENOSPC, errno.EDQUOT, errno.EFBIG})
+"""What writing to a full device raises (reading an input never does)."""
 
 
 def _replacing_unencodable() -> None:

@@ -136,7 +136,7 @@ def evaluation_text(answer: EvaluateResponse, clearance: float | None = None) ->
         where = "" if answer.failed_waypoint is None else f" at waypoint {answer.failed_waypoint}"
         if answer.failed_pass is not None:
             named = "" if answer.failed_operation is None else f", {answer.failed_operation}"
-            where += f" (pass {answer.failed_pass}{named})"
+            where += f" (pass {answer.failed_pass + 1}{named})"  # as import numbers them
         lines.append(f"infeasible: {answer.reason}{where}")
         if answer.collision is not None:
             limit = "" if clearance is None else f" (clearance {_fixed(clearance * 1e3, 1)} mm)"

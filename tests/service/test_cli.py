@@ -19,7 +19,16 @@ from typing import Any
 import pytest
 from fastapi.testclient import TestClient
 
-from service.cli import CLOSED_PIPE, INFEASIBLE, INTERRUPTED, INVALID, OK, USAGE, main
+from service.cli import (
+    CLOSED_PIPE,
+    INFEASIBLE,
+    INTERRUPTED,
+    INVALID,
+    NOT_WRITTEN,
+    OK,
+    USAGE,
+    main,
+)
 from service.config import get_settings
 from solver.core.robots import example_robot_data_dir
 from solver.families.opw.arms import ARMS
@@ -125,6 +134,11 @@ def test_an_unreachable_placement_is_exit_infeasible(capsys: pytest.CaptureFixtu
     assert code == INFEASIBLE
     assert out.startswith("units: inches (inferred: ")  # how the program was read, first
     assert out.splitlines()[-1].startswith("infeasible: ")
+    # The pass as the import lists it, from 1 (it said "pass 0": the audit of stop 55).
+    _, listing, _ = run(capsys, "import", str(PROGRAM))
+    first = re.search(r"^\s+1\s+waypoints 0-\d+\s+(\S+)", listing, re.M)
+    assert first is not None
+    assert out.splitlines()[-1].endswith(f"at waypoint 0 (pass 1, {first.group(1)})")
 
 
 def test_a_feed_the_path_cannot_run_is_exit_infeasible(capsys: pytest.CaptureFixture[str]) -> None:
@@ -848,15 +862,29 @@ def test_a_cell_file_that_cannot_be_read_is_an_invalid_input(
     assert err.startswith(f"error: cell: {said}")
 
 
-@pytest.mark.parametrize("closed", ["1", "2"], ids=["stdout", "stderr"])
-def test_a_command_started_with_a_standard_stream_closed_runs(tmp_path: Path, closed: str) -> None:
-    """`dtf-place import f >&-` (or `2>&-`): AttributeError on None's flush, exit 1."""
+@pytest.mark.parametrize(
+    ("redirect", "expected"),
+    [("2>&-", OK), (">&-", NOT_WRITTEN), ("> /dev/full", NOT_WRITTEN)],
+    ids=["stderr closed", "stdout closed", "stdout full"],
+)
+def test_an_answer_that_cannot_be_written_is_not_a_success(
+    tmp_path: Path, redirect: str, expected: int
+) -> None:
+    """`dtf-place import f >&-` exited 0 with the answer nowhere, `> /dev/full` 3 (invalid
+    input, which it was not; the work-bounds audit of stop 55); stderr closed still answers.
+
+    (Before stop 52: AttributeError on None's flush, exit 1.)
+    """
+    if redirect.endswith("/dev/full") and not Path("/dev/full").exists():
+        pytest.skip("no /dev/full here")
     marker = tmp_path / "rc"
     command = (
-        f'"{sys.executable}" -m service.cli import "{PROGRAM}" {closed}>&-; echo $? > "{marker}"'
+        f'"{sys.executable}" -m service.cli import "{PROGRAM}" {redirect}; echo $? > "{marker}"'
     )
-    subprocess.run(["bash", "-c", command], cwd=ROOT, timeout=300, capture_output=True)
-    assert marker.read_text().strip() == str(OK)
+    done = subprocess.run(["bash", "-c", command], cwd=ROOT, timeout=300, capture_output=True)
+    assert marker.read_text().strip() == str(expected)
+    if expected == NOT_WRITTEN:
+        assert b"error: " in done.stderr and b"written" in done.stderr
 
 
 def test_ctrl_c_stops_a_map_with_one_line_and_the_shells_code(tmp_path: Path) -> None:
