@@ -179,3 +179,26 @@ def test_free_spin_is_refused_beyond_seven_joints() -> None:
     with pytest.raises(InvalidInputError) as info:
         evaluate_path(robot, load_path("curved_line"), Placement(0.4, 0, 0.1, 0), spin_mode="free")
     assert info.value.field == "spin_mode" and "8 joints" in info.value.message
+
+
+@pytest.mark.parametrize("tilt", [1e-8, 1e-6])
+def test_an_axis_a_hair_off_a_coordinate_axis_is_read_as_it_is(tilt: float) -> None:
+    """FK(IK(T)) = T where a joint's axis is tilted under 1.5e-8 rad from y (the UR5's shoulder).
+
+    Such an axis rounded to |y . axis| == 1 and was paired with an x square to y, not to the
+    axis: the joint frame skewed by the tilt, answers 7e-9 m off (the robots audit of stop 55).
+    """
+    path = example_robot_data_dir() / "ur_description" / "urdf" / "ur5_robot.urdf"
+    urdf = _exact_right_angles(path.read_text())
+    shoulder = urdf.index('name="shoulder_lift_joint"')
+    axis = urdf.index('<axis xyz="0 1 0"/>', shoulder)
+    urdf = urdf[:axis] + f'<axis xyz="0 1 {tilt}"/>' + urdf[axis + len('<axis xyz="0 1 0"/>') :]
+    robot = robot_from_urdf(urdf, base_frame="base", tool_frame="tool0")
+    assert isinstance(robot.family, NumericFamily)  # not recognised as a UR arm: tilted
+    waypoints = load_path("curved_line")[:20]
+    placement = Placement(0.0, 0.45, 0.1, 0.0)
+    answer = evaluate_path(robot, waypoints, placement)
+    assert answer.feasible and answer.q is not None
+    poses = placement.transform_workpiece_to_base() @ waypoints
+    reached = np.array([tool_pose_in_base(robot, q) for q in answer.q])
+    assert np.abs(reached - poses).max() < 1e-10
