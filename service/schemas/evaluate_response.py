@@ -221,13 +221,13 @@ class EvaluateResponse(ResponseModel):
     spins: list[float] | None = Field(
         default=None,
         description="In free spin mode, the tool spin (rad) about each waypoint's tool axis that "
-        "realises mu_path: the spin rate nearest zero at the feed the LP gives at the given "
-        "spin's configurations (cam.md section 2), summed along each pass. The waypoints' q "
-        "follow these spins exactly, and mu_path is what that joint path runs: for an angled "
-        "or offset spindle, or seven joints, whose spin moves more than the last joint, the "
-        "path is solved again at the spun poses and judged as in fixed mode (these spins in "
-        "fixed mode, on the same branch, give the same answer). Null in fixed mode or when "
-        "infeasible.",
+        "realises mu_path: the spin rate nearest zero at the feed the LP gives (cam.md "
+        "section 2), summed along each pass. The waypoints' q follow these spins exactly, and "
+        "mu_path is what that joint path runs: for an angled or offset spindle, or seven "
+        "joints, whose spin moves more than the last joint, the path is solved again at the "
+        "spun poses and judged as in fixed mode (these spins in fixed mode, on the same "
+        "branch, give the same answer), the LP taken again at the spun joints, up to four "
+        "rounds, the best kept. Null in fixed mode or when infeasible.",
     )
     axis_correction: float = Field(
         default=0.0,

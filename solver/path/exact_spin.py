@@ -26,6 +26,15 @@ from solver.core.task import ANGULAR_TOLERANCE, LINEAR_TOLERANCE
 from solver.path.problem import PathProblem
 from solver.path.tracking import Tracked, track
 
+ROUNDS = 4
+"""Rounds of schedule and spun paths at most (solver.path.pipeline): the LP at the unspun
+configurations puts the spin where the joints are not; each round takes the LP where the last
+round's joints were. The UR5 with its tool tilted 0.5 rad and 3 cm off the flange axis, on the
+README path: its spun path runs 0.7291, 1.0325, 1.1007, 1.1037 m/s in rounds 1 to 4, the LP at
+its own configurations 1.1052 (6 rounds: 1.1038); the KR210 L150 on the fan-shaped CSV at
+(2.0, 0.4, 0.3, 1.57): 0.5288, 0.5684, 0.5762, 0.5765 (the LP there 0.5801)."""
+ROUND_RTOL = 1e-4
+"""A round that raises no branch's mu_path by this (relative) ends them."""
 SCHEDULE_INSIDE = 1.0 - 1e-9
 """The share of the LP's feed the schedule's spin rates are taken at here (1 - 1e-12 where the
 schedule's joint speeds are the answer's). Where two joints' bounds on the rate are nearly

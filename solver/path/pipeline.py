@@ -24,7 +24,7 @@ from solver.core.codes import ACC_TIE_RTOL, FEASIBLE, UNREACHABLE
 from solver.core.family import PathSolutions
 from solver.core.progress import Progress, span
 from solver.path.bounded import bounded_solutions, in_one_pass, pick_stands
-from solver.path.exact_spin import SCHEDULE_INSIDE, spun_exactly
+from solver.path.exact_spin import ROUND_RTOL, ROUNDS, SCHEDULE_INSIDE, spun_exactly
 from solver.path.in_pieces import bound_in_pieces, track_in_pieces
 from solver.path.limits import JointMotion, bound_by_limits
 from solver.path.placed import placed_flange, turn_by_yaw
@@ -206,18 +206,13 @@ def run_chunk(
     if solutions.bound is not None and not pick_stands(solutions, branches, mu_path):
         return run_chunk(problem, placements, progress=progress, excluded=excluded)  # unpruned
     spins = None
-    if qd_spin is not None and problem.exact_spin:  # an angled or offset spindle
-        part = _part(progress, shares, 6)
-        spins, _ = schedule(
-            problem, motion, qd_spin, mu_path, span(part, 0.0, 0.5), inside=SCHEDULE_INSIDE
-        )
-        tracked, qd_unit, speed, limiting = _spun_exactly(
+    if qd_spin is not None and problem.exact_spin:  # an angled or offset spindle, 7 joints
+        spins, tracked, qd_unit, speed, limiting = _exact_free_spin(
             problem,
             placements,
-            (spins, branches, np.isfinite(mu_path)),
-            tracked,
-            motion,
-            span(part, 0.5, 1.0),
+            (tracked, motion, mu_path),
+            (twist, spin, tool_position),
+            _part(progress, shares, 6),
         )
         v_max = np.where(path.pure_rotation, 0.0, speed)
         feasible = tracked.reason == FEASIBLE
@@ -260,33 +255,110 @@ def run_chunk(
     )
 
 
-def _spun_exactly(
+def _exact_free_spin(
     problem: PathProblem,
     placements: np.ndarray,
-    schedules: tuple[np.ndarray, np.ndarray, np.ndarray],
-    tracked: Tracked,
-    motion: JointMotion,
+    run: tuple[Tracked, JointMotion, np.ndarray],
+    vectors: tuple[np.ndarray, np.ndarray, np.ndarray],
     progress: Progress | None,
-) -> tuple[Tracked, np.ndarray, np.ndarray, np.ndarray]:
-    """The branches with a schedule along it exactly; the rest as run.
+) -> tuple[np.ndarray, Tracked, np.ndarray, np.ndarray, np.ndarray]:
+    """Free spin along each branch's spun path, solved exactly (:mod:`solver.path.exact_spin`).
 
-    :func:`solver.path.exact_spin.spun_exactly` of ``schedules`` (the spins (B, C, W), the
-    rows' branches (B,), which rows have one (B, C)), then the waypoint limits (fixed spin's:
-    the spun path's own t_hat; ``progress`` after each piece). Returns the tracking, J^-1 t_hat,
-    the speed and the limiting joint.
+    Round 1: the spin schedule of the LP at the unspun configurations, each branch solved at
+    its spun poses and judged as that path. Each next round takes the schedule of the LP at the
+    last round's spun configurations, where the spin rates are the ones those joints need; a
+    branch keeps the round whose path runs fastest, and the rounds stop once none gains
+    :data:`solver.path.exact_spin.ROUND_RTOL` (at most :data:`~solver.path.exact_spin.ROUNDS`).
+
+    Args:
+        problem: the robot, the path, the options.
+        placements: shape (C, 5).
+        run: the unspun tracking, its motion (J^-1 t_hat, J^-1 [0; z_tool], the null space)
+            and the LP's mu_path (B, C).
+        vectors: t_hat (6, C, W), [0; z_tool] (6, C, W) and the tool point (3, C, W) in {B}.
+        progress: after each round's schedule and each round's paths.
+
+    Returns:
+        The spins (B, C, W), the tracking, J^-1 t_hat, the speed and the limiting joint of the
+        kept rounds.
     """
-    spins, branches, scheduled = schedules
-    spun, qd_spun = spun_exactly(problem, placements, spins, branches, scheduled, tracked.q)
-    rows, cells = np.nonzero(scheduled)
-    reason, failed = tracked.reason.copy(), tracked.failed_waypoint.copy()
-    q, qd_unit = tracked.q.copy(), motion.qd_unit.copy()
-    reason[rows, cells], failed[rows, cells] = spun.reason, spun.failed_waypoint
-    q[:, rows, cells], qd_unit[:, rows, cells] = spun.q, qd_spun
-    out = Tracked(reason=reason, failed_waypoint=failed, q=q)
-    speed, limiting = bound_in_pieces(
-        problem.waypoint_limits, JointMotion(q=out.q, qd_unit=qd_unit), progress
+    robot, path, family, branches = (
+        problem.robot,
+        problem.prepared,
+        problem.family,
+        problem.branches,
     )
-    return out, qd_unit, speed, limiting
+    unspun, motion, lp_mu = run
+    twist, spin, tool_point = (v[:, None] for v in vectors)
+    best: tuple[np.ndarray, Tracked, np.ndarray, np.ndarray, np.ndarray] | None = None
+    best_mu = np.full(lp_mu.shape, -np.inf)
+    for k in range(ROUNDS):
+        part = span(progress, k / ROUNDS, (k + 1) / ROUNDS)
+        assert motion.qd_spin is not None
+        spins, _ = schedule(
+            problem, motion, motion.qd_spin, lp_mu, span(part, 0.0, 0.5), inside=SCHEDULE_INSIDE
+        )
+        scheduled = np.isfinite(lp_mu)
+        spun, qd_spun = spun_exactly(problem, placements, spins, branches, scheduled, unspun.q)
+        rows, cells = np.nonzero(scheduled)
+        reason, failed = unspun.reason.copy(), unspun.failed_waypoint.copy()
+        q, qd_unit = unspun.q.copy(), motion.qd_unit.copy()
+        reason[rows, cells], failed[rows, cells] = spun.reason, spun.failed_waypoint
+        q[:, rows, cells], qd_unit[:, rows, cells] = spun.q, qd_spun
+        tracked = Tracked(reason=reason, failed_waypoint=failed, q=q)
+        speed, limiting = bound_in_pieces(
+            problem.waypoint_limits, JointMotion(q=q, qd_unit=qd_unit), span(part, 0.5, 1.0)
+        )
+        v_max = np.where(path.pure_rotation, 0.0, speed)
+        # A row without a schedule this round (its last path failed) has no answer of it.
+        mu = np.where(scheduled & (reason == FEASIBLE), v_max.min(axis=-1), -np.inf)
+        round_ = (spins, tracked, qd_unit, speed, limiting)
+        if best is None:
+            best, best_mu = round_, mu
+        else:
+            gains = mu > best_mu * (1.0 + ROUND_RTOL)
+            if not gains.any():
+                break
+            best = _kept(gains, round_, best)
+            best_mu = np.where(gains, mu, best_mu)
+        if k + 1 < ROUNDS:  # the LP at this round's spun configurations
+            on = reason == FEASIBLE
+            motion = JointMotion(
+                q=q,
+                qd_unit=family.joint_speeds_per_unit_twist(
+                    q, twist, tool_point, qdot_max=robot.qdot_max
+                ),
+                qd_spin=family.joint_speeds_per_unit_twist(q, spin, tool_point),
+                qd_null=None if robot.dof <= 6 else family.null_space(q, tool_point),
+            )
+            lp, _ = bound_in_pieces(problem.waypoint_limits, motion, None)
+            lp_mu = np.where(on, np.where(path.pure_rotation, 0.0, lp).min(axis=-1), -np.inf)
+    if progress is not None:
+        progress(1.0)
+    assert best is not None
+    return best
+
+
+def _kept(
+    gains: np.ndarray,
+    new: tuple[np.ndarray, Tracked, np.ndarray, np.ndarray, np.ndarray],
+    old: tuple[np.ndarray, Tracked, np.ndarray, np.ndarray, np.ndarray],
+) -> tuple[np.ndarray, Tracked, np.ndarray, np.ndarray, np.ndarray]:
+    """Round ``new`` where ``gains`` (B, C), else ``old``: spins, tracking, J^-1 t_hat, bounds."""
+    spins, tracked, qd_unit, speed, limiting = new
+    was_spins, was, was_qd, was_speed, was_limiting = old
+    rows, paths = gains[None, ..., None], gains[..., None]
+    return (
+        np.where(paths, spins, was_spins),
+        Tracked(
+            reason=np.where(gains, tracked.reason, was.reason),
+            failed_waypoint=np.where(gains, tracked.failed_waypoint, was.failed_waypoint),
+            q=np.where(rows, tracked.q, was.q),
+        ),
+        np.where(rows, qd_unit, was_qd),
+        np.where(paths, speed, was_speed),
+        np.where(paths, limiting, was_limiting),
+    )
 
 
 SHARES = (0.8, 0.85, 0.95, 1.0, 1.0, 1.0, 1.0)

@@ -36,17 +36,21 @@ from solver.path.prepare import PreparedPath, prepare_path
 DEFAULT_MAX_JOINT_STEP = 0.35
 DEFAULT_BLEND_LENGTH = 0.002  # m, the corner zone of motion.md section 1 (ABB z1, UR 1 mm)
 BLEND_LENGTHS = (1e-6, 1.0)
-EXACT_SPIN_COST = 10.0
-"""A placement's work in free spin with the spun poses solved again (:attr:`PathProblem.exact_spin`,
-on the numpy pipeline) against the closed-form unit (about 2 us a pose: DTF_MAX_MAP_POSES' 5
-million, about 10 s). Measured 15 us a pose: the UR5 with a tcp tilted 0.5 rad and 3 cm off
-its axis, the ERK map (546 placements, 133 waypoints), 1.1 s, 2026-12-05, idle machine."""
-NUMERIC_EXACT_SPIN_COST = 2.0
-"""The same for a numeric family, whose figure already weighs its following: the spun paths
-followed again from their first solutions."""
 """m, the blend lengths taken: a controller's corner zone (ABB's largest, z200, is 0.4 m across)
 above CAM's rounding (1e-4 mm). Below 1e-100 s +- b rounded to s and mu_acc jumped back to
 mu_path (78,000 times 1e-12's); at 1000 m the blended path was no longer the pass's."""
+EXACT_SPIN_COST = 30.0
+"""A placement's work in free spin with the spun poses solved again (:attr:`PathProblem.exact_spin`,
+on the numpy pipeline, up to solver.path.exact_spin.ROUNDS rounds) against the closed-form unit
+(about 2 us a pose: DTF_MAX_MAP_POSES' 5 million, about 10 s). Measured 59 us a pose: the UR5
+with a tcp tilted 0.5 rad and 3 cm off its axis, the ERK map (546 placements, 133 waypoints,
+four rounds), 4.3 s, 2026-12-05, the machine loaded (the kernel's map without the rounds:
+0.023 s)."""
+NUMERIC_EXACT_SPIN_COST = 5.0
+"""The same for a numeric family, whose figure already weighs its following: the rounds' spun
+paths followed again from their first solutions. Maps of 55 placements on the ERK path, CPU
+time, loaded machine, 2026-12-05: the Panda 4.4 s against 0.97 s, the xArm7 6.3 against 1.35,
+the Jaco2 0.34 against 0.09 (before solving the spun poses)."""
 
 SpinMode = Literal["fixed", "free"]
 SPIN_MODES: tuple[SpinMode, ...] = ("fixed", "free")

@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+import scipy.optimize
 from scipy.spatial.transform import Rotation
 
 from solver.core.kinematics import jacobian_in_base, straight_spindle, tool_pose_in_base
@@ -44,6 +45,36 @@ def _spun_poses(path: np.ndarray, placement: Placement, spins: np.ndarray) -> np
     turn[:, :3, :3] = Rotation.from_rotvec(np.outer(spins, [0.0, 0.0, 1.0])).as_matrix()
     out: np.ndarray = placement.transform_workpiece_to_base() @ path @ turn
     return out
+
+
+def _twists(poses: np.ndarray) -> list[np.ndarray]:
+    """t_hat of each waypoint's segment (the last its segment's), from scipy's rotations."""
+    out = []
+    for i in range(len(poses)):
+        a, b = (i, i + 1) if i + 1 < len(poses) else (i - 1, i)
+        dp = poses[b, :3, 3] - poses[a, :3, 3]
+        dphi = Rotation.from_matrix(poses[b, :3, :3] @ poses[a, :3, :3].T).as_rotvec()
+        out.append(np.concatenate([dp, dphi]) / np.linalg.norm(dp))
+    return out
+
+
+def _spin_free_lp(
+    jacobian: np.ndarray, twist: np.ndarray, axis: np.ndarray, limits: np.ndarray
+) -> float:
+    """HiGHS on max s s.t. J qdot = s t_hat + sigma [0; z], |qdot| <= limits, sigma free."""
+    n = jacobian.shape[1]
+    cost = np.zeros(n + 2)
+    cost[n] = -1.0
+    spin = np.concatenate([np.zeros(3), axis])
+    result = scipy.optimize.linprog(
+        cost,
+        A_eq=np.hstack([jacobian, -twist[:, None], -spin[:, None]]),
+        b_eq=np.zeros(6),
+        bounds=[(-m, m) for m in limits] + [(0.0, None), (None, None)],
+        method="highs",
+    )
+    assert result.status == 0, result.message
+    return float(result.x[n])
 
 
 def _independent_mu(robot: Robot, q: np.ndarray, poses: np.ndarray) -> float:
@@ -121,3 +152,25 @@ def test_an_angled_spindles_free_spin_map_runs_the_pipeline_and_equals_evaluate(
             assert (np.isfinite(cell) and answer.mu_path == cell) or (
                 not np.isfinite(cell) and not answer.feasible
             )
+
+
+def test_the_spins_are_where_the_spun_joints_need_them() -> None:
+    """The answer is near its own fixed point: the spin-free LP at its own joints (the path's
+    t_hat, the tool's z there; HiGHS in the test) is within 0.5 % of its mu_path.
+
+    One schedule of the LP at the unspun joints left the UR5's spun path at 0.729 m/s where
+    the LP at those spun joints allowed 1.094 (33 % apart); the rounds (solver/path/
+    pipeline.py, exact_spin.ROUNDS) take the LP where the last round's joints were: 1.1037.
+    """
+    robot, path = _angled_ur5(), load_path("curved_line")
+    answer = evaluate_path(robot, path, PLACEMENT, spin_mode="free")
+    assert answer.mu_path is not None and answer.q is not None
+    poses = PLACEMENT.transform_workpiece_to_base() @ path  # unspun: the spin is the LP's
+    bound = min(
+        _spin_free_lp(
+            jacobian_in_base(robot, q), t, tool_pose_in_base(robot, q)[:3, 2], robot.qdot_max
+        )
+        for q, t in zip(answer.q, _twists(poses), strict=True)
+    )
+    assert answer.mu_path <= bound * (1 + 1e-9)
+    assert answer.mu_path >= 0.995 * bound
