@@ -92,7 +92,9 @@ def import_text(answer: PathImportResponse, name: str) -> str:
         f"feed: {_feed(answer.feed)} (the highest programmed)",
         "passes:",
     ]
-    for number, part in enumerate(answer.pass_details, start=1):
+    # Passes from 0, as the waypoints and the API's failed_pass and messages count them (this
+    # listing counted from 1, and a failure's "pass 0" was the listing's pass 1).
+    for number, part in enumerate(answer.pass_details):
         lines.append(
             f"  {number:3d}  waypoints {part.start}-{part.stop - 1}  "
             f"{part.operation or '-'}  {_feed(part.feed)}"
@@ -136,7 +138,7 @@ def evaluation_text(answer: EvaluateResponse, clearance: float | None = None) ->
         where = "" if answer.failed_waypoint is None else f" at waypoint {answer.failed_waypoint}"
         if answer.failed_pass is not None:
             named = "" if answer.failed_operation is None else f", {answer.failed_operation}"
-            where += f" (pass {answer.failed_pass + 1}{named})"  # as import numbers them
+            where += f" (pass {answer.failed_pass}{named})"
         lines.append(f"infeasible: {answer.reason}{where}")
         if answer.collision is not None:
             limit = "" if clearance is None else f" (clearance {_fixed(clearance * 1e3, 1)} mm)"

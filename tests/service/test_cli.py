@@ -134,11 +134,11 @@ def test_an_unreachable_placement_is_exit_infeasible(capsys: pytest.CaptureFixtu
     assert code == INFEASIBLE
     assert out.startswith("units: inches (inferred: ")  # how the program was read, first
     assert out.splitlines()[-1].startswith("infeasible: ")
-    # The pass as the import lists it, from 1 (it said "pass 0": the audit of stop 55).
+    # The pass as the import lists it (it listed from 1 and said "pass 0": the audit of stop 55).
     _, listing, _ = run(capsys, "import", str(PROGRAM))
-    first = re.search(r"^\s+1\s+waypoints 0-\d+\s+(\S+)", listing, re.M)
+    first = re.search(r"^\s+0\s+waypoints 0-\d+\s+(\S+)", listing, re.M)
     assert first is not None
-    assert out.splitlines()[-1].endswith(f"at waypoint 0 (pass 1, {first.group(1)})")
+    assert out.splitlines()[-1].endswith(f"at waypoint 0 (pass 0, {first.group(1)})")
 
 
 def test_a_feed_the_path_cannot_run_is_exit_infeasible(capsys: pytest.CaptureFixture[str]) -> None:
