@@ -47,7 +47,7 @@ def _spun_poses(path: np.ndarray, placement: Placement, spins: np.ndarray) -> np
     return out
 
 
-def _twists(poses: np.ndarray) -> list[np.ndarray]:
+def segment_twists(poses: np.ndarray) -> list[np.ndarray]:
     """t_hat of each waypoint's segment (the last its segment's), from scipy's rotations."""
     out = []
     for i in range(len(poses)):
@@ -84,11 +84,7 @@ def _independent_mu(robot: Robot, q: np.ndarray, poses: np.ndarray) -> float:
     R_{i+1} R_i^T), the last waypoint its segment's; J pinocchio's at the tool point.
     """
     speeds = []
-    for i in range(len(poses)):
-        a, b = (i, i + 1) if i + 1 < len(poses) else (i - 1, i)
-        dp = poses[b, :3, 3] - poses[a, :3, 3]
-        dphi = Rotation.from_matrix(poses[b, :3, :3] @ poses[a, :3, :3].T).as_rotvec()
-        twist = np.concatenate([dp, dphi]) / np.linalg.norm(dp)
+    for i, twist in enumerate(segment_twists(poses)):
         qd = np.linalg.solve(jacobian_in_base(robot, q[i]), twist)
         speeds.append(1.0 / np.max(np.abs(qd) / robot.qdot_max))
     return float(min(speeds))
@@ -170,7 +166,7 @@ def test_the_spins_are_where_the_spun_joints_need_them() -> None:
         _spin_free_lp(
             jacobian_in_base(robot, q), t, tool_pose_in_base(robot, q)[:3, 2], robot.qdot_max
         )
-        for q, t in zip(answer.q, _twists(poses), strict=True)
+        for q, t in zip(answer.q, segment_twists(poses), strict=True)
     )
     assert answer.mu_path <= bound * (1 + 1e-9)
     assert answer.mu_path >= 0.995 * bound

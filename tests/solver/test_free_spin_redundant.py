@@ -24,6 +24,7 @@ from solver.families import get_robot
 from solver.kernels import spin_lp as compiled_lp
 from tests.cases import EXAMPLES, FREE_SPIN_LP_RTOL, MAP_EVALUATE_RTOL
 from tests.problems import capability_map, evaluate_path
+from tests.solver.test_exact_spin import segment_twists
 
 PLACEMENT = Placement(0.0, 0.45, 0.1, 0.0)
 
@@ -151,13 +152,10 @@ def test_the_pandas_free_spin_path_runs_at_the_lp_of_each_waypoint(path: np.ndar
     poses[:, :3, :3] = poses[:, :3, :3] @ turns
     reached = np.array([tool_pose_in_base(robot, q) for q in free.q])
     assert np.abs(reached - poses).max() < 1e-9
-    expected = []
-    for i, q in enumerate(free.q):
-        a, b = (i, i + 1) if i + 1 < len(poses) else (i - 1, i)
-        dp = poses[b, :3, 3] - poses[a, :3, 3]
-        dphi = Rotation.from_matrix(poses[b, :3, :3] @ poses[a, :3, :3].T).as_rotvec()
-        twist = np.concatenate([dp, dphi]) / np.linalg.norm(dp)
-        expected.append(spin_lp(jacobian_in_base(robot, q), twist, np.zeros(3), robot.qdot_max))
+    expected = [
+        spin_lp(jacobian_in_base(robot, q), twist, np.zeros(3), robot.qdot_max)
+        for q, twist in zip(free.q, segment_twists(poses), strict=True)
+    ]
     np.testing.assert_allclose(free.v_max, expected, rtol=FREE_SPIN_LP_RTOL)
     assert free.mu_path == pytest.approx(min(expected), rel=FREE_SPIN_LP_RTOL)
     fixed = evaluate_path(robot, path, PLACEMENT, branch=free.branch)
