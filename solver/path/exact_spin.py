@@ -1,18 +1,21 @@
-"""Free spin with an angled or offset spindle: the joint paths exactly along the spin schedule.
+"""Free spin where the spin moves more than the last joint: its joint paths solved exactly.
 
 cam.md section 2. The spin schedule (:mod:`solver.path.spin_schedule`) moves the joints by
-sigma dt J^-1 [0; z_tool] at each step: exact where the tool turns about the last joint's own
-axis (a straight spindle: only that joint moves), first order otherwise, and there the joint
-path drifted from the path (the published KR210 L150 URDF, whose tool z is square to joint 6,
-on the published fan-shaped CSV: 22.6 mm and 0.16 rad off) while mu_path, the LP's bound at the
-unspun configurations, promised a feed the spun path cannot run (0.5934 against 0.5288 m/s,
-12 % too high; the robots audit of stop 55). A closed-form family (UR, OPW, a URDF recognised
-as one) solves each branch again at the spun poses, R_i Rz(phi_i), and the spun path is then
-judged as in fixed mode with those spins (`/v1/evaluate` with the answer's ``spins`` gives the
-same answer): its own task requirements (the spin turns each segment's rotation), the step
-test, the position limits and V_max. The spins stay those the LP chose at the unspun
-configurations (the schedule realises that feed to first order); the feed reported is the one
-the spun path runs.
+sigma dt J^-1 [0; z_tool] at each step: exact where six joints turn the tool about the last
+joint's own axis (a straight spindle: only that joint moves), first order otherwise (an angled
+or offset spindle, seven joints), and there the joint path drifted from the path (the published
+KR210 L150 URDF, whose tool z is square to joint 6, on the published fan-shaped CSV: 22.6 mm and
+0.16 rad off) while mu_path, the LP's bound at the unspun configurations, promised a feed the
+spun path cannot run (0.5934 against 0.5288 m/s, 12 % too high; the robots audit of stop 55).
+
+Here each branch is solved again at its spun poses, R_i Rz(phi_i) (a closed-form family at any
+pose by its branch label; a numeric family followed from its solution at the first waypoint,
+which no spin turns: :meth:`solver.core.family.KinematicsFamily.follow_from`), and the spun path
+is judged as in fixed mode with those spins (`/v1/evaluate` with the answer's ``spins`` gives
+the same answer): its own task requirements (the spin turns each segment's rotation), the step
+test, the position limits and V_max. :func:`solver.path.pipeline.run_chunk` then takes the LP
+again at each round's spun configurations, up to :data:`ROUNDS` rounds, each branch keeping
+its fastest; the feed reported is the one the spun path runs.
 """
 
 from __future__ import annotations

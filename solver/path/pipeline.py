@@ -10,7 +10,8 @@ optimisers) both run :func:`run_chunk`; only the robot's kinematics family
 What makes it fast (dtf.md section 9): t_hat is computed once in {O} and only turned by each
 placement's yaw (:mod:`solver.path.placed`); all placements of a chunk, all waypoints and all IK
 branches are one set of component-first arrays with waypoints last. Free spin's schedule is
-:mod:`solver.path.spin_schedule`; the path checks (the cell) run after, in
+:mod:`solver.path.spin_schedule`, its spun paths solved exactly where the spin moves more than
+the last joint in :mod:`solver.path.exact_spin`; the path checks (the cell) run after, in
 :mod:`solver.path.path_checks`.
 """
 
