@@ -107,7 +107,8 @@ def spun_exactly(
     """The ``which`` branches solved at their spun poses and tracked; their J^-1 t_hat.
 
     Args:
-        problem: the robot (a closed-form family), the path and the options.
+        problem: the robot (any family: a closed-form one solves each pose by its branch
+            label, a numeric one follows from ``start``), the path and the options.
         placements: shape (C, 5), one spin.
         spins: shape (B, C, W), rad, each branch's schedule at each placement.
         branches: shape (B,), the family's branch of each row.
