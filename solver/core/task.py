@@ -44,13 +44,39 @@ class TaskRequirements:
 
     def twists(self) -> np.ndarray:
         """t_hat per waypoint, shape (N, 6): [u_T; u_R / h], or [0; u_R] where h = 0."""
-        twist = np.zeros((self.h.shape[0], 6))
-        pure_rotation = self.h == 0.0
-        twist[:, :3] = self.u_T
-        with np.errstate(divide="ignore", invalid="ignore"):
-            twist[:, 3:] = np.where(pure_rotation[:, None], self.u_R, self.u_R / self.h[:, None])
-        twist[np.isinf(self.h), 3:] = 0.0
-        return twist
+        return twists_of(self.u_T, self.u_R, self.h)
+
+
+def twists_of(u_t: np.ndarray, u_r: np.ndarray, h: np.ndarray) -> np.ndarray:
+    """t_hat, shape (..., 6), of u_T and u_R (..., 3) and h (...): [u_T; u_R / h].
+
+    [0; u_R] where h = 0 (pure reorientation), [u_T; 0] where h = inf (pure translation).
+    """
+    h = h[..., None]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        angular = np.where(h == 0.0, u_r, np.where(np.isinf(h), 0.0, u_r / h))
+    return np.concatenate([np.broadcast_to(u_t, angular.shape), angular], axis=-1)
+
+
+def segment_requirements(
+    displacement: np.ndarray, rotation_vector: np.ndarray
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """u_T, u_R and h of segments from their displacements and rotation vectors (..., 3).
+
+    A displacement under LINEAR_TOLERANCE or a rotation under ANGULAR_TOLERANCE counts as none:
+    its unit vector is 0, and h is inf without rotation, 0 with rotation alone. The arrays
+    broadcast against each other (one path's displacements, many spun paths' rotations).
+    """
+    linear = np.linalg.norm(displacement, axis=-1)
+    angular = np.linalg.norm(rotation_vector, axis=-1)
+    moving = linear >= LINEAR_TOLERANCE
+    turning = angular >= ANGULAR_TOLERANCE
+    safe_linear = np.where(moving, linear, 1.0)
+    safe_angular = np.where(turning, angular, 1.0)
+    u_t = np.where(moving[..., None], displacement / safe_linear[..., None], 0.0)
+    u_r = np.where(turning[..., None], rotation_vector / safe_angular[..., None], 0.0)
+    h = np.where(turning, np.where(moving, linear, 0.0) / safe_angular, math.inf)
+    return u_t, u_r, h
 
 
 def _determinants(m: np.ndarray) -> np.ndarray:
@@ -142,13 +168,7 @@ def task_requirements(poses: np.ndarray, *, field: str = "path.waypoints") -> Ta
             "of rotation is undefined; add a waypoint between them",
             waypoint=i,
         )
-    moving = linear >= LINEAR_TOLERANCE
-    turning = angular >= ANGULAR_TOLERANCE
-    safe_linear = np.where(moving, linear, 1.0)
-    safe_angular = np.where(turning, angular, 1.0)
-    u_t = np.where(moving[:, None], displacement / safe_linear[:, None], 0.0)
-    u_r = np.where(turning[:, None], rotation_vector / safe_angular[:, None], 0.0)
-    h = np.where(turning, np.where(moving, linear, 0.0) / safe_angular, math.inf)
+    u_t, u_r, h = segment_requirements(displacement, rotation_vector)
     last = slice(-1, None)
     return TaskRequirements(
         u_T=np.concatenate([u_t, u_t[last]]),

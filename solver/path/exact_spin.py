@@ -20,12 +20,10 @@ its fastest; the feed reported is the one the spun path runs.
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 
-from solver.core.spatial import rotation_vectors
-from solver.core.task import ANGULAR_TOLERANCE, LINEAR_TOLERANCE
+from solver.core.spatial import rotation_about_z, rotation_vectors
+from solver.core.task import segment_requirements, twists_of
 from solver.path.problem import PathProblem
 from solver.path.tracking import Tracked, track
 
@@ -47,53 +45,23 @@ as its tcp, one arm, had spins 2 % apart and mu_path 4e-5. The spun path is judg
 so the rates need only be well placed: at (1 - 1e-9) the two agree to 2e-12."""
 
 
-def spun_twists(problem: PathProblem, spins: np.ndarray, spin: float) -> np.ndarray:
-    """t_hat in {O} of the path turned by ``spin`` + ``spins`` about each tool z, (6, ..., W).
+def spun_twists(problem: PathProblem, spins: np.ndarray) -> np.ndarray:
+    """t_hat in {O} of the path turned by ``spins`` (..., W) about each tool z, (6, ..., W).
 
-    As :func:`solver.core.task.task_requirements` forms it from the spun poses: the segment's
-    displacement (a spin leaves the tool point where it is) and the rotation vector of
-    R'_{i+1} R'_i^T with R'_i = R_i Rz(spin + phi_i); the last waypoint takes its segment's.
-
-    Args:
-        problem: the path.
-        spins: shape (..., W), rad.
-        spin: rad, the placement's constant spin.
+    As :func:`solver.core.task.task_requirements` forms it from the spun poses (its
+    :func:`~solver.core.task.segment_requirements` and :func:`~solver.core.task.twists_of`):
+    the segment's displacement (a spin leaves the tool point where it is) and the rotation
+    vector of R'_{i+1} R'_i^T with R'_i = R_i Rz(phi_i); the last waypoint takes its segment's.
     """
     path = problem.prepared
-    turned = _spun_rotations(path.tool_rotation, spins + spin)  # (..., W, 3, 3)
+    turned = path.tool_rotation @ rotation_about_z(spins)  # (..., W, 3, 3)
     relative = np.einsum("...nij,...nkj->...nik", turned[..., 1:, :, :], turned[..., :-1, :, :])
-    rotation_vector = rotation_vectors(relative)  # (..., W - 1, 3)
-    displacement = np.diff(path.tool_position, axis=0)  # (W - 1, 3)
-    linear = np.linalg.norm(displacement, axis=1)
-    angular = np.linalg.norm(rotation_vector, axis=-1)
-    moving = linear >= LINEAR_TOLERANCE
-    turning = angular >= ANGULAR_TOLERANCE
-    with np.errstate(divide="ignore", invalid="ignore"):
-        u_t = np.where(moving[:, None], displacement / np.where(moving, linear, 1.0)[:, None], 0.0)
-        u_r = np.where(
-            turning[..., None], rotation_vector / np.where(turning, angular, 1.0)[..., None], 0.0
-        )
-        h = np.where(
-            turning, np.where(moving, linear, 0.0) / np.where(turning, angular, 1.0), math.inf
-        )
-        angular_part = np.where(
-            (h == 0.0)[..., None], u_r, np.where(np.isinf(h)[..., None], 0.0, u_r / h[..., None])
-        )
-    linear_part = np.broadcast_to(u_t, angular_part.shape)
-    twist = np.concatenate([linear_part, angular_part], axis=-1)  # (..., W - 1, 6)
+    u_t, u_r, h = segment_requirements(
+        np.diff(path.tool_position, axis=0), rotation_vectors(relative)
+    )
+    twist = twists_of(u_t, u_r, h)  # (..., W - 1, 6)
     twist = np.concatenate([twist, twist[..., -1:, :]], axis=-2)  # the last reuses its segment's
     return np.moveaxis(twist, -1, 0)
-
-
-def _spun_rotations(rotation: np.ndarray, angles: np.ndarray) -> np.ndarray:
-    """R_i Rz(angle_i): rotations (W, 3, 3), angles (..., W) -> (..., W, 3, 3)."""
-    cos, sin = np.cos(angles)[..., None], np.sin(angles)[..., None]
-    x, y = rotation[..., :, 0], rotation[..., :, 1]  # (W, 3) each
-    out = np.empty(angles.shape + (3, 3))
-    out[..., :, 0] = cos * x + sin * y
-    out[..., :, 1] = -sin * x + cos * y
-    out[..., :, 2] = np.broadcast_to(rotation[..., :, 2], out[..., :, 2].shape)
-    return out
 
 
 def spun_exactly(
@@ -113,8 +81,8 @@ def spun_exactly(
         spins: shape (B, C, W), rad, each branch's schedule at each placement.
         branches: shape (B,), the family's branch of each row.
         which: shape (B, C), bool: the K rows at placements to solve (``np.nonzero`` order).
-        start: shape (n, B, C, W) or (n, B, C), rad: each row's solution at the first waypoint
-            (a numeric family follows from it; no spin turns a pass's first pose).
+        start: shape (n, B, C, W), rad: the unspun joint paths, whose first waypoint a numeric
+            family follows from (no spin turns a pass's first pose).
 
     Returns:
         The tracking of the K spun paths (q (n, K, W); the position limits and the step test
@@ -122,12 +90,11 @@ def spun_exactly(
     """
     robot, path, family = problem.robot, problem.prepared, problem.family
     rows, cells = np.nonzero(which)
-    start = start[..., 0] if start.ndim == 4 else start
     angles = spins[rows, cells] + float(placements[0, 4])  # (K, W)
     yaw = placements[cells, 3][:, None]  # (K, 1)
     cos, sin = np.cos(yaw), np.sin(yaw)
     offset = placements[cells, :3].T[:, :, None]  # (3, K, 1)
-    turned = _spun_rotations(path.tool_rotation, angles)  # (K, W, 3, 3) in {O}
+    turned = path.tool_rotation @ rotation_about_z(angles)  # (K, W, 3, 3) in {O}
     flange_rotation = turned @ path.tool_to_flange[:3, :3]
     flange_position = path.tool_position + turned @ path.tool_to_flange[:3, 3]  # (K, W, 3)
 
@@ -146,7 +113,7 @@ def spun_exactly(
         q, status = q_all[:, branches[rows], k], status_all[branches[rows], k]
     else:  # numeric: each followed from its solution at the first waypoint, which no spin moves
         q, status = family.follow_from(
-            np.ascontiguousarray(start[:, rows, cells].T),
+            np.ascontiguousarray(start[:, rows, cells, 0].T),
             np.ascontiguousarray(np.moveaxis(rotation, (0, 1), (-2, -1))),
             np.ascontiguousarray(np.moveaxis(position, 0, -1)),
         )
@@ -158,7 +125,7 @@ def spun_exactly(
         max_joint_step=problem.options.max_joint_step,
         segment_checked=path.segment_in_pass,
     )
-    twist_o = spun_twists(problem, angles, 0.0)  # (6, K, W) in {O}
+    twist_o = spun_twists(problem, angles)  # (6, K, W) in {O}
     twist = np.concatenate([to_base(twist_o[:3]), to_base(twist_o[3:])])
     tool_position = to_base(
         np.broadcast_to(path.tool_position.T[:, None], (3, 1, path.n_waypoints))
