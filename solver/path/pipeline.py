@@ -179,27 +179,17 @@ def run_chunk(
         max_joint_step=problem.options.max_joint_step,
         segment_checked=path.segment_in_pass,
     )
-    # For dof > 6 these are the exact DTF LP's joint speeds per unit speed (robots.md section 5),
-    # so the ratio below gives the LP's V_max for every dof.
-    qd_unit = family.joint_speeds_per_unit_twist(
-        tracked.q,
-        twist[:, None],
-        tool_position[:, None],
-        qdot_max=robot.qdot_max,
-        progress=_part(progress, shares, 2),
-    )
-    qd_spin = qd_null = None
+    spin = None
     if free:
         tool_z = turn_by_yaw(path.tool_rotation[:, :, 2].T, yaws)
         spin = np.concatenate([np.zeros_like(tool_z), np.broadcast_to(tool_z, twist[3:].shape)])
-        qd_spin = family.joint_speeds_per_unit_twist(
-            tracked.q, spin[:, None], tool_position[:, None], progress=_part(progress, shares, 3)
-        )  # the least-norm solution for more than six joints
-        if robot.dof > 6:
-            qd_null = family.null_space(
-                tracked.q, tool_position[:, None], progress=_part(progress, shares, 4)
-            )
-    motion = JointMotion(q=tracked.q, qd_unit=qd_unit, qd_spin=qd_spin, qd_null=qd_null)
+    motion = _joint_motion(
+        problem,
+        tracked.q,
+        (twist, spin, tool_position),
+        tuple(_part(progress, shares, k) for k in (2, 3, 4)),
+    )
+    qd_unit, qd_spin, qd_null = motion.qd_unit, motion.qd_spin, motion.qd_null
     speed, limiting = bound_in_pieces(problem.waypoint_limits, motion, _part(progress, shares, 5))
     v_max = np.where(path.pure_rotation, 0.0, speed)
     feasible = tracked.reason == FEASIBLE  # (B, C)
@@ -207,7 +197,7 @@ def run_chunk(
     if solutions.bound is not None and not pick_stands(solutions, branches, mu_path):
         return run_chunk(problem, placements, progress=progress, excluded=excluded)  # unpruned
     spins = None
-    if qd_spin is not None and problem.exact_spin:  # an angled or offset spindle, 7 joints
+    if spin is not None and problem.exact_spin:  # an angled or offset spindle, 7 joints
         spins, tracked, qd_unit, speed, limiting = _exact_free_spin(
             problem,
             placements,
@@ -283,14 +273,8 @@ def _exact_free_spin(
         The spins (B, C, W), the tracking, J^-1 t_hat, the speed and the limiting joint of the
         kept rounds.
     """
-    robot, path, family, branches = (
-        problem.robot,
-        problem.prepared,
-        problem.family,
-        problem.branches,
-    )
+    path, branches = problem.prepared, problem.branches
     unspun, motion, lp_mu = run
-    twist, spin, tool_point = (v[:, None] for v in vectors)
     best: tuple[np.ndarray, Tracked, np.ndarray, np.ndarray, np.ndarray] | None = None
     best_mu = np.full(lp_mu.shape, -np.inf)
     for k in range(ROUNDS):
@@ -324,20 +308,43 @@ def _exact_free_spin(
             best_mu = np.where(gains, mu, best_mu)
         if k + 1 < ROUNDS:  # the LP at this round's spun configurations
             on = reason == FEASIBLE
-            motion = JointMotion(
-                q=q,
-                qd_unit=family.joint_speeds_per_unit_twist(
-                    q, twist, tool_point, qdot_max=robot.qdot_max
-                ),
-                qd_spin=family.joint_speeds_per_unit_twist(q, spin, tool_point),
-                qd_null=None if robot.dof <= 6 else family.null_space(q, tool_point),
-            )
+            motion = _joint_motion(problem, q, vectors)
             lp, _ = bound_in_pieces(problem.waypoint_limits, motion, None)
             lp_mu = np.where(on, np.where(path.pure_rotation, 0.0, lp).min(axis=-1), -np.inf)
     if progress is not None:
         progress(1.0)
     assert best is not None
     return best
+
+
+def _joint_motion(
+    problem: PathProblem,
+    q: np.ndarray,
+    vectors: tuple[np.ndarray, np.ndarray | None, np.ndarray],
+    progress: tuple[Progress | None, ...] = (None, None, None),
+) -> JointMotion:
+    """What the limits see of joint paths q (n, B, C, W): their joint speeds per unit feed.
+
+    ``vectors``: t_hat (6, C, W), [0; z_tool] (6, C, W) or None in fixed spin, and the tool point
+    (3, C, W), in {B}. For dof > 6 J^-1 t_hat is the exact DTF LP's joint speeds per unit speed
+    (robots.md section 5), so 1 / max_j |qd_j| / qdot_max_j is the LP's V_max for every dof; in
+    free spin J^-1 [0; z_tool] too (the least-norm solution for more than six joints) and, for
+    seven joints, the null space of J. ``progress``: for each of the three.
+    """
+    robot, family = problem.robot, problem.family
+    twist, spin, tool_point = vectors
+    qd_unit = family.joint_speeds_per_unit_twist(
+        q, twist[:, None], tool_point[:, None], qdot_max=robot.qdot_max, progress=progress[0]
+    )
+    if spin is None:
+        return JointMotion(q=q, qd_unit=qd_unit)
+    qd_spin = family.joint_speeds_per_unit_twist(
+        q, spin[:, None], tool_point[:, None], progress=progress[1]
+    )
+    qd_null = (
+        None if robot.dof <= 6 else family.null_space(q, tool_point[:, None], progress=progress[2])
+    )
+    return JointMotion(q=q, qd_unit=qd_unit, qd_spin=qd_spin, qd_null=qd_null)
 
 
 def _kept(

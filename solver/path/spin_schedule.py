@@ -28,25 +28,22 @@ def spin_schedule(
 ) -> tuple[np.ndarray, Tracked]:
     """The spins that realise mu_path in free mode, and the joint paths along them.
 
-    At the feed F = mu_path each waypoint admits an interval of spin rates; the one nearest zero
-    is held over the segment (its duration |dp_i| / F), which gives the spins phi_i. The joints
-    follow q_i + sum_k<i sigma_k dt_k J^-1 [0; z_tool]_k: exact for a straight spindle (only the
-    last joint moves), first order otherwise (cam.md section 2; a closed-form family then
-    solves the spun poses instead, :mod:`solver.path.exact_spin`). Those joint paths are
-    tracked again, so the last joint's limits and steps are checked along the schedule.
+    Six joints turning a straight spindle only (:attr:`PathProblem.exact_spin` false): at the
+    feed F = mu_path each waypoint admits an interval of spin rates; the one nearest zero is held
+    over the segment (its duration |dp_i| / F), which gives the spins phi_i (:func:`schedule`).
+    The joints follow q_i + sum_k<i sigma_k dt_k J^-1 [0; z_tool]_k, exact here since only the
+    last joint moves (cam.md section 2; where the spin moves more, the spun poses are solved
+    instead, :mod:`solver.path.exact_spin`). Those joint paths are tracked again, so the last
+    joint's limits and steps are checked along the schedule.
 
     Args:
         problem: the robot, the prepared path and the options.
         tracked: the branches followed at the given spin; q (n, B, C, W).
-        motion: their joint speeds per unit feed (qd_unit) and, for seven joints, the null
-            space of J (qd_null), each (n, B, C, W). A seven-joint arm's spin rate is that of
-            the three-variable LP (:func:`solver.core.dtf_redundant.spin_rate_at_feed`), and
-            its joints follow the spin by the least-norm qd_spin.
-        qd_spin: shape (n, B, C, W), J^-1 [0; z_tool] (the least-norm one for seven joints).
+        motion: their joint speeds per unit feed (qd_unit), each (n, B, C, W).
+        qd_spin: shape (n, B, C, W), J^-1 [0; z_tool].
         mu_path: shape (B, C), m/s, -inf where infeasible.
-        progress: called after each piece of waypoints whose spin rates are found (seven
-            joints: the LP, :func:`solver.path.in_pieces.spin_rates_in_pieces`), then after each
-            piece of branches tracked along the spins.
+        progress: called after each piece of waypoints whose spin rates are found, then after
+            each piece of branches tracked along the spins.
 
     Returns:
         spins (B, C, W), rad (0 where infeasible or mu_path = 0), and the tracking of the spun
@@ -92,8 +89,10 @@ def schedule(
 
     At the feed F = mu_path (none where infeasible or 0), the spin rate nearest zero at each
     segment's first waypoint held over the segment (|dp_i| / F), summed within each pass.
-    ``progress``: a seven-joint arm's spin LP, piece by piece. ``inside``: the share of the feed
-    the rates are taken at (:func:`solver.core.two_variable_lp.spin_rate_nearest_zero`).
+    A seven-joint arm's rate is that of the three-variable LP
+    (:func:`solver.core.dtf_redundant.spin_rate_at_feed`, ``motion.qd_null`` its null space),
+    reported to ``progress`` piece by piece. ``inside``: the share of the feed the rates are
+    taken at (:func:`solver.core.two_variable_lp.spin_rate_nearest_zero`).
     """
     robot, path = problem.robot, problem.prepared
     feed = np.where(np.isfinite(mu_path) & (mu_path > 0.0), mu_path, 0.0)[..., None]
