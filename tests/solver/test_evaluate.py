@@ -29,17 +29,23 @@ def load_path(name: str) -> np.ndarray:
     return np.array([pose_matrix(w["position"], w["orientation"], field="w") for w in waypoints])
 
 
+def segment_twists(poses: np.ndarray) -> list[np.ndarray]:
+    """t_hat of each waypoint's segment (the last its segment's), from scipy's rotations."""
+    out = []
+    for i in range(len(poses)):
+        a, b = (i, i + 1) if i + 1 < len(poses) else (i - 1, i)
+        dp = poses[b, :3, 3] - poses[a, :3, 3]
+        dphi = Rotation.from_matrix(poses[b, :3, :3] @ poses[a, :3, :3].T).as_rotvec()
+        out.append(np.concatenate([dp, dphi]) / np.linalg.norm(dp))
+    return out
+
+
 def independent_mu_path(name: str, path: np.ndarray, placement: Placement, step: float) -> float:
     """mu_path from other code: ur-analytic-ik, nearest-solution tracking, scipy rotations, LP."""
     robot = get_robot(name)
     poses = placement.transform_workpiece_to_base() @ path
     solutions = [getattr(ur_analytic_ik, name).inverse_kinematics(p) for p in poses]
-    twists = []
-    for i in range(len(poses)):
-        a, b = (i, i + 1) if i + 1 < len(poses) else (i - 1, i)
-        dp = poses[b, :3, 3] - poses[a, :3, 3]
-        dphi = Rotation.from_matrix(poses[b, :3, :3] @ poses[a, :3, :3].T).as_rotvec()
-        twists.append(np.concatenate([dp, dphi]) / np.linalg.norm(dp))
+    twists = segment_twists(poses)
     best = -1.0
     for start in solutions[0]:
         track = [np.array(start)]

@@ -22,7 +22,7 @@ from solver.core.spatial import Placement
 from solver.families import get_robot
 from solver.path.kernel_cells import kernel_of
 from tests.problems import capability_map, evaluate_path, problem
-from tests.solver.test_evaluate import load_path
+from tests.solver.test_evaluate import load_path, segment_twists
 
 PLACEMENT = Placement(0.0, 0.45, 0.1, 0.0)
 
@@ -44,17 +44,6 @@ def _spun_poses(path: np.ndarray, placement: Placement, spins: np.ndarray) -> np
     turn = np.tile(np.eye(4), (len(spins), 1, 1))
     turn[:, :3, :3] = Rotation.from_rotvec(np.outer(spins, [0.0, 0.0, 1.0])).as_matrix()
     out: np.ndarray = placement.transform_workpiece_to_base() @ path @ turn
-    return out
-
-
-def segment_twists(poses: np.ndarray) -> list[np.ndarray]:
-    """t_hat of each waypoint's segment (the last its segment's), from scipy's rotations."""
-    out = []
-    for i in range(len(poses)):
-        a, b = (i, i + 1) if i + 1 < len(poses) else (i - 1, i)
-        dp = poses[b, :3, 3] - poses[a, :3, 3]
-        dphi = Rotation.from_matrix(poses[b, :3, :3] @ poses[a, :3, :3].T).as_rotvec()
-        out.append(np.concatenate([dp, dphi]) / np.linalg.norm(dp))
     return out
 
 

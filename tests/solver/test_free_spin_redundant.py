@@ -24,7 +24,7 @@ from solver.families import get_robot
 from solver.kernels import spin_lp as compiled_lp
 from tests.cases import EXAMPLES, FREE_SPIN_LP_RTOL, MAP_EVALUATE_RTOL
 from tests.problems import capability_map, evaluate_path
-from tests.solver.test_exact_spin import segment_twists
+from tests.solver.test_evaluate import segment_twists
 
 PLACEMENT = Placement(0.0, 0.45, 0.1, 0.0)
 
