@@ -6,8 +6,8 @@
 Prints, from one run: the three-variable spin LP (solver.kernels.spin_lp.spin_speed) and the spin
 rates at a feed on random directions, compiled against solver.core.dtf_redundant's numpy vertex
 enumeration (the same answers, checked here to 1e-9); then the Panda's evaluation along a line in
-fixed and in free spin (CPU time), the ratio the free spin's work weight
-(FREE_SPIN_REDUNDANT_COST) stands for.
+fixed and in free spin (CPU time), against the ratio of their work weights (PathProblem.path_cost:
+FREE_SPIN_REDUNDANT_COST, times the spun paths solved again, PathProblem.exact_spin_weight).
 """
 
 from __future__ import annotations
@@ -22,7 +22,6 @@ import numpy as np
 from solver.core import dtf_redundant
 from solver.core.spatial import Placement
 from solver.families import get_robot
-from solver.families.numeric.costs import FREE_SPIN_REDUNDANT_COST
 from solver.kernels import spin_lp
 from solver.path.evaluate import evaluate_path
 from solver.path.problem import PathOptions, PathProblem
@@ -75,14 +74,15 @@ def main() -> None:
         )
     robot, placement = get_robot("panda"), Placement(0.0, 0.45, 0.1, 0.0)
     evaluate_path(PathProblem.of(robot, line(20), PathOptions(spin_mode="free")), placement)
-    times = {}
+    times, weights = {}, {}
     for mode in ("fixed", "free"):
         problem = PathProblem.of(robot, line(waypoints), PathOptions(spin_mode=mode))
         times[mode] = cpu(partial(evaluate_path, problem, placement))
+        weights[mode] = problem.path_cost(waypoints)
     print(
         f"Panda evaluate, {waypoints} waypoints (CPU, best of 2): fixed {times['fixed']:.3f} s, "
         f"free {times['free']:.3f} s, {times['free'] / times['fixed']:.2f}x "
-        f"(weighed {FREE_SPIN_REDUNDANT_COST:g}x)"
+        f"(weighed {weights['free'] / weights['fixed']:g}x)"
     )
 
 
