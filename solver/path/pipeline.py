@@ -25,7 +25,7 @@ from solver.core.codes import ACC_TIE_RTOL, FEASIBLE, UNREACHABLE
 from solver.core.family import PathSolutions
 from solver.core.progress import Progress, span
 from solver.path.bounded import bounded_solutions, in_one_pass, pick_stands
-from solver.path.exact_spin import ROUND_RTOL, ROUNDS, SCHEDULE_INSIDE, spun_exactly
+from solver.path.exact_spin import ROUNDS, SCHEDULE_INSIDE, spun_exactly
 from solver.path.in_pieces import bound_in_pieces, track_in_pieces
 from solver.path.limits import JointMotion, bound_by_limits
 from solver.path.placed import placed_flange, turn_by_yaw
@@ -257,9 +257,10 @@ def _exact_free_spin(
 
     Round 1: the spin schedule of the LP at the unspun configurations, each branch solved at
     its spun poses and judged as that path. Each next round takes the schedule of the LP at the
-    last round's spun configurations, where the spin rates are the ones those joints need; a
-    branch keeps the round whose path runs fastest, and the rounds stop once none gains
-    :data:`solver.path.exact_spin.ROUND_RTOL` (at most :data:`~solver.path.exact_spin.ROUNDS`).
+    last round's spun configurations, where the spin rates are the ones those joints need;
+    every branch runs :data:`solver.path.exact_spin.ROUNDS` rounds (fewer where its paths
+    fail) and keeps the one whose path runs fastest, the first of equals: each row's answer
+    is its own, whatever rows are computed with it.
 
     Args:
         problem: the robot, the path, the options.
@@ -301,9 +302,7 @@ def _exact_free_spin(
         if best is None:
             best, best_mu = round_, mu
         else:
-            gains = mu > best_mu * (1.0 + ROUND_RTOL)
-            if not gains.any():
-                break
+            gains = mu > best_mu
             best = _kept(gains, round_, best)
             best_mu = np.where(gains, mu, best_mu)
         if k + 1 < ROUNDS:  # the LP at this round's spun configurations
@@ -311,6 +310,8 @@ def _exact_free_spin(
             motion = _joint_motion(problem, q, vectors)
             lp, _ = bound_in_pieces(problem.waypoint_limits, motion, None)
             lp_mu = np.where(on, np.where(path.pure_rotation, 0.0, lp).min(axis=-1), -np.inf)
+            if not np.isfinite(lp_mu).any():  # no row has a schedule: no round to run
+                break
     if progress is not None:
         progress(1.0)
     assert best is not None
