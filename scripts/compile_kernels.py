@@ -88,6 +88,11 @@ def _analytic() -> None:
     for name in ("ur5", "kuka_kr6_r700_sixx"):
         _run(name)
     feed_profile.warm_up()  # the cycle time's (an evaluation with acceleration limits)
+    angled = _tool(0.12)  # a tool 3 cm off the flange's axis: free spin's spun paths
+    angled[0, 3] = 0.03
+    robot = get_robot("ur5").with_options(transform_tool_to_tcp=angled)
+    problem = PathProblem.of(robot, _path(), PathOptions(spin_mode="free"))
+    capability_map(problem, xs=XS, ys=YS, z=Z, yaws=YAWS)
 
 
 def _with_cell() -> None:

@@ -50,7 +50,7 @@ from solver.core.exceptions import SolverError
 from solver.core.progress import Cancelled
 from solver.core.spatial import Placement
 from solver.families import catalogue
-from solver.kernels import feed_profile
+from solver.kernels import feed_profile, spun_rows
 from solver.kernels import fixed_spin as map_kernel
 from solver.kernels import free_spin as free_spin_kernel
 from solver.path.evaluate import evaluate_path
@@ -123,11 +123,12 @@ def _warm_up() -> None:
 
     The catalogue reads its URDFs and the first path evaluation imports and sets up its
     modules: a few hundred milliseconds in which /healthz would wait. The compiled map kernels
-    (fixed and free spin) are loaded from numba's disk cache, or compiled (about 10 s each,
-    once per installation), and the cycle time's feed profiles (2 s).
+    (fixed and free spin, and free spin's spun paths) are loaded from numba's disk cache, or
+    compiled (about 10 s each, once per installation), and the cycle time's feed profiles (2 s).
     """
     map_kernel.warm_up()
     free_spin_kernel.warm_up()
+    spun_rows.warm_up()
     feed_profile.warm_up()
     robot = catalogue()["ur5"]
     waypoints = np.repeat(np.eye(4)[None], 2, axis=0)

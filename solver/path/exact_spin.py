@@ -20,10 +20,13 @@ its fastest; the feed reported is the one the spun path runs.
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 
 from solver.core.spatial import rotation_about_z, rotation_vectors
 from solver.core.task import segment_requirements, twists_of
+from solver.kernels.spun_rows import spun_rows
 from solver.path.problem import PathProblem
 from solver.path.tracking import Tracked, track
 
@@ -67,6 +70,24 @@ def spun_twists(problem: PathProblem, spins: np.ndarray) -> np.ndarray:
     return np.moveaxis(twist, -1, 0)
 
 
+@dataclass(frozen=True)
+class SpunPaths:
+    """K branches at placements solved at their spun poses (:func:`spun_exactly`).
+
+    Attributes:
+        tracked: their tracking: q (n, K, W), the position limits and the step test applied.
+        qd_spun: shape (n, K, W), their joint speeds per unit feed, t_hat the spun path's own.
+        qd_unit: shape (n, K, W), J^-1 of the unspun t_hat at their joints (the next round's
+            LP), where the compiled kernel solved them; None: not computed.
+        qd_spin: shape (n, K, W), J^-1 [0; z_tool] there; None with ``qd_unit``.
+    """
+
+    tracked: Tracked
+    qd_spun: np.ndarray
+    qd_unit: np.ndarray | None = None
+    qd_spin: np.ndarray | None = None
+
+
 def spun_exactly(
     problem: PathProblem,
     placements: np.ndarray,
@@ -74,7 +95,9 @@ def spun_exactly(
     branches: np.ndarray,
     which: np.ndarray,
     start: np.ndarray,
-) -> tuple[Tracked, np.ndarray]:
+    *,
+    compiled: bool = True,
+) -> SpunPaths:
     """The ``which`` branches solved at their spun poses and tracked; their J^-1 t_hat.
 
     Args:
@@ -86,14 +109,93 @@ def spun_exactly(
         which: shape (B, C), bool: the K rows at placements to solve (``np.nonzero`` order).
         start: shape (n, B, C, W), rad: the unspun joint paths, whose first waypoint a numeric
             family follows from (no spin turns a pass's first pose).
+        compiled: a closed-form family's rows by the compiled kernel; False: by numpy.
 
     Returns:
-        The tracking of the K spun paths (q (n, K, W); the position limits and the step test
-        applied) and their joint speeds per unit feed (n, K, W), t_hat the spun path's own.
+        The K spun paths, in ``np.nonzero(which)`` order. A closed-form family's are solved by
+        the compiled kernel (:mod:`solver.kernels.spun_rows`, which gives the next round's J^-1
+        too); the numpy arithmetic below is its reference, and solves a numeric family's.
     """
-    robot, path, family = problem.robot, problem.prepared, problem.family
+    family = problem.family
     rows, cells = np.nonzero(which)
     angles = spins[rows, cells] + float(placements[0, 4])  # (K, W)
+    kernel = family.map_kernel() if compiled else None
+    if kernel is not None:
+        solved = _compiled(problem, kernel, placements[cells], angles, branches[rows])
+        if solved is not None:
+            q, status, qd_spun, qd_unit, qd_spin = solved
+            return SpunPaths(_tracked(problem, q, status), qd_spun, qd_unit, qd_spin)
+    return _spun_numpy(problem, placements, angles, branches[rows], rows, cells, start)
+
+
+def _tracked(problem: PathProblem, q: np.ndarray, status: np.ndarray) -> Tracked:
+    """Spun joint paths q (n, K, W) tracked: the position limits and the step test applied."""
+    return track(
+        q,
+        status,
+        lower=problem.robot.q_lower,
+        upper=problem.robot.q_upper,
+        max_joint_step=problem.options.max_joint_step,
+        segment_checked=problem.prepared.segment_in_pass,
+    )
+
+
+def _compiled(
+    problem: PathProblem,
+    kernel: tuple[int, np.ndarray],
+    placements: np.ndarray,
+    angles: np.ndarray,
+    branch_rows: np.ndarray,
+) -> tuple[np.ndarray, ...] | None:
+    """:func:`solver.kernels.spun_rows.spun_rows` of K rows: q, status, J^-1 of three vectors.
+
+    ``placements``: shape (K, 5), each row's; ``angles``: (K, W), its spins; ``branch_rows``:
+    (K,), the family's branch of each. None where a spun segment turns within 1e-2 rad of a
+    half turn (the numpy rotation vector reads pinocchio's log3 there).
+    """
+    family, path = problem.family, problem.prepared
+    if family.base_turn is not None and family.base_turn.tilt is None:
+        placements = family.base_turn.placements_in(placements)  # as the map kernels place
+    own_flange = np.eye(4) if family.flange_offset is None else family.flange_offset.matrix
+    n_rows, n_waypoints = angles.shape
+    q, *speeds = (np.empty((6, n_rows, n_waypoints)) for _ in range(4))
+    status = np.empty((n_rows, n_waypoints), dtype=np.int64)
+    near_half_turn = np.empty(n_rows, dtype=bool)
+    contiguous = np.ascontiguousarray
+    spun_rows(
+        kernel[0],
+        kernel[1],
+        contiguous(path.tool_rotation),
+        contiguous(path.tool_position),
+        contiguous(path.tool_to_flange),
+        contiguous(own_flange),
+        contiguous(path.twist),
+        np.cos(placements[:, 3]),
+        np.sin(placements[:, 3]),
+        contiguous(placements[:, :3]),
+        contiguous(angles),
+        contiguous(branch_rows, dtype=np.int64),
+        q,
+        status,
+        *speeds,
+        near_half_turn,
+    )
+    if near_half_turn.any():
+        return None
+    return (q, status, *speeds)
+
+
+def _spun_numpy(
+    problem: PathProblem,
+    placements: np.ndarray,
+    angles: np.ndarray,
+    branch_rows: np.ndarray,
+    rows: np.ndarray,
+    cells: np.ndarray,
+    start: np.ndarray,
+) -> SpunPaths:
+    """:func:`spun_exactly` in numpy: the reference, and a numeric family's way."""
+    robot, path, family = problem.robot, problem.prepared, problem.family
     yaw = placements[cells, 3][:, None]  # (K, 1)
     cos, sin = np.cos(yaw), np.sin(yaw)
     offset = placements[cells, :3].T[:, :, None]  # (3, K, 1)
@@ -113,21 +215,14 @@ def spun_exactly(
     if family.map_kernel() is not None:  # closed form: each branch's own label at any pose
         q_all, status_all = family.solve(rotation, position)  # (n, B_all, K, W), (B_all, K, W)
         k = np.arange(len(rows))
-        q, status = q_all[:, branches[rows], k], status_all[branches[rows], k]
+        q, status = q_all[:, branch_rows, k], status_all[branch_rows, k]
     else:  # numeric: each followed from its solution at the first waypoint, which no spin moves
         q, status = family.follow_from(
             np.ascontiguousarray(start[:, rows, cells, 0].T),
             np.ascontiguousarray(np.moveaxis(rotation, (0, 1), (-2, -1))),
             np.ascontiguousarray(np.moveaxis(position, 0, -1)),
         )
-    tracked = track(
-        q,
-        status,
-        lower=robot.q_lower,
-        upper=robot.q_upper,
-        max_joint_step=problem.options.max_joint_step,
-        segment_checked=path.segment_in_pass,
-    )
+    tracked = _tracked(problem, q, status)
     twist_o = spun_twists(problem, angles)  # (6, K, W) in {O}
     twist = np.concatenate([to_base(twist_o[:3]), to_base(twist_o[3:])])
     tool_position = to_base(
@@ -136,4 +231,4 @@ def spun_exactly(
     qd_unit = family.joint_speeds_per_unit_twist(
         tracked.q, twist, tool_position + offset, qdot_max=robot.qdot_max
     )
-    return tracked, qd_unit
+    return SpunPaths(tracked, qd_unit)

@@ -113,6 +113,7 @@ def run_chunk(
     solutions: PathSolutions | None = None,
     excluded: np.ndarray | None = None,
     first: tuple[np.ndarray, np.ndarray] | None = None,
+    compiled: bool = True,
 ) -> ChunkResult:
     """The pipeline at C placements on the problem's branches.
 
@@ -136,6 +137,8 @@ def run_chunk(
         first: these placements' first-waypoint seeding from an earlier run of them
             (:attr:`ChunkResult.first` and ``branches_found``), taken by a run pruned in one
             pass instead of seeding again (the same arrays); ignored by other runs.
+        compiled: free spin's spun paths on a closed-form family by the compiled kernel
+            (:mod:`solver.kernels.spun_rows`); False: by numpy, the reference.
     """
     robot, path, branches = problem.robot, problem.prepared, problem.branches
     family = problem.family
@@ -195,7 +198,9 @@ def run_chunk(
     feasible = tracked.reason == FEASIBLE  # (B, C)
     mu_path = np.where(feasible, v_max.min(axis=-1), -np.inf)
     if solutions.bound is not None and not pick_stands(solutions, branches, mu_path):
-        return run_chunk(problem, placements, progress=progress, excluded=excluded)  # unpruned
+        return run_chunk(  # unpruned
+            problem, placements, progress=progress, excluded=excluded, compiled=compiled
+        )
     spins = None
     if spin is not None and problem.exact_spin:  # an angled or offset spindle, 7 joints
         spins, tracked, qd_unit, speed, limiting = _exact_free_spin(
@@ -204,6 +209,7 @@ def run_chunk(
             (tracked, motion, mu_path),
             (twist, spin, tool_position),
             _part(progress, shares, 6),
+            compiled=compiled,
         )
         v_max = np.where(path.pure_rotation, 0.0, speed)
         feasible = tracked.reason == FEASIBLE
@@ -252,6 +258,8 @@ def _exact_free_spin(
     run: tuple[Tracked, JointMotion, np.ndarray],
     vectors: tuple[np.ndarray, np.ndarray, np.ndarray],
     progress: Progress | None,
+    *,
+    compiled: bool = True,
 ) -> tuple[np.ndarray, Tracked, np.ndarray, np.ndarray, np.ndarray]:
     """Free spin along each branch's spun path, solved exactly (:mod:`solver.path.exact_spin`).
 
@@ -269,6 +277,7 @@ def _exact_free_spin(
             and the LP's mu_path (B, C).
         vectors: t_hat (6, C, W), [0; z_tool] (6, C, W) and the tool point (3, C, W) in {B}.
         progress: after each round's schedule and each round's paths.
+        compiled: as :func:`run_chunk`'s.
 
     Returns:
         The spins (B, C, W), the tracking, J^-1 t_hat, the speed and the limiting joint of the
@@ -276,6 +285,7 @@ def _exact_free_spin(
     """
     path, branches = problem.prepared, problem.branches
     unspun, motion, lp_mu = run
+    unspun_motion = motion
     best: tuple[np.ndarray, Tracked, np.ndarray, np.ndarray, np.ndarray] | None = None
     best_mu = np.full(lp_mu.shape, -np.inf)
     for k in range(ROUNDS):
@@ -285,12 +295,15 @@ def _exact_free_spin(
             problem, motion, motion.qd_spin, lp_mu, span(part, 0.0, 0.5), inside=SCHEDULE_INSIDE
         )
         scheduled = np.isfinite(lp_mu)
-        spun, qd_spun = spun_exactly(problem, placements, spins, branches, scheduled, unspun.q)
+        spun = spun_exactly(
+            problem, placements, spins, branches, scheduled, unspun.q, compiled=compiled
+        )
         rows, cells = np.nonzero(scheduled)
         reason, failed = unspun.reason.copy(), unspun.failed_waypoint.copy()
-        q, qd_unit = unspun.q.copy(), motion.qd_unit.copy()
-        reason[rows, cells], failed[rows, cells] = spun.reason, spun.failed_waypoint
-        q[:, rows, cells], qd_unit[:, rows, cells] = spun.q, qd_spun
+        q, qd_unit = unspun.q.copy(), unspun_motion.qd_unit.copy()
+        reason[rows, cells] = spun.tracked.reason
+        failed[rows, cells] = spun.tracked.failed_waypoint
+        q[:, rows, cells], qd_unit[:, rows, cells] = spun.tracked.q, spun.qd_spun
         tracked = Tracked(reason=reason, failed_waypoint=failed, q=q)
         speed, limiting = bound_in_pieces(
             problem.waypoint_limits, JointMotion(q=q, qd_unit=qd_unit), span(part, 0.5, 1.0)
@@ -307,7 +320,15 @@ def _exact_free_spin(
             best_mu = np.where(gains, mu, best_mu)
         if k + 1 < ROUNDS:  # the LP at this round's spun configurations
             on = reason == FEASIBLE
-            motion = _joint_motion(problem, q, vectors)
+            if spun.qd_unit is not None and spun.qd_spin is not None:
+                # The kernel's J^-1 at the spun joints; the other rows' joints are the unspun
+                # ones, whose J^-1 is the first's.
+                assert unspun_motion.qd_spin is not None  # free spin
+                at_unit, at_spin = unspun_motion.qd_unit.copy(), unspun_motion.qd_spin.copy()
+                at_unit[:, rows, cells], at_spin[:, rows, cells] = spun.qd_unit, spun.qd_spin
+                motion = JointMotion(q=q, qd_unit=at_unit, qd_spin=at_spin)
+            else:
+                motion = _joint_motion(problem, q, vectors)
             lp, _ = bound_in_pieces(problem.waypoint_limits, motion, None)
             lp_mu = np.where(on, np.where(path.pure_rotation, 0.0, lp).min(axis=-1), -np.inf)
             if not np.isfinite(lp_mu).any():  # no row has a schedule: no round to run

@@ -142,6 +142,7 @@ def _task(
     chunk: int,
     inputs: dict[float, KernelInputs] | None,
     prune: bool,
+    compiled: bool,
     placements: np.ndarray,
 ) -> tuple[np.ndarray, ...]:
     """Evaluate a task's placements in chunks: the columns of :func:`columns_of_run`, concatenated.
@@ -149,8 +150,9 @@ def _task(
     The compiled kernel (:mod:`solver.kernels.fixed_spin`, in free spin
     :mod:`solver.kernels.free_spin`) where ``inputs`` holds its inputs (one per spin of the
     placements, made once for all the tasks), or else the numpy pipeline, both taking
-    placements of any yaws together. A task may run in another process (a Dask worker), so it
-    sets the malloc thresholds itself.
+    placements of any yaws together (``compiled``: the numpy pipeline's free spin solves its
+    spun paths by the compiled kernel, :mod:`solver.kernels.spun_rows`, where it can). A task
+    may run in another process (a Dask worker), so it sets the malloc thresholds itself.
     """
     raise_malloc_thresholds()
     columns_of = partial(columns_of_run, problem, with_speeds=with_speeds)
@@ -178,7 +180,7 @@ def _task(
     else:
         parts = []
         for rows in _pieces(placements, chunk):
-            run = run_chunk(problem, rows, prune=prune)
+            run = run_chunk(problem, rows, prune=prune, compiled=compiled)
             part = columns_of(run)
             if problem.path_checks:  # on the run's own joint paths: no IK solved again
                 part = refuse_colliding(problem, rows, part, columns_of, run=run)
@@ -253,7 +255,7 @@ def evaluate_placements(
     inputs = None  # the kernel's, made once per spin, not once per task (a map's 5 tasks: 6 ms)
     if kernel is not None:
         inputs = {spin: kernel_inputs(problem, spin, kernel) for spin in set(cells[:, 4].tolist())}
-    work = partial(_task, problem, with_speeds, chunk, inputs, prune)
+    work = partial(_task, problem, with_speeds, chunk, inputs, prune, compiled)
     parts = runner.run(work, tasks, done)
     n_waypoints = problem.prepared.n_waypoints
     empty = (np.zeros(0), *(np.zeros(0, dtype=int),) * 5, np.zeros((0, n_waypoints)))

@@ -39,13 +39,14 @@ BLEND_LENGTHS = (1e-6, 1.0)
 """m, the blend lengths taken: a controller's corner zone (ABB's largest, z200, is 0.4 m across)
 above CAM's rounding (1e-4 mm). Below 1e-100 s +- b rounded to s and mu_acc jumped back to
 mu_path (78,000 times 1e-12's); at 1000 m the blended path was no longer the pass's."""
-EXACT_SPIN_COST = 30.0
+EXACT_SPIN_COST = 12.0
 """A placement's work in free spin with the spun poses solved again (:attr:`PathProblem.exact_spin`,
-on the numpy pipeline, up to solver.path.exact_spin.ROUNDS rounds) against the closed-form unit
-(about 2 us a pose: DTF_MAX_MAP_POSES' 5 million, about 10 s). Measured 59 us a pose: the UR5
+on the numpy pipeline, solver.path.exact_spin.ROUNDS rounds, a closed-form family's spun poses
+by the compiled :mod:`solver.kernels.spun_rows`) against the closed-form unit (about 2 us a
+pose: DTF_MAX_MAP_POSES' 5 million, about 10 s). Measured 23-24 us a pose (CPU time): the UR5
 with a tcp tilted 0.5 rad and 3 cm off its axis, the ERK map (546 placements, 133 waypoints,
-four rounds), 4.3 s, 2026-12-05, the machine loaded (the kernel's map without the rounds:
-0.023 s)."""
+four rounds), 1.7 s, 2026-12-05, the machine loaded (the numpy arithmetic's spun poses, in the
+same run: 57-59 us a pose, the weight was 30; the kernel's map without the rounds: 0.022 s)."""
 NUMERIC_EXACT_SPIN_COST = 5.0
 """The same for a numeric family, whose figure already weighs its following: the rounds' spun
 paths followed again from their first solutions. Maps of 55 placements on the ERK path, CPU

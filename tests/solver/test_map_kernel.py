@@ -54,12 +54,16 @@ def grid(xs: np.ndarray, ys: np.ndarray, z: float, yaws: np.ndarray) -> np.ndarr
 
 
 def same_cells(
-    robot: Robot, waypoints: np.ndarray, placements: np.ndarray, **options: object
+    robot: Robot,
+    waypoints: np.ndarray,
+    placements: np.ndarray,
+    rtol: float = 1e-12,
+    **options: object,
 ) -> tuple[PlacementResults, set[str]]:
     """Assert the kernel's cells equal the reference's; the results and the reasons seen.
 
     ``accelerations`` (rad/s^2, every joint's or one per joint; None: no limits) among the
-    options.
+    options; ``rtol`` on mu_path, V_max and mu_acc.
     """
     acceleration = options.pop("accelerations", None)
     if acceleration is not None:
@@ -78,13 +82,13 @@ def same_cells(
     for name in COLUMNS:
         np.testing.assert_array_equal(getattr(compiled, name), getattr(numpy, name), err_msg=name)
     np.testing.assert_array_equal(np.isnan(compiled.mu_path), np.isnan(numpy.mu_path))
-    np.testing.assert_allclose(compiled.mu_path, numpy.mu_path, rtol=1e-12, atol=0.0)
-    np.testing.assert_allclose(compiled.v_max, numpy.v_max, rtol=1e-12, atol=0.0)
+    np.testing.assert_allclose(compiled.mu_path, numpy.mu_path, rtol=rtol, atol=0.0)
+    np.testing.assert_allclose(compiled.v_max, numpy.v_max, rtol=rtol, atol=0.0)
     if acceleration is None:
         assert compiled.mu_acc is None and numpy.mu_acc is None
     else:
         lowest = float(np.min(acceleration))  # type: ignore[call-overload]
-        same_acceleration_cells(compiled, numpy, lowest, path.options.blend_length)
+        same_acceleration_cells(compiled, numpy, lowest, path.options.blend_length, 2 * rtol)
     reasons = {REASONS[r] for r in numpy.reason if r >= 0}
     if np.isfinite(numpy.mu_path).any():
         reasons.add("feasible")
@@ -92,11 +96,15 @@ def same_cells(
 
 
 def same_acceleration_cells(
-    compiled: PlacementResults, numpy: PlacementResults, acceleration: float, blend: float
+    compiled: PlacementResults,
+    numpy: PlacementResults,
+    acceleration: float,
+    blend: float,
+    rtol: float = 2e-12,
 ) -> None:
     """Assert the acceleration columns agree: discrete ones identical, mu_acc and V_acc to the
     rounding of the joint angles through D_i (on 1 / V^2, which is linear in |D|; ``acceleration``
-    the lowest joint limit)."""
+    the lowest joint limit), ``rtol`` relative."""
     for name in ACC_COLUMNS:
         np.testing.assert_array_equal(getattr(compiled, name), getattr(numpy, name), err_msg=name)
     assert compiled.mu_acc is not None and numpy.mu_acc is not None
@@ -105,7 +113,7 @@ def same_acceleration_cells(
     for ours, theirs in ((compiled.mu_acc, numpy.mu_acc), (compiled.v_acc, numpy.v_acc)):
         np.testing.assert_array_equal(np.isnan(ours), np.isnan(theirs))
         np.testing.assert_array_equal(np.isinf(ours), np.isinf(theirs))
-        np.testing.assert_allclose(ours**-2.0, theirs**-2.0, rtol=2e-12, atol=rounding)
+        np.testing.assert_allclose(ours**-2.0, theirs**-2.0, rtol=rtol, atol=rounding)
     feasible = ~np.isnan(numpy.mu_acc)
     assert np.all(compiled.mu_acc[feasible] <= compiled.mu_path[feasible])
 
