@@ -48,6 +48,15 @@ def grid_of(values: dict[str, str]) -> dict[str, Any]:
     }
 
 
+def beside(field: str, detail: dict[str, Any]) -> str:
+    """The text the page shows beside the field whose loc is ``field`` for an API error: the
+    message, led by the part of the error's loc the field does not name ("[2]: ...")."""
+    loc = [str(p) for p in detail["loc"] if p not in ("body", "request")]
+    rest = loc[len(field.split(".")) :]
+    text = "".join(f"[{p}]" if p.isdigit() else ("." if k else "") + p for k, p in enumerate(rest))
+    return f"{text}: {detail['msg']}" if text else str(detail["msg"])
+
+
 def run_small_map(page: Page, url: str) -> dict[str, Any]:
     """Run the small map from the page; the API's map of the same body."""
     assert page.input_value("#robot-model") == "ur5"
@@ -438,7 +447,7 @@ def test_acceleration_limits_the_api_refuses_show_its_error_beside_the_field(
     assert answer.status_code == 422
     detail = answer.json()["detail"]
     assert [d["loc"][2:4] for d in detail] == [["robot", "joint_acceleration_limits"]]
-    assert page.text_content(selector) == detail[0]["msg"]
+    assert page.text_content(selector) == beside("robot.joint_acceleration_limits", detail[0])
     assert page.text_content("#form-error") == ""
     assert page.get_attribute("#summary", "data-cells") is None  # no map ran
 

@@ -19,7 +19,7 @@ from scipy.spatial.transform import Rotation
 
 from tests.cases import ROOT
 from tests.web.conftest import snapshot
-from tests.web.test_page import EXAMPLE_PATH, SMALL, fill, grid_of, pixel
+from tests.web.test_page import EXAMPLE_PATH, SMALL, beside, fill, grid_of, pixel
 from tests.web.test_page import cell_point as panel_point
 
 README = (ROOT / "README.md").read_text()
@@ -360,10 +360,11 @@ def test_an_invalid_size_shows_the_apis_error_beside_its_field(
     body = {"robot": {"model": "ur5"}, "path": EXAMPLE_PATH, "grid": grid_of(SMALL), "cell": cell}
     detail = httpx.post(f"{url}/v1/map", json=body, timeout=60).json()["detail"]
     assert [".".join(map(str, d["loc"][1:])) for d in detail] == [f"{loc}.1"]
-    assert page.text_content(selector) == detail[0]["msg"]
+    assert page.text_content(selector) == beside(loc, detail[0]) == f"[1]: {detail[0]['msg']}"
     assert page.text_content("#form-error") == ""
     row = page.locator(".cell-box").last
-    assert row.locator(".field[data-tail='box.size'] .error").text_content() == detail[0]["msg"]
+    shown = row.locator(".field[data-tail='box.size'] .error").text_content()
+    assert shown == beside(loc, detail[0])
 
 
 @pytest.mark.parametrize("width", [1280, 800])
@@ -408,7 +409,7 @@ def test_the_table_tool_and_clearance_errors_show_beside_their_fields(
     assert answer.status_code == 422
     detail = answer.json()["detail"]
     assert [".".join(map(str, d["loc"][2:])) for d in detail] == [api_loc]
-    assert page.text_content(selector) == detail[0]["msg"]
+    assert page.text_content(selector) == beside(loc, detail[0])
     assert page.text_content("#form-error") == ""
 
 

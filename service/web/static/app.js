@@ -13,7 +13,7 @@ const REASON_COLOURS = {
 };
 const state = {
   robots: [], path: null, pathProblem: "no path loaded yet", source: null, map: null, grid: null,
-  run: null, optimization: null, evaluation: null, cursor: null,
+  run: null, optimization: null, evaluation: null, cursor: null, tipAt: null,
 };
 
 // ---- inputs -------------------------------------------------------------------------------
@@ -30,9 +30,14 @@ function value(id) {
 
 function spinMode() { return $("spin-mode").value || undefined; }
 
+// A pasted robot object that is not JSON throws, saying so: its callers show it beside Robot.
 function robotBody() {
   const own = $("robot-json").value.trim();
-  if (own) return JSON.parse(own);  // a pasted robot object carries its own limits
+  if (own) {  // a pasted robot object carries its own limits
+    try { return JSON.parse(own); } catch (error) {
+      throw new Error(`the robot object is not JSON: ${error.message}`);
+    }
+  }
   // Empty: none. Otherwise every entry is sent as typed (a wrong count or a word is the API's
   // error beside the field, never dropped here): Number("x") is NaN, sent as null.
   const acc = $("acc-limits").value.trim();
@@ -275,26 +280,55 @@ function showErrors(details, aliases = {}) {
     const target = field ? field.querySelector(".error") : $("form-error");
     const folded = target.closest("details");
     if (folded) folded.open = true;  // an error inside a folded section is seen
-    const msg = field || !loc.length ? d.msg : `${loc.join(".")}: ${d.msg}`;
+    // The part of the loc the field does not name (a waypoint, a joint, an item of a list)
+    // leads the message: "waypoints[7].orientation: ...", "[2]: ..." beside the limits.
+    const named = field ? field.dataset.loc.split(".").length : 0;
+    const rest = locText(loc.slice(named));
+    const msg = rest ? `${rest}: ${d.msg}` : d.msg;
     if (!target.textContent.split(" | ").includes(msg)) {
       target.textContent = (target.textContent ? target.textContent + " | " : "") + msg;
     }
   }
 }
 
-// `signal` (an AbortSignal) aborts the request: it then throws before showing anything.
+// A loc's parts as the API counts them: names joined by dots, indices in brackets.
+function locText(parts) {
+  return parts.map((p, k) => (/^\d+$/.test(p) ? `[${p}]` : (k ? "." : "") + p)).join("");
+}
+
+// An error detail in words: its loc (the body's own fields) before its message.
+function detailText(d) {
+  const loc = locText((d.loc || []).filter((p) => p !== "body" && p !== "request").map(String));
+  return loc ? `${loc}: ${d.msg}` : d.msg;
+}
+
+// `signal` (an AbortSignal) aborts the request: it then throws before showing anything. Any
+// other failure is shown under the buttons (or beside its field) before it throws: no answer
+// (the network, the service stopped), an answer that is not JSON (a proxy's page, a 500 in
+// text), an error status.
 async function api(method, url, body, aliases = {}, signal = undefined) {
-  const response = await fetch(url, {
-    method, headers: body ? { "Content-Type": "application/json" } : {},
-    body: body ? JSON.stringify(body) : undefined, signal,
-  });
+  let response;
+  try {
+    response = await fetch(url, {
+      method, headers: body ? { "Content-Type": "application/json" } : {},
+      body: body ? JSON.stringify(body) : undefined, signal,
+    });
+  } catch (error) {
+    if (error.name !== "AbortError") {
+      showErrors([{ loc: [], msg: `no answer from the service to ${method} ${url}: ${error.message}` }]);
+    }
+    throw error;
+  }
   if (response.status === 204) return null;
-  const answer = await response.json();
-  if (!response.ok) {
-    const detail = Array.isArray(answer.detail) ? answer.detail
-      : [{ loc: [], msg: String(answer.detail) }];
+  let answer = null;
+  try { answer = await response.json(); } catch { answer = null; }  // none, or not JSON
+  if (!response.ok || answer === null) {
+    const status = `HTTP ${response.status}${response.statusText ? ` ${response.statusText}` : ""}`;
+    const detail = answer && Array.isArray(answer.detail) ? answer.detail
+      : [{ loc: [], msg: answer && answer.detail != null ? `${status}: ${answer.detail}`
+        : `${status} from ${method} ${url}${response.ok ? ": the answer is not JSON" : ""}` }];
     showErrors(detail, aliases);
-    throw new Error(detail.map((d) => d.msg).join("; "));
+    throw new Error(detail.map(detailText).join("; "));
   }
   return answer;
 }
@@ -463,6 +497,7 @@ function drawMap(answer) {
     paintPanel(canvas);
     canvas.addEventListener("mousemove", (e) => hover(canvas, e));
     canvas.addEventListener("mouseleave", () => { $("tooltip").hidden = true; state.tipCell = null; });
+    canvas.addEventListener("blur", () => { $("tooltip").hidden = true; state.tipCell = null; });
     canvas.addEventListener("click", (e) => { const c = cellAt(canvas, e); if (c) evaluateCell(c); });
     canvas.addEventListener("keydown", (e) => keys(canvas, e));
   }
@@ -488,11 +523,13 @@ function paintPanel(canvas) {
   if (state.optimum && state.optimum.canvas === canvas) drawMarker(canvas, state.optimum.placement);
 }
 
+// The cell under the pointer, from the canvas's drawing area (inside any border it has).
 function cellAt(canvas, event) {
   const box = canvas.getBoundingClientRect();
   const { xs, ys } = state.scale;
-  const i = Math.floor((event.clientX - box.left) / state.scale.size);
-  const j = ys.length - 1 - Math.floor((event.clientY - box.top) / state.scale.size);
+  const left = box.left + canvas.clientLeft, top = box.top + canvas.clientTop;
+  const i = Math.floor((event.clientX - left) / state.scale.size);
+  const j = ys.length - 1 - Math.floor((event.clientY - top) / state.scale.size);
   if (i < 0 || i >= xs.length || j < 0 || j >= ys.length) return null;
   return state.map.cells[Number(canvas.dataset.first) + j * xs.length + i];
 }
@@ -537,7 +574,11 @@ function askWhere(c) {
   delete body.grid;
   api("POST", "/v1/evaluate", body).then((answer) => {
     state.whereAcc.set(cellKey(c), collides ? answer.collision : answer.acceleration);
-    if (state.tipCell === c) { $("tooltip").textContent = describe(c); $("tooltip").dataset.where = "1"; }
+    if (state.tipCell === c) {
+      $("tooltip").textContent = describe(c);
+      $("tooltip").dataset.where = "1";
+      placeTip();  // longer now: kept inside the window
+    }
   }).catch(() => state.whereAcc.delete(cellKey(c)));
 }
 
@@ -560,8 +601,24 @@ function hover(canvas, event) {
   const tip = $("tooltip");
   if (!c) { tip.hidden = true; state.tipCell = null; return; }
   if (state.tipCell !== c) showTip(c);
-  tip.style.left = `${event.clientX + 12}px`; tip.style.top = `${event.clientY + 12}px`;
+  state.tipAt = { x: event.clientX, y: event.clientY };
   tip.hidden = false;
+  placeTip();
+}
+
+// The tooltip beside state.tipAt (a window point), inside the window: to the right of and
+// below the point where it fits, else to its left or above it, else against the window's edge.
+function placeTip() {
+  const tip = $("tooltip"), at = state.tipAt;
+  if (!at || tip.hidden) return;
+  const width = tip.offsetWidth, height = tip.offsetHeight, gap = 12, edge = 4;
+  const room = (size, space) => Math.max(edge, space - size - edge);
+  let left = at.x + gap, top = at.y + gap;
+  if (left + width > window.innerWidth - edge) left = at.x - gap - width;
+  if (top + height > window.innerHeight - edge) top = at.y - gap - height;
+  left = Math.min(Math.max(left, edge), room(width, window.innerWidth));
+  top = Math.min(Math.max(top, edge), room(height, window.innerHeight));
+  tip.style.left = `${left}px`; tip.style.top = `${top}px`;
 }
 
 function keys(canvas, event) {
@@ -576,6 +633,14 @@ function keys(canvas, event) {
     state.cursor = cur;
     document.querySelectorAll(".panel canvas").forEach(paintPanel);
     showTip(cell());
+    // Shown beside the cell under the cursor (a role="status" region: read out as it changes).
+    const box = canvas.getBoundingClientRect(), size = state.scale.size;
+    state.tipAt = {
+      x: box.left + canvas.clientLeft + (cur.i + 1) * size,
+      y: box.top + canvas.clientTop + (ys.length - cur.j) * size,
+    };
+    $("tooltip").hidden = false;
+    placeTip();
   } else if (event.key === "Enter") {
     event.preventDefault();
     state.cursor = cur;
@@ -586,32 +651,32 @@ function keys(canvas, event) {
 // ---- one placement: V_max and joint use along the path ---------------------------------------
 // The evaluation under way is state.evaluation, a token: one no longer there (clearCell: a new
 // click, map, path or robot came meanwhile) shows nothing of its answers.
+// A cell is evaluated with its map's own request (the robot, its limits, the path, the IK
+// options, the spin mode and the cell the map was computed with), as its hover text is: the
+// form edited since the map (a joint limit, the cell's table) would otherwise give a cell
+// another answer than its colour's. Only the feed to check is the form's.
 async function evaluateCell(c) {
   clearErrors();
   clearCell();
-  if (!havePath()) return;
+  const map = state.mapBody;
+  if (!map) return;
   const evaluation = {};
   state.evaluation = evaluation;
-  const body = {
-    robot: robotBody(), path: state.path,
-    placement: placementOf(c),
-    feed: value("feed"),
-    ik: ikBody(),
-    spin_mode: state.mapBody ? state.mapBody.spin_mode : spinMode(),
-    cell: cellBody(),
-  };
+  const body = { ...map, placement: placementOf(c), feed: value("feed") };
+  delete body.grid;
   $("cell-summary").textContent = "evaluating…";
   const answer = await api("POST", "/v1/evaluate", body).catch(() => null);
   if (state.evaluation !== evaluation) return;
-  if (!answer) { clearCell(); return; }
+  if (!answer) { $("cell-summary").textContent = "no evaluation: see the errors above"; return; }
   const where = `x ${metres(c.x)}, y ${metres(c.y)}, yaw ${radians(c.yaw)}`;
   // The feed checked: the field's, else the program's (CL data), else none (the field empty).
   body.feed = answer.feed_check ? answer.feed_check.feed : undefined;
   const use = body.feed === undefined ? "; no feed to check"
     : `; at ${fixed(body.feed, 6)} m/s the largest joint use is ${(100 * body.feed / answer.mu_path).toFixed(1)} %`;
-  $("cell-summary").textContent = answer.feasible
+  $("cell-summary").textContent = (answer.feasible
     ? `${where}: mu_path ${answer.mu_path.toFixed(6)} m/s${use}`
-    : `${where}: infeasible (${answer.reason} at waypoint ${answer.failed_waypoint})`;
+    : `${where}: infeasible (${answer.reason} at waypoint ${answer.failed_waypoint})`)
+    + (formChanged(map) ? " (with the map's inputs: the form has changed since; run the map again for its own)" : "");
   $("cell-verdict").textContent = cellVerdict(answer, body.cell);
   if (answer.feasible && answer.spin_mode === "free") await compareFixedSpin(body, answer);
   if (state.evaluation !== evaluation) return;
@@ -621,6 +686,16 @@ async function evaluateCell(c) {
   $("bottleneck").dataset.joint = b ? String(b.joint) : "";
   showAcceleration(answer, body);
   plot(answer, body);
+}
+
+// Whether the form now asks another map than ``map`` (its grid aside): a robot, limit, path,
+// IK option, spin mode or cell edited since.
+function formChanged(map) {
+  try {
+    const now = mapBody(), then = { ...map };
+    delete now.grid; delete then.grid;
+    return JSON.stringify(now) !== JSON.stringify(then);
+  } catch { return true; }  // a robot object that is no longer JSON
 }
 
 // With the spin free, what it is worth: mu_path with the spin fixed at the same placement.

@@ -17,7 +17,7 @@ async function runMap(event) {
   dropOptimization("a map was run; optimise again for its inputs");
   if (!havePath()) return;
   let body;
-  try { body = mapBody(); } catch (error) { showErrors([{ loc: ["robot"], msg: String(error) }]); return; }
+  try { body = mapBody(); } catch (error) { showErrors([{ loc: ["robot"], msg: error.message }]); return; }
   const run = { id: null };
   state.run = run; $("run").disabled = true;
   $("job-status").textContent = "submitting the map…";

@@ -48,8 +48,10 @@ async function optimize() {
     showErrors([{ loc: ["grid", "z"], msg: "Field required: the optimiser searches at this height" }]);
     return;
   }
+  let robot;
+  try { robot = robotBody(); } catch (error) { showErrors([{ loc: ["robot"], msg: error.message }]); return; }
   const body = {
-    robot: robotBody(), path: state.path, method: $("method").value, z: grid.z, ik: ikBody(),
+    robot, path: state.path, method: $("method").value, z: grid.z, ik: ikBody(),
     bounds: { x: [grid.x.min, grid.x.max], y: [grid.y.min, grid.y.max], yaw: yawRange(grid) },
     spin_mode: spinMode(), cell: cellBody(),
   };

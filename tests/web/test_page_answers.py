@@ -1,0 +1,138 @@
+"""What the page says is its map's and the API's (the page audit of stop 56, in Chromium).
+
+A clicked cell is evaluated with the map's own request, as its hover text is, whatever the
+form says since; the cell under the pointer is the one painted there, to its last pixel; an
+error names the waypoint, joint or item its loc names; a failure without a JSON answer, and a
+pasted robot object that is not JSON, are said, never a blank; the tooltip stays inside the
+window and shows for the keyboard too.
+"""
+
+from __future__ import annotations
+
+import copy
+import json
+from typing import Any
+
+import httpx
+from playwright.sync_api import Page, Route
+
+from tests.web.test_page import EXAMPLE_PATH, SMALL, cell_point, fill, grid_of, run_small_map
+from tests.web.test_page_findings import choose_file, error_beside
+
+
+def _first_feasible(api: dict[str, Any]) -> dict[str, Any]:
+    return next(c for c in api["cells"] if c["mu_path"] is not None)
+
+
+def test_a_clicked_cell_is_the_maps_even_after_the_form_changed(page: Page, url: str) -> None:
+    """Joint 1's speed limit lowered to 0.5 rad/s after the map: the click still answers the
+    map's mu_path (the API's evaluation of the map's request), and says so (before, it answered
+    0.187889 m/s beside a cell coloured 0.291404)."""
+    api = run_small_map(page, url)
+    cell = _first_feasible(api)
+    page.fill("#limits input >> nth=0", "0.5")
+    page.dispatch_event("#limits input >> nth=0", "input")
+    point = cell_point(page, 0, cell, api)
+    page.mouse.click(point["x"], point["y"])
+    page.wait_for_function(
+        "document.getElementById('cell-summary').textContent.includes('mu_path')", timeout=30_000
+    )
+    placement = {"x": cell["x"], "y": cell["y"], "z": 0.1, "yaw": cell["yaw"], "spin": 0.0}
+    body = {"robot": {"model": "ur5"}, "path": EXAMPLE_PATH, "placement": placement}
+    evaluation = httpx.post(f"{url}/v1/evaluate", json=body, timeout=60).json()
+    summary = page.text_content("#cell-summary") or ""
+    assert f"mu_path {evaluation['mu_path']:.6f} m/s" in summary
+    assert f"{cell['mu_path']:.6f}" in summary
+    assert "with the map's inputs" in summary
+
+
+def test_the_cell_under_the_pointer_is_the_one_painted_there(page: Page, url: str) -> None:
+    """At the last pixel of a cell's drawing (Playwright's position is from the canvas's
+    padding box, inside any border) the tooltip names that cell, not its neighbour."""
+    api = run_small_map(page, url)
+    xs = sorted({c["x"] for c in api["cells"]})
+    ys = sorted({c["y"] for c in api["cells"]})
+    canvas = page.locator(".panel canvas").nth(0)
+    size = int(canvas.get_attribute("data-cell") or 0)
+    for i in range(len(xs)):
+        for at in (0.5, size - 0.5):  # the first and the last pixel of cell column i
+            canvas.hover(position={"x": i * size + at, "y": size * (len(ys) - 0.5)})
+            tooltip = page.text_content("#tooltip") or ""
+            assert tooltip.startswith(f"x {xs[i]:.4f} m, y {ys[0]:.4f} m"), (i, at, tooltip)
+
+
+def _bad_path(waypoint: int) -> str:
+    path = copy.deepcopy(EXAMPLE_PATH)
+    path["waypoints"][waypoint]["orientation"] = [0.9, 0.0, 0.0, 0.0]
+    return json.dumps(path)
+
+
+def test_an_error_names_its_waypoint_and_its_joint(page: Page, url: str) -> None:
+    """A path with a bad quaternion at waypoint 7: beside the path as it is read, and again
+    when Run finds no path; a joint's speed limit beside the limits, by its index."""
+    choose_file(page, "#path-file", "bad.json", _bad_path(7))
+    body = {"robot": {"model": "ur5"}, "path": json.loads(_bad_path(7)), "grid": grid_of(SMALL)}
+    detail = httpx.post(f"{url}/v1/map", json=body, timeout=60).json()["detail"]
+    assert detail[0]["loc"] == ["body", "path", "waypoints", 7, "orientation"]
+    assert error_beside(page, "path") == f"waypoints[7].orientation: {detail[0]['msg']}"
+    fill(page, SMALL)
+    page.click("#run")
+    page.wait_for_function(
+        "document.querySelector(\".field[data-loc='path'] .error\").textContent"
+        ".startsWith('No path to run')"
+    )
+    error = page.text_content(".field[data-loc='path'] .error") or ""
+    assert f"path.waypoints[7].orientation: {detail[0]['msg']}" in error
+    page.reload()
+    page.wait_for_selector("body[data-ready='1']", timeout=30_000)
+    page.fill("#limits input >> nth=2", "-1")
+    page.dispatch_event("#limits input >> nth=2", "input")
+    fill(page, SMALL)
+    page.click("#run")
+    assert error_beside(page, "robot.joint_velocity_limits").startswith("[2]: ")
+
+
+def test_an_answer_that_is_not_json_or_none_is_said(page: Page) -> None:
+    def text_500(route: Route) -> None:
+        route.fulfill(status=500, content_type="text/plain", body="Internal Server Error")
+
+    page.route("**/v1/jobs", text_500)
+    fill(page, SMALL)
+    page.click("#run")
+    page.wait_for_function("document.getElementById('form-error').textContent !== ''")
+    assert (page.text_content("#form-error") or "").startswith("HTTP 500")
+    page.unroute("**/v1/jobs")
+    page.route("**/v1/optimize", lambda route: route.abort())
+    page.click("#optimize")
+    page.wait_for_function(
+        "document.getElementById('form-error').textContent.includes('no answer from the service')"
+    )
+
+
+def test_a_robot_object_that_is_not_json_is_said_beside_the_robot(page: Page) -> None:
+    errors: list[str] = []
+    page.on("pageerror", lambda error: errors.append(str(error)))
+    page.click("#own-json summary")
+    page.fill("#robot-json", "{oops")
+    fill(page, SMALL)
+    page.click("#optimize")
+    assert error_beside(page, "robot").startswith("the robot object is not JSON: ")
+    assert errors == []
+
+
+def test_the_tooltip_stays_in_the_window_and_shows_for_the_keyboard(page: Page, url: str) -> None:
+    api = run_small_map(page, url)
+    page.set_viewport_size({"width": 700, "height": 900})
+    canvas = page.locator(".panel canvas").last
+    canvas.scroll_into_view_if_needed()
+    size = int(canvas.get_attribute("data-cell") or 0)
+    xs = sorted({c["x"] for c in api["cells"]})
+    canvas.hover(position={"x": len(xs) * size - 1, "y": size / 2})
+    tip = page.locator("#tooltip").bounding_box()
+    assert tip is not None
+    assert 0 <= tip["x"] and tip["x"] + tip["width"] <= 700
+    page.mouse.move(0, 0)
+    page.locator(".panel canvas").first.focus()
+    page.keyboard.press("ArrowRight")
+    assert page.is_visible("#tooltip")
+    assert (page.text_content("#tooltip") or "").startswith(f"x {xs[1]:.4f} m")
