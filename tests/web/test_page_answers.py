@@ -136,3 +136,55 @@ def test_the_tooltip_stays_in_the_window_and_shows_for_the_keyboard(page: Page, 
     page.keyboard.press("ArrowRight")
     assert page.is_visible("#tooltip")
     assert (page.text_content("#tooltip") or "").startswith(f"x {xs[1]:.4f} m")
+
+
+def _refused_as_work(route: Route) -> None:
+    """The route's answer to a search over its size limit (service/config.py's hint)."""
+    detail = [
+        {
+            "loc": ["body", "bounds"],
+            "msg": "the casadi search evaluates placements of 133 waypoints: ..., as work "
+            "6.339e+06 closed-form poses (ur IK, with a cell); the limit is 5000000 "
+            "(DTF_MAX_MAP_POSES); narrow the bounds; POST /v1/jobs runs bigger searches",
+            "type": "invalid_input",
+        }
+    ]
+    route.fulfill(status=422, content_type="application/json", body=json.dumps({"detail": detail}))
+
+
+def test_a_search_too_large_for_a_request_runs_as_a_job(page: Page, url: str) -> None:
+    """The route refusing the search for its size (as it refuses a cell at the default bounds:
+    6.3 million poses), the page submits the same body as an optimisation job and shows its
+    answer, which is the route's."""
+    page.route("**/v1/optimize", _refused_as_work)
+    fill(page, SMALL)
+    with page.expect_request(lambda r: r.method == "POST" and r.url.endswith("/v1/jobs")) as sent:
+        page.click("#optimize")
+    submitted = json.loads(sent.value.post_data or "{}")
+    assert submitted["kind"] == "optimize"
+    page.wait_for_function(
+        "document.getElementById('opt-mu').textContent.endsWith(' m/s')", timeout=120_000
+    )
+    api = httpx.post(f"{url}/v1/optimize", json=submitted["request"], timeout=120).json()
+    assert page.text_content("#opt-mu") == f"{api['mu_path']:.6f} m/s"
+    assert page.is_disabled("#opt-cancel")
+
+
+def test_an_optimisation_job_is_stopped_from_the_page(page: Page, url: str) -> None:
+    page.route("**/v1/optimize", _refused_as_work)
+    fill(page, {**SMALL, "x-min": "-0.3", "x-max": "0.3", "y-min": "0.2", "y-max": "0.7"})
+    page.click("#opt-any-yaw")
+    page.click("#optimize")
+    page.wait_for_function(
+        "document.getElementById('opt-mu').textContent.startsWith('optimising as job')",
+        timeout=60_000,
+    )
+    job_id = (page.text_content("#opt-mu") or "").split()[3].rstrip(":")
+    page.click("#opt-cancel")
+    assert (page.text_content("#opt-mu") or "").startswith("cancelled: stopped from the page")
+    for _ in range(50):
+        status = httpx.get(f"{url}/v1/jobs/{job_id}").json()["status"]
+        if status != "running":
+            break
+        page.wait_for_timeout(100)
+    assert status == "cancelled"

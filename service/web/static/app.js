@@ -305,8 +305,9 @@ function detailText(d) {
 // `signal` (an AbortSignal) aborts the request: it then throws before showing anything. Any
 // other failure is shown under the buttons (or beside its field) before it throws: no answer
 // (the network, the service stopped), an answer that is not JSON (a proxy's page, a 500 in
-// text), an error status.
-async function api(method, url, body, aliases = {}, signal = undefined) {
+// text), an error status. With `show` false an error status is not shown: the error thrown
+// carries it (`detail`, `status`) for the caller to act on.
+async function api(method, url, body, aliases = {}, signal = undefined, show = true) {
   let response;
   try {
     response = await fetch(url, {
@@ -327,8 +328,10 @@ async function api(method, url, body, aliases = {}, signal = undefined) {
     const detail = answer && Array.isArray(answer.detail) ? answer.detail
       : [{ loc: [], msg: answer && answer.detail != null ? `${status}: ${answer.detail}`
         : `${status} from ${method} ${url}${response.ok ? ": the answer is not JSON" : ""}` }];
-    showErrors(detail, aliases);
-    throw new Error(detail.map(detailText).join("; "));
+    if (show) showErrors(detail, aliases);
+    const error = new Error(detail.map(detailText).join("; "));
+    error.detail = detail; error.status = response.status;
+    throw error;
   }
   return answer;
 }
@@ -777,6 +780,7 @@ async function start() {
   $("inputs").addEventListener("submit", runMap);
   $("cancel").addEventListener("click", cancelMap);
   $("optimize").addEventListener("click", optimize);
+  $("opt-cancel").addEventListener("click", () => dropOptimization("stopped from the page"));
   startCellEditor();
   await loadExample();
   document.body.dataset.ready = "1";

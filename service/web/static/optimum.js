@@ -35,13 +35,51 @@ const BOUND_FIELDS = {
   "bounds.y.1": "grid.y.max", "bounds.x": "grid.x.min", "bounds.y": "grid.y.min", z: "grid.z",
 };
 
-// The optimisation under way is state.optimization ({abort}: its request's AbortController);
-// one no longer there was dropped (dropOptimization, or a newer click) and shows nothing.
+// A search the service refuses as more work than a request may take: its 422 says that
+// POST /v1/jobs runs it (the routes' size limits' own words, DTF_MAX_MAP_POSES and the like).
+function needsJob(error) {
+  return error.status === 422 && Array.isArray(error.detail)
+    && error.detail.some((d) => String(d.msg).includes("POST /v1/jobs"));
+}
+
+// The same search as a job (api.md "Jobs", kind "optimize"): its progress shown on the
+// optimum's line until it ends; its answer is the route's. Null when it failed (said), was
+// cancelled, or the run was dropped meanwhile (its job then cancelled).
+async function optimizeAsJob(body, run) {
+  $("opt-mu").textContent = "more work than a request may take: submitting it as a job…";
+  const job = await api("POST", "/v1/jobs", { kind: "optimize", request: body }, BOUND_FIELDS)
+    .catch(() => null);
+  if (!job) return null;
+  run.jobId = job.id;
+  if (state.optimization !== run) { cancelJob(job.id); return null; }
+  for (let failed = 0; ;) {
+    let status = null;
+    try { status = await getJson(`/v1/jobs/${job.id}`); failed = 0; } catch (error) {
+      if (++failed > POLL_RETRIES_MS.length) {
+        if (state.optimization === run) $("opt-mu").textContent = `no optimum: the job's status could not be read (${error.message})`;
+        return null;
+      }
+    }
+    if (state.optimization !== run) return null;
+    if (status && status.status === "done") return status.result;
+    if (status && status.status === "failed") { showErrors(status.error, BOUND_FIELDS); return null; }
+    if (status && status.status === "cancelled") return null;
+    if (status) {
+      const eta = status.progress.eta_seconds;
+      $("opt-mu").textContent = `optimising as job ${job.id}: ${(100 * status.progress.fraction).toFixed(0)} %`
+        + (eta == null ? "" : `, about ${eta.toFixed(0)} s left`);
+    }
+    await new Promise((resolve) => setTimeout(resolve, failed ? POLL_RETRIES_MS[failed - 1] : 500));
+  }
+}
+
+// The optimisation under way is state.optimization ({abort}: its request's AbortController;
+// {jobId} once it runs as a job); one no longer there was dropped (dropOptimization, or a
+// newer click) and shows nothing.
 async function optimize() {
   clearErrors();
   clearOptimum();
-  if (state.optimization) state.optimization.abort.abort();  // a newer click: the older goes
-  state.optimization = null;
+  dropOptimization("a newer optimisation");  // a newer click: the older goes (its job too)
   if (!havePath()) return;
   const grid = gridBody();
   if (grid.z === undefined) {  // the API would take it for a search over the height
@@ -55,13 +93,23 @@ async function optimize() {
     bounds: { x: [grid.x.min, grid.x.max], y: [grid.y.min, grid.y.max], yaw: yawRange(grid) },
     spin_mode: spinMode(), cell: cellBody(),
   };
-  const run = { abort: new AbortController() };
+  const run = { abort: new AbortController(), jobId: null };
   state.optimization = run;
+  $("opt-cancel").disabled = false;
   $("opt-mu").textContent = "optimising…";
   $("opt-mu-line").hidden = false;
-  const answer = await api("POST", "/v1/optimize", body, BOUND_FIELDS, run.abort.signal).catch(() => null);
+  let answer = await api("POST", "/v1/optimize", body, BOUND_FIELDS, run.abort.signal, false)
+    .catch((error) => error);
+  if (answer instanceof Error) {
+    if (state.optimization === run && needsJob(answer)) answer = await optimizeAsJob(body, run);
+    else {
+      if (state.optimization === run && answer.detail) showErrors(answer.detail, BOUND_FIELDS);
+      answer = null;
+    }
+  }
   if (state.optimization !== run) return;  // dropped meanwhile: its answer is not the inputs'
   state.optimization = null;
+  $("opt-cancel").disabled = true;
   if (!answer) { $("opt-mu").textContent = "no optimum: see the errors above"; return; }
   if (!answer.found) {
     $("opt-mu").textContent = body.cell ? "no feasible placement free of collisions" : "no feasible placement";
@@ -133,7 +181,9 @@ function dropOptimization(why) {
   const run = state.optimization;
   if (!run) return;
   state.optimization = null;
+  $("opt-cancel").disabled = true;
   run.abort.abort();
+  if (run.jobId) cancelJob(run.jobId);
   clearOptimum();
   $("opt-mu").textContent = `cancelled: ${why}`;
   $("opt-mu-line").hidden = false;
