@@ -150,7 +150,7 @@ def problem_of(
         blend_length=ik.blend_length,
         cell=cell,
     )
-    return PathProblem.of(robot, poses, options, passes=path.passes)
+    return PathProblem.of(robot, poses, options, passes=path.passes, source=path.source)
 
 
 def cell_of(cell: schemas.CellSpec | None, settings: Settings) -> Cell | None:

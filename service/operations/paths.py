@@ -8,14 +8,22 @@ from service.convert.path_read import read_fields
 from service.schemas.path_input import PathInput
 from service.schemas.paths_import import ImportedPose, PathImportRequest, PathImportResponse
 from solver.cam.frames import quaternions_wxyz
+from solver.path.prepare import path_requirements
 
 
 def import_of(body: PathImportRequest, settings: Settings) -> PathImportResponse:
-    """The answer of ``POST /v1/paths/import``, the path's size checked as every route does."""
+    """The answer of ``POST /v1/paths/import``, the path checked as every route checks it.
+
+    Its size, and each pass's segments (:func:`solver.path.prepare.path_requirements`: a
+    waypoint repeating the one before, a turn of about half a turn): a path this accepts,
+    /v1/evaluate and /v1/map accept too (cam.md section 9).
+    """
     convert.check_path_size(
         body.path, limit=settings.max_path_waypoints, setting="DTF_MAX_PATH_WAYPOINTS"
     )
-    return imported(convert.path_of(body.path))
+    path = convert.path_of(body.path)
+    path_requirements(path.poses, path.passes, field=path.source)
+    return imported(path)
 
 
 def imported(path: PathInput) -> PathImportResponse:

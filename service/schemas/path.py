@@ -111,7 +111,9 @@ class ToolAxisPath(RequestModel):
         )
         poses, correction = poses_from_tool_axes(positions, np.array([p.axis for p in points]))
         task_requirements(poses, field=field)  # names this field, not path.waypoints, on an error
-        return PathInput(poses=poses, axis_correction=correction, default_spin_mode="free")
+        return PathInput(
+            poses=poses, axis_correction=correction, default_spin_mode="free", source=field
+        )
 
 
 _FORMS = ("waypoints", "tool_axis_waypoints", "cl_data", "csv")

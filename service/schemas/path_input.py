@@ -40,6 +40,9 @@ class PathInput:
         report: what the CL reader skipped, dropped and inferred; ``None`` for other forms.
         cam_form: the CAM form the path came in (``cl_data``, ``csv``); ``None`` for poses
             and tool axes.
+        source: the request's field the path came in (``path.waypoints``,
+            ``path.tool_axis_waypoints``, ``path.cl_data``, ``path.csv``): the path's errors
+            name it.
     """
 
     poses: np.ndarray
@@ -55,6 +58,7 @@ class PathInput:
     one_point_passes: int = 0
     report: ReadReport | None = None
     cam_form: Literal["cl_data", "csv"] | None = None
+    source: str = "path.waypoints"
 
     @classmethod
     def from_cam(
@@ -83,4 +87,5 @@ class PathInput:
             one_point_passes=cam.one_point_passes,
             report=report,
             cam_form=form,
+            source=field,
         )

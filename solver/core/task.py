@@ -93,12 +93,16 @@ def _determinants(m: np.ndarray) -> np.ndarray:
     return determinants
 
 
-def check_waypoints(poses: np.ndarray, *, field: str = "path.waypoints") -> np.ndarray:
+def check_waypoints(
+    poses: np.ndarray, *, field: str = "path.waypoints", first: int = 0
+) -> np.ndarray:
     """Return ``poses`` as a float array after checking shape and values.
 
     Args:
         poses: shape (N, 4, 4), N >= 2, homogeneous transforms with rotation matrices.
         field: name of the input, for error messages.
+        first: the index of ``poses[0]`` in the path they are part of (a pass's first), which
+            errors count from.
 
     Raises:
         InvalidInputError: fewer than 2 waypoints, wrong shape, non-finite values, or a
@@ -119,8 +123,8 @@ def check_waypoints(poses: np.ndarray, *, field: str = "path.waypoints") -> np.n
             | ~(_determinants(rotations) >= 0)
         )
     if bad.any():  # the first bad pose, with the message of the first check it fails
-        i = int(np.argmax(bad))
-        pose = arr[i]
+        k = int(np.argmax(bad))
+        pose, i = arr[k], first + k
         if not np.all(np.isfinite(pose)):
             raise InvalidInputError(field, "pose has values that are not finite", waypoint=i)
         if np.max(np.abs(pose[:3, 3])) > MAX_COORDINATE:
@@ -131,12 +135,16 @@ def check_waypoints(poses: np.ndarray, *, field: str = "path.waypoints") -> np.n
     return arr
 
 
-def task_requirements(poses: np.ndarray, *, field: str = "path.waypoints") -> TaskRequirements:
+def task_requirements(
+    poses: np.ndarray, *, field: str = "path.waypoints", first: int = 0
+) -> TaskRequirements:
     """Spec section 2: u_T, u_R and h of every waypoint of a path.
 
     Args:
         poses: shape (N, 4, 4), the waypoints (tool point poses), all in one frame.
         field: name of the input, for error messages.
+        first: the index of ``poses[0]`` in the path they are part of (a pass's first): the
+            waypoints errors name count from it.
 
     Returns:
         The requirements in that frame.
@@ -148,7 +156,7 @@ def task_requirements(poses: np.ndarray, *, field: str = "path.waypoints") -> Ta
         InvalidInputError: a segment turning by a half turn (within 1e-6 rad), naming its
             second waypoint (issue 9: the sign of u_R would come from rounding).
     """
-    arr = check_waypoints(poses, field=field)
+    arr = check_waypoints(poses, field=field, first=first)
     displacement = arr[1:, :3, 3] - arr[:-1, :3, 3]
     rotation_vector = rotation_vectors(
         np.einsum("nij,nkj->nik", arr[1:, :3, :3], arr[:-1, :3, :3])  # R_{i+1} R_i^T
@@ -157,16 +165,16 @@ def task_requirements(poses: np.ndarray, *, field: str = "path.waypoints") -> Ta
     angular = np.linalg.norm(rotation_vector, axis=1)
     no_move = (linear < LINEAR_TOLERANCE) & (angular < ANGULAR_TOLERANCE)
     if np.any(no_move):
-        raise RepeatedWaypointError(int(np.argmax(no_move)) + 1, field=field)
+        raise RepeatedWaypointError(first + int(np.argmax(no_move)) + 1, field=field)
     half_turn = np.flatnonzero(angular > math.pi - HALF_TURN_TOLERANCE)
     if half_turn.size:
-        i = int(half_turn[0]) + 1
+        k = int(half_turn[0])
         raise InvalidInputError(
             field,
-            f"the orientation turns by {math.degrees(float(angular[i - 1])):.6f} deg from "
-            f"waypoint {i - 1}: within {HALF_TURN_TOLERANCE:g} rad of a half turn the direction "
-            "of rotation is undefined; add a waypoint between them",
-            waypoint=i,
+            f"the orientation turns by {math.degrees(float(angular[k])):.6f} deg from "
+            f"waypoint {first + k}: within {HALF_TURN_TOLERANCE:g} rad of a half turn the "
+            "direction of rotation is undefined; add a waypoint between them",
+            waypoint=first + k + 1,
         )
     u_t, u_r, h = segment_requirements(displacement, rotation_vector)
     last = slice(-1, None)

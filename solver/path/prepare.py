@@ -72,11 +72,42 @@ def check_passes(
     return ranges
 
 
+def path_requirements(
+    waypoints: np.ndarray,
+    passes: Sequence[tuple[int, int]] | None = None,
+    *,
+    field: str = "path.waypoints",
+) -> TaskRequirements:
+    """The task requirements of a path of passes, each pass's own; the path checked.
+
+    Args:
+        waypoints: shape (N, 4, 4), T_O_i (metres).
+        passes: as :func:`prepare_path`'s.
+        field: the request's field the path came in (``path.cl_data`` for a CL program):
+            errors name it, and the waypoint in the whole path.
+
+    Raises:
+        InvalidInputError, RepeatedWaypointError: as :func:`solver.core.task.task_requirements`,
+            or passes that do not cover the path.
+    """
+    path = np.asarray(waypoints, dtype=float)
+    parts = [
+        task_requirements(path[start:stop], field=field, first=start)
+        for start, stop in check_passes(passes, len(path))
+    ]
+    return TaskRequirements(  # u_T, u_R turn with the yaw, h does not
+        u_T=np.concatenate([part.u_T for part in parts]),
+        u_R=np.concatenate([part.u_R for part in parts]),
+        h=np.concatenate([part.h for part in parts]),
+    )
+
+
 def prepare_path(
     robot: Robot,
     waypoints_in_workpiece: np.ndarray,
     *,
     passes: Sequence[tuple[int, int]] | None = None,
+    field: str = "path.waypoints",
 ) -> PreparedPath:
     """Check a path and precompute its placement-independent data.
 
@@ -85,18 +116,14 @@ def prepare_path(
         waypoints_in_workpiece: shape (N, 4, 4), T_O_i (metres).
         passes: index ranges [start, stop) of the passes (cam.md section 5), in order and
             covering every waypoint; None: one pass. The requirements are taken per pass.
+        field: the request's field the path came in, which errors name.
 
     Raises:
-        InvalidInputError, RepeatedWaypointError: as :func:`solver.core.task.task_requirements`.
+        InvalidInputError, RepeatedWaypointError: as :func:`path_requirements`.
     """
     path = np.asarray(waypoints_in_workpiece, dtype=float)
     ranges = check_passes(passes, len(path))
-    parts = [task_requirements(path[start:stop]) for start, stop in ranges]
-    requirements = TaskRequirements(  # u_T, u_R turn with the yaw, h does not
-        u_T=np.concatenate([part.u_T for part in parts]),
-        u_R=np.concatenate([part.u_R for part in parts]),
-        h=np.concatenate([part.h for part in parts]),
-    )
+    requirements = path_requirements(path, ranges, field=field)
     segment_in_pass = np.ones(max(len(path) - 1, 0), dtype=bool)
     segment_in_pass[[start - 1 for start, _ in ranges[1:]]] = False
     tool_to_flange = np.linalg.inv(robot.transform_tool_to_tcp)

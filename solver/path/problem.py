@@ -125,12 +125,15 @@ class PathProblem:
         options: how the path is evaluated.
         passes: index ranges [start, stop) of the passes of a CAM program (cam.md section 5);
             None: one pass.
+        source: the request's field the path came in (``path.cl_data`` for a CL program),
+            which the path's errors name, with the waypoint in the whole path.
     """
 
     robot: Robot
     waypoints: np.ndarray
     options: PathOptions = field(default_factory=PathOptions)
     passes: tuple[tuple[int, int], ...] | None = None
+    source: str = "path.waypoints"
 
     def __post_init__(self) -> None:
         """Hold the waypoints as a float array and the passes as a tuple."""
@@ -147,10 +150,11 @@ class PathProblem:
         options: PathOptions | None = None,
         *,
         passes: Sequence[tuple[int, int]] | None = None,
+        source: str = "path.waypoints",
     ) -> PathProblem:
         """The problem of ``robot`` along ``waypoints`` (default options)."""
         passes_tuple = None if passes is None else tuple(passes)
-        return cls(robot, waypoints, options or PathOptions(), passes_tuple)
+        return cls(robot, waypoints, options or PathOptions(), passes_tuple, source)
 
     @property
     def family(self) -> KinematicsFamily:
@@ -165,7 +169,7 @@ class PathProblem:
     @functools.cached_property
     def prepared(self) -> PreparedPath:
         """The path checked and reduced to what every placement needs (in {O})."""
-        return prepare_path(self.robot, self.waypoints, passes=self.passes)
+        return prepare_path(self.robot, self.waypoints, passes=self.passes, field=self.source)
 
     @functools.cached_property
     def limits(self) -> tuple[Limit, ...]:

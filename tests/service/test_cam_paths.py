@@ -200,3 +200,55 @@ def test_the_joint_use_picture_at_the_feed(client: TestClient) -> None:
         # not an input error (api.md): a picture saying the path does not run there
         told = client.post(route, json=far, headers=headers)
         assert told.status_code == 200 and told.content.startswith(b"\x89PNG\r\n\x1a\n")
+
+
+FLIPPED = """UNITS/MM
+FEDRAT/MMPM,1000
+GOTO/0,400,100,0,0,1
+GOTO/10,400,100,0,0,1
+GOTO/20,400,100,0,0,1
+RAPID
+GOTO/0,450,100,0,0,1
+FEDRAT/MMPM,1000
+GOTO/10,450,100,0,0,1
+GOTO/15,450,100,0,0,1
+"""
+"""Two passes; the lines FLIP then add to the second a tool axis turned about half a turn."""
+FLIP = "GOTO/20,450,100,0.0017,0,-0.99999\nGOTO/30,450,100,0.0017,0,-0.99999\n"
+
+
+def test_an_error_in_a_later_pass_names_the_program_and_the_waypoint_of_the_path(
+    client: TestClient,
+) -> None:
+    """A tool axis that turns half a turn between two points of the second pass: every route
+    and the import refuse it alike, naming ``path.cl_data`` and the waypoint as the import
+    lists the program (the second pass's end in the program without the flip: the flipped
+    point follows it), where they named ``path.waypoints`` and the waypoint within its pass."""
+    before = client.post("/v1/paths/import", json={"path": {"cl_data": FLIPPED}}).json()
+    (_, first_stop), (second_start, flipped) = before["passes"]
+    assert second_start == first_stop > 0
+    path = {"cl_data": FLIPPED + FLIP}
+    answers = [
+        client.post("/v1/paths/import", json={"path": path}),
+        client.post("/v1/evaluate", json={"robot": ROBOT, "path": path, "placement": PLACEMENT}),
+    ]
+    for answer in answers:
+        assert answer.status_code == 422, answer.text
+        (detail,) = answer.json()["detail"]
+        assert detail["loc"] == ["body", "path", "cl_data", flipped]
+        assert f"turns by 180.000000 deg from waypoint {flipped - 1}:" in detail["msg"]
+
+
+def test_the_import_refuses_a_path_every_route_refuses(client: TestClient) -> None:
+    """A waypoint repeating the one before: the import answered 200 (repeated_points 0) for a
+    path /v1/evaluate refuses; now the same 422, naming the waypoint."""
+    waypoints = json.loads((ROOT / "examples" / "evaluate_request.json").read_text())["path"]
+    waypoints = waypoints["waypoints"]
+    path = {"waypoints": [*waypoints[:5], waypoints[4], *waypoints[5:]]}
+    imported = client.post("/v1/paths/import", json={"path": path})
+    evaluated = client.post(
+        "/v1/evaluate", json={"robot": ROBOT, "path": path, "placement": PLACEMENT}
+    )
+    assert imported.status_code == evaluated.status_code == 422
+    assert imported.json()["detail"] == evaluated.json()["detail"]
+    assert imported.json()["detail"][0]["loc"] == ["body", "path", "waypoints", 5]
