@@ -114,7 +114,8 @@ def extreme(cmap: CapabilityMap, *, best: bool) -> schemas.MapExtreme | None:
     )
 
 
-_LIMITED_BY: tuple[Literal["speed", "acceleration"], ...] = ("speed", "acceleration")
+LIMITED_BY: tuple[Literal["speed", "acceleration"], ...] = ("speed", "acceleration")
+"""What binds mu_acc, by the map's ``limited_by`` code (0 the speeds, 1 the accelerations)."""
 
 
 def acceleration_columns(cmap: CapabilityMap) -> tuple[list[Any], list[Any]]:
@@ -124,7 +125,7 @@ def acceleration_columns(cmap: CapabilityMap) -> tuple[list[Any], list[Any]]:
     """
     if cmap.mu_acc is None or cmap.limited_by is None:
         return [None] * cmap.mu_path.size, [None] * cmap.mu_path.size
-    bound = [_LIMITED_BY[min(k, 1)] for k in cmap.limited_by.ravel().tolist()]
+    bound = [LIMITED_BY[min(k, 1)] for k in cmap.limited_by.ravel().tolist()]
     return cmap.mu_acc.ravel().tolist(), bound
 
 

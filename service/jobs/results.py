@@ -10,6 +10,8 @@ from __future__ import annotations
 
 import json
 import sqlite3
+from collections.abc import Iterable
+from dataclasses import dataclass
 from typing import Any
 
 PAGE_CELLS = 1000
@@ -55,15 +57,45 @@ def make_tables(db: sqlite3.Connection) -> None:
             db.execute(f"ALTER TABLE jobs ADD COLUMN {name} {kind}")
 
 
-def write_result(
-    db: sqlite3.Connection, job_id: str, result: dict[str, Any]
-) -> tuple[str, int | None]:
+@dataclass(frozen=True)
+class CellPages:
+    """A map's answer for the store, its cells already JSON text a page at a time.
+
+    A map job wrote a validated model a cell, dumped it to dicts and those to JSON: for 400,000
+    cells 3.2, 1.6 and 1.9 s after its last progress report (the jobs audit of stop 56), and
+    4.8 GB at 2 million cells. Its cells now come as the map route writes them, from the
+    map's columns (:func:`service.convert.map_json.cell_pages`), a page at a time as the store
+    takes them.
+
+    Attributes:
+        rest: the answer but its cells, as JSON values.
+        pages: PAGE_CELLS cells a page (the last fewer), each page its cells' JSON objects
+            joined by commas, in the answer's order; read once.
+        count: how many cells.
+    """
+
+    rest: dict[str, Any]
+    pages: Iterable[str]
+    count: int
+
+
+Result = dict[str, Any] | CellPages
+"""A job's answer as its work gives it to the store."""
+
+
+def write_result(db: sqlite3.Connection, job_id: str, result: Result) -> tuple[str, int | None]:
     """Keep a result's ``cells`` in pages (replacing any of an earlier run).
 
     Returns:
         The rest of the result as JSON text, and the number of cells (None without cells).
     """
     db.execute("DELETE FROM job_cells WHERE job_id = ?", (job_id,))
+    if isinstance(result, CellPages):
+        db.executemany(
+            "INSERT INTO job_cells (job_id, page, cells) VALUES (?, ?, ?)",
+            ((job_id, k, "[" + text + "]") for k, text in enumerate(result.pages)),
+        )
+        return json.dumps(result.rest), result.count
     cells = result.get("cells")
     if not isinstance(cells, list):
         return json.dumps(result), None

@@ -18,7 +18,7 @@ import uuid
 from typing import Any
 
 from service.jobs.job import Job, Kind, QueueFull, Status, job_of_row
-from service.jobs.results import write_result
+from service.jobs.results import Result, write_result
 from service.jobs.store_reads import JobReads
 
 
@@ -94,7 +94,7 @@ class JobStore(JobReads):
         job_id: str,
         status: Status,
         *,
-        result: dict[str, Any] | None = None,
+        result: Result | None = None,
         error: list[dict[str, Any]] | None = None,
         if_running: bool = False,
     ) -> None:
@@ -121,7 +121,7 @@ class JobStore(JobReads):
         job_id: str,
         status: Status,
         *,
-        result: dict[str, Any] | None,
+        result: Result | None,
         error: list[dict[str, Any]] | None,
     ) -> None:
         """Write a job's end, its result's cells in pages (inside the caller's transaction)."""

@@ -9,7 +9,7 @@ optimisers, casadi), which a command line that evaluates or maps never loads.
 """
 
 from service.operations.evaluate import evaluation_of, joint_use_png
-from service.operations.map import checked_grid, computed_map, map_of, map_png
+from service.operations.map import checked_grid, computed_map, map_png
 from service.operations.paths import import_of, imported
 
 __all__ = [
@@ -19,6 +19,5 @@ __all__ = [
     "import_of",
     "imported",
     "joint_use_png",
-    "map_of",
     "map_png",
 ]

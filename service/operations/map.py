@@ -7,7 +7,7 @@ from typing import NamedTuple
 from service import convert
 from service.config import Settings
 from service.operations.threads import thread_runner
-from service.schemas import MapRequest, MapResponse, PathRead
+from service.schemas import MapRequest, PathRead
 from solver.core.parallel import TaskRunner
 from solver.core.progress import Progress
 from solver.core.robots import Robot
@@ -96,16 +96,6 @@ def computed_map(
         runner=thread_runner(settings.threads) if runner is None else runner,
     )
     return ComputedMap(result, robot, problem.options.spin_mode, path_read)
-
-
-def map_of(
-    body: MapRequest, settings: Settings, progress: Progress, runner: TaskRunner | None = None
-) -> MapResponse:
-    """The JSON answer of ``POST /v1/map`` (a map job's result too, its tasks on ``runner``)."""
-    result, robot, spin_mode, path_read = computed_map(
-        body, settings, png=False, progress=progress, runner=runner
-    )
-    return convert.map_response(result, robot, spin_mode=spin_mode, path_read=path_read)
 
 
 def map_png(result: CapabilityMap, robot: Robot) -> bytes:

@@ -9,13 +9,14 @@ null), and odd numbers (small and large magnitudes, negative zero).
 
 from __future__ import annotations
 
+import json
 import math
 
 import numpy as np
 import pytest
 
 from service.convert import map_response
-from service.convert.map_json import map_json
+from service.convert.map_json import cell_pages, map_json
 from solver.core.robots import Robot
 from solver.families import get_robot
 from solver.path.problem import SpinMode
@@ -62,3 +63,19 @@ def test_a_map_without_a_feasible_cell() -> None:
     expected = map_response(cmap, robot, spin_mode="fixed").model_dump_json()
     assert '"best":null' in expected
     assert map_json(cmap, robot, spin_mode="fixed") == expected.encode()
+
+
+@pytest.mark.parametrize("page", [1, 7, 13, 1000])
+def test_pages_of_any_size_join_to_the_routes_cells(page: int) -> None:
+    """A map job stores its cells a page at a time (service.convert.map_json.cell_pages): pages
+    that cut rows of x anywhere hold, in order, the cells the route answers."""
+    robot, spin_mode, spins = ROBOTS["accelerations"]
+    cmap = capability_map(
+        robot, load_path("curved_line"), spin_mode=spin_mode, xs=XS, ys=YS, z=0.1, yaws=YAWS,
+        spins=spins,
+    )  # fmt: skip
+    pages = list(cell_pages(cmap, robot, page=page))
+    assert len(pages) == -(-cmap.mu_path.size // page)
+    cells = [cell for text in pages for cell in json.loads(f"[{text}]")]
+    expected = map_response(cmap, robot, spin_mode=spin_mode).model_dump(mode="json")["cells"]
+    assert cells == expected
