@@ -7,8 +7,9 @@ route's, which computes them in the web process.
 
 from __future__ import annotations
 
+import math
 import time
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import Any
 
@@ -17,7 +18,12 @@ import numpy as np
 import pytest
 from distributed import LocalCluster
 
-from tests.test_jobs import BIG_GRID, EXAMPLE, GRID_8K, map_request, server, wait_for
+from service.config import Settings
+from service.jobs import dask_runner
+from service.jobs.dask_runner import ClusterUnavailable, DaskRunner
+from service.jobs.store import JobStore
+from service.jobs.worker import run_job, task_runner
+from tests.test_jobs import BIG_GRID, EXAMPLE, GRID_8K, SMALL_GRID, map_request, server, wait_for
 
 
 @pytest.fixture(scope="module")
@@ -110,3 +116,56 @@ def test_an_optimize_job_on_dask_finds_the_routes_optimum(
     finally:
         process.terminate()
         process.wait()
+
+
+def _noted(done: list[int]) -> Callable[[int], None]:
+    return done.append
+
+
+def test_a_runner_whose_client_closed_connects_again(cluster: LocalCluster) -> None:
+    """A scheduler's outage past the client's reconnect window closes it for good: every later
+    job failed ('NoneType' object has no attribute 'ncores') until the service restarted."""
+    runner = DaskRunner(cluster.scheduler_address)
+    done: list[int] = []
+    assert runner.run(abs, [-1, -2, 3], _noted(done)) == [1, 2, 3]
+    runner.client().close()  # as an outage longer than the reconnect window leaves it
+    assert runner.task_size(1000, 32) >= 32
+    assert runner.run(abs, [-4, 5], _noted(done)) == [4, 5]
+    assert sorted(done) == [0, 0, 1, 1, 2]
+
+
+def test_a_tasks_own_error_is_raised_as_it_is(cluster: LocalCluster) -> None:
+    runner = DaskRunner(cluster.scheduler_address)
+    with pytest.raises(ValueError, match="math domain error"):
+        runner.run(math.sqrt, [4.0, -1.0], _noted([]))
+
+
+def test_a_cluster_that_cannot_run_a_job_says_so() -> None:
+    """No scheduler at the address; a scheduler without a worker (the tasks would wait, the job
+    running, its ETA growing): ClusterUnavailable, naming the address and what is missing."""
+    with pytest.raises(ClusterUnavailable, match=r"tcp://127.0.0.1:9 .* cannot be reached"):
+        DaskRunner("tcp://127.0.0.1:9", connect_seconds=1.0).run(abs, [1], _noted([]))
+    with LocalCluster(n_workers=0, dashboard_address=":0") as empty:
+        runner = DaskRunner(empty.scheduler_address, connect_seconds=0.5)
+        with pytest.raises(ClusterUnavailable, match=r"has no worker after 0\.5 s"):
+            runner.task_size(1000, 32)
+
+
+def test_a_job_the_cluster_cannot_run_fails_as_unavailable(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Its error's type is 'unavailable' (it was 'internal', which reads as a bug of ours)."""
+    monkeypatch.setattr(dask_runner, "CONNECT_SECONDS", 1.0)
+    task_runner.cache_clear()
+    store = JobStore(tmp_path / "jobs.sqlite3")
+    job = store.create("map", map_request(SMALL_GRID), total=1)
+    try:
+        run_job(store, job.id, Settings(dask_scheduler="tcp://127.0.0.1:9"))
+    finally:
+        task_runner.cache_clear()
+    state = store.get(job.id)
+    assert state is not None and state.status == "failed"
+    assert state.error is not None
+    (error,) = state.error
+    assert error["type"] == "unavailable", error
+    assert "tcp://127.0.0.1:9" in error["msg"]

@@ -3,6 +3,13 @@
 Dask's ``distributed`` is the standard engine for numpy work across machines; it is imported
 only when a scheduler is set. The workers must have this package installed (README, "Jobs on a
 Dask cluster"). Progress comes from completed tasks; a cancel cancels the futures.
+
+A cluster that cannot run a job's tasks (its scheduler unreachable, lost during the job, or
+without a worker) is :class:`ClusterUnavailable`: the job fails saying so (type
+``unavailable``), and the next job connects again: a client that its scheduler's outage closed
+for good (longer than its reconnect window) is made anew, where every later job failed with
+``AttributeError: 'NoneType' object has no attribute 'ncores'`` until the service restarted (the
+jobs audit of stop 56).
 """
 
 from __future__ import annotations
@@ -16,7 +23,13 @@ T = TypeVar("T")
 R = TypeVar("R")
 
 CONNECT_SECONDS = 10.0
-"""How long to wait for the scheduler before a job fails (s)."""
+"""How long to wait for the scheduler, and for a worker on it, before a job fails (s)."""
+LIVE = ("newly-created", "connecting", "running")
+"""A ``distributed.Client``'s states in which it is, or will be, connected."""
+
+
+class ClusterUnavailable(RuntimeError):
+    """The Dask cluster cannot run a job's tasks: its scheduler unreachable or lost, no worker."""
 
 
 class DaskRunner:
@@ -24,50 +37,111 @@ class DaskRunner:
 
     threads = 1  # the cluster's threads run the tasks; the caller's own work stays in its thread
 
-    def __init__(self, address: str) -> None:
-        """A runner on the scheduler at ``address`` (``tcp://host:8786``)."""
+    def __init__(self, address: str, *, connect_seconds: float | None = None) -> None:
+        """A runner on the scheduler at ``address`` (``tcp://host:8786``).
+
+        ``connect_seconds``: how long to wait for the scheduler and a worker (default
+        :data:`CONNECT_SECONDS`).
+        """
         self.address = address
+        self.connect_seconds = CONNECT_SECONDS if connect_seconds is None else connect_seconds
         self._client: Any = None
 
+    def _unavailable(self, what: str, error: BaseException | None = None) -> ClusterUnavailable:
+        said = "" if error is None else f": {type(error).__name__}: {str(error)[:300]}"
+        return ClusterUnavailable(
+            f"the Dask cluster of {self.address} (DTF_DASK_SCHEDULER) {what}{said}; the job "
+            "can be submitted again once the cluster runs"
+        )
+
     def client(self) -> Any:
-        """The connected client (``distributed.Client``), made on first use."""
+        """The connected client (``distributed.Client``), made on first use and after it closed.
+
+        Raises:
+            ClusterUnavailable: the scheduler cannot be reached within ``connect_seconds``.
+        """
+        if self._client is not None and self._client.status not in LIVE:
+            self._client = None  # closed for good (an outage past its reconnect window)
         if self._client is None:
             from distributed import Client
 
             try:
                 self._client = Client(  # type: ignore[no-untyped-call]
-                    self.address, timeout=CONNECT_SECONDS, set_as_default=False
+                    self.address, timeout=self.connect_seconds, set_as_default=False
                 )
             except (OSError, TimeoutError) as error:
-                raise RuntimeError(
-                    f"cannot reach the Dask scheduler {self.address} (DTF_DASK_SCHEDULER): {error}"
-                ) from None
+                raise self._unavailable("cannot be reached", error) from None
         return self._client
 
     def task_size(self, n_placements: int, chunk: int) -> int:
         """About eight tasks per cluster thread, each a fraction of a second at most.
 
         Progress and a cancel are seen as tasks complete, so no task may be long.
+
+        Raises:
+            ClusterUnavailable: the scheduler is unreachable, or no worker joins it within
+                ``connect_seconds`` (the job's tasks would wait for one, its status running).
         """
-        threads = sum(self.client().nthreads().values()) or 1
-        return tasks_of(n_placements, chunk, per_worker=8, workers=threads, cap=8 * chunk)
+        client = self.client()
+        try:
+            threads = sum(client.nthreads().values())
+            if not threads:
+                client.wait_for_workers(1, timeout=self.connect_seconds)
+                threads = sum(client.nthreads().values())
+        except TimeoutError:
+            raise self._unavailable(f"has no worker after {self.connect_seconds:g} s") from None
+        except (OSError, AttributeError) as error:  # a client closed meanwhile: None inside
+            raise self._unavailable("was lost", error) from None
+        return tasks_of(n_placements, chunk, per_worker=8, workers=threads or 1, cap=8 * chunk)
 
     def run(
         self, work: Callable[[T], R], tasks: Sequence[T], done: Callable[[int], None]
     ) -> list[R]:
-        """The tasks as futures; completions reported as they arrive; cancelled on a raise."""
+        """The tasks as futures; completions reported as they arrive; cancelled on a raise.
+
+        A task's own exception is raised as it is; the cluster's (the scheduler's connection
+        lost, the client closed) as :class:`ClusterUnavailable`.
+        """
+        from concurrent.futures import CancelledError
+
         from distributed import as_completed
+        from distributed.client import ClosedClientError
 
         client = self.client()
-        futures = client.map(work, list(tasks), pure=False)
+        lost = (OSError, CancelledError, ClosedClientError, AttributeError)
+        try:
+            futures = client.map(work, list(tasks), pure=False)
+        except lost as error:
+            raise self._unavailable("was lost", error) from None
         index = {future.key: i for i, future in enumerate(futures)}
+        failed = None  # a task that raised
         try:
             for future in as_completed(futures, loop=client.loop):  # type: ignore[no-untyped-call]
                 if future.status == "error":
-                    future.result()  # the task's exception, raised here
+                    failed = future
+                    break
+                if future.status == "cancelled":  # not the job's cancel: that raises in done
+                    raise CancelledError(future.key)
                 done(index[future.key])
+            else:
+                results: list[R] = client.gather(futures)
+                return results
+        except lost as error:
+            client_cancel(client, futures)
+            raise self._unavailable("was lost", error) from None
         except BaseException:
-            client.cancel(futures)
+            client_cancel(client, futures)
             raise
-        results: list[R] = client.gather(futures)
-        return results
+        try:
+            failed.result()  # the task's own exception, raised here as it is
+        finally:
+            client_cancel(client, futures)
+        raise AssertionError("a task in error gave a result")  # not reached
+
+
+def client_cancel(client: Any, futures: list[Any]) -> None:
+    """Cancel the futures on the cluster, if it can still be told."""
+    try:
+        client.cancel(futures)
+    except Exception:  # noqa: BLE001 - the scheduler gone: nothing runs there to cancel
+        return

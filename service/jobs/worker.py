@@ -26,6 +26,7 @@ from pydantic import ValidationError
 from service.config import Settings
 from service.convert.map_json import cell_pages, rest_json
 from service.errors import request_errors, solver_error_location, solver_error_type
+from service.jobs.dask_runner import ClusterUnavailable
 from service.jobs.job import DamagedJob, JobStoreUnavailable
 from service.jobs.results import PAGE_CELLS, CellPages, Result
 from service.jobs.store import JobStore
@@ -141,6 +142,10 @@ def run_job(store: JobStore, job_id: str, settings: Settings) -> None:
         detail = {"loc": loc, "msg": error.message, "type": solver_error_type(error)}
         store.finish(job_id, "failed", error=[detail])
         log.info("job %s failed: %s", job_id, error.message[:200])
+    except ClusterUnavailable as error:  # the cluster's fault, not the request's or ours
+        detail = {"loc": [], "msg": str(error), "type": "unavailable"}
+        store.finish(job_id, "failed", error=[detail])
+        log.warning("job %s failed: %s", job_id, error)
     except ValidationError as error:
         # as the route's 422 gives them (errors.request_errors), under the route's body
         located = [{**e, "loc": ("body", *e["loc"])} for e in error.errors()]
