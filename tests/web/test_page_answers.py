@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import copy
 import json
+import math
 from typing import Any
 
 import httpx
@@ -188,3 +189,38 @@ def test_an_optimisation_job_is_stopped_from_the_page(page: Page, url: str) -> N
             break
         page.wait_for_timeout(100)
     assert status == "cancelled"
+
+
+def test_the_best_line_says_the_spin_of_a_spun_map(page: Page, url: str) -> None:
+    fill(page, {**SMALL, "spins": "0, 1.2"})
+    page.click("#run")
+    page.wait_for_function("document.getElementById('summary').dataset.cells", timeout=60_000)
+    grid = {**grid_of(SMALL), "spin": [0.0, 1.2]}
+    body = {"robot": {"model": "ur5"}, "path": EXAMPLE_PATH, "grid": grid}
+    best = httpx.post(f"{url}/v1/map", json=body, timeout=60).json()["best"]["placement"]
+    assert (page.text_content("#best-where") or "").endswith(f"spin {best['spin']:.4f} rad")
+
+
+def test_an_optimum_marked_on_another_yaws_panel_says_so(page: Page, url: str) -> None:
+    """Any yaw: the optimum's yaw is none of the map's two; its marker goes on the nearest
+    panel's, and the page says which and what the optimum's is."""
+    api = run_small_map(page, url)
+    page.click("#opt-any-yaw")
+    page.click("#optimize")
+    page.wait_for_selector(".panel canvas[data-optimum='1']", timeout=120_000)
+    request = {
+        "robot": {"model": "ur5"},
+        "path": EXAMPLE_PATH,
+        "method": "casadi",
+        "z": 0.1,
+        "bounds": {"x": [-0.1, 0.1], "y": [0.3, 0.5], "yaw": [-math.pi, math.pi]},
+    }
+    optimum = httpx.post(f"{url}/v1/optimize", json=request, timeout=120).json()["placement"]
+    yaws = sorted({c["yaw"] for c in api["cells"]})
+    nearest = min(yaws, key=lambda y: abs(y - optimum["yaw"]))
+    note = page.text_content("#opt-marked") or ""
+    if abs(nearest - optimum["yaw"]) > 1e-9:
+        assert page.is_visible("#opt-marked")
+        assert f"at yaw {nearest:.4f} rad" in note and f"{optimum['yaw']:.4f} rad" in note
+    else:
+        assert not page.is_visible("#opt-marked")

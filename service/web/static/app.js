@@ -361,7 +361,8 @@ function clearCell() {
 }
 
 function clearOptimum() {
-  for (const id of ["opt-mu", "opt-acc", "opt-acc-binds", "opt-improvement", "opt-where", "opt-clearance", "opt-why"]) $(id).textContent = "";
+  for (const id of ["opt-mu", "opt-acc", "opt-acc-binds", "opt-improvement", "opt-where", "opt-clearance", "opt-why", "opt-marked"]) $(id).textContent = "";
+  $("opt-marked").hidden = true;
   $("opt-acc-line").hidden = true;
   $("opt-clearance").hidden = true;
   $("opt-why").hidden = true;
@@ -469,8 +470,12 @@ function drawMap(answer) {
   $("best-mu").textContent = !answer.best ? "none feasible"
     : key === "mu_acc" ? `mu_acc ${answer.best.mu_acc.toFixed(6)} m/s (mu_path ${answer.best.mu_path.toFixed(6)} m/s)`
     : answer.best.mu_path.toFixed(6) + " m/s";
+  // The spin too where the map has spins other than 0 (or the spin is free: its start).
+  const spun = cells.some((c) => c.spin !== 0) || answer.spin_mode === "free";
   $("best-where").textContent = answer.best
-    ? `at x ${metres(answer.best.placement.x)}, y ${metres(answer.best.placement.y)}, yaw ${radians(answer.best.placement.yaw)}` : "";
+    ? `at x ${metres(answer.best.placement.x)}, y ${metres(answer.best.placement.y)}, yaw ${radians(answer.best.placement.yaw)}`
+      + (spun ? `, spin ${radians(answer.best.placement.spin)}${answer.spin_mode === "free" ? " + free rate" : ""}` : "")
+    : "";
   $("colourbar").hidden = false;
   $("best-line").hidden = false;
   $("cb-min").textContent = feasible.length ? `${low.toFixed(3)} m/s` : "";

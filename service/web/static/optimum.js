@@ -173,6 +173,11 @@ function markOptimum() {
   state.optimum.canvas = canvases[k];
   canvases.forEach(paintPanel);
   canvases[k].dataset.optimum = "1";
+  // Marked on the nearest panel's yaw: said where that is not the optimum's own.
+  const note = $("opt-marked");
+  note.hidden = Math.abs(yaws[k] - p.yaw) <= 1e-9;
+  note.textContent = note.hidden ? ""
+    : `Marked at its x and y on the map's panel at yaw ${radians(yaws[k])}, the nearest of the map's yaws to the optimum's ${radians(p.yaw)} (${fixed((p.yaw * 180) / Math.PI, 2)} deg).`;
 }
 
 // A new path or robot while an optimisation runs: its request is aborted (the service stops the
