@@ -183,7 +183,8 @@ class Settings(BaseSettings):
     job_attempts: int = Field(
         default=3,
         gt=0,
-        description="Times a job interrupted by a restart is run before it fails.",
+        description="Times a job interrupted by a restart, or whose worker process died (killed "
+        "for memory, say), is run before it fails.",
     )
     max_job_cells: int = Field(
         default=2_000_000,

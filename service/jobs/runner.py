@@ -160,11 +160,17 @@ class JobRunner:
                 else:
                     self._workers[i] = _Worker(worker.process, worker.connection)
                     continue
-            if not worker.process.is_alive():
-                message = f"the worker process ended (exit code {worker.process.exitcode})"
-                error = [{"loc": [], "msg": message, "type": "internal"}]
-                self.store.finish(job_id, "failed", error=error, if_running=True)
-                log.error("job %s failed: %s", job_id, message)
+            if not worker.process.is_alive():  # killed (out of memory, say): run again, a few times
+                attempts = self.settings.job_attempts
+                message = (
+                    f"the worker process ended (exit code {worker.process.exitcode}) in each of "
+                    f"the job's {attempts} runs (DTF_JOB_ATTEMPTS)"
+                )
+                error = [{"loc": [], "msg": message, "type": "interrupted"}]
+                if self.store.retry(job_id, attempts=attempts, error=error):
+                    log.warning("job %s queued again: its worker process ended", job_id)
+                else:
+                    log.error("job %s failed: %s", job_id, message)
                 self._replace(i)
             elif job_id in cancels:
                 worker.cancel_seen = worker.cancel_seen or now

@@ -82,6 +82,22 @@ class JobStore(JobReads):
             ).rowcount
         return bool(changed)
 
+    def retry(self, job_id: str, *, attempts: int, error: list[dict[str, Any]]) -> bool:
+        """Queue again a running job whose run ended abnormally (its worker died), or fail it.
+
+        Queued again, from no progress, while it has had fewer than ``attempts`` runs and no
+        cancel was asked; else failed with ``error``. Returns whether it was queued again.
+        """
+        with self._connection() as db:
+            queued = db.execute(
+                "UPDATE jobs SET status = 'queued', done = 0, started = NULL WHERE id = ? AND "
+                "status = 'running' AND attempts < ? AND cancel = 0",
+                (job_id, attempts),
+            ).rowcount
+        if not queued:
+            self.finish(job_id, "failed", error=error, if_running=True)
+        return bool(queued)
+
     def progress(self, job_id: str, fraction: float) -> bool:
         """Record the fraction done; whether to stop (a cancel was asked, or the job deleted)."""
         with self._connection() as db:

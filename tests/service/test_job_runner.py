@@ -74,17 +74,31 @@ def test_an_unexpected_exception_fails_the_job_with_its_message(
     ]
 
 
-def test_a_dead_worker_fails_its_job_and_is_replaced(runner: JobRunner) -> None:
-    job = runner.store.create("map", BIG_MAP)
-    runner.wake()
-    wait_for(runner.store, job.id, lambda j: j.status != "queued")
-    runner._workers[0].process.kill()
-    failed = wait_for(runner.store, job.id, lambda j: j.status != "running")
-    assert failed.status == "failed" and failed.error is not None
-    assert "the worker process ended" in failed.error[0]["msg"]
-    second = runner.store.create("evaluate", EVALUATE)
-    runner.wake()
-    assert wait_for(runner.store, second.id, lambda j: j.status == "done").status == "done"
+def test_a_dead_worker_is_replaced_and_its_job_run_again_up_to_its_attempts(
+    tmp_path: Path,
+) -> None:
+    """A worker killed (for memory, say) failed its job at once (the jobs audit): the job is
+    now run again, from no progress, until DTF_JOB_ATTEMPTS runs ended so; other jobs run."""
+    runner = JobRunner(settings(tmp_path, job_attempts=2))
+    try:
+        job = runner.store.create("map", BIG_MAP)
+        runner.wake()
+        for attempt in (1, 2):
+            running = wait_for(runner.store, job.id, lambda j: j.status == "running")
+            assert running.status == "running" and running.attempts == attempt
+            runner._workers[0].process.kill()
+            ended = wait_for(runner.store, job.id, lambda j: j.status != "running")
+            if attempt == 1:
+                assert ended.status in ("queued", "running") and ended.attempts <= 2
+        assert ended.status == "failed" and ended.error is not None
+        assert ended.error[0]["type"] == "interrupted"
+        assert "the worker process ended" in ended.error[0]["msg"]
+        assert "2 runs (DTF_JOB_ATTEMPTS)" in ended.error[0]["msg"]
+        second = runner.store.create("evaluate", EVALUATE)
+        runner.wake()
+        assert wait_for(runner.store, second.id, lambda j: j.status == "done").status == "done"
+    finally:
+        runner.close()
 
 
 @pytest.mark.latency  # a cancel within a second: run alone (scripts/run_tests.py)
