@@ -117,13 +117,22 @@ class JobStore(JobReads):
         """Record how a job ended (with ``if_running``, only if it is still running).
 
         A job deleted meanwhile (or, with ``if_running``, not running) is left alone: nothing is
-        written, its result's cells neither, in the transaction that looks for it.
+        written, its result's cells neither, in the transaction that looks for it. A job whose
+        cancel was asked before its work's end is written ended there, ``cancelled``, without its
+        result: the client asked for it, and a map's answer stored from its columns may end
+        before the next progress report would have seen the cancel (api.md: cancel stops the
+        job, which is kept as cancelled).
         """
         condition = " AND status = 'running'" if if_running else ""
         with self._connection() as db:
             db.execute("BEGIN IMMEDIATE")  # the write lock, before the look
             try:
-                if db.execute("SELECT 1 FROM jobs WHERE id = ?" + condition, (job_id,)).fetchone():
+                row = db.execute(
+                    "SELECT cancel FROM jobs WHERE id = ?" + condition, (job_id,)
+                ).fetchone()
+                if row is not None:
+                    if status == "done" and row[0]:
+                        status, result = "cancelled", None
                     self._finish(db, job_id, status, result=result, error=error)
                 db.execute("COMMIT")
             except BaseException:

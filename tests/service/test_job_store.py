@@ -180,3 +180,20 @@ def test_a_job_queued_again_after_a_restart_starts_its_progress_again(tmp_path: 
     assert store.start(job.id)
     running = store.state(job.id)
     assert running is not None and running.fraction == 0.0 and running.started is not None
+
+
+def test_a_job_whose_cancel_came_before_its_end_is_cancelled_not_done(tmp_path: Path) -> None:
+    """A map's answer stored from its columns may end before the next progress report would
+    have seen the cancel: the job is then cancelled, its answer not kept (api.md: cancel stops
+    the job, kept as cancelled); one that ended before the cancel stays done."""
+    store = JobStore(tmp_path / "jobs.sqlite3")
+    asked, late = (store.create("evaluate", {"n": k}) for k in range(2))
+    for job in (asked, late):
+        assert store.start(job.id)
+    store.cancel(asked.id)
+    store.finish(asked.id, "done", result={"mu_path": 0.3})
+    store.finish(late.id, "done", result={"mu_path": 0.3})
+    store.cancel(late.id)
+    cancelled, done = store.get(asked.id), store.get(late.id)
+    assert cancelled is not None and cancelled.status == "cancelled" and cancelled.result is None
+    assert done is not None and done.status == "done" and done.result == {"mu_path": 0.3}
