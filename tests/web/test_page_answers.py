@@ -15,7 +15,9 @@ import math
 from typing import Any
 
 import httpx
+import numpy as np
 from playwright.sync_api import Page, Route
+from scipy.spatial.transform import Rotation
 
 from tests.web.test_page import EXAMPLE_PATH, SMALL, cell_point, fill, grid_of, run_small_map
 from tests.web.test_page_findings import choose_file, error_beside
@@ -224,3 +226,20 @@ def test_an_optimum_marked_on_another_yaws_panel_says_so(page: Page, url: str) -
         assert f"at yaw {nearest:.4f} rad" in note and f"{optimum['yaw']:.4f} rad" in note
     else:
         assert not page.is_visible("#opt-marked")
+
+
+def test_the_tool_point_fields_give_the_robots_tcp(page: Page, url: str) -> None:
+    """A catalogue robot's tool point from the page (its tool in the cell needs one): the six
+    fields are sent as robot.tcp, the angles as scipy turns them (R = Rz Ry Rx, degrees), and
+    the map is the API's of that body."""
+    fill(page, {**SMALL, "tcp-z": "0.12", "tcp-roll": "20", "tcp-yaw": "-35"})
+    with page.expect_request(lambda r: r.method == "POST" and r.url.endswith("/v1/jobs")) as sent:
+        page.click("#run")
+    request = json.loads(sent.value.post_data or "{}")["request"]
+    tcp = request["robot"]["tcp"]
+    assert tcp["position"] == [0, 0, 0.12]
+    expected = Rotation.from_euler("ZYX", [-35.0, 0.0, 20.0], degrees=True).as_quat()
+    np.testing.assert_allclose(tcp["orientation"], expected, atol=1e-15)
+    page.wait_for_function("document.getElementById('summary').dataset.cells", timeout=60_000)
+    api = httpx.post(f"{url}/v1/map", json=request, timeout=60).json()
+    assert page.text_content("#best-mu") == f"{api['best']['mu_path']:.6f} m/s"

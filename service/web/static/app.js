@@ -42,12 +42,14 @@ function robotBody() {
   // error beside the field, never dropped here): Number("x") is NaN, sent as null.
   const acc = $("acc-limits").value.trim();
   const accLimits = acc ? acc.split(",").map((v) => (v.trim() === "" ? null : Number(v))) : null;
+  const tcp = tcpBody();
   if ($("urdf").value.trim()) {  // the URDF as written; a frame left empty is the API's error
     const robot = { urdf: $("urdf").value };
     const base = $("base-frame").value.trim(), tool = $("tool-frame").value.trim();
     if (base) robot.base_frame = base;
     if (tool) robot.tool_frame = tool;
     if (accLimits) robot.joint_acceleration_limits = accLimits;
+    if (tcp) robot.tcp = tcp;
     return robot;
   }
   const robot = { model: $("robot-model").value };
@@ -55,7 +57,24 @@ function robotBody() {
   const limits = [...$("limits").querySelectorAll("input")].map((i) => Number(i.value));
   if (info && limits.some((v, k) => v !== info.qdot_max[k])) robot.joint_velocity_limits = limits;
   if (accLimits) robot.joint_acceleration_limits = accLimits;
+  if (tcp) robot.tcp = tcp;
   return robot;
+}
+
+const TCP_FIELDS = ["tcp-x", "tcp-y", "tcp-z", "tcp-roll", "tcp-pitch", "tcp-yaw"];
+
+// The robot's tool point in its flange frame (the API's robot.tcp), where any of its six
+// fields is filled: an empty one is then 0, as the label says; a word is sent as null, which
+// the API refuses beside the field. Angles in degrees: R = Rz(yaw) Ry(pitch) Rx(roll).
+function tcpBody() {
+  if (TCP_FIELDS.every((id) => $(id).value.trim() === "")) return undefined;
+  const [x, y, z, roll, pitch, yaw] = TCP_FIELDS.map((id) => {
+    const text = $(id).value.trim();
+    return text === "" ? 0 : Number(text);
+  });
+  const turn = [roll, pitch, yaw].some((a) => !Number.isFinite(a)) ? [null, null, null, null]
+    : quaternionOf(roll * DEGREE, pitch * DEGREE, yaw * DEGREE);
+  return { position: [x, y, z], orientation: turn };
 }
 
 // The links of a URDF, for the frame fields' suggestions; the base and tool frames filled in
@@ -121,6 +140,7 @@ function showOwnRobot() {
     input.disabled = own || urdf;
   }
   $("acc-limits").disabled = own;
+  for (const id of TCP_FIELDS) $(id).disabled = own;  // a pasted robot object gives its own
   $("own-robot-note").hidden = !own;
   $("urdf-note").hidden = !urdf;
 }
