@@ -76,6 +76,7 @@ def cell_point(
     xs = sorted({c["x"] for c in api["cells"]})
     ys = sorted({c["y"] for c in api["cells"]})
     canvas = page.locator(".panel canvas").nth(panel)
+    canvas.scroll_into_view_if_needed()  # the mouse reaches only what the window shows
     size = int(canvas.get_attribute("data-cell") or 0)
     box = canvas.bounding_box()
     assert box is not None

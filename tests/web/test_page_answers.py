@@ -20,6 +20,7 @@ from playwright.sync_api import Page, Route
 from scipy.spatial.transform import Rotation
 
 from tests.web.test_page import EXAMPLE_PATH, SMALL, cell_point, fill, grid_of, run_small_map
+from tests.web.test_page_cell import open_editor
 from tests.web.test_page_findings import choose_file, error_beside
 
 
@@ -232,6 +233,7 @@ def test_the_tool_point_fields_give_the_robots_tcp(page: Page, url: str) -> None
     """A catalogue robot's tool point from the page (its tool in the cell needs one): the six
     fields are sent as robot.tcp, the angles as scipy turns them (R = Rz Ry Rx, degrees), and
     the map is the API's of that body."""
+    page.click("#tool-point summary")
     fill(page, {**SMALL, "tcp-z": "0.12", "tcp-roll": "20", "tcp-yaw": "-35"})
     with page.expect_request(lambda r: r.method == "POST" and r.url.endswith("/v1/jobs")) as sent:
         page.click("#run")
@@ -243,3 +245,41 @@ def test_the_tool_point_fields_give_the_robots_tcp(page: Page, url: str) -> None
     page.wait_for_function("document.getElementById('summary').dataset.cells", timeout=60_000)
     api = httpx.post(f"{url}/v1/map", json=request, timeout=60).json()
     assert page.text_content("#best-mu") == f"{api['best']['mu_path']:.6f} m/s"
+
+
+SELF_GRID = {  # the page audit's grid: 25 of its cells self-colliding on the UR5
+    "x-min": "-0.4",
+    "x-max": "0.6",
+    "x-step": "0.05",
+    "y-min": "0.1",
+    "y-max": "0.8",
+    "y-step": "0.05",
+    "z": "0.1",
+    "yaws": "0, 1.5708",
+    "spins": "0",
+}
+
+
+def test_the_robot_is_checked_against_itself_with_no_object(page: Page, url: str) -> None:
+    """Asked (or a clearance given), the page sends a cell with no object: the arm against
+    itself (cell.md); before, link radii or a clearance without an object were dropped and
+    nothing was checked."""
+    open_editor(page)
+    page.check("#self-check")
+    assert "the robot against itself (no object)" in (page.text_content("#cell-status") or "")
+    fill(page, SELF_GRID)
+    with page.expect_request(lambda r: r.method == "POST" and r.url.endswith("/v1/jobs")) as sent:
+        page.click("#run")
+    request = json.loads(sent.value.post_data or "{}")["request"]
+    assert request["cell"] == {"fixed": [], "workpiece": []}
+    page.wait_for_function("document.getElementById('summary').dataset.cells", timeout=120_000)
+    api = httpx.post(f"{url}/v1/map", json=request, timeout=120).json()
+    collisions = sum(c["reason"] == "collision" for c in api["cells"])
+    assert collisions > 0
+    assert page.get_attribute("#summary", "data-collisions") == str(collisions)
+    page.uncheck("#self-check")
+    page.fill("#clearance", "0.01")
+    with page.expect_request(lambda r: r.method == "POST" and r.url.endswith("/v1/jobs")) as sent:
+        page.click("#run")
+    cell = json.loads(sent.value.post_data or "{}")["request"]["cell"]
+    assert cell == {"fixed": [], "workpiece": [], "clearance": 0.01}

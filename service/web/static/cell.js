@@ -134,12 +134,19 @@ function cellBody() {
     group.push(boxObject(row));
   }
   const tool = toolBody();
-  if (!fixed.length && !workpiece.length && !tool) return undefined;
+  if (!fixed.length && !workpiece.length && !tool && !selfChecked()) return undefined;
   const cell = { fixed, workpiece };
   if (tool) cell.tool = tool;
   if ($("clearance").value.trim() !== "") cell.clearance = value("clearance");
   if ($("link-radii").value.trim() !== "") cell.link_radii = numbers($("link-radii").value);
   return cell;
+}
+
+// Whether the robot is to be checked against itself with no object: asked, or a clearance or
+// link radii given (which mean nothing without a cell: they were dropped without a word).
+function selfChecked() {
+  return $("self-check").checked || $("clearance").value.trim() !== ""
+    || $("link-radii").value.trim() !== "";
 }
 
 // What the editor holds, in a line under it.
@@ -151,7 +158,8 @@ function showCellStatus() {
     .filter(Boolean);
   $("cell-status").textContent = things.length
     ? `Checked along the path against ${things.join(", ")}, and the robot against itself.`
-    : "Empty: nothing is checked (no cell is sent).";
+    : selfChecked() ? "Checked along the path: the robot against itself (no object)."
+      : "Empty: nothing is checked (no cell is sent).";
 }
 
 function millimetres(metresValue) { return `${fixed(1000 * metresValue, 1)} mm`; }
@@ -206,8 +214,9 @@ function cellModel(answer) {
 
 function startCellEditor() {
   $("add-box").addEventListener("click", addBox);
-  for (const id of ["table-height", "tool-radius", "tool-length", "tool-cutting-length"]) {
+  for (const id of ["table-height", "tool-radius", "tool-length", "tool-cutting-length", "clearance", "link-radii"]) {
     $(id).addEventListener("input", showCellStatus);
   }
+  $("self-check").addEventListener("change", showCellStatus);
   showCellStatus();
 }
