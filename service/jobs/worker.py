@@ -66,10 +66,16 @@ def _map(
     From the map's columns (:func:`service.convert.map_json.cell_pages`), no model a cell.
     """
     body = MapRequest.model_validate(request)
-    per_cell = map_cost(checked_grid(body, settings).problem)
+    checked = checked_grid(body, settings)
+    per_cell = map_cost(checked.problem)
     share = per_cell / (per_cell + STORED_CELL_COST)  # the placements' part of the job's work
     result, robot, spin_mode, path_read = computed_map(
-        body, settings, png=False, progress=lambda done: progress(share * done), runner=runner
+        body,
+        settings,
+        png=False,
+        progress=lambda done: progress(share * done),
+        runner=runner,
+        checked=checked,
     )
     rest = json.loads(rest_json(result, robot, spin_mode=spin_mode, path_read=path_read))
     del rest["cells"]

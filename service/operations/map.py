@@ -77,12 +77,15 @@ def computed_map(
     png: bool,
     progress: Progress,
     runner: TaskRunner | None = None,
+    checked: CheckedGrid | None = None,
 ) -> ComputedMap:
     """The map a request asks for, its size checked first; the robot; the spin mode; the reading.
 
-    The placements run on ``runner``, by default on DTF_THREADS threads.
+    The placements run on ``runner``, by default on DTF_THREADS threads. ``checked``: the
+    request's :func:`checked_grid` where the caller made it already (its problem's prepared
+    path is then not made again).
     """
-    robot, grid, problem, path_read = checked_grid(body, settings)
+    robot, grid, problem, path_read = checked_grid(body, settings) if checked is None else checked
     if png:
         convert.check_png_size(grid, settings=settings)
     result = capability_map(
