@@ -37,6 +37,12 @@ BIG_GRID = {  # 401 x 241 x 2 = 193,282 placements, far over the route's limit
     "z": 0.1,
     "yaw": [0.0, 1.0],
 }
+GRID_50K = {  # 200 x 125 x 2 = 50,000 placements, the route's cell limit
+    "x": {"min": -0.5, "max": 0.495, "step": 0.005},
+    "y": {"min": 0.0, "max": 0.62, "step": 0.005},
+    "z": 0.1,
+    "yaw": [0.0, 1.0],
+}
 GRID_8K = {  # 80 x 50 x 2 placements: seconds of work, within the route's limits
     "x": {"min": -0.4, "max": 0.39, "step": 0.01},
     "y": {"min": 0.2, "max": 0.69, "step": 0.01},
@@ -129,8 +135,10 @@ def test_a_running_map_job_is_cancelled_within_a_second(tmp_path: Path) -> None:
 
 
 def test_a_restart_finishes_an_interrupted_job_with_the_same_result(tmp_path: Path) -> None:
-    limits = {"DTF_MAX_MAP_POSES": "10000000"}
-    body = map_request(GRID_8K)
+    # 50,000 placements, its answer in the job's result: since map jobs store their cells from
+    # the columns, 8,000 ended within a poll of running, before the kill (a flaky test).
+    limits = {"DTF_MAX_MAP_POSES": "10000000", "DTF_JOB_PAGE_CELLS": "50000"}
+    body = map_request(GRID_50K)
     process, url = server(tmp_path, **limits)
     submitted = httpx.post(f"{url}/v1/jobs", json={"kind": "map", "request": body})
     job_id = submitted.json()["id"]
