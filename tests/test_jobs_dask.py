@@ -8,11 +8,15 @@ route's, which computes them in the web process.
 from __future__ import annotations
 
 import math
+import os
+import threading
 import time
 from collections.abc import Callable, Iterator
+from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 from typing import Any
 
+import dask
 import httpx
 import numpy as np
 import pytest
@@ -169,3 +173,50 @@ def test_a_job_the_cluster_cannot_run_fails_as_unavailable(
     (error,) = state.error
     assert error["type"] == "unavailable", error
     assert "tcp://127.0.0.1:9" in error["msg"]
+
+
+def _nap(seconds: float) -> float:
+    time.sleep(seconds)
+    return seconds
+
+
+def test_a_cluster_that_loses_its_workers_during_a_job_says_so() -> None:
+    """Every worker gone while the tasks run: they waited for one, the job running for ever
+    (the runner blocked in as_completed); now ClusterUnavailable once none has come back for
+    ``connect_seconds``."""
+    with LocalCluster(
+        n_workers=1, threads_per_worker=1, processes=True, dashboard_address=None
+    ) as lonely:
+        runner = DaskRunner(lonely.scheduler_address, connect_seconds=1.0)
+        done: list[int] = []
+
+        def retire_after_first(i: int) -> None:
+            done.append(i)
+            if len(done) == 1:
+                threading.Thread(target=lonely.scale, args=(0,)).start()
+
+        with ThreadPoolExecutor(1) as pool:
+            running = pool.submit(runner.run, _nap, [0.2] * 40, retire_after_first)
+            try:
+                with pytest.raises(ClusterUnavailable, match=r"has had no worker for 1 s"):
+                    running.result(timeout=60)
+            finally:
+                runner.client().close()  # unblocks a runner that waits for ever
+        assert 1 <= len(done) < 40
+
+
+def _die() -> None:
+    os._exit(3)
+
+
+def test_a_task_that_kills_its_workers_is_the_clusters_failure_named() -> None:
+    """A worker process dying under a task (out of memory, say) until the scheduler gives the
+    task up (KilledWorker): the job failed as 'internal', a bug of ours; now unavailable,
+    saying a worker died."""
+    with dask.config.set({"distributed.scheduler.allowed-failures": 0}):
+        with LocalCluster(
+            n_workers=1, threads_per_worker=1, processes=True, dashboard_address=None
+        ) as fragile:
+            runner = DaskRunner(fragile.scheduler_address, connect_seconds=5.0)
+            with pytest.raises(ClusterUnavailable, match=r"worker process die .* KilledWorker"):
+                runner.run(lambda _: _die(), [0], _noted([]))

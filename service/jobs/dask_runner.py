@@ -4,8 +4,9 @@ Dask's ``distributed`` is the standard engine for numpy work across machines; it
 only when a scheduler is set. The workers must have this package installed (README, "Jobs on a
 Dask cluster"). Progress comes from completed tasks; a cancel cancels the futures.
 
-A cluster that cannot run a job's tasks (its scheduler unreachable, lost during the job, or
-without a worker) is :class:`ClusterUnavailable`: the job fails saying so (type
+A cluster that cannot run a job's tasks (its scheduler unreachable or lost during the job, no
+worker when it starts or none left for ``CONNECT_SECONDS`` during it, a worker process dead under
+a task) is :class:`ClusterUnavailable`: the job fails saying so (type
 ``unavailable``), and the next job connects again: a client that its scheduler's outage closed
 for good (longer than its reconnect window) is made anew, where every later job failed with
 ``AttributeError: 'NoneType' object has no attribute 'ncores'`` until the service restarted (the
@@ -14,6 +15,7 @@ jobs audit of stop 56).
 
 from __future__ import annotations
 
+import time
 from collections.abc import Callable, Sequence
 from typing import Any, TypeVar
 
@@ -24,6 +26,8 @@ R = TypeVar("R")
 
 CONNECT_SECONDS = 10.0
 """How long to wait for the scheduler, and for a worker on it, before a job fails (s)."""
+POLL_SECONDS = 0.25
+"""How often a job waiting for its tasks asks whether the cluster still has a worker (s)."""
 LIVE = ("newly-created", "connecting", "running")
 """A ``distributed.Client``'s states in which it is, or will be, connected."""
 
@@ -100,11 +104,12 @@ class DaskRunner:
         """The tasks as futures; completions reported as they arrive; cancelled on a raise.
 
         A task's own exception is raised as it is; the cluster's (the scheduler's connection
-        lost, the client closed) as :class:`ClusterUnavailable`.
+        lost, the client closed, no worker left for ``connect_seconds``, a worker process dead
+        under a task: ``KilledWorker``) as :class:`ClusterUnavailable`.
         """
         from concurrent.futures import CancelledError
 
-        from distributed import as_completed
+        from distributed import KilledWorker, as_completed
         from distributed.client import ClosedClientError
 
         client = self.client()
@@ -114,16 +119,28 @@ class DaskRunner:
         except lost as error:
             raise self._unavailable("was lost", error) from None
         index = {future.key: i for i, future in enumerate(futures)}
+        completed: Any = as_completed(futures, loop=client.loop)  # type: ignore[no-untyped-call]
         failed = None  # a task that raised
+        alone_since: float | None = None  # when the cluster was last seen with no worker
         try:
-            for future in as_completed(futures, loop=client.loop):  # type: ignore[no-untyped-call]
-                if future.status == "error":
-                    failed = future
-                    break
-                if future.status == "cancelled":  # not the job's cancel: that raises in done
-                    raise CancelledError(future.key)
-                done(index[future.key])
-            else:
+            while failed is None and not completed.is_empty():
+                finished = completed.next_batch(block=False)
+                if not finished:  # none yet: wait a while, then ask whether a worker is left
+                    with completed.thread_condition:  # a completion notifies it, under its lock
+                        if not completed.has_ready():
+                            completed.thread_condition.wait(timeout=POLL_SECONDS)
+                    if not completed.has_ready():
+                        alone_since = self._still_staffed(client, alone_since)
+                    continue
+                alone_since = None
+                for future in finished:
+                    if future.status == "error":
+                        failed = future
+                        break
+                    if future.status == "cancelled":  # not the job's cancel: that raises in done
+                        raise CancelledError(future.key)
+                    done(index[future.key])
+            if failed is None:
                 results: list[R] = client.gather(futures)
                 return results
         except lost as error:
@@ -133,10 +150,31 @@ class DaskRunner:
             client_cancel(client, futures)
             raise
         try:
+            if isinstance(failed.exception(), KilledWorker):
+                raise self._unavailable(
+                    "had a worker process die under one of the job's tasks (out of memory, say)",
+                    failed.exception(),
+                ) from None
             failed.result()  # the task's own exception, raised here as it is
         finally:
             client_cancel(client, futures)
         raise AssertionError("a task in error gave a result")  # not reached
+
+    def _still_staffed(self, client: Any, alone_since: float | None) -> float | None:
+        """None while the cluster has a worker; else since when it has had none.
+
+        Raises:
+            ClusterUnavailable: it has had none for ``connect_seconds`` (the job's tasks would
+                wait for one, the job running, for ever).
+        """
+        if client.nthreads():
+            return None
+        now = time.monotonic()
+        if alone_since is None:
+            return now
+        if now - alone_since >= self.connect_seconds:
+            raise self._unavailable(f"has had no worker for {self.connect_seconds:g} s")
+        return alone_since
 
 
 def client_cancel(client: Any, futures: list[Any]) -> None:
