@@ -283,3 +283,33 @@ def test_the_robot_is_checked_against_itself_with_no_object(page: Page, url: str
         page.click("#run")
     cell = json.loads(sent.value.post_data or "{}")["request"]["cell"]
     assert cell == {"fixed": [], "workpiece": [], "clearance": 0.01}
+
+
+def test_the_ik_branch_and_joint_step_chosen_on_the_page_reach_the_api(
+    page: Page, url: str
+) -> None:
+    """The page had no field for either: every map, cell and optimum followed the auto branch
+    with the 0.35 rad step. A branch made of the robot's levels (GET /v1/robots) and a step are
+    sent, the page's best is the API's answer to that body, and every feasible cell is on the
+    branch chosen; a step the API refuses is said beside its field."""
+    branch = {"shoulder": "right", "elbow": "down", "wrist": "flip"}
+    options = page.locator("#ik-branch option")
+    assert options.count() == 1 + 8  # auto and the UR5's 2 x 2 x 2
+    page.select_option("#ik-branch", json.dumps(branch, separators=(",", ":")))
+    fill(page, {**SMALL, "max-joint-step": "0.3"})
+    with page.expect_request(lambda r: r.method == "POST" and r.url.endswith("/v1/jobs")) as sent:
+        page.click("#run")
+    submitted = json.loads(sent.value.post_data or "{}")["request"]
+    assert submitted["ik"] == {"blend_length": 0.002, "max_joint_step": 0.3, "branch": branch}
+    page.wait_for_function("document.getElementById('summary').dataset.cells", timeout=60_000)
+    api = httpx.post(f"{url}/v1/map", json=submitted, timeout=60).json()
+    feasible = [c for c in api["cells"] if c["mu_path"] is not None]
+    assert feasible and all(c["branch"] == branch for c in feasible)
+    assert page.text_content("#best-mu") == f"{api['best']['mu_path']:.6f} m/s"
+    fill(page, {"max-joint-step": "-1"})
+    page.click("#run")
+    detail = httpx.post(
+        f"{url}/v1/map", json={**submitted, "ik": {**submitted["ik"], "max_joint_step": -1.0}}
+    ).json()["detail"]
+    assert [d["loc"][1:] for d in detail] == [["ik", "max_joint_step"]]
+    assert error_beside(page, "ik.max_joint_step") == detail[0]["msg"]

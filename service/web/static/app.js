@@ -128,8 +128,31 @@ function showBaseHint() {
   $("base-frame-hint").textContent = hint && $("base-frame").value.trim() === hint.frame ? hint.text : "";
 }
 
+// Empty fields and the auto branch are left out: the API's defaults.
 function ikBody() {
-  return { blend_length: value("blend-length") };  // empty: left out, the API's default
+  const ik = { blend_length: value("blend-length"), max_joint_step: value("max-joint-step") };
+  const branch = $("ik-branch");
+  if (!branch.disabled && branch.value !== "auto") ik.branch = JSON.parse(branch.value);
+  return ik;
+}
+
+// The catalogue robot's branches (GET /v1/robots: levels and their choices), each combination
+// an option; a pasted robot object or a URDF follows the auto branch (its branches are its own).
+function showBranches(info) {
+  const select = $("ik-branch");
+  const kept = select.value;
+  select.replaceChildren(select.options[0]);
+  let combinations = [{}];
+  for (const { level, choices } of info ? info.branches : []) {
+    combinations = combinations.flatMap((c) => choices.map((choice) => ({ ...c, [level]: choice })));
+  }
+  for (const branch of info && info.branches.length ? combinations : []) {
+    const option = document.createElement("option");
+    option.value = JSON.stringify(branch);
+    option.textContent = Object.entries(branch).map(([level, choice]) => `${level} ${choice}`).join(", ");
+    select.appendChild(option);
+  }
+  select.value = [...select.options].some((o) => o.value === kept) ? kept : "auto";
 }
 
 // A pasted robot object brings its own limits: the catalogue's fields are then greyed out.
@@ -140,6 +163,7 @@ function showOwnRobot() {
     input.disabled = own || urdf;
   }
   $("acc-limits").disabled = own;
+  $("ik-branch").disabled = own || urdf;
   for (const id of TCP_FIELDS) $(id).disabled = own;  // a pasted robot object gives its own
   $("own-robot-note").hidden = !own;
   $("urdf-note").hidden = !urdf;
@@ -164,6 +188,7 @@ function showLimits() {
   const info = state.robots.find((r) => r.name === $("robot-model").value);
   const box = $("limits");
   box.textContent = "";
+  showBranches(info);
   if (!info) return;
   info.qdot_max.forEach((v, k) => {
     const input = document.createElement("input");
