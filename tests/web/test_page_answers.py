@@ -313,3 +313,35 @@ def test_the_ik_branch_and_joint_step_chosen_on_the_page_reach_the_api(
     ).json()["detail"]
     assert [d["loc"][1:] for d in detail] == [["ik", "max_joint_step"]]
     assert error_beside(page, "ik.max_joint_step") == detail[0]["msg"]
+
+
+def test_the_optimiser_searches_the_height_and_spin_ranges_given_on_the_page(
+    page: Page, url: str
+) -> None:
+    """The page searched only at the grid's z and without spin (bounds.z and bounds.spin had no
+    field). Both ranges reach the request (without z, as the API asks), the page's optimum is
+    the API's answer to it, inside them; a range the wrong way round is said beside its field."""
+    fill(
+        page,
+        {**SMALL, "opt-z-min": "0.05", "opt-z-max": "0.15", "opt-spin-min": "-0.5",
+         "opt-spin-max": "0.5"},
+    )  # fmt: skip
+    with page.expect_request(lambda r: r.method == "POST" and "/v1/optimize" in r.url) as sent:
+        page.click("#optimize")
+    submitted = json.loads(sent.value.post_data or "{}")
+    assert "z" not in submitted
+    assert submitted["bounds"]["z"] == [0.05, 0.15]
+    assert submitted["bounds"]["spin"] == [-0.5, 0.5]
+    page.wait_for_function(
+        "document.getElementById('opt-mu').textContent.endsWith(' m/s')", timeout=120_000
+    )
+    api = httpx.post(f"{url}/v1/optimize", json=submitted, timeout=120).json()
+    assert page.text_content("#opt-mu") == f"{api['mu_path']:.6f} m/s"
+    placement = api["placement"]
+    assert 0.05 <= placement["z"] <= 0.15 and -0.5 <= placement["spin"] <= 0.5
+    fill(page, {"opt-z-min": "0.15", "opt-z-max": "0.05"})
+    page.click("#optimize")
+    wrong = {**submitted, "bounds": {**submitted["bounds"], "z": [0.15, 0.05]}}
+    detail = httpx.post(f"{url}/v1/optimize", json=wrong).json()["detail"]
+    assert [d["loc"][1:3] for d in detail] == [["bounds", "z"]]
+    assert error_beside(page, "bounds.z") == detail[0]["msg"]

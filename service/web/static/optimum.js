@@ -20,6 +20,20 @@ function yawRange(grid) {
   return [low ?? Math.min(...yaws), high ?? Math.max(...yaws)];
 }
 
+// The height searched: the grid's z (fixed: the request's z), or a range (bounds.z, and the
+// request without z), an empty end being the grid's z.
+function heightOf(grid) {
+  const low = value("opt-z-min"), high = value("opt-z-max");
+  if (low === undefined && high === undefined) return { z: grid.z };
+  return { range: [low ?? grid.z, high ?? grid.z] };
+}
+
+// The constant tool spin searched (bounds.spin): left out when both ends are empty (0).
+function spinRange() {
+  const low = value("opt-spin-min"), high = value("opt-spin-max");
+  return low === undefined && high === undefined ? undefined : [low ?? 0, high ?? 0];
+}
+
 function showYawRange() {
   const any = $("opt-any-yaw").checked;
   const yaws = numbers($("yaws").value).filter(Number.isFinite);
@@ -82,15 +96,20 @@ async function optimize() {
   dropOptimization("a newer optimisation");  // a newer click: the older goes (its job too)
   if (!havePath()) return;
   const grid = gridBody();
-  if (grid.z === undefined) {  // the API would take it for a search over the height
-    showErrors([{ loc: ["grid", "z"], msg: "Field required: the optimiser searches at this height" }]);
+  const height = heightOf(grid);
+  if (height.range ? height.range.includes(undefined) : grid.z === undefined) {
+    showErrors([{ loc: ["grid", "z"], msg: "Field required: the optimiser searches at this height"
+      + (height.range ? " (the height range's empty end)" : "") }]);
     return;
   }
   let robot;
   try { robot = robotBody(); } catch (error) { showErrors([{ loc: ["robot"], msg: error.message }]); return; }
   const body = {
-    robot, path: state.path, method: $("method").value, z: grid.z, ik: ikBody(),
-    bounds: { x: [grid.x.min, grid.x.max], y: [grid.y.min, grid.y.max], yaw: yawRange(grid) },
+    robot, path: state.path, method: $("method").value, z: height.z, ik: ikBody(),
+    bounds: {
+      x: [grid.x.min, grid.x.max], y: [grid.y.min, grid.y.max], yaw: yawRange(grid),
+      z: height.range, spin: spinRange(),
+    },
     spin_mode: spinMode(), cell: cellBody(),
   };
   const run = { abort: new AbortController(), jobId: null };
