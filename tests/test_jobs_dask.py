@@ -220,3 +220,19 @@ def test_a_task_that_kills_its_workers_is_the_clusters_failure_named() -> None:
             runner = DaskRunner(fragile.scheduler_address, connect_seconds=5.0)
             with pytest.raises(ClusterUnavailable, match=r"worker process die .* KilledWorker"):
                 runner.run(lambda _: _die(), [0], _noted([]))
+
+
+def test_workers_whose_code_is_not_the_services_are_refused(
+    cluster: LocalCluster, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A worker on another release (or another numpy) gave its own numbers without a word.
+    Here the service's side is made to differ: every worker is named, with what differs."""
+    assert DaskRunner(cluster.scheduler_address).run(abs, [-1], _noted([])) == [1]
+    elsewhere = {**dask_runner.code_fingerprint(), "numpy": "0.0.1"}
+    monkeypatch.setattr(dask_runner, "code_fingerprint", lambda: elsewhere)
+    runner = DaskRunner(cluster.scheduler_address)
+    with pytest.raises(ClusterUnavailable, match=r"2 worker\(s\) whose code") as refused:
+        runner.run(abs, [-1], _noted([]))
+    said = str(refused.value)
+    for address in cluster.scheduler_info["workers"]:
+        assert f"{address}: numpy {np.__version__} (here 0.0.1)" in said

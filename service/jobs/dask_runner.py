@@ -15,10 +15,15 @@ jobs audit of stop 56).
 
 from __future__ import annotations
 
+import functools
+import hashlib
+import importlib.metadata
 import time
 from collections.abc import Callable, Sequence
+from pathlib import Path
 from typing import Any, TypeVar
 
+import solver
 from solver.core.parallel import tasks_of
 
 T = TypeVar("T")
@@ -30,6 +35,27 @@ POLL_SECONDS = 0.25
 """How often a job waiting for its tasks asks whether the cluster still has a worker (s)."""
 LIVE = ("newly-created", "connecting", "running")
 """A ``distributed.Client``'s states in which it is, or will be, connected."""
+
+
+CODE_PACKAGES = ("numpy", "scipy", "numba", "pin", "casadi")
+"""The libraries whose versions a worker must share with the service (its numbers are theirs)."""
+
+
+@functools.cache
+def code_fingerprint() -> dict[str, str]:
+    """What a placement's numbers depend on here: the solver's sources (a hash) and libraries."""
+    digest = hashlib.sha256()
+    root = Path(solver.__file__).parent
+    for source in sorted(root.rglob("*.py")):
+        digest.update(source.relative_to(root).as_posix().encode())
+        digest.update(source.read_bytes())
+    versions = {name: importlib.metadata.version(name) for name in CODE_PACKAGES}
+    return {"solver sources": digest.hexdigest()[:12], **versions}
+
+
+def worker_fingerprint() -> dict[str, str]:
+    """:func:`code_fingerprint` as a worker computes it (sent by reference, run in its process)."""
+    return code_fingerprint()
 
 
 class ClusterUnavailable(RuntimeError):
@@ -50,6 +76,7 @@ class DaskRunner:
         self.address = address
         self.connect_seconds = CONNECT_SECONDS if connect_seconds is None else connect_seconds
         self._client: Any = None
+        self._checked: frozenset[str] = frozenset()  # workers whose code is the service's
 
     def _unavailable(self, what: str, error: BaseException | None = None) -> ClusterUnavailable:
         said = "" if error is None else f": {type(error).__name__}: {str(error)[:300]}"
@@ -115,6 +142,7 @@ class DaskRunner:
         client = self.client()
         lost = (OSError, CancelledError, ClosedClientError, AttributeError)
         try:
+            self._same_code(client)
             futures = client.map(work, list(tasks), pure=False)
         except lost as error:
             raise self._unavailable("was lost", error) from None
@@ -159,6 +187,36 @@ class DaskRunner:
         finally:
             client_cancel(client, futures)
         raise AssertionError("a task in error gave a result")  # not reached
+
+    def _same_code(self, client: Any) -> None:
+        """Refuse workers that compute with other code than the service's (checked once each).
+
+        A worker left on an older release, or with another numpy, gives other numbers without a
+        word: a map's cells would depend on which worker ran them.
+
+        Raises:
+            ClusterUnavailable: naming up to three such workers and what differs.
+        """
+        workers = frozenset(client.nthreads())
+        if workers <= self._checked:
+            return
+        mine = code_fingerprint()
+        theirs = client.run(worker_fingerprint, workers=sorted(workers - self._checked))
+        differ = {
+            address: [
+                f"{key} {value} (here {mine.get(key)})"
+                for key, value in sorted(worker.items())
+                if mine.get(key) != value
+            ]
+            for address, worker in sorted(theirs.items())
+        }
+        wrong = [f"{address}: {', '.join(said)}" for address, said in differ.items() if said]
+        if wrong:
+            raise self._unavailable(
+                f"has {len(wrong)} worker(s) whose code is not the service's, which would give "
+                f"other numbers ({'; '.join(wrong[:3])}); install the service's release on them"
+            )
+        self._checked = self._checked | workers
 
     def _still_staffed(self, client: Any, alone_since: float | None) -> float | None:
         """None while the cluster has a worker; else since when it has had none.
