@@ -8,8 +8,10 @@ fixture box makes the velocity-best placement collide. Screenshots go to ``tests
 
 from __future__ import annotations
 
+import base64
 import json
 import re
+import struct
 from typing import Any
 
 import httpx
@@ -21,6 +23,7 @@ from tests.cases import ROOT
 from tests.web.conftest import snapshot
 from tests.web.test_page import EXAMPLE_PATH, SMALL, beside, fill, grid_of, pixel
 from tests.web.test_page import cell_point as panel_point
+from tests.web.test_page_findings import error_beside
 
 README = (ROOT / "README.md").read_text()
 COLLISION_RGB = (0xC6, 0x28, 0x28)  # the page's collision colour, written again
@@ -441,3 +444,97 @@ def test_an_arm_without_geometry_takes_its_link_radii_from_the_editor(page: Page
         f"; links approximated by capsules: {', '.join(mapped['cell_approximated'])}"
         + not_checked(mapped)
     )
+
+
+# ---- STL meshes --------------------------------------------------------------------------------
+def _cube_triangles(half: float) -> list[list[tuple[float, float, float]]]:
+    """The 12 triangles of a cube of half side ``half`` about the origin (outward order)."""
+    triangles = []
+    for axis in range(3):
+        for sign in (-1.0, 1.0):
+            u, v = (axis + 1) % 3, (axis + 2) % 3
+            corners = []
+            for a, b in ((-1, -1), (1, -1), (1, 1), (-1, 1)):
+                point = [0.0, 0.0, 0.0]
+                point[axis], point[u], point[v] = sign * half, a * half, b * half * sign
+                corners.append((point[0], point[1], point[2]))
+            triangles += [
+                [corners[0], corners[1], corners[2]],
+                [corners[0], corners[2], corners[3]],
+            ]
+    return triangles
+
+
+def cube_stl(half: float, *, binary: bool) -> bytes:
+    """A cube as an STL file; the binary one's header begins with 'solid', as SolidWorks writes
+    them (a reader that looks at the first word takes it for ASCII)."""
+    triangles = _cube_triangles(half)
+    if binary:
+        header = b"solid cube exported as binary".ljust(80, b" ")
+        records = b"".join(
+            struct.pack("<12fH", 0.0, 0.0, 0.0, *[c for corner in t for c in corner], 0)
+            for t in triangles
+        )
+        return header + struct.pack("<I", len(triangles)) + records
+    facets = "".join(
+        "facet normal 0 0 0\nouter loop\n"
+        + "".join(f"vertex {x:g} {y:g} {z:g}\n" for x, y, z in t)
+        + "endloop\nendfacet\n"
+        for t in triangles
+    )
+    return f"solid cube\n{facets}endsolid cube\n".encode()
+
+
+def add_mesh(page: Page, *, name: str, stl: bytes, units: str, at: list[str]) -> None:
+    """Add a fixed mesh row, choose its file and unit, and place it (the last row)."""
+    open_editor(page)
+    page.click("#add-mesh")
+    row = page.locator(".cell-box").last
+    row.locator(".box-name").fill(name)
+    row.locator(".mesh-file").set_input_files(
+        files=[{"name": f"{name}.stl", "mimeType": "model/stl", "buffer": stl}]
+    )
+    page.wait_for_function("[...document.querySelectorAll('.mesh-read')].at(-1).textContent !== ''")
+    if units:
+        row.locator(".mesh-units").select_option(units)
+    inputs = row.locator(".field[data-tail='mesh.pose.position'] input")
+    for k, value in enumerate(at):
+        inputs.nth(k).fill(value)
+
+
+def test_an_stl_fixture_from_the_editor_is_sent_as_read_and_checked(page: Page, url: str) -> None:
+    """The editor had boxes only: a fixture or a part from CAD could not be given. A binary STL
+    (its header starting 'solid') is sent in base64 of its exact bytes, an ASCII one as its text,
+    each with the unit chosen; the same cube either way collides at the same cells, as the API
+    answers for the body sent, the mesh named; an unchosen unit is the API's error beside it."""
+    fill(page, SMALL)
+    binary = cube_stl(100.0, binary=True)  # mm: a 0.2 m cube
+    add_mesh(page, name="fixture", stl=binary, units="mm", at=["0", "0", "0.2"])
+    assert "binary" in (page.text_content(".mesh-read") or "")
+    request = run_map(page)
+    (mesh,) = request["cell"]["fixed"]
+    assert mesh["shape"] == "mesh" and mesh["units"] == "mm" and mesh["name"] == "fixture"
+    assert base64.b64decode(mesh["stl"]) == binary
+    assert mesh["pose"]["position"] == [0, 0, 0.2]
+    from_binary = api_map(url, request)
+    assert page.get_attribute("#summary", "data-collisions") == str(
+        sum(c["reason"] == "collision" for c in from_binary["cells"])
+    )
+    page.click("button[aria-label='Remove mesh 1']")
+    ascii_stl = cube_stl(100.0, binary=False)
+    add_mesh(page, name="fixture", stl=ascii_stl, units="mm", at=["0", "0", "0.2"])
+    request = run_map(page)
+    assert request["cell"]["fixed"][0]["stl"] == ascii_stl.decode()
+    from_ascii = api_map(url, request)
+    reasons = [c["reason"] for c in from_ascii["cells"]]
+    assert reasons == [c["reason"] for c in from_binary["cells"]]
+    assert "collision" in reasons
+    hit = next(c for c in from_ascii["cells"] if c["reason"] == "collision")
+    body = {key: value for key, value in request.items() if key != "grid"}
+    body["placement"] = {"x": hit["x"], "y": hit["y"], "z": 0.1, "yaw": hit["yaw"]}
+    evaluation = httpx.post(f"{url}/v1/evaluate", json=body, timeout=60).json()
+    assert evaluation["collision"]["obstacle_name"] == "fixture", evaluation
+    page.click("button[aria-label='Remove mesh 2']")
+    add_mesh(page, name="fixture", stl=ascii_stl, units="", at=["0", "0", "0.2"])
+    page.click("#run")
+    assert "'m', 'mm', 'cm' or 'in'" in error_beside(page, "cell.fixed.0.mesh.units")

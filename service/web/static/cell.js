@@ -51,16 +51,18 @@ function numberGroup(tail, label, names, values, owner) {
   return field;
 }
 
-// A new box row: its frame (fixed or workpiece), name, sizes, position and angles.
-function addBox() {
+// A new object row: its frame (fixed or workpiece), name, shape's own fields (a box's sizes, a
+// mesh's STL file and unit), position and angles.
+function addObject(shape) {
   cellEditor.boxes += 1;
   const n = cellEditor.boxes;
-  const owner = `box ${n}`;
+  const owner = `${shape} ${n}`;
   const row = document.createElement("fieldset");
   row.className = "cell-box";
   row.dataset.box = String(n);
+  row.dataset.shape = shape;
   const legend = document.createElement("legend");
-  legend.textContent = `Box ${n}`;
+  legend.textContent = `${shape === "box" ? "Box" : "STL mesh"} ${n}`;
   row.appendChild(legend);
   const head = document.createElement("div");
   head.className = "field";
@@ -73,9 +75,14 @@ function addBox() {
     <input class="box-name" type="text" value="${owner}" aria-label="${owner} name">
     <span class="error" role="alert"></span>`;
   row.appendChild(head);
-  row.appendChild(numberGroup("box.size", "Size lx, ly, lz (m)", ["lx (m)", "ly (m)", "lz (m)"], [0.1, 0.1, 0.1], owner));
-  row.appendChild(numberGroup("box.pose.position", "Centre x, y, z (m)", ["x (m)", "y (m)", "z (m)"], [0, 0, 0], owner));
-  row.appendChild(numberGroup("box.pose.orientation", "Roll, pitch, yaw (deg; R = Rz(yaw) Ry(pitch) Rx(roll))",
+  if (shape === "box") {
+    row.appendChild(numberGroup("box.size", "Size lx, ly, lz (m)", ["lx (m)", "ly (m)", "lz (m)"], [0.1, 0.1, 0.1], owner));
+  } else {
+    for (const field of meshFields(row, owner)) row.appendChild(field);
+  }
+  const position = shape === "box" ? "Centre x, y, z (m)" : "Position of the file's origin x, y, z (m)";
+  row.appendChild(numberGroup(`${shape}.pose.position`, position, ["x (m)", "y (m)", "z (m)"], [0, 0, 0], owner));
+  row.appendChild(numberGroup(`${shape}.pose.orientation`, "Roll, pitch, yaw (deg; R = Rz(yaw) Ry(pitch) Rx(roll))",
     ["roll (deg)", "pitch (deg)", "yaw (deg)"], [0, 0, 0], owner));
   const remove = document.createElement("button");
   remove.type = "button"; remove.className = "remove-box"; remove.textContent = "Remove";
@@ -87,21 +94,72 @@ function addBox() {
   return row;
 }
 
+function addBox() { return addObject("box"); }
+
+// A binary STL: 80 header bytes, a triangle count, 50 bytes a triangle, exactly (its header
+// may begin with "solid" as an ASCII file does: SolidWorks writes them so).
+function binaryStl(bytes) {
+  if (bytes.length < 84) return false;
+  const count = new DataView(bytes.buffer, bytes.byteOffset, bytes.length).getUint32(80, true);
+  return bytes.length === 84 + 50 * count;
+}
+
+function base64Of(bytes) {
+  let text = "";
+  for (let i = 0; i < bytes.length; i += 0x8000) text += String.fromCharCode(...bytes.subarray(i, i + 0x8000));
+  return btoa(text);
+}
+
+// A mesh row's file and unit fields. The file is sent as the API takes it: an ASCII STL as its
+// text, a binary one in base64. An STL states no unit, so the unit is chosen (none chosen: the
+// API's error beside it, never a unit guessed); no file: the API's error beside the file.
+function meshFields(row, owner) {
+  const file = document.createElement("div");
+  file.className = "field";
+  file.dataset.tail = "mesh.stl";
+  file.innerHTML = `<label>STL file (ASCII or binary; each separate part taken as its convex hull)</label>
+    <input class="mesh-file" type="file" accept=".stl" aria-label="${owner} STL file">
+    <span class="mesh-read note"></span>
+    <span class="error" role="alert"></span>`;
+  row.dataset.stl = "";
+  file.querySelector(".mesh-file").addEventListener("change", async (event) => {
+    const chosen = event.target.files[0];
+    if (!chosen) return;
+    const bytes = new Uint8Array(await chosen.arrayBuffer());
+    const binary = binaryStl(bytes);
+    row.dataset.stl = binary ? base64Of(bytes) : new TextDecoder().decode(bytes);
+    file.querySelector(".mesh-read").textContent = `${chosen.name}: ${binary ? "binary" : "ASCII"}, ${bytes.length} bytes`;
+    showCellStatus();
+  });
+  const units = document.createElement("div");
+  units.className = "field";
+  units.dataset.tail = "mesh.units";
+  units.innerHTML = `<label>The file's unit (an STL states none)</label>
+    <select class="mesh-units" aria-label="${owner} unit">
+      <option value="">choose</option><option value="mm">mm</option><option value="cm">cm</option>
+      <option value="m">m</option><option value="in">inch</option>
+    </select>
+    <span class="error" role="alert"></span>`;
+  return [file, units];
+}
+
 function parts(row, tail) {
   return [...row.querySelector(`.field[data-tail="${tail}"]`).querySelectorAll("input")].map(typed);
 }
 
-// The box of a row as the API takes it.
+// The object of a row as the API takes it: a box, or a mesh (an unchosen unit sent as "", which
+// the API refuses beside its field).
 function boxObject(row) {
-  const [roll, pitch, yaw] = parts(row, "box.pose.orientation").map((a) => a * DEGREE);
+  const shape = row.dataset.shape || "box";
+  const [roll, pitch, yaw] = parts(row, `${shape}.pose.orientation`).map((a) => a * DEGREE);
   const name = row.querySelector(".box-name").value.trim();
-  const box = {
-    shape: "box",
-    size: parts(row, "box.size"),
-    pose: { position: parts(row, "box.pose.position"), orientation: quaternionOf(roll, pitch, yaw) },
+  const pose = {
+    position: parts(row, `${shape}.pose.position`), orientation: quaternionOf(roll, pitch, yaw),
   };
-  if (name) box.name = name;
-  return box;
+  const object = shape === "box" ? { shape, size: parts(row, "box.size"), pose }
+    : { shape, stl: row.dataset.stl, units: row.querySelector(".mesh-units").value, pose };
+  if (name) object.name = name;
+  return object;
 }
 
 // The tool, when any of its fields is filled: each as typed (an empty radius or length is the
@@ -151,10 +209,13 @@ function selfChecked() {
 
 // What the editor holds, in a line under it.
 function showCellStatus() {
-  const boxes = $("cell-boxes").querySelectorAll(".cell-box").length;
+  const rows = [...$("cell-boxes").querySelectorAll(".cell-box")];
+  const boxes = rows.filter((row) => row.dataset.shape !== "mesh").length;
+  const meshes = rows.length - boxes;
   const table = $("table-height").value.trim() !== "";
   const tool = ["tool-radius", "tool-length", "tool-cutting-length"].some((id) => $(id).value.trim() !== "");
-  const things = [table ? "a table top" : "", boxes ? `${boxes} box${boxes === 1 ? "" : "es"}` : "", tool ? "the tool" : ""]
+  const things = [table ? "a table top" : "", boxes ? `${boxes} box${boxes === 1 ? "" : "es"}` : "",
+    meshes ? `${meshes} mesh${meshes === 1 ? "" : "es"}` : "", tool ? "the tool" : ""]
     .filter(Boolean);
   $("cell-status").textContent = things.length
     ? `Checked along the path against ${things.join(", ")}, and the robot against itself.`
@@ -214,6 +275,7 @@ function cellModel(answer) {
 
 function startCellEditor() {
   $("add-box").addEventListener("click", addBox);
+  $("add-mesh").addEventListener("click", () => addObject("mesh"));
   for (const id of ["table-height", "tool-radius", "tool-length", "tool-cutting-length", "clearance", "link-radii"]) {
     $(id).addEventListener("input", showCellStatus);
   }
