@@ -170,7 +170,15 @@ class JobInfo(ResponseModel):
         "EvaluateResponse, as kind says).",
     )
     error: list[ErrorDetail] | None = Field(
-        default=None, description="When failed: what was wrong, as a 422's detail."
+        default=None,
+        description="When failed: what was wrong, as a 422's detail. Its type says whose "
+        "it is: the request's (as the route's 422 would say: a validation type, invalid_input, "
+        "repeated_waypoint, unknown_robot and the like, loc naming the field); unavailable (the"
+        " Dask cluster cannot run the job: its scheduler unreachable or lost, no worker, a "
+        "worker process dead under a task, or a worker whose code is not the service's; submit "
+        "it again once the cluster runs); interrupted (service restarts, or its worker process "
+        "ending, in each of its DTF_JOB_ATTEMPTS runs); damaged (its stored request cannot be "
+        "read); internal (a bug of the service's: the message names the exception).",
     )
     result_cells: ResultCells | None = Field(
         default=None,

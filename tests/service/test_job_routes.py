@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import re
 import sqlite3
 import time
 import uuid
@@ -228,3 +229,20 @@ def test_the_spec_declares_the_503_of_the_job_routes_and_metrics(client: TestCli
     for path, method in [("/v1/jobs", "post"), ("/v1/jobs/{job_id}", "get"), ("/metrics", "get")]:
         declared = paths[path][method]["responses"]["503"]
         assert "job store" in declared["description"], (path, declared)
+
+
+def test_every_error_type_a_job_can_fail_with_is_in_the_contract() -> None:
+    """Read from the job code's own literals (a regex), each type is explained in JobInfo.error's
+    description, the client's only account of whose fault a failure is ('unavailable' was in
+    no document)."""
+    from service.schemas.jobs import JobInfo
+
+    sources = (ROOT / "service" / "jobs").glob("*.py")
+    emitted = {
+        kind
+        for source in sources
+        for kind in re.findall(r'"type": "([a-z_]+)"', source.read_text())
+    }
+    assert {"unavailable", "interrupted", "damaged", "internal"} <= emitted
+    description = JobInfo.model_fields["error"].description or ""
+    assert [kind for kind in sorted(emitted) if f"{kind} (" not in description] == []
