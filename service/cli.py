@@ -312,11 +312,20 @@ def _json_file(file: Path, field: str) -> Any:
 
 
 def _with_options(body: dict[str, Any], args: argparse.Namespace) -> dict[str, Any]:
-    """``body`` with what the solving commands share, where given: spin mode, branch, cell."""
+    """``body`` with what the solving commands share, where given: spin mode, IK, cell."""
     if args.spin_mode is not None:
         body["spin_mode"] = args.spin_mode
-    if args.branch is not None:
-        body["ik"] = {"branch": args.branch}
+    ik = {
+        name: value
+        for name, value in (
+            ("branch", args.branch),
+            ("max_joint_step", args.max_joint_step),
+            ("blend_length", args.blend_length),
+        )
+        if value is not None
+    }
+    if ik:
+        body["ik"] = ik
     if args.cell is not None:
         body["cell"] = _json_file(Path(args.cell), "cell")
     return body
@@ -552,6 +561,20 @@ def _parser() -> argparse.ArgumentParser:
         type=_branch,
         help="the IK branch to follow: auto (the default: the fastest), SHOULDER/ELBOW/WRIST "
         "(left/up/noflip on a UR, front/up/noflip on an OPW arm) or a numeric arm's solution index",
+    )
+    solving.add_argument(
+        "--max-joint-step",
+        type=float,
+        metavar="RAD",
+        help="the largest move of any joint between neighbouring waypoints: more is a jump off "
+        "the branch (default 0.35)",
+    )
+    solving.add_argument(
+        "--blend-length",
+        type=float,
+        metavar="M",
+        help="the corner zone joint accelerations are taken over, with a robot's acceleration "
+        "limits (default 0.002)",
     )
     solving.add_argument(
         "--cell",

@@ -1019,3 +1019,24 @@ def test_a_bad_setting_is_named_by_its_variable(tmp_path: Path) -> None:
     done = subprocess.run(command, capture_output=True, text=True, cwd=ROOT, env=env, timeout=120)
     assert done.returncode == INVALID
     assert done.stderr.startswith("error: DTF_THREADS='0': Input should be greater than 0")
+
+
+def test_the_joint_step_and_blend_length_reach_the_request(
+    client: TestClient, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """The command line had no option for either (a post-processor could not ask for a finer
+    step or another blend): each is the API's answer to the body with it, and changes it."""
+    robot = {"model": "ur5e", "joint_acceleration_limits": [2.0] * 6}
+    file = _file(tmp_path, "robot.json", robot)
+    argv = ["evaluate", str(PROGRAM), "--robot", file, "--at=0,0.3,0,0", "--json"]
+    body = {"robot": robot, "path": {"cl_data": PROGRAM.read_text()}, "placement": AT}
+    body["detail"] = "summary"
+    plain = api(client, "/v1/evaluate", body)
+    code, out, _ = run(capsys, *argv, "--blend-length", "0.01")
+    blended = api(client, "/v1/evaluate", {**body, "ik": {"blend_length": 0.01}})
+    assert code == OK and json.loads(out) == blended
+    assert blended["acceleration"]["mu_acc"] != plain["acceleration"]["mu_acc"]
+    code, out, _ = run(capsys, *argv, "--max-joint-step", "0.001")
+    stepped = api(client, "/v1/evaluate", {**body, "ik": {"max_joint_step": 0.001}})
+    assert code == INFEASIBLE and json.loads(out) == stepped
+    assert plain["feasible"] and stepped["reason"] == "discontinuous"
