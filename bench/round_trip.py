@@ -107,10 +107,10 @@ def round_trips(*, repeats: int) -> None:
         def in_process() -> None:
             request = MapRequest.model_validate_json(raw)
             runner = ThreadRunner(settings.threads)
-            result, robot, spin_mode, _ = computed_map(
+            computed = computed_map(
                 request, settings, png=False, progress=lambda _: None, runner=runner
             )
-            map_json(result, robot, spin_mode=spin_mode)
+            map_json(computed.result, computed.robot, spin_mode=computed.spin_mode)
 
         with httpx.Client(base_url=url, timeout=120) as client:
             healthz = _times(

@@ -401,10 +401,15 @@ def _map(args: argparse.Namespace) -> int:
     body: dict[str, Any] = {"robot": _robot(args), "path": _path(args), "grid": grid}
     request = _validated(MapRequest, _with_options(body, args))
     with ProgressBar(enabled=args.progress) as bar:
-        result, robot, spin_mode, path_read = computed_map(
-            request, _settings(), png=True, progress=bar
-        )
-    answer = convert.map_response(result, robot, spin_mode=spin_mode, path_read=path_read)
+        computed = computed_map(request, _settings(), png=True, progress=bar)
+    result, robot = computed.result, computed.robot
+    answer = convert.map_response(
+        result,
+        robot,
+        spin_mode=computed.spin_mode,
+        path_read=computed.path_read,
+        axis_correction=computed.axis_correction,
+    )
     try:
         png.write_bytes(map_png(result, robot))
     except OSError as error:  # the folder went, the disk filled: said on --png

@@ -128,12 +128,27 @@ def read_text(read: PathRead | None) -> list[str]:
     return lines
 
 
+SAID_CORRECTION = 1e-6
+"""The least ``axis_correction`` the text says: below it, the rounding of a file's printed
+digits (the NX example's tool axes are 5e-8 off unit, the README path's quaternions 6e-13), a
+microradian at most; ``--json`` gives every one."""
+
+
+def normalised_text(correction: float) -> list[str]:
+    """The answer's ``axis_correction`` said, where a unit vector or quaternion was corrected."""
+    if not correction > SAID_CORRECTION:
+        return []
+    return [
+        f"normalised: the request's tool axes or quaternions, largest correction {correction:.1e}"
+    ]
+
+
 def evaluation_text(answer: EvaluateResponse, clearance: float | None = None) -> str:
     """How the program was read; mu_path, the bottleneck and the feed check, or why not.
 
     ``clearance``: the cell's (m), named beside a collision.
     """
-    lines = read_text(answer.path_read)
+    lines = read_text(answer.path_read) + normalised_text(answer.axis_correction)
     if not answer.feasible:
         where = "" if answer.failed_waypoint is None else f" at waypoint {answer.failed_waypoint}"
         if answer.failed_pass is not None:
@@ -182,7 +197,7 @@ def _placement(placement: PlacementResult) -> list[str]:
 
 def map_text(answer: MapResponse, png: str) -> str:
     """How the program was read; the map's size, its best placement, the picture's file."""
-    lines = read_text(answer.path_read)
+    lines = read_text(answer.path_read) + normalised_text(answer.axis_correction)
     collide = sum(cell.reason == "collision" for cell in answer.cells)
     collisions = f" ({collide} in collision)" if collide else ""
     feasible = f"{answer.feasible_cells} of {len(answer.cells)} placements feasible"
@@ -195,7 +210,8 @@ def map_text(answer: MapResponse, png: str) -> str:
 
 def optimum_text(answer: OptimizeResponse) -> str:
     """How the program was read; the optimum with its controller frames, or that none is."""
-    lines = read_text(answer.path_read)
+    correction = 0.0 if answer.evaluation is None else answer.evaluation.axis_correction
+    lines = read_text(answer.path_read) + normalised_text(correction)
     if not answer.found or answer.placement is None or answer.mu_path is None:
         why = "" if answer.failure is None else f": {answer.failure.message}"
         return "\n".join([*lines, f"no feasible placement inside the bounds{why}"])

@@ -40,9 +40,12 @@ def map_json(
     *,
     spin_mode: SpinMode,
     path_read: schemas.PathRead | None = None,
+    axis_correction: float = 0.0,
 ) -> bytes:
-    """``map_response(cmap, robot, spin_mode=..., path_read=...).model_dump_json()``, as bytes."""
-    rest = rest_json(cmap, robot, spin_mode=spin_mode, path_read=path_read)
+    """``map_response(cmap, robot, ...).model_dump_json()`` (the same keywords), as bytes."""
+    rest = rest_json(
+        cmap, robot, spin_mode=spin_mode, path_read=path_read, axis_correction=axis_correction
+    )
     cells = ",".join(cell_pages(cmap, robot, page=max(1, cmap.mu_path.size)))
     return ('{"cells":[' + cells + "]" + rest[len(_NO_CELLS) :]).encode()
 
@@ -53,11 +56,13 @@ def rest_json(
     *,
     spin_mode: SpinMode,
     path_read: schemas.PathRead | None = None,
+    axis_correction: float = 0.0,
 ) -> str:
     """The map answer's JSON without cells (``{"cells":[],"best":...``), as the model writes it."""
-    rest = schemas.MapResponse(
-        cells=[], **answer_fields(cmap, robot, spin_mode=spin_mode, path_read=path_read)
-    ).model_dump_json()
+    fields = answer_fields(
+        cmap, robot, spin_mode=spin_mode, path_read=path_read, axis_correction=axis_correction
+    )
+    rest = schemas.MapResponse(cells=[], **fields).model_dump_json()
     if not rest.startswith(_NO_CELLS.decode()):  # not reached: cells is the model's first field
         raise RuntimeError(f"MapResponse JSON starts {rest[:20]!r}")
     return rest

@@ -135,10 +135,13 @@ def map_response(
     *,
     spin_mode: SpinMode,
     path_read: schemas.PathRead | None = None,
+    axis_correction: float = 0.0,
 ) -> schemas.MapResponse:
     """The JSON answer of ``POST /v1/map``: cells yaw-major, then y, then x.
 
-    ``path_read``: how the CAM program was read, None for poses and tool axes.
+    ``path_read``: how the CAM program was read, None for poses and tool axes;
+    ``axis_correction``: the largest correction made in normalising the request's unit vectors
+    and quaternions.
 
     The columns are read as Python lists once (indexing numpy arrays cell by cell took longer
     than validating the cells; ``model_construct``, unvalidated, was slower still).
@@ -170,7 +173,14 @@ def map_response(
             )
         )
     return schemas.MapResponse(
-        cells=cells, **answer_fields(cmap, robot, spin_mode=spin_mode, path_read=path_read)
+        cells=cells,
+        **answer_fields(
+            cmap,
+            robot,
+            spin_mode=spin_mode,
+            path_read=path_read,
+            axis_correction=axis_correction,
+        ),
     )
 
 
@@ -180,6 +190,7 @@ def answer_fields(
     *,
     spin_mode: SpinMode,
     path_read: schemas.PathRead | None,
+    axis_correction: float = 0.0,
 ) -> dict[str, Any]:
     """The map answer's fields but its cells, as both writers give them.
 
@@ -194,5 +205,6 @@ def answer_fields(
         "recognised": require_family(robot).recognised,
         "path_read": path_read,
         "robot_read": robot_read_of(robot),
+        "axis_correction": axis_correction,
         **cell_model_to_api(cmap.cell_approximated, cmap.cell_unchecked),
     }

@@ -69,7 +69,7 @@ def _map(
     checked = checked_grid(body, settings)
     per_cell = map_cost(checked.problem)
     share = per_cell / (per_cell + STORED_CELL_COST)  # the placements' part of the job's work
-    result, robot, spin_mode, path_read = computed_map(
+    computed = computed_map(
         body,
         settings,
         png=False,
@@ -77,7 +77,16 @@ def _map(
         runner=runner,
         checked=checked,
     )
-    rest = json.loads(rest_json(result, robot, spin_mode=spin_mode, path_read=path_read))
+    result, robot = computed.result, computed.robot
+    rest = json.loads(
+        rest_json(
+            result,
+            robot,
+            spin_mode=computed.spin_mode,
+            path_read=computed.path_read,
+            axis_correction=computed.axis_correction,
+        )
+    )
     del rest["cells"]
     return CellPages(rest, cell_pages(result, robot, page=PAGE_CELLS), result.mu_path.size)
 

@@ -23,21 +23,30 @@ class ComputedMap(NamedTuple):
         robot: the robot it is of.
         spin_mode: the spin mode it was computed in.
         path_read: how the CAM program was read (None for poses and tool axes).
+        axis_correction: the largest correction made in normalising the request's tool axes
+            and quaternions (the path's, the tcp's, the cell's objects'), as an evaluation
+            answers it.
     """
 
     result: CapabilityMap
     robot: Robot
     spin_mode: SpinMode
     path_read: PathRead | None
+    axis_correction: float
 
 
 class CheckedGrid(NamedTuple):
-    """A map request checked: the robot, the grid, the problem, how the path was read."""
+    """A map request checked: its robot, grid, problem, reading and normalisation.
+
+    ``axis_correction``: the largest correction made in normalising the request's unit vectors
+    and quaternions.
+    """
 
     robot: Robot
     grid: convert.MapGrid
     problem: PathProblem
     path_read: PathRead | None
+    axis_correction: float
 
 
 def checked_grid(body: MapRequest, settings: Settings) -> CheckedGrid:
@@ -67,7 +76,8 @@ def checked_grid(body: MapRequest, settings: Settings) -> CheckedGrid:
         cost=map_cost(problem),
         with_cell=body.cell is not None,
     )
-    return CheckedGrid(robot, grid, problem, convert.path_read_of(path))
+    correction = max(path.axis_correction, convert.quaternion_correction(body.robot, body.cell))
+    return CheckedGrid(robot, grid, problem, convert.path_read_of(path), correction)
 
 
 def computed_map(
@@ -85,7 +95,9 @@ def computed_map(
     request's :func:`checked_grid` where the caller made it already (its problem's prepared
     path is then not made again).
     """
-    robot, grid, problem, path_read = checked_grid(body, settings) if checked is None else checked
+    robot, grid, problem, path_read, correction = (
+        checked_grid(body, settings) if checked is None else checked
+    )
     if png:
         convert.check_png_size(grid, settings=settings)
     result = capability_map(
@@ -98,7 +110,7 @@ def computed_map(
         progress=progress,
         runner=thread_runner(settings.threads) if runner is None else runner,
     )
-    return ComputedMap(result, robot, problem.options.spin_mode, path_read)
+    return ComputedMap(result, robot, problem.options.spin_mode, path_read, correction)
 
 
 def map_png(result: CapabilityMap, robot: Robot) -> bytes:

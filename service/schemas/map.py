@@ -247,6 +247,13 @@ class MapResponse(ResponseModel):
     )
     path_read: PathRead | None = Field(default=None, description=PATH_READ)
     robot_read: RobotRead | None = Field(default=None, description=ROBOT_READ)
+    axis_correction: float = Field(
+        default=0.0,
+        description="The largest correction made in normalising the request's unit vectors and "
+        "quaternions, as /v1/evaluate's axis_correction: the path's tool axes (their length) or "
+        "pose quaternions (their norm), the robot's tcp and the cell's object poses "
+        "(dimensionless; 0 when none was needed).",
+    )
     cell_approximated: list[str] | None = Field(
         default=None, description=f"{CELL_APPROXIMATED} Null without a cell."
     )

@@ -1040,3 +1040,21 @@ def test_the_joint_step_and_blend_length_reach_the_request(
     stepped = api(client, "/v1/evaluate", {**body, "ik": {"max_joint_step": 0.001}})
     assert code == INFEASIBLE and json.loads(out) == stepped
     assert plain["feasible"] and stepped["reason"] == "discontinuous"
+
+
+def test_a_normalised_quaternion_is_said(
+    client: TestClient, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A tcp quaternion 2e-4 off unit is normalised: the text said nothing of it."""
+    robot = {"model": "ur5e", "tcp": {"position": [0, 0, 0.1], "orientation": [0, 0, 0, 0.9998]}}
+    file = _file(tmp_path, "robot.json", robot)
+    for argv in (
+        ["evaluate", str(PROGRAM), "--robot", file, "--at=0,0.3,0,0"],
+        [*MAP, "--robot", file, "--png", str(tmp_path / "map.png")],
+    ):
+        _, out, _ = run(capsys, *argv)
+        assert (
+            "normalised: the request's tool axes or quaternions, largest correction 2.0e-04" in out
+        )
+    _, out, _ = run(capsys, "evaluate", str(PROGRAM), "--robot", "ur5e", "--at=0,0.3,0,0")
+    assert "normalised" not in out

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import io
 import json
+import time
 from collections.abc import Iterator
 from typing import Any
 
@@ -155,3 +156,41 @@ def test_bad_grid(
     response = client.post("/v1/map", json=map_body(path, **grid))
     assert response.status_code == 422, response.text
     assert response.json()["detail"][0]["loc"][: len(loc)] == loc
+
+
+def test_a_map_says_what_it_normalised_as_an_evaluation_does(
+    client: TestClient, path: dict[str, Any]
+) -> None:
+    """Quaternions 5e-4 off unit are normalised (api.md, Pose): /v1/evaluate and /v1/optimize
+    said so in axis_correction, the map said nothing. Its answer (and a map job's, and the PNG
+    route's JSON twin) now carries the largest correction: here the path's (|1.0005 - 1|) and a
+    tcp's 2e-4 below it."""
+    stretched = json.loads(json.dumps(path))
+    for waypoint in stretched["waypoints"]:
+        waypoint["orientation"] = [1.0005 * v for v in waypoint["orientation"]]
+    grid = {"x": {"min": 0.0, "max": 0.1, "step": 0.1}, "y": {"min": 0.4, "max": 0.4, "step": 0.1}}
+    body = map_body(stretched, **grid, yaw=0.0)
+    body["robot"] = {
+        "model": "ur5",
+        "tcp": {"position": [0, 0, 0.1], "orientation": [0, 0, 0, 0.9998]},
+    }
+    stretched_map = client.post("/v1/map", json=body).json()
+    norm = float(np.linalg.norm(stretched["waypoints"][0]["orientation"]))
+    assert stretched_map["axis_correction"] == pytest.approx(norm - 1.0, abs=1e-12)
+    placement = {"x": 0.0, "y": 0.4, "z": 0.1, "yaw": 0.0}
+    evaluation = client.post(
+        "/v1/evaluate", json={"robot": body["robot"], "path": stretched, "placement": placement}
+    ).json()
+    assert stretched_map["axis_correction"] == evaluation["axis_correction"]
+    plain = client.post("/v1/map", json=map_body(path, **grid, yaw=0.0)).json()
+    assert plain["axis_correction"] < 1e-12  # the file's own digits: its norms 1 to 6e-13
+    unit = client.post("/v1/map", json={**body, "path": path}).json()
+    assert unit["axis_correction"] == pytest.approx(2e-4, abs=1e-12)  # the tcp's alone
+    job = client.post("/v1/jobs", json={"kind": "map", "request": body}).json()
+    for _ in range(600):
+        job = client.get(f"/v1/jobs/{job['id']}").json()
+        if job["status"] not in ("queued", "running"):
+            break
+        time.sleep(0.05)
+    assert job["status"] == "done", job
+    assert job["result"]["axis_correction"] == stretched_map["axis_correction"]

@@ -345,3 +345,26 @@ def test_the_optimiser_searches_the_height_and_spin_ranges_given_on_the_page(
     detail = httpx.post(f"{url}/v1/optimize", json=wrong).json()["detail"]
     assert [d["loc"][1:3] for d in detail] == [["bounds", "z"]]
     assert error_beside(page, "bounds.z") == detail[0]["msg"]
+
+
+def test_the_map_and_a_clicked_cell_say_what_was_normalised(page: Page, url: str) -> None:
+    """A pasted robot's tcp quaternion 2e-4 off unit is normalised by the API: the map and the
+    cell said nothing of it (the map's answer did not carry it either)."""
+    robot = {"model": "ur5", "tcp": {"position": [0, 0, 0.05], "orientation": [0, 0, 0, 0.9998]}}
+    page.click("#own-json summary")
+    page.fill("#robot-json", json.dumps(robot))
+    fill(page, SMALL)
+    page.click("#run")
+    page.wait_for_function("document.getElementById('summary').dataset.cells", timeout=120_000)
+    body = {"robot": robot, "path": EXAMPLE_PATH, "grid": grid_of(SMALL)}
+    api = httpx.post(f"{url}/v1/map", json=body, timeout=120).json()
+    said = "normalised, largest correction 2.0e-4"
+    assert f"{api['axis_correction']:.1e}".replace("e-04", "e-4") == "2.0e-4"
+    assert said in (page.text_content("#summary") or "")
+    cell = _first_feasible(api)
+    point = cell_point(page, 0, cell, api)
+    page.mouse.click(point["x"], point["y"])
+    page.wait_for_function(
+        "document.getElementById('cell-summary').textContent.includes('mu_path')", timeout=30_000
+    )
+    assert said in (page.text_content("#cell-summary") or "")

@@ -50,14 +50,19 @@ async def post_map(
     png = convert.wants_png(accept)
 
     def work(progress: Progress) -> MapResponse | Response:
-        result, robot, spin_mode, path_read = computed_map(
-            body, settings, png=png, progress=progress
-        )
+        computed = computed_map(body, settings, png=png, progress=progress)
+        result, robot = computed.result, computed.robot
         PLACEMENTS.inc(result.mu_path.size)
         if png:
             return _picture(result, robot)
         # The model's JSON written from the columns (no model a cell; tests/service/test_map_json)
-        answer = map_json(result, robot, spin_mode=spin_mode, path_read=path_read)
+        answer = map_json(
+            result,
+            robot,
+            spin_mode=computed.spin_mode,
+            path_read=computed.path_read,
+            axis_correction=computed.axis_correction,
+        )
         return Response(answer, media_type="application/json")
 
     return await run_stoppable(request, work)
@@ -87,7 +92,8 @@ async def post_map_png(
     """The map of ``POST /v1/map`` as a picture (generated clients get bytes)."""
 
     def work(progress: Progress) -> Response:
-        result, robot, _, _ = computed_map(body, settings, png=True, progress=progress)
+        computed = computed_map(body, settings, png=True, progress=progress)
+        result, robot = computed.result, computed.robot
         PLACEMENTS.inc(result.mu_path.size)
         return _picture(result, robot)
 

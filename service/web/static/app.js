@@ -481,6 +481,13 @@ function urdfRead(read) {
     + (read.locked_joints.length ? `; locked at 0, they move no tool: ${names(read.locked_joints)}` : "");
 }
 
+// A correction made in normalising the request's tool axes or quaternions (the answer's
+// axis_correction), said above the rounding of a file's printed digits, 1e-6 (as dtf-place).
+function normalisedText(correction) {
+  return correction > 1e-6
+    ? `; the request's tool axes or quaternions normalised, largest correction ${correction.toExponential(1)}` : "";
+}
+
 // The map's colour: mu_acc when the request gave acceleration limits (the API then fills it in
 // every feasible cell and ranks best and worst by it), else mu_path.
 function drawMap(answer) {
@@ -499,6 +506,7 @@ function drawMap(answer) {
   $("summary").textContent = `${cells.length} cells, ${answer.feasible_cells} feasible`
     + (key === "mu_acc" ? `; colour: mu_acc, limited by acceleration in ${byAcc} cells, by speed in ${answer.feasible_cells - byAcc}` : "")
     + (state.mapBody && state.mapBody.cell ? `; ${collisions} in collision with the cell` : "")
+    + normalisedText(answer.axis_correction)
     + cellModel(answer);
   // How a URDF's IK was solved: the closed form where its chain was recognised (the API's
   // sentence: the arm, its frames, its parameters), else numeric IK, said as plainly.
@@ -729,6 +737,7 @@ async function evaluateCell(c) {
   $("cell-summary").textContent = (answer.feasible
     ? `${where}: mu_path ${answer.mu_path.toFixed(6)} m/s${use}`
     : `${where}: infeasible (${answer.reason} at waypoint ${answer.failed_waypoint})`)
+    + normalisedText(answer.axis_correction)
     + (formChanged(map) ? " (with the map's inputs: the form has changed since; run the map again for its own)" : "");
   $("cell-verdict").textContent = cellVerdict(answer, body.cell);
   if (answer.feasible && answer.spin_mode === "free") await compareFixedSpin(body, answer);
