@@ -46,6 +46,7 @@ def test_operation_ids_are_short_and_the_png_is_binary() -> None:
         "list_jobs",
         "get_job",
         "get_job_result",
+        "get_job_request",
         "cancel_job",
         "delete_job",
         "metrics",

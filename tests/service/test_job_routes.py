@@ -246,3 +246,20 @@ def test_every_error_type_a_job_can_fail_with_is_in_the_contract() -> None:
     assert {"unavailable", "interrupted", "damaged", "internal"} <= emitted
     description = JobInfo.model_fields["error"].description or ""
     assert [kind for kind in sorted(emitted) if f"{kind} (" not in description] == []
+
+
+@pytest.mark.parametrize("kind", ["evaluate", "map"])
+def test_a_jobs_request_is_read_back_as_submitted(client: TestClient, kind: str) -> None:
+    """A client that lost the body (a page reloaded while its map ran) could not learn what a
+    job computes, nor evaluate a map's cells with their own request."""
+    body = route_body(kind, EXAMPLE["path"]) | {"ik": {"max_joint_step": 0.3}}
+    submitted = client.post("/v1/jobs", json={"kind": kind, "request": body})
+    assert submitted.status_code == 202, submitted.text
+    job = submitted.json()
+    read = client.get(f"/v1/jobs/{job['id']}/request")
+    assert read.status_code == 200
+    assert read.json() == {"kind": kind, "request": body}
+    assert client.delete(f"/v1/jobs/{job['id']}").status_code == 204
+    gone = client.get(f"/v1/jobs/{job['id']}/request")
+    assert gone.status_code == 404
+    assert gone.json()["detail"][0]["loc"] == ["path", "job_id"]

@@ -368,3 +368,37 @@ def test_the_map_and_a_clicked_cell_say_what_was_normalised(page: Page, url: str
         "document.getElementById('cell-summary').textContent.includes('mu_path')", timeout=30_000
     )
     assert said in (page.text_content("#cell-summary") or "")
+
+
+def test_a_reloaded_page_shows_its_last_map_with_the_maps_own_request(page: Page, url: str) -> None:
+    """A reload lost the map (a long job ran on with nothing to show it): the page remembers
+    its last map job, offers it, draws the job's cells and evaluates a clicked cell with the
+    job's request (GET /v1/jobs/{id}/request), not the form's."""
+    fill(page, SMALL)
+    with page.expect_response(
+        lambda r: r.request.method == "POST" and r.url.endswith("/v1/jobs")
+    ) as sent:
+        page.click("#run")
+    job_id = sent.value.json()["id"]
+    page.wait_for_function("document.getElementById('summary').dataset.cells", timeout=60_000)
+    page.reload()
+    page.wait_for_function("document.body.dataset.ready === '1'")
+    assert page.is_visible("#resume")
+    assert f"job {job_id}" in (page.text_content("#resume-text") or "")
+    assert "done" in (page.text_content("#resume-text") or "")
+    page.click("#resume-show")
+    page.wait_for_function("document.getElementById('summary').dataset.cells", timeout=60_000)
+    request = httpx.get(f"{url}/v1/jobs/{job_id}/request").json()["request"]
+    api = httpx.post(f"{url}/v1/map", json=request, timeout=60).json()
+    assert page.get_attribute("#summary", "data-cells") == str(len(api["cells"]))
+    assert page.text_content("#best-mu") == f"{api['best']['mu_path']:.6f} m/s"
+    cell = _first_feasible(api)
+    point = cell_point(page, 0, cell, api)
+    page.mouse.click(point["x"], point["y"])
+    page.wait_for_function(
+        "document.getElementById('cell-summary').textContent.includes('mu_path')", timeout=30_000
+    )
+    body = {key: value for key, value in request.items() if key != "grid"}
+    body["placement"] = {"x": cell["x"], "y": cell["y"], "z": 0.1, "yaw": cell["yaw"], "spin": 0.0}
+    evaluation = httpx.post(f"{url}/v1/evaluate", json=body, timeout=60).json()
+    assert f"mu_path {evaluation['mu_path']:.6f} m/s" in (page.text_content("#cell-summary") or "")

@@ -9,6 +9,7 @@ While the job store cannot be used, every route here answers 503 saying why.
 from __future__ import annotations
 
 import functools
+import json
 from typing import Annotated, Any
 from uuid import UUID
 
@@ -188,6 +189,44 @@ def get_job(job_id: JobId, settings: SettingsDep) -> Response:
     return json_response(
         job_info(job, store, result=job.result, page_limit=settings.job_page_cells)
     )
+
+
+@router.get(
+    "/{job_id}/request",
+    operation_id="get_job_request",
+    summary="What a job computes: its kind and request, as submitted",
+    response_class=Response,
+    responses={
+        200: {
+            "description": "The job's body, as POST /v1/jobs took it.",
+            "content": {
+                "application/json": {
+                    "schema": {
+                        "oneOf": [
+                            {"$ref": f"#/components/schemas/{model.__name__}"}
+                            for model in JOB_MODELS
+                        ]
+                    }
+                }
+            },
+        },
+        **NOT_FOUND,
+    },
+)
+def get_job_request(job_id: JobId, settings: SettingsDep) -> Response:
+    """The body ``POST /v1/jobs`` took: its ``kind`` and ``request`` (the fields it was given).
+
+    For a client that no longer holds it (a page reloaded while its map ran): a map's cells are
+    evaluated with their own request. Not in ``GET /v1/jobs/{id}``, which a client polls: a
+    request may hold a path of 20,000 waypoints.
+    """
+    store = get_runner(settings).store
+    state = store.state(str(job_id))
+    request = store.request(str(job_id))
+    if state is None or request is None:
+        raise job_not_found(job_id)
+    body = json.dumps({"kind": state.kind, "request": request}, separators=(",", ":"))
+    return Response(body, media_type="application/json")
 
 
 @router.post(

@@ -842,6 +842,7 @@ async function start() {
   $("opt-cancel").addEventListener("click", () => dropOptimization("stopped from the page"));
   startCellEditor();
   await loadExample();
+  await offerLastJob();
   document.body.dataset.ready = "1";
 }
 

@@ -25,7 +25,48 @@ async function runMap(event) {
   if (state.run !== run) { if (job) cancelJob(job.id); return; }  // dropped while submitted
   if (!job) { endRun(); $("job-status").textContent = "no map: see the errors above"; return; }
   run.id = job.id; state.grid = body.grid; state.mapBody = body;
+  rememberJob(job.id);
+  $("resume").hidden = true;
   $("cancel").disabled = false;
+  await watch(run);
+}
+
+// The last map job submitted from this browser (localStorage): a page reloaded while it ran, or
+// after, shows it again on request, watched to its end if it still runs, its cells evaluated
+// with its own request (GET /v1/jobs/{id}/request), whatever the form holds.
+const LAST_JOB_KEY = "dtf-placement.last-map-job";
+
+function rememberJob(id) {
+  try { localStorage.setItem(LAST_JOB_KEY, id); } catch { /* storage refused: nothing kept */ }
+}
+
+async function offerLastJob() {
+  let id = null;
+  try { id = localStorage.getItem(LAST_JOB_KEY); } catch { return; }
+  if (!id) return;
+  let job;
+  try { job = await getJson(`/v1/jobs/${id}`); } catch (error) {
+    if (error.status === 404) localStorage.removeItem(LAST_JOB_KEY);  // deleted or expired
+    return;
+  }
+  const when = new Date(job.created * 1000).toLocaleString();
+  $("resume-text").textContent = `Your last map, job ${id} (submitted ${when}): `
+    + `${job.status}, ${job.progress.done} of ${job.progress.total} placements.`;
+  $("resume").hidden = false;
+  $("resume-show").onclick = () => resumeMap(id);
+}
+
+async function resumeMap(id) {
+  if (state.run) return;
+  clearErrors();
+  const asked = await api("GET", `/v1/jobs/${id}/request`).catch(() => null);
+  if (!asked || state.run) return;
+  clearResults();
+  dropOptimization("an earlier map was shown; optimise again for its inputs");
+  $("resume").hidden = true;
+  const run = { id, resumed: true };
+  state.run = run; $("run").disabled = true; $("cancel").disabled = false;
+  state.grid = asked.request.grid; state.mapBody = asked.request;
   await watch(run);
 }
 
@@ -40,8 +81,12 @@ function dropRun(why) {
   const run = state.run;
   if (!run) return;
   endRun();
-  if (run.id) cancelJob(run.id);
   $("bar").value = 0; $("eta").textContent = "";
+  if (run.resumed) {  // an earlier job shown again: not this form's, so left to run
+    $("job-status").textContent = `no longer watched (job ${run.id} runs on): ${why}`;
+    return;
+  }
+  if (run.id) cancelJob(run.id);
   $("job-status").textContent = `cancelled: ${why}`;
 }
 
