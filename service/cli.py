@@ -24,9 +24,10 @@ as the routes do. Settings come from the environment as for the service (``DTF_*
 command's work is bounded as a job's is (DTF_MAX_JOB_CELLS, DTF_MAX_JOB_POSES; a route's
 limit where larger), not as a synchronous request's (:func:`_settings`).
 Exit codes: :data:`OK` (0), :data:`USAGE` (2), :data:`INVALID` (3), :data:`INFEASIBLE` (4),
-:data:`INTERRUPTED` (130, Ctrl-C), :data:`CLOSED_PIPE` (141, the output's reader closed it
-early); 1 is Python's own, for a crash. Errors name the field (and waypoint, line) as the API
-does, or the option (``--png``, ``--robot``). ``--json`` is written in ASCII (JSON's escapes),
+:data:`NOT_WRITTEN` (5, the answer could not be written), :data:`INTERRUPTED` (130, Ctrl-C),
+:data:`CLOSED_PIPE` (141, the output's reader closed it early); 1 is Python's own, for a
+crash. Errors name the field (and waypoint, line) as the API does, or the option (``--png``,
+``--robot``). ``--json`` is written in ASCII (JSON's escapes),
 the same JSON on any console's encoding.
 """
 
@@ -531,7 +532,9 @@ def _parser() -> argparse.ArgumentParser:
         prog="dtf-place",
         description="Workpiece placement for robot machining, from a CL or CSV program: "
         "the import, mu_path at a placement, the capability map, the best placement. "
-        f"Exit codes: {OK} ok, {INFEASIBLE} infeasible, {USAGE} usage, {INVALID} invalid input. "
+        f"Exit codes: {OK} ok, {INFEASIBLE} infeasible, {USAGE} usage, {INVALID} invalid input, "
+        f"{NOT_WRITTEN} answer not written (output closed, disk full), {INTERRUPTED} "
+        f"interrupted (Ctrl-C), {CLOSED_PIPE} output closed early by its reader. "
         "Settings come from DTF_* variables as for the service; the work of a command is "
         "bounded as a job's (DTF_MAX_JOB_CELLS, DTF_MAX_JOB_POSES, or a route's limit where "
         "larger).",
