@@ -12,6 +12,7 @@ from __future__ import annotations
 import copy
 import json
 import math
+from pathlib import Path
 from typing import Any
 
 import httpx
@@ -402,3 +403,33 @@ def test_a_reloaded_page_shows_its_last_map_with_the_maps_own_request(page: Page
     body["placement"] = {"x": cell["x"], "y": cell["y"], "z": 0.1, "yaw": cell["yaw"], "spin": 0.0}
     evaluation = httpx.post(f"{url}/v1/evaluate", json=body, timeout=60).json()
     assert f"mu_path {evaluation['mu_path']:.6f} m/s" in (page.text_content("#cell-summary") or "")
+
+
+def test_the_map_is_saved_as_the_apis_png_and_a_refusal_is_said(page: Page, url: str) -> None:
+    """The page drew its map on canvases with nothing to save for a report: 'Save the map as a
+    PNG' downloads the API's picture of the map's own request, byte for byte; a picture the
+    route refuses (too many panels, say) is said beside the button, no file."""
+    run_small_map(page, url)
+    with page.expect_request(lambda r: r.url.endswith("/v1/map/png")) as sent:
+        with page.expect_download() as download:
+            page.click("#png")
+    saved = Path(download.value.path()).read_bytes()
+    api = httpx.post(f"{url}/v1/map/png", json=sent.value.post_data_json, timeout=60)
+    assert api.status_code == 200 and saved[:8] == b"\x89PNG\r\n\x1a\n"
+    assert saved == api.content
+    assert sent.value.post_data_json["grid"] == grid_of(SMALL)
+    assert page.text_content("#png-status") == "saved as dtf-map.png"
+
+    def refuse(route: Route) -> None:
+        said = "40 panels; the limit is 16 (DTF_MAX_PNG_PANELS)"
+        detail = [{"loc": ["body", "grid"], "msg": said, "type": "invalid_input"}]
+        route.fulfill(
+            status=422, content_type="application/json", body=json.dumps({"detail": detail})
+        )
+
+    page.route("**/v1/map/png", refuse)
+    page.click("#png")
+    page.wait_for_function("document.getElementById('png-status').textContent.startsWith('no')")
+    assert page.text_content("#png-status") == (
+        "no picture: grid: 40 panels; the limit is 16 (DTF_MAX_PNG_PANELS)"
+    )

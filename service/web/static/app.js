@@ -393,6 +393,7 @@ function clearMap() {
   const bar = $("colourbar-canvas");
   bar.getContext("2d").clearRect(0, 0, bar.width, bar.height);
   $("colourbar").hidden = true;
+  $("png-line").hidden = true;
   $("best-line").hidden = true;
 }
 
@@ -531,6 +532,8 @@ function drawMap(answer) {
     : "";
   $("colourbar").hidden = false;
   $("best-line").hidden = false;
+  $("png-line").hidden = false;
+  $("png-status").textContent = "";
   $("cb-min").textContent = feasible.length ? `${low.toFixed(3)} m/s` : "";
   $("cb-max").textContent = feasible.length ? `${high.toFixed(3)} m/s` : "";
   const bar = $("colourbar-canvas").getContext("2d");
@@ -750,6 +753,34 @@ async function evaluateCell(c) {
   plot(answer, body);
 }
 
+// The map drawn as the API draws it (POST /v1/map/png with the map's own request: panels, colour
+// bar, reasons' colours, best and worst marked), saved as a file. The route computes it again,
+// within a request's limits: a map too large for one says so (dtf-place map draws any size).
+async function savePng() {
+  const body = state.mapBody;
+  if (!body) return;
+  $("png-status").textContent = "drawing…";
+  let response;
+  try {
+    response = await fetch("/v1/map/png", {
+      method: "POST", headers: { "Content-Type": "application/json" }, body: JSON.stringify(body),
+    });
+  } catch (error) { $("png-status").textContent = `no picture: no answer (${error.message})`; return; }
+  if (state.mapBody !== body) return;  // another map meanwhile
+  if (!response.ok) {
+    let said = `HTTP ${response.status}`;
+    try { said = (await response.json()).detail.map(detailText).join("; "); } catch { /* not JSON */ }
+    $("png-status").textContent = `no picture: ${said}`;
+    return;
+  }
+  const link = document.createElement("a");
+  link.href = URL.createObjectURL(await response.blob());
+  link.download = "dtf-map.png";
+  link.click();
+  setTimeout(() => URL.revokeObjectURL(link.href), 10_000);
+  $("png-status").textContent = "saved as dtf-map.png";
+}
+
 // Whether the form now asks another map than ``map`` (its grid aside): a robot, limit, path,
 // IK option, spin mode or cell edited since.
 function formChanged(map) {
@@ -840,6 +871,7 @@ async function start() {
   $("cancel").addEventListener("click", cancelMap);
   $("optimize").addEventListener("click", optimize);
   $("opt-cancel").addEventListener("click", () => dropOptimization("stopped from the page"));
+  $("png").addEventListener("click", savePng);
   startCellEditor();
   await loadExample();
   await offerLastJob();
