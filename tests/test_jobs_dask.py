@@ -236,3 +236,18 @@ def test_workers_whose_code_is_not_the_services_are_refused(
     said = str(refused.value)
     for address in cluster.scheduler_info["workers"]:
         assert f"{address}: numpy {np.__version__} (here 0.0.1)" in said
+
+
+def test_workers_that_cannot_be_asked_their_code_are_the_clusters_failure(
+    cluster: LocalCluster, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A worker gone between the scheduler's list and the question (a KeyError out of the
+    client) failed the job as 'internal'."""
+    runner = DaskRunner(cluster.scheduler_address)
+
+    def gone(*args: object, **kwargs: object) -> None:
+        raise KeyError("tcp://127.0.0.1:1")
+
+    monkeypatch.setattr(runner.client(), "run", gone)
+    with pytest.raises(ClusterUnavailable, match="could not be asked which code .* KeyError"):
+        runner.run(abs, [-1], _noted([]))

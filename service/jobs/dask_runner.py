@@ -201,7 +201,11 @@ class DaskRunner:
         if workers <= self._checked:
             return
         mine = code_fingerprint()
-        theirs = client.run(worker_fingerprint, workers=sorted(workers - self._checked))
+        try:
+            theirs = client.run(worker_fingerprint, workers=sorted(workers - self._checked))
+        except Exception as error:  # noqa: BLE001 - a worker gone meanwhile, the scheduler lost
+            asked = "could not be asked which code its workers run"
+            raise self._unavailable(asked, error) from None
         differ = {
             address: [
                 f"{key} {value} (here {mine.get(key)})"
