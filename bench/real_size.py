@@ -54,7 +54,7 @@ from service.convert import map_response  # noqa: E402
 from service.convert.map_json import map_json  # noqa: E402
 from service.jobs.store import JobStore  # noqa: E402
 from service.jobs.worker import _map  # noqa: E402
-from service.operations.map import computed_map  # noqa: E402
+from service.operations.map import ComputedMap, computed_map  # noqa: E402
 from service.schemas import MapRequest  # noqa: E402
 from solver.core.parallel import ThreadRunner  # noqa: E402
 from tests.live import start_server  # noqa: E402
@@ -71,11 +71,12 @@ def erk_route_parts(*, repeats: int) -> None:
     request = MapRequest.model_validate_json(raw)
     settings = Settings()
 
-    def computed(threads: int) -> tuple[Any, ...]:
+    def computed(threads: int) -> ComputedMap:
         runner = ThreadRunner(threads)
         return computed_map(request, settings, png=False, progress=lambda _: None, runner=runner)
 
-    result, robot, spin_mode, _ = computed(settings.threads)
+    answer = computed(settings.threads)
+    result, robot, spin_mode = answer.result, answer.robot, answer.spin_mode
     response = map_response(result, robot, spin_mode=spin_mode)
     parts = {
         "validation": best_time(lambda: MapRequest.model_validate_json(raw), repeats),
