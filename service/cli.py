@@ -93,7 +93,7 @@ Model = TypeVar("Model", bound=BaseModel)
 
 
 # The options whose values may start with a minus sign (a range or a list of numbers).
-_SIGNED_VALUES = frozenset({"--at", "--x", "--y", "--z", "--yaw", "--spin", "--feed"})
+_SIGNED_VALUES = frozenset({"--at", "--start", "--x", "--y", "--z", "--yaw", "--spin", "--feed"})
 _STARTS_SIGNED = re.compile(r"-[0-9.]")
 
 
@@ -465,6 +465,8 @@ def _optimise(args: argparse.Namespace) -> int:
         bounds["z"] = args.z
     else:
         body["z"] = args.z
+    if args.start is not None:
+        body["start"] = dict(zip(("x", "y", "z", "yaw"), args.start, strict=True))
     from service.operations.optimize import optimum_of  # the optimisers' libraries: here only
 
     request = _validated(OptimizeRequest, _with_options(body, args))
@@ -644,6 +646,13 @@ def _parser() -> argparse.ArgumentParser:
         default="scipy",
         help="scipy (the default here: differential evolution, then SLSQP) or casadi (IPOPT "
         "from a coarse map's best cells: the API's default)",
+    )
+    run.add_argument(
+        "--start",
+        type=_numbers(4, ","),
+        metavar="X,Y,Z,YAW",
+        help="the placement now (inside the bounds; default their centre): the gain is over it, "
+        "and of equally fast placements the one nearest it is answered",
     )
     run.set_defaults(run=_optimise)
     return parser

@@ -1058,3 +1058,29 @@ def test_a_normalised_quaternion_is_said(
         )
     _, out, _ = run(capsys, "evaluate", str(PROGRAM), "--robot", "ur5e", "--at=0,0.3,0,0")
     assert "normalised" not in out
+
+
+def test_optimise_starts_from_the_placement_given(
+    client: TestClient, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """The command line had no --start: the gain was over the box's centre, not over where the
+    part is now. The answer is the API's for the body with that start (a negative value after a
+    space, as --at takes it), its start is that placement, and one outside the box is refused
+    naming start."""
+    argv = [
+        "optimise", str(PROGRAM), "--robot", "ur5e", "--x=-0.1:0.1", "--y", "0.25:0.35",
+        "--yaw=-0.5:0.5", "--method", "casadi", "--json",
+    ]  # fmt: skip
+    code, out, _ = run(capsys, *argv, "--start", "-0.05,0.3,0,0.2")
+    assert code == OK
+    mine = json.loads(out)
+    start = {"x": -0.05, "y": 0.3, "z": 0.0, "yaw": 0.2}
+    bounds = {"x": [-0.1, 0.1], "y": [0.25, 0.35], "yaw": [-0.5, 0.5]}
+    body = {"robot": ROBOT, "path": {"cl_data": PROGRAM.read_text()}, "bounds": bounds, "z": 0.0}
+    theirs = api(client, "/v1/optimize", {**body, "start": start})
+    for answer in (mine, theirs):
+        answer["solver"].pop("seconds")
+    assert mine == theirs
+    assert {k: mine["start"]["placement"][k] for k in start} == start
+    code, _, err = run(capsys, *argv, "--start=0.5,0.3,0,0")
+    assert code == INVALID and "start" in err
