@@ -433,3 +433,27 @@ def test_the_map_is_saved_as_the_apis_png_and_a_refusal_is_said(page: Page, url:
     assert page.text_content("#png-status") == (
         "no picture: grid: 40 panels; the limit is 16 (DTF_MAX_PNG_PANELS)"
     )
+
+
+def test_the_optimiser_starts_where_the_part_is_now(page: Page, url: str) -> None:
+    """The page had no start: the gain it showed was over the box's centre. A start typed in is
+    sent (z the grid's), and the gain shown is the API's over it; an empty field beside filled
+    ones is the API's error beside the start."""
+    fill(page, {**SMALL, "opt-start-x": "-0.05", "opt-start-y": "0.35", "opt-start-yaw": "0.5"})
+    with page.expect_request(lambda r: r.method == "POST" and "/v1/optimize" in r.url) as sent:
+        page.click("#optimize")
+    submitted = json.loads(sent.value.post_data or "{}")
+    assert submitted["start"] == {"x": -0.05, "y": 0.35, "z": 0.1, "yaw": 0.5}
+    page.wait_for_function(
+        "document.getElementById('opt-mu').textContent.endsWith(' m/s')", timeout=120_000
+    )
+    api = httpx.post(f"{url}/v1/optimize", json=submitted, timeout=120).json()
+    start = f"{api['start']['mu_path']:.6f} m/s"
+    gain = f"+{api['improvement_percent']:.2f} %"
+    assert page.text_content("#opt-improvement") == f"({gain} over the start, {start})"
+    fill(page, {"opt-start-y": ""})
+    page.click("#optimize")
+    refused = {**submitted, "start": {**submitted["start"], "y": None}}
+    detail = httpx.post(f"{url}/v1/optimize", json=refused).json()["detail"]
+    assert [d["loc"][1:] for d in detail] == [["start", "y"]]
+    assert error_beside(page, "start") == f"y: {detail[0]['msg']}"

@@ -34,6 +34,16 @@ function spinRange() {
   return low === undefined && high === undefined ? undefined : [low ?? 0, high ?? 0];
 }
 
+// The start placement (the part now), or undefined (the API's default: the bounds' centre).
+// A field left empty beside filled ones is sent as null: the API says so beside them.
+function startOf(height) {
+  const ids = ["opt-start-x", "opt-start-y", "opt-start-yaw"];
+  if (ids.every((id) => $(id).value.trim() === "")) return undefined;
+  const [x, y, yaw] = ids.map((id) => value(id) ?? null);
+  const z = height.range ? (height.range[0] + height.range[1]) / 2 : height.z;
+  return { x, y, z, yaw };
+}
+
 function showYawRange() {
   const any = $("opt-any-yaw").checked;
   const yaws = numbers($("yaws").value).filter(Number.isFinite);
@@ -110,7 +120,7 @@ async function optimize() {
       x: [grid.x.min, grid.x.max], y: [grid.y.min, grid.y.max], yaw: yawRange(grid),
       z: height.range, spin: spinRange(),
     },
-    spin_mode: spinMode(), cell: cellBody(),
+    start: startOf(height), spin_mode: spinMode(), cell: cellBody(),
   };
   const run = { abort: new AbortController(), jobId: null };
   state.optimization = run;
