@@ -125,7 +125,7 @@ class CellSpec(RequestModel):
             )
         shapes = {
             group: tuple(
-                item.to_solver(f"cell.{group}.{k}", max_triangles)
+                item.to_solver(f"cell.{group}.{k}.{item.shape}", max_triangles)
                 for k, item in enumerate(getattr(self, group))
             )
             for group in ("fixed", "workpiece")

@@ -171,16 +171,16 @@ TWO_CUBES = base64.b64encode(
         (
             {"fixed": [mesh(CUBE)]},
             {"max_mesh_triangles": 11},
-            ["cell", "fixed", 0, "stl"],
+            ["cell", "fixed", 0, "mesh", "stl"],  # as the schema's own errors of the field
             "DTF_MAX_MESH_TRIANGLES",
         ),
         (
             {"workpiece": [mesh("hello, not a mesh")]},
             {},
-            ["cell", "workpiece", 0, "stl"],
+            ["cell", "workpiece", 0, "mesh", "stl"],
             "not an STL",
         ),
-        ({"fixed": [mesh("c29saWQ=")]}, {}, ["cell", "fixed", 0, "stl"], "not an STL"),
+        ({"fixed": [mesh("c29saWQ=")]}, {}, ["cell", "fixed", 0, "mesh", "stl"], "not an STL"),
         ({"fixed": [{"shape": "box", "size": [0.1, -0.1, 0.1]}]}, {}, ["cell", "fixed", 0], ""),
         ({"fixed": [{"shape": "cone", "radius": 0.1}]}, {}, ["cell", "fixed", 0], ""),
         ({"tool": {"radius": 0.02, "length": 0.01}}, {}, ["cell", "tool", "cutting_length"], ""),
@@ -356,7 +356,7 @@ def test_a_job_with_a_bad_cell_is_refused_at_submit_as_its_route_refuses_it(
     body = route_body(kind, EXAMPLE["path"])
     body["cell"] = {"workpiece": [mesh("hello, not a mesh")]}
     direct = client.post(f"/v1/{kind}", json=body)
-    assert_names(direct, 422, ["body", "cell", "workpiece", 0, "stl"])
+    assert_names(direct, 422, ["body", "cell", "workpiece", 0, "mesh", "stl"])
     submitted = client.post("/v1/jobs", json={"kind": kind, "request": body})
     assert submitted.status_code == 422, submitted.text
     (expected,), (detail,) = direct.json()["detail"], submitted.json()["detail"]
@@ -401,3 +401,16 @@ def test_a_larger_clearance_never_checks_fewer_self_pairs(client: TestClient) ->
             names[k] for k in (a, b)
         )
         assert collision["distance"] == pytest.approx(expected, abs=1e-6)
+
+
+def test_a_meshs_errors_have_one_loc_whoever_finds_them(client: TestClient) -> None:
+    """An empty STL (the schema's error) was at cell.fixed.0.mesh.stl, one that is no STL (the
+    reader's) at cell.fixed.0.stl: a client (the page) showing errors beside fields put the
+    second on another line."""
+    body = route_body("evaluate", EXAMPLE["path"])
+    locs = []
+    for stl in ("", "hello, not a mesh"):
+        body["cell"] = {"fixed": [mesh(stl)]}
+        (detail,) = client.post("/v1/evaluate", json=body).json()["detail"]
+        locs.append(detail["loc"])
+    assert locs == [["body", "cell", "fixed", 0, "mesh", "stl"]] * 2
