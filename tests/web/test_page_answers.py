@@ -457,3 +457,54 @@ def test_the_optimiser_starts_where_the_part_is_now(page: Page, url: str) -> Non
     detail = httpx.post(f"{url}/v1/optimize", json=refused).json()["detail"]
     assert [d["loc"][1:] for d in detail] == [["start", "y"]]
     assert error_beside(page, "start") == f"y: {detail[0]['msg']}"
+
+
+def test_a_numeric_arms_branch_and_an_optimisation_after_a_fixed_branch_map_are_taken(
+    page: Page, url: str
+) -> None:
+    """Found by a page audit: a Panda branch was sent as {"solution": "3"} (GET /v1/robots lists
+    the indices as words) and refused; and with any branch chosen Optimise sent ik.branch,
+    which /v1/optimize refuses (it takes the fastest). The index is sent as a number; the
+    optimiser's request leaves the branch out."""
+    page.select_option("#robot-model", "panda")
+    page.select_option("#ik-branch", json.dumps({"solution": 3}, separators=(",", ":")))
+    fill(page, {**SMALL, "yaws": "0"})
+    with page.expect_request(lambda r: r.method == "POST" and r.url.endswith("/v1/jobs")) as sent:
+        page.click("#run")
+    request = json.loads(sent.value.post_data or "{}")["request"]
+    assert request["ik"]["branch"] == {"solution": 3}
+    assert httpx.post(f"{url}/v1/map", json=request, timeout=120).status_code == 200
+    page.wait_for_function("document.getElementById('summary').dataset.cells", timeout=120_000)
+    page.select_option("#robot-model", "ur5")
+    page.select_option("#ik-branch", json.dumps(UR_BRANCH, separators=(",", ":")))
+    fill(page, {**SMALL, "opt-spin-min": "0.5", "opt-spin-max": "1", "opt-start-x": "0",
+                "opt-start-y": "0.4", "opt-start-yaw": "0"})  # fmt: skip
+    with page.expect_request(lambda r: r.method == "POST" and "/v1/optimize" in r.url) as sent:
+        page.click("#optimize")
+    submitted = json.loads(sent.value.post_data or "{}")
+    assert "branch" not in submitted["ik"]
+    assert submitted["start"]["spin"] == 0.75  # the spin range's middle: 0 is outside it
+    page.wait_for_function(
+        "document.getElementById('opt-mu').textContent.endsWith(' m/s')", timeout=120_000
+    )
+    api = httpx.post(f"{url}/v1/optimize", json=submitted, timeout=120).json()
+    assert page.text_content("#opt-mu") == f"{api['mu_path']:.6f} m/s"
+
+
+UR_BRANCH = {"shoulder": "left", "elbow": "up", "wrist": "noflip"}
+
+
+def test_a_cancelled_last_job_is_not_offered(page: Page, url: str) -> None:
+    """It was offered, and showing it drew nothing: only queued, running and done jobs are."""
+    fill(page, {**SMALL, "x-min": "-0.5", "x-max": "0.5", "x-step": "0.004",
+                "y-min": "0.0", "y-max": "0.8", "y-step": "0.004"})  # fmt: skip
+    page.click("#run")
+    page.wait_for_function("document.getElementById('bar').value > 0", timeout=60_000)
+    page.click("#cancel")
+    page.wait_for_function(
+        "document.getElementById('job-status').textContent.startsWith('cancelled')",
+        timeout=10_000,
+    )
+    page.reload()
+    page.wait_for_function("document.body.dataset.ready === '1'")
+    assert page.is_hidden("#resume")

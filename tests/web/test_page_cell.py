@@ -538,3 +538,20 @@ def test_an_stl_fixture_from_the_editor_is_sent_as_read_and_checked(page: Page, 
     add_mesh(page, name="fixture", stl=ascii_stl, units="", at=["0", "0", "0.2"])
     page.click("#run")
     assert "'m', 'mm', 'cm' or 'in'" in error_beside(page, "cell.fixed.0.mesh.units")
+
+
+def test_a_binary_stl_cut_short_is_sent_as_its_bytes_and_its_error_is_beside_the_file(
+    page: Page, url: str
+) -> None:
+    """Found by a page audit: a binary STL cut short (its header 'solid ...') was taken for
+    ASCII and sent as mangled text, and the reader's error (at cell.fixed.0.stl, where the
+    schema's were at cell.fixed.0.mesh.stl) landed on the row's first line."""
+    cut = cube_stl(100.0, binary=True)[:-10]
+    fill(page, SMALL)
+    add_mesh(page, name="fixture", stl=cut, units="mm", at=["0", "0", "0.2"])
+    with page.expect_request(lambda r: r.method == "POST" and r.url.endswith("/v1/jobs")) as sent:
+        page.click("#run")
+    (mesh,) = sent_json(sent.value)["request"]["cell"]["fixed"]
+    assert base64.b64decode(mesh["stl"]) == cut
+    said = error_beside(page, "cell.fixed.0.mesh.stl")
+    assert "STL" in said or "triangle" in said, said

@@ -138,13 +138,15 @@ function ikBody() {
 
 // The catalogue robot's branches (GET /v1/robots: levels and their choices), each combination
 // an option; a pasted robot object or a URDF follows the auto branch (its branches are its own).
+// A numeric arm's level, "solution", lists its indices as words: ik.branch takes the number.
 function showBranches(info) {
   const select = $("ik-branch");
   const kept = select.value;
   select.replaceChildren(select.options[0]);
   let combinations = [{}];
   for (const { level, choices } of info ? info.branches : []) {
-    combinations = combinations.flatMap((c) => choices.map((choice) => ({ ...c, [level]: choice })));
+    const named = (choice) => (level === "solution" ? Number(choice) : choice);
+    combinations = combinations.flatMap((c) => choices.map((choice) => ({ ...c, [level]: named(choice) })));
   }
   for (const branch of info && info.branches.length ? combinations : []) {
     const option = document.createElement("option");
@@ -760,6 +762,11 @@ async function savePng() {
   const body = state.mapBody;
   if (!body) return;
   $("png-status").textContent = "drawing…";
+  $("png").disabled = true;  // one picture at a time: each computes the map again
+  try { await downloadPng(body); } finally { $("png").disabled = false; }
+}
+
+async function downloadPng(body) {
   let response;
   try {
     response = await fetch("/v1/map/png", {

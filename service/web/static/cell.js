@@ -126,7 +126,9 @@ function meshFields(row, owner) {
     const chosen = event.target.files[0];
     if (!chosen) return;
     const bytes = new Uint8Array(await chosen.arrayBuffer());
-    const binary = binaryStl(bytes);
+    // Text only where every byte is ASCII: anything else (a binary STL cut short, not an STL)
+    // goes as its bytes, whose errors the API's reader names, not as mangled text.
+    const binary = binaryStl(bytes) || bytes.some((b) => b > 127);
     row.dataset.stl = binary ? base64Of(bytes) : new TextDecoder().decode(bytes);
     file.querySelector(".mesh-read").textContent = `${chosen.name}: ${binary ? "binary" : "ASCII"}, ${bytes.length} bytes`;
     showCellStatus();

@@ -49,6 +49,7 @@ async function offerLastJob() {
     if (error.status === 404) localStorage.removeItem(LAST_JOB_KEY);  // deleted or expired
     return;
   }
+  if (!["queued", "running", "done"].includes(job.status)) return;  // nothing of it to draw
   const when = new Date(job.created * 1000).toLocaleString();
   $("resume-text").textContent = `Your last map, job ${id} (submitted ${when}): `
     + `${job.status}, ${job.progress.done} of ${job.progress.total} placements.`;

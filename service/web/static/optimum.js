@@ -35,13 +35,16 @@ function spinRange() {
 }
 
 // The start placement (the part now), or undefined (the API's default: the bounds' centre).
-// A field left empty beside filled ones is sent as null: the API says so beside them.
-function startOf(height) {
+// A field left empty beside filled ones is sent as null: the API says so beside them. Its z and
+// spin are the middles of their ranges where they are searched (the grid's z, no spin else).
+function startOf(height, spins) {
   const ids = ["opt-start-x", "opt-start-y", "opt-start-yaw"];
   if (ids.every((id) => $(id).value.trim() === "")) return undefined;
   const [x, y, yaw] = ids.map((id) => value(id) ?? null);
   const z = height.range ? (height.range[0] + height.range[1]) / 2 : height.z;
-  return { x, y, z, yaw };
+  const start = { x, y, z, yaw };
+  if (spins) start.spin = (spins[0] + spins[1]) / 2;
+  return start;
 }
 
 function showYawRange() {
@@ -114,13 +117,16 @@ async function optimize() {
   }
   let robot;
   try { robot = robotBody(); } catch (error) { showErrors([{ loc: ["robot"], msg: error.message }]); return; }
+  const ik = ikBody();
+  delete ik.branch;  // the optimiser takes the fastest branch (ik.branch "auto" only)
+  const spins = spinRange();
   const body = {
-    robot, path: state.path, method: $("method").value, z: height.z, ik: ikBody(),
+    robot, path: state.path, method: $("method").value, z: height.z, ik,
     bounds: {
       x: [grid.x.min, grid.x.max], y: [grid.y.min, grid.y.max], yaw: yawRange(grid),
-      z: height.range, spin: spinRange(),
+      z: height.range, spin: spins,
     },
-    start: startOf(height), spin_mode: spinMode(), cell: cellBody(),
+    start: startOf(height, spins), spin_mode: spinMode(), cell: cellBody(),
   };
   const run = { abort: new AbortController(), jobId: null };
   state.optimization = run;
