@@ -57,6 +57,14 @@ def path_of(path: schemas.Path) -> PathInput:
     return path.to_solver()
 
 
+def request_correction(path: PathInput, *parts: BaseModel | None) -> float:
+    """The answer's ``axis_correction``: the path's and :func:`quaternion_correction`'s, the larger.
+
+    ``parts``: the request's robot and cell.
+    """
+    return max(path.axis_correction, quaternion_correction(*parts))
+
+
 def quaternion_correction(*parts: BaseModel | None) -> float:
     """The largest |norm - 1| of the quaternions of every Pose in ``parts`` (0 for none).
 

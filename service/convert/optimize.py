@@ -134,8 +134,8 @@ def optimize_response(
     (``cycle_time``, with acceleration limits) as ``/v1/evaluate`` does.
 
     ``path``: the request's path, for how a CAM program was read (``path_read``) and the pass
-    and operation of a failure; the answer's ``axis_correction`` is the larger of its and
-    ``axis_correction`` (the request's other quaternions).
+    and operation of a failure; ``axis_correction``: the request's
+    (:func:`~service.convert.common.request_correction`).
     """
     report = optimum.solver
     start = optimum.start_evaluation
@@ -149,7 +149,7 @@ def optimize_response(
         else evaluate_response(
             optimum.evaluation,
             robot,
-            axis_correction=max(axis_correction, 0.0 if path is None else path.axis_correction),
+            axis_correction=axis_correction,
             feed=None
             if path is None or path.feed is None
             else check_feed(optimum.evaluation, path.feed, robot.qdot_max),

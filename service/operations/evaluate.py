@@ -109,9 +109,7 @@ def evaluation_of(
     return convert.evaluate_response(
         evaluation,
         robot,
-        axis_correction=max(
-            path.axis_correction, convert.quaternion_correction(body.robot, body.cell)
-        ),
+        axis_correction=convert.request_correction(path, body.robot, body.cell),
         with_waypoints=detail == "waypoints",
         feed=None if feed is None else check_feed(evaluation, feed, robot.qdot_max),
         cycle_time=cycle_time(problem, evaluation),

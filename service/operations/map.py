@@ -76,7 +76,7 @@ def checked_grid(body: MapRequest, settings: Settings) -> CheckedGrid:
         cost=map_cost(problem),
         with_cell=body.cell is not None,
     )
-    correction = max(path.axis_correction, convert.quaternion_correction(body.robot, body.cell))
+    correction = convert.request_correction(path, body.robot, body.cell)
     return CheckedGrid(robot, grid, problem, convert.path_read_of(path), correction)
 
 

@@ -53,7 +53,7 @@ def optimum_of(
     return convert.optimize_response(
         optimum,
         robot,
-        axis_correction=convert.quaternion_correction(body.robot, body.cell),
+        axis_correction=convert.request_correction(path, body.robot, body.cell),
         path=path,
         cycle_time=None if optimum.evaluation is None else cycle_time(problem, optimum.evaluation),
     )
