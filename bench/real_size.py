@@ -50,8 +50,6 @@ from erk_http import ERK_GRID, EXAMPLE, erk_map_over_http  # noqa: E402 - bench/
 from timing import best_time  # noqa: E402
 
 from service.config import Settings  # noqa: E402
-from service.convert import map_response  # noqa: E402
-from service.convert.map_json import map_json  # noqa: E402
 from service.jobs.store import JobStore  # noqa: E402
 from service.jobs.worker import _map  # noqa: E402
 from service.operations.map import ComputedMap, computed_map  # noqa: E402
@@ -76,16 +74,15 @@ def erk_route_parts(*, repeats: int) -> None:
         return computed_map(request, settings, png=False, progress=lambda _: None, runner=runner)
 
     answer = computed(settings.threads)
-    result, robot, spin_mode = answer.result, answer.robot, answer.spin_mode
-    response = map_response(result, robot, spin_mode=spin_mode)
+    response = answer.answer()
     parts = {
         "validation": best_time(lambda: MapRequest.model_validate_json(raw), repeats),
         "map on 1 thread": best_time(lambda: computed(1), repeats),
         f"map on {settings.threads}": best_time(lambda: computed(settings.threads), repeats),
-        "response cells": best_time(lambda: map_response(result, robot, spin_mode=spin_mode), 10),
+        "response cells": best_time(answer.answer, 10),
         "JSON": best_time(response.model_dump_json, repeats),
         "written body (cells and JSON, what the route does)": best_time(
-            lambda: map_json(result, robot, spin_mode=spin_mode), repeats
+            answer.answer_json, repeats
         ),
     }
     print(
@@ -194,7 +191,7 @@ def map_job_storing(*, step: float) -> None:
         )  # fmt: skip
         placements = time.perf_counter() - began
         began = time.perf_counter()
-        dumped = map_response(computed.result, computed.robot, spin_mode=computed.spin_mode)
+        dumped = computed.answer()
         before = time.perf_counter() - began
         before += stored(dumped.model_dump(mode="json"))
         del dumped

@@ -39,7 +39,6 @@ sys.path.insert(0, str(ROOT))
 from erk_http import ERK_GRID, EXAMPLE  # noqa: E402 - bench/erk_http.py, beside this
 
 from service.config import Settings  # noqa: E402
-from service.convert.map_json import map_json  # noqa: E402
 from service.operations.map import computed_map  # noqa: E402
 from service.schemas import MapRequest  # noqa: E402
 from solver.core.parallel import ThreadRunner  # noqa: E402
@@ -110,7 +109,7 @@ def round_trips(*, repeats: int) -> None:
             computed = computed_map(
                 request, settings, png=False, progress=lambda _: None, runner=runner
             )
-            map_json(computed.result, computed.robot, spin_mode=computed.spin_mode)
+            computed.answer_json()
 
         with httpx.Client(base_url=url, timeout=120) as client:
             healthz = _times(

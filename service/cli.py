@@ -47,7 +47,6 @@ from typing import Any, TypeVar
 
 from pydantic import BaseModel, ValidationError
 
-from service import convert
 from service.cli_files import decoded, file_bytes, text_file
 from service.cli_text import ProgressBar, evaluation_text, import_text, map_text, optimum_text
 from service.config import Settings, settings_or_exit
@@ -403,16 +402,9 @@ def _map(args: argparse.Namespace) -> int:
     request = _validated(MapRequest, _with_options(body, args))
     with ProgressBar(enabled=args.progress) as bar:
         computed = computed_map(request, _settings(), png=True, progress=bar)
-    result, robot = computed.result, computed.robot
-    answer = convert.map_response(
-        result,
-        robot,
-        spin_mode=computed.spin_mode,
-        path_read=computed.path_read,
-        axis_correction=computed.axis_correction,
-    )
+    answer = computed.answer()
     try:
-        png.write_bytes(map_png(result, robot))
+        png.write_bytes(map_png(computed.result, computed.robot))
     except OSError as error:  # the folder went, the disk filled: said on --png
         raise InvalidInputError("--png", f"cannot write {str(png)!r}: {error.strerror}") from error
     robot, read = body["robot"], (answer.recognised, answer.robot_read)

@@ -24,7 +24,7 @@ from typing import Any
 from pydantic import ValidationError
 
 from service.config import Settings
-from service.convert.map_json import cell_pages, rest_json
+from service.convert.map_json import cell_pages
 from service.errors import request_errors, solver_error_location, solver_error_type
 from service.jobs.dask_runner import ClusterUnavailable
 from service.jobs.job import DamagedJob, JobStoreUnavailable
@@ -77,18 +77,10 @@ def _map(
         runner=runner,
         checked=checked,
     )
-    result, robot = computed.result, computed.robot
-    rest = json.loads(
-        rest_json(
-            result,
-            robot,
-            spin_mode=computed.spin_mode,
-            path_read=computed.path_read,
-            axis_correction=computed.axis_correction,
-        )
-    )
+    rest = json.loads(computed.rest_json())
     del rest["cells"]
-    return CellPages(rest, cell_pages(result, robot, page=PAGE_CELLS), result.mu_path.size)
+    result = computed.result
+    return CellPages(rest, cell_pages(result, computed.robot, page=PAGE_CELLS), result.mu_path.size)
 
 
 def _optimize(

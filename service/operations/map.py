@@ -2,12 +2,13 @@
 
 from __future__ import annotations
 
-from typing import NamedTuple
+from typing import Any, NamedTuple
 
 from service import convert
 from service.config import Settings
+from service.convert.map_json import map_json, rest_json
 from service.operations.threads import thread_runner
-from service.schemas import MapRequest, PathRead
+from service.schemas import MapRequest, MapResponse, PathRead
 from solver.core.parallel import TaskRunner
 from solver.core.progress import Progress
 from solver.core.robots import Robot
@@ -33,6 +34,26 @@ class ComputedMap(NamedTuple):
     spin_mode: SpinMode
     path_read: PathRead | None
     axis_correction: float
+
+    def answer(self) -> MapResponse:
+        """The route's answer as its model (:func:`service.convert.map_response`)."""
+        return convert.map_response(self.result, self.robot, **self._said())
+
+    def answer_json(self) -> bytes:
+        """The route's answer as the route writes it (:func:`service.convert.map_json.map_json`)."""
+        return map_json(self.result, self.robot, **self._said())
+
+    def rest_json(self) -> str:
+        """The answer without its cells (:func:`service.convert.map_json.rest_json`)."""
+        return rest_json(self.result, self.robot, **self._said())
+
+    def _said(self) -> dict[str, Any]:
+        """What the answer says besides the cells, as the writers take it."""
+        return {
+            "spin_mode": self.spin_mode,
+            "path_read": self.path_read,
+            "axis_correction": self.axis_correction,
+        }
 
 
 class CheckedGrid(NamedTuple):

@@ -9,7 +9,6 @@ from fastapi.responses import Response
 
 from service import convert
 from service.body import body_in_thread, body_openapi
-from service.convert.map_json import map_json
 from service.deps import SettingsDep
 from service.errors import ERROR_RESPONSES
 from service.metrics import PLACEMENTS
@@ -56,14 +55,7 @@ async def post_map(
         if png:
             return _picture(result, robot)
         # The model's JSON written from the columns (no model a cell; tests/service/test_map_json)
-        answer = map_json(
-            result,
-            robot,
-            spin_mode=computed.spin_mode,
-            path_read=computed.path_read,
-            axis_correction=computed.axis_correction,
-        )
-        return Response(answer, media_type="application/json")
+        return Response(computed.answer_json(), media_type="application/json")
 
     return await run_stoppable(request, work)
 
