@@ -172,6 +172,8 @@ def test_jobs_through_typed_models(generated: ModuleType, client: Any) -> None:
         job = _call(generated, "get_job", client=client, job_id=job.id)
     assert job.status == models.JobStatus.DONE
     assert isinstance(job.result, models.MapResponse) and len(job.result.cells) == 4
+    picture = _call(generated, "get_job_png", client=client, job_id=job.id)
+    assert picture.payload.read().startswith(PNG)
     listed = _call(generated, "list_jobs", client=client, status=models.JobStatus.DONE)
     assert isinstance(listed, models.JobList) and job.id in [j.id for j in listed.jobs]
     kept = _call(generated, "cancel_job", client=client, job_id=job.id)

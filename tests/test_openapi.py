@@ -47,12 +47,17 @@ def test_operation_ids_are_short_and_the_png_is_binary() -> None:
         "get_job",
         "get_job_result",
         "get_job_request",
+        "get_job_png",
         "cancel_job",
         "delete_job",
         "metrics",
     }
-    for route in ("/v1/map/png", "/v1/evaluate/png"):
-        answer = spec["paths"][route]["post"]["responses"]["200"]["content"]
+    for route, method in (
+        ("/v1/map/png", "post"),
+        ("/v1/evaluate/png", "post"),
+        ("/v1/jobs/{job_id}/png", "get"),
+    ):
+        answer = spec["paths"][route][method]["responses"]["200"]["content"]
         assert answer == {"image/png": {"schema": {"type": "string", "format": "binary"}}}
     for route in ("/v1/map", "/v1/evaluate"):  # one content type an operation (Accept unsaid)
         assert list(spec["paths"][route]["post"]["responses"]["200"]["content"]) == [

@@ -13,10 +13,13 @@ import pytest
 from fastapi.testclient import TestClient
 
 from service.config import Settings
+from service.convert.common import robot_from_schema
+from service.convert.stored_map import StoredCellsMismatch, stored_map
 from service.jobs.job import DamagedJob
 from service.jobs.results import CellPages
 from service.jobs.store import JobStore
 from service.jobs.worker import _map
+from service.schemas import MapRequest
 from solver.core.parallel import SERIAL
 from tests.cases import ROOT
 from tests.service.conftest import served_with
@@ -154,3 +157,90 @@ def test_a_map_jobs_progress_leaves_its_storing_a_share(tmp_path: Path) -> None:
     store.finish(job.id, "done", result=answer)
     state = store.state(job.id)
     assert state is not None and state.cells == 2500
+
+
+def _job_png(client: TestClient, request: dict[str, Any]) -> bytes:
+    submitted = client.post("/v1/jobs", json={"kind": "map", "request": request})
+    assert submitted.status_code == 202, submitted.text
+    job_id = submitted.json()["id"]
+    assert done_job(client, job_id)["status"] == "done"
+    picture = client.get(f"/v1/jobs/{job_id}/png")
+    assert picture.status_code == 200, picture.text
+    assert picture.headers["content-type"] == "image/png"
+    return picture.content
+
+
+def test_a_map_jobs_picture_is_the_map_routes_picture(
+    client: TestClient, paged_store: Settings
+) -> None:
+    # 2,500 cells in three stored pages, two yaws, cells out of reach among them: drawn from the
+    # store, the picture is the one the PNG route draws of the map computed again, byte for byte
+    grid = {**GRID_2500, "x": {"min": -0.98, "max": 0.0, "step": 0.02}}  # far cells out of reach
+    request = {"robot": EXAMPLE["robot"], "path": SHORT_PATH, "grid": grid}
+    direct = client.post("/v1/map/png", json=request)
+    assert direct.status_code == 200, direct.text
+    reasons = {c["reason"] for c in client.post("/v1/map", json=request).json()["cells"]}
+    assert {None, "unreachable"} <= reasons  # feasible cells and others in their colour
+    assert _job_png(client, request) == direct.content
+
+
+@pytest.mark.parametrize(
+    "grid",
+    [
+        {
+            "x": {"min": -0.1, "max": 0.1, "step": 0.05},
+            "y": {"min": 0.35, "max": 0.45, "step": 0.05},
+        },
+        # nothing feasible (out of reach): the bar still says mu_acc, as the route's picture does
+        {"x": {"min": 2.0, "max": 2.1, "step": 0.05}, "y": {"min": 2.0, "max": 2.1, "step": 0.05}},
+    ],
+)
+def test_a_map_jobs_picture_with_acceleration_limits(
+    client: TestClient, paged_store: Settings, grid: dict[str, Any]
+) -> None:
+    robot = {**EXAMPLE["robot"], "joint_acceleration_limits": [3.0] * 6}
+    request = {"robot": robot, "path": SHORT_PATH, "grid": {**grid, "z": 0.1, "yaw": 0.3}}
+    direct = client.post("/v1/map/png", json=request)
+    assert direct.status_code == 200, direct.text
+    assert _job_png(client, request) == direct.content
+
+
+def test_a_jobs_picture_is_refused_unless_a_done_map_within_the_panel_limit(
+    client: TestClient, paged_store: Settings
+) -> None:
+    missing = client.get("/v1/jobs/00000000-0000-4000-8000-000000000000/png")
+    assert missing.status_code == 404, missing.text
+    evaluate = {"kind": "evaluate", "request": {**EXAMPLE, "path": SHORT_PATH}}
+    job_id = client.post("/v1/jobs", json=evaluate).json()["id"]
+    assert done_job(client, job_id)["status"] == "done"
+    answer = client.get(f"/v1/jobs/{job_id}/png")
+    assert answer.status_code == 409 and "evaluate job" in answer.json()["detail"][0]["msg"]
+    yaws = [0.1 * k for k in range(paged_store.max_png_panels + 1)]
+    grid = {"x": {"min": 0.0, "max": 0.0, "step": 0.1}, "y": {"min": 0.4, "max": 0.4, "step": 0.1}}
+    request = {
+        "robot": EXAMPLE["robot"],
+        "path": SHORT_PATH,
+        "grid": {**grid, "z": 0.1, "yaw": yaws},
+    }
+    job_id = client.post("/v1/jobs", json={"kind": "map", "request": request}).json()["id"]
+    assert done_job(client, job_id)["status"] == "done"
+    answer = client.get(f"/v1/jobs/{job_id}/png")
+    assert answer.status_code == 409, answer.text
+    said = answer.json()["detail"][0]["msg"]
+    assert f"{len(yaws)} PNG panels" in said and "DTF_MAX_PNG_PANELS" in said
+
+
+def test_stored_cells_that_are_not_the_grids_are_refused() -> None:
+    body = MapRequest.model_validate(
+        {"robot": EXAMPLE["robot"], "path": SHORT_PATH, "grid": GRID_2500}
+    )
+    robot = robot_from_schema(body.robot)
+    cell = {"mu_path": 0.1, "mu_acc": None, "reason": None}
+    with pytest.raises(StoredCellsMismatch, match="2499 cells stored, the grid has 2500"):
+        stored_map(body, robot, [[cell] * 1000, [cell] * 1000, [cell] * 499])
+    with pytest.raises(StoredCellsMismatch, match="more cells stored than the grid's 2500"):
+        stored_map(body, robot, [[cell] * 2000, [cell] * 501])
+    with pytest.raises(StoredCellsMismatch, match="'overheated' is unknown"):
+        stored_map(body, robot, [[{**cell, "reason": "overheated"}] * 2500])
+    whole = stored_map(body, robot, [[cell] * 2500])
+    assert whole.mu_path.shape == (1, 2, 25, 50) and whole.mu_acc is None

@@ -407,18 +407,28 @@ def test_a_reloaded_page_shows_its_last_map_with_the_maps_own_request(page: Page
 
 def test_the_map_is_saved_as_the_apis_png_and_a_refusal_is_said(page: Page, url: str) -> None:
     """The page drew its map on canvases with nothing to save for a report: 'Save the map as a
-    PNG' downloads the API's picture of the map's own request, byte for byte; a picture the
-    route refuses (too many panels, say) is said beside the button, no file."""
+    PNG' downloads the API's picture of the map: its job's (drawn from the stored cells, any
+    size), which is the map route's picture of the job's request byte for byte; where the job
+    is gone, the map route's. A picture refused is said beside the button, no file."""
     run_small_map(page, url)
-    with page.expect_request(lambda r: r.url.endswith("/v1/map/png")) as sent:
+    with page.expect_request(lambda r: "/v1/jobs/" in r.url and r.url.endswith("/png")) as sent:
         with page.expect_download() as download:
             page.click("#png")
     saved = Path(download.value.path()).read_bytes()
-    api = httpx.post(f"{url}/v1/map/png", json=sent.value.post_data_json, timeout=60)
+    job_id = sent.value.url.split("/")[-2]
+    asked = httpx.get(f"{url}/v1/jobs/{job_id}/request", timeout=60).json()
+    assert asked["request"]["grid"] == grid_of(SMALL)
+    api = httpx.post(f"{url}/v1/map/png", json=asked["request"], timeout=60)
     assert api.status_code == 200 and saved[:8] == b"\x89PNG\r\n\x1a\n"
     assert saved == api.content
-    assert sent.value.post_data_json["grid"] == grid_of(SMALL)
     assert page.text_content("#png-status") == "saved as dtf-map.png"
+
+    assert httpx.delete(f"{url}/v1/jobs/{job_id}", timeout=60).status_code == 204
+    with page.expect_request(lambda r: r.url.endswith("/v1/map/png")) as again:
+        with page.expect_download() as download:
+            page.click("#png")
+    assert again.value.post_data_json == asked["request"]
+    assert Path(download.value.path()).read_bytes() == api.content
 
     def refuse(route: Route) -> None:
         said = "40 panels; the limit is 16 (DTF_MAX_PNG_PANELS)"

@@ -1,8 +1,10 @@
-"""``GET /v1/jobs/{id}/result``: a done map job's cells in pages (api.md "Jobs").
+"""A done map job's cells in pages (``GET /v1/jobs/{id}/result``, api.md "Jobs"), and its picture.
 
 A map job may have 2 million placements; its answer as one body would be hundreds of MiB.
 ``GET /v1/jobs/{id}`` answers a result over DTF_JOB_PAGE_CELLS cells without its cells, and
-this route gives them a page at a time, reading only that page from the store.
+``/result`` gives them a page at a time, reading only that page from the store.
+``GET /v1/jobs/{id}/png`` draws the stored cells as ``POST /v1/map/png`` draws a map: a map too
+large for a request has its picture too, without computing it again.
 """
 
 from __future__ import annotations
@@ -13,12 +15,19 @@ from typing import Annotated
 from fastapi import APIRouter, HTTPException, Query, Response, status
 from fastapi.exceptions import RequestValidationError
 
+from service import convert
 from service.api.routes.jobs import JOB_RESPONSES, NOT_FOUND, JobId
+from service.convert.stored_map import StoredCellsMismatch, stored_grid, stored_map
 from service.deps import SettingsDep
 from service.errors import job_not_found
+from service.jobs.job import DamagedJob, JobState
 from service.jobs.runner import get_runner
+from service.jobs.store import JobStore
 from service.jobs.views import page_url
+from service.operations import map_png
+from service.schemas import MapRequest
 from service.schemas.jobs import JobResultPage
+from solver.core.exceptions import InvalidInputError
 
 router = APIRouter(prefix="/jobs", tags=["jobs"], responses=JOB_RESPONSES)
 
@@ -61,19 +70,7 @@ def get_job_result_page(
             ]
         )
     store = get_runner(settings).store
-    state = store.state(str(job_id))
-    if state is None:
-        raise job_not_found(job_id)
-    if state.status != "done":
-        raise HTTPException(
-            status.HTTP_409_CONFLICT, f"job {state.id!r} is {state.status}: no result to page"
-        )
-    if state.kind != "map":
-        raise HTTPException(
-            status.HTTP_409_CONFLICT,
-            f"job {state.id!r} is a {state.kind} job: its result has no cells to page; "
-            f"GET /v1/jobs/{state.id} gives it whole",
-        )
+    state = _done_map(store, str(job_id), "no result to page")
     cells, count = store.cells_json(state.id, offset=offset, limit=page_limit)
     end = offset + count
     total = state.cells if state.cells is not None else store.cell_count(state.id)
@@ -82,3 +79,62 @@ def get_job_result_page(
     # The cells are stored JSON, copied as they are: the page's text is put together here.
     text = json.dumps(head)[:-1] + f', "cells": {cells}}}'
     return Response(text, media_type="application/json")
+
+
+@router.get(
+    "/{job_id}/png",
+    operation_id="get_job_png",
+    summary="A done map job's colour map, as a PNG",
+    response_class=Response,
+    responses={
+        200: {
+            "content": {"image/png": {"schema": {"type": "string", "format": "binary"}}},
+            "description": "The map as POST /v1/map/png draws it for the job's request (the "
+            "same picture), drawn from the stored cells.",
+        },
+        **NOT_FOUND,
+        409: {
+            "description": "The job is not done, is not a map, or its map has more panels "
+            "(yaws x spins) than a picture draws (DTF_MAX_PNG_PANELS)."
+        },
+    },
+)
+def get_job_png(job_id: JobId, settings: SettingsDep) -> Response:
+    """The colour map of a done map job, drawn from its stored cells (no map computed again).
+
+    ``POST /v1/map/png`` computes a map within a request's limits; a map run as a job (up to
+    DTF_MAX_JOB_CELLS placements) is drawn here. The stored cells are read a page at a
+    time (about 2 s a million cells).
+    """
+    store = get_runner(settings).store
+    state = _done_map(store, str(job_id), "no map to draw")
+    body = MapRequest.model_validate(store.request(state.id))
+    grid = stored_grid(body)
+    try:
+        convert.check_png_size(grid, settings=settings)
+    except InvalidInputError as error:
+        raise HTTPException(status.HTTP_409_CONFLICT, f"job {state.id!r}: {error}") from None
+    robot = convert.robot_from_schema(body.robot)
+    try:
+        cmap = stored_map(body, robot, store.cell_pages(state.id))
+    except StoredCellsMismatch as error:
+        raise DamagedJob(store.path, state.id, str(error)) from None
+    return Response(map_png(cmap, robot), media_type="image/png")
+
+
+def _done_map(store: JobStore, job_id: str, nothing: str) -> JobState:
+    """The state of a done map job; else 404 (unknown) or 409 (saying ``nothing``, and why)."""
+    state = store.state(job_id)
+    if state is None:
+        raise job_not_found(job_id)
+    if state.status != "done":
+        raise HTTPException(
+            status.HTTP_409_CONFLICT, f"job {state.id!r} is {state.status}: {nothing}"
+        )
+    if state.kind != "map":
+        raise HTTPException(
+            status.HTTP_409_CONFLICT,
+            f"job {state.id!r} is a {state.kind} job: {nothing}; "
+            f"GET /v1/jobs/{state.id} gives its result",
+        )
+    return state

@@ -385,7 +385,7 @@ async function api(method, url, body, aliases = {}, signal = undefined, show = t
 
 // ---- stale results go ----------------------------------------------------------------------
 function clearMap() {
-  state.map = null; state.cursor = null; state.tipCell = null;
+  state.map = null; state.cursor = null; state.tipCell = null; state.mapJob = null;
   if (state.optimum) state.optimum.canvas = null;  // the optimum stays, to mark the next map
   $("panels").textContent = "";
   $("tooltip").hidden = true;
@@ -755,23 +755,27 @@ async function evaluateCell(c) {
   plot(answer, body);
 }
 
-// The map drawn as the API draws it (POST /v1/map/png with the map's own request: panels, colour
-// bar, reasons' colours, best and worst marked), saved as a file. The route computes it again,
-// within a request's limits: a map too large for one says so (dtf-place map draws any size).
+// The map drawn as the API draws it (panels, colour bar, reasons' colours, best and worst
+// marked), saved as a file: the map's job's picture (GET /v1/jobs/{id}/png, drawn from its
+// stored cells, any size), or where the job is gone (deleted, expired) POST /v1/map/png with the
+// map's own request, which computes it again within a request's limits.
 async function savePng() {
   const body = state.mapBody;
   if (!body) return;
   $("png-status").textContent = "drawing…";
-  $("png").disabled = true;  // one picture at a time: each computes the map again
-  try { await downloadPng(body); } finally { $("png").disabled = false; }
+  $("png").disabled = true;  // one picture at a time
+  try { await downloadPng(body, state.mapJob); } finally { $("png").disabled = false; }
 }
 
-async function downloadPng(body) {
+async function downloadPng(body, job) {
   let response;
   try {
-    response = await fetch("/v1/map/png", {
-      method: "POST", headers: { "Content-Type": "application/json" }, body: JSON.stringify(body),
-    });
+    if (job) response = await fetch(`/v1/jobs/${job}/png`);
+    if (!response || response.status === 404) {
+      response = await fetch("/v1/map/png", {
+        method: "POST", headers: { "Content-Type": "application/json" }, body: JSON.stringify(body),
+      });
+    }
   } catch (error) { $("png-status").textContent = `no picture: no answer (${error.message})`; return; }
   if (state.mapBody !== body) return;  // another map meanwhile
   if (!response.ok) {

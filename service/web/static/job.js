@@ -161,6 +161,7 @@ async function watch(run) {
       endRun();
       $("job-status").textContent = status; $("bar").value = 1;
       drawMap({ ...job.result, cells });
+      state.mapJob = run.id;  // its picture is the job's (savePng)
       return;
     }
     if (!["queued", "running"].includes(job.status)) {
