@@ -20,7 +20,8 @@ Kind = Literal["map", "optimize", "evaluate"]
 FINISHED = ("done", "failed", "cancelled")
 
 STATE_COLUMNS = (
-    "id, kind, status, error, done, total, cells, created, started, finished, attempts, cancel"
+    "id, kind, status, error, done, total, cells, created, started, finished, attempts, cancel, "
+    "first_at, first_done"
 )
 """The columns of a job's state: everything but its request and its result (the large ones)."""
 
@@ -77,6 +78,9 @@ class JobState:
         cells: how many cells its result holds in pages (``JobStore.cells``); None when the
             result has no cells (not a map, not done, or stored whole by an older release).
         created, started, finished: Unix times (s); None until they happen.
+        first_report: the time (Unix, s) and fraction of the run's first progress report over
+            0 (the rate of progress after it excludes the run's set-up); None before it, and for
+            a run by a release that did not keep it.
     """
 
     id: str
@@ -91,6 +95,7 @@ class JobState:
     finished: float | None
     attempts: int
     cancel: bool
+    first_report: tuple[float, float] | None
 
 
 @dataclass(frozen=True)
@@ -130,6 +135,9 @@ def _state_fields(row: sqlite3.Row) -> dict[str, Any]:
         "finished": row["finished"],
         "attempts": row["attempts"],
         "cancel": row["cancel"],
+        "first_report": None
+        if row["first_at"] is None or row["first_done"] is None
+        else (row["first_at"], row["first_done"]),
     }
 
 

@@ -34,7 +34,9 @@ CREATE TABLE IF NOT EXISTS jobs (
     attempts INTEGER NOT NULL DEFAULT 0,
     cancel INTEGER NOT NULL DEFAULT 0,
     total INTEGER,
-    cells INTEGER
+    cells INTEGER,
+    first_at REAL,
+    first_done REAL
 );
 CREATE INDEX IF NOT EXISTS jobs_created ON jobs (created);
 CREATE INDEX IF NOT EXISTS jobs_finished ON jobs (finished);
@@ -46,7 +48,7 @@ CREATE TABLE IF NOT EXISTS job_cells (
 );
 """
 
-_ADDED_COLUMNS = {"total": "INTEGER", "cells": "INTEGER"}
+_ADDED_COLUMNS = {"total": "INTEGER", "cells": "INTEGER", "first_at": "REAL", "first_done": "REAL"}
 """Columns a store made by an older release lacks (added on open; NULL in its rows)."""
 
 

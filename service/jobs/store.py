@@ -76,8 +76,9 @@ class JobStore(JobReads):
         """Mark a queued job running (one more attempt, from no progress); False if not queued."""
         with self._connection() as db:
             changed = db.execute(
-                "UPDATE jobs SET status = 'running', started = ?, done = 0, "
-                "attempts = attempts + 1 WHERE id = ? AND status = 'queued' AND cancel = 0",
+                "UPDATE jobs SET status = 'running', started = ?, done = 0, first_at = NULL, "
+                "first_done = NULL, attempts = attempts + 1 "
+                "WHERE id = ? AND status = 'queued' AND cancel = 0",
                 (time.time(), job_id),
             ).rowcount
         return bool(changed)
@@ -99,9 +100,19 @@ class JobStore(JobReads):
         return bool(queued)
 
     def progress(self, job_id: str, fraction: float) -> bool:
-        """Record the fraction done; whether to stop (a cancel was asked, or the job deleted)."""
+        """Record the fraction done; whether to stop (a cancel was asked, or the job deleted).
+
+        The run's first report over 0 is kept too (``JobState.first_report``): the ETA's rate.
+        """
         with self._connection() as db:
-            db.execute("UPDATE jobs SET done = ? WHERE id = ?", (fraction, job_id))
+            if fraction > 0.0:
+                db.execute(
+                    "UPDATE jobs SET done = ?, first_at = COALESCE(first_at, ?), "
+                    "first_done = COALESCE(first_done, ?) WHERE id = ?",
+                    (fraction, time.time(), fraction, job_id),
+                )
+            else:
+                db.execute("UPDATE jobs SET done = ? WHERE id = ?", (fraction, job_id))
             row = db.execute("SELECT cancel FROM jobs WHERE id = ?", (job_id,)).fetchone()
         return bool(row is None or row[0])
 

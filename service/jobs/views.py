@@ -36,6 +36,23 @@ def page_url(job_id: str, *, offset: int, limit: int) -> str:
     return f"/v1/jobs/{job_id}/result?offset={offset}&limit={limit}"
 
 
+def eta_seconds(state: JobState, now: float) -> float | None:
+    """The time a running job needs yet (s) at ``now``, at its rate of progress; else None.
+
+    The rate is taken from the run's first progress report on: before it the run sets up
+    (reads its request, builds its problem, an optimiser's first generation), and taken from
+    the start, that time counted as progress made the first estimates several times too high.
+    Until a later report, from the start.
+    """
+    if state.status != "running" or state.started is None or state.fraction <= 0.0:
+        return None
+    if state.first_report is not None:
+        at, done = state.first_report
+        if state.fraction > done and now > at:
+            return (now - at) * (1.0 - state.fraction) / (state.fraction - done)
+    return (now - state.started) * (1.0 - state.fraction) / state.fraction
+
+
 def job_info(
     state: JobState,
     store: JobStore,
@@ -45,10 +62,7 @@ def job_info(
 ) -> JobInfo:
     """The API's view of a stored job (its result as given; where a map's cells are)."""
     total = _units(state, store)
-    eta = None
-    if state.status == "running" and state.started is not None and state.fraction > 0.0:
-        elapsed = time.time() - state.started
-        eta = elapsed * (1.0 - state.fraction) / state.fraction
+    eta = eta_seconds(state, time.time())
     cells = None
     if state.cells is not None and page_limit > 0:
         cells = ResultCells(

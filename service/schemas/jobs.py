@@ -109,7 +109,9 @@ class JobProgress(ResponseModel):
     total: int = Field(description="Units of work in all.")
     fraction: float = Field(description="done / total, 0 to 1.")
     eta_seconds: float | None = Field(
-        description="Estimated seconds to the end, from the rate so far; null before any report."
+        description="Estimated seconds to the end, at the rate of progress since the run's "
+        "first report (its set-up before it is not counted; until a second report, since its "
+        "start); null unless running with some progress."
     )
 
 

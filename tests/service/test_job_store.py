@@ -2,18 +2,21 @@
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import os
 import sqlite3
 import subprocess
 import sys
 import threading
+import time
 from pathlib import Path
 
 import pytest
 
-from service.jobs.job import JobStoreUnavailable, QueueFull
+from service.jobs.job import JobState, JobStoreUnavailable, QueueFull
 from service.jobs.store import JobStore
+from service.jobs.views import eta_seconds
 from tests.cases import ROOT
 
 EXAMPLE = json.loads((ROOT / "examples" / "evaluate_request.json").read_text())
@@ -197,3 +200,58 @@ def test_a_job_whose_cancel_came_before_its_end_is_cancelled_not_done(tmp_path: 
     cancelled, done = store.get(asked.id), store.get(late.id)
     assert cancelled is not None and cancelled.status == "cancelled" and cancelled.result is None
     assert done is not None and done.status == "done" and done.result == {"mu_path": 0.3}
+
+
+def _running(fraction: float, first_report: tuple[float, float] | None) -> JobState:
+    return JobState(
+        id="j", kind="map", status="running", error=None, fraction=fraction, total=100,
+        cells=None, created=0.0, started=0.0, finished=None, attempts=1, cancel=False,
+        first_report=first_report,
+    )  # fmt: skip
+
+
+def test_the_eta_is_taken_at_the_rate_after_the_set_up() -> None:
+    # A run that sets up for 8 s, then does 5 % a second: 10 % at 10 s (its first report), 60 %
+    # at 20 s; it ends at 28 s. From the start, 20 s for 60 % said 13.3 s left.
+    assert eta_seconds(_running(0.6, (10.0, 0.1)), now=20.0) == pytest.approx(8.0, abs=1e-12)
+    # one report only: no rate after it yet, from the start; a row without one likewise
+    assert eta_seconds(_running(0.1, (10.0, 0.1)), now=10.0) == pytest.approx(90.0, abs=1e-12)
+    assert eta_seconds(_running(0.5, None), now=20.0) == pytest.approx(20.0, abs=1e-12)
+    assert eta_seconds(_running(0.0, None), now=20.0) is None
+    queued = dataclasses.replace(_running(0.0, None), status="queued", started=None)
+    assert eta_seconds(queued, now=20.0) is None
+
+
+def test_a_runs_first_report_is_kept_and_a_new_run_forgets_it(tmp_path: Path) -> None:
+    store = JobStore(tmp_path / "jobs.sqlite3")
+    job = store.create("evaluate", EVALUATE)
+    assert store.start(job.id)
+    store.progress(job.id, 0.0)
+    assert (state := store.state(job.id)) is not None and state.first_report is None
+    before = time.time()
+    store.progress(job.id, 0.25)
+    store.progress(job.id, 0.5)
+    state = store.state(job.id)
+    assert state is not None and state.first_report is not None and state.fraction == 0.5
+    at, done = state.first_report
+    assert done == 0.25 and before <= at <= time.time()
+    assert store.recover(attempts=3) == [job.id] and store.start(job.id)
+    assert (state := store.state(job.id)) is not None and state.first_report is None
+
+
+def test_a_store_of_an_older_release_gets_the_new_columns(tmp_path: Path) -> None:
+    path = tmp_path / "jobs.sqlite3"
+    with sqlite3.connect(path) as db:  # the jobs table before total, cells and first reports
+        db.execute(
+            "CREATE TABLE jobs (id TEXT PRIMARY KEY, kind TEXT NOT NULL, status TEXT NOT NULL, "
+            "request TEXT NOT NULL, result TEXT, error TEXT, done REAL NOT NULL DEFAULT 0, "
+            "created REAL NOT NULL, started REAL, finished REAL, "
+            "attempts INTEGER NOT NULL DEFAULT 0, cancel INTEGER NOT NULL DEFAULT 0)"
+        )
+        db.execute(
+            "INSERT INTO jobs (id, kind, status, request, done, created, started, attempts) "
+            "VALUES ('old', 'evaluate', 'running', '{}', 0.5, 1.0, 2.0, 1)"
+        )
+    state = JobStore(path).state("old")
+    assert state is not None and (state.total, state.cells, state.first_report) == (None,) * 3
+    assert eta_seconds(state, now=12.0) == pytest.approx(10.0, abs=1e-12)
