@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import math
 import os
+import socket
 import threading
 import time
 from collections.abc import Callable, Iterator
@@ -251,3 +252,39 @@ def test_workers_that_cannot_be_asked_their_code_are_the_clusters_failure(
     monkeypatch.setattr(runner.client(), "run", gone)
     with pytest.raises(ClusterUnavailable, match="could not be asked which code .* KeyError"):
         runner.run(abs, [-1], _noted([]))
+
+
+def test_a_worker_restarted_at_its_address_is_checked_again(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """Checked once an address, a worker restarted at the same address (a fixed port) with
+    other code was taken for the one checked. Here one worker on a fixed port is restarted by
+    its nanny; the service's side is then made to differ (as the test above): refused."""
+    port = _free_port()
+    with LocalCluster(
+        n_workers=1,
+        threads_per_worker=1,
+        processes=True,
+        dashboard_address=None,
+        worker_port=port,
+    ) as fixed:
+        runner = DaskRunner(fixed.scheduler_address)
+        assert runner.run(abs, [-1], _noted([])) == [1]
+        (address,) = fixed.scheduler_info["workers"]
+        client = runner.client()
+        before = client.scheduler_info(n_workers=-1)["workers"][address]["local_directory"]
+        client.restart_workers([address])
+        after = client.scheduler_info(n_workers=-1)["workers"]
+        assert list(after) == [address]  # the same address, another process:
+        assert after[address]["local_directory"] != before
+        elsewhere = {**dask_runner.code_fingerprint(), "numpy": "0.0.1"}
+        monkeypatch.setattr(dask_runner, "code_fingerprint", lambda: elsewhere)
+        with pytest.raises(ClusterUnavailable, match=r"1 worker\(s\) whose code"):
+            runner.run(abs, [-1], _noted([]))
+
+
+def _free_port() -> int:
+    with socket.socket() as probe:
+        probe.bind(("127.0.0.1", 0))
+        port: int = probe.getsockname()[1]
+    return port

@@ -76,7 +76,7 @@ class DaskRunner:
         self.address = address
         self.connect_seconds = CONNECT_SECONDS if connect_seconds is None else connect_seconds
         self._client: Any = None
-        self._checked: frozenset[str] = frozenset()  # workers whose code is the service's
+        self._checked: frozenset[str] = frozenset()  # worker processes whose code is the service's
 
     def _unavailable(self, what: str, error: BaseException | None = None) -> ClusterUnavailable:
         said = "" if error is None else f": {type(error).__name__}: {str(error)[:300]}"
@@ -192,17 +192,22 @@ class DaskRunner:
         """Refuse workers that compute with other code than the service's (checked once each).
 
         A worker left on an older release, or with another numpy, gives other numbers without a
-        word: a map's cells would depend on which worker ran them.
+        word: a map's cells would depend on which worker ran them. Each worker process is
+        checked once (:func:`worker_processes`): one restarted at the same address, upgraded
+        or not, is checked again.
 
         Raises:
             ClusterUnavailable: naming up to three such workers and what differs.
         """
-        workers = frozenset(client.nthreads())
-        if workers <= self._checked:
+        processes = worker_processes(client)
+        unchecked = sorted(
+            address for address, key in processes.items() if key not in self._checked
+        )
+        if not unchecked:
             return
         mine = code_fingerprint()
         try:
-            theirs = client.run(worker_fingerprint, workers=sorted(workers - self._checked))
+            theirs = client.run(worker_fingerprint, workers=unchecked)
         except Exception as error:  # noqa: BLE001 - a worker gone meanwhile, the scheduler lost
             asked = "could not be asked which code its workers run"
             raise self._unavailable(asked, error) from None
@@ -220,7 +225,7 @@ class DaskRunner:
                 f"has {len(wrong)} worker(s) whose code is not the service's, which would give "
                 f"other numbers ({'; '.join(wrong[:3])}); install the service's release on them"
             )
-        self._checked = self._checked | workers
+        self._checked = self._checked | frozenset(processes.values())
 
     def _still_staffed(self, client: Any, alone_since: float | None) -> float | None:
         """None while the cluster has a worker; else since when it has had none.
@@ -237,6 +242,19 @@ class DaskRunner:
         if now - alone_since >= self.connect_seconds:
             raise self._unavailable(f"has had no worker for {self.connect_seconds:g} s")
         return alone_since
+
+
+def worker_processes(client: Any) -> dict[str, str]:
+    """Each worker's address, and a key of its process.
+
+    The scheduler names no process id; a worker's scratch directory (``local_directory``) is
+    made anew, with a random name, each time a worker process starts, so the address with it
+    tells a worker restarted at the same address (a fixed port) from the one checked before.
+    """
+    workers = client.scheduler_info(n_workers=-1)["workers"]
+    return {
+        address: f"{address} {info.get('local_directory', '')}" for address, info in workers.items()
+    }
 
 
 def client_cancel(client: Any, futures: list[Any]) -> None:
