@@ -518,3 +518,38 @@ def test_a_cancelled_last_job_is_not_offered(page: Page, url: str) -> None:
     page.reload()
     page.wait_for_function("document.body.dataset.ready === '1'")
     assert page.is_hidden("#resume")
+
+
+def test_a_map_cleared_or_a_resumed_job_left_is_offered_again(page: Page, url: str) -> None:
+    """A map cleared by another robot, or a reopened job left by one, was offered again only
+    after a reload: it is offered at once, and shown again as it was."""
+    fill(page, SMALL)
+    page.click("#run")
+    page.wait_for_function("document.getElementById('summary').dataset.cells", timeout=60_000)
+    cells = page.get_attribute("#summary", "data-cells")
+    page.select_option("#robot-model", "ur10")
+    page.wait_for_function("!document.getElementById('resume').hidden", timeout=10_000)
+    assert "done" in (page.text_content("#resume-text") or "")
+    page.click("#resume-show")
+    page.wait_for_function("document.getElementById('summary').dataset.cells", timeout=60_000)
+    assert page.get_attribute("#summary", "data-cells") == cells
+
+    fill(page, {**SMALL, "x-min": "-0.5", "x-max": "0.5", "x-step": "0.004",
+                "y-min": "0.0", "y-max": "0.8", "y-step": "0.004"})  # fmt: skip
+    with page.expect_response(
+        lambda r: r.request.method == "POST" and r.url.endswith("/v1/jobs")
+    ) as sent:
+        page.click("#run")
+    job_id = sent.value.json()["id"]
+    page.wait_for_function("document.getElementById('bar').value > 0", timeout=60_000)
+    page.reload()
+    page.wait_for_function("document.body.dataset.ready === '1'")
+    page.click("#resume-show")
+    page.wait_for_function(
+        "document.getElementById('job-status').textContent.startsWith('running')"
+    )
+    page.select_option("#robot-model", "ur10")
+    page.wait_for_function("!document.getElementById('resume').hidden", timeout=10_000)
+    assert (page.text_content("#job-status") or "").startswith(f"no longer watched (job {job_id}")
+    assert f"job {job_id}" in (page.text_content("#resume-text") or "")
+    httpx.post(f"{url}/v1/jobs/{job_id}/cancel", timeout=30)

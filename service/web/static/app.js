@@ -444,7 +444,10 @@ function inputsChanged(why) {
   clearResults();
   dropRun(why);
   dropOptimization(why);
-  if (drawn) $("job-status").textContent = `map cleared: ${why}`;
+  if (drawn) {
+    $("job-status").textContent = `map cleared: ${why}`;
+    offerLastJob();  // a done map's job: shown again on request, with its own request
+  }
 }
 
 // Nothing runs without a path: the reason there is none goes beside the path field.

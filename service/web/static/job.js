@@ -83,8 +83,9 @@ function dropRun(why) {
   if (!run) return;
   endRun();
   $("bar").value = 0; $("eta").textContent = "";
-  if (run.resumed) {  // an earlier job shown again: not this form's, so left to run
+  if (run.resumed) {  // an earlier job shown again: not this form's, so left to run, and offered
     $("job-status").textContent = `no longer watched (job ${run.id} runs on): ${why}`;
+    offerLastJob();
     return;
   }
   if (run.id) cancelJob(run.id);
