@@ -74,7 +74,17 @@ def _call(package: ModuleType, operation: str, **kwargs: Any) -> Any:
     """Call ``api.<tag>.<operation>`` of the generated client (``sync``: the parsed answer)."""
     tag = next(
         name
-        for name in ("health", "robots", "dtf", "evaluate", "maps", "optimize", "paths", "jobs")
+        for name in (
+            "health",
+            "robots",
+            "limits",
+            "dtf",
+            "evaluate",
+            "maps",
+            "optimize",
+            "paths",
+            "jobs",
+        )
         if importlib.util.find_spec(f"{package.__name__}.api.{name}.{operation}") is not None
     )
     return _module(package, f"api.{tag}.{operation}").sync(**kwargs)
@@ -95,6 +105,8 @@ def test_every_route_through_typed_models(generated: ModuleType, client: Any) ->
     health = _call(generated, "health", client=client)
     assert isinstance(health, models.HealthResponse) and health.status == "ok"
     assert "dtf_jobs" in _call(generated, "metrics", client=client)
+    limits = _call(generated, "get_limits", client=client)
+    assert isinstance(limits, models.LimitsResponse) and limits.max_path_waypoints == 20_000
     robots = _call(generated, "list_robots", client=client)
     assert isinstance(robots, models.RobotsResponse)
     assert {r.name for r in robots.robots} >= {"ur5", "kuka_kr6_r700_sixx"}

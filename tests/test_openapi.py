@@ -35,6 +35,7 @@ def test_operation_ids_are_short_and_the_png_is_binary() -> None:
     assert operations == {
         "health",
         "list_robots",
+        "get_limits",
         "dtf",
         "evaluate",
         "evaluate_png",

@@ -4,10 +4,21 @@ from __future__ import annotations
 
 from fastapi import APIRouter
 
-from service.api.routes import dtf, evaluate, job_results, jobs, map, optimize, paths, robots
+from service.api.routes import (
+    dtf,
+    evaluate,
+    job_results,
+    jobs,
+    limits,
+    map,
+    optimize,
+    paths,
+    robots,
+)
 
 api_router = APIRouter(prefix="/v1")
 api_router.include_router(robots.router)
+api_router.include_router(limits.router)
 api_router.include_router(dtf.router)
 api_router.include_router(evaluate.router)
 api_router.include_router(map.router)

@@ -14,6 +14,7 @@ const REASON_COLOURS = {
 const state = {
   robots: [], path: null, pathProblem: "no path loaded yet", source: null, map: null, grid: null,
   run: null, optimization: null, evaluation: null, cursor: null, tipAt: null,
+  limits: null,  // GET /v1/limits: what a request may hold, said before it is sent
 };
 
 // ---- inputs -------------------------------------------------------------------------------
@@ -887,6 +888,7 @@ async function start() {
   $("opt-cancel").addEventListener("click", () => dropOptimization("stopped from the page"));
   $("png").addEventListener("click", savePng);
   startCellEditor();
+  state.limits = await fetch("/v1/limits").then((r) => (r.ok ? r.json() : null)).catch(() => null);
   await loadExample();
   await offerLastJob();
   document.body.dataset.ready = "1";

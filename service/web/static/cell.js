@@ -104,6 +104,27 @@ function binaryStl(bytes) {
   return bytes.length === 84 + 50 * count;
 }
 
+// What a mesh file would meet, said at its choice (GET /v1/limits): a body over the service's
+// limit is refused whole (413) and an STL of more triangles than it takes too. The body holds
+// the file as sent (base64: 4 bytes for 3; ASCII: its text, each line end escaped).
+function meshTooLarge(bytes, binary, sent) {
+  const limits = state.limits;
+  if (!limits) return "";
+  const said = [];
+  const triangles = binary
+    ? (binaryStl(bytes) ? new DataView(bytes.buffer, bytes.byteOffset).getUint32(80, true) : null)
+    : (sent.match(/\bfacet\b/g) || []).length;
+  if (triangles !== null && triangles > limits.max_mesh_triangles) {
+    said.push(`${triangles} triangles; the service takes at most ${limits.max_mesh_triangles} a mesh (DTF_MAX_MESH_TRIANGLES)`);
+  }
+  const size = JSON.stringify(sent).length;
+  if (size > limits.max_body_bytes) {
+    said.push(`sent as ${size} bytes${binary ? " (base64)" : ""}; the service takes requests of at most `
+      + `${limits.max_body_bytes} bytes (DTF_MAX_BODY_BYTES)${binary ? "" : ": a binary STL is about a fifth of the size"}`);
+  }
+  return said.length ? ` — too large to send: ${said.join("; ")}` : "";
+}
+
 function base64Of(bytes) {
   let text = "";
   for (let i = 0; i < bytes.length; i += 0x8000) text += String.fromCharCode(...bytes.subarray(i, i + 0x8000));
@@ -130,7 +151,8 @@ function meshFields(row, owner) {
     // goes as its bytes, whose errors the API's reader names, not as mangled text.
     const binary = binaryStl(bytes) || bytes.some((b) => b > 127);
     row.dataset.stl = binary ? base64Of(bytes) : new TextDecoder().decode(bytes);
-    file.querySelector(".mesh-read").textContent = `${chosen.name}: ${binary ? "binary" : "ASCII"}, ${bytes.length} bytes`;
+    file.querySelector(".mesh-read").textContent = `${chosen.name}: ${binary ? "binary" : "ASCII"}, ${bytes.length} bytes`
+      + meshTooLarge(bytes, binary, row.dataset.stl);
     showCellStatus();
   });
   const units = document.createElement("div");
