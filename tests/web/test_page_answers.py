@@ -553,3 +553,33 @@ def test_a_map_cleared_or_a_resumed_job_left_is_offered_again(page: Page, url: s
     assert (page.text_content("#job-status") or "").startswith(f"no longer watched (job {job_id}")
     assert f"job {job_id}" in (page.text_content("#resume-text") or "")
     httpx.post(f"{url}/v1/jobs/{job_id}/cancel", timeout=30)
+
+
+def test_earlier_maps_are_listed_and_shown_again(page: Page, url: str) -> None:
+    """Only the last map job was offered after a reload: the service's earlier map jobs are
+    listed, newest first, and any of them is drawn again with its own request."""
+    ids = []
+    for values in (SMALL, {**SMALL, "y-step": "0.1"}):  # 50 cells, then 30
+        fill(page, values)
+        with page.expect_response(
+            lambda r: r.request.method == "POST" and r.url.endswith("/v1/jobs")
+        ) as sent:
+            page.click("#run")
+        ids.append(sent.value.json()["id"])
+        page.wait_for_function(
+            "document.getElementById('job-status').textContent.startsWith('done')",
+            timeout=60_000,
+        )
+    page.reload()
+    page.wait_for_function("document.body.dataset.ready === '1'")
+    assert page.is_visible("#earlier")
+    page.click("#earlier summary")
+    listed = page.eval_on_selector_all("#earlier-list li", "items => items.map(i => i.dataset.job)")
+    assert ids[0] in listed and ids[1] in listed
+    assert listed.index(ids[1]) < listed.index(ids[0])  # newest first
+    page.click(f"#earlier-list li[data-job='{ids[0]}'] button")
+    page.wait_for_function("document.getElementById('summary').dataset.cells", timeout=60_000)
+    request = httpx.get(f"{url}/v1/jobs/{ids[0]}/request").json()["request"]
+    api = httpx.post(f"{url}/v1/map", json=request, timeout=60).json()
+    assert page.get_attribute("#summary", "data-cells") == str(len(api["cells"]))
+    assert page.text_content("#best-mu") == f"{api['best']['mu_path']:.6f} m/s"

@@ -891,6 +891,7 @@ async function start() {
   state.limits = await fetch("/v1/limits").then((r) => (r.ok ? r.json() : null)).catch(() => null);
   await loadExample();
   await offerLastJob();
+  await listEarlierMaps();
   document.body.dataset.ready = "1";
 }
 

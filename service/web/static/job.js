@@ -57,6 +57,32 @@ async function offerLastJob() {
   $("resume-show").onclick = () => resumeMap(id);
 }
 
+// The service's map jobs, newest first (this browser's and other clients': GET /v1/jobs holds
+// them until DTF_JOB_TTL), each shown again on request with its own request, as the last one.
+const EARLIER_MAPS = 10;
+
+async function listEarlierMaps() {
+  let listed;
+  try { listed = await getJson("/v1/jobs?limit=100"); } catch { return; }  // no store: no list
+  const maps = listed.jobs
+    .filter((j) => j.kind === "map" && ["queued", "running", "done"].includes(j.status))
+    .slice(0, EARLIER_MAPS);
+  const list = $("earlier-list");
+  list.textContent = "";
+  for (const job of maps) {
+    const item = document.createElement("li");
+    item.dataset.job = job.id;
+    item.textContent = `${new Date(job.created * 1000).toLocaleString()}: job ${job.id}, `
+      + `${job.status}, ${job.progress.total} placements `;
+    const show = document.createElement("button");
+    show.type = "button"; show.textContent = "Show";
+    show.addEventListener("click", () => resumeMap(job.id));
+    item.append(show);
+    list.append(item);
+  }
+  $("earlier").hidden = maps.length === 0;
+}
+
 async function resumeMap(id) {
   if (state.run) return;
   clearErrors();
@@ -74,6 +100,7 @@ async function resumeMap(id) {
 function endRun() {
   state.run = null;
   $("cancel").disabled = true; $("run").disabled = false;
+  listEarlierMaps();
 }
 
 // A new path or robot while a map is submitted or runs: its job is cancelled on the service and
