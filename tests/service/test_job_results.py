@@ -244,3 +244,18 @@ def test_stored_cells_that_are_not_the_grids_are_refused() -> None:
         stored_map(body, robot, [[{**cell, "reason": "overheated"}] * 2500])
     whole = stored_map(body, robot, [[cell] * 2500])
     assert whole.mu_path.shape == (1, 2, 25, 50) and whole.mu_acc is None
+
+
+def test_a_map_job_stored_with_a_request_this_release_cannot_read_is_a_409(
+    client: TestClient, paged_store: Settings
+) -> None:
+    # a done map job of an older release's store, its request without a grid: no 500
+    store = JobStore(paged_store.data_dir / "jobs.sqlite3")
+    job = store.create("map", {"robot": EXAMPLE["robot"], "path": SHORT_PATH}, total=1)
+    store.start(job.id)
+    store.finish(job.id, "done", result={"cells": [CELLS[0]], "feasible_cells": 1})
+    answer = client.get(f"/v1/jobs/{job.id}/png")
+    assert answer.status_code == 409, answer.text
+    said = answer.json()["detail"][0]["msg"]
+    assert "not a map request this release reads (grid: Field required)" in said
+    assert f"GET /v1/jobs/{job.id}/result" in said

@@ -14,6 +14,7 @@ from typing import Annotated
 
 from fastapi import APIRouter, HTTPException, Query, Response, status
 from fastapi.exceptions import RequestValidationError
+from pydantic import ValidationError
 
 from service import convert
 from service.api.routes.jobs import JOB_RESPONSES, NOT_FOUND, JobId
@@ -94,8 +95,9 @@ def get_job_result_page(
         },
         **NOT_FOUND,
         409: {
-            "description": "The job is not done, is not a map, or its map has more panels "
-            "(yaws x spins) than a picture draws (DTF_MAX_PNG_PANELS)."
+            "description": "The job is not done, is not a map, its map has more panels "
+            "(yaws x spins) than a picture draws (DTF_MAX_PNG_PANELS), or its request was "
+            "stored by a release whose map requests this one does not read."
         },
     },
 )
@@ -108,7 +110,16 @@ def get_job_png(job_id: JobId, settings: SettingsDep) -> Response:
     """
     store = get_runner(settings).store
     state = _done_map(store, str(job_id), "no map to draw")
-    body = MapRequest.model_validate(store.request(state.id))
+    try:
+        body = MapRequest.model_validate(store.request(state.id))
+    except ValidationError as error:  # stored by a release whose map requests differ
+        first = error.errors()[0]
+        said = f"{'.'.join(map(str, first['loc']))}: {first['msg']}"
+        raise HTTPException(
+            status.HTTP_409_CONFLICT,
+            f"job {state.id!r}: its request is not a map request this release reads ({said}); "
+            f"its cells are at GET /v1/jobs/{state.id}/result",
+        ) from None
     grid = stored_grid(body)
     try:
         convert.check_png_size(grid, settings=settings)
