@@ -25,6 +25,22 @@ from tests.web.test_page_cell import open_editor
 from tests.web.test_page_findings import choose_file, error_beside
 
 
+def run_job(page: Page) -> str:
+    """Click Run: the id of the map job the page submits."""
+    with page.expect_response(
+        lambda r: r.request.method == "POST" and r.url.endswith("/v1/jobs")
+    ) as sent:
+        page.click("#run")
+    job_id: str = sent.value.json()["id"]
+    return job_id
+
+
+def reload_page(page: Page) -> None:
+    """Reload the page and wait until it is ready."""
+    page.reload()
+    page.wait_for_function("document.body.dataset.ready === '1'")
+
+
 def _first_feasible(api: dict[str, Any]) -> dict[str, Any]:
     return next(c for c in api["cells"] if c["mu_path"] is not None)
 
@@ -376,14 +392,9 @@ def test_a_reloaded_page_shows_its_last_map_with_the_maps_own_request(page: Page
     its last map job, offers it, draws the job's cells and evaluates a clicked cell with the
     job's request (GET /v1/jobs/{id}/request), not the form's."""
     fill(page, SMALL)
-    with page.expect_response(
-        lambda r: r.request.method == "POST" and r.url.endswith("/v1/jobs")
-    ) as sent:
-        page.click("#run")
-    job_id = sent.value.json()["id"]
+    job_id = run_job(page)
     page.wait_for_function("document.getElementById('summary').dataset.cells", timeout=60_000)
-    page.reload()
-    page.wait_for_function("document.body.dataset.ready === '1'")
+    reload_page(page)
     assert page.is_visible("#resume")
     assert f"job {job_id}" in (page.text_content("#resume-text") or "")
     assert "done" in (page.text_content("#resume-text") or "")
@@ -515,8 +526,7 @@ def test_a_cancelled_last_job_is_not_offered(page: Page, url: str) -> None:
         "document.getElementById('job-status').textContent.startsWith('cancelled')",
         timeout=10_000,
     )
-    page.reload()
-    page.wait_for_function("document.body.dataset.ready === '1'")
+    reload_page(page)
     assert page.is_hidden("#resume")
 
 
@@ -536,14 +546,9 @@ def test_a_map_cleared_or_a_resumed_job_left_is_offered_again(page: Page, url: s
 
     fill(page, {**SMALL, "x-min": "-0.5", "x-max": "0.5", "x-step": "0.004",
                 "y-min": "0.0", "y-max": "0.8", "y-step": "0.004"})  # fmt: skip
-    with page.expect_response(
-        lambda r: r.request.method == "POST" and r.url.endswith("/v1/jobs")
-    ) as sent:
-        page.click("#run")
-    job_id = sent.value.json()["id"]
+    job_id = run_job(page)
     page.wait_for_function("document.getElementById('bar').value > 0", timeout=60_000)
-    page.reload()
-    page.wait_for_function("document.body.dataset.ready === '1'")
+    reload_page(page)
     page.click("#resume-show")
     page.wait_for_function(
         "document.getElementById('job-status').textContent.startsWith('running')"
@@ -561,17 +566,12 @@ def test_earlier_maps_are_listed_and_shown_again(page: Page, url: str) -> None:
     ids = []
     for values in (SMALL, {**SMALL, "y-step": "0.1"}):  # 50 cells, then 30
         fill(page, values)
-        with page.expect_response(
-            lambda r: r.request.method == "POST" and r.url.endswith("/v1/jobs")
-        ) as sent:
-            page.click("#run")
-        ids.append(sent.value.json()["id"])
+        ids.append(run_job(page))
         page.wait_for_function(
             "document.getElementById('job-status').textContent.startsWith('done')",
             timeout=60_000,
         )
-    page.reload()
-    page.wait_for_function("document.body.dataset.ready === '1'")
+    reload_page(page)
     assert page.is_visible("#earlier")
     page.click("#earlier summary")
     listed = page.eval_on_selector_all("#earlier-list li", "items => items.map(i => i.dataset.job)")
