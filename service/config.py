@@ -44,7 +44,7 @@ class Settings(BaseSettings):
     max_map_cells: int = Field(
         default=50_000,
         gt=0,
-        description="Most placements (x * y * yaw values) one /v1/map request may ask for.",
+        description="Most placements (x * y * yaw * spin values) one /v1/map request may ask for.",
     )
     max_map_poses: int = Field(
         default=5_000_000,

@@ -117,17 +117,21 @@ class JobReads(StoreFile):
     def cell_pages(self, job_id: str) -> Iterator[list[dict[str, Any]]]:
         """Every cell of a done job's result, a stored page (PAGE_CELLS) at a time, in order.
 
-        Read on one connection (a 2-million-cell map has 2,000 pages), each page parsed as it
-        is taken: parsed ahead, fifty pages' cells alive at once made Python's garbage
-        collector twice the parsing's time. A result stored whole by an older release is one
-        page.
+        Read on one connection in one transaction (a 2-million-cell map has 2,000 pages): one
+        snapshot of the file, so a job deleted (or expired) meanwhile is read whole, or not at
+        all (no page: the job is gone), never in part. Each page is parsed as it is taken:
+        parsed ahead, fifty pages' cells alive at once made Python's garbage collector twice
+        the parsing's time. A result stored whole by an older release is one page.
         """
-        state = self.state(job_id)
-        if state is None or state.cells is None:
-            yield self.cells(job_id, offset=0, limit=2**62)
-            return
-        pages = -(-state.cells // PAGE_CELLS)
         with self._connection() as db:
+            db.execute("BEGIN")  # deferred: the snapshot is taken at the first read below
+            row = db.execute("SELECT result, cells FROM jobs WHERE id = ?", (job_id,)).fetchone()
+            if row is None or row["result"] is None:
+                return
+            if row["cells"] is None:  # stored whole by an older release
+                yield list(json.loads(row["result"]).get("cells", []))
+                return
+            pages = -(-row["cells"] // PAGE_CELLS)
             for first in range(0, pages, READ_PAGES):
                 texts = page_texts(db, job_id, first=first, last=first + READ_PAGES - 1)
                 yield from (parsed_cells(text) for text in texts)

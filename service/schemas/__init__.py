@@ -42,6 +42,7 @@ from service.schemas.jobs import (
     OptimizeJob,
     ResultCells,
 )
+from service.schemas.limits import LimitsResponse
 from service.schemas.map import Grid, GridAxis, MapCell, MapExtreme, MapRequest, MapResponse
 from service.schemas.motion import AccelerationResult, CycleTimeResult, LimitedBy, PassCycleTime
 from service.schemas.optimize import (
@@ -74,6 +75,7 @@ __all__ = [
     "DetailLevel",
     "JobStatus",
     "LimitedBy",
+    "LimitsResponse",
     "ProgramUnits",
     "SpinMode",
     "AccelerationResult",

@@ -110,8 +110,8 @@ class JobProgress(ResponseModel):
     fraction: float = Field(description="done / total, 0 to 1.")
     eta_seconds: float | None = Field(
         description="Estimated seconds to the end, at the rate of progress since the run's "
-        "first report (its set-up before it is not counted; until a second report, since its "
-        "start); null unless running with some progress."
+        "first report (its set-up before it is not counted); null unless running, and until "
+        "a second report gives a rate."
     )
 
 

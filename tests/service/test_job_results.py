@@ -15,6 +15,7 @@ from fastapi.testclient import TestClient
 from service.config import Settings
 from service.convert.common import robot_from_schema
 from service.convert.stored_map import StoredCellsMismatch, stored_map
+from service.jobs import store_reads
 from service.jobs.job import DamagedJob
 from service.jobs.results import CellPages
 from service.jobs.store import JobStore
@@ -214,7 +215,7 @@ def test_a_jobs_picture_is_refused_unless_a_done_map_within_the_panel_limit(
     job_id = client.post("/v1/jobs", json=evaluate).json()["id"]
     assert done_job(client, job_id)["status"] == "done"
     answer = client.get(f"/v1/jobs/{job_id}/png")
-    assert answer.status_code == 409 and "evaluate job" in answer.json()["detail"][0]["msg"]
+    assert answer.status_code == 409 and "is an evaluate job" in answer.json()["detail"][0]["msg"]
     yaws = [0.1 * k for k in range(paged_store.max_png_panels + 1)]
     grid = {"x": {"min": 0.0, "max": 0.0, "step": 0.1}, "y": {"min": 0.4, "max": 0.4, "step": 0.1}}
     request = {
@@ -227,7 +228,8 @@ def test_a_jobs_picture_is_refused_unless_a_done_map_within_the_panel_limit(
     answer = client.get(f"/v1/jobs/{job_id}/png")
     assert answer.status_code == 409, answer.text
     said = answer.json()["detail"][0]["msg"]
-    assert f"{len(yaws)} PNG panels" in said and "DTF_MAX_PNG_PANELS" in said
+    assert f"= {len(yaws)} panels; a picture draws at most {paged_store.max_png_panels}" in said
+    assert "(DTF_MAX_PNG_PANELS)" in said and f"GET /v1/jobs/{job_id}/result" in said
 
 
 def test_stored_cells_that_are_not_the_grids_are_refused() -> None:
@@ -259,3 +261,36 @@ def test_a_map_job_stored_with_a_request_this_release_cannot_read_is_a_409(
     said = answer.json()["detail"][0]["msg"]
     assert "not a map request this release reads (grid: Field required)" in said
     assert f"GET /v1/jobs/{job.id}/result" in said
+
+
+def test_a_jobs_cells_are_read_whole_when_it_is_deleted_meanwhile(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    # A page a query: deleted after the first page is read, the job's cells were cut short
+    # (the picture's route then said the job was damaged); one snapshot reads them all.
+    monkeypatch.setattr(store_reads, "READ_PAGES", 1)
+    store = JobStore(tmp_path / "jobs.sqlite3")
+    job = store.create("map", {}, total=2500)
+    store.start(job.id)
+    store.finish(job.id, "done", result={"cells": CELLS, "feasible_cells": 2500})
+    pages = store.cell_pages(job.id)
+    first = next(pages)
+    assert JobStore(tmp_path / "jobs.sqlite3").delete(job.id)
+    assert [cell for page in (first, *pages) for cell in page] == CELLS
+    assert list(store.cell_pages(job.id)) == []  # read after: nothing
+
+
+def test_a_map_jobs_picture_of_a_job_deleted_while_read_is_a_404(
+    client: TestClient, paged_store: Settings, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    request = {"robot": EXAMPLE["robot"], "path": SHORT_PATH, "grid": GRID_2500}
+    job_id = client.post("/v1/jobs", json={"kind": "map", "request": request}).json()["id"]
+    assert done_job(client, job_id)["status"] == "done"
+
+    def deleted_first(self: JobStore, job: str) -> Iterator[list[dict[str, Any]]]:
+        self.delete(job)  # as a DELETE just before the cells are read
+        yield from ()
+
+    monkeypatch.setattr(JobStore, "cell_pages", deleted_first)
+    answer = client.get(f"/v1/jobs/{job_id}/png")
+    assert answer.status_code == 404, answer.text

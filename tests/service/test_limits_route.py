@@ -8,7 +8,7 @@ from fastapi.testclient import TestClient
 
 from service.config import Settings
 from service.main import app
-from service.schemas.limits import LIMIT_SETTINGS
+from service.schemas import LimitsResponse
 from tests.cases import ROOT
 from tests.service.conftest import served_with
 
@@ -20,10 +20,10 @@ def test_the_limits_said_are_the_settings_served_and_enforced() -> None:
     settings = Settings(max_path_waypoints=7, max_mesh_triangles=3)
     with served_with(settings), TestClient(app) as client:
         limits = client.get("/v1/limits").json()
-        assert set(limits) == set(LIMIT_SETTINGS)
-        assert {name: limits[name] for name in LIMIT_SETTINGS} == {
-            name: getattr(settings, name) for name in LIMIT_SETTINGS
-        }
+        assert set(limits) == set(LimitsResponse.model_fields)
+        for name in set(limits) & set(Settings.model_fields):  # each setting as served
+            assert limits[name] == getattr(settings, name), name
+        assert limits["job_ttl_seconds"] == settings.job_ttl
         assert (limits["max_body_bytes"], limits["max_path_waypoints"]) == (2_000_000, 7)
         waypoints = EXAMPLE["path"]["waypoints"]
         at = client.post("/v1/evaluate", json={**EXAMPLE, "path": {"waypoints": waypoints[:7]}})
@@ -40,9 +40,32 @@ def test_the_limits_said_are_the_settings_served_and_enforced() -> None:
             assert answer.status_code == refused, answer.text[:200]  # 422: the pad is no field
 
 
-def test_each_limit_says_its_setting() -> None:
+def test_each_limit_says_its_setting_or_that_it_has_none() -> None:
     schema = app.openapi()["components"]["schemas"]["LimitsResponse"]
-    assert sorted(schema["required"]) == sorted(LIMIT_SETTINGS)
-    for name in LIMIT_SETTINGS:
-        said = schema["properties"][name]["description"]
-        assert said.startswith(f"DTF_{name.upper()}: ") and len(said) > 30, (name, said)
+    for name, field in schema["properties"].items():
+        said = field["description"]
+        setting = "job_ttl" if name == "job_ttl_seconds" else name
+        if setting in Settings.model_fields:
+            assert said.endswith(f"(DTF_{setting.upper()})"), (name, said)
+        else:
+            assert said.endswith("(the schema's; no setting)"), (name, said)
+
+
+def test_a_setting_above_the_schemas_bound_is_said_as_the_bound_in_force() -> None:
+    """DTF_MAX_PATH_WAYPOINTS=30000 was said as 30,000 while the schema refuses 20,001
+    waypoints (a body over 2 MB here), DTF_MAX_CELL_OBJECTS=5000 as 5,000 while it refuses
+    1,001 objects: the limit said is the one a request meets; the schema's own bounds too."""
+    settings = Settings(max_path_waypoints=30_000, max_cell_objects=5_000)
+    with served_with(settings), TestClient(app) as client:
+        limits = client.get("/v1/limits").json()
+        assert (limits["max_path_waypoints"], limits["max_cell_objects"]) == (20_000, 1_000)
+        box = {"shape": "box", "size": [0.1, 0.1, 0.1], "pose": {"position": [2, 2, 2]}}
+        cell = {"fixed": [box] * (limits["max_cell_objects"] + 1)}
+        over = client.post("/v1/evaluate", json={**EXAMPLE, "cell": cell})
+        assert over.status_code == 422 and "at most 1000 items" in over.text, over.text[:300]
+        yaws = [0.0] * (limits["max_grid_values"] + 1)
+        grid = {"x": {"min": 0, "max": 0, "step": 1}, "y": {"min": 0.4, "max": 0.4, "step": 1}}
+        body = {**EXAMPLE, "grid": {**grid, "z": 0.1, "yaw": yaws}}
+        del body["placement"]
+        answer = client.post("/v1/map", json=body)
+        assert answer.status_code == 422 and f"at most {len(yaws) - 1} items" in answer.text

@@ -28,7 +28,6 @@ from service.jobs.views import page_url
 from service.operations import map_png
 from service.schemas import MapRequest
 from service.schemas.jobs import JobResultPage
-from solver.core.exceptions import InvalidInputError
 
 router = APIRouter(prefix="/jobs", tags=["jobs"], responses=JOB_RESPONSES)
 
@@ -121,14 +120,20 @@ def get_job_png(job_id: JobId, settings: SettingsDep) -> Response:
             f"its cells are at GET /v1/jobs/{state.id}/result",
         ) from None
     grid = stored_grid(body)
-    try:
-        convert.check_png_size(grid, settings=settings)
-    except InvalidInputError as error:
-        raise HTTPException(status.HTTP_409_CONFLICT, f"job {state.id!r}: {error}") from None
+    panels = len(grid.yaws) * len(grid.spins)
+    if panels > settings.max_png_panels:
+        raise HTTPException(
+            status.HTTP_409_CONFLICT,
+            f"job {state.id!r}: its map has {len(grid.yaws)} yaws * {len(grid.spins)} spins = "
+            f"{panels} panels; a picture draws at most {settings.max_png_panels} "
+            f"(DTF_MAX_PNG_PANELS); its cells are at GET /v1/jobs/{state.id}/result",
+        )
     robot = convert.robot_from_schema(body.robot)
     try:
         cmap = stored_map(body, robot, store.cell_pages(state.id))
     except StoredCellsMismatch as error:
+        if store.state(state.id) is None:  # deleted (or expired) before its cells were read
+            raise job_not_found(job_id) from None
         raise DamagedJob(store.path, state.id, str(error)) from None
     return Response(map_png(cmap, robot), media_type="image/png")
 
@@ -145,7 +150,8 @@ def _done_map(store: JobStore, job_id: str, nothing: str) -> JobState:
     if state.kind != "map":
         raise HTTPException(
             status.HTTP_409_CONFLICT,
-            f"job {state.id!r} is a {state.kind} job: {nothing}; "
+            f"job {state.id!r} is {'an' if state.kind[0] in 'aeiou' else 'a'} {state.kind} "
+            f"job: {nothing}; "
             f"GET /v1/jobs/{state.id} gives its result",
         )
     return state

@@ -16,8 +16,8 @@ router = APIRouter(prefix="/limits", tags=["limits"])
     summary="The request limits of this service",
     response_model=LimitsResponse,
 )
-def get_limits(settings: SettingsDep) -> object:
-    """Each limit a request meets, with its ``DTF_`` setting.
+def get_limits(settings: SettingsDep) -> LimitsResponse:
+    """Each limit a request meets, with its ``DTF_`` setting (or the schema's own bound).
 
     What would be refused, and why, can be said before a request is sent: the body's bytes, a
     path's waypoints, a map's placements and work, a mesh's triangles, a job's cells.
