@@ -583,3 +583,29 @@ def test_earlier_maps_are_listed_and_shown_again(page: Page, url: str) -> None:
     api = httpx.post(f"{url}/v1/map", json=request, timeout=60).json()
     assert page.get_attribute("#summary", "data-cells") == str(len(api["cells"]))
     assert page.text_content("#best-mu") == f"{api['best']['mu_path']:.6f} m/s"
+
+
+def test_a_late_offer_of_the_last_map_does_not_follow_a_newer_map(page: Page, url: str) -> None:
+    """The audit's race: map A drawn, the robot changed (A offered again, its GET slow) and a
+    map B run at once: B drawn, then 'Your last map, job A' appeared, whose 'Show it' replaced B."""
+    fill(page, SMALL)
+    first = run_job(page)
+    page.wait_for_function("document.getElementById('summary').dataset.cells", timeout=60_000)
+    asked = []
+
+    def slow(route: Route) -> None:
+        asked.append(route.request.url)
+        page.wait_for_timeout(1500)
+        route.continue_()
+
+    page.route(f"**/v1/jobs/{first}", slow)
+    page.select_option("#robot-model", "ur10")
+    fill(page, {**SMALL, "y-step": "0.1"})
+    second = run_job(page)
+    assert second != first
+    page.wait_for_function(
+        "document.getElementById('job-status').textContent.startsWith('done')", timeout=60_000
+    )
+    page.wait_for_timeout(2500)  # the slow answer about the first job has come meanwhile
+    assert asked and page.is_hidden("#resume")
+    assert page.get_attribute("#summary", "data-cells") == "30"  # the second map's

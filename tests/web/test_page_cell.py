@@ -575,3 +575,18 @@ def test_a_mesh_too_large_to_send_is_said_at_its_choice(page: Page, url: str) ->
     assert f"{count} triangles; the service takes at most {limits['max_mesh_triangles']}" in said
     assert f"sent as {sent} bytes (base64)" in said
     assert f"at most {limits['max_body_bytes']} bytes (DTF_MAX_BODY_BYTES)" in said
+
+
+def test_meshes_too_large_together_are_said(page: Page, url: str) -> None:
+    """Each of two meshes under the body limit, both over it: the second is said at its choice."""
+    limits = httpx.get(f"{url}/v1/limits", timeout=30).json()
+    small = cube_stl(100.0, binary=True)
+    count = int(0.6 * limits["max_body_bytes"] * 3 / 4 / 50)  # base64: 60 % of the limit each
+    mesh = small[:80] + struct.pack("<I", count) + small[84:134] * count
+    each = 2 + 4 * math.ceil(len(mesh) / 3)
+    assert each < limits["max_body_bytes"] < 2 * each
+    add_mesh(page, name="first", stl=mesh, units="mm", at=["0", "0", "0.2"])
+    assert "too large" not in (page.locator(".mesh-read").last.text_content() or "")
+    add_mesh(page, name="second", stl=mesh, units="mm", at=["0", "0", "0.4"])
+    said = page.locator(".mesh-read").last.text_content() or ""
+    assert f"with the cell's other meshes, sent as {2 * each} bytes" in said

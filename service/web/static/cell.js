@@ -118,9 +118,14 @@ function meshTooLarge(bytes, binary, sent) {
     said.push(`${triangles} triangles; the service takes at most ${limits.max_mesh_triangles} a mesh (DTF_MAX_MESH_TRIANGLES)`);
   }
   const size = JSON.stringify(sent).length;
+  const meshes = [...document.querySelectorAll(".cell-box")]
+    .reduce((sum, row) => sum + (row.dataset.stl ? JSON.stringify(row.dataset.stl).length : 0), 0);
+  const most = `the service takes requests of at most ${limits.max_body_bytes} bytes (DTF_MAX_BODY_BYTES)`;
   if (size > limits.max_body_bytes) {
-    said.push(`sent as ${size} bytes${binary ? " (base64)" : ""}; the service takes requests of at most `
-      + `${limits.max_body_bytes} bytes (DTF_MAX_BODY_BYTES)${binary ? "" : ": a binary STL is about a fifth of the size"}`);
+    said.push(`sent as ${size} bytes${binary ? " (base64)" : ""}; ${most}`
+      + `${binary ? "" : ": a binary STL is about a fifth of the size"}`);
+  } else if (meshes > limits.max_body_bytes) {
+    said.push(`with the cell's other meshes, sent as ${meshes} bytes; ${most}`);
   }
   return said.length ? ` — too large to send: ${said.join("; ")}` : "";
 }

@@ -20,6 +20,7 @@ async function runMap(event) {
   try { body = mapBody(); } catch (error) { showErrors([{ loc: ["robot"], msg: error.message }]); return; }
   const run = { id: null };
   state.run = run; $("run").disabled = true;
+  $("resume").hidden = true; disableEarlier();
   $("job-status").textContent = "submitting the map…";
   const job = await api("POST", "/v1/jobs", { kind: "map", request: body }).catch(() => null);
   if (state.run !== run) { if (job) cancelJob(job.id); return; }  // dropped while submitted
@@ -50,6 +51,7 @@ async function offerLastJob() {
     return;
   }
   if (!["queued", "running", "done"].includes(job.status)) return;  // nothing of it to draw
+  if (state.run || state.map) return;  // a map run or drawn meanwhile: it is the one shown
   const when = new Date(job.created * 1000).toLocaleString();
   $("resume-text").textContent = `Your last map, job ${id} (submitted ${when}): `
     + `${job.status}, ${job.progress.done} of ${job.progress.total} placements.`;
@@ -83,6 +85,11 @@ async function listEarlierMaps() {
   $("earlier").hidden = maps.length === 0;
 }
 
+// While a map runs, no other is shown (listEarlierMaps enables them again as it ends).
+function disableEarlier() {
+  for (const button of $("earlier-list").querySelectorAll("button")) button.disabled = true;
+}
+
 async function resumeMap(id) {
   if (state.run) return;
   clearErrors();
@@ -93,6 +100,7 @@ async function resumeMap(id) {
   $("resume").hidden = true;
   const run = { id, resumed: true };
   state.run = run; $("run").disabled = true; $("cancel").disabled = false;
+  disableEarlier();
   state.grid = asked.request.grid; state.mapBody = asked.request;
   await watch(run);
 }
