@@ -106,3 +106,17 @@ def test_the_work_weights_the_readme_names_are_the_codes() -> None:
 
     (weight,) = re.findall(r"such maps weigh (\d+) closed-form poses a pose", README)
     assert float(weight) == EXACT_SPIN_COST
+
+
+def test_every_route_is_named_in_the_readme() -> None:
+    """Each operation of the app, as `METHOD /path` (`{id}` for a job's id; `/v1/jobs[/{id}]`
+    names the listing and one job): a route added without a word in the README fails here."""
+    named = set()
+    for method, path in re.findall(r"`(GET|POST|PUT|PATCH|DELETE) (/[^`\s]*)`", README):
+        named |= {(method, re.sub(r"\[.*?\]", "", path)), (method, re.sub(r"[\[\]]", "", path))}
+    operations = {
+        (method.upper(), path.replace("{job_id}", "{id}"))
+        for path, methods in app.openapi()["paths"].items()
+        for method in methods
+    }
+    assert operations - named == set()
