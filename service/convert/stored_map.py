@@ -10,7 +10,7 @@ the picture is the one ``POST /v1/map/png`` draws of the same request.
 
 from __future__ import annotations
 
-from collections.abc import Iterable
+from collections.abc import Callable, Iterable, Iterator
 from typing import Any
 
 import numpy as np
@@ -22,6 +22,21 @@ from solver.core.robots import Robot
 from solver.path.capability_map import CapabilityMap, grid_axis
 
 _REASON_INDEX = {reason: k for k, reason in enumerate(REASONS)}
+
+
+def reported(
+    pages: Iterable[list[dict[str, Any]]], progress: Callable[[float], None], *, total: int
+) -> Iterator[list[dict[str, Any]]]:
+    """``pages``, ``progress`` told the fraction of ``total`` cells read after each.
+
+    ``progress`` may raise (the client left: :class:`solver.core.progress.Cancelled`): the
+    pages are then no longer read (their generator closed, its store connection with it).
+    """
+    read = 0
+    for page in pages:
+        yield page
+        read += len(page)
+        progress(min(read / total, 1.0))
 
 
 class StoredCellsMismatch(ValueError):

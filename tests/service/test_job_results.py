@@ -8,10 +8,12 @@ import time
 from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
+from uuid import UUID
 
 import pytest
 from fastapi.testclient import TestClient
 
+from service.api.routes.job_results import job_picture
 from service.config import Settings
 from service.convert.common import robot_from_schema
 from service.convert.stored_map import StoredCellsMismatch, stored_map
@@ -22,6 +24,7 @@ from service.jobs.store import JobStore
 from service.jobs.worker import _map
 from service.schemas import MapRequest
 from solver.core.parallel import SERIAL
+from solver.core.progress import Cancelled
 from tests.cases import ROOT
 from tests.service.conftest import served_with
 
@@ -294,3 +297,33 @@ def test_a_map_jobs_picture_of_a_job_deleted_while_read_is_a_404(
     monkeypatch.setattr(JobStore, "cell_pages", deleted_first)
     answer = client.get(f"/v1/jobs/{job_id}/png")
     assert answer.status_code == 404, answer.text
+
+
+def test_a_jobs_picture_stops_reading_when_its_client_leaves(
+    client: TestClient, paged_store: Settings, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The reading of 2 million cells takes seconds: it is told after each page, and stops
+    (its store connection closed) when the client has left, as a map route's work does."""
+    request = {"robot": EXAMPLE["robot"], "path": SHORT_PATH, "grid": GRID_2500}
+    job_id = client.post("/v1/jobs", json={"kind": "map", "request": request}).json()["id"]
+    assert done_job(client, job_id)["status"] == "done"
+    read, closed = [], []
+    pages_of = JobStore.cell_pages
+
+    def counted(self: JobStore, job: str) -> Iterator[list[dict[str, Any]]]:
+        try:
+            for page in pages_of(self, job):
+                read.append(len(page))
+                yield page
+        finally:
+            closed.append(True)
+
+    def left(fraction: float) -> None:
+        told.append(fraction)
+        raise Cancelled
+
+    told: list[float] = []
+    monkeypatch.setattr(JobStore, "cell_pages", counted)
+    with pytest.raises(Cancelled):
+        job_picture(UUID(job_id), paged_store, left)
+    assert told == [0.4] and read == [1000] and closed == [True]  # one page of three read

@@ -11,14 +11,16 @@ from __future__ import annotations
 
 import json
 from typing import Annotated
+from uuid import UUID
 
-from fastapi import APIRouter, HTTPException, Query, Response, status
+from fastapi import APIRouter, HTTPException, Query, Request, Response, status
 from fastapi.exceptions import RequestValidationError
 from pydantic import ValidationError
 
 from service import convert
 from service.api.routes.jobs import JOB_RESPONSES, NOT_FOUND, JobId
-from service.convert.stored_map import StoredCellsMismatch, stored_grid, stored_map
+from service.config import Settings
+from service.convert.stored_map import StoredCellsMismatch, reported, stored_grid, stored_map
 from service.deps import SettingsDep
 from service.errors import job_not_found
 from service.jobs.job import DamagedJob, JobState
@@ -28,6 +30,8 @@ from service.jobs.views import page_url
 from service.operations import map_png
 from service.schemas import MapRequest
 from service.schemas.jobs import JobResultPage
+from service.work import run_stoppable
+from solver.core.progress import Progress
 
 router = APIRouter(prefix="/jobs", tags=["jobs"], responses=JOB_RESPONSES)
 
@@ -100,13 +104,19 @@ def get_job_result_page(
         },
     },
 )
-def get_job_png(job_id: JobId, settings: SettingsDep) -> Response:
+async def get_job_png(request: Request, job_id: JobId, settings: SettingsDep) -> Response:
     """The colour map of a done map job, drawn from its stored cells (no map computed again).
 
     ``POST /v1/map/png`` computes a map within a request's limits; a map run as a job (up to
     DTF_MAX_JOB_CELLS placements) is drawn here. The stored cells are read a page at a
-    time (about 2 s a million cells).
+    time (about 2 s a million cells), in a worker thread, and the reading stops when the
+    client leaves.
     """
+    return await run_stoppable(request, lambda progress: job_picture(job_id, settings, progress))
+
+
+def job_picture(job_id: UUID, settings: Settings, progress: Progress) -> Response:
+    """:func:`get_job_png`'s work; ``progress`` told each page read (it raises to stop)."""
     store = get_runner(settings).store
     state = _done_map(store, str(job_id), "no map to draw")
     try:
@@ -130,7 +140,8 @@ def get_job_png(job_id: JobId, settings: SettingsDep) -> Response:
         )
     robot = convert.robot_from_schema(body.robot)
     try:
-        cmap = stored_map(body, robot, store.cell_pages(state.id))
+        pages = reported(store.cell_pages(state.id), progress, total=state.cells or 1)
+        cmap = stored_map(body, robot, pages)
     except StoredCellsMismatch as error:
         if store.state(state.id) is None:  # deleted (or expired) before its cells were read
             raise job_not_found(job_id) from None
