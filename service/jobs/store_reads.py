@@ -65,13 +65,16 @@ class JobReads(StoreFile):
             row = db.execute(f"SELECT {STATE_COLUMNS} FROM jobs WHERE id = ?", (job_id,)).fetchone()
         return None if row is None else state_of_row(row, store=self.path)
 
-    def jobs(self, *, status: str | None, limit: int, after: str | None = None) -> list[JobState]:
-        """The newest jobs first, optionally of one status, without requests and results.
+    def jobs(
+        self, *, status: str | None, limit: int, after: str | None = None, kind: str | None = None
+    ) -> list[JobState]:
+        """The newest jobs first, optionally of one status and kind, without requests and results.
 
         Jobs submitted in the same instant are in the order of their ids, so the order is total.
 
         Args:
             status: only the jobs of this status (None: all).
+            kind: only the jobs of this kind (None: all).
             limit: at most this many.
             after: the listing goes on after this job's place in it (the last id of a page);
                 an id the store does not hold gives no jobs.
@@ -79,6 +82,9 @@ class JobReads(StoreFile):
         conditions, args = [], []
         if status is not None:
             conditions, args = ["status = ?"], [status]
+        if kind is not None:
+            conditions.append("kind = ?")
+            args.append(kind)
         if after is not None:
             conditions.append("(created, id) < (SELECT created, id FROM jobs WHERE id = ?)")
             args.append(after)

@@ -34,6 +34,7 @@ from service.schemas.ik import AutoIkPolicy, Branch, IkPolicy, NumericBranch
 from service.schemas.jobs import (
     EvaluateJob,
     JobInfo,
+    JobKind,
     JobList,
     JobProgress,
     JobResultPage,
@@ -94,6 +95,7 @@ __all__ = [
     "JobProgress",
     "JobList",
     "JobInfo",
+    "JobKind",
     "JobResultPage",
     "ResultCells",
     "EvaluateJob",

@@ -23,6 +23,14 @@ JobStatus = TypeAliasType(
     ],
 )
 """One component for a job's status and the status filter of GET /v1/jobs."""
+JobKind = TypeAliasType(
+    "JobKind",
+    Annotated[
+        Literal["map", "optimize", "evaluate"],
+        Field(description="What a job computes: a map, an optimisation or an evaluation."),
+    ],
+)
+"""One component for a job's kind and the kind filter of GET /v1/jobs."""
 JobResult = Annotated[
     dict[str, Any] | None,
     WithJsonSchema(
@@ -160,7 +168,7 @@ class JobInfo(ResponseModel):
     model_config = ConfigDict(json_schema_extra={"examples": [_JOB_EXAMPLE]})
 
     id: str = Field(description="The job's id (a random UUID).")
-    kind: Literal["map", "optimize", "evaluate"] = Field(description="What the job computes.")
+    kind: JobKind = Field(description="What the job computes.")
     status: JobStatus = Field(description="queued, running, done, failed or cancelled.")
     progress: JobProgress = Field(description="How far it is.")
     created: float = Field(description="When it was submitted (Unix time, s).")

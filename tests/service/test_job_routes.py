@@ -145,6 +145,26 @@ def test_the_job_listing_is_read_in_pages_with_after(client: TestClient, own_sto
     assert unknown.json()["detail"][0]["loc"] == ["query", "after"]
 
 
+def test_the_job_listing_is_filtered_by_kind(client: TestClient, own_store: Path) -> None:
+    """The page listed its earlier maps among the newest 100 jobs of every kind: a client's
+    evaluations could hide its maps. ``kind`` lists one kind, with ``status`` and ``after``."""
+    kinds = ["map", "evaluate", "map", "evaluate"]
+    ids = [
+        client.post("/v1/jobs", json={"kind": k, "request": route_body(k, EXAMPLE["path"])}).json()[
+            "id"
+        ]
+        for k in kinds
+    ]
+    maps = client.get("/v1/jobs", params={"kind": "map"}).json()["jobs"]
+    assert [j["id"] for j in maps] == [ids[2], ids[0]] and {j["kind"] for j in maps} == {"map"}
+    after = client.get("/v1/jobs", params={"kind": "map", "after": ids[2]}).json()["jobs"]
+    assert [j["id"] for j in after] == [ids[0]]
+    none = client.get("/v1/jobs", params={"kind": "optimize"}).json()["jobs"]
+    assert none == []
+    bad = client.get("/v1/jobs", params={"kind": "maps"})
+    assert bad.status_code == 422 and bad.json()["detail"][0]["loc"] == ["query", "kind"]
+
+
 def test_a_finished_job_expires_while_the_service_runs(client: TestClient, tmp_path: Path) -> None:
     job = {"kind": "evaluate", "request": route_body("evaluate", EXAMPLE["path"])}
     with served_with(Settings(data_dir=tmp_path, workers=1, job_ttl=1.0)):

@@ -29,6 +29,7 @@ from service.schemas import ErrorDetail, ErrorResponse
 from service.schemas.jobs import (
     EvaluateJob,
     JobInfo,
+    JobKind,
     JobList,
     JobRequest,
     JobStatus,
@@ -141,6 +142,10 @@ async def post_job(
 def get_jobs(
     settings: SettingsDep,
     job_status: Annotated[JobStatus | None, Query(alias="status")] = None,
+    kind: Annotated[
+        JobKind | None,
+        Query(description="Only the jobs of this kind (a client listing its maps)."),
+    ] = None,
     limit: Annotated[int, Query(ge=1, le=1000)] = 100,
     after: Annotated[
         UUID | None,
@@ -163,7 +168,9 @@ def get_jobs(
         raise job_not_found(
             after, loc=("query", "after"), why=" (deleted, or expired after DTF_JOB_TTL)"
         )
-    states = store.jobs(status=job_status, limit=limit, after=None if after is None else str(after))
+    states = store.jobs(
+        status=job_status, kind=kind, limit=limit, after=None if after is None else str(after)
+    )
     return JobList(jobs=[job_info(state, store) for state in states])
 
 

@@ -65,9 +65,9 @@ const EARLIER_MAPS = 10;
 
 async function listEarlierMaps() {
   let listed;
-  try { listed = await getJson("/v1/jobs?limit=100"); } catch { return; }  // no store: no list
+  try { listed = await getJson("/v1/jobs?kind=map&limit=100"); } catch { return; }  // no store
   const maps = listed.jobs
-    .filter((j) => j.kind === "map" && ["queued", "running", "done"].includes(j.status))
+    .filter((j) => ["queued", "running", "done"].includes(j.status))
     .slice(0, EARLIER_MAPS);
   const list = $("earlier-list");
   list.textContent = "";
