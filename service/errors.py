@@ -20,6 +20,7 @@ from starlette.routing import Route
 
 from service.jobs.job import JobStoreUnavailable
 from service.schemas import ErrorDetail, ErrorResponse
+from service.work import STOPPING
 from solver.core.exceptions import SolverError
 from solver.core.progress import Cancelled
 
@@ -74,7 +75,8 @@ ERROR_RESPONSES: dict[int | str, dict[str, Any]] = {
     },
     status.HTTP_503_SERVICE_UNAVAILABLE: {
         "model": ErrorResponse,
-        "description": "The work was stopped because the service is shutting down; retry.",
+        "description": "The work was stopped because the service is shutting down (or its "
+        "client left); retry.",
         "headers": RETRY_AFTER,
     },
     status.HTTP_422_UNPROCESSABLE_CONTENT: {
@@ -210,10 +212,12 @@ async def server_error_handler(request: Request, error: Exception) -> JSONRespon
 
 
 async def cancelled_handler(request: Request, error: Cancelled) -> JSONResponse:
-    """Answer work stopped on the way (the client left, or the service is stopping) with 503."""
-    detail = ErrorDetail(
-        loc=[], msg="the work was stopped: the service is shutting down", type="cancelled"
-    )
+    """Answer work stopped on the way (the client left, or the service is stopping) with 503.
+
+    A client that left hears nothing; a proxy, a log or a test may: each says its own cause.
+    """
+    why = "the service is shutting down" if STOPPING.is_set() else "its client left"
+    detail = ErrorDetail(loc=[], msg=f"the work was stopped: {why}", type="cancelled")
     response = error_response(status.HTTP_503_SERVICE_UNAVAILABLE, [detail])
     response.headers["Retry-After"] = "5"
     return response

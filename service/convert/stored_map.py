@@ -78,14 +78,19 @@ def stored_map(
         end = filled + len(page)
         if end > total:
             raise StoredCellsMismatch(f"more cells stored than the grid's {total}")
-        mu_path[filled:end] = [np.nan if c["mu_path"] is None else c["mu_path"] for c in page]
-        mu_acc[filled:end] = [np.nan if c.get("mu_acc") is None else c["mu_acc"] for c in page]
         try:
-            reason[filled:end] = [
-                FEASIBLE if c["reason"] is None else _REASON_INDEX[c["reason"]] for c in page
-            ]
-        except KeyError as error:
-            raise StoredCellsMismatch(f"a cell's reason {error.args[0]!r} is unknown") from None
+            mu_path[filled:end] = [np.nan if c["mu_path"] is None else c["mu_path"] for c in page]
+            mu_acc[filled:end] = [np.nan if c.get("mu_acc") is None else c["mu_acc"] for c in page]
+            codes = [c["reason"] for c in page]
+        except (KeyError, TypeError, ValueError) as error:  # a cell the service never writes
+            what = f"no {error.args[0]!r}" if isinstance(error, KeyError) else str(error)[:80]
+            raise StoredCellsMismatch(f"a stored cell near cell {filled}: {what}") from None
+        unknown = [
+            c for c in codes if c is not None and not (isinstance(c, str) and c in _REASON_INDEX)
+        ]
+        if unknown:
+            raise StoredCellsMismatch(f"a cell's reason {str(unknown[0])[:40]!r} is unknown")
+        reason[filled:end] = [FEASIBLE if code is None else _REASON_INDEX[code] for code in codes]
         filled = end
     if filled != total:
         raise StoredCellsMismatch(f"{filled} cells stored, the grid has {total}")

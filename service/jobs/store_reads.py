@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import dataclasses
 import json
-from collections.abc import Iterator
+from collections.abc import Generator
 from typing import Any
 
 from service.jobs.job import (
@@ -120,7 +120,7 @@ class JobReads(StoreFile):
         cells = json.loads(row["result"]).get("cells", [])
         return list(cells[offset : offset + limit])
 
-    def cell_pages(self, job_id: str) -> Iterator[list[dict[str, Any]]]:
+    def cell_pages(self, job_id: str) -> Generator[list[dict[str, Any]], None, None]:
         """Every cell of a done job's result, a stored page (PAGE_CELLS) at a time, in order.
 
         Read on one connection in one transaction (a 2-million-cell map has 2,000 pages): one

@@ -16,6 +16,9 @@ from starlette.types import Message, Receive, Scope, Send
 
 from service.body_limits import BodySizeLimitMiddleware
 from service.convert import wants_png
+from service.errors import cancelled_handler
+from service.work import STOPPING
+from solver.core.progress import Cancelled
 from tests.cases import EXAMPLES, ROOT
 
 DELETE = object()
@@ -554,3 +557,19 @@ def test_a_bad_yaw_is_named_once_where_it_is(client: TestClient, yaw: Any, loc: 
     assert answer.status_code == 422
     (detail,) = answer.json()["detail"]
     assert detail["loc"] == loc and detail["msg"] == "Input should be less than or equal to 1000"
+
+
+def test_work_stopped_says_whether_its_client_left_or_the_service_stops() -> None:
+    """Both were 'the service is shutting down': a proxy or a log read the wrong cause."""
+
+    def said() -> str:
+        answer = asyncio.run(cancelled_handler(None, Cancelled()))  # type: ignore[arg-type]
+        assert answer.status_code == 503 and answer.headers["Retry-After"] == "5"
+        return str(json.loads(answer.body)["detail"][0]["msg"])
+
+    assert said() == "the work was stopped: its client left"
+    STOPPING.set()
+    try:
+        assert said() == "the work was stopped: the service is shutting down"
+    finally:
+        STOPPING.clear()

@@ -247,6 +247,10 @@ def test_stored_cells_that_are_not_the_grids_are_refused() -> None:
         stored_map(body, robot, [[cell] * 2000, [cell] * 501])
     with pytest.raises(StoredCellsMismatch, match="'overheated' is unknown"):
         stored_map(body, robot, [[{**cell, "reason": "overheated"}] * 2500])
+    with pytest.raises(StoredCellsMismatch, match=r"'\[1\]' is unknown"):  # not even a string
+        stored_map(body, robot, [[{**cell, "reason": [1]}] * 2500])
+    with pytest.raises(StoredCellsMismatch, match="near cell 0: no 'mu_path'"):  # was a KeyError
+        stored_map(body, robot, [[{"reason": None}] * 2500])
     whole = stored_map(body, robot, [[cell] * 2500])
     assert whole.mu_path.shape == (1, 2, 25, 50) and whole.mu_acc is None
 
@@ -324,6 +328,28 @@ def test_a_jobs_picture_stops_reading_when_its_client_leaves(
 
     told: list[float] = []
     monkeypatch.setattr(JobStore, "cell_pages", counted)
-    with pytest.raises(Cancelled):
+    with pytest.raises(Cancelled) as stopped:
         job_picture(UUID(job_id), paged_store, left)
+    # While the exception (its traceback holds the reading's frames) lives on, as it does until
+    # the route's answer is made on another thread, the reading is closed already: its
+    # connection and read transaction gone, a checkpoint of the store not held up.
+    assert stopped.value is not None
     assert told == [0.4] and read == [1000] and closed == [True]  # one page of three read
+    with sqlite3.connect(paged_store.data_dir / "jobs.sqlite3") as db:
+        assert db.execute("PRAGMA wal_checkpoint(TRUNCATE)").fetchone()[0] == 0  # not busy
+
+
+def test_a_map_jobs_picture_of_a_job_deleted_before_its_request_is_read_is_a_404(
+    client: TestClient, paged_store: Settings, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    request = {"robot": EXAMPLE["robot"], "path": SHORT_PATH, "grid": GRID_2500}
+    job_id = client.post("/v1/jobs", json={"kind": "map", "request": request}).json()["id"]
+    assert done_job(client, job_id)["status"] == "done"
+
+    def gone(self: JobStore, job: str) -> None:
+        self.delete(job)  # as a DELETE between the job's state and its request
+        return None
+
+    monkeypatch.setattr(JobStore, "request", gone)
+    answer = client.get(f"/v1/jobs/{job_id}/png")
+    assert answer.status_code == 404, answer.text  # was a 409 'not a map request'

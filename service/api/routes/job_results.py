@@ -10,6 +10,7 @@ large for a request has its picture too, without computing it again.
 from __future__ import annotations
 
 import json
+from contextlib import closing
 from typing import Annotated
 from uuid import UUID
 
@@ -119,8 +120,11 @@ def job_picture(job_id: UUID, settings: Settings, progress: Progress) -> Respons
     """:func:`get_job_png`'s work; ``progress`` told each page read (it raises to stop)."""
     store = get_runner(settings).store
     state = _done_map(store, str(job_id), "no map to draw")
+    asked = store.request(state.id)
+    if asked is None:  # deleted (or expired) since its state was read
+        raise job_not_found(job_id)
     try:
-        body = MapRequest.model_validate(store.request(state.id))
+        body = MapRequest.model_validate(asked)
     except ValidationError as error:  # stored by a release whose map requests differ
         first = error.errors()[0]
         said = f"{'.'.join(map(str, first['loc']))}: {first['msg']}"
@@ -140,8 +144,12 @@ def job_picture(job_id: UUID, settings: Settings, progress: Progress) -> Respons
         )
     robot = convert.robot_from_schema(body.robot)
     try:
-        pages = reported(store.cell_pages(state.id), progress, total=state.cells or 1)
-        cmap = stored_map(body, robot, pages)
+        # closed here, in this worker thread, on every way out (its SQLite connection is this
+        # thread's): left to the garbage collector, a generator stopped by a client's leaving
+        # kept its read transaction open, and the store's checkpoints waiting, until a cycle
+        # collection ran on another thread, where its connection could not be closed
+        with closing(store.cell_pages(state.id)) as cells:
+            cmap = stored_map(body, robot, reported(cells, progress, total=state.cells or 1))
     except StoredCellsMismatch as error:
         if store.state(state.id) is None:  # deleted (or expired) before its cells were read
             raise job_not_found(job_id) from None

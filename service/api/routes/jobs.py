@@ -144,15 +144,15 @@ def get_jobs(
     job_status: Annotated[JobStatus | None, Query(alias="status")] = None,
     kind: Annotated[
         JobKind | None,
-        Query(description="Only the jobs of this kind (a client listing its maps)."),
+        Query(description="Only the jobs of this kind (every client's: the page lists maps)."),
     ] = None,
     limit: Annotated[int, Query(ge=1, le=1000)] = 100,
     after: Annotated[
         UUID | None,
         Query(
-            description="A job's id: the listing goes on after that job (the last id of the "
-            "previous page). An id the store does not hold (deleted or expired) is a 404 "
-            "naming ``after``."
+            description="A job's id: the listing goes on after that job's place in it (the "
+            "last id of the previous page; a position, whatever that job's kind or status). "
+            "An id the store does not hold (deleted or expired) is a 404 naming ``after``."
         ),
     ] = None,
 ) -> JobList:
