@@ -590,3 +590,5 @@ def test_meshes_too_large_together_are_said(page: Page, url: str) -> None:
     add_mesh(page, name="second", stl=mesh, units="mm", at=["0", "0", "0.4"])
     said = page.locator(".mesh-read").last.text_content() or ""
     assert f"with the cell's other meshes, sent as {2 * each} bytes" in said
+    colour = page.locator(".mesh-read").last.evaluate("e => getComputedStyle(e).color")
+    assert colour == "rgb(176, 0, 32)"  # the errors' colour, not a note's grey

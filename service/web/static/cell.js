@@ -156,8 +156,10 @@ function meshFields(row, owner) {
     // goes as its bytes, whose errors the API's reader names, not as mangled text.
     const binary = binaryStl(bytes) || bytes.some((b) => b > 127);
     row.dataset.stl = binary ? base64Of(bytes) : new TextDecoder().decode(bytes);
-    file.querySelector(".mesh-read").textContent = `${chosen.name}: ${binary ? "binary" : "ASCII"}, ${bytes.length} bytes`
-      + meshTooLarge(bytes, binary, row.dataset.stl);
+    const tooLarge = meshTooLarge(bytes, binary, row.dataset.stl);
+    const read = file.querySelector(".mesh-read");
+    read.textContent = `${chosen.name}: ${binary ? "binary" : "ASCII"}, ${bytes.length} bytes` + tooLarge;
+    read.classList.toggle("too-large", tooLarge !== "");  // in the errors' colour
     showCellStatus();
   });
   const units = document.createElement("div");
