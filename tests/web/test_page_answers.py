@@ -400,6 +400,10 @@ def test_a_reloaded_page_shows_its_last_map_with_the_maps_own_request(page: Page
     assert "done" in (page.text_content("#resume-text") or "")
     page.click("#resume-show")
     page.wait_for_function("document.getElementById('summary').dataset.cells", timeout=60_000)
+    # the form is not the shown map's: said beside its status
+    assert f"(job {job_id}'s own inputs; the form keeps yours)" in (
+        page.text_content("#job-status") or ""
+    )
     request = httpx.get(f"{url}/v1/jobs/{job_id}/request").json()["request"]
     api = httpx.post(f"{url}/v1/map", json=request, timeout=60).json()
     assert page.get_attribute("#summary", "data-cells") == str(len(api["cells"]))

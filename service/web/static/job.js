@@ -189,7 +189,10 @@ async function watch(run) {
     $("bar").value = job.progress.fraction;
     const eta = job.progress.eta_seconds;
     $("eta").textContent = eta == null ? "" : `about ${eta.toFixed(1)} s left`;
-    const status = `${job.status}: ${job.progress.done} of ${job.progress.total} placements`;
+    // A job shown again is drawn with its own inputs, which the form does not take: said, so
+    // that the form's fields are not read as the map's.
+    const status = `${job.status}: ${job.progress.done} of ${job.progress.total} placements`
+      + (run.resumed ? ` (job ${run.id}'s own inputs; the form keeps yours)` : "");
     $("job-status").textContent = status;
     if (job.status === "done") {
       const cells = await readCells(run, job);
