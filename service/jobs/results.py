@@ -130,11 +130,8 @@ def read_cells(
     if limit <= 0:
         return []
     first, last = offset // PAGE_CELLS, (offset + limit - 1) // PAGE_CELLS
-    rows = db.execute(
-        "SELECT cells FROM job_cells WHERE job_id = ? AND page BETWEEN ? AND ? ORDER BY page",
-        (job_id, first, last),
-    ).fetchall()
-    cells = [cell for row in rows for cell in parsed_cells(row[0])]
+    texts = page_texts(db, job_id, first=first, last=last)
+    cells = [cell for text in texts for cell in parsed_cells(text)]
     start = offset - first * PAGE_CELLS
     return cells[start : start + limit]
 
