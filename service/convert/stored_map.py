@@ -71,7 +71,8 @@ def stored_map(
     shape = (len(grid.spins), len(grid.yaws), len(grid.ys), len(grid.xs))
     total = int(np.prod(shape))
     mu_path = np.full(total, np.nan)
-    mu_acc = np.full(total, np.nan)
+    # mu_acc only where the map has it (the robot's acceleration limits): the map's colour then
+    mu_acc = None if robot.qddot_max is None else np.full(total, np.nan)
     reason = np.full(total, FEASIBLE, dtype=np.int64)
     filled = 0
     for page in pages:
@@ -80,7 +81,9 @@ def stored_map(
             raise StoredCellsMismatch(f"more cells stored than the grid's {total}")
         try:
             mu_path[filled:end] = [np.nan if c["mu_path"] is None else c["mu_path"] for c in page]
-            mu_acc[filled:end] = [np.nan if c.get("mu_acc") is None else c["mu_acc"] for c in page]
+            if mu_acc is not None:
+                accs = [c.get("mu_acc") for c in page]
+                mu_acc[filled:end] = [np.nan if a is None else a for a in accs]
             codes = [c["reason"] for c in page]
         except (KeyError, TypeError, ValueError) as error:  # a cell the service never writes
             what = f"no {error.args[0]!r}" if isinstance(error, KeyError) else str(error)[:80]
@@ -107,5 +110,5 @@ def stored_map(
         branch=none,
         bottleneck_waypoint=none,
         bottleneck_joint=none,
-        mu_acc=None if robot.qddot_max is None else mu_acc.reshape(shape),
+        mu_acc=None if mu_acc is None else mu_acc.reshape(shape),
     )
