@@ -107,7 +107,7 @@ function binaryStl(bytes) {
 // What a mesh file would meet, said at its choice (GET /v1/limits): a body over the service's
 // limit is refused whole (413) and an STL of more triangles than it takes too. The body holds
 // the file as sent (base64: 4 bytes for 3; ASCII: its text, each line end escaped).
-function meshTooLarge(bytes, binary, sent) {
+function meshTooLarge(row, bytes, binary, sent) {
   const limits = state.limits;
   if (!limits) return "";
   const said = [];
@@ -118,14 +118,14 @@ function meshTooLarge(bytes, binary, sent) {
     said.push(`${triangles} triangles; the service takes at most ${limits.max_mesh_triangles} a mesh (DTF_MAX_MESH_TRIANGLES)`);
   }
   const size = JSON.stringify(sent).length;
-  const meshes = [...document.querySelectorAll(".cell-box")]
-    .reduce((sum, row) => sum + (row.dataset.stl ? JSON.stringify(row.dataset.stl).length : 0), 0);
   const most = `the service takes requests of at most ${limits.max_body_bytes} bytes (DTF_MAX_BODY_BYTES)`;
   if (size > limits.max_body_bytes) {
     said.push(`sent as ${size} bytes${binary ? " (base64)" : ""}; ${most}`
       + `${binary ? "" : ": a binary STL is about a fifth of the size"}`);
-  } else if (meshes > limits.max_body_bytes) {
-    said.push(`with the cell's other meshes, sent as ${meshes} bytes; ${most}`);
+  } else {  // this mesh's size, and the other rows' meshes as they are sent
+    const meshes = [...document.querySelectorAll(".cell-box")].filter((other) => other !== row)
+      .reduce((sum, other) => sum + (other.dataset.stl ? JSON.stringify(other.dataset.stl).length : 0), size);
+    if (meshes > limits.max_body_bytes) said.push(`with the cell's other meshes, sent as ${meshes} bytes; ${most}`);
   }
   return said.length ? ` — too large to send: ${said.join("; ")}` : "";
 }
@@ -156,7 +156,7 @@ function meshFields(row, owner) {
     // goes as its bytes, whose errors the API's reader names, not as mangled text.
     const binary = binaryStl(bytes) || bytes.some((b) => b > 127);
     row.dataset.stl = binary ? base64Of(bytes) : new TextDecoder().decode(bytes);
-    const tooLarge = meshTooLarge(bytes, binary, row.dataset.stl);
+    const tooLarge = meshTooLarge(row, bytes, binary, row.dataset.stl);
     const read = file.querySelector(".mesh-read");
     read.textContent = `${chosen.name}: ${binary ? "binary" : "ASCII"}, ${bytes.length} bytes` + tooLarge;
     read.classList.toggle("too-large", tooLarge !== "");  // in the errors' colour
