@@ -36,6 +36,8 @@ async function runMap(event) {
 // after, shows it again on request, watched to its end if it still runs, its cells evaluated
 // with its own request (GET /v1/jobs/{id}/request), whatever the form holds.
 const LAST_JOB_KEY = "dtf-placement.last-map-job";
+// The statuses of a map job shown again: drawn once done, watched until then.
+const DRAWABLE = ["queued", "running", "done"];
 
 function rememberJob(id) {
   try { localStorage.setItem(LAST_JOB_KEY, id); } catch { /* storage refused: nothing kept */ }
@@ -50,7 +52,7 @@ async function offerLastJob() {
     if (error.status === 404) localStorage.removeItem(LAST_JOB_KEY);  // deleted or expired
     return;
   }
-  if (!["queued", "running", "done"].includes(job.status)) return;  // nothing of it to draw
+  if (!DRAWABLE.includes(job.status)) return;  // nothing of it to draw
   if (state.run || state.map) return;  // a map run or drawn meanwhile: it is the one shown
   const when = new Date(job.created * 1000).toLocaleString();
   $("resume-text").textContent = `Your last map, job ${id} (submitted ${when}): `
@@ -67,7 +69,7 @@ async function listEarlierMaps() {
   let listed;
   try { listed = await getJson("/v1/jobs?kind=map&limit=100"); } catch { return; }  // no store
   const maps = listed.jobs
-    .filter((j) => ["queued", "running", "done"].includes(j.status))
+    .filter((j) => DRAWABLE.includes(j.status))
     .slice(0, EARLIER_MAPS);
   const list = $("earlier-list");
   list.textContent = "";
