@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import io
 import json
+import re
 import time
 from collections.abc import Iterator
 from typing import Any
@@ -49,6 +50,23 @@ def test_cells_are_in_yaw_y_x_order(answer: dict[str, Any]) -> None:
     )
     assert answer["feasible_cells"] == sum(c["mu_path"] is not None for c in cells)
     assert 0 < answer["feasible_cells"] < len(cells)
+
+
+def test_cells_and_extremes_are_at_the_grid_values_as_written(
+    client: TestClient, path: dict[str, Any]
+) -> None:
+    """-0.25 + 15 x 0.02 is answered 0.05 (not 0.04999999999999999), and 50 mm in the
+    controllers' frames (not 49.999999999999986): the grid's values are the decimals of its
+    min and step, read by a regex from the answer's own text."""
+    x = {"min": -0.25, "max": 0.25, "step": 0.02}
+    body = map_body(path, x=x, y={"min": 0.45, "max": 0.45, "step": 0.1}, yaw=0.0)
+    response = client.post("/v1/map", json=body)
+    assert response.status_code == 200, response.text
+    written = re.findall(r'"x":\s*(-?[0-9.eE+-]+)', response.text)[:26]  # the cells' first
+    assert written == [f"{i / 100:.2f}".rstrip("0") for i in range(-25, 27, 2)]
+    for extreme in ("best", "worst"):
+        kuka = response.json()[extreme]["placement"]["frames"]["kuka"]
+        assert re.fullmatch(r"-?[0-9]+\.0", repr(kuka["X"])), kuka
 
 
 def test_random_cells_equal_evaluate(

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+from fractions import Fraction
 
 import numpy as np
 import pytest
@@ -140,6 +141,35 @@ def test_infeasible_everywhere() -> None:
 def test_grid_axis(lower: float, upper: float, step: float, expected: int) -> None:
     axis = grid_axis(lower, upper, step, field="grid.x")
     assert len(axis) == expected and axis[0] == lower and axis[-1] <= upper + 1e-12
+
+
+@pytest.mark.parametrize(
+    ("lower", "upper", "step"),
+    [
+        (-0.25, 0.25, 0.02),
+        (0.25, 0.65, 0.02),
+        (-1.2, 3.7, 0.15),
+        (0.0, 1e-3, 1e-5),
+        (-7.5, 12.25, 0.125),
+    ],
+)
+def test_grid_values_are_the_decimals_the_axis_is_written_in(
+    lower: float, upper: float, step: float
+) -> None:
+    """Each value is the float nearest lower + i step in exact decimal arithmetic (Fractions of
+    the numbers as written): 0.05 on the ERK grid, not 0.04999999999999999."""
+    axis = grid_axis(lower, upper, step, field="grid.x")
+    exact = [Fraction(repr(lower)) + i * Fraction(repr(step)) for i in range(len(axis))]
+    assert axis.tolist() == [float(value) for value in exact]
+    assert 0.05 in grid_axis(-0.25, 0.25, 0.02, field="grid.x").tolist()
+
+
+def test_grid_values_past_exact_integers_are_the_floats_sums() -> None:
+    """A bound written in 17 digits (0.1 + 0.2) cannot be summed exactly in integers: the floats'
+    own sum, as before."""
+    lower = 0.1 + 0.2
+    axis = grid_axis(lower, 1.0, 0.1, field="grid.x")
+    assert axis.tolist() == [lower + 0.1 * i for i in range(len(axis))]
 
 
 @pytest.mark.parametrize(("lower", "upper", "step"), [(0, 1, 0), (1, 0, 0.1), (0, math.inf, 1)])

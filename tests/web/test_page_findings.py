@@ -438,7 +438,9 @@ def test_an_empty_z_is_refused_beside_the_field_not_read_as_zero(
 
 
 def test_cell_summaries_are_rounded(page: Page, url: str) -> None:
-    values = {**SMALL, "x-min": "-0.25", "x-max": "0.0", "yaws": "0"}
+    # A step of 11 decimals: cells at x = -0.18333333333 and the like (a grid's values are the
+    # decimals its bounds and step are written in, so 0.05 steps no longer make long floats).
+    values = {**SMALL, "x-min": "-0.25", "x-max": "0.0", "x-step": "0.06666666667", "yaws": "0"}
     fill(page, values)
     page.click("#run")
     page.wait_for_function("document.getElementById('summary').dataset.cells", timeout=60_000)
