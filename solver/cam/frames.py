@@ -76,15 +76,21 @@ def frames_of_placement(placement: Placement) -> ControllerFrames:
 
 
 def _frames_of_rigid(transform: np.ndarray) -> ControllerFrames:
-    """:func:`controller_frames` of a transform already known to be rigid."""
+    """:func:`controller_frames` of a transform already known to be rigid.
+
+    Every number is given with its zero unsigned (adding 0.0 to -0.0 gives 0.0 and changes no
+    other float): an unturned placement's sin(0) entries and B were -0.0, which a post-processor
+    writes as "B -0.000".
+    """
+    transform = transform + 0.0
     rotation, position = transform[:3, :3], transform[:3, 3]
-    yaw, pitch, roll = (math.degrees(v) for v in zyx_angles(rotation))
+    yaw, pitch, roll = (math.degrees(v) + 0.0 for v in zyx_angles(rotation))
     pitch = min(max(pitch, -90.0), 90.0)  # degrees(pi / 2) is 90.00000000000001
-    x, y, z = (float(v) * _MM for v in position)
-    quaternion = quaternion_wxyz(rotation)
+    x, y, z = (float(v) * _MM + 0.0 for v in position)
+    quaternion = quaternion_wxyz(rotation) + 0.0
     return ControllerFrames(
         matrix=transform.tolist(),
-        ur=[*map(float, position), *map(float, _vector_of_quaternion(quaternion))],
+        ur=[*map(float, position), *(float(v) + 0.0 for v in _vector_of_quaternion(quaternion))],
         kuka={"X": x, "Y": y, "Z": z, "A": yaw, "B": pitch, "C": roll},
         abb=[[x, y, z], [float(v) for v in quaternion]],
         fanuc={"X": x, "Y": y, "Z": z, "W": roll, "P": pitch, "R": yaw},

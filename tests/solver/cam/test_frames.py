@@ -161,6 +161,24 @@ def test_frames_of_a_placement() -> None:
     np.testing.assert_array_equal(frames.matrix, placement.transform_workpiece_to_base())
 
 
+def _numbers(value: Any) -> list[float]:
+    """Every number of a frames field, nested lists and dicts flattened."""
+    if isinstance(value, dict):
+        return [n for v in value.values() for n in _numbers(v)]
+    if isinstance(value, list):
+        return [n for v in value for n in _numbers(v)]
+    return [value]
+
+
+@pytest.mark.parametrize(("x", "yaw"), [(0.25, 0.0), (0.0, 0.0), (-0.1, math.pi), (0.0, -0.0)])
+def test_no_frame_number_is_a_negative_zero(x: float, yaw: float) -> None:
+    """An unturned placement's sin(0) entries and B were -0.0 ("B -0.000" in a program)."""
+    frames = frames_of_placement(Placement(x=x, y=0.65, z=0.0, yaw=yaw))
+    for field in ("matrix", "ur", "kuka", "abb", "fanuc"):
+        numbers = _numbers(getattr(frames, field))
+        assert not [n for n in numbers if n == 0.0 and math.copysign(1.0, n) < 0.0], field
+
+
 @pytest.mark.parametrize("yaw", [0.0, 0.3, -2.0, math.pi, -math.pi, 3.0 * math.pi])
 def test_a_placement_s_frames_equal_the_checked_transform_s(yaw: float) -> None:
     """frames_of_placement skips the rigidity check; its answer is controller_frames' exactly."""
