@@ -8,6 +8,7 @@ from types import TracebackType
 
 from service.schemas import (
     EvaluateResponse,
+    FeedCheckResult,
     MapResponse,
     OptimizeResponse,
     PathRead,
@@ -166,12 +167,16 @@ def evaluation_text(answer: EvaluateResponse, clearance: float | None = None) ->
             f"{answer.bottleneck.joint_name}"
         )
     lines += _how_it_runs(answer)
-    check = answer.feed_check
-    if check is not None:
-        verdict = "runs" if check.feasible else "does not run"
-        margin = "" if check.margin is None else f", margin {check.margin:.3f}"
-        lines.append(f"feed {_feed(check.feed)}: {verdict}{margin}")
+    if answer.feed_check is not None:
+        lines.append(_feed_check(answer.feed_check))
     return "\n".join(lines)
+
+
+def _feed_check(check: FeedCheckResult) -> str:
+    """Whether the program's feed runs, and mu_path / feed (the margin: 1 or more runs)."""
+    verdict = "runs" if check.feasible else "does not run"
+    margin = "" if check.margin is None else f", margin {check.margin:.3f} (mu_path / feed)"
+    return f"feed {_feed(check.feed)}: {verdict}{margin}"
 
 
 def _placement(placement: PlacementResult) -> list[str]:
@@ -225,7 +230,7 @@ def optimum_text(answer: OptimizeResponse) -> str:
         lines += _how_it_runs(answer.evaluation)
     check = None if answer.evaluation is None else answer.evaluation.feed_check
     if check is not None:
-        lines.append(f"feed {_feed(check.feed)}: {'runs' if check.feasible else 'does not run'}")
+        lines.append(_feed_check(check))
     return "\n".join(lines)
 
 

@@ -146,7 +146,13 @@ def test_a_feed_the_path_cannot_run_is_exit_infeasible(capsys: pytest.CaptureFix
         capsys, "evaluate", str(PROGRAM), "--robot", "ur5e", "--at=0,0.3,0,0", "--feed", "50"
     )
     assert code == INFEASIBLE
-    assert "does not run" in out
+    line = re.search(
+        r"^feed [0-9.]+ mm/min: does not run, margin ([0-9.]+) \(mu_path / feed\)$", out, re.M
+    )
+    assert line is not None, out  # the margin said as what it is (was a bare "margin 0.123")
+    at = ["evaluate", str(PROGRAM), "--robot", "ur5e", "--at=0,0.3,0,0", "--feed", "50", "--json"]
+    _, answer, _ = run(capsys, *at)
+    assert float(line.group(1)) == round(json.loads(answer)["feed_check"]["margin"], 3) < 1.0
 
 
 def test_a_robot_from_a_json_file(
