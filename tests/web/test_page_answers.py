@@ -12,6 +12,7 @@ from __future__ import annotations
 import copy
 import json
 import math
+import re
 from pathlib import Path
 from typing import Any
 
@@ -209,6 +210,79 @@ def test_an_optimisation_job_is_stopped_from_the_page(page: Page, url: str) -> N
             break
         page.wait_for_timeout(100)
     assert status == "cancelled"
+
+
+def _submit_optimisation_job(page: Page) -> str:
+    """Optimise a search the route refuses as work (as a job): its id, once it runs."""
+    page.route("**/v1/optimize", _refused_as_work)
+    fill(page, {**SMALL, "x-min": "-0.3", "x-max": "0.3", "y-min": "0.2", "y-max": "0.7"})
+    page.click("#opt-any-yaw")
+    with page.expect_response(
+        lambda r: r.request.method == "POST" and r.url.endswith("/v1/jobs")
+    ) as sent:
+        page.click("#optimize")
+    job_id: str = sent.value.json()["id"]
+    return job_id
+
+
+def test_a_reloaded_page_shows_its_last_optimisation_job_again(page: Page, url: str) -> None:
+    """An optimisation that ran as a job was lost at a reload (only the last map job was
+    offered): now offered, watched to its end, and shown with the job's own inputs whatever the
+    form holds; a path change leaves it running, and Stop optimising cancels it."""
+    job_id = _submit_optimisation_job(page)
+    reload_page(page)
+    page.wait_for_selector("#opt-resume:not([hidden])", timeout=30_000)
+    offer = page.text_content("#opt-resume-text") or ""
+    said = r"((queued|running), \d+ %|done)"
+    assert re.fullmatch(rf"Your last optimisation, job {job_id} \(submitted .+\): {said}\.", offer)
+    fill(page, {"x-min": "-0.05", "x-max": "0.05"})  # the form's inputs are not the job's
+    page.click("#opt-resume-show")
+    page.wait_for_selector("#opt-resume", state="hidden")
+    page.wait_for_function(
+        "document.getElementById('opt-mu').textContent.endsWith(' m/s')", timeout=120_000
+    )
+    job = httpx.get(f"{url}/v1/jobs/{job_id}").json()
+    assert job["status"] == "done"
+    assert page.text_content("#opt-mu") == f"{job['result']['mu_path']:.6f} m/s"
+    assert (page.text_content("#opt-own") or "").startswith(
+        f"Job {job_id}'s optimum, with the job's own inputs"
+    )
+    assert page.is_visible("#frames")
+    assert page.locator(".panel canvas[data-optimum='1']").count() == 0
+
+
+def test_a_resumed_optimisation_job_runs_on_when_the_inputs_change(page: Page, url: str) -> None:
+    job_id = _submit_optimisation_job(page)
+    reload_page(page)
+    page.wait_for_selector("#opt-resume:not([hidden])", timeout=30_000)
+    if (page.text_content("#opt-resume-text") or "").endswith(": done."):
+        return  # ended before the reload: nothing runs to leave or stop (the test above)
+    page.click("#opt-resume-show")
+    page.wait_for_function(
+        f"document.getElementById('opt-mu').textContent.startsWith('optimising as job {job_id}')"
+    )
+    page.fill("#x-step", "0.04")  # not a path or robot change: watched on
+    page.select_option("#robot-model", "ur10")
+    assert (page.text_content("#opt-mu") or "").startswith(
+        f"no longer watched (job {job_id} runs on)"
+    )
+    assert httpx.get(f"{url}/v1/jobs/{job_id}").json()["status"] in ("queued", "running", "done")
+    page.wait_for_selector("#opt-resume:not([hidden])", timeout=30_000)
+    page.click("#opt-resume-show")
+    page.wait_for_function(
+        f"document.getElementById('opt-mu').textContent.startsWith('optimising as job {job_id}')"
+        " || document.getElementById('opt-mu').textContent.endsWith(' m/s')"
+    )
+    if (page.text_content("#opt-mu") or "").endswith(" m/s"):
+        return  # it ended meanwhile
+    page.click("#opt-cancel")
+    assert (page.text_content("#opt-mu") or "").startswith("cancelled: stopped from the page")
+    for _ in range(50):
+        status = httpx.get(f"{url}/v1/jobs/{job_id}").json()["status"]
+        if status not in ("queued", "running"):
+            break
+        page.wait_for_timeout(100)
+    assert status in ("cancelled", "done")
 
 
 def test_the_best_line_says_the_spin_of_a_spun_map(page: Page, url: str) -> None:

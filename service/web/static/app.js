@@ -410,8 +410,9 @@ function clearCell() {
 }
 
 function clearOptimum() {
-  for (const id of ["opt-mu", "opt-acc", "opt-acc-binds", "opt-improvement", "opt-where", "opt-clearance", "opt-why", "opt-marked"]) $(id).textContent = "";
+  for (const id of ["opt-mu", "opt-acc", "opt-acc-binds", "opt-improvement", "opt-where", "opt-clearance", "opt-why", "opt-marked", "opt-own"]) $(id).textContent = "";
   $("opt-marked").hidden = true;
+  $("opt-own").hidden = true;
   $("opt-acc-line").hidden = true;
   $("opt-clearance").hidden = true;
   $("opt-why").hidden = true;
@@ -449,6 +450,7 @@ function inputsChanged(why) {
     $("job-status").textContent = `map cleared: ${why}`;
     offerLastJob();  // a done map's job: shown again on request, with its own request
   }
+  offerLastOptimisation();  // and the last optimisation job's, as the map's
 }
 
 // Nothing runs without a path: the reason there is none goes beside the path field.
@@ -885,13 +887,14 @@ async function start() {
   $("inputs").addEventListener("submit", runMap);
   $("cancel").addEventListener("click", cancelMap);
   $("optimize").addEventListener("click", optimize);
-  $("opt-cancel").addEventListener("click", () => dropOptimization("stopped from the page"));
+  $("opt-cancel").addEventListener("click", stopOptimization);
   $("png").addEventListener("click", savePng);
   startCellEditor();
   state.limits = await fetch("/v1/limits").then((r) => (r.ok ? r.json() : null)).catch(() => null);
   await loadExample();
   await offerLastJob();
   await listEarlierMaps();
+  await offerLastOptimisation();
   document.body.dataset.ready = "1";
 }
 

@@ -79,9 +79,16 @@ async function optimizeAsJob(body, run) {
   if (!job) return null;
   run.jobId = job.id;
   if (state.optimization !== run) { cancelJob(job.id); return null; }
+  rememberOptimisation(job.id);
+  return watchOptimisation(job.id, run);
+}
+
+// An optimisation job watched to its end: its answer, or null (failed: said; cancelled; the
+// run dropped meanwhile; its status unreadable: said).
+async function watchOptimisation(id, run) {
   for (let failed = 0; ;) {
     let status = null;
-    try { status = await getJson(`/v1/jobs/${job.id}`); failed = 0; } catch (error) {
+    try { status = await getJson(`/v1/jobs/${id}`); failed = 0; } catch (error) {
       if (++failed > POLL_RETRIES_MS.length) {
         if (state.optimization === run) $("opt-mu").textContent = `no optimum: the job's status could not be read (${error.message})`;
         return null;
@@ -93,11 +100,64 @@ async function optimizeAsJob(body, run) {
     if (status && status.status === "cancelled") return null;
     if (status) {
       const eta = status.progress.eta_seconds;
-      $("opt-mu").textContent = `optimising as job ${job.id}: ${(100 * status.progress.fraction).toFixed(0)} %`
+      $("opt-mu").textContent = `optimising as job ${id}: ${(100 * status.progress.fraction).toFixed(0)} %`
         + (eta == null ? "" : `, about ${eta.toFixed(0)} s left`);
     }
     await new Promise((resolve) => setTimeout(resolve, failed ? POLL_RETRIES_MS[failed - 1] : 500));
   }
+}
+
+// The last optimisation job submitted from this browser (localStorage), as the last map job
+// (job.js): a page reloaded while it ran, or after, shows it again on request, watched to its
+// end if it still runs, with its own request (GET /v1/jobs/{id}/request), whatever the form
+// holds. Its optimum is not marked on the map, which may be another request's.
+const LAST_OPTIMISATION_KEY = "dtf-placement.last-optimisation-job";
+
+function rememberOptimisation(id) {
+  try { localStorage.setItem(LAST_OPTIMISATION_KEY, id); } catch { /* storage refused */ }
+}
+
+async function offerLastOptimisation() {
+  $("opt-resume").hidden = true;
+  let id = null;
+  try { id = localStorage.getItem(LAST_OPTIMISATION_KEY); } catch { return; }
+  if (!id) return;
+  let job;
+  try { job = await getJson(`/v1/jobs/${id}`); } catch (error) {
+    if (error.status === 404) localStorage.removeItem(LAST_OPTIMISATION_KEY);  // deleted or expired
+    return;
+  }
+  if (!DRAWABLE.includes(job.status)) return;  // failed or cancelled: nothing to show
+  if (state.optimization || state.optimum) return;  // one run or shown meanwhile
+  const when = new Date(job.created * 1000).toLocaleString();
+  const done = job.status === "done" ? "done" : `${job.status}, ${(100 * job.progress.fraction).toFixed(0)} %`;
+  $("opt-resume-text").textContent = `Your last optimisation, job ${id} (submitted ${when}): ${done}.`;
+  $("opt-resume").hidden = false;
+  $("opt-resume-show").onclick = () => resumeOptimisation(id);
+}
+
+async function resumeOptimisation(id) {
+  clearErrors();
+  const asked = await api("GET", `/v1/jobs/${id}/request`).catch(() => null);
+  if (!asked) return;
+  clearOptimum();
+  dropOptimization("an earlier optimisation was shown");
+  $("opt-resume").hidden = true;
+  const run = { abort: new AbortController(), jobId: id, resumed: true };
+  state.optimization = run;
+  $("opt-cancel").disabled = false;
+  $("opt-mu").textContent = `optimising as job ${id}…`;
+  $("opt-mu-line").hidden = false;
+  const answer = await watchOptimisation(id, run);
+  if (state.optimization !== run) return;
+  state.optimization = null;
+  $("opt-cancel").disabled = true;
+  showOptimum(answer, asked.request);
+  if (!answer) return;
+  if (state.optimum) state.optimum.resumed = true;
+  $("opt-own").textContent = `Job ${id}'s optimum, with the job's own inputs (the form keeps yours)`
+    + (state.optimum ? ": not marked on the map, which may be of other inputs." : ".");
+  $("opt-own").hidden = false;
 }
 
 // The optimisation under way is state.optimization ({abort}: its request's AbortController;
@@ -107,6 +167,7 @@ async function optimize() {
   clearErrors();
   clearOptimum();
   dropOptimization("a newer optimisation");  // a newer click: the older goes (its job too)
+  $("opt-resume").hidden = true;
   if (!havePath()) return;
   const grid = gridBody();
   const height = heightOf(grid);
@@ -145,6 +206,13 @@ async function optimize() {
   if (state.optimization !== run) return;  // dropped meanwhile: its answer is not the inputs'
   state.optimization = null;
   $("opt-cancel").disabled = true;
+  showOptimum(answer, body);
+  if (state.optimum) markOptimum();
+}
+
+// An optimisation's answer (null: none, the errors said) for its request ``body``: its
+// figures, its placement and its frames (state.optimum, not yet marked).
+function showOptimum(answer, body) {
   if (!answer) { $("opt-mu").textContent = "no optimum: see the errors above"; return; }
   if (!answer.found) {
     $("opt-mu").textContent = body.cell ? "no feasible placement free of collisions" : "no feasible placement";
@@ -194,14 +262,13 @@ async function optimize() {
   }
   $("frames").hidden = false;
   state.optimum = { canvas: null, placement: p };
-  markOptimum();
 }
 
 // The optimum shown (state.optimum), marked on the map drawn, if any, on the panel whose yaw
 // is nearest the optimum's: called by both answers, the optimiser's and the map's.
 function markOptimum() {
   const canvases = [...document.querySelectorAll(".panel canvas")];
-  if (!state.optimum || !state.map || !canvases.length) return;
+  if (!state.optimum || state.optimum.resumed || !state.map || !canvases.length) return;
   const p = state.optimum.placement;
   const yaws = canvases.map((c) => state.map.cells[Number(c.dataset.first)].yaw);
   const k = yaws.reduce((best, y, i) => (Math.abs(y - p.yaw) < Math.abs(yaws[best] - p.yaw) ? i : best), 0);
@@ -217,14 +284,25 @@ function markOptimum() {
 
 // A new path or robot while an optimisation runs: its request is aborted (the service stops the
 // search when its client goes) and its answer, of the old inputs, never shown; the status says so.
-function dropOptimization(why) {
+// An earlier job shown again (resumeOptimisation) is not this form's: it is left to run (unless
+// ``stop``: "Stop optimising" was clicked) and offered again.
+function dropOptimization(why, stop = false) {
   const run = state.optimization;
   if (!run) return;
   state.optimization = null;
   $("opt-cancel").disabled = true;
   run.abort.abort();
-  if (run.jobId) cancelJob(run.jobId);
   clearOptimum();
-  $("opt-mu").textContent = `cancelled: ${why}`;
   $("opt-mu-line").hidden = false;
+  if (run.resumed && !stop) {
+    $("opt-mu").textContent = `no longer watched (job ${run.jobId} runs on): ${why}`;
+    offerLastOptimisation();
+    return;
+  }
+  if (run.jobId) cancelJob(run.jobId);
+  $("opt-mu").textContent = `cancelled: ${why}`;
+}
+
+function stopOptimization() {
+  dropOptimization("stopped from the page", true);
 }
