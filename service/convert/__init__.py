@@ -27,7 +27,7 @@ from service.convert.common import (
 )
 from service.convert.dtf import dtf_response
 from service.convert.evaluate import evaluate_response
-from service.convert.maps import MapGrid, check_png_size, map_grid, map_response
+from service.convert.maps import MapGrid, check_png_size, map_grid, map_response, png_panels_over
 from service.convert.optimize import bounds_of, optimize_response
 from service.convert.path_read import pass_at, path_read_of
 from service.convert.robots import robot_info, robot_read_of
@@ -47,6 +47,7 @@ __all__ = [
     "joint_path_of",
     "map_grid",
     "map_response",
+    "png_panels_over",
     "optimize_response",
     "pass_at",
     "path_of",

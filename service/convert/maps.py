@@ -87,19 +87,30 @@ def map_grid(
     )
 
 
+def png_panels_over(grid: MapGrid, *, settings: Settings) -> str | None:
+    """What is over the limit in a PNG of more panels (yaw x spin values) than allowed.
+
+    The size asked for and the limit, said for either picture route to end as it may (the
+    map's answers a 422, a job's a 409); None within the limit.
+    """
+    panels = len(grid.yaws) * len(grid.spins)
+    if panels <= settings.max_png_panels:
+        return None
+    return (
+        f"{len(grid.yaws)} yaws * {len(grid.spins)} spins = {panels} PNG panels; the limit is "
+        f"{settings.max_png_panels} (DTF_MAX_PNG_PANELS)"
+    )
+
+
 def check_png_size(grid: MapGrid, *, settings: Settings) -> None:
     """Refuse a PNG of more panels (yaw x spin values) than the setting allows.
 
     Raises:
         InvalidInputError: on ``grid``, saying the size asked for and the limit.
     """
-    panels = len(grid.yaws) * len(grid.spins)
-    if panels > settings.max_png_panels:
-        raise InvalidInputError(
-            "grid",
-            f"{len(grid.yaws)} yaws * {len(grid.spins)} spins = {panels} PNG panels; the limit "
-            f"is {settings.max_png_panels} (DTF_MAX_PNG_PANELS); ask for JSON for more",
-        )
+    over = png_panels_over(grid, settings=settings)
+    if over is not None:
+        raise InvalidInputError("grid", f"{over}; ask for JSON for more")
 
 
 def extreme(cmap: CapabilityMap, *, best: bool) -> schemas.MapExtreme | None:

@@ -231,7 +231,7 @@ def test_a_jobs_picture_is_refused_unless_a_done_map_within_the_panel_limit(
     answer = client.get(f"/v1/jobs/{job_id}/png")
     assert answer.status_code == 409, answer.text
     said = answer.json()["detail"][0]["msg"]
-    assert f"= {len(yaws)} panels; a picture draws at most {paged_store.max_png_panels}" in said
+    assert f"= {len(yaws)} PNG panels; the limit is {paged_store.max_png_panels}" in said
     assert "(DTF_MAX_PNG_PANELS)" in said and f"GET /v1/jobs/{job_id}/result" in said
 
 

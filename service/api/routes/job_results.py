@@ -133,14 +133,12 @@ def job_picture(job_id: UUID, settings: Settings, progress: Progress) -> Respons
             f"job {state.id!r}: its request is not a map request this release reads ({said}); "
             f"its cells are at GET /v1/jobs/{state.id}/result",
         ) from None
-    grid = stored_grid(body)
-    panels = len(grid.yaws) * len(grid.spins)
-    if panels > settings.max_png_panels:
+    over = convert.png_panels_over(stored_grid(body), settings=settings)
+    if over is not None:
         raise HTTPException(
             status.HTTP_409_CONFLICT,
-            f"job {state.id!r}: its map has {len(grid.yaws)} yaws * {len(grid.spins)} spins = "
-            f"{panels} panels; a picture draws at most {settings.max_png_panels} "
-            f"(DTF_MAX_PNG_PANELS); its cells are at GET /v1/jobs/{state.id}/result",
+            f"job {state.id!r}: its map has {over}; its cells are at GET "
+            f"/v1/jobs/{state.id}/result",
         )
     robot = convert.robot_from_schema(body.robot)
     try:
