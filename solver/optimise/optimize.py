@@ -21,6 +21,7 @@ import time
 
 import numpy as np
 
+from solver.core.blas import one_blas_thread
 from solver.core.exceptions import InvalidInputError
 from solver.core.parallel import SERIAL, TaskRunner
 from solver.core.progress import Progress, span
@@ -136,6 +137,7 @@ def optimize_placement(
             ``max_coarse_poses``, or whose search is over ``max_search_poses`` (on ``bounds``).
     """
     began = time.perf_counter()
+    one_blas_thread()  # the same steps on every host (solver.core.blas)
     chosen_method = check_search(
         problem, bounds=bounds, start=start, method=method, max_spin_step=max_spin_step
     )
