@@ -75,7 +75,9 @@ class Settings(BaseSettings):
         "the waypoints that bind (three evolutions on at most 300, their best placements "
         "checked on the whole path), which admits a closed-form arm over x, y and yaw up to "
         "about 18,000 waypoints; with numeric IK it admits a short path (the Panda on 10 "
-        "waypoints: about 20 s) and refuses a search that would take much longer.",
+        "waypoints: about 20 s) and refuses a search that would take much longer. Where the "
+        "search also starts from the coarse map (where the map at most doubles its work), the "
+        "work the map adds is weighed against DTF_MAX_MAP_POSES, as the casadi method's map is.",
     )
     max_path_waypoints: int = Field(
         default=20_000,

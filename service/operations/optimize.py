@@ -74,17 +74,18 @@ def check_work(
     solves' whole-path checks, the candidates), each weighed by the problem's ``path_cost``:
     against DTF_MAX_MAP_POSES for casadi, DTF_MAX_SEARCH_POSES for scipy (DTF_MAX_JOB_POSES
     for either in a job); a coarse map of more cells than DTF_MAX_MAP_CELLS (DTF_MAX_JOB_CELLS)
-    first.
+    first. The scipy search that also starts from the coarse map
+    (:func:`solver.optimise.work.seeds_from_map`, a rule of the method, not of the limits) is
+    weighed as it was without the map against DTF_MAX_SEARCH_POSES, and the work the map adds
+    against DTF_MAX_MAP_POSES, as the casadi method's map is.
 
     Raises:
         InvalidInputError: on ``bounds``, saying the phases, the work and the limit.
     """
     bounds.check()
     limits = settings.map_limits()
-    # the scipy method also starts from the coarse map where that fits (as it will decide)
-    seeded = method_named(body.method).map_seeds and seeds_from_map(
-        problem, bounds, max_cells=limits.cells, max_poses=limits.search_poses
-    )
+    # the scipy method also starts from the coarse map (as it will: the limits do not decide)
+    seeded = method_named(body.method).map_seeds and seeds_from_map(problem, bounds)
     work = work_of(
         problem,
         bounds,
@@ -99,6 +100,7 @@ def check_work(
         hint = "; fix a variable, shorten the path, or try method casadi" + jobs
     else:
         limit, setting, hint = limits.poses, limits.poses_setting, "; narrow the bounds" + jobs
+    if body.method == "casadi" or seeded:
         cells = work.placements(COARSE_MAP, search="")  # a narrower search's map is smaller
         if cells > limits.cells:
             raise InvalidInputError(
@@ -106,6 +108,18 @@ def check_work(
                 f"the search box needs a coarse map of {cells} cells (20 mm, 15 deg); the "
                 f"limit is {limits.cells} ({limits.cells_setting}){hint}",
             )
+    if seeded:  # the map's work against the maps' limit, the rest against the search's
+        alone = work_of(
+            problem, bounds, method="scipy", max_spin_step=max_spin_step_of(body), seed_map=False
+        ).weighed(problem)
+        if weighed - alone > limits.poses:
+            raise InvalidInputError(
+                "bounds",
+                f"the scipy search starts from the coarse map too, which adds "
+                f"{weighed - alone:.4g} closed-form poses of work; the limit is {limits.poses} "
+                f"({limits.poses_setting}){hint}",
+            )
+        weighed = alone
     if weighed > limit:
         cell = ", with a cell" if problem.options.cell is not None else ""
         raise InvalidInputError(

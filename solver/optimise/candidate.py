@@ -62,7 +62,7 @@ class Search:
             map's, its evolution's), for a failure's tally (:mod:`solver.optimise.failures`);
             None keeps none.
         seed_map: the scipy method also starts from the coarse map's maxima, as the casadi
-            method does (:func:`solver.optimise.work.seeds_from_map`: where they fit).
+            method does (:func:`solver.optimise.work.seeds_from_map`).
     """
 
     symmetric: bool

@@ -157,17 +157,10 @@ def optimize_placement(
         active_set=active_set,
         tried=Tried(),
     )
+    if chosen_method.map_seeds:
+        settings = dataclasses.replace(settings, seed_map=seeds_from_map(problem, bounds))
     chosen_method.check(problem, bounds, settings)
     problem.prepared  # noqa: B018 - the path is checked before the options (evaluate_path's)
-    if chosen_method.map_seeds:
-        seeded = seeds_from_map(
-            problem,
-            bounds,
-            max_cells=max_coarse_cells,
-            max_poses=max_search_poses,
-            active_set=active_set,
-        )
-        settings = dataclasses.replace(settings, seed_map=seeded)
     start_evaluation = evaluate_path(problem, start, thorough=False)  # its reason and mu
     candidates, iterations = _searched(problem, bounds, chosen_method, settings, method)
     # The start last: it is the answer only when nothing the solver found is better.

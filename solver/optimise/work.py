@@ -170,30 +170,32 @@ def ipopt_solve_cost(problem: PathProblem, n_waypoints: int) -> float:
     return float(scale * math.pow(n_waypoints, exponent))
 
 
-def seeds_from_map(
-    problem: PathProblem,
-    bounds: PlacementBounds,
-    *,
-    max_cells: int,
-    max_poses: int | None,
-    active_set: bool = True,
-) -> bool:
-    """Whether the scipy method also starts from the coarse map's maxima: where they fit.
+SEEDED_WORK_RATIO = 2.0
+"""The scipy method also starts from the coarse map wherever its search with the map weighs at
+most this many times its search without: a constant of the method, so that a limit accepts or
+refuses the search but never chooses it."""
+
+
+def seeds_from_map(problem: PathProblem, bounds: PlacementBounds) -> bool:
+    """Whether the scipy method also starts from the coarse map's maxima.
 
     Differential evolution can miss a narrow basin the casadi method's coarse map holds (a
     KR16-2 on a 0.11 x 0.07 m box with any yaw: 0.7188 m/s against the map's 0.7990, 11 %
     below; the optimiser audit, stop 53). The scipy method then also refines and polishes from
-    the map's best cells, so its answer too is never below the map's best cell, where the map
-    has at most ``max_cells`` cells and the whole search with it weighs at most ``max_poses``
-    (None: no limit); elsewhere it searches as before, its work as before.
+    the map's best cells, so its answer too is never below the map's best cell, wherever the
+    map at most doubles the search's work (:data:`SEEDED_WORK_RATIO`: every optimiser test
+    problem and the long programs, 1.2 to 1.7 times; not the Panda over the ERK box, where the
+    map of its numeric IK would be 20 times the evolution). The limits weigh the search chosen
+    and refuse it when over. They chose it before (the map where the search with it fit), so
+    a synchronous request and a job of one body, whose limits are larger, answered two optima
+    (the determinism audit of stop 59: 1.129638 and 1.130841 m/s on a 2,500-move program).
     """
     bounds = bounds.within_a_turn()  # as the search is (optimize_placement)
-    if coarse_map_cells(bounds, symmetric=symmetric_search(problem)) > max_cells:
-        return False
-    if max_poses is None:
-        return True
-    seeded = work_of(problem, bounds, method="scipy", active_set=active_set, seed_map=True)
-    return seeded.weighed(problem) <= max_poses
+    without, with_map = (
+        work_of(problem, bounds, method="scipy", seed_map=seeded).weighed(problem)
+        for seeded in (False, True)
+    )
+    return with_map <= SEEDED_WORK_RATIO * without
 
 
 def work_of(

@@ -23,7 +23,7 @@ import pytest
 from solver.families import get_robot
 from solver.optimise import active_set, back_off, coarse_rows, coarse_search, local_search
 from solver.optimise import optimize as front_door
-from solver.optimise.coarse_search import MAX_COARSE_CELLS, coarse_cells
+from solver.optimise.coarse_search import coarse_cells
 from solver.optimise.methods import casadi_method, placement_scipy
 from solver.optimise.search_space import PlacementBounds
 from solver.optimise.work import seeds_from_map, work_of
@@ -171,9 +171,7 @@ def test_the_estimate_covers_every_evaluation(
     path = load_path("curved_line")[:n_waypoints]
     problem = PathProblem.of(get_robot(name), path, PathOptions(cell=cell))
     # the scipy method also starts from the coarse map where it fits, as the front door decides
-    seeded = method == "scipy" and seeds_from_map(
-        problem, bounds, max_cells=MAX_COARSE_CELLS, max_poses=None
-    )
+    seeded = method == "scipy" and seeds_from_map(problem, bounds)
     estimate = work_of(problem, bounds, method=method, seed_map=seeded)
     optimum = front_door.optimize_placement(problem, bounds=bounds, method=method)
     assert optimum.found

@@ -35,9 +35,10 @@ class Method:
         search: the entry point: candidates and the solver's iterations.
         check: refuses a search too large before any work.
         spin_path: whether it also gives each waypoint its own spin (cam.md section 4).
-        map_seeds: whether it also starts from the coarse map's maxima where the map fits, a
-            choice made before it runs (:func:`solver.optimise.work.seeds_from_map`; the casadi
-            method always starts from them).
+        map_seeds: whether it also starts from the coarse map's maxima (where the map at most
+            doubles the search's work, whatever the limits), a choice made before it
+            runs (:func:`solver.optimise.work.seeds_from_map`; the casadi method always starts
+            from them).
     """
 
     description: str

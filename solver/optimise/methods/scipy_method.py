@@ -1,9 +1,9 @@
 """The ``scipy`` method: differential evolution, compass refinement, SLSQP, Nelder-Mead climbs.
 
 Differential evolution over the free variables, every generation one batch through
-:mod:`solver.path.placements`, beside the casadi method's coarse map where it fits (its maxima
-ranked with the evolution's basins: :func:`solver.optimise.work.seeds_from_map`); each basin
-is climbed by the compass search, then
+:mod:`solver.path.placements`, beside the casadi method's coarse map (where it at most doubles
+the search's work; its maxima ranked with the evolution's basins:
+:func:`solver.optimise.work.seeds_from_map`); each basin is climbed by the compass search, then
 polished by SLSQP on the epigraph form with finite-difference gradients on the branch it ends
 on (:mod:`solver.optimise.methods.placement_scipy`); Nelder-Mead climbs mu_path from the best.
 With a cell, a polish that is not clear of it is also backed off towards its start
@@ -25,7 +25,7 @@ from solver.optimise.active_set import (
 )
 from solver.optimise.back_off import back_off
 from solver.optimise.candidate import ZERO_SPEED, Candidate, Search
-from solver.optimise.coarse_search import Cell, search_cells
+from solver.optimise.coarse_search import Cell, coarse_map_cells, search_cells
 from solver.optimise.local_search import REFINED_CELLS, climbs, refine_cells
 from solver.optimise.methods.placement_scipy import (
     Basin,
@@ -54,14 +54,24 @@ def size_of(problem: PathProblem, bounds: PlacementBounds) -> SearchSize:
 
 
 def check(problem: PathProblem, bounds: PlacementBounds, settings: Search) -> None:
-    """Refuse a differential evolution whose weighed work is over ``max_search_poses``.
+    """Refuse a scipy search too large: its evolution's work, its coarse map's cells.
 
-    Runs before the path is prepared (a search too large is refused before any work).
+    Differential evolution whose weighed work is over ``max_search_poses``, and a search that
+    starts from a coarse map (``seed_map``) of more than ``max_coarse_cells`` cells. Runs
+    before any placement is evaluated (a search too large is refused before any work).
 
     Raises:
         InvalidInputError: on ``bounds``, saying the size asked for and the limit.
     """
     family, n_waypoints = problem.family, len(problem.waypoints)
+    if settings.seed_map:  # its coarse map too, checked before the evolution, not after it
+        cells = coarse_map_cells(bounds, symmetric=settings.symmetric)
+        if cells > settings.max_coarse_cells:
+            raise InvalidInputError(
+                "bounds",
+                f"the scipy search starts from a coarse map of {cells} cells (20 mm, 15 deg) "
+                f"too; the limit is {settings.max_coarse_cells}",
+            )
     size = size_of(problem, bounds)
     max_poses = settings.max_search_poses
     if max_poses is None:
