@@ -134,8 +134,9 @@ class Settings(BaseSettings):
     max_solver_seconds: float = Field(
         default=20.0,
         gt=0.0,
-        description="Longest time (s) one IPOPT solve of /v1/optimize may take; it then stops "
-        "and its best point so far is judged by the evaluator like any other.",
+        description="Longest time (s) one IPOPT solve of /v1/optimize may take, by the wall "
+        "clock (other requests' work does not count); it then stops and its best point so far "
+        "is judged by the evaluator like any other.",
     )
     data_dir: Path = Field(
         default=Path("var"),

@@ -5,6 +5,7 @@ from __future__ import annotations
 import dataclasses
 import math
 import threading
+from typing import Any
 
 import numpy as np
 import pytest
@@ -16,6 +17,7 @@ from solver.core.robots import Robot
 from solver.core.spatial import Placement
 from solver.families import get_robot
 from solver.optimise import local_search
+from solver.optimise.methods import placement_nlp
 from solver.optimise.optimize import optimize_placement as optimise_problem
 from solver.optimise.optimum import PlacementOptimum
 from solver.optimise.search_space import PlacementBounds, vector_of
@@ -271,6 +273,26 @@ def test_the_scipy_optimum_does_not_depend_on_the_host_s_blas_threads() -> None:
     first, second = answers
     assert (first.placement, first.mu_path) == (second.placement, second.mu_path)
     assert first.solver.iterations == second.solver.iterations
+
+
+def test_an_ipopt_solve_s_time_limit_is_its_own_wall_time(monkeypatch: pytest.MonkeyPatch) -> None:
+    """DTF_MAX_SOLVER_SECONDS was IPOPT's max_cpu_time, the whole process's CPU time (Ipopt's
+    getrusage): three clients' maps in the same server used up one solve's budget, and it
+    stopped at another iterate each run (stop 59's determinism audit). IPOPT says which clock
+    stopped a solve: under a limit no solve meets, its wall time's."""
+    statuses: list[str] = []
+    solve = placement_nlp.PlacementNlp.solve
+
+    def recorded(self: placement_nlp.PlacementNlp, *args: Any, **keywords: Any) -> Any:
+        result = solve(self, *args, **keywords)
+        statuses.append(result.status)
+        return result
+
+    monkeypatch.setattr(placement_nlp.PlacementNlp, "solve", recorded)
+    optimize_placement(
+        get_robot("ur5"), load_path("curved_line"), bounds=BOUNDS, max_solver_seconds=1e-4
+    )
+    assert statuses and set(statuses) == {"Maximum_WallTime_Exceeded"}, statuses
 
 
 def test_on_two_threads_the_climbs_run_beside_ipopt_and_change_nothing(

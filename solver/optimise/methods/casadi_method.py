@@ -69,7 +69,7 @@ def search(
         return [Candidate(cells[0].vector, ZERO_SPEED)], 0
     candidates = [Candidate(cells[0].vector, "best cell of the coarse map, refined")]
     seconds = settings.max_solver_seconds
-    options: dict[str, object] | None = None if seconds is None else {"max_cpu_time": seconds}
+    options: dict[str, object] | None = None if seconds is None else {"max_wall_time": seconds}
 
     whole: list[PlacementNlp] = []  # the whole problem's NLP, built once for every start
 
