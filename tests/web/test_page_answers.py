@@ -26,12 +26,12 @@ from tests.web.test_page_cell import open_editor
 from tests.web.test_page_findings import choose_file, error_beside
 
 
-def run_job(page: Page) -> str:
-    """Click Run: the id of the map job the page submits."""
+def run_job(page: Page, button: str = "#run") -> str:
+    """Click Run (or ``button``): the id of the job the page submits."""
     with page.expect_response(
         lambda r: r.request.method == "POST" and r.url.endswith("/v1/jobs")
     ) as sent:
-        page.click("#run")
+        page.click(button)
     job_id: str = sent.value.json()["id"]
     return job_id
 
@@ -217,12 +217,7 @@ def _submit_optimisation_job(page: Page) -> str:
     page.route("**/v1/optimize", _refused_as_work)
     fill(page, {**SMALL, "x-min": "-0.3", "x-max": "0.3", "y-min": "0.2", "y-max": "0.7"})
     page.click("#opt-any-yaw")
-    with page.expect_response(
-        lambda r: r.request.method == "POST" and r.url.endswith("/v1/jobs")
-    ) as sent:
-        page.click("#optimize")
-    job_id: str = sent.value.json()["id"]
-    return job_id
+    return run_job(page, "#optimize")
 
 
 def test_a_reloaded_page_shows_its_last_optimisation_job_again(page: Page, url: str) -> None:

@@ -43,16 +43,24 @@ function rememberJob(id) {
   try { localStorage.setItem(LAST_JOB_KEY, id); } catch { /* storage refused: nothing kept */ }
 }
 
-async function offerLastJob() {
+// The job this browser remembers under ``key`` (localStorage), if it can still be shown:
+// queued, running or done. A job the service no longer holds (deleted or expired) is forgotten.
+async function rememberedJob(key) {
   let id = null;
-  try { id = localStorage.getItem(LAST_JOB_KEY); } catch { return; }
-  if (!id) return;
+  try { id = localStorage.getItem(key); } catch { return null; }
+  if (!id) return null;
   let job;
   try { job = await getJson(`/v1/jobs/${id}`); } catch (error) {
-    if (error.status === 404) localStorage.removeItem(LAST_JOB_KEY);  // deleted or expired
-    return;
+    if (error.status === 404) localStorage.removeItem(key);
+    return null;
   }
-  if (!DRAWABLE.includes(job.status)) return;  // nothing of it to draw
+  return DRAWABLE.includes(job.status) ? job : null;
+}
+
+async function offerLastJob() {
+  const job = await rememberedJob(LAST_JOB_KEY);
+  if (!job) return;  // nothing of it to draw
+  const id = job.id;
   if (state.run || state.map) return;  // a map run or drawn meanwhile: it is the one shown
   const when = new Date(job.created * 1000).toLocaleString();
   $("resume-text").textContent = `Your last map, job ${id} (submitted ${when}): `

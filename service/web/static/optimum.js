@@ -119,16 +119,10 @@ function rememberOptimisation(id) {
 
 async function offerLastOptimisation() {
   $("opt-resume").hidden = true;
-  let id = null;
-  try { id = localStorage.getItem(LAST_OPTIMISATION_KEY); } catch { return; }
-  if (!id) return;
-  let job;
-  try { job = await getJson(`/v1/jobs/${id}`); } catch (error) {
-    if (error.status === 404) localStorage.removeItem(LAST_OPTIMISATION_KEY);  // deleted or expired
-    return;
-  }
-  if (!DRAWABLE.includes(job.status)) return;  // failed or cancelled: nothing to show
+  const job = await rememberedJob(LAST_OPTIMISATION_KEY);
+  if (!job) return;  // failed or cancelled: nothing to show
   if (state.optimization || state.optimum) return;  // one run or shown meanwhile
+  const id = job.id;
   const when = new Date(job.created * 1000).toLocaleString();
   const done = job.status === "done" ? "done" : `${job.status}, ${(100 * job.progress.fraction).toFixed(0)} %`;
   $("opt-resume-text").textContent = `Your last optimisation, job ${id} (submitted ${when}): ${done}.`;
