@@ -60,10 +60,30 @@ def _place_on_arc(
         moved = arc_point(*arc_coordinates(x, y, yaw), bounds, near=near)
         if moved is not None:
             x, y, yaw = moved
+    x, y, yaw, spin, z = _bounds_as_written(np.array([x, y, yaw, spin, z], dtype=float), bounds)
     given = variables_of(clamped)
     turn = math.atan2(y, x) - math.atan2(given.y, given.x) if symmetric else 0.0
     placement = Placement(float(x), float(y), float(z), float(yaw), spin=float(spin))
     return placement, (turn + math.pi) % (2 * math.pi) - math.pi
+
+
+ON_A_BOUND = 1e-12
+"""m or rad: a candidate's variable this near a bound of the box is taken at the bound."""
+
+
+def _bounds_as_written(vector: np.ndarray, bounds: PlacementBounds) -> np.ndarray:
+    """The decision vector with each variable within ON_A_BOUND of a bound put on it.
+
+    An optimum often stops on the box's edge, reached through a solver's arithmetic or the
+    arc's trigonometry a few ulps off it: the corner optimum (-0.1, 0.3) was answered at x
+    -0.09999999999999996, y 0.30000000000000004, which the controllers' frames then say (X
+    -99.99999999999996 mm). The candidate is judged where it is reported, so moving it by an
+    ulp changes nothing but the digits.
+    """
+    lower, upper = bounds.lower, bounds.upper
+    on_lower = np.abs(vector - lower) <= ON_A_BOUND
+    on_upper = np.abs(vector - upper) <= ON_A_BOUND
+    return np.where(on_lower, lower, np.where(on_upper, upper, vector))
 
 
 def _turned_joint_path(robot: Robot, joint_path: np.ndarray, turn: float) -> np.ndarray:

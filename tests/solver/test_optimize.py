@@ -363,6 +363,9 @@ def test_casadi_reaches_the_better_of_two_corner_maxima() -> None:
     optimum = optimize_placement(robot, path, bounds=bounds, method="casadi")
     assert optimum.mu_path is not None
     assert optimum.mu_path >= corner.mu_path * (1.0 - 1e-9)
+    # on the corner as the box is written (was x -0.09999999999999996, y 0.30000000000000004)
+    assert (optimum.placement.x, optimum.placement.y, optimum.placement.yaw) == (-0.1, 0.3, -0.61)
+    assert optimum.evaluation.mu_path == evaluate_path(robot, path, optimum.placement).mu_path
 
 
 def test_a_yaw_range_of_many_turns_searches_one() -> None:
