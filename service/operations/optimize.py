@@ -12,7 +12,13 @@ from solver.core.progress import Progress
 from solver.optimise.methods import method_named
 from solver.optimise.optimize import optimize_placement
 from solver.optimise.search_space import PlacementBounds
-from solver.optimise.work import COARSE_MAP, seeds_from_map, work_of
+from solver.optimise.work import (
+    COARSE_MAP,
+    OptimisationWork,
+    map_is_worth_it,
+    scipy_works,
+    work_of,
+)
 from solver.path.cycle_time import cycle_time
 from solver.path.problem import PathProblem
 
@@ -84,15 +90,16 @@ def check_work(
     """
     bounds.check()
     limits = settings.map_limits()
-    # the scipy method also starts from the coarse map (as it will: the limits do not decide)
-    seeded = method_named(body.method).map_seeds and seeds_from_map(problem, bounds)
-    work = work_of(
-        problem,
-        bounds,
-        method=body.method,
-        max_spin_step=max_spin_step_of(body),
-        seed_map=seeded,
-    )
+    max_spin_step = max_spin_step_of(body)
+    alone: OptimisationWork | None = None  # the scipy search without the coarse map
+    if method_named(body.method).map_seeds:
+        # the scipy method also starts from the coarse map (as it will: the limits do not decide)
+        alone, with_map = scipy_works(problem, bounds, max_spin_step=max_spin_step)
+        seeded = map_is_worth_it(problem, alone, with_map)
+        work = with_map if seeded else alone
+    else:
+        seeded = False
+        work = work_of(problem, bounds, method=body.method, max_spin_step=max_spin_step)
     weighed = work.weighed(problem)
     jobs = limits.hint.replace("maps", "searches")  # a route's: POST /v1/jobs; a job's: none
     if body.method == "scipy":
@@ -108,18 +115,16 @@ def check_work(
                 f"the search box needs a coarse map of {cells} cells (20 mm, 15 deg); the "
                 f"limit is {limits.cells} ({limits.cells_setting}){hint}",
             )
-    if seeded:  # the map's work against the maps' limit, the rest against the search's
-        alone = work_of(
-            problem, bounds, method="scipy", max_spin_step=max_spin_step_of(body), seed_map=False
-        ).weighed(problem)
-        if weighed - alone > limits.poses:
+    if seeded and alone is not None:  # the map's work against the maps' limit, the rest
+        without = alone.weighed(problem)  # against the search's
+        if weighed - without > limits.poses:
             raise InvalidInputError(
                 "bounds",
                 f"the scipy search starts from the coarse map too, which adds "
-                f"{weighed - alone:.4g} closed-form poses of work; the limit is {limits.poses} "
+                f"{weighed - without:.4g} closed-form poses of work; the limit is {limits.poses} "
                 f"({limits.poses_setting}){hint}",
             )
-        weighed = alone
+        weighed = without
     if weighed > limit:
         cell = ", with a cell" if problem.options.cell is not None else ""
         raise InvalidInputError(

@@ -190,12 +190,25 @@ def seeds_from_map(problem: PathProblem, bounds: PlacementBounds) -> bool:
     a synchronous request and a job of one body, whose limits are larger, answered two optima
     (the determinism audit of stop 59: 1.129638 and 1.130841 m/s on a 2,500-move program).
     """
-    bounds = bounds.within_a_turn()  # as the search is (optimize_placement)
+    return map_is_worth_it(problem, *scipy_works(problem, bounds))
+
+
+def scipy_works(
+    problem: PathProblem, bounds: PlacementBounds, *, max_spin_step: float | None = None
+) -> tuple[OptimisationWork, OptimisationWork]:
+    """The scipy search's work without the coarse map, and with it (:func:`work_of`'s)."""
     without, with_map = (
-        work_of(problem, bounds, method="scipy", seed_map=seeded).weighed(problem)
+        work_of(problem, bounds, method="scipy", max_spin_step=max_spin_step, seed_map=seeded)
         for seeded in (False, True)
     )
-    return with_map <= SEEDED_WORK_RATIO * without
+    return without, with_map
+
+
+def map_is_worth_it(
+    problem: PathProblem, without: OptimisationWork, with_map: OptimisationWork
+) -> bool:
+    """:func:`seeds_from_map`'s rule on the two works :func:`scipy_works` gives."""
+    return with_map.weighed(problem) <= SEEDED_WORK_RATIO * without.weighed(problem)
 
 
 def work_of(
