@@ -102,6 +102,14 @@ def done_job(client: TestClient, job_id: str) -> dict[str, Any]:
         time.sleep(0.1)
 
 
+def done_map_job(client: TestClient) -> str:
+    """The id of a map job of GRID_2500 (three stored pages of cells), run to its end."""
+    request = {"robot": EXAMPLE["robot"], "path": SHORT_PATH, "grid": GRID_2500}
+    job_id: str = client.post("/v1/jobs", json={"kind": "map", "request": request}).json()["id"]
+    assert done_job(client, job_id)["status"] == "done"
+    return job_id
+
+
 def test_a_map_job_pages_equal_the_map_routes_cells(
     client: TestClient, paged_store: Settings
 ) -> None:
@@ -290,9 +298,7 @@ def test_a_jobs_cells_are_read_whole_when_it_is_deleted_meanwhile(
 def test_a_map_jobs_picture_of_a_job_deleted_while_read_is_a_404(
     client: TestClient, paged_store: Settings, monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    request = {"robot": EXAMPLE["robot"], "path": SHORT_PATH, "grid": GRID_2500}
-    job_id = client.post("/v1/jobs", json={"kind": "map", "request": request}).json()["id"]
-    assert done_job(client, job_id)["status"] == "done"
+    job_id = done_map_job(client)
 
     def deleted_first(self: JobStore, job: str) -> Iterator[list[dict[str, Any]]]:
         self.delete(job)  # as a DELETE just before the cells are read
@@ -308,9 +314,7 @@ def test_a_jobs_picture_stops_reading_when_its_client_leaves(
 ) -> None:
     """The reading of 2 million cells takes seconds: it is told after each page, and stops
     (its store connection closed) when the client has left, as a map route's work does."""
-    request = {"robot": EXAMPLE["robot"], "path": SHORT_PATH, "grid": GRID_2500}
-    job_id = client.post("/v1/jobs", json={"kind": "map", "request": request}).json()["id"]
-    assert done_job(client, job_id)["status"] == "done"
+    job_id = done_map_job(client)
     read, closed = [], []
     pages_of = JobStore.cell_pages
 
@@ -342,9 +346,7 @@ def test_a_jobs_picture_stops_reading_when_its_client_leaves(
 def test_a_map_jobs_picture_of_a_job_deleted_before_its_request_is_read_is_a_404(
     client: TestClient, paged_store: Settings, monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    request = {"robot": EXAMPLE["robot"], "path": SHORT_PATH, "grid": GRID_2500}
-    job_id = client.post("/v1/jobs", json={"kind": "map", "request": request}).json()["id"]
-    assert done_job(client, job_id)["status"] == "done"
+    job_id = done_map_job(client)
 
     def gone(self: JobStore, job: str) -> None:
         self.delete(job)  # as a DELETE between the job's state and its request
