@@ -9,7 +9,6 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
-from decimal import Decimal
 from typing import Any
 
 import numpy as np
@@ -18,6 +17,7 @@ from solver.core.codes import REASONS
 from solver.core.exceptions import InvalidInputError
 from solver.core.parallel import SERIAL, TaskRunner
 from solver.core.spatial import Placement
+from solver.core.written import stepped_as_written
 from solver.path.cell.cost import with_cell
 from solver.path.cell.verdict import Unchecked
 from solver.path.path_checks import checks_model
@@ -130,24 +130,14 @@ def grid_axis(lower: float, upper: float, step: float, *, field: str) -> np.ndar
     """Grid values lower, lower + step, ... up to upper.
 
     upper is included when it falls on the grid to within 1e-9 of a step. Each value is the
-    float nearest lower + i step taken in the decimals the two are written in (their shortest
-    repr: what a request's JSON says): -0.25 + 15 x 0.02 is 0.05, where the floats' own sum is
-    0.04999999999999999, which a placement's answer then printed as X 49.999999999999986 mm.
-    The integers lower and step are in their last decimal are summed exactly and divided once
-    (IEEE division rounds to the nearest); where they cannot be (more than 22 decimals, or a
-    sum past 2^53), the floats' sum.
+    float nearest lower + i step taken in the decimals the two are written in
+    (:func:`solver.core.written.stepped_as_written`): -0.25 + 15 x 0.02 is 0.05, where the
+    floats' own sum is 0.04999999999999999.
 
     Raises:
         InvalidInputError: values not finite, step <= 0 or upper < lower.
     """
-    count = axis_length(lower, upper, step, field=field)
-    written = [Decimal(repr(float(v))) for v in (lower, step)]
-    decimals = max(0, -min(int(w.as_tuple().exponent) for w in written))
-    first, stride = (int(w.scaleb(decimals)) for w in written)
-    if decimals > 22 or abs(first) + stride * (count - 1) > 2**53:  # 10^22: the last exact power
-        return lower + step * np.arange(count)
-    scale = float(10**decimals)  # exact
-    return (first + stride * np.arange(count, dtype=np.int64)).astype(np.float64) / scale
+    return stepped_as_written(lower, step, axis_length(lower, upper, step, field=field))
 
 
 def capability_map(
