@@ -18,6 +18,7 @@ from solver.core.exceptions import InvalidInputError
 from solver.core.parallel import SERIAL, TaskRunner
 from solver.core.progress import Progress
 from solver.core.spatial import MAX_COORDINATE
+from solver.core.written import stepped_as_written
 from solver.optimise.candidate import Search
 from solver.optimise.coarse_rows import map_values, mapped_waypoints
 from solver.optimise.failures import Tried
@@ -60,7 +61,7 @@ def _spin_values(bounds: PlacementBounds) -> tuple[np.ndarray, bool]:
 def _heights(bounds: PlacementBounds) -> np.ndarray:
     """The coarse map's heights: z, or its range at COARSE_STEP when z is free."""
     low, high = bounds.z_range
-    return low + COARSE_STEP * np.arange(math.floor((high - low) / COARSE_STEP + 1e-9) + 1)
+    return stepped_as_written(low, COARSE_STEP, math.floor((high - low) / COARSE_STEP + 1e-9) + 1)
 
 
 def _local_maxima(values: np.ndarray, periodic: tuple[bool, ...]) -> list[tuple[int, ...]]:
@@ -94,8 +95,12 @@ def _axis(
     short of it IPOPT may climb to another maximum (the UR5 on a wall,
     tests/solver/families/test_tilted_base.py: 10 % lower). The lengths' 20 mm steps leave
     little to their ends; none is added there (a map's size is its work).
+
+    The values are stepped in the decimals ``low`` and ``step`` are written in
+    (:func:`solver.core.written.stepped_as_written`), as a map's grid is: a cell that is itself
+    the answer reads x -0.16, not -0.16000000000000003.
     """
-    axis = low + step * np.arange(math.floor((high - low) / step + slack) + 1)
+    axis = stepped_as_written(low, step, math.floor((high - low) / step + slack) + 1)
     if ends and high - axis[-1] > step / 2:
         axis = np.append(axis, high)
     return axis

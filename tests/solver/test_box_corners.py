@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import itertools
 import math
+from fractions import Fraction
 
 import numpy as np
 import pytest
@@ -62,6 +63,22 @@ def test_the_coarse_cells_hold_each_placement_once(symmetric: bool) -> None:
     assert len(cells) > 4
     for a, b in itertools.combinations(cells, 2):
         assert not _one_placement(a.vector, b.vector), (a, b)
+
+
+def test_the_coarse_cells_are_the_decimals_the_box_is_written_in() -> None:
+    """A coarse cell (or edge point) may itself be the answer: its x and y are the floats nearest
+    the box's lower bound plus whole steps of 0.02 in exact decimal arithmetic (Fractions of the
+    numbers as written), as a map's grid is: -0.23, not -0.22999999999999998. In floats, 16 of
+    the 26 values from -0.25 differ in their last bit, 18 of 26 from -0.3."""
+    bounds = PlacementBounds(x=(-0.25, 0.25), y=(-0.3, 0.2), yaw=(2.5, 3.5), z=0.1)
+    problem = PathProblem.of(get_robot("ur5"), load_path("curved_line")[::4])
+    cells = coarse_cells(problem, bounds, symmetric=False, near=math.pi / 2)
+    step = Fraction("0.02")
+    for variable, (low, high) in enumerate((bounds.x, bounds.y)):
+        written = {float(Fraction(repr(low)) + i * step) for i in range(26)} | {low, high}
+        values = {float(cell.vector[variable]) for cell in cells}
+        assert len(values) > 3, values  # cells inside the box, not only its corners
+        assert values <= written, values - written
 
 
 def test_the_edge_lines_run_along_one_variable_from_each_corner() -> None:
