@@ -146,7 +146,11 @@ class Bottleneck(ResponseModel):
         json_schema_extra={"examples": [{"waypoint": 0, "joint": 2, "joint_name": "elbow_joint"}]}
     )
 
-    waypoint: int = Field(description="Index of the waypoint with the smallest v_max.")
+    waypoint: int = Field(
+        description="Index of the waypoint with the smallest v_max; of waypoints whose v_max "
+        "tie within 1e-12 (relative: the same corner cut on several levels), the first, as a "
+        "map cell of the same placement names it."
+    )
     joint: int = Field(description="Index of the joint on its speed limit there.")
     joint_name: str = Field(description="Name of that joint.")
 

@@ -170,7 +170,9 @@ class MapCell(ResponseModel):
         description="First waypoint that fails; null when feasible."
     )
     bottleneck_waypoint: int | None = Field(
-        default=None, description="Where V_max is smallest along the path; null when infeasible."
+        default=None,
+        description="Where V_max is smallest along the path (of waypoints that tie within "
+        "1e-12, the first, as /v1/evaluate names it); null when infeasible.",
     )
     bottleneck_joint: int | None = Field(
         default=None, description="The joint on its speed limit there; null when infeasible."

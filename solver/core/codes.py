@@ -38,6 +38,14 @@ REASON_COLLISION = 4
 # Branches whose mu_path is within this relative tolerance of the best tie; the first in the
 # family's order is chosen (dtf.md section 4).
 TIE_RTOL = 1e-12
+# Along a path, a waypoint takes the bottleneck over only where its V_max is below this
+# fraction of every earlier waypoint's: a tie in the last bits stays with the earlier waypoint,
+# as a branch tie with the first branch. Repeated geometry ties: the same corner cut on
+# several levels binds joint 1 at the same V_max on each, which a map's kernel and the
+# evaluator round apart in the last bit (14 of 117 cells of a 2,500-move pocket program named
+# two waypoints). :func:`solver.path.bottleneck.bottleneck_waypoint` and the kernels' running
+# minimum (solver/kernels/fixed_follow.py, free_follow.py) apply it alike.
+TAKES_OVER = 1.0 - TIE_RTOL
 # The same for mu_acc (motion.md section 2): D_i divides the joint angles' last bits by b^2, so
 # mu_acc is known to a few 1e-12 only (at b = 2 mm, 10 rad/s^2 and 0.24 m/s a bit of q moves it
 # by up to 2.6e-12), and the wrist-flip branches, whose q6 differ by pi, tie to that rounding.

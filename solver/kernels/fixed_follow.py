@@ -22,6 +22,7 @@ from solver.core.codes import (
     REASON_SINGULAR,
     REASON_UNREACHABLE,
     SINGULAR,
+    TAKES_OVER,
     UNREACHABLE,
 )
 from solver.families.kernels import N_JOINTS, pose_block
@@ -48,11 +49,12 @@ def follow_rows(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
 
     Each row: unreachable, then singular, then the step test cos(dq) >= cos(max_joint_step)
     against the previous waypoint, with the sums of the fast position tests; then its DTF and
-    running minimum (``slowest``, ``slowest_at``, ``slowest_joint``; V_max in ``speeds``);
-    after the path the position limits (:func:`first_outside_pairs`). A row whose running
-    minimum falls below its ``limit`` is pruned (:func:`solver.kernels.cell.prune`); ``hint`` keeps
-    where each row's minimum was. Arrays as :func:`solver.kernels.fixed_spin.map_cells` makes
-    them.
+    running minimum (``slowest``, ``slowest_at``, ``slowest_joint``, where a tie in the last
+    bits stays with the earlier waypoint: :data:`solver.core.codes.TAKES_OVER`; V_max in
+    ``speeds``); after the path the position limits (:func:`first_outside_pairs`). A row
+    whose running minimum falls below its ``limit`` is pruned
+    (:func:`solver.kernels.cell.prune`); ``hint`` keeps where each row's minimum was. Arrays
+    as :func:`solver.kernels.fixed_spin.map_cells` makes them.
     """
     n_waypoints = poses.shape[1]
     check_steps = max_joint_step < math.pi
@@ -122,9 +124,10 @@ def follow_rows(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
                 speed, limiting = joint_speed_bound(qd, b, w, inverse_qdot)
                 v = 0.0 if pure_rotation[w] else speed
                 if w == 0 or v < slowest[i]:
+                    if w == 0 or v < slowest[i] * TAKES_OVER:  # not a tie: takes it over
+                        slowest_at[i] = w
+                        slowest_joint[i] = limiting
                     slowest[i] = v
-                    slowest_at[i] = w
-                    slowest_joint[i] = limiting
                     if v < limit[i]:
                         prune(i, w, v, alive, why, where, slowest, hint)
                         n_live -= 1

@@ -20,6 +20,7 @@ from solver.core.codes import (
     REASON_SINGULAR,
     REASON_UNREACHABLE,
     SINGULAR,
+    TAKES_OVER,
     UNREACHABLE,
 )
 from solver.families.kernels import N_JOINTS, pose_block
@@ -47,8 +48,9 @@ def follow_free_rows(  # type: ignore[no-untyped-def]  # pragma: no cover - comp
 
     Each row: unreachable, then singular, then the step test against the previous waypoint;
     V_max by the two-variable LP and its running minimum (``slowest``, ``slowest_at``,
-    ``slowest_joint``; V_max in ``speeds``). A row whose running minimum falls below its
-    ``limit`` is pruned; ``hint`` keeps where each row's minimum was. Arrays as
+    ``slowest_joint``, a tie in the last bits staying with the earlier waypoint:
+    :data:`solver.core.codes.TAKES_OVER`; V_max in ``speeds``). A row whose running minimum
+    falls below its ``limit`` is pruned; ``hint`` keeps where each row's minimum was. Arrays as
     :func:`solver.kernels.free_spin.free_cells` makes them.
     """
     n_waypoints = poses.shape[1]
@@ -89,9 +91,10 @@ def follow_free_rows(  # type: ignore[no-untyped-def]  # pragma: no cover - comp
                 speed, limiting = two_variable_speed(qd, qs, b, w, qdot_max)
                 v = 0.0 if pure_rotation[w] else speed
                 if w == 0 or v < slowest[i]:
+                    if w == 0 or v < slowest[i] * TAKES_OVER:  # not a tie: takes it over
+                        slowest_at[i] = w
+                        slowest_joint[i] = limiting
                     slowest[i] = v
-                    slowest_at[i] = w
-                    slowest_joint[i] = limiting
                     if v < limit[i]:
                         prune(i, w, v, alive, why, where, slowest, hint)
                         n_live -= 1

@@ -22,6 +22,7 @@ from solver.core.progress import Progress
 from solver.core.spatial import Placement, rotation_about_z
 from solver.core.two_variable_lp import spin_rate_nearest_zero
 from solver.kernels.spin_lp import spin_rate_at_feed
+from solver.path.bottleneck import bottleneck_waypoints
 from solver.path.cell.verdict import CellVerdict, Contact, Unchecked
 from solver.path.limits import JointAccelerationLimit, JointMotion, PathVerdict, bound_by_limits
 from solver.path.path_checks import check_path, checks_model, clear_pick
@@ -234,7 +235,7 @@ def evaluate_path(
             path.pure_rotation, speed, np.where(np.isinf(path.h), 0.0, speed / path.h)
         )
     limiting = run.limiting[pick, 0]
-    bottleneck = int(np.argmin(v_max))
+    bottleneck = int(bottleneck_waypoints(v_max))
     qdot = run.qd_unit[:, pick, 0] * speed
     spins = None if run.spins is None else run.spins[pick, 0]
     if run.spins is not None and run.qd_spin is not None:  # else the spun path's own (exact_spin)
@@ -247,7 +248,7 @@ def evaluate_path(
             qdot = qdot + null_rate * b
         qdot = qdot + spin_rate * c
     q = run.tracked.q[:, pick, 0].T
-    mu_path = float(v_max[bottleneck])
+    mu_path = float(np.min(v_max))  # V_max at the bottleneck, or a last bit below (a tie)
     return dataclasses.replace(
         infeasible,
         feasible=True,

@@ -21,6 +21,7 @@ from solver.core.exceptions import InvalidInputError
 from solver.core.kinematics import tool_pose_in_base
 from solver.core.progress import Progress
 from solver.core.spatial import Placement, rotation_about_z
+from solver.path.bottleneck import bottleneck_waypoints
 from solver.path.evaluate import PathEvaluation, acceleration_index, cell_detail
 from solver.path.limits import JointMotion, bound_by_limits
 from solver.path.path_checks import check_path, checks_model
@@ -178,8 +179,8 @@ def evaluate_joint_path(
         omega_max = np.where(
             path.pure_rotation, speed, np.where(np.isinf(path.h), 0.0, speed / path.h)
         )
-    bottleneck = int(np.argmin(v_max))
-    mu_path = float(v_max[bottleneck])
+    bottleneck = int(bottleneck_waypoints(v_max))
+    mu_path = float(np.min(v_max))  # V_max at the bottleneck, or a last bit below (a tie)
     return dataclasses.replace(
         infeasible,
         feasible=True,

@@ -17,6 +17,7 @@ import numpy as np
 from solver.core.codes import FEASIBLE
 from solver.core.malloc import raise_malloc_thresholds
 from solver.core.parallel import SERIAL, TaskRunner
+from solver.path.bottleneck import bottleneck_waypoints
 from solver.path.bounded import one_pass_chunk
 from solver.path.kernel_branches import KernelBranches
 from solver.path.kernel_cells import (
@@ -110,7 +111,7 @@ def columns_of_run(
     pick, columns = run.pick, np.arange(len(run.pick))
     any_feasible = (run.tracked.reason == FEASIBLE).any(axis=0)
     chosen_v = np.where(any_feasible[:, None], run.v_max[pick, columns], np.nan)  # (C, W)
-    worst = np.nan_to_num(chosen_v, nan=np.inf).argmin(axis=-1)
+    worst = bottleneck_waypoints(np.nan_to_num(chosen_v, nan=np.inf))
     speed_columns = (
         np.where(any_feasible, run.mu_path[pick, columns], np.nan),
         run.tracked.reason[pick, columns],
