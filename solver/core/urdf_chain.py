@@ -21,7 +21,13 @@ from dataclasses import dataclass
 import numpy as np
 import pinocchio as pin
 
-from solver.core.exceptions import InvalidInputError, RobotModelError, quoted, quoted_names
+from solver.core.exceptions import (
+    InvalidInputError,
+    RobotModelError,
+    cut,
+    quoted,
+    quoted_names,
+)
 from solver.core.native_stderr import first_error, native_stderr
 from solver.core.urdf_structure import (
     ContinuousJoint,
@@ -32,6 +38,7 @@ from solver.core.urdf_structure import (
     joint_problem,
     mimic_joints,
     nesting_depth,
+    not_well_formed,
     parsed,
     root_links,
     stray_links,
@@ -87,14 +94,27 @@ def readable_urdf(
     left out (:func:`without_stray_links`, ``frames`` as there).
 
     Raises:
-        RobotModelError: on ``robot.urdf``, elements nested deeper than MAX_URDF_DEPTH, a
+        RobotModelError: on ``robot.urdf``, a document that is not well-formed XML or whose
+            root is not ``<robot>``, elements nested deeper than MAX_URDF_DEPTH, a
             joint whose axis has a length outside AXIS_LENGTHS, joints that are no tree, a
             joint with two mimics, a mimic multiplier, a negative velocity or an origin out of
             bounds, or a limit whose lower is above its upper (naming the joint or link).
     """
     root = parsed(urdf)
-    if root is not None:  # no XML at all: the parser says why (chain_from_urdf)
-        _refuse_unreadable(root)
+    if root is None:
+        # pinocchio's parser reads documents this one refuses (junk after </robot>, a second
+        # root, an undefined entity), and every check here and of the collision meshes
+        # (solver.path.cell.robot_geometry) reads the document with this one: such a document
+        # skipped them all (a mesh read from anywhere on the server; the hostile-input audit)
+        reason = cut(not_well_formed(urdf) or "")
+        raise RobotModelError("robot.urdf", f"cannot parse the URDF: not well-formed XML: {reason}")
+    if root.tag != "robot":  # a namespace (xmlns="...") the checks' parser reads, pinocchio's not
+        raise RobotModelError(
+            "robot.urdf",
+            f"cannot parse the URDF: its root element is {quoted(root.tag)}, not 'robot' (a URDF's "
+            "elements are in no XML namespace)",
+        )
+    _refuse_unreadable(root)
     urdf, left_out = without_stray_links(urdf, frames=frames)
     urdf, continuous = continuous_as_revolute(urdf)
     return urdf, continuous, left_out

@@ -54,6 +54,15 @@ def parsed(urdf: str) -> ElementTree.Element | None:
     return _tree(urdf)
 
 
+def not_well_formed(urdf: str) -> str | None:
+    """Why the document is not well-formed XML (the XML parser's words), or None where it is."""
+    try:
+        ElementTree.fromstring(urdf)
+    except ElementTree.ParseError as error:
+        return str(error)
+    return None
+
+
 def nesting_depth(root: ElementTree.Element) -> int:
     """How deep a parsed document's elements nest (the root alone: 1).
 

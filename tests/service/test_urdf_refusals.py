@@ -150,3 +150,64 @@ def test_a_zero_joint_axis_is_a_422_naming_the_joint(
     detail = response.json()["detail"][0]
     assert detail["loc"] == ["body", "robot", "urdf"]
     assert detail["msg"].startswith("joint 'shoulder_pan_joint': its axis (0 0 0) has length 0")
+
+
+BASE_MESH = "package://example-robot-data/robots/ur_description/meshes/ur5/collision/base.stl"
+FAR_SPHERE = {
+    "shape": "sphere",
+    "radius": 0.01,
+    "pose": {"position": [3, 3, 3], "orientation": [0, 0, 0, 1]},
+}
+NOT_WELL_FORMED = {
+    "junk after </robot>": lambda urdf: urdf + "<junk/>",
+    "a second root": lambda urdf: urdf + '<robot name="b"/>',
+    "an undefined entity": lambda urdf: urdf.replace(
+        '<robot name="ur5"', '<robot a="&b;" name="ur5"'
+    ),
+}
+
+
+@pytest.mark.parametrize("edit", NOT_WELL_FORMED.values(), ids=NOT_WELL_FORMED.keys())
+def test_a_urdf_that_is_not_well_formed_xml_is_a_422(
+    client: TestClient, evaluate_body: dict[str, Any], edit: Any
+) -> None:
+    """pinocchio's parser reads these, while every check of the document (its axes, mimics,
+    collision meshes) parses it as XML and skipped a document it could not: a zero axis was a
+    500 (LinAlgError), a mesh named anywhere on the server was read (the hostile-input audit)."""
+    urdf = edit(UR5.replace('<axis xyz="0 0 1"/>', '<axis xyz="0 0 0"/>', 1))
+    detail = refusal(client, evaluate_body, urdf)
+    assert detail["msg"].startswith("cannot parse the URDF: not well-formed XML: "), detail
+    outside = str(example_robot_data_dir() / "ur_description/meshes/ur5/collision/base.stl")
+    evaluate_body["cell"] = {"fixed": [FAR_SPHERE]}
+    detail = refusal(client, evaluate_body, edit(UR5.replace(BASE_MESH, outside)))
+    assert detail["msg"].startswith("cannot parse the URDF: not well-formed XML: "), detail
+
+
+def test_a_urdf_in_an_xml_namespace_is_a_422(
+    client: TestClient, evaluate_body: dict[str, Any]
+) -> None:
+    """With a cell, its collision geometry was parsed from the checks' rewrite (ns0:robot),
+    which pinocchio cannot read: a 500."""
+    evaluate_body["cell"] = {"fixed": [FAR_SPHERE]}
+    urdf = UR5.replace('<robot name="ur5"', '<robot xmlns="urn:x" name="ur5"')
+    detail = refusal(client, evaluate_body, urdf)
+    assert detail["msg"] == (
+        "cannot parse the URDF: its root element is '{urn:x}robot', not 'robot' (a URDF's "
+        "elements are in no XML namespace)"
+    )
+
+
+def test_a_mesh_outside_the_share_is_not_read(
+    client: TestClient, evaluate_body: dict[str, Any]
+) -> None:
+    """The well-formed document's mesh named by its path (not package://): approximated."""
+    outside = str(example_robot_data_dir() / "ur_description/meshes/ur5/collision/base.stl")
+    evaluate_body["cell"] = {"fixed": [FAR_SPHERE]}
+    evaluate_body["robot"] = {
+        "urdf": UR5.replace(BASE_MESH, outside),
+        "base_frame": "base",
+        "tool_frame": "tool0",
+    }
+    response = client.post("/v1/evaluate", json=evaluate_body)
+    assert response.status_code == 200, response.text[:300]
+    assert response.json()["cell_approximated"] == ["base"]

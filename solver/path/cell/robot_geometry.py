@@ -224,8 +224,8 @@ def _collisions_in_share(urdf: str, share: str, *, meshes: bool = True) -> str:
     anywhere (a file outside, or a FIFO, a folder: a 500; the contract audit, stop 54).
     """
     root = parsed(urdf)
-    if root is None:
-        return urdf
+    if root is None:  # refused on reading (solver.core.urdf_chain.readable_urdf): no meshes
+        raise InvalidInputError("robot.urdf", "cannot parse the URDF: not well-formed XML")
     read, elements = 0, 0
     for parent in list(root.iter()):
         for collision in [child for child in parent if child.tag == "collision"]:
