@@ -100,7 +100,8 @@ class Settings(BaseSettings):
     max_cell_objects: int = Field(
         default=100,
         gt=0,
-        description="Most objects (fixed and workpiece) a request's cell may hold.",
+        description="Most objects (fixed and workpiece) a request's cell may hold, and most "
+        "collision elements a URDF robot checked against a cell may have.",
     )
     max_mesh_triangles: int = Field(
         default=50_000,

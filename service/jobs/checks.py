@@ -52,7 +52,7 @@ def _problem(
         path,
         ik=body.ik,
         spin_mode=spin_mode,
-        cell=convert.cell_of(body.cell, settings),
+        cell=convert.cell_of(body.cell, settings, robot),
     )
     problem.prepared  # noqa: B018 - the path checked (repeated waypoints, passes)
     problem.branches  # noqa: B018 - the options checked against the robot

@@ -30,7 +30,7 @@ def _evaluated(
     path = convert.path_of(body.path)
     poses, placement = convert.spun_poses(path, body.spins), convert.placement_of(body.placement)
     spin_mode = convert.spin_mode_of(body.spin_mode, path)
-    cell = convert.cell_of(body.cell, settings)
+    cell = convert.cell_of(body.cell, settings, robot)
     problem = convert.problem_of(robot, poses, path, ik=body.ik, spin_mode=spin_mode, cell=cell)
     _check_work(problem, settings)
     if body.joint_path is not None:

@@ -85,7 +85,7 @@ def checked_grid(body: MapRequest, settings: Settings) -> CheckedGrid:
     robot = convert.robot_from_schema(body.robot)
     path = convert.path_of(body.path)
     spin_mode = convert.spin_mode_of(body.spin_mode, path)
-    cell = convert.cell_of(body.cell, settings)
+    cell = convert.cell_of(body.cell, settings, robot)
     problem = convert.problem_of(
         robot, path.poses, path, ik=body.ik, spin_mode=spin_mode, cell=cell
     )

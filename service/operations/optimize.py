@@ -38,7 +38,7 @@ def optimum_of(
     bounds = convert.bounds_of(body.bounds, z=body.z)
     start = None if body.start is None else convert.placement_of(body.start)
     spin_mode = convert.spin_mode_of(body.spin_mode, path)
-    cell = convert.cell_of(body.cell, settings)
+    cell = convert.cell_of(body.cell, settings, robot)
     problem = convert.problem_of(
         robot, path.poses, path, ik=body.ik, spin_mode=spin_mode, cell=cell
     )

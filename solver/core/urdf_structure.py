@@ -365,6 +365,12 @@ def joint_count(urdf: str) -> int:
     return 0 if root is None else sum(1 for _ in root.iter("joint"))
 
 
+def collision_count(urdf: str) -> int:
+    """How many ``<collision>`` elements the document has (0 where it is no XML)."""
+    root = _tree(urdf)
+    return 0 if root is None else sum(1 for _ in root.iter("collision"))
+
+
 def mimic_joints(urdf: str) -> dict[str, Mimic]:
     """The document's mimic joints by name."""
     root = _tree(urdf)

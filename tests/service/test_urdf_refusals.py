@@ -211,3 +211,33 @@ def test_a_mesh_outside_the_share_is_not_read(
     response = client.post("/v1/evaluate", json=evaluate_body)
     assert response.status_code == 200, response.text[:300]
     assert response.json()["cell_approximated"] == ["base"]
+
+
+def test_a_robot_of_more_collision_elements_than_a_cell_may_hold_is_a_422(
+    client: TestClient, evaluate_body: dict[str, Any]
+) -> None:
+    """Every two of a robot's collision elements are checked against each other: 1,800 small
+    boxes in a 186 KB URDF took minutes and 8 GB (the hostile-input audit). Over
+    DTF_MAX_CELL_OBJECTS (100) with a cell, refused before any work; without a cell its
+    collision elements are not read."""
+    boxes = "".join(
+        f'<collision><origin xyz="0 0 {0.001 * k}"/><geometry><box size="0.01 0.01 0.01"/>'
+        "</geometry></collision>"
+        for k in range(93)
+    )  # the UR5's own 8: 101
+    urdf = UR5.replace('<link name="wrist_3_link">', f'<link name="wrist_3_link">{boxes}', 1)
+    assert urdf != UR5
+    evaluate_body["robot"] = {"urdf": urdf, "base_frame": "base", "tool_frame": "tool0"}
+    assert client.post("/v1/evaluate", json=evaluate_body).status_code == 200
+    evaluate_body["cell"] = {"fixed": [FAR_SPHERE]}
+    detail = refusal(client, evaluate_body, urdf)
+    assert detail["msg"].startswith(
+        "101 collision elements; a robot checked against a cell may have at most 100 "
+        "(DTF_MAX_CELL_OBJECTS)"
+    ), detail
+    job = client.post("/v1/jobs", json={"kind": "evaluate", "request": evaluate_body})
+    assert job.status_code == 422, job.text[:300]
+    assert job.json()["detail"][0]["loc"] == ["body", "request", "robot", "urdf"]
+    first = boxes[: boxes.index("</collision>") + len("</collision>")]
+    evaluate_body["robot"]["urdf"] = urdf.replace(first, "", 1)  # 100: taken
+    assert client.post("/v1/evaluate", json=evaluate_body).status_code == 200
