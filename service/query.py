@@ -6,6 +6,9 @@ FastAPI reads the parameters an operation declares and drops the rest: ``POST
 string against the parameters it declares (a dependency of the app) and answers any other
 with a 422 naming it, as an unknown field of a body is. The page, the docs and ``/metrics``
 take any query string, as web pages and scrapers send them.
+
+A parameter given twice is refused too (``?limit=1&limit=2`` took the last, without a word):
+every parameter the API takes is one value.
 """
 
 from __future__ import annotations
@@ -19,7 +22,7 @@ API_PREFIX = "/v1/"
 
 
 async def known_query_parameters(request: Request) -> None:
-    """Refuse a query parameter the matched operation does not declare.
+    """Refuse a query parameter the matched operation does not declare, or one given twice.
 
     Raises:
         RequestValidationError: at ``("query", name)`` for each one (cut to 100 characters).
@@ -33,6 +36,24 @@ async def known_query_parameters(request: Request) -> None:
     for sub in route.dependant.dependencies:  # parameters of the operation's dependencies
         declared.update(field.alias for field in sub.query_params)
     unknown = [name for name in request.query_params if name not in declared]
+    repeated = [
+        name
+        for name in dict.fromkeys(request.query_params)
+        if name in declared and len(request.query_params.getlist(name)) > 1
+    ]
+    if repeated and not unknown:
+        raise RequestValidationError(
+            [
+                {
+                    "loc": ("query", name),
+                    "msg": f"{name!r} is given {len(request.query_params.getlist(name))} "
+                    "times; give it once",
+                    "type": "repeated",
+                    "input": request.query_params.getlist(name)[:10],
+                }
+                for name in repeated
+            ]
+        )
     if unknown:
         taken = ", ".join(sorted(declared)) if declared else "none"
         hint = (

@@ -193,6 +193,24 @@ def test_a_query_parameter_an_operation_does_not_take_is_a_422(
     assert f"takes no query parameter {name!r}" in detail[0]["msg"]
 
 
+@pytest.mark.parametrize(
+    ("url", "name", "times"),
+    [
+        ("/v1/jobs?limit=1&limit=2", "limit", 2),
+        ("/v1/jobs?status=done&kind=map&status=failed&status=done", "status", 3),
+    ],
+)
+def test_a_query_parameter_given_twice_is_a_422(
+    client: TestClient, url: str, name: str, times: int
+) -> None:
+    """The last was taken without a word (the hostile-input audit): ?limit=1&limit=2 listed 2."""
+    answer = client.get(url)
+    assert answer.status_code == 422, answer.text
+    detail = answer.json()["detail"]
+    assert [d["loc"] for d in detail] == [["query", name]]
+    assert detail[0]["msg"] == f"{name!r} is given {times} times; give it once"
+
+
 def test_the_page_its_docs_and_metrics_take_any_query_string(client: TestClient) -> None:
     for url in ("/?from=mail", "/docs?x=1", "/metrics?name[]=dtf_placements_total"):
         assert client.get(url).status_code == 200, url
