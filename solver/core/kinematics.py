@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pinocchio as pin
 
-from solver.core.exceptions import InvalidInputError
+from solver.core.exceptions import InvalidInputError, quoted_names
 from solver.core.robots import Robot
 
 
@@ -25,7 +25,11 @@ def check_configuration(
     """
     q_arr = np.asarray(q, dtype=float)
     if q_arr.shape != (robot.dof,):
-        raise InvalidInputError(field, f"{q_arr.shape=} but the robot has {robot.dof} joints")
+        given = f"{q_arr.size} joint positions" if q_arr.ndim == 1 else f"shape {q_arr.shape}"
+        raise InvalidInputError(
+            field,
+            f"{given}; the robot has {robot.dof} joints ({quoted_names(robot.joint_names)})",
+        )
     bad = np.flatnonzero(~np.isfinite(q_arr))
     if bad.size:
         raise InvalidInputError(

@@ -96,3 +96,18 @@ def test_panda_urdf_uses_lp_and_beats_the_pseudo_inverse(
     assert result["v_max"] >= pinv_speed * (1 - 1e-9)
     limiting = result["limiting_joint"]
     assert abs(result["qdot"][limiting]) == pytest.approx(arm.velocityLimit[limiting], rel=1e-9)
+
+
+def test_too_few_joint_positions_are_counted_and_the_joints_named(
+    client: TestClient, dtf_body: dict[str, Any]
+) -> None:
+    """The refusal read as debug output: "q_arr.shape=(5,) but the robot has 6 joints"."""
+    dtf_body["q"] = dtf_body["q"][:5]
+    response = client.post("/v1/dtf", json=dtf_body)
+    assert response.status_code == 422, response.text
+    detail = response.json()["detail"][0]
+    assert detail["loc"] == ["body", "q"]
+    assert detail["msg"] == (
+        "5 joint positions; the robot has 6 joints ('shoulder_pan_joint', 'shoulder_lift_joint', "
+        "'elbow_joint', 'wrist_1_joint', 'wrist_2_joint', 'wrist_3_joint')"
+    )
