@@ -118,7 +118,7 @@ def axis_length(lower: float, upper: float, step: float, *, field: str) -> int:
         raise InvalidInputError(field, "min, max and step must be finite")
     if step <= 0 or upper < lower:
         raise InvalidInputError(
-            field, f"needs step > 0 and max >= min, got {lower=}, {upper=}, {step=}"
+            field, f"needs step > 0 and max >= min; got min {lower}, max {upper}, step {step}"
         )
     count = (upper - lower) / step + 1e-9
     if count >= 2**53:

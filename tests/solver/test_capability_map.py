@@ -179,6 +179,13 @@ def test_bad_grid_axis(lower: float, upper: float, step: float) -> None:
     assert info.value.field == "grid.x"
 
 
+def test_a_bad_grid_axis_is_told_in_the_request_s_words() -> None:
+    """The grid's fields are min, max and step (the message said lower=0.1, upper=-0.1)."""
+    with pytest.raises(InvalidInputError) as info:
+        grid_axis(0.1, -0.1, 0.05, field="grid.x")
+    assert info.value.message == "needs step > 0 and max >= min; got min 0.1, max -0.1, step 0.05"
+
+
 def test_joint_limit_and_singular_cells_equal_evaluate() -> None:
     limited = dataclasses.replace(
         get_robot("ur5e"), q_lower=np.full(6, -math.pi / 2), q_upper=np.full(6, math.pi)
