@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import math
 import xml.etree.ElementTree as ElementTree
+from collections import Counter
 from collections.abc import Iterator
 from dataclasses import dataclass
 
@@ -270,10 +271,19 @@ def inverted_limits(root: ElementTree.Element) -> list[tuple[str, float, float]]
 def tree_problem(root: ElementTree.Element) -> str | None:
     """What keeps a parsed document's joints from forming a tree, or None where they do.
 
+    A link or joint named twice (the parser then named two root links, both the same).
     A link that is the child of two joints, or joints that lead back to where they started,
     close a loop: pinocchio's parser crashed the process on such a document (a segmentation
     fault) or read one of the two joints twice and dropped the other.
     """
+    for kind in ("link", "joint"):
+        counts = Counter(element.get("name", "") for element in root.findall(kind))
+        twice = next((name for name, count in counts.items() if count > 1), None)
+        if twice is not None:  # pinocchio's parser then named two root links, both this one
+            return (
+                f"{kind} {quoted(twice)} is defined {counts[twice]} times: each {kind} is one "
+                f"<{kind}> element"
+            )
     parents: dict[str, list[str]] = {}  # child link: the joints that have it as their child
     parent_link: dict[str, str] = {}
     for joint in root.findall("joint"):

@@ -241,3 +241,12 @@ def test_a_robot_of_more_collision_elements_than_a_cell_may_hold_is_a_422(
     first = boxes[: boxes.index("</collision>") + len("</collision>")]
     evaluate_body["robot"]["urdf"] = urdf.replace(first, "", 1)  # 100: taken
     assert client.post("/v1/evaluate", json=evaluate_body).status_code == 200
+
+
+def test_a_link_defined_twice_is_named(client: TestClient, evaluate_body: dict[str, Any]) -> None:
+    """The parser said "2 root links ('world', 'world')" (the hostile-input audit)."""
+    urdf = UR5.replace("</robot>", '<link name="stray"/><link name="stray"/></robot>')
+    detail = refusal(client, evaluate_body, urdf)
+    assert detail["msg"] == (
+        "cannot read the URDF: link 'stray' is defined 2 times: each link is one <link> element"
+    )
