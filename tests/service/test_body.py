@@ -154,6 +154,24 @@ def test_a_lone_surrogate_is_a_422_on_every_route(
     assert answer.json()["detail"][0]["type"] == "json_invalid"
 
 
+@pytest.mark.parametrize("large", [False, True], ids=["small", "large"])
+def test_a_body_after_a_utf8_byte_order_mark_is_read(client: TestClient, large: bool) -> None:
+    """RFC 8259 lets a parser ignore one (Windows tools write it); the answer was a 422 "Invalid
+    JSON: expected value at line 1 column 1". Small (validated on the loop) and large (in
+    pieces, in a thread) bodies alike: the same answer as without it."""
+    example = json.loads((ROOT / "examples" / "evaluate_request.json").read_text())
+    if large:
+        example["path"] = {"waypoints": example["path"]["waypoints"] + POSES["waypoints"][:300]}
+    raw = json.dumps(example).encode()
+    assert (len(raw) > body.INLINE_BODY_BYTES) == large
+    headers = {"content-type": "application/json"}
+    plain = client.post("/v1/evaluate", content=raw, headers=headers)
+    marked = client.post("/v1/evaluate", content=b"\xef\xbb\xbf" + raw, headers=headers)
+    assert plain.status_code == 200, plain.text[:300]
+    assert marked.status_code == 200, marked.text[:300]
+    assert marked.json() == plain.json()
+
+
 def test_a_compressed_body_is_a_415_naming_the_encoding(client: TestClient) -> None:
     """A gzip body was read as JSON: 422 'Invalid JSON', the encoding never named."""
     example = (ROOT / "examples" / "evaluate_request.json").read_bytes()
