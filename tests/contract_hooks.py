@@ -424,8 +424,13 @@ CUBE_STL = (
 )
 
 
+MESHED_ARMS = {"ur3", "ur5", "ur10"}
+"""The catalogue's 6-joint arms whose URDFs mesh every link: link radii for them are a 422."""
+
+
 def _repair_cell(body: dict[str, Any], route: str) -> None:
-    """A cell the robot can be checked in: radii for every arm (7: all are 6-joint arms here),
+    """A cell the robot can be checked in: radii for every arm but the meshed ones (7: all are
+    6-joint arms here),
     an STL for a random string, a cutting length within the tool, the robot's tcp at the tool's
     tip (a tool starting behind the flange is refused), a normal that is not 0, at
     most three objects a group. Maps and optimisations drop it: their work with a cell is
@@ -435,7 +440,12 @@ def _repair_cell(body: dict[str, Any], route: str) -> None:
         body.pop("cell")
         return
     cell = body["cell"]
-    cell["link_radii"] = [0.05] * 7
+    robot = body.get("robot")
+    meshed = isinstance(robot, dict) and robot.get("model") in MESHED_ARMS
+    if meshed:  # radii would size nothing there: a 422 (tests/service/test_cell.py)
+        cell.pop("link_radii", None)
+    else:
+        cell["link_radii"] = [0.05] * 7
     tool = cell.get("tool")
     if isinstance(tool, dict) and tool.get("cutting_length") is not None:
         tool["cutting_length"] = min(tool["cutting_length"], tool["length"])

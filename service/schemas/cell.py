@@ -109,7 +109,8 @@ class CellSpec(RequestModel):
         "published collision capsules (UR5e, UR10e: MuJoCo Menagerie's, where the links are) or "
         "its URDF's geometry; given for a UR5e or UR10e, they replace the published capsules. "
         "They size the capsules of the links the answer's cell_approximated names: an arm whose "
-        "links all carry collision geometry (the UR5's URDF meshes, the Panda's) uses none.",
+        "links all carry collision geometry (the UR5's URDF meshes, the Panda's) uses none, and "
+        "radii given for one are a 422 (they would size nothing).",
     )
 
     def to_solver(self, *, max_objects: int, max_triangles: int) -> Cell:

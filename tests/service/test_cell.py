@@ -216,6 +216,20 @@ def test_a_bad_cell_is_a_422_naming_its_field(
     assert words in json.dumps(response.json())
 
 
+def test_link_radii_for_an_arm_whose_links_all_carry_geometry_are_a_422(
+    client: TestClient, body: dict
+) -> None:
+    """The UR5's URDF meshes every link: radii of 0.05 or 0.9 m answered alike, nothing said
+    they sized nothing (the hostile-input audit, on the Panda)."""
+    body["cell"] = {"fixed": [TABLE], "link_radii": [0.9] * 7}
+    response = client.post("/v1/evaluate", json=body)
+    assert_names(response, 422, ["body", "cell", "link_radii"])
+    assert response.json()["detail"][0]["msg"] == (
+        "every link of 'ur5' carries its URDF's collision geometry, and link_radii size only the "
+        "capsules of links without any: leave them out"
+    )
+
+
 def test_a_map_in_a_cell_weighs_its_collision_work(
     client: TestClient, body: dict, setting: Any
 ) -> None:
@@ -274,7 +288,6 @@ def test_a_tool_without_thickness_is_checked(client: TestClient, body: dict) -> 
     body["robot"]["tcp"] = {"position": [0.0, 0.0, 0.12], "orientation": [0, 0, 0, 1]}
     body["cell"] = {
         "fixed": [TABLE],
-        "link_radii": [0.05] * 7,
         "tool": {"radius": 5e-324, "length": 0.12, "cutting_length": 5e-324},
         "collision_step": 0.001,
     }
@@ -318,8 +331,9 @@ def test_an_optimisation_in_a_cell_weighs_its_collision_work(
 def test_the_answer_names_the_links_given_capsules(
     client: TestClient, body: dict, model: str, count: int
 ) -> None:
+    """The UR5's URDF meshes every link (link radii for it are a 422: the test above)."""
     body["robot"] = {"model": model}
-    body["cell"] = {"fixed": [TABLE], "link_radii": [0.05] * 7}
+    body["cell"] = {"fixed": [TABLE]} | ({"link_radii": [0.05] * 7} if count else {})
     answer = client.post("/v1/evaluate", json=body).json()
     assert len(answer["cell_approximated"]) == count
 

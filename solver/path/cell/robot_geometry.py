@@ -90,8 +90,9 @@ def robot_geometry(
     """The geometry of ``robot`` (and its tool) on ``robot.model``.
 
     Raises:
-        InvalidInputError: on ``cell.link_radii``: the wrong count, or none given for an arm
-            without collision elements or published radii.
+        InvalidInputError: on ``cell.link_radii``: the wrong count, none given for an arm
+            without collision elements or published radii, or some given for an arm whose
+            links all carry collision elements (they would size nothing).
     """
     model = robot.model
     published = None if link_radii is not None else published_geometry(robot)
@@ -104,6 +105,12 @@ def robot_geometry(
     seats = _below_mount(robot, geometry) if published is not None else [0.0] * geometry.ngeoms
     bare = [] if published is not None else _bare_joints(model, geometry)
     radii = _radii(robot, link_radii, needed=bool(bare) and robot.urdf is None)
+    if link_radii is not None and not bare:  # they would size nothing: say so, not drop them
+        raise InvalidInputError(
+            "cell.link_radii",
+            f"every link of {robot.shown_name!r} carries its URDF's collision geometry, and "
+            "link_radii size only the capsules of links without any: leave them out",
+        )
     approximated = []
     for joint in bare:
         radius = radii[joint] if radii is not None else DEFAULT_URDF_LINK_RADIUS
