@@ -18,7 +18,7 @@ from solver.kernels.fixed_spin import map_cells
 from solver.kernels.free_spin import free_cells
 from solver.kernels.joint_paths import branch_paths, spun_branch_paths
 from solver.kernels.positions import limit_modes
-from solver.path.limits import JointAccelerationLimit
+from solver.path.limits import JointAccelerationLimit, JointSpeedLimit
 from solver.path.placed import flange_at_spin
 from solver.path.problem import PathProblem
 
@@ -237,12 +237,17 @@ def kernel_of(problem: PathProblem) -> tuple[int, np.ndarray] | None:
     """The compiled pose kernel of the robot's family, where it has one (either spin mode).
 
     With or without joint acceleration limits: the kernels compute mu_acc as the numpy pipeline
-    does (:mod:`solver.kernels.accelerations`). None where a final-path limit other than the
-    joint accelerations is given (no kernel has its hook), or in free spin with an angled or
-    offset spindle (the spun poses are solved again, :mod:`solver.path.exact_spin`, which the
-    free-spin kernel does not): the numpy pipeline runs.
+    does (:mod:`solver.kernels.accelerations`). None where a limit other than the joint speed
+    limits (at each waypoint: the kernels compute the DTF of ``robot.qdot_max`` themselves) and
+    the joint accelerations (on the final path) is given: no kernel has its hook, and a new
+    limit was silently dropped by the maps and the optimisers while the evaluator applied it
+    (the seams audit: a 0.1 m/s feed cap, 0.294 m/s on the map); or in free spin with an
+    angled or offset spindle (the spun poses are solved again, :mod:`solver.path.exact_spin`,
+    which the free-spin kernel does not): the numpy pipeline runs.
     """
-    if any(not isinstance(limit, JointAccelerationLimit) for limit in problem.final_path_limits):
+    if any(type(limit) is not JointSpeedLimit for limit in problem.waypoint_limits):
+        return None
+    if any(type(limit) is not JointAccelerationLimit for limit in problem.final_path_limits):
         return None
     if problem.exact_spin:
         return None
