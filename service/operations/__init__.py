@@ -8,6 +8,7 @@ the same code's. The optimisation is imported from its module
 optimisers, casadi), which a command line that evaluates or maps never loads.
 """
 
+from service.operations.dtf import dtf_of
 from service.operations.evaluate import evaluation_of, joint_use_png
 from service.operations.map import checked_grid, computed_map, map_png
 from service.operations.paths import import_of, imported
@@ -15,6 +16,7 @@ from service.operations.paths import import_of, imported
 __all__ = [
     "checked_grid",
     "computed_map",
+    "dtf_of",
     "evaluation_of",
     "import_of",
     "imported",

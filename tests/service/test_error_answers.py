@@ -191,7 +191,7 @@ def test_a_fault_is_a_json_500(monkeypatch: pytest.MonkeyPatch, tmp_path: Path) 
     def broken(*args: Any, **kwargs: Any) -> None:
         raise RuntimeError("a bug")
 
-    monkeypatch.setattr("service.api.routes.dtf.dtf", broken)
+    monkeypatch.setattr("service.operations.dtf.dtf", broken)
     body = {"robot": {"model": "ur5"}, "q": [0.1, -1.2, 1.3, -1.5, -1.4, 0.2], "u_T": [1, 0, 0]}
     answer = TestClient(app, raise_server_exceptions=False).post("/v1/dtf", json=body)
     detail = _is_error_list(answer, 500)
