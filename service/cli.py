@@ -50,7 +50,7 @@ from pydantic import BaseModel, ValidationError
 from service.cli_files import decoded, file_bytes, text_file
 from service.cli_text import ProgressBar, evaluation_text, import_text, map_text, optimum_text
 from service.config import Settings, settings_or_exit
-from service.errors import request_errors, solver_error_location
+from service.convert.errors import request_errors, solver_error_location
 from service.operations import computed_map, evaluation_of, import_of, map_png
 from service.schemas import EvaluateRequest, MapRequest, OptimizeRequest, RobotRead
 from service.schemas.paths_import import PathImportRequest

@@ -10,8 +10,6 @@ of placements, a DE generation or an IPOPT iteration), so no thread keeps comput
 from __future__ import annotations
 
 import asyncio
-import os
-import sys
 import threading
 from collections.abc import Callable
 from typing import TypeVar
@@ -20,6 +18,7 @@ import anyio
 from fastapi import Request, Response
 from pydantic import BaseModel
 
+from service.operations.threads import lower_this_thread
 from solver.core.progress import Cancelled, Progress
 
 T = TypeVar("T")
@@ -27,30 +26,6 @@ WATCH_SECONDS = 0.1
 """How often the connection is looked at while work runs (s)."""
 STOPPING = threading.Event()
 """Set when the service shuts down: every running work stops at its next report."""
-WORK_NICENESS = 10
-"""How much lower than the event loop a worker thread runs (Linux nice steps)."""
-
-
-def lower_this_thread() -> None:
-    """Run the calling thread WORK_NICENESS below the process; threads it starts inherit it.
-
-    On a machine whose cores are all busy with solver work, the event loop otherwise waits
-    for a time slice like any worker, and /healthz takes tens of milliseconds. Linux only: a
-    thread's nice value is its own; elsewhere nothing changes. A thread already that low (one
-    started by a lowered thread) is left as it is.
-    """
-    if getattr(_lowered, "done", False) or not sys.platform.startswith("linux"):
-        return
-    thread = threading.get_native_id()
-    lowered = min(_PROCESS_NICENESS + WORK_NICENESS, 19)
-    if os.getpriority(os.PRIO_PROCESS, thread) < lowered:
-        os.setpriority(os.PRIO_PROCESS, thread, lowered)
-    _lowered.done = True
-
-
-_lowered = threading.local()
-_PROCESS_NICENESS = os.getpriority(os.PRIO_PROCESS, 0) if sys.platform.startswith("linux") else 0
-"""The nice value of the thread that imports this module (the process's main thread)."""
 
 
 def json_response(answer: BaseModel) -> Response:

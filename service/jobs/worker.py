@@ -24,8 +24,8 @@ from typing import Any
 from pydantic import ValidationError
 
 from service.config import Settings
+from service.convert.errors import request_errors, solver_error_location, solver_error_type
 from service.convert.map_json import cell_pages
-from service.errors import request_errors, solver_error_location, solver_error_type
 from service.jobs.dask_runner import ClusterUnavailable
 from service.jobs.job import DamagedJob, JobStoreUnavailable
 from service.jobs.results import PAGE_CELLS, CellPages, Result

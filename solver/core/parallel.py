@@ -91,7 +91,8 @@ class ThreadRunner:
     Args:
         threads: threads at most, >= 1.
         initializer: called in each helper thread as it starts (the service lowers the
-            thread's priority below its event loop's: :func:`service.work.lower_this_thread`).
+            thread's priority below its event loop's:
+            :func:`service.operations.threads.lower_this_thread`).
     """
 
     def __init__(self, threads: int, *, initializer: Callable[[], None] | None = None) -> None:

@@ -8,8 +8,7 @@ import threading
 
 import pytest
 
-from service.operations.threads import thread_runner
-from service.work import WORK_NICENESS, lower_this_thread
+from service.operations.threads import WORK_NICENESS, lower_this_thread, thread_runner
 
 pytestmark = pytest.mark.skipif(not sys.platform.startswith("linux"), reason="Linux thread nice")
 
