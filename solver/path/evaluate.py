@@ -24,7 +24,13 @@ from solver.core.two_variable_lp import spin_rate_nearest_zero
 from solver.kernels.spin_lp import spin_rate_at_feed
 from solver.path.bottleneck import bottleneck_waypoints
 from solver.path.cell.verdict import CellVerdict, Contact, Unchecked
-from solver.path.limits import JointAccelerationLimit, JointMotion, PathVerdict, bound_by_limits
+from solver.path.limits import (
+    JointAccelerationLimit,
+    JointMotion,
+    PathVerdict,
+    bound_by_limits,
+    refused_reason,
+)
 from solver.path.path_checks import check_path, checks_model, clear_pick
 from solver.path.pipeline import run_chunk
 from solver.path.placed import check_placements
@@ -199,13 +205,14 @@ def evaluate_path(
     pick = int(run.pick[0])
     reason = int(run.tracked.reason[pick, 0])
     verdict: PathVerdict | None = None
-    collision, model = None, {}
+    collision, model, refused_at = None, {}, None
     if reason == FEASIBLE and problem.path_checks:
         chosen, verdict, refusal = clear_pick(problem, run, cell, 0, thorough=thorough)
         model = checks_model(problem)
         if chosen is None and refusal is not None:
-            reason = problem.path_checks[0].reason
-            collision = cell_detail(refusal).collision
+            reason, refused_at = refused_reason(refusal), refusal.failed_waypoint
+            report = cell_report(refusal)
+            collision = None if report is None else report.collision
         else:
             pick = int(chosen) if chosen is not None else pick
     infeasible = PathEvaluation(
@@ -214,9 +221,9 @@ def evaluate_path(
         bottleneck_waypoint=None,
         bottleneck_joint=None,
         reason=REASONS[reason] if reason != FEASIBLE else None,
-        failed_waypoint=(
-            int(run.tracked.failed_waypoint[pick, 0]) if collision is None else collision.waypoint
-        ),
+        failed_waypoint=int(run.tracked.failed_waypoint[pick, 0])
+        if refused_at is None
+        else refused_at,
         branch=family.branches[int(indices[pick])],
         u_T=_turned(path.u_T, placement.yaw),
         u_R=_turned(path.u_R, placement.yaw),
@@ -265,7 +272,7 @@ def evaluate_path(
         qdot=qdot.T,
         limiting_joint=limiting,
         spins=spins,
-        min_clearance=None if verdict is None else cell_detail(verdict).closest,
+        min_clearance=closest_of(verdict),
     )
 
 
@@ -284,12 +291,16 @@ def with_min_clearance(
     verdict = check_path(problem, evaluation.q, placement.as_row(), thorough=True)
     if verdict is None:
         return evaluation
-    return dataclasses.replace(evaluation, min_clearance=cell_detail(verdict).closest)
+    return dataclasses.replace(evaluation, min_clearance=closest_of(verdict))
 
 
-def cell_detail(verdict: PathVerdict) -> CellVerdict:
-    """The cell's report in a path check's verdict."""
-    detail = verdict.detail
-    if not isinstance(detail, CellVerdict):
-        raise TypeError(f"a path check gave {type(detail).__name__}, not a CellVerdict")
-    return detail
+def cell_report(verdict: PathVerdict | None) -> CellVerdict | None:
+    """The cell's report in a path check's verdict; None for another check's, or no verdict."""
+    detail = None if verdict is None else verdict.detail
+    return detail if isinstance(detail, CellVerdict) else None
+
+
+def closest_of(verdict: PathVerdict | None) -> Contact | None:
+    """The closest pair a verdict of the cell reports (``min_clearance``); None otherwise."""
+    report = cell_report(verdict)
+    return None if report is None else report.closest

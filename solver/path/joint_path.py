@@ -17,13 +17,19 @@ import math
 
 import numpy as np
 
+from solver.core.codes import REASONS
 from solver.core.exceptions import InvalidInputError
 from solver.core.kinematics import tool_pose_in_base
 from solver.core.progress import Progress
 from solver.core.spatial import Placement, rotation_about_z
 from solver.path.bottleneck import bottleneck_waypoints
-from solver.path.evaluate import PathEvaluation, acceleration_index, cell_detail
-from solver.path.limits import JointMotion, bound_by_limits
+from solver.path.evaluate import (
+    PathEvaluation,
+    acceleration_index,
+    cell_report,
+    closest_of,
+)
+from solver.path.limits import JointMotion, bound_by_limits, refused_reason
 from solver.path.path_checks import check_path, checks_model
 from solver.path.placed import turn_by_yaw
 from solver.path.problem import PathProblem
@@ -167,11 +173,12 @@ def evaluate_joint_path(
         return dataclasses.replace(infeasible, reason="singular", failed_waypoint=int(singular[0]))
     verdict = check_path(problem, q, placement.as_row(), thorough=True)
     if verdict is not None and verdict.failed_waypoint is not None:
+        report = cell_report(verdict)
         return dataclasses.replace(
             infeasible,
-            reason="collision",
+            reason=REASONS[refused_reason(verdict)],
             failed_waypoint=verdict.failed_waypoint,
-            collision=cell_detail(verdict).collision,
+            collision=None if report is None else report.collision,
             **checks_model(problem),
         )
     v_max = np.where(path.pure_rotation, 0.0, speed)
@@ -195,7 +202,7 @@ def evaluate_joint_path(
         omega_max=omega_max,
         qdot=(qd_unit * speed).T,
         limiting_joint=limiting,
-        min_clearance=None if verdict is None else cell_detail(verdict).closest,
+        min_clearance=closest_of(verdict),
         **({} if verdict is None else checks_model(problem)),
     )
 

@@ -121,10 +121,25 @@ class PathVerdict:
     Attributes:
         failed_waypoint: where the path is refused; None: admitted.
         detail: the check's report (the cell: :class:`solver.path.cell.verdict.CellVerdict`).
+        reason: the refusing check's reason code (:data:`solver.core.codes.REASONS`); None
+            where admitted. A problem may hold several checks: answers take the reason from
+            the verdict that refused, not from the first check.
     """
 
     failed_waypoint: int | None
     detail: object
+    reason: int | None = None
+
+
+def refused_reason(verdict: PathVerdict) -> int:
+    """The reason code of a refusing verdict: its check's (not the problem's first check's).
+
+    Raises:
+        ValueError: the verdict refuses no path, or its check gave no reason.
+    """
+    if verdict.failed_waypoint is None or verdict.reason is None:
+        raise ValueError("a path check refused a path without giving its reason")
+    return verdict.reason
 
 
 class PathCheck(abc.ABC):

@@ -24,7 +24,7 @@ from solver.path.branch_candidates import (
     pipeline_candidates,
     run_candidates,
 )
-from solver.path.limits import PathVerdict
+from solver.path.limits import PathVerdict, refused_reason
 from solver.path.pipeline import ChunkResult, run_chunk
 from solver.path.problem import PathProblem
 
@@ -300,7 +300,7 @@ def _refuse_the_rest(
     """The ``cells`` among the refused placements refused where their first pick was."""
     for c in cells.tolist():
         verdict = refused[int(c)][1]
-        _refuse(out, int(c), problem.path_checks[0].reason, int(verdict.failed_waypoint or 0))
+        _refuse(out, int(c), refused_reason(verdict), int(verdict.failed_waypoint or 0))
 
 
 PRUNED_ROUNDS = 2

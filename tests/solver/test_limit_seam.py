@@ -1,4 +1,4 @@
-"""A limit of its own plugs into the problem's limits, and every route honours it.
+"""A limit or path check of its own plugs into the problem, and every route honours it.
 
 The compiled map kernels compute the joint speed limits' DTF themselves: a waypoint limit they
 do not know was silently dropped by the maps and every optimiser while the evaluator applied
@@ -10,10 +10,12 @@ from __future__ import annotations
 
 import numpy as np
 
+from solver.core.codes import REASON_COLLISION, REASON_JOINT_LIMITS, REASONS
+from solver.core.spatial import Placement
 from solver.families import get_robot
 from solver.path.capability_map import capability_map
 from solver.path.evaluate import evaluate_path
-from solver.path.limits import JointMotion, Limit
+from solver.path.limits import JointMotion, Limit, PathCheck, PathVerdict
 from solver.path.problem import PathProblem
 from tests.solver.test_evaluate import load_path
 
@@ -40,3 +42,43 @@ def test_a_map_honours_a_limit_the_kernels_do_not_know() -> None:
     for index in feasible:
         assert cmap.mu_path[index] == CAP
         assert evaluate_path(problem, cmap.placement(index)).mu_path == CAP
+
+
+class Joint1Range(PathCheck):
+    """A check of the test's own: joint 1 within +-bound (a cable that must not wind)."""
+
+    name = "joint 1 range"
+    reason = REASON_JOINT_LIMITS
+
+    def __init__(self, bound: float) -> None:
+        self.bound = bound
+
+    def check(self, q: np.ndarray, placement: np.ndarray, *, thorough: bool) -> PathVerdict:
+        outside = np.flatnonzero(np.abs(q[:, 0]) > self.bound)
+        if not outside.size:
+            return PathVerdict(None, None)
+        return PathVerdict(int(outside[0]), None, self.reason)
+
+
+class Admits(PathCheck):
+    """A check that admits every path, first in the problem's checks."""
+
+    name = "admits"
+    reason = REASON_COLLISION
+
+    def check(self, q: np.ndarray, placement: np.ndarray, *, thorough: bool) -> PathVerdict:
+        return PathVerdict(None, None)
+
+
+def test_a_path_check_of_its_own_refuses_with_its_reason() -> None:
+    """The answers took the first check's reason and read a cell's report from any refusal:
+    a check other than the cell's crashed evaluate_path (TypeError), and behind another check
+    its refusals were called collisions (the seams audit)."""
+    problem = PathProblem.of(get_robot("ur5"), load_path("curved_line")[::4])
+    problem.__dict__["path_checks"] = (Admits(), Joint1Range(0.0))  # |q1| > 0: every branch
+    evaluation = evaluate_path(problem, Placement(0.0, 0.45, 0.1, 0.0))
+    assert (evaluation.reason, evaluation.failed_waypoint) == ("joint_limits", 0)
+    assert evaluation.collision is None
+    cmap = capability_map(problem, xs=np.array([-0.1, 0.1]), ys=np.array([0.45]), z=0.1,
+                          yaws=np.zeros(1))  # fmt: skip
+    assert [REASONS[r] for r in cmap.reason.ravel()] == ["joint_limits", "joint_limits"]

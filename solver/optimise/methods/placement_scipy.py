@@ -222,7 +222,7 @@ def evolve(
         population keeps moving towards the fast placements, whose edge against the obstacles
         is where the cell's optimum lies, instead of settling in the first clear basin.
         """
-        refused = np.flatnonzero(reasons == problem.path_checks[0].reason)
+        refused = np.flatnonzero(np.isin(reasons, [c.reason for c in problem.path_checks]))
         if len(refused):
             kinematic = evaluate_placements(clear, bounds.rows(vectors[refused]), runner=runner)
             values[refused] = 1.0 / (2.0 + np.nan_to_num(kinematic.feed_index))

@@ -36,7 +36,7 @@ class CellLimit(PathCheck):
         transform = Placement(x, y, z, yaw).transform_workpiece_to_base()
         verdict = self.checker.check(q, self.segment_in_pass, transform, closest=thorough)
         failed = None if verdict.collision is None else verdict.collision.waypoint
-        return PathVerdict(failed, verdict)
+        return PathVerdict(failed, verdict, None if failed is None else self.reason)
 
     def model(self) -> dict[str, Any]:
         """The links given capsules and the parts not checked (``CapabilityMap``'s fields)."""
@@ -64,7 +64,10 @@ class CellLimit(PathCheck):
             joint_paths, self.segment_in_pass, workpiece_to_base(placements)
         )
         return [
-            PathVerdict(None if v.collision is None else v.collision.waypoint, v) for v in verdicts
+            PathVerdict(None, v)
+            if v.collision is None
+            else PathVerdict(v.collision.waypoint, v, self.reason)
+            for v in verdicts
         ]
 
 
