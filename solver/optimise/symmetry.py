@@ -20,7 +20,6 @@ import numpy as np
 from solver.core.kinematics import jacobian_in_base, tool_pose_in_base
 from solver.core.robots import Robot
 from solver.optimise.search_space import PlacementBounds
-from solver.path.cell.shapes import Cell, Halfspace
 from solver.path.problem import PathProblem
 
 _TWO_PI = 2 * math.pi
@@ -47,22 +46,14 @@ def turns_about_base_z(robot: Robot) -> bool:
 def symmetric_search(problem: PathProblem) -> bool:
     """Whether the optimisers search over (r, psi).
 
-    Joint 1 turns about the base z axis (:func:`turns_about_base_z`) and the problem's cell, if
-    any, turns into itself about it.
+    Joint 1 turns about the base z axis (:func:`turns_about_base_z`), and every limit and path
+    check of the problem keeps a turn of the placement about it
+    (:attr:`PathProblem.keeps_base_turn`: the cell's, where its fixed objects turn into
+    themselves). A limit or check that does not say so breaks the symmetry: the search then
+    runs over (x, y, yaw), slower but right (a joint-1 range searched over (r, psi) was
+    silently wrong: the seams audit).
     """
-    cell = problem.options.cell
-    return turns_about_base_z(problem.robot) and (cell is None or _turns_into_itself(cell))
-
-
-def _turns_into_itself(cell: Cell) -> bool:
-    """Whether every fixed object is a halfspace whose normal (posed) is the base z axis."""
-    for shape in cell.fixed:
-        if not isinstance(shape, Halfspace):
-            return False
-        normal = np.asarray(shape.pose, dtype=float)[:3, :3] @ np.asarray(shape.normal, float)
-        if np.linalg.norm(np.cross(normal, [0.0, 0.0, 1.0])) > 1e-12 * np.linalg.norm(normal):
-            return False
-    return True
+    return turns_about_base_z(problem.robot) and problem.keeps_base_turn
 
 
 def arc_coordinates(x: float, y: float, yaw: float) -> tuple[float, float]:

@@ -61,6 +61,10 @@ class Limit(abc.ABC):
     #: False: it bounds V_max at each waypoint (mu_path); True: it bounds a constant feed along
     #: the final tracked joint path (mu_acc), and V_max keeps its meaning.
     on_final_path: bool = False
+    #: True where its bound is the same at a placement turned about the base z axis (the joint
+    #: paths then differ by joint 1's shift alone): the optimisers may search over (r, psi)
+    #: (:func:`solver.optimise.symmetry.symmetric_search`). False unless a limit says so.
+    keeps_base_turn: bool = False
 
     @abc.abstractmethod
     def speed_bound(self, motion: JointMotion) -> tuple[np.ndarray, np.ndarray]:
@@ -86,6 +90,7 @@ class JointSpeedLimit(Limit):
     """
 
     name = "speed"
+    keeps_base_turn = True  # joint speeds per unit feed do not depend on q1
 
     def __init__(self, qdot_max: np.ndarray) -> None:
         """Hold the limits.
@@ -199,6 +204,7 @@ class JointAccelerationLimit(Limit):
 
     name = "acceleration"
     on_final_path = True
+    keeps_base_turn = True  # D_i: second differences of the joint paths, joint 1's shift cancels
 
     def __init__(self, qddot_max: np.ndarray, stencil: BlendStencil) -> None:
         """Hold the limits and the path's stencil.

@@ -200,6 +200,20 @@ class PathProblem:
         checker = checker_for(self.robot, cell)
         return (CellLimit(checker, self.prepared.segment_in_pass),)
 
+    @property
+    def keeps_base_turn(self) -> bool:
+        """Whether every limit and path check is the same at a placement turned about base z.
+
+        Each limit says so (:attr:`solver.path.limits.Limit.keeps_base_turn`); the path checks
+        are the cell's (:attr:`path_checks`), which keeps it where its fixed objects turn into
+        themselves (:meth:`solver.path.cell.shapes.Cell.turns_into_itself`), told from the cell
+        without building its checker. A check added to :attr:`path_checks` says here whether
+        it keeps the turn.
+        """
+        cell = self.options.cell
+        limits_keep = all(limit.keeps_base_turn for limit in self.limits)
+        return limits_keep and (cell is None or cell.turns_into_itself())
+
     @functools.cached_property
     def exact_spin(self) -> bool:
         """Whether free spin's joint paths are solved again at the spun poses.

@@ -13,6 +13,7 @@ import numpy as np
 from solver.core.codes import REASON_COLLISION, REASON_JOINT_LIMITS, REASONS
 from solver.core.spatial import Placement
 from solver.families import get_robot
+from solver.optimise.symmetry import symmetric_search
 from solver.path.capability_map import capability_map
 from solver.path.evaluate import evaluate_path
 from solver.path.limits import JointMotion, Limit, PathCheck, PathVerdict
@@ -82,3 +83,13 @@ def test_a_path_check_of_its_own_refuses_with_its_reason() -> None:
     cmap = capability_map(problem, xs=np.array([-0.1, 0.1]), ys=np.array([0.45]), z=0.1,
                           yaws=np.zeros(1))  # fmt: skip
     assert [REASONS[r] for r in cmap.reason.ravel()] == ["joint_limits", "joint_limits"]
+
+
+def test_a_limit_that_does_not_say_it_keeps_a_base_turn_breaks_the_symmetry() -> None:
+    """The (r, psi) search assumes every limit is the same at a placement turned about the base
+    z axis; it was decided from the cell alone, and a joint-1 range searched that way was
+    silently wrong (the seams audit). A limit is taken to keep the turn only where it says so."""
+    problem = PathProblem.of(get_robot("ur5"), load_path("curved_line")[::4])
+    assert symmetric_search(problem)
+    problem.__dict__["limits"] = (*problem.limits, FeedCap())
+    assert not symmetric_search(problem)

@@ -291,6 +291,21 @@ class Cell:
     collision_step: float = DEFAULT_COLLISION_STEP
     link_radii: tuple[float, ...] | None = None
 
+    def turns_into_itself(self) -> bool:
+        """Whether the cell is the same after a turn of the placement about the base z axis.
+
+        The workpiece objects, the tool and the robot turn with the placement; the fixed
+        objects must turn into themselves: each a halfspace whose normal (posed) is the base z
+        axis (a floor or table top). A fixture beside the robot does not.
+        """
+        for shape in self.fixed:
+            if not isinstance(shape, Halfspace):
+                return False
+            normal = np.asarray(shape.pose, dtype=float)[:3, :3] @ np.asarray(shape.normal, float)
+            if np.linalg.norm(np.cross(normal, [0.0, 0.0, 1.0])) > 1e-12 * np.linalg.norm(normal):
+                return False
+        return True
+
     def check(self) -> None:
         """Raise InvalidInputError on the first bad field, named as the request names it."""
         for group, shapes in (("fixed", self.fixed), ("workpiece", self.workpiece)):
