@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import enum
 import json
+import typing
 from typing import Any
 
 import pytest
@@ -13,6 +14,8 @@ from typing_extensions import TypeAliasType
 
 from service import schemas
 from service.main import app
+from solver.core.family import KinematicsFamily
+from solver.families import catalogue
 
 MODELS = [
     model
@@ -69,3 +72,15 @@ def test_failure_reasons_are_one_enum() -> None:
     ]
     text = json.dumps(COMPONENTS)
     assert text.count('"discontinuous"') == 1
+
+
+def _subclasses(cls: type) -> set[type]:
+    return {sub for direct in cls.__subclasses__() for sub in {direct, *_subclasses(direct)}}
+
+
+def test_the_answers_family_names_every_family_of_the_solver() -> None:
+    """ik.family is a closed list in the contract: a family the solver adds answered 500 on
+    /v1/evaluate until the schema named it (the seams audit). This holds the two together."""
+    catalogue()  # every family module imported
+    names = {getattr(c, "name", None) for c in _subclasses(KinematicsFamily)} - {None}
+    assert names == set(typing.get_args(schemas.IkInfo.model_fields["family"].annotation))
