@@ -17,6 +17,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from solver.core.exceptions import InvalidLineError
+from solver.core.spatial import MAX_COORDINATE
 from solver.core.tool_axis import NEAR_UNIT_TOLERANCE
 
 
@@ -48,7 +49,8 @@ def msys(values: np.ndarray, *, field: str, line: int, text: str) -> CoordinateS
     """The system of ``MSYS/x, y, z, xi, xj, xk, yi, yj, yk`` (9 numbers).
 
     Raises:
-        InvalidLineError: another count, or axes that are not orthonormal within 1e-3.
+        InvalidLineError: another count, axes that are not orthonormal within 1e-3, or an
+            origin beyond MAX_ORIGIN.
     """
     if values.shape != (9,):
         raise InvalidLineError(
@@ -64,14 +66,17 @@ def msys(values: np.ndarray, *, field: str, line: int, text: str) -> CoordinateS
         line=line,
         text=text,
     )
-    return CoordinateSystem(rotation=rotation, origin=values[:3].copy())
+    return CoordinateSystem(
+        rotation=rotation, origin=_origin(values[:3], field=field, line=line, text=text)
+    )
 
 
 def csys(values: np.ndarray, *, field: str, line: int, text: str) -> CoordinateSystem:
     """The system of ``CSYS/`` and its 3 x 4 matrix, row by row (12 numbers).
 
     Raises:
-        InvalidLineError: another count, or a matrix whose R is not a rotation within 1e-3.
+        InvalidLineError: another count, a matrix whose R is not a rotation within 1e-3, or an
+            origin beyond MAX_ORIGIN.
     """
     if values.shape != (12,):
         raise InvalidLineError(
@@ -82,7 +87,32 @@ def csys(values: np.ndarray, *, field: str, line: int, text: str) -> CoordinateS
         )
     matrix = values.reshape(3, 4)
     rotation = _orthonormal(matrix[:, :3], field=field, line=line, text=text)
-    return CoordinateSystem(rotation=rotation, origin=matrix[:, 3].copy())
+    return CoordinateSystem(
+        rotation=rotation, origin=_origin(matrix[:, 3], field=field, line=line, text=text)
+    )
+
+
+MAX_ORIGIN = MAX_COORDINATE / 1e-3
+"""The largest coordinate of a system's origin, in the file's unit: MAX_COORDINATE in mm, the
+smallest unit a program states (its unit may be stated after the system). An origin beyond it
+was refused at the next GOTO, as that point's position (the hostile-input audit: MSYS/1e308)."""
+
+
+def _origin(origin: np.ndarray, *, field: str, line: int, text: str) -> np.ndarray:
+    """The system's origin, refused where it is not finite or beyond MAX_ORIGIN.
+
+    Raises:
+        InvalidLineError: on the system's own line.
+    """
+    if not np.all(np.abs(origin) <= MAX_ORIGIN):  # NaN too
+        raise InvalidLineError(
+            field,
+            f"the coordinate system's origin {origin.tolist()} is beyond +-{MAX_COORDINATE:g} m "
+            "in any length unit",
+            line=line,
+            text=text,
+        )
+    return origin.copy()
 
 
 def _orthonormal(rotation: np.ndarray, *, field: str, line: int, text: str) -> np.ndarray:

@@ -9,11 +9,12 @@ from __future__ import annotations
 import math
 
 import numpy as np
+import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from solver.cam.cl_data import read_cl_data
-from solver.core.exceptions import SolverError
+from solver.core.exceptions import InvalidLineError, SolverError
 
 WORDS = [
     "GOTO", "CIRCLE", "FEDRAT", "RAPID", "UNITS", "UNIT", "MULTAX", "TLAXIS", "MSYS", "CSYS",
@@ -65,3 +66,18 @@ def test_a_huge_arc_at_a_fine_tolerance_is_refused_not_computed() -> None:
     else:
         raise AssertionError("a 1e-300 m tolerance on a 900 m arc must be refused")
     assert math.isfinite(read_cl_data(program).positions.max())
+
+
+@pytest.mark.parametrize(
+    ("record", "line"),
+    [("MSYS/1e308,0,0,1,0,0,0,1,0", 2), ("CSYS/1,0,0,0,0,1,0,0,0,0,1,2e6", 2)],
+)
+def test_a_coordinate_system_beyond_reach_is_refused_on_its_own_line(
+    record: str, line: int
+) -> None:
+    """The MSYS origin 1e308 was refused at the next GOTO, as that point's position."""
+    with pytest.raises(InvalidLineError) as error:
+        read_cl_data(f"UNITS/MM\n{record}\nGOTO/1,2,3\nGOTO/2,2,3\n")
+    assert error.value.line == line
+    assert "the coordinate system's origin" in error.value.message
+    assert "beyond +-1000 m in any length unit" in error.value.message
