@@ -9,10 +9,14 @@ numpy pipeline, which loops over the limits.
 from __future__ import annotations
 
 import numpy as np
+import pytest
 
 from solver.core.codes import REASON_COLLISION, REASON_JOINT_LIMITS, REASONS
+from solver.core.exceptions import InvalidInputError
 from solver.core.spatial import Placement
 from solver.families import get_robot
+from solver.optimise.optimize import optimize_placement
+from solver.optimise.search_space import PlacementBounds
 from solver.optimise.symmetry import symmetric_search
 from solver.path.capability_map import capability_map
 from solver.path.evaluate import evaluate_path
@@ -93,3 +97,18 @@ def test_a_limit_that_does_not_say_it_keeps_a_base_turn_breaks_the_symmetry() ->
     assert symmetric_search(problem)
     problem.__dict__["limits"] = (*problem.limits, FeedCap())
     assert not symmetric_search(problem)
+
+
+def test_the_casadi_method_refuses_a_limit_its_nlp_has_no_rows_for() -> None:
+    """IPOPT's rows are the joint speed and acceleration limits by name: with another limit it
+    climbed to the optimum of those alone (the seams audit). The scipy method evaluates every
+    limit: its optimum holds the cap."""
+    problem = PathProblem.of(get_robot("ur5"), load_path("curved_line")[::4])
+    problem.__dict__["limits"] = (*problem.limits, FeedCap())
+    bounds = PlacementBounds(x=(-0.05, 0.05), y=(0.4, 0.5), yaw=(-0.2, 0.2), z=0.1)
+    with pytest.raises(InvalidInputError) as error:
+        optimize_placement(problem, bounds=bounds, method="casadi")
+    assert error.value.field == "method"
+    assert "not for the 'feed cap' limit: use method scipy" in error.value.message
+    optimum = optimize_placement(problem, bounds=bounds, method="scipy")
+    assert optimum.mu_path == CAP

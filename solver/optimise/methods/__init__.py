@@ -49,7 +49,9 @@ class Method:
 
 
 METHODS: dict[str, Method] = {
-    "casadi": Method(casadi_method.DESCRIPTION, casadi_method.search, spin_path=True),
+    "casadi": Method(
+        casadi_method.DESCRIPTION, casadi_method.search, casadi_method.check, spin_path=True
+    ),
     "scipy": Method(
         scipy_method.DESCRIPTION, scipy_method.search, scipy_method.check, map_seeds=True
     ),

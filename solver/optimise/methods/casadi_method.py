@@ -18,6 +18,7 @@ from functools import partial
 
 import numpy as np
 
+from solver.core.exceptions import InvalidInputError
 from solver.core.progress import Progress, span
 from solver.optimise.active_set import (
     MAX_ROUNDS,
@@ -32,10 +33,33 @@ from solver.optimise.local_search import climbs, refine_cells
 from solver.optimise.methods.placement_nlp import NlpResult, PlacementNlp
 from solver.optimise.search_space import PlacementBounds
 from solver.path.evaluate import evaluate_path
+from solver.path.limits import JointAccelerationLimit, JointSpeedLimit
 from solver.path.problem import PathProblem
 
 DESCRIPTION = "ipopt (casadi), from the coarse map's maxima"
 N_STARTS = 4  # IPOPT solves, from the coarse maxima that refine best
+NLP_LIMITS = (JointSpeedLimit, JointAccelerationLimit)
+"""The limits the NLP has rows for (:mod:`solver.optimise.methods.placement_nlp`)."""
+
+
+def check(problem: PathProblem, bounds: PlacementBounds, settings: Search) -> None:
+    """Refuse a problem with a limit the NLP has no rows for, before any work.
+
+    IPOPT would climb to the optimum of the other limits alone, which the evaluator then
+    judges: an answer below what the search could find, silently (the seams audit: the NLP
+    builds its rows from the robot's speed and acceleration limits by name). The scipy method
+    evaluates every limit.
+
+    Raises:
+        InvalidInputError: on ``method``, naming the limit.
+    """
+    for limit in problem.limits:
+        if type(limit) not in NLP_LIMITS:
+            raise InvalidInputError(
+                "method",
+                f"the casadi method's NLP has rows for the joint speed and acceleration limits "
+                f"only, not for the {limit.name!r} limit: use method scipy",
+            )
 
 
 def search(
