@@ -118,7 +118,7 @@ class OptimisationWork:
 
         ``search``: of that search only ("" the request's own); None: the whole work.
         """
-        clear = problem.with_options(cell=None)
+        clear = problem.without_path_checks()
         return sum(
             phase.placements * phase.solve_cost
             if phase.solve_cost is not None

@@ -255,6 +255,18 @@ class PathProblem:
         """The limits on a constant feed along the final joint path (mu_acc); () for none."""
         return tuple(limit for limit in self.limits if limit.on_final_path)
 
+    def without_path_checks(self) -> PathProblem:
+        """The same problem with no path checks: the kinematics and the limits alone.
+
+        What a search scores a refused placement by (how fast the arm would be there). Every
+        path check is left out, not only the cell's: ``with_options(cell=None)``, as the
+        searches wrote it, kept any other check (and, on a problem without a cell, shared its
+        checks as they were).
+        """
+        clear = self.with_options(cell=None)
+        clear.__dict__["path_checks"] = ()  # the cached property, as with_options shares it
+        return clear
+
     def with_options(self, **changes: object) -> PathProblem:
         """The same robot and path with some options changed (e.g. ``branch=...``).
 

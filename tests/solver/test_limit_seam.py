@@ -112,3 +112,15 @@ def test_the_casadi_method_refuses_a_limit_its_nlp_has_no_rows_for() -> None:
     assert "not for the 'feed cap' limit: use method scipy" in error.value.message
     optimum = optimize_placement(problem, bounds=bounds, method="scipy")
     assert optimum.mu_path == CAP
+
+
+def test_the_kinematics_alone_are_the_problem_without_any_path_check() -> None:
+    """What the scipy method scores a refused placement by: the problem with no path check,
+    whichever checks it holds (it was written as ``with_options(cell=None)`` at each use)."""
+    problem = PathProblem.of(get_robot("ur5"), load_path("curved_line")[::4])
+    problem.__dict__["path_checks"] = (Joint1Range(0.0),)
+    at = Placement(0.0, 0.45, 0.1, 0.0)
+    assert evaluate_path(problem, at).reason == "joint_limits"
+    clear = problem.without_path_checks()
+    assert clear.path_checks == ()
+    assert evaluate_path(clear, at).feasible

@@ -196,7 +196,7 @@ def evolve(
         every placement evaluated, and DE's generations.
     """
     seen: list[tuple[np.ndarray, np.ndarray, np.ndarray]] = []
-    clear = problem.with_options(cell=None)  # the kinematics alone, for placements in collision
+    clear = problem.without_path_checks()  # the kinematics alone, for placements refused
 
     def objective(points: np.ndarray) -> np.ndarray:  # points: (F, S)
         vectors = full_vectors(bounds, points.T)
