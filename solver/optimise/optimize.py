@@ -33,7 +33,12 @@ from solver.optimise.failures import Tried, search_failure
 from solver.optimise.methods import Method, method_named
 from solver.optimise.narrower import narrower_searches
 from solver.optimise.optimum import PlacementOptimum, SolverReport
-from solver.optimise.search_space import PlacementBounds, variables_of, vector_of
+from solver.optimise.search_space import (
+    PlacementBounds,
+    decision_vector,
+    variables_of,
+    vector_of,
+)
 from solver.optimise.symmetry import arc_coordinates, arc_point, symmetric_search
 from solver.optimise.work import seeds_from_map, work_of
 from solver.path.evaluate import PathEvaluation, evaluate_path, with_min_clearance
@@ -54,17 +59,18 @@ def _place_on_arc(
         the placement, and the turn (rad) about the base z axis that moved it along its arc
         (joint 1 of a joint path moves by as much).
     """
-    clamped = bounds.clamp(vector)
-    x, y, yaw, spin, z = variables_of(clamped)
+    given = variables_of(bounds.clamp(vector))
+    x, y, yaw = given.x, given.y, given.yaw
     if symmetric:
         moved = arc_point(*arc_coordinates(x, y, yaw), bounds, near=near)
         if moved is not None:
             x, y, yaw = moved
-    x, y, yaw, spin, z = _bounds_as_written(np.array([x, y, yaw, spin, z], dtype=float), bounds)
-    given = variables_of(clamped)
-    turn = math.atan2(y, x) - math.atan2(given.y, given.x) if symmetric else 0.0
-    placement = Placement(float(x), float(y), float(z), float(yaw), spin=float(spin))
-    return placement, (turn + math.pi) % (2 * math.pi) - math.pi
+    placed = _bounds_as_written(
+        decision_vector(x=x, y=y, yaw=yaw, spin=given.spin, z=given.z), bounds
+    )
+    at = variables_of(placed)
+    turn = math.atan2(at.y, at.x) - math.atan2(given.y, given.x) if symmetric else 0.0
+    return bounds.placement(placed), (turn + math.pi) % (2 * math.pi) - math.pi
 
 
 ON_A_BOUND = 1e-12
