@@ -33,7 +33,8 @@ from solver.optimise.optimize import optimize_placement
 from solver.optimise.search_space import PlacementBounds
 from solver.path.capability_map import capability_map, grid_axis
 from solver.path.cell import kept_tables
-from solver.path.cell.shapes import Box, Cell, Halfspace, Tool
+from solver.path.cell.cache import checker_for
+from solver.path.cell.shapes import Box, Cell, Halfspace, Sphere, Tool
 from solver.path.problem import PathOptions, PathProblem
 
 
@@ -104,6 +105,42 @@ def _numeric_line(path: np.ndarray, xs: np.ndarray, ys: np.ndarray, z: float) ->
         )
 
 
+def _weight_line(
+    robot: Robot, path: np.ndarray, xs: np.ndarray, ys: np.ndarray, z: float, *, smoke: bool
+) -> None:
+    """The check's work a pose against its weight in the size limits, as the objects grow.
+
+    CELL with 0, 47 and 97 more spheres of 2 cm behind the robot (none touched: nothing stops
+    early), on a 6 x 6 grid (2 x 2 with --smoke): the extra time a pose over the map without a
+    cell, in poses of that bare analytic map (the size limits' unit, the same run), against
+    :meth:`PathProblem.checks_cost` a waypoint (50, more above 250 checked pairs).
+    """
+    arm = robot.with_options(transform_tool_to_tcp=_pose(0.0, 0.0, TOOL_LENGTH))
+    step = 4 if smoke else 1
+    grid = {"xs": xs[::step][:6], "ys": ys[::step][:6], "z": z, "yaws": np.zeros(1)}
+    poses = len(grid["xs"]) * len(grid["ys"]) * len(path)
+    bare = PathProblem.of(arm, path)
+    capability_map(bare, **grid)
+    unit = best_time(lambda: capability_map(bare, **grid), 3) / poses
+    figures = []
+    for extra in (0, 47, 97):
+        spheres = tuple(
+            Sphere(0.02, _pose(-0.6 + 1.2 * k / extra, -0.55, 0.2 + 0.3 * (k % 3)), name=f"s{k}")
+            for k in range(extra)
+        )
+        cell = Cell(fixed=CELL.fixed + spheres, workpiece=CELL.workpiece, tool=CELL.tool)
+        problem = PathProblem.of(arm, path, PathOptions(cell=cell))
+        capability_map(problem, **grid)
+        seconds = best_time(lambda problem=problem: capability_map(problem, **grid), 2)
+        pairs = checker_for(arm, cell).pair_count
+        took = (seconds / poses - unit) / unit
+        figures.append(
+            f"{3 + extra} objects ({pairs} pairs) took {took:.0f}, weighed "
+            f"{problem.checks_cost(1):.0f}"
+        )
+    print(f"  the check's work a pose, in bare-map poses ({robot.name}): " + "; ".join(figures))
+
+
 def cell_lines(
     robot: Robot,
     path: np.ndarray,
@@ -146,6 +183,7 @@ def cell_lines(
             f"arm's tables kept (another cell) {t_kept:.2f} s"
         )
     _numeric_line(path, xs, ys, z)
+    _weight_line(robot, path, xs, ys, z, smoke=smoke)
     bounds = (
         PlacementBounds(x=(-0.05, 0.05), y=(0.4, 0.5), yaw=(-0.2, 0.2), z=z)
         if smoke

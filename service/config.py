@@ -57,7 +57,9 @@ class Settings(BaseSettings):
         "spin, by its own; /v1/map computes on DTF_THREADS threads). A pair of a numeric-IK "
         "arm counts as the work of many (its family's path_cost: about 50 a waypoint for 6 "
         "joints, 200 for 7, plus 800 to 1,000 or 2,600 a placement for the seeds), so its "
-        "limit is about 0.5 to 1.2 s; a cell adds 50 a pair for its collision check. "
+        "limit is about 0.5 to 1.2 s; a cell adds 50 a pair for its collision check (more, "
+        "in proportion, where it computes more than 250 distances a configuration: robot "
+        "part against object or part). "
         "/v1/evaluate weighs its one placement the same way against this limit.",
     )
     max_search_poses: int = Field(

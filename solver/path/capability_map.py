@@ -18,7 +18,6 @@ from solver.core.exceptions import InvalidInputError
 from solver.core.parallel import SERIAL, TaskRunner
 from solver.core.spatial import Placement
 from solver.core.written import stepped_as_written
-from solver.path.cell.cost import with_cell
 from solver.path.cell.verdict import Unchecked
 from solver.path.path_checks import checks_model
 from solver.path.placements import DEFAULT_CHUNK, evaluate_placements
@@ -246,16 +245,14 @@ def map_cost(problem: PathProblem) -> float:
     The family's map figure (:meth:`solver.core.family.KinematicsFamily.map_cost`), told
     whether the map may drop branches (:func:`solver.path.pruning.can_prune`), times
     :attr:`PathProblem.exact_spin_weight` in free spin with an angled or offset spindle or seven
-    joints (:attr:`PathProblem.exact_spin`), plus the collision check's with a cell
-    (:func:`solver.path.cell.cost.with_cell`). A map with a cell is given the figure of
-    following every branch: it drops branches too, but follows a refused placement's next
-    branches again (:mod:`solver.path.path_checks`).
+    joints (:attr:`PathProblem.exact_spin`), plus the path checks' (a cell's collision check:
+    :meth:`PathProblem.checks_cost`). A map with a path check is given the figure of following
+    every branch: it drops branches too, but follows a refused placement's next branches again
+    (:mod:`solver.path.path_checks`).
     """
     n_waypoints = problem.prepared.n_waypoints
     free_spin = problem.options.spin_mode == "free"
-    pruned = problem.options.cell is None and can_prune(problem)
+    pruned = not problem.path_checks and can_prune(problem)
     cost = problem.family.map_cost(n_waypoints, free_spin=free_spin, pruned=pruned)
     cost *= problem.exact_spin_weight  # the spun poses solved again, on the numpy pipeline
-    if problem.options.cell is not None:
-        return with_cell(cost, n_waypoints, problem.options.cell)
-    return cost
+    return cost + problem.checks_cost(n_waypoints)

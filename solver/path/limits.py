@@ -166,6 +166,16 @@ class PathCheck(abc.ABC):
                 as fast as can be (a map, an optimiser).
         """
 
+    @abc.abstractmethod
+    def pose_cost(self) -> float:
+        """What checking one pose of a path weighs, in poses of a closed-form family's map.
+
+        The size limits add it to the family's figure at every waypoint
+        (:meth:`solver.path.problem.PathProblem.path_cost`,
+        :func:`solver.path.capability_map.map_cost`), so a check's work is weighed before any
+        of it runs; the cell's: :func:`solver.path.cell.cost.cell_pose_cost`.
+        """
+
     def check_many(self, joint_paths: np.ndarray, placements: np.ndarray) -> list[PathVerdict]:
         """:meth:`check` of N joint paths, not thorough (a map's chunk): the same verdicts.
 

@@ -27,7 +27,6 @@ from solver.core.kinematics import straight_spindle
 from solver.core.robots import Robot
 from solver.path.blend_stencil import BlendStencil
 from solver.path.cell.cache import checker_for
-from solver.path.cell.cost import with_cell
 from solver.path.cell.limit import CellLimit
 from solver.path.cell.shapes import Cell
 from solver.path.limits import JointAccelerationLimit, JointSpeedLimit, Limit, PathCheck
@@ -231,12 +230,20 @@ class PathProblem:
         """The work of one placement of ``n_waypoints``, in poses of a closed-form family's map.
 
         The family's cost (:meth:`KinematicsFamily.path_cost`; times :attr:`exact_spin_weight`
-        where the spun poses are solved again, :attr:`exact_spin`), plus the collision check's
-        with a cell (:func:`solver.path.cell.cost.with_cell`): what the size limits of the maps
-        and searches weigh.
+        where the spun poses are solved again, :attr:`exact_spin`), plus each path check's
+        (:meth:`checks_cost`): what the size limits of the maps and searches weigh.
         """
         cost = self.family.path_cost(n_waypoints, free_spin=self.options.spin_mode == "free")
-        return with_cell(cost * self.exact_spin_weight, n_waypoints, self.options.cell)
+        return cost * self.exact_spin_weight + self.checks_cost(n_waypoints)
+
+    def checks_cost(self, n_waypoints: int) -> float:
+        """The path checks' work along ``n_waypoints``, in closed-form poses.
+
+        Each check's weight a pose (:meth:`solver.path.limits.PathCheck.pose_cost`; the cell's
+        grows with its collision step and its pairs), added to the family's figure whatever the
+        family: a check looks at the joint paths the family found, not at how it found them.
+        """
+        return n_waypoints * sum(check.pose_cost() for check in self.path_checks)
 
     @property
     def exact_spin_weight(self) -> float:

@@ -242,6 +242,37 @@ def test_a_map_in_a_cell_weighs_its_collision_work(
     assert client.post("/v1/map", json=request).status_code == 200
 
 
+def test_a_cell_of_many_objects_weighs_its_pairs(
+    client: TestClient, body: dict, setting: Any
+) -> None:
+    """The check computes every moving robot part against every object, so its work grows with
+    the objects: 100 small spheres 5 m away (no collision, nothing stops early) took the UR5's
+    map 3 times the weight of 50 a pose, a URDF of 100 collision elements 26 times
+    (solver.path.cell.cost.PAIRS_IN_WEIGHT). At a limit that admits the map at 50 a pose
+    (3 placements x 133 waypoints x 51), 20 spheres are admitted and 100 refused."""
+    request = map_request(body)
+    setting(max_map_poses=3 * 133 * (1 + int(CELL_POSE_COST)) + 1)
+
+    def spheres(count: int) -> list[dict[str, Any]]:
+        return [
+            {
+                "shape": "sphere",
+                "radius": 0.01,
+                "pose": {"position": [5.0, 0.1 * k - 5.0, 0.5], "orientation": [0, 0, 0, 1]},
+            }
+            for k in range(count)
+        ]
+
+    request["cell"] = {"fixed": spheres(20)}
+    admitted = client.post("/v1/map", json=request)
+    assert admitted.status_code == 200, admitted.text
+    assert {cell["reason"] for cell in admitted.json()["cells"]} == {None}  # all feasible
+    request["cell"] = {"fixed": spheres(100)}
+    refused = client.post("/v1/map", json=request)
+    assert_names(refused, 422, ["body", "grid"])
+    assert "in a cell" in refused.json()["detail"][0]["msg"]
+
+
 def test_a_numeric_arm_in_a_cell_adds_the_check_to_its_ik_work(
     client: TestClient, setting: Any
 ) -> None:

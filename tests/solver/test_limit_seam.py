@@ -64,6 +64,9 @@ class Joint1Range(PathCheck):
             return PathVerdict(None, None)
         return PathVerdict(int(outside[0]), None, self.reason)
 
+    def pose_cost(self) -> float:
+        return 0.01  # one comparison a pose
+
 
 class Admits(PathCheck):
     """A check that admits every path, first in the problem's checks."""
@@ -73,6 +76,9 @@ class Admits(PathCheck):
 
     def check(self, q: np.ndarray, placement: np.ndarray, *, thorough: bool) -> PathVerdict:
         return PathVerdict(None, None)
+
+    def pose_cost(self) -> float:
+        return 0.0
 
 
 def test_a_path_check_of_its_own_refuses_with_its_reason() -> None:

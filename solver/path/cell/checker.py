@@ -54,6 +54,11 @@ class CellChecker:
             (objects[a].name, objects[b].name): p for p, (a, b) in enumerate(self._pairs)
         }
 
+    @property
+    def pair_count(self) -> int:
+        """How many pairs the check computes at each configuration (what its work grows with)."""
+        return len(self._pairs)
+
     def configurations(
         self, q: np.ndarray, segment_in_pass: np.ndarray
     ) -> tuple[np.ndarray, np.ndarray]:

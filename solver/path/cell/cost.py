@@ -1,9 +1,10 @@
 """What the collision check weighs in the size limits: its cost per pose of a path (cell.md).
 
 A request's work is estimated before it starts in poses of a closed-form family's map
-(:meth:`solver.core.family.KinematicsFamily.path_cost`); a cell adds its check's,
-:func:`cell_pose_cost` a pose (:func:`with_cell`), so the size limits refuse a map or an
-optimisation whose collision check would be too long before any of it runs.
+(:meth:`solver.core.family.KinematicsFamily.path_cost`); each path check adds its own weight a
+pose (:meth:`solver.path.limits.PathCheck.pose_cost`), the cell's :func:`cell_pose_cost`, so
+the size limits refuse a map or an optimisation whose collision check would be too long before
+any of it runs.
 """
 
 from __future__ import annotations
@@ -35,19 +36,32 @@ from solver.path.cell.shapes import DEFAULT_COLLISION_STEP, Cell
 CELL_POSE_COST = 50.0
 
 
-def cell_pose_cost(cell: Cell) -> float:
-    """The collision check's weight per pose: CELL_POSE_COST at the default collision step.
+# The checked pairs (robot part against obstacle, and robot part against robot part) that
+# CELL_POSE_COST covers: a cell with more weighs proportionally more. Each pair is a bound or a
+# coal distance at every configuration, so the check's work grows with their number, and 50
+# held only for a few objects: measured (2026-12-06, CPU time of the extra work a pose against
+# the analytic UR5 map's, 36 placements of the ERK path, every placement collision-free, so no
+# check stopped early; a second process at nice 19 on the other core), the UR5 (8 meshes and the
+# tool) 47 units a pose with 3 objects (56 pairs) and 145 with 100 (929 pairs), the UR5e
+# (capsules) 14 and 95 (63 and 1,033 pairs), the UR5 with 42 more collision spheres on its
+# links 116 with 3 objects (860 pairs) and 287 with 20 (1,727), with 92 more 247 with 3 (2,920)
+# and 1,327 with 100 (12,717 pairs): from 300 to 960 pairs a 50 units; 250 weighs every one of
+# them above what it took (by up to 1.9 times), where a weight of 50 whatever the pairs weighed
+# the last 26 times below it. A cell of up to 250 pairs (the catalogue's arms with up to about
+# 25 objects) weighs what it did. bench/cell.py prints the check's work against its weight.
+PAIRS_IN_WEIGHT = 250
+
+
+def cell_pose_cost(cell: Cell, pairs: int) -> float:
+    """The collision check's weight per pose: CELL_POSE_COST at the default step, 250 pairs.
 
     A finer step checks proportionally more sub-steps between waypoints, so it weighs more
-    (at the least step, 0.001 rad, 50 times as much): the size limits see it before the work.
+    (at the least step, 0.001 rad, 50 times as much), and more than PAIRS_IN_WEIGHT checked
+    pairs weigh proportionally more: the size limits see both before the work.
+
+    Args:
+        cell: the cell (its collision step).
+        pairs: how many pairs its check computes (:attr:`CellChecker.pair_count`).
     """
-    return CELL_POSE_COST * max(1.0, DEFAULT_COLLISION_STEP / cell.collision_step)
-
-
-def with_cell(cost: float, n_waypoints: int, cell: Cell | None) -> float:
-    """``cost``, a placement's work along ``n_waypoints``, plus ``cell``'s check of its poses.
-
-    Its collision check weighs :func:`cell_pose_cost` a pose whatever the family: the check
-    looks at the joint paths the family found, not at how it found them. No cell: ``cost``.
-    """
-    return cost if cell is None else cost + cell_pose_cost(cell) * n_waypoints
+    steps = max(1.0, DEFAULT_COLLISION_STEP / cell.collision_step)
+    return CELL_POSE_COST * steps * max(1.0, pairs / PAIRS_IN_WEIGHT)

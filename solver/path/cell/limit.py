@@ -10,6 +10,7 @@ import numpy as np
 from solver.core.codes import REASON_COLLISION
 from solver.core.spatial import Placement
 from solver.path.cell.checker import CellChecker
+from solver.path.cell.cost import cell_pose_cost
 from solver.path.cell.verdict import CellVerdict
 from solver.path.limits import PathCheck, PathVerdict
 
@@ -37,6 +38,10 @@ class CellLimit(PathCheck):
         verdict = self.checker.check(q, self.segment_in_pass, transform, closest=thorough)
         failed = None if verdict.collision is None else verdict.collision.waypoint
         return PathVerdict(failed, verdict, None if failed is None else self.reason)
+
+    def pose_cost(self) -> float:
+        """The check's weight a pose: its step and its pairs' (:func:`cell_pose_cost`)."""
+        return cell_pose_cost(self.checker.cell, self.checker.pair_count)
 
     def model(self) -> dict[str, Any]:
         """The links given capsules and the parts not checked (``CapabilityMap``'s fields)."""
