@@ -47,6 +47,7 @@ from typing import Any, TypeVar
 
 from pydantic import BaseModel, ValidationError
 
+from service import caches
 from service.cli_files import decoded, file_bytes, text_file
 from service.cli_text import ProgressBar, evaluation_text, import_text, map_text, optimum_text
 from service.config import Settings, settings_or_exit
@@ -126,6 +127,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         if sys.stderr is not None:
             print("error: the standard output is closed: no answer can be written", file=sys.stderr)  # noqa: T201
         return NOT_WRITTEN
+    _say_where_caches_are()
     echo = native_stderr.ECHO.set(False)  # a refused URDF's reason is in the error printed
     try:
         code = int(args.run(args))
@@ -153,6 +155,16 @@ def main(argv: Sequence[str] | None = None) -> int:
     finally:
         native_stderr.ECHO.reset(echo)
     return INVALID
+
+
+def _say_where_caches_are() -> None:
+    """A line on stderr for each cache kept in the temporary directory, not where it belongs.
+
+    :func:`service.caches.cache_notes`.
+    """
+    for note in caches.cache_notes():
+        if sys.stderr is not None:
+            print(f"note: {note}", file=sys.stderr)  # noqa: T201
 
 
 _WRITE_ERRORS = frozenset({errno.ENOSPC, errno.EDQUOT, errno.EFBIG})

@@ -24,6 +24,7 @@ from fastapi_offline import FastAPIOffline
 from pydantic.json_schema import models_json_schema
 from starlette.exceptions import HTTPException as StarletteHTTPException
 
+from service import caches
 from service.api import api_router
 from service.api.routes import health
 from service.body import BODY_MODELS
@@ -101,6 +102,8 @@ async def lifespan(app: FastAPI) -> AsyncIterator[None]:
     _stop_work_on(signal.SIGTERM)
     _stop_work_on(signal.SIGINT)
     log_to_stderr()
+    for note in caches.cache_notes():  # a read-only install, an account without a home
+        startup_log.info(note)
     started = time.monotonic()
     startup_log.info(
         "warming up: loading the compiled map kernels (the first start after an install "
