@@ -13,6 +13,13 @@ from pathlib import Path
 from pydantic import Field, PrivateAttr, ValidationError, field_validator
 from pydantic_settings import BaseSettings, SettingsConfigDict
 
+MAX_PATH_WAYPOINTS = 20_000
+"""The most waypoints any route's schema takes: DTF_MAX_PATH_WAYPOINTS and
+DTF_MAX_OPTIMIZE_WAYPOINTS may lower it, and a start that sets either higher stops, naming it
+(it was capped without a word)."""
+MAX_CELL_OBJECTS = 1_000
+"""The most objects a cell's schema takes: DTF_MAX_CELL_OBJECTS may lower it, not raise it."""
+
 _ROUTE_LIMIT_NAMES = (
     "DTF_MAX_MAP_CELLS",
     "DTF_MAX_MAP_POSES",
@@ -84,7 +91,9 @@ class Settings(BaseSettings):
     max_path_waypoints: int = Field(
         default=20_000,
         gt=0,
-        description="Most waypoints a path of /v1/evaluate or /v1/map may have. Validating a body "
+        le=MAX_PATH_WAYPOINTS,
+        description="Most waypoints a path of /v1/evaluate or /v1/map may have (at most 20,000, "
+        "the schemas' bound: a start with more stops, naming it). Validating a body "
         "holds the GIL for about 10 us a waypoint (one pydantic-core call), so a body at this "
         "limit delays other requests once by up to 0.3 s on a 2-core machine; lower it where "
         "that matters.",
@@ -92,7 +101,9 @@ class Settings(BaseSettings):
     max_optimize_waypoints: int = Field(
         default=20_000,
         gt=0,
-        description="Most waypoints a path of /v1/optimize may have. The local solves work on the "
+        le=MAX_PATH_WAYPOINTS,
+        description="Most waypoints a path of /v1/optimize may have (at most 20,000). The local "
+        "solves work on the "
         "waypoints that bind (an active set, checked on the whole path), and a program over "
         "2,000 waypoints is mapped on such a set too, so the work grows slowly with the path: "
         "a 10,487-move program on a UR5e takes seconds. The scipy method's differential "
@@ -102,8 +113,10 @@ class Settings(BaseSettings):
     max_cell_objects: int = Field(
         default=100,
         gt=0,
+        le=MAX_CELL_OBJECTS,
         description="Most objects (fixed and workpiece) a request's cell may hold, and most "
-        "collision elements a URDF robot checked against a cell may have.",
+        "collision elements a URDF robot checked against a cell may have (at most 1,000, the "
+        "schema's bound).",
     )
     max_mesh_triangles: int = Field(
         default=50_000,

@@ -11,6 +11,7 @@ import math
 
 from pydantic import ConfigDict, Field
 
+from service.config import MAX_CELL_OBJECTS
 from service.schemas.cell_objects import CellObject, Size
 from service.schemas.common import RequestModel, ResponseModel
 from solver.core.exceptions import InvalidInputError
@@ -26,7 +27,6 @@ from solver.path.cell.shapes import (
 from solver.path.cell.verdict import Contact as SolverContact
 from solver.path.cell.verdict import Unchecked as SolverUnchecked
 
-MAX_CELL_OBJECTS = 1_000  # the schema's bound; the setting DTF_MAX_CELL_OBJECTS is lower
 MAX_LINK_RADII = 64
 
 

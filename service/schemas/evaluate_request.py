@@ -12,11 +12,11 @@ from pydantic.config import JsonDict
 from pydantic_core import PydanticCustomError
 from typing_extensions import TypeAliasType
 
+from service.config import MAX_PATH_WAYPOINTS
 from service.schemas.cell import CellSpec
 from service.schemas.common import Angle, RequestModel, SpinMode
 from service.schemas.ik import IkPolicy
 from service.schemas.path import Path
-from service.schemas.path_input import MAX_PATH_WAYPOINTS
 from service.schemas.placement import Placement
 from service.schemas.robot import Robot
 from service.schemas.robot_options import MAX_JOINTS

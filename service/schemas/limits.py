@@ -1,10 +1,10 @@
 """The response of ``GET /v1/limits``: the request limits in force on this service.
 
 Most limits are settings (``DTF_<NAME>``, :class:`service.config.Settings`), a few the schema's
-own bounds; a setting above its schema bound does not raise it, so each value is the one a
-request meets (the smaller). A client (a CAM post-processor, the page) reads them before it
-sends: a path too long, a grid too large or an STL mesh that makes the body too large is then
-said before anything is sent.
+own bounds; a setting cannot be above its schema's bound (the start stops, naming it), so
+each value is the one a request meets. A client (a CAM post-processor, the page) reads them
+before it sends: a path too long, a grid too large or an STL mesh that makes the body too
+large is then said before anything is sent.
 """
 
 from __future__ import annotations
@@ -14,11 +14,9 @@ from typing import Any
 from pydantic import ConfigDict, Field
 
 from service.config import Settings
-from service.schemas.cell import MAX_CELL_OBJECTS
 from service.schemas.common import ResponseModel
 from service.schemas.map import MAX_GRID_VALUES
 from service.schemas.path_cam import MAX_CAM_TEXT
-from service.schemas.path_input import MAX_PATH_WAYPOINTS
 from service.schemas.robot_options import MAX_JOINTS
 
 
@@ -119,12 +117,12 @@ class LimitsResponse(ResponseModel):
 
 
 def limits_of(settings: Settings) -> LimitsResponse:
-    """The limits a request meets under ``settings``: each setting, within its schema bound."""
+    """The limits a request meets under ``settings`` (each within its schema's bound)."""
     return LimitsResponse(
         max_body_bytes=settings.max_body_bytes,
         body_read_seconds=settings.body_read_seconds,
-        max_path_waypoints=min(settings.max_path_waypoints, MAX_PATH_WAYPOINTS),
-        max_optimize_waypoints=min(settings.max_optimize_waypoints, MAX_PATH_WAYPOINTS),
+        max_path_waypoints=settings.max_path_waypoints,
+        max_optimize_waypoints=settings.max_optimize_waypoints,
         max_detail_waypoints=settings.max_detail_waypoints,
         max_cam_characters=MAX_CAM_TEXT,
         max_map_cells=settings.max_map_cells,
@@ -132,7 +130,7 @@ def limits_of(settings: Settings) -> LimitsResponse:
         max_search_poses=settings.max_search_poses,
         max_grid_values=MAX_GRID_VALUES,
         max_png_panels=settings.max_png_panels,
-        max_cell_objects=min(settings.max_cell_objects, MAX_CELL_OBJECTS),
+        max_cell_objects=settings.max_cell_objects,
         max_mesh_triangles=settings.max_mesh_triangles,
         max_urdf_joints=settings.max_urdf_joints,
         max_joint_values=MAX_JOINTS,

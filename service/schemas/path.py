@@ -13,9 +13,10 @@ from typing import Annotated
 import numpy as np
 from pydantic import ConfigDict, Discriminator, Field, Tag
 
+from service.config import MAX_PATH_WAYPOINTS
 from service.schemas.common import Pose, RequestModel, ToolAxisWaypoint
 from service.schemas.path_cam import ClDataPath, CsvPath
-from service.schemas.path_input import MAX_PATH_WAYPOINTS, PathInput
+from service.schemas.path_input import PathInput
 from solver.core.spatial import check_position, pose_matrices
 from solver.core.task import task_requirements
 from solver.core.tool_axis import poses_from_tool_axes

@@ -11,8 +11,9 @@ from typing import Annotated, Literal
 from pydantic import ConfigDict, Field, PrivateAttr
 from typing_extensions import TypeAliasType
 
+from service.config import MAX_PATH_WAYPOINTS
 from service.schemas.common import RequestModel
-from service.schemas.path_input import MAX_PATH_WAYPOINTS, PathInput
+from service.schemas.path_input import PathInput
 from solver.cam.cam_path import CamPath, Units
 from solver.cam.cl_data import DEFAULT_ARC_TOLERANCE, read_cl_data
 from solver.cam.csv_path import csv_waypoints, read_csv_path

@@ -15,9 +15,6 @@ from service.schemas.common import SpinMode
 from solver.cam.cam_path import CamPath
 from solver.cam.read_report import ReadReport, UnitsSource
 
-MAX_PATH_WAYPOINTS = 20_000
-"""The most waypoints any route takes (DTF_MAX_PATH_WAYPOINTS may lower it, never raise it)."""
-
 
 @dataclass(frozen=True)
 class PathInput:

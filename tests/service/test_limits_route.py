@@ -3,10 +3,12 @@
 from __future__ import annotations
 
 import json
+from typing import Any
 
+import pytest
 from fastapi.testclient import TestClient
 
-from service.config import Settings
+from service.config import INVALID_SETTINGS, Settings, get_settings, settings_or_exit
 from service.main import app
 from service.schemas import LimitsResponse
 from tests.cases import ROOT
@@ -51,11 +53,36 @@ def test_each_limit_says_its_setting_or_that_it_has_none() -> None:
             assert said.endswith("(the schema's; no setting)"), (name, said)
 
 
-def test_a_setting_above_the_schemas_bound_is_said_as_the_bound_in_force() -> None:
-    """DTF_MAX_PATH_WAYPOINTS=30000 was said as 30,000 while the schema refuses 20,001
-    waypoints (a body over 2 MB here), DTF_MAX_CELL_OBJECTS=5000 as 5,000 while it refuses
-    1,001 objects: the limit said is the one a request meets; the schema's own bounds too."""
-    settings = Settings(max_path_waypoints=30_000, max_cell_objects=5_000)
+@pytest.mark.parametrize(
+    ("variable", "value", "bound"),
+    [
+        ("DTF_MAX_PATH_WAYPOINTS", "30000", 20_000),
+        ("DTF_MAX_OPTIMIZE_WAYPOINTS", "20001", 20_000),
+        ("DTF_MAX_CELL_OBJECTS", "5000", 1_000),
+    ],
+)
+def test_a_setting_above_the_schemas_bound_stops_the_start(
+    variable: str, value: str, bound: int, monkeypatch: pytest.MonkeyPatch, capsys: Any
+) -> None:
+    """DTF_MAX_PATH_WAYPOINTS=30000 was capped at the schema's 20,000 without a word (the
+    limits route said 20,000, a CLI user's 20,500-move program was refused at 20,000: stop
+    61's CLI audit): a setting above its schema's bound now stops the start, named."""
+    monkeypatch.setenv(variable, value)
+    get_settings.cache_clear()
+    try:
+        with pytest.raises(SystemExit) as stopped:
+            settings_or_exit()
+    finally:
+        get_settings.cache_clear()
+    assert stopped.value.code == INVALID_SETTINGS
+    assert capsys.readouterr().err == (
+        f"error: {variable}={value!r}: Input should be less than or equal to {bound}\n"
+    )
+
+
+def test_the_schemas_own_bounds_are_said_as_the_limits_in_force() -> None:
+    """The most cell objects and grid values a request meets, at their settings' bounds."""
+    settings = Settings(max_path_waypoints=20_000, max_cell_objects=1_000)
     with served_with(settings), TestClient(app) as client:
         limits = client.get("/v1/limits").json()
         assert (limits["max_path_waypoints"], limits["max_cell_objects"]) == (20_000, 1_000)
