@@ -143,10 +143,10 @@ def main(argv: Sequence[str] | None = None) -> int:
     except ValidationError as error:
         for detail in request_errors(error.errors()):
             where = ".".join(str(part) for part in detail.loc)
-            print(f"error: {where}: {detail.msg}", file=sys.stderr)  # noqa: T201
+            print(f"error: {_with_option(where)}: {detail.msg}", file=sys.stderr)  # noqa: T201
     except SolverError as error:
         where = ".".join(str(part) for part in solver_error_location(error)[1:])
-        print(f"error: {where}: {error.message}", file=sys.stderr)  # noqa: T201
+        print(f"error: {_with_option(where)}: {error.message}", file=sys.stderr)  # noqa: T201
     except OSError as error:
         if error.errno in _WRITE_ERRORS:  # the output's device: the answer was not written
             print(f"error: the answer could not be written: {error}", file=sys.stderr)  # noqa: T201
@@ -165,6 +165,36 @@ def _say_where_caches_are() -> None:
     for note in caches.cache_notes():
         if sys.stderr is not None:
             print(f"note: {note}", file=sys.stderr)  # noqa: T201
+
+
+AXES = ("x", "y", "z", "yaw", "spin")
+"""The grid's and the bounds' axes, each an option of its own name."""
+_OPTIONS = (
+    ("path.units", "--units"),
+    ("path.arc_tolerance", "--arc-tolerance"),
+    ("path", "PROGRAM"),
+    ("robot", "--robot"),
+    ("cell", "--cell"),
+    ("feed", "--feed: m/s, or with its unit: 508mm/min, 20in/min"),
+    ("placement.spin", "--spin"),
+    *((f"{part}.{axis}", f"--{axis}") for part in ("grid", "bounds") for axis in AXES),
+    ("z", "--z"),
+    ("placement", "--at"),
+    ("start", "--start"),
+    ("spin_mode", "--spin-mode"),
+    ("ik", "--branch"),
+)
+"""The request's fields and the options that fill them: an error names both (``path.units
+(--units)``), since the API's words alone did not tell a command-line user what to give (the
+published NX program without units was told to "give units with the program")."""
+
+
+def _with_option(where: str) -> str:
+    """``where`` (a request field, dotted) with the option that fills it, where one does."""
+    for field, option in _OPTIONS:
+        if where == field or where.startswith(f"{field}."):
+            return f"{where} ({option})"
+    return where
 
 
 _WRITE_ERRORS = frozenset({errno.ENOSPC, errno.EDQUOT, errno.EFBIG})
@@ -457,6 +487,31 @@ def _same_file(a: Path, b: Path) -> bool:
         return False
 
 
+FEED_UNITS = {"m/s": 1.0, "mm/min": 0.001 / 60.0, "in/min": 0.0254 / 60.0, "ipm": 0.0254 / 60.0}
+"""``--feed``'s units, in m/s: a number alone is m/s (the API's), and the feeds printed are in
+mm/min (a CAM program's), so a feed copied from the answer took 508 for m/s (refused above
+100 m/s without a unit named; 50 mm/min would have been read as 50 m/s)."""
+_FEED = re.compile(r"\s*([-+0-9.eE]+)\s*([a-z/]*)\s*")
+
+
+def _feed(text: str) -> float:
+    """``--feed``'s value in m/s: a number, with one of :data:`FEED_UNITS` or none (m/s).
+
+    Raises:
+        argparse.ArgumentTypeError: no number, or another unit.
+    """
+    match = _FEED.fullmatch(text.lower())
+    unit = match.group(2) if match else ""
+    if match is None or (unit and unit not in FEED_UNITS):
+        units = ", ".join(FEED_UNITS)
+        raise argparse.ArgumentTypeError(f"{text!r}: give a number of m/s, or one with {units}")
+    try:
+        value = float(match.group(1))
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r}: give a number") from None
+    return value * FEED_UNITS[unit or "m/s"]
+
+
 def _optimise(args: argparse.Namespace) -> int:
     bounds: dict[str, Any] = {"x": args.x, "y": args.y, "yaw": args.yaw, "spin": args.spin}
     body: dict[str, Any] = {
@@ -607,7 +662,12 @@ def _parser() -> argparse.ArgumentParser:
     run = commands.add_parser("evaluate", parents=[solving], help="mu_path at a placement")
     run.add_argument("--at", type=_numbers(4, ","), required=True, metavar="X,Y,Z,YAW")
     run.add_argument("--spin", type=float, default=0.0, help="rad, a constant tool spin")
-    run.add_argument("--feed", type=float, help="m/s to check (default: the program's FEDRAT)")
+    run.add_argument(
+        "--feed",
+        type=_feed,
+        help="the feed to check: m/s, or with its unit (508mm/min, 20in/min; the unit the "
+        "answers print feeds in is mm/min); default: the program's FEDRAT",
+    )
     run.set_defaults(run=_evaluate)
     run = commands.add_parser("map", parents=[solving], help="the capability map, as a PNG")
     run.add_argument("--x", type=_axis, required=True, metavar="MIN:MAX:STEP")

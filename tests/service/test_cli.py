@@ -155,6 +155,27 @@ def test_a_feed_the_path_cannot_run_is_exit_infeasible(capsys: pytest.CaptureFix
     assert float(line.group(1)) == round(json.loads(answer)["feed_check"]["margin"], 3) < 1.0
 
 
+def test_a_feed_is_given_in_m_per_s_or_with_its_unit(capsys: pytest.CaptureFixture[str]) -> None:
+    """The answers print feeds in mm/min (a CAM program's unit) and --feed took m/s alone:
+    508 copied from an answer was refused as "less than or equal to 100", no unit named, and
+    50 mm/min would have been checked as 50 m/s (the CLI audit of stop 61)."""
+    at = ["evaluate", str(PROGRAM), "--robot", "ur5e", "--at=0.2,0.3,0,1.57", "--json"]
+    answers = {}
+    for feed in ("508mm/min", "20 in/min", "20IPM", str(508 / 60_000), str(0.0254 * 20 / 60)):
+        code, out, _ = run(capsys, *at, "--feed", feed)
+        answers[feed] = (code, json.loads(out)["feed_check"])
+    assert answers["508mm/min"] == answers[str(508 / 60_000)]
+    assert answers["20 in/min"] == answers["20IPM"] == answers[str(0.0254 * 20 / 60)]
+    assert answers["508mm/min"][1]["feed"] == pytest.approx(508 / 60_000, rel=1e-15)
+    code, out, err = run(capsys, *at, "--feed", "508")
+    assert (code, out) == (INVALID, "")
+    assert err.startswith("error: feed (--feed: m/s, or with its unit: 508mm/min, 20in/min): ")
+    with pytest.raises(SystemExit) as usage:
+        run(capsys, *at, "--feed", "508mm/s")
+    assert usage.value.code == 2
+    assert "give a number of m/s, or one with m/s, mm/min, in/min, ipm" in capsys.readouterr().err
+
+
 def test_a_robot_from_a_json_file(
     client: TestClient, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
@@ -213,11 +234,13 @@ def test_invalid_input_names_the_field_and_exits_invalid(
     bare.write_text("GOTO/0,0,0\nFEDRAT/MMPM,250\nGOTO/10,0,0\n")
     code, out, err = run(capsys, "import", str(bare))
     assert (code, out) == (INVALID, "")
-    assert err.startswith("error: path.units: ") and "FEDRAT/MMPM at line 2" in err
+    # the option that fills the field named too (a published NX program was told to "give
+    # units with the program", no option named: the CLI audit of stop 61)
+    assert err.startswith("error: path.units (--units): ") and "FEDRAT/MMPM at line 2" in err
     broken = tmp_path / "broken.cl"
     broken.write_text("UNITS/MM\nGOTO/0,0,0\nGOTO/1,0,0,0,0\n")
     code, _, err = run(capsys, "import", str(broken))
-    assert code == INVALID and err.startswith("error: path.cl_data: line 3: ")
+    assert code == INVALID and err.startswith("error: path.cl_data (PROGRAM): line 3: ")
 
 
 def test_a_csv_needs_its_units_and_errors_name_the_api_field(
@@ -227,12 +250,12 @@ def test_a_csv_needs_its_units_and_errors_name_the_api_field(
     table.write_text("x,y,z,i,j,k\n100,0,0,0,0,1\n110,0,0,0,0,1\n")
     code, out, err = run(capsys, "import", str(table))
     assert (code, out) == (INVALID, "")
-    assert err.startswith("error: path.units: ") and "--units" in err
+    assert err.startswith("error: path.units (--units): ") and "--units mm" in err
     program = tmp_path / "line.cl"
     program.write_text("UNITS/MM\nGOTO/0,0,0\nGOTO/1,0,0\n")
     code, _, err = run(capsys, "import", "--arc-tolerance", "-1", str(program))
     assert code == INVALID  # the location as the API gives it, without the union's tags
-    assert err.startswith("error: path.arc_tolerance: ")
+    assert err.startswith("error: path.arc_tolerance (--arc-tolerance): ")
 
 
 def test_a_robot_file_that_is_not_json_exits_invalid(
@@ -241,7 +264,7 @@ def test_a_robot_file_that_is_not_json_exits_invalid(
     file = tmp_path / "robot.json"
     file.write_text("{model: ur5")
     code, _, err = run(capsys, "evaluate", str(PROGRAM), "--robot", str(file), "--at=0,0.3,0,0")
-    assert code == INVALID and err.startswith("error: robot: the file is not JSON")
+    assert code == INVALID and err.startswith("error: robot (--robot): the file is not JSON")
 
 
 def test_usage_errors_exit_usage(capsys: pytest.CaptureFixture[str]) -> None:
@@ -416,10 +439,14 @@ def test_a_cell_file_that_is_not_json_or_not_a_cell_exits_invalid(
     broken = tmp_path / "broken.json"
     broken.write_text("{fixed: [")
     code, out, err = run(capsys, *at, str(broken))
-    assert (code, out) == (INVALID, "") and err.startswith("error: cell: the file is not JSON")
+    assert (code, out) == (INVALID, "") and err.startswith(
+        "error: cell (--cell): the file is not JSON"
+    )
     flat = {"fixed": [{"shape": "box", "size": [0.1, -1.0, 0.1]}]}
     code, out, err = run(capsys, *at, _file(tmp_path, "flat.json", flat))
-    assert (code, out) == (INVALID, "") and err.startswith("error: cell.fixed.0.box.size.1: ")
+    assert (code, out) == (INVALID, "") and err.startswith(
+        "error: cell.fixed.0.box.size.1 (--cell): "
+    )
 
 
 UR5_URDF = example_robot_data_dir() / "ur_description" / "urdf" / "ur5_robot.urdf"
@@ -505,8 +532,9 @@ def test_a_refused_urdf_is_said_once_without_the_parsers_own_lines(
     out, err = capfd.readouterr()
     assert (code, out) == (INVALID, "")
     assert err.splitlines() == [
-        "error: robot.urdf: cannot parse the URDF: 2 root links ('world', 'cart'): every link "
-        "but one must be a joint's child; remove the stray link or attach it with a fixed joint"
+        "error: robot.urdf (--robot): cannot parse the URDF: 2 root links ('world', 'cart'): "
+        "every link but one must be a joint's child; remove the stray link or attach it with a "
+        "fixed joint"
     ]
 
 
@@ -577,10 +605,12 @@ def test_frames_with_a_robot_that_is_no_urdf_or_not_in_it_exit_invalid(
     for option in (["--base-frame", "base"], ["--tool-frame", "tool0"]):
         code, out, err = run(capsys, *at, "ur5e", *option)
         assert (code, out) == (INVALID, "")  # refused, not ignored (even the default's name)
-        assert err.startswith("error: robot: --base-frame and --tool-frame choose a URDF file's")
+        assert err.startswith(
+            "error: robot (--robot): --base-frame and --tool-frame choose a URDF file's"
+        )
     code, out, err = run(capsys, *at, str(UR5_URDF), "--tool-frame", "nowhere")
     assert (code, out) == (INVALID, "")
-    assert err.startswith("error: robot.tool_frame: no frame 'nowhere' in the model")
+    assert err.startswith("error: robot.tool_frame (--robot): no frame 'nowhere' in the model")
 
 
 def test_map_takes_lists_of_yaws_and_spins_a_panel_each(
@@ -658,7 +688,9 @@ def test_a_branch_that_is_no_branch_exits_usage_or_invalid(
     assert "SHOULDER/ELBOW/WRIST" in capsys.readouterr().err
     code, out, err = run(capsys, *at, "front/up/flip")  # an OPW arm's names on a UR
     assert (code, out) == (INVALID, "")
-    assert err.startswith("error: ik.branch: {shoulder=front, elbow=up, wrist=flip} is not a")
+    assert err.startswith(
+        "error: ik.branch (--branch): {shoulder=front, elbow=up, wrist=flip} is not a"
+    )
 
 
 def test_a_command_is_bounded_by_the_job_limits_not_the_routes(
@@ -865,7 +897,7 @@ def test_a_cell_file_that_cannot_be_read_is_an_invalid_input(
         capsys, "evaluate", str(PROGRAM), "--robot", "ur5e", "--cell", str(cell), "--at=0,0.3,0,0"
     )
     assert code == INVALID
-    assert err.startswith(f"error: cell: {said}")
+    assert err.startswith(f"error: cell (--cell): {said}")
 
 
 @pytest.mark.parametrize(
@@ -997,7 +1029,10 @@ def test_files_that_are_missing_huge_or_folders_are_named_on_their_option(
         (["import", str(tmp_path)], "program: "),
         (["import", str(huge)], "program: "),
         ([*MAP[:2], "--robot", str(tmp_path / "arm.json"), *MAP[4:], "--png", "m.png"], "--robot"),
-        ([*MAP, "--png", str(tmp_path / "m.png"), "--cell", str(tmp_path / "c.json")], "cell: no"),
+        (
+            [*MAP, "--png", str(tmp_path / "m.png"), "--cell", str(tmp_path / "c.json")],
+            "cell (--cell): no",
+        ),
     ]
     for argv, said in cases:
         code, _, err = run(capsys, *argv)
