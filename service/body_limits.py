@@ -14,7 +14,7 @@ from starlette.datastructures import Headers
 from starlette.types import ASGIApp, Message, Receive, Scope, Send
 
 from service.config import get_settings
-from service.errors import error_response
+from service.errors import CLIENT_CLOSED_REQUEST, client_left, error_response
 from service.schemas import ErrorDetail
 
 
@@ -89,6 +89,17 @@ def is_json(content_type: str) -> bool:
     )
 
 
+def _client_left(scope: Scope, size: int) -> JSONResponse:
+    """The answer (nobody hears it) to a body its client stopped sending and left.
+
+    Sent so that the request metrics count it, as 4xx (:data:`CLIENT_CLOSED_REQUEST`): the
+    middleware returned without an answer, which the metrics counted as a server error.
+    """
+    client_left(scope["method"], scope["path"], f"its body stopped after {size} bytes")
+    detail = ErrorDetail(loc=["body"], msg="the client left before its body ended", type="left")
+    return error_response(CLIENT_CLOSED_REQUEST, [detail])
+
+
 class BodySizeLimitMiddleware:
     """Answer ``413`` to a body over ``Settings.max_body_bytes``, ``415`` to one not JSON.
 
@@ -135,6 +146,7 @@ class BodySizeLimitMiddleware:
             while more_body:
                 message = await receive()
                 if message["type"] != "http.request":  # the client went away
+                    await _client_left(scope, size)(scope, receive, send)
                     return
                 chunk: bytes = message.get("body", b"")
                 size += len(chunk)

@@ -24,6 +24,7 @@ from service.convert.errors import (
     solver_error_type,
 )
 from service.jobs.job import JobStoreUnavailable
+from service.logs import request_log
 from service.schemas import ErrorDetail, ErrorResponse
 from service.work import STOPPING
 from solver.core.exceptions import SolverError
@@ -62,8 +63,8 @@ ERROR_RESPONSES: dict[int | str, dict[str, Any]] = {
     },
     status.HTTP_503_SERVICE_UNAVAILABLE: {
         "model": ErrorResponse,
-        "description": "The work was stopped because the service is shutting down (or its "
-        "client left); retry.",
+        "description": "The work was stopped because the service is shutting down; retry. (A "
+        "client that left is answered 499, which nobody hears, for the request metrics.)",
         "headers": RETRY_AFTER,
     },
     status.HTTP_422_UNPROCESSABLE_CONTENT: {
@@ -147,16 +148,36 @@ async def server_error_handler(request: Request, error: Exception) -> JSONRespon
     return error_response(status.HTTP_500_INTERNAL_SERVER_ERROR, [detail])
 
 
-async def cancelled_handler(request: Request, error: Cancelled) -> JSONResponse:
-    """Answer work stopped on the way (the client left, or the service is stopping) with 503.
+CLIENT_CLOSED_REQUEST = 499
+"""The status of a request its client left before the answer (nginx's "Client Closed
+Request"): nobody hears it, but the request metrics count it as 4xx, the client's doing, not
+as a server error (a 503, counted 5xx: every impatient client, closed browser tab or proxy
+timeout raised the 5xx rate an operator alerts on, with no log line to explain it; the soak
+audit of stop 61)."""
 
-    A client that left hears nothing; a proxy, a log or a test may: each says its own cause.
+
+async def cancelled_handler(request: Request, error: Cancelled) -> JSONResponse:
+    """Answer work stopped on the way: 503 while the service stops, 499 for a client that left.
+
+    A client that left hears nothing; a proxy, a log or a test may: each says its own cause,
+    and a line in the log says which request was left (uvicorn logs no access line for it).
     """
-    why = "the service is shutting down" if STOPPING.is_set() else "its client left"
-    detail = ErrorDetail(loc=[], msg=f"the work was stopped: {why}", type="cancelled")
-    response = error_response(status.HTTP_503_SERVICE_UNAVAILABLE, [detail])
-    response.headers["Retry-After"] = "5"
-    return response
+    if STOPPING.is_set():
+        detail = ErrorDetail(
+            loc=[], msg="the work was stopped: the service is shutting down", type="cancelled"
+        )
+        response = error_response(status.HTTP_503_SERVICE_UNAVAILABLE, [detail])
+        response.headers["Retry-After"] = "5"
+        return response
+    if request is not None:  # (a test calls the handler alone)
+        client_left(request.method, request.url.path, "its work was stopped")
+    detail = ErrorDetail(loc=[], msg="the work was stopped: its client left", type="cancelled")
+    return error_response(CLIENT_CLOSED_REQUEST, [detail])
+
+
+def client_left(method: str, path: str, what: str) -> None:
+    """Log that a request's client left before its answer (``what``: what then happened)."""
+    request_log.info("%s %s %s: %s, its client left", method, path, CLIENT_CLOSED_REQUEST, what)
 
 
 STORE_RETRY_SECONDS = 30

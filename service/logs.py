@@ -1,4 +1,7 @@
-"""The service's own log lines (``dtf.*``): the jobs' and the start's, sent to stderr once."""
+"""The service's own log lines (``dtf.*``), sent to stderr once.
+
+The jobs', the start's, and the requests' whose client left before the answer.
+"""
 
 from __future__ import annotations
 
@@ -7,6 +10,8 @@ import logging
 log = logging.getLogger("dtf.jobs")
 startup_log = logging.getLogger("dtf.startup")
 """The start's lines: the kernels' warm-up (its first time compiles them, about 30 s)."""
+request_log = logging.getLogger("dtf.requests")
+"""Requests whose client left before the answer (uvicorn writes no access line for them)."""
 
 
 def log_to_stderr() -> None:

@@ -37,7 +37,8 @@ async def run_stoppable(request: Request, work: Callable[[Progress], T]) -> T:
     """Run ``work(progress)`` in a worker thread; stop it when the client goes away.
 
     Raises:
-        Cancelled: the client left or the service is stopping (answered 503 if anyone listens).
+        Cancelled: the client left (answered 499, for the metrics) or the service is stopping
+            (503).
     """
     stop = threading.Event()
 

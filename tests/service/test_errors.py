@@ -5,6 +5,7 @@ from __future__ import annotations
 import asyncio
 import copy
 import json
+import logging
 import re
 from collections.abc import Callable
 from typing import Any
@@ -12,6 +13,7 @@ from typing import Any
 import httpx
 import pytest
 from fastapi.testclient import TestClient
+from starlette.requests import Request
 from starlette.types import Message, Receive, Scope, Send
 
 from service.body_limits import BodySizeLimitMiddleware
@@ -385,6 +387,36 @@ def test_middleware_hands_on_the_whole_body(body_limit: int) -> None:
     assert received == [b"a" * 200 + b"b" * 200]
 
 
+def test_a_body_its_client_left_is_answered_499_and_logged(
+    body_limit: int, caplog: pytest.LogCaptureFixture
+) -> None:
+    """The middleware returned without an answer, which /metrics counted as a server error
+    (5xx), and logged nothing (the soak audit of stop 61): a 499 nobody hears, and a line."""
+    messages: list[Message] = [
+        {"type": "http.request", "body": b"a" * 100, "more_body": True},
+        {"type": "http.disconnect"},
+    ]
+    sent: list[Message] = []
+    ran: list[bool] = []
+
+    async def app(scope: Scope, receive: Receive, send: Send) -> None:
+        ran.append(True)
+
+    async def receive() -> Message:
+        return messages.pop(0)
+
+    async def send(message: Message) -> None:
+        sent.append(message)
+
+    scope: Scope = {"type": "http", "method": "POST", "path": "/v1/map", "headers": []}
+    with caplog.at_level(logging.INFO, logger="dtf.requests"):
+        asyncio.run(BodySizeLimitMiddleware(app)(scope, receive, send))
+    assert ran == [] and sent[0]["status"] == 499
+    assert caplog.messages == [
+        "POST /v1/map 499: its body stopped after 100 bytes, its client left"
+    ]
+
+
 # Finite but extreme numbers: each is either answered (200) or refused naming its field (422),
 # never a 5xx.
 EXTREME_DTF_CASES = [
@@ -559,17 +591,28 @@ def test_a_bad_yaw_is_named_once_where_it_is(client: TestClient, yaw: Any, loc: 
     assert detail["loc"] == loc and detail["msg"] == "Input should be less than or equal to 1000"
 
 
-def test_work_stopped_says_whether_its_client_left_or_the_service_stops() -> None:
-    """Both were 'the service is shutting down': a proxy or a log read the wrong cause."""
+def test_work_stopped_says_whether_its_client_left_or_the_service_stops(
+    caplog: pytest.LogCaptureFixture,
+) -> None:
+    """Both were 'the service is shutting down': a proxy or a log read the wrong cause. And a
+    client that left was answered 503, which nobody heard and /metrics counted as a server
+    error, with no log line (the soak audit of stop 61): 499, and a line naming the request."""
+    scope = {"type": "http", "method": "POST", "path": "/v1/map", "headers": []}
 
-    def said() -> str:
-        answer = asyncio.run(cancelled_handler(None, Cancelled()))  # type: ignore[arg-type]
-        assert answer.status_code == 503 and answer.headers["Retry-After"] == "5"
-        return str(json.loads(answer.body)["detail"][0]["msg"])
+    def said(request: Request) -> tuple[int, str | None, str]:
+        answer = asyncio.run(cancelled_handler(request, Cancelled()))
+        message = str(json.loads(answer.body)["detail"][0]["msg"])
+        return answer.status_code, answer.headers.get("Retry-After"), message
 
-    assert said() == "the work was stopped: its client left"
+    with caplog.at_level(logging.INFO, logger="dtf.requests"):
+        left = said(Request(scope))
+    assert left == (499, None, "the work was stopped: its client left")
+    assert caplog.messages == [
+        "POST /v1/map 499: its work was stopped, its client left",
+    ]
     STOPPING.set()
     try:
-        assert said() == "the work was stopped: the service is shutting down"
+        stopping = said(Request(scope))
     finally:
         STOPPING.clear()
+    assert stopping == (503, "5", "the work was stopped: the service is shutting down")
