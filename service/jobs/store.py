@@ -20,6 +20,7 @@ from typing import Any
 from service.jobs.job import Job, Kind, QueueFull, Status, job_of_row
 from service.jobs.results import Result, write_result
 from service.jobs.store_reads import JobReads
+from service.logs import log
 
 
 class JobStore(JobReads):
@@ -238,6 +239,7 @@ class JobStore(JobReads):
         """
         now = time.time()
         with self._connection() as db:
+            left = db.execute("SELECT id, attempts FROM jobs WHERE status = 'running'").fetchall()
             db.execute(
                 "UPDATE jobs SET status = 'failed', finished = ?, error = ? WHERE "
                 "status = 'running' AND attempts >= ?",
@@ -253,6 +255,12 @@ class JobStore(JobReads):
             rows = db.execute(
                 "SELECT id FROM jobs WHERE status = 'queued' ORDER BY created"
             ).fetchall()
+        for job_id, runs in left:  # a restart's work said (only a second 'running' line was)
+            if runs >= attempts:
+                log.info("job %s interrupted by a restart after %d runs: failed", job_id, runs)
+            else:
+                log.info("job %s interrupted by a restart: queued again (run %d of at most %d)",
+                         job_id, runs + 1, attempts)  # fmt: skip
         return [row[0] for row in rows]
 
     def statistics(self) -> tuple[dict[str, int], list[float]]:

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import dataclasses
 import json
+import logging
 import os
 import sqlite3
 import subprocess
@@ -169,6 +170,28 @@ def test_an_expired_job_goes_with_its_result_pages(tmp_path: Path) -> None:
     assert store.get(expired.id) is None and store.cells(expired.id, offset=0, limit=9) == []
     assert store.cells(kept.id, offset=0, limit=9) == cells
     assert stored_cells(store.path) == 1
+
+
+def test_a_restart_says_which_jobs_it_queued_again_and_which_failed(
+    tmp_path: Path, caplog: pytest.LogCaptureFixture
+) -> None:
+    """After a restart only a job's second 'running' line told it had been interrupted (stop
+    61's soak audit): each interrupted job is said, queued again or failed on its runs."""
+    store = JobStore(tmp_path / "jobs.sqlite3")
+    again, spent, waiting = (store.create("evaluate", EVALUATE) for _ in range(3))
+    assert store.start(spent.id)
+    for _ in range(2):  # spent's third run is interrupted too
+        store.recover(attempts=9)
+        assert store.start(spent.id)
+    assert store.start(again.id)  # its first run
+    caplog.clear()
+    with caplog.at_level(logging.INFO, logger="dtf.jobs"):
+        queued = store.recover(attempts=3)
+    assert queued == [again.id, waiting.id]
+    assert caplog.messages == [
+        f"job {again.id} interrupted by a restart: queued again (run 2 of at most 3)",
+        f"job {spent.id} interrupted by a restart after 3 runs: failed",
+    ]
 
 
 def test_a_job_queued_again_after_a_restart_starts_its_progress_again(tmp_path: Path) -> None:
