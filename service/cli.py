@@ -25,10 +25,10 @@ command's work is bounded as a job's is (DTF_MAX_JOB_CELLS, DTF_MAX_JOB_POSES; a
 limit where larger), not as a synchronous request's (:func:`_settings`).
 Exit codes: :data:`OK` (0), :data:`USAGE` (2), :data:`INVALID` (3), :data:`INFEASIBLE` (4),
 :data:`NOT_WRITTEN` (5, the answer could not be written), :data:`INTERRUPTED` (130, Ctrl-C),
-:data:`CLOSED_PIPE` (141, the output's reader closed it early); 1 is Python's own, for a
-crash. Errors name the field (and waypoint, line) as the API does, or the option (``--png``,
-``--robot``). ``--json`` is written in ASCII (JSON's escapes),
-the same JSON on any console's encoding.
+:data:`CLOSED_PIPE` (141, the output's reader closed it early), :data:`TERMINATED` (143,
+SIGTERM); 1 is Python's own, for a crash. Errors name the field (and waypoint, line) as the
+API does with the option that fills it, or the option alone (``--png``). ``--json`` is
+written in ASCII (JSON's escapes), the same JSON on any console's encoding.
 """
 
 from __future__ import annotations
@@ -40,7 +40,9 @@ import json
 import math
 import os
 import re
+import signal
 import sys
+import threading
 from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any, TypeVar
@@ -75,6 +77,10 @@ answer a post-processor never gets is no success, and no input of its was wrong)
 INTERRUPTED = 130
 """Interrupted (Ctrl-C, SIGINT): the work stopped, ``interrupted`` on stderr (128 + SIGINT, as
 a shell reports it)."""
+TERMINATED = 143
+"""Stopped by SIGTERM (what ``timeout`` and a job runner send): the work stopped,
+``terminated`` on stderr, nothing written (128 + SIGTERM, as a shell reports it; the process
+was ended by the signal with nothing said)."""
 CLOSED_PIPE = 141
 """The reader of the output closed it early (``dtf-place ... | head``): nothing more is printed,
 as a shell reports a process the pipe's signal ends (128 + SIGPIPE)."""
@@ -129,6 +135,8 @@ def main(argv: Sequence[str] | None = None) -> int:
         return NOT_WRITTEN
     _say_where_caches_are()
     echo = native_stderr.ECHO.set(False)  # a refused URDF's reason is in the error printed
+    on_main_thread = threading.current_thread() is threading.main_thread()
+    before = signal.signal(signal.SIGTERM, _terminated) if on_main_thread else None
     try:
         code = int(args.run(args))
         sys.stdout.flush()  # a closed pipe is seen here, not at the interpreter's exit
@@ -136,10 +144,11 @@ def main(argv: Sequence[str] | None = None) -> int:
     except BrokenPipeError:
         _quiet_stdout()
         return CLOSED_PIPE
-    except KeyboardInterrupt:  # Ctrl-C: the work stopped, nothing more to say than that
+    except (KeyboardInterrupt, Terminated) as stop:  # the work stopped: nothing more to say
         if sys.stderr is not None:
-            print("interrupted", file=sys.stderr)  # noqa: T201
-        return INTERRUPTED
+            said = "terminated" if isinstance(stop, Terminated) else "interrupted"
+            print(said, file=sys.stderr)  # noqa: T201
+        return TERMINATED if isinstance(stop, Terminated) else INTERRUPTED
     except ValidationError as error:
         for detail in request_errors(error.errors()):
             where = ".".join(str(part) for part in detail.loc)
@@ -154,7 +163,18 @@ def main(argv: Sequence[str] | None = None) -> int:
         print(f"error: {error}", file=sys.stderr)  # noqa: T201
     finally:
         native_stderr.ECHO.reset(echo)
+        if before is not None:
+            signal.signal(signal.SIGTERM, before)
     return INVALID
+
+
+class Terminated(BaseException):  # noqa: N818 - a signal's stop, as KeyboardInterrupt
+    """SIGTERM arrived: raised in the main thread, as SIGINT's KeyboardInterrupt is."""
+
+
+def _terminated(signum: int, frame: object) -> None:
+    """SIGTERM's handler while a command runs: stop it as Ctrl-C would (:data:`TERMINATED`)."""
+    raise Terminated
 
 
 def _say_where_caches_are() -> None:
@@ -595,7 +615,8 @@ def _parser() -> argparse.ArgumentParser:
         "the import, mu_path at a placement, the capability map, the best placement. "
         f"Exit codes: {OK} ok, {INFEASIBLE} infeasible, {USAGE} usage, {INVALID} invalid input, "
         f"{NOT_WRITTEN} answer not written (output closed, disk full), {INTERRUPTED} "
-        f"interrupted (Ctrl-C), {CLOSED_PIPE} output closed early by its reader. "
+        f"interrupted (Ctrl-C), {CLOSED_PIPE} output closed early by its reader, {TERMINATED} "
+        "terminated (SIGTERM). "
         "Settings come from DTF_* variables as for the service; the work of a command is "
         "bounded as a job's (DTF_MAX_JOB_CELLS, DTF_MAX_JOB_POSES, or a route's limit where "
         "larger).",

@@ -26,6 +26,7 @@ from service.cli import (
     INVALID,
     NOT_WRITTEN,
     OK,
+    TERMINATED,
     USAGE,
     main,
 )
@@ -925,8 +926,15 @@ def test_an_answer_that_cannot_be_written_is_not_a_success(
         assert b"error: " in done.stderr and b"written" in done.stderr
 
 
-def test_ctrl_c_stops_a_map_with_one_line_and_the_shells_code(tmp_path: Path) -> None:
-    """SIGINT during a map printed a 30-line KeyboardInterrupt traceback (exit 1)."""
+@pytest.mark.parametrize(
+    ("stop", "said", "exit_code"),
+    [(signal.SIGINT, "interrupted", 130), (signal.SIGTERM, "terminated", 143)],
+)
+def test_ctrl_c_stops_a_map_with_one_line_and_the_shells_code(
+    tmp_path: Path, stop: signal.Signals, said: str, exit_code: int
+) -> None:
+    """SIGINT during a map printed a 30-line KeyboardInterrupt traceback (exit 1); SIGTERM
+    (what timeout(1) and job runners send) ended it with nothing said (stop 61's CLI audit)."""
     grid = ["--x=-0.8:0.8:0.002", "--y=-0.8:0.8:0.002", "--png", str(tmp_path / "map.png")]
     command = [sys.executable, "-m", "service.cli", *MAP[:4], *grid, "--progress"]
     big = {"DTF_MAX_MAP_CELLS": "1000000", "DTF_MAX_MAP_POSES": "100000000"}  # minutes of work
@@ -938,11 +946,12 @@ def test_ctrl_c_stops_a_map_with_one_line_and_the_shells_code(tmp_path: Path) ->
             byte = process.stderr.read(1)
             assert byte, seen.decode()  # it ended before its bar
             seen += byte
-        process.send_signal(signal.SIGINT)
-        said = process.stderr.read().decode()
+        process.send_signal(stop)
+        told = process.stderr.read().decode()
         code = process.wait(timeout=120)
-    assert code == INTERRUPTED == 130
-    assert said.rstrip().endswith("interrupted") and "Traceback" not in said
+    assert code == exit_code and exit_code in (INTERRUPTED, TERMINATED)
+    assert told.rstrip().endswith(said) and "Traceback" not in told
+    assert not (tmp_path / "map.png").exists()
 
 
 def test_an_operation_name_the_outputs_encoding_lacks_is_escaped_not_a_traceback(
