@@ -57,7 +57,7 @@ from service.convert.errors import request_errors, solver_error_location
 from service.operations import computed_map, evaluation_of, import_of, map_png
 from service.schemas import EvaluateRequest, MapRequest, OptimizeRequest, RobotRead
 from service.schemas.paths_import import PathImportRequest
-from solver.core import native_stderr
+from solver.core import cache_home, native_stderr
 from solver.core.exceptions import InvalidInputError, SolverError, cut
 from solver.core.urdf_structure import fixed_to_root
 from solver.families import closed_form_bases
@@ -138,7 +138,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     on_main_thread = threading.current_thread() is threading.main_thread()
     before = signal.signal(signal.SIGTERM, _terminated) if on_main_thread else None
     try:
-        code = int(args.run(args))
+        with cache_home.on_first_compile(_say_compiling):
+            code = int(args.run(args))
         sys.stdout.flush()  # a closed pipe is seen here, not at the interpreter's exit
         return code
     except BrokenPipeError:
@@ -175,6 +176,21 @@ class Terminated(BaseException):  # noqa: N818 - a signal's stop, as KeyboardInt
 def _terminated(signum: int, frame: object) -> None:
     """SIGTERM's handler while a command runs: stop it as Ctrl-C would (:data:`TERMINATED`)."""
     raise Terminated
+
+
+def _say_compiling() -> None:
+    """The note that the kernels are being compiled: a run that a cold cache makes minutes long.
+
+    Said once, when numba starts compiling (not loading from its cache): an unattended caller
+    saw a silent wait of one to two minutes on its first run (the CLI audit of stop 61).
+    """
+    if sys.stderr is not None:
+        print(  # noqa: T201
+            "note: compiling the kernels this command needs (their first use in this "
+            "installation or account: up to a few minutes, once; later runs load them)",
+            file=sys.stderr,
+            flush=True,
+        )
 
 
 def _say_where_caches_are() -> None:

@@ -12,12 +12,16 @@ be: the caller says so (:data:`FALLBACK`; the CLI on stderr, the service in its 
 
 from __future__ import annotations
 
+import contextlib
 import os
 import stat
 import tempfile
+import threading
+from collections.abc import Callable, Iterator
 from pathlib import Path
 
 import numba.core.config
+import numba.core.event
 
 from solver.core.compiled_cache import numba_cache_folder
 
@@ -72,3 +76,35 @@ def private_folder(name: str, temporary: Path | None = None) -> Path | None:
     except OSError:
         return None
     return folder
+
+
+class _FirstCompile(numba.core.event.Listener):  # type: ignore[misc]  # numba has no stubs
+    """Calls ``say`` once, when numba starts compiling a function (not loading it from a cache)."""
+
+    def __init__(self, say: Callable[[], None]) -> None:
+        self.say, self.said, self.lock = say, False, threading.Lock()
+
+    def on_start(self, event: numba.core.event.Event) -> None:
+        with self.lock:
+            first, self.said = not self.said, True
+        if first:
+            self.say()
+
+    def on_end(self, event: numba.core.event.Event) -> None:
+        pass
+
+
+@contextlib.contextmanager
+def on_first_compile(say: Callable[[], None]) -> Iterator[None]:
+    """Within the block, ``say()`` once if numba compiles anything (a cache it did not find).
+
+    numba's ``numba:compile`` event is broadcast only when a function is compiled, not when
+    its machine code is loaded from the disk cache: the first use of the kernels in an
+    installation or an account compiles them for one to two minutes, which a command then says.
+    """
+    listener = _FirstCompile(say)
+    numba.core.event.register("numba:compile", listener)
+    try:
+        yield
+    finally:
+        numba.core.event.unregister("numba:compile", listener)

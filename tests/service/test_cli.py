@@ -16,9 +16,11 @@ import sys
 from pathlib import Path
 from typing import Any
 
+import numba
 import pytest
 from fastapi.testclient import TestClient
 
+from service import cli
 from service.cli import (
     CLOSED_PIPE,
     INFEASIBLE,
@@ -175,6 +177,34 @@ def test_a_feed_is_given_in_m_per_s_or_with_its_unit(capsys: pytest.CaptureFixtu
         run(capsys, *at, "--feed", "508mm/s")
     assert usage.value.code == 2
     assert "give a number of m/s, or one with m/s, mm/min, in/min, ipm" in capsys.readouterr().err
+
+
+def test_a_command_that_compiles_kernels_says_so_once(
+    capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The first run in an installation or account compiles for one to two minutes, and an
+    unattended caller saw nothing on stderr (the CLI audit of stop 61): one note when numba
+    compiles (here two signatures of a function of the test's own), none when it loads."""
+
+    @numba.njit(cache=False)
+    def fresh(x: float) -> float:
+        return x + 1
+
+    reads = cli.import_of
+
+    def compiling(*args: Any, **kwargs: Any) -> Any:
+        fresh(1)
+        fresh(2.0)
+        return reads(*args, **kwargs)
+
+    monkeypatch.setattr(cli, "import_of", compiling)
+    code, _, err = run(capsys, "import", str(PROGRAM))
+    assert code == 0 and err.splitlines() == [
+        "note: compiling the kernels this command needs (their first use in this installation "
+        "or account: up to a few minutes, once; later runs load them)"
+    ]
+    code, _, err = run(capsys, "import", str(PROGRAM))  # compiled now: nothing to say
+    assert (code, err) == (0, "")
 
 
 def test_a_robot_from_a_json_file(
