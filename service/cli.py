@@ -53,7 +53,7 @@ from service import caches
 from service.cli_files import decoded, file_bytes, text_file
 from service.cli_text import ProgressBar, evaluation_text, import_text, map_text, optimum_text
 from service.config import Settings, settings_or_exit
-from service.convert.errors import request_errors, solver_error_location
+from service.convert.errors import request_errors, solver_error_location, solver_error_type
 from service.operations import computed_map, evaluation_of, import_of, map_png
 from service.schemas import EvaluateRequest, MapRequest, OptimizeRequest, RobotRead
 from service.schemas.paths_import import PathImportRequest
@@ -151,22 +151,47 @@ def main(argv: Sequence[str] | None = None) -> int:
             print(said, file=sys.stderr)  # noqa: T201
         return TERMINATED if isinstance(stop, Terminated) else INTERRUPTED
     except ValidationError as error:
-        for detail in request_errors(error.errors()):
-            where = ".".join(str(part) for part in detail.loc)
-            print(f"error: {_with_option(where)}: {detail.msg}", file=sys.stderr)  # noqa: T201
+        found = request_errors(error.errors())
+        _refused(args, [(list(d.loc), d.msg, d.type) for d in found])
     except SolverError as error:
-        where = ".".join(str(part) for part in solver_error_location(error)[1:])
-        print(f"error: {_with_option(where)}: {error.message}", file=sys.stderr)  # noqa: T201
+        _refused(
+            args, [(solver_error_location(error)[1:], error.message, solver_error_type(error))]
+        )
     except OSError as error:
         if error.errno in _WRITE_ERRORS:  # the output's device: the answer was not written
             print(f"error: the answer could not be written: {error}", file=sys.stderr)  # noqa: T201
             return NOT_WRITTEN
-        print(f"error: {error}", file=sys.stderr)  # noqa: T201
+        _refused(args, [([], str(error), "os_error")])
     finally:
         native_stderr.ECHO.reset(echo)
         if before is not None:
             signal.signal(signal.SIGTERM, before)
     return INVALID
+
+
+def _refused(args: argparse.Namespace, details: list[tuple[list[str | int], str, str]]) -> None:
+    """Say why the input is refused: a line on stderr each, and with --json the route's 422 body.
+
+    Each detail: where (a request field's path, or an option), the message, the error type.
+    With ``--json`` the standard output holds one JSON document whatever happens, so a calling
+    program reads a refusal as it reads the route's (``{"detail": [{"loc", "msg", "type"}]}``,
+    the request's fields under ``body``); it had only the English lines on stderr (the CLI
+    audit of stop 61).
+    """
+    for loc, message, _ in details:
+        where = _with_option(".".join(str(part) for part in loc))
+        print(f"error: {where}: {message}" if where else f"error: {message}", file=sys.stderr)  # noqa: T201
+    if getattr(args, "json", False):
+        body = [
+            {"loc": loc if _is_option(loc) else ["body", *loc], "msg": message, "type": kind}
+            for loc, message, kind in details
+        ]
+        print(json.dumps({"detail": body}, ensure_ascii=True))  # noqa: T201
+
+
+def _is_option(loc: list[str | int]) -> bool:
+    """Whether ``loc`` names an option or the program file rather than a request field."""
+    return not loc or (isinstance(loc[0], str) and (loc[0].startswith("--") or loc[0] == "program"))
 
 
 class Terminated(BaseException):  # noqa: N818 - a signal's stop, as KeyboardInterrupt

@@ -171,7 +171,7 @@ def test_a_feed_is_given_in_m_per_s_or_with_its_unit(capsys: pytest.CaptureFixtu
     assert answers["20 in/min"] == answers["20IPM"] == answers[str(0.0254 * 20 / 60)]
     assert answers["508mm/min"][1]["feed"] == pytest.approx(508 / 60_000, rel=1e-15)
     code, out, err = run(capsys, *at, "--feed", "508")
-    assert (code, out) == (INVALID, "")
+    assert (code, json.loads(out)["detail"][0]["loc"]) == (INVALID, ["body", "feed"])
     assert err.startswith("error: feed (--feed: m/s, or with its unit: 508mm/min, 20in/min): ")
     with pytest.raises(SystemExit) as usage:
         run(capsys, *at, "--feed", "508mm/s")
@@ -272,6 +272,25 @@ def test_invalid_input_names_the_field_and_exits_invalid(
     broken.write_text("UNITS/MM\nGOTO/0,0,0\nGOTO/1,0,0,0,0\n")
     code, _, err = run(capsys, "import", str(broken))
     assert code == INVALID and err.startswith("error: path.cl_data (PROGRAM): line 3: ")
+
+
+def test_a_refusal_with_json_is_the_routes_422_body_on_stdout(
+    client: TestClient, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """With --json a caller parses stdout; a refusal was only English on stderr (the CLI audit
+    of stop 61): now the route's 422 body too, the English lines still on stderr."""
+    text = "GOTO/0,0,0\nFEDRAT/MMPM,250\nGOTO/10,0,0\n"
+    bare = tmp_path / "bare.cl"
+    bare.write_text(text)
+    code, out, err = run(capsys, "import", str(bare), "--json")
+    route = client.post("/v1/paths/import", json={"path": {"cl_data": text}})
+    assert route.status_code == 422
+    assert (code, json.loads(out)) == (INVALID, route.json())
+    assert err.startswith("error: path.units (--units): ")
+    map_png = [*MAP, "--png", str(tmp_path), "--json"]  # a folder: refused on its option
+    code, out, _ = run(capsys, *map_png)
+    assert code == INVALID
+    assert json.loads(out)["detail"][0]["loc"] == ["--png"]
 
 
 def test_a_csv_needs_its_units_and_errors_name_the_api_field(
