@@ -1,8 +1,9 @@
 """``GET /metrics``: Prometheus text, from the maintained prometheus-fastapi-instrumentator.
 
 Request counts and latencies per route come from the instrumentator; the service adds the jobs
-by status and the durations of finished jobs (read from the job store at each scrape, since jobs
-run in other processes), and the placements its synchronous maps computed.
+by status and the count and seconds of the jobs that ran to an end (read from the job store at
+each scrape, since jobs run in other processes; totals that only grow, as a Prometheus summary
+must), and the placements its synchronous maps computed.
 """
 
 from __future__ import annotations
@@ -19,14 +20,16 @@ from prometheus_fastapi_instrumentator import Instrumentator
 
 from service.errors import JSON_ERROR, RETRY_AFTER, SERVER_ERROR_RESPONSE
 
+JOB_SECONDS = "Seconds of the jobs that ran to an end, since the store began."
+
 PLACEMENTS = Counter("dtf_placements", "Placements computed by /v1/map (synchronous maps).")
 
 
 class JobStatistics(Protocol):
     """What the collector reads from the job store (:class:`service.jobs.store.JobStore`)."""
 
-    def statistics(self) -> tuple[dict[str, int], list[float]]:
-        """Jobs by status, and the durations of finished jobs (s)."""
+    def statistics(self) -> tuple[dict[str, int], tuple[int, float]]:
+        """Jobs by status; the jobs that ran to an end and their seconds, only growing."""
         ...
 
 
@@ -40,7 +43,7 @@ class _JobCollector(Collector):
     def describe(self) -> Iterable[GaugeMetricFamily | SummaryMetricFamily]:
         """The two job metrics, without values: registering the collector reads no store."""
         yield GaugeMetricFamily("dtf_jobs", "Jobs by status.", labels=["status"])
-        yield SummaryMetricFamily("dtf_job_seconds", "Durations of finished jobs (s).")
+        yield SummaryMetricFamily("dtf_job_seconds", JOB_SECONDS)
 
     def collect(self) -> Iterable[GaugeMetricFamily | SummaryMetricFamily]:
         """The two job metrics.
@@ -50,12 +53,12 @@ class _JobCollector(Collector):
         """
         store = self.store()
         by_status = GaugeMetricFamily("dtf_jobs", "Jobs by status.", labels=["status"])
-        counts, durations = store.statistics()
+        counts, (finished, seconds) = store.statistics()
         for status in ("queued", "running", "done", "failed", "cancelled"):
             by_status.add_metric([status], counts.get(status, 0))
         yield by_status
-        summary = SummaryMetricFamily("dtf_job_seconds", "Durations of finished jobs (s).")
-        summary.add_metric([], count_value=len(durations), sum_value=sum(durations))
+        summary = SummaryMetricFamily("dtf_job_seconds", JOB_SECONDS)
+        summary.add_metric([], count_value=finished, sum_value=seconds)
         yield summary
 
 

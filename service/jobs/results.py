@@ -46,6 +46,25 @@ CREATE TABLE IF NOT EXISTS job_cells (
     cells TEXT NOT NULL,
     PRIMARY KEY (job_id, page)
 );
+CREATE TABLE IF NOT EXISTS job_totals (
+    one INTEGER PRIMARY KEY CHECK (one = 1),
+    finished INTEGER NOT NULL,
+    seconds REAL NOT NULL
+);
+INSERT OR IGNORE INTO job_totals
+    SELECT 1, COUNT(*), COALESCE(SUM(finished - started), 0.0) FROM jobs
+    WHERE finished IS NOT NULL AND started IS NOT NULL;
+CREATE TRIGGER IF NOT EXISTS job_ran_to_its_end AFTER UPDATE OF finished ON jobs
+    WHEN OLD.finished IS NULL AND NEW.finished IS NOT NULL AND NEW.started IS NOT NULL
+BEGIN
+    UPDATE job_totals SET finished = finished + 1, seconds = seconds + NEW.finished - NEW.started;
+END;
+"""
+"""The jobs, their result pages, and the totals of the jobs that ran to an end (``/metrics``).
+
+The totals only grow: a trigger adds each job as it finishes after running (done, failed,
+cancelled), whichever update finishes it; a deleted or expired job stays counted. A store
+made by an older release gets them from its finished jobs, once.
 """
 
 _ADDED_COLUMNS = {"total": "INTEGER", "cells": "INTEGER", "first_at": "REAL", "first_done": "REAL"}

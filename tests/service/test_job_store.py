@@ -279,3 +279,47 @@ def test_a_store_of_an_older_release_gets_the_new_columns(tmp_path: Path) -> Non
     state = JobStore(path).state("old")
     assert state is not None and (state.total, state.cells, state.first_report) == (None,) * 3
     assert eta_seconds(state, now=12.0) == pytest.approx(10.0, abs=1e-12)
+
+
+def test_the_jobs_that_ran_are_counted_once_each_and_never_less(tmp_path: Path) -> None:
+    """/metrics' dtf_job_seconds was read from the jobs held: its count fell from 748 to 0 when
+    they were deleted or expired (a counter reset to Prometheus), and each scrape read every
+    finished job's times (the soak audit of stop 61). Done, failed by restarts, cancelled while
+    running: each counted once with its seconds, whatever the update that ended it; deleting
+    and expiring them changes nothing; a job cancelled before it ran is not counted."""
+    store = JobStore(tmp_path / "jobs.sqlite3")
+    done, spent, stopped, waiting = (store.create("evaluate", EVALUATE) for _ in range(4))
+    for job in (done, spent, stopped):
+        assert store.start(job.id)
+    store.finish(done.id, "done", result={"mu_path": 0.3})
+    store.recover(attempts=1)  # spent and stopped were running: failed on their one run
+    assert store.start(waiting.id)
+    store.cancel(waiting.id)  # asked while running: the worker ends it cancelled
+    store.finish(waiting.id, "done", result={"mu_path": 0.3}, if_running=True)
+    store.cancel(store.create("evaluate", EVALUATE).id)  # never ran: not counted
+    with sqlite3.connect(store.path) as db:
+        expected = db.execute(
+            "SELECT COUNT(*), SUM(finished - started) FROM jobs WHERE started IS NOT NULL "
+            "AND status IN ('done', 'failed', 'cancelled')"
+        ).fetchone()
+    counts, totals = store.statistics()
+    assert counts == {"done": 1, "failed": 2, "cancelled": 2}
+    assert totals == (4, pytest.approx(expected[1], rel=1e-12, abs=1e-12)) and expected[0] == 4
+    for job in (done, spent):
+        assert store.delete(job.id)
+    assert store.expire(ttl=-1.0) == 3  # every finished job left
+    assert store.statistics() == ({}, totals)
+
+
+def test_a_store_of_an_older_release_counts_the_jobs_it_holds(tmp_path: Path) -> None:
+    """A store made before the totals gets them from its finished jobs when it is opened."""
+    path = tmp_path / "jobs.sqlite3"
+    store = JobStore(path)
+    job = store.create("evaluate", EVALUATE)
+    assert store.start(job.id)
+    store.finish(job.id, "done", result={"mu_path": 0.3})
+    with sqlite3.connect(path) as db:
+        db.execute("DROP TRIGGER job_ran_to_its_end")
+        db.execute("DROP TABLE job_totals")
+        started, finished = db.execute("SELECT started, finished FROM jobs").fetchone()
+    assert JobStore(path).statistics() == ({"done": 1}, (1, pytest.approx(finished - started)))
