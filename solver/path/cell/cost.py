@@ -46,7 +46,7 @@ CELL_POSE_COST = 50.0
 # (capsules) 14 and 95 (63 and 1,033 pairs), the UR5 with 42 more collision spheres on its
 # links 116 with 3 objects (860 pairs) and 287 with 20 (1,727), with 92 more 247 with 3 (2,920)
 # and 1,327 with 100 (12,717 pairs): from 300 to 960 pairs a 50 units; 250 weighs every one of
-# them above what it took (by up to 1.9 times), where a weight of 50 whatever the pairs weighed
+# them above what it took (by up to 2.2 times), where a weight of 50 whatever the pairs weighed
 # the last 26 times below it. A cell of up to 250 pairs (the catalogue's arms with up to about
 # 25 objects) weighs what it did. bench/cell.py prints the check's work against its weight.
 PAIRS_IN_WEIGHT = 250
