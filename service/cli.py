@@ -52,10 +52,11 @@ from pydantic import BaseModel, ValidationError
 from service import caches
 from service.cli_files import decoded, file_bytes, text_file
 from service.cli_text import ProgressBar, evaluation_text, import_text, map_text, optimum_text
-from service.config import Settings, settings_or_exit
+from service.config import MAX_PATH_WAYPOINTS, Settings, settings_or_exit
 from service.convert.errors import request_errors, solver_error_location, solver_error_type
 from service.operations import computed_map, evaluation_of, import_of, map_png
 from service.schemas import EvaluateRequest, MapRequest, OptimizeRequest, RobotRead
+from service.schemas.path_cam import MAX_CAM_TEXT
 from service.schemas.paths_import import PathImportRequest
 from solver.core import cache_home, native_stderr
 from solver.core.exceptions import InvalidInputError, SolverError, cut
@@ -290,6 +291,12 @@ def _quiet_stdout() -> None:
 def _path(args: argparse.Namespace) -> dict[str, Any]:
     """The request's ``path`` object of the program file."""
     text = decoded(file_bytes(Path(args.program), "program"), errors="replace")
+    if len(text) > MAX_CAM_TEXT:  # said as what a program is, not as a string's length
+        message = (
+            f"{len(text):,} characters: a program is read up to {MAX_CAM_TEXT:,} (about the "
+            f"{MAX_PATH_WAYPOINTS:,} moves a path may have): split it between passes"
+        )
+        raise InvalidInputError("program", message)
     if args.program.lower().endswith(".csv"):
         if args.units is None:  # a CSV says nothing of its units: never assumed
             message = "a CSV states no units: give --units mm, inch or m"

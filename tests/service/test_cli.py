@@ -293,6 +293,23 @@ def test_a_refusal_with_json_is_the_routes_422_body_on_stdout(
     assert json.loads(out)["detail"][0]["loc"] == ["--png"]
 
 
+def test_a_program_over_the_character_limit_is_said_as_a_program(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Over 2,000,000 characters the refusal was pydantic's 'String should have at most
+    2000000 characters' (the CLI audit of stop 61): said as a program's length, with what to do."""
+    line = "GOTO/1.0000,2.0000,3.0000\n"
+    long = tmp_path / "long.cl"
+    long.write_text("UNITS/MM\n" + line * (2_000_000 // len(line) + 1))
+    code, out, err = run(capsys, "import", str(long))
+    size = len(long.read_text())
+    assert (code, out) == (INVALID, "")
+    assert err == (
+        f"error: program: {size:,} characters: a program is read up to 2,000,000 (about the "
+        "20,000 moves a path may have): split it between passes\n"
+    )
+
+
 def test_a_csv_needs_its_units_and_errors_name_the_api_field(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
