@@ -86,10 +86,10 @@ def import_text(answer: PathImportResponse, name: str) -> str:
     """The import summary: counts, units and how known, passes and operations, skipped."""
     lines = [
         f"program: {name}",
-        f"waypoints: {len(answer.waypoints)} in {len(answer.passes)} passes "
+        f"waypoints: {len(answer.waypoints)} in {_passes(len(answer.passes))} "
         f"({answer.arcs} arcs interpolated; dropped: {answer.repeated_points} repeated point(s), "
         f"{answer.one_point_passes} one-point pass(es))",
-        f"units: {answer.units} ({answer.units_source}: {answer.units_note})",
+        _units(answer.units, answer.units_source, answer.units_note),
         f"feed: {_feed(answer.feed)} (the highest programmed)",
         "passes:",
     ]
@@ -108,6 +108,22 @@ def import_text(answer: PathImportResponse, name: str) -> str:
     return "\n".join(lines)
 
 
+def _passes(count: int) -> str:
+    """``1 pass``, ``2 passes``."""
+    return f"{count} pass" if count == 1 else f"{count} passes"
+
+
+def _units(units: str, source: str, note: str) -> str:
+    """The units line: how they are known; the API's "request" is the command's ``--units``.
+
+    The reader's note says "the request's units" where the file states none, which on the
+    command line (no request sent) read as if they came from elsewhere (the CLI audit of stop 61).
+    """
+    if source == "request":
+        return f"units: {units} (given with --units: the file states none)"
+    return f"units: {units} ({source}: {note})"
+
+
 def read_text(read: PathRead | None) -> list[str]:
     """How the program was read: its units and how known, passes, what was skipped or dropped.
 
@@ -116,7 +132,7 @@ def read_text(read: PathRead | None) -> list[str]:
     if read is None:
         return []
     line = (
-        f"read: {len(read.pass_details)} passes ({read.arcs} arcs interpolated; dropped: "
+        f"read: {_passes(len(read.pass_details))} ({read.arcs} arcs interpolated; dropped: "
         f"{read.repeated_points} repeated point(s), {read.one_point_passes} one-point pass(es))"
     )
     if read.skipped_records:
@@ -125,7 +141,7 @@ def read_text(read: PathRead | None) -> list[str]:
             + (")" if r.recognised else ", not recognised: check it moves nothing)")
             for r in read.skipped_records
         )
-    lines = [f"units: {read.units} ({read.units_source}: {read.units_note})", line]
+    lines = [_units(read.units, read.units_source, read.units_note), line]
     return lines
 
 

@@ -310,6 +310,21 @@ def test_a_program_over_the_character_limit_is_said_as_a_program(
     )
 
 
+def test_units_given_on_the_command_line_are_said_as_the_option(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """'units: mm (request: the request's units (the file states none))' where no request was
+    sent, and '1 passes' (the CLI audit of stop 61)."""
+    table = tmp_path / "fan.csv"
+    table.write_text("x,y,z,i,j,k\n100,0,0,0,0,1\n110,0,0,0,0,1\n")
+    code, out, _ = run(capsys, "import", str(table), "--units", "mm")
+    assert code == 0 and out.splitlines()[1:3] == [
+        "waypoints: 2 in 1 pass (0 arcs interpolated; dropped: 0 repeated point(s), 0 one-point "
+        "pass(es))",
+        "units: mm (given with --units: the file states none)",
+    ]
+
+
 def test_a_csv_needs_its_units_and_errors_name_the_api_field(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
