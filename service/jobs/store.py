@@ -225,6 +225,7 @@ class JobStore(JobReads):
             # the second statement removes.
             deleted = db.execute("DELETE FROM jobs WHERE id = ?", (job_id,)).rowcount
             db.execute("DELETE FROM job_cells WHERE job_id = ?", (job_id,))
+            _give_back(db)
         return bool(deleted)
 
     def recover(self, *, attempts: int) -> list[str]:
@@ -290,7 +291,19 @@ class JobStore(JobReads):
         with self._connection() as db:
             db.execute(f"DELETE FROM job_cells WHERE job_id IN ({expired})", (cutoff,))
             count = db.execute(f"DELETE FROM jobs WHERE id IN ({expired})", (cutoff,)).rowcount
+            if count:
+                _give_back(db)
         return int(count)
+
+
+def _give_back(db: sqlite3.Connection) -> None:
+    """Return the pages deleted rows freed to the disk (a store made with ``auto_vacuum``).
+
+    The file never shrank: 748 jobs deleted left it at 564 MB, the free pages only reused (the
+    soak audit of stop 61; a map job keeps about 240 bytes a cell, 480 MB at 2 million).
+    ``executescript`` steps the pragma to its end (``execute`` ran one step: nothing freed).
+    """
+    db.executescript("PRAGMA incremental_vacuum;")
 
 
 def _interrupted(attempts: int) -> dict[str, Any]:

@@ -77,6 +77,11 @@ class StoreFile:
         db = sqlite3.connect(uri, uri=True, timeout=30, isolation_level=None)
         db.row_factory = sqlite3.Row
         try:
+            # Pages that deleted and expired jobs free go back to the disk (JobStore.delete,
+            # expire): set before the first table, a no-op on a file that has tables (a store
+            # of an older release keeps its size until VACUUMed once, README); before WAL,
+            # which would otherwise keep it from taking.
+            db.execute("PRAGMA auto_vacuum = INCREMENTAL")
             db.execute("PRAGMA journal_mode=WAL")
             yield db
         finally:
