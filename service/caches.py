@@ -43,11 +43,15 @@ def settle_matplotlib_folder() -> Path | None:
     global FALLBACK
     if FALLBACK is not None or os.environ.get("MPLCONFIGDIR"):
         return FALLBACK
-    home = Path.home() if os.environ.get("HOME") else Path(tempfile.gettempdir())
-    config = Path(os.environ.get("XDG_CONFIG_HOME") or home / ".config") / "matplotlib"
-    cache = Path(os.environ.get("XDG_CACHE_HOME") or home / ".cache") / "matplotlib"
-    if _writable(config) and _writable(cache):
-        return None
+    try:  # matplotlib's own rule: the XDG folders, else the home's (HOME, else the account's)
+        home = Path.home()
+    except RuntimeError:  # no home at all
+        home = None
+    if home is not None:
+        config = Path(os.environ.get("XDG_CONFIG_HOME") or home / ".config") / "matplotlib"
+        cache = Path(os.environ.get("XDG_CACHE_HOME") or home / ".cache") / "matplotlib"
+        if _writable(config) and _writable(cache):
+            return None
     folder = private_folder("dtf-placement-matplotlib")
     if folder is not None:
         os.environ["MPLCONFIGDIR"] = str(folder)
