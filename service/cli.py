@@ -58,6 +58,7 @@ from service.operations import computed_map, evaluation_of, import_of, map_png
 from service.schemas import EvaluateRequest, MapRequest, OptimizeRequest, RobotRead
 from service.schemas.path_cam import MAX_CAM_TEXT
 from service.schemas.paths_import import PathImportRequest
+from solver.cam.cam_path import METRES_PER_UNIT
 from solver.core import cache_home, native_stderr
 from solver.core.exceptions import InvalidInputError, SolverError, cut
 from solver.core.urdf_structure import fixed_to_root
@@ -555,7 +556,12 @@ def _same_file(a: Path, b: Path) -> bool:
         return False
 
 
-FEED_UNITS = {"m/s": 1.0, "mm/min": 0.001 / 60.0, "in/min": 0.0254 / 60.0, "ipm": 0.0254 / 60.0}
+FEED_UNITS = {
+    "m/s": 1.0,
+    "mm/min": METRES_PER_UNIT["mm"] / 60.0,
+    "in/min": METRES_PER_UNIT["inches"] / 60.0,
+    "ipm": METRES_PER_UNIT["inches"] / 60.0,
+}
 """``--feed``'s units, in m/s: a number alone is m/s (the API's), and the feeds printed are in
 mm/min (a CAM program's), so a feed copied from the answer took 508 for m/s (refused above
 100 m/s without a unit named; 50 mm/min would have been read as 50 m/s)."""
