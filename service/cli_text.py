@@ -90,6 +90,7 @@ def import_text(answer: PathImportResponse, name: str) -> str:
         f"({answer.arcs} arcs interpolated; dropped: {answer.repeated_points} repeated point(s), "
         f"{answer.one_point_passes} one-point pass(es))",
         _units(answer.units, answer.units_source, answer.units_note),
+        _end(answer.ended, answer.end_note),
         f"feed: {_feed(answer.feed)} (the highest programmed)",
         "passes:",
     ]
@@ -124,6 +125,11 @@ def _units(units: str, source: str, note: str) -> str:
     return f"units: {units} ({source}: {note})"
 
 
+def _end(ended: bool | None, note: str) -> str:
+    """The end line: the end record found, or a warning that the program may be cut short."""
+    return f"end: {note}" if ended is not False else f"end: WARNING: {note}"
+
+
 def read_text(read: PathRead | None) -> list[str]:
     """How the program was read: its units and how known, passes, what was skipped or dropped.
 
@@ -141,8 +147,11 @@ def read_text(read: PathRead | None) -> list[str]:
             + (")" if r.recognised else ", not recognised: check it moves nothing)")
             for r in read.skipped_records
         )
-    lines = [_units(read.units, read.units_source, read.units_note), line]
-    return lines
+    return [
+        _units(read.units, read.units_source, read.units_note),
+        _end(read.ended, read.end_note),
+        line,
+    ]
 
 
 SAID_CORRECTION = 1e-6

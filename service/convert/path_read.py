@@ -12,6 +12,13 @@ from typing import Any
 from service import schemas
 from service.schemas.path_input import PathInput
 
+NO_END_RECORD = {
+    "csv": "a CSV has no end record: a file cut at the end of a line cannot be told from a whole "
+    "one",
+    None: "waypoints sent as JSON have no end record: the path is taken as sent",
+}
+"""``end_note`` of the forms with no end record (``ended`` null), by ``cam_form``."""
+
 
 def read_fields(path: PathInput) -> dict[str, Any]:
     """The fields the import answer and ``path_read`` share: units, feed, passes, skipped.
@@ -43,6 +50,8 @@ def read_fields(path: PathInput) -> dict[str, Any]:
         "repeated_points": 0 if report is None else report.repeated_points,
         "one_point_passes": path.one_point_passes,
         "arcs": 0 if report is None else report.arcs,
+        "ended": None if report is None else report.ended,
+        "end_note": NO_END_RECORD[path.cam_form] if report is None else report.end_note,
     }
 
 

@@ -55,6 +55,16 @@ UNITS_SOURCE = (
     "waypoints)."
 )
 UNITS_NOTE = "The evidence for the units, e.g. 'UNITS/MM at line 3'."
+ENDED = (
+    "CL data: whether the program ends as CAM systems end one: FINI or END-OF-PATH after its "
+    "last move and, where an NX listing states its length on its last line, that many lines. "
+    "false: the program may be cut short (a transfer, a full disk) and the path is only what "
+    "was read: end_note says where it stops. null for a CSV, which has no end record."
+)
+END_NOTE = (
+    "How the program ends: 'FINI at line 233', or where it stops and what is missing ('no "
+    "FINI or END-OF-PATH after the last move (GOTO at line 812): ...')."
+)
 SKIPPED = (
     "CL data: the records skipped (no geometry, no feed), one entry a word, in the order "
     "first met; empty for other forms."
@@ -89,6 +99,9 @@ class PathRead(ResponseModel):
                     "repeated_points": 1,
                     "one_point_passes": 0,
                     "arcs": 2,
+                    "ended": True,
+                    "end_note": "END-OF-PATH at line 95; 89 lines, as the listing's last line "
+                    "states",
                 }
             ]
         }
@@ -111,6 +124,8 @@ class PathRead(ResponseModel):
     )
     one_point_passes: int = Field(description="CL data: passes of a single point, dropped.")
     arcs: int = Field(description="CL data: CIRCLE moves interpolated into waypoints.")
+    ended: bool | None = Field(description=ENDED)
+    end_note: str = Field(description=END_NOTE)
 
 
 PATH_READ = (

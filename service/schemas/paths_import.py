@@ -9,6 +9,8 @@ from pydantic import ConfigDict, Field
 from service.schemas.common import RequestModel, ResponseModel, SpinMode
 from service.schemas.path import Path
 from service.schemas.path_read import (
+    END_NOTE,
+    ENDED,
     SKIPPED,
     UNITS_NOTE,
     UNITS_SOURCE,
@@ -73,6 +75,8 @@ class PathImportResponse(ResponseModel):
                     "repeated_points": 0,
                     "one_point_passes": 0,
                     "arcs": 0,
+                    "ended": True,
+                    "end_note": "FINI at line 9",
                 }
             ]
         }
@@ -103,3 +107,5 @@ class PathImportResponse(ResponseModel):
     )
     one_point_passes: int = Field(description="CL data: passes of a single point, dropped.")
     arcs: int = Field(description="CL data: CIRCLE moves interpolated into waypoints.")
+    ended: bool | None = Field(description=ENDED)
+    end_note: str = Field(description=END_NOTE)

@@ -33,6 +33,7 @@ from __future__ import annotations
 import dataclasses
 
 from solver.cam.cam_path import METRES_PER_UNIT, CamPath, Units, assemble_cam_path
+from solver.cam.cl_end import program_end
 from solver.cam.cl_reader import ClReader
 from solver.cam.cl_records import SKIPPED, records
 from solver.cam.cl_units import UnitsReading, units_of
@@ -106,6 +107,7 @@ def read_cl_data(
         operations=reader.operations,
         drop_one_point_passes=True,
     )
+    end = program_end(all_records)
     report = ReadReport(
         skipped_records=tuple(reader.skipped.values()),
         units_source=reading.source,
@@ -113,5 +115,7 @@ def read_cl_data(
         repeated_points=reader.repeated,
         arcs=reader.arcs,
         arc_tolerance=arc_tolerance,
+        ended=end.ended,
+        end_note=end.note,
     )
     return dataclasses.replace(path, report=report)

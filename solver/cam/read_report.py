@@ -38,6 +38,9 @@ class ReadReport:
         repeated_points: GOTOs to where the tool already was (same point and axis), dropped.
         arcs: CIRCLE moves interpolated.
         arc_tolerance: m, the chordal tolerance they were interpolated to.
+        ended: whether the program ends as CAM systems end one (:mod:`solver.cam.cl_end`);
+            ``False``: it may be cut short.
+        end_note: the end record and its line, or where the program stops and what is missing.
     """
 
     skipped_records: tuple[SkippedRecord, ...]
@@ -46,3 +49,5 @@ class ReadReport:
     repeated_points: int
     arcs: int
     arc_tolerance: float
+    ended: bool
+    end_note: str

@@ -42,6 +42,8 @@ READ_FIELDS = (
     "repeated_points",
     "one_point_passes",
     "arcs",
+    "ended",
+    "end_note",
 )
 
 
@@ -88,6 +90,33 @@ def test_a_csv_says_the_request_gave_its_units(client: TestClient) -> None:
     read = answer_of(client, "evaluate", {"csv": csv, "units": "mm"})["path_read"]
     assert (read["form"], read["units"], read["units_source"]) == ("csv", "mm", "request")
     assert read["pass_details"] == [{"start": 0, "stop": 3, "operation": None, "feed": None}]
+    assert read["ended"] is None and read["end_note"].startswith("a CSV has no end record")
+
+
+def test_a_program_cut_short_is_said_by_the_routes_and_the_command(
+    client: TestClient, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """The NX listing cut after its last move (its END-OF-PATH and listing length gone)."""
+    lines = TEXT.splitlines()
+    last = max(n for n, line in enumerate(lines, 1) if line.startswith("GOTO/"))
+    cut = "\n".join(lines[:last]) + "\n"
+    said = f"no FINI or END-OF-PATH after the last move (GOTO at line {last}): "
+    whole = imported(client, {"cl_data": TEXT})
+    assert whole["ended"] is True and whole["end_note"].startswith("END-OF-PATH at line ")
+    read = answer_of(client, "evaluate", {"cl_data": cut})["path_read"]
+    assert read["ended"] is False and read["end_note"].startswith(said)
+    assert {key: read[key] for key in READ_FIELDS} == imported(client, {"cl_data": cut})
+    program = tmp_path / "cut.cls"
+    program.write_text(cut)
+    assert main(["import", str(program)]) == OK
+    assert f"\nend: WARNING: {said}" in capsys.readouterr().out
+
+
+def test_waypoints_sent_as_json_have_no_end_record(client: TestClient) -> None:
+    answer = client.post("/v1/paths/import", json={"path": POSES})
+    assert answer.status_code == 200, answer.text
+    assert answer.json()["ended"] is None
+    assert answer.json()["end_note"].startswith("waypoints sent as JSON have no end record")
 
 
 @pytest.mark.parametrize("route", ["evaluate", "optimize", "map"])

@@ -211,6 +211,9 @@ def test_the_page_shows_what_the_import_read(page: Page, url: str) -> None:
         f"{s['word']}: {s['count']} (first at line {s['first_line']})"
         for s in api["skipped_records"]
     ]
+    assert api["ended"] is True
+    assert page.text_content("#import-end") == api["end_note"]
+    assert "cut-short" not in (page.get_attribute("#import-end", "class") or "")
     assert (ROOT / "service" / "web" / "static" / "examples" / "nx_slot_plate.cls").read_text() == (
         program
     )
@@ -246,6 +249,11 @@ def test_a_program_without_units_asks_for_them_beside_the_field(page: Page, url:
         page.text_content("#import-units")
         == "mm (request: the request's units (the file states none))"
     )
+    # No FINI after its last move: the page says it may be cut short, in red
+    assert (page.text_content("#import-end") or "").startswith(
+        "no FINI or END-OF-PATH after the last move (GOTO at line 2): the program may be cut short"
+    )
+    assert page.get_attribute("#import-end", "class") == "cut-short"
 
 
 # ---- joint accelerations (issue 24): mu_acc, what binds, the cycle time ------------------------

@@ -245,7 +245,7 @@ function setPath(name, text) {
 function clearImport() {
   const box = $("import");
   delete box.dataset.waypoints;
-  for (const id of ["import-summary", "import-units"]) $(id).textContent = "";
+  for (const id of ["import-summary", "import-units", "import-end"]) $(id).textContent = "";
   $("import-passes").tBodies[0].textContent = "";
   $("import-skipped").textContent = "";
 }
@@ -284,6 +284,9 @@ async function showImport(name) {
     + (read.arcs ? `, ${read.arcs} arcs interpolated` : "")
     + (dropped ? `; dropped ${read.repeated_points} repeated points, ${read.one_point_passes} one-point passes` : "");
   $("import-units").textContent = `${read.units} (${read.units_source}: ${read.units_note})`;
+  // A program with no end record after its last move may be cut short: said in red.
+  $("import-end").textContent = read.end_note;
+  $("import-end").classList.toggle("cut-short", read.ended === false);
   const rows = $("import-passes").tBodies[0];
   read.pass_details.forEach((p, k) => {
     const row = rows.insertRow();
