@@ -27,7 +27,7 @@ import re
 from collections.abc import Iterator
 from dataclasses import dataclass
 
-from solver.cam.reading import BOM, text_lines
+from solver.cam.reading import BOM, is_number, text_lines
 from solver.core.exceptions import InvalidLineError
 
 READ = frozenset(
@@ -225,6 +225,13 @@ def _record(line: int, text: str, *, field: str) -> Record:
     """A record split into its word and the rest."""
     match = _WORD.fullmatch(text)
     if match is None:
-        raise InvalidLineError(field, "not a record (WORD/arguments)", line=line, text=text)
+        message = "not a record (WORD/arguments)"
+        numbers = text.split(",")
+        if len(numbers) >= 3 and all(is_number(n) for n in numbers):  # x, y, z, ...
+            message += (
+                ": numbers alone are a CSV's line; a CSV is read as one with its units "
+                "(path.csv and path.units; dtf-place reads a file named .csv as one)"
+            )
+        raise InvalidLineError(field, message, line=line, text=text)
     word = " ".join(match.group(1).upper().split())
     return Record(line, word, match.group(2).strip(), text)

@@ -388,3 +388,22 @@ def test_a_request_in_mm_for_a_program_whose_feed_is_in_inches_is_refused() -> N
         )
     both = read_cl_data("\n".join([*inch, "FEDRAT/MMPM,500", "GOTO/2,1,0"]), units="mm")
     np.testing.assert_allclose(both.positions[1], [MM, 0.0, 0.0])
+
+
+@pytest.mark.parametrize("header", [[], ["x,y,z,i,j,k"]], ids=["bare", "with its header"])
+def test_a_csv_given_as_cl_data_is_refused_saying_it_is_a_csv(header: list[str]) -> None:
+    """A CSV sent as CL data (or piped to dtf-place under another name) was 'not a record'."""
+    lines = [*header, "10.0,20.0,5.0,0,0,1", "11.0,20.0,5.0,0,0,1"]
+    with pytest.raises(InvalidLineError) as refused:
+        read_cl_data("\n".join(lines) + "\n", units="mm")
+    assert refused.value.line == len(header) + 1
+    assert "numbers alone are a CSV's line; a CSV is read as one with its units" in str(
+        refused.value
+    )
+
+
+def test_a_record_that_is_no_record_and_no_numbers_gets_no_csv_hint() -> None:
+    with pytest.raises(InvalidLineError) as refused:
+        read_cl_data("GOTO/0,0,0\n1,2\n", units="mm")
+    assert "not a record (WORD/arguments)" in str(refused.value)
+    assert "CSV" not in str(refused.value)
