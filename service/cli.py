@@ -24,7 +24,8 @@ as the routes do. Settings come from the environment as for the service (``DTF_*
 command's work is bounded as a job's is (DTF_MAX_JOB_CELLS, DTF_MAX_JOB_POSES; a route's
 limit where larger), not as a synchronous request's (:func:`_settings`).
 Exit codes: :data:`OK` (0), :data:`USAGE` (2), :data:`INVALID` (3), :data:`INFEASIBLE` (4),
-:data:`NOT_WRITTEN` (5, the answer could not be written), :data:`INTERRUPTED` (130, Ctrl-C),
+:data:`NOT_WRITTEN` (5, the answer could not be written), :data:`SETTINGS` (6, a ``DTF_``
+variable of the environment refused), :data:`INTERRUPTED` (130, Ctrl-C),
 :data:`CLOSED_PIPE` (141, the output's reader closed it early), :data:`TERMINATED` (143,
 SIGTERM); 1 is Python's own, for a crash. Errors name the field (and waypoint, line) as the
 API does with the option that fills it, or the option alone (``--png``). ``--json`` is
@@ -76,6 +77,11 @@ INVALID = 3
 NOT_WRITTEN = 5
 """The answer could not be written: the standard output is closed, or its device full (an
 answer a post-processor never gets is no success, and no input of its was wrong)."""
+SETTINGS = 6
+"""A ``DTF_`` variable of the environment is refused, each named on stderr: the installation's
+settings, not the program or the options given (it was 3, the status of an input refused, and a
+post-processor told the CAM programmer to fix a program that was fine; the CLI audit of stop
+61)."""
 INTERRUPTED = 130
 """Interrupted (Ctrl-C, SIGINT): the work stopped, ``interrupted`` on stderr (128 + SIGINT, as
 a shell reports it)."""
@@ -453,7 +459,7 @@ def _settings() -> Settings:
     with a cell over a 0.3 x 0.4 m box, yaw within 0.5 rad: 1,680 coarse placements, about 7 s
     of work; POST /v1/optimize refuses it).
     """
-    return settings_or_exit().for_commands()  # a bad DTF_ variable named, exit 3
+    return settings_or_exit(SETTINGS).for_commands()  # a bad DTF_ variable named
 
 
 def _validated(model: type[Model], body: dict[str, Any]) -> Model:

@@ -300,8 +300,11 @@ def get_settings() -> Settings:
     return Settings()
 
 
-def settings_or_exit() -> Settings:
-    """:func:`get_settings`, or each bad ``DTF_`` variable named on stderr and exit status 3.
+def settings_or_exit(status: int | None = None) -> Settings:
+    """:func:`get_settings`, or each bad ``DTF_`` variable named on stderr and exit ``status``.
+
+    ``status``: :data:`INVALID_SETTINGS` (3) by default, the service's; the CLI gives its own
+    (:data:`service.cli.SETTINGS`), 3 there being an input refused.
 
     Called where the service starts, before any warm-up: a bad value was refused only after
     it (30 s on a first start), by a traceback through the lifespan that named the field
@@ -315,11 +318,11 @@ def settings_or_exit() -> Settings:
             value = os.environ.get(name, "")
             message = item["msg"].removeprefix("Value error, ")
             print(f"error: {name}={value[:100]!r}: {message}", file=sys.stderr)  # noqa: T201
-        raise SystemExit(INVALID_SETTINGS) from None
+        raise SystemExit(INVALID_SETTINGS if status is None else status) from None
 
 
 INVALID_SETTINGS = 3
-"""The exit status of a service started with a bad ``DTF_`` variable (the CLI's for input)."""
+"""The exit status of a service started with a bad ``DTF_`` variable (dtf-place's is 6)."""
 _SCHEDULER_ADDRESS = re.compile(
     r"(?:[a-z][a-z0-9+.-]*://)?(?:\[[0-9A-Fa-f:.]+\]|[^:/\s\[\]]+):\d{1,5}"
 )
