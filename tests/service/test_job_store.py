@@ -12,12 +12,15 @@ import sys
 import threading
 import time
 from pathlib import Path
+from typing import Any
 
 import pytest
+from fastapi.testclient import TestClient
 
 from service.jobs.job import JobState, JobStoreUnavailable, QueueFull
 from service.jobs.store import JobStore
 from service.jobs.views import eta_seconds
+from service.schemas import EvaluateResponse
 from tests.cases import ROOT
 
 EXAMPLE = json.loads((ROOT / "examples" / "evaluate_request.json").read_text())
@@ -365,3 +368,41 @@ def test_the_file_keeps_wal_and_incremental_vacuum_set_once_by_its_maker(tmp_pat
     with sqlite3.connect(path) as db:
         assert db.execute("PRAGMA journal_mode").fetchone() == ("wal",)
         assert db.execute("PRAGMA auto_vacuum").fetchone() == (2,)  # INCREMENTAL
+
+
+@pytest.mark.parametrize(
+    ("path", "note"),
+    [
+        ({"cl_data": (ROOT / "examples" / "cam" / "sweep_mm.cl").read_text()}, "earlier release"),
+        ({"csv": "0,0,0,0,0,1\n10,0,0,0,0,1\n20,0,1,0,0,1\n", "units": "mm"}, "a CSV has no end"),
+    ],
+    ids=["cl_data", "csv"],
+)
+def test_results_stored_by_an_older_release_get_the_fields_answers_now_have(
+    tmp_path: Path, client: TestClient, path: dict[str, Any], note: str
+) -> None:
+    """An evaluation of a CAM program stored before its reading said how the program ends
+    (``path_read`` without ``ended`` and ``end_note``, which the current schema requires) is
+    answered with both, once its store is opened by this release: the end not checked (null),
+    every other value as it was stored."""
+    body = {**EVALUATE, "path": path, "placement": {"x": 0.3, "y": 0.3, "z": 0.0, "yaw": 0.0}}
+    answer = client.post("/v1/evaluate", json=body)
+    assert answer.status_code == 200, answer.text
+    old = answer.json()
+    for field in ("ended", "end_note"):  # as a release before stop 62 wrote it
+        del old["path_read"][field]
+    store = JobStore(tmp_path / "jobs.sqlite3")
+    job = store.create("evaluate", body)
+    assert store.start(job.id)
+    store.finish(job.id, "done", result=old)
+    with sqlite3.connect(store.path) as db:
+        db.execute("PRAGMA user_version = 0")  # the store of an older release
+    stored = JobStore(tmp_path / "jobs.sqlite3").get(job.id)
+    assert stored is not None and stored.result is not None
+    EvaluateResponse.model_validate(stored.result)  # what the current schema requires is there
+    read = stored.result["path_read"]
+    assert read["ended"] is None and note in read["end_note"]
+    del read["ended"], read["end_note"]
+    assert stored.result == old
+    with sqlite3.connect(store.path) as db:
+        assert db.execute("PRAGMA user_version").fetchone() == (1,)
