@@ -106,3 +106,21 @@ def test_a_vertex_of_four_numbers_is_refused() -> None:
     assert b"vertex 1 2 3 4" in text
     with pytest.raises(InvalidInputError, match="a vertex is not three numbers"):
         read_stl(text, max_triangles=12)
+
+
+def test_an_ascii_stl_cut_after_a_whole_facet_is_refused_naming_its_last_vertex() -> None:
+    """It was read as the part of the solid it held: a fixture with fewer triangles than it has,
+    placements that hit the rest answered free of it. Every cut after a facet's end is refused;
+    the whole file is read."""
+    text = ascii_stl(cube_triangles(0.1))
+    lines = text.decode().splitlines()
+    ends = [n for n, line in enumerate(lines, 1) if line == "endfacet"]
+    for end in ends:
+        cut = ("\n".join(lines[:end]) + "\n").encode()
+        last_vertex = max(n for n, line in enumerate(lines[:end], 1) if line.startswith("vertex"))
+        with pytest.raises(InvalidInputError, match="no endsolid after its last vertex") as refused:
+            read_stl(cut, max_triangles=12, field="cell.fixed.0.stl")
+        assert f"(line {last_vertex})" in str(refused.value)
+        assert refused.value.field == "cell.fixed.0.stl"
+    np.testing.assert_allclose(read_stl(text, max_triangles=12), cube_triangles(0.1), atol=1e-12)
+    assert len(ends) == 12

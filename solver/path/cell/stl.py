@@ -1,8 +1,9 @@
 """STL files, ASCII or binary, read into triangles (cell.md section 1), bounded in size.
 
 Only the facets' corners are read (normals are recomputed by whoever needs them). A file that
-is neither a well-formed ASCII STL nor a binary STL whose length matches its triangle count is
-an error naming the field, never a guess.
+is neither a well-formed ASCII STL (its ``endsolid`` after its last facet) nor a binary STL
+whose length matches its triangle count is an error naming the field, never a guess: either
+check tells a file cut short from a whole one.
 """
 
 from __future__ import annotations
@@ -20,6 +21,7 @@ _RECORD = 50  # bytes per binary triangle: normal, three corners (float32), attr
 # ASCII STL's keywords in any case: exporters write SOLID, FACET NORMAL, VERTEX too
 _VERTEX = re.compile(rb"vertex[ \t]+([^\r\n]*)", re.I)
 _FACET = re.compile(rb"facet\s+normal", re.I)
+_END = re.compile(rb"endsolid", re.I)
 
 
 def read_stl(
@@ -69,7 +71,8 @@ def _ascii(data: bytes, limit: tuple[int, str], field: str) -> np.ndarray:
     count = len(_FACET.findall(data))
     if count > limit[0]:
         raise _too_many(count, limit, field)
-    rows = [line.split() for line in _VERTEX.findall(data)]
+    vertices = list(_VERTEX.finditer(data))
+    rows = [vertex.group(1).split() for vertex in vertices]
     try:
         if any(len(row) != 3 for row in rows):
             raise ValueError(next(b" ".join(row) for row in rows if len(row) != 3).decode())
@@ -80,6 +83,17 @@ def _ascii(data: bytes, limit: tuple[int, str], field: str) -> np.ndarray:
     if len(corners) != 3 * count:
         raise InvalidInputError(
             field, f"not an STL: {count} facets but {len(corners)} vertices (three a facet)"
+        )
+    # A file cut after a whole facet (a transfer, a full disk) read as the part of the solid
+    # it held: a fixture with half its triangles checked as the whole, placements that hit it
+    # answered free of it. Every ASCII STL ends with endsolid, so one without is refused.
+    last = vertices[-1].end() if vertices else 0
+    if _END.search(data, last) is None:
+        line = data.count(b"\n", 0, last) + 1
+        raise InvalidInputError(
+            field,
+            f"not a whole STL: no endsolid after its last vertex (line {line}): the file may "
+            "be cut short, and a solid is not checked from part of its triangles",
         )
     return corners.reshape(-1, 3, 3)
 
