@@ -44,7 +44,7 @@ from service.jobs.runner import close_runners, get_runner
 from service.logs import log, log_to_stderr, startup_log
 from service.metrics import instrument
 from service.query import known_query_parameters
-from service.spec import defaults_in_words
+from service.spec import defaults_in_words, with_paged_map
 from service.web import mount_page
 from service.work import STOPPING
 from solver.core.exceptions import SolverError
@@ -206,7 +206,7 @@ def _openapi() -> dict[str, Any]:
         components = spec.setdefault("components", {}).setdefault("schemas", {})
         for name, schema in top.get("$defs", {}).items():
             components.setdefault(name, schema)
-        app.openapi_schema = defaults_in_words(spec)
+        app.openapi_schema = with_paged_map(defaults_in_words(spec))
     return app.openapi_schema
 
 

@@ -10,8 +10,12 @@ the service applies it as before.
 
 from __future__ import annotations
 
+import copy
 import json
 from typing import Any
+
+PAGED_MAP = "MapResponseWithoutCells"
+"""The component of a map job's answer whose cells are read in pages (``JobInfo.result``)."""
 
 
 def _refs(value: Any) -> set[str]:
@@ -52,4 +56,28 @@ def defaults_in_words(spec: dict[str, Any]) -> dict[str, Any]:
             description = field.get("description", "")
             if "default" not in description.lower():
                 field["description"] = f"{description} Default: {json.dumps(default)}.".strip()
+    return spec
+
+
+def with_paged_map(spec: dict[str, Any]) -> dict[str, Any]:
+    """``spec`` with :data:`PAGED_MAP`: MapResponse without ``cells``, as it is, not written again.
+
+    A map job over DTF_JOB_PAGE_CELLS answers its result without ``cells``
+    (``result_cells.in_result`` false: they are read in pages); the spec said that result was a
+    MapResponse, which requires them, so a generated client left it an untyped dict
+    (openapi-python-client) or refused it (a strict validator). Derived from MapResponse's
+    component, so the two never differ elsewhere.
+    """
+    schemas = spec["components"]["schemas"]
+    paged = copy.deepcopy(schemas["MapResponse"])
+    paged["properties"].pop("cells")
+    paged["required"] = [name for name in paged.get("required", []) if name != "cells"]
+    for example in paged.get("examples", []):
+        example.pop("cells", None)
+    paged["title"] = PAGED_MAP
+    paged["description"] = (
+        "A map job's answer whose cells are read in pages (JobInfo.result_cells.in_result false: "
+        "more than DTF_JOB_PAGE_CELLS): MapResponse without cells."
+    )
+    schemas[PAGED_MAP] = paged
     return spec

@@ -166,6 +166,17 @@ def test_every_route_through_typed_models(generated: ModuleType, client: Any) ->
     assert read.passes == [[0, 13], [13, 26], [26, 39]] and read.units == "mm"
 
 
+def _finished(generated: ModuleType, client: Any, job: Any) -> Any:
+    """The job, read again through the generated client until it is done or failed (2 min)."""
+    models = _module(generated, "models")
+    deadline = time.monotonic() + 120
+    while job.status not in (models.JobStatus.DONE, models.JobStatus.FAILED):
+        assert time.monotonic() < deadline, job
+        time.sleep(0.2)
+        job = _call(generated, "get_job", client=client, job_id=job.id)
+    return job
+
+
 def test_jobs_through_typed_models(generated: ModuleType, client: Any) -> None:
     """The 202 is a JobInfo, and a finished job's result the route's own typed answer."""
     models = _module(generated, "models")
@@ -177,11 +188,7 @@ def test_jobs_through_typed_models(generated: ModuleType, client: Any) -> None:
         body=models.MapJob.from_dict({"kind": "map", "request": request}),
     )
     assert isinstance(job, models.JobInfo)
-    deadline = time.monotonic() + 120
-    while job.status not in (models.JobStatus.DONE, models.JobStatus.FAILED):
-        assert time.monotonic() < deadline, job
-        time.sleep(0.2)
-        job = _call(generated, "get_job", client=client, job_id=job.id)
+    job = _finished(generated, client, job)
     assert job.status == models.JobStatus.DONE
     assert isinstance(job.result, models.MapResponse) and len(job.result.cells) == 4
     picture = _call(generated, "get_job_png", client=client, job_id=job.id)
@@ -256,3 +263,27 @@ def test_fixed_field_names_keep_their_wire_names(generated: ModuleType) -> None:
     assert error.type_ == "missing" and error.to_dict()["type"] == "missing"
     request = models.DtfRequest.from_dict({"robot": {"model": "ur5"}, "q": [0.0] * 6})
     assert hasattr(request, "u_t") and not hasattr(request, "u_T")
+
+
+def test_a_map_job_whose_cells_are_paged_is_read_through_typed_models(
+    generated: ModuleType, client: Any, tmp_path: Path
+) -> None:
+    """Over DTF_JOB_PAGE_CELLS, a map job's result has no ``cells`` (they are read in pages):
+    the spec said it was a MapResponse, which requires them."""
+    from service.config import Settings
+    from tests.service.conftest import served_with
+
+    models = _module(generated, "models")
+    request = {"robot": EVALUATE["robot"], "path": EVALUATE["path"], "grid": GRID}
+    with served_with(Settings(data_dir=tmp_path, workers=1, job_page_cells=2)):
+        job = _call(
+            generated,
+            "submit_job",
+            client=client,
+            body=models.MapJob.from_dict({"kind": "map", "request": request}),
+        )
+        job = _finished(generated, client, job)
+    assert job.status == models.JobStatus.DONE
+    assert job.result_cells.in_result is False and job.result_cells.total == 4
+    assert isinstance(job.result, models.MapResponseWithoutCells)
+    assert job.result.feasible_cells == 4 and "cells" not in job.result.to_dict()

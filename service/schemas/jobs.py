@@ -37,6 +37,7 @@ JobResult = Annotated[
         {
             "anyOf": [
                 {"$ref": "#/components/schemas/MapResponse"},
+                {"$ref": "#/components/schemas/MapResponseWithoutCells"},
                 {"$ref": "#/components/schemas/OptimizeResponse"},
                 {"$ref": "#/components/schemas/EvaluateResponse"},
                 {"type": "null"},
@@ -177,7 +178,8 @@ class JobInfo(ResponseModel):
     result: JobResult = Field(
         default=None,
         description="When done: the route's own answer (MapResponse, OptimizeResponse or "
-        "EvaluateResponse, as kind says).",
+        "EvaluateResponse, as kind says); a map whose cells are read in pages "
+        "(result_cells.in_result false) is a MapResponseWithoutCells.",
     )
     error: list[ErrorDetail] | None = Field(
         default=None,
