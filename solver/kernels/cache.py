@@ -16,8 +16,22 @@ import solver.kernels.free_follow
 import solver.kernels.limits
 import solver.kernels.positions
 import solver.kernels.spin_schedule
+from solver.core import codes, spatial, task
 from solver.core.compiled_cache import drop_stale_caches
 from solver.families.kernels import KERNEL_SOURCES
+from solver.families.opw import ik as opw_ik
+from solver.families.opw import parameters as opw_parameters
+from solver.families.ur import dh as ur_dh
+from solver.families.ur import ik as ur_ik
+
+TAKEN_IN = (codes, spatial, task, ur_dh, ur_ik, opw_ik, opw_parameters)
+"""Modules with no compiled function whose constants (or numba-compiled helpers' constants) the
+map kernels build in: the reasons and ties of :mod:`solver.core.codes`, the half-turn and path
+tolerances of :mod:`~solver.core.spatial` and :mod:`~solver.core.task`, the families' own. An
+edit of one changes the machine code without changing any kernel's file: they are hashed too
+(the upgrade audit of stop 62 changed ``codes.TAKES_OVER`` alone and got the old code's map,
+59 of 126 cells with another bottleneck waypoint). tests/solver/test_compiled_caches.py holds
+every marker to the modules its kernels import."""
 
 
 def drop_stale_compiled_code(name: str) -> None:
@@ -48,4 +62,5 @@ def drop_stale_compiled_code(name: str) -> None:
         sys.modules[name],
     )
     files = [Path(str(module.__file__)) for module in modules]
-    drop_stale_caches(files[-1].stem, files, files)
+    taken_in = [Path(str(module.__file__)) for module in TAKEN_IN]
+    drop_stale_caches(files[-1].stem, [*files, *taken_in], files)

@@ -15,12 +15,20 @@ GIL released.
 from __future__ import annotations
 
 import math
+from pathlib import Path
 
 import numpy as np
 from numba import njit
 
+from solver.core import dtf_redundant, kernel_arrays
+from solver.core.compiled_cache import drop_stale_caches
 from solver.core.dtf_redundant import VERTEX_DET_RTOL, VERTEX_RTOL
 from solver.core.kernel_arrays import kernel_array
+
+# The LPs build in the vertex tolerances of solver.core.dtf_redundant: an edit there changes
+# their machine code, which numba's cache (keyed by this file alone) would otherwise keep.
+_SOURCES = [Path(__file__), Path(str(dtf_redundant.__file__)), Path(str(kernel_arrays.__file__))]
+drop_stale_caches(Path(__file__).stem, _SOURCES, [Path(__file__)])
 
 _INSIDE = 1.0 - 1e-12  # as solver.core.dtf_redundant.spin_rate_at_feed
 

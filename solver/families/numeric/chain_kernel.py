@@ -24,6 +24,7 @@ from pathlib import Path
 import numpy as np
 from numba import njit
 
+from solver.core import codes
 from solver.core.compiled_cache import drop_stale_caches
 from solver.families.numeric import lu_kernel
 from solver.families.numeric.lu_kernel import lu_solve
@@ -34,7 +35,8 @@ def drop_stale_cache(module_file: Path, *also: Path) -> None:
 
     numba keys a function's disk cache by its own source file, but the IK and redundant-speed
     kernels take this chain's code and its LU's (:mod:`~solver.families.numeric.lu_kernel`)
-    into themselves: after an edit of either they would load the old code. A marker named by
+    into themselves, and the status codes of :mod:`solver.core.codes` they return: after an
+    edit of any they would load the old code. A marker named by
     the hash of these sources and the module's says which code the cache holds (as
     :mod:`solver.kernels.cache` does for the map kernels), wherever numba keeps it.
 
@@ -42,7 +44,7 @@ def drop_stale_cache(module_file: Path, *also: Path) -> None:
         module_file: the source file of the module whose cache to check.
         also: the source files of other modules whose compiled code it takes in.
     """
-    shared = (Path(__file__), Path(str(lu_kernel.__file__)))
+    shared = (Path(__file__), Path(str(lu_kernel.__file__)), Path(str(codes.__file__)))
     drop_stale_caches(module_file.stem, (*shared, module_file, *also), (module_file,))
 
 
