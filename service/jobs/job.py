@@ -11,6 +11,7 @@ from typing import Any, Literal, TypeVar
 
 from pydantic import TypeAdapter, ValidationError
 
+from service.jobs.results import answered_now
 from service.schemas import ErrorDetail
 
 T = TypeVar("T")
@@ -176,7 +177,7 @@ def job_of_row(row: sqlite3.Row, *, store: Path) -> Job:
 
     def read() -> Job:
         request = json.loads(row["request"])
-        result = None if row["result"] is None else json.loads(row["result"])
+        result = None if row["result"] is None else answered_now(json.loads(row["result"]))
         return _JOB.validate_python({**_state_fields(row), "request": request, "result": result})
 
     return _checked(row, store, read)

@@ -73,51 +73,33 @@ _ADDED_COLUMNS = {"total": "INTEGER", "cells": "INTEGER", "first_at": "REAL", "f
 """Columns a store made by an older release lacks (added on open; NULL in its rows)."""
 
 
-RESULTS_VERSION = 1
-"""``PRAGMA user_version`` of a store whose results have every field the answers have now.
-
-1: a CAM program's reading says how the program ends (``path_read.ended`` and ``end_note``,
-required by the answers' schemas since stop 62). A store of an older release (version 0) is
-brought up to it once, when opened (:func:`_upgrade_results`)."""
 UNCHECKED_END = "read by an earlier release, which did not check how a program ends"
 """``end_note`` of a CL program's reading stored before the end was checked (``ended`` null)."""
 
 
 def make_tables(db: sqlite3.Connection) -> None:
-    """The tables, and the columns and result fields an older store lacks."""
+    """The tables, and the columns an older store lacks."""
     db.executescript(SCHEMA)
     present = {row[1] for row in db.execute("PRAGMA table_info(jobs)")}
     for name, kind in _ADDED_COLUMNS.items():
         if name not in present:
             db.execute(f"ALTER TABLE jobs ADD COLUMN {name} {kind}")
-    if db.execute("PRAGMA user_version").fetchone()[0] < RESULTS_VERSION:
-        _upgrade_results(db)
-        db.execute(f"PRAGMA user_version = {RESULTS_VERSION}")
 
 
-def _upgrade_results(db: sqlite3.Connection) -> None:
-    """Results stored by an older release given the fields the answers' schemas now require.
+def answered_now(result: Any) -> Any:
+    """A stored answer with the fields the answers' schemas require now, where it lacks them.
 
-    A finished job's answer is kept as its route gave it; one computed from a CAM program
-    before stop 62 has a ``path_read`` without ``ended`` and ``end_note``, which a client
-    generated from the current spec refuses. They are added as null (not checked) with a note
-    saying so, by SQLite's JSON functions, which keep every other value's text as it was.
-    Idempotent: two processes opening the store at once do the same.
+    A finished job's answer is kept as its route gave it. One computed from a CAM program by a
+    release before stop 62 (in a store kept across an upgrade, or written by an older release
+    during a rollback or a rolling upgrade) has a ``path_read`` without ``ended`` and
+    ``end_note``, which a client generated from the current spec refuses: they are added as
+    read, ``ended`` null (not checked) with a note saying so. The stored text is not changed.
     """
-    db.execute(
-        """
-        UPDATE jobs SET result = json_set(
-            result,
-            '$.path_read.ended', json('null'),
-            '$.path_read.end_note',
-            CASE json_extract(result, '$.path_read.form') WHEN 'csv' THEN ? ELSE ? END
-        )
-        WHERE result IS NOT NULL AND json_valid(result)
-            AND json_type(result, '$.path_read') = 'object'
-            AND json_type(result, '$.path_read.ended') IS NULL
-        """,
-        (NO_END_RECORD["csv"], UNCHECKED_END),
-    )
+    read = result.get("path_read") if isinstance(result, dict) else None
+    if isinstance(read, dict) and "ended" not in read:
+        note = NO_END_RECORD["csv"] if read.get("form") == "csv" else UNCHECKED_END
+        result["path_read"] = {**read, "ended": None, "end_note": read.get("end_note", note)}
+    return result
 
 
 @dataclass(frozen=True)
