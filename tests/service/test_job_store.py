@@ -402,3 +402,26 @@ def test_results_stored_by_an_older_release_get_the_fields_answers_now_have(
     assert read["ended"] is None and note in read["end_note"]
     del read["ended"], read["end_note"]
     assert stored.result == old
+
+
+def test_a_store_made_without_incremental_vacuum_is_said_once_with_the_command(
+    tmp_path: Path, caplog: pytest.LogCaptureFixture
+) -> None:
+    """A store of a release before 2026-12-06 keeps its size after deletes: the start says so
+    and names the command; a store of this release says nothing."""
+    old = tmp_path / "old.sqlite3"
+    with sqlite3.connect(old) as db:  # as an older release made it: WAL, no auto_vacuum
+        db.execute("PRAGMA journal_mode=WAL")
+        db.execute("CREATE TABLE kept (x)")
+    with caplog.at_level(logging.WARNING, logger="dtf.jobs"):
+        JobStore(old).jobs(status=None, limit=1)
+        JobStore(tmp_path / "new.sqlite3").jobs(status=None, limit=1)
+    said = [r.getMessage() for r in caplog.records if r.name == "dtf.jobs"]
+    assert said == [
+        f"the job store {old} was made by a release before 2026-12-06: deleted and expired "
+        "jobs' pages are reused but not given back to the disk; to give them back once, stop "
+        f"the service and run: sqlite3 {old} 'PRAGMA auto_vacuum=INCREMENTAL; VACUUM' (README, "
+        "Upgrading)"
+    ]
+    with sqlite3.connect(old) as db:
+        assert db.execute("PRAGMA auto_vacuum").fetchone() == (0,)
