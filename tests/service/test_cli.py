@@ -1216,3 +1216,15 @@ def test_optimise_starts_from_the_placement_given(
     assert {k: mine["start"]["placement"][k] for k in start} == start
     code, _, err = run(capsys, *argv, "--start=0.5,0.3,0,0")
     assert code == INVALID and "start" in err
+
+
+def test_the_help_lists_every_exit_code(capsys: pytest.CaptureFixture[str]) -> None:
+    """A post-processor's author reads the codes there: 6 (a DTF_ variable refused) was missing
+    from it (the upgrade audit of stop 62)."""
+    with pytest.raises(SystemExit) as ended:
+        main(["--help"])
+    assert ended.value.code == 0
+    text = " ".join(capsys.readouterr().out.split())
+    codes = (OK, INFEASIBLE, USAGE, INVALID, NOT_WRITTEN, SETTINGS, INTERRUPTED, CLOSED_PIPE)
+    for code in (*codes, TERMINATED):
+        assert re.search(rf"\b{code} [a-z]", text), code
