@@ -15,7 +15,14 @@ from __future__ import annotations
 
 import threading
 
-from threadpoolctl import ThreadpoolController
+try:
+    from threadpoolctl import ThreadpoolController
+except ModuleNotFoundError as missing:  # an installation upgraded by its code alone (README)
+    raise ModuleNotFoundError(
+        f"{missing.name} is not installed, and this release needs it (pyproject.toml): after "
+        "updating the code, install again: pip install -e .",
+        name=missing.name,
+    ) from missing
 
 _controller: ThreadpoolController | None = None
 _lock = threading.Lock()
