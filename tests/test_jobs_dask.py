@@ -254,6 +254,26 @@ def test_workers_that_cannot_be_asked_their_code_are_the_clusters_failure(
         runner.run(abs, [-1], _noted([]))
 
 
+def test_workers_of_a_release_before_the_check_are_told_to_be_upgraded(
+    cluster: LocalCluster, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A worker on a release older than the check cannot unpickle it: the job failed as if the
+    cluster were down ("submitted again once the cluster runs", which never helps; the upgrade
+    audit of stop 62, F10). The worker's error as Dask relays it, raised here."""
+    runner = DaskRunner(cluster.scheduler_address)
+    old = "Can't get attribute 'worker_fingerprint' on <module 'service.jobs.dask_runner'>"
+
+    def older(*args: object, **kwargs: object) -> None:
+        raise Exception(repr(AttributeError(old)))  # noqa: TRY002 - as distributed relays it
+
+    monkeypatch.setattr(runner.client(), "run", older)
+    with pytest.raises(ClusterUnavailable) as refused:
+        runner.run(abs, [-1], _noted([]))
+    said = str(refused.value)
+    assert "worker(s) whose code is not the service's" in said
+    assert "install the service's release on them" in said and "could not be asked" not in said
+
+
 def test_a_worker_restarted_at_its_address_is_checked_again(
     monkeypatch: pytest.MonkeyPatch,
 ) -> None:

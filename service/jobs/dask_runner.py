@@ -209,6 +209,15 @@ class DaskRunner:
         try:
             theirs = client.run(worker_fingerprint, workers=unchecked)
         except Exception as error:  # noqa: BLE001 - a worker gone meanwhile, the scheduler lost
+            if "worker_fingerprint" in str(error) or "dask_runner" in str(error):
+                # The worker cannot load the check itself: its service.jobs.dask_runner is of a
+                # release before the check (c09b554), or none. Submitting again fails the same.
+                raise self._unavailable(
+                    "has worker(s) whose code is not the service's: they cannot load its check "
+                    "of which code they run (a release before it, or no service installed); "
+                    "install the service's release on them",
+                    error,
+                ) from None
             asked = "could not be asked which code its workers run"
             raise self._unavailable(asked, error) from None
         differ = {
