@@ -20,7 +20,10 @@ from prometheus_fastapi_instrumentator import Instrumentator
 
 from service.errors import JSON_ERROR, RETRY_AFTER, SERVER_ERROR_RESPONSE
 
-JOB_SECONDS = "Seconds of the jobs that ran to an end, since the store began."
+JOB_SECONDS = (
+    "Seconds of the jobs that ran to an end, since the store began (a run a restart "
+    "interrupted counts, with no seconds: how long it ran is not known)."
+)
 
 PLACEMENTS = Counter("dtf_placements", "Placements computed by /v1/map (synchronous maps).")
 

@@ -197,6 +197,25 @@ def test_a_restart_says_which_jobs_it_queued_again_and_which_failed(
     ]
 
 
+def test_a_run_a_restart_failed_is_counted_without_the_downtime(tmp_path: Path) -> None:
+    """The totals counted a failed job's finished - started, the restart's time: an outage of
+    a weekend added two days to dtf_job_seconds (the upgrade audit of stop 62). The run is
+    counted, with no seconds; a job that ran to its end keeps its own."""
+    store = JobStore(tmp_path / "jobs.sqlite3")
+    done, cut = (store.create("evaluate", EVALUATE) for _ in range(2))
+    assert store.start(done.id) and store.start(cut.id)
+    store.finish(done.id, "done", result={"mu_path": 0.3})
+    with sqlite3.connect(store.path) as db:  # the service was down for 1,000 s after cut started
+        db.execute("UPDATE jobs SET started = started - 1000 WHERE id = ?", (cut.id,))
+        started, finished = db.execute(
+            "SELECT started, finished FROM jobs WHERE id = ?", (done.id,)
+        ).fetchone()
+    assert store.recover(attempts=1) == []
+    state = store.state(cut.id)
+    assert state is not None and state.status == "failed"
+    assert store.statistics()[1] == (2, pytest.approx(finished - started, abs=1e-6))
+
+
 def test_a_job_queued_again_after_a_restart_starts_its_progress_again(tmp_path: Path) -> None:
     store = JobStore(tmp_path / "jobs.sqlite3")
     job = store.create("evaluate", EVALUATE)
@@ -288,8 +307,9 @@ def test_the_jobs_that_ran_are_counted_once_each_and_never_less(tmp_path: Path) 
     """/metrics' dtf_job_seconds was read from the jobs held: its count fell from 748 to 0 when
     they were deleted or expired (a counter reset to Prometheus), and each scrape read every
     finished job's times (the soak audit of stop 61). Done, failed by restarts, cancelled while
-    running: each counted once with its seconds, whatever the update that ended it; deleting
-    and expiring them changes nothing; a job cancelled before it ran is not counted."""
+    running: each counted once with its seconds (a run a restart failed with none: how long it
+    ran is not known), whatever the update that ended it; deleting and expiring them changes
+    nothing; a job cancelled before it ran is not counted."""
     store = JobStore(tmp_path / "jobs.sqlite3")
     done, spent, stopped, waiting = (store.create("evaluate", EVALUATE) for _ in range(4))
     for job in (done, spent, stopped):
@@ -302,8 +322,8 @@ def test_the_jobs_that_ran_are_counted_once_each_and_never_less(tmp_path: Path) 
     store.cancel(store.create("evaluate", EVALUATE).id)  # never ran: not counted
     with sqlite3.connect(store.path) as db:
         expected = db.execute(
-            "SELECT COUNT(*), SUM(finished - started) FROM jobs WHERE started IS NOT NULL "
-            "AND status IN ('done', 'failed', 'cancelled')"
+            "SELECT COUNT(*), SUM(CASE status WHEN 'failed' THEN 0 ELSE finished - started END) "
+            "FROM jobs WHERE started IS NOT NULL AND status IN ('done', 'failed', 'cancelled')"
         ).fetchone()
     counts, totals = store.statistics()
     assert counts == {"done": 1, "failed": 2, "cancelled": 2}
