@@ -98,7 +98,7 @@ def answered_now(result: Any) -> Any:
     read = result.get("path_read") if isinstance(result, dict) else None
     if isinstance(read, dict) and "ended" not in read:
         note = NO_END_RECORD["csv"] if read.get("form") == "csv" else UNCHECKED_END
-        result["path_read"] = {**read, "ended": None, "end_note": read.get("end_note", note)}
+        result["path_read"] = {**read, "ended": None, "end_note": note}
     return result
 
 

@@ -240,17 +240,19 @@ class JobStore(JobReads):
         """
         now = time.time()
         with self._connection() as db:
-            left = db.execute("SELECT id, attempts FROM jobs WHERE status = 'running'").fetchall()
             db.execute("BEGIN IMMEDIATE")
+            left = db.execute(
+                "SELECT id, attempts, started FROM jobs WHERE status = 'running'"
+            ).fetchall()
             # The trigger job_ran_to_its_end counts a failed job's finished - started: here the
             # restart's time, so the service's downtime too (35.6 s for a run of about 3 s, the
             # upgrade audit of stop 62). How long the interrupted run took is not known: it is
             # counted, with no seconds.
-            (downtime,) = db.execute(
-                "SELECT COALESCE(SUM(? - started), 0.0) FROM jobs WHERE status = 'running' "
-                "AND attempts >= ? AND started IS NOT NULL",
-                (now, attempts),
-            ).fetchone()
+            downtime = sum(
+                now - started
+                for _, runs, started in left
+                if runs >= attempts and started is not None
+            )
             db.execute(
                 "UPDATE jobs SET status = 'failed', finished = ?, error = ? WHERE "
                 "status = 'running' AND attempts >= ?",
@@ -268,7 +270,7 @@ class JobStore(JobReads):
             rows = db.execute(
                 "SELECT id FROM jobs WHERE status = 'queued' ORDER BY created"
             ).fetchall()
-        for job_id, runs in left:  # a restart's work said (only a second 'running' line was)
+        for job_id, runs, _ in left:  # a restart's work said (only a second 'running' line was)
             if runs >= attempts:
                 log.info("job %s interrupted by a restart after %d runs: failed", job_id, runs)
             else:
