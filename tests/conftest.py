@@ -2,11 +2,12 @@
 
 The app reads its settings on first use, after this module has set the environment; the
 in-process tests that reach ``/v1/jobs`` (the schemathesis fuzz) then queue small jobs in one
-worker process, under a directory removed at the end, never under the repository.
+worker process, under a directory removed when the run ends, never under the repository.
 """
 
 from __future__ import annotations
 
+import atexit
 import os
 import shutil
 import tempfile
@@ -14,8 +15,14 @@ from collections.abc import Iterator
 
 import pytest
 
-_DATA = tempfile.mkdtemp(prefix="dtf-test-jobs-")
-os.environ.setdefault("DTF_DATA_DIR", _DATA)
+if "DTF_DATA_DIR" not in os.environ:
+    # Made by the first process (pytest-xdist's controller), whose workers inherit it, and
+    # removed when that process exits, after its workers: a directory made in every process
+    # and removed by the workers' session end left the controller's, the one the workers
+    # used, in the temporary directory after every run.
+    _DATA = tempfile.mkdtemp(prefix="dtf-test-jobs-")
+    os.environ["DTF_DATA_DIR"] = _DATA
+    atexit.register(shutil.rmtree, _DATA, ignore_errors=True)
 os.environ.setdefault("DTF_WORKERS", "1")
 os.environ.setdefault("DTF_MAX_JOB_CELLS", "2000")
 os.environ.setdefault("DTF_MAX_JOB_POSES", "200000")
@@ -46,4 +53,3 @@ def _jobs_stop_at_the_end() -> Iterator[None]:
     from service.jobs.runner import close_runners
 
     close_runners()
-    shutil.rmtree(_DATA, ignore_errors=True)

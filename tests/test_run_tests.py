@@ -1,10 +1,15 @@
-"""scripts/run_tests.py's latency run collects only LATENCY_MODULES: they must be every module
-that marks a test ``latency``, or a test marked elsewhere would run in neither run."""
+"""scripts/run_tests.py's runs: the latency run collects only LATENCY_MODULES, which must be every
+module that marks a test ``latency``, or a test marked elsewhere would run in neither run; and a
+run leaves nothing in the temporary directory."""
 
 from __future__ import annotations
 
 import importlib.util
+import os
 import re
+import subprocess
+import sys
+from pathlib import Path
 
 from tests.cases import ROOT
 
@@ -27,3 +32,24 @@ def test_the_latency_run_collects_every_module_that_marks_a_latency_test() -> No
     }
     assert marked, "no test is marked latency: the latency run would collect none"
     assert set(_latency_modules()) == marked
+
+
+def test_a_run_on_two_workers_leaves_no_jobs_directory_behind(tmp_path: Path) -> None:
+    # tests/conftest.py's jobs directory: every run on two workers left one in the temporary
+    # directory (made by every process, removed only by the workers, not the one they used)
+    environment = {k: v for k, v in os.environ.items() if k != "DTF_DATA_DIR"}
+    environment["TMPDIR"] = str(tmp_path)
+    test = (
+        "tests/test_run_tests.py::"
+        + test_the_latency_run_collects_every_module_that_marks_a_latency_test.__name__
+    )
+    run = subprocess.run(
+        [sys.executable, "-m", "pytest", "-q", "-n", "2", "-p", "no:cacheprovider", test],
+        cwd=ROOT,
+        env=environment,
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
+    assert run.returncode == 0, run.stdout + run.stderr
+    assert sorted(p.name for p in tmp_path.glob("dtf-test-jobs-*")) == []
