@@ -2,16 +2,17 @@
 
 :func:`scan_row` is the exact V_acc of every stencil row (motion.md section 2) along a branch's
 final joint path, the bits :func:`solver.kernels.limits.acceleration_at` forms row by row from
-:func:`solver.kernels.accelerations.moved_steps`, computed in two passes a compiler vectorises:
-the branch's steps joint by joint along the path (:func:`joint_steps`, the asin series of
-:func:`solver.kernels.positions.pair_step` on every step, its other cases made again one by
-one where a step needs them), then the stencil rows joint by joint (:func:`row_ratios`). The
+:func:`solver.kernels.accelerations.moved_steps`, computed in two passes: the branch's steps
+joint by joint along the path (:func:`joint_steps`, the asin series of
+:func:`solver.kernels.positions.pair_step` on every step, a loop a compiler vectorises, its
+other cases made again one by one where a step needs them), then the stencil rows joint by
+joint, each over its own span (:func:`row_ratios`, :func:`solver.kernels.limits.row_second`). The
 rows are then read in order as the row-by-row scan reads them, so what it reports (where the
 least V_acc is, where a branch is left) is the same.
 
 Where the limits cannot bind, no row is read: a branch followed to the end passed the step
 test, so each step of a stencil row is at most ``max_joint_step``, |D_j| at most
-sum_t |c[k, t]| times that, and V_acc at least a floor the stencil and the limits give
+sum_t |c_k(t)| times that, and V_acc at least a floor the stencil and the limits give
 (:func:`scan_work`). A branch whose mu_path is below the floor has mu_acc = mu_path exactly,
 bound by its speeds (what the scan would report: its least V_acc, and where, are read only
 where they bind, and the row is never left, as mu_path is at least its bar).
@@ -26,6 +27,7 @@ from numba import njit
 
 from solver.families.kernels import N_JOINTS
 from solver.kernels.cell import prune
+from solver.kernels.limits import row_second
 from solver.kernels.positions import pair_step, series_holds, small_step, wrapped_step
 
 _TWO_PI = 2 * math.pi
@@ -37,6 +39,11 @@ _FLOOR_STEP = 3.0
 # bound is within 2.2e-8 rad of it, where the cosine is near 1).
 _FLOOR_RTOL = 1e-6
 _FLOOR_ATOL = 1e-7
+DENSE_WASTE = 2
+"""The most a step-by-step table may hold beyond its rows' spans, as a multiple of them."""
+DENSE_VALUES = 1_000_000
+"""The most values a step-by-step table may hold (8 MB, and as many again for its joint path's
+padding columns at most)."""
 
 
 @njit(cache=True, error_model="numpy", nogil=True)
@@ -45,7 +52,8 @@ def scan_work(index, c, n_waypoints, segment_checked, max_joint_step, qddot_max)
 
     Args:
         index: shape (K, 5), the blend stencil's waypoints.
-        c: shape (K, S), 1/m^2, from :func:`solver.kernels.limits.step_stencil`.
+        c: shape (K, 4), 1/m^2, its runs' weights, from
+            :func:`solver.kernels.limits.step_stencil`.
         n_waypoints: W.
         segment_checked: shape (W - 1,), bool, where the step bound applies.
         max_joint_step: rad, the step bound.
@@ -54,23 +62,32 @@ def scan_work(index, c, n_waypoints, segment_checked, max_joint_step, qddot_max)
     Returns:
         first: shape (K,), index[k, 0] + 1, each row's first step; contiguous: whether
         first[k] = first[0] + k (one pass, rows on consecutive waypoints); weights: shape
-        (S, K), c transposed; joint_path: shape (6, W + S), rad, a branch's steps by joint (the
-        last S columns stay 0: the zero weights of a short row read there); sums: shape (K,);
-        worst: shape (K,), max_j |D_j| / a_j per row; floor:
+        (S, K), the steps' weights by step t of each row (S the longest span), where that
+        table is small (:func:`dense_table`), else (0, K): each row is then summed over its
+        own span alone; index; c; joint_path: shape (6, W + S) (dense) or (6, W), rad, a
+        branch's steps by joint (the last S columns stay 0: the zero weights of a short row
+        read there); sums: shape (K,); worst: shape (K,), max_j |D_j| / a_j per row; floor:
         m/s, a lower bound of V_acc on every row of a branch that passed the step test (0:
         none, where a row reads a step the test does not bound or the bound is a half turn).
     """
-    n_rows, span = c.shape
+    n_rows = index.shape[0]
     first = np.empty(n_rows, dtype=np.int64)
     contiguous, bounded, weight = True, max_joint_step <= _FLOOR_STEP, 0.0
+    span, spans = 0, 0
     for k in range(n_rows):
         first[k] = index[k, 0] + 1
         contiguous = contiguous and first[k] == first[0] + k
+        span = max(span, index[k, 4] - index[k, 0])
+        spans += index[k, 4] - index[k, 0]
         total = 0.0
-        for t in range(span):
-            if c[k, t] != 0.0:
-                total += abs(c[k, t])
-                bounded = bounded and segment_checked[index[k, 0] + t]
+        t = 0
+        for run in range(4):  # the steps' weights in t's order, as the table summed them
+            end = index[k, run + 1] - index[k, 0]
+            while t < end:
+                if c[k, run] != 0.0:
+                    total += abs(c[k, run])
+                    bounded = bounded and segment_checked[index[k, 0] + t]
+                t += 1
         weight = max(weight, total)
     least = np.inf  # the least acceleration limit (none without limits: no floor needed)
     for j in range(qddot_max.shape[0]):
@@ -79,11 +96,33 @@ def scan_work(index, c, n_waypoints, segment_checked, max_joint_step, qddot_max)
     floor = 0.0
     if bounded and least > 0.0 and least < np.inf:
         floor = (1.0 - _FLOOR_RTOL) / math.sqrt(weight * step / least)
-    weights = np.ascontiguousarray(c.T)
-    joint_path = np.zeros((N_JOINTS, n_waypoints + span))
+    dense = dense_table(n_rows, span, spans)
+    weights = np.zeros((span if dense else 0, n_rows))
+    for k in range(n_rows if dense else 0):
+        t = 0
+        for run in range(4):
+            end = index[k, run + 1] - index[k, 0]
+            while t < end:
+                weights[t, k] = c[k, run]
+                t += 1
+    joint_path = np.zeros((N_JOINTS, n_waypoints + (span if dense else 0)))
     sums = np.empty(n_rows)
     worst = np.empty(n_rows)
-    return first, contiguous, weights, joint_path, sums, worst, floor
+    return first, contiguous, weights, index, c, joint_path, sums, worst, floor
+
+
+@njit(cache=True, error_model="numpy", nogil=True, inline="always")
+def dense_table(n_rows, span, spans):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
+    """Whether :func:`row_ratios` sums the rows step by step across them all, from a table.
+
+    Where the rows' spans are short and alike (a path's usual blend: two to a few steps), a
+    pass over every row at each step t is a loop the compiler vectorises: the ERK-size map with
+    the limits ran 1.5x its time without them that way, 1.75x row by row. The table holds
+    n_rows x the longest span: kept where that is at most DENSE_WASTE times the spans' sum and
+    DENSE_VALUES values (a path with a dense stretch, or a blend spanning thousands of
+    waypoints, is summed row by row over each row's own span).
+    """
+    return n_rows * span <= DENSE_WASTE * spans + n_rows and n_rows * span <= DENSE_VALUES
 
 
 @njit(cache=True, error_model="numpy", nogil=True)
@@ -135,29 +174,35 @@ def joint_steps(cq, sq, qs, b, moves, joint_path):  # type: ignore[no-untyped-de
 def row_ratios(rows, qddot_max):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
     """Every stencil row's max_j |D_j| / a_j into ``rows``' ``worst``.
 
-    D_j = sum_t c[k, t] steps[first[k] + t, j], summed in t's order from 0.0 as
-    :func:`solver.kernels.limits.acceleration_at` sums it (a short row's zero weights add
-    zeros: the same bits). The maximum is taken without its joint (a select the compiler
-    vectorises, where keeping the joint was a branch per row and joint): the joint is read
-    only where a row binds (:func:`row_joint`). ``rows``: from :func:`scan_work`, the joint
-    path filled (:func:`joint_steps`); ``qddot_max``: shape (6,), rad/s^2.
+    D_j as :func:`solver.kernels.limits.row_second` forms it for every hook: summed in t's
+    order from 0.0, row by row over each row's own span, or step by step across the rows from
+    the table where :func:`scan_work` made one (a short row's zero weights add zeros: the same
+    |D|, to the bit). The maximum is taken without its joint (a select the compiler
+    vectorises): the joint is read only where a row binds (:func:`row_joint`). ``rows``: from
+    :func:`scan_work`, the joint path filled (:func:`joint_steps`); ``qddot_max``: shape (6,),
+    rad/s^2.
     """
-    first, contiguous, weights, joint_path, sums, worst, _ = rows
+    first, contiguous, weights, index, c, joint_path, sums, worst, _ = rows
     n_rows = first.shape[0]
     worst[:] = -1.0
     for j in range(N_JOINTS):
-        sums[:] = 0.0
+        path = joint_path[j]
+        limit = qddot_max[j]
+        if weights.shape[0] == 0:  # row by row, each over its own span
+            for k in range(n_rows):
+                ratio = abs(row_second(path, first[k], index, c, k)) / limit
+                worst[k] = ratio if ratio > worst[k] else worst[k]
+            continue
+        sums[:] = 0.0  # step by step across the rows: the same sums (a short row adds zeros)
         for t in range(weights.shape[0]):
             weight = weights[t]
             if contiguous:
-                steps = joint_path[j, first[0] + t : first[0] + t + n_rows]
+                steps = path[first[0] + t : first[0] + t + n_rows]
                 for k in range(n_rows):
                     sums[k] += weight[k] * steps[k]
             else:
-                path = joint_path[j]
                 for k in range(n_rows):
                     sums[k] += weight[k] * path[first[k] + t]
-        limit = qddot_max[j]
         for k in range(n_rows):
             ratio = abs(sums[k]) / limit
             worst[k] = ratio if ratio > worst[k] else worst[k]
@@ -169,13 +214,10 @@ def row_joint(rows, k, qddot_max):  # type: ignore[no-untyped-def]  # pragma: no
 
     Each ratio as :func:`row_ratios` forms it: the same sums, in the same order (the same bits).
     """
-    first, _, weights, joint_path, _, _, _ = rows
+    first, _, _, index, c, joint_path, _, _, _ = rows
     largest, joint = -1.0, 0
     for j in range(N_JOINTS):
-        second = 0.0
-        for t in range(weights.shape[0]):
-            second += weights[t, k] * joint_path[j, first[k] + t]
-        ratio = abs(second) / qddot_max[j]
+        ratio = abs(row_second(joint_path[j], first[k], index, c, k)) / qddot_max[j]
         if ratio > largest:
             largest, joint = ratio, j
     return joint
@@ -203,13 +245,13 @@ def scan_row(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
     atomic increment and decrement of each array argument at every call.
     """
     keep = acc_speeds.shape[1] > 0
-    if slowest[i] < rows[6] and not keep:  # below the floor: the speeds bind, as a scan finds
+    if slowest[i] < rows[8] and not keep:  # below the floor: the speeds bind, as a scan finds
         feed[i] = slowest[i]
         acc_at[i], acc_joint[i], acc_hint[i] = -1, -1, -1
         return
-    joint_steps(cq, sq, qs, b, moves, rows[3])
+    joint_steps(cq, sq, qs, b, moves, rows[5])
     row_ratios(rows, qddot_max)
-    worst = rows[5]
+    worst = rows[7]
     if keep:
         acc_speeds[i, :] = np.inf
     largest, at, left = -1.0, -1, False

@@ -139,7 +139,7 @@ def left_at_probes(  # type: ignore[no-untyped-def]  # pragma: no cover - compil
             continue
         start, span = index[p, 0], index[p, -1] - index[p, 0]
         spun_steps(cq, sq, qd, qs, b, start, start + span, rate, length, qdot_max, steps)
-        worst, _ = acceleration_at(steps, start, span, c, p, qddot_max)
+        worst, _ = acceleration_at(steps, start, index, c, p, qddot_max)
         speed = 1.0 / math.sqrt(worst)
         if speed < limit:
             prune(i, p, min(slowest[i], speed), alive, why, where, slowest, acc_hint)
@@ -158,7 +158,7 @@ def probed_speed(i, k, b, cq, sq, status, index, c, qddot_max, steps):  # type: 
         if status[b, w] != OK:
             return -np.inf
     pair_steps(cq, sq, b, start, start + span, steps)
-    worst, _ = acceleration_at(steps, start, span, c, k, qddot_max)
+    worst, _ = acceleration_at(steps, start, index, c, k, qddot_max)
     return 1.0 / math.sqrt(worst)
 
 

@@ -62,45 +62,70 @@ def two_variable_speed(qd, qs, b, w, qdot_max):  # type: ignore[no-untyped-def] 
 
 @njit(cache=True, error_model="numpy", nogil=True)
 def step_stencil(index, weight):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
-    """The blend stencil on the joint path's steps: D_k = sum_t c[k, t] steps[index[k, 0] + 1 + t].
+    """The blend stencil on the joint path's steps, by runs: D_k = sum_t c_k(t) steps[w0 + 1 + t].
 
     The weights of a row sum to 0, so D_k = sum_m weight[k, m] (q[index[k, m]] -
     q[index[k, 0]]), and each difference is a sum of the steps between: the step w has the
     weight of every stencil waypoint at or after it. D so formed sees neither the angles' size
     nor the weights' rounding (the steps are small), and two joint paths whose steps are equal
-    or opposite have equal |D|, to the bit.
+    or opposite have equal |D|, to the bit. The steps' weight is constant on four runs: run m
+    (1 to 4) holds the steps t (from w0 = index[k, 0]) with index[k, m - 1] - w0 <= t <
+    index[k, m] - w0, of weight weight[k, m] + ... + weight[k, 4] (summed in that order from
+    0.0: the bits the steps' weights had when they were a (K, S) table, S the longest row's
+    span; that table was two of 1.6 GB each for 20,000 waypoints whose blend spanned half the
+    path, and a row's sum ran over S steps whatever its own span).
 
     Args:
         index: shape (K, 5), the stencil's waypoints (ascending along a row).
         weight: shape (K, 5), 1/m^2, their weights.
 
     Returns:
-        c: shape (K, S), 1/m^2, S the longest row's span index[k, 4] - index[k, 0] (the rest
-        of a shorter row 0).
+        c: shape (K, 4), 1/m^2, each row's runs' weights (:func:`row_second`).
     """
-    span = 0
+    c = np.zeros((index.shape[0], 4))
     for k in range(index.shape[0]):
-        span = max(span, index[k, -1] - index[k, 0])
-    c = np.zeros((index.shape[0], span))
-    for k in range(index.shape[0]):
-        for m in range(1, index.shape[1]):
-            for w in range(index[k, 0] + 1, index[k, m] + 1):
-                c[k, w - index[k, 0] - 1] += weight[k, m]
+        for run in range(1, 5):
+            total = 0.0
+            for m in range(run, 5):
+                total += weight[k, m]
+            c[k, run - 1] = total
     return c
 
 
 @njit(cache=True, error_model="numpy", nogil=True, inline="always")
-def acceleration_at(steps, start, span, c, k, qddot_max):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
+def row_second(steps, first, index, c, k):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
+    """D of stencil row k on one joint: sum_t c_k(t) steps[first + t], t from 0 in order.
+
+    ``steps``: one joint's steps, from ``first`` (the row's first step, the one after its
+    waypoint index[k, 0]) on; ``index``, ``c``: the stencil and its runs
+    (:func:`step_stencil`). Every hook forms D here: the same sums in the same order, the
+    same bits.
+    """
+    second = 0.0
+    base = index[k, 0]
+    t = 0
+    for run in range(4):
+        end = index[k, run + 1] - base
+        weight = c[k, run]
+        while t < end:
+            second += weight * steps[first + t]
+            t += 1
+    return second
+
+
+@njit(cache=True, error_model="numpy", nogil=True, inline="always")
+def acceleration_at(steps, start, index, c, k, qddot_max):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
     """Joint accelerations at a constant feed at stencil row k: max_j |D_j| / qddot_max_j, and j.
 
     :class:`solver.path.limits.JointAccelerationLimit` at one waypoint, from the joint path's
-    steps (:func:`step_stencil`); V_acc = 1 / sqrt of the ratio; the first joint at a tie.
+    steps (:func:`step_stencil`, :func:`row_second`); V_acc = 1 / sqrt of the ratio; the first
+    joint at a tie.
 
     Args:
         steps: shape (W, 6), rad, steps[w] = q_w - q_(w-1), read from start + 1 to
-            start + span.
+            index[k, 4].
         start: index[k, 0] of the stencil.
-        span: index[k, 4] - index[k, 0].
+        index: shape (K, 5), the stencil's waypoints.
         c: from :func:`step_stencil`.
         k: the stencil's row.
         qddot_max: shape (6,), rad/s^2.
@@ -108,10 +133,7 @@ def acceleration_at(steps, start, span, c, k, qddot_max):  # type: ignore[no-unt
     worst = -1.0
     limiting = 0
     for j in range(steps.shape[1]):
-        second = 0.0
-        for t in range(span):
-            second += c[k, t] * steps[start + 1 + t, j]
-        ratio = abs(second) / qddot_max[j]
+        ratio = abs(row_second(steps[:, j], start + 1, index, c, k)) / qddot_max[j]
         if ratio > worst:
             worst = ratio
             limiting = j

@@ -33,7 +33,7 @@ def floor_of(limit: JointAccelerationLimit, checked: np.ndarray, max_joint_step:
     index = np.ascontiguousarray(limit.stencil.index, dtype=np.int64)
     c = step_stencil(index, np.ascontiguousarray(limit.stencil.weight))
     rows = scan_work(index, c, int(checked.size) + 1, checked, max_joint_step, limit.qddot_max)
-    return float(rows[6])
+    return float(rows[8])
 
 
 def erk_limit(qddot_max: np.ndarray) -> tuple[JointAccelerationLimit, np.ndarray, float]:

@@ -57,14 +57,7 @@ def step_form(path: np.ndarray, limit: JointAccelerationLimit) -> tuple[np.ndarr
     steps[1:] = np.diff(path, axis=0)
     c = step_stencil(stencil.index, stencil.weight)
     rows = [
-        acceleration_at(
-            steps,
-            stencil.index[k, 0],
-            stencil.index[k, -1] - stencil.index[k, 0],
-            c,
-            k,
-            limit.qddot_max,
-        )
+        acceleration_at(steps, stencil.index[k, 0], stencil.index, c, k, limit.qddot_max)
         for k in range(len(stencil.waypoints))
     ]
     return np.array([r[0] for r in rows]), np.array([r[1] for r in rows])
@@ -126,9 +119,7 @@ def test_a_joint_moved_by_pi_or_mirrored_gives_the_same_bits() -> None:
         pair_steps(cq, sq, b, 0, n - 1, steps)
         rows.append(
             [
-                acceleration_at(
-                    steps, index[k, 0], index[k, -1] - index[k, 0], c, k, limit.qddot_max
-                )
+                acceleration_at(steps, index[k, 0], index, c, k, limit.qddot_max)
                 for k in range(len(index))
             ]
         )
