@@ -66,7 +66,8 @@ class Settings(BaseSettings):
         "joints, 200 for 7, plus 800 to 1,000 or 2,600 a placement for the seeds), so its "
         "limit is about 0.5 to 1.2 s; a cell adds 50 a pair for its collision check (more, "
         "in proportion, where it computes more than 250 distances a configuration: robot "
-        "part against object or part). "
+        "part against object or part); joint acceleration limits add 0.5 plus 0.04 a step of "
+        "the blend's span in waypoints (2 ik.blend_length over their spacing). "
         "/v1/evaluate weighs its one placement the same way against this limit.",
     )
     max_search_poses: int = Field(

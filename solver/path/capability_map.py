@@ -245,7 +245,8 @@ def map_cost(problem: PathProblem) -> float:
     The family's map figure (:meth:`solver.core.family.KinematicsFamily.map_cost`), told
     whether the map may drop branches (:func:`solver.path.pruning.can_prune`), times
     :attr:`PathProblem.exact_spin_weight` in free spin with an angled or offset spindle or seven
-    joints (:attr:`PathProblem.exact_spin`), plus the path checks' (a cell's collision check:
+    joints (:attr:`PathProblem.exact_spin`), plus the limits' (joint accelerations:
+    :meth:`PathProblem.limits_cost`) and the path checks' (a cell's collision check:
     :meth:`PathProblem.checks_cost`). A map with a path check is given the figure of following
     every branch: it drops branches too, but follows a refused placement's next branches again
     (:mod:`solver.path.path_checks`).
@@ -255,4 +256,4 @@ def map_cost(problem: PathProblem) -> float:
     pruned = not problem.path_checks and can_prune(problem)
     cost = problem.family.map_cost(n_waypoints, free_spin=free_spin, pruned=pruned)
     cost *= problem.exact_spin_weight  # the spun poses solved again, on the numpy pipeline
-    return cost + problem.checks_cost(n_waypoints)
+    return cost + problem.limits_cost(n_waypoints) + problem.checks_cost(n_waypoints)

@@ -31,6 +31,18 @@ from solver.core.two_variable_lp import two_variable_speed
 from solver.kernels.spin_lp import spin_speed
 from solver.path.blend_stencil import BlendStencil
 
+ACC_ROW_COST = 0.5
+"""A waypoint's work under joint acceleration limits (its stencil row's scan, the probes) besides
+its span's, in closed-form poses: the UR5's ERK-size map was 1.46x its time without them
+(bench/run.py, 2026-12-06), 1.7x on a 20,000-waypoint path at b = 10 um (two steps a row)."""
+ACC_STEP_COST = 0.04
+"""The work of one step of a stencil row's span at one placement, in closed-form poses: 5.0 to
+6.8 ns on one thread (0.029 to 0.040 of the UR5 map's pose without the limits, 171 ns), a
+20,000-waypoint dome path, 49 placements, b = 2 mm to 30 mm (249 to 3,119 steps a row),
+2026-12-06. Unweighed, a 196-placement map of that path at b = 5 cm was accepted at 78 % of
+DTF_MAX_MAP_POSES and ran 190 s (47 s since a row reads its own span, not the longest); at
+b = 2 mm it ran 3.3 s on two threads against 0.43 s without the limits (weighed 11 x)."""
+
 
 @dataclass(frozen=True)
 class JointMotion:
@@ -79,6 +91,16 @@ class Limit(abc.ABC):
             joint: shape ``...``, the binding joint's index.
         """
 
+    @abc.abstractmethod
+    def pose_cost(self) -> float:
+        """What this limit adds to one pose's work, in poses of a closed-form family's map.
+
+        The size limits add it to the family's figure at every waypoint
+        (:meth:`solver.path.problem.PathProblem.path_cost`,
+        :func:`solver.path.capability_map.map_cost`), as a :class:`PathCheck`'s, so a new
+        limit's work is weighed before any of it runs (0 where the family's figure holds it).
+        """
+
 
 class JointSpeedLimit(Limit):
     """Joint speed limits: the DTF, 1 / max_j |qd_j| / qdot_max_j (Sensors 2022 eq. (30)).
@@ -117,6 +139,10 @@ class JointSpeedLimit(Limit):
         with np.errstate(divide="ignore", invalid="ignore"):  # infeasible branches
             speed = 1.0 / worst
         return speed, limiting
+
+    def pose_cost(self) -> float:
+        """None added: every family's figure is the work of its DTF (the index itself)."""
+        return 0.0
 
 
 @dataclass(frozen=True)
@@ -240,6 +266,19 @@ class JointAccelerationLimit(Limit):
             speed[..., self.stencil.waypoints] = 1.0 / np.sqrt(worst)
         joint[..., self.stencil.waypoints] = ratio.argmax(axis=0)
         return speed, joint
+
+    def pose_cost(self) -> float:
+        """ACC_ROW_COST, plus ACC_STEP_COST for each step of a stencil row's span, on average.
+
+        The compiled kernels form a row's D from the steps its blend spans
+        (:func:`solver.kernels.limits.row_second`): a map's work at each placement grows with
+        the spans, 2 b over the waypoints' spacing, a hundred steps and more on a dense path
+        (the numpy pipeline's D reads five waypoints a row: weighed as the kernels' here).
+        """
+        spans = self.stencil.index[:, -1] - self.stencil.index[:, 0]
+        if not spans.size:
+            return 0.0
+        return ACC_ROW_COST + ACC_STEP_COST * float(spans.mean())
 
 
 def bound_by_limits(

@@ -230,11 +230,22 @@ class PathProblem:
         """The work of one placement of ``n_waypoints``, in poses of a closed-form family's map.
 
         The family's cost (:meth:`KinematicsFamily.path_cost`; times :attr:`exact_spin_weight`
-        where the spun poses are solved again, :attr:`exact_spin`), plus each path check's
-        (:meth:`checks_cost`): what the size limits of the maps and searches weigh.
+        where the spun poses are solved again, :attr:`exact_spin`), plus each limit's
+        (:meth:`limits_cost`) and each path check's (:meth:`checks_cost`): what the size limits
+        of the maps and searches weigh.
         """
         cost = self.family.path_cost(n_waypoints, free_spin=self.options.spin_mode == "free")
-        return cost * self.exact_spin_weight + self.checks_cost(n_waypoints)
+        cost *= self.exact_spin_weight
+        return cost + self.limits_cost(n_waypoints) + self.checks_cost(n_waypoints)
+
+    def limits_cost(self, n_waypoints: int) -> float:
+        """The limits' work along ``n_waypoints`` beyond the family's figure, in closed-form poses.
+
+        Each limit's weight a pose (:meth:`solver.path.limits.Limit.pose_cost`: none for the
+        joint speeds, whose DTF the figure is; the joint accelerations' grows with the blend's
+        span in waypoints).
+        """
+        return n_waypoints * sum(limit.pose_cost() for limit in self.limits)
 
     def checks_cost(self, n_waypoints: int) -> float:
         """The path checks' work along ``n_waypoints``, in closed-form poses.
