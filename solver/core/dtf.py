@@ -170,19 +170,38 @@ def lp_speed(
     cost = np.zeros(n + 1)
     cost[-1] = -1.0
     a_eq = np.hstack([jacobian * qdot_max, -twist[:, None] / scale])
+    # Each row to its largest coefficient (the same equalities): a robot of hundreds of metres
+    # with speed limits of thousands of rad/s put coefficients of 1e6 beside ones of 1e-3, and
+    # HiGHS stopped without proving its answer (a contract test's case: a 500).
+    largest = np.max(np.abs(a_eq), axis=1, keepdims=True)
+    a_eq = a_eq / np.where(largest > 0.0, largest, 1.0)
+    # and s to its column's largest, so that s is of the joints' size (s = s' / s_scale)
+    s_scale = float(np.max(np.abs(a_eq[:, -1])))
+    a_eq[:, -1] /= s_scale
     bounds = [(-1.0, 1.0)] * n + [(0.0, None)]
-    result = scipy.optimize.linprog(
-        cost,
-        A_eq=a_eq,
-        b_eq=np.zeros(6),
-        bounds=bounds,
-        method="highs",
-        options={"primal_feasibility_tolerance": 1e-10, "dual_feasibility_tolerance": 1e-10},
-    )
-    if result.status != 0:  # The origin is always feasible and s is bounded: not expected.
-        raise RuntimeError(f"HiGHS failed on the DTF LP: {result.message}")
+    result = None
+    for method in ("highs", "highs-ipm"):  # the dual simplex, then the interior point method
+        result = scipy.optimize.linprog(
+            cost,
+            A_eq=a_eq,
+            b_eq=np.zeros(6),
+            bounds=bounds,
+            method=method,
+            options={"primal_feasibility_tolerance": 1e-10, "dual_feasibility_tolerance": 1e-10},
+        )
+        if result.status == 0:
+            break
+    assert result is not None
+    if result.status != 0:  # the origin is feasible and s bounded: the numbers defeat HiGHS
+        raise InvalidInputError(
+            "robot",
+            "the DTF LP could not be solved to its tolerances at this configuration (HiGHS: "
+            f"{result.message}); its Jacobian times the speed limits spans "
+            f"{float(np.min(largest)):.3g} to {float(np.max(largest)):.3g} a row: check the "
+            "robot's lengths (m) and speed limits (rad/s)",
+        )
     # + 0.0: HiGHS answers -0.0 where the optimum is 0 (a chain that cannot move along t_hat)
-    return float(result.x[-1]) / scale + 0.0, np.asarray(result.x[:n]) * qdot_max + 0.0
+    return float(result.x[-1]) / s_scale / scale + 0.0, np.asarray(result.x[:n]) * qdot_max + 0.0
 
 
 def dtf(

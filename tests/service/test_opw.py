@@ -171,3 +171,74 @@ def test_dtf_on_an_opw_arm(client: TestClient) -> None:
         abs(v) / m for v, m in zip(answer["qdot"], get_robot("fanuc_m20ia").qdot_max, strict=True)
     ) == pytest.approx(1.0, rel=1e-12)
     assert math.isfinite(answer["omega_max"])
+
+
+def test_the_lp_of_an_arm_of_hundreds_of_metres_is_answered(client: TestClient) -> None:
+    # The contract test's case (stop 63): an OPW arm of hundreds of metres with speed limits of
+    # thousands of rad/s, the LP asked for: J times the limits spans 4e3 to 6e6 a row, and
+    # HiGHS stopped without proving its answer (RuntimeError, a 500). Rows and s are scaled now.
+    body = {
+        "h": None,
+        "robot": {
+            "joint_velocity_limits": [
+                7745.001146803348,
+                5970.242942909562,
+                5442.392486786082,
+                7609.0512262792545,
+                6527.931929964032,
+                1094.124756067725,
+            ],
+            "opw": {
+                "a2": -2.00001,
+                "a1": 34.26244237711285,
+                "sign_corrections": [-1, -1, 1, -1, -1, -1],
+                "c2": 69.86701692529121,
+                "c4": -57.243484255191646,
+                "offsets": [
+                    -2.6853948407507237e-288,
+                    -0.3333333333333333,
+                    237.6407492482399,
+                    -2.2250738585e-313,
+                    3.532225612617526e-111,
+                    754.97924833105,
+                ],
+                "c1": -12.679311543250392,
+                "c3": 1.1754943508222875e-38,
+                "b": -49.90304627927918,
+            },
+            "tcp": {
+                "orientation": [
+                    -0.9661985494144,
+                    1.0618976554111744e-227,
+                    -0.25779907507496824,
+                    8.90312684744586e-218,
+                ],
+                "position": [1.302015, -661.4113262784862, 610.0530783044462],
+            },
+            "joint_position_limits": [
+                [-467.6717315462947, 1.192092896e-07],
+                [-1.347854691030735e-245, 796.4831141009593],
+                [-977.3966368704898, -197.10771297553117],
+                [-446.6612180158894, 707.3327966653028],
+                [-2.225073858507e-311, 439.3019225305916],
+                [-253.65591304715792, 939.1384091828363],
+            ],
+        },
+        "u_R": None,
+        "u_T": [1.0, 0.0, 0.0],
+        "method": "lp",
+        "q": [
+            1.192092896e-07,
+            796.4831141009593,
+            -197.10771297553117,
+            -1.0742289508517208e-54,
+            -2.225073858507e-311,
+            939.1384091828363,
+        ],
+    }
+    response = client.post("/v1/dtf", json=body)
+    assert response.status_code == 200, response.text
+    answer = response.json()
+    assert answer["method"] == "lp" and answer["v_max"] >= 0.0
+    limits = body["robot"]["joint_velocity_limits"]
+    assert all(abs(v) <= m * (1 + 1e-9) for v, m in zip(answer["qdot"], limits, strict=True))
