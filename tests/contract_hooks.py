@@ -52,6 +52,9 @@ NORMALISED: Counter[str] = Counter()
 """Positive cases moved onto each rule stated in words (one count per case and rule)."""
 KEPT_OUT: Counter[tuple[str, int]] = Counter()
 """Positive cases kept out of positive_data_acceptance, per rule and the status answered."""
+REPEATED: Counter[tuple[str, str]] = Counter()
+"""Cases not sent, per operation and generation mode: the very request was sent and checked
+before (``tests/contract_live.py``, ``sent_before``)."""
 KEEP_OUT = {
     "height": "POST /v1/optimize: z or bounds.z, exactly one (the operation's description)",
 }
@@ -467,10 +470,14 @@ def before_add_examples(context: Any, examples: list[schemathesis.Case]) -> None
     examples[:] = [map_case(context, case) for case in examples]
 
 
+def mode(case: schemathesis.Case) -> str:
+    """``positive`` or ``negative``: the case's generation mode, as the figures name it."""
+    return "positive" if _positive(case) else "negative"
+
+
 def after_call(context: Any, case: schemathesis.Case, response: Any) -> None:
     """Count the answer's status, per operation and generation mode."""
-    mode = "positive" if _positive(case) else "negative"
-    STATUSES[(case.operation.label, mode, response.status_code)] += 1
+    STATUSES[(case.operation.label, mode(case), response.status_code)] += 1
 
 
 def operations(schema: Any) -> list[tuple[str, str, str]]:
