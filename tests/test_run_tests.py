@@ -1,6 +1,6 @@
 """scripts/run_tests.py's runs: the latency run collects only LATENCY_MODULES, which must be every
 module that marks a test ``latency``, or a test marked elsewhere would run in neither run; and a
-run leaves nothing in the temporary directory."""
+run leaves nothing in the temporary directory; the modules given out first exist."""
 
 from __future__ import annotations
 
@@ -53,3 +53,14 @@ def test_a_run_on_two_workers_leaves_no_jobs_directory_behind(tmp_path: Path) ->
     )
     assert run.returncode == 0, run.stdout + run.stderr
     assert sorted(p.name for p in tmp_path.glob("dtf-test-jobs-*")) == []
+
+
+def test_the_modules_given_out_first_are_test_modules_once_each() -> None:
+    # tests/conftest.py's FIRST orders the workers' modules by name: a module renamed or moved
+    # would silently fall back to collection order
+    from tests.conftest import FIRST
+
+    assert len(set(FIRST)) == len(FIRST)
+    missing = [module for module in FIRST if not (ROOT / module).is_file()]
+    assert not missing, missing
+    assert all(Path(module).name.startswith("test_") for module in FIRST)
