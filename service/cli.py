@@ -11,13 +11,13 @@ the route answers:
 - ``optimise PROGRAM --robot R --x MIN:MAX --y MIN:MAX``: the best placement and its
   controller frames.
 
-PROGRAM is CL data, or a CSV when its name ends in ``.csv`` (``--units`` then required). R is a
-catalogue name (``ur5e``), a JSON file holding the API's ``robot`` object (its acceleration
-limits add mu_acc and the cycle time), or a URDF file (``.urdf``: its chain from
-``--base-frame`` to ``--tool-frame``, unless given REP 199's ``base`` (the controller's frame,
-where the URDF has it; else ``base_link``) and ``tool0``, its own velocity limits). A
-ROS-Industrial OPW parameter file (``.yaml``) is refused with the ``opw`` object read from it,
-since it has no joint limits (:mod:`service.cli_opw`).
+PROGRAM is CL data (``-``: read from standard input), or a CSV when its name ends in ``.csv``
+(``--units`` then required). R is a catalogue name (``ur5e``), a JSON file holding the API's
+``robot`` object (its acceleration limits add mu_acc and the cycle time), or a URDF file
+(``.urdf``: its chain from ``--base-frame`` to ``--tool-frame``, unless given REP 199's
+``base`` (the controller's frame, where the URDF has it; else ``base_link``) and ``tool0``, its
+own velocity limits). A ROS-Industrial OPW parameter file (``.yaml``) is refused with the
+``opw`` object read from it, since it has no joint limits (:mod:`service.cli_opw`).
 ``--cell FILE``, a JSON file holding the API's ``cell`` object (cell.md: the table, fixtures,
 the part, the tool, the clearance), checks the robot against it on evaluate, map and optimise
 as the routes do. Settings come from the environment as for the service (``DTF_*``); a
@@ -51,7 +51,7 @@ from typing import Any, TypeVar
 from pydantic import BaseModel, ValidationError
 
 from service import caches
-from service.cli_files import decoded, file_bytes, text_file
+from service.cli_files import STDIN, decoded, file_bytes, stdin_bytes, text_file
 from service.cli_text import ProgressBar, evaluation_text, import_text, map_text, optimum_text
 from service.config import MAX_PATH_WAYPOINTS, Settings, settings_or_exit
 from service.convert.errors import request_errors, solver_error_location, solver_error_type
@@ -297,7 +297,12 @@ def _quiet_stdout() -> None:
 
 def _path(args: argparse.Namespace) -> dict[str, Any]:
     """The request's ``path`` object of the program file."""
-    text = decoded(file_bytes(Path(args.program), "program"), errors="replace")
+    data = (
+        stdin_bytes("program")
+        if args.program == STDIN
+        else file_bytes(Path(args.program), "program")
+    )
+    text = decoded(data, errors="replace")
     if len(text) > MAX_CAM_TEXT:  # said as what a program is, not as a string's length
         message = (
             f"{len(text):,} characters: a program is read up to {MAX_CAM_TEXT:,} (about the "
@@ -488,7 +493,8 @@ def _ascii(json_text: str) -> str:
 def _import(args: argparse.Namespace) -> int:
     body = _validated(PathImportRequest, {"path": _path(args)})
     answer = import_of(body, _settings())
-    _print(answer, args, lambda: import_text(answer, args.program))
+    name = "standard input" if args.program == STDIN else args.program
+    _print(answer, args, lambda: import_text(answer, name))
     return OK
 
 
@@ -684,7 +690,11 @@ def _parser() -> argparse.ArgumentParser:
     )
     commands = parser.add_subparsers(required=True, metavar="COMMAND")
     common = argparse.ArgumentParser(add_help=False)
-    common.add_argument("program", help="CL data (NX, SolidWorks CAM, CATIA, ...) or a .csv")
+    common.add_argument(
+        "program",
+        help="CL data (NX, SolidWorks CAM, CATIA, ...), - to read it from standard input, or a "
+        ".csv",
+    )
     common.add_argument(
         "--units",
         choices=["mm", "inch", "m"],

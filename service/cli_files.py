@@ -7,6 +7,7 @@ with one; both were Python tracebacks (UnicodeDecodeError) or a refused first li
 from __future__ import annotations
 
 import codecs
+import sys
 from pathlib import Path
 
 from solver.core.exceptions import InvalidInputError
@@ -15,6 +16,21 @@ MAX_FILE_BYTES = 8_000_000
 """The most bytes read of a file: 2,000,000 characters (the longest program, URDF or cell text
 a request may hold) of up to 4 bytes in UTF-8. ``import /dev/zero`` read until memory ran out
 (MemoryError, exit 1) before any limit was checked."""
+
+
+STDIN = "-"
+"""The program's name that reads it from standard input, as Unix commands take it
+(``cam-post | dtf-place import -``): a post-processor need not write its program to a file
+first. CL data only: a CSV is told by its file name (``.csv``)."""
+
+
+def stdin_bytes(field: str) -> bytes:
+    """The bytes of standard input, at most MAX_FILE_BYTES.
+
+    Raises:
+        InvalidInputError: on ``field``, when longer.
+    """
+    return _limited(sys.stdin.buffer.read(MAX_FILE_BYTES + 1), "standard input", field)
 
 
 def file_bytes(file: Path, field: str) -> bytes:
@@ -32,10 +48,15 @@ def file_bytes(file: Path, field: str) -> bytes:
             data = stream.read(MAX_FILE_BYTES + 1)
     except OSError as error:
         raise InvalidInputError(field, f"cannot read {str(file)!r}: {error.strerror}") from error
+    return _limited(data, repr(str(file)), field)
+
+
+def _limited(data: bytes, name: str, field: str) -> bytes:
+    """``data`` (read up to one byte over MAX_FILE_BYTES), refused on ``field`` where longer."""
     if len(data) > MAX_FILE_BYTES:
         raise InvalidInputError(
             field,
-            f"{str(file)!r} is longer than {MAX_FILE_BYTES:,} bytes: no program, URDF or cell "
+            f"{name} is longer than {MAX_FILE_BYTES:,} bytes: no program, URDF or cell "
             "the service reads is (2,000,000 characters at most)",
         )
     return data

@@ -6,6 +6,7 @@ codes are the ones a script tests (0 ok, 2 usage, 3 invalid input, 4 infeasible)
 
 from __future__ import annotations
 
+import io
 import json
 import math
 import os
@@ -33,6 +34,7 @@ from service.cli import (
     USAGE,
     main,
 )
+from service.cli_files import MAX_FILE_BYTES
 from service.config import get_settings
 from solver.core.robots import example_robot_data_dir
 from solver.families.opw.arms import ARMS
@@ -109,6 +111,34 @@ def test_evaluate_json_is_the_api_answer(
     assert code == OK
     assert json.loads(out) == expected
     assert expected["feasible"] and expected["feed_check"]["feasible"]
+
+
+def _stdin(monkeypatch: pytest.MonkeyPatch, data: bytes) -> None:
+    monkeypatch.setattr(sys, "stdin", io.TextIOWrapper(io.BytesIO(data)))
+
+
+def test_a_program_named_dash_is_read_from_standard_input(
+    client: TestClient, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    # a post-processor pipes its program (`post | dtf-place evaluate - ...`): "-" was "no file"
+    _stdin(monkeypatch, PROGRAM.read_bytes())
+    code, out, err = run(capsys, "evaluate", "-", "--robot", "ur5e", "--at=0,0.3,0,0", "--json")
+    body = {"robot": ROBOT, "path": {"cl_data": PROGRAM.read_text()}, "placement": AT}
+    assert (code, err) == (OK, "")
+    assert json.loads(out) == api(client, "/v1/evaluate", {**body, "detail": "summary"})
+    _stdin(monkeypatch, PROGRAM.read_bytes())
+    code, out, _ = run(capsys, "import", "-")
+    assert code == OK
+    assert out.splitlines()[0] == "program: standard input"
+
+
+def test_standard_input_over_the_file_limit_is_refused_on_the_program(
+    capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    _stdin(monkeypatch, b"GOTO/0,0,0\n" * (MAX_FILE_BYTES // 11 + 1))
+    code, _, err = run(capsys, "import", "-")
+    assert code == INVALID
+    assert "program" in err and "standard input is longer than 8,000,000 bytes" in err
 
 
 def test_values_from_a_negative_number_need_no_equals_sign(
