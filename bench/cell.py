@@ -34,6 +34,7 @@ from solver.optimise.search_space import PlacementBounds
 from solver.path.capability_map import capability_map, grid_axis
 from solver.path.cell import kept_tables
 from solver.path.cell.cache import checker_for
+from solver.path.cell.robot_geometry import forget_urdf_geometries
 from solver.path.cell.shapes import Box, Cell, Halfspace, Sphere, Tool
 from solver.path.problem import PathOptions, PathProblem
 
@@ -172,15 +173,16 @@ def cell_lines(
             t_coal = time.perf_counter() - start
         reason = getattr(cmap, "reason")  # noqa: B009 - an object typed loosely above
         kept_tables.forget()
+        forget_urdf_geometries()
         t_build = _build_seconds(arm)  # what the first map of the arm pays once
-        t_kept = _build_seconds(arm)  # a new cell for the same arm: its tables kept
+        t_kept = _build_seconds(arm)  # a new cell for the same arm: its tables, hulls kept
         print(
             f"  {arm.name}: with the cell {t_with:7.3f} s, without {t_without:7.3f} s (best of "
             f"{repeats} each): {t_with / t_without:.1f}x (goal <= 3x); coal only (one run) "
             f"{t_coal:7.3f} s: {t_coal / t_without:.1f}x; "
             f"{int((reason == -1).sum())} feasible, {int((reason == 4).sum())} collision cells; "
             f"the checker's build (pair tables made, once per arm) {t_build:.2f} s, with the "
-            f"arm's tables kept (another cell) {t_kept:.2f} s"
+            f"arm's tables and hulls kept (another cell) {t_kept:.3f} s"
         )
     _numeric_line(path, xs, ys, z)
     _weight_line(robot, path, xs, ys, z, smoke=smoke)

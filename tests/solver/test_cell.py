@@ -735,3 +735,40 @@ def ur5_geometry_meshes() -> tuple[pin.Model, pin.GeometryModel]:
     return model, pin.buildGeomFromUrdfString(
         model, urdf, pin.COLLISION, package_dirs=[str(robots.parent.parent)]
     )
+
+
+def test_an_arms_meshes_are_read_once_whatever_the_cell(monkeypatch: pytest.MonkeyPatch) -> None:
+    """Every request with a cell the checkers' cache had not met read the UR5's meshes and made
+    their hulls again (0.07 to 0.09 s): each edit of a cell on the page. The arm's URDF geometry
+    is now kept, whatever the tool point; each answer is its own copy, which the tool's parts
+    are added to."""
+    robots = example_robot_data_dir()
+    urdf = (robots / "ur_description" / "urdf" / "ur5_robot.urdf").read_text()
+    urdf = urdf.replace("</robot>", "<!-- read once (test_cell) --></robot>")  # no kept one
+    frames = {"base_frame": "base_link", "tool_frame": "tool0"}
+    arm = robot_from_urdf(urdf, **frames)
+    reads = []
+    build = pin.buildGeomFromUrdfString
+
+    def counted(*args: object, **kwargs: object) -> pin.GeometryModel:
+        reads.append(args[1])
+        return build(*args, **kwargs)
+
+    monkeypatch.setattr(pin, "buildGeomFromUrdfString", counted)
+    bare = robot_geometry(arm, tool=None, link_radii=None)
+    tipped = arm.with_options(transform_tool_to_tcp=pose(0.0, 0.0, 0.1))  # the tool's tip
+    tooled = robot_geometry(tipped, tool=Tool(radius=0.03, length=0.1), link_radii=None)
+    again = robot_geometry(arm, tool=None, link_radii=None)
+    assert len(reads) == 1
+    assert tooled.geometry.ngeoms == bare.geometry.ngeoms + 2  # the holder and cutting part
+    assert again.geometry.ngeoms == bare.geometry.ngeoms  # the tool added to a copy only
+    assert [o.name for o in again.geometry.geometryObjects] == [
+        o.name for o in bare.geometry.geometryObjects
+    ]
+    assert again.keys == bare.keys and again.approximated == bare.approximated == ()
+    # another URDF is read: the forearm's collision element out, the forearm approximated
+    start = urdf.index("<collision>", urdf.index('<link name="forearm_link">'))
+    cut = urdf[:start] + urdf[urdf.index("</collision>", start) + len("</collision>") :]
+    other = robot_geometry(robot_from_urdf(cut, **frames), tool=None, link_radii=None)
+    assert len(reads) == 2
+    assert other.approximated == ("elbow_joint",)

@@ -2,8 +2,9 @@
 
 Building a checker (the URDF's meshes read and made convex hulls, the compiled side's packs,
 the pair weights, the self-collision probe at the zero configuration) took 0.07 to 0.1 s for
-the UR5, ten times the ERK map without a cell (its self pairs' tables, about 0.4 s more, are
-made at a map's first use and kept per arm, :mod:`solver.path.cell.kept_tables`): every
+the UR5 (the hulls are now kept per arm too, by ``robot_geometry._urdf_geometry``), ten times
+the ERK map without a cell (its self pairs' tables, about 0.4 s more, are made at a map's first
+use and kept per arm, :mod:`solver.path.cell.kept_tables`): every
 request, map and optimisation builds its own :class:`solver.path.problem.PathProblem`, and
 each asked for a new checker. A checker is
 read-only once built (a placement's geometry is a copy, :meth:`CellChecker.check`), so

@@ -24,7 +24,9 @@ import hashlib
 import math
 import os
 import pickle
+import threading
 import xml.etree.ElementTree as ElementTree
+from collections import OrderedDict
 from dataclasses import dataclass
 
 import coal
@@ -53,9 +55,10 @@ PUBLISHED_RADII: dict[str, tuple[float, ...]] = {
 DEFAULT_URDF_LINK_RADIUS = 0.05
 MAX_MESH_BYTES = 20_000_000
 """The most bytes of collision mesh files one URDF may have read (repeats counted): each is
-loaded and made a hull per request, 2.7 s for one 28 MB mesh; fifteen copies of one (at other
-scales, so no cache helps) held a 6 kB request 41 s and /healthz 2.9 s (the contract audit,
-stop 54). The catalogue's arms read 0.2 to 7 MB."""
+loaded and made a hull at the arm's first request with a cell (then kept: _urdf_geometry), 2.7 s
+for one 28 MB mesh; fifteen copies of one (at other scales, so no cache helps) held a 6 kB
+request 41 s and /healthz 2.9 s (the contract audit, stop 54). The catalogue's arms read 0.2 to
+7 MB."""
 TOOL_HOLDER, TOOL_CUTTING = "tool", "tool_cutting"
 CAPSULE_SUFFIX = "_capsule"  # the name of a capsule made for a link without geometry ends so
 
@@ -195,8 +198,68 @@ def content_digest(*parts: bytes) -> str:
     return digest.hexdigest()
 
 
+MAX_KEPT_URDF_GEOMETRIES = 8
+"""URDF geometries kept (:func:`_urdf_geometry`), the least recently used dropped first (a UR5's
+hulls are about 1 MB)."""
+_kept_urdf_geometries: OrderedDict[str, pin.GeometryModel] = OrderedDict()
+_kept_lock = threading.Lock()
+
+
 def _urdf_geometry(robot: Robot) -> pin.GeometryModel:
-    """The URDF's collision elements with meshes as convex hulls; primitives only if unreadable."""
+    """The URDF's collision elements with meshes as convex hulls; primitives only if unreadable.
+
+    Kept per arm (its URDF text and kinematic tree, :func:`_tree_digest`): reading the UR5's
+    meshes and making their hulls took 0.07 to 0.09 s, for every request with a cell the
+    checkers' cache (:mod:`solver.path.cell.cache`) had not met, as every edit of a cell on the
+    page is, or another tool point or limit. The answer is a copy
+    (:meth:`pin.GeometryModel.copy`: its own objects, which the caller adds to and places; the
+    hulls shared, never changed, as the checkers' copies share them).
+    """
+    key = _tree_digest(robot)
+    with _kept_lock:
+        kept = _kept_urdf_geometries.get(key)
+        if kept is not None:
+            _kept_urdf_geometries.move_to_end(key)
+            return kept.copy()
+    geometry = _read_urdf_geometry(robot)  # outside the lock: another thread may read its own
+    with _kept_lock:
+        _kept_urdf_geometries[key] = geometry
+        _kept_urdf_geometries.move_to_end(key)
+        while len(_kept_urdf_geometries) > MAX_KEPT_URDF_GEOMETRIES:
+            _kept_urdf_geometries.popitem(last=False)
+    return geometry.copy()
+
+
+def forget_urdf_geometries() -> None:
+    """Drop every kept URDF geometry (a benchmark timing what an arm's first cell pays)."""
+    with _kept_lock:
+        _kept_urdf_geometries.clear()
+
+
+def _tree_digest(robot: Robot) -> str:
+    """A digest of what the URDF's geometry is read on (:func:`_urdf_geometry`'s key).
+
+    The URDF, and the model's joints (names, parents, placements, types) and frames (names,
+    parents, placements), all but the tool point, which no collision element is on (a
+    request's tcp moves it; its limits are not read either).
+    """
+    model = robot.model
+    frames = [
+        (frame.name, frame.parentJoint, frame.placement.homogeneous.tobytes())
+        for frame in model.frames
+        if frame.name != "tool_point"
+    ]
+    joints = [
+        (name, parent, placement.homogeneous.tobytes(), joint.shortname())
+        for name, parent, placement, joint in zip(
+            model.names, model.parents, model.jointPlacements, model.joints, strict=True
+        )
+    ]
+    return content_digest((robot.urdf or "").encode(), pickle.dumps((joints, frames)))
+
+
+def _read_urdf_geometry(robot: Robot) -> pin.GeometryModel:
+    """The URDF's collision elements read, meshes made convex hulls (:func:`_urdf_geometry`)."""
     share = str(example_robot_data_dir().parent.parent)  # package://example-robot-data/...
     try:
         geometry = pin.buildGeomFromUrdfString(
