@@ -227,3 +227,47 @@ def test_the_spec_declares_error_bodies_and_headers(
         assert answer["content"]["application/json"]["schema"] == ERROR_SCHEMA
     if header is not None:
         assert header in answer["headers"]
+
+
+def _two_waypoints() -> dict[str, Any]:
+    points = ([0.0, 0.4, 0.0], [0.01, 0.4, 0.0])  # two points along x, the tool pointing down
+    return {"waypoints": [{"position": p, "orientation": [1, 0, 0, 0]} for p in points]}
+
+
+@pytest.mark.parametrize(
+    ("route", "body"),
+    [
+        (
+            "/v1/map",
+            {
+                "grid": {
+                    "x": {"min": 1e-16, "max": 1e-16, "step": 1000},
+                    "y": {"min": 0.0, "max": 0.0, "step": 0.1},
+                    "z": 0.1,
+                    "yaw": 0.0,
+                }
+            },
+        ),
+        (
+            "/v1/optimize",
+            {"z": 1e-21, "bounds": {"x": [-0.02, 0.02], "y": [-0.02, 0.02], "yaw": [0.0, 0.1]}},
+        ),
+        (
+            "/v1/optimize",
+            {"bounds": {"x": [1e-21, 0.01], "y": [0, 0.01], "yaw": [1e-21, 0.1], "z": [0.1, 0.1]}},
+        ),
+    ],
+)
+def test_an_axis_of_one_value_written_to_many_decimals_is_answered(
+    client: TestClient, route: str, body: dict[str, Any]
+) -> None:
+    """A one-value axis whose value is written to 16 or 21 decimals (a grid axis narrower than
+    its step, a fixed height, a box narrower than the coarse map's 20 mm): the stride of its
+    written decimals passed int64, a 500 on both routes and their jobs (audit 22)."""
+    request = {"robot": {"model": "ur5"}, "path": _two_waypoints(), **body}
+    answer = client.post(route, json=request)
+    assert answer.status_code == 200, answer.text
+    kind = route.removeprefix("/v1/")
+    queued = client.post("/v1/jobs", json={"kind": kind, "request": request})
+    assert queued.status_code == 202, queued.text
+    assert client.delete(f"/v1/jobs/{queued.json()['id']}").status_code == 204

@@ -12,6 +12,7 @@ import pytest
 from solver.core.codes import REASONS
 from solver.core.exceptions import InvalidInputError
 from solver.core.family import Branch
+from solver.core.written import stepped_as_written
 from solver.families import get_robot
 from solver.families.ur.ik import BRANCHES
 from solver.path.capability_map import grid_axis, serpentine
@@ -170,6 +171,17 @@ def test_grid_values_past_exact_integers_are_the_floats_sums() -> None:
     lower = 0.1 + 0.2
     axis = grid_axis(lower, 1.0, 0.1, field="grid.x")
     assert axis.tolist() == [lower + 0.1 * i for i in range(len(axis))]
+
+
+@pytest.mark.parametrize(
+    ("value", "step"), [(1e-16, 1000.0), (1e-21, 0.02), (1e-21, 0.2617993877991494), (0.3, 1e19)]
+)
+def test_a_one_value_axis_is_its_value_whatever_the_step(value: float, step: float) -> None:
+    """An axis narrower than its step, its bound written to many decimals: the stride in the
+    last decimal (10^19 and more) passed int64 and was an OverflowError, a 500 (audit 22)."""
+    assert grid_axis(value, value, step, field="grid.x").tolist() == [value]
+    assert stepped_as_written(value, step, 1).tolist() == [value]
+    assert stepped_as_written(value, step, 0).tolist() == []
 
 
 @pytest.mark.parametrize(("lower", "upper", "step"), [(0, 1, 0), (1, 0, 0.1), (0, math.inf, 1)])
