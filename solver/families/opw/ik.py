@@ -78,7 +78,9 @@ def solve_components(
         status: shape (8, *batch), ``OK``, ``UNREACHABLE`` or ``SINGULAR`` (shoulder, elbow or
         wrist singularity; q is still a solution there).
     """
-    with np.errstate(invalid="ignore", divide="ignore"):
+    # NaN and inf (a pose far beyond reach overflows) are unreachable: said in the answer, not
+    # as numpy warnings in the service's log (audit 22).
+    with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
         return _solve(parameters, rotation, position)
 
 

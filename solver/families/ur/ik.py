@@ -129,6 +129,14 @@ def solve_components(
         q: shape (6, 8, *batch), rad in [-pi, pi], NaN where unreachable;
         status: shape (8, *batch).
     """
+    # A pose metres beyond any reach overflows to inf and NaN, which the reach tests make
+    # unreachable: said in the answer, not as numpy warnings in the service's log (audit 22).
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+        return _solve(dh, rotation, position)
+
+
+def _solve(dh: UrDh, rotation: np.ndarray, position: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The body of :func:`solve_components`."""
     batch = np.broadcast_shapes(rotation.shape[2:], position.shape[1:])
     ones = (1,) * len(batch)
     n_x, n_y = rotation[0, 0], rotation[1, 0]  # flange x axis
@@ -137,8 +145,7 @@ def solve_components(
     w_y = position[1] - dh.d6 * a_y
     w_z = position[2] - dh.d6 * a_z
     radius = np.hypot(w_x, w_y)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        ratio1 = dh.d4 / radius
+    ratio1 = dh.d4 / radius
     reach1 = np.abs(ratio1) <= 1.0 + REACH_TOLERANCE
     sign = np.array([1.0, -1.0]).reshape((2, *ones))
     # Shoulder level, shape (2, M): w . z1 = d4 with z1 = (sin q1, -cos q1, 0).

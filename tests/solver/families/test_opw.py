@@ -278,3 +278,16 @@ def assert_solutions_reach(
     assert len(reached) > 0
     fk = forward_kinematics(p, reached)
     np.testing.assert_allclose(fk, np.broadcast_to(pose, fk.shape), atol=FK_IK_ATOL)
+
+
+@pytest.mark.filterwarnings("error")
+@pytest.mark.parametrize("position", [(1e200, 0.0, 1e200), (1e308, 1e308, 0.0), (0.0, 0.0, 1e300)])
+def test_a_pose_far_beyond_reach_is_unreachable_without_a_warning(
+    position: tuple[float, float, float],
+) -> None:
+    """Overflows to inf there were numpy RuntimeWarnings in the service's log (audit 22:
+    ``overflow encountered`` at the elbow's and shoulder's cosines): the reach tests make the
+    pose unreachable, which the answer says."""
+    rotation = np.eye(3)[:, :, None]
+    q, status = solve_components(ARMS[0].parameters, rotation, np.array(position)[:, None])
+    assert np.isnan(q).all() and (status == UNREACHABLE).all()

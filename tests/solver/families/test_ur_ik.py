@@ -13,6 +13,7 @@ from solver.core.family import Branch
 from solver.core.kinematics import jacobian_in_base, tool_pose_in_base
 from solver.core.spatial import wrap_angle
 from solver.families import get_robot
+from solver.families.ur.dh import UR_DH
 from solver.families.ur.ik import BRANCHES, joint_copies, solve_batch
 from tests.cases import FK_IK_ATOL, UR_MODELS
 
@@ -101,3 +102,19 @@ def test_joint_copies_within_limits() -> None:
     assert copies.shape == (2 * 2 * 1 * 2 * 2 * 3, 6)
     assert np.all((copies >= lower - 1e-12) & (copies <= upper + 1e-12))
     np.testing.assert_allclose(wrap_angle(copies - q), 0.0, atol=1e-12)
+
+
+@pytest.mark.filterwarnings("error")
+@pytest.mark.parametrize(
+    "position", [(1e-320, 0.0, 0.5), (1e200, 0.0, 1e200), (1e308, 1e308, 0.0), (0.0, 0.0, 1e300)]
+)
+def test_a_pose_far_beyond_reach_is_unreachable_without_a_warning(
+    position: tuple[float, float, float],
+) -> None:
+    """Overflows to inf and NaN there were numpy RuntimeWarnings in the service's log (audit 22:
+    ``overflow encountered in divide`` at the shoulder's d4 / radius): the reach tests make the
+    pose unreachable, which the answer says."""
+    pose = np.eye(4)
+    pose[:3, 3] = position
+    q, status = solve_batch(UR_DH["ur5"], pose[None])
+    assert np.isnan(q).all() and (status == UNREACHABLE).all()
