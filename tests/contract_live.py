@@ -153,6 +153,7 @@ def sent_before(case: schemathesis.Case, rule: str | None) -> bool:
     """
     if case.method.upper() != "POST":
         return False
+    mode = contract_hooks.mode(case)
     body = case.body
     text = body.hex() if isinstance(body, bytes) else json.dumps(body, sort_keys=True, default=str)
     key = (
@@ -162,11 +163,11 @@ def sent_before(case: schemathesis.Case, rule: str | None) -> bool:
         json.dumps(case.headers, sort_keys=True, default=str),
         str(case.media_type),
         text,
-        contract_hooks.mode(case),
+        mode,
         str(rule),
     )
     if key in SENT:
-        contract_hooks.REPEATED[(case.operation.label, contract_hooks.mode(case))] += 1
+        contract_hooks.REPEATED[(case.operation.label, mode)] += 1
         return True
     SENT.add(key)
     return False

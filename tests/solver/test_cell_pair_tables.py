@@ -8,7 +8,6 @@ the tables is the map without them and the coal-only map, cell for cell.
 from __future__ import annotations
 
 import dataclasses
-from collections import OrderedDict
 
 import numpy as np
 import pinocchio as pin
@@ -21,6 +20,7 @@ from solver.path.capability_map import capability_map, grid_axis
 from solver.path.cell import kept_tables
 from solver.path.cell.checker import CellChecker
 from solver.path.cell.fast import MARGIN
+from solver.path.cell.kept import Kept
 from solver.path.cell.pair_tables import build_tables, empty_tables, table_bound
 from solver.path.cell.robot_geometry import robot_geometry
 from solver.path.cell.shapes import Halfspace, Tool
@@ -90,7 +90,7 @@ def test_map_with_tables_equals_without(name: str, monkeypatch: pytest.MonkeyPat
         "z": 0.1,
         "yaws": np.array([0.0, 0.6]),
     }
-    monkeypatch.setattr(cache_module, "_checkers", OrderedDict())
+    monkeypatch.setattr(cache_module, "_checkers", Kept(cache_module.MAX_CHECKERS))
     problem = PathProblem.of(_arm(name), load_path("curved_line"), PathOptions(cell=ON_TABLE))
     tabled = capability_map(problem, **axes)  # type: ignore[arg-type]
     assert (problem.path_checks[0].checker._fast.tables[0] >= 0).any() == (name == "ur5")
@@ -99,7 +99,7 @@ def test_map_with_tables_equals_without(name: str, monkeypatch: pytest.MonkeyPat
         return empty_tables(len(args[3]))  # type: ignore[arg-type]
 
     monkeypatch.setattr(fast_module, "build_tables", no_tables)
-    monkeypatch.setattr(cache_module, "_checkers", OrderedDict())
+    monkeypatch.setattr(cache_module, "_checkers", Kept(cache_module.MAX_CHECKERS))
     problem = PathProblem.of(_arm(name), load_path("curved_line"), PathOptions(cell=ON_TABLE))
     plain = capability_map(problem, **axes)  # type: ignore[arg-type]
     assert not (problem.path_checks[0].checker._fast.tables[0] >= 0).any()
@@ -108,7 +108,7 @@ def test_map_with_tables_equals_without(name: str, monkeypatch: pytest.MonkeyPat
         raise NotImplementedError
 
     monkeypatch.setattr(fast_module, "FastCell", coal_only)
-    monkeypatch.setattr(cache_module, "_checkers", OrderedDict())
+    monkeypatch.setattr(cache_module, "_checkers", Kept(cache_module.MAX_CHECKERS))
     problem = PathProblem.of(_arm(name), load_path("curved_line"), PathOptions(cell=ON_TABLE))
     reference = capability_map(problem, **axes)  # type: ignore[arg-type]
     assert problem.path_checks[0].checker._fast is None

@@ -20,12 +20,11 @@ takes it away gets a checker of coal alone, not a cached one).
 from __future__ import annotations
 
 import pickle
-import threading
-from collections import OrderedDict
 
 from solver.core.robots import Robot
 from solver.path.cell import fast
 from solver.path.cell.checker import CellChecker
+from solver.path.cell.kept import Kept
 from solver.path.cell.robot_geometry import content_digest
 from solver.path.cell.shapes import Cell
 
@@ -33,8 +32,7 @@ from solver.path.cell.shapes import Cell
 # its self pairs' tables, 0.65 MB).
 MAX_CHECKERS = 8
 
-_checkers: OrderedDict[tuple[object, str], CellChecker] = OrderedDict()
-_lock = threading.Lock()
+_checkers: Kept[tuple[object, str], CellChecker] = Kept(MAX_CHECKERS)
 
 
 def _content(robot: Robot, cell: Cell) -> str:
@@ -55,15 +53,8 @@ def checker_for(robot: Robot, cell: Cell) -> CellChecker:
         InvalidInputError: as :class:`CellChecker` (a bad cell field or link radii).
     """
     key = (fast.FastCell, _content(robot, cell))
-    with _lock:
-        checker = _checkers.get(key)
-        if checker is not None:
-            _checkers.move_to_end(key)
-            return checker
-    checker = CellChecker(robot, cell)  # outside the lock: another thread may build its own
-    with _lock:
-        _checkers[key] = checker
-        _checkers.move_to_end(key)
-        while len(_checkers) > MAX_CHECKERS:
-            _checkers.popitem(last=False)
+    checker = _checkers.get(key)
+    if checker is None:
+        checker = CellChecker(robot, cell)  # outside the lock: another thread may build its own
+        _checkers.keep(key, checker)
     return checker

@@ -9,10 +9,9 @@ recently used dropped first, read-only (threads share them).
 
 from __future__ import annotations
 
-import threading
-from collections import OrderedDict
-
 import numpy as np
+
+from solver.path.cell.kept import Kept
 
 Row = tuple[list[int], list[int], list[float], np.ndarray]
 """A pair's table: the q indices of its joints, the grid counts, the weights, coal's distances."""
@@ -20,19 +19,12 @@ Row = tuple[list[int], list[int], list[float], np.ndarray]
 MAX_KEPT = 64
 """Tables kept (a UR5's five are 0.65 MB)."""
 
-_kept: OrderedDict[tuple[str, str], Row] = OrderedDict()
-_lock = threading.Lock()
+_kept: Kept[tuple[str, str], Row] = Kept(MAX_KEPT)
 
 
 def kept_row(key: tuple[str, str] | None) -> Row | None:
     """The kept table of ``key``'s parts, if any (it becomes the most recently used)."""
-    if key is None:
-        return None
-    with _lock:
-        made = _kept.get(key)
-        if made is not None:
-            _kept.move_to_end(key)
-        return made
+    return None if key is None else _kept.get(key)
 
 
 def keep_row(key: tuple[str, str] | None, made: Row) -> None:
@@ -40,14 +32,9 @@ def keep_row(key: tuple[str, str] | None, made: Row) -> None:
     if key is None:
         return
     made[3].flags.writeable = False
-    with _lock:
-        _kept[key] = made
-        _kept.move_to_end(key)
-        while len(_kept) > MAX_KEPT:
-            _kept.popitem(last=False)
+    _kept.keep(key, made)
 
 
 def forget() -> None:
     """Drop every kept table (tests that count the tables made)."""
-    with _lock:
-        _kept.clear()
+    _kept.clear()

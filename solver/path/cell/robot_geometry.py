@@ -24,9 +24,7 @@ import hashlib
 import math
 import os
 import pickle
-import threading
 import xml.etree.ElementTree as ElementTree
-from collections import OrderedDict
 from dataclasses import dataclass
 
 import coal
@@ -36,6 +34,7 @@ import pinocchio as pin
 from solver.core.exceptions import InvalidInputError
 from solver.core.robots import Robot, example_robot_data_dir
 from solver.core.urdf_structure import parsed
+from solver.path.cell.kept import Kept
 from solver.path.cell.published_geometry import published_geometry
 from solver.path.cell.shapes import Tool, convex_hull
 
@@ -201,8 +200,7 @@ def content_digest(*parts: bytes) -> str:
 MAX_KEPT_URDF_GEOMETRIES = 8
 """URDF geometries kept (:func:`_urdf_geometry`), the least recently used dropped first (a UR5's
 hulls are about 1 MB)."""
-_kept_urdf_geometries: OrderedDict[str, pin.GeometryModel] = OrderedDict()
-_kept_lock = threading.Lock()
+_kept_urdf_geometries: Kept[str, pin.GeometryModel] = Kept(MAX_KEPT_URDF_GEOMETRIES)
 
 
 def _urdf_geometry(robot: Robot) -> pin.GeometryModel:
@@ -216,24 +214,16 @@ def _urdf_geometry(robot: Robot) -> pin.GeometryModel:
     hulls shared, never changed, as the checkers' copies share them).
     """
     key = _tree_digest(robot)
-    with _kept_lock:
-        kept = _kept_urdf_geometries.get(key)
-        if kept is not None:
-            _kept_urdf_geometries.move_to_end(key)
-            return kept.copy()
-    geometry = _read_urdf_geometry(robot)  # outside the lock: another thread may read its own
-    with _kept_lock:
-        _kept_urdf_geometries[key] = geometry
-        _kept_urdf_geometries.move_to_end(key)
-        while len(_kept_urdf_geometries) > MAX_KEPT_URDF_GEOMETRIES:
-            _kept_urdf_geometries.popitem(last=False)
+    geometry = _kept_urdf_geometries.get(key)
+    if geometry is None:
+        geometry = _read_urdf_geometry(robot)  # outside the lock: another thread may read its own
+        _kept_urdf_geometries.keep(key, geometry)
     return geometry.copy()
 
 
 def forget_urdf_geometries() -> None:
     """Drop every kept URDF geometry (a benchmark timing what an arm's first cell pays)."""
-    with _kept_lock:
-        _kept_urdf_geometries.clear()
+    _kept_urdf_geometries.clear()
 
 
 def _tree_digest(robot: Robot) -> str:
