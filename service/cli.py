@@ -25,7 +25,8 @@ command's work is bounded as a job's is (DTF_MAX_JOB_CELLS, DTF_MAX_JOB_POSES; a
 limit where larger), not as a synchronous request's (:func:`_settings`).
 Exit codes: :data:`OK` (0), :data:`USAGE` (2), :data:`INVALID` (3), :data:`INFEASIBLE` (4),
 :data:`NOT_WRITTEN` (5, the answer could not be written), :data:`SETTINGS` (6, a ``DTF_``
-variable of the environment refused), :data:`INTERRUPTED` (130, Ctrl-C),
+variable of the environment refused), :data:`CUT` (7, the answer is of a program that may be cut
+short), :data:`INTERRUPTED` (130, Ctrl-C),
 :data:`CLOSED_PIPE` (141, the output's reader closed it early), :data:`TERMINATED` (143,
 SIGTERM); 1 is Python's own, for a crash. Errors name the field (and waypoint, line) as the
 API does with the option that fills it, or the option alone (``--png``). ``--json`` is
@@ -56,7 +57,7 @@ from service.cli_text import ProgressBar, evaluation_text, import_text, map_text
 from service.config import MAX_PATH_WAYPOINTS, Settings, settings_or_exit
 from service.convert.errors import request_errors, solver_error_location, solver_error_type
 from service.operations import computed_map, evaluation_of, import_of, map_png
-from service.schemas import EvaluateRequest, MapRequest, OptimizeRequest, RobotRead
+from service.schemas import EvaluateRequest, MapRequest, OptimizeRequest, PathRead, RobotRead
 from service.schemas.path_cam import MAX_CAM_TEXT
 from service.schemas.paths_import import PathImportRequest
 from solver.cam.cam_path import METRES_PER_UNIT
@@ -82,6 +83,13 @@ SETTINGS = 6
 settings, not the program or the options given (it was 3, the status of an input refused, and a
 post-processor told the CAM programmer to fix a program that was fine; the CLI audit of stop
 61)."""
+CUT = 7
+"""The answer was printed, but of a CL program that may be cut short (``ended`` false: no FINI
+or END-OF-PATH after its last move, or an NX listing not as long as its last line states), and
+whatever it says (the path runs or not): the path is only what was read, and the answer's
+``end:`` line (``path_read.end_note``) says where it stops. It was 0 or 4, with the warning in
+the text alone, so a post-processor that started before CAM finished writing the file, or got
+one cut in a transfer, took the answer for the whole program's (the CLI audit of stop 61)."""
 INTERRUPTED = 130
 """Interrupted (Ctrl-C, SIGINT): the work stopped, ``interrupted`` on stderr (128 + SIGINT, as
 a shell reports it)."""
@@ -495,7 +503,12 @@ def _import(args: argparse.Namespace) -> int:
     answer = import_of(body, _settings())
     name = "standard input" if args.program == STDIN else args.program
     _print(answer, args, lambda: import_text(answer, name))
-    return OK
+    return CUT if answer.ended is False else OK
+
+
+def _status(code: int, read: PathRead | None) -> int:
+    """``code`` (OK or INFEASIBLE), or :data:`CUT` where the program read may be cut short."""
+    return CUT if read is not None and read.ended is False else code
 
 
 def _evaluate(args: argparse.Namespace) -> int:
@@ -515,7 +528,7 @@ def _evaluate(args: argparse.Namespace) -> int:
     robot, read = body["robot"], (answer.ik.recognised, answer.robot_read)
     _print(answer, args, lambda: _chained(args, robot, read, evaluation_text(answer, clearance)))
     runs = answer.feasible and (answer.feed_check is None or answer.feed_check.feasible)
-    return OK if runs else INFEASIBLE
+    return _status(OK if runs else INFEASIBLE, answer.path_read)
 
 
 def _map(args: argparse.Namespace) -> int:
@@ -532,7 +545,7 @@ def _map(args: argparse.Namespace) -> int:
         raise InvalidInputError("--png", f"cannot write {str(png)!r}: {error.strerror}") from error
     robot, read = body["robot"], (answer.recognised, answer.robot_read)
     _print(answer, args, lambda: _chained(args, robot, read, map_text(answer, args.png)))
-    return OK if answer.feasible_cells else INFEASIBLE
+    return _status(OK if answer.feasible_cells else INFEASIBLE, answer.path_read)
 
 
 def _png_file(args: argparse.Namespace) -> Path:
@@ -621,7 +634,8 @@ def _optimise(args: argparse.Namespace) -> int:
     robot, read = body["robot"], (recognised, answer.robot_read)
     _print(answer, args, lambda: _chained(args, robot, read, optimum_text(answer)))
     check = None if answer.evaluation is None else answer.evaluation.feed_check
-    return OK if answer.found and (check is None or check.feasible) else INFEASIBLE
+    runs = answer.found and (check is None or check.feasible)
+    return _status(OK if runs else INFEASIBLE, answer.path_read)
 
 
 def _numbers(count: int, separator: str) -> Callable[[str], list[float]]:
@@ -681,7 +695,8 @@ def _parser() -> argparse.ArgumentParser:
         "the import, mu_path at a placement, the capability map, the best placement. "
         f"Exit codes: {OK} ok, {INFEASIBLE} infeasible, {USAGE} usage, {INVALID} invalid input, "
         f"{NOT_WRITTEN} answer not written (output closed, disk full), {SETTINGS} a DTF_* "
-        f"variable refused, {INTERRUPTED} "
+        f"variable refused, {CUT} answered, but the program may be cut short (no FINI or "
+        f"END-OF-PATH after its last move), {INTERRUPTED} "
         f"interrupted (Ctrl-C), {CLOSED_PIPE} output closed early by its reader, {TERMINATED} "
         "terminated (SIGTERM). "
         "Settings come from DTF_* variables as for the service; the work of a command is "

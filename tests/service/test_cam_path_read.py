@@ -17,7 +17,7 @@ from typing import Any
 import pytest
 from fastapi.testclient import TestClient
 
-from service.cli import OK, main
+from service.cli import CUT, INFEASIBLE, OK, main
 from service.config import Settings
 from tests.cases import ROOT
 from tests.service.conftest import served_with
@@ -108,8 +108,42 @@ def test_a_program_cut_short_is_said_by_the_routes_and_the_command(
     assert {key: read[key] for key in READ_FIELDS} == imported(client, {"cl_data": cut})
     program = tmp_path / "cut.cls"
     program.write_text(cut)
-    assert main(["import", str(program)]) == OK
+    assert main(["import", str(program)]) == CUT
     assert f"\nend: WARNING: {said}" in capsys.readouterr().out
+
+
+COMMANDS = {
+    "import": [],
+    "evaluate": ["--robot", "ur5e", "--at=0,0.3,0,0"],
+    "map": ["--robot", "ur5e", "--x=-0.1:0.1:0.1", "--y=0.3:0.3:0.1", "--z", "0"],
+    "optimise": ["--robot", "ur5e", "--x=-0.05:0.05", "--y=0.25:0.35", "--yaw=-0.2:0.2", "--z=0"],
+}
+
+
+@pytest.mark.parametrize("command", COMMANDS)
+def test_the_command_exits_7_on_a_program_cut_short_whatever_its_answer(
+    command: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A post-processor that reads the exit code alone: the answer is of part of the program.
+
+    The same listing whole exits 0 (or 4), its cut exits 7, with the answer printed all the
+    same (the import's ``end:`` line, the others' JSON ``path_read.ended`` false). A picture
+    beside the program, for the map.
+    """
+    lines = TEXT.splitlines()
+    last = max(n for n, line in enumerate(lines, 1) if line.startswith("GOTO/"))
+    programs = {"whole": TEXT, "cut": "\n".join(lines[:last]) + "\n"}
+    for name, text in programs.items():
+        (tmp_path / f"{name}.cls").write_text(text)
+    extra = ["--png", str(tmp_path / "map.png")] if command == "map" else []
+    options = [*COMMANDS[command], *extra, *([] if command == "import" else ["--json"])]
+    codes = {}
+    for name in programs:
+        codes[name] = main([command, str(tmp_path / f"{name}.cls"), *options])
+        out = capsys.readouterr().out
+        if command != "import":
+            assert json.loads(out)["path_read"]["ended"] is (name == "whole")
+    assert codes["whole"] in (OK, INFEASIBLE) and codes["cut"] == CUT
 
 
 def test_waypoints_sent_as_json_have_no_end_record(client: TestClient) -> None:

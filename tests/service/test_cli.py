@@ -24,6 +24,7 @@ from fastapi.testclient import TestClient
 from service import cli
 from service.cli import (
     CLOSED_PIPE,
+    CUT,
     INFEASIBLE,
     INTERRUPTED,
     INVALID,
@@ -1073,7 +1074,7 @@ def test_an_operation_name_the_outputs_encoding_lacks_is_escaped_not_a_traceback
     UnicodeEncodeError (exit 1)."""
     program = tmp_path / "op.cl"
     program.write_text(
-        "UNITS/MM\nTOOL PATH/荒加工_ÉBAUCHE,TOOL,T1\nGOTO/0,0,0,0,0,1\nGOTO/10,0,0,0,0,1\n",
+        "UNITS/MM\nTOOL PATH/荒加工_ÉBAUCHE,TOOL,T1\nGOTO/0,0,0,0,0,1\nGOTO/10,0,0,0,0,1\nFINI\n",
         encoding="utf-8",
     )
     env = {**os.environ, "PYTHONIOENCODING": "cp1252"}
@@ -1255,6 +1256,6 @@ def test_the_help_lists_every_exit_code(capsys: pytest.CaptureFixture[str]) -> N
         main(["--help"])
     assert ended.value.code == 0
     text = " ".join(capsys.readouterr().out.split())
-    codes = (OK, INFEASIBLE, USAGE, INVALID, NOT_WRITTEN, SETTINGS, INTERRUPTED, CLOSED_PIPE)
+    codes = (OK, INFEASIBLE, USAGE, INVALID, NOT_WRITTEN, SETTINGS, CUT, INTERRUPTED, CLOSED_PIPE)
     for code in (*codes, TERMINATED):
         assert re.search(rf"\b{code} [a-z]", text), code
