@@ -27,15 +27,20 @@ BOM = "\ufeff"
 CL reader refused such a program ('line 1: not a record'), the CSV reader its header."""
 
 
-_LINE_BREAK = re.compile(r"\r\n|\r|\n")
+_LINE_BREAK = re.compile(r"\r*\n|\r")
 
 
 def text_lines(text: str) -> list[str]:
-    r"""The lines of a file as editors and ``grep -n`` count them: at CR LF, CR or LF only.
+    r"""The lines of a file as editors and ``grep -n`` count them: at LF, CR LF or CR only.
 
     ``str.splitlines`` also breaks at a form feed, a vertical tab, ``\x1c``-``\x1e``,
     ``\x85`` and U+2028: after one, every line number an answer named was one too many (the
-    CAM reader audit, stop 54). One break at the end makes no empty last line.
+    CAM reader audit, stop 54). CRs before a LF end one line with it, as ``grep -n`` counts
+    them: a CR LF file converted once more in a text-mode transfer ends its lines with CR CR
+    LF, and every line number was doubled (an NX listing then said to be twice its stated
+    length: cut short or lines added; the CLI audit of stop 61). A CR alone ends a line (an
+    old Mac file), so CR CR without a LF is an empty line. One break at the end makes no empty
+    last line.
     """
     lines = _LINE_BREAK.split(text)
     return lines[:-1] if lines and lines[-1] == "" else lines

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import re
 
+import numpy as np
 import pytest
 
 from solver.cam.cam_path import Units
@@ -98,3 +99,31 @@ def test_comments_after_fini_and_an_end_between_operations() -> None:
     assert not ended and note.startswith(
         "no FINI or END-OF-PATH after the last move (GOTO at line 6)"
     )
+
+
+@pytest.mark.parametrize("line_end", ["\r\n", "\r\r\n", "\r"], ids=["crlf", "crcrlf", "cr"])
+@pytest.mark.parametrize("program", [SOLIDWORKS, NX_LISTING], ids=["solidworks", "nx"])
+def test_line_ends_of_any_transfer_read_as_the_lines_of_the_text(
+    program: list[str], line_end: str
+) -> None:
+    """CR CR LF (a CR LF file converted again in a text-mode transfer) ends one line each, as
+    ``grep -n`` counts: the NX listing was said to be twice as long as it states (the CLI
+    audit of stop 61, on the published NX files converted once more), every line named
+    doubled. Each report, the waypoints and their lines as with LF, the lines counted here."""
+    plain = read_cl_data("\n".join(program) + "\n")
+    other = read_cl_data(line_end.join(program) + line_end)
+    assert other.report == plain.report and other.report is not None
+    assert other.report.ended
+    assert other.lines.tolist() == plain.lines.tolist()
+    moves = [n for n, text in enumerate(program, 1) if MOVE.match(text)]
+    assert set(other.lines.tolist()) <= set(moves)
+    np.testing.assert_array_equal(other.positions, plain.positions)
+    np.testing.assert_array_equal(other.axes, plain.axes)
+
+
+def test_cr_alone_ends_a_line_and_two_make_an_empty_one() -> None:
+    """An old Mac file: a CR alone is a line end, CR CR an empty line between (no LF follows)."""
+    text = "\r".join(["UNITS/MM", "GOTO/0,0,0", "", "GOTO/5,0,0", "FINI"]) + "\r"
+    path = read_cl_data(text)
+    assert path.lines.tolist() == [2, 4]
+    assert path.report is not None and path.report.end_note == "FINI at line 5"
