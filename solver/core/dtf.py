@@ -22,6 +22,11 @@ from solver.core.exceptions import InvalidInputError
 UNIT_TOLERANCE = 1e-3  # cam.md section 6: a direction within it is normalised, beyond refused
 # Below this reciprocal condition number a 6x6 Jacobian is treated as singular and the LP is used.
 SINGULAR_RCOND = 1e-12
+JACOBIAN_NOISE = 1e-12
+"""Relative to its largest, a coefficient of J diag(qdot_max) at most this is the LP's zero
+(:func:`lp_speed`): far above J's rounding (a few 1e-16 of its largest), far below any length
+or speed an arm has beside its largest (lengths within 100 m, speed limits within their
+bounds)."""
 
 Method = Literal["auto", "closed_form", "lp"]
 
@@ -169,7 +174,13 @@ def lp_speed(
     scale = float(np.max(np.abs(twist)))
     cost = np.zeros(n + 1)
     cost[-1] = -1.0
-    a_eq = np.hstack([jacobian * qdot_max, -twist[:, None] / scale])
+    weighted = jacobian * qdot_max
+    # The Jacobian's rounding is no constraint: at a singular configuration written with a turn
+    # (sin 2 pi is -2.4e-16) J holds ~1e-16 where it holds 0 at the same configuration without
+    # it, and the row scaling below made a row of such noise a constraint of unit size (the
+    # UR5e at q = 0 had V_max 0.391, the same pose with q2 = 2 pi 0.0; audit 23).
+    weighted[np.abs(weighted) <= JACOBIAN_NOISE * np.max(np.abs(weighted))] = 0.0
+    a_eq = np.hstack([weighted, -twist[:, None] / scale])
     # Each row to its largest coefficient (the same equalities): a robot of hundreds of metres
     # with speed limits of thousands of rad/s put coefficients of 1e6 beside ones of 1e-3, and
     # HiGHS stopped without proving its answer (a contract test's case: a 500).

@@ -200,3 +200,34 @@ def test_bad_task_input_names_the_field(kwargs: dict, field: str) -> None:
     with pytest.raises(InvalidInputError) as info:
         dtf(jacobian, qdot_max=[math.pi] * 6, **kwargs)
     assert info.value.field == field
+
+
+@pytest.mark.parametrize("turned", [None, 1, 2, 3, 4, "1e-15"])
+def test_a_singular_configuration_gives_one_answer_however_written(turned: object) -> None:
+    """The UR5e at q = 0 (elbow stretched, wrist singular) and the same pose with a joint turned
+    by 2 pi, or off by rounding: the LP answered 0.391 at q = 0 and 0.0 with q2 = 2 pi, its row
+    scaling making a row of J's rounding a constraint (audit 23). Against HiGHS on J with the
+    rounding of sin(2 pi) left out, written here (no scaling): J at q = 0 exactly."""
+    robot = get_robot("ur5e")
+    q = np.zeros(6)
+    if isinstance(turned, int):
+        q[turned] = 2 * math.pi
+    elif isinstance(turned, str):
+        q[1] = float(turned)
+    u_t, u_r, h = np.array([1.0, 0.0, 0.0]), np.array([0.0, 0.0, 1.0]), 0.5
+    answer = dtf(jacobian_in_base(robot, q), u_T=u_t, u_R=u_r, h=h, qdot_max=robot.qdot_max)
+    import scipy.optimize
+
+    exact = jacobian_in_base(robot, np.zeros(6))
+    twist = np.concatenate([u_t, u_r / h])
+    n = exact.shape[1]
+    reference = scipy.optimize.linprog(
+        np.r_[np.zeros(n), -1.0],
+        A_eq=np.hstack([exact, -twist[:, None]]),
+        b_eq=np.zeros(6),
+        bounds=[(-v, v) for v in robot.qdot_max] + [(0.0, None)],
+        method="highs",
+    )
+    assert reference.status == 0 and -reference.fun > 0.3  # the tool can move along t_hat
+    assert answer.method == "lp"
+    assert answer.v_max == pytest.approx(-reference.fun, rel=1e-9)
