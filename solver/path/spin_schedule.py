@@ -53,8 +53,14 @@ def spin_schedule(
     spins, step = schedule(problem, motion, qd_spin, mu_path, span(progress, 0.0, 0.5))
 
     def spun_joints(rows: slice) -> np.ndarray:
-        """The joint paths of some branches moved by the spins, (n, b, C, W)."""
-        moved = cumsum_within_passes(step[rows] * qd_spin[:, rows, ..., :-1], path.segment_in_pass)
+        """The joint paths of some branches moved by the spins, (n, b, C, W).
+
+        A singular branch's J^-1 [0; z_tool] is inf where its spin step is 0 (it has no
+        spins): the NaN of 0 inf is its move, 0, without a numpy warning (audit 23).
+        """
+        with np.errstate(invalid="ignore"):
+            moves = step[rows] * qd_spin[:, rows, ..., :-1]
+        moved = cumsum_within_passes(moves, path.segment_in_pass)
         joints: np.ndarray = tracked.q[:, rows] + np.nan_to_num(moved)
         return joints
 

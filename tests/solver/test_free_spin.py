@@ -210,3 +210,24 @@ def test_free_spin_needs_a_revolute_last_joint() -> None:
     with pytest.raises(InvalidInputError) as error:
         evaluate_path(get_robot("ur5"), load_path("curved_line"), README_PLACEMENT, spin_mode="x")
     assert error.value.field == "spin_mode"
+
+
+@pytest.mark.filterwarnings("error")
+@pytest.mark.parametrize("compiled", [True, False])
+def test_a_path_singular_on_every_pose_is_singular_without_a_warning(compiled: bool) -> None:
+    """The UR5e's elbow stretched (q3 = 0) along a turn of its base, in free spin: the answer
+    was right (singular at the first waypoint), with a numpy RuntimeWarning in the service's log
+    from the spun joint paths (0 times inf; audit 23). The path from forward kinematics."""
+    robot = get_robot("ur5e")
+    base = np.array([0.3, -1.0, 0.0, -1.0, 1.0, 0.5])
+    poses = np.array(
+        [tool_pose_in_base(robot, base + [t, 0, 0, 0, 0, 0]) for t in np.linspace(0, 0.3, 11)]
+    )
+    origin = Placement(0.0, 0.0, 0.0, 0.0)
+    answer = evaluate_path(robot, poses, origin, spin_mode="free")
+    assert (answer.reason, answer.failed_waypoint) == ("singular", 0)
+    cells = capability_map(
+        robot, poses, xs=np.zeros(1), ys=np.zeros(1), z=0.0, yaws=np.zeros(1), spin_mode="free",
+        compiled=compiled,
+    )  # fmt: skip
+    assert np.isnan(cells.mu_path).all()
