@@ -259,6 +259,8 @@ _OPTIONS = (
     ("placement", "--at"),
     ("start", "--start"),
     ("spin_mode", "--spin-mode"),
+    ("ik.max_joint_step", "--max-joint-step"),
+    ("ik.blend_length", "--blend-length"),
     ("ik", "--branch"),
 )
 """The request's fields and the options that fill them: an error names both (``path.units

@@ -1259,3 +1259,16 @@ def test_the_help_lists_every_exit_code(capsys: pytest.CaptureFixture[str]) -> N
     codes = (OK, INFEASIBLE, USAGE, INVALID, NOT_WRITTEN, SETTINGS, CUT, INTERRUPTED, CLOSED_PIPE)
     for code in (*codes, TERMINATED):
         assert re.search(rf"\b{code} [a-z]", text), code
+
+
+@pytest.mark.parametrize(
+    ("option", "field"),
+    [("--max-joint-step", "ik.max_joint_step"), ("--blend-length", "ik.blend_length")],
+)
+def test_an_ik_option_refused_is_named_as_itself(
+    capsys: pytest.CaptureFixture[str], option: str, field: str
+) -> None:
+    """Both were named --branch, the first option of the request's ``ik`` (audit 23)."""
+    at = ["evaluate", str(PROGRAM), "--robot", "ur5e", "--at=0,0.3,0,0"]
+    code, _, err = run(capsys, *at, option, "0")
+    assert code == INVALID and err.startswith(f"error: {field} ({option}): "), err
