@@ -380,3 +380,18 @@ def test_a_yaw_range_of_many_turns_searches_one() -> None:
     one, wide = (optimise_problem(problem, bounds=b) for b in (turn, many))
     assert wide.mu_path == pytest.approx(one.mu_path, rel=1e-9)
     assert -math.pi <= wide.placement.yaw <= math.pi
+
+
+@pytest.mark.parametrize("method", ["casadi", "scipy"])
+def test_a_box_narrower_than_the_snap_answers_no_less_than_its_start(method: str) -> None:
+    """Every candidate of a box 1e-12 wide, its start's too, was judged on the box's corner
+    (ON_A_BOUND): the answer was 1.86e-10 % below the start (audit 23). The start is judged
+    here on its own."""
+    robot = get_robot("ur5")
+    path = load_path("curved_line")
+    bounds = PlacementBounds(x=(0.0, 1e-12), y=(0.45, 0.45 + 1e-12), yaw=(0.0, 1e-12), z=0.1)
+    optimum = optimize_placement(robot, path, bounds=bounds, method=method)
+    start = evaluate_path(robot, path, Placement(5e-13, 0.45 + 5e-13, 0.1, 5e-13))
+    assert optimum.mu_path is not None and start.mu_path is not None
+    assert optimum.mu_path >= start.mu_path
+    assert optimum.improvement_percent is not None and optimum.improvement_percent >= 0.0
