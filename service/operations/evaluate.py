@@ -5,9 +5,10 @@ from __future__ import annotations
 from service import convert
 from service.config import Settings
 from service.schemas import EvaluateRequest, EvaluateResponse, PathInput
-from solver.core.exceptions import InvalidInputError
+from solver.core.exceptions import InvalidInputError, SolverError
 from solver.core.progress import Progress
 from solver.core.robots import Robot as SolverRobot
+from solver.core.task import task_requirements
 from solver.path.cycle_time import cycle_time
 from solver.path.evaluate import PathEvaluation, evaluate_path
 from solver.path.feed import check_feed
@@ -33,6 +34,8 @@ def _evaluated(
     cell = convert.cell_of(body.cell, settings, robot)
     problem = convert.problem_of(robot, poses, path, ik=body.ik, spin_mode=spin_mode, cell=cell)
     _check_work(problem, settings)
+    if body.spins is not None:
+        _prepared_with_spins(problem, path)
     if body.joint_path is not None:
         if spin_mode != "fixed":
             raise InvalidInputError("joint_path", "a joint path is evaluated in spin_mode fixed")
@@ -42,6 +45,35 @@ def _evaluated(
         evaluation = evaluate_path(problem, placement, progress=progress)
     feed = body.feed if body.feed is not None else path.feed
     return robot, path, evaluation, feed, problem
+
+
+def _prepared_with_spins(problem: PathProblem, path: PathInput) -> None:
+    """The spun path prepared; an error of its waypoints the path sent has not is the spins'.
+
+    Spins can turn a waypoint onto the pose before it (a pure spin turned back), or make a
+    segment a half turn: the refusal named ``path.waypoints[i]`` of a path that is valid as
+    sent (audit 23). It names ``spins[i]`` there, saying so.
+
+    Raises:
+        SolverError: the path's own, as preparing it raises them; InvalidInputError on
+            ``spins`` where the waypoints i - 1 and i are a valid segment without them.
+    """
+    try:
+        problem.prepared  # noqa: B018 - prepared here to tell whose error it is
+    except SolverError as error:
+        index = error.waypoint
+        if not error.field.startswith("path") or index is None or index < 1:
+            raise
+        try:
+            task_requirements(path.poses[index - 1 : index + 1], field=error.field)
+        except SolverError:
+            raise error from None
+        raise InvalidInputError(
+            "spins",
+            f"with spins {index - 1} and {index} the segment from waypoint {index - 1} is "
+            f"refused, not without them: {error.message}",
+            waypoint=index,
+        ) from error
 
 
 def _check_work(problem: PathProblem, settings: Settings) -> None:

@@ -1,6 +1,7 @@
 from __future__ import annotations
 
 import json
+import math
 from typing import Any
 
 import pytest
@@ -67,3 +68,34 @@ def test_pure_translation_has_null_h(client: TestClient, evaluate_body: dict[str
     assert result["feasible"] is True
     assert all(w["h"] is None and w["omega_max"] == 0 for w in result["waypoints"])
     assert all(w["u_R"] == [0.0, 0.0, 0.0] for w in result["waypoints"])
+
+
+def _turned_about_z(quaternion: list[float], angle: float) -> list[float]:
+    """``quaternion`` (x, y, z, w) turned by ``angle`` about its own z axis (q * (0, 0, s, c))."""
+    x, y, z, w = quaternion
+    s, c = math.sin(angle / 2), math.cos(angle / 2)
+    return [x * c + y * s, y * c - x * s, z * c + w * s, w * c - z * s]
+
+
+def test_spins_that_undo_a_segment_are_named_not_the_path(
+    client: TestClient, evaluate_body: dict[str, Any]
+) -> None:
+    """A segment that only spins the tool by 0.1 rad, given spins 0 and -0.1: the spun poses
+    repeat, and the 422 named path.waypoints[1] of a path valid as sent (audit 23). A path that
+    repeats itself is still named."""
+    first = evaluate_body["path"]["waypoints"][0]
+    turned = {
+        "position": first["position"],
+        "orientation": _turned_about_z(first["orientation"], 0.1),
+    }
+    body = {**evaluate_body, "path": {"waypoints": [first, turned]}}
+    assert client.post("/v1/evaluate", json=body).status_code == 200
+    refused = client.post("/v1/evaluate", json={**body, "spins": [0.0, -0.1]})
+    assert refused.status_code == 422
+    (detail,) = refused.json()["detail"]
+    assert (
+        detail["loc"] == ["body", "spins", 1] and "waypoint 1 repeats waypoint 0" in detail["msg"]
+    )
+    repeated = {**evaluate_body, "path": {"waypoints": [first, first]}, "spins": [0.0, 0.0]}
+    (detail,) = client.post("/v1/evaluate", json=repeated).json()["detail"]
+    assert detail["loc"] == ["body", "path", "waypoints", 1]
