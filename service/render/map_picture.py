@@ -26,6 +26,7 @@ from matplotlib.colors import BoundaryNorm, ListedColormap
 from matplotlib.image import AxesImage
 from matplotlib.lines import Line2D
 from matplotlib.patches import Patch
+from matplotlib.ticker import AutoLocator, FixedLocator
 
 from service.render.kept import DPI, KeptFigures, new_figure, png_of
 from solver.core.codes import REASONS
@@ -38,6 +39,11 @@ TITLE_INCHES = 0.3  # the figure's title, above the panels
 LEGEND_INCHES = 0.5  # the legend, below them: two rows
 PANEL_MARGINS_INCHES = (0.75, 0.2, 0.5, 0.3)  # left, right, bottom, top of each panel's axes
 _COLOURS = matplotlib.colormaps["viridis"].with_extremes(bad="white")
+EVEN_RANGE = 0.05
+EVEN_SPAN = 0.01
+"""A map of one speed everywhere has a colour bar from it up by EVEN_RANGE of it, EVEN_SPAN
+(m/s) at least: its range was 1e-9, labelled ``1e-9`` (a map of mu_path 0 everywhere, a path
+that only turns the tool)."""
 _MARKERS = (("*", "red"), ("X", "black"))  # the best, the worst
 REASON_COLOURS = {  # the page's (service/web/static/app.js, REASON_COLOURS), in REASONS' order
     "unreachable": "#e0e0e0",
@@ -161,9 +167,10 @@ class MapFigure:
         feasible = ~np.isnan(colour_of)
         low = float(np.nanmin(colour_of)) if feasible.any() else 0.0
         high = float(np.nanmax(colour_of)) if feasible.any() else 1.0
+        if high <= low:  # one speed everywhere: a bar of EVEN_RANGE from it, not of 1e-9
+            high = low + max(EVEN_RANGE * abs(low), EVEN_SPAN)
         best, worst = cmap.extreme(best=True), cmap.extreme(best=False)
-        half_x = (cmap.xs[1] - cmap.xs[0]) / 2 if len(cmap.xs) > 1 else 0.005
-        half_y = (cmap.ys[1] - cmap.ys[0]) / 2 if len(cmap.ys) > 1 else 0.005
+        half_x, half_y = _half_steps(cmap.xs, cmap.ys)
         extent = (
             cmap.xs[0] - half_x,
             cmap.xs[-1] + half_x,
@@ -173,8 +180,14 @@ class MapFigure:
         for panel, (s, k) in enumerate(np.ndindex(len(cmap.spins), len(cmap.yaws))):
             axes, image = self.panels[panel], self.images[panel]
             image.set_data(np.ma.masked_invalid(colour_of[s, k]))
-            image.set_clim(low, high if high > low else low + 1e-9)
+            image.set_clim(low, high)
             image.set_extent(extent)  # and the axes' limits to it, a kept figure's too
+            for axis, values in ((axes.xaxis, cmap.xs), (axes.yaxis, cmap.ys)):
+                # an axis of one value is ticked at it (a row 2 cm high had three labels on
+                # one another); the others as matplotlib ticks them, a kept figure's too
+                axis.set_major_locator(
+                    FixedLocator([float(values[0])]) if len(values) == 1 else AutoLocator()
+                )
             reason = cmap.reason[s, k]
             self.reasons[panel].set_data(np.ma.masked_array(reason, reason < 0))
             self.reasons[panel].set_extent(extent)
@@ -192,6 +205,18 @@ class MapFigure:
         self.colour_bar.set_label(label)
         self.figure.suptitle(title, fontsize=10, y=1.0 - 0.08 / self.height_in, va="top")
         return png_of(self.figure)
+
+
+def _half_steps(xs: np.ndarray, ys: np.ndarray) -> tuple[float, float]:
+    """Half a cell's width and height (m), from the grid's steps.
+
+    Along an axis of one value the cells are square (the other's step), 5 mm where both have
+    one: a row was 1 cm high whatever its cells' width.
+    """
+    half_x = (xs[1] - xs[0]) / 2 if len(xs) > 1 else None
+    half_y = (ys[1] - ys[0]) / 2 if len(ys) > 1 else None
+    half_x = half_x if half_x is not None else half_y if half_y is not None else 0.005
+    return float(half_x), float(half_y if half_y is not None else half_x)
 
 
 KEPT: KeptFigures[MapFigure] = KeptFigures(4, 16 * 2**20)

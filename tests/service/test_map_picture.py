@@ -228,3 +228,32 @@ def test_a_urdf_robots_picture_is_titled_by_the_urdfs_own_name(monkeypatch) -> N
     nameless = robot_from_urdf(re.sub(r'name="cell_7_arm"', 'name=""', renamed, count=1),
                                base_frame="base", tool_frame="tool0")  # fmt: skip
     assert nameless.shown_name == "URDF"
+
+
+@pytest.mark.parametrize("speed", [0.0, 0.3])
+def test_a_row_of_one_speed_is_ticked_at_its_row_and_barred_over_a_readable_range(
+    monkeypatch, speed: float
+) -> None:
+    """A grid of one row (y ticks 0.445, 0.450 and 0.455 on a strip 1 cm high) of one speed (a
+    colour bar of 1e-9 for a path that only turns the tool, mu_path 0; audit 23), drawn between
+    two maps on the same kept figure: those keep their ticks and range."""
+    monkeypatch.setattr(map_picture, "KEPT", KeptFigures(4, 2**30))
+    figure = MapFigure(1)
+    row = _map(8, 1, seed=10)
+    row.mu_path[:] = speed
+    row.reason[:] = -1
+    axes = figure.panels[0]
+    for cmap in (_map(26, 9, seed=1), row, _map(26, 9, seed=3)):
+        figure.png(cmap, title="t")
+        ticks = axes.yaxis.get_majorticklocs()
+        if cmap is row:
+            assert ticks.tolist() == [row.ys[0]]
+            assert axes.get_ylim() == pytest.approx((row.ys[0] - 0.01, row.ys[0] + 0.01))
+            assert figure.images[0].get_clim() == pytest.approx(
+                (speed, speed + max(0.05 * speed, 0.01))
+            )
+        else:
+            assert len(ticks) > 2
+            assert figure.images[0].get_clim() == pytest.approx(
+                (np.nanmin(cmap.mu_path), np.nanmax(cmap.mu_path))
+            )
