@@ -58,12 +58,24 @@ class InvalidInputError(SolverError):
 class RepeatedWaypointError(SolverError):
     """Two consecutive waypoints are the same pose: the segment between them has no direction."""
 
-    def __init__(self, index: int, *, field: str = "path.waypoints") -> None:
-        """Name the second waypoint of the repeated pair."""
+    def __init__(
+        self, index: int, *, field: str = "path.waypoints", free_spin: bool = False
+    ) -> None:
+        """Name the second waypoint of the repeated pair.
+
+        ``free_spin``: the pair differs by a turn about the tool axis alone, which free spin
+        leaves to the spin (the same position and tool axis).
+        """
+        same = (
+            "same position and tool axis: in free spin a turn about the tool axis alone is the "
+            "spin's, no motion"
+            if free_spin
+            else "same position and orientation"
+        )
         super().__init__(
             field,
-            f"waypoint {index} repeats waypoint {index - 1} (same position and orientation): "
-            "a segment needs a displacement or a rotation",
+            f"waypoint {index} repeats waypoint {index - 1} ({same}): a segment needs a "
+            "displacement or a rotation",
             waypoint=index,
         )
 

@@ -11,9 +11,15 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from solver.core.exceptions import InvalidInputError
+from solver.core.exceptions import InvalidInputError, RepeatedWaypointError
 from solver.core.robots import Robot
-from solver.core.task import TaskRequirements, task_requirements
+from solver.core.spatial import rotation_vectors
+from solver.core.task import (
+    ANGULAR_TOLERANCE,
+    LINEAR_TOLERANCE,
+    TaskRequirements,
+    task_requirements,
+)
 
 
 @dataclass(frozen=True)
@@ -142,3 +148,31 @@ def prepare_path(
         pure_rotation=requirements.h == 0.0,
         segment_in_pass=segment_in_pass,
     )
+
+
+def check_free_spin_segments(
+    waypoints: np.ndarray, passes: Sequence[tuple[int, int]] | None, *, field: str
+) -> None:
+    """Refuse a segment that is a turn about the tool axis alone, where free spin is asked for.
+
+    Free spin leaves the turn about the tool axis to the spin, so such a segment moves
+    nothing: a repeated waypoint, as the fixed-spin rule has it (dtf.md section 2). Its
+    free-spin LP has no bound (the spin takes the whole turn, the joints none), and its
+    omega_max came out a number of rounding, 6.6e15 rad/s (audit 24).
+
+    Raises:
+        RepeatedWaypointError: the segment's second waypoint (``free_spin``).
+    """
+    path = np.asarray(waypoints, dtype=float)
+    for start, stop in check_passes(passes, len(path)):
+        part = path[start:stop]
+        moved = np.linalg.norm(np.diff(part[:, :3, 3], axis=0), axis=1)
+        turn = rotation_vectors(np.einsum("nij,nkj->nik", part[1:, :3, :3], part[:-1, :3, :3]))
+        axis = part[:-1, :3, 2]  # the tool axis at each segment's start, in {O}
+        about = np.einsum("ni,ni->n", turn, axis)
+        tilted = np.linalg.norm(turn - about[:, None] * axis, axis=1)
+        still = (moved < LINEAR_TOLERANCE) & (tilted < ANGULAR_TOLERANCE)
+        if np.any(still):
+            raise RepeatedWaypointError(
+                start + int(np.argmax(still)) + 1, field=field, free_spin=True
+            )

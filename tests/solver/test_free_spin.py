@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 import scipy.optimize
 
-from solver.core.exceptions import InvalidInputError
+from solver.core.exceptions import InvalidInputError, RepeatedWaypointError
 from solver.core.kinematics import jacobian_in_base, tool_pose_in_base
 from solver.core.spatial import Placement
 from solver.core.two_variable_lp import spin_rate_nearest_zero, two_variable_speed
@@ -231,3 +231,32 @@ def test_a_path_singular_on_every_pose_is_singular_without_a_warning(compiled: b
         compiled=compiled,
     )  # fmt: skip
     assert np.isnan(cells.mu_path).all()
+
+
+def _spun_about_tool_z(pose: np.ndarray, angle: float, tilt: float = 0.0) -> np.ndarray:
+    """``pose`` turned in place by ``angle`` about its own z axis (then ``tilt`` about its x)."""
+    c, s = math.cos(angle), math.sin(angle)
+    turn = np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
+    c, s = math.cos(tilt), math.sin(tilt)
+    turn = turn @ np.array([[1.0, 0.0, 0.0], [0.0, c, -s], [0.0, s, c]])
+    turned = pose.copy()
+    turned[:3, :3] = pose[:3, :3] @ turn
+    return turned
+
+
+def test_a_turn_about_the_tool_axis_alone_repeats_its_waypoint_in_free_spin() -> None:
+    """The spin takes the whole turn and the joints none: the free-spin LP had no bound and
+    omega_max came out 6.6e15 rad/s (audit 24). Refused as a repeated waypoint, naming it; in
+    fixed spin the same path is answered, pure reorientation there (V_max 0); a turn that also
+    tilts the tool axis by 1e-6 rad is a segment in free spin too."""
+    robot = get_robot("ur5")
+    path = load_path("curved_line")[:6].copy()
+    path[3] = _spun_about_tool_z(path[2], 0.2)
+    with pytest.raises(RepeatedWaypointError) as refused:
+        evaluate_path(robot, path, README_PLACEMENT, spin_mode="free")
+    assert refused.value.waypoint == 3 and "free spin" in refused.value.message
+    fixed = evaluate_path(robot, path, README_PLACEMENT, spin_mode="fixed")
+    assert fixed.mu_path == 0.0 and fixed.omega_max is not None and fixed.omega_max[2] < 100.0
+    path[3] = _spun_about_tool_z(path[2], 0.2, tilt=1e-6)
+    tilted = evaluate_path(robot, path, README_PLACEMENT, spin_mode="free")
+    assert tilted.mu_path == 0.0  # pure reorientation: V_max 0 (dtf.md section 2)
