@@ -714,7 +714,7 @@ def _parser() -> argparse.ArgumentParser:
     )
     common.add_argument(
         "--units",
-        choices=["mm", "inch", "m"],
+        choices=["mm", "inch", "inches", "m"],
         help="the program's length unit, where it states none",
     )
     common.add_argument("--arc-tolerance", type=float, help="m, chordal (default 1e-5)")

@@ -21,8 +21,11 @@ from solver.cam.csv_path import csv_waypoints, read_csv_path
 ProgramUnits = TypeAliasType(
     "ProgramUnits",
     Annotated[
-        Literal["mm", "inch"],
-        Field(description="The length unit of a CL program that states none: mm or inch."),
+        Literal["mm", "inch", "inches"],
+        Field(
+            description="The length unit of a CL program that states none: mm or inch "
+            "(inches, as answers name it, too)."
+        ),
     ],
 )
 """The units a request gives a CL program (a named component for generated clients)."""
@@ -32,7 +35,9 @@ MAX_CAM_TEXT = 2_000_000
 """Characters of CL data or CSV at most (a request body is at most 2 MB anyway)."""
 
 
-CL_UNITS: dict[str, Units] = {"mm": "mm", "inch": "inches"}
+CL_UNITS: dict[str, Units] = {"mm": "mm", "inch": "inches", "inches": "inches"}
+"""A request's units of a CL program; ``inches`` is how answers name the unit, so an answer's
+``units`` can be sent back (it was refused: audit 24)."""
 
 
 class ClDataPath(RequestModel):
@@ -128,7 +133,9 @@ class CsvPath(RequestModel):
         "x,y,z,qx,qy,qz,qw (a pose); an optional header line naming those columns. Vectors "
         "within 1e-3 of unit length are normalised and the correction reported.",
     )
-    units: Literal["mm", "inch", "m"] = Field(description="The unit of x, y, z: mm, inch or m.")
+    units: Literal["mm", "inch", "inches", "m"] = Field(
+        description="The unit of x, y, z: mm, inch (inches, as answers name it, too) or m."
+    )
 
     def n_waypoints(self) -> int:
         """The number of waypoints as read: the non-blank lines after any header (cam.md 9)."""

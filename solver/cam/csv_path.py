@@ -25,7 +25,7 @@ from solver.cam.reading import (
 from solver.core.exceptions import InvalidInputError, InvalidLineError
 from solver.core.spatial import rotation_from_quaternion
 
-_UNITS: dict[str, Units] = {"mm": "mm", "inch": "inches", "m": "m"}
+_UNITS: dict[str, Units] = {"mm": "mm", "inch": "inches", "inches": "inches", "m": "m"}
 HEADERS = {
     6: ("x", "y", "z", "i", "j", "k"),
     7: ("x", "y", "z", "qx", "qy", "qz", "qw"),

@@ -252,3 +252,18 @@ def test_the_import_refuses_a_path_every_route_refuses(client: TestClient) -> No
     assert imported.status_code == evaluated.status_code == 422
     assert imported.json()["detail"] == evaluated.json()["detail"]
     assert imported.json()["detail"][0]["loc"] == ["body", "path", "waypoints", 5]
+
+
+def test_the_units_an_import_answers_can_be_sent_back(client: TestClient) -> None:
+    """A CSV or a CL program without units given ``inch`` was answered ``inches``, which the
+    request refused (audit 24): sent back, it reads the same waypoints."""
+    csv = "x,y,z,i,j,k\n0,0,0,0,0,1\n10,0,0,0,0,1\n20,0,1,0,0,1\n"
+    cl = "GOTO/0,0,0,0,0,1\nGOTO/10,0,0,0,0,1\nGOTO/20,0,1,0,0,1\nFINI\n"
+    for path in ({"csv": csv, "units": "inch"}, {"cl_data": cl, "units": "inch"}):
+        first = client.post("/v1/paths/import", json={"path": path})
+        assert first.status_code == 200, first.text
+        assert first.json()["units"] == "inches"
+        again = client.post("/v1/paths/import", json={"path": {**path, "units": "inches"}})
+        assert again.status_code == 200, again.text
+        assert again.json()["waypoints"] == first.json()["waypoints"]
+        assert first.json()["waypoints"][1]["position"][0] == pytest.approx(0.254)

@@ -108,9 +108,11 @@ def test_no_waypoint(text: str) -> None:
         read_csv_path(text, units="m")
 
 
-def test_units_other_than_mm_or_m() -> None:
+@pytest.mark.parametrize("units", ["cm", "feet", "MM"])
+def test_units_other_than_mm_inch_or_m(units: str) -> None:
+    """(``inches``, as answers name the unit, is read as ``inch``: the service's audit 24.)"""
     with pytest.raises(InvalidInputError, match="mm or m") as caught:
-        read_csv_path("0,0,0,0,0,1\n1,0,0,0,0,1\n", units="inches")
+        read_csv_path("0,0,0,0,0,1\n1,0,0,0,0,1\n", units=units)
     assert caught.value.field == "units"
 
 
