@@ -459,3 +459,23 @@ def test_a_meshs_errors_have_one_loc_whoever_finds_them(client: TestClient) -> N
         (detail,) = client.post("/v1/evaluate", json=body).json()["detail"]
         locs.append(detail["loc"])
     assert locs == [["body", "cell", "fixed", 0, "mesh", "stl"]] * 2
+
+
+def test_a_halfspace_normal_of_any_length_is_the_same_halfspace(
+    client: TestClient, body: dict
+) -> None:
+    """n . p <= d with n not of unit length (the schema takes components within 1.001): the
+    offset scales with the normal. Dropping that scaling passed every cell test (audit 24). A
+    floor 2 cm above the base's foot, the example's closest obstacle (9.3 mm from the upper
+    arm; the wrist's own links are 13.6 mm apart), written three ways (one plane), gives one
+    clearance, to the floor."""
+    answers = []
+    for k in (1.0, 0.5, 0.25):
+        floor = {"shape": "halfspace", "name": "floor", "normal": [0, 0, k], "offset": 0.02 * k}
+        answer = client.post("/v1/evaluate", json={**body, "cell": {"fixed": [floor]}}).json()
+        assert answer["feasible"], answer
+        assert answer["min_clearance"]["obstacle_name"] == "floor"
+        answers.append(answer["min_clearance"]["distance"])
+    assert answers[0] < 0.0136  # nearer than the wrist's own links: the floor is measured
+    assert answers[1] == pytest.approx(answers[0], abs=1e-12)
+    assert answers[2] == pytest.approx(answers[0], abs=1e-12)

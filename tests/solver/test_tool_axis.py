@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
@@ -97,3 +99,16 @@ def test_right_angle_turn_between_neighbours_is_refused() -> None:
     with pytest.raises(InvalidInputError) as error:
         poses_from_tool_axes(positions, axes)
     assert error.value.waypoint == 1
+
+
+@pytest.mark.parametrize("along_x", [0.6, 0.985, 0.995])
+def test_the_first_frame_leaves_the_workpiece_x_axis_beyond_0_99(along_x: float) -> None:
+    """cam.md section 1: x_0 is the workpiece x axis projected onto the plane normal to z_0, the
+    workpiece y axis where |x . z_0| > 0.99 (only 0 and 1 were tested: 0.999 passed them all;
+    audit 24). The projection written here."""
+    axis = np.array([along_x, 0.0, math.sqrt(1.0 - along_x**2)])
+    poses, _ = poses_from_tool_axes(np.array([[0.0, 0, 0], [0.0, 0, 0.01]]), np.array([axis, axis]))
+    z0 = -axis
+    start = np.array([1.0, 0, 0]) if along_x <= 0.99 else np.array([0.0, 1, 0])
+    projected = start - (start @ z0) * z0
+    np.testing.assert_allclose(poses[0, :3, 0], projected / np.linalg.norm(projected), atol=1e-12)
