@@ -39,6 +39,8 @@ TITLE_INCHES = 0.3  # the figure's title, above the panels
 LEGEND_INCHES = 0.5  # the legend, below them: two rows
 PANEL_MARGINS_INCHES = (0.75, 0.2, 0.5, 0.3)  # left, right, bottom, top of each panel's axes
 _COLOURS = matplotlib.colormaps["viridis"].with_extremes(bad="white")
+TICK_DECIMALS = 9
+"""An axis of one value is ticked at it to this many decimals of a metre."""
 EVEN_RANGE = 0.05
 EVEN_SPAN = 0.01
 """A map of one speed everywhere has a colour bar from it up by EVEN_RANGE of it, EVEN_SPAN
@@ -183,10 +185,14 @@ class MapFigure:
             image.set_clim(low, high)
             image.set_extent(extent)  # and the axes' limits to it, a kept figure's too
             for axis, values in ((axes.xaxis, cmap.xs), (axes.yaxis, cmap.ys)):
-                # an axis of one value is ticked at it (a row 2 cm high had three labels on
-                # one another); the others as matplotlib ticks them, a kept figure's too
+                # an axis of one value is ticked at it, to the nanometre (a row 2 cm high had
+                # three labels on one another; matplotlib's formatter fails on a subnormal
+                # tick, -2.2e-311: a 500); the others as matplotlib ticks them, a kept
+                # figure's too
                 axis.set_major_locator(
-                    FixedLocator([float(values[0])]) if len(values) == 1 else AutoLocator()
+                    FixedLocator([round(float(values[0]), TICK_DECIMALS) + 0.0])
+                    if len(values) == 1
+                    else AutoLocator()
                 )
             reason = cmap.reason[s, k]
             self.reasons[panel].set_data(np.ma.masked_array(reason, reason < 0))

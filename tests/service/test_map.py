@@ -211,3 +211,20 @@ def test_a_map_says_what_it_normalised_as_an_evaluation_does(
         job = client.get(f"/v1/jobs/{job['id']}").json()
     assert job["status"] == "done", job
     assert job["result"]["axis_correction"] == stretched_map["axis_correction"]
+
+
+def test_the_png_of_a_cell_at_a_subnormal_y_is_drawn(client: TestClient) -> None:
+    """The body the contract test found a 500 with (the picture's tick at y = -2.2e-311)."""
+    body = {
+        "grid": {
+            "x": {"min": 0.5, "step": 1111.7968065590455, "max": 356.58047128571},
+            "y": {"max": 0.0, "min": -2.225073858507e-311, "step": 1.0000000000000002e-06},
+            "yaw": 0.0,
+            "z": 0.0,
+        },
+        "path": {"cl_data": "UNITS/MM\nGOTO/0, 0, 0, 0, 0, 1\nGOTO/5, 0, 0, 0, 0.6, 0.8\n"},
+        "robot": {"model": "ur3"},
+    }
+    answer = client.post("/v1/map/png", json=body)
+    assert answer.status_code == 200, answer.text
+    assert answer.headers["content-type"] == "image/png"

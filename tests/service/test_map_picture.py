@@ -257,3 +257,18 @@ def test_a_row_of_one_speed_is_ticked_at_its_row_and_barred_over_a_readable_rang
             assert figure.images[0].get_clim() == pytest.approx(
                 (np.nanmin(cmap.mu_path), np.nanmax(cmap.mu_path))
             )
+
+
+@pytest.mark.parametrize("y", [-2.225073858507e-311, 5e-324, 1e-10])
+def test_a_cell_at_a_subnormal_coordinate_is_drawn(monkeypatch, y: float) -> None:
+    """A one-cell map whose y is subnormal (the contract test's grid: y from -2.2e-311 to 0 in
+    steps of 1e-6): its tick at that y made matplotlib's formatter raise OverflowError, a 500
+    of /v1/map/png. The tick is at the row's y to the nanometre: 0."""
+    monkeypatch.setattr(map_picture, "KEPT", KeptFigures(4, 2**30))
+    cmap = _map(1, 1, seed=11)
+    cmap.ys[:] = y
+    png = render_png(cmap, title="t")
+    assert png.startswith(b"\x89PNG")
+    figure = MapFigure(1)
+    figure.png(cmap, title="t")
+    assert figure.panels[0].yaxis.get_majorticklocs().tolist() == [0.0]
