@@ -65,7 +65,9 @@ def _prepared_with_spins(problem: PathProblem, path: PathInput) -> None:
         if not error.field.startswith("path") or index is None or index < 1:
             raise
         try:
-            task_requirements(path.poses[index - 1 : index + 1], field=error.field)
+            free_spin = problem.options.spin_mode == "free"
+            segment = path.poses[index - 1 : index + 1]
+            task_requirements(segment, field=error.field, free_spin=free_spin)
         except SolverError:
             raise error from None
         raise InvalidInputError(

@@ -136,7 +136,7 @@ def check_waypoints(
 
 
 def task_requirements(
-    poses: np.ndarray, *, field: str = "path.waypoints", first: int = 0
+    poses: np.ndarray, *, field: str = "path.waypoints", first: int = 0, free_spin: bool = False
 ) -> TaskRequirements:
     """Spec section 2: u_T, u_R and h of every waypoint of a path.
 
@@ -145,6 +145,9 @@ def task_requirements(
         field: name of the input, for error messages.
         first: the index of ``poses[0]`` in the path they are part of (a pass's first): the
             waypoints errors name count from it.
+        free_spin: the path runs in free spin, which leaves the turn about the tool axis to
+            the spin: a segment that only turns about it moves nothing, a repeated waypoint
+            too (its free-spin LP had no bound: omega_max 6.6e15 rad/s, audit 24).
 
     Returns:
         The requirements in that frame.
@@ -152,7 +155,7 @@ def task_requirements(
     Raises:
         InvalidInputError: see :func:`check_waypoints`.
         RepeatedWaypointError: two consecutive waypoints with the same position and
-            orientation; it names the second one.
+            orientation (in free spin, tool axis); it names the second one.
         InvalidInputError: a segment turning by a half turn (within 1e-6 rad), naming its
             second waypoint (issue 9: the sign of u_R would come from rounding).
     """
@@ -176,6 +179,14 @@ def task_requirements(
             "direction of rotation is undefined; add a waypoint between them",
             waypoint=first + k + 1,
         )
+    if free_spin:
+        axis = arr[:-1, :3, 2]  # the tool axis at each segment's start
+        about = np.einsum("ni,ni->n", rotation_vector, axis)
+        tilted = np.linalg.norm(rotation_vector - about[:, None] * axis, axis=1)
+        in_place = (linear < LINEAR_TOLERANCE) & (tilted < ANGULAR_TOLERANCE)
+        if np.any(in_place):
+            at = first + int(np.argmax(in_place)) + 1
+            raise RepeatedWaypointError(at, field=field, free_spin=True)
     u_t, u_r, h = segment_requirements(displacement, rotation_vector)
     last = slice(-1, None)
     return TaskRequirements(

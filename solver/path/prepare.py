@@ -11,15 +11,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from solver.core.exceptions import InvalidInputError, RepeatedWaypointError
+from solver.core.exceptions import InvalidInputError
 from solver.core.robots import Robot
-from solver.core.spatial import rotation_vectors
-from solver.core.task import (
-    ANGULAR_TOLERANCE,
-    LINEAR_TOLERANCE,
-    TaskRequirements,
-    task_requirements,
-)
+from solver.core.task import TaskRequirements, task_requirements
 
 
 @dataclass(frozen=True)
@@ -83,6 +77,7 @@ def path_requirements(
     passes: Sequence[tuple[int, int]] | None = None,
     *,
     field: str = "path.waypoints",
+    free_spin: bool = False,
 ) -> TaskRequirements:
     """The task requirements of a path of passes, each pass's own; the path checked.
 
@@ -91,6 +86,7 @@ def path_requirements(
         passes: as :func:`prepare_path`'s.
         field: the request's field the path came in (``path.cl_data`` for a CL program):
             errors name it, and the waypoint in the whole path.
+        free_spin: as :func:`solver.core.task.task_requirements` takes it.
 
     Raises:
         InvalidInputError, RepeatedWaypointError: as :func:`solver.core.task.task_requirements`,
@@ -98,7 +94,7 @@ def path_requirements(
     """
     path = np.asarray(waypoints, dtype=float)
     parts = [
-        task_requirements(path[start:stop], field=field, first=start)
+        task_requirements(path[start:stop], field=field, first=start, free_spin=free_spin)
         for start, stop in check_passes(passes, len(path))
     ]
     return TaskRequirements(  # u_T, u_R turn with the yaw, h does not
@@ -114,6 +110,7 @@ def prepare_path(
     *,
     passes: Sequence[tuple[int, int]] | None = None,
     field: str = "path.waypoints",
+    free_spin: bool = False,
 ) -> PreparedPath:
     """Check a path and precompute its placement-independent data.
 
@@ -123,13 +120,15 @@ def prepare_path(
         passes: index ranges [start, stop) of the passes (cam.md section 5), in order and
             covering every waypoint; None: one pass. The requirements are taken per pass.
         field: the request's field the path came in, which errors name.
+        free_spin: the path runs in free spin (a turn about the tool axis alone is no motion:
+            :func:`solver.core.task.task_requirements`).
 
     Raises:
         InvalidInputError, RepeatedWaypointError: as :func:`path_requirements`.
     """
     path = np.asarray(waypoints_in_workpiece, dtype=float)
     ranges = check_passes(passes, len(path))
-    requirements = path_requirements(path, ranges, field=field)
+    requirements = path_requirements(path, ranges, field=field, free_spin=free_spin)
     segment_in_pass = np.ones(max(len(path) - 1, 0), dtype=bool)
     segment_in_pass[[start - 1 for start, _ in ranges[1:]]] = False
     tool_to_flange = np.linalg.inv(robot.transform_tool_to_tcp)
@@ -148,31 +147,3 @@ def prepare_path(
         pure_rotation=requirements.h == 0.0,
         segment_in_pass=segment_in_pass,
     )
-
-
-def check_free_spin_segments(
-    waypoints: np.ndarray, passes: Sequence[tuple[int, int]] | None, *, field: str
-) -> None:
-    """Refuse a segment that is a turn about the tool axis alone, where free spin is asked for.
-
-    Free spin leaves the turn about the tool axis to the spin, so such a segment moves
-    nothing: a repeated waypoint, as the fixed-spin rule has it (dtf.md section 2). Its
-    free-spin LP has no bound (the spin takes the whole turn, the joints none), and its
-    omega_max came out a number of rounding, 6.6e15 rad/s (audit 24).
-
-    Raises:
-        RepeatedWaypointError: the segment's second waypoint (``free_spin``).
-    """
-    path = np.asarray(waypoints, dtype=float)
-    for start, stop in check_passes(passes, len(path)):
-        part = path[start:stop]
-        moved = np.linalg.norm(np.diff(part[:, :3, 3], axis=0), axis=1)
-        turn = rotation_vectors(np.einsum("nij,nkj->nik", part[1:, :3, :3], part[:-1, :3, :3]))
-        axis = part[:-1, :3, 2]  # the tool axis at each segment's start, in {O}
-        about = np.einsum("ni,ni->n", turn, axis)
-        tilted = np.linalg.norm(turn - about[:, None] * axis, axis=1)
-        still = (moved < LINEAR_TOLERANCE) & (tilted < ANGULAR_TOLERANCE)
-        if np.any(still):
-            raise RepeatedWaypointError(
-                start + int(np.argmax(still)) + 1, field=field, free_spin=True
-            )

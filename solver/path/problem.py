@@ -30,7 +30,7 @@ from solver.path.cell.cache import checker_for
 from solver.path.cell.limit import CellLimit
 from solver.path.cell.shapes import Cell
 from solver.path.limits import JointAccelerationLimit, JointSpeedLimit, Limit, PathCheck
-from solver.path.prepare import PreparedPath, check_free_spin_segments, prepare_path
+from solver.path.prepare import PreparedPath, prepare_path
 
 DEFAULT_MAX_JOINT_STEP = 0.35
 DEFAULT_BLEND_LENGTH = 0.002  # m, the corner zone of motion.md section 1 (ABB z1, UR 1 mm)
@@ -170,12 +170,12 @@ class PathProblem:
         """The path checked and reduced to what every placement needs (in {O}).
 
         In free spin a segment that only turns about the tool axis is a repeated waypoint
-        (:func:`solver.path.prepare.check_free_spin_segments`).
+        (:func:`solver.core.task.task_requirements`).
         """
-        prepared = prepare_path(self.robot, self.waypoints, passes=self.passes, field=self.source)
-        if self.options.spin_mode == "free":
-            check_free_spin_segments(self.waypoints, self.passes, field=self.source)
-        return prepared
+        free_spin = self.options.spin_mode == "free"
+        return prepare_path(
+            self.robot, self.waypoints, passes=self.passes, field=self.source, free_spin=free_spin
+        )
 
     @functools.cached_property
     def limits(self) -> tuple[Limit, ...]:
