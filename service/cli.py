@@ -59,7 +59,7 @@ from service.convert.errors import request_errors, solver_error_location, solver
 from service.operations import computed_map, evaluation_of, import_of, map_png
 from service.schemas import EvaluateRequest, MapRequest, OptimizeRequest, PathRead, RobotRead
 from service.schemas.path_cam import MAX_CAM_TEXT
-from service.schemas.paths_import import PathImportRequest
+from service.schemas.paths_import import PathImportRequest, PathImportResponse
 from solver.cam.cam_path import METRES_PER_UNIT
 from solver.core import cache_home, native_stderr
 from solver.core.exceptions import InvalidInputError, SolverError, cut
@@ -505,10 +505,10 @@ def _import(args: argparse.Namespace) -> int:
     answer = import_of(body, _settings())
     name = "standard input" if args.program == STDIN else args.program
     _print(answer, args, lambda: import_text(answer, name))
-    return CUT if answer.ended is False else OK
+    return _status(OK, answer)
 
 
-def _status(code: int, read: PathRead | None) -> int:
+def _status(code: int, read: PathRead | PathImportResponse | None) -> int:
     """``code`` (OK or INFEASIBLE), or :data:`CUT` where the program read may be cut short."""
     return CUT if read is not None and read.ended is False else code
 
