@@ -479,3 +479,40 @@ def test_a_halfspace_normal_of_any_length_is_the_same_halfspace(
     assert answers[0] < 0.0136  # nearer than the wrist's own links: the floor is measured
     assert answers[1] == pytest.approx(answers[0], abs=1e-12)
     assert answers[2] == pytest.approx(answers[0], abs=1e-12)
+
+
+def test_when_every_branch_collides_the_answer_is_the_fastest_branchs_collision(
+    client: TestClient, body: dict
+) -> None:
+    # A floor 0.2 m below the base at a clearance of 13.7 mm: every branch of the example
+    # collides, two of them only at waypoints 27 and 48 (audit 24's D8). The answer is the
+    # branch auto takes without the cell, where it first collides (README, the cell), as its
+    # own pinned evaluation and the map's cell say it; not the branch that collides furthest.
+    plain = client.post("/v1/evaluate", json=body).json()
+    body["cell"] = {
+        "fixed": [{"shape": "halfspace", "normal": [0, 0, 1], "offset": -0.2}],
+        "clearance": 0.0137,
+    }
+    answer = client.post("/v1/evaluate", json=body).json()
+    pinned = client.post("/v1/evaluate", json={**body, "ik": {"branch": plain["branch"]}}).json()
+    furthest = 0
+    for shoulder in ("left", "right"):
+        for elbow in ("up", "down"):
+            for wrist in ("noflip", "flip"):
+                branch = {"shoulder": shoulder, "elbow": elbow, "wrist": wrist}
+                each = client.post("/v1/evaluate", json={**body, "ik": {"branch": branch}})
+                assert each.json()["reason"] == "collision", branch
+                furthest = max(furthest, each.json()["failed_waypoint"])
+    assert answer["reason"] == pinned["reason"] == "collision"
+    assert answer["branch"] == plain["branch"]
+    assert answer["failed_waypoint"] == pinned["failed_waypoint"] < furthest
+    assert answer["collision"] == pinned["collision"]
+    grid = {
+        "x": {"min": 0.0, "max": 0.0, "step": 0.1},
+        "y": {"min": 0.45, "max": 0.45, "step": 0.1},
+    }
+    request = {k: body[k] for k in ("robot", "path", "cell")}
+    cells = client.post("/v1/map", json={**request, "grid": {**grid, "z": 0.1, "yaw": 0.0}})
+    assert cells.status_code == 200, cells.text
+    (cell,) = cells.json()["cells"]
+    assert cell["reason"] == "collision" and cell["failed_waypoint"] == answer["failed_waypoint"]
