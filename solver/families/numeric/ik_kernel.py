@@ -19,7 +19,7 @@ from numba import njit
 
 from solver.core.codes import OK, OK_MIRRORED, SINGULAR
 from solver.families.numeric.chain_kernel import drop_stale_cache, frames, jacobian_at, workspace
-from solver.families.numeric.lu_kernel import det_negative, lu_solve
+from solver.families.numeric.lu_kernel import det_negative, lu_solve, normal_solve
 
 drop_stale_cache(Path(__file__))
 
@@ -93,7 +93,9 @@ def _levenberg_marquardt(  # type: ignore[no-untyped-def]  # pragma: no cover - 
     first step takes them from there: the same numbers, one chain evaluation fewer. ``stall``:
     (steps, ratio), give up (False) at every ``steps``-th step where |e|_inf is above ``ratio``
     times what it was ``steps`` steps before (``ik.solve``'s ``stall``); steps 0: never. On
-    return ``work`` holds the frames of the last iterate (:func:`chain_kernel.frames`).
+    return ``work`` holds the frames of the last iterate (:func:`chain_kernel.frames`). The
+    damped normal equations are solved by LDL^T (:func:`lu_kernel.normal_solve`; LU where that
+    meets a pivot not positive), numpy's reference by LU: the same step to rounding.
     """
     tolerance, scale, floor = constants[0], constants[1], constants[2]
     stall_steps, stall_ratio = stall
@@ -124,7 +126,7 @@ def _levenberg_marquardt(  # type: ignore[no-untyped-def]  # pragma: no cover - 
             _normal(jac, normal)
         for i in range(6):
             normal[i, i] += damping
-        if not lu_solve(normal, error):
+        if not (normal_solve(normal, error) or lu_solve(normal, error)):
             return False
         for j in range(n):
             moved = q[j]

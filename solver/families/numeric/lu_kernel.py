@@ -1,4 +1,4 @@
-"""The numeric family's compiled LU: J x = t solved in place, and the sign of det J.
+"""The numeric family's compiled solves: J x = t by LU, the sign of det J, the normal equations.
 
 LU with partial pivoting in scalar loops, what LAPACK's gesv (``np.linalg.solve``) and getrf
 (``np.linalg.det``) do, for the compiled chain (:mod:`solver.families.numeric.chain_kernel`)
@@ -101,3 +101,99 @@ def det_negative(jac, a):  # type: ignore[no-untyped-def]  # pragma: no cover - 
             for k in range(col + 1, 6):
                 a[row, k] -= f * a[col, k]
     return negative
+
+
+@njit(cache=True, nogil=True, error_model="numpy", inline="always")
+def normal_solve(a, b):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
+    """Solve a x = b in place (x in ``b``), ``a`` (6, 6) symmetric positive definite: LDL^T.
+
+    The damped normal equations (J J^T + lambda I) y = e of every least-squares step
+    (:func:`solver.families.numeric.ik_kernel._levenberg_marquardt`,
+    :func:`~solver.families.numeric.scout_kernel.rough_steps`): a = L D L^T (L unit lower, D
+    diagonal; Cholesky without its square roots, backward stable on such matrices without
+    pivoting), from the lower triangle of ``a``, which is left as it is. Written out on
+    scalars, so the factors stay in registers: 45 to 60 ns a solve against 170 to 250 for
+    :func:`lu_solve` on the same matrices (2026-12-06, one thread); the solution agrees with
+    LU's (and numpy's) to rounding, 8e-16 relative on a random J J^T. False, ``b`` left as it
+    is, where a pivot d_j is not positive (a not positive definite as rounded): the caller
+    then takes :func:`lu_solve`.
+    """
+    a00, a10, a11, a20, a21, a22 = a[0, 0], a[1, 0], a[1, 1], a[2, 0], a[2, 1], a[2, 2]
+    a30, a31, a32, a33 = a[3, 0], a[3, 1], a[3, 2], a[3, 3]
+    a40, a41, a42, a43, a44 = a[4, 0], a[4, 1], a[4, 2], a[4, 3], a[4, 4]
+    a50, a51, a52, a53, a54, a55 = a[5, 0], a[5, 1], a[5, 2], a[5, 3], a[5, 4], a[5, 5]
+    # column 0: d0, then l_i0 = c_i0 / d0 (c_ik = l_ik d_k)
+    d0 = a00
+    if not d0 > 0.0:
+        return False
+    r0 = 1.0 / d0
+    c10 = a10
+    l10 = c10 * r0
+    c20 = a20
+    l20 = c20 * r0
+    c30 = a30
+    l30 = c30 * r0
+    c40 = a40
+    l40 = c40 * r0
+    c50 = a50
+    l50 = c50 * r0
+    # column 1: d1, then l_i1 = c_i1 / d1 (c_ik = l_ik d_k)
+    d1 = a11 - c10 * l10
+    if not d1 > 0.0:
+        return False
+    r1 = 1.0 / d1
+    c21 = a21 - c20 * l10
+    l21 = c21 * r1
+    c31 = a31 - c30 * l10
+    l31 = c31 * r1
+    c41 = a41 - c40 * l10
+    l41 = c41 * r1
+    c51 = a51 - c50 * l10
+    l51 = c51 * r1
+    # column 2: d2, then l_i2 = c_i2 / d2 (c_ik = l_ik d_k)
+    d2 = a22 - c20 * l20 - c21 * l21
+    if not d2 > 0.0:
+        return False
+    r2 = 1.0 / d2
+    c32 = a32 - c30 * l20 - c31 * l21
+    l32 = c32 * r2
+    c42 = a42 - c40 * l20 - c41 * l21
+    l42 = c42 * r2
+    c52 = a52 - c50 * l20 - c51 * l21
+    l52 = c52 * r2
+    # column 3: d3, then l_i3 = c_i3 / d3 (c_ik = l_ik d_k)
+    d3 = a33 - c30 * l30 - c31 * l31 - c32 * l32
+    if not d3 > 0.0:
+        return False
+    r3 = 1.0 / d3
+    c43 = a43 - c40 * l30 - c41 * l31 - c42 * l32
+    l43 = c43 * r3
+    c53 = a53 - c50 * l30 - c51 * l31 - c52 * l32
+    l53 = c53 * r3
+    # column 4: d4, then l_i4 = c_i4 / d4 (c_ik = l_ik d_k)
+    d4 = a44 - c40 * l40 - c41 * l41 - c42 * l42 - c43 * l43
+    if not d4 > 0.0:
+        return False
+    r4 = 1.0 / d4
+    c54 = a54 - c50 * l40 - c51 * l41 - c52 * l42 - c53 * l43
+    l54 = c54 * r4
+    # column 5: d5, then l_i5 = c_i5 / d5 (c_ik = l_ik d_k)
+    d5 = a55 - c50 * l50 - c51 * l51 - c52 * l52 - c53 * l53 - c54 * l54
+    if not d5 > 0.0:
+        return False
+    r5 = 1.0 / d5
+    # L y = b, then D L^T x = y
+    y0 = b[0]
+    y1 = b[1] - l10 * y0
+    y2 = b[2] - l20 * y0 - l21 * y1
+    y3 = b[3] - l30 * y0 - l31 * y1 - l32 * y2
+    y4 = b[4] - l40 * y0 - l41 * y1 - l42 * y2 - l43 * y3
+    y5 = b[5] - l50 * y0 - l51 * y1 - l52 * y2 - l53 * y3 - l54 * y4
+    x5 = y5 * r5
+    x4 = y4 * r4 - l54 * x5
+    x3 = y3 * r3 - l43 * x4 - l53 * x5
+    x2 = y2 * r2 - l32 * x3 - l42 * x4 - l52 * x5
+    x1 = y1 * r1 - l21 * x2 - l31 * x3 - l41 * x4 - l51 * x5
+    x0 = y0 * r0 - l10 * x1 - l20 * x2 - l30 * x3 - l40 * x4 - l50 * x5
+    b[0], b[1], b[2], b[3], b[4], b[5] = x0, x1, x2, x3, x4, x5
+    return True
