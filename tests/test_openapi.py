@@ -116,3 +116,19 @@ def test_the_height_rule_is_in_the_optimize_description() -> None:
     """z and bounds.z both given or both missing: the one rule kept out of the contract test."""
     description = json.loads(SPEC_PATH.read_text())["paths"]["/v1/optimize"]["post"]["description"]
     assert "exactly one of them (both or neither is a 422)" in re.sub(r"\s+", " ", description)
+
+
+def test_every_error_answer_declares_its_json_body() -> None:
+    """Every 4xx and 5xx of every operation declares the ErrorResponse it sends (audit 25: a 409
+    declared without a body was parsed as None by the generated client, its reason lost)."""
+    spec = json.loads(SPEC_PATH.read_text())
+    bare = [
+        (method.upper(), path, code)
+        for path, operations in spec["paths"].items()
+        for method, operation in operations.items()
+        for code, answer in operation["responses"].items()
+        if code[0] in "45"
+        and answer.get("content", {}).get("application/json", {}).get("schema")
+        != {"$ref": "#/components/schemas/ErrorResponse"}
+    ]
+    assert not bare

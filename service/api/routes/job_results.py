@@ -29,7 +29,7 @@ from service.jobs.runner import get_runner
 from service.jobs.store import JobStore
 from service.jobs.views import page_url
 from service.operations import map_png
-from service.schemas import MapRequest
+from service.schemas import ErrorResponse, MapRequest
 from service.schemas.jobs import JobResultPage
 from service.work import run_stoppable
 from solver.core.progress import Progress
@@ -44,7 +44,10 @@ router = APIRouter(prefix="/jobs", tags=["jobs"], responses=JOB_RESPONSES)
     response_model=JobResultPage,
     responses={
         **NOT_FOUND,
-        409: {"description": "The job is not done, or its result has no cells (not a map)."},
+        409: {
+            "model": ErrorResponse,
+            "description": "The job is not done, or its result has no cells (not a map).",
+        },
     },
 )
 def get_job_result_page(
@@ -99,6 +102,7 @@ def get_job_result_page(
         },
         **NOT_FOUND,
         409: {
+            "model": ErrorResponse,
             "description": "The job is not done, is not a map, its map has more panels "
             "(yaws x spins) than a picture draws (DTF_MAX_PNG_PANELS), or its request was "
             "stored by a release whose map requests this one does not read."
