@@ -112,7 +112,8 @@ SpinMode = TypeAliasType(
         Literal["fixed", "free"],
         Field(
             description="How the tool spin about its axis is taken: fixed, the orientations as "
-            "given; free, chosen per waypoint (a spindle, disc or grinder; cam.md section 2)."
+            "given; free, chosen per waypoint (a spindle, disc or grinder; cam.md section 2).",
+            examples=["fixed"],
         ),
     ],
 )

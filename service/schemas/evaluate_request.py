@@ -28,7 +28,8 @@ DetailLevel = TypeAliasType(
         Literal["summary", "waypoints"],
         Field(
             description="summary: mu_path, bottleneck and branch only; waypoints: also every "
-            "waypoint's detail."
+            "waypoint's detail.",
+            examples=["summary"],
         ),
     ],
 )

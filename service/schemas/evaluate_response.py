@@ -5,8 +5,10 @@ from __future__ import annotations
 from enum import StrEnum
 from typing import Literal
 
-from pydantic import ConfigDict, Field
+from pydantic import ConfigDict, Field, GetJsonSchemaHandler
 from pydantic.config import JsonDict
+from pydantic.json_schema import JsonSchemaValue
+from pydantic_core import CoreSchema
 
 from service.schemas.cell import CELL_APPROXIMATED, CELL_UNCHECKED, Contact, UncheckedPair
 from service.schemas.common import ResponseModel, SpinMode
@@ -65,6 +67,15 @@ class FailureReason(StrEnum):
     SINGULAR = "singular"
     DISCONTINUOUS = "discontinuous"
     COLLISION = "collision"
+
+    @classmethod
+    def __get_pydantic_json_schema__(
+        cls, core_schema: CoreSchema, handler: GetJsonSchemaHandler
+    ) -> JsonSchemaValue:
+        """The enum's schema with an example, as every component has (api.md)."""
+        schema = handler.resolve_ref_schema(handler(core_schema))
+        schema["examples"] = ["joint_limits"]
+        return schema
 
 
 class FeedCheckResult(ResponseModel):

@@ -19,7 +19,10 @@ JobStatus = TypeAliasType(
     "JobStatus",
     Annotated[
         Literal["queued", "running", "done", "failed", "cancelled"],
-        Field(description="Where a job is: queued, running, done, failed or cancelled."),
+        Field(
+            description="Where a job is: queued, running, done, failed or cancelled.",
+            examples=["done"],
+        ),
     ],
 )
 """One component for a job's status and the status filter of GET /v1/jobs."""
@@ -27,7 +30,10 @@ JobKind = TypeAliasType(
     "JobKind",
     Annotated[
         Literal["map", "optimize", "evaluate"],
-        Field(description="What a job computes: a map, an optimisation or an evaluation."),
+        Field(
+            description="What a job computes: a map, an optimisation or an evaluation.",
+            examples=["map"],
+        ),
     ],
 )
 """One component for a job's kind and the kind filter of GET /v1/jobs."""

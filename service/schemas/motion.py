@@ -16,7 +16,8 @@ LimitedBy = TypeAliasType(
         Literal["speed", "acceleration"],
         Field(
             description="What binds mu_acc: speed, a joint speed limit (mu_acc = mu_path); "
-            "acceleration, a joint acceleration limit."
+            "acceleration, a joint acceleration limit.",
+            examples=["acceleration"],
         ),
     ],
 )

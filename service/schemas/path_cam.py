@@ -24,7 +24,8 @@ ProgramUnits = TypeAliasType(
         Literal["mm", "inch", "inches"],
         Field(
             description="The length unit of a CL program that states none: mm or inch "
-            "(inches, as answers name it, too)."
+            "(inches, as answers name it, too).",
+            examples=["mm"],
         ),
     ],
 )

@@ -105,7 +105,7 @@ def get_job_result_page(
             "model": ErrorResponse,
             "description": "The job is not done, is not a map, its map has more panels "
             "(yaws x spins) than a picture draws (DTF_MAX_PNG_PANELS), or its request was "
-            "stored by a release whose map requests this one does not read."
+            "stored by a release whose map requests this one does not read.",
         },
     },
 )

@@ -141,12 +141,19 @@ async def post_job(
 )
 def get_jobs(
     settings: SettingsDep,
-    job_status: Annotated[JobStatus | None, Query(alias="status")] = None,
+    job_status: Annotated[
+        JobStatus | None,
+        Query(
+            alias="status", description="Only the jobs in this state (all of them if not given)."
+        ),
+    ] = None,
     kind: Annotated[
         JobKind | None,
         Query(description="Only the jobs of this kind (every client's: the page lists maps)."),
     ] = None,
-    limit: Annotated[int, Query(ge=1, le=1000)] = 100,
+    limit: Annotated[
+        int, Query(ge=1, le=1000, description="Most jobs to list (the page's length).")
+    ] = 100,
     after: Annotated[
         UUID | None,
         Query(
