@@ -153,3 +153,18 @@ def test_every_schema_has_a_description_and_an_example_and_every_parameter_a_des
         if not parameter.get("description")
     ]
     assert not unsaid
+
+
+def test_a_jobs_id_is_typed_as_the_job_routes_take_it() -> None:
+    """JobInfo.id has the format of every {job_id} path parameter, so a generated client passes
+    a submitted job's id to the job routes as it is (audit 25: a str against a UUID)."""
+    spec = json.loads(SPEC_PATH.read_text())
+    formats = {
+        parameter["schema"].get("format")
+        for operations in spec["paths"].values()
+        for operation in operations.values()
+        for parameter in operation.get("parameters", [])
+        if parameter["name"] == "job_id"
+    }
+    assert formats == {"uuid"}
+    assert spec["components"]["schemas"]["JobInfo"]["properties"]["id"]["format"] == "uuid"

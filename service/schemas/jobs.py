@@ -174,7 +174,9 @@ class JobInfo(ResponseModel):
 
     model_config = ConfigDict(json_schema_extra={"examples": [_JOB_EXAMPLE]})
 
-    id: str = Field(description="The job's id (a random UUID).")
+    id: str = Field(
+        description="The job's id (a random UUID).", json_schema_extra={"format": "uuid"}
+    )
     kind: JobKind = Field(description="What the job computes.")
     status: JobStatus = Field(description="queued, running, done, failed or cancelled.")
     progress: JobProgress = Field(description="How far it is.")
