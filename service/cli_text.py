@@ -194,6 +194,8 @@ def evaluation_text(answer: EvaluateResponse, clearance: float | None = None) ->
     lines += _how_it_runs(answer)
     if answer.feed_check is not None:
         lines.append(_feed_check(answer.feed_check))
+    if answer.placement is not None:  # the placement given, in controller terms
+        lines += _placement(answer.placement)
     return "\n".join(lines)
 
 

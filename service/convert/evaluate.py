@@ -9,8 +9,9 @@ import numpy as np
 from pydantic import TypeAdapter
 
 from service import schemas
-from service.convert.common import branch_to_api, cell_model_to_api
+from service.convert.common import api_placement, branch_to_api, cell_model_to_api
 from solver.core.robots import Robot
+from solver.core.spatial import Placement
 from solver.path.cycle_time import CycleTime
 from solver.path.evaluate import AccelerationIndex, PathEvaluation
 from solver.path.feed import FeedCheck
@@ -121,6 +122,7 @@ def evaluate_response(
     path_read: schemas.PathRead | None = None,
     robot_read: schemas.RobotRead | None = None,
     failed_in: tuple[int | None, str | None] = (None, None),
+    placement: Placement | None = None,
 ) -> schemas.EvaluateResponse:
     """The response of ``POST /v1/evaluate`` (per-waypoint detail when ``with_waypoints``).
 
@@ -128,7 +130,8 @@ def evaluate_response(
     ``/v1/optimize``'s evaluation, whose answer has it); ``robot_read``: what was changed in
     the robot's URDF (:func:`service.convert.robots.robot_read_of`; None in that evaluation
     too); ``failed_in``: the pass and operation of the failed waypoint, of CAM input
-    (:func:`service.convert.path_read.pass_at`).
+    (:func:`service.convert.path_read.pass_at`); ``placement``: the placement evaluated,
+    answered with its controller frames.
     """
     ev = evaluation
     bottleneck = None
@@ -159,6 +162,7 @@ def evaluate_response(
         detail="waypoints" if with_waypoints else "summary",
         spin_mode=ev.spin_mode,
         spins=None if ev.spins is None else ev.spins.tolist(),
+        placement=None if placement is None else api_placement(placement),
         axis_correction=axis_correction,
         acceleration=acceleration_to_api(ev.acceleration, robot),
         cycle_time=cycle_time_to_api(cycle_time),

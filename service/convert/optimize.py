@@ -154,6 +154,7 @@ def optimize_response(
             if path is None or path.feed is None
             else check_feed(optimum.evaluation, path.feed, robot.qdot_max),
             cycle_time=cycle_time,
+            placement=optimum.placement,
         ),
         start=schemas.StartInfo(
             placement=api_placement(optimum.start),

@@ -150,4 +150,5 @@ def evaluation_of(
         path_read=convert.path_read_of(path),
         robot_read=convert.robot_read_of(robot),
         failed_in=convert.pass_at(path, evaluation.failed_waypoint),
+        placement=convert.placement_of(body.placement),
     )

@@ -16,6 +16,7 @@ from service.schemas.evaluate_request import DetailLevel
 from service.schemas.ik import Branch, NumericBranch
 from service.schemas.motion import AccelerationResult, CycleTimeResult
 from service.schemas.path_read import FAILED_OPERATION, FAILED_PASS, PATH_READ, PathRead
+from service.schemas.placement import PlacementResult, placement_example
 from service.schemas.robot_read import ROBOT_READ, RobotRead
 
 _RESPONSE_EXAMPLE_WAYPOINT: JsonDict = {
@@ -40,6 +41,7 @@ _RESPONSE_EXAMPLE: JsonDict = {
     "ik": {"family": "ur", "seeds": None, "branches_found": None, "recognised": None},
     "spin_mode": "fixed",
     "spins": None,
+    "placement": placement_example(0.0, 0.45, 0.1, 0.0),
     "axis_correction": 0.0,
     "waypoints": [
         _RESPONSE_EXAMPLE_WAYPOINT,
@@ -233,6 +235,11 @@ class EvaluateResponse(ResponseModel):
     )
     ik: IkInfo = Field(description="The IK family that solved the path, and its seeds.")
     spin_mode: SpinMode = Field(description="The spin mode used (fixed or free).")
+    placement: PlacementResult | None = Field(
+        default=None,
+        description="The placement evaluated, with its controller frames (cam.md section 8): "
+        "the request's; in /v1/optimize's evaluation, the optimum's.",
+    )
     spins: list[float] | None = Field(
         default=None,
         description="In free spin mode, the tool spin (rad) about each waypoint's tool axis that "

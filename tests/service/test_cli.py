@@ -112,6 +112,9 @@ def test_evaluate_json_is_the_api_answer(
     assert code == OK
     assert json.loads(out) == expected
     assert expected["feasible"] and expected["feed_check"]["feasible"]
+    code, out, _ = run(capsys, "evaluate", str(PROGRAM), "--robot", "ur5e", "--at=0,0.3,0,0.5")
+    assert code == OK  # the placement given, in controller terms (KUKA's A the yaw in degrees)
+    assert "KUKA base (mm, deg): X 0.00, Y 300.00, Z 0.00, A 28.65, B 0.00, C 0.00" in out
 
 
 def _stdin(monkeypatch: pytest.MonkeyPatch, data: bytes) -> None:

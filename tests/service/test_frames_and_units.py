@@ -61,6 +61,13 @@ def test_every_placement_in_every_answer_comes_in_controller_terms(client: TestC
     ).json()
     check_frames(optimum["placement"])
     check_frames(optimum["start"]["placement"])
+    # the placement evaluated, in /v1/optimize's evaluation the optimum's (audit 25: a placement
+    # a CAM tool chose itself had no controller frames)
+    assert optimum["evaluation"]["placement"] == optimum["placement"]
+    at = {"x": 0.03, "y": 0.47, "z": 0.12, "yaw": 2.4, "spin": 0.2}
+    evaluation = client.post("/v1/evaluate", json={**REQUEST, "placement": at}).json()
+    assert {k: evaluation["placement"][k] for k in at} == at
+    check_frames(evaluation["placement"])
 
 
 # Sensors 2022 table 3, typed as printed (4 decimals): u_T, u_R, h of three UR5e path segments.
