@@ -177,9 +177,11 @@ def evaluation_text(answer: EvaluateResponse, clearance: float | None = None) ->
     lines = read_text(answer.path_read) + normalised_text(answer.axis_correction)
     if not answer.feasible:
         where = "" if answer.failed_waypoint is None else f" at waypoint {answer.failed_waypoint}"
+        within = [] if answer.failed_line is None else [f"line {answer.failed_line}"]
         if answer.failed_pass is not None:
             named = "" if answer.failed_operation is None else f", {answer.failed_operation}"
-            where += f" (pass {answer.failed_pass}{named})"
+            within.append(f"pass {answer.failed_pass}{named}")
+        where += f" ({', '.join(within)})" if within else ""
         lines.append(f"infeasible: {answer.reason}{where}")
         if answer.collision is not None:
             limit = "" if clearance is None else f" (clearance {_fixed(clearance * 1e3, 1)} mm)"
@@ -187,9 +189,11 @@ def evaluation_text(answer: EvaluateResponse, clearance: float | None = None) ->
         return "\n".join(lines + _cell_model(answer))
     lines.append(f"mu_path: {answer.mu_path:.4f} m/s (spin {answer.spin_mode})")
     if answer.bottleneck is not None:
+        line = answer.bottleneck.line
         lines.append(
-            f"bottleneck: waypoint {answer.bottleneck.waypoint}, joint "
-            f"{answer.bottleneck.joint_name}"
+            f"bottleneck: waypoint {answer.bottleneck.waypoint}"
+            + ("" if line is None else f" (line {line})")
+            + f", joint {answer.bottleneck.joint_name}"
         )
     lines += _how_it_runs(answer)
     if answer.feed_check is not None:

@@ -123,6 +123,7 @@ def evaluate_response(
     robot_read: schemas.RobotRead | None = None,
     failed_in: tuple[int | None, str | None] = (None, None),
     placement: Placement | None = None,
+    lines: np.ndarray | None = None,
 ) -> schemas.EvaluateResponse:
     """The response of ``POST /v1/evaluate`` (per-waypoint detail when ``with_waypoints``).
 
@@ -131,7 +132,8 @@ def evaluate_response(
     the robot's URDF (:func:`service.convert.robots.robot_read_of`; None in that evaluation
     too); ``failed_in``: the pass and operation of the failed waypoint, of CAM input
     (:func:`service.convert.path_read.pass_at`); ``placement``: the placement evaluated,
-    answered with its controller frames.
+    answered with its controller frames; ``lines``: the program's line of each waypoint, of
+    CAM input (:attr:`~service.schemas.path_input.PathInput.lines`).
     """
     ev = evaluation
     bottleneck = None
@@ -140,6 +142,7 @@ def evaluate_response(
             waypoint=ev.bottleneck_waypoint,
             joint=ev.bottleneck_joint,
             joint_name=robot.joint_names[ev.bottleneck_joint],
+            line=None if lines is None else int(lines[ev.bottleneck_waypoint]),
         )
     return schemas.EvaluateResponse(
         feasible=ev.feasible,
@@ -148,6 +151,9 @@ def evaluate_response(
         reason=None if ev.reason is None else schemas.FailureReason(ev.reason),
         failed_waypoint=ev.failed_waypoint,
         failed_pass=failed_in[0],
+        failed_line=None
+        if lines is None or ev.failed_waypoint is None
+        else int(lines[ev.failed_waypoint]),
         failed_operation=failed_in[1],
         branch=branch_to_api(ev.branch),
         ik=schemas.IkInfo.model_validate(

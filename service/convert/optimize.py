@@ -155,6 +155,7 @@ def optimize_response(
             else check_feed(optimum.evaluation, path.feed, robot.qdot_max),
             cycle_time=cycle_time,
             placement=optimum.placement,
+            lines=None if path is None else path.lines,
         ),
         start=schemas.StartInfo(
             placement=api_placement(optimum.start),

@@ -151,4 +151,5 @@ def evaluation_of(
         robot_read=convert.robot_read_of(robot),
         failed_in=convert.pass_at(path, evaluation.failed_waypoint),
         placement=convert.placement_of(body.placement),
+        lines=path.lines,
     )

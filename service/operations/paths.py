@@ -36,6 +36,7 @@ def imported(path: PathInput) -> PathImportResponse:
     passes = path.passes or ((0, len(path.poses)),)
     return PathImportResponse(
         waypoints=waypoints,
+        lines=None if path.lines is None else path.lines.tolist(),
         passes=[[start, stop] for start, stop in passes],
         correction=path.axis_correction,
         spin_mode=path.default_spin_mode,

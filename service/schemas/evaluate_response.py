@@ -15,7 +15,13 @@ from service.schemas.common import ResponseModel, SpinMode
 from service.schemas.evaluate_request import DetailLevel
 from service.schemas.ik import Branch, NumericBranch
 from service.schemas.motion import AccelerationResult, CycleTimeResult
-from service.schemas.path_read import FAILED_OPERATION, FAILED_PASS, PATH_READ, PathRead
+from service.schemas.path_read import (
+    FAILED_LINE,
+    FAILED_OPERATION,
+    FAILED_PASS,
+    PATH_READ,
+    PathRead,
+)
 from service.schemas.placement import PlacementResult, placement_example
 from service.schemas.robot_read import ROBOT_READ, RobotRead
 
@@ -165,6 +171,11 @@ class Bottleneck(ResponseModel):
         "map cell of the same placement names it."
     )
     joint: int = Field(description="Index of the joint on its speed limit there.")
+    line: int | None = Field(
+        default=None,
+        description="When the path came as CL data or CSV: the line of the program (from 1) "
+        "the waypoint was read from; null otherwise.",
+    )
     joint_name: str = Field(description="Name of that joint.")
 
 
@@ -227,6 +238,7 @@ class EvaluateResponse(ResponseModel):
         description="Index of the first waypoint that fails; null when feasible."
     )
     failed_pass: int | None = Field(default=None, description=FAILED_PASS)
+    failed_line: int | None = Field(default=None, description=FAILED_LINE)
     failed_operation: str | None = Field(default=None, description=FAILED_OPERATION)
     branch: Branch | NumericBranch | None = Field(
         description="IK branch used (when infeasible with auto: the one that got furthest): "

@@ -40,6 +40,9 @@ class PathInput:
         source: the request's field the path came in (``path.waypoints``,
             ``path.tool_axis_waypoints``, ``path.cl_data``, ``path.csv``): the path's errors
             name it.
+        lines: shape (N,), int, the line of the program (from 1) each waypoint was read from
+            (CAM input: an arc's inner points the CIRCLE's line, its end the GOTO's); ``None``
+            for poses and tool axes.
     """
 
     poses: np.ndarray
@@ -56,6 +59,7 @@ class PathInput:
     report: ReadReport | None = None
     cam_form: Literal["cl_data", "csv"] | None = None
     source: str = "path.waypoints"
+    lines: np.ndarray | None = None
 
     @classmethod
     def from_cam(
@@ -85,4 +89,5 @@ class PathInput:
             report=report,
             cam_form=form,
             source=field,
+            lines=cam.lines,
         )

@@ -139,6 +139,10 @@ FAILED_PASS = (
     "When the path came as CL data or CSV and a waypoint fails: the pass holding it (index into "
     "path_read.pass_details, from 0); null otherwise."
 )
+FAILED_LINE = (
+    "When the path came as CL data or CSV and a waypoint fails: the line of the program (from "
+    "1) it was read from (an arc's inner points: the CIRCLE's line); null otherwise."
+)
 FAILED_OPERATION = (
     "When the path came as CL data or CSV and a waypoint fails: the operation of its pass, as "
     "the file names it (NX TOOL PATH, PARTNO, PPRINT); null otherwise or where none is named."

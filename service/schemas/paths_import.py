@@ -59,6 +59,7 @@ class PathImportResponse(ResponseModel):
                         {"position": [0.0, 0.0, 0.0], "orientation": [1.0, 0.0, 0.0, 0.0]},
                         {"position": [0.01, 0.0, 0.0], "orientation": [1.0, 0.0, 0.0, 0.0]},
                     ],
+                    "lines": [6, 7],
                     "passes": [[0, 2]],
                     "feed": 0.025,
                     "units": "mm",
@@ -83,6 +84,12 @@ class PathImportResponse(ResponseModel):
     )
 
     waypoints: list[ImportedPose] = Field(description="The N waypoints, poses in {O} (m).")
+    lines: list[int] | None = Field(
+        default=None,
+        description="CL data or CSV: the line of the program (from 1) each waypoint was read "
+        "from (an arc's inner points: the CIRCLE's line), so a failed_waypoint or bottleneck "
+        "leads back to its record; null for poses and tool axes.",
+    )
     passes: list[list[int]] = Field(
         description="Each pass as [start, stop) into the waypoints, in order (a rapid between "
         "two passes belongs to neither)."

@@ -176,7 +176,11 @@ def test_an_unreachable_placement_is_exit_infeasible(capsys: pytest.CaptureFixtu
     _, listing, _ = run(capsys, "import", str(PROGRAM))
     first = re.search(r"^\s+0\s+waypoints 0-\d+\s+(\S+)", listing, re.M)
     assert first is not None
-    assert out.splitlines()[-1].endswith(f"at waypoint 0 (pass 0, {first.group(1)})")
+    # and the program's line of the waypoint: its first cutting GOTO's, after the first FEDRAT
+    text = PROGRAM.read_text().splitlines()
+    fedrat = next(n for n, line in enumerate(text) if line.startswith("FEDRAT"))
+    goto = next(n for n in range(fedrat, len(text)) if text[n].startswith("GOTO")) + 1
+    assert out.splitlines()[-1].endswith(f"at waypoint 0 (line {goto}, pass 0, {first.group(1)})")
 
 
 def test_a_feed_the_path_cannot_run_is_exit_infeasible(capsys: pytest.CaptureFixture[str]) -> None:

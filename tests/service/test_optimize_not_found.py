@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import json
 import math
+import re
 from typing import Any
 
 import pytest
@@ -140,7 +141,9 @@ def test_the_cli_says_why(tmp_path: Any, capsys: pytest.CaptureFixture[str]) -> 
     file.write_text(program())
     code = main(["evaluate", str(file), "--robot", "ur5e", "--at=0,0.4,0.1,0"])
     out = capsys.readouterr().out
-    assert code == INFEASIBLE and out.splitlines()[-1].endswith("(pass 1, ROTARY_SPIN)")
+    said = re.search(r"\(line (\d+), pass 1, ROTARY_SPIN\)$", out.splitlines()[-1])
+    assert code == INFEASIBLE and said is not None  # the line of a GOTO of that pass
+    assert program().splitlines()[int(said.group(1)) - 1].startswith("GOTO")
     code = main(
         ["optimise", str(file), "--robot", "ur5e", "--x=-0.3:0.3", "--y=0.2:0.6", "--z=0.1"]
     )
