@@ -167,8 +167,11 @@ class JobRunner:
                     f"the job's {attempts} runs (DTF_JOB_ATTEMPTS)"
                 )
                 error = [{"loc": [], "msg": message, "type": "interrupted"}]
-                if self.store.retry(job_id, attempts=attempts, error=error):
+                ended = self.store.retry(job_id, attempts=attempts, error=error)
+                if ended == "queued":
                     log.warning("job %s queued again: its worker process ended", job_id)
+                elif ended == "cancelled":  # its cancel was asked: not a failure of the job
+                    log.info("job %s cancelled (its worker process ended)", job_id)
                 else:
                     log.error("job %s failed: %s", job_id, message)
                 self._replace(i)

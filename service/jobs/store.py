@@ -15,7 +15,7 @@ import json
 import sqlite3
 import time
 import uuid
-from typing import Any
+from typing import Any, Literal
 
 from service.jobs.job import Job, Kind, QueueFull, Status, job_of_row
 from service.jobs.results import Result, write_result
@@ -84,11 +84,14 @@ class JobStore(JobReads):
             ).rowcount
         return bool(changed)
 
-    def retry(self, job_id: str, *, attempts: int, error: list[dict[str, Any]]) -> bool:
-        """Queue again a running job whose run ended abnormally (its worker died), or fail it.
+    def retry(
+        self, job_id: str, *, attempts: int, error: list[dict[str, Any]]
+    ) -> Literal["queued", "cancelled", "failed"]:
+        """Queue again a running job whose run ended abnormally (its worker died), or end it.
 
         Queued again, from no progress, while it has had fewer than ``attempts`` runs and no
-        cancel was asked; else failed with ``error``. Returns whether it was queued again.
+        cancel was asked; cancelled where a cancel was asked (what its user asked for, whatever
+        killed the worker); else failed with ``error``. Returns which.
         """
         with self._connection() as db:
             queued = db.execute(
@@ -96,9 +99,14 @@ class JobStore(JobReads):
                 "status = 'running' AND attempts < ? AND cancel = 0",
                 (job_id, attempts),
             ).rowcount
-        if not queued:
-            self.finish(job_id, "failed", error=error, if_running=True)
-        return bool(queued)
+            row = db.execute("SELECT cancel FROM jobs WHERE id = ?", (job_id,)).fetchone()
+        if queued:
+            return "queued"
+        if row is not None and row[0]:
+            self.finish(job_id, "cancelled", if_running=True)
+            return "cancelled"
+        self.finish(job_id, "failed", error=error, if_running=True)
+        return "failed"
 
     def progress(self, job_id: str, fraction: float) -> bool:
         """Record the fraction done; whether to stop (a cancel was asked, or the job deleted).
@@ -231,6 +239,10 @@ class JobStore(JobReads):
     def recover(self, *, attempts: int) -> list[str]:
         """After a restart: jobs left running are queued again (or failed after ``attempts``).
 
+        A job whose cancel was asked before the restart (its worker stopped with the service
+        before it could end the job) is cancelled: queued again it would never run (``queued``
+        hands out no cancelled job) and never end, holding a place in the queue.
+
         A job queued again has no progress and no start time until it runs again.
 
         Result pages of no job (an older release's) are removed.
@@ -242,7 +254,7 @@ class JobStore(JobReads):
         with self._connection() as db:
             db.execute("BEGIN IMMEDIATE")
             left = db.execute(
-                "SELECT id, attempts, started FROM jobs WHERE status = 'running'"
+                "SELECT id, attempts, started, cancel FROM jobs WHERE status = 'running'"
             ).fetchall()
             # The trigger job_ran_to_its_end counts a failed job's finished - started: here the
             # restart's time, so the service's downtime too (35.6 s for a run of about 3 s, the
@@ -250,8 +262,13 @@ class JobStore(JobReads):
             # counted, with no seconds.
             downtime = sum(
                 now - started
-                for _, runs, started in left
-                if runs >= attempts and started is not None
+                for _, runs, started, cancel in left
+                if (runs >= attempts or cancel) and started is not None
+            )
+            db.execute(
+                "UPDATE jobs SET status = 'cancelled', finished = ? WHERE status = 'running' "
+                "AND cancel = 1",
+                (now,),
             )
             db.execute(
                 "UPDATE jobs SET status = 'failed', finished = ?, error = ? WHERE "
@@ -270,8 +287,10 @@ class JobStore(JobReads):
             rows = db.execute(
                 "SELECT id FROM jobs WHERE status = 'queued' ORDER BY created"
             ).fetchall()
-        for job_id, runs, _ in left:  # a restart's work said (only a second 'running' line was)
-            if runs >= attempts:
+        for job_id, runs, _, cancel in left:  # a restart's work said (only a second line was)
+            if cancel:
+                log.info("job %s, cancelled before a restart: cancelled", job_id)
+            elif runs >= attempts:
                 log.info("job %s interrupted by a restart after %d runs: failed", job_id, runs)
             else:
                 log.info("job %s interrupted by a restart: queued again (run %d of at most %d)",

@@ -216,6 +216,46 @@ def test_a_run_a_restart_failed_is_counted_without_the_downtime(tmp_path: Path) 
     assert store.statistics()[1] == (2, pytest.approx(finished - started, abs=1e-6))
 
 
+def test_a_cancel_asked_before_a_restart_ends_the_job_cancelled(
+    tmp_path: Path, caplog: pytest.LogCaptureFixture
+) -> None:
+    """Audit 26's F5: a running job cancelled, the service stopped before its worker ended it:
+    queued again after the restart it never ran (no cancelled job is handed out) and never
+    ended, holding a place in the queue. Cancelled now, its downtime not counted."""
+    store = JobStore(tmp_path / "jobs.sqlite3")
+    asked, other = (store.create("evaluate", EVALUATE) for _ in range(2))
+    assert store.start(asked.id) and store.start(other.id)
+    store.cancel(asked.id)
+    with sqlite3.connect(store.path) as db:  # the service was down for 1,000 s
+        db.execute("UPDATE jobs SET started = started - 1000")
+    with caplog.at_level(logging.INFO, logger="dtf.jobs"):
+        assert store.recover(attempts=3) == [other.id]
+    state = store.state(asked.id)
+    assert state is not None and state.status == "cancelled" and state.finished is not None
+    assert store.queued(exclude=set(), limit=9) == [other.id]
+    assert f"job {asked.id}, cancelled before a restart: cancelled" in caplog.messages
+    assert store.statistics()[1] == (1, 0.0)
+
+
+def test_a_cancelled_job_whose_worker_dies_is_cancelled_not_failed(tmp_path: Path) -> None:
+    """Audit 26's F11: a cancel asked, then the worker killed before it ended the job: the job
+    was failed, "in each of the job's 3 runs", after one run. Its user asked it to stop."""
+    store = JobStore(tmp_path / "jobs.sqlite3")
+    asked, dead = (store.create("evaluate", EVALUATE) for _ in range(2))
+    error = [{"loc": [], "msg": "the worker process ended", "type": "interrupted"}]
+    for job in (asked, dead):
+        assert store.start(job.id)
+    store.cancel(asked.id)
+    assert store.retry(asked.id, attempts=3, error=error) == "cancelled"
+    state = store.state(asked.id)
+    assert state is not None and state.status == "cancelled" and state.error is None
+    assert store.retry(dead.id, attempts=3, error=error) == "queued"  # its first run of three
+    assert store.start(dead.id)
+    assert store.retry(dead.id, attempts=2, error=error) == "failed"
+    failed = store.state(dead.id)
+    assert failed is not None and failed.status == "failed" and failed.error == error
+
+
 def test_a_job_queued_again_after_a_restart_starts_its_progress_again(tmp_path: Path) -> None:
     store = JobStore(tmp_path / "jobs.sqlite3")
     job = store.create("evaluate", EVALUATE)
