@@ -21,6 +21,7 @@ import numpy as np
 from playwright.sync_api import Page, Route
 from scipy.spatial.transform import Rotation
 
+from tests.cases import EXAMPLES
 from tests.web.test_page import EXAMPLE_PATH, SMALL, cell_point, fill, grid_of, run_small_map
 from tests.web.test_page_cell import open_editor
 from tests.web.test_page_findings import choose_file, error_beside
@@ -682,3 +683,39 @@ def test_a_late_offer_of_the_last_map_does_not_follow_a_newer_map(page: Page, ur
     page.wait_for_timeout(2500)  # the slow answer about the first job has come meanwhile
     assert asked and page.is_hidden("#resume")
     assert page.get_attribute("#summary", "data-cells") == "30"  # the second map's
+
+
+def test_another_clients_job_shown_from_earlier_maps_is_only_stopped_watching(
+    page: Page, url: str
+) -> None:
+    """Audit 26's F1: a page showing another client's running map from Earlier maps cancelled
+    it with its Cancel (its owner's page said only 'cancelled'), though a new robot or path
+    leaves such a job running. Its Cancel now says and does 'Stop watching'."""
+    body = json.loads((EXAMPLES / "evaluate_request.json").read_text())
+    grid = {
+        "x": {"min": -0.5, "max": 0.5, "step": 0.004},
+        "y": {"min": 0.0, "max": 0.8, "step": 0.004},
+    }
+    request = {"robot": body["robot"], "path": body["path"], "grid": {**grid, "z": 0.1, "yaw": 0.0}}
+    submitted = httpx.post(f"{url}/v1/jobs", json={"kind": "map", "request": request}, timeout=30)
+    assert submitted.status_code == 202, submitted.text
+    job_id = submitted.json()["id"]
+    try:
+        reload_page(page)
+        page.click("#earlier summary")
+        page.click(f"#earlier-list li[data-job='{job_id}'] button")
+        page.wait_for_function(
+            "document.getElementById('job-status').textContent.startsWith('running')",
+            timeout=60_000,
+        )
+        assert page.text_content("#cancel") == "Stop watching"
+        page.click("#cancel")
+        page.wait_for_function(
+            "document.getElementById('job-status').textContent.startsWith('no longer watched')"
+        )
+        assert f"job {job_id} runs on" in (page.text_content("#job-status") or "")
+        assert page.text_content("#cancel") == "Cancel" and page.is_disabled("#cancel")
+        status = httpx.get(f"{url}/v1/jobs/{job_id}", timeout=30).json()["status"]
+        assert status in ("running", "done")
+    finally:
+        httpx.post(f"{url}/v1/jobs/{job_id}/cancel", timeout=30)

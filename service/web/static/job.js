@@ -108,8 +108,13 @@ async function resumeMap(id) {
   clearResults();
   dropOptimization("an earlier map was shown; optimise again for its inputs");
   $("resume").hidden = true;
-  const run = { id, resumed: true };
+  // Another client's job (from Earlier maps), or one this browser submitted before its last:
+  // its Cancel stops watching it, as a new robot or path does (dropRun), and leaves it to run.
+  let own = false;
+  try { own = localStorage.getItem(LAST_JOB_KEY) === id; } catch { /* storage refused */ }
+  const run = { id, resumed: true, own };
   state.run = run; $("run").disabled = true; $("cancel").disabled = false;
+  $("cancel").textContent = own ? "Cancel" : "Stop watching";
   disableEarlier();
   state.grid = asked.request.grid; state.mapBody = asked.request;
   await watch(run);
@@ -118,6 +123,7 @@ async function resumeMap(id) {
 function endRun() {
   state.run = null;
   $("cancel").disabled = true; $("run").disabled = false;
+  $("cancel").textContent = "Cancel";
   listEarlierMaps();
 }
 
@@ -245,5 +251,6 @@ async function cancelMap() {  // POST .../cancel: DELETE would forget the job
   const run = state.run;
   if (!run || !run.id) return;
   if (run.reading) { dropRun("the map's cells were not all read"); return; }  // the job is done
+  if (run.resumed && !run.own) { dropRun("stopped watching; not this browser's job"); return; }
   await api("POST", `/v1/jobs/${run.id}/cancel`).catch(() => null);
 }
