@@ -152,6 +152,25 @@ def test_a_map_job_pages_equal_the_map_routes_cells(
     assert listed["progress"]["total"] == 2500
 
 
+def test_a_page_read_while_another_client_deletes_the_job_is_a_404(
+    client: TestClient, paged_store: Settings, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Audit 26's F10: the job's state read, then deleted by another client, then its cells
+    read (none): the page answered 200 with the whole total, no cells and itself as next."""
+    job_id = done_map_job(client)
+    read = JobStore.cells_json
+
+    def deleted_first(store: JobStore, job: str, *, offset: int, limit: int) -> tuple[str, int]:
+        store.delete(job)  # the other client's DELETE, between the two reads
+        return read(store, job, offset=offset, limit=limit)
+
+    monkeypatch.setattr(JobStore, "cells_json", deleted_first)
+    page = client.get(f"/v1/jobs/{job_id}/result", params={"offset": 1000, "limit": 100})
+    assert page.status_code == 404, page.text
+    assert page.json()["detail"][0]["loc"] == ["path", "job_id"]
+    assert "deleted while its page was read" in page.json()["detail"][0]["msg"]
+
+
 def test_a_map_jobs_progress_leaves_its_storing_a_share(tmp_path: Path) -> None:
     """The placements done, a map job has its cells to write: their progress is reported as
     their share of the job (about four fifths on a UR5's map of the example path), so its ETA

@@ -82,6 +82,10 @@ def get_job_result_page(
     cells, count = store.cells_json(state.id, offset=offset, limit=page_limit)
     end = offset + count
     total = state.cells if state.cells is not None else store.cell_count(state.id)
+    if count == 0 and offset < total and store.state(state.id) is None:
+        # deleted by another client between the state's read and the cells': a page of no
+        # cells within the total, whose next is itself, would be the answer (audit 26, F10)
+        raise job_not_found(job_id, why=" (deleted while its page was read)")
     after = page_url(state.id, offset=end, limit=page_limit) if end < total else None
     head = {"offset": offset, "limit": page_limit, "total": total, "next": after}
     # The cells are stored JSON, copied as they are: the page's text is put together here.
