@@ -152,8 +152,10 @@ class Settings(BaseSettings):
         default=20.0,
         gt=0.0,
         description="Longest time (s) one IPOPT solve of /v1/optimize may take, by the wall "
-        "clock (other requests' work does not count); it then stops and its best point so far "
-        "is judged by the evaluator like any other.",
+        "clock; it then stops and its best point so far is judged by the evaluator like any "
+        "other. On a machine busy with other work a "
+        "solve does fewer iterations in that time, so an answer it stops can depend on the load "
+        "(the process's CPU time, IPOPT's other limit, would count every request's work).",
     )
     data_dir: Path = Field(
         default=Path("var"),
