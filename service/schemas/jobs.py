@@ -228,6 +228,7 @@ class JobResultPage(ResponseModel):
                     "total": 500000,
                     "cells": [_CELL],
                     "next": "/v1/jobs/0b6f3c1e-7f1e-4d0a-9d55-3c5d8b1f2a10/result?offset=1&limit=1",
+                    "next_offset": 1,
                 }
             ]
         }
@@ -241,3 +242,8 @@ class JobResultPage(ResponseModel):
         "fewer than ``limit`` at the end."
     )
     next: str | None = Field(description="The URL of the next page; null on the last one.")
+    next_offset: int | None = Field(
+        default=None,
+        description="The next page's offset (its limit this page's), as ``next`` asks it: for a "
+        "client that calls the operation with its parameters; null on the last page.",
+    )

@@ -140,6 +140,10 @@ def test_a_map_job_pages_equal_the_map_routes_cells(
         assert page.json()["offset"] == len(cells) and page.json()["total"] == 2500
         cells += page.json()["cells"]
         url = page.json()["next"]
+        # the same page by parameters, for a client that calls the operation with them
+        offset = page.json()["next_offset"]
+        assert (url is None) == (offset is None)
+        assert url is None or url == f"/v1/jobs/{job_id}/result?offset={offset}&limit=700"
     assert cells == expected["cells"]
     middle = client.get(f"/v1/jobs/{job_id}/result", params={"offset": 1990, "limit": 25})
     assert middle.json()["cells"] == expected["cells"][1990:2015]

@@ -87,7 +87,13 @@ def get_job_result_page(
         # cells within the total, whose next is itself, would be the answer (audit 26, F10)
         raise job_not_found(job_id, why=" (deleted while its page was read)")
     after = page_url(state.id, offset=end, limit=page_limit) if end < total else None
-    head = {"offset": offset, "limit": page_limit, "total": total, "next": after}
+    head = {
+        "offset": offset,
+        "limit": page_limit,
+        "total": total,
+        "next": after,
+        "next_offset": end if end < total else None,
+    }
     # The cells are stored JSON, copied as they are: the page's text is put together here.
     text = json.dumps(head)[:-1] + f', "cells": {cells}}}'
     return Response(text, media_type="application/json")
