@@ -92,14 +92,17 @@ def import_text(answer: PathImportResponse, name: str) -> str:
         _units(answer.units, answer.units_source, answer.units_note),
         _end(answer.ended, answer.end_note),
         f"feed: {_feed(answer.feed)} (the highest programmed)",
+        *_programmed_time(answer),
         "passes:",
     ]
     # Passes from 0, as the waypoints and the API's failed_pass and messages count them (this
     # listing counted from 1, and a failure's "pass 0" was the listing's pass 1).
     for number, part in enumerate(answer.pass_details):
+        way = "" if part.length is None else f", {_fixed(part.length * 1e3, 1)} mm"
+        took = "" if part.time is None else f" in {_fixed(part.time, 1)} s as programmed"
         lines.append(
             f"  {number:3d}  waypoints {part.start}-{part.stop - 1}  "
-            f"{part.operation or '-'}  {_feed(part.feed)}"
+            f"{part.operation or '-'}  {_feed(part.feed)}{way}{took}"
         )
     if answer.skipped_records:
         lines.append("skipped records (no geometry, no feed):")
@@ -107,6 +110,18 @@ def import_text(answer: PathImportResponse, name: str) -> str:
         known = "" if record.recognised else "  (not recognised: check it moves nothing)"
         lines.append(f"  {record.word}: {record.count} (first at line {record.first_line}){known}")
     return "\n".join(lines)
+
+
+def _programmed_time(answer: PathImportResponse) -> list[str]:
+    """The program's cutting time at its programmed feeds, where every pass has one."""
+    times = [part.time for part in answer.pass_details]
+    if not times or any(t is None for t in times):
+        return []
+    total = sum(t for t in times if t is not None)
+    return [
+        f"cutting time: {_fixed(total, 1)} s at the programmed feeds (the passes' moves: not the "
+        "rapids, nor the moves from their targets into the passes)"
+    ]
 
 
 def _passes(count: int) -> str:

@@ -9,6 +9,8 @@ from __future__ import annotations
 
 from typing import Any
 
+import numpy as np
+
 from service import schemas
 from service.schemas.path_input import PathInput
 
@@ -18,6 +20,16 @@ NO_END_RECORD = {
     None: "waypoints sent as JSON have no end record: the path is taken as sent",
 }
 """``end_note`` of the forms with no end record (``ended`` null), by ``cam_form``."""
+
+
+def _time(moves: np.ndarray, path: PathInput, start: int, stop: int) -> float | None:
+    """The pass's moves at their programmed feeds (s); None where a move has none."""
+    if path.segment_feeds is None:
+        return None
+    feeds = path.segment_feeds[start : stop - 1]
+    if not np.all(feeds > 0.0):  # NaN: no feed programmed
+        return None
+    return float((moves / feeds).sum())
 
 
 def read_fields(path: PathInput) -> dict[str, Any]:
@@ -30,13 +42,21 @@ def read_fields(path: PathInput) -> dict[str, Any]:
     operations = path.pass_operations or (None,) * len(passes)
     feeds = path.pass_feeds or (path.feed,) * len(passes)
     report = path.report
+    moves = np.linalg.norm(np.diff(path.poses[:, :3, 3], axis=0), axis=-1)  # move i: i -> i + 1
     return {
         "units": path.units,
         "units_source": path.units_source,
         "units_note": path.units_note,
         "feed": path.feed,
         "pass_details": [
-            schemas.PassOut(start=start, stop=stop, operation=operation, feed=feed)
+            schemas.PassOut(
+                start=start,
+                stop=stop,
+                operation=operation,
+                feed=feed,
+                length=float(moves[start : stop - 1].sum()),
+                time=_time(moves[start : stop - 1], path, start, stop),
+            )
             for (start, stop), operation, feed in zip(passes, operations, feeds, strict=True)
         ],
         "skipped_records": []

@@ -43,6 +43,9 @@ class PathInput:
         lines: shape (N,), int, the line of the program (from 1) each waypoint was read from
             (CAM input: an arc's inner points the CIRCLE's line, its end the GOTO's); ``None``
             for poses and tool axes.
+        segment_feeds: shape (N,), m/s, the programmed feed of each waypoint's move to the next
+            (:attr:`solver.cam.cam_path.CamPath.feeds`), NaN where none; ``None`` for poses and
+            tool axes.
     """
 
     poses: np.ndarray
@@ -60,6 +63,7 @@ class PathInput:
     cam_form: Literal["cl_data", "csv"] | None = None
     source: str = "path.waypoints"
     lines: np.ndarray | None = None
+    segment_feeds: np.ndarray | None = None
 
     @classmethod
     def from_cam(
@@ -90,4 +94,5 @@ class PathInput:
             cam_form=form,
             source=field,
             lines=cam.lines,
+            segment_feeds=cam.feeds,
         )

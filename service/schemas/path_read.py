@@ -36,7 +36,16 @@ class PassOut(ResponseModel):
 
     model_config = ConfigDict(
         json_schema_extra={
-            "examples": [{"start": 0, "stop": 108, "operation": "CAVITY_MILL", "feed": 0.004233}]
+            "examples": [
+                {
+                    "start": 0,
+                    "stop": 108,
+                    "operation": "CAVITY_MILL",
+                    "feed": 0.004233,
+                    "length": 0.2381,
+                    "time": 61.7,
+                }
+            ]
         }
     )
 
@@ -47,6 +56,16 @@ class PassOut(ResponseModel):
         "where the file names none."
     )
     feed: float | None = Field(description="Its highest programmed feed (m/s), or null.")
+    length: float | None = Field(
+        default=None, description="The tool point's way along the pass (m), its moves summed."
+    )
+    time: float | None = Field(
+        default=None,
+        description="How long the pass runs as programmed (s): each of its moves' length at its "
+        "programmed feed, from its first waypoint (the move into it from a rapid's target is "
+        "no pass's; a move that only turns the tool counts 0; no ramps); null where a move has "
+        "no feed (poses and tool axes, or a CSV without feeds).",
+    )
 
 
 UNITS_SOURCE = (

@@ -112,7 +112,9 @@ def test_poses_say_their_units_come_from_the_api(client: TestClient) -> None:
     ]
     read = imported(client, {"tool_axis_waypoints": axes})
     assert (read["units"], read["units_source"], read["skipped_records"]) == ("m", "request", [])
-    assert read["pass_details"] == [{"start": 0, "stop": 2, "operation": None, "feed": None}]
+    assert read["pass_details"] == [
+        {"start": 0, "stop": 2, "operation": None, "feed": None, "length": 0.01, "time": None}
+    ]
 
 
 def repeated_program(n_points: int, repeats: int) -> str:

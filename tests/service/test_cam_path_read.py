@@ -14,6 +14,7 @@ from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
+import numpy as np
 import pytest
 from fastapi.testclient import TestClient
 
@@ -89,7 +90,12 @@ def test_a_csv_says_the_request_gave_its_units(client: TestClient) -> None:
     csv = "x,y,z,i,j,k\n0,0,0,0,0,1\n10,0,0,0,0,1\n20,0,1,0,0,1\n"
     read = answer_of(client, "evaluate", {"csv": csv, "units": "mm"})["path_read"]
     assert (read["form"], read["units"], read["units_source"]) == ("csv", "mm", "request")
-    assert read["pass_details"] == [{"start": 0, "stop": 3, "operation": None, "feed": None}]
+    (part,) = read["pass_details"]
+    assert part["length"] == pytest.approx((10.0 + np.hypot(10.0, 1.0)) / 1000.0, rel=1e-12)
+    assert part == {
+        "start": 0, "stop": 3, "operation": None, "feed": None, "length": part["length"],
+        "time": None,  # no feed: no time as programmed
+    }  # fmt: skip
     assert read["ended"] is None and read["end_note"].startswith("a CSV has no end record")
 
 
