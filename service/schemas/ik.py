@@ -100,7 +100,8 @@ class AutoIkPolicy(RequestModel):
     branch: Literal["auto"] = Field(
         default="auto",
         description='"auto": each candidate follows its own feasible branch, continuous along '
-        "the path, and the answer uses the best.",
+        "the path, and the answer uses the best. The optimisers search no fixed branch: a "
+        "configuration the cell requires is mapped (/v1/map with that branch) or evaluated.",
     )
     max_joint_step: float = Field(
         default=DEFAULT_MAX_JOINT_STEP,
