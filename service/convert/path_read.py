@@ -82,13 +82,6 @@ def path_read_of(path: PathInput) -> schemas.PathRead | None:
     return schemas.PathRead(form=path.cam_form, **read_fields(path))
 
 
-def line_at(path: PathInput, waypoint: int | None) -> int | None:
-    """The line of the program (from 1) ``waypoint`` was read from, of CAM input; else None."""
-    if path.lines is None or waypoint is None or not 0 <= waypoint < len(path.lines):
-        return None
-    return int(path.lines[waypoint])
-
-
 def pass_at(path: PathInput, waypoint: int | None) -> tuple[int | None, str | None]:
     """The pass (its index, from 0) holding ``waypoint`` and its operation's name, of CAM input.
 
