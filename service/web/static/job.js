@@ -150,8 +150,10 @@ function cancelJob(id) {
 
 // A request about the job that gets no answer (the network, the service restarting: jobs
 // survive a restart) or an error (a 5xx: the job store unusable, the service stopping) is asked
-// again after these waits (ms); then the page gives up.
-const POLL_RETRIES_MS = [500, 1000, 2000, 4000];
+// again after these waits (ms), about two and a half minutes in all; then the page gives up. A
+// first start after an upgrade compiles the kernels (two minutes on two cores): 7.5 s of
+// waits gave up on a job the restarted service then ran (audit 26, O2).
+const POLL_RETRIES_MS = [500, 1000, 2000, 4000, 8000, ...Array(9).fill(15000)];
 
 // GET url: its JSON, or an error that carries the HTTP status (none: no answer) and, in
 // error.answered, the status and what the service said of it (its detail's messages).
