@@ -183,8 +183,12 @@ def test_a_full_queue_is_a_json_429_with_retry_after(
         "request": {k: EXAMPLE[k] for k in ("robot", "path", "placement")},
     }
     answer = client.post("/v1/jobs", json=body)
-    assert _is_error_list(answer, 429)["type"] == "queue_full"
+    detail = _is_error_list(answer, 429)
+    assert detail["type"] == "queue_full"
     assert int(answer.headers["retry-after"]) > 0
+    # the page shows this beside its form: that the jobs are every client's, and when to retry
+    # (audit 26, O1: it said the limit only, to a user whose own queue was empty)
+    assert "every client's" in detail["msg"] and "Retry-After" in detail["msg"]
 
 
 def test_a_fault_is_a_json_500(monkeypatch: pytest.MonkeyPatch, tmp_path: Path) -> None:

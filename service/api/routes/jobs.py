@@ -115,7 +115,8 @@ async def post_job(
     except QueueFull:
         detail = ErrorDetail(
             loc=[],
-            msg=f"{settings.max_queued_jobs} jobs are queued or running (DTF_MAX_QUEUED_JOBS)",
+            msg=f"{settings.max_queued_jobs} jobs are queued or running, every client's "
+            "(DTF_MAX_QUEUED_JOBS): submit again once some have ended (Retry-After)",
             type="queue_full",
         )
         raise HTTPException(
