@@ -19,7 +19,7 @@ from numba import njit
 
 from solver.core.codes import OK, OK_MIRRORED, SINGULAR
 from solver.families.numeric.chain_kernel import drop_stale_cache, frames, jacobian_at, workspace
-from solver.families.numeric.lu_kernel import det_negative, lu_solve, normal_solve
+from solver.families.numeric.lu_kernel import damped_solve, det_negative
 
 drop_stale_cache(Path(__file__))
 
@@ -94,7 +94,7 @@ def _levenberg_marquardt(  # type: ignore[no-untyped-def]  # pragma: no cover - 
     (steps, ratio), give up (False) at every ``steps``-th step where |e|_inf is above ``ratio``
     times what it was ``steps`` steps before (``ik.solve``'s ``stall``); steps 0: never. On
     return ``work`` holds the frames of the last iterate (:func:`chain_kernel.frames`). The
-    damped normal equations are solved by LDL^T (:func:`lu_kernel.normal_solve`; LU where that
+    damped normal equations are solved by LDL^T (:func:`lu_kernel.damped_solve`; LU where that
     meets a pivot not positive), numpy's reference by LU: the same step to rounding.
     """
     tolerance, scale, floor = constants[0], constants[1], constants[2]
@@ -126,7 +126,7 @@ def _levenberg_marquardt(  # type: ignore[no-untyped-def]  # pragma: no cover - 
             _normal(jac, normal)
         for i in range(6):
             normal[i, i] += damping
-        if not (normal_solve(normal, error) or lu_solve(normal, error)):
+        if not damped_solve(normal, error):
             return False
         for j in range(n):
             moved = q[j]

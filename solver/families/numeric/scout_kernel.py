@@ -18,12 +18,7 @@ from solver.core.codes import OK, OK_MIRRORED, SINGULAR
 from solver.families.numeric import ik_kernel
 from solver.families.numeric.chain_kernel import drop_stale_cache, frames, jacobian_at
 from solver.families.numeric.ik_kernel import _levenberg_marquardt, _pose_error, _singular
-from solver.families.numeric.lu_kernel import (
-    det_negative,
-    lu_solve,
-    lu_solve_signed,
-    normal_solve,
-)
+from solver.families.numeric.lu_kernel import damped_solve, det_negative, lu_solve, lu_solve_signed
 
 drop_stale_cache(Path(__file__), Path(ik_kernel.__file__))
 
@@ -155,7 +150,7 @@ def rough_steps(chain, q, target_r, target_p, steps, residual, constants, work):
             return False
         for i in range(6):
             normal[i, i] += scale * 0.5 * energy + floor
-        if not (normal_solve(normal, error) or lu_solve(normal, error)):
+        if not damped_solve(normal, error):
             return False
         for j in range(n):
             q[j] += (
