@@ -23,13 +23,16 @@ NO_END_RECORD = {
 
 
 def _time(moves: np.ndarray, path: PathInput, start: int, stop: int) -> float | None:
-    """The pass's moves at their programmed feeds (s); None where a move has none."""
+    """The moves of the pass [start, stop) at their programmed feeds (s); None where one has none.
+
+    ``moves``: every move's length (m), move i from waypoint i to i + 1.
+    """
     if path.segment_feeds is None:
         return None
     feeds = path.segment_feeds[start : stop - 1]
     if not np.all(feeds > 0.0):  # NaN: no feed programmed
         return None
-    return float((moves / feeds).sum())
+    return float((moves[start : stop - 1] / feeds).sum())
 
 
 def read_fields(path: PathInput) -> dict[str, Any]:
@@ -55,7 +58,7 @@ def read_fields(path: PathInput) -> dict[str, Any]:
                 operation=operation,
                 feed=feed,
                 length=float(moves[start : stop - 1].sum()),
-                time=_time(moves[start : stop - 1], path, start, stop),
+                time=_time(moves, path, start, stop),
             )
             for (start, stop), operation, feed in zip(passes, operations, feeds, strict=True)
         ],
