@@ -107,8 +107,9 @@ GROUPS: dict[str, Callable[[], None]] = {
     "numeric7": lambda: _run("panda"),
 }
 """The kernels of the analytic families' maps and paths, of the cell, of the numeric chain (6
-and 7 joints). On a cold cache, alone, on the development machine: about 33, 19 (after the
-first), 67 and 35 s of CPU."""
+and 7 joints). On a cold cache, on the development machine, in scripts/run_tests.py's two
+processes (2026-12-06): about 50, 28 (after the first), 71 and 26 s (after numeric6; 45 s
+without)."""
 
 
 def main(groups: list[str]) -> int:

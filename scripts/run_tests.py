@@ -1,7 +1,7 @@
 """Run the tests: the kernels compiled first, most tests on two workers, the latency tests alone.
 
 1. The numba kernels are compiled into their disk cache (``scripts/compile_kernels.py``, its
-   groups in two processes, the cores): on a fresh clone about 140 s of CPU, which the two
+   groups in two processes, the cores): on a fresh clone about 180 s of CPU, which the two
    workers and the live servers they start would otherwise each spend on the kernels they meet
    together (the map kernels in a server's warm-up and in the other worker's tests at once).
 2. The tests on two worker processes (pytest-xdist, each module on one worker, handed out in
@@ -25,8 +25,12 @@ import time
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
-COMPILE_GROUPS = (("numeric6",), ("analytic", "cell", "numeric7"))
-"""scripts/compile_kernels.py's groups in two processes: about 70 and 85 s of CPU, cold."""
+COMPILE_GROUPS = (("numeric6", "numeric7"), ("analytic", "cell"))
+"""scripts/compile_kernels.py's groups in two processes: about 99 and 81 s on a fresh clone
+(2026-12-06). The numeric groups share a process, where the seven-joint group reuses the
+six-joint group's seeding and following (one signature each) and takes 26 s, not the 45 s it took
+beside the analytic and cell groups; these share the UR kernels. The earlier split, numeric6
+alone against the other three, took 126 s: 85 against 122."""
 COVERAGE = ["--cov=solver", "--cov=service", "--cov-report=term:skip-covered"]
 LATENCY_MODULES = (
     "tests/test_live_server.py",
