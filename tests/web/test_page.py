@@ -206,6 +206,11 @@ def test_the_page_shows_what_the_import_read(page: Page, url: str) -> None:
     )
     operations = page.locator("#import-passes tbody tr td:nth-child(3)").all_text_contents()
     assert operations == [p["operation"] for p in api["pass_details"]]
+    # numbered as the API's failed_pass and messages number them (from 0), its waypoints too
+    numbers = page.locator("#import-passes tbody tr td:nth-child(1)").all_text_contents()
+    assert numbers == [str(k) for k in range(len(api["passes"]))]
+    spans = page.locator("#import-passes tbody tr td:nth-child(2)").all_text_contents()
+    assert spans == [f"{start}-{stop - 1}" for start, stop in api["passes"]]
     skipped = page.locator("#import-skipped li").all_text_contents()
     assert skipped == [
         f"{s['word']}: {s['count']} (first at line {s['first_line']})"

@@ -288,10 +288,12 @@ async function showImport(name) {
   $("import-end").textContent = read.end_note;
   $("import-end").classList.toggle("cut-short", read.ended === false);
   const rows = $("import-passes").tBodies[0];
+  // Passes from 0, as the waypoints, the API's failed_pass and its messages (shown on this
+  // page) and the command line count them: this table counted from 1.
   read.pass_details.forEach((p, k) => {
     const row = rows.insertRow();
     const feed = p.feed == null ? "-" : (p.feed * 60000).toFixed(1);
-    for (const value of [k + 1, `${p.start}-${p.stop - 1}`, p.operation ?? "-", feed]) {
+    for (const value of [k, `${p.start}-${p.stop - 1}`, p.operation ?? "-", feed]) {
       row.insertCell().textContent = value;
     }
   });
