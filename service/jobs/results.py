@@ -48,6 +48,12 @@ CREATE TABLE IF NOT EXISTS job_cells (
     cells TEXT NOT NULL,
     PRIMARY KEY (job_id, page)
 );
+CREATE TABLE IF NOT EXISTS job_places (
+    id TEXT PRIMARY KEY,
+    created REAL NOT NULL,
+    forgotten REAL NOT NULL
+);
+CREATE INDEX IF NOT EXISTS job_places_forgotten ON job_places (forgotten);
 CREATE TABLE IF NOT EXISTS job_totals (
     one INTEGER PRIMARY KEY CHECK (one = 1),
     finished INTEGER NOT NULL,
@@ -62,7 +68,12 @@ BEGIN
     UPDATE job_totals SET finished = finished + 1, seconds = seconds + NEW.finished - NEW.started;
 END;
 """
-"""The jobs, their result pages, and the totals of the jobs that ran to an end (``/metrics``).
+"""The jobs, their result pages, the places of forgotten jobs in the listing, and the totals of
+the jobs that ran to an end (``/metrics``).
+
+A job deleted or expired leaves its id and submission time (``job_places``) for another TTL, so
+that a listing read in pages goes on after it (``GET /v1/jobs?after=<id>``) when another client
+deleted the last job of the page before.
 
 The totals only grow: a trigger adds each job as it finishes after running (done, failed,
 cancelled), whichever update finishes it; a deleted or expired job stays counted. A store

@@ -229,6 +229,7 @@ class JobStore(JobReads):
         cancel (the supervisor stops a worker that does not).
         """
         with self._connection() as db:
+            _keep_places(db, "SELECT id, created, ? FROM jobs WHERE id = ?", (time.time(), job_id))
             # The row first: a finish() after it writes nothing; one before it wrote cells that
             # the second statement removes.
             deleted = db.execute("DELETE FROM jobs WHERE id = ?", (job_id,)).rowcount
@@ -315,18 +316,33 @@ class JobStore(JobReads):
 
         The jobs are found by their end time (an index) and the pages by their job, so its
         cost is that of the jobs expired, not of the store (the supervisor runs it every
-        minute).
+        minute). Their places in the listing are kept for another ``ttl`` (:func:`_keep_places`),
+        and the places forgotten longer ago dropped.
         """
         expired = (
             "SELECT id FROM jobs WHERE finished < ? AND status IN ('done', 'failed', 'cancelled')"
         )
-        cutoff = time.time() - ttl
+        now = time.time()
+        cutoff = now - ttl
         with self._connection() as db:
+            db.execute("DELETE FROM job_places WHERE forgotten < ?", (cutoff,))
+            _keep_places(
+                db, f"SELECT id, created, ? FROM jobs WHERE id IN ({expired})", (now, cutoff)
+            )
             db.execute(f"DELETE FROM job_cells WHERE job_id IN ({expired})", (cutoff,))
             count = db.execute(f"DELETE FROM jobs WHERE id IN ({expired})", (cutoff,)).rowcount
             if count:
                 _give_back(db)
         return int(count)
+
+
+def _keep_places(db: sqlite3.Connection, jobs: str, args: tuple[object, ...]) -> None:
+    """Keep the id and submission time of the jobs ``jobs`` selects (id, created, now).
+
+    ``GET /v1/jobs?after=<id>`` goes on after a job's place in the listing; a client reading it
+    in pages got a 404 when another client deleted the last job of its page (audit 26, F4).
+    """
+    db.execute(f"INSERT OR REPLACE INTO job_places (id, created, forgotten) {jobs}", args)
 
 
 def _give_back(db: sqlite3.Connection) -> None:

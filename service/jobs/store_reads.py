@@ -34,6 +34,11 @@ from service.logs import log
 
 READ_PAGES = 50
 """Stored pages of cells read in one query by :meth:`JobReads.cell_pages` (about 11 MB)."""
+_PLACE = (
+    "SELECT created, id FROM jobs WHERE id = ? "
+    "UNION ALL SELECT created, id FROM job_places WHERE id = ? LIMIT 1"
+)
+"""A job's place in the listing (created, id), held or forgotten within a TTL (the id twice)."""
 
 
 class JobReads(StoreFile):
@@ -59,6 +64,11 @@ class JobReads(StoreFile):
                     job = dataclasses.replace(job, result=with_cells(job.result, cells))
         return job
 
+    def placed(self, job_id: str) -> bool:
+        """Whether the listing has a place for this id: a job held, or forgotten within a TTL."""
+        with self._connection() as db:
+            return db.execute(_PLACE, (job_id, job_id)).fetchone() is not None
+
     def state(self, job_id: str) -> JobState | None:
         """The job without its request and result, or None for an unknown id."""
         with self._connection() as db:
@@ -76,8 +86,9 @@ class JobReads(StoreFile):
             status: only the jobs of this status (None: all).
             kind: only the jobs of this kind (None: all).
             limit: at most this many.
-            after: the listing goes on after this job's place in it (the last id of a page);
-                an id the store does not hold gives no jobs.
+            after: the listing goes on after this job's place in it (the last id of a page),
+                a deleted or expired job's too while its place is kept (:meth:`placed`); an id
+                of neither gives no jobs.
         """
         conditions, args = [], []
         if status is not None:
@@ -86,8 +97,8 @@ class JobReads(StoreFile):
             conditions.append("kind = ?")
             args.append(kind)
         if after is not None:
-            conditions.append("(created, id) < (SELECT created, id FROM jobs WHERE id = ?)")
-            args.append(after)
+            conditions.append(f"(created, id) < ({_PLACE})")
+            args += [after, after]
         where = f" WHERE {' AND '.join(conditions)}" if conditions else ""
         query = f"SELECT {STATE_COLUMNS} FROM jobs{where} ORDER BY created DESC, id DESC LIMIT ?"
         with self._connection() as db:

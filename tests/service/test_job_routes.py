@@ -145,6 +145,23 @@ def test_the_job_listing_is_read_in_pages_with_after(client: TestClient, own_sto
     assert unknown.json()["detail"][0]["loc"] == ["query", "after"]
 
 
+def test_a_listing_goes_on_after_a_job_deleted_between_its_pages(
+    client: TestClient, own_store: Path
+) -> None:
+    """Another client deleting the last job of a page made the next page a 404 (audit 26, F4):
+    the listing goes on after its place, as if it were there."""
+    job = {"kind": "evaluate", "request": route_body("evaluate", EXAMPLE["path"])}
+    ids = [client.post("/v1/jobs", json=job).json()["id"] for _ in range(4)]
+    everything = [j["id"] for j in client.get("/v1/jobs").json()["jobs"]]
+    assert sorted(everything) == sorted(ids)
+    first = [j["id"] for j in client.get("/v1/jobs", params={"limit": 2}).json()["jobs"]]
+    assert client.delete(f"/v1/jobs/{first[-1]}").status_code == 204  # another client's delete
+    second = client.get("/v1/jobs", params={"limit": 2, "after": first[-1]})
+    assert second.status_code == 200, second.text
+    assert [j["id"] for j in second.json()["jobs"]] == everything[2:]
+    assert client.get(f"/v1/jobs/{first[-1]}").status_code == 404  # the job itself is gone
+
+
 def test_the_job_listing_is_filtered_by_kind(client: TestClient, own_store: Path) -> None:
     """The page listed its earlier maps among the newest 100 jobs of every kind: a client's
     evaluations could hide its maps. ``kind`` lists one kind, with ``status`` and ``after``."""

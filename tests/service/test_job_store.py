@@ -175,6 +175,27 @@ def test_an_expired_job_goes_with_its_result_pages(tmp_path: Path) -> None:
     assert stored_cells(store.path) == 1
 
 
+def test_an_expired_jobs_place_in_the_listing_is_kept_for_another_ttl(tmp_path: Path) -> None:
+    """``after`` an expired job goes on after its place (audit 26, F4), until a TTL after."""
+    store = JobStore(tmp_path / "jobs.sqlite3")
+    older, expired, newer = (store.create("evaluate", {"n": k}) for k in range(3))
+    for job in (older, expired, newer):
+        assert store.start(job.id)
+        store.finish(job.id, "done", result={})
+    with sqlite3.connect(store.path) as db:
+        db.execute("UPDATE jobs SET finished = finished - 100 WHERE id = ?", (expired.id,))
+        for k, job in enumerate((older, expired, newer)):  # submitted 1 s apart
+            db.execute("UPDATE jobs SET created = created + ? WHERE id = ?", (k, job.id))
+    assert store.expire(ttl=50.0) == 1 and store.state(expired.id) is None
+    assert store.placed(expired.id)
+    assert [j.id for j in store.jobs(status=None, limit=9, after=expired.id)] == [older.id]
+    with sqlite3.connect(store.path) as db:  # forgotten over a TTL ago
+        db.execute("UPDATE job_places SET forgotten = forgotten - 100")
+    assert store.expire(ttl=50.0) == 0
+    assert not store.placed(expired.id)
+    assert store.jobs(status=None, limit=9, after=expired.id) == []
+
+
 def test_a_restart_says_which_jobs_it_queued_again_and_which_failed(
     tmp_path: Path, caplog: pytest.LogCaptureFixture
 ) -> None:

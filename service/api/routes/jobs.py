@@ -159,8 +159,10 @@ def get_jobs(
         UUID | None,
         Query(
             description="A job's id: the listing goes on after that job's place in it (the "
-            "last id of the previous page; a position, whatever that job's kind or status). "
-            "An id the store does not hold (deleted or expired) is a 404 naming ``after``."
+            "last id of the previous page; a position, whatever that job's kind or status), "
+            "also when that job was deleted or expired since (its place is kept for another "
+            "DTF_JOB_TTL). An id the store never held, or forgot longer ago, is a 404 naming "
+            "``after``."
         ),
     ] = None,
 ) -> JobList:
@@ -171,10 +173,12 @@ def get_jobs(
     (jobs submitted in the same instant are in the order of their ids).
     """
     store = get_runner(settings).store
-    if after is not None and store.state(str(after)) is None:
+    if after is not None and not store.placed(str(after)):
         # a 404, as the same id in the path is: the job it names is not there
         raise job_not_found(
-            after, loc=("query", "after"), why=" (deleted, or expired after DTF_JOB_TTL)"
+            after,
+            loc=("query", "after"),
+            why=" (never held, or forgotten over DTF_JOB_TTL ago: its place in the listing too)",
         )
     states = store.jobs(
         status=job_status, kind=kind, limit=limit, after=None if after is None else str(after)
