@@ -26,7 +26,7 @@ from pathlib import Path
 from service.config import Settings
 from service.jobs.job import JobStoreUnavailable
 from service.jobs.store import JobStore
-from service.jobs.worker import serve
+from service.jobs.worker import UNSTORED, serve
 from service.logs import log
 
 POLL_SECONDS = 0.05
@@ -75,6 +75,7 @@ class JobRunner:
         self.store = JobStore(Path(settings.data_dir) / "jobs.sqlite3")
         self._context = multiprocessing.get_context("spawn")
         self._workers: list[_Worker] = []  # started when jobs first wait (each is 250 MB)
+        self._unsettled: set[str] = set()  # jobs whose worker could not store their end
         self._wake = threading.Event()
         self._stop = threading.Event()
         self._thread = threading.Thread(target=self._supervise, name="dtf-jobs", daemon=True)
@@ -128,6 +129,7 @@ class JobRunner:
                     self.store.expire(ttl=self.settings.job_ttl)
                     expired = now
                 self._watch()
+                self.settle()
                 waiting = self._dispatch()
             except JobStoreUnavailable as error:
                 if not failing:
@@ -154,11 +156,13 @@ class JobRunner:
                 continue
             if worker.connection.poll():
                 try:
-                    worker.connection.recv()
+                    answer = worker.connection.recv()
                 except (EOFError, OSError):
                     pass  # died as it answered: handled below
                 else:
                     self._workers[i] = _Worker(worker.process, worker.connection)
+                    if isinstance(answer, tuple) and answer[1] is False:  # its end not stored
+                        self._unsettled.add(job_id)
                     continue
             if not worker.process.is_alive():  # killed (out of memory, say): run again, a few times
                 attempts = self.settings.job_attempts
@@ -183,6 +187,30 @@ class JobRunner:
                     self.store.finish(job_id, "cancelled", if_running=True)
                     log.info("job %s cancelled (its worker was stopped)", job_id)
                     self._replace(i)
+
+    def settle(self) -> None:
+        """Queue again, or end, each job whose worker could not write its end nor its failure.
+
+        The store failed as the job ended (a full disk): the job is still ``running`` with no
+        worker. It is queued again, as a job whose worker died is, up to DTF_JOB_ATTEMPTS
+        runs, then failed; cancelled where its cancel was asked. A job the store cannot take
+        this either stays to be settled at the next look (the supervisor backs off meanwhile).
+        """
+        attempts = self.settings.job_attempts
+        for job_id in sorted(self._unsettled):
+            message = (
+                "its end could not be written to the job store (a full disk, say) in each of "
+                f"the job's {attempts} runs (DTF_JOB_ATTEMPTS)"
+            )
+            error = [{"loc": [], "msg": message, "type": UNSTORED}]
+            ended = self.store.retry(job_id, attempts=attempts, error=error)
+            self._unsettled.discard(job_id)
+            if ended == "queued":
+                log.warning("job %s queued again: its end could not be stored", job_id)
+            elif ended == "cancelled":
+                log.info("job %s cancelled (its end could not be stored)", job_id)
+            else:
+                log.error("job %s failed: %s", job_id, message)
 
     def _replace(self, i: int) -> None:
         self._workers[i].connection.close()

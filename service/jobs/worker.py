@@ -193,6 +193,33 @@ def serve(connection: Connection, store_path: str, settings_json: str) -> None:
             return  # the service has gone
         try:
             run_job(store, job_id, settings)
-        except JobStoreUnavailable as error:  # the supervisor reports it (once)
-            log.warning("job %s not run: %s", job_id, error)
-        connection.send(job_id)
+            stored = True
+        except JobStoreUnavailable as error:  # the supervisor reports the store (once)
+            stored = fail_unstored(store, job_id, error)
+        connection.send((job_id, stored))
+
+
+UNSTORED = "unstored"
+"""The error type of a job whose end the store could not take (a full disk, say)."""
+
+
+def fail_unstored(store: JobStore, job_id: str, error: JobStoreUnavailable) -> bool:
+    """End as failed a job whose end could not be written; whether that could be.
+
+    Writing its result failed (a full disk: rolled back, the job still running); a failure is a
+    small write, which the store often takes then. Left running, a job was polled ``running``
+    forever, kept its place in the queue and did not end on a cancel (the operator audit of
+    2026-12-07, H1; logged "not run" as a warning). Where even that write fails the worker
+    says so to the supervisor, which queues the job again or ends it once the store answers
+    (:meth:`service.jobs.runner.JobRunner.settle`). A job that did not start (the store
+    failing before it) is left as it was: ``if_running``.
+    """
+    message = f"its end could not be written to the job store: {error.reason}"
+    try:
+        detail = {"loc": [], "msg": message, "type": UNSTORED}
+        store.finish(job_id, "failed", error=[detail], if_running=True)
+    except JobStoreUnavailable as again:
+        log.error("job %s: %s; nor its failure (%s): to the supervisor", job_id, message, again)
+        return False
+    log.error("job %s failed: %s", job_id, message)
+    return True

@@ -19,7 +19,7 @@ from service.jobs.runner import IDLE_POLL_SECONDS, KILL_AFTER, POLL_SECONDS, Job
 from service.jobs.store import JobStore
 from service.logs import log
 from tests.cases import ROOT
-from tests.service.jobs_workers import stuck
+from tests.service.jobs_workers import full_for_ends, full_for_results, stuck
 
 EXAMPLE = json.loads((ROOT / "examples" / "evaluate_request.json").read_text())
 EVALUATE = {k: EXAMPLE[k] for k in ("robot", "path", "placement")}
@@ -72,6 +72,45 @@ def test_an_unexpected_exception_fails_the_job_with_its_message(
     assert failed.error == [
         {"loc": [], "msg": "internal error: ZeroDivisionError: a bug", "type": "internal"}
     ]
+
+
+def test_a_job_whose_result_the_store_cannot_take_ends_failed_saying_why(tmp_path: Path) -> None:
+    """On a full disk a job's result was not written and the job stayed running forever: polled
+    so, its cancel ignored, its queue place held (the operator audit, H1). Its failure, a small
+    write, is stored instead, naming the store's reason; the next job runs."""
+    runner = JobRunner(settings(tmp_path), worker=full_for_results)
+    try:
+        job = runner.store.create("evaluate", EVALUATE)
+        runner.wake()
+        ended = wait_for(runner.store, job.id, lambda j: j.status not in ("queued", "running"))
+        assert ended.status == "failed" and ended.error is not None, ended.status
+        assert ended.error[0]["type"] == worker.UNSTORED
+        assert "could not be written to the job store" in ended.error[0]["msg"]
+        assert "database or disk is full" in ended.error[0]["msg"]
+        assert ended.result is None
+        second = runner.store.create("evaluate", EVALUATE)
+        runner.wake()
+        assert wait_for(runner.store, second.id, lambda j: j.status == "failed").status == "failed"
+    finally:
+        runner.close()
+
+
+def test_a_job_whose_end_the_store_cannot_take_at_all_is_run_again_then_failed(
+    tmp_path: Path,
+) -> None:
+    """Where the worker's store takes not even the failure, the supervisor queues the job again
+    (as a dead worker's) and fails it after DTF_JOB_ATTEMPTS runs, saying why."""
+    runner = JobRunner(settings(tmp_path, job_attempts=2), worker=full_for_ends)
+    try:
+        job = runner.store.create("evaluate", EVALUATE)
+        runner.wake()
+        ended = wait_for(runner.store, job.id, lambda j: j.status not in ("queued", "running"))
+        assert ended.status == "failed" and ended.error is not None, ended.status
+        assert ended.attempts == 2
+        assert ended.error[0]["type"] == worker.UNSTORED
+        assert "in each of the job's 2 runs (DTF_JOB_ATTEMPTS)" in ended.error[0]["msg"]
+    finally:
+        runner.close()
 
 
 def test_a_dead_worker_is_replaced_and_its_job_run_again_up_to_its_attempts(
