@@ -7,6 +7,7 @@ import importlib.util
 import os
 import re
 import sys
+from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -160,8 +161,18 @@ class Settings(BaseSettings):
     data_dir: Path = Field(
         default=Path("var"),
         description="Where jobs and their results are kept (an SQLite file), created on first "
-        "start.",
+        "start; a relative path is taken from the working directory (the start log names the "
+        "file).",
     )
+
+    @field_validator("data_dir", mode="before")
+    @classmethod
+    def _named_directory(cls, value: object) -> object:
+        """Refuse an empty path: it meant the working directory (the operator audit, M6)."""
+        if isinstance(value, str) and not value.strip():
+            raise ValueError("an empty path; name a directory (the default is ./var)")
+        return value
+
     workers: int = Field(
         default_factory=lambda: os.cpu_count() or 1,
         gt=0,
@@ -314,7 +325,7 @@ def settings_or_exit(status: int | None = None) -> Settings:
     (``workers``), not the variable a deployment sets (``DTF_WORKERS``).
     """
     try:
-        return get_settings()
+        settings = get_settings()
     except ValidationError as error:
         for item in error.errors():
             name = "DTF_" + "_".join(str(part) for part in item["loc"]).upper()
@@ -322,6 +333,23 @@ def settings_or_exit(status: int | None = None) -> Settings:
             message = item["msg"].removeprefix("Value error, ")
             print(f"error: {name}={value[:100]!r}: {message}", file=sys.stderr)  # noqa: T201
         raise SystemExit(INVALID_SETTINGS if status is None else status) from None
+    for name in unknown_names(os.environ):
+        print(  # noqa: T201
+            f"warning: {name} is not a setting (misspelt?): ignored; the settings are in "
+            "README (Settings) and service/config.py",
+            file=sys.stderr,
+        )
+    return settings
+
+
+def unknown_names(environment: Mapping[str, str]) -> list[str]:
+    """The ``DTF_`` names in ``environment`` that are no setting, sorted.
+
+    pydantic-settings ignores them: ``DTF_WORKER=2`` (for DTF_WORKERS) ran one worker per
+    core without a word (the operator audit of 2026-12-07, M6).
+    """
+    known = {"DTF_" + name.upper() for name in Settings.model_fields}
+    return sorted(name for name in environment if name.startswith("DTF_") and name not in known)
 
 
 INVALID_SETTINGS = 3

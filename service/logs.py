@@ -22,3 +22,14 @@ def log_to_stderr() -> None:
         handler.setFormatter(logging.Formatter("%(asctime)s %(name)s %(message)s"))
         logger.addHandler(handler)
         logger.setLevel(logging.INFO)
+
+
+def duration(seconds: float) -> str:
+    """A length of time as a person reads it: ``7 days``, ``3 h``, ``45 min``, ``7 s``."""
+    if seconds >= 86400.0:
+        days = f"{seconds / 86400.0:.3g}"
+        return f"{days} day" if days == "1" else f"{days} days"
+    for unit, size in (("h", 3600.0), ("min", 60.0)):
+        if seconds >= size:
+            return f"{seconds / size:.3g} {unit}"
+    return f"{seconds:.3g} s"

@@ -13,6 +13,7 @@ import sys
 import threading
 import time
 from collections.abc import AsyncIterator
+from pathlib import Path
 from types import FrameType
 from typing import Any
 
@@ -29,7 +30,7 @@ from service.api import api_router
 from service.api.routes import health
 from service.body import BODY_MODELS
 from service.body_limits import BodySizeLimitMiddleware
-from service.config import get_settings, settings_or_exit
+from service.config import Settings, get_settings, settings_or_exit
 from service.errors import (
     SERVER_ERROR_RESPONSE,
     cancelled_handler,
@@ -41,7 +42,7 @@ from service.errors import (
 )
 from service.jobs.job import JobStoreUnavailable
 from service.jobs.runner import close_runners, get_runner
-from service.logs import log, log_to_stderr, startup_log
+from service.logs import duration, log, log_to_stderr, startup_log
 from service.metrics import instrument
 from service.query import known_query_parameters
 from service.spec import defaults_in_words, with_paged_map
@@ -111,6 +112,7 @@ async def lifespan(app: FastAPI) -> AsyncIterator[None]:
     )
     await anyio.to_thread.run_sync(_warm_up)
     startup_log.info("ready after %.1f s of warm-up", time.monotonic() - started)
+    startup_log.info(jobs_line(get_settings()))
     gc.collect()
     gc.freeze()  # what startup made lives on: full collections no longer walk it
     try:
@@ -119,6 +121,25 @@ async def lifespan(app: FastAPI) -> AsyncIterator[None]:
         log.error("jobs are unavailable: %s", error)
     yield
     close_runners()
+
+
+def jobs_line(settings: Settings) -> str:
+    """The start's line of where jobs are kept and run, and for how long.
+
+    The start named neither the store (a relative DTF_DATA_DIR, ``var`` by default, is taken
+    from the working directory: a unit without one put it in /var) nor the settings the jobs
+    run with (the operator audit of 2026-12-07, M6).
+    """
+    store = (Path(settings.data_dir) / "jobs.sqlite3").resolve()
+    where = (
+        f"their tasks on the Dask cluster at {settings.dask_scheduler}"
+        if settings.dask_scheduler
+        else f"{settings.workers} worker process(es) (DTF_WORKERS)"
+    )
+    return (
+        f"jobs: kept in {store}, finished ones for {duration(settings.job_ttl)} (DTF_JOB_TTL = "
+        f"{settings.job_ttl:g} s); {where}; maps on {settings.threads} thread(s) (DTF_THREADS)"
+    )
 
 
 def _warm_up() -> None:

@@ -27,7 +27,7 @@ from service.config import Settings
 from service.jobs.job import JobStoreUnavailable
 from service.jobs.store import JobStore
 from service.jobs.worker import UNSTORED, serve
-from service.logs import log
+from service.logs import duration, log
 
 POLL_SECONDS = 0.05
 """How often the supervisor looks at the workers and the queue while a job runs or waits (s)."""
@@ -106,10 +106,28 @@ class JobRunner:
         Returns:
             The ids queued, oldest first; they run as workers become idle.
         """
-        self.store.expire(ttl=self.settings.job_ttl)
+        self.expire()
         ids = self.store.recover(attempts=self.settings.job_attempts)
         self._wake.set()
         return ids
+
+    def expire(self) -> int:
+        """Forget the jobs that finished over DTF_JOB_TTL ago, saying how many; how many.
+
+        It was silent: DTF_JOB_TTL=7 (meant as days) emptied a 318 MB store at the next start
+        without a line (the operator audit of 2026-12-07, M5).
+        """
+        ttl = self.settings.job_ttl
+        count = self.store.expire(ttl=ttl)
+        if count:
+            log.info(
+                "forgot %d job(s) that finished over DTF_JOB_TTL = %g s (%s) ago, with their "
+                "results",
+                count,
+                ttl,
+                duration(ttl),
+            )
+        return count
 
     def _supervise(self) -> None:
         """Watch and dispatch every POLL_SECONDS; after a failure, log once and back off.
@@ -126,7 +144,7 @@ class JobRunner:
             try:
                 now = time.monotonic()
                 if now - expired >= min(self.settings.job_ttl, EXPIRE_SECONDS):
-                    self.store.expire(ttl=self.settings.job_ttl)
+                    self.expire()
                     expired = now
                 self._watch()
                 self.settle()

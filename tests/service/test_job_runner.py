@@ -113,6 +113,31 @@ def test_a_job_whose_end_the_store_cannot_take_at_all_is_run_again_then_failed(
         runner.close()
 
 
+def test_expired_jobs_are_said_as_they_go(tmp_path: Path, caplog: pytest.LogCaptureFixture) -> None:
+    """DTF_JOB_TTL=7 (meant as days) emptied a store at the next start without a line (the
+    operator audit, M5): the jobs forgotten are counted in the log, with the TTL in words."""
+    store = JobStore(tmp_path / "jobs.sqlite3")
+    old, kept = (store.create("evaluate", EVALUATE) for _ in range(2))
+    for job in (old, kept):
+        assert store.start(job.id)
+        store.finish(job.id, "done", result={})
+    with sqlite3.connect(store.path) as db:
+        db.execute("UPDATE jobs SET finished = finished - 100000 WHERE id = ?", (old.id,))
+    with caplog.at_level(logging.INFO, logger="dtf.jobs"):
+        runner = JobRunner(settings(tmp_path, job_ttl=86400.0))
+        try:
+            deadline = time.monotonic() + 10
+            while runner.store.get(old.id) is not None and time.monotonic() < deadline:
+                time.sleep(0.02)
+        finally:
+            runner.close()
+    assert runner.store.get(old.id) is None and runner.store.get(kept.id) is not None
+    said = [r.getMessage() for r in caplog.records if r.getMessage().startswith("forgot ")]
+    assert said == [
+        "forgot 1 job(s) that finished over DTF_JOB_TTL = 86400 s (1 day) ago, with their results"
+    ]
+
+
 def test_a_dead_worker_is_replaced_and_its_job_run_again_up_to_its_attempts(
     tmp_path: Path,
 ) -> None:

@@ -10,6 +10,7 @@ from pathlib import Path
 
 import pytest
 from fastapi.testclient import TestClient
+from pydantic import ValidationError
 
 from service.config import Settings
 from service.main import app
@@ -20,9 +21,39 @@ def test_the_warm_up_is_logged_before_and_after(caplog: pytest.LogCaptureFixture
     with caplog.at_level(logging.INFO, logger="dtf.startup"), TestClient(app):
         pass
     lines = [r.getMessage() for r in caplog.records if r.name == "dtf.startup"]
-    assert len(lines) == 2, lines
+    assert len(lines) == 3, lines
     assert "compiles them, about 30 s" in lines[0]
     assert lines[1].startswith("ready after ")
+    # where jobs are kept, as an absolute path, and the settings they run with (operator
+    # audit M6: a relative DTF_DATA_DIR is the working directory's, and nothing said which)
+    settings = Settings()
+    store = (Path(settings.data_dir) / "jobs.sqlite3").resolve()
+    assert lines[2].startswith(f"jobs: kept in {store}, finished ones for "), lines[2]
+    assert f"(DTF_JOB_TTL = {settings.job_ttl:g} s)" in lines[2]
+    assert f"{settings.workers} worker process(es) (DTF_WORKERS)" in lines[2]
+    assert f"maps on {settings.threads} thread(s) (DTF_THREADS)" in lines[2]
+
+
+def test_a_dtf_name_that_is_no_setting_is_warned_of() -> None:
+    """DTF_WORKER=2 (for DTF_WORKERS) was ignored without a word (operator audit, M6)."""
+    env = {**os.environ, "DTF_WORKER": "2"}
+    code = "from service.config import settings_or_exit; settings_or_exit()"
+    done = subprocess.run(
+        [sys.executable, "-c", code], capture_output=True, text=True, cwd=ROOT, env=env, timeout=60
+    )
+    assert done.returncode == 0, done.stderr[-800:]
+    assert done.stderr.startswith("warning: DTF_WORKER is not a setting (misspelt?): ignored")
+    assert "DTF_WORKERS" not in done.stderr and "DTF_DATA_DIR" not in done.stderr
+
+
+def test_an_empty_data_directory_is_refused(monkeypatch: pytest.MonkeyPatch) -> None:
+    """DTF_DATA_DIR= meant the working directory (operator audit, M6)."""
+    monkeypatch.setenv("DTF_DATA_DIR", "")
+    with pytest.raises(ValidationError, match="an empty path; name a directory"):
+        Settings()
+    monkeypatch.setenv("DTF_DATA_DIR", " ")
+    with pytest.raises(ValidationError, match="an empty path"):
+        Settings()
 
 
 @pytest.mark.parametrize(
