@@ -76,6 +76,8 @@ class JobRunner:
         self._context = multiprocessing.get_context("spawn")
         self._workers: list[_Worker] = []  # started when jobs first wait (each is 250 MB)
         self._unsettled: set[str] = set()  # jobs whose worker could not store their end
+        self.failure: str | None = None
+        """Why the supervisor's last look failed (the store's reason), None when it did not."""
         self._wake = threading.Event()
         self._stop = threading.Event()
         self._thread = threading.Thread(target=self._supervise, name="dtf-jobs", daemon=True)
@@ -152,12 +154,15 @@ class JobRunner:
             except JobStoreUnavailable as error:
                 if not failing:
                     log.error("jobs wait: %s (a look every %g s at most)", error, MAX_BACKOFF)
+                self.failure = error.reason
                 failing, delay = True, min(2.0 * delay, MAX_BACKOFF)
-            except Exception:  # noqa: BLE001 - the supervisor must outlive any one failure
+            except Exception as error:  # noqa: BLE001 - the supervisor must outlive any one failure
                 if not failing:
                     log.exception("job supervisor (looking again every %g s at most)", MAX_BACKOFF)
+                self.failure = f"the job supervisor failed: {type(error).__name__}: {error}"[:500]
                 failing, delay = True, min(2.0 * delay, MAX_BACKOFF)
             else:
+                self.failure = None
                 if failing:
                     log.warning("job supervisor: the store answers again; jobs run")
                 busy = waiting or any(w.job_id is not None for w in self._workers)
@@ -274,6 +279,11 @@ def get_runner(settings: Settings) -> JobRunner:
     if key not in _RUNNERS:
         _RUNNERS[key] = JobRunner(settings)
     return _RUNNERS[key]
+
+
+def runner_if_made(settings: Settings) -> JobRunner | None:
+    """The service's runner for these settings if one was made, without making one."""
+    return _RUNNERS.get(settings.model_dump_json())
 
 
 def close_runners() -> None:

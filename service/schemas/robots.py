@@ -40,11 +40,19 @@ class BranchLevel(ResponseModel):
 
 
 class HealthResponse(ResponseModel):
-    """The service is up."""
+    """The service is up; and whether its jobs can run."""
 
-    model_config = ConfigDict(json_schema_extra={"examples": [{"status": "ok"}]})
+    model_config = ConfigDict(json_schema_extra={"examples": [{"status": "ok", "jobs": "ok"}]})
 
     status: Literal["ok"] = Field(description='Always "ok" when the service answers.')
+    jobs: str = Field(
+        default="ok",
+        description='"ok", or "unavailable: <why>" while the job supervisor\'s last look at '
+        "the job store failed (a corrupt, deleted or unwritable file: the job routes answer "
+        "503 then); the synchronous routes serve either way. It says the last look, at most a "
+        "few seconds old: no store is read for it.",
+        examples=["ok"],
+    )
 
 
 class RobotInfo(ResponseModel):

@@ -300,3 +300,27 @@ def test_a_jobs_request_is_read_back_as_submitted(client: TestClient, kind: str)
     gone = client.get(f"/v1/jobs/{job['id']}/request")
     assert gone.status_code == 404
     assert gone.json()["detail"][0]["loc"] == ["path", "job_id"]
+
+
+def test_health_says_when_the_jobs_cannot_run_and_when_they_can_again(
+    client: TestClient, tmp_path: Path
+) -> None:
+    """A service whose job store could not be used answered /healthz "ok" alone (the operator
+    audit, M2): ``jobs`` says the supervisor's last look, without reading the store."""
+    assert client.get("/healthz").json()["jobs"] == "ok"
+    blocked = tmp_path / "not-a-directory"
+    blocked.write_text("a file where the data directory should be")
+    with served_with(Settings(data_dir=blocked, workers=1)):
+        assert client.get("/v1/jobs").status_code == 503  # the runner made, its store refused
+        deadline = time.monotonic() + 10
+        while (jobs := client.get("/healthz").json()["jobs"]) == "ok":
+            assert time.monotonic() < deadline, "the supervisor never looked"
+            time.sleep(0.05)
+        assert jobs.startswith("unavailable: the job store ") and str(blocked) in jobs, jobs
+        blocked.unlink()
+        blocked.mkdir()  # the directory now there: the next looks succeed
+        deadline = time.monotonic() + 15
+        while (jobs := client.get("/healthz").json()["jobs"]) != "ok":
+            assert time.monotonic() < deadline, jobs
+            time.sleep(0.05)
+    assert client.get("/healthz").json() == {"status": "ok", "jobs": "ok"}

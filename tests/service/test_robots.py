@@ -11,7 +11,7 @@ from tests.cases import NUMERIC_MODELS, OPW_MODELS, UR_MODELS
 def test_healthz(client: TestClient) -> None:
     response = client.get("/healthz")
     assert response.status_code == 200
-    assert response.json() == {"status": "ok"}
+    assert response.json() == {"status": "ok", "jobs": "ok"}
 
 
 def test_robots_lists_every_ur_and_opw_model(client: TestClient) -> None:
