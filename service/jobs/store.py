@@ -229,12 +229,13 @@ class JobStore(JobReads):
         cancel (the supervisor stops a worker that does not).
         """
         with self._connection() as db:
-            _keep_places(db, "SELECT id, created, ? FROM jobs WHERE id = ?", (time.time(), job_id))
+            places = db.execute("SELECT id, created FROM jobs WHERE id = ?", (job_id,)).fetchall()
             # The row first: a finish() after it writes nothing; one before it wrote cells that
             # the second statement removes.
             deleted = db.execute("DELETE FROM jobs WHERE id = ?", (job_id,)).rowcount
             db.execute("DELETE FROM job_cells WHERE job_id = ?", (job_id,))
             _give_back(db)
+            _keep_places(db, places)
         return bool(deleted)
 
     def recover(self, *, attempts: int) -> list[str]:
@@ -322,27 +323,39 @@ class JobStore(JobReads):
         expired = (
             "SELECT id FROM jobs WHERE finished < ? AND status IN ('done', 'failed', 'cancelled')"
         )
-        now = time.time()
-        cutoff = now - ttl
+        cutoff = time.time() - ttl
         with self._connection() as db:
             db.execute("DELETE FROM job_places WHERE forgotten < ?", (cutoff,))
-            _keep_places(
-                db, f"SELECT id, created, ? FROM jobs WHERE id IN ({expired})", (now, cutoff)
-            )
+            places = db.execute(
+                f"SELECT id, created FROM jobs WHERE id IN ({expired})", (cutoff,)
+            ).fetchall()
             db.execute(f"DELETE FROM job_cells WHERE job_id IN ({expired})", (cutoff,))
             count = db.execute(f"DELETE FROM jobs WHERE id IN ({expired})", (cutoff,)).rowcount
             if count:
                 _give_back(db)
+            _keep_places(db, places)
         return int(count)
 
 
-def _keep_places(db: sqlite3.Connection, jobs: str, args: tuple[object, ...]) -> None:
-    """Keep the id and submission time of the jobs ``jobs`` selects (id, created, now).
+def _keep_places(db: sqlite3.Connection, places: list[sqlite3.Row]) -> None:
+    """Keep the ids and submission times of jobs just forgotten (rows of id, created).
 
     ``GET /v1/jobs?after=<id>`` goes on after a job's place in the listing; a client reading it
     in pages got a 404 when another client deleted the last job of its page (audit 26, F4).
+    Written after the jobs are deleted, and only if the store takes it: on a full disk the
+    delete, which frees room, must not fail for want of room for their places (the listing
+    after such an id is then a 404, as before).
     """
-    db.execute(f"INSERT OR REPLACE INTO job_places (id, created, forgotten) {jobs}", args)
+    if not places:
+        return
+    now = time.time()
+    try:
+        db.executemany(
+            "INSERT OR REPLACE INTO job_places (id, created, forgotten) VALUES (?, ?, ?)",
+            [(row[0], row[1], now) for row in places],
+        )
+    except sqlite3.Error as error:
+        log.warning("the places of %d forgotten job(s) not kept: %s", len(places), error)
 
 
 def _give_back(db: sqlite3.Connection) -> None:

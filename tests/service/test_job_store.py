@@ -196,6 +196,24 @@ def test_an_expired_jobs_place_in_the_listing_is_kept_for_another_ttl(tmp_path: 
     assert store.jobs(status=None, limit=9, after=expired.id) == []
 
 
+def test_a_store_that_takes_no_place_still_deletes_and_expires_its_jobs(tmp_path: Path) -> None:
+    """On a full disk deleting a job frees room: it must not fail for want of room for the
+    job's place in the listing (kept after the delete, if the store takes it)."""
+    store = JobStore(tmp_path / "jobs.sqlite3")
+    deleted, expired = (store.create("evaluate", {"n": k}) for k in range(2))
+    assert store.start(expired.id)
+    store.finish(expired.id, "done", result={})
+    with sqlite3.connect(store.path) as db:  # every place refused, as a full disk would
+        db.execute(
+            "CREATE TRIGGER full BEFORE INSERT ON job_places "
+            "BEGIN SELECT RAISE(FAIL, 'database or disk is full'); END"
+        )
+        db.execute("UPDATE jobs SET finished = finished - 100 WHERE id = ?", (expired.id,))
+    assert store.delete(deleted.id) and store.state(deleted.id) is None
+    assert store.expire(ttl=50.0) == 1 and store.state(expired.id) is None
+    assert not store.placed(deleted.id) and not store.placed(expired.id)
+
+
 def test_a_restart_says_which_jobs_it_queued_again_and_which_failed(
     tmp_path: Path, caplog: pytest.LogCaptureFixture
 ) -> None:
