@@ -259,11 +259,22 @@ class JobRunner:
         return waiting
 
     def close(self) -> None:
-        """Stop the supervisor and the workers (unfinished jobs run again after a restart)."""
+        """Stop the supervisor and the workers (unfinished jobs run again after a restart).
+
+        Each job stopped so is logged: a shutdown said nothing until the next start queued it
+        again, and each such run counts against DTF_JOB_ATTEMPTS (the operator audit, L2).
+        """
         self._stop.set()
         self._wake.set()
         self._thread.join(timeout=5)
         for worker in self._workers:
+            if worker.job_id is not None and worker.process.is_alive():
+                log.warning(
+                    "job %s stopped by the shutdown: it runs again at the next start (a run "
+                    "of its DTF_JOB_ATTEMPTS = %d)",
+                    worker.job_id,
+                    self.settings.job_attempts,
+                )
             worker.process.kill()
         for worker in self._workers:
             worker.process.join(timeout=5)

@@ -133,8 +133,8 @@ class JobStore(JobReads):
         result: Result | None = None,
         error: list[dict[str, Any]] | None = None,
         if_running: bool = False,
-    ) -> None:
-        """Record how a job ended (with ``if_running``, only if it is still running).
+    ) -> bool:
+        """Record how a job ended (with ``if_running``, only if still running); whether it was.
 
         A job deleted meanwhile (or, with ``if_running``, not running) is left alone: nothing is
         written, its result's cells neither, in the transaction that looks for it. A job whose
@@ -159,6 +159,7 @@ class JobStore(JobReads):
                 if db.in_transaction:
                     db.execute("ROLLBACK")
                 raise
+        return row is not None
 
     @staticmethod
     def _finish(

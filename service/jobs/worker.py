@@ -217,9 +217,12 @@ def fail_unstored(store: JobStore, job_id: str, error: JobStoreUnavailable) -> b
     message = f"its end could not be written to the job store: {error.reason}"
     try:
         detail = {"loc": [], "msg": message, "type": UNSTORED}
-        store.finish(job_id, "failed", error=[detail], if_running=True)
+        ended = store.finish(job_id, "failed", error=[detail], if_running=True)
     except JobStoreUnavailable as again:
         log.error("job %s: %s; nor its failure (%s): to the supervisor", job_id, message, again)
         return False
-    log.error("job %s failed: %s", job_id, message)
+    if ended:
+        log.error("job %s failed: %s", job_id, message)
+    else:  # the store failed before the job ran (it waits, queued), or it was deleted
+        log.warning("job %s not run: %s", job_id, error.reason)
     return True

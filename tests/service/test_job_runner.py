@@ -113,6 +113,40 @@ def test_a_job_whose_end_the_store_cannot_take_at_all_is_run_again_then_failed(
         runner.close()
 
 
+def test_a_job_the_store_failed_before_it_ran_is_not_said_failed(
+    tmp_path: Path, caplog: pytest.LogCaptureFixture
+) -> None:
+    """The worker's answer to a failing store logged "failed" for a job the store had not even
+    started (it stays queued and runs later): a false ERROR line."""
+    store = JobStore(tmp_path / "jobs.sqlite3")
+    job = store.create("evaluate", EVALUATE)
+    with caplog.at_level(logging.INFO, logger="dtf.jobs"):
+        assert worker.fail_unstored(store, job.id, JobStoreUnavailable("the store is full"))
+    state = store.state(job.id)
+    assert state is not None and state.status == "queued"
+    said = [(r.levelname, r.getMessage()) for r in caplog.records if r.name == "dtf.jobs"]
+    assert said == [("WARNING", f"job {job.id} not run: the store is full")]
+
+
+def test_a_shutdown_says_which_running_jobs_it_stops(
+    tmp_path: Path, caplog: pytest.LogCaptureFixture
+) -> None:
+    """A shutdown killed a running job's worker without a line (the operator audit, L2)."""
+    runner = JobRunner(settings(tmp_path, job_attempts=3), worker=stuck)
+    job = runner.store.create("evaluate", EVALUATE)
+    runner.wake()
+    try:
+        assert wait_for(runner.store, job.id, lambda j: j.status == "running").status == "running"
+    finally:
+        with caplog.at_level(logging.INFO, logger="dtf.jobs"):
+            runner.close()
+    said = [r.getMessage() for r in caplog.records if "stopped by the shutdown" in r.getMessage()]
+    assert said == [
+        f"job {job.id} stopped by the shutdown: it runs again at the next start (a run of its "
+        "DTF_JOB_ATTEMPTS = 3)"
+    ]
+
+
 def test_expired_jobs_are_said_as_they_go(tmp_path: Path, caplog: pytest.LogCaptureFixture) -> None:
     """DTF_JOB_TTL=7 (meant as days) emptied a store at the next start without a line (the
     operator audit, M5): the jobs forgotten are counted in the log, with the TTL in words."""
