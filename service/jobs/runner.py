@@ -188,19 +188,8 @@ class JobRunner:
                         self._unsettled.add(job_id)
                     continue
             if not worker.process.is_alive():  # killed (out of memory, say): run again, a few times
-                attempts = self.settings.job_attempts
-                message = (
-                    f"the worker process ended (exit code {worker.process.exitcode}) in each of "
-                    f"the job's {attempts} runs (DTF_JOB_ATTEMPTS)"
-                )
-                error = [{"loc": [], "msg": message, "type": "interrupted"}]
-                ended = self.store.retry(job_id, attempts=attempts, error=error)
-                if ended == "queued":
-                    log.warning("job %s queued again: its worker process ended", job_id)
-                elif ended == "cancelled":  # its cancel was asked: not a failure of the job
-                    log.info("job %s cancelled (its worker process ended)", job_id)
-                else:
-                    log.error("job %s failed: %s", job_id, message)
+                cause = f"the worker process ended (exit code {worker.process.exitcode})"
+                self._run_again(job_id, cause, "interrupted")
                 self._replace(i)
             elif job_id in cancels:
                 worker.cancel_seen = worker.cancel_seen or now
@@ -219,21 +208,27 @@ class JobRunner:
         runs, then failed; cancelled where its cancel was asked. A job the store cannot take
         this either stays to be settled at the next look (the supervisor backs off meanwhile).
         """
-        attempts = self.settings.job_attempts
+        cause = "its end could not be written to the job store (a full disk, say)"
         for job_id in sorted(self._unsettled):
-            message = (
-                "its end could not be written to the job store (a full disk, say) in each of "
-                f"the job's {attempts} runs (DTF_JOB_ATTEMPTS)"
-            )
-            error = [{"loc": [], "msg": message, "type": UNSTORED}]
-            ended = self.store.retry(job_id, attempts=attempts, error=error)
+            self._run_again(job_id, cause, UNSTORED)
             self._unsettled.discard(job_id)
-            if ended == "queued":
-                log.warning("job %s queued again: its end could not be stored", job_id)
-            elif ended == "cancelled":
-                log.info("job %s cancelled (its end could not be stored)", job_id)
-            else:
-                log.error("job %s failed: %s", job_id, message)
+
+    def _run_again(self, job_id: str, cause: str, error_type: str) -> None:
+        """Queue again a running job whose run ended abnormally, or end it (``store.retry``).
+
+        Failed, once it has had DTF_JOB_ATTEMPTS runs, with the error ``error_type`` saying
+        ``cause`` in each; cancelled where its cancel was asked (not a failure of the job).
+        """
+        attempts = self.settings.job_attempts
+        message = f"{cause} in each of the job's {attempts} runs (DTF_JOB_ATTEMPTS)"
+        error = [{"loc": [], "msg": message, "type": error_type}]
+        ended = self.store.retry(job_id, attempts=attempts, error=error)
+        if ended == "queued":
+            log.warning("job %s queued again: %s", job_id, cause)
+        elif ended == "cancelled":
+            log.info("job %s cancelled: %s", job_id, cause)
+        else:
+            log.error("job %s failed: %s", job_id, message)
 
     def _replace(self, i: int) -> None:
         self._workers[i].connection.close()

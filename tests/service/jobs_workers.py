@@ -28,10 +28,10 @@ def full_for_results(connection: Connection, store_path: str, settings_json: str
     """``serve`` on a store that cannot take a job's result (a full disk), but its failure."""
     finish = JobStore.finish
 
-    def no_result(self: JobStore, job_id: str, status: Status, **ends: Any) -> None:
+    def no_result(self: JobStore, job_id: str, status: Status, **ends: Any) -> bool:
         if status == "done":
             raise JobStoreUnavailable(FULL.format(store_path))
-        finish(self, job_id, status, **ends)
+        return finish(self, job_id, status, **ends)
 
     JobStore.finish = no_result  # type: ignore[method-assign]
     serve(connection, store_path, settings_json)
@@ -40,7 +40,7 @@ def full_for_results(connection: Connection, store_path: str, settings_json: str
 def full_for_ends(connection: Connection, store_path: str, settings_json: str) -> None:
     """``serve`` on a store that takes no job's end at all (a full disk, a failure too)."""
 
-    def no_end(self: JobStore, job_id: str, status: Status, **ends: Any) -> None:
+    def no_end(self: JobStore, job_id: str, status: Status, **ends: Any) -> bool:
         raise JobStoreUnavailable(FULL.format(store_path))
 
     JobStore.finish = no_end  # type: ignore[method-assign]

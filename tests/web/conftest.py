@@ -46,7 +46,7 @@ def browser() -> Iterator[Browser]:
 
 @pytest.hookimpl(wrapper=True)
 def pytest_runtest_makereport(item: pytest.Item) -> Iterator[None]:
-    """Each phase's report kept on its test (``item.failed_call``), for :func:`page`."""
+    """Whether a test's call failed, kept on it (``item.failed_call``), for :func:`page`."""
     report = yield
     if report.when == "call":
         item.failed_call = report.failed  # type: ignore[attr-defined]
