@@ -32,6 +32,7 @@ import numpy as np
 from numba import njit
 
 from solver.path.cell.advance import clear_until as advance
+from solver.path.cell.advance import travelled
 from solver.path.cell.closed_form import box_param, params
 from solver.path.cell.kernel_cache import drop_stale_cell_kernels
 from solver.path.cell.kinematics import parts as _parts
@@ -144,6 +145,7 @@ def first_due(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
     radius, exact = robot[8], robot[9]
     kind, o_ends, o_radius, o_rot, o_centre, o_half, o_exact = obstacles[:7]
     n_robot = radius.shape[0]
+    travel = travelled(configurations)  # each joint's running travel (advance.py's search)
     # Each pair waits in the bucket of the configuration it is next due at (a linked list per
     # configuration: head, then following): a configuration costs its due pairs, not a look at
     # every pair and their minimum (the UR5e's ERK-size map's sweep 74 -> 65 ms on one thread;
@@ -186,7 +188,9 @@ def first_due(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
                     need[p] = needed = True
                     p = after
                     continue
-            clear_until[p] = advance(configurations, weights, p, index, distance - clearance)
+            clear_until[p] = advance(
+                configurations, travel, weights, p, index, distance - clearance
+            )
             due = clear_until[p] + 1
             if due < count:
                 following[p], head[due] = head[due], p
