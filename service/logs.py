@@ -14,14 +14,26 @@ request_log = logging.getLogger("dtf.requests")
 """Requests whose client left before the answer (uvicorn writes no access line for them)."""
 
 
+FORMAT = "%(asctime)s %(levelname)s %(name)s %(message)s"
+"""The lines' form where no logging configuration of the operator's places them."""
+
+
 def log_to_stderr() -> None:
-    """Send the service's own log lines (``dtf.*``, INFO and up) to stderr, once."""
+    """Send the service's own log lines (``dtf.*``, INFO and up) to stderr, once.
+
+    Unless logging is configured already (``uvicorn --log-config`` of a file that gives the
+    root logger a handler, or ``dtf`` one): the lines then go where that configuration sends
+    them, in its form and at its levels. A handler of their own besides wrote each line twice
+    there, one copy without a level, and INFO whatever the configuration said (the operator
+    audit of 2026-12-07, M3). Each line says its level (``WARNING``, ``ERROR``).
+    """
     logger = logging.getLogger("dtf")
-    if not logger.handlers:
-        handler = logging.StreamHandler()
-        handler.setFormatter(logging.Formatter("%(asctime)s %(name)s %(message)s"))
-        logger.addHandler(handler)
-        logger.setLevel(logging.INFO)
+    if logger.handlers or logging.getLogger().handlers:
+        return
+    handler = logging.StreamHandler()
+    handler.setFormatter(logging.Formatter(FORMAT))
+    logger.addHandler(handler)
+    logger.setLevel(logging.INFO)
 
 
 def duration(seconds: float) -> str:
