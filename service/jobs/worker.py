@@ -27,10 +27,10 @@ from service.config import Settings
 from service.convert.errors import request_errors, solver_error_location, solver_error_type
 from service.convert.map_json import cell_pages
 from service.jobs.dask_runner import ClusterUnavailable
-from service.jobs.job import DamagedJob, JobStoreUnavailable
+from service.jobs.job import DamagedJob, Job, JobStoreUnavailable
 from service.jobs.results import PAGE_CELLS, CellPages, Result
 from service.jobs.store import JobStore
-from service.logs import log, log_to_stderr
+from service.logs import duration, log, log_to_stderr
 from service.operations import checked_grid, computed_map, evaluation_of
 from service.operations.optimize import optimum_of
 from service.schemas import EvaluateRequest, MapRequest, OptimizeRequest
@@ -116,11 +116,21 @@ def task_runner(dask_scheduler: str | None, workers: int) -> TaskRunner:
     return ThreadRunner(max(1, (os.cpu_count() or 1) // workers))
 
 
+def _what(job: Job) -> str:
+    """A job as its log lines name it: its kind, a map's placements, its run."""
+    size = f", {job.total:,} placements" if job.kind == "map" and job.total is not None else ""
+    return f"{job.kind}{size}, run {job.attempts}"
+
+
 def run_job(store: JobStore, job_id: str, settings: Settings) -> None:
-    """Run one job to its end; every outcome is written to the store."""
+    """Run one job to its end; every outcome is written to the store.
+
+    The log says what runs (kind, a map's size, which run) and, at its end, how long it took:
+    the lines said neither (operator audit of 2026-12-07, M4).
+    """
     if not store.start(job_id):
         return  # cancelled while queued, or taken by another worker
-    log.info("job %s running", job_id)
+    began = time.monotonic()
     try:
         job = store.get(job_id)
     except DamagedJob as error:  # not run, and not left running either
@@ -129,7 +139,8 @@ def run_job(store: JobStore, job_id: str, settings: Settings) -> None:
         return
     if job is None:
         return
-    last = [time.monotonic()]
+    log.info("job %s running: %s", job_id, _what(job))
+    last = [began]
 
     def progress(fraction: float) -> None:
         now = time.monotonic()
@@ -138,34 +149,37 @@ def run_job(store: JobStore, job_id: str, settings: Settings) -> None:
             if store.progress(job_id, fraction):
                 raise Cancelled
 
+    def took() -> str:
+        return duration(time.monotonic() - began)
+
     try:
         runner = task_runner(settings.dask_scheduler, settings.workers)
         result = KINDS[job.kind](job.request, settings.for_jobs(), progress, runner)
     except Cancelled:
         store.finish(job_id, "cancelled")
-        log.info("job %s cancelled", job_id)
+        log.info("job %s cancelled after %s", job_id, took())
     except SolverError as error:
         loc = solver_error_location(error)
         detail = {"loc": loc, "msg": error.message, "type": solver_error_type(error)}
         store.finish(job_id, "failed", error=[detail])
-        log.info("job %s failed: %s", job_id, error.message[:200])
+        log.info("job %s failed after %s: %s", job_id, took(), error.message[:200])
     except ClusterUnavailable as error:  # the cluster's fault, not the request's or ours
         detail = {"loc": [], "msg": str(error), "type": "unavailable"}
         store.finish(job_id, "failed", error=[detail])
-        log.warning("job %s failed: %s", job_id, error)
+        log.warning("job %s failed after %s: %s", job_id, took(), error)
     except ValidationError as error:
         # as the route's 422 gives them (errors.request_errors), under the route's body
         located = [{**e, "loc": ("body", *e["loc"])} for e in error.errors()]
         details = [detail.model_dump() for detail in request_errors(located)]
         store.finish(job_id, "failed", error=details)
-        log.info("job %s failed: invalid request", job_id)
+        log.info("job %s failed: invalid request (%d error(s))", job_id, len(details))
     except Exception as error:  # noqa: BLE001 - a job must end with a status, whatever happens
         message = f"internal error: {type(error).__name__}: {str(error)[:500]}"
         store.finish(job_id, "failed", error=[{"loc": [], "msg": message, "type": "internal"}])
-        log.exception("job %s failed", job_id)
+        log.exception("job %s failed after %s", job_id, took())
     else:
         store.finish(job_id, "done", result=result)
-        log.info("job %s done", job_id)
+        log.info("job %s done in %s", job_id, took())
 
 
 def _die_with_the_service() -> None:

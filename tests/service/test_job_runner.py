@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import logging
+import re
 import sqlite3
 import time
 from collections.abc import Callable, Iterator
@@ -315,3 +316,26 @@ def test_an_idle_supervisor_looks_seldom_and_still_finds_another_process_s_job(
         assert wait_for(other, job.id, lambda j: j.status == "done").status == "done"
     finally:
         runner.close()
+
+
+def test_a_jobs_lines_say_what_runs_and_how_long_it_took(
+    tmp_path: Path, caplog: pytest.LogCaptureFixture
+) -> None:
+    """Kind, a map's size and the run, then the time it took (operator audit, M4): the lines
+    were "job <id> running" and "job <id> done"."""
+    store = JobStore(tmp_path / "jobs.sqlite3")
+    grid = {"x": {"min": 0.0, "max": 0.1, "step": 0.1}, "y": {"min": 0.4, "max": 0.4, "step": 0.1}}
+    grid = {**grid, "z": 0.1, "yaw": 0.0}
+    small_map = {"robot": EXAMPLE["robot"], "path": EXAMPLE["path"], "grid": grid}
+    mapped = store.create("map", small_map, total=2)
+    bad = store.create("evaluate", {**EVALUATE, "placement": {"x": "far"}})
+    with caplog.at_level(logging.INFO, logger="dtf.jobs"):
+        worker.run_job(store, mapped.id, settings(tmp_path))
+        worker.run_job(store, bad.id, settings(tmp_path))
+    said = [r.getMessage() for r in caplog.records if r.name == "dtf.jobs"]
+    assert len(said) == 4, said
+    assert said[0] == f"job {mapped.id} running: map, 2 placements, run 1"
+    assert re.fullmatch(rf"job {mapped.id} done in \d+(\.\d+)?(e-\d+)? s", said[1]), said[1]
+    assert said[2] == f"job {bad.id} running: evaluate, run 1"
+    assert said[3].startswith(f"job {bad.id} failed: invalid request (")
+    assert store.state(mapped.id).status == "done"  # type: ignore[union-attr]
