@@ -65,6 +65,15 @@ class _JobCollector(Collector):
         yield summary
 
 
+ROUTE_BUCKETS = (0.01, 0.05, 0.1, 0.5, 1.0, 2.5, 5.0, 10.0, 30.0, 60.0)
+"""Seconds: the per-route latency histogram's buckets (``http_request_duration_seconds``).
+
+The instrumentator's own (0.1, 0.5, 1) ended at a second, where maps and optimisations run
+for many (an IPOPT solve alone may take DTF_MAX_SOLVER_SECONDS, 20 s): every slow request
+fell in +Inf alike (operator audit of 2026-12-07, M4).
+"""
+
+
 def instrument(app: FastAPI, *, job_store: Callable[[], JobStatistics]) -> None:
     """Count and time every request per route, and answer ``GET /metrics``.
 
@@ -72,7 +81,9 @@ def instrument(app: FastAPI, *, job_store: Callable[[], JobStatistics]) -> None:
         app: the application.
         job_store: gives the job store to read at each scrape (the service's runner's).
     """
-    Instrumentator(excluded_handlers=["/metrics"]).instrument(app)
+    Instrumentator(excluded_handlers=["/metrics"]).instrument(
+        app, latency_lowr_buckets=ROUTE_BUCKETS
+    )
 
     @app.get(
         "/metrics",
