@@ -18,12 +18,15 @@ from prometheus_client.core import GaugeMetricFamily, SummaryMetricFamily
 from prometheus_client.registry import Collector
 from prometheus_fastapi_instrumentator import Instrumentator
 
-from service.errors import JSON_ERROR, RETRY_AFTER, SERVER_ERROR_RESPONSE
+from service.errors import JSON_ERROR, SERVER_ERROR_RESPONSE
+from service.jobs.job import JobStoreUnavailable
 
 JOB_SECONDS = (
     "Seconds of the jobs that ran to an end, since the store began (a run a restart "
     "interrupted counts, with no seconds: how long it ran is not known)."
 )
+
+STORE_UP = "1 when the job store could be read at this scrape, 0 when not (no job series then)."
 
 PLACEMENTS = Counter("dtf_placements", "Placements computed by /v1/map (synchronous maps).")
 
@@ -44,19 +47,27 @@ class _JobCollector(Collector):
         self.store = store
 
     def describe(self) -> Iterable[GaugeMetricFamily | SummaryMetricFamily]:
-        """The two job metrics, without values: registering the collector reads no store."""
+        """The job metrics, without values: registering the collector reads no store."""
+        yield GaugeMetricFamily("dtf_job_store_up", STORE_UP)
         yield GaugeMetricFamily("dtf_jobs", "Jobs by status.", labels=["status"])
         yield SummaryMetricFamily("dtf_job_seconds", JOB_SECONDS)
 
     def collect(self) -> Iterable[GaugeMetricFamily | SummaryMetricFamily]:
-        """The two job metrics.
+        """Whether the job store can be read and, when it can, the job metrics.
 
-        A store that cannot be used raises its ``JobStoreUnavailable``: ``/metrics`` then
-        answers 503 saying why, like the job routes (no partial scrape that reads as no jobs).
+        A store that cannot be used gives ``dtf_job_store_up 0`` and no job series (none that
+        would read as no jobs), and the scrape goes on: it answered 503, and Prometheus lost
+        the request metrics too, for as long as the store was down, when they were most
+        wanted (operator audit of 2026-12-07, M2). Why it cannot be used is in the log and
+        in the job routes' 503.
         """
-        store = self.store()
+        try:
+            counts, (finished, seconds) = self.store().statistics()
+        except JobStoreUnavailable:
+            yield GaugeMetricFamily("dtf_job_store_up", STORE_UP, value=0)
+            return
+        yield GaugeMetricFamily("dtf_job_store_up", STORE_UP, value=1)
         by_status = GaugeMetricFamily("dtf_jobs", "Jobs by status.", labels=["status"])
-        counts, (finished, seconds) = store.statistics()
         for status in ("queued", "running", "done", "failed", "cancelled"):
             by_status.add_metric([status], counts.get(status, 0))
         yield by_status
@@ -94,12 +105,6 @@ def instrument(app: FastAPI, *, job_store: Callable[[], JobStatistics]) -> None:
         responses={
             200: {"content": {"text/plain": {"schema": {"type": "string"}}}},
             500: {**SERVER_ERROR_RESPONSE[500], **JSON_ERROR},
-            503: {
-                **JSON_ERROR,
-                "description": "The job store cannot be used (the detail says why); the job "
-                "metrics cannot be read, retry after Retry-After.",
-                "headers": RETRY_AFTER,
-            },
         },
     )
     def metrics() -> PlainTextResponse:

@@ -263,6 +263,19 @@ def assert_store_unavailable(answer: httpx.Response, reason: str) -> None:
     assert detail["type"] == "job_store_unavailable" and reason in detail["msg"], detail
 
 
+def assert_metrics_without_the_store(answer: httpx.Response) -> None:
+    """The scrape goes on: the request metrics, the store said down, no job series.
+
+    It answered 503, and Prometheus lost the request metrics with it for as long as the
+    store was down (operator audit of 2026-12-07, M2).
+    """
+    assert answer.status_code == 200, answer.text
+    lines = answer.text.splitlines()
+    assert "dtf_job_store_up 0.0" in lines
+    assert not [line for line in lines if line.startswith(("dtf_jobs{", "dtf_job_seconds_"))]
+    assert [line for line in lines if line.startswith('http_requests_total{handler="/healthz"')]
+
+
 def test_a_corrupt_store_takes_down_the_jobs_not_the_service(tmp_path: Path) -> None:
     (tmp_path / "jobs.sqlite3").write_bytes(b"not a database" * 100)
     process, url = server(tmp_path)  # it used to exit at startup
@@ -271,10 +284,10 @@ def test_a_corrupt_store_takes_down_the_jobs_not_the_service(tmp_path: Path) -> 
         assert httpx.post(f"{url}/v1/evaluate", json=EXAMPLE, timeout=60).status_code == 200
         for answer in (
             httpx.get(f"{url}/v1/jobs"),
-            httpx.get(f"{url}/metrics"),
             httpx.post(f"{url}/v1/jobs", json={"kind": "map", "request": map_request(SMALL_GRID)}),
         ):
             assert_store_unavailable(answer, "file is not a database")
+        assert_metrics_without_the_store(httpx.get(f"{url}/metrics"))
         assert process.poll() is None
     finally:
         process.terminate()
@@ -290,8 +303,8 @@ def test_a_store_corrupted_or_deleted_while_serving_answers_503(tmp_path: Path) 
         store = tmp_path / "jobs.sqlite3"
         with store.open("r+b") as file:
             file.write(b"garbage!" * 512)
-        for answer in (httpx.get(f"{url}/v1/jobs/{job_id}"), httpx.get(f"{url}/metrics")):
-            assert_store_unavailable(answer, "cannot be used")
+        assert_store_unavailable(httpx.get(f"{url}/v1/jobs/{job_id}"), "cannot be used")
+        assert_metrics_without_the_store(httpx.get(f"{url}/metrics"))
         for file in tmp_path.glob("jobs.sqlite3*"):
             file.unlink()
         assert_store_unavailable(httpx.get(f"{url}/v1/jobs"), "was deleted while the service ran")
