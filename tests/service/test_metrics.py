@@ -19,3 +19,10 @@ def test_route_latencies_are_bucketed_up_to_a_minute(client: TestClient) -> None
     )
     assert bounds == ["0.01", "0.05", "0.1", "0.5", "1.0", "2.5", "5.0", "10.0", "30.0", "60.0",
                       "+Inf"]  # fmt: skip
+
+
+def test_a_readable_job_store_is_said_up_with_its_job_series(client: TestClient) -> None:
+    lines = client.get("/metrics").text.splitlines()
+    assert "dtf_job_store_up 1.0" in lines
+    statuses = {line.split('"')[1] for line in lines if line.startswith('dtf_jobs{status="')}
+    assert statuses == {"queued", "running", "done", "failed", "cancelled"}
