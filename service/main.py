@@ -45,6 +45,7 @@ from service.jobs.runner import close_runners, get_runner
 from service.logs import duration, log, log_to_stderr, startup_log
 from service.metrics import instrument
 from service.query import known_query_parameters
+from service.refusals import RefusalLogMiddleware
 from service.spec import defaults_in_words, with_paged_map
 from service.web import mount_page
 from service.work import STOPPING
@@ -206,6 +207,7 @@ def create_app() -> FastAPI:
     app.include_router(api_router)
     mount_page(app)
     app.add_middleware(BodySizeLimitMiddleware)
+    app.add_middleware(RefusalLogMiddleware)  # outside it: its 413, 415 and 408 are logged too
     instrument(app, job_store=lambda: get_runner(get_settings()).store)
     return app
 

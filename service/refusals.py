@@ -1,0 +1,86 @@
+"""A log line for each refused request, with the reason its answer gives (``dtf.requests``).
+
+uvicorn's access line says ``"POST /v1/map HTTP/1.1" 422`` and nothing of why: an operator
+could not tell a client's bad grid from a body over the limit or a full queue without the
+client (the operator audit of 2026-12-07, M4). Every error answer of the service has a
+``detail`` list (:mod:`service.errors`); this pure ASGI middleware reads the list of each
+answer of status 400 or more as it is sent (error bodies are small; at most :data:`KEEP`
+bytes are kept) and logs the request, the status and the first detail's location and message.
+A 499 (a client that left) has its own line already (:func:`service.errors.client_left`).
+"""
+
+from __future__ import annotations
+
+import json
+import logging
+import re
+
+from starlette.types import ASGIApp, Message, Receive, Scope, Send
+
+from service.errors import CLIENT_CLOSED_REQUEST
+from service.logs import request_log
+
+KEEP = 65536
+"""Bytes of an error answer kept to read its first detail."""
+
+MESSAGE_CHARACTERS = 200
+"""A detail's message is cut to this many characters in the line."""
+
+
+def reason_of(body: bytes, *, cut: bool = False) -> str:
+    """``body.grid.x.step: Input should be greater than 0 (and 2 more)`` from an error body.
+
+    ``cut``: the body is the answer's first :data:`KEEP` bytes only (a list of thousands of
+    details): its first detail is read from them, and the others not counted.
+    """
+    if cut:
+        found = re.search(rb'"loc":\[(.*?)\],"msg":"((?:[^"\\]|\\.)*)"', body)
+        if found is None:
+            return f"an answer over {KEEP} bytes"
+        where = ".".join(part.strip('"') for part in found[1].decode().split(",") if part)
+        said = json.loads(b'"' + found[2] + b'"')[:MESSAGE_CHARACTERS]
+        return f"{where}: {said} (and more)" if where else f"{said} (and more)"
+    try:
+        details = json.loads(body)["detail"]
+        first = details[0]
+        where = ".".join(str(part) for part in first.get("loc", []))
+        said = str(first["msg"])[:MESSAGE_CHARACTERS]
+    except (ValueError, LookupError, TypeError, AttributeError):
+        return "no detail list"
+    more = f" (and {len(details) - 1} more)" if len(details) > 1 else ""
+    return f"{where}: {said}{more}" if where else f"{said}{more}"
+
+
+class RefusalLogMiddleware:
+    """Log each answer of status 400 or more with its first detail; pass every message on."""
+
+    def __init__(self, app: ASGIApp) -> None:
+        """Wrap ``app``."""
+        self.app = app
+
+    async def __call__(self, scope: Scope, receive: Receive, send: Send) -> None:
+        """Pass the request on; read the answer's body where its status is an error's."""
+        if scope["type"] != "http":
+            await self.app(scope, receive, send)
+            return
+        status = 0
+        kept = bytearray()
+        cut = False
+
+        async def watch(message: Message) -> None:
+            nonlocal status, cut
+            if message["type"] == "http.response.start":
+                status = int(message["status"])
+            elif message["type"] == "http.response.body" and status >= 400:
+                chunk = message.get("body", b"")
+                cut = cut or len(kept) + len(chunk) > KEEP
+                kept.extend(chunk[: max(0, KEEP - len(kept))])
+                if not message.get("more_body", False) and status != CLIENT_CLOSED_REQUEST:
+                    reason = reason_of(bytes(kept), cut=cut)
+                    level = logging.WARNING if status >= 500 else logging.INFO
+                    request_log.log(
+                        level, "%s %s %d: %s", scope["method"], scope["path"], status, reason
+                    )
+            await send(message)
+
+        await self.app(scope, receive, watch)
