@@ -1,6 +1,7 @@
 """The service's own log lines (``dtf.*``), sent to stderr once.
 
-The jobs', the start's, and the requests' whose client left before the answer.
+The jobs', the start's, and the requests' refused (:mod:`service.refusals`) or left by their
+client before the answer.
 """
 
 from __future__ import annotations
@@ -11,7 +12,8 @@ log = logging.getLogger("dtf.jobs")
 startup_log = logging.getLogger("dtf.startup")
 """The start's lines: the kernels' warm-up (its first time compiles them, about 30 s)."""
 request_log = logging.getLogger("dtf.requests")
-"""Requests whose client left before the answer (uvicorn writes no access line for them)."""
+"""Requests refused, with their answer's first detail (uvicorn's access line has the status
+alone), and requests whose client left before the answer (uvicorn writes no line for them)."""
 
 
 FORMAT = "%(asctime)s %(levelname)s %(name)s %(message)s"
