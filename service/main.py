@@ -119,7 +119,11 @@ async def lifespan(app: FastAPI) -> AsyncIterator[None]:
     try:
         get_runner(get_settings()).recover()  # jobs a restart interrupted run again
     except JobStoreUnavailable as error:  # the job routes answer 503; the rest serves
-        log.error("jobs are unavailable: %s", error)
+        log.error(
+            "jobs are unavailable: %s (the jobs a restart interrupted are queued again once "
+            "the store answers)",
+            error,
+        )
     yield
     close_runners()
 

@@ -76,6 +76,7 @@ class JobRunner:
         self._context = multiprocessing.get_context("spawn")
         self._workers: list[_Worker] = []  # started when jobs first wait (each is 250 MB)
         self._unsettled: set[str] = set()  # jobs whose worker could not store their end
+        self._recovery_due = False  # recover() was refused by the store: the supervisor's to do
         self.failure: str | None = None
         """Why the supervisor's last look failed (the store's reason), None when it did not."""
         self._wake = threading.Event()
@@ -105,11 +106,21 @@ class JobRunner:
     def recover(self) -> list[str]:
         """Forget expired jobs, then queue again every job a restart interrupted.
 
+        Where the store refuses (its ``JobStoreUnavailable`` is raised), the supervisor does it
+        at its first look that the store answers, before it hands out any job: the jobs the
+        restart interrupted stayed ``running`` with no worker, for good, holding their queue
+        places (the operator audit of 2026-12-07, H1's third part).
+
         Returns:
             The ids queued, oldest first; they run as workers become idle.
         """
-        self.expire()
-        ids = self.store.recover(attempts=self.settings.job_attempts)
+        try:
+            self.expire()
+            ids = self.store.recover(attempts=self.settings.job_attempts)
+        except JobStoreUnavailable:
+            self._recovery_due = True
+            raise
+        self._recovery_due = False
         self._wake.set()
         return ids
 
@@ -144,6 +155,8 @@ class JobRunner:
             self._wake.wait(delay)
             self._wake.clear()
             try:
+                if self._recovery_due:
+                    self.recover()
                 now = time.monotonic()
                 if now - expired >= min(self.settings.job_ttl, EXPIRE_SECONDS):
                     self.expire()

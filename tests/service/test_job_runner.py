@@ -339,3 +339,30 @@ def test_a_jobs_lines_say_what_runs_and_how_long_it_took(
     assert said[2] == f"job {bad.id} running: evaluate, run 1"
     assert said[3].startswith(f"job {bad.id} failed: invalid request (")
     assert store.state(mapped.id).status == "done"  # type: ignore[union-attr]
+
+
+def test_a_recovery_the_store_refused_at_the_start_is_done_when_it_answers(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The start's recovery failed on a store that then came back: the job the restart had
+    interrupted stayed running with no worker, for good (operator audit, H1's third part)."""
+    store = JobStore(tmp_path / "jobs.sqlite3")
+    job = store.create("evaluate", EVALUATE)
+    assert store.start(job.id)  # running when the service stopped
+    runner = JobRunner(settings(tmp_path))
+    try:
+        recover, refusals = runner.store.recover, [JobStoreUnavailable("the store is full")]
+
+        def refusing_once(*, attempts: int) -> list[str]:
+            if refusals:
+                raise refusals.pop()
+            return recover(attempts=attempts)
+
+        monkeypatch.setattr(runner.store, "recover", refusing_once)
+        with pytest.raises(JobStoreUnavailable):
+            runner.recover()
+        runner.wake()
+        ended = wait_for(runner.store, job.id, lambda j: j.status == "done")
+        assert ended.status == "done" and ended.attempts == 2
+    finally:
+        runner.close()
