@@ -120,3 +120,25 @@ def test_every_route_is_named_in_the_readme() -> None:
         for method in methods
     }
     assert operations - named == set()
+
+
+def test_the_settings_table_lists_every_setting_with_its_default() -> None:
+    """Read from README's table (a regex) against the settings' own fields: operators found
+    five limits (DTF_MAX_MAP_CELLS, DTF_MAX_SOLVER_SECONDS...) named nowhere but the code
+    (operator audit of 2026-12-07, L1)."""
+    from service.config import Settings
+
+    table = README.split("### Settings", 1)[1].split("### Upgrading", 1)[0]
+    shown = dict(re.findall(r"^\| `DTF_(\w+)` \| ([^|]+?) \|", table, flags=re.MULTILINE))
+    fields = Settings.model_fields
+    assert sorted(shown) == sorted(name.upper() for name in fields)
+    for name, field in fields.items():
+        said = shown[name.upper()]
+        if field.default_factory is not None:
+            assert said == "the core count", name
+        elif field.default is None:
+            assert said == "none", name
+        elif isinstance(field.default, int | float):
+            assert float(said.replace(",", "")) == field.default, name
+        else:
+            assert said == str(field.default), name
