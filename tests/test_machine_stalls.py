@@ -1,0 +1,36 @@
+"""The sleeper that sets the machine's stalls apart (tests/machine_stalls.py) sees a stall.
+
+A stall is made by stopping the sleeper itself (SIGSTOP, then SIGCONT after a measured time):
+what it reports must cover that interval, and ``within`` must cut the stalls to a probe's
+interval. (The machine's own stalls may add intervals of their own: nothing here bounds them.)
+"""
+
+from __future__ import annotations
+
+import signal
+import time
+
+from tests import machine_stalls as stalls
+
+
+def test_a_stopped_sleeper_reports_the_stall_and_within_cuts_it() -> None:
+    before = stalls.now()
+    with stalls.MachineStalls() as machine:
+        time.sleep(0.05)
+        assert machine._process is not None
+        stopped = stalls.now()
+        machine._process.send_signal(signal.SIGSTOP)
+        time.sleep(0.2)
+        machine._process.send_signal(signal.SIGCONT)
+        resumed = stalls.now()
+        time.sleep(0.05)
+    assert resumed - stopped >= 0.2
+    # One stall covers the stopped time, up to the sleeper's 1 ms wait and its wake-up.
+    covering = [(s, e) for s, e in machine.stalls if s <= stopped + 0.003 and e >= resumed - 0.003]
+    assert len(covering) == 1, machine.stalls
+    start, end = covering[0]
+    assert machine.within(stopped, resumed) >= resumed - stopped - 0.003
+    # A probe half inside it counts its inside only; one before the sleeper started, nothing.
+    middle = (start + end) / 2
+    assert abs(machine.within(middle, end) - (end - middle)) < 1e-9
+    assert machine.within(before - 1.0, before) == 0.0
