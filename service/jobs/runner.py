@@ -77,6 +77,7 @@ class JobRunner:
         self._workers: list[_Worker] = []  # started when jobs first wait (each is 250 MB)
         self._unsettled: set[str] = set()  # jobs whose worker could not store their end
         self._recovery_due = False  # recover() was refused by the store: the supervisor's to do
+        self._expired_at = -math.inf  # when expire() last ran (monotonic, s)
         self.failure: str | None = None
         """Why the supervisor's last look failed (the store's reason), None when it did not."""
         self._wake = threading.Event()
@@ -132,6 +133,7 @@ class JobRunner:
         """
         ttl = self.settings.job_ttl
         count = self.store.expire(ttl=ttl)
+        self._expired_at = time.monotonic()
         if count:
             log.info(
                 "forgot %d job(s) that finished over DTF_JOB_TTL = %g s (%s) ago, with their "
@@ -147,20 +149,19 @@ class JobRunner:
 
         When no job runs or waits, every IDLE_POLL_SECONDS (a wake looks at once). Every
         EXPIRE_SECONDS (or DTF_JOB_TTL if shorter) it also forgets the expired jobs, so that a
-        long-running service does not keep them past their TTL.
+        long-running service does not keep them past their TTL; counted from the last expiry,
+        so the one ``recover()`` did at the start is not done again at the first look.
         """
         delay, failing = POLL_SECONDS, False
-        expired = -math.inf  # when the supervisor last forgot expired jobs (monotonic, s)
         while not self._stop.is_set():
             self._wake.wait(delay)
             self._wake.clear()
             try:
                 if self._recovery_due:
                     self.recover()
-                now = time.monotonic()
-                if now - expired >= min(self.settings.job_ttl, EXPIRE_SECONDS):
+                since = time.monotonic() - self._expired_at
+                if since >= min(self.settings.job_ttl, EXPIRE_SECONDS):
                     self.expire()
-                    expired = now
                 self._watch()
                 self.settle()
                 waiting = self._dispatch()

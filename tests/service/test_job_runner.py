@@ -366,3 +366,27 @@ def test_a_recovery_the_store_refused_at_the_start_is_done_when_it_answers(
         assert ended.status == "done" and ended.attempts == 2
     finally:
         runner.close()
+
+
+def test_a_start_forgets_the_expired_jobs_once(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """recover() forgets the expired jobs, and the supervisor's first look did it again at once
+    (its own mark started at minus infinity): the store's expiry ran twice at every start."""
+    calls: list[float] = []
+    expire = JobStore.expire
+
+    def counted(store: JobStore, *, ttl: float) -> int:
+        calls.append(ttl)
+        return expire(store, ttl=ttl)
+
+    monkeypatch.setattr(JobStore, "expire", counted)
+    runner = JobRunner(settings(tmp_path))
+    try:
+        runner.recover()  # as the service's start does, at once
+        for _ in range(6):  # the supervisor's looks
+            runner.wake()
+            time.sleep(0.1)
+    finally:
+        runner.close()
+    assert len(calls) == 1
