@@ -51,6 +51,11 @@ def reason_of(body: bytes, *, cut: bool = False) -> str:
     return f"{where}: {said}{more}" if where else f"{said}{more}"
 
 
+def refused(status: int) -> bool:
+    """An answer this middleware logs: an error's status, but a 499's (its line is its own)."""
+    return status >= 400 and status != CLIENT_CLOSED_REQUEST
+
+
 class RefusalLogMiddleware:
     """Log each answer of status 400 or more with its first detail; pass every message on."""
 
@@ -71,11 +76,11 @@ class RefusalLogMiddleware:
             nonlocal status, cut
             if message["type"] == "http.response.start":
                 status = int(message["status"])
-            elif message["type"] == "http.response.body" and status >= 400:
+            elif message["type"] == "http.response.body" and refused(status):
                 chunk = message.get("body", b"")
                 cut = cut or len(kept) + len(chunk) > KEEP
                 kept.extend(chunk[: max(0, KEEP - len(kept))])
-                if not message.get("more_body", False) and status != CLIENT_CLOSED_REQUEST:
+                if not message.get("more_body", False):
                     reason = reason_of(bytes(kept), cut=cut)
                     level = logging.WARNING if status >= 500 else logging.INFO
                     request_log.log(

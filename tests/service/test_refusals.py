@@ -75,17 +75,10 @@ def test_a_long_detail_list_cut_still_gives_its_first_detail() -> None:
     assert reason_of(b'{"detail":[{"lo', cut=True) == f"an answer over {KEEP} bytes"
 
 
-def test_the_middleware_keeps_a_long_answers_start_and_passes_every_message_on(
-    caplog: pytest.LogCaptureFixture,
-) -> None:
-    details = [{"loc": ["body", "path", k], "msg": "bad", "type": "t"} for k in range(4000)]
-    body = json.dumps({"detail": details}, separators=(",", ":")).encode()
-    half = len(body) // 2
-    answer: list[Message] = [
-        {"type": "http.response.start", "status": 422, "headers": []},
-        {"type": "http.response.body", "body": body[:half], "more_body": True},
-        {"type": "http.response.body", "body": body[half:], "more_body": False},
-    ]
+def _through_the_middleware(
+    answer: list[Message], caplog: pytest.LogCaptureFixture
+) -> tuple[list[Message], list[tuple[str, str]]]:
+    """The messages an app's ``answer`` reaches the server as, and the lines it gave."""
 
     async def app(scope: Scope, receive: Receive, send: Send) -> None:
         for message in answer:
@@ -102,5 +95,32 @@ def test_the_middleware_keeps_a_long_answers_start_and_passes_every_message_on(
     scope: Scope = {"type": "http", "method": "POST", "path": "/v1/evaluate", "headers": []}
     with caplog.at_level(logging.INFO, logger="dtf.requests"):
         asyncio.run(RefusalLogMiddleware(app)(scope, receive, send))
+    return sent, _said(caplog)
+
+
+def test_the_middleware_keeps_a_long_answers_start_and_passes_every_message_on(
+    caplog: pytest.LogCaptureFixture,
+) -> None:
+    details = [{"loc": ["body", "path", k], "msg": "bad", "type": "t"} for k in range(4000)]
+    body = json.dumps({"detail": details}, separators=(",", ":")).encode()
+    half = len(body) // 2
+    answer: list[Message] = [
+        {"type": "http.response.start", "status": 422, "headers": []},
+        {"type": "http.response.body", "body": body[:half], "more_body": True},
+        {"type": "http.response.body", "body": body[half:], "more_body": False},
+    ]
+    sent, said = _through_the_middleware(answer, caplog)
     assert sent == answer
-    assert _said(caplog) == [("INFO", "POST /v1/evaluate 422: body.path.0: bad (and more)")]
+    assert said == [("INFO", "POST /v1/evaluate 422: body.path.0: bad (and more)")]
+
+
+def test_a_client_that_left_has_no_refusal_line(caplog: pytest.LogCaptureFixture) -> None:
+    """A 499 is said by service.errors.client_left already: no second line, its body passed on."""
+    body = json.dumps({"detail": [{"loc": [], "msg": "the client left", "type": "t"}]}).encode()
+    answer: list[Message] = [
+        {"type": "http.response.start", "status": 499, "headers": []},
+        {"type": "http.response.body", "body": body, "more_body": False},
+    ]
+    sent, said = _through_the_middleware(answer, caplog)
+    assert sent == answer
+    assert said == []
