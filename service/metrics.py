@@ -3,12 +3,13 @@
 Request counts and latencies per route come from the instrumentator; the service adds the jobs
 by status and the count and seconds of the jobs that ran to an end (read from the job store at
 each scrape, since jobs run in other processes; totals that only grow, as a Prometheus summary
-must), and the placements its synchronous maps computed.
+must), the store's size on disk, and the placements its synchronous maps computed.
 """
 
 from __future__ import annotations
 
 from collections.abc import Callable, Iterable
+from pathlib import Path
 from typing import Protocol
 
 from fastapi import FastAPI
@@ -28,15 +29,29 @@ JOB_SECONDS = (
 
 STORE_UP = "1 when the job store could be read at this scrape, 0 when not (no job series then)."
 
+STORE_BYTES = (
+    "Bytes the job store takes on disk: its SQLite file and its write-ahead log (results are "
+    "kept DTF_JOB_TTL seconds; DTF_DATA_DIR's disk must hold them)."
+)
+
 PLACEMENTS = Counter("dtf_placements", "Placements computed by /v1/map (synchronous maps).")
 
 
 class JobStatistics(Protocol):
     """What the collector reads from the job store (:class:`service.jobs.store.JobStore`)."""
 
+    path: Path
+    """The store's SQLite file."""
+
     def statistics(self) -> tuple[dict[str, int], tuple[int, float]]:
         """Jobs by status; the jobs that ran to an end and their seconds, only growing."""
         ...
+
+
+def store_bytes(path: Path) -> int:
+    """The bytes of a SQLite store on disk: the file and its write-ahead log, where they are."""
+    sizes = (f.stat().st_size for f in (path, path.with_name(path.name + "-wal")) if f.exists())
+    return sum(sizes)
 
 
 class _JobCollector(Collector):
@@ -51,6 +66,7 @@ class _JobCollector(Collector):
         yield GaugeMetricFamily("dtf_job_store_up", STORE_UP)
         yield GaugeMetricFamily("dtf_jobs", "Jobs by status.", labels=["status"])
         yield SummaryMetricFamily("dtf_job_seconds", JOB_SECONDS)
+        yield GaugeMetricFamily("dtf_job_store_bytes", STORE_BYTES)
 
     def collect(self) -> Iterable[GaugeMetricFamily | SummaryMetricFamily]:
         """Whether the job store can be read and, when it can, the job metrics.
@@ -62,7 +78,8 @@ class _JobCollector(Collector):
         in the job routes' 503.
         """
         try:
-            counts, (finished, seconds) = self.store().statistics()
+            store = self.store()
+            counts, (finished, seconds) = store.statistics()
         except JobStoreUnavailable:
             yield GaugeMetricFamily("dtf_job_store_up", STORE_UP, value=0)
             return
@@ -74,6 +91,11 @@ class _JobCollector(Collector):
         summary = SummaryMetricFamily("dtf_job_seconds", JOB_SECONDS)
         summary.add_metric([], count_value=finished, sum_value=seconds)
         yield summary
+        try:
+            size = store_bytes(store.path)
+        except OSError:  # the file gone between the read and the stat: no figure, no 500
+            return
+        yield GaugeMetricFamily("dtf_job_store_bytes", STORE_BYTES, value=size)
 
 
 ROUTE_BUCKETS = (0.01, 0.05, 0.1, 0.5, 1.0, 2.5, 5.0, 10.0, 30.0, 60.0)

@@ -2,9 +2,14 @@
 
 from __future__ import annotations
 
+import os
 import re
+from pathlib import Path
 
 from fastapi.testclient import TestClient
+
+from service.jobs.store import JobStore
+from service.metrics import _JobCollector
 
 
 def test_route_latencies_are_bucketed_up_to_a_minute(client: TestClient) -> None:
@@ -26,3 +31,20 @@ def test_a_readable_job_store_is_said_up_with_its_job_series(client: TestClient)
     assert "dtf_job_store_up 1.0" in lines
     statuses = {line.split('"')[1] for line in lines if line.startswith('dtf_jobs{status="')}
     assert statuses == {"queued", "running", "done", "failed", "cancelled"}
+
+
+def test_the_job_stores_size_on_disk_is_a_gauge(client: TestClient, tmp_path: Path) -> None:
+    """An operator saw the store reach 318 MB only by looking at the disk (operator audit, L3):
+    the gauge is the file's and its write-ahead log's sizes, read here with os.stat."""
+    store = JobStore(tmp_path / "jobs.sqlite3")
+    for _ in range(3):
+        job = store.create("evaluate", {"robot": "ur5e", "padding": "x" * 50_000})
+        assert store.start(job.id)
+        store.finish(job.id, "done", result={"feed": 0.1, "padding": "y" * 50_000})
+    collected = {m.name: m for m in _JobCollector(lambda: store).collect()}
+    [sample] = collected["dtf_job_store_bytes"].samples
+    files = [tmp_path / "jobs.sqlite3", tmp_path / "jobs.sqlite3-wal"]
+    assert sample.value == sum(os.stat(f).st_size for f in files if f.exists())
+    assert sample.value > 3 * 100_000  # the bodies are in it
+    scraped = re.search(r"^dtf_job_store_bytes (\S+)$", client.get("/metrics").text, re.M)
+    assert scraped is not None and float(scraped[1]) > 0  # the service's own store
