@@ -3,7 +3,8 @@
 Request counts and latencies per route come from the instrumentator; the service adds the jobs
 by status and the count and seconds of the jobs that ran to an end (read from the job store at
 each scrape, since jobs run in other processes; totals that only grow, as a Prometheus summary
-must), the store's size on disk, and the placements its synchronous maps computed.
+must), the jobs that ended by status (a total that only grows), the store's size on disk, and
+the placements its synchronous maps computed.
 """
 
 from __future__ import annotations
@@ -15,7 +16,7 @@ from typing import Protocol
 from fastapi import FastAPI
 from fastapi.responses import PlainTextResponse
 from prometheus_client import CONTENT_TYPE_LATEST, REGISTRY, Counter, generate_latest
-from prometheus_client.core import GaugeMetricFamily, SummaryMetricFamily
+from prometheus_client.core import CounterMetricFamily, GaugeMetricFamily, SummaryMetricFamily
 from prometheus_client.registry import Collector
 from prometheus_fastapi_instrumentator import Instrumentator
 
@@ -28,6 +29,11 @@ JOB_SECONDS = (
 )
 
 STORE_UP = "1 when the job store could be read at this scrape, 0 when not (no job series then)."
+
+ENDED = (
+    "Jobs that ended since the store began, by status (a job deleted or expired stays counted; "
+    "a job cancelled before it ran counts)."
+)
 
 STORE_BYTES = (
     "Bytes the job store takes on disk: its SQLite file and its write-ahead log (results are "
@@ -47,6 +53,10 @@ class JobStatistics(Protocol):
         """Jobs by status; the jobs that ran to an end and their seconds, only growing."""
         ...
 
+    def ended(self) -> dict[str, int]:
+        """Jobs that ended, by status, only growing."""
+        ...
+
 
 def store_bytes(path: Path) -> int:
     """The bytes of a SQLite store on disk: the file and its write-ahead log, where they are."""
@@ -61,14 +71,15 @@ class _JobCollector(Collector):
         """Read the store that ``store()`` gives at each scrape (opened on first use)."""
         self.store = store
 
-    def describe(self) -> Iterable[GaugeMetricFamily | SummaryMetricFamily]:
+    def describe(self) -> Iterable[GaugeMetricFamily | SummaryMetricFamily | CounterMetricFamily]:
         """The job metrics, without values: registering the collector reads no store."""
         yield GaugeMetricFamily("dtf_job_store_up", STORE_UP)
         yield GaugeMetricFamily("dtf_jobs", "Jobs by status.", labels=["status"])
         yield SummaryMetricFamily("dtf_job_seconds", JOB_SECONDS)
+        yield CounterMetricFamily("dtf_jobs_ended", ENDED, labels=["status"])
         yield GaugeMetricFamily("dtf_job_store_bytes", STORE_BYTES)
 
-    def collect(self) -> Iterable[GaugeMetricFamily | SummaryMetricFamily]:
+    def collect(self) -> Iterable[GaugeMetricFamily | SummaryMetricFamily | CounterMetricFamily]:
         """Whether the job store can be read and, when it can, the job metrics.
 
         A store that cannot be used gives ``dtf_job_store_up 0`` and no job series (none that
@@ -80,6 +91,7 @@ class _JobCollector(Collector):
         try:
             store = self.store()
             counts, (finished, seconds) = store.statistics()
+            ended = store.ended()
         except JobStoreUnavailable:
             yield GaugeMetricFamily("dtf_job_store_up", STORE_UP, value=0)
             return
@@ -91,6 +103,10 @@ class _JobCollector(Collector):
         summary = SummaryMetricFamily("dtf_job_seconds", JOB_SECONDS)
         summary.add_metric([], count_value=finished, sum_value=seconds)
         yield summary
+        by_end = CounterMetricFamily("dtf_jobs_ended", ENDED, labels=["status"])
+        for status in ("done", "failed", "cancelled"):
+            by_end.add_metric([status], ended.get(status, 0))
+        yield by_end
         try:
             size = store_bytes(store.path)
         except OSError:  # the file gone between the read and the stat: no figure, no 500

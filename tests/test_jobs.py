@@ -95,6 +95,7 @@ def test_a_map_job_answers_what_the_route_answers(tmp_path: Path) -> None:
         assert [j["id"] for j in listed] == [job_id] and listed[0]["result"] is None
         metrics = httpx.get(f"{url}/metrics").text.splitlines()
         assert 'dtf_jobs{status="done"} 1.0' in metrics
+        assert 'dtf_jobs_ended_total{status="done"} 1.0' in metrics
         assert "dtf_placements_total 50.0" in metrics  # the synchronous map above
         assert any(line.startswith("dtf_job_seconds_count 1.0") for line in metrics)
         assert any(

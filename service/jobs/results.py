@@ -67,6 +67,19 @@ CREATE TRIGGER IF NOT EXISTS job_ran_to_its_end AFTER UPDATE OF finished ON jobs
 BEGIN
     UPDATE job_totals SET finished = finished + 1, seconds = seconds + NEW.finished - NEW.started;
 END;
+CREATE TABLE IF NOT EXISTS job_ended (
+    status TEXT PRIMARY KEY,
+    count INTEGER NOT NULL
+);
+INSERT OR IGNORE INTO job_ended
+    SELECT ended.status, (SELECT COUNT(*) FROM jobs WHERE jobs.status = ended.status
+                          AND finished IS NOT NULL)
+    FROM (SELECT 'done' AS status UNION ALL SELECT 'failed' UNION ALL SELECT 'cancelled') AS ended;
+CREATE TRIGGER IF NOT EXISTS job_ended_as AFTER UPDATE OF finished ON jobs
+    WHEN OLD.finished IS NULL AND NEW.finished IS NOT NULL
+BEGIN
+    UPDATE job_ended SET count = count + 1 WHERE status = NEW.status;
+END;
 """
 """The jobs, their result pages, the places of forgotten jobs in the listing, and the totals of
 the jobs that ran to an end (``/metrics``).
@@ -77,7 +90,9 @@ deleted the last job of the page before.
 
 The totals only grow: a trigger adds each job as it finishes after running (done, failed,
 cancelled), whichever update finishes it; a deleted or expired job stays counted. A store
-made by an older release gets them from its finished jobs, once.
+made by an older release gets them from its finished jobs, once. ``job_ended`` counts the jobs
+that ended by how they ended (a job cancelled before it ran too), the same way: its three rows
+are made once, from the jobs the store holds then.
 """
 
 _ADDED_COLUMNS = {"total": "INTEGER", "cells": "INTEGER", "first_at": "REAL", "first_done": "REAL"}

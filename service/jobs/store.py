@@ -313,6 +313,16 @@ class JobStore(JobReads):
             finished, seconds = db.execute("SELECT finished, seconds FROM job_totals").fetchone()
         return {str(k): int(v) for k, v in counts.items()}, (int(finished), float(seconds))
 
+    def ended(self) -> dict[str, int]:
+        """Jobs that ended since the store began, by status (done, failed, cancelled); only grows.
+
+        The jobs held by status fall as jobs are deleted or expire: an alert on failed jobs
+        could not tell a failure from an expiry (operator audit of 2026-12-07, L3).
+        """
+        with self._connection() as db:
+            rows = db.execute("SELECT status, count FROM job_ended").fetchall()
+        return {str(status): int(count) for status, count in rows}
+
     def expire(self, *, ttl: float) -> int:
         """Forget finished jobs older than ``ttl`` seconds, and their results' pages; how many.
 

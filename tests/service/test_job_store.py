@@ -413,6 +413,51 @@ def test_the_jobs_that_ran_are_counted_once_each_and_never_less(tmp_path: Path) 
     assert store.statistics() == ({}, totals)
 
 
+def test_the_jobs_that_ended_are_counted_by_status_and_never_less(tmp_path: Path) -> None:
+    """The jobs held by status fall as jobs are deleted or expire: an alert on failed jobs could
+    not tell a failure from an expiry (operator audit, L3). Each end counted once by its status,
+    whichever update ended the job, a job cancelled before it ran too; read against the jobs
+    table itself before they go, and unchanged after."""
+    store = JobStore(tmp_path / "jobs.sqlite3")
+    done, spent, stopped, waiting, never = (store.create("evaluate", EVALUATE) for _ in range(5))
+    for job in (done, spent, stopped):
+        assert store.start(job.id)
+    store.finish(done.id, "done", result={"mu_path": 0.3})
+    store.cancel(stopped.id)  # asked while running, then a restart: cancelled by recover
+    store.recover(attempts=1)  # spent was running: failed on its one run
+    assert store.start(waiting.id)
+    store.finish(waiting.id, "failed", error=[{"loc": [], "msg": "m", "type": "t"}])
+    store.cancel(never.id)  # never ran: ended all the same
+    store.create("evaluate", EVALUATE)  # still queued: not ended
+    with sqlite3.connect(store.path) as db:
+        held = dict(
+            db.execute(
+                "SELECT status, COUNT(*) FROM jobs WHERE finished IS NOT NULL GROUP BY status"
+            ).fetchall()
+        )
+    assert held == {"done": 1, "failed": 2, "cancelled": 2}
+    assert store.ended() == held
+    for job in (done, spent):
+        assert store.delete(job.id)
+    assert store.expire(ttl=-1.0) == 3
+    assert store.ended() == held
+    assert JobStore(store.path).ended() == held  # opened again: not counted twice
+
+
+def test_a_store_of_an_older_release_counts_its_ended_jobs_once(tmp_path: Path) -> None:
+    path = tmp_path / "jobs.sqlite3"
+    store = JobStore(path)
+    for status in ("done", "cancelled"):
+        job = store.create("evaluate", EVALUATE)
+        assert store.start(job.id)
+        store.finish(job.id, status, result={"mu_path": 0.3})
+    with sqlite3.connect(path) as db:
+        db.execute("DROP TRIGGER job_ended_as")
+        db.execute("DROP TABLE job_ended")
+    assert JobStore(path).ended() == {"done": 1, "failed": 0, "cancelled": 1}
+    assert JobStore(path).ended() == {"done": 1, "failed": 0, "cancelled": 1}
+
+
 def test_a_store_of_an_older_release_counts_the_jobs_it_holds(tmp_path: Path) -> None:
     """A store made before the totals gets them from its finished jobs when it is opened."""
     path = tmp_path / "jobs.sqlite3"

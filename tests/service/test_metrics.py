@@ -33,7 +33,7 @@ def test_a_readable_job_store_is_said_up_with_its_job_series(client: TestClient)
     assert statuses == {"queued", "running", "done", "failed", "cancelled"}
 
 
-def test_the_job_stores_size_on_disk_is_a_gauge(client: TestClient, tmp_path: Path) -> None:
+def test_the_job_stores_size_on_disk_and_its_ended_jobs(client: TestClient, tmp_path: Path) -> None:
     """An operator saw the store reach 318 MB only by looking at the disk (operator audit, L3):
     the gauge is the file's and its write-ahead log's sizes, read here with os.stat."""
     store = JobStore(tmp_path / "jobs.sqlite3")
@@ -46,5 +46,10 @@ def test_the_job_stores_size_on_disk_is_a_gauge(client: TestClient, tmp_path: Pa
     files = [tmp_path / "jobs.sqlite3", tmp_path / "jobs.sqlite3-wal"]
     assert sample.value == sum(os.stat(f).st_size for f in files if f.exists())
     assert sample.value > 3 * 100_000  # the bodies are in it
+    ended = {s.labels["status"]: s.value for s in collected["dtf_jobs_ended"].samples}
+    assert ended == {"done": 3, "failed": 0, "cancelled": 0}
     scraped = re.search(r"^dtf_job_store_bytes (\S+)$", client.get("/metrics").text, re.M)
     assert scraped is not None and float(scraped[1]) > 0  # the service's own store
+    text = client.get("/metrics").text
+    for status in ("done", "failed", "cancelled"):
+        assert re.search(rf'^dtf_jobs_ended_total{{status="{status}"}} \d', text, re.M), status
