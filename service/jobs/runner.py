@@ -13,6 +13,7 @@ logs once more when the store is back; the web process and its compute routes go
 
 from __future__ import annotations
 
+import logging
 import math
 import multiprocessing
 import threading
@@ -190,17 +191,14 @@ class JobRunner:
         for i, worker in enumerate(self._workers):
             job_id = worker.job_id
             if job_id is None:
+                _heard(worker.connection)  # its lines (a warm-up's, say)
                 continue
-            if worker.connection.poll():
-                try:
-                    answer = worker.connection.recv()
-                except (EOFError, OSError):
-                    pass  # died as it answered: handled below
-                else:
-                    self._workers[i] = _Worker(worker.process, worker.connection)
-                    if isinstance(answer, tuple) and answer[1] is False:  # its end not stored
-                        self._unsettled.add(job_id)
-                    continue
+            answer = _heard(worker.connection)
+            if answer is not None:
+                self._workers[i] = _Worker(worker.process, worker.connection)
+                if isinstance(answer, tuple) and answer[1] is False:  # its end not stored
+                    self._unsettled.add(job_id)
+                continue
             if not worker.process.is_alive():  # killed (out of memory, say): run again, a few times
                 cause = f"the worker process ended (exit code {worker.process.exitcode})"
                 self._run_again(job_id, cause, "interrupted")
@@ -288,6 +286,26 @@ class JobRunner:
         for worker in self._workers:
             worker.process.join(timeout=5)
             worker.connection.close()
+
+
+def _heard(connection: Connection) -> object | None:
+    """What a worker sent since the last look: its log lines said here, its answer returned.
+
+    The lines are logged by their own logger in this process, at the levels it has here
+    (where an operator's logging configuration places them); None where no answer came, or
+    the pipe broke (a worker that died as it answered: the look sees it dead).
+    """
+    try:
+        while connection.poll():
+            message: object = connection.recv()
+            if not isinstance(message, logging.LogRecord):
+                return message
+            logger = logging.getLogger(message.name)
+            if logger.isEnabledFor(message.levelno):
+                logger.handle(message)
+    except (EOFError, OSError):
+        pass
+    return None
 
 
 _RUNNERS: dict[str, JobRunner] = {}

@@ -12,9 +12,12 @@ import ctypes
 import ctypes.util
 import functools
 import json
+import logging
+import logging.handlers
 import os
 import signal
 import sys
+import threading
 import time
 from collections.abc import Callable
 from multiprocessing.connection import Connection
@@ -30,7 +33,7 @@ from service.jobs.dask_runner import ClusterUnavailable
 from service.jobs.job import DamagedJob, Job, JobStoreUnavailable
 from service.jobs.results import PAGE_CELLS, CellPages, Result
 from service.jobs.store import JobStore
-from service.logs import duration, log, log_to_stderr
+from service.logs import duration, log
 from service.operations import checked_grid, computed_map, evaluation_of
 from service.operations.optimize import optimum_of
 from service.schemas import EvaluateRequest, MapRequest, OptimizeRequest
@@ -192,11 +195,48 @@ def _die_with_the_service() -> None:
         libc.prctl(PR_SET_PDEATHSIG, signal.SIGKILL)
 
 
+class _Pipe:
+    """The worker's end of its pipe as a :class:`logging.handlers.QueueHandler`'s queue.
+
+    Each record goes to the web process (:meth:`service.jobs.runner.JobRunner`'s look), which
+    logs it there, where the operator's logging configuration places it; the job's answer goes
+    the same way, after its lines. One lock for both: a pipe's sends must not interleave.
+    """
+
+    def __init__(self, connection: Connection) -> None:
+        self.connection = connection
+        self.lock = threading.Lock()
+
+    def put_nowait(self, message: Any) -> None:
+        """Send ``message`` (a log record, or the job's answer) to the web process."""
+        with self.lock:
+            self.connection.send(message)
+
+
+def _log_to_the_service(pipe: _Pipe) -> None:
+    """The worker's ``dtf`` lines go to the web process, which says them as its own are said.
+
+    They went to the worker's own stderr in the service's form: an operator's logging
+    configuration (``uvicorn --log-config``) placed the web process's lines and never the
+    workers' (the operator audit of 2026-12-07). The web process filters them by its levels.
+    """
+    logger = logging.getLogger("dtf")
+    for handler in list(logger.handlers):
+        logger.removeHandler(handler)
+    logger.addHandler(logging.handlers.QueueHandler(pipe))  # type: ignore[arg-type]  # a queue that only puts
+    logger.setLevel(logging.DEBUG)
+    logger.propagate = False
+
+
 def serve(connection: Connection, store_path: str, settings_json: str) -> None:
-    """A worker process's life: run each job id received, answer it back when it has ended."""
+    """A worker process's life: run each job id received, answer it back when it has ended.
+
+    The job's log lines and its answer go back through ``connection`` (:class:`_Pipe`).
+    """
     _die_with_the_service()
     os.nice(NICENESS)
-    log_to_stderr()
+    pipe = _Pipe(connection)
+    _log_to_the_service(pipe)
     store = JobStore(Path(store_path), create=False)  # never a new, empty file
     settings = Settings.model_validate_json(settings_json)
     map_kernel.warm_up()  # before the first job, not in it
@@ -210,7 +250,7 @@ def serve(connection: Connection, store_path: str, settings_json: str) -> None:
             stored = True
         except JobStoreUnavailable as error:  # the supervisor reports the store (once)
             stored = fail_unstored(store, job_id, error)
-        connection.send((job_id, stored))
+        pipe.put_nowait((job_id, stored))
 
 
 UNSTORED = "unstored"

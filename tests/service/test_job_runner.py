@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import logging
+import os
 import re
 import sqlite3
 import time
@@ -390,3 +391,29 @@ def test_a_start_forgets_the_expired_jobs_once(
     finally:
         runner.close()
     assert [store for store in calls if store is runner.store] == [runner.store]
+
+
+def test_a_workers_lines_are_said_by_the_service_where_its_logging_places_them(
+    tmp_path: Path, caplog: pytest.LogCaptureFixture
+) -> None:
+    """A worker wrote its lines to its own stderr in the service's form: an operator's logging
+    configuration (uvicorn --log-config) placed the web process's lines, never the workers'
+    (the operator audit of 2026-12-07). They now reach this process's loggers: here caplog's
+    handler on the root, at this process's levels (a DEBUG-level filter let nothing through)."""
+    with caplog.at_level(logging.INFO, logger="dtf.jobs"):
+        runner = JobRunner(settings(tmp_path))
+        try:
+            job = runner.store.create("evaluate", EVALUATE)
+            runner.wake()
+            assert wait_for(runner.store, job.id, lambda j: j.status != "queued").status
+            deadline = time.monotonic() + 30
+            while time.monotonic() < deadline and not any(
+                r.getMessage().startswith(f"job {job.id} done in ") for r in caplog.records
+            ):
+                time.sleep(0.02)
+        finally:
+            runner.close()
+    said = [r for r in caplog.records if r.getMessage().startswith(f"job {job.id} ")]
+    assert [r.getMessage() for r in said][:1] == [f"job {job.id} running: evaluate, run 1"]
+    assert re.fullmatch(rf"job {job.id} done in \S+ s", said[1].getMessage()), said[1]
+    assert {r.process for r in said} - {os.getpid()} and len(said) == 2  # the worker's lines
