@@ -10,12 +10,15 @@ from __future__ import annotations
 import asyncio
 import json
 import logging
+import re
+import time
 
 import httpx
 import pytest
 from fastapi.testclient import TestClient
 from starlette.types import Message, Receive, Scope, Send
 
+from service import refusals
 from service.refusals import KEEP, RefusalLogMiddleware, reason_of
 from tests.cases import ROOT
 
@@ -76,11 +79,13 @@ def test_a_long_detail_list_cut_still_gives_its_first_detail() -> None:
 
 
 def _through_the_middleware(
-    answer: list[Message], caplog: pytest.LogCaptureFixture
+    answer: list[Message], caplog: pytest.LogCaptureFixture, *, after: float = 0.0
 ) -> tuple[list[Message], list[tuple[str, str]]]:
-    """The messages an app's ``answer`` reaches the server as, and the lines it gave."""
+    """The messages an app's ``answer`` (sent ``after`` seconds) reaches the server as, and the
+    lines it gave."""
 
     async def app(scope: Scope, receive: Receive, send: Send) -> None:
+        await asyncio.sleep(after)
         for message in answer:
             await send(message)
 
@@ -124,3 +129,33 @@ def test_a_client_that_left_has_no_refusal_line(caplog: pytest.LogCaptureFixture
     sent, said = _through_the_middleware(answer, caplog)
     assert sent == answer
     assert said == []
+
+
+def test_a_slow_answer_is_logged_with_its_time_and_a_fast_one_is_not(
+    caplog: pytest.LogCaptureFixture, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """uvicorn's access line has no duration: which request was slow could not be told (the
+    operator audit of 2026-12-07). Slow is SLOW_SECONDS; lowered here to keep the test short."""
+    ok: list[Message] = [
+        {"type": "http.response.start", "status": 200, "headers": []},
+        {"type": "http.response.body", "body": b"{}", "more_body": False},
+    ]
+    assert refusals.SLOW_SECONDS == 1.0
+    assert _through_the_middleware(ok, caplog)[1] == []  # fast: uvicorn's line is enough
+    monkeypatch.setattr(refusals, "SLOW_SECONDS", 0.05)
+    began = time.perf_counter()
+    sent, said = _through_the_middleware(ok, caplog, after=0.08)
+    took = time.perf_counter() - began
+    assert sent == ok and len(said) == 1, said
+    level, line = said[0]
+    found = re.fullmatch(r"POST /v1/evaluate 200 in (\S+) s", line)
+    assert level == "INFO" and found is not None, line
+    assert 0.08 <= float(found[1]) <= took + 0.001
+    caplog.clear()
+    refused: list[Message] = [
+        {"type": "http.response.start", "status": 422, "headers": []},
+        {"type": "http.response.body", "body": b'{"detail":[]}', "more_body": False},
+    ]
+    assert _through_the_middleware(refused, caplog, after=0.08)[1] == [
+        ("INFO", "POST /v1/evaluate 422: no detail list")
+    ]  # its refusal line alone
