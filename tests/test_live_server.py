@@ -24,6 +24,7 @@ from typing import Any
 import httpx
 import pytest
 
+from tests import machine_stalls as stalls
 from tests.cases import ROOT
 from tests.live import start_server
 
@@ -122,18 +123,23 @@ def test_healthz_stays_fast_while_a_request_at_the_limit_runs(
     answers: list[int] = []
     work = threading.Thread(target=_post, args=(url, route, body, answers))
     work.start()
-    latencies = []
-    with httpx.Client(base_url=url) as client:
+    probes = []
+    with stalls.MachineStalls() as machine, httpx.Client(base_url=url) as client:
         while work.is_alive():
-            began = time.perf_counter()
+            began = stalls.now()
             assert client.get("/healthz").status_code == 200
-            latencies.append(time.perf_counter() - began)
+            probes.append((began, stalls.now()))
             time.sleep(0.02)
     work.join()
     assert answers == [200]  # the request at the limit is accepted and answered
-    assert len(latencies) >= 10, "the request ended before /healthz could be measured"
-    assert statistics.median(latencies) < 0.010
-    assert sorted(latencies)[int(0.9 * len(latencies))] < 0.050
+    assert len(probes) >= 10, "the request ended before /healthz could be measured"
+    # Each probe less the machine's stalls it overlapped (tests/machine_stalls.py: after the
+    # suite's minutes of load this machine stops every process for about 100 ms at times while
+    # both CPUs are busy); the server's own blocking stays in. The raw times are in the message.
+    latencies = sorted(end - start - machine.within(start, end) for start, end in probes)
+    raw = sorted(end - start for start, end in probes)
+    assert statistics.median(latencies) < 0.010, (latencies, raw, machine.stalls)
+    assert latencies[int(0.9 * len(latencies))] < 0.050, (latencies, raw, machine.stalls)
 
 
 def _cpu_seconds(pid: int) -> float:
