@@ -1,14 +1,17 @@
 """The sleeper that sets the machine's stalls apart (tests/machine_stalls.py) sees a stall.
 
-A stall is made by stopping the sleeper itself (SIGSTOP, then SIGCONT after a measured time):
+A stall is made by stopping a CPU's sleeper (SIGSTOP, then SIGCONT after a measured time):
 what it reports must cover that interval, and ``within`` must cut the stalls to a probe's
-interval. (The machine's own stalls may add intervals of their own: nothing here bounds them.)
+interval and count time two CPUs were stalled once. (The machine's own stalls may add intervals
+of their own: nothing here bounds them.)
 """
 
 from __future__ import annotations
 
 import signal
 import time
+
+import pytest
 
 from tests import machine_stalls as stalls
 
@@ -17,11 +20,11 @@ def test_a_stopped_sleeper_reports_the_stall_and_within_cuts_it() -> None:
     before = stalls.now()
     with stalls.MachineStalls() as machine:
         time.sleep(0.05)
-        assert machine._process is not None
+        sleeper = machine._processes[0]
         stopped = stalls.now()
-        machine._process.send_signal(signal.SIGSTOP)
+        sleeper.send_signal(signal.SIGSTOP)
         time.sleep(0.2)
-        machine._process.send_signal(signal.SIGCONT)
+        sleeper.send_signal(signal.SIGCONT)
         resumed = stalls.now()
         time.sleep(0.05)
     assert resumed - stopped >= 0.2
@@ -34,3 +37,12 @@ def test_a_stopped_sleeper_reports_the_stall_and_within_cuts_it() -> None:
     middle = (start + end) / 2
     assert abs(machine.within(middle, end) - (end - middle)) < 1e-9
     assert machine.within(before - 1.0, before) == 0.0
+
+
+def test_stalls_of_two_cpus_at_once_count_once() -> None:
+    machine = stalls.MachineStalls()
+    machine.stalls = sorted([(1.0, 2.0), (1.5, 2.5), (3.0, 3.5), (1.2, 1.4)])
+    assert machine.within(0.0, 10.0) == 2.0  # [1, 2.5] and [3, 3.5]
+    assert machine.within(1.8, 3.2) == pytest.approx(0.7 + 0.2, abs=1e-12)
+    assert machine.within(2.6, 2.9) == 0.0
+    assert machine.total == 2.0
