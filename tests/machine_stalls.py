@@ -86,6 +86,10 @@ class MachineStalls:
                 reached = high
         return total
 
+    def less_stalls(self, start: float, end: float) -> float:
+        """A probe's time from ``start`` to ``end`` less the time some CPU was stalled in it."""
+        return end - start - self.within(start, end)
+
     @property
     def total(self) -> float:
         """The seconds some CPU was stalled while the block ran."""

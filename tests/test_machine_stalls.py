@@ -36,6 +36,7 @@ def test_a_stopped_sleeper_reports_the_stall_and_within_cuts_it() -> None:
     # A probe half inside it counts its inside only; one before the sleeper started, nothing.
     middle = (start + end) / 2
     assert abs(machine.within(middle, end) - (end - middle)) < 1e-9
+    assert abs(machine.less_stalls(middle, end)) < 1e-9  # all of it a stall
     assert machine.within(before - 1.0, before) == 0.0
 
 
