@@ -14,7 +14,6 @@ import json
 import math
 import os
 import sys
-import time
 from pathlib import Path
 from typing import Any
 
@@ -24,7 +23,7 @@ import numpy as np
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-from run import load_path, scalar_cell  # noqa: E402 - bench/run.py, beside this script
+from run import load_path, scalar_loop_seconds  # noqa: E402 - bench/run.py, beside this script
 from timing import best_time, plain_post  # noqa: E402
 
 from solver.core.spatial import Placement  # noqa: E402
@@ -89,11 +88,11 @@ def erk_map_over_http(*, repeats: int, subset: int, smoke: bool = False) -> None
     ys = grid_axis(0.25, 0.65, 0.02, field="y")
     cells = len(xs) * len(ys)
     picks = np.random.default_rng(0).choice(cells, size=subset, replace=False)
-    began = time.perf_counter()
-    for p in picks:
-        placement = Placement(float(xs[p % len(xs)]), float(ys[p // len(xs)]), 0.1, 0.0)
-        scalar_cell(robot, path, placement)
-    t_scalar = (time.perf_counter() - began) / subset * cells
+    placements = [
+        Placement(float(xs[p % len(xs)]), float(ys[p // len(xs)]), 0.1, 0.0) for p in picks
+    ]
+    seconds = scalar_loop_seconds(robot, path, placements, repeats=1 if smoke else 3)
+    t_scalar = seconds / subset * cells
     plain, heavy = t_http["http.client"], t_http["httpx"]
     print(
         f"ERK-size map through POST /v1/map ({cells} placements, best of {repeats}, "
