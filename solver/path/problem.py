@@ -230,8 +230,9 @@ class PathProblem:
         (whose spin moves every joint): :mod:`solver.path.exact_spin`, on the numpy pipeline,
         whose work :attr:`exact_spin_weight` weighs.
         """
-        straight = self.robot.dof == 6 and straight_spindle(self.robot)
-        return self.options.spin_mode == "free" and not straight
+        if self.options.spin_mode != "free":  # the spindle read only where it matters
+            return False
+        return not (self.robot.dof == 6 and straight_spindle(self.robot))
 
     def path_cost(self, n_waypoints: int) -> float:
         """The work of one placement of ``n_waypoints``, in poses of a closed-form family's map.
