@@ -20,7 +20,7 @@ from solver.core.spatial import Placement
 from solver.core.written import stepped_as_written
 from solver.path.cell.verdict import Unchecked
 from solver.path.path_checks import checks_model
-from solver.path.placements import DEFAULT_CHUNK, evaluate_placements
+from solver.path.placements import evaluate_placements
 from solver.path.problem import PathProblem
 from solver.path.pruning import can_prune
 
@@ -147,7 +147,7 @@ def capability_map(
     z: float,
     yaws: np.ndarray,
     spins: np.ndarray | None = None,
-    chunk: int = DEFAULT_CHUNK,
+    chunk: int | None = None,
     progress: Callable[[float], None] | None = None,
     runner: TaskRunner = SERIAL,
     compiled: bool = True,
@@ -165,7 +165,8 @@ def capability_map(
         z: m, the height of every placement.
         yaws: shape (nyaw,), rad, placement yaw values.
         spins: shape (nspin,), rad, constant tool spins (cam.md section 3); default [0].
-        chunk: placements computed together.
+        chunk: placements computed together; None: as
+            :func:`solver.path.placements.chunk_of` decides.
         progress: called with the fraction done (0..1] as the work goes; it may raise
             :class:`solver.core.progress.Cancelled` to stop it.
         runner: where the placements' tasks run (:mod:`solver.core.parallel`); same answer on any.

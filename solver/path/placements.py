@@ -35,6 +35,15 @@ from solver.path.problem import PathProblem
 __all__ = ["PlacementResults", "columns_of_run", "evaluate_placements", "results_of_columns"]
 
 DEFAULT_CHUNK = 32
+SMALL_RUN_POSES = 500_000.0
+"""Without a chunk asked for, a compiled-kernel run of at most this much work (closed-form
+poses, :meth:`solver.path.problem.PathProblem.path_cost` a placement: about 45 ms of the UR5's
+map on one thread) is cut into one task per thread rather than chunks of
+:data:`DEFAULT_CHUNK`: each kernel call starts its pruning afresh (its first placement follows
+every branch to the end) and costs about 15 us to enter. The ERK-size map (546 placements, 133
+waypoints, 72,618 poses) took 3.6-3.7 ms on two threads in two tasks against 3.7-4.1 ms in
+six, and 6.3-6.5 ms serially in one against 7.2-7.4 ms in eighteen (2026-12-07, medians of 100,
+in process); its progress is then said twice, once a thread, within a few milliseconds."""
 
 
 @dataclass(frozen=True)
@@ -207,12 +216,30 @@ def _pieces(placements: np.ndarray, size: int) -> list[np.ndarray]:
     return [run[start : start + size] for run in runs for start in range(0, len(run), size)]
 
 
+def chunk_of(
+    problem: PathProblem, n_placements: int, threads: int, kernel: bool, chunk: int | None
+) -> int:
+    """The placements a run computes together: ``chunk`` where the caller asked for one.
+
+    Else :data:`DEFAULT_CHUNK`, or, where the compiled kernel takes each task in one call
+    (``kernel``, no path checks) and the whole run is at most :data:`SMALL_RUN_POSES` of work,
+    enough that each of the runner's ``threads`` takes one task.
+    """
+    if chunk is not None:
+        return chunk
+    if kernel and not problem.path_checks:
+        work = n_placements * problem.path_cost(problem.prepared.n_waypoints)
+        if work <= SMALL_RUN_POSES:
+            return max(DEFAULT_CHUNK, -(-n_placements // max(1, threads)))
+    return DEFAULT_CHUNK
+
+
 def evaluate_placements(
     problem: PathProblem,
     placements: np.ndarray,
     *,
     with_speeds: bool = False,
-    chunk: int = DEFAULT_CHUNK,
+    chunk: int | None = None,
     progress: Callable[[float], None] | None = None,
     runner: TaskRunner = SERIAL,
     compiled: bool = True,
@@ -226,7 +253,8 @@ def evaluate_placements(
         placements: shape (P, 5), [x (m), y (m), z (m), yaw (rad), spin (rad)] of {O} in {B}
             (:meth:`solver.core.spatial.Placement.as_row`); (P, 4) is taken with spin 0.
         with_speeds: also return V_max at every waypoint.
-        chunk: placements computed together.
+        chunk: placements computed together (and progress said at least once a chunk); None:
+            :data:`DEFAULT_CHUNK`, or one task a thread for a small run (:func:`chunk_of`).
         progress: called with the fraction done (0..1] as tasks complete; it may raise
             (:class:`solver.core.progress.Cancelled`) to stop the work.
         runner: runs the tasks (:mod:`solver.core.parallel`); every runner gives the same answer.
@@ -243,6 +271,8 @@ def evaluate_placements(
     _ = problem.path_checks  # and the cell
     cells = check_placements(placements)
     raise_malloc_thresholds()
+    kernel = kernel_of(problem) if compiled else None
+    chunk = chunk_of(problem, len(cells), runner.threads, kernel is not None, chunk)
     chunk = one_pass_chunk(problem, chunk) if prune else chunk
     tasks = _pieces(cells, runner.task_size(len(cells), chunk))
     completed = [0]
@@ -252,7 +282,6 @@ def evaluate_placements(
         if progress is not None:
             progress(completed[0] / len(cells))
 
-    kernel = kernel_of(problem) if compiled else None
     inputs = None  # the kernel's, made once per spin, not once per task (a map's 5 tasks: 6 ms)
     if kernel is not None:
         inputs = {spin: kernel_inputs(problem, spin, kernel) for spin in set(cells[:, 4].tolist())}

@@ -9,9 +9,10 @@ import time
 import numpy as np
 import pytest
 
-from solver.core.parallel import SERIAL, ThreadRunner, tasks_of
+from solver.core.parallel import SERIAL, SerialRunner, ThreadRunner, tasks_of
 from solver.core.progress import Cancelled
 from solver.families import get_robot
+from solver.path import placements as placements_module
 from tests.problems import evaluate_placements, prepare_path
 from tests.solver.test_evaluate import load_path
 
@@ -194,3 +195,44 @@ def test_task_sizes_are_whole_chunks_within_the_cap() -> None:
     assert tasks_of(10**6, 32, per_worker=4, workers=2, cap=512) == 512
     with pytest.raises(ValueError, match="threads=0"):
         ThreadRunner(0)
+
+
+@pytest.mark.parametrize("runner", [SERIAL, ThreadRunner(2)])
+def test_a_small_kernel_run_without_a_chunk_asked_takes_one_task_a_thread(
+    runner: SerialRunner | ThreadRunner,
+) -> None:
+    """solver.path.placements.chunk_of: the same answers as chunks of 32, progress once a thread.
+
+    432 placements of the 49-waypoint s-curve are 21,168 closed-form poses of work, far under
+    SMALL_RUN_POSES: each of the runner's threads takes one task, so progress is said once a
+    thread, where chunks of 32 say it 14 times (in 7 tasks of 64 on two threads).
+    """
+    robot = get_robot("ur5")
+    path = prepare_path(robot, load_path("s_curve"))
+    placements = grid_placements()
+    assert len(placements) * len(load_path("s_curve")) < placements_module.SMALL_RUN_POSES
+    chunked: list[float] = []
+    ours: list[float] = []
+    every = evaluate_placements(
+        robot, path, placements, with_speeds=True, chunk=32, progress=chunked.append, runner=runner
+    )
+    run = evaluate_placements(
+        robot, path, placements, with_speeds=True, progress=ours.append, runner=runner
+    )
+    for name in ("mu_path", "reason", "failed_waypoint", "branch", "bottleneck_waypoint", "v_max"):
+        np.testing.assert_array_equal(getattr(run, name), getattr(every, name), err_msg=name)
+    assert len(chunked) >= 7  # tasks of 32 placements (two threads: 64, four a thread at most)
+    assert len(ours) == runner.threads and ours[-1] == 1.0
+
+
+def test_a_large_run_or_a_numpy_run_keeps_the_default_chunk() -> None:
+    """Over SMALL_RUN_POSES of work, or without the kernel, chunks of DEFAULT_CHUNK."""
+    robot = get_robot("ur5")
+    problem = prepare_path(robot, load_path("s_curve"))
+    n_waypoints = problem.prepared.n_waypoints
+    small = int(placements_module.SMALL_RUN_POSES // n_waypoints)
+    chunk_of = placements_module.chunk_of
+    assert chunk_of(problem, small, 2, True, None) == math.ceil(small / 2)
+    assert chunk_of(problem, small + 1, 2, True, None) == placements_module.DEFAULT_CHUNK
+    assert chunk_of(problem, small, 2, False, None) == placements_module.DEFAULT_CHUNK
+    assert chunk_of(problem, small, 2, True, 8) == 8  # a chunk asked for is taken
