@@ -49,12 +49,11 @@ class JobStatistics(Protocol):
     path: Path
     """The store's SQLite file."""
 
-    def statistics(self) -> tuple[dict[str, int], tuple[int, float]]:
-        """Jobs by status; the jobs that ran to an end and their seconds, only growing."""
-        ...
+    def figures(self) -> tuple[dict[str, int], tuple[int, float], dict[str, int]]:
+        """Jobs by status, the jobs that ran to an end and their seconds, the ended ones.
 
-    def ended(self) -> dict[str, int]:
-        """Jobs that ended, by status, only growing."""
+        Read in one transaction; the last two only grow.
+        """
         ...
 
 
@@ -90,8 +89,7 @@ class _JobCollector(Collector):
         """
         try:
             store = self.store()
-            counts, (finished, seconds) = store.statistics()
-            ended = store.ended()
+            counts, (finished, seconds), ended = store.figures()
         except JobStoreUnavailable:
             yield GaugeMetricFamily("dtf_job_store_up", STORE_UP, value=0)
             return

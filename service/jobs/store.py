@@ -309,9 +309,7 @@ class JobStore(JobReads):
         piled up: the soak audit of stop 61).
         """
         with self._connection() as db:
-            counts = dict(db.execute("SELECT status, COUNT(*) FROM jobs GROUP BY status"))
-            finished, seconds = db.execute("SELECT finished, seconds FROM job_totals").fetchone()
-        return {str(k): int(v) for k, v in counts.items()}, (int(finished), float(seconds))
+            return _statistics(db)
 
     def ended(self) -> dict[str, int]:
         """Jobs that ended since the store began, by status (done, failed, cancelled); only grows.
@@ -320,8 +318,22 @@ class JobStore(JobReads):
         could not tell a failure from an expiry (operator audit of 2026-12-07, L3).
         """
         with self._connection() as db:
-            rows = db.execute("SELECT status, count FROM job_ended").fetchall()
-        return {str(status): int(count) for status, count in rows}
+            return _ended(db)
+
+    def figures(self) -> tuple[dict[str, int], tuple[int, float], dict[str, int]]:
+        """:meth:`statistics` and :meth:`ended` in one read of the store: what /metrics shows.
+
+        One connection and one read transaction, so the figures agree with each other (a job
+        that ends between two reads was counted running by one and ended by the other) and
+        the file is opened once a scrape, not twice.
+        """
+        with self._connection() as db:
+            db.execute("BEGIN")
+            try:
+                counts, totals = _statistics(db)
+                return counts, totals, _ended(db)
+            finally:
+                db.execute("COMMIT")
 
     def expire(self, *, ttl: float) -> int:
         """Forget finished jobs older than ``ttl`` seconds, and their results' pages; how many.
@@ -385,3 +397,16 @@ def _interrupted(attempts: int) -> dict[str, Any]:
         "msg": f"the job was interrupted {attempts} times (service restarts) and is not retried",
         "type": "interrupted",
     }
+
+
+def _statistics(db: sqlite3.Connection) -> tuple[dict[str, int], tuple[int, float]]:
+    """:meth:`JobStore.statistics` on an open connection."""
+    counts = dict(db.execute("SELECT status, COUNT(*) FROM jobs GROUP BY status"))
+    finished, seconds = db.execute("SELECT finished, seconds FROM job_totals").fetchone()
+    return {str(k): int(v) for k, v in counts.items()}, (int(finished), float(seconds))
+
+
+def _ended(db: sqlite3.Connection) -> dict[str, int]:
+    """:meth:`JobStore.ended` on an open connection."""
+    rows = db.execute("SELECT status, count FROM job_ended").fetchall()
+    return {str(status): int(count) for status, count in rows}

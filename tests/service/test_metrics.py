@@ -4,7 +4,10 @@ from __future__ import annotations
 
 import os
 import re
+import sqlite3
 from pathlib import Path
+from typing import Any
+from unittest import mock
 
 from fastapi.testclient import TestClient
 
@@ -53,3 +56,33 @@ def test_the_job_stores_size_on_disk_and_its_ended_jobs(client: TestClient, tmp_
     text = client.get("/metrics").text
     for status in ("done", "failed", "cancelled"):
         assert re.search(rf'^dtf_jobs_ended_total{{status="{status}"}} \d', text, re.M), status
+
+
+def test_a_scrape_reads_the_store_once_in_one_transaction(tmp_path: Path) -> None:
+    """The jobs by status and the ended jobs came from two connections, each its own read: a
+    job that ended between them was counted running by one and ended by the other. Every
+    statement of a scrape now runs on one connection, inside one BEGIN ... COMMIT (SQLite's
+    trace of the statements, read here)."""
+    store = JobStore(tmp_path / "jobs.sqlite3")
+    job = store.create("evaluate", {"robot": "ur5e"})
+    assert store.start(job.id)
+    store.finish(job.id, "done", result={"feed": 0.1})
+    opened: list[list[str]] = []
+    connect = sqlite3.connect
+
+    def traced(*args: Any, **kwargs: Any) -> sqlite3.Connection:
+        db = connect(*args, **kwargs)
+        statements: list[str] = []
+        opened.append(statements)
+        db.set_trace_callback(statements.append)
+        return db
+
+    with mock.patch.object(sqlite3, "connect", traced):
+        collected = {m.name: m for m in _JobCollector(lambda: store).collect()}
+    assert len(opened) == 1
+    [statements] = opened
+    assert statements[0] == "BEGIN" and statements[-1] == "COMMIT"
+    assert sum(s.startswith("SELECT") for s in statements) == 3
+    held = {s.labels["status"]: s.value for s in collected["dtf_jobs"].samples}
+    ended = {s.labels["status"]: s.value for s in collected["dtf_jobs_ended"].samples}
+    assert held["done"] == ended["done"] == 1
