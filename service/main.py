@@ -26,7 +26,7 @@ from pydantic.json_schema import models_json_schema
 from starlette.exceptions import HTTPException as StarletteHTTPException
 
 from service import caches
-from service.api import api_router
+from service.api import API_ROUTERS
 from service.api.routes import health
 from service.body import BODY_MODELS
 from service.body_limits import BodySizeLimitMiddleware
@@ -208,7 +208,8 @@ def create_app() -> FastAPI:
         dependencies=[Depends(known_query_parameters)],
     )
     app.include_router(health.router)
-    app.include_router(api_router)
+    for router in API_ROUTERS:
+        app.include_router(router, prefix="/v1")
     mount_page(app)
     app.add_middleware(BodySizeLimitMiddleware)
     app.add_middleware(RefusalLogMiddleware)  # outside it: its 413, 415 and 408 are logged too
