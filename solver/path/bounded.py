@@ -49,12 +49,16 @@ ROUGH = 3
 """Damped least-squares steps a stride when a slot other than the candidate is scouted
 (without a convergence test). From one waypoint to the next (UR5 on the ERK path), one step
 leaves |e|_inf about 1e-4, two about 1e-9 (90th percentile); over a stride of 8 two leave
-about 1e-5, so three."""
-STRIDE = 8
+about 1e-5, so three (kept with the stride of 12 below, measured with it)."""
+STRIDE = 12
 """Waypoints a scouted slot goes at a time (stopping at the candidate's slowest waypoint).
 The UR5-as-URDF ERK map's compiled following took 0.56 times as long as following every slot
 other than the candidate exactly (with drops), with the lead alone 0.35 (the same slots
-dropped; loaded machine, best of 5, same run); strides of 4 and 12 about the same as 8."""
+dropped; loaded machine, best of 5, same run); strides of 4 and 12 about the same as 8 then.
+Measured again on an idle machine (2026-12-07, six alternations, best of 3 each): the whole map
+294-310 ms with 12 against 303-362 with 8 (best 0.97x, median 0.95x), 4, 16 and 24 slower
+(1.04-1.14x); the IRB 2400 as a URDF the same with either (333 and 334 ms). The same answers
+with any stride (a slot handed on is followed exactly)."""
 RESIDUAL = 1e-6
 """A stride whose rough steps leave |e|_inf (m, rad) above this is not trusted to have stayed
 on the slot's branch: the slot is followed exactly instead."""
