@@ -300,40 +300,33 @@ class JobStore(JobReads):
                          job_id, runs + 1, attempts)  # fmt: skip
         return [row[0] for row in rows]
 
-    def statistics(self) -> tuple[dict[str, int], tuple[int, float]]:
-        """Jobs held by status; how many jobs ran to an end since the store began, their seconds.
-
-        The second only grows (the store's ``job_totals``, kept by a trigger): read from the
-        jobs held, it fell when jobs were deleted or expired, which Prometheus reads as a
-        counter reset, and a scrape read every finished job's times (48 to 160 ms as 748 jobs
-        piled up: the soak audit of stop 61).
-        """
-        with self._connection() as db:
-            return _statistics(db)
-
-    def ended(self) -> dict[str, int]:
-        """Jobs that ended since the store began, by status (done, failed, cancelled); only grows.
-
-        The jobs held by status fall as jobs are deleted or expire: an alert on failed jobs
-        could not tell a failure from an expiry (operator audit of 2026-12-07, L3).
-        """
-        with self._connection() as db:
-            return _ended(db)
-
     def figures(self) -> tuple[dict[str, int], tuple[int, float], dict[str, int]]:
-        """:meth:`statistics` and :meth:`ended` in one read of the store: what /metrics shows.
+        """What /metrics shows, in one read of the store.
 
-        One connection and one read transaction, so the figures agree with each other (a job
-        that ends between two reads was counted running by one and ended by the other) and
-        the file is opened once a scrape, not twice.
+        Jobs held by status; how many jobs ran to an end since the store began and their
+        seconds (the store's ``job_totals``, kept by a trigger: read from the jobs held, it fell
+        when jobs were deleted or expired, which Prometheus reads as a counter reset, and a
+        scrape read every finished job's times, 48 to 160 ms as 748 jobs piled up: the soak
+        audit of stop 61); the jobs that ended since the store began by status (done, failed,
+        cancelled; the jobs held by status fall as jobs are deleted or expire, so an alert on
+        failed jobs could not tell a failure from an expiry: operator audit of 2026-12-07, L3).
+        The last two only grow. One connection and one read transaction, so the figures agree
+        with each other (a job that ends between two reads was counted running by one and ended
+        by the other) and the file is opened once a scrape.
         """
         with self._connection() as db:
             db.execute("BEGIN")
             try:
-                counts, totals = _statistics(db)
-                return counts, totals, _ended(db)
+                counts = dict(db.execute("SELECT status, COUNT(*) FROM jobs GROUP BY status"))
+                totals = db.execute("SELECT finished, seconds FROM job_totals").fetchone()
+                ended = db.execute("SELECT status, count FROM job_ended").fetchall()
             finally:
                 db.execute("COMMIT")
+        return (
+            {str(k): int(v) for k, v in counts.items()},
+            (int(totals[0]), float(totals[1])),
+            {str(status): int(count) for status, count in ended},
+        )
 
     def expire(self, *, ttl: float) -> int:
         """Forget finished jobs older than ``ttl`` seconds, and their results' pages; how many.
@@ -397,16 +390,3 @@ def _interrupted(attempts: int) -> dict[str, Any]:
         "msg": f"the job was interrupted {attempts} times (service restarts) and is not retried",
         "type": "interrupted",
     }
-
-
-def _statistics(db: sqlite3.Connection) -> tuple[dict[str, int], tuple[int, float]]:
-    """:meth:`JobStore.statistics` on an open connection."""
-    counts = dict(db.execute("SELECT status, COUNT(*) FROM jobs GROUP BY status"))
-    finished, seconds = db.execute("SELECT finished, seconds FROM job_totals").fetchone()
-    return {str(k): int(v) for k, v in counts.items()}, (int(finished), float(seconds))
-
-
-def _ended(db: sqlite3.Connection) -> dict[str, int]:
-    """:meth:`JobStore.ended` on an open connection."""
-    rows = db.execute("SELECT status, count FROM job_ended").fetchall()
-    return {str(status): int(count) for status, count in rows}

@@ -64,7 +64,7 @@ def test_a_corrupt_file_makes_the_store_unavailable_with_its_reason(
         lambda: store.get("x"),
         lambda: store.jobs(status=None, limit=10),
         lambda: store.create("evaluate", EVALUATE, limit=10),
-        store.statistics,
+        store.figures,
     ):
         with pytest.raises(JobStoreUnavailable) as raised:
             call()
@@ -252,7 +252,7 @@ def test_a_run_a_restart_failed_is_counted_without_the_downtime(tmp_path: Path) 
     assert store.recover(attempts=1) == []
     state = store.state(cut.id)
     assert state is not None and state.status == "failed"
-    assert store.statistics()[1] == (2, pytest.approx(finished - started, abs=1e-6))
+    assert store.figures()[1] == (2, pytest.approx(finished - started, abs=1e-6))
 
 
 def test_a_cancel_asked_before_a_restart_ends_the_job_cancelled(
@@ -273,7 +273,7 @@ def test_a_cancel_asked_before_a_restart_ends_the_job_cancelled(
     assert state is not None and state.status == "cancelled" and state.finished is not None
     assert store.queued(exclude=set(), limit=9) == [other.id]
     assert f"job {asked.id}, cancelled before a restart: cancelled" in caplog.messages
-    assert store.statistics()[1] == (1, 0.0)
+    assert store.figures()[1] == (1, 0.0)
 
 
 def test_a_cancelled_job_whose_worker_dies_is_cancelled_not_failed(tmp_path: Path) -> None:
@@ -404,13 +404,13 @@ def test_the_jobs_that_ran_are_counted_once_each_and_never_less(tmp_path: Path) 
             "SELECT COUNT(*), SUM(CASE status WHEN 'failed' THEN 0 ELSE finished - started END) "
             "FROM jobs WHERE started IS NOT NULL AND status IN ('done', 'failed', 'cancelled')"
         ).fetchone()
-    counts, totals = store.statistics()
+    counts, totals, _ = store.figures()
     assert counts == {"done": 1, "failed": 2, "cancelled": 2}
     assert totals == (4, pytest.approx(expected[1], rel=1e-12, abs=1e-12)) and expected[0] == 4
     for job in (done, spent):
         assert store.delete(job.id)
     assert store.expire(ttl=-1.0) == 3  # every finished job left
-    assert store.statistics() == ({}, totals)
+    assert store.figures()[:2] == ({}, totals)
 
 
 def test_the_jobs_that_ended_are_counted_by_status_and_never_less(tmp_path: Path) -> None:
@@ -436,12 +436,12 @@ def test_the_jobs_that_ended_are_counted_by_status_and_never_less(tmp_path: Path
             ).fetchall()
         )
     assert held == {"done": 1, "failed": 2, "cancelled": 2}
-    assert store.ended() == held
+    assert store.figures()[2] == held
     for job in (done, spent):
         assert store.delete(job.id)
     assert store.expire(ttl=-1.0) == 3
-    assert store.ended() == held
-    assert JobStore(store.path).ended() == held  # opened again: not counted twice
+    assert store.figures()[2] == held
+    assert JobStore(store.path).figures()[2] == held  # opened again: not counted twice
 
 
 def test_a_store_of_an_older_release_counts_its_ended_jobs_once(tmp_path: Path) -> None:
@@ -454,8 +454,8 @@ def test_a_store_of_an_older_release_counts_its_ended_jobs_once(tmp_path: Path) 
     with sqlite3.connect(path) as db:
         db.execute("DROP TRIGGER job_ended_as")
         db.execute("DROP TABLE job_ended")
-    assert JobStore(path).ended() == {"done": 1, "failed": 0, "cancelled": 1}
-    assert JobStore(path).ended() == {"done": 1, "failed": 0, "cancelled": 1}
+    assert JobStore(path).figures()[2] == {"done": 1, "failed": 0, "cancelled": 1}
+    assert JobStore(path).figures()[2] == {"done": 1, "failed": 0, "cancelled": 1}
 
 
 def test_a_store_of_an_older_release_counts_the_jobs_it_holds(tmp_path: Path) -> None:
@@ -469,7 +469,7 @@ def test_a_store_of_an_older_release_counts_the_jobs_it_holds(tmp_path: Path) ->
         db.execute("DROP TRIGGER job_ran_to_its_end")
         db.execute("DROP TABLE job_totals")
         started, finished = db.execute("SELECT started, finished FROM jobs").fetchone()
-    assert JobStore(path).statistics() == ({"done": 1}, (1, pytest.approx(finished - started)))
+    assert JobStore(path).figures()[:2] == ({"done": 1}, (1, pytest.approx(finished - started)))
 
 
 def test_deleted_and_expired_jobs_give_their_space_back_to_the_disk(tmp_path: Path) -> None:
