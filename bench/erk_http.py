@@ -18,7 +18,6 @@ from pathlib import Path
 from typing import Any
 
 import httpx
-import numpy as np
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
@@ -26,7 +25,6 @@ sys.path.insert(0, str(ROOT))
 from run import load_path, scalar_loop_seconds  # noqa: E402 - bench/run.py, beside this script
 from timing import best_time, plain_post  # noqa: E402
 
-from solver.core.spatial import Placement  # noqa: E402
 from solver.families import get_robot  # noqa: E402
 from solver.path.capability_map import grid_axis  # noqa: E402
 from tests.live import start_server  # noqa: E402
@@ -87,11 +85,9 @@ def erk_map_over_http(*, repeats: int, subset: int, smoke: bool = False) -> None
     xs = grid_axis(-0.25, 0.25, 0.02, field="x")
     ys = grid_axis(0.25, 0.65, 0.02, field="y")
     cells = len(xs) * len(ys)
-    picks = np.random.default_rng(0).choice(cells, size=subset, replace=False)
-    placements = [
-        Placement(float(xs[p % len(xs)]), float(ys[p // len(xs)]), 0.1, 0.0) for p in picks
-    ]
-    seconds = scalar_loop_seconds(robot, path, placements, repeats=1 if smoke else 3)
+    seconds = scalar_loop_seconds(
+        robot, path, (xs, ys, ERK_GRID["z"]), subset=subset, repeats=1 if smoke else 3
+    )
     t_scalar = seconds / subset * cells
     plain, heavy = t_http["http.client"], t_http["httpx"]
     print(

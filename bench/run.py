@@ -88,15 +88,24 @@ def scalar_cell(robot: Robot, path: np.ndarray, placement: Placement) -> float:
 
 
 def scalar_loop_seconds(
-    robot: Robot, path: np.ndarray, placements: list[Placement], *, repeats: int = 3
+    robot: Robot,
+    path: np.ndarray,
+    grid: tuple[np.ndarray, np.ndarray, float],
+    *,
+    subset: int,
+    repeats: int = 3,
 ) -> float:
-    """The scalar loop's time over ``placements``: each cell the best of ``repeats``, summed.
+    """The scalar loop's time over ``subset`` cells of the grid (xs, ys, z), drawn by a seed.
 
-    The same statistic as the maps it is set against (best of several runs), after one cell
-    run once to warm up: timed once and cold, 24 cells read 47 s extrapolated and then
-    44.5, 41.4, 41.1 and 40.7 s in the same process, where the best of five a cell gave 40.0 s
-    (2026-12-07), so a ratio taken against one cold pass was up to a sixth too high.
+    Each cell the best of ``repeats``, summed: the same statistic as the maps it is set
+    against (best of several runs), after one cell run once to warm up. Timed once and cold,
+    24 cells read 47 s extrapolated and then 44.5, 41.4, 41.1 and 40.7 s in the same process,
+    where the best of five a cell gave 40.0 s (2026-12-07), so a ratio taken against one cold
+    pass was up to a sixth too high.
     """
+    xs, ys, z = grid
+    picks = np.random.default_rng(0).choice(len(xs) * len(ys), size=subset, replace=False)
+    placements = [Placement(float(xs[p % len(xs)]), float(ys[p // len(xs)]), z, 0.0) for p in picks]
     scalar_cell(robot, path, placements[0])
     total = 0.0
     for placement in placements:
@@ -163,10 +172,9 @@ def main() -> None:
     t_opw = best_time(opw_map, repeats)
     t_opw_numpy = best_time(lambda: opw_map(compiled=False), repeats)
     opw_cells = len(opw_xs) * len(opw_ys)
-    rng = np.random.default_rng(0)
-    picks = rng.choice(cells, size=subset, replace=False)
-    placements = [Placement(float(xs[p % len(xs)]), float(ys[p // len(xs)]), z, 0.0) for p in picks]
-    t_scalar_subset = scalar_loop_seconds(robot, path, placements, repeats=1 if args.smoke else 3)
+    t_scalar_subset = scalar_loop_seconds(
+        robot, path, (xs, ys, z), subset=subset, repeats=1 if args.smoke else 3
+    )
     t_scalar = t_scalar_subset / subset * cells
 
     print(
