@@ -1,9 +1,10 @@
 """The service's own log lines: their level said, once, where the operator's logging sends them.
 
 Each case runs in a fresh interpreter (logging's state is the process's): the lines the
-service writes by itself (``service.logs.log_to_stderr``, as the start and every job worker
-call it), and the lines under a logging configuration of the operator's (what ``uvicorn
---log-config`` applies before the start), read back from stdout and stderr with a regex.
+service writes by itself (``service.logs.log_to_stderr``, as the start calls it; a job worker's
+lines go to the web process, which says them so: tests/service/test_job_runner.py), and the
+lines under a logging configuration of the operator's (what ``uvicorn --log-config`` applies
+before the start), read back from stdout and stderr with a regex.
 """
 
 from __future__ import annotations
@@ -19,7 +20,7 @@ _SAY = (
     "{configure}"
     "from service.logs import log, log_to_stderr\n"
     "log_to_stderr()\n"
-    "log_to_stderr()\n"  # a second call (the start after a worker's) adds nothing
+    "log_to_stderr()\n"  # a second call adds nothing
     "log.info('job a1 queued')\n"
     "log.warning('job a1 ran again')\n"
     "log.debug('not said')\n"
