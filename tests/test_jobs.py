@@ -169,6 +169,46 @@ def test_a_restart_finishes_an_interrupted_job_with_the_same_result(tmp_path: Pa
         process.wait()
 
 
+def test_a_second_service_on_the_directory_leaves_a_running_job_and_takes_it_if_the_first_dies(
+    tmp_path: Path,
+) -> None:
+    """An overlapping deploy (the operator audit's M1): the second service's start queued again
+    the job the first one was running, which then ran twice. Now it is the first's while that
+    lives; killed, its job is taken by the second within TAKE_OVER_SECONDS (10 s), run 2."""
+    store = JobStore(tmp_path / "jobs.sqlite3")
+    body = {**map_request(GRID_8K), "robot": {"model": "panda"}}  # about 20 s of work
+    first, url = server(tmp_path)
+    second = None
+    try:
+        submitted = httpx.post(f"{url}/v1/jobs", json={"kind": "map", "request": body})
+        job_id = submitted.json()["id"]
+        wait_for(url, job_id, lambda j: j["status"] == "running", timeout=30)
+        (owner,) = store.running_owners()
+        second, other = server(tmp_path)
+        job = store.get(job_id)
+        assert job is not None and (job.status, job.attempts) == ("running", 1)
+        assert store.running_owners() == {owner}
+        first.send_signal(signal.SIGKILL)  # its worker dies with it
+        first.wait()
+        deadline = time.monotonic() + 20
+        while time.monotonic() < deadline:
+            job = store.get(job_id)
+            assert job is not None
+            if job.status == "running" and job.attempts == 2:
+                break
+            time.sleep(0.1)
+        assert (job.status, job.attempts) == ("running", 2)
+        assert store.running_owners() not in ({owner}, set())  # the second's now
+        httpx.post(f"{other}/v1/jobs/{job_id}/cancel")
+        ended = wait_for(other, job_id, lambda j: j["status"] != "running", timeout=10)
+        assert ended["status"] == "cancelled"
+    finally:
+        for process in (first, second):
+            if process is not None:
+                process.terminate()
+                process.wait()
+
+
 @pytest.mark.latency
 def test_health_stays_fast_while_four_map_jobs_run(tmp_path: Path) -> None:
     process, url = server(tmp_path, DTF_WORKERS="4")

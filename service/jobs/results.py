@@ -38,7 +38,8 @@ CREATE TABLE IF NOT EXISTS jobs (
     total INTEGER,
     cells INTEGER,
     first_at REAL,
-    first_done REAL
+    first_done REAL,
+    owner TEXT
 );
 CREATE INDEX IF NOT EXISTS jobs_created ON jobs (created);
 CREATE INDEX IF NOT EXISTS jobs_finished ON jobs (finished);
@@ -95,7 +96,13 @@ that ended by how they ended (a job cancelled before it ran too), the same way: 
 are made once, from the jobs the store holds then.
 """
 
-_ADDED_COLUMNS = {"total": "INTEGER", "cells": "INTEGER", "first_at": "REAL", "first_done": "REAL"}
+_ADDED_COLUMNS = {
+    "total": "INTEGER",
+    "cells": "INTEGER",
+    "first_at": "REAL",
+    "first_done": "REAL",
+    "owner": "TEXT",  # the service running the job (service.jobs.owner)
+}
 """Columns a store made by an older release lacks (added on open; NULL in its rows)."""
 
 

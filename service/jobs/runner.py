@@ -6,6 +6,11 @@ It also watches the running ones: a worker that has not stopped a cancelled job 
 ``KILL_AFTER`` seconds is killed and replaced, so a cancel stops the work within a second even
 inside a long solver step, and a worker that dies fails its job instead of hanging it.
 
+Several services may share a data directory: each holds a lock of its own and keeps its id with
+the jobs it starts (:mod:`service.jobs.owner`); a start queues again only the running jobs of a
+service that is gone, and every ``TAKE_OVER_SECONDS`` the supervisor looks for those too (a
+service that died while another runs).
+
 When the store cannot be used (``JobStoreUnavailable``: a corrupt, replaced or deleted file),
 the supervisor logs it once and looks again less and less often (up to ``MAX_BACKOFF``), and
 logs once more when the store is back; the web process and its compute routes go on.
@@ -26,6 +31,7 @@ from pathlib import Path
 
 from service.config import Settings
 from service.jobs.job import JobStoreUnavailable
+from service.jobs.owner import ServiceLock, alive
 from service.jobs.store import JobStore
 from service.jobs.worker import UNSTORED, serve
 from service.logs import duration, log
@@ -43,6 +49,11 @@ KILL_AFTER = 0.5
 
 MAX_BACKOFF = 5.0
 """The longest wait between two looks at a store that is failing (s)."""
+
+TAKE_OVER_SECONDS = 10.0
+"""How often the supervisor looks for running jobs of a service that is gone (s): another
+service on the same data directory that stopped or died. Its jobs are queued again, as a
+restart queues its own."""
 
 EXPIRE_SECONDS = 60.0
 """How often the supervisor forgets the jobs older than DTF_JOB_TTL (s; more often for a
@@ -74,11 +85,14 @@ class JobRunner:
         self.settings = settings
         self._worker = worker
         self.store = JobStore(Path(settings.data_dir) / "jobs.sqlite3")
+        self.service = ServiceLock(Path(settings.data_dir))
+        """This service's lock and id (its jobs are its own while it lives)."""
         self._context = multiprocessing.get_context("spawn")
         self._workers: list[_Worker] = []  # started when jobs first wait (each is 250 MB)
         self._unsettled: set[str] = set()  # jobs whose worker could not store their end
         self._recovery_due = False  # recover() was refused by the store: the supervisor's to do
         self._expired_at = -math.inf  # when expire() last ran (monotonic, s)
+        self._looked_at = time.monotonic()  # when the last look for a gone service's jobs was
         self.failure: str | None = None
         """Why the supervisor's last look failed (the store's reason), None when it did not."""
         self._wake = threading.Event()
@@ -86,11 +100,29 @@ class JobRunner:
         self._thread = threading.Thread(target=self._supervise, name="dtf-jobs", daemon=True)
         self._thread.start()
 
+    def _owner(self) -> str:
+        """This service's id, its lock held (taken at the first job).
+
+        Raises:
+            JobStoreUnavailable: the lock cannot be made or taken (jobs wait: a job started
+                without it would be any other service's to run again).
+        """
+        try:
+            return self.service.hold()
+        except OSError as error:
+            raise JobStoreUnavailable(
+                f"the service's lock {str(self.service.path)!r} cannot be held: {error}"
+            ) from error
+
+    def _alive(self, owner: str | None) -> bool:
+        """Whether the service ``owner`` runs: this one, or another holding its lock."""
+        return owner == self.service.id or alive(Path(self.settings.data_dir), owner)
+
     def _start_worker(self) -> _Worker:
         ours, theirs = self._context.Pipe()
         process = self._context.Process(
             target=self._worker,
-            args=(theirs, str(self.store.path), self.settings.model_dump_json()),
+            args=(theirs, str(self.store.path), self.settings.model_dump_json(), self._owner()),
             name="dtf-job-worker",
             daemon=True,
         )
@@ -118,11 +150,25 @@ class JobRunner:
         """
         try:
             self.expire()
-            ids = self.store.recover(attempts=self.settings.job_attempts)
+            ids = self.store.recover(attempts=self.settings.job_attempts, alive=self._alive)
+            self._looked_at = time.monotonic()
         except JobStoreUnavailable:
             self._recovery_due = True
             raise
         self._recovery_due = False
+        self._wake.set()
+        return ids
+
+    def take_over(self) -> list[str]:
+        """Queue again the running jobs of the services that are gone; the ids queued.
+
+        A cheap read when every running job's service lives (the store's write lock is taken
+        only when one is gone).
+        """
+        self._looked_at = time.monotonic()
+        if all(self._alive(owner) for owner in self.store.running_owners()):
+            return []
+        ids = self.store.recover(attempts=self.settings.job_attempts, alive=self._alive)
         self._wake.set()
         return ids
 
@@ -163,6 +209,8 @@ class JobRunner:
                 since = time.monotonic() - self._expired_at
                 if since >= min(self.settings.job_ttl, EXPIRE_SECONDS):
                     self.expire()
+                if time.monotonic() - self._looked_at >= TAKE_OVER_SECONDS:
+                    self.take_over()
                 self._watch()
                 self.settle()
                 waiting = self._dispatch()
@@ -286,6 +334,7 @@ class JobRunner:
         for worker in self._workers:
             worker.process.join(timeout=5)
             worker.connection.close()
+        self.service.release()  # after the workers: their jobs are free to run again now
 
 
 def _heard(connection: Connection) -> object | None:

@@ -15,6 +15,7 @@ import json
 import sqlite3
 import time
 import uuid
+from collections.abc import Callable
 from typing import Any, Literal
 
 from service.jobs.job import Job, Kind, QueueFull, Status, job_of_row
@@ -73,14 +74,18 @@ class JobStore(JobReads):
                 raise
         return job_of_row(row, store=self.path)
 
-    def start(self, job_id: str) -> bool:
-        """Mark a queued job running (one more attempt, from no progress); False if not queued."""
+    def start(self, job_id: str, owner: str | None = None) -> bool:
+        """Mark a queued job running (one more attempt, from no progress); False if not queued.
+
+        ``owner``: the id of the service that runs it (:mod:`service.jobs.owner`), whose
+        recovery alone may queue it again while that service lives.
+        """
         with self._connection() as db:
             changed = db.execute(
                 "UPDATE jobs SET status = 'running', started = ?, done = 0, first_at = NULL, "
-                "first_done = NULL, attempts = attempts + 1 "
+                "first_done = NULL, attempts = attempts + 1, owner = ? "
                 "WHERE id = ? AND status = 'queued' AND cancel = 0",
-                (time.time(), job_id),
+                (time.time(), owner, job_id),
             ).rowcount
         return bool(changed)
 
@@ -239,8 +244,15 @@ class JobStore(JobReads):
             _keep_places(db, places)
         return bool(deleted)
 
-    def recover(self, *, attempts: int) -> list[str]:
-        """After a restart: jobs left running are queued again (or failed after ``attempts``).
+    def recover(
+        self, *, attempts: int, alive: Callable[[str | None], bool] = lambda _: False
+    ) -> list[str]:
+        """Jobs left running by a service that is gone are queued again (or failed, cancelled).
+
+        ``alive``: whether the service of a job's ``owner`` id still runs
+        (:func:`service.jobs.owner.alive`); its jobs are left to it, so that a second service
+        on the same data directory does not run them again (the operator audit's M1). By
+        default every owner is gone: the jobs left running were interrupted by a restart.
 
         A job whose cancel was asked before the restart (its worker stopped with the service
         before it could end the job) is cancelled: queued again it would never run (``queued``
@@ -256,9 +268,13 @@ class JobStore(JobReads):
         now = time.time()
         with self._connection() as db:
             db.execute("BEGIN IMMEDIATE")
-            left = db.execute(
-                "SELECT id, attempts, started, cancel FROM jobs WHERE status = 'running'"
+            running = db.execute(
+                "SELECT id, attempts, started, cancel, owner FROM jobs WHERE status = 'running'"
             ).fetchall()
+            owners = {row["owner"] for row in running}
+            gone = {owner for owner in owners if not alive(owner)}
+            left = [tuple(row)[:4] for row in running if row["owner"] in gone]
+            kept = len(running) - len(left)
             # The trigger job_ran_to_its_end counts a failed job's finished - started: here the
             # restart's time, so the service's downtime too (35.6 s for a run of about 3 s, the
             # upgrade audit of stop 62). How long the interrupted run took is not known: it is
@@ -268,23 +284,28 @@ class JobStore(JobReads):
                 for _, runs, started, cancel in left
                 if (runs >= attempts or cancel) and started is not None
             )
-            db.execute(
-                "UPDATE jobs SET status = 'cancelled', finished = ? WHERE status = 'running' "
-                "AND cancel = 1",
-                (now,),
-            )
-            db.execute(
-                "UPDATE jobs SET status = 'failed', finished = ?, error = ? WHERE "
-                "status = 'running' AND attempts >= ?",
-                (now, json.dumps([_interrupted(attempts)]), attempts),
-            )
+            ids = [job_id for job_id, *_ in left]
+            for job_id, runs, _, cancel in left:
+                if cancel:
+                    db.execute(
+                        "UPDATE jobs SET status = 'cancelled', finished = ? WHERE id = ?",
+                        (now, job_id),
+                    )
+                elif runs >= attempts:
+                    db.execute(
+                        "UPDATE jobs SET status = 'failed', finished = ?, error = ? WHERE id = ?",
+                        (now, json.dumps([_interrupted(attempts)]), job_id),
+                    )
             db.execute("UPDATE job_totals SET seconds = seconds - ?", (downtime,))
-            db.execute("COMMIT")
-            # the interrupted run's progress and start time are not the next run's
-            db.execute(
+            # The interrupted run's progress and start time are not the next run's. In the
+            # same transaction: two services recovering at once must not both take a job (the
+            # second would queue again the run the first had started meanwhile).
+            db.executemany(
                 "UPDATE jobs SET status = 'queued', done = 0, started = NULL "
-                "WHERE status = 'running'"
+                "WHERE id = ? AND status = 'running'",
+                [(job_id,) for job_id in ids],
             )
+            db.execute("COMMIT")
             # Pages of no job: left by an older release, whose finish() wrote a deleted job's.
             db.execute("DELETE FROM job_cells WHERE job_id NOT IN (SELECT id FROM jobs)")
             rows = db.execute(
@@ -292,13 +313,22 @@ class JobStore(JobReads):
             ).fetchall()
         for job_id, runs, _, cancel in left:  # a restart's work said (only a second line was)
             if cancel:
-                log.info("job %s, cancelled before a restart: cancelled", job_id)
+                log.info("job %s, cancelled before its service stopped: cancelled", job_id)
             elif runs >= attempts:
-                log.info("job %s interrupted by a restart after %d runs: failed", job_id, runs)
+                log.info("job %s interrupted (its service stopped) after %d runs: failed",
+                         job_id, runs)  # fmt: skip
             else:
-                log.info("job %s interrupted by a restart: queued again (run %d of at most %d)",
-                         job_id, runs + 1, attempts)  # fmt: skip
+                log.info("job %s interrupted (its service stopped): queued again (run %d of at "
+                         "most %d)", job_id, runs + 1, attempts)  # fmt: skip
+        if kept:
+            log.info("%d running job(s) left to the other service(s) that run them", kept)
         return [row[0] for row in rows]
+
+    def running_owners(self) -> set[str | None]:
+        """The ids of the services running jobs (None: a job started before owners were kept)."""
+        with self._connection() as db:
+            rows = db.execute("SELECT DISTINCT owner FROM jobs WHERE status = 'running'").fetchall()
+        return {row[0] for row in rows}
 
     def figures(self) -> tuple[dict[str, int], tuple[int, float], dict[str, int]]:
         """What /metrics shows, in one read of the store.

@@ -125,13 +125,14 @@ def _what(job: Job) -> str:
     return f"{job.kind}{size}, run {job.attempts}"
 
 
-def run_job(store: JobStore, job_id: str, settings: Settings) -> None:
+def run_job(store: JobStore, job_id: str, settings: Settings, owner: str | None = None) -> None:
     """Run one job to its end; every outcome is written to the store.
 
     The log says what runs (kind, a map's size, which run) and, at its end, how long it took:
-    the lines said neither (operator audit of 2026-12-07, M4).
+    the lines said neither (operator audit of 2026-12-07, M4). ``owner``: the id of the
+    service whose worker runs it (:mod:`service.jobs.owner`), kept with the job.
     """
-    if not store.start(job_id):
+    if not store.start(job_id, owner):
         return  # cancelled while queued, or taken by another worker
     began = time.monotonic()
     try:
@@ -228,10 +229,13 @@ def _log_to_the_service(pipe: _Pipe) -> None:
     logger.propagate = False
 
 
-def serve(connection: Connection, store_path: str, settings_json: str) -> None:
+def serve(
+    connection: Connection, store_path: str, settings_json: str, owner: str | None = None
+) -> None:
     """A worker process's life: run each job id received, answer it back when it has ended.
 
     The job's log lines and its answer go back through ``connection`` (:class:`_Pipe`).
+    ``owner``: the id of the service that started the worker (:mod:`service.jobs.owner`).
     """
     _die_with_the_service()
     os.nice(NICENESS)
@@ -246,7 +250,7 @@ def serve(connection: Connection, store_path: str, settings_json: str) -> None:
         except (EOFError, OSError):
             return  # the service has gone
         try:
-            run_job(store, job_id, settings)
+            run_job(store, job_id, settings, owner)
             stored = True
         except JobStoreUnavailable as error:  # the supervisor reports the store (once)
             stored = fail_unstored(store, job_id, error)

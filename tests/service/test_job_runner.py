@@ -354,10 +354,10 @@ def test_a_recovery_the_store_refused_at_the_start_is_done_when_it_answers(
     try:
         recover, refusals = runner.store.recover, [JobStoreUnavailable("the store is full")]
 
-        def refusing_once(*, attempts: int) -> list[str]:
+        def refusing_once(*, attempts: int, alive: Callable[[str | None], bool]) -> list[str]:
             if refusals:
                 raise refusals.pop()
-            return recover(attempts=attempts)
+            return recover(attempts=attempts, alive=alive)
 
         monkeypatch.setattr(runner.store, "recover", refusing_once)
         with pytest.raises(JobStoreUnavailable):

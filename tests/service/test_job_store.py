@@ -231,8 +231,8 @@ def test_a_restart_says_which_jobs_it_queued_again_and_which_failed(
         queued = store.recover(attempts=3)
     assert queued == [again.id, waiting.id]
     assert caplog.messages == [
-        f"job {again.id} interrupted by a restart: queued again (run 2 of at most 3)",
-        f"job {spent.id} interrupted by a restart after 3 runs: failed",
+        f"job {again.id} interrupted (its service stopped): queued again (run 2 of at most 3)",
+        f"job {spent.id} interrupted (its service stopped) after 3 runs: failed",
     ]
 
 
@@ -272,7 +272,7 @@ def test_a_cancel_asked_before_a_restart_ends_the_job_cancelled(
     state = store.state(asked.id)
     assert state is not None and state.status == "cancelled" and state.finished is not None
     assert store.queued(exclude=set(), limit=9) == [other.id]
-    assert f"job {asked.id}, cancelled before a restart: cancelled" in caplog.messages
+    assert f"job {asked.id}, cancelled before its service stopped: cancelled" in caplog.messages
     assert store.figures()[1] == (1, 0.0)
 
 

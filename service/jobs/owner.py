@@ -1,0 +1,96 @@
+"""Which service runs a job: a lock each service holds under the data directory while it lives.
+
+Several services may share one ``DTF_DATA_DIR`` (an overlapping deploy, ``uvicorn --workers N``):
+each takes queued jobs from the store, which hands each to one. A start queued again every job
+the store held as running, the other services' too, which then ran twice (the operator audit's
+M1). Now each service holds a lock of its own, ``services/<id>.lock`` under the data directory
+(``flock``, exclusive), from its runner's making to its close; the store keeps the id of the
+service that started a job (:meth:`service.jobs.store.JobStore.start`), and a recovery queues
+again only the jobs of a service whose lock is free: one that stopped or died (the kernel frees a
+dead process's lock; its job workers die with it, ``PR_SET_PDEATHSIG``). A lock file found free
+is removed by the service that found it.
+
+``flock`` is not reliable on a network filesystem (nor is SQLite's locking, README): the data
+directory is a local disk's.
+"""
+
+from __future__ import annotations
+
+import fcntl
+import os
+import re
+import uuid
+from pathlib import Path
+
+SERVICES = "services"
+"""The directory under the data directory that holds the services' locks."""
+
+_ID = re.compile(r"[0-9a-f]{32}")
+
+
+class ServiceLock:
+    """This service's lock: its id, held from :meth:`hold` to :meth:`release`."""
+
+    def __init__(self, data_dir: Path) -> None:
+        """A new id for a service on ``data_dir``; the lock is taken by :meth:`hold`."""
+        self.directory = Path(data_dir) / SERVICES
+        self.id = uuid.uuid4().hex
+        self._fd: int | None = None
+
+    @property
+    def path(self) -> Path:
+        """The lock's file."""
+        return self.directory / f"{self.id}.lock"
+
+    def hold(self) -> str:
+        """Take the lock (once; later calls keep it); this service's id.
+
+        Raises:
+            OSError: the directory or the file cannot be made, or locked.
+        """
+        if self._fd is None:
+            self.directory.mkdir(parents=True, exist_ok=True)
+            fd = os.open(self.path, os.O_RDWR | os.O_CREAT, 0o644)
+            try:
+                fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+                os.write(fd, f"{os.getpid()}\n".encode())
+            except OSError:
+                os.close(fd)
+                raise
+            self._fd = fd
+        return self.id
+
+    def release(self) -> None:
+        """Free the lock and remove its file (the service stops; its running jobs are free)."""
+        if self._fd is None:
+            return
+        try:
+            self.path.unlink(missing_ok=True)
+        finally:
+            os.close(self._fd)  # closing frees the flock
+            self._fd = None
+
+
+def alive(data_dir: Path, owner: str | None) -> bool:
+    """Whether the service ``owner`` still holds its lock under ``data_dir``.
+
+    No owner (a job started by a release before owners), an id not of this module's making, or
+    no lock file: not alive. A lock file whose lock is free (its service stopped or died) is
+    removed here.
+    """
+    if owner is None or not _ID.fullmatch(owner):
+        return False
+    path = Path(data_dir) / SERVICES / f"{owner}.lock"
+    try:
+        fd = os.open(path, os.O_RDWR)
+    except FileNotFoundError:
+        return False
+    try:
+        fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+    except BlockingIOError:
+        return True  # held: its service lives
+    else:
+        path.unlink(missing_ok=True)
+        return False
+    finally:
+        os.close(fd)
