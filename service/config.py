@@ -10,9 +10,10 @@ import sys
 from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Annotated
 
 from pydantic import Field, PrivateAttr, ValidationError, field_validator
-from pydantic_settings import BaseSettings, SettingsConfigDict
+from pydantic_settings import BaseSettings, NoDecode, SettingsConfigDict
 
 MAX_PATH_WAYPOINTS = 20_000
 """The most waypoints any route's schema takes: DTF_MAX_PATH_WAYPOINTS and
@@ -20,6 +21,9 @@ DTF_MAX_OPTIMIZE_WAYPOINTS may lower it, and a start that sets either higher sto
 (it was capped without a word)."""
 MAX_CELL_OBJECTS = 1_000
 """The most objects a cell's schema takes: DTF_MAX_CELL_OBJECTS may lower it, not raise it."""
+
+_WEB_ORIGIN = re.compile(r"[a-z][a-z0-9+.-]*://([a-z0-9.-]+|\[[0-9a-f:.]+\])(:[0-9]{1,5})?")
+"""An origin as a browser's Origin header gives it (RFC 6454): scheme, host, the port if any."""
 
 _ROUTE_LIMIT_NAMES = (
     "DTF_MAX_MAP_CELLS",
@@ -202,6 +206,37 @@ class Settings(BaseSettings):
         if importlib.util.find_spec("distributed") is None:
             raise ValueError("jobs on a Dask cluster need the dask extra: pip install -e '.[dask]'")
         return address
+
+    cors_origins: Annotated[tuple[str, ...], NoDecode] = Field(
+        default=(),
+        description="Web origins whose pages may call the API from a browser (CORS): "
+        "scheme://host[:port] each, comma-separated, or * for any; none by default (the "
+        "service's own page needs none).",
+    )
+
+    @field_validator("cors_origins", mode="before")
+    @classmethod
+    def _listed_origins(cls, value: object) -> object:
+        """A comma-separated list, as the environment gives it; empty entries dropped."""
+        if isinstance(value, str):
+            return tuple(part.strip() for part in value.split(",") if part.strip())
+        return value
+
+    @field_validator("cors_origins")
+    @classmethod
+    def _web_origins(cls, origins: tuple[str, ...]) -> tuple[str, ...]:
+        """Each an origin as a browser sends it: a page's URL without its path is refused.
+
+        A browser's Origin header never ends in a slash nor holds a path, so such an entry
+        would let no page in, without a word.
+        """
+        for origin in origins:
+            if origin != "*" and not _WEB_ORIGIN.fullmatch(origin):
+                raise ValueError(
+                    f"{origin[:100]!r} is not a web origin: scheme://host[:port], lower case, "
+                    "no path nor trailing slash (or * for any)"
+                )
+        return origins
 
     max_queued_jobs: int = Field(
         default=100,

@@ -31,6 +31,7 @@ from service.api.routes import health
 from service.body import BODY_MODELS
 from service.body_limits import BodySizeLimitMiddleware
 from service.config import Settings, get_settings, settings_or_exit
+from service.cors import CorsMiddleware
 from service.errors import (
     SERVER_ERROR_RESPONSE,
     cancelled_handler,
@@ -213,6 +214,7 @@ def create_app() -> FastAPI:
     mount_page(app)
     app.add_middleware(BodySizeLimitMiddleware)
     app.add_middleware(RefusalLogMiddleware)  # outside it: its 413, 415 and 408 are logged too
+    app.add_middleware(CorsMiddleware)  # outermost: a page elsewhere reads the refusals too
     instrument(app, job_store=lambda: get_runner(get_settings()).store)
     return app
 

@@ -62,6 +62,7 @@ def test_an_empty_data_directory_is_refused(monkeypatch: pytest.MonkeyPatch) -> 
         ("DTF_WORKERS", "abc", "Input should be a valid integer"),
         ("DTF_MAX_BODY_BYTES", "-5", "Input should be greater than 0"),
         ("DTF_DASK_SCHEDULER", "garbage", "'garbage' is not a scheduler address"),
+        ("DTF_CORS_ORIGINS", "http://cam:3000/", "'http://cam:3000/' is not a web origin"),
     ],
 )
 def test_a_bad_setting_stops_the_start_naming_its_variable(
