@@ -3,13 +3,15 @@
 robots.md section 4. At the first waypoint of a path the IK starts from a fixed set of seeds
 covering the joint box (a fractional factorial design at each joint's quartiles,
 :func:`solver.families.numeric.ik.seeds`; K = 32 for six joints, 64 for seven or more; a seed
-whose error stops shrinking is given up, ``ik.STALL_STEPS``), keeps every distinct solution
-within the joint limits as a branch, labelled by its index in seed order, and
-follows each branch to the next waypoint from its solution at the previous one. The same input
-gives the same branches. Six joints: each regular solution's status carries the sign of det J
-(``OK`` / ``OK_MIRRORED``), so tracking sees a branch that crosses a singularity between two
-waypoints (robots.md: a wrist never passes q5 = 0) where an analytic branch, whose label fixes
-that sign, jumps; seven joints have no det J (their statuses stay ``OK``). A numeric family
+whose error stops shrinking is given up, ``ik.STALL_STEPS``; six joints that found an odd
+number of solutions, which says one was missed, try 2K more, :func:`ik.more_seeds`), keeps
+every distinct solution within the joint limits as a branch, labelled by its index in seed
+order, and follows each branch to the next waypoint from its solution at the previous one.
+The same input gives the same branches. Six joints: each regular solution's status carries the
+sign of det J (``OK`` / ``OK_MIRRORED``), so tracking sees a branch that crosses a singularity
+between two waypoints (robots.md: a wrist never passes q5 = 0) where an analytic branch, whose
+label fixes that sign, jumps; seven joints have no det J (their statuses stay ``OK``). A numeric
+family
 cannot promise that it found every branch: it reports how many it found.
 
 J^-1 t and the null space: :mod:`solver.families.numeric.velocity`; the work model:
@@ -79,6 +81,11 @@ class NumericFamily(KinematicsFamily, CompiledFollowing):
         count = seed_count(self.chain.dof)
         self.seeds = ik.seeds(
             count, lower=self.lower, upper=self.upper, revolute=self.chain.q_revolute
+        )
+        self.more_seeds = (
+            ik.more_seeds(count, lower=self.lower, upper=self.upper, revolute=self.chain.q_revolute)
+            if self.chain.dof == 6
+            else np.empty((0, self.chain.dof))
         )
         self._branches = tuple(Branch.named(solution=str(k)) for k in range(count))
         # The compiled chain has no mimic joints: a coupled chain runs on numpy.
@@ -156,7 +163,11 @@ class NumericFamily(KinematicsFamily, CompiledFollowing):
             q_shape = (self.dof, len(self.seeds), *batch)
             return q_k.reshape(q_shape), status_k.reshape(q_shape[1:])
         slots, _ = reference.seeded(
-            self.chain, self.seeds, (self.lower, self.upper), rotation_flat, position_flat
+            self.chain,
+            (self.seeds, self.more_seeds),
+            (self.lower, self.upper),
+            rotation_flat,
+            position_flat,
         )
         q, status = reference.wrapped_with_status(self.chain, slots)  # (P, K, n), (P, K)
         q = np.moveaxis(q.reshape(*batch, len(self.seeds), self.dof), (-1, -2), (0, 1))
@@ -197,7 +208,7 @@ class NumericFamily(KinematicsFamily, CompiledFollowing):
             )
         slots, count = reference.seeded(
             self.chain,
-            self.seeds,
+            (self.seeds, self.more_seeds),
             (self.lower, self.upper),
             rotations[:, 0],
             positions[:, 0],

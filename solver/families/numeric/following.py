@@ -40,12 +40,15 @@ class CompiledFollowing(FollowsInSteps):
 
     Attributes:
         seeds: shape (K, n), rad or m, the IK's seeds.
+        more_seeds: shape (M, n), those tried where the seeds found an odd number of
+            solutions (six joints, :func:`solver.families.numeric.ik.more_seeds`; else M = 0).
         lower: shape (n,), the joints' lower limits.
         upper: shape (n,), the joints' upper limits.
         compiled: whether the family runs on the compiled chain.
     """
 
     seeds: np.ndarray
+    more_seeds: np.ndarray
     lower: np.ndarray
     upper: np.ndarray
     compiled: bool
@@ -95,6 +98,7 @@ class CompiledFollowing(FollowsInSteps):
         current, count = seed_kernel.seed_paths(
             self._packed,
             self.seeds,
+            self.more_seeds,
             (self.lower, self.upper),
             kernel_array(rotations),
             kernel_array(positions),

