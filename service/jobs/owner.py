@@ -22,6 +22,8 @@ import re
 import uuid
 from pathlib import Path
 
+from service.logs import log
+
 SERVICES = "services"
 """The directory under the data directory that holds the services' locks."""
 
@@ -94,3 +96,20 @@ def alive(data_dir: Path, owner: str | None) -> bool:
         return False
     finally:
         os.close(fd)
+
+
+def forget_gone(data_dir: Path) -> int:
+    """Remove the lock files of the services that are gone; how many.
+
+    A service that was killed leaves its file (the kernel frees the lock, not the file): a look
+    for its jobs removes it, but one that ran none left it for good. A start removes them all.
+    """
+    directory = Path(data_dir) / SERVICES
+    gone = 0
+    try:
+        for path in sorted(directory.glob("*.lock")):
+            if _ID.fullmatch(path.stem) and not alive(data_dir, path.stem):
+                gone += 1
+    except OSError as error:  # a directory it may not read: the files stay, nothing else
+        log.warning("the lock files of stopped services under %s not removed: %s", directory, error)
+    return gone

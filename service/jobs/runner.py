@@ -31,7 +31,7 @@ from pathlib import Path
 
 from service.config import Settings
 from service.jobs.job import JobStoreUnavailable
-from service.jobs.owner import ServiceLock, alive
+from service.jobs.owner import ServiceLock, alive, forget_gone
 from service.jobs.store import JobStore
 from service.jobs.worker import UNSTORED, serve
 from service.logs import duration, log
@@ -138,7 +138,11 @@ class JobRunner:
         self._wake.set()
 
     def recover(self) -> list[str]:
-        """Forget expired jobs, then queue again every job a restart interrupted.
+        """Forget expired jobs, then queue again the running jobs of services that are gone.
+
+        Those a restart interrupted, this service's before it, and any other stopped service's;
+        a live service's are left to it (:mod:`service.jobs.owner`). The lock files of stopped
+        services are removed.
 
         Where the store refuses (its ``JobStoreUnavailable`` is raised), the supervisor does it
         at its first look that the store answers, before it hands out any job: the jobs the
@@ -152,6 +156,7 @@ class JobRunner:
             self.expire()
             ids = self.store.recover(attempts=self.settings.job_attempts, alive=self._alive)
             self._looked_at = time.monotonic()
+            forget_gone(Path(self.settings.data_dir))  # the files of services killed idle
         except JobStoreUnavailable:
             self._recovery_due = True
             raise

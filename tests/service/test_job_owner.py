@@ -123,3 +123,22 @@ def test_a_running_service_takes_over_the_jobs_of_one_that_stopped(
         first.close()
         if second is not None:
             second.close()
+
+
+def test_a_start_removes_the_lock_files_of_services_killed_idle(tmp_path: Path) -> None:
+    """A killed service's file stays (the kernel frees its lock, not the file); one that ran no
+    job is never looked at again, and such files piled up with every crash."""
+    live, killed = ServiceLock(tmp_path), ServiceLock(tmp_path)
+    live.hold()
+    killed.path.parent.mkdir(parents=True, exist_ok=True)
+    killed.path.write_text("12345\n")  # its lock freed, its file left
+    other = tmp_path / SERVICES / "notes.txt"
+    other.write_text("an operator's")
+    runner = JobRunner(settings(tmp_path))
+    try:
+        assert runner.recover() == []
+        assert not killed.path.exists()
+        assert live.path.exists() and other.exists()
+    finally:
+        runner.close()
+        live.release()
