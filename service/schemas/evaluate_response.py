@@ -196,9 +196,10 @@ class IkInfo(ResponseModel):
         "branch; numeric solves by damped least squares from fixed seeds (robots.md section 4)."
     )
     seeds: int | None = Field(
-        description="Numeric family: how many start configurations (seeds) the IK started from "
-        "at the first waypoint (32 for 6 joints, 64 for more); null for a closed-form family, "
-        "or when the request gave the joint_path."
+        description="Numeric family: how many start configurations (seeds) the IK starts from "
+        "at the first waypoint (32 for 6 joints, 64 for more; a six-joint arm whose seeds find "
+        "an odd number of solutions, which says one was missed, tries 64 more there); null for "
+        "a closed-form family, or when the request gave the joint_path."
     )
     branches_found: int | None = Field(
         description="Numeric family: how many distinct IK solutions within the joint limits the "
