@@ -198,7 +198,7 @@ class IkInfo(ResponseModel):
     seeds: int | None = Field(
         description="Numeric family: how many start configurations (seeds) the IK starts from "
         "at the first waypoint (32 for 6 joints, 64 for more; a six-joint arm whose seeds find "
-        "an odd number of solutions, which says one was missed, tries 64 more there); null for "
+        "an odd number of solutions, which says one was missed, tries 128 more there); null for "
         "a closed-form family, or when the request gave the joint_path."
     )
     branches_found: int | None = Field(

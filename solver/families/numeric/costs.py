@@ -19,8 +19,9 @@ from __future__ import annotations
 # stall early). Seven: the Panda 2,021 and 125, the xArm7 1,388 and 177 (the following line
 # kept at the 200 measured before, which the free spin's weight was measured against).
 # Seeding includes the more seeds a six-joint chain tries where its seeds found an odd number of
-# solutions (ik.more_seeds): 9 % more on 3,000 random poses of the UR5 as a URDF (200 against
-# 184 us a pose, best of 3, 2026-12-07), nothing measurable on the ERK map; within the margin.
+# solutions (ik.more_seeds): 15 % more on 3,000 random poses of the UR5 as a URDF (212 against
+# 184 us a pose, best of 2 or 3, 2026-12-07), up to 48 % on an OPW arm as a URDF (the M20iA's
+# random poses), nothing measurable on the ERK map; within the margin.
 # Maps share these lines with evaluations, which follow every branch: a six-joint map pruned
 # in one pass (solver/path/bounded.py) costs about a quarter of its line (UR5 as a URDF, ERK
 # map, 2026-12-02), so its estimate is an upper bound; the lines are not lowered for it.

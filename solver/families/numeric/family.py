@@ -4,7 +4,7 @@ robots.md section 4. At the first waypoint of a path the IK starts from a fixed 
 covering the joint box (a fractional factorial design at each joint's quartiles,
 :func:`solver.families.numeric.ik.seeds`; K = 32 for six joints, 64 for seven or more; a seed
 whose error stops shrinking is given up, ``ik.STALL_STEPS``; six joints that found an odd
-number of solutions, which says one was missed, try 2K more, :func:`ik.more_seeds`), keeps
+number of solutions, which says one was missed, try 128 more, :func:`ik.more_seeds`), keeps
 every distinct solution within the joint limits as a branch, labelled by its index in seed
 order, and follows each branch to the next waypoint from its solution at the previous one.
 The same input gives the same branches. Six joints: each regular solution's status carries the
@@ -20,6 +20,8 @@ steers: :mod:`solver.families.numeric.following`.
 """
 
 from __future__ import annotations
+
+import functools
 
 import numpy as np
 import pinocchio as pin
@@ -82,11 +84,6 @@ class NumericFamily(KinematicsFamily, CompiledFollowing):
         self.seeds = ik.seeds(
             count, lower=self.lower, upper=self.upper, revolute=self.chain.q_revolute
         )
-        self.more_seeds = (
-            ik.more_seeds(count, lower=self.lower, upper=self.upper, revolute=self.chain.q_revolute)
-            if self.chain.dof == 6
-            else np.empty((0, self.chain.dof))
-        )
         self._branches = tuple(Branch.named(solution=str(k)) for k in range(count))
         # The compiled chain has no mimic joints: a coupled chain runs on numpy.
         self.compiled = compiled and self.chain.coupling is None
@@ -96,6 +93,18 @@ class NumericFamily(KinematicsFamily, CompiledFollowing):
     def dof(self) -> int:
         """Number of joints."""
         return self.chain.dof
+
+    @functools.cached_property
+    def more_seeds(self) -> np.ndarray:
+        """The seeds tried where the seeds found an odd number of solutions (six joints).
+
+        :func:`ik.more_seeds`; none for other numbers of joints. Made at the first seeding, not
+        with the family: the catalogue's families are made in every command of dtf-place, and
+        the Sobol points' scipy.stats loads scipy.optimize (tests/service/test_cli.py).
+        """
+        if self.chain.dof != 6:
+            return np.empty((0, self.chain.dof))
+        return ik.more_seeds(lower=self.lower, upper=self.upper, revolute=self.chain.q_revolute)
 
     def path_cost(self, n_waypoints: int, *, free_spin: bool = False) -> float:
         """Seeding plus following, in closed-form poses (:func:`costs.path_cost`)."""

@@ -40,15 +40,12 @@ class CompiledFollowing(FollowsInSteps):
 
     Attributes:
         seeds: shape (K, n), rad or m, the IK's seeds.
-        more_seeds: shape (M, n), those tried where the seeds found an odd number of
-            solutions (six joints, :func:`solver.families.numeric.ik.more_seeds`; else M = 0).
         lower: shape (n,), the joints' lower limits.
         upper: shape (n,), the joints' upper limits.
         compiled: whether the family runs on the compiled chain.
     """
 
     seeds: np.ndarray
-    more_seeds: np.ndarray
     lower: np.ndarray
     upper: np.ndarray
     compiled: bool
@@ -58,6 +55,14 @@ class CompiledFollowing(FollowsInSteps):
     @abc.abstractmethod
     def dof(self) -> int:
         """Number of joints."""
+
+    @property
+    @abc.abstractmethod
+    def more_seeds(self) -> np.ndarray:
+        """Shape (M, n): the seeds tried where the seeds found an odd number of solutions.
+
+        Six joints: :func:`solver.families.numeric.ik.more_seeds`; else M = 0.
+        """
 
     def _settings(self) -> tuple[np.ndarray, np.ndarray]:
         """The compiled IK's settings and constants (:func:`seed_kernel.seed_paths`)."""

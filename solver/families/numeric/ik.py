@@ -16,6 +16,7 @@ Layout: batch first: q (M, n), rotations (M, 3, 3), positions (M, 3).
 
 from __future__ import annotations
 
+import functools
 import itertools
 import math
 
@@ -43,6 +44,10 @@ TRACK_ITERATIONS = 12
 # seeding steps on the ERK grid, 91 % of the Panda's).
 STALL_STEPS = 10
 STALL_RATIO = 0.8
+# Seeds tried where a six-joint chain's first ones found an odd number of solutions
+# (:func:`more_seeds`), and the seed of their scrambled Sobol sequence.
+MORE_SEEDS = 128
+MORE_SEEDS_SEED = 0
 # Two solutions are distinct when their wrapped joint distance exceeds this (rad, m).
 DISTINCT = 1e-3
 # A solution whose Jacobian has sigma_min / sigma_max below this is singular (the analytic
@@ -225,29 +230,41 @@ def seeds(count: int, *, lower: np.ndarray, upper: np.ndarray, revolute: np.ndar
     return box
 
 
-def more_seeds(
-    count: int, *, lower: np.ndarray, upper: np.ndarray, revolute: np.ndarray
-) -> np.ndarray:
+def more_seeds(*, lower: np.ndarray, upper: np.ndarray, revolute: np.ndarray) -> np.ndarray:
     """The seeds tried where a six-joint chain's first seeds found an odd number of solutions.
 
     A six-joint chain's inverse kinematics has an even number of real solutions at any pose
     but a singular one: they are the real roots of a polynomial system of 16 complex roots for
     six revolute joints (Raghavan & Roth, "Inverse kinematics of the general 6R manipulator",
-    J. Mech. Des. 1993; 16, 8, 2 for prismatic joints among them), and the complex ones come in
-    conjugate pairs. An odd count found says a solution was missed (or lies outside the joint
-    box). On 3,000 random poses of the UR5 as a URDF, the first 32 seeds found fewer solutions
-    than the closed form at 119 poses, 108 of them with an odd count; these seeds found the
-    missing solutions at 103 of the 108 (the FANUC M20iA: 179 of 242; the KUKA KR 16-2: 41 of
-    43).
+    J. Mech. Des. 1993; 16, 8 or 2 with prismatic joints among them), and the complex ones come
+    in conjugate pairs. An odd count found says a solution was missed (or lies outside the
+    joint box, which hides it).
 
-    The same design as :func:`seeds` at the eighths of each joint's range instead of its
-    quartiles: ``2 count`` starts, the design at 1/8 and 7/8, then at 3/8 and 5/8.
+    :data:`MORE_SEEDS` points of a scrambled Sobol sequence (a fixed seed) over the range the
+    first seeds cover. Short of the closed form's solutions within the limits, at 3,000 random
+    poses of the UR5 as a URDF and 2,000 of each OPW arm as a URDF (2026-12-07): 32 seeds alone
+    119 poses (UR5), 291 (FANUC M20iA), 54 (KUKA KR 16-2), 130 (ABB IRB 4600); with 64 more at
+    the eighths of each range (the first seeds' design there) 16, 112, 13, 43; with these 12,
+    50, 11, 39. The seeding then took 15 %, 48 %, 10 % and 35 % longer on those poses (the
+    closed form's own count is odd at 89 of the IRB 4600's: a solution outside its box).
     """
     low, high = _seeded_range(lower, upper, revolute)
-    design = _design(count, len(lower))
-    outer = low + (0.5 + 0.375 * design) * (high - low)
-    inner = low + (0.5 + 0.125 * design) * (high - low)
-    return np.concatenate([outer, inner])
+    return np.asarray(low + _sobol(len(lower)) * (high - low))
+
+
+@functools.cache
+def _sobol(dimensions: int) -> np.ndarray:
+    """:data:`MORE_SEEDS` scrambled Sobol points in [0, 1)^dimensions, the same each time.
+
+    scipy.stats is imported here, at a six-joint numeric arm's first seeding: at the module's
+    import it loaded scipy.optimize into every command of dtf-place (tests/service/test_cli.py).
+    """
+    from scipy.stats import qmc  # noqa: PLC0415 - heavy, and only numeric arms need it
+
+    sobol = qmc.Sobol(d=dimensions, scramble=True, seed=MORE_SEEDS_SEED)
+    points = np.asarray(sobol.random(MORE_SEEDS), dtype=float)
+    points.setflags(write=False)
+    return points
 
 
 def _design(count: int, n: int) -> np.ndarray:
