@@ -27,6 +27,7 @@ placement optimisation of the same problem
 from __future__ import annotations
 
 import argparse
+import copy
 import http.client
 import json
 import math
@@ -54,6 +55,7 @@ from solver.core.robots import Robot
 from solver.core.spatial import Placement, pose_matrix
 from solver.core.task import task_requirements
 from solver.families import get_robot, robot_from_urdf
+from solver.families.numeric.family import NumericFamily
 from solver.optimise.optimize import optimize_placement
 from solver.optimise.search_space import PlacementBounds
 from solver.path.capability_map import capability_map, grid_axis
@@ -223,6 +225,7 @@ def main() -> None:
     cell_lines(robot, path, xs, ys, z, repeats=repeats, smoke=args.smoke)
     picture_lines(robot, path, xs, ys, z, smoke=args.smoke)
     numeric_maps(path, xs, ys, z, t_map, repeats=1 if args.smoke else 3)
+    numeric_branches(poses=200 if args.smoke else 3000)
     numeric_optimisation_lines(path, smoke=args.smoke)
     optimisation(robot, path, smoke=args.smoke)
     active_set_lines(smoke=args.smoke)
@@ -367,6 +370,42 @@ def numeric_maps(
     seconds = time.perf_counter() - start
     label = "Panda unpruned"
     print(f"  {label:14s} {seconds:8.3f} s   {seconds / t_map:6.1f}x (every branch followed)")
+
+
+def numeric_branches(*, poses: int) -> None:
+    """How many of the closed form's IK solutions numeric IK finds (issue 27: every branch).
+
+    The UR5 read as a URDF with the numeric family at random poses (configurations within a
+    turn of zero, seeded), against ur-analytic-ik's solutions (a library of its own), with the
+    more seeds tried where the first found an odd number (ik.more_seeds) and without them.
+    """
+    numeric = ur5_as_numeric(ur5_urdf())
+    family = numeric.family
+    assert isinstance(family, NumericFamily)
+    q = np.random.default_rng(5).uniform(-math.pi, math.pi, (poses, 6))
+    rotation, position = family.chain.forward(q)
+    closed = []
+    for r, p in zip(rotation, position, strict=True):
+        pose = np.eye(4)
+        pose[:3, :3], pose[:3, 3] = r, p
+        solutions = np.array(ur_analytic_ik.ur5.inverse_kinematics(pose)).reshape(-1, 6)
+        closed.append(int(np.isfinite(solutions).all(axis=1).sum()))
+    analytic = np.array(closed)
+    first_only = copy.copy(family)
+    first_only.more_seeds = np.empty((0, 6))
+    figures = []
+    for label, seeded in (("with the more seeds", family), ("the 32 seeds alone", first_only)):
+        seeded.seed_first(rotation[:2], position[:2])  # compiled or loaded before the clock
+        start = time.perf_counter()
+        _, count = seeded.seed_first(rotation, position)
+        seconds = time.perf_counter() - start
+        short = int(np.sum(count < analytic))
+        figures.append(
+            f"{label}: {int(np.minimum(count, analytic).sum()):,} of {int(analytic.sum()):,}, "
+            f"{short} poses short, {seconds / poses * 1e6:.0f} us a pose"
+        )
+    print(f"numeric IK branches, UR5 as a URDF, {poses:,} random poses against ur-analytic-ik: "
+          + "; ".join(figures))  # fmt: skip
 
 
 def optimisation(robot: Robot, path: np.ndarray, *, smoke: bool) -> None:
