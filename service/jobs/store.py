@@ -321,7 +321,7 @@ class JobStore(JobReads):
                 log.info("job %s interrupted (its service stopped): queued again (run %d of at "
                          "most %d)", job_id, runs + 1, attempts)  # fmt: skip
         if kept:
-            log.info("%d running job(s) left to the other service(s) that run them", kept)
+            log.info("%d running job(s) left to the live service(s) that run them", kept)
         return [row[0] for row in rows]
 
     def running_owners(self) -> set[str | None]:

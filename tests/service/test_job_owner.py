@@ -7,6 +7,7 @@ data directory and keeps its id with the jobs it starts (:mod:`service.jobs.owne
 
 from __future__ import annotations
 
+import logging
 import signal
 import subprocess
 import sys
@@ -24,7 +25,7 @@ from tests.service.test_job_runner import EVALUATE, settings, wait_for
 
 
 def test_a_second_service_leaves_a_live_ones_running_job_and_takes_it_once_it_stops(
-    tmp_path: Path,
+    tmp_path: Path, caplog: pytest.LogCaptureFixture
 ) -> None:
     store = JobStore(tmp_path / "jobs.sqlite3")
     first, second = ServiceLock(tmp_path), ServiceLock(tmp_path)
@@ -36,13 +37,18 @@ def test_a_second_service_leaves_a_live_ones_running_job_and_takes_it_once_it_st
     def lives(owner: str | None) -> bool:  # the second service's view, as its runner's
         return owner == second.id or alive(tmp_path, owner)
 
-    assert store.recover(attempts=3, alive=lives) == []  # the second service starts
+    with caplog.at_level(logging.INFO, logger="dtf.jobs"):
+        assert store.recover(attempts=3, alive=lives) == []  # the second service starts
+    assert "1 running job(s) left to the live service(s) that run them" in caplog.messages
     running = store.get(job.id)
     assert running is not None and (running.status, running.attempts) == ("running", 1)
     assert store.running_owners() == {first.id}
 
     first.release()  # the first service stops: its job is free
-    assert store.recover(attempts=3, alive=lives) == [job.id]
+    with caplog.at_level(logging.INFO, logger="dtf.jobs"):
+        assert store.recover(attempts=3, alive=lives) == [job.id]
+    said = f"job {job.id} interrupted (its service stopped): queued again (run 2 of at most 3)"
+    assert said in caplog.messages
     queued = store.get(job.id)
     assert queued is not None and queued.status == "queued"
     assert store.start(job.id, second.id)
