@@ -30,19 +30,20 @@ SERVICES = "services"
 _ID = re.compile(r"[0-9a-f]{32}")
 
 
+def lock_file(data_dir: Path, owner: str) -> Path:
+    """The lock file of the service ``owner`` under ``data_dir``."""
+    return Path(data_dir) / SERVICES / f"{owner}.lock"
+
+
 class ServiceLock:
     """This service's lock: its id, held from :meth:`hold` to :meth:`release`."""
 
     def __init__(self, data_dir: Path) -> None:
         """A new id for a service on ``data_dir``; the lock is taken by :meth:`hold`."""
-        self.directory = Path(data_dir) / SERVICES
         self.id = uuid.uuid4().hex
-        self._fd: int | None = None
-
-    @property
-    def path(self) -> Path:
+        self.path = lock_file(data_dir, self.id)
         """The lock's file."""
-        return self.directory / f"{self.id}.lock"
+        self._fd: int | None = None
 
     def hold(self) -> str:
         """Take the lock (once; later calls keep it); this service's id.
@@ -51,7 +52,7 @@ class ServiceLock:
             OSError: the directory or the file cannot be made, or locked.
         """
         if self._fd is None:
-            self.directory.mkdir(parents=True, exist_ok=True)
+            self.path.parent.mkdir(parents=True, exist_ok=True)
             fd = os.open(self.path, os.O_RDWR | os.O_CREAT, 0o644)
             try:
                 fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
@@ -82,7 +83,7 @@ def alive(data_dir: Path, owner: str | None) -> bool:
     """
     if owner is None or not _ID.fullmatch(owner):
         return False
-    path = Path(data_dir) / SERVICES / f"{owner}.lock"
+    path = lock_file(data_dir, owner)
     try:
         fd = os.open(path, os.O_RDWR)
     except FileNotFoundError:

@@ -25,14 +25,23 @@ PREFLIGHT = {
 }
 
 
-@pytest.fixture
-def origins(monkeypatch: pytest.MonkeyPatch) -> Iterator[None]:
-    """Two named origins, set through the environment as a deployment would."""
-    monkeypatch.setenv("DTF_CORS_ORIGINS", f"{CAM}, http://localhost:3000")
-    get_settings.cache_clear()
+@pytest.fixture(autouse=True)
+def _settings_read_again() -> Iterator[None]:
+    """Each test's DTF_CORS_ORIGINS (monkeypatch undoes it) is not kept past the test."""
     yield
-    monkeypatch.delenv("DTF_CORS_ORIGINS")
     get_settings.cache_clear()
+
+
+def set_origins(monkeypatch: pytest.MonkeyPatch, value: str) -> None:
+    """DTF_CORS_ORIGINS set through the environment, as a deployment would."""
+    monkeypatch.setenv("DTF_CORS_ORIGINS", value)
+    get_settings.cache_clear()
+
+
+@pytest.fixture
+def origins(monkeypatch: pytest.MonkeyPatch) -> None:
+    """Two named origins."""
+    set_origins(monkeypatch, f"{CAM}, http://localhost:3000")
 
 
 @pytest.fixture
@@ -101,14 +110,9 @@ def test_an_origin_not_named_gets_no_cors_headers(
 def test_any_origin_with_a_star(
     client: TestClient, evaluate_body: dict[str, Any], monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    monkeypatch.setenv("DTF_CORS_ORIGINS", "*")
-    get_settings.cache_clear()
-    try:
-        answer = client.post("/v1/evaluate", json=evaluate_body, headers={"Origin": CAM})
-        assert answer.headers["access-control-allow-origin"] == "*"
-    finally:
-        monkeypatch.delenv("DTF_CORS_ORIGINS")
-        get_settings.cache_clear()
+    set_origins(monkeypatch, "*")
+    answer = client.post("/v1/evaluate", json=evaluate_body, headers={"Origin": CAM})
+    assert answer.headers["access-control-allow-origin"] == "*"
 
 
 @pytest.mark.parametrize(

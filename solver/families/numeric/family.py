@@ -11,8 +11,7 @@ The same input gives the same branches. Six joints: each regular solution's stat
 sign of det J (``OK`` / ``OK_MIRRORED``), so tracking sees a branch that crosses a singularity
 between two waypoints (robots.md: a wrist never passes q5 = 0) where an analytic branch, whose
 label fixes that sign, jumps; seven joints have no det J (their statuses stay ``OK``). A numeric
-family
-cannot promise that it found every branch: it reports how many it found.
+family cannot promise that it found every branch: it reports how many it found.
 
 J^-1 t and the null space: :mod:`solver.families.numeric.velocity`; the work model:
 :mod:`solver.families.numeric.costs`; the compiled seeding and following that the pruned map
