@@ -92,6 +92,7 @@ class JobRunner:
         self._unsettled: set[str] = set()  # jobs whose worker could not store their end
         self._recovery_due = False  # recover() was refused by the store: the supervisor's to do
         self._expired_at = -math.inf  # when expire() last ran (monotonic, s)
+        self._expiring = threading.Lock()  # recover() at the start and the supervisor's look
         self._looked_at = time.monotonic()  # when the last look for a gone service's jobs was
         self.failure: str | None = None
         """Why the supervisor's last look failed (the store's reason), None when it did not."""
@@ -153,7 +154,7 @@ class JobRunner:
             The ids queued, oldest first; they run as workers become idle.
         """
         try:
-            self.expire()
+            self.expire()  # unless the supervisor's first look just did
             ids = self.store.recover(attempts=self.settings.job_attempts, alive=self._alive)
             self._looked_at = time.monotonic()
             forget_gone(Path(self.settings.data_dir))  # the files of services killed idle
@@ -180,12 +181,19 @@ class JobRunner:
     def expire(self) -> int:
         """Forget the jobs that finished over DTF_JOB_TTL ago, saying how many; how many.
 
+        Done when EXPIRE_SECONDS (or DTF_JOB_TTL if shorter) have passed since it last was,
+        else nothing (0); under a lock, so that the supervisor's first look and ``recover()``
+        at the start, which race, do it once between them (both did it when the look came
+        first or while the start's expiry ran: a fresh-clone CI on a loaded machine, stop 72).
         It was silent: DTF_JOB_TTL=7 (meant as days) emptied a 318 MB store at the next start
         without a line (the operator audit of 2026-12-07, M5).
         """
         ttl = self.settings.job_ttl
-        count = self.store.expire(ttl=ttl)
-        self._expired_at = time.monotonic()
+        with self._expiring:
+            if time.monotonic() - self._expired_at < min(ttl, EXPIRE_SECONDS):
+                return 0
+            count = self.store.expire(ttl=ttl)
+            self._expired_at = time.monotonic()
         if count:
             log.info(
                 "forgot %d job(s) that finished over DTF_JOB_TTL = %g s (%s) ago, with their "
@@ -211,9 +219,7 @@ class JobRunner:
             try:
                 if self._recovery_due:
                     self.recover()
-                since = time.monotonic() - self._expired_at
-                if since >= min(self.settings.job_ttl, EXPIRE_SECONDS):
-                    self.expire()
+                self.expire()  # when due
                 if time.monotonic() - self._looked_at >= TAKE_OVER_SECONDS:
                     self.take_over()
                 self._watch()
