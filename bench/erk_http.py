@@ -38,6 +38,11 @@ ERK_GRID = {
 }
 
 
+def _bounds(axis: Any) -> tuple[float, float, float]:
+    """An axis of ERK_GRID as grid_axis takes it: min, max, step."""
+    return axis["min"], axis["max"], axis["step"]
+
+
 def _map_seconds(body: dict[str, Any], threads: int | None, repeats: int) -> dict[str, float]:
     """POST /v1/map of ``body``, best of ``repeats``, on a server with DTF_THREADS ``threads``.
 
@@ -82,8 +87,7 @@ def erk_map_over_http(*, repeats: int, subset: int, smoke: bool = False) -> None
     t_one = _map_seconds(body, 1, repeats)["http.client"]
     t_http = _map_seconds(body, None, repeats)
     robot, path = get_robot("ur5"), load_path("curved_line")
-    xs = grid_axis(-0.25, 0.25, 0.02, field="x")
-    ys = grid_axis(0.25, 0.65, 0.02, field="y")
+    xs, ys = (grid_axis(*_bounds(ERK_GRID[name]), field=name) for name in ("x", "y"))
     cells = len(xs) * len(ys)
     seconds = scalar_loop_seconds(
         robot, path, (xs, ys, ERK_GRID["z"]), subset=subset, repeats=1 if smoke else 3
