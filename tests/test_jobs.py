@@ -17,6 +17,7 @@ from typing import Any
 import httpx
 import pytest
 
+from service.jobs import runner as runner_module
 from service.jobs.store import JobStore
 from tests import machine_stalls as stalls
 from tests.cases import ROOT
@@ -190,7 +191,10 @@ def test_a_second_service_on_the_directory_leaves_a_running_job_and_takes_it_if_
         assert store.running_owners() == {owner}
         first.send_signal(signal.SIGKILL)  # its worker dies with it
         first.wait()
-        deadline = time.monotonic() + 20
+        # The second's next look (within TAKE_OVER_SECONDS), then a job worker of its own
+        # started (the second has none until a job waits) that takes the job: its spawn and
+        # imports take 2 to 5 s on an idle machine, more on a loaded one.
+        deadline = time.monotonic() + runner_module.TAKE_OVER_SECONDS + 30
         while time.monotonic() < deadline:
             job = store.get(job_id)
             assert job is not None
