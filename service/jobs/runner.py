@@ -184,7 +184,7 @@ class JobRunner:
         Done when EXPIRE_SECONDS (or DTF_JOB_TTL if shorter) have passed since it last was,
         else nothing (0); under a lock, so that the supervisor's first look and ``recover()``
         at the start, which race, do it once between them (both did it when the look came
-        first or while the start's expiry ran: a fresh-clone CI on a loaded machine, stop 72).
+        first or while the start's expiry ran: the project's CI of stop 71 found it).
         It was silent: DTF_JOB_TTL=7 (meant as days) emptied a 318 MB store at the next start
         without a line (the operator audit of 2026-12-07, M5).
         """
