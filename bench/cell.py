@@ -24,9 +24,11 @@ from pathlib import Path
 
 import numpy as np
 from arms import ur5_as_numeric, ur5_urdf
-from timing import best_time
+from timing import best_time, phase_seconds, phase_text
 
+import solver.path.cell.batch as batch_module
 import solver.path.cell.checker as checker_module
+import solver.path.kernel_cells as kernel_cells_module
 from solver.core.robots import Robot
 from solver.families import get_robot
 from solver.optimise.optimize import optimize_placement
@@ -56,6 +58,20 @@ CELL = Cell(
     workpiece=(Box((0.3, 0.12, 0.09), _pose(0.0, 0.06, -0.045), name="part"),),
     tool=Tool(radius=0.03, length=TOOL_LENGTH),
 )
+
+
+CELL_PHASES: dict[str, tuple[object, str]] = {
+    "the map kernel": (kernel_cells_module, "map_cells"),
+    "compiled sweep": (batch_module, "first_due_paths"),
+    "coal after the sweep": (batch_module, "resume"),
+    "coal at a refusal's waypoint": (checker_module.CellChecker, "collides_at"),
+    "refused placements' other branches": (kernel_cells_module, "branch_paths"),
+}
+"""Where a map with the cell spends its time (issue 22: the goal's line says what stands between
+it and 3x): the analytic map's kernel, the check's compiled sweep of every path
+(solver.path.cell.batch), coal where the sweep's bounds cannot decide a pair, coal's quick test
+of a refused pair on another branch (solver.path.cell.limit), and the kernel that gives a
+refused placement its other branches; the rest is the pipeline's Python and numpy."""
 
 
 def _build_seconds(arm: Robot) -> float:
@@ -186,6 +202,8 @@ def cell_lines(
             f"the checker's build (pair tables made, once per arm) {t_build:.2f} s, with the "
             f"arm's tables and hulls kept (another cell) {t_kept:.3f} s"
         )
+        split = phase_seconds(lambda run_map=run_map: run_map(CELL), CELL_PHASES)
+        print(f"    one more run with the cell: {phase_text(split)}")
     _numeric_line(path, xs, ys, z)
     _weight_line(robot, path, xs, ys, z, smoke=smoke)
     bounds = (

@@ -47,7 +47,7 @@ from arms import UR5_FRAMES, ur5_as_numeric, ur5_urdf
 from cell import cell_lines
 from numeric_optimisation import numeric_optimisation_lines
 from pictures import picture_lines
-from timing import best_time, plain_post
+from timing import best_time, phase_seconds, phase_text, plain_post
 
 from solver.core.kinematics import jacobian_in_base
 from solver.core.parallel import SERIAL, ThreadRunner
@@ -55,6 +55,13 @@ from solver.core.robots import Robot
 from solver.core.spatial import Placement, pose_matrix
 from solver.core.task import task_requirements
 from solver.families import get_robot, robot_from_urdf
+from solver.families.numeric import (
+    bounded_kernel,
+    bounded_redundant_kernel,
+    chain_kernel,
+    redundant_kernel,
+    seed_kernel,
+)
 from solver.families.numeric.family import NumericFamily
 from solver.optimise.optimize import optimize_placement
 from solver.optimise.search_space import PlacementBounds
@@ -292,6 +299,23 @@ def evaluate_over_http(*, requests: int) -> None:
     )
 
 
+NUMERIC_PHASES = {
+    6: {
+        "seeding": (seed_kernel, "seed_paths"),
+        "bounded following": (bounded_kernel, "follow_bounded"),
+        "speeds": (chain_kernel, "speeds_per_twist"),
+    },
+    7: {
+        "seeding": (seed_kernel, "seed_paths"),
+        "bounded following": (bounded_redundant_kernel, "follow_bounded"),
+        "speeds": (redundant_kernel, "redundant_speeds"),
+    },
+}
+"""The numeric family's compiled phases of a map (solver/families/numeric/following.py and
+velocity.py call them through their modules), by the arm's joints: issue 27's lines say where
+the map's time goes, the rest being the pipeline's Python and numpy around them."""
+
+
 def numeric_maps(
     path: np.ndarray, xs: np.ndarray, ys: np.ndarray, z: float, t_map: float, *, repeats: int
 ) -> None:
@@ -317,6 +341,7 @@ def numeric_maps(
         PathProblem.of(analytic, path), xs=xs, ys=ys, z=z, yaws=np.zeros(1)
     ).mu_path
     print(f"numeric IK maps ({len(xs) * len(ys)} placements, best of {repeats} each):")
+    grid = {"xs": xs, "ys": ys, "z": z, "yaws": np.zeros(1)}
     for label, (arm, goal) in arms.items():
         capability_map(PathProblem.of(arm, path[:3]), xs=xs[:1], ys=ys[:1], z=z, yaws=np.zeros(1))
         problem, seconds = PathProblem.of(arm, path), math.inf
@@ -334,6 +359,11 @@ def numeric_maps(
             )
             line += f"; equal to it on {same.mean():.1%} of the cells"
         print(line)
+        if goal.startswith("goal"):  # where its time goes: what the goal has to cut
+            split = phase_seconds(
+                lambda problem=problem: capability_map(problem, **grid), NUMERIC_PHASES[arm.dof]
+            )
+            print(f"    one more run: {phase_text(split)}")
     # Read from a frame 1 mrad off level (a cell measured a little out of true) the UR5 keeps
     # its closed form, tilted (solver.families.recognise.first_axis_tilt); the kernels write
     # each block's poses in its tilted frame (solver.families.kernels.pose_block). Against it,
