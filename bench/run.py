@@ -312,7 +312,7 @@ NUMERIC_PHASES = {
     },
 }
 """The numeric family's compiled phases of a map (solver/families/numeric/following.py and
-velocity.py call them through their modules), by the arm's joints: issue 27's lines say where
+velocity.py call them through their modules), six joints and more: issue 27's lines say where
 the map's time goes, the rest being the pipeline's Python and numpy around them."""
 
 
@@ -337,17 +337,15 @@ def numeric_maps(
         "UR5 recognised": (robot_from_urdf(urdf, **UR5_FRAMES), "the UR closed form"),
         "Panda": (get_robot("panda"), "goal <= 60x"),
     }
-    reference = capability_map(
-        PathProblem.of(analytic, path), xs=xs, ys=ys, z=z, yaws=np.zeros(1)
-    ).mu_path
-    print(f"numeric IK maps ({len(xs) * len(ys)} placements, best of {repeats} each):")
     grid = {"xs": xs, "ys": ys, "z": z, "yaws": np.zeros(1)}
+    reference = capability_map(PathProblem.of(analytic, path), **grid).mu_path
+    print(f"numeric IK maps ({len(xs) * len(ys)} placements, best of {repeats} each):")
     for label, (arm, goal) in arms.items():
         capability_map(PathProblem.of(arm, path[:3]), xs=xs[:1], ys=ys[:1], z=z, yaws=np.zeros(1))
         problem, seconds = PathProblem.of(arm, path), math.inf
         for _ in range(repeats):
             start = time.perf_counter()
-            cmap = capability_map(problem, xs=xs, ys=ys, z=z, yaws=np.zeros(1))
+            cmap = capability_map(problem, **grid)
             seconds = min(seconds, time.perf_counter() - start)
         line = (
             f"  {label:14s} {seconds:8.3f} s   {seconds / t_map:6.1f}x the analytic UR5 map "
@@ -359,10 +357,9 @@ def numeric_maps(
             )
             line += f"; equal to it on {same.mean():.1%} of the cells"
         print(line)
-        if goal.startswith("goal"):  # where its time goes: what the goal has to cut
-            split = phase_seconds(
-                lambda problem=problem: capability_map(problem, **grid), NUMERIC_PHASES[arm.dof]
-            )
+        if isinstance(arm.family, NumericFamily):  # where its time goes: what the goal has to cut
+            phases = NUMERIC_PHASES[6 if arm.dof == 6 else 7]  # following.py's choice of kernels
+            split = phase_seconds(lambda problem=problem: capability_map(problem, **grid), phases)
             print(f"    one more run: {phase_text(split)}")
     # Read from a frame 1 mrad off level (a cell measured a little out of true) the UR5 keeps
     # its closed form, tilted (solver.families.recognise.first_axis_tilt); the kernels write
