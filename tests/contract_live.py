@@ -30,6 +30,7 @@ import tomllib
 from collections.abc import Callable, Iterator
 
 import hypothesis
+import requests
 import schemathesis
 from schemathesis.config import SchemathesisConfig
 from schemathesis.specs.openapi.checks import positive_data_acceptance
@@ -136,6 +137,14 @@ run every operation (``include`` no longer filtered), 63,628 cases against 7,961
 contract_hooks.register(pictures, limits=LIMITS)
 
 
+SESSION = requests.Session()
+SESSION.trust_env = False  # the live server is local: no proxy applies
+SESSION.headers.clear()  # as schemathesis sends a case without one: the case's headers alone
+"""The one HTTP session every contract case is sent on. schemathesis otherwise makes a session
+for each case: a new connection each time, and requests reading every proxy variable of the
+environment for each (4.8 of the 93 s of the jobs' test under a profiler, 2026-12-07)."""
+
+
 SENT: set[tuple[str, ...]] = set()
 """The POST requests sent so far (:func:`sent_before`), with their generation mode and rule."""
 
@@ -190,7 +199,7 @@ def _contract_test(method: str, path: str) -> Callable[..., None]:
             return
         excluded = [] if rule is None else [positive_data_acceptance]
         response = case.call_and_validate(
-            base_url=live_url, excluded_checks=excluded, timeout=READ_TIMEOUT
+            base_url=live_url, session=SESSION, excluded_checks=excluded, timeout=READ_TIMEOUT
         )
         if rule is not None:  # the service enforces the rule it states in words
             contract_hooks.KEPT_OUT[(rule, response.status_code)] += 1
