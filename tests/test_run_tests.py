@@ -1,6 +1,7 @@
 """scripts/run_tests.py's runs: the latency run collects only LATENCY_MODULES, which must be every
 module that marks a test ``latency``, or a test marked elsewhere would run in neither run; and a
-run leaves nothing in the temporary directory; the modules given out first exist."""
+run leaves nothing in the temporary directory; the modules given out first exist; the sources'
+bytecode is written where imports read it."""
 
 from __future__ import annotations
 
@@ -10,16 +11,21 @@ import re
 import subprocess
 import sys
 from pathlib import Path
+from types import ModuleType
 
 from tests.cases import ROOT
 
 
-def _latency_modules() -> tuple[str, ...]:
+def _run_tests() -> ModuleType:
     spec = importlib.util.spec_from_file_location("run_tests", ROOT / "scripts" / "run_tests.py")
     assert spec is not None and spec.loader is not None
     module = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(module)
-    return tuple(module.LATENCY_MODULES)
+    return module
+
+
+def _latency_modules() -> tuple[str, ...]:
+    return tuple(_run_tests().LATENCY_MODULES)
 
 
 def test_the_latency_run_collects_every_module_that_marks_a_latency_test() -> None:
@@ -64,3 +70,16 @@ def test_the_modules_given_out_first_are_test_modules_once_each() -> None:
     missing = [module for module in FIRST if not (ROOT / module).is_file()]
     assert not missing, missing
     assert all(Path(module).name.startswith("test_") for module in FIRST)
+
+
+def test_the_sources_bytecode_is_written_where_imports_look_for_it() -> None:
+    # where PYTHONDONTWRITEBYTECODE is set every process the tests start compiled the sources
+    # again; the runner writes their bytecode first, where the import system reads it
+    assert _run_tests().compile_sources()
+    sources = [path for name in ("solver", "service") for path in (ROOT / name).rglob("*.py")]
+    missing = [
+        path.relative_to(ROOT).as_posix()
+        for path in sources
+        if not Path(importlib.util.cache_from_source(str(path))).is_file()
+    ]
+    assert sources and not missing, missing
