@@ -96,7 +96,7 @@ async def lifespan(app: FastAPI) -> AsyncIterator[None]:
     Solver work runs in worker threads; between numpy calls it holds the GIL, and by default
     a waiting thread gets it only every 5 ms. The event loop needs it several times per request,
     so /healthz took 20 ms at the median while a map ran; at 1 ms it stays a few milliseconds.
-    What startup made (about 240,000 objects: numba, pinocchio, matplotlib) is frozen out of the
+    What startup made (about 266,000 objects: numba, pinocchio, matplotlib) is frozen out of the
     garbage collector: a full collection walked it in 0.15 to 0.3 s, holding the GIL, whenever a
     big answer was being built.
     """
@@ -152,7 +152,12 @@ def _warm_up() -> None:
     """Do before serving what the first requests would otherwise pay for, holding the GIL.
 
     The catalogue reads its URDFs and the first path evaluation imports and sets up its
-    modules: a few hundred milliseconds in which /healthz would wait. The compiled map kernels
+    modules: a few hundred milliseconds in which /healthz would wait. matplotlib is imported and
+    draws a first figure (0.4 s; the first picture asked for held the GIL that long), so that
+    its 42,000 objects are frozen with the rest: made by a first picture instead, a full
+    collection in the next large request walked them (66 ms on an idle machine, 2026-12-07; a
+    CI run's /healthz probe waited 188 ms during a Panda evaluation after the map picture's
+    test). The compiled map kernels
     (fixed and free spin, and free spin's spun paths) are loaded from numba's disk cache, or
     compiled (about 10 s each, once per installation), and the cycle time's feed profiles (2 s).
     """
@@ -160,6 +165,9 @@ def _warm_up() -> None:
     free_spin_kernel.warm_up()
     spun_rows.warm_up()
     feed_profile.warm_up()
+    from service.render import render_message  # noqa: PLC0415 - the app's importers need no matplotlib
+
+    render_message("")  # matplotlib's import and first figure: 0.4 s, 42,000 objects
     robot = catalogue()["ur5"]
     waypoints = np.repeat(np.eye(4)[None], 2, axis=0)
     waypoints[1, 0, 3] = 0.01
