@@ -21,7 +21,7 @@ from service.jobs import runner as runner_module
 from service.jobs.store import JobStore
 from tests import machine_stalls as stalls
 from tests.cases import ROOT
-from tests.live import start_server
+from tests.live import descendants, running, start_server
 
 # The tests that bound response times are marked latency: scripts/run_tests.py runs them alone,
 # after the rest; the others run beside the suite's other worker.
@@ -39,11 +39,11 @@ BIG_GRID = {  # 401 x 241 x 2 = 193,282 placements, far over the route's limit
     "z": 0.1,
     "yaw": [0.0, 1.0],
 }
-GRID_50K = {  # 200 x 125 x 2 = 50,000 placements, the route's cell limit
-    "x": {"min": -0.5, "max": 0.495, "step": 0.005},
-    "y": {"min": 0.0, "max": 0.62, "step": 0.005},
+PANDA_800 = {  # 16 x 50 placements of the Panda (numeric IK): about 2 s of work
+    "x": {"min": -0.4, "max": 0.35, "step": 0.05},
+    "y": {"min": 0.2, "max": 0.69, "step": 0.01},
     "z": 0.1,
-    "yaw": [0.0, 1.0],
+    "yaw": 0.0,
 }
 GRID_8K = {  # 80 x 50 x 2 placements: seconds of work, within the route's limits
     "x": {"min": -0.4, "max": 0.39, "step": 0.01},
@@ -66,6 +66,15 @@ def server(data: Path, **settings: str) -> tuple[Any, str]:
         **settings,
     }
     return start_server(env, "--timeout-graceful-shutdown", "2")
+
+
+def outlived(started: set[int], seconds: float = 1.0) -> set[int]:
+    """Those of ``started`` still running ``seconds`` after their service ended (none, if
+    its job worker and the fork server it was forked from die with it)."""
+    deadline = time.monotonic() + seconds
+    while running(started) and time.monotonic() < deadline:
+        time.sleep(0.05)
+    return running(started)
 
 
 def wait_for(url: str, job_id: str, done: Any, timeout: float = 60.0) -> dict[str, Any]:
@@ -102,9 +111,12 @@ def test_a_map_job_answers_what_the_route_answers(tmp_path: Path) -> None:
         assert any(
             'handler="/v1/jobs"' in line and "http_requests_total" in line for line in metrics
         )
+        started = descendants(process.pid)  # the job worker, the fork server it came from
+        assert started
     finally:
         process.terminate()
         process.wait()
+    assert not outlived(started)  # a shutdown stops them
 
 
 @pytest.mark.latency
@@ -139,16 +151,21 @@ def test_a_running_map_job_is_cancelled_within_a_second(tmp_path: Path) -> None:
 
 
 def test_a_restart_finishes_an_interrupted_job_with_the_same_result(tmp_path: Path) -> None:
-    # 50,000 placements, its answer in the job's result: since map jobs store their cells from
-    # the columns, 8,000 ended within a poll of running, before the kill (a flaky test).
-    limits = {"DTF_MAX_MAP_POSES": "10000000", "DTF_JOB_PAGE_CELLS": "50000"}
-    body = map_request(GRID_50K)
+    # A job that runs for seconds, its answer in the job's result. The UR5's 50,000 placements
+    # took 0.5 s once the worker's kernels came loaded with its fork (they ended before the
+    # kill); earlier 8,000 had ended within a poll of running, once map jobs stored their cells
+    # from the columns (a flaky test both times).
+    limits = {"DTF_MAX_MAP_POSES": "100000000", "DTF_JOB_PAGE_CELLS": "50000"}
+    body = {**map_request(PANDA_800), "robot": {"model": "panda"}}
     process, url = server(tmp_path, **limits)
     submitted = httpx.post(f"{url}/v1/jobs", json={"kind": "map", "request": body})
     job_id = submitted.json()["id"]
     wait_for(url, job_id, lambda j: j["status"] == "running", timeout=30)
+    started = descendants(process.pid)  # the job worker, the fork server it came from
+    assert started
     process.send_signal(signal.SIGKILL)  # a crash: nothing is told, its worker dies with it
     process.wait()
+    assert not outlived(started)  # they end with it
     interrupted = JobStore(tmp_path / "jobs.sqlite3").get(job_id)
     assert interrupted is not None and interrupted.status == "running"
     process, url = server(tmp_path, **limits)
@@ -192,8 +209,8 @@ def test_a_second_service_on_the_directory_leaves_a_running_job_and_takes_it_if_
         first.send_signal(signal.SIGKILL)  # its worker dies with it
         first.wait()
         # The second's next look (within TAKE_OVER_SECONDS), then a job worker of its own
-        # started (the second has none until a job waits) that takes the job: its spawn and
-        # imports take 2 to 5 s on an idle machine, more on a loaded one.
+        # started (the second has none until a job waits) that takes the job: its fork
+        # server's start and imports take 2 to 5 s on an idle machine, more on a loaded one.
         deadline = time.monotonic() + runner_module.TAKE_OVER_SECONDS + 30
         while time.monotonic() < deadline:
             job = store.get(job_id)

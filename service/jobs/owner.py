@@ -7,7 +7,7 @@ M1). Now each service holds a lock of its own, ``services/<id>.lock`` under the 
 (``flock``, exclusive), from its runner's making to its close; the store keeps the id of the
 service that started a job (:meth:`service.jobs.store.JobStore.start`), and a recovery queues
 again only the jobs of a service whose lock is free: one that stopped or died (the kernel frees a
-dead process's lock; its job workers die with it, ``PR_SET_PDEATHSIG``). A lock file found free
+dead process's lock; its job workers die with it, ``service.jobs.worker``). A lock file found free
 is removed by the service that found it.
 
 ``flock`` is not reliable on a network filesystem (nor is SQLite's locking, README): the data

@@ -8,15 +8,14 @@ process, so ``/healthz`` and small requests stay fast while jobs run.
 
 from __future__ import annotations
 
-import ctypes
-import ctypes.util
 import functools
 import json
 import logging
 import logging.handlers
+import multiprocessing
 import os
+import select
 import signal
-import sys
 import threading
 import time
 from collections.abc import Callable
@@ -52,8 +51,9 @@ work (:func:`solver.path.capability_map.map_cost`, closed-form poses): 2.25 us a
 The placements' progress is reported as that share of the job, so that its ETA counts the
 storing (before, a 2-million-cell job said 0.0 to 0.1 s left for 83 s)."""
 
-PR_SET_PDEATHSIG = 1
-"""Linux ``prctl`` option: the signal a process gets when its parent dies."""
+SERVICE_POLL_SECONDS = 0.5
+"""How often a worker looks whether its service still runs where it cannot wait for its end
+(no ``os.pidfd_open``: not Linux) (s)."""
 
 NICENESS = 10
 """How much lower than the web process's a worker's CPU priority is (``os.nice``)."""
@@ -187,13 +187,47 @@ def run_job(store: JobStore, job_id: str, settings: Settings, owner: str | None 
 
 
 def _die_with_the_service() -> None:
-    """Have Linux kill this worker when the service dies, even by SIGKILL.
+    """Have this worker kill itself when the service that started it ends, even by SIGKILL.
 
-    No orphan worker then goes on with a job that the restarted service runs again.
+    No orphan worker then goes on with a job that the restarted service runs again. A thread
+    waits for the service's end (a pidfd on Linux, else a look every SERVICE_POLL_SECONDS).
+    Not Linux's parent death signal (``PR_SET_PDEATHSIG``): a worker's parent is the fork
+    server (:func:`service.jobs.runner.worker_context`), which lives on as long as any worker
+    does; with the signal a service killed by SIGKILL left both running, and the job on.
+    Nothing is watched where no service started this process (``serve`` called in a test).
     """
-    if sys.platform.startswith("linux"):
-        libc = ctypes.CDLL(ctypes.util.find_library("c"), use_errno=True)
-        libc.prctl(PR_SET_PDEATHSIG, signal.SIGKILL)
+    service = multiprocessing.parent_process()  # the process that asked for this one
+    if service is None or service.pid is None:
+        return
+    watch = threading.Thread(
+        target=_end_with, args=(service.pid,), name="dtf-service-watch", daemon=True
+    )
+    watch.start()
+
+
+def _end_with(pid: int) -> None:
+    """Wait until the process ``pid`` ends, then kill this one (as a SIGKILL from outside)."""
+    try:
+        handle: int | None = os.pidfd_open(pid)
+    except ProcessLookupError:  # already gone
+        handle = None
+    except (AttributeError, OSError):  # no pidfd here: look now and then
+        while _runs(pid):
+            time.sleep(SERVICE_POLL_SECONDS)
+        handle = None
+    if handle is not None:
+        select.select([handle], [], [])  # readable once it has ended
+    os.kill(os.getpid(), signal.SIGKILL)
+
+
+def _runs(pid: int) -> bool:
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:  # it runs, as another user's process
+        return True
+    return True
 
 
 class _Pipe:
