@@ -239,6 +239,7 @@ def main() -> None:
     evaluate_over_http(requests=20 if args.smoke else 200)
     parallel.threads(robot, path, xs, ys, z)
     parallel.map_job(smoke=args.smoke)
+    parallel.worker_starts(smoke=args.smoke)
     memory.peak_rss(smoke=args.smoke)
 
 
