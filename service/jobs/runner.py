@@ -73,9 +73,13 @@ def worker_context() -> SpawnContext | ForkServerContext:
 
     The fork server is a process of its own, started with the first worker and single-threaded
     (safe to fork, unlike the web process with its threads); it imports ``WORKER_MODULES``
-    (the solver, its compiled kernels, the schemas) once, and each worker after is a fork of it
-    that starts at once and shares those pages. Started by ``spawn`` each worker imported them
-    itself: about 2 s of CPU before its first job, again for each worker replaced after a cancel.
+    (the solver, numba, scipy, the schemas) once, and each worker after is a fork of it that
+    starts at once and shares those pages. Started by ``spawn`` each worker imported them
+    itself: about 2 s of CPU before its first job, again for each worker replaced after a kill
+    (bench/parallel.py: four jobs on four new workers 5.8 s spawned, 2.8 s forked with the fork
+    server's start, 0.4 s once it runs). A program started as a script (the ``uvicorn``
+    command) is still imported again by each worker, as ``__mp_main__``: multiprocessing's
+    ``__main__`` preload does nothing for a fork server on Python 3.11 (it is given no path).
     ``spawn`` where the platform has no fork server.
     """
     if "forkserver" not in multiprocessing.get_all_start_methods():
@@ -113,7 +117,7 @@ class JobRunner:
         self.service = ServiceLock(Path(settings.data_dir))
         """This service's lock and id (its jobs are its own while it lives)."""
         self._context = worker_context()
-        self._workers: list[_Worker] = []  # started when jobs first wait (each is 250 MB)
+        self._workers: list[_Worker] = []  # started when jobs first wait (README: memory)
         self._unsettled: set[str] = set()  # jobs whose worker could not store their end
         self._recovery_due = False  # recover() was refused by the store: the supervisor's to do
         self._expired_at = -math.inf  # when expire() last ran (monotonic, s)
