@@ -41,15 +41,23 @@ def start_server(env: dict[str, str], *options: str) -> tuple[subprocess.Popen[b
     raise RuntimeError("the server did not start within 60 s")
 
 
+def stat_fields(stat: Path) -> list[str]:
+    """A /proc stat file's fields after the command's name: the state first, then the parent.
+
+    The name (field 2) is in parentheses and may hold spaces and parentheses itself: the fields
+    are read after its last ``)``. Raises OSError where the process (or thread) has ended.
+    """
+    return stat.read_text().rsplit(")", 1)[1].split()
+
+
 def descendants(pid: int) -> set[int]:
     """The processes started by ``pid``, by their children and so on (read from /proc)."""
     children: dict[int, list[int]] = {}
     for stat in Path("/proc").glob("[0-9]*/stat"):
         try:
-            text = stat.read_text()
+            parent = int(stat_fields(stat)[1])
         except OSError:  # it ended while we read
             continue
-        parent = int(text.rsplit(")", 1)[1].split()[1])  # the field after the state
         children.setdefault(parent, []).append(int(stat.parent.name))
     found: set[int] = set()
     todo = [pid]
@@ -66,7 +74,7 @@ def running(pids: set[int]) -> set[int]:
     alive = set()
     for pid in pids:
         try:
-            state = (Path("/proc") / str(pid) / "stat").read_text().rsplit(")", 1)[1].split()[0]
+            state = stat_fields(Path("/proc") / str(pid) / "stat")[0]
         except OSError:
             continue
         if state not in ("Z", "X"):

@@ -26,7 +26,7 @@ import pytest
 
 from tests import machine_stalls as stalls
 from tests.cases import ROOT
-from tests.live import start_server
+from tests.live import start_server, stat_fields
 
 # Response times are bounded here: scripts/run_tests.py runs these alone, after the rest.
 pytestmark = pytest.mark.latency
@@ -164,7 +164,7 @@ def _probes_said(
 
 def _cpu_seconds(pid: int) -> float:
     """User + system CPU time of a process so far (s), from /proc."""
-    fields = (Path("/proc") / str(pid) / "stat").read_text().rsplit(")", 1)[1].split()
+    fields = stat_fields(Path("/proc") / str(pid) / "stat")
     return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
 
 
@@ -235,7 +235,7 @@ def _busy(pid: int, seconds: float) -> float:
         states = []
         for task in (Path("/proc") / str(pid) / "task").iterdir():
             try:
-                states.append((task / "stat").read_text().rsplit(")", 1)[1].split()[0])
+                states.append(stat_fields(task / "stat")[0])
             except OSError:
                 continue  # the thread ended meanwhile
         samples, busy = samples + 1, busy + ("R" in states)
