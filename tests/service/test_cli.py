@@ -6,6 +6,7 @@ codes are the ones a script tests (0 ok, 2 usage, 3 invalid input, 4 infeasible)
 
 from __future__ import annotations
 
+import contextlib
 import io
 import json
 import math
@@ -14,6 +15,7 @@ import re
 import signal
 import subprocess
 import sys
+from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
@@ -1048,6 +1050,23 @@ def test_an_answer_that_cannot_be_written_is_not_a_success(
         assert b"error: " in done.stderr and b"written" in done.stderr
 
 
+@contextlib.contextmanager
+def _interruptible() -> Iterator[None]:
+    """SIGINT caught (not ignored) here while a child starts, so the child starts with it default.
+
+    As an interactive shell starts a command: a suite started in the background by a script
+    (``cmd &``, nohup) has SIGINT ignored, which a child inherits through exec and Python then
+    keeps (it installs KeyboardInterrupt only over the default), so the map below ran to its
+    end and exited 0 (stop 76, a worktree run started with ``&``). A caught signal is reset to
+    its default at exec; the test's own handler is put back at once.
+    """
+    before = signal.signal(signal.SIGINT, signal.default_int_handler)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, before)
+
+
 @pytest.mark.parametrize(
     ("stop", "said", "exit_code"),
     [(signal.SIGINT, "interrupted", 130), (signal.SIGTERM, "terminated", 143)],
@@ -1061,7 +1080,9 @@ def test_ctrl_c_stops_a_map_with_one_line_and_the_shells_code(
     command = [sys.executable, "-m", "service.cli", *MAP[:4], *grid, "--progress"]
     big = {"DTF_MAX_MAP_CELLS": "1000000", "DTF_MAX_MAP_POSES": "100000000"}  # minutes of work
     env = {**os.environ, **big}
-    with subprocess.Popen(command, stderr=subprocess.PIPE, cwd=ROOT, env=env) as process:
+    with _interruptible():
+        process = subprocess.Popen(command, stderr=subprocess.PIPE, cwd=ROOT, env=env)
+    with process:
         assert process.stderr is not None
         seen = b""
         while b"%" not in seen:  # the progress bar: the map is under way (not an import)
