@@ -6,6 +6,7 @@ import importlib
 import json
 import re
 import sys
+from pathlib import Path
 
 import pytest
 from fastapi.testclient import TestClient
@@ -75,16 +76,31 @@ def test_cam_example_output() -> None:
     assert printed == lines
 
 
-def test_cam_command_line_output(capsys: pytest.CaptureFixture[str]) -> None:
-    """The NX listing through ``dtf-place``: the README shows what the commands print."""
+def test_cam_command_line_output(capsys: pytest.CaptureFixture[str], tmp_path: Path) -> None:
+    """The NX listing through ``dtf-place``: the README shows what the commands print.
+
+    A picture the README writes (``--png /tmp/...``) is written to the test's own folder
+    instead, its name put back in what is compared: the README's file is one fixed path, which
+    a run by another account could not write (owned by the account that ran the tests first:
+    exit 3, "cannot be written (permissions)", stop 76) and which two runs at once shared.
+    """
     section = README.split("### CL files as CAM systems write them", 1)[1]
     block = section.split("```sh\n", 1)[1].split("```", 1)[0]
     commands = [line.split() for line in block.splitlines() if line]
     printed = re.search(r"print\n\n```\n(.*?)\n```", section, re.S).group(1)
     assert all(command[0] == "dtf-place" for command in commands)
+    pictures: dict[str, str] = {}  # the test's file: the README's
     for command in commands:
+        if "--png" in command:
+            at = command.index("--png") + 1
+            ours = str(tmp_path / Path(command[at]).name)
+            pictures[ours], command[at] = command[at], ours
         assert main(command[1:]) == OK
-    assert capsys.readouterr().out.rstrip("\n") == printed
+    out = capsys.readouterr().out
+    for ours, theirs in pictures.items():
+        assert Path(ours).read_bytes().startswith(b"\x89PNG")
+        out = out.replace(ours, theirs)
+    assert pictures and out.rstrip("\n") == printed
 
 
 def test_acceleration_example_output() -> None:
