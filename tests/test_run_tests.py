@@ -84,3 +84,53 @@ def test_the_sources_bytecode_is_written_where_imports_look_for_it() -> None:
         if not Path(importlib.util.cache_from_source(str(path))).is_file()
     ]
     assert sources and not missing, missing
+
+
+CHILD_TEST = """
+import os
+from pathlib import Path
+
+import pytest
+
+from service.config import Settings, get_settings
+
+
+@pytest.mark.parametrize("name", ["one", "two"])
+def test_settings(name):
+    Path(os.environ["SEEN"], name).write_text(os.environ["DTF_DATA_DIR"])
+    assert "DTF_MAX_MAP_CELLS" not in os.environ
+    assert get_settings().max_map_cells == Settings.model_fields["max_map_cells"].default
+"""
+"""A test module run by :func:`test_a_shells_dtf_settings_are_left_out_and_named` in a child."""
+
+
+def test_a_shells_dtf_settings_are_left_out_and_named(tmp_path: Path) -> None:
+    # tests/conftest.py's settle_environment: a shell serving the app has its DTF_ settings
+    # in the environment; the tests took them (its job store written, its limits applied)
+    store, seen = tmp_path / "store", tmp_path / "seen"
+    store.mkdir()
+    seen.mkdir()
+    (tmp_path / "test_child.py").write_text(CHILD_TEST)
+    shell = {name: value for name, value in os.environ.items() if not name.startswith("DTF_")}
+    environment = shell | {
+        "DTF_DATA_DIR": str(store),
+        "DTF_MAX_MAP_CELLS": "100",
+        "SEEN": str(seen),
+        "TMPDIR": str(tmp_path),
+    }
+    command = ["-m", "pytest", "-q", "-n", "2", "-p", "no:cacheprovider", "-p", "tests.conftest"]
+    run = subprocess.run(
+        [sys.executable, *command, "-c", str(ROOT / "pyproject.toml"), str(tmp_path)],
+        cwd=ROOT,
+        env=environment,
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
+    assert run.returncode == 0, run.stdout + run.stderr
+    assert "left out (the tests set their own): DTF_DATA_DIR, DTF_MAX_MAP_CELLS" in run.stdout
+    directories = {path.read_text() for path in seen.iterdir()}
+    assert len(list(seen.iterdir())) == 2 and len(directories) == 1  # both workers, one store
+    (directory,) = directories
+    assert Path(directory).parent == tmp_path and not Path(directory).exists()
+    assert list(store.iterdir()) == []
