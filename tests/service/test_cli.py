@@ -12,6 +12,7 @@ import json
 import math
 import os
 import re
+import shlex
 import signal
 import subprocess
 import sys
@@ -1042,7 +1043,8 @@ def test_an_answer_that_cannot_be_written_is_not_a_success(
         pytest.skip("no /dev/full here")
     marker = tmp_path / "rc"
     command = (
-        f'"{sys.executable}" -m service.cli import "{PROGRAM}" {redirect}; echo $? > "{marker}"'
+        f"{shlex.quote(sys.executable)} -m service.cli import {shlex.quote(str(PROGRAM))} "
+        f"{redirect}; echo $? > {shlex.quote(str(marker))}"
     )
     done = subprocess.run(["bash", "-c", command], cwd=ROOT, timeout=300, capture_output=True)
     assert marker.read_text().strip() == str(expected)

@@ -12,6 +12,7 @@ temporary directory (TMPDIR, the test's folder).
 from __future__ import annotations
 
 import os
+import shlex
 import subprocess
 import sys
 from pathlib import Path
@@ -21,11 +22,14 @@ import pytest
 from tests.cases import ROOT
 
 PROGRAM = ROOT / "examples" / "cam" / "nx_slot_plate.cls"
+READ_ONLY = f"mount --bind -o ro {shlex.quote(str(ROOT))} {shlex.quote(str(ROOT))}"
+"""The shell command that mounts the checkout read-only over itself (quoted: a space in its path
+split it, and the probe's failure skipped the tests as if the machine could not run them)."""
 
 
 def _locked_down(args: list[str], temporary: Path) -> subprocess.CompletedProcess[str]:
     """``python -m service.cli ARGS`` with ROOT read-only, HOME unwritable, TMPDIR given."""
-    mounted = f'mount --bind -o ro {ROOT} {ROOT} && exec "$@"'
+    mounted = f'{READ_ONLY} && exec "$@"'
     command = ["unshare", "-m", "--propagation", "private", "sh", "-c", mounted, "sh"]
     command += [sys.executable, "-m", "service.cli", *args]
     keep = {"PATH", "LANG", "LC_ALL"}
@@ -39,7 +43,7 @@ def _locked_down(args: list[str], temporary: Path) -> subprocess.CompletedProces
             "private",
             "sh",
             "-c",
-            f"mount --bind -o ro {ROOT} {ROOT}",
+            READ_ONLY,
         ],
         capture_output=True,
         check=False,
