@@ -28,6 +28,20 @@ def _latency_modules() -> tuple[str, ...]:
     return tuple(_run_tests().LATENCY_MODULES)
 
 
+def _on_two_workers(
+    arguments: list[str], environment: dict[str, str]
+) -> subprocess.CompletedProcess[str]:
+    """A pytest run of ``arguments`` on two workers in a child process, from the checkout."""
+    return subprocess.run(
+        [sys.executable, "-m", "pytest", "-q", "-n", "2", "-p", "no:cacheprovider", *arguments],
+        cwd=ROOT,
+        env=environment,
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
+
+
 def test_the_latency_run_collects_every_module_that_marks_a_latency_test() -> None:
     # read from the files (a regex), not from pytest's collection: a decorator, a module's
     # pytestmark or a mark in a parametrisation all spell the mark out
@@ -49,14 +63,7 @@ def test_a_run_on_two_workers_leaves_no_jobs_directory_behind(tmp_path: Path) ->
         "tests/test_run_tests.py::"
         + test_the_latency_run_collects_every_module_that_marks_a_latency_test.__name__
     )
-    run = subprocess.run(
-        [sys.executable, "-m", "pytest", "-q", "-n", "2", "-p", "no:cacheprovider", test],
-        cwd=ROOT,
-        env=environment,
-        capture_output=True,
-        text=True,
-        timeout=300,
-    )
+    run = _on_two_workers([test], environment)
     assert run.returncode == 0, run.stdout + run.stderr
     assert sorted(p.name for p in tmp_path.glob("dtf-test-jobs-*")) == []
 
@@ -118,15 +125,8 @@ def test_a_shells_dtf_settings_are_left_out_and_named(tmp_path: Path) -> None:
         "SEEN": str(seen),
         "TMPDIR": str(tmp_path),
     }
-    command = ["-m", "pytest", "-q", "-n", "2", "-p", "no:cacheprovider", "-p", "tests.conftest"]
-    run = subprocess.run(
-        [sys.executable, *command, "-c", str(ROOT / "pyproject.toml"), str(tmp_path)],
-        cwd=ROOT,
-        env=environment,
-        capture_output=True,
-        text=True,
-        timeout=300,
-    )
+    arguments = ["-p", "tests.conftest", "-c", str(ROOT / "pyproject.toml"), str(tmp_path)]
+    run = _on_two_workers(arguments, environment)
     assert run.returncode == 0, run.stdout + run.stderr
     assert "left out (the tests set their own): DTF_DATA_DIR, DTF_MAX_MAP_CELLS" in run.stdout
     directories = {path.read_text() for path in seen.iterdir()}
