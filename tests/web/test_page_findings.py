@@ -424,6 +424,33 @@ def test_a_link_no_joint_names_is_no_frame_and_the_map_says_what_the_api_changed
     snapshot(page, "urdf-left-out-link")
 
 
+# ---- a decimal comma in a list of yaws or spins ----------------------------------------------
+def test_a_lists_reading_is_said_beside_it_and_a_decimal_comma_is_named(page: Page) -> None:
+    """A list "1,57" is two yaws (1 and 57 rad, which the API takes): the page says so as it is typed.
+
+    The angles a value beyond a turn is the same as, by hand: 57 - 9 (2 pi) = 0.45133,
+    14 - 2 (2 pi) = 1.43363, -7 + 2 pi = -0.71681.
+    """
+    assert page.text_content("#yaws-read") == ""  # one yaw, 0: nothing to say
+    page.fill("#yaws", "0, 1,57")
+    assert page.text_content("#yaws-read") == (
+        "read as 3 yaws: 0, 1, 57 rad; 57 rad is more than a turn (the same as 0.4513 rad): "
+        "a decimal takes a point (1.57, not 1,57)"
+    )
+    assert "too-large" in (page.get_attribute("#yaws-read", "class") or "")
+    page.fill("#yaws", "0, 1.57")
+    assert page.text_content("#yaws-read") == "read as 2 yaws: 0, 1.57 rad"
+    assert "too-large" not in (page.get_attribute("#yaws-read", "class") or "")
+    page.fill("#spins", "3,14")
+    assert page.text_content("#spins-read") == (
+        "read as 2 spins: 3, 14 rad; 14 rad is more than a turn (the same as 1.4336 rad): "
+        "a decimal takes a point (3.14, not 3,14)"
+    )
+    page.fill("#yaws", "-7")
+    assert page.text_content("#yaws-read") == "-7 rad is more than a turn (the same as -0.7168 rad)"
+    snapshot(page, "list-reading")
+
+
 @pytest.mark.parametrize("button", ["#run", "#optimize"])
 def test_an_empty_z_is_refused_beside_the_field_not_read_as_zero(
     page: Page, url: str, button: str

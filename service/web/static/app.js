@@ -172,6 +172,31 @@ function showOwnRobot() {
   $("urdf-note").hidden = !urdf;
 }
 
+// How a list field is read, said beside it as the user types: "1,57" is two values, 1 and 57
+// rad, not 1.57 (the lists are comma-separated; a decimal takes a point). A value beyond a turn
+// is named with the angle it is the same as and, where a digit and a comma come right before
+// it, the decimal it may have meant: the API takes any angle within 1000 rad, so this is the
+// one place a decimal comma shows before a map of the wrong yaws is run.
+function showListReading(id, plural) {
+  const raw = $(id).value.split(",");
+  const pieces = raw.map((v) => v.trim()).filter((v) => v !== "");
+  const turn = 2 * Math.PI;
+  let text = pieces.length > 1 ? `read as ${pieces.length} ${plural}: ${pieces.join(", ")} rad` : "";
+  const k = raw.findIndex((v) => v.trim() !== "" && Number.isFinite(Number(v)) && Math.abs(Number(v)) > turn);
+  if (k >= 0) {
+    const v = Number(raw[k]);
+    const same = v - turn * Math.round(v / turn);  // the same angle, within half a turn
+    text += `${text ? "; " : ""}${raw[k].trim()} rad is more than a turn (the same as ${radians(same)})`;
+    if (k > 0 && /^\d+$/.test(raw[k]) && /-?\d+$/.test(raw[k - 1])) {
+      const whole = raw[k - 1].match(/-?\d+$/)[0];
+      text += `: a decimal takes a point (${whole}.${raw[k]}, not ${whole},${raw[k]})`;
+    }
+  }
+  const note = $(`${id}-read`);
+  note.textContent = text;
+  note.classList.toggle("too-large", k >= 0);
+}
+
 function gridBody() {
   const axis = (name) => ({
     min: value(`${name}-min`), max: value(`${name}-max`), step: value(`${name}-step`),
@@ -877,6 +902,10 @@ async function start() {
     showOwnRobot();
   });
   $("yaws").addEventListener("input", showYawRange);
+  for (const [id, plural] of [["yaws", "yaws"], ["spins", "spins"]]) {
+    $(id).addEventListener("input", () => showListReading(id, plural));
+    showListReading(id, plural);
+  }
   $("opt-any-yaw").addEventListener("change", showYawRange);
   showYawRange();
   clearResults();
