@@ -533,8 +533,27 @@ def _evaluate(args: argparse.Namespace) -> int:
     return _status(OK if runs else INFEASIBLE, answer.path_read)
 
 
+def _say_beyond_a_turn(args: argparse.Namespace) -> None:
+    """A note on stderr for each ``--yaw`` or ``--spin`` value of a map beyond a turn.
+
+    The lists are comma-separated, so ``--yaw 0,1,57`` typed for 0 and 1.57 rad is three yaws,
+    1 and 57 rad among them, which the API takes (any angle within 1000 rad): said before the
+    work with the angle the value is the same as, as the page says it beside its lists.
+    """
+    for option, given in (("--yaw", args.yaw), ("--spin", args.spin)):
+        for value in given if isinstance(given, list) else [given]:
+            if abs(value) > 2 * math.pi and math.isfinite(value) and sys.stderr is not None:
+                same = value - 2 * math.pi * round(value / (2 * math.pi))
+                print(  # noqa: T201
+                    f"note: {option} {value:g} rad is more than a turn (the same as {same:.4f} "
+                    "rad); a list is comma-separated and a decimal takes a point (1.57)",
+                    file=sys.stderr,
+                )
+
+
 def _map(args: argparse.Namespace) -> int:
     png = _png_file(args)  # before the work: a map may take minutes
+    _say_beyond_a_turn(args)
     grid = {"x": args.x, "y": args.y, "z": args.z, "yaw": args.yaw, "spin": args.spin}
     body: dict[str, Any] = {"robot": _robot(args), "path": _path(args), "grid": grid}
     request = _validated(MapRequest, _with_options(body, args))

@@ -757,6 +757,29 @@ def test_map_takes_lists_of_yaws_and_spins_a_panel_each(
     assert width > 1.5 * height  # panels side by side (one panel is about 1.4 times as wide)
 
 
+def test_a_map_value_beyond_a_turn_is_noted_before_the_work(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """``--yaw 0,1,57`` (a decimal comma) is three yaws, as the API takes them, and said so.
+
+    By hand: 57 - 9 (2 pi) = 0.45133 rad, -7 + 2 pi = -0.71681 rad.
+    """
+    png = tmp_path / "map.png"
+    lists = ["--yaw", "0,1,57", "--spin=-7", "--spin-mode", "fixed", "--json"]
+    code, out, err = run(capsys, *MAP, *lists, "--png", str(png))
+    assert code == OK
+    assert sorted({cell["yaw"] for cell in json.loads(out)["cells"]}) == [0.0, 1.0, 57.0]
+    said = [line for line in err.splitlines() if line.startswith("note: --")]  # not the caches'
+    assert said == [
+        "note: --yaw 57 rad is more than a turn (the same as 0.4513 rad); a list is "
+        "comma-separated and a decimal takes a point (1.57)",
+        "note: --spin -7 rad is more than a turn (the same as -0.7168 rad); a list is "
+        "comma-separated and a decimal takes a point (1.57)",
+    ]
+    code, _, err = run(capsys, *MAP, "--yaw", "0,1.57", "--png", str(png))
+    assert code == OK and "note: --" not in err
+
+
 def test_optimise_searches_a_height_range_and_a_spin_range_as_the_route(
     client: TestClient, capsys: pytest.CaptureFixture[str]
 ) -> None:
