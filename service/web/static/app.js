@@ -182,7 +182,8 @@ function showListReading(id, plural) {
   const pieces = raw.map((v) => v.trim()).filter((v) => v !== "");
   const turn = 2 * Math.PI;
   let text = pieces.length > 1 ? `read as ${pieces.length} ${plural}: ${pieces.join(", ")} rad` : "";
-  const k = raw.findIndex((v) => v.trim() !== "" && Number.isFinite(Number(v)) && Math.abs(Number(v)) > turn);
+  const beyond = (v) => v.trim() !== "" && Number.isFinite(Number(v)) && Math.abs(Number(v)) > turn;
+  const k = raw.findIndex(beyond);
   if (k >= 0) {
     const v = Number(raw[k]);
     const same = v - turn * Math.round(v / turn);  // the same angle, within half a turn
