@@ -542,7 +542,7 @@ def _say_beyond_a_turn(args: argparse.Namespace) -> None:
     """
     for option, given in (("--yaw", args.yaw), ("--spin", args.spin)):
         for value in given if isinstance(given, list) else [given]:
-            if abs(value) > 2 * math.pi and math.isfinite(value) and sys.stderr is not None:
+            if abs(value) > 2 * math.pi and sys.stderr is not None:
                 same = value - 2 * math.pi * round(value / (2 * math.pi))
                 print(  # noqa: T201
                     f"note: {option} {value:g} rad is more than a turn (the same as {same:.4f} "
@@ -553,10 +553,10 @@ def _say_beyond_a_turn(args: argparse.Namespace) -> None:
 
 def _map(args: argparse.Namespace) -> int:
     png = _png_file(args)  # before the work: a map may take minutes
-    _say_beyond_a_turn(args)
     grid = {"x": args.x, "y": args.y, "z": args.z, "yaw": args.yaw, "spin": args.spin}
     body: dict[str, Any] = {"robot": _robot(args), "path": _path(args), "grid": grid}
     request = _validated(MapRequest, _with_options(body, args))
+    _say_beyond_a_turn(args)  # of values the request takes (a refused one is its error)
     with ProgressBar(enabled=args.progress) as bar:
         computed = computed_map(request, _settings(), png=True, progress=bar)
     answer = computed.answer()

@@ -778,6 +778,11 @@ def test_a_map_value_beyond_a_turn_is_noted_before_the_work(
     ]
     code, _, err = run(capsys, *MAP, "--yaw", "0,1.57", "--png", str(png))
     assert code == OK and "note: --" not in err
+    code, _, err = run(capsys, *MAP, "--yaw", "1e300", "--png", str(png))  # refused: no note
+    assert code == INVALID and err.splitlines()[-1] == (
+        "error: grid.yaw (--yaw): Input should be less than or equal to 1000"
+    )
+    assert "note: --" not in err
 
 
 def test_optimise_searches_a_height_range_and_a_spin_range_as_the_route(
