@@ -426,7 +426,7 @@ def test_a_link_no_joint_names_is_no_frame_and_the_map_says_what_the_api_changed
 
 # ---- a decimal comma in a list of yaws or spins ----------------------------------------------
 def test_a_lists_reading_is_said_beside_it_and_a_decimal_comma_is_named(page: Page) -> None:
-    """A list "1,57" is two yaws (1 and 57 rad, which the API takes): the page says so as it is typed.
+    """A list "1,57" is two yaws (1 and 57 rad, which the API takes): the page says so as typed.
 
     The angles a value beyond a turn is the same as, by hand: 57 - 9 (2 pi) = 0.45133,
     14 - 2 (2 pi) = 1.43363, -7 + 2 pi = -0.71681.
