@@ -451,6 +451,48 @@ def test_a_lists_reading_is_said_beside_it_and_a_decimal_comma_is_named(page: Pa
     snapshot(page, "list-reading")
 
 
+UNREAD = "not a number as typed (the browser reads it as empty); a decimal takes a point"
+
+
+@pytest.mark.parametrize("button", ["#run", "#optimize"])
+def test_a_number_the_browser_cannot_read_is_refused_beside_its_field_not_left_out(
+    page: Page, url: str, button: str
+) -> None:
+    """A "1e400" in a number field: its value is "", which read as empty dropped a table.
+
+    The browser's own reading, checked first: the field's value is "" and its badInput is set.
+    """
+    before = job_count(url)
+    fill(page, SMALL)
+    page.eval_on_selector_all("details", "els => els.forEach(e => e.open = true)")
+    page.fill("#table-height", "1e400")
+    page.fill("#tcp-yaw", "1e400")
+    assert page.evaluate(
+        "['table-height', 'tcp-yaw'].map((id) => [document.getElementById(id).value,"
+        " document.getElementById(id).validity.badInput])"
+    ) == [["", True], ["", True]]
+    page.eval_on_selector_all("details", "els => els.forEach(e => e.open = false)")
+    page.click(button)
+    assert error_beside(page, "cell.table") == UNREAD
+    assert error_beside(page, "robot.tcp") == f"tcp yaw (deg): {UNREAD}"
+    assert page.evaluate("document.getElementById('cell-details').open")  # the error is seen
+    page.wait_for_timeout(500)
+    assert job_count(url) == before
+    status = "#job-status" if button == "#run" else "#opt-mu"
+    assert page.text_content(status) == (
+        "no map: see the errors above" if button == "#run" else "no optimum: see the errors above"
+    )
+
+
+def test_a_feed_the_browser_cannot_read_is_refused_beside_it(page: Page, url: str) -> None:
+    api = run_small_map(page, url)
+    page.fill("#feed", "1e400")
+    point = cell_point(page, 0, api["cells"][0], api)
+    page.mouse.click(point["x"], point["y"])
+    assert error_beside(page, "feed") == UNREAD
+    assert page.text_content("#cell-summary") == "no evaluation: see the errors above"
+
+
 @pytest.mark.parametrize("button", ["#run", "#optimize"])
 def test_an_empty_z_is_refused_beside_the_field_not_read_as_zero(
     page: Page, url: str, button: str

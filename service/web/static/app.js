@@ -172,6 +172,28 @@ function showOwnRobot() {
   $("urdf-note").hidden = !urdf;
 }
 
+// Number fields whose text the browser cannot read as a number ("1e400", "1.2.3"): their value
+// is then "", which every reader here takes for an empty field, so a table height, a tool
+// point or a blend length so typed was left out of the request without a word. Each is said
+// beside its field (named, where the field has several inputs) and the caller sends nothing.
+// ``skip(id)``: the inputs the action does not read. Disabled inputs are not sent: not read.
+function unreadNumbers(skip) {
+  const details = [];
+  for (const input of document.querySelectorAll("input[type=number]")) {
+    if (input.disabled || !input.validity.badInput || skip(input.id)) continue;
+    const field = input.closest(".field[data-loc]");
+    const label = input.getAttribute("aria-label") || input.labels?.[0]?.textContent || input.id;
+    const said = "not a number as typed (the browser reads it as empty); a decimal takes a point";
+    // Named where its field has other inputs (the tool point's six, a box's sizes, the limits)
+    details.push({
+      loc: field ? field.dataset.loc.split(".") : [],
+      msg: !field || field.querySelectorAll("input").length > 1 ? `${label}: ${said}` : said,
+    });
+  }
+  showErrors(details);
+  return details.length > 0;
+}
+
 // How a list field is read, said beside it as the user types: "1,57" is two values, 1 and 57
 // rad, not 1.57 (the lists are comma-separated; a decimal takes a point). A value beyond a turn
 // is named with the angle it is the same as and, where a digit and a comma come right before
@@ -763,6 +785,10 @@ async function evaluateCell(c) {
   clearCell();
   const map = state.mapBody;
   if (!map) return;
+  if (unreadNumbers((id) => id !== "feed")) {  // the map's own inputs, and the feed typed
+    $("cell-summary").textContent = "no evaluation: see the errors above";
+    return;
+  }
   const evaluation = {};
   state.evaluation = evaluation;
   const body = { ...map, placement: placementOf(c), feed: value("feed") };

@@ -16,6 +16,10 @@ async function runMap(event) {
   clearResults();
   dropOptimization("a map was run; optimise again for its inputs");
   if (!havePath()) return;
+  if (unreadNumbers((id) => id.startsWith("opt-") || id === "feed")) {
+    $("job-status").textContent = "no map: see the errors above";
+    return;
+  }
   let body;
   try { body = mapBody(); } catch (error) { showErrors([{ loc: ["robot"], msg: error.message }]); return; }
   const run = { id: null };

@@ -163,6 +163,10 @@ async function optimize() {
   dropOptimization("a newer optimisation");  // a newer click: the older goes (its job too)
   $("opt-resume").hidden = true;
   if (!havePath()) return;
+  if (unreadNumbers((id) => id === "feed" || id === "x-step" || id === "y-step")) {
+    $("opt-mu").textContent = "no optimum: see the errors above";
+    return;
+  }
   const grid = gridBody();
   const height = heightOf(grid);
   if (height.range ? height.range.includes(undefined) : grid.z === undefined) {
