@@ -20,7 +20,7 @@ from typing import Any
 import yaml
 
 from service.cli_files import text_file
-from solver.core.exceptions import InvalidInputError, cut
+from solver.core.exceptions import InvalidInputError, cut, quoted_names
 from solver.families.opw.arms import ARMS
 
 GEOMETRY = "opw_kinematics_geometric_parameters"
@@ -44,9 +44,12 @@ def refuse_opw_file(file: Path) -> None:
         InvalidInputError: on ``robot``, always: the file's ``opw`` object and the limits it
             lacks, or why it is not such a file.
     """
-    geometry = opw_object(file)
+    geometry, absent = opw_object(file)
     same = [arm.name for arm in ARMS if _same(arm.parameters, geometry)]
     also = f"; its geometry is the catalogue's {same[0]}: --robot {same[0]}" if same else ""
+    if absent:  # the defaults taken for a list the file lacks: written into the object, said
+        taken = ", ".join({OFFSETS: "offsets 0", SIGNS: "sign corrections 1"}[k] for k in absent)
+        also += f" (the file has no {' and no '.join(absent)}: {taken} written)"
     raise InvalidInputError(
         "robot",
         f"{file.name} is a ROS-Industrial OPW parameter file: it gives the arm's geometry but "
@@ -57,8 +60,11 @@ def refuse_opw_file(file: Path) -> None:
     )
 
 
-def opw_object(file: Path) -> dict[str, Any]:
-    """The API's ``opw`` object written by an OPW parameter file.
+def opw_object(file: Path) -> tuple[dict[str, Any], list[str]]:
+    """The API's ``opw`` object written by an OPW parameter file, and the lists it lacks.
+
+    A file without ``opw_kinematics_joint_offsets`` or ``..._sign_corrections`` gets six zeros
+    or six ones there; the second value names the lists so taken.
 
     Raises:
         InvalidInputError: on ``robot``: not YAML, or not an OPW parameter file.
@@ -86,6 +92,8 @@ def opw_object(file: Path) -> dict[str, Any]:
             f"{file.name} is not an OPW parameter file (no {GEOMETRY}): give a catalogue name, "
             "a URDF file or a JSON file of the API's robot object",
         )
+    _known_keys(data, (GEOMETRY, OFFSETS, SIGNS), "", file)
+    _known_keys(lengths, LENGTHS, GEOMETRY, file)
     out: dict[str, Any] = {
         key: _number(lengths.get(key), f"{GEOMETRY}.{key}", file) for key in LENGTHS
     }
@@ -95,11 +103,34 @@ def opw_object(file: Path) -> dict[str, Any]:
     out["sign_corrections"] = [
         _sign(v, f"{SIGNS}[{i}]", file) for i, v in enumerate(_six(data, SIGNS, file))
     ]
-    return out
+    return out, [key for key in (OFFSETS, SIGNS) if key not in data]
 
 
 MAX_YAML_DEPTH = 10
 """The deepest nesting of flow lists and maps (brackets) read in a parameter file (its own: 1)."""
+
+
+def _known_keys(data: dict[Any, Any], known: tuple[str, ...], parent: str, file: Path) -> None:
+    """Refuse a key the reader does not know: a misspelt one would leave its values out.
+
+    ``opw_kinematics_joint_offset`` (one letter short) left the file's offsets out, and the
+    robot object printed carried zeros in their place without a word. ``parent``: the map the
+    keys are in ("" the file's top level).
+
+    Raises:
+        InvalidInputError: on ``robot``, naming the keys and the known ones.
+    """
+    unknown = [str(key) for key in data if key not in known]
+    if unknown:
+        keys = "key" if len(unknown) == 1 else "keys"
+        where = f" of {parent}" if parent else ""
+        holder = "it" if parent else "an OPW parameter file"
+        raise InvalidInputError(
+            "robot",
+            f"{file.name}: {keys} {quoted_names(unknown)}{where} not read: {holder} holds "
+            f"{', '.join(known[:-1])} and {known[-1]}, and a misspelt key would leave its values "
+            "out",
+        )
 
 
 def _bracket_depth(text: str) -> int:

@@ -938,6 +938,26 @@ def test_an_opw_parameter_file_is_refused_with_the_robot_object_it_gives(
     assert json.loads(out)["mu_path"] == json.loads(catalogue)["mu_path"] > 0.0
 
 
+def test_an_opw_files_lists_it_lacks_are_said_with_what_is_written_for_them(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    lacking = "\n".join(line for line in OPW_FILE.splitlines() if "joint_" not in line)
+    robot = _text_file(tmp_path, "m20ia.yaml", lacking)
+    code, _, err = run(capsys, "evaluate", str(PROGRAM), "--robot", robot, "--at=0,0.3,0,0")
+    assert code == INVALID
+    opw = json.loads(err.split('{"opw": ', 1)[1].split(', "joint_position_limits"', 1)[0])
+    assert (opw["offsets"], opw["sign_corrections"]) == ([0.0] * 6, [1] * 6)
+    assert err.rstrip().endswith(
+        "(the file has no opw_kinematics_joint_offsets and no "
+        "opw_kinematics_joint_sign_corrections: offsets 0, sign corrections 1 written)"
+    )
+    code, _, err = run(
+        capsys, "evaluate", str(PROGRAM), "--robot", _text_file(tmp_path, "full.yaml", OPW_FILE),
+        "--at=0,0.3,0,0",
+    )  # fmt: skip
+    assert code == INVALID and "written)" not in err  # the file gives both
+
+
 @pytest.mark.parametrize(
     ("name", "content", "message"),
     [
@@ -966,6 +986,19 @@ def test_an_opw_parameter_file_is_refused_with_the_robot_object_it_gives(
         ),
         (
             "arm.yaml",
+            OPW_FILE.replace("joint_offsets:", "joint_offset:"),
+            "arm.yaml: key 'opw_kinematics_joint_offset' not read: an OPW parameter file holds "
+            "opw_kinematics_geometric_parameters, opw_kinematics_joint_offsets and "
+            "opw_kinematics_joint_sign_corrections, and a misspelt key would leave its values out",
+        ),
+        (
+            "arm.yaml",
+            OPW_FILE.replace("    c4:  0.1\n", "    c4:  0.1\n    c5:  0.2\n    C4:  0.1\n"),
+            "arm.yaml: keys 'c5', 'C4' of opw_kinematics_geometric_parameters not read: it holds "
+            "a1, a2, b, c1, c2, c3 and c4",
+        ),
+        (
+            "arm.yaml",
             "a: " + "[" * 20_000 + "]" * 20_000,
             "arm.yaml: lists or maps nested 20000 deep (at most 10)",
         ),
@@ -986,6 +1019,8 @@ def test_an_opw_parameter_file_is_refused_with_the_robot_object_it_gives(
         "nan-sign (a traceback)",
         "fractional sign (cut to -1)",
         "400-digit length (a traceback)",
+        "misspelt key (its offsets left out, zeros printed)",
+        "unknown lengths (left out)",
         "nested 20,000 deep (a traceback after 37 s)",
         "alias bomb (8 GB, a minute)",
     ],
