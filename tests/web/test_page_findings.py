@@ -484,6 +484,15 @@ def test_a_number_the_browser_cannot_read_is_refused_beside_its_field_not_left_o
     )
 
 
+def test_an_unreadable_size_of_a_box_just_added_is_refused_beside_the_box(page: Page) -> None:
+    page.eval_on_selector_all("details", "els => els.forEach(e => e.open = true)")
+    page.click("#add-box")
+    page.fill("#cell-boxes input[aria-label='box 1 ly (m)']", "1e400")
+    page.click("#run")
+    assert error_beside(page, "cell.fixed.0.box.size") == f"box 1 ly (m): {UNREAD}"
+    assert page.text_content("#form-error") == ""
+
+
 def test_a_feed_the_browser_cannot_read_is_refused_beside_it(page: Page, url: str) -> None:
     api = run_small_map(page, url)
     page.fill("#feed", "1e400")

@@ -178,6 +178,7 @@ function showOwnRobot() {
 // beside its field (named, where the field has several inputs) and the caller sends nothing.
 // ``skip(id)``: the inputs the action does not read. Disabled inputs are not sent: not read.
 function unreadNumbers(skip) {
+  numberCellFields();  // a box added since the last request gets its loc: its error beside it
   const details = [];
   for (const input of document.querySelectorAll("input[type=number]")) {
     if (input.disabled || !input.validity.badInput || skip(input.id)) continue;

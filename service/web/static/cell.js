@@ -203,24 +203,33 @@ function toolBody() {
   return tool;
 }
 
+// Each cell field's loc, numbered as cellBody numbers the objects (the table, when given, the
+// first fixed one; each box in its frame's list): the API's errors, and the page's own before
+// a request, go beside their fields.
+function numberCellFields() {
+  const table = $("table-height");
+  const tabled = table.value.trim() !== "";
+  table.closest(".field").dataset.loc = tabled ? "cell.fixed.0" : "cell.table";
+  const count = { fixed: tabled ? 1 : 0, workpiece: 0 };
+  for (const row of $("cell-boxes").querySelectorAll(".cell-box")) {
+    const group = row.querySelector(".box-frame").value === "workpiece" ? "workpiece" : "fixed";
+    const place = `cell.${group}.${count[group]++}`;
+    for (const field of row.querySelectorAll(".field")) {
+      field.dataset.loc = field.dataset.tail ? `${place}.${field.dataset.tail}` : place;
+    }
+  }
+}
+
 // The request's `cell`, or undefined (left out of the body) when there is nothing in it. Every
 // field's loc is numbered as the body is, so that the API's errors go beside their fields.
 function cellBody() {
   const fixed = [], workpiece = [];
-  const table = $("table-height");
-  if (table.value.trim() !== "") {
-    table.closest(".field").dataset.loc = "cell.fixed.0";
+  numberCellFields();
+  if ($("table-height").value.trim() !== "") {
     fixed.push({ shape: "halfspace", name: "table", normal: [0, 0, 1], offset: value("table-height") });
-  } else {
-    table.closest(".field").dataset.loc = "cell.table";
   }
   for (const row of $("cell-boxes").querySelectorAll(".cell-box")) {
-    const group = row.querySelector(".box-frame").value === "workpiece" ? workpiece : fixed;
-    const place = `cell.${group === fixed ? "fixed" : "workpiece"}.${group.length}`;
-    for (const field of row.querySelectorAll(".field")) {
-      field.dataset.loc = field.dataset.tail ? `${place}.${field.dataset.tail}` : place;
-    }
-    group.push(boxObject(row));
+    (row.querySelector(".box-frame").value === "workpiece" ? workpiece : fixed).push(boxObject(row));
   }
   const tool = toolBody();
   if (!fixed.length && !workpiece.length && !tool && !selfChecked()) return undefined;
