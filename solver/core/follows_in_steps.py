@@ -52,7 +52,10 @@ class FollowsInSteps(abc.ABC):
         """Follow every slot of ``current`` that is not NaN along a piece of its path.
 
         The same numbers, slot by slot, as :meth:`KinematicsFamily.solve_path` gives there,
-        whatever the other slots and however the path is cut in pieces.
+        whatever the other slots, for a path in one piece. A family may start a waypoint's solve
+        from the solutions before it (the numeric family's six joints: ``ik.PREDICT_SMOOTH``),
+        which a later piece does not see: a path cut in pieces goes through
+        :meth:`follow_ranges`, whose ``out`` holds them.
 
         Args:
             current: shape (P, K, n), in and out: each slot's solution at the waypoint before
@@ -116,5 +119,7 @@ class FollowsInSteps(abc.ABC):
             positions: shape (P, W, 3).
             start: shape (K, P), each slot's first waypoint.
             stop: shape (K, P), the waypoint after its last (``stop <= start``: not followed).
-            out: q (n, K, P, W) and status (K, P, W), written at the slots' pieces only.
+            out: q (n, K, P, W) and status (K, P, W), written at the slots' pieces only; q
+                holds each slot's solutions before its ``start`` where it was followed there
+                (NaN where not): a path cut in pieces gives the bits of one piece.
         """

@@ -27,7 +27,7 @@ from solver.families.numeric.chain_kernel import (
     frames,
     workspace,
 )
-from solver.families.numeric.ik_kernel import _levenberg_marquardt
+from solver.families.numeric.ik_kernel import _levenberg_marquardt, extrapolated
 from solver.families.numeric.scout_kernel import (
     hopeless,
     scouted,
@@ -78,6 +78,7 @@ def _exact(chain, slot, path, limits, settings, constants, rules, work, spare, o
     for j in range(len(slot)):
         low[j], high[j], before[j] = slot[j], slot[j], slot[j]
     for w in range(len(positions)):
+        predicted = w > 0 and extrapolated(slot, q, w, revolute, settings[6])
         if w > 0 and not _levenberg_marquardt(
             chain,
             slot,
@@ -87,7 +88,7 @@ def _exact(chain, slot, path, limits, settings, constants, rules, work, spare, o
             None,
             constants,
             work,
-            True,  # the frames, J and J J^T of the waypoint before, from _singular
+            not predicted,  # the frames, J and J J^T of q_(w-1), from _singular
             (0, 0.0),
         ):
             return least, slowest, True, False

@@ -25,6 +25,7 @@ import functools
 import numpy as np
 import pinocchio as pin
 
+from solver.core.codes import UNREACHABLE
 from solver.core.family import Branch, KinematicsFamily, PathSolutions
 from solver.core.progress import Progress, span
 from solver.families.numeric import costs, ik, reference, velocity
@@ -130,9 +131,10 @@ class NumericFamily(KinematicsFamily, CompiledFollowing):
     ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """The compiled seeding and following at rotations (P, W, 3, 3) and positions (P, W, 3).
 
-        :meth:`seed_first` at the first waypoints, then :meth:`follow_piece` in pieces of
+        :meth:`seed_first` at the first waypoints, then :meth:`follow_ranges` in pieces of
         :data:`FOLLOW_WAYPOINTS` waypoints, ``progress`` called after each (the pieces give the
-        same bits as one).
+        same bits as one: each piece extrapolates from the solutions of the one before,
+        ``ik.PREDICT_SMOOTH``).
 
         Returns:
             q (n, K, P, W), rad, wrapped, NaN in slots without a solution; status (K, P, W);
@@ -144,15 +146,14 @@ class NumericFamily(KinematicsFamily, CompiledFollowing):
         if progress is not None:
             progress(SEED_SHARE)
         (n_paths, n_waypoints), n_seeds = positions.shape[:2], len(self.seeds)
-        q = np.empty((self.dof, n_seeds, n_paths, n_waypoints))
-        status = np.empty((n_seeds, n_paths, n_waypoints), dtype=np.int64)
+        q = np.full((self.dof, n_seeds, n_paths, n_waypoints), np.nan)
+        status = np.full((n_seeds, n_paths, n_waypoints), UNREACHABLE)
         for first in range(0, n_waypoints, FOLLOW_WAYPOINTS):
-            piece = slice(first, min(first + FOLLOW_WAYPOINTS, n_waypoints))
-            q[..., piece], status[..., piece] = self.follow_piece(
-                current, rotations[:, piece], positions[:, piece], first > 0
-            )
+            last = min(first + FOLLOW_WAYPOINTS, n_waypoints)
+            start, stop = (np.full((n_seeds, n_paths), value) for value in (first, last))
+            self.follow_ranges(current, rotations, positions, start, stop, (q, status))
             if progress is not None:
-                progress(SEED_SHARE + (1.0 - SEED_SHARE) * piece.stop / n_waypoints)
+                progress(SEED_SHARE + (1.0 - SEED_SHARE) * last / n_waypoints)
         return q, status, count
 
     def solve(self, rotation: np.ndarray, position: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -2,7 +2,9 @@
 
 The compiled twin of :class:`~solver.families.numeric.family.NumericFamily`'s following
 (robots.md section 4): each slot solved at each next waypoint from its solution at the one
-before (:func:`solver.families.numeric.ik_kernel._levenberg_marquardt`), its status
+before (:func:`solver.families.numeric.ik_kernel._levenberg_marquardt`; six joints from the
+extrapolation of the solutions before, where the path is smooth:
+:func:`~solver.families.numeric.ik_kernel.extrapolated`), its status
 (:func:`~solver.families.numeric.ik_kernel.regular_status`), the same decisions as the numpy
 reference the tests hold it to. Every function releases the GIL.
 """
@@ -18,7 +20,11 @@ from numba import njit
 from solver.core.codes import UNREACHABLE
 from solver.families.numeric import ik_kernel
 from solver.families.numeric.chain_kernel import drop_stale_cache, frames, workspace
-from solver.families.numeric.ik_kernel import _levenberg_marquardt, regular_status
+from solver.families.numeric.ik_kernel import (
+    _levenberg_marquardt,
+    extrapolated,
+    regular_status,
+)
 
 _TWO_PI = 2.0 * math.pi
 
@@ -37,6 +43,7 @@ def _follow(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
     track_iterations,
     rcond,
     revolute,
+    smooth,
     constants,
     work,
     q,
@@ -52,10 +59,13 @@ def _follow(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
     ``last``. The serving loops of :func:`follow_paths` and :func:`follow_ranges`.
     """
     n = slot.shape[0]
+    solved = q[:, b, p]
     if skip_first:
         frames(chain, slot, work)
     for w in range(first, last):
-        if not (skip_first and w == first) and not _levenberg_marquardt(
+        solve = not (skip_first and w == first)
+        predicted = solve and extrapolated(slot, solved, w, revolute, smooth)
+        if solve and not _levenberg_marquardt(
             chain,
             slot,
             rotations[w],
@@ -64,7 +74,7 @@ def _follow(  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
             None,
             constants,
             work,
-            w > first,  # the frames, J and J J^T of the waypoint before, from _singular
+            w > first and not predicted,  # the frames, J and J J^T of q_(w-1), from _singular
             (0, 0.0),
         ):
             slot[:] = np.nan
@@ -85,7 +95,9 @@ def follow_paths(chain, current, rotations, positions, solve_first, settings, co
 
     A slot is followed to each next waypoint from its solution at the previous one, without the
     joint box, until it does not converge; it is then lost (NaN from there, and in every later
-    piece). A path cut in pieces gives the same bits as the whole path in one piece.
+    piece). Six joints extrapolate from the solutions written in ``q``, this piece's only: a
+    path cut in pieces gives the bits of one piece through :func:`follow_ranges`, which writes
+    every piece into one array.
 
     Args:
         chain: :meth:`SerialChain.packed`.
@@ -127,6 +139,7 @@ def follow_paths(chain, current, rotations, positions, solve_first, settings, co
                 track_iterations,
                 rcond,
                 revolute,
+                settings[6],
                 constants,
                 work,
                 q,
@@ -144,7 +157,8 @@ def follow_ranges(chain, current, rotations, positions, start, stop, out, settin
 
     :func:`follow_paths` with a piece per slot: the same decisions and numbers, a slot's
     waypoints solved as they would be in any pieces (the first piece's first waypoint is the
-    seed's solution, not solved again).
+    seed's solution, not solved again; six joints extrapolate from the solutions ``out``
+    holds before ``start``, written by the pieces before).
 
     Args:
         chain: :meth:`SerialChain.packed`.
@@ -183,6 +197,7 @@ def follow_ranges(chain, current, rotations, positions, start, stop, out, settin
                 track_iterations,
                 rcond,
                 revolute,
+                settings[6],
                 constants,
                 work,
                 q,

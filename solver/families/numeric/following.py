@@ -74,6 +74,7 @@ class CompiledFollowing(FollowsInSteps):
                 ik.SINGULAR_RCOND,
                 ik.STALL_STEPS,
                 ik.STALL_RATIO,
+                ik.PREDICT_SMOOTH,
             ],
             dtype=float,
         )

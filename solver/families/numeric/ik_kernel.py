@@ -144,6 +144,51 @@ def _levenberg_marquardt(  # type: ignore[no-untyped-def]  # pragma: no cover - 
     return False
 
 
+@njit(cache=True, nogil=True, error_model="numpy", inline="always")
+def _joint_step(newer, older, revolute):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
+    """The step from ``older`` to ``newer``, a revolute joint's within [-pi, pi] (both wrapped)."""
+    step = newer - older
+    if revolute:
+        if step > math.pi:
+            step -= 2.0 * math.pi
+        elif step < -math.pi:
+            step += 2.0 * math.pi
+    return step
+
+
+@njit(cache=True, nogil=True, error_model="numpy", inline="always")
+def _extrapolated_step(qs, j, w, revolute):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
+    """Joint j's last step s_1 and its extrapolation 3 s_1 - 3 s_2 + s_3 (``ik.extrapolated``)."""
+    s1 = _joint_step(qs[j, w - 1], qs[j, w - 2], revolute)
+    s2 = _joint_step(qs[j, w - 2], qs[j, w - 3], revolute)
+    s3 = _joint_step(qs[j, w - 3], qs[j, w - 4], revolute)
+    return s1, 3.0 * s1 - 3.0 * s2 + s3
+
+
+@njit(cache=True, nogil=True, error_model="numpy", inline="always")
+def extrapolated(slot, qs, w, revolute, smooth):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
+    """``ik.extrapolated`` for one slot before waypoint w: True where ``slot`` was moved.
+
+    ``slot``: shape (n,), its solution at waypoint w - 1 (unwrapped), moved to the extrapolation
+    where the rule of ``ik.PREDICT_SMOOTH`` (``smooth``) takes it, six joints only. ``qs``:
+    shape (n, W), the slot's solutions as written (wrapped; NaN where none): the steps are taken
+    from them, so a path followed in any pieces extrapolates alike.
+    """
+    if len(slot) != 6 or w < 4:
+        return False
+    largest, deviation, finite = 0.0, 0.0, True
+    for j in range(6):
+        s1, step = _extrapolated_step(qs, j, w, revolute[j])
+        finite = finite and not math.isnan(step)
+        largest = max(largest, abs(s1))
+        deviation = max(deviation, abs(step - s1))
+    if not (finite and largest > 0.0 and deviation <= smooth * largest):
+        return False
+    for j in range(6):
+        slot[j] += _extrapolated_step(qs, j, w, revolute[j])[1]
+    return True
+
+
 @njit(cache=True, nogil=True, error_model="numpy")
 def solve_rows(chain, start, target_r, target_p, iterations, box, constants, stall=(0, 0.0)):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
     """``ik.solve`` over M problems: q (M, n), the last iterates, and converged (M,), bool.

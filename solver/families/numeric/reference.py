@@ -114,9 +114,12 @@ def followed(
             break
         if progress is not None:
             progress(waypoint / n_waypoints)
+        begin = current  # six joints: from the extrapolation where the path is smooth
+        if chain.dof == 6 and waypoint >= 4:
+            begin, _ = ik.extrapolated(current, local[:, waypoint - 4 : waypoint])
         solved, converged = ik.solve(
             chain,
-            current,
+            begin,
             rotations[:, waypoint],
             positions[:, waypoint],
             iterations=ik.TRACK_ITERATIONS,
