@@ -120,6 +120,28 @@ def test_an_empty_editor_sends_no_cell(page: Page, url: str) -> None:
     assert page.is_hidden("#opt-clearance")
 
 
+def test_the_line_under_the_editor_counts_a_table_whose_height_it_cannot_read(page: Page) -> None:
+    """A table height typed "1e400" reads as "" (badInput): the line said no table was there,
+    while Run refused the height. It counts the table and names what is not a number, a box's
+    size too; mended, the line is as for any table."""
+    open_editor(page)
+    page.fill("#table-height", "1e400")
+    assert page.text_content("#cell-status") == (
+        "Checked along the path against a table top, and the robot against itself. "
+        "Not a number as typed: table height (nothing is sent until it is)."
+    )
+    add_box(page, frame="fixed", name="", size=["1e400", "0.1", "0.1"], at=[], rpy=[])
+    assert page.text_content("#cell-status") == (
+        "Checked along the path against a table top, 1 box, and the robot against itself. "
+        "Not a number as typed: table height, box 1 lx (m) (nothing is sent until it is)."
+    )
+    page.fill("#table-height", "-0.5")
+    page.locator(".cell-box input[aria-label='box 1 lx (m)']").fill("0.1")
+    assert page.text_content("#cell-status") == (
+        "Checked along the path against a table top, 1 box, and the robot against itself."
+    )
+
+
 def test_a_table_above_the_base_makes_every_cell_collide_and_the_hover_names_the_parts(
     page: Page, url: str
 ) -> None:

@@ -247,20 +247,36 @@ function selfChecked() {
     || $("link-radii").value.trim() !== "";
 }
 
-// What the editor holds, in a line under it.
+// The editor's own number fields by a short name, for the line under it (a box's sizes and
+// pose have theirs in their aria-label: "box 1 ly (m)").
+const UNREAD_NAMES = {
+  "table-height": "table height", "tool-radius": "tool radius", "tool-length": "tool length",
+  "tool-cutting-length": "cutting length", clearance: "clearance",
+};
+
+// Whether a field of the editor holds something: a value, or a text the browser cannot read as
+// a number (its value is then "", and the line said the table was not there while Run refused
+// its height: unreadNumbers).
+function filledIn(id) { return $(id).value.trim() !== "" || $(id).validity.badInput; }
+
+// What the editor holds, in a line under it; the number fields it cannot read are named after it.
 function showCellStatus() {
   const rows = [...$("cell-boxes").querySelectorAll(".cell-box")];
   const boxes = rows.filter((row) => row.dataset.shape !== "mesh").length;
   const meshes = rows.length - boxes;
-  const table = $("table-height").value.trim() !== "";
-  const tool = ["tool-radius", "tool-length", "tool-cutting-length"].some((id) => $(id).value.trim() !== "");
+  const table = filledIn("table-height");
+  const tool = ["tool-radius", "tool-length", "tool-cutting-length"].some(filledIn);
   const things = [table ? "a table top" : "", boxes ? `${boxes} box${boxes === 1 ? "" : "es"}` : "",
     meshes ? `${meshes} mesh${meshes === 1 ? "" : "es"}` : "", tool ? "the tool" : ""]
     .filter(Boolean);
-  $("cell-status").textContent = things.length
+  const unread = [...$("cell-details").querySelectorAll("input[type=number]")]
+    .filter((input) => input.validity.badInput)
+    .map((input) => UNREAD_NAMES[input.id] || input.getAttribute("aria-label") || input.id);
+  $("cell-status").textContent = (things.length
     ? `Checked along the path against ${things.join(", ")}, and the robot against itself.`
     : selfChecked() ? "Checked along the path: the robot against itself (no object)."
-      : "Empty: nothing is checked (no cell is sent).";
+      : "Empty: nothing is checked (no cell is sent).")
+    + (unread.length ? ` Not a number as typed: ${unread.join(", ")} (nothing is sent until it is).` : "");
 }
 
 function millimetres(metresValue) { return `${fixed(1000 * metresValue, 1)} mm`; }
@@ -316,9 +332,7 @@ function cellModel(answer) {
 function startCellEditor() {
   $("add-box").addEventListener("click", addBox);
   $("add-mesh").addEventListener("click", () => addObject("mesh"));
-  for (const id of ["table-height", "tool-radius", "tool-length", "tool-cutting-length", "clearance", "link-radii"]) {
-    $(id).addEventListener("input", showCellStatus);
-  }
+  $("cell-details").addEventListener("input", showCellStatus);  // a box's fields too
   $("self-check").addEventListener("change", showCellStatus);
   showCellStatus();
 }
