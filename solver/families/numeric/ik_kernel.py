@@ -158,11 +158,12 @@ def _joint_step(newer, older, revolute):  # type: ignore[no-untyped-def]  # prag
 
 @njit(cache=True, nogil=True, error_model="numpy", inline="always")
 def _extrapolated_step(qs, j, w, revolute):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
-    """Joint j's last step s_1 and its extrapolation 3 s_1 - 3 s_2 + s_3 (``ik.extrapolated``)."""
+    """Joint j's last step s_1 and its extrapolation 4 s_1 - 6 s_2 + 4 s_3 - s_4 (``ik``'s)."""
     s1 = _joint_step(qs[j, w - 1], qs[j, w - 2], revolute)
     s2 = _joint_step(qs[j, w - 2], qs[j, w - 3], revolute)
     s3 = _joint_step(qs[j, w - 3], qs[j, w - 4], revolute)
-    return s1, 3.0 * s1 - 3.0 * s2 + s3
+    s4 = _joint_step(qs[j, w - 4], qs[j, w - 5], revolute)
+    return s1, 4.0 * s1 - 6.0 * s2 + 4.0 * s3 - s4
 
 
 @njit(cache=True, nogil=True, error_model="numpy", inline="always")
@@ -174,7 +175,7 @@ def extrapolated(slot, qs, w, revolute, smooth):  # type: ignore[no-untyped-def]
     shape (n, W), the slot's solutions as written (wrapped; NaN where none): the steps are taken
     from them, so a path followed in any pieces extrapolates alike.
     """
-    if len(slot) != 6 or w < 4:
+    if len(slot) != 6 or w < 5:
         return False
     largest, deviation, finite = 0.0, 0.0, True
     for j in range(6):

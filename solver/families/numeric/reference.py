@@ -115,8 +115,8 @@ def followed(
         if progress is not None:
             progress(waypoint / n_waypoints)
         begin = current  # six joints: from the extrapolation where the path is smooth
-        if chain.dof == 6 and waypoint >= 4:
-            begin, _ = ik.extrapolated(current, local[:, waypoint - 4 : waypoint])
+        if chain.dof == 6 and waypoint >= 5:
+            begin, _ = ik.extrapolated(current, local[:, waypoint - 5 : waypoint])
         solved, converged = ik.solve(
             chain,
             begin,

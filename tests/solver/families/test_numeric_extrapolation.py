@@ -1,9 +1,10 @@
 """A six-joint numeric arm's waypoint solves start from the extrapolated solutions before them.
 
-``ik.PREDICT_SMOOTH``: where the last three joint steps are smooth, the next solve starts at
-q_(w-1) + 3 s_1 - 3 s_2 + s_3 (one damped step then meets the tolerance, against three from
-q_(w-1)); at a corner of the path, from q_(w-1). Known answers: the extrapolation is exact for a
-cubic (algebra); a raster's corners are where its Cartesian steps change (geometry); the maps
+``ik.PREDICT_SMOOTH``: where the last four joint steps are smooth, the next solve starts at
+q_(w-1) + 4 s_1 - 6 s_2 + 4 s_3 - s_4 (one damped step then meets the tolerance, against three
+from q_(w-1)); at a corner of the path, from q_(w-1). Known answers: the extrapolation is exact
+for a quartic (algebra); a raster's corners are where its Cartesian steps change (geometry); the
+maps
 equal the analytic UR5's on every cell of a raster with its corners, as on the ERK path
 (tests/solver/families/test_numeric_vs_analytic_map.py).
 """
@@ -39,33 +40,34 @@ def raster(step: float = 0.005, stepover: float = 0.01, rows: int = 4) -> np.nda
     return poses
 
 
-def test_a_cubic_joint_path_is_extrapolated_exactly() -> None:
-    # q(w) = a + b w + c w^2 + d w^3 per joint, dyadic numbers: every sum below is exact.
+def test_a_quartic_joint_path_is_extrapolated_exactly() -> None:
+    # q(w) = a + b w + c w^2 + d w^3 + e w^4 per joint, dyadic numbers: every sum is exact.
     a = np.array([1, -2, 3, 0, 5, -8]) / 64.0
     b = np.array([8, -8, 6, 10, -7, 9]) / 64.0
     c = np.array([1, 0, 2, -1, 1, 0]) / 256.0
     d = np.array([0, 1, -1, 1, 0, 2]) / 1024.0
-    q = np.array([a + b * w + c * w**2 + d * w**3 for w in range(5)])  # (5, 6)
-    start, predicted = ik.extrapolated(q[3][None], q[None, :4])
+    e = np.array([1, 0, 0, -1, 1, 0]) / 8192.0
+    q = np.array([a + b * w + c * w**2 + d * w**3 + e * w**4 for w in range(6)])  # (6, 6)
+    start, predicted = ik.extrapolated(q[4][None], q[None, :5])
     assert bool(predicted[0])
-    np.testing.assert_array_equal(start[0], q[4])
+    np.testing.assert_array_equal(start[0], q[5])
 
 
 @pytest.mark.parametrize(
     "steps",
     [
-        [0.01, 0.01, -0.01],  # a reversal: 3 s_1 - 3 s_2 + s_3 = -5 s, four steps from -s
-        [0.01, 0.01, 0.03],  # a step three times the one before
-        [0.0, 0.0, 0.0],  # standing still: nothing to extrapolate
-        [0.01, np.nan, 0.01],  # a waypoint without a solution
+        [0.01, 0.01, 0.01, -0.01],  # a reversal: 4 s_1 - 6 s_2 + 4 s_3 - s_4 = -7 s
+        [0.01, 0.01, 0.01, 0.03],  # a step three times the one before
+        [0.0, 0.0, 0.0, 0.0],  # standing still: nothing to extrapolate
+        [0.01, 0.01, np.nan, 0.01],  # a waypoint without a solution
     ],
 )
 def test_a_corner_or_no_motion_starts_from_the_last_solution(steps: list[float]) -> None:
-    history = np.zeros((1, 4, 6))
+    history = np.zeros((1, 5, 6))
     history[0, 1:, 0] = np.cumsum(steps)  # joint 1 moves, the others stand
-    start, predicted = ik.extrapolated(history[:, 3], history)
+    start, predicted = ik.extrapolated(history[:, 4], history)
     assert not predicted[0]
-    np.testing.assert_array_equal(start, history[:, 3])
+    np.testing.assert_array_equal(start, history[:, 4])
 
 
 def test_the_compiled_rule_is_the_numpy_rule() -> None:
@@ -74,15 +76,15 @@ def test_the_compiled_rule_is_the_numpy_rule() -> None:
     flags = []
     for case in range(200):
         base = rng.uniform(-np.pi, np.pi, 6)
-        moves = rng.normal(0.0, 0.05, 6) * np.arange(4)[:, None]  # (4, 6), straight
-        noise = rng.normal(0.0, 10.0 ** rng.uniform(-6, -1), (4, 6))  # smooth or not, at random
-        history = base + moves + noise  # (4, 6), unwrapped
-        start, predicted = ik.extrapolated(history[3][None], history[None])
+        moves = rng.normal(0.0, 0.05, 6) * np.arange(5)[:, None]  # (5, 6), straight
+        noise = rng.normal(0.0, 10.0 ** rng.uniform(-6, -1), (5, 6))  # smooth or not, at random
+        history = base + moves + noise  # (5, 6), unwrapped
+        start, predicted = ik.extrapolated(history[4][None], history[None])
         wrapped = (history + np.pi) % (2 * np.pi) - np.pi
-        qs = np.full((6, 6), np.nan)
-        qs[:, 1:5] = wrapped.T  # waypoints 1..4 solved, waypoint 5 next
-        slot = history[3].copy()
-        moved = extrapolated(slot, qs, 5, REVOLUTE, ik.PREDICT_SMOOTH)
+        qs = np.full((6, 7), np.nan)
+        qs[:, 1:6] = wrapped.T  # waypoints 1..5 solved, waypoint 6 next
+        slot = history[4].copy()
+        moved = extrapolated(slot, qs, 6, REVOLUTE, ik.PREDICT_SMOOTH)
         assert moved == predicted[0], case
         np.testing.assert_allclose(slot, start[0], rtol=0, atol=1e-13)
         flags.append(moved)
@@ -99,9 +101,9 @@ def test_the_raster_is_extrapolated_along_its_lines_and_not_at_its_corners() -> 
     branch = int(np.flatnonzero(np.all(np.isfinite(q[0]), axis=-1))[0])
     joints = np.unwrap(q[:, branch].T, axis=0)  # (W, 6)
     points = path[:, :3, 3]
-    for w in range(4, len(path)):
-        _, predicted = ik.extrapolated(joints[w - 1][None], joints[None, w - 4 : w])
-        steps = np.diff(points[w - 4 : w], axis=0)
+    for w in range(5, len(path)):
+        _, predicted = ik.extrapolated(joints[w - 1][None], joints[None, w - 5 : w])
+        steps = np.diff(points[w - 5 : w], axis=0)
         straight = bool(np.allclose(steps, steps[0], rtol=0, atol=1e-12))
         assert predicted[0] == straight, w
 
