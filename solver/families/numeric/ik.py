@@ -236,11 +236,10 @@ def extrapolated(last: np.ndarray, history: np.ndarray) -> tuple[np.ndarray, np.
         start: shape (M, n); predicted: shape (M,), bool, the rows that start extrapolated.
     """
     s1, s2, s3, s4 = (history[:, k] - history[:, k - 1] for k in (4, 3, 2, 1))
-    newest = s1
     step = 4.0 * s1 - 6.0 * s2 + 4.0 * s3 - s4
     with np.errstate(invalid="ignore"):
-        largest = np.max(np.abs(newest), axis=1)
-        deviation = np.max(np.abs(step - newest), axis=1)
+        largest = np.max(np.abs(s1), axis=1)
+        deviation = np.max(np.abs(step - s1), axis=1)
         predicted = (largest > 0.0) & (deviation <= PREDICT_SMOOTH * largest)
     return np.where(predicted[:, None], last + step, last), predicted
 
